@@ -1,0 +1,3 @@
+from designkit.cli import main
+
+main()

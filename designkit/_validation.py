@@ -1,0 +1,123 @@
+"""Input checks shared by every layer.
+
+Bad input raises :class:`InputError`, a :class:`ValueError` whose message is one
+line that names the offending parameter and its value. The CLI prints that line
+and exits with status 2; library users catch ``ValueError``.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+__all__ = [
+    "InputError",
+    "as_generator",
+    "check_effusivity",
+    "check_effusivity_range",
+    "check_finite",
+    "check_nonnegative",
+    "check_positive",
+]
+
+
+class InputError(ValueError):
+    """A parameter is outside the domain the model is defined on."""
+
+
+def _fmt(value: Any) -> str:
+    if isinstance(value, float):
+        return f"{value:g}"
+    return repr(value)
+
+
+def check_finite(name: str, value: float) -> float:
+    """Return ``value`` as float, or raise if it is NaN, infinite or not a number."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be a number, got {_fmt(value)}") from None
+    if not math.isfinite(v):
+        raise InputError(f"{name} must be finite, got {_fmt(v)}")
+    return v
+
+
+def check_positive(name: str, value: float, *, allow_inf: bool = False) -> float:
+    """Return ``value`` as float, or raise unless it is > 0 (and finite, unless allowed)."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be a number, got {_fmt(value)}") from None
+    if math.isnan(v) or v <= 0 or (math.isinf(v) and not allow_inf):
+        what = "positive" if allow_inf else "positive and finite"
+        raise InputError(f"{name} must be {what}, got {_fmt(v)}")
+    return v
+
+
+def check_nonnegative(name: str, value: float) -> float:
+    """Return ``value`` as float, or raise unless it is finite and >= 0."""
+    v = check_finite(name, value)
+    if v < 0:
+        raise InputError(f"{name} must be >= 0, got {_fmt(v)}")
+    return v
+
+
+def check_effusivity(name: str, value: float, *, allow_zero: bool = False,
+                     allow_inf: bool = False) -> float:
+    """Check one effusivity [J s^-1/2 K^-1 m^-2].
+
+    The physics layer accepts the limits 0 and infinity (a perfect insulator and a
+    perfect conductor); recognition and query inputs do not.
+    """
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"effusivity {name} must be a number, got {_fmt(value)}") from None
+    if math.isnan(v):
+        raise InputError(f"effusivity {name} must be a number, got nan")
+    if v < 0 or (v == 0 and not allow_zero):
+        raise InputError(f"effusivity {name} must be positive, got {_fmt(v)}")
+    if math.isinf(v) and not allow_inf:
+        raise InputError(f"effusivity {name} must be finite, got {_fmt(v)}")
+    return v
+
+
+def check_effusivity_range(name: str, low: float, high: float) -> tuple[float, float]:
+    """Check an effusivity class [low, high) with 0 <= low < high < inf."""
+    lo = check_effusivity(f"{name} lower bound", low, allow_zero=True)
+    hi = check_effusivity(f"{name} upper bound", high)
+    if not hi > lo:
+        raise InputError(
+            f"effusivity range {name} must have positive width, got [{_fmt(lo)}, {_fmt(hi)})"
+        )
+    return lo, hi
+
+
+def as_generator(seed: "int | np.random.Generator | np.random.SeedSequence | list[int] | tuple[int, ...]") -> np.random.Generator:
+    """Turn an explicit seed into a :class:`numpy.random.Generator`.
+
+    ``None`` is refused: every random draw in designkit is reproducible. A
+    sequence of non-negative integers (``[seed, interval, repeat]``) is hashed by
+    :class:`numpy.random.SeedSequence`, which gives independent streams for
+    different keys and the same stream for the same key on every machine.
+    """
+    if seed is None:
+        raise InputError("a seed or numpy Generator is required (designkit never draws unseeded)")
+    if isinstance(seed, np.random.Generator):
+        return seed
+    if isinstance(seed, np.random.SeedSequence):
+        return np.random.Generator(np.random.PCG64(seed))
+    if isinstance(seed, (list, tuple)):
+        key = [int(k) for k in seed]
+        if any(k < 0 for k in key):
+            raise InputError(f"seed entries must be >= 0, got {key}")
+        return np.random.Generator(np.random.PCG64(np.random.SeedSequence(key)))
+    try:
+        s = int(seed)
+    except (TypeError, ValueError):
+        raise InputError(f"seed must be a non-negative integer, got {_fmt(seed)}") from None
+    if s < 0 or s != seed:
+        raise InputError(f"seed must be a non-negative integer, got {_fmt(seed)}")
+    return np.random.Generator(np.random.PCG64(np.random.SeedSequence(s)))

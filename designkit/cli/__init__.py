@@ -1,0 +1,9 @@
+"""Command-line interface: a thin skin over the library (see ``designkit --help``)."""
+
+from ._app import app, main
+
+# Each module registers its commands on ``app``; keep imports cheap (no numpy work,
+# no scikit-learn) at module level.
+from . import core  # noqa: E402,F401  simulate, f1
+
+__all__ = ["app", "main"]

@@ -1,0 +1,162 @@
+"""``designkit simulate`` and ``designkit f1``: the model and the recognizer, one scene at a time."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+from ._app import app, console, emit_json
+from ._options import E1, E2, Ambient, Contact, DeltaT, Folds, Json, Noise, Seed, SensorOpt, Threshold, Trials, Width
+
+
+@app.command()
+def simulate(
+    e: Annotated[float, typer.Option("--e", help="Object effusivity [J s^-1/2 K^-1 m^-2] (0 and inf allowed).")],
+    contact: Contact = 4.0,
+    noise: Noise = 0.05,
+    sensor_temp: Annotated[float, typer.Option("--sensor-temp", help="Initial sensor temperature [°C].")] = 35.0,
+    ambient: Ambient = 25.0,
+    trials: Annotated[int, typer.Option("--trials", help="Number of touches.")] = 1,
+    seed: Seed = 0,
+    sensor: SensorOpt = "paper",
+    out: Annotated[Optional[Path], typer.Option("--out", help="Write a CSV: time_s, then one column per trial.")] = None,
+    plot: Annotated[Optional[Path], typer.Option("--plot", help="Write a PNG of the curves (needs designkit[figures]).")] = None,
+    json_: Json = False,
+) -> None:
+    """Simulate touches of one object (paper eq. 4): sensor temperature against time."""
+    from ..physics import contact_temperature
+    from ..scene import Scene
+    from ..sensor import load_sensor
+    from ..simulation import simulate_trials
+
+    if trials < 1:
+        raise ValueError(f"trials must be >= 1, got {trials}")
+    sen = load_sensor(sensor)
+    scene = Scene(contact_s=contact, noise_c=noise, sensor_temp_c=sensor_temp, ambient_temp_c=ambient)
+    result = simulate_trials(e, sen, scene, n_trials=trials, seed=seed)
+    tc = float(contact_temperature(sensor_temp, ambient, sen.effusivity, e))
+    if out is not None:
+        _write_curves_csv(out, result.time_s, result.temperature_c)
+    if plot is not None:
+        from ..figures import plot_curves
+
+        plot_curves(plot, result.time_s, result.temperature_c,
+                    title=f"e = {e:g} J s^-1/2 K^-1 m^-2, sigma = {noise:g} °C, {sen.name} sensor")
+    if json_:
+        emit_json({
+            "time_s": result.time_s,
+            "temperature_c": result.temperature_c,
+            "e": e,
+            "contact_temperature_c": tc,
+            "scene": scene.to_dict(),
+            "sensor": sen.to_dict(),
+            "seed": seed,
+            "out": str(out) if out else None,
+            "plot": str(plot) if plot else None,
+        })
+        return
+    con = console()
+    final = result.temperature_c[:, -1]
+    con.print(f"[bold]{trials} touch(es)[/] of e = {e:g} J s^-1/2 K^-1 m^-2 for {contact:g} s "
+              f"({result.time_s.size} samples at {sen.sample_rate_hz:g} Hz, {sen.name} sensor, tau = {sen.tau_s:.3f} s)")
+    con.print(f"  sensor {sensor_temp:g} °C, object {ambient:g} °C, contact surface Tc = {tc:.4f} °C")
+    con.print(f"  reading at {result.time_s[-1]:g} s: {final.mean():.4f} °C"
+              + (f" (trials {final.min():.4f} to {final.max():.4f})" if trials > 1 else ""))
+    if out is not None:
+        con.print(f"  wrote {out}")
+    if plot is not None:
+        con.print(f"  wrote {plot}")
+
+
+def _write_curves_csv(path: Path, time_s, temps) -> None:
+    import io
+
+    import numpy as np
+
+    from .._io import atomic_write_text
+
+    buf = io.StringIO()
+    header = ["time_s"] + [f"trial_{i + 1}" for i in range(temps.shape[0])]
+    np.savetxt(buf, np.column_stack([time_s, temps.T]), delimiter=",", header=",".join(header),
+               comments="", fmt="%.10g")
+    atomic_write_text(path, buf.getvalue())
+
+
+@app.command()
+def f1(
+    e1: E1 = None,
+    e2: E2 = None,
+    contact: Contact = 2.0,
+    noise: Noise = 0.05,
+    delta_t: DeltaT = 10.0,
+    ambient: Ambient = 25.0,
+    width: Width = 80.0,
+    trials: Trials = 100,
+    folds: Folds = 3,
+    seed: Seed = 0,
+    threshold: Threshold = 0.9,
+    sensor: SensorOpt = "paper",
+    json_: Json = False,
+) -> None:
+    """F1 of the paper's SVM and of the ideal observer for classes [e1, e1+width) and [e2, e2+width)."""
+    from .._validation import InputError, check_effusivity
+    from ..ideal import ideal_pair
+    from ..recognition import interval_pair_f1
+    from ..scene import Scene
+    from ..sensor import load_sensor
+
+    if e1 is None or e2 is None:
+        raise InputError("give both --e1 and --e2")
+    e1 = check_effusivity("e1", e1)
+    e2 = check_effusivity("e2", e2)
+    if e1 == e2:
+        raise InputError(f"e1 and e2 are equal ({e1:g}): nothing to separate")
+    if folds < 2:
+        raise InputError(f"folds must be >= 2, got {folds}")
+    if trials < folds:
+        raise InputError(f"trials per class ({trials}) must be at least the number of folds ({folds})")
+    sen = load_sensor(sensor)
+    scene = Scene.from_delta_t(contact_s=contact, noise_c=noise, delta_t_c=delta_t, ambient_temp_c=ambient)
+    ra, rb = (e1, e1 + width), (e2, e2 + width)
+    t0 = time.perf_counter()
+    svm = interval_pair_f1(ra, rb, sen, scene, trials=trials, folds=folds, seed=seed)
+    t1 = time.perf_counter()
+    ideal = ideal_pair(ra, rb, sen, scene, seed=seed)
+    t2 = time.perf_counter()
+    payload = {
+        "svm_f1": svm.f1,
+        "svm_standard_error": svm.standard_error,
+        "fold_f1": list(svm.fold_f1),
+        "svm_accuracy": svm.accuracy,
+        "ideal_f1": ideal.f1,
+        "ideal_accuracy": ideal.accuracy,
+        "ideal_method": ideal.method,
+        "threshold": threshold,
+        "distinguishable": svm.f1 >= threshold,
+        "ideal_distinguishable": ideal.f1 >= threshold,
+        "e1_range": list(ra),
+        "e2_range": list(rb),
+        "positive_class": "higher effusivity",
+        "trials": trials,
+        "folds": folds,
+        "seed": seed,
+        "scene": scene.to_dict(),
+        "sensor": sen.to_dict(),
+        "svm_time_s": t1 - t0,
+        "ideal_time_s": t2 - t1,
+    }
+    if json_:
+        emit_json(payload)
+        return
+    con = console()
+    con.print(f"[bold]{e1:g}[/] vs [bold]{e2:g}[/] J s^-1/2 K^-1 m^-2 (classes {width:g} wide), contact {contact:g} s, "
+              f"noise {noise:g} °C, dT {delta_t:g} °C, {sen.name} sensor")
+    verdict = "[green]distinguishable[/]" if svm.f1 >= threshold else "[red]not distinguishable[/]"
+    folds_txt = ", ".join(f"{f:.3f}" for f in svm.fold_f1)
+    con.print(f"  SVM F1    {svm.f1:.3f} ± {svm.standard_error:.3f}  (folds {folds_txt}; {trials} trials/class)"
+              f"  -> {verdict} at F1 >= {threshold:g}")
+    con.print(f"  ideal F1  {ideal.f1:.3f}, accuracy {ideal.accuracy:.3f}  ({ideal.method}; no classifier does better)")
+    con.print(f"  [dim]{(t1 - t0) * 1e3:.0f} ms SVM, {(t2 - t1) * 1e3:.0f} ms ideal[/]")

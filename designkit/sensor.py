@@ -1,0 +1,211 @@
+"""The sensor: a frozen description of a heated thermal tactile sensor.
+
+A :class:`Sensor` holds the parameters of the semi-infinite model (paper eq. 2)
+that belong to the sensor rather than to the scene: its effusivity e_s, its
+diffusivity alpha_s, the thermistor depth x and the sampling rate. Named
+presets live in :data:`SENSORS`; calibration writes sensor YAML files that
+:func:`load_sensor` reads back.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Mapping
+
+import numpy as np
+
+from ._validation import InputError, check_nonnegative, check_positive
+from .physics import time_constant
+
+__all__ = ["SENSORS", "Sensor", "load_sensor", "sample_times_s"]
+
+SENSOR_FILE_VERSION = 1
+
+
+def sample_times_s(contact_s: float, sample_rate_hz: float) -> np.ndarray:
+    """Sample times of one touch: ``k / fs`` for ``k = 0 .. floor(contact_s * fs)``.
+
+    The first sample is taken at the instant of contact (t = 0), so a contact
+    shorter than one sample period still has one sample, which carries no
+    material information. A 2 s touch at 200 Hz has 401 samples.
+
+    Parameters
+    ----------
+    contact_s : float
+        Contact duration [s], > 0.
+    sample_rate_hz : float
+        Sampling rate [Hz], > 0.
+
+    Returns
+    -------
+    ndarray
+        Times [s], float64.
+    """
+    contact_s = check_positive("contact time [s]", contact_s)
+    fs = check_positive("sample rate [Hz]", sample_rate_hz)
+    # A tolerance of 1e-9 samples keeps 2.0 s * 200 Hz = 400 from rounding down.
+    n = int(math.floor(contact_s * fs + 1e-9))
+    return np.arange(n + 1, dtype=np.float64) / fs
+
+
+@dataclass(frozen=True)
+class Sensor:
+    """A heated thermal sensor (paper section II, appendix).
+
+    Parameters
+    ----------
+    effusivity : float
+        Sensor effusivity e_s [J s^-1/2 K^-1 m^-2].
+    diffusivity_m2_s : float
+        Sensor diffusivity alpha_s [m^2 s^-1].
+    depth_m : float
+        Thermistor depth x below the contact surface [m]. Only
+        ``tau = x^2 / (4 alpha_s)`` matters to the model.
+    sample_rate_hz : float
+        Sampling rate [Hz].
+    name : str
+        Label used in tables and reports.
+    noise_c : float or None
+        Measured noise standard deviation [degC], when known (calibration
+        estimates it from pre-contact samples). Scenes set their own noise.
+    provenance : mapping
+        Free-form record of where the numbers came from (not compared).
+    """
+
+    effusivity: float
+    diffusivity_m2_s: float
+    depth_m: float = 80e-6
+    sample_rate_hz: float = 200.0
+    name: str = "custom"
+    noise_c: float | None = None
+    provenance: Mapping[str, Any] = field(default_factory=dict, compare=False, hash=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "effusivity", check_positive("sensor effusivity e_s", self.effusivity))
+        object.__setattr__(self, "diffusivity_m2_s",
+                           check_positive("sensor diffusivity alpha_s [m^2/s]", self.diffusivity_m2_s))
+        object.__setattr__(self, "depth_m", check_nonnegative("thermistor depth [m]", self.depth_m))
+        object.__setattr__(self, "sample_rate_hz", check_positive("sample rate [Hz]", self.sample_rate_hz))
+        if self.noise_c is not None:
+            object.__setattr__(self, "noise_c", check_nonnegative("sensor noise [degC]", self.noise_c))
+        object.__setattr__(self, "provenance", dict(self.provenance))
+
+    @property
+    def tau_s(self) -> float:
+        """Time constant ``tau = x^2 / (4 alpha_s)`` [s] (1.3445 s for the paper's sensor)."""
+        return float(time_constant(self.depth_m, self.diffusivity_m2_s))
+
+    def times_s(self, contact_s: float) -> np.ndarray:
+        """Sample times [s] of a touch lasting ``contact_s`` (see :func:`sample_times_s`)."""
+        return sample_times_s(contact_s, self.sample_rate_hz)
+
+    def replace(self, **changes: Any) -> "Sensor":
+        """A copy with some fields changed."""
+        return dataclasses.replace(self, **changes)
+
+    # ------------------------------------------------------------------ I/O
+    def to_dict(self) -> dict[str, Any]:
+        """Plain-data form, the content of a sensor YAML file."""
+        out: dict[str, Any] = {
+            "designkit_sensor": SENSOR_FILE_VERSION,
+            "name": self.name,
+            "effusivity": self.effusivity,
+            "diffusivity_m2_s": self.diffusivity_m2_s,
+            "depth_m": self.depth_m,
+            "tau_s": self.tau_s,
+            "sample_rate_hz": self.sample_rate_hz,
+        }
+        if self.noise_c is not None:
+            out["noise_c"] = self.noise_c
+        if self.provenance:
+            out["provenance"] = dict(self.provenance)
+        return out
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any], *, source: str = "sensor") -> "Sensor":
+        """Build from :meth:`to_dict` output, with one-line errors naming ``source``."""
+        if not isinstance(data, Mapping):
+            raise InputError(f"{source}: a sensor must be a mapping of fields, got {type(data).__name__}")
+        version = data.get("designkit_sensor", SENSOR_FILE_VERSION)
+        if version != SENSOR_FILE_VERSION:
+            raise InputError(f"{source}: unsupported sensor file version {version!r} "
+                             f"(this designkit reads version {SENSOR_FILE_VERSION})")
+        missing = [k for k in ("effusivity", "diffusivity_m2_s") if k not in data]
+        if missing:
+            raise InputError(f"{source}: missing sensor field(s) {', '.join(missing)}")
+        known = {f.name for f in dataclasses.fields(cls)} | {"designkit_sensor", "tau_s"}
+        unknown = sorted(set(data) - known)
+        if unknown:
+            raise InputError(f"{source}: unknown sensor field(s) {', '.join(unknown)}")
+        kwargs = {k: data[k] for k in data if k not in ("designkit_sensor", "tau_s")}
+        try:
+            sensor = cls(**kwargs)
+        except InputError as exc:
+            raise InputError(f"{source}: {exc}") from None
+        if "tau_s" in data:
+            tau = float(data["tau_s"])
+            if not math.isclose(tau, sensor.tau_s, rel_tol=1e-6):
+                raise InputError(
+                    f"{source}: tau_s = {tau:g} s disagrees with depth and diffusivity "
+                    f"(x^2 / (4 alpha_s) = {sensor.tau_s:g} s)")
+        return sensor
+
+    def to_yaml(self, path: str | Path) -> Path:
+        """Write a sensor YAML file (atomically) and return its path."""
+        import yaml
+
+        from ._io import atomic_write_text
+
+        text = "# designkit sensor file: effusivity [J s^-1/2 K^-1 m^-2], diffusivity [m^2/s],\n" \
+               "# depth [m], tau = depth^2 / (4 diffusivity) [s], sample rate [Hz], noise [degC]\n"
+        text += yaml.safe_dump(self.to_dict(), sort_keys=False)
+        return atomic_write_text(Path(path), text)
+
+    @classmethod
+    def from_yaml(cls, path: str | Path) -> "Sensor":
+        """Read a sensor YAML file written by :meth:`to_yaml` or by calibration."""
+        import yaml
+
+        p = Path(path)
+        try:
+            text = p.read_text()
+        except OSError as exc:
+            raise InputError(f"cannot read sensor file {p}: {exc.strerror or exc}") from None
+        try:
+            data = yaml.safe_load(text)
+        except yaml.YAMLError as exc:
+            line = getattr(getattr(exc, "problem_mark", None), "line", None)
+            where = f" (line {line + 1})" if line is not None else ""
+            raise InputError(f"sensor file {p} is not valid YAML{where}") from None
+        return cls.from_dict(data, source=f"sensor file {p}")
+
+
+#: Named sensor presets. ``paper``: the values identified in the paper's
+#: appendix (e_s = 892, alpha_s = 1.19e-9 m^2/s) with the 80 um thermistor depth
+#: of the same lab's public model code, sampled at 200 Hz.
+SENSORS: dict[str, Sensor] = {
+    "paper": Sensor(
+        effusivity=892.0,
+        diffusivity_m2_s=1.19e-9,
+        depth_m=80e-6,
+        sample_rate_hz=200.0,
+        name="paper",
+        provenance={"source": "Bai et al., appendix (e_s, alpha_s); thermistor depth 80 um"},
+    ),
+}
+
+
+def load_sensor(name_or_path: "str | Path | Sensor") -> Sensor:
+    """A sensor from a preset name (``"paper"``), a YAML path, or a :class:`Sensor`."""
+    if isinstance(name_or_path, Sensor):
+        return name_or_path
+    key = str(name_or_path)
+    if key in SENSORS:
+        return SENSORS[key]
+    p = Path(key)
+    if p.suffix.lower() in (".yaml", ".yml") or p.exists():
+        return Sensor.from_yaml(p)
+    raise InputError(f"unknown sensor {key!r}: use a preset ({', '.join(SENSORS)}) or a sensor YAML file")

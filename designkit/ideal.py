@@ -139,6 +139,11 @@ def _e_of_w(w, e_sensor):
     return np.where(w <= 0.0, 0.0, e)
 
 
+def _cut_point(w_cut, wa, wb, a, b, e_sensor):
+    inside = np.clip(_e_of_w(np.clip(w_cut, wa, wb), e_sensor), a, b)
+    return np.where(w_cut <= wa, a, np.where(w_cut >= wb, b, inside))
+
+
 def class_survival(t, e_low, e_high, e_sensor, s):
     """``P(v > t)`` for ``v = w(e) + N(0, s^2)``, ``e ~ U[e_low, e_high)``.
 
@@ -163,9 +168,11 @@ def class_survival(t, e_low, e_high, e_sensor, s):
     t, a, b, s = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64) for x in (t, e_low, e_high, s)))
     wa = object_weight(e_sensor, a)
     wb = object_weight(e_sensor, b)
-    # [e_lo, e_hi]: where Phi((w(e) - t)/s) is neither 0 nor 1 to double precision
-    e_lo = np.clip(_e_of_w(np.clip(t - _CUT * s, wa, wb), e_sensor), a, b)
-    e_hi = np.clip(_e_of_w(np.clip(t + _CUT * s, wa, wb), e_sensor), a, b)
+    # [e_lo, e_hi]: where Phi((w(e) - t)/s) is neither 0 nor 1 to double precision.
+    # Cuts outside the class use its exact ends: w -> e -> w does not round-trip
+    # exactly, which would matter for very narrow classes.
+    e_lo = _cut_point(t - _CUT * s, wa, wb, a, b, e_sensor)
+    e_hi = _cut_point(t + _CUT * s, wa, wb, a, b, e_sensor)
     half = 0.5 * (e_hi - e_lo)
     mid = 0.5 * (e_hi + e_lo)
     nodes = mid[..., None] + half[..., None] * _GL_X

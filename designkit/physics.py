@@ -133,8 +133,8 @@ def object_weight(e_sensor, e_object):
     """
     es = np.asarray(e_sensor, dtype=np.float64)
     eo = np.asarray(e_object, dtype=np.float64)
-    with np.errstate(divide="ignore"):
-        ratio = es / eo  # inf for e_o = 0, 0 for e_o = inf
+    with np.errstate(divide="ignore", over="ignore"):
+        ratio = es / eo  # inf for e_o = 0 (or denormal), 0 for e_o = inf
     return 1.0 / (1.0 + ratio)
 
 
@@ -170,7 +170,8 @@ def _tau_over_t(time_s, tau_s):
     t, tau = np.broadcast_arrays(t, tau)
     out = np.empty(t.shape, dtype=np.float64)
     pos = t > 0
-    np.divide(tau, t, out=out, where=pos)
+    with np.errstate(over="ignore"):  # tau / (denormal t) -> inf: the correct limit
+        np.divide(tau, t, out=out, where=pos)
     # At t = 0: a buried thermistor (tau > 0) has not moved yet (ratio = inf, erfc = 0);
     # one on the surface (tau = 0) is already at the contact temperature (ratio = 0).
     out[~pos] = np.where(tau[~pos] > 0, np.inf, 0.0)

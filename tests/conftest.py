@@ -1,0 +1,43 @@
+"""Shared fixtures. Tests run against whatever `designkit` is importable (the
+installed package in CI), never against a copy of the shared recordings."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parent.parent
+
+
+@pytest.fixture(scope="session")
+def paper_sensor():
+    from designkit import SENSORS
+
+    return SENSORS["paper"]
+
+
+@pytest.fixture(scope="session")
+def robot_data_dir() -> Path:
+    """The shared real robot recordings, or a skip with the reason."""
+    env = os.environ.get("DESIGNKIT_ROBOT_DATA")
+    path = Path(env) if env else REPO.parent / "shared" / "data" / "robot-thermal-recordings"
+    if not (path / "index.csv").is_file():
+        pytest.skip(f"robot recordings not found at {path} (set DESIGNKIT_ROBOT_DATA to their folder)")
+    return path
+
+
+@pytest.fixture
+def cli():
+    """Invoke the designkit CLI in-process; returns typer's Result."""
+    from typer.testing import CliRunner
+
+    from designkit.cli import app
+
+    runner = CliRunner()
+
+    def invoke(*args: str, input: str | None = None):
+        return runner.invoke(app, [str(a) for a in args], input=input)
+
+    return invoke

@@ -1,0 +1,39 @@
+"""The explicit package list in pyproject.toml covers the tree (a forgotten subpackage
+would be missing from a non-editable install)."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parent.parent
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    tomllib = pytest.importorskip("tomli")
+
+
+def test_every_subpackage_is_listed():
+    pyproject = REPO / "pyproject.toml"
+    if not pyproject.is_file():
+        pytest.skip("not running from a source checkout")
+    cfg = tomllib.loads(pyproject.read_text())["tool"]["setuptools"]
+    listed = set(cfg["packages"])
+    found = {".".join(p.parent.relative_to(REPO).parts) for p in (REPO / "designkit").rglob("__init__.py")
+             if "__pycache__" not in p.parts}
+    assert found <= listed, f"add to pyproject.toml packages: {sorted(found - listed)}"
+    for pkg, folder in cfg["package-dir"].items():
+        assert pkg in listed and (REPO / folder).is_dir()
+
+
+def test_cli_import_stays_light():
+    """`designkit --help` and table queries must not pay for scikit-learn, matplotlib or dask."""
+    import subprocess
+
+    code = ("import sys, designkit.cli; bad = [m for m in ('sklearn', 'matplotlib', 'dask', 'scipy.optimize')"
+            " if m in sys.modules]; print(','.join(bad))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == ""

@@ -64,13 +64,48 @@ class F1Result:
                 "accuracy": self.accuracy, "n_per_class": self.n_per_class}
 
 
-def make_classifier():
-    """The paper's classifier: standardization then a linear-kernel SVM (C = 1)."""
-    from sklearn.pipeline import make_pipeline
-    from sklearn.preprocessing import StandardScaler
+def _linear_gram_svc_class():
+    """scikit-learn's SVC solving the linear-kernel problem from a BLAS Gram matrix.
+
+    ``SVC(kernel="linear")`` evaluates the kernel inside libsvm one pair at a
+    time; with a few hundred touches and thousands of features it is faster to
+    hand libsvm the Gram matrix ``X X^T`` (one matrix product) and the same
+    solver (``kernel="precomputed"``). The optimization problem, solver and
+    predictions are identical (tests/test_recognition.py checks this).
+    """
+    from sklearn.base import BaseEstimator, ClassifierMixin
     from sklearn.svm import SVC
 
-    return make_pipeline(StandardScaler(), SVC(kernel="linear"))
+    class LinearGramSVC(ClassifierMixin, BaseEstimator):
+        def __init__(self, C: float = 1.0):
+            self.C = C
+
+        def fit(self, X, y):
+            X = np.asarray(X, dtype=np.float64)
+            self.X_fit_ = X
+            self.svc_ = SVC(kernel="precomputed", C=self.C).fit(X @ X.T, y)
+            self.classes_ = self.svc_.classes_
+            return self
+
+        def decision_function(self, X):
+            return self.svc_.decision_function(np.asarray(X, dtype=np.float64) @ self.X_fit_.T)
+
+        def predict(self, X):
+            return self.svc_.predict(np.asarray(X, dtype=np.float64) @ self.X_fit_.T)
+
+    return LinearGramSVC
+
+
+def make_classifier():
+    """The paper's classifier: standardization then a linear-kernel SVM (C = 1).
+
+    Same model and solver as ``make_pipeline(StandardScaler(), SVC(kernel="linear"))``,
+    about twice as fast here (see :func:`_linear_gram_svc_class`).
+    """
+    from sklearn.pipeline import make_pipeline
+    from sklearn.preprocessing import StandardScaler
+
+    return make_pipeline(StandardScaler(), _linear_gram_svc_class()())
 
 
 def f1_standard_error(tpr: float, fpr: float, n_per_class: int) -> float:

@@ -38,6 +38,26 @@ def test_feature_matrix_shape():
     assert feature_matrix(np.zeros((4, 1)), 200.0).shape == (4, 2)
 
 
+def test_gram_matrix_svm_equals_scikit_learns_linear_kernel_svm(paper_sensor):
+    from sklearn.model_selection import StratifiedKFold, cross_val_predict
+    from sklearn.pipeline import make_pipeline
+    from sklearn.preprocessing import StandardScaler
+    from sklearn.svm import SVC
+
+    from designkit.recognition import make_classifier
+    from designkit.simulation import simulate_interval
+
+    for (a, b), contact in [((35000, 20000), 1.0), ((500, 560), 2.0), ((1000, 1080), 4.0)]:
+        lo = simulate_interval(a, a + 80, 60, paper_sensor, Scene(contact_s=contact), seed=[1, 0]).temperature_c
+        hi = simulate_interval(b, b + 80, 60, paper_sensor, Scene(contact_s=contact), seed=[1, 1]).temperature_c
+        X = feature_matrix(np.vstack([lo, hi]), 200.0)
+        y = np.r_[np.zeros(60, int), np.ones(60, int)]
+        cv = StratifiedKFold(3, shuffle=True, random_state=0)
+        ref = cross_val_predict(make_pipeline(StandardScaler(), SVC(kernel="linear")), X, y, cv=cv)
+        ours = cross_val_predict(make_classifier(), X, y, cv=cv)
+        np.testing.assert_array_equal(ours, ref)
+
+
 def test_far_pair_is_perfectly_separated_and_order_does_not_matter(paper_sensor):
     scene = Scene(contact_s=1.0)
     a = interval_pair_f1((500, 580), (20000, 20080), paper_sensor, scene, trials=30)

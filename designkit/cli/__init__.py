@@ -5,5 +5,6 @@ from ._app import app, main
 # Each module registers its commands on ``app``; keep imports cheap (no numpy work,
 # no scikit-learn) at module level.
 from . import core  # noqa: E402,F401  simulate, f1
+from . import materials  # noqa: E402,F401  materials list, materials show
 
 __all__ = ["app", "main"]

@@ -1,0 +1,113 @@
+"""``designkit materials list|show``: the shipped materials table (designkit.materials)."""
+
+from __future__ import annotations
+
+from typing import Annotated, Optional
+
+import typer
+
+from ._app import console, emit_json, sub_app
+from ._options import Json
+
+materials_app = sub_app(
+    "materials",
+    "Materials: effusivity and diffusivity ranges of engineering material families "
+    "(public handbook table) and of the paper's 12 experiment materials.",
+)
+
+SetOpt = Annotated[str, typer.Option(
+    "--set", help="Named set: 'database' (handbook families) or 'paper12' (the paper's robot materials).")]
+_SORTS = ("file", "name", "effusivity")
+
+
+def _range(lo: float, hi: float, fmt: str, sep: str = " – ") -> str:
+    return f"{lo:{fmt}}{sep}{hi:{fmt}}"
+
+
+@materials_app.command("list")
+def list_(
+    family: Annotated[Optional[str], typer.Option(
+        "--family", help="Only one family: metals, ceramics, polymers or composites.")] = None,
+    set_: SetOpt = "database",
+    sort: Annotated[str, typer.Option(
+        "--sort", help="Order: 'file' (grouped by family), 'name' or 'effusivity' (by e_min).")] = "file",
+    json_: Json = False,
+) -> None:
+    """List materials with their effusivity and diffusivity ranges."""
+    from .._validation import InputError
+    from ..materials import FAMILY_LABELS, list_materials
+
+    if sort not in _SORTS:
+        raise InputError(f"unknown sort {sort!r}; choose one of: {', '.join(_SORTS)}")
+    mats = list_materials(family=family, set=set_)
+    if sort == "name":
+        mats = tuple(sorted(mats, key=lambda m: m.name.lower()))
+    elif sort == "effusivity":
+        mats = tuple(sorted(mats, key=lambda m: (m.e_min, m.e_max)))
+    if json_:
+        emit_json({"set": set_.strip().lower(), "family": family, "count": len(mats),
+                   "materials": [m.to_dict() for m in mats]})
+        return
+    from rich.table import Table
+
+    paper = set_.strip().lower() == "paper12"
+    table = Table(title=f"{len(mats)} materials ({set_.strip().lower()} set)", title_justify="left")
+    table.add_column("name", min_width=15)
+    table.add_column("family", no_wrap=True)
+    if paper:
+        table.add_column("identified", justify="right", no_wrap=True)
+    table.add_column("e min–max", justify="right", no_wrap=True)
+    table.add_column("α min–max", justify="right", no_wrap=True)
+    for m in mats:
+        row = [m.name + (" [!]" if m.flags else ""), m.family]
+        if paper:
+            row.append("–" if m.identified is None else f"{m.identified:.2f}")
+        row.append(_range(m.e_min, m.e_max, ".2f" if paper else ".0f", "–"))
+        row.append(_range(m.diffusivity_min_m2_s * 1e6, m.diffusivity_max_m2_s * 1e6, ".3g", "–"))
+        table.add_row(*row)
+    con = console()
+    con.print(table)
+    counts = ", ".join(f"{f} {sum(m.family == f for m in mats)}" for f in FAMILY_LABELS
+                       if any(m.family == f for m in mats))
+    rule = ("as printed in the paper; α from the database family named by 'show'" if paper else
+            "sqrt(k rho c) and k/(rho c) at the corners of the k, rho, c ranges")
+    flagged = "; [!] = flagged, see 'show'" if any(m.flags for m in mats) else ""
+    con.print(f"[dim]{counts}. e in J s^-1/2 K^-1 m^-2, α in mm²/s: {rule}{flagged}.[/]")
+
+
+@materials_app.command("show")
+def show(
+    name: Annotated[str, typer.Argument(help="Material name or alias (case, punctuation and word order ignored); "
+                                             "prefix 'paper12:' for the paper's set.")],
+    set_: Annotated[Optional[str], typer.Option(
+        "--set", help="Look only in this set (default: database, then paper12).")] = None,
+    json_: Json = False,
+) -> None:
+    """Show one material: property ranges, effusivity, diffusivity and source."""
+    from ..materials import get_material
+
+    m = get_material(name, set=set_)
+    if json_:
+        emit_json(m.to_dict())
+        return
+    con = console()
+    con.print(f"[bold]{m.name}[/]  ({m.family_label}; {m.set} set)")
+    if m.aliases:
+        con.print(f"  aliases          {', '.join(m.aliases)}")
+    if m.conductivity_min_w_mk is not None:
+        con.print(f"  conductivity k   {_range(m.conductivity_min_w_mk, m.conductivity_max_w_mk, 'g')} W m^-1 K^-1")
+        con.print(f"  density rho      {_range(m.density_min_kg_m3, m.density_max_kg_m3, 'g')} kg m^-3")
+        con.print(f"  specific heat c  {_range(m.specific_heat_min_j_kgk, m.specific_heat_max_j_kgk, 'g')} J kg^-1 K^-1")
+    con.print(f"  effusivity e     {_range(m.e_min, m.e_max, ',.2f')} J s^-1/2 K^-1 m^-2"
+              + ("  (sqrt(k rho c) at the range corners)" if m.set == "database" else "  (as printed in the paper)"))
+    if m.identified is not None:
+        con.print(f"  identified e     {m.identified:,.2f} J s^-1/2 K^-1 m^-2 (paper's sensor calibration)")
+    con.print(f"  diffusivity α    {_range(m.diffusivity_min_m2_s, m.diffusivity_max_m2_s, '.3g')} m^2 s^-1"
+              + (f"  (from database '{m.diffusivity_from}')" if m.diffusivity_from else ""))
+    for flag in m.flags:
+        if flag == "identified_outside_range":
+            con.print("  [yellow]note[/]             the paper's identified value lies outside its printed range "
+                      "(kept as printed)")
+        else:
+            con.print(f"  [yellow]flag[/]             {flag}")
+    con.print(f"  source           {m.source}")

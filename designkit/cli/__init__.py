@@ -6,5 +6,6 @@ from ._app import app, main
 # no scikit-learn) at module level.
 from . import core  # noqa: E402,F401  simulate, f1
 from . import materials  # noqa: E402,F401  materials list, materials show
+from . import thin  # noqa: E402,F401  validity
 
 __all__ = ["app", "main"]

@@ -1,0 +1,149 @@
+"""``designkit validity``: how long a thin sample looks semi-infinite to the sensor."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+from ._app import app, console, emit_json
+from ._options import DeltaT, Json, SensorOpt
+
+#: Contact times [s] at which the deviation is reported (the paper's 1-4 s, and longer).
+REPORT_TIMES_S = (1.0, 2.0, 3.0, 4.0, 10.0, 30.0, 60.0)
+
+
+@app.command()
+def validity(
+    thickness: Annotated[float, typer.Option("--thickness", help="Object thickness [m] (e.g. 0.003 for 3 mm).")],
+    material: Annotated[Optional[str], typer.Option(
+        "--material", help="Object material (see 'designkit materials list'); its ranges give a worst case.")] = None,
+    e: Annotated[Optional[float], typer.Option(
+        "--e", help="Object effusivity [J s^-1/2 K^-1 m^-2] (instead of --material; needs --alpha).")] = None,
+    alpha: Annotated[Optional[float], typer.Option(
+        "--alpha", help="Object diffusivity [m^2/s] (instead of --material; needs --e).")] = None,
+    backing: Annotated[str, typer.Option(
+        "--backing", help="What lies behind the object: insulated, air, steel, wood, table, or a material name.")
+    ] = "insulated",
+    tolerance: Annotated[float, typer.Option(
+        "--tolerance", help="Acceptable deviation from the semi-infinite reading [°C] "
+                            "(default 0.01: the paper's smallest noise level).")] = 0.01,
+    delta_t: DeltaT = 10.0,
+    sensor: SensorOpt = "paper",
+    horizon: Annotated[float, typer.Option("--horizon", help="Longest contact time examined [s].")] = 3600.0,
+    plot: Annotated[Optional[Path], typer.Option(
+        "--plot", help="Write a PNG of the deviation against contact time.")] = None,
+    json_: Json = False,
+) -> None:
+    """Contact time up to which the semi-infinite model (paper eq. 2) holds for a slab of this thickness.
+
+    The reading of a slab differs from the semi-infinite one once heat reflected
+    at its back face reaches the thermistor (image series, docs/thin_samples.md).
+    Prints the first contact time at which that difference exceeds --tolerance.
+    """
+    import numpy as np
+
+    from .._validation import InputError, check_positive
+    from ..sensor import load_sensor
+    from ..slab import material_validity, resolve_backing, semi_infinite_deviation, semi_infinite_validity
+
+    L = check_positive("thickness [m]", thickness)
+    sen = load_sensor(sensor)
+    back = resolve_backing(backing)
+    kw = dict(delta_t_c=delta_t, tolerance_c=tolerance, horizon_s=horizon)
+    if material is not None:
+        if e is not None or alpha is not None:
+            raise InputError("give either --material or --e with --alpha, not both")
+        mv = material_validity(material, L, back, sen, **kw)
+        nominal, worst, name = mv.nominal, mv.worst, mv.material.name
+        ranges = {"effusivity": [mv.material.e_min, mv.material.e_max],
+                  "diffusivity_m2_s": [mv.material.diffusivity_min_m2_s, mv.material.diffusivity_max_m2_s]}
+    else:
+        if e is None or alpha is None:
+            raise InputError("give --material NAME, or both --e and --alpha")
+        nominal = worst = semi_infinite_validity(e, alpha, L, back, sen, **kw)
+        name, ranges = None, None
+    t_report = np.array(REPORT_TIMES_S)
+    dev = delta_t * semi_infinite_deviation(t_report, nominal.e_object, nominal.alpha_object_m2_s, L, back,
+                                            sen)[0]
+    # T - Ts0 = (Ta - Ts0) u with Ta - Ts0 = -delta_t: a slab reading minus the semi-infinite one
+    dev_c = -dev
+    if plot is not None:
+        _plot(plot, nominal, L, back, sen, delta_t, tolerance, name)
+    payload = {
+        "valid_up_to_s": _finite(worst.time_s),
+        "nominal_valid_up_to_s": _finite(nominal.time_s),
+        "fourier_number_at_limit": _finite(worst.fourier_number),
+        "limiting_object": {"effusivity": worst.e_object, "diffusivity_m2_s": worst.alpha_object_m2_s},
+        "material": name,
+        "material_ranges": ranges,
+        "object": {"effusivity": nominal.e_object, "diffusivity_m2_s": nominal.alpha_object_m2_s},
+        "thickness_m": L,
+        "backing": {"name": back.name, "effusivity": back.effusivity,
+                    "diffusivity_m2_s": back.diffusivity_m2_s if not back.insulated else None},
+        "tolerance_c": tolerance,
+        "delta_t_c": delta_t,
+        "horizon_s": horizon,
+        "sensor": sen.name,
+        "deviation_c": {f"{t:g}": float(d) for t, d in zip(REPORT_TIMES_S, dev_c)},
+        "plot": str(plot) if plot else None,
+    }
+    if json_:
+        emit_json(payload)
+        return
+    con = console()
+    what = name if name else f"object (e {nominal.e_object:.4g}, alpha {nominal.alpha_object_m2_s:.3g} m²/s)"
+    con.print(f"[bold]{L * 1e3:g} mm {what}[/] on {back.name}")
+    con.print(f"  (backing e_b {back.effusivity:.4g}; {sen.name} sensor {delta_t:g} °C above the object)")
+    fo = f" (Fo = {nominal.fourier_number:.3g})" if math.isfinite(nominal.time_s) else ""
+    con.print(f"  semi-infinite model within {tolerance:g} °C up to "
+              f"[bold]{_fmt_time(nominal.time_s, horizon)}[/] of contact{fo}")
+    if name is not None:
+        con.print(f"  worst case over the material's ranges: [bold]{_fmt_time(worst.time_s, horizon)}[/] "
+                  f"(e {worst.e_object:.4g}, alpha {worst.alpha_object_m2_s:.3g} m²/s)")
+    cells = ", ".join(f"{t:g} s {d + 0.0:.2g}" for t, d in zip(REPORT_TIMES_S, dev_c))
+    con.print(f"  slab minus semi-infinite reading [°C]: {cells}")
+    if plot is not None:
+        con.print(f"  wrote {plot}")
+
+
+def _finite(x: float):
+    return x if math.isfinite(x) else None
+
+
+def _fmt_time(t: float, horizon: float) -> str:
+    if not math.isfinite(t):
+        return f"beyond {horizon:g} s (the horizon examined)"
+    return f"{t:.3g} s"
+
+
+def _plot(path: Path, v, L, back, sen, delta_t, tolerance, name) -> None:
+    import numpy as np
+
+    from ..figures import pyplot
+    from ..slab import semi_infinite_deviation
+
+    plt = pyplot()
+    t_end = v.time_s * 3 if math.isfinite(v.time_s) else v.horizon_s
+    t = np.geomspace(1e-2, max(t_end, 1.0), 400)
+    dev = -delta_t * semi_infinite_deviation(t, v.e_object, v.alpha_object_m2_s, L, back, sen)[0]
+    fig, ax = plt.subplots(figsize=(6.4, 4.0), constrained_layout=True)
+    floor = tolerance * 1e-4
+    ax.plot(t, np.maximum(np.abs(dev), floor), color="C0", lw=1.2, label="|slab - semi-infinite|")
+    ax.axhline(tolerance, color="grey", ls="--", lw=0.8, label=f"tolerance {tolerance:g} °C")
+    if math.isfinite(v.time_s):
+        ax.axvline(v.time_s, color="C3", lw=0.8, label=f"valid up to {v.time_s:.3g} s")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_ylim(bottom=floor)
+    ax.set_xlabel("contact time [s]")
+    ax.set_ylabel("reading difference [°C]")
+    ax.set_title(f"{L * 1e3:g} mm {name or 'object'} on {back.name}, dT = {delta_t:g} °C", fontsize=9)
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=8)
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=120)
+    plt.close(fig)

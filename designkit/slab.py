@@ -101,7 +101,7 @@ METHODS = ("auto", "semi-infinite", "image-series", "finite-volume")
 #: run-time study (``benchmarks/bench_slab.py``, ``docs/thin_samples.md``)
 #: whose worst-case error against the converged series is below 1e-3 degC at
 #: a 10 degC sensor-object difference (1e-4 in normalized units).
-FV_DEFAULTS: dict[str, Any] = {"integrator": "crank-nicolson", "cells_per_layer": 64, "step_ratio": 0.05}
+FV_DEFAULTS: dict[str, Any] = {"integrator": "crank-nicolson", "cells_per_layer": 48, "step_ratio": 0.05}
 
 _MAX_TERMS = 20000          # image terms the series may use before the FV solver takes over
 _MAX_SERIES_WORK = 4e8      # terms x samples x objects per call (a few seconds of BLAS)
@@ -247,8 +247,13 @@ def reflection_coefficients(e_object, e_backing, e_sensor):
     = 2 w - 1``, ``R_b = (e_o - e_b) / (e_o + e_b)`` (1 for an insulated back,
     ``e_b = 0``). Exact at ``e_o = 0`` and ``e_o = inf``.
     """
-    w = object_weight(e_sensor, e_object)
-    wb = object_weight(e_backing, e_object)  # e_o / (e_b + e_o)
+    eo = np.asarray(e_object, dtype=np.float64)
+    eb = np.asarray(e_backing, dtype=np.float64)
+    w = object_weight(e_sensor, eo)
+    # e_o / (e_b + e_o); 0/0 (no object on an insulated back) carries no heat
+    # either way (w = 0): take R_b = 0 there instead of NaN
+    both_zero = (eo == 0) & (eb == 0)
+    wb = np.where(both_zero, 0.5, object_weight(np.where(both_zero, 1.0, eb), eo))
     return w, 2.0 * w - 1.0, 2.0 * wb - 1.0
 
 
@@ -262,9 +267,8 @@ def _series_terms(w, rs, rb, sqrt_tau, flight, t_max, tolerance, max_terms):
     """
     amp = 2.0 * w * (1.0 - w) * np.abs(rb)  # (K,)
     r = np.abs(rb * rs)
-    with np.errstate(divide="ignore"):
-        geo_tail = amp / np.where(r < 1.0, 1.0 - r, 0.0)
-    geo_tail = np.where(amp == 0.0, 0.0, geo_tail)
+    # |r| < 1 whenever amp > 0 (finite, positive e_o); e_o = 0 or inf carry no reflections
+    geo_tail = np.where(amp == 0.0, 0.0, amp / np.where(r < 1.0, 1.0 - r, 1.0))
     if t_max <= 0:
         return 0, 0.0
     st = math.sqrt(t_max)

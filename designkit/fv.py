@@ -21,10 +21,13 @@ Only what the contact time reaches is gridded: a semi-infinite layer (the
 sensor, a thick object, a backing) is cut at the depth where the heat that has
 entered within ``time_max_s`` is negligible (:func:`truncation_depth_m`) and
 closed there by an insulated face, so that the whole stack conserves energy
-exactly (:func:`heat_content`). Cells are graded smoothly, fine at the
-interfaces and coarse far from them (an exponential map in each semi-infinite
-layer, a tanh map in each finite one); refining ``cells_per_layer`` refines all
-of them together, which keeps the scheme's formal second order in space.
+(:func:`heat_content`; to rounding in the integrators). Cells are graded
+smoothly, fine at the interfaces and coarse far from them (an exponential map
+in each semi-infinite layer, a tanh map in each finite one); the thermistor sits
+on a cell face, with most of the sensor's cells between it and the contact,
+where the early reading is decided. Refining ``cells_per_layer`` refines all
+of them together, which keeps the scheme's formal second order in space
+(observed: 2.00, ``benchmarks/bench_slab.py``).
 
 Three time integrators for the semi-discrete system ``M du/dt = -A u``
 (``M`` diagonal heat capacities, ``A`` symmetric tridiagonal conductances):
@@ -32,9 +35,10 @@ Three time integrators for the semi-discrete system ``M du/dt = -A u``
 * :func:`integrate_crank_nicolson`: trapezoidal rule on a geometric time
   grid, with Rannacher start-up (four backward-Euler quarter steps) against the
   initial discontinuity, one banded solve per step
-  (:func:`scipy.linalg.solve_banded`); second order, A-stable.
+  (:func:`scipy.linalg.solve_banded`); second order, A-stable. The default.
 * :func:`integrate_bdf`: :func:`scipy.integrate.solve_ivp` with the BDF method
-  (orders 1-5, L-stable at low order, adaptive) and the constant sparse Jacobian.
+  (variable order 1-5, adaptive) and the constant sparse Jacobian; several
+  times slower here for the same accuracy.
 * :func:`integrate_explicit`: forward Euler, only to show why it cannot be used
   here: it is stable only for ``dt < 2 / lambda_max`` (:func:`explicit_step_limit_s`),
   nanoseconds for micrometre cells in copper.
@@ -237,12 +241,15 @@ def build_grid(sensor: Layer, body: Sequence[Layer], probe_depth_m: float, time_
     time_max_s : float
         Longest time that will be asked for [s] (sets how deep the grid reaches).
     cells_per_layer : int
-        Cells in every layer (the resolution knob; total ``N`` is at most
-        ``cells_per_layer * (1 + len(body))``).
+        Cells in every body layer (the resolution knob).
     time_min_s : float, optional
-        Earliest time whose reading matters [s]; sets the finest cell near each
-        interface to a fraction of ``sqrt(alpha t_min)``. Defaults to
-        ``time_max_s / 100``.
+        Earliest time whose reading matters [s]; the cell-size ratio of each
+        layer is its extent over ``sqrt(alpha t_min)`` (at most 400).
+        Defaults to ``time_max_s / 100``.
+    sensor_cells : int, optional
+        Cells between the contact and the thermistor (default
+        ``2 * cells_per_layer``); behind the thermistor the cells keep growing
+        by the same factor until the truncation depth.
 
     Returns
     -------

@@ -480,9 +480,12 @@ def slab_response(time_s, e_object, alpha_object_m2_s, thickness_m, backing="ins
     --------
     >>> import numpy as np
     >>> from designkit.slab import slab_response
-    >>> r = slab_response(np.array([1.0, 4.0]), 576.0, 1.09e-7, 0.003, "steel")
-    >>> r.method, r.response.shape
-    ('image-series', (1, 2))
+    >>> r = slab_response(np.array([1.0, 4.0]), 583.0, 1.18e-7, 0.003, "steel")
+    >>> r.method  # 3 mm of acrylic: no reflection reaches the thermistor within 4 s
+    'semi-infinite'
+    >>> r = slab_response(np.array([1.0, 10.0]), 583.0, 1.18e-7, 0.001, "steel")
+    >>> r.method, r.n_terms, r.response.shape  # 1 mm, 10 s: it does
+    ('image-series', 2, (1, 2))
     """
     t = _check_times(time_s)
     e, alpha = _check_objects(e_object, alpha_object_m2_s)
@@ -679,7 +682,7 @@ def semi_infinite_validity(e_object, alpha_object_m2_s, thickness_m, backing="in
     """
     from scipy.optimize import brentq
 
-    L = check_positive("object thickness [m]", thickness_m)
+    L = check_positive("object thickness [m]", thickness_m, allow_inf=True)
     dt = abs(check_finite("temperature difference [degC]", delta_t_c))
     tol = check_positive("tolerance [degC]", tolerance_c)
     horizon = check_positive("horizon [s]", horizon_s)
@@ -689,7 +692,7 @@ def semi_infinite_validity(e_object, alpha_object_m2_s, thickness_m, backing="in
     a = np.atleast_1d(np.asarray(alpha_object_m2_s, dtype=np.float64)).ravel()
     ee, aa = (v.ravel() for v in np.meshgrid(e, a, indexing="ij"))
     _check_objects(ee, aa)
-    if dt == 0:
+    if dt == 0 or not math.isfinite(L):  # nothing to deviate, or nothing to reflect from
         return Validity(math.inf, tol, dt, math.inf, float(ee[0]), float(aa[0]), L, back.name, horizon)
     # log-time grid from well before the first reflection can matter to the horizon
     t_first = max(min(1e-3, horizon), horizon * 1e-9)

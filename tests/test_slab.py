@@ -255,8 +255,9 @@ def test_validity_is_the_first_crossing():
     # a thicker sheet holds longer, roughly as L^2 once the slab's flight time dominates
     v6 = semi_infinite_validity(*ACRYLIC, 6e-3, "steel", delta_t_c=10.0, tolerance_c=0.01)
     assert 3.0 < v6.time_s / v.time_s < 4.5
-    # no temperature difference: nothing to deviate
+    # no temperature difference, or no back face: nothing to deviate
     assert semi_infinite_validity(*ACRYLIC, 3e-3, "steel", delta_t_c=0.0).time_s == math.inf
+    assert semi_infinite_validity(*ACRYLIC, math.inf, "steel").time_s == math.inf
 
 
 def test_validity_of_a_very_thin_foil_is_short_and_bracketed_from_zero():

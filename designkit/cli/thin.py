@@ -17,13 +17,13 @@ REPORT_TIMES_S = (1.0, 2.0, 3.0, 4.0, 10.0, 30.0, 60.0)
 
 @app.command()
 def validity(
-    thickness: Annotated[float, typer.Option("--thickness", help="Object thickness [m] (e.g. 0.003 for 3 mm).")],
+    thickness: Annotated[float, typer.Option("--thickness", help="Object thickness \\[m] (e.g. 0.003 for 3 mm).")],
     material: Annotated[Optional[str], typer.Option(
         "--material", help="Object material (see 'designkit materials list'); its ranges give a worst case.")] = None,
     e: Annotated[Optional[float], typer.Option(
         "--e", help="Object effusivity [J s^-1/2 K^-1 m^-2] (instead of --material; needs --alpha).")] = None,
     alpha: Annotated[Optional[float], typer.Option(
-        "--alpha", help="Object diffusivity [m^2/s] (instead of --material; needs --e).")] = None,
+        "--alpha", help="Object diffusivity \\[m^2/s] (instead of --material; needs --e).")] = None,
     backing: Annotated[str, typer.Option(
         "--backing", help="What lies behind the object: insulated, air, steel, wood, table, or a material name.")
     ] = "insulated",
@@ -32,7 +32,7 @@ def validity(
                             "(default 0.01: the paper's smallest noise level).")] = 0.01,
     delta_t: DeltaT = 10.0,
     sensor: SensorOpt = "paper",
-    horizon: Annotated[float, typer.Option("--horizon", help="Longest contact time examined [s].")] = 3600.0,
+    horizon: Annotated[float, typer.Option("--horizon", help="Longest contact time examined \\[s].")] = 3600.0,
     plot: Annotated[Optional[Path], typer.Option(
         "--plot", help="Write a PNG of the deviation against contact time.")] = None,
     json_: Json = False,

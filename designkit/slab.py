@@ -89,6 +89,7 @@ __all__ = [
     "reflection_coefficients",
     "resolve_backing",
     "semi_infinite_deviation",
+    "semi_infinite_error_bound",
     "semi_infinite_validity",
     "slab_response",
     "slab_temperature",
@@ -611,6 +612,35 @@ def semi_infinite_deviation(time_s, e_object, alpha_object_m2_s, thickness_m, ba
         n_terms = _MAX_TERMS
     full = image_series(t, e, alpha, L, back.effusivity, sen.effusivity, sen.tau_s, n_terms=n_terms)
     return full - image_series(t, e, alpha, L, back.effusivity, sen.effusivity, sen.tau_s, n_terms=0)
+
+
+def semi_infinite_error_bound(contact_s, e_object, alpha_object_m2_s, thickness_m, backing="insulated",
+                              sensor: Sensor | None = None) -> np.ndarray:
+    """Rigorous bound on ``|u_slab - u_semi|`` over ``[0, contact_s]``, per object (cheap).
+
+    ``2 w (1 - w) |R_b| erfc((sqrt(tau) + L / sqrt(alpha_o)) / sqrt(t)) / (1 - |R_b R_s|)``
+    at ``t = contact_s`` (it grows with t): all reflected image terms together
+    (module docstring). Times ``|Ts0 - Ta|`` for degC. A quick, conservative
+    test of whether a semi-infinite table answers a thin-sample scene, e.g. for
+    a warning; :func:`semi_infinite_validity` gives the exact time instead.
+
+    Returns
+    -------
+    ndarray, shape (K,)
+        Normalized bound; 0 for ``L = inf``.
+    """
+    t = check_positive("contact time [s]", contact_s)
+    e, alpha = _check_objects(e_object, alpha_object_m2_s)
+    L = check_positive("object thickness [m]", thickness_m, allow_inf=True)
+    back = resolve_backing(backing)
+    sen = SENSORS["paper"] if sensor is None else sensor
+    if not math.isfinite(L):
+        return np.zeros(e.shape)
+    w, rs, rb = reflection_coefficients(e, back.effusivity, sen.effusivity)
+    amp = 2.0 * w * (1.0 - w) * np.abs(rb)
+    r = np.abs(rb * rs)
+    a1 = (math.sqrt(sen.tau_s) + L / np.sqrt(alpha)) / math.sqrt(t)
+    return np.where(amp == 0.0, 0.0, amp * special.erfc(a1) / np.where(r < 1.0, 1.0 - r, 1.0))
 
 
 @dataclass(frozen=True)

@@ -25,6 +25,7 @@ from designkit.slab import (
     reflection_coefficients,
     resolve_backing,
     semi_infinite_deviation,
+    semi_infinite_error_bound,
     semi_infinite_validity,
     slab_response,
 )
@@ -345,3 +346,21 @@ def test_cli_validity_console_script():
     proc = subprocess.run([str(exe), "validity", "--thickness", "0.003"], capture_output=True, text=True,
                           timeout=120)
     assert proc.returncode == 2 and proc.stderr.startswith("Error: ") and "Traceback" not in proc.stderr
+
+
+def test_cheap_error_bound_bounds_the_deviation():
+    rng = np.random.default_rng(11)
+    for _ in range(30):
+        e, a, L = 10 ** rng.uniform(1, 4.7), 10 ** rng.uniform(-8, -4), 10 ** rng.uniform(-5, -1)
+        back = Backing("b", 10 ** rng.uniform(0, 4.7), 1e-6) if rng.random() < 0.7 else "insulated"
+        contact = 10 ** rng.uniform(-1, 2)
+        t = np.linspace(0.0, contact, 400)
+        dev = np.max(np.abs(semi_infinite_deviation(t, e, a, L, back, tolerance=1e-14)))
+        bound = float(semi_infinite_error_bound(contact, e, a, L, back)[0])
+        assert dev <= bound + 1e-15
+        if dev > 1e-6:
+            # conservative, not vacuous: the terms shrink at least geometrically (ratio
+            # |R_b R_s| <= 0.953 here), so even an alternating sum keeps a share (1 - |r|)
+            # of its first term, while the bound adds at most 1 / (1 - |r|): <= 1 / 0.047^2
+            assert bound < 500 * dev
+    assert semi_infinite_error_bound(4.0, 600.0, 1e-7, math.inf, "steel")[0] == 0.0

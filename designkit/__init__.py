@@ -12,10 +12,24 @@ The top-level namespace is kept light (no scikit-learn, no scipy.optimize):
 from their modules (``designkit.recognition``, ``designkit.query`` ...).
 """
 
-from ._validation import InputError
-from .scene import Scene
-from .sensor import SENSORS, Sensor, load_sensor
-
 __version__ = "0.1.0"
+
+_LAZY = {
+    "InputError": "._validation",
+    "Scene": ".scene",
+    "SENSORS": ".sensor",
+    "Sensor": ".sensor",
+    "load_sensor": ".sensor",
+}
+
+
+def __getattr__(name: str):
+    # PEP 562: the command line imports ``designkit.cli`` without paying for numpy
+    # work it does not need; ``designkit.Scene`` etc. load on first use.
+    if name in _LAZY:
+        import importlib
+
+        return getattr(importlib.import_module(_LAZY[name], __name__), name)
+    raise AttributeError(f"module 'designkit' has no attribute {name!r}")
 
 __all__ = ["InputError", "SENSORS", "Scene", "Sensor", "__version__", "load_sensor"]

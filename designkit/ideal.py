@@ -210,7 +210,7 @@ def _golden_max(f, lo, hi, iters: int = 60):
     return best, x
 
 
-def ideal_scores(low_a, low_b, high_a, high_b, e_sensor: float, s):
+def ideal_scores(low_a, low_b, high_a, high_b, e_sensor: float, s, *, accuracy: bool = True):
     """Best F1 and Bayes accuracy for fixed initial conditions, vectorized.
 
     Parameters
@@ -223,10 +223,13 @@ def ideal_scores(low_a, low_b, high_a, high_b, e_sensor: float, s):
         Sensor effusivity [J s^-1/2 K^-1 m^-2].
     s : array_like
         Projection noise (:func:`projection_noise`), >= 0, may be inf.
+    accuracy : bool
+        Also compute the Bayes accuracy (else it is returned as None, at half
+        the cost; the sweep engine needs F1 only).
 
     Returns
     -------
-    f1, accuracy : ndarray
+    f1, accuracy : ndarray (accuracy None when not asked for)
         Broadcast over the inputs.
     """
     la, lb, ha, hb, s = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64)
@@ -244,18 +247,19 @@ def ideal_scores(low_a, low_b, high_a, high_b, e_sensor: float, s):
         def rates(t):
             return class_survival(t, ha_, hb_, e_sensor, s_), class_survival(t, la_, lb_, e_sensor, s_)
 
-        def accuracy(t):
+        def accuracy_at(t):
             tpr, fpr = rates(t)
             return 0.5 * (1.0 + tpr - fpr)
 
-        def f1_score(t):
+        def f1_at(t):
             tpr, fpr = rates(t)
             return 2.0 * tpr / (1.0 + tpr + fpr)
 
-        acc[ok], _ = _golden_max(accuracy, lo, hi)
-        f1_best, _ = _golden_max(f1_score, lo, hi)
+        f1_best, _ = _golden_max(f1_at, lo, hi)
         f1[ok] = np.maximum(f1_best, _TRIVIAL_F1)
-    return f1.reshape(shape), acc.reshape(shape)
+        if accuracy:
+            acc[ok], _ = _golden_max(accuracy_at, lo, hi)
+    return f1.reshape(shape), (acc.reshape(shape) if accuracy else None)
 
 
 # ----------------------------------------------------------------- Monte Carlo

@@ -29,7 +29,6 @@ tail, available in log form through :func:`log_response_shape`).
 from __future__ import annotations
 
 import numpy as np
-from scipy import special
 
 __all__ = [
     "contact_temperature",
@@ -199,6 +198,8 @@ def response_shape(time_s, tau_s):
         Underflows to 0 for ``tau / t`` above about 740; use
         :func:`log_response_shape` there.
     """
+    from scipy import special  # imported here: a table query never needs it (~150 ms)
+
     return special.erfc(np.sqrt(_tau_over_t(time_s, tau_s)))
 
 
@@ -214,6 +215,8 @@ def log_response_shape(time_s, tau_s):
     ndarray
         log g; ``-inf`` at t = 0 for tau > 0.
     """
+    from scipy import special
+
     z = np.sqrt(_tau_over_t(time_s, tau_s))
     return _LOG2 + special.log_ndtr(-_SQRT2 * z)
 

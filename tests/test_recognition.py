@@ -115,6 +115,19 @@ def test_svm_never_beats_the_ideal_observer_with_varied_initial_conditions(paper
     assert ideal.accuracy <= fixed.accuracy + 3 * ideal.accuracy_standard_error
 
 
+def test_binary_f1_equals_scikit_learn():
+    from sklearn.metrics import f1_score
+
+    from designkit.recognition import binary_f1
+
+    rng = np.random.default_rng(0)
+    for n in (1, 2, 7, 50):
+        for _ in range(50):
+            y, p = rng.integers(0, 2, n), rng.integers(0, 2, n)
+            assert binary_f1(y, p) == pytest.approx(f1_score(y, p, zero_division=0.0), abs=1e-15)
+    assert binary_f1([0, 0], [0, 0]) == 0.0
+
+
 def test_standard_error_is_sane():
     assert 0 < f1_standard_error(1.0, 0.0, 100) < 0.01
     assert 0.03 < f1_standard_error(0.7, 0.3, 100) < 0.08

@@ -72,6 +72,9 @@ app = typer.Typer(
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
+    # markdown, not rich markup: unit brackets like [s] or [J s^-1/2 K^-1 m^-2] in help
+    # texts are not style tags
+    rich_markup_mode="markdown",
     context_settings={"help_option_names": ["-h", "--help"]},
 )
 
@@ -79,7 +82,7 @@ app = typer.Typer(
 def sub_app(name: str, help: str) -> typer.Typer:
     """A command group (``designkit NAME ...``) registered on the main app."""
     group = typer.Typer(cls=_Group, help=help, no_args_is_help=True, add_completion=False,
-                        pretty_exceptions_enable=False)
+                        pretty_exceptions_enable=False, rich_markup_mode="markdown")
     app.add_typer(group, name=name)
     return group
 

@@ -1,0 +1,307 @@
+"""Design questions: min-contact, max-noise, min-delta-t, delta-e, distinguishable.
+
+Answered from the shipped tables in milliseconds (this module and the table
+path import neither scikit-learn nor matplotlib), or with ``--exact`` computed
+for the one pair and scene.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Any, Optional
+
+import typer
+
+from ._app import app, console, emit_json
+from ._options import E1, E2, Json, SensorOpt, Threshold
+
+M1 = Annotated[Optional[str], typer.Option("--m1", help="First material by name (instead of --e1); see 'designkit materials list'.")]
+M2 = Annotated[Optional[str], typer.Option("--m2", help="Second material by name (instead of --e2).")]
+NoiseQ = Annotated[float, typer.Option("--noise", help="Noise sigma per sample [°C].")]
+DeltaTQ = Annotated[float, typer.Option("--delta-t", help="Sensor minus object temperature before contact [°C].")]
+ContactQ = Annotated[float, typer.Option("--contact", help="Contact time [s].")]
+Exact = Annotated[bool, typer.Option("--exact", help="Compute for this pair and scene (seconds) instead of reading a table.")]
+TableOpt = Annotated[str, typer.Option("--table", help="Lookup table (name or path) for the SVM answer.")]
+IdealTableOpt = Annotated[str, typer.Option("--ideal-table", help="Lookup table for the ideal-observer bound.")]
+TrialsQ = Annotated[int, typer.Option("--trials", help="--exact: simulated touches per class.")]
+RepeatsQ = Annotated[int, typer.Option("--repeats", help="--exact: seeds per evaluation (Monte Carlo error).")]
+SeedQ = Annotated[int, typer.Option("--seed", help="--exact: random seed.")]
+WidthQ = Annotated[float, typer.Option("--width", help="--exact: class width [J s^-1/2 K^-1 m^-2] around each effusivity.")]
+JobsQ = Annotated[int, typer.Option("--jobs", "-j", help="--exact: worker processes (-1: all cores).")]
+
+
+def _sides(e1, e2, m1, m2, *, exact: bool, width: float) -> tuple[Optional[float], Optional[float], Any, dict]:
+    """Resolve numbers or material names to (e1, e2, ranges, labels)."""
+    from .._validation import InputError, check_effusivity
+
+    if (e1 is None and m1 is None) or (e2 is None and m2 is None):
+        raise InputError("give two objects: --e1/--m1 and --e2/--m2")
+    if e1 is not None and m1 is not None or e2 is not None and m2 is not None:
+        raise InputError("give each object once: either --e1 or --m1, either --e2 or --m2")
+    if m1 is None and m2 is None:
+        return e1, e2, None, {"e1": f"{e1:g}", "e2": f"{e2:g}"}
+    from ..materials import get_material
+
+    ranges, labels = [], {}
+    for key, e, m in (("e1", e1, m1), ("e2", e2, m2)):
+        if m is not None:
+            mat = get_material(m)
+            ranges.append(tuple(mat.effusivity_range))
+            labels[key] = f"{mat.name} ({mat.effusivity_range[0]:.0f}–{mat.effusivity_range[1]:.0f})"
+        else:
+            v = check_effusivity(key, e)
+            ranges.append((v, v + width) if exact else (v, v))
+            labels[key] = f"{v:g}"
+    return None, None, tuple(ranges), labels
+
+
+def _emit(ans, labels: dict, json_: bool, render) -> None:
+    d = ans.to_dict()
+    if json_:
+        emit_json(render(d, json_=True))
+        return
+    render(d, json_=False, labels=labels)
+
+
+def _fmt(x, unit="", digits=3) -> str:
+    return "—" if x is None else f"{x:.{digits}g}{unit}"
+
+
+def _header_line(con, d, labels, extra=""):
+    inp = d["inputs"]
+    scene = []
+    if inp.get("noise_c") is not None:
+        scene.append(f"noise {inp['noise_c']:g} °C")
+    if inp.get("delta_t_c") is not None:
+        scene.append(f"dT {inp['delta_t_c']:g} °C")
+    if inp.get("contact_s") is not None:
+        scene.append(f"contact {inp['contact_s']:g} s")
+    con.print(f"[bold]{labels.get('e1', '')}[/] vs [bold]{labels.get('e2', '')}[/] J s^-1/2 K^-1 m^-2, "
+              f"{', '.join(scene)}, {inp.get('sensor', 'paper')} sensor, F1 >= {inp['threshold']:g}{extra}")
+    if inp.get("rule"):
+        con.print(f"  [dim]materials: {inp['rule']}[/]")
+
+
+def _source_line(con, d):
+    if d["source"] == "table":
+        where = "inside its grid" if all(d["in_grid"].values()) else \
+            "OUTSIDE its grid along " + ", ".join(k for k, v in d["in_grid"].items() if not v)
+        con.print(f"  [dim]from table {d['table']} ({where}), interpolated; --exact computes it for this pair[/]")
+    else:
+        wall = d["extra"].get("wall_s")
+        con.print(f"  [dim]computed for this pair ({d['inputs'].get('repeats')} seeds x "
+                  f"{d['inputs'].get('trials')} trials per class{f', {wall:.1f} s' if wall else ''})[/]")
+    if d.get("note"):
+        con.print(f"  [yellow]{d['note']}[/]")
+
+
+def _common(d: dict) -> dict:
+    inp = d["inputs"]
+    return {"source": d["source"], "table": d["table"], "ideal_table": d["ideal_table"],
+            "e1": inp.get("e1"), "e2": inp.get("e2"), "e1_range": inp.get("e1_range"),
+            "e2_range": inp.get("e2_range"), "rule": inp.get("rule"),
+            "noise_c": inp.get("noise_c"), "delta_t_c": inp.get("delta_t_c"),
+            "contact_s": inp.get("contact_s"), "threshold": inp["threshold"],
+            "fidelity": d["extra"].get("fidelity", "svm"), "sensor": inp.get("sensor"),
+            "in_grid": d["in_grid"], "note": d["note"], "inputs": inp, "details": d["extra"]}
+
+
+# ============================================================ min-contact
+@app.command("min-contact")
+def min_contact_cmd(
+    e1: E1 = None, e2: E2 = None, m1: M1 = None, m2: M2 = None,
+    noise: NoiseQ = 0.05, delta_t: DeltaTQ = 10.0, threshold: Threshold = 0.9, sensor: SensorOpt = "paper",
+    exact: Exact = False, table: TableOpt = "svm-paper", ideal_table: IdealTableOpt = "ideal-paper",
+    trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
+    max_contact: Annotated[float, typer.Option("--max-contact", help="--exact: longest contact time to consider [s].")] = 10.0,
+    json_: Json = False,
+) -> None:
+    """Shortest contact time that separates two materials (e.g. --e1 35000 --e2 20000)."""
+    from .. import query
+
+    v1, v2, ranges, labels = _sides(e1, e2, m1, m2, exact=exact, width=width)
+    if exact:
+        ans = query.exact_min_contact(v1, v2, noise_c=noise, delta_t_c=delta_t, threshold=threshold, sensor=sensor,
+                                      width=width, trials=trials, folds=3, seed=seed, repeats=repeats, jobs=jobs,
+                                      max_contact_s=max_contact, ranges=ranges)
+    else:
+        ans = query.min_contact(v1, v2, noise_c=noise, delta_t_c=delta_t, threshold=threshold, table=table,
+                                ideal_table=ideal_table, sensor=None if sensor == "paper" else sensor,
+                                ranges=ranges)
+
+    def render(d, json_, labels=None):
+        if json_:
+            return {"contact_time_s": d["value"], "contact_time_interval_s": d["interval"],
+                    "ideal_contact_time_s": d["ideal"], **_common(d)}
+        con = console()
+        _header_line(con, d, labels)
+        lo, hi = d["interval"]
+        if not all(d["in_grid"].values()):
+            con.print("  [yellow]no answer from the table[/] (the question lies outside its grid)")
+        elif d["value"] is None:
+            con.print("  SVM (the paper's classifier): [red]no contact time in range separates them[/]")
+        else:
+            con.print(f"  SVM (the paper's classifier): [bold green]{d['value']:.2f} s[/] of contact at least "
+                      f"(Monte Carlo interval {_fmt(lo, ' s')} to {_fmt(hi, ' s')})")
+        ideal = d["ideal"]
+        con.print(f"  ideal observer bound:         {_fmt(ideal, ' s')}"
+                  + ("  (no classifier can do with less)" if ideal is not None else ""))
+        _source_line(con, d)
+
+    _emit(ans, labels, json_, render)
+
+
+# ============================================================ max-noise / min-delta-t
+@app.command("max-noise")
+def max_noise_cmd(
+    e1: E1 = None, e2: E2 = None, m1: M1 = None, m2: M2 = None,
+    contact: ContactQ = 2.0, delta_t: DeltaTQ = 10.0, threshold: Threshold = 0.9, sensor: SensorOpt = "paper",
+    exact: Exact = False, table: TableOpt = "svm-paper", ideal_table: IdealTableOpt = "ideal-paper",
+    trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
+    json_: Json = False,
+) -> None:
+    """Largest sensor noise at which a contact time still separates two materials."""
+    from .. import query
+
+    v1, v2, ranges, labels = _sides(e1, e2, m1, m2, exact=exact, width=width)
+    if exact:
+        ans = query.exact_max_noise(v1, v2, contact_s=contact, delta_t_c=delta_t, threshold=threshold, sensor=sensor,
+                                    width=width, trials=trials, seed=seed, repeats=repeats, jobs=jobs, ranges=ranges)
+    else:
+        ans = query.max_noise(v1, v2, contact_s=contact, delta_t_c=delta_t, threshold=threshold, table=table,
+                              ideal_table=ideal_table, sensor=None if sensor == "paper" else sensor, ranges=ranges)
+    _emit(ans, labels, json_, _render_scalar("max_noise_c", "largest noise", " °C"))
+
+
+@app.command("min-delta-t")
+def min_delta_t_cmd(
+    e1: E1 = None, e2: E2 = None, m1: M1 = None, m2: M2 = None,
+    contact: ContactQ = 2.0, noise: NoiseQ = 0.05, threshold: Threshold = 0.9, sensor: SensorOpt = "paper",
+    exact: Exact = False, table: TableOpt = "svm-paper", ideal_table: IdealTableOpt = "ideal-paper",
+    trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
+    json_: Json = False,
+) -> None:
+    """Smallest sensor-object temperature difference that separates two materials."""
+    from .. import query
+
+    v1, v2, ranges, labels = _sides(e1, e2, m1, m2, exact=exact, width=width)
+    if exact:
+        ans = query.exact_min_delta_t(v1, v2, contact_s=contact, noise_c=noise, threshold=threshold, sensor=sensor,
+                                      width=width, trials=trials, seed=seed, repeats=repeats, jobs=jobs, ranges=ranges)
+    else:
+        ans = query.min_delta_t(v1, v2, contact_s=contact, noise_c=noise, threshold=threshold, table=table,
+                                ideal_table=ideal_table, sensor=None if sensor == "paper" else sensor, ranges=ranges)
+    _emit(ans, labels, json_, _render_scalar("min_delta_t_c", "smallest temperature difference", " °C"))
+
+
+def _render_scalar(key: str, words: str, unit: str):
+    def render(d, json_, labels=None):
+        if json_:
+            return {key: d["value"], key.replace("_c", "_interval_c"): d["interval"],
+                    f"ideal_{key}": d["ideal"], **_common(d)}
+        con = console()
+        _header_line(con, d, labels)
+        lo, hi = d["interval"]
+        if d["source"] == "table" and d["value"] is None and d["note"].startswith("outside"):
+            con.print("  [yellow]no answer from the table[/] (the question lies outside its grid)")
+        else:
+            con.print(f"  SVM (the paper's classifier): {words} [bold green]{_fmt(d['value'], unit)}[/] "
+                      f"(Monte Carlo interval {_fmt(lo, unit)} to {_fmt(hi, unit)})")
+            con.print(f"  ideal observer bound:         {_fmt(d['ideal'], unit)}")
+        _source_line(con, d)
+
+    return render
+
+
+# ============================================================ delta-e
+@app.command("delta-e")
+def delta_e_cmd(
+    e: Annotated[Optional[float], typer.Option("--e", help="Reference effusivity [J s^-1/2 K^-1 m^-2].")] = None,
+    m: Annotated[Optional[str], typer.Option("--m", help="Reference material (its range's midpoint).")] = None,
+    contact: ContactQ = 2.0, noise: NoiseQ = 0.05, delta_t: DeltaTQ = 10.0, threshold: Threshold = 0.9,
+    sensor: SensorOpt = "paper", exact: Exact = False, table: TableOpt = "svm-paper",
+    ideal_table: IdealTableOpt = "ideal-paper", trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0,
+    width: WidthQ = 80.0, jobs: JobsQ = -1, json_: Json = False,
+) -> None:
+    """Smallest distinguishable effusivity difference delta(e), towards lower and higher effusivity."""
+    from .. import query
+    from .._validation import InputError
+
+    if (e is None) == (m is None):
+        raise InputError("give the reference as --e NUMBER or --m MATERIAL")
+    label = f"{e:g}" if e is not None else m
+    if m is not None:
+        from ..materials import get_material
+
+        mat = get_material(m)
+        e = 0.5 * (mat.effusivity_range[0] + mat.effusivity_range[1])
+        label = f"{mat.name} (midpoint {e:.0f})"
+    if exact:
+        ans = query.exact_delta_e(e, contact_s=contact, noise_c=noise, delta_t_c=delta_t, threshold=threshold,
+                                  sensor=sensor, width=width, trials=trials, seed=seed, repeats=repeats, jobs=jobs)
+    else:
+        ans = query.delta_e(e, contact_s=contact, noise_c=noise, delta_t_c=delta_t, threshold=threshold, table=table,
+                            ideal_table=ideal_table, sensor=None if sensor == "paper" else sensor)
+
+    def render(d, json_, labels=None):
+        x = d["extra"]
+        if json_:
+            return {"delta_e_lower": x.get("delta_e_lower"), "delta_e_upper": x.get("delta_e_upper"),
+                    "delta_e_lower_interval": x.get("delta_e_lower_interval"),
+                    "delta_e_upper_interval": x.get("delta_e_upper_interval"),
+                    "ideal_delta_e_lower": x.get("delta_e_lower_ideal"),
+                    "ideal_delta_e_upper": x.get("delta_e_upper_ideal"), "e": d["inputs"]["e"], **_common(d)}
+        con = console()
+        inp = d["inputs"]
+        con.print(f"delta(e) at [bold]{label}[/] J s^-1/2 K^-1 m^-2: contact {inp['contact_s']:g} s, noise "
+                  f"{inp['noise_c']:g} °C, dT {inp['delta_t_c']:g} °C, F1 >= {inp['threshold']:g}")
+        for side, key in (("towards lower e ", "delta_e_lower"), ("towards higher e", "delta_e_upper")):
+            iv = x.get(key + "_interval") or [None, None]
+            con.print(f"  {side}: SVM [bold green]{_fmt(x.get(key), '', 4)}[/] "
+                      f"(interval {_fmt(iv[0], '', 4)} to {_fmt(iv[1], '', 4)}), ideal {_fmt(x.get(key + '_ideal'), '', 4)}")
+        con.print("  [dim]— : no distinguishable effusivity in that direction within the grid[/]")
+        _source_line(con, d)
+
+    _emit(ans, {}, json_, render)
+
+
+# ============================================================ distinguishable
+@app.command("distinguishable")
+def distinguishable_cmd(
+    e1: E1 = None, e2: E2 = None, m1: M1 = None, m2: M2 = None,
+    contact: ContactQ = 2.0, noise: NoiseQ = 0.05, delta_t: DeltaTQ = 10.0, threshold: Threshold = 0.9,
+    sensor: SensorOpt = "paper", exact: Exact = False, table: TableOpt = "svm-paper",
+    ideal_table: IdealTableOpt = "ideal-paper", trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0,
+    width: WidthQ = 80.0, jobs: JobsQ = -1, json_: Json = False,
+) -> None:
+    """Whether a scene separates two materials, with the SVM's and the ideal observer's F1."""
+    from .. import query
+
+    v1, v2, ranges, labels = _sides(e1, e2, m1, m2, exact=exact, width=width)
+    if exact:
+        ans = query.exact_distinguishable(v1, v2, contact_s=contact, noise_c=noise, delta_t_c=delta_t,
+                                          threshold=threshold, sensor=sensor, width=width, trials=trials, seed=seed,
+                                          repeats=repeats, jobs=jobs, ranges=ranges)
+    else:
+        ans = query.distinguishable(v1, v2, contact_s=contact, noise_c=noise, delta_t_c=delta_t, threshold=threshold,
+                                    table=table, ideal_table=ideal_table,
+                                    sensor=None if sensor == "paper" else sensor, ranges=ranges)
+
+    def render(d, json_, labels=None):
+        x = d["extra"]
+        if json_:
+            return {"distinguishable": x.get("distinguishable"), "svm_f1": x.get("svm_f1"),
+                    "svm_standard_error": x.get("svm_standard_error"), "ideal_f1": x.get("ideal_f1"),
+                    "ideal_distinguishable": x.get("ideal_distinguishable"), **_common(d)}
+        con = console()
+        _header_line(con, d, labels)
+        if x.get("distinguishable") is None:
+            con.print("  [yellow]no answer[/]")
+        else:
+            yes = "[bold green]yes[/]" if x["distinguishable"] else "[bold red]no[/]"
+            f1 = f", F1 {x['svm_f1']:.3f} ± {x['svm_standard_error']:.3f}" if x.get("svm_f1") is not None else ""
+            con.print(f"  SVM (the paper's classifier): {yes}{f1}")
+            con.print(f"  ideal observer: F1 {x['ideal_f1']:.3f}"
+                      + (" (distinguishable)" if x["ideal_distinguishable"] else " (not even in principle)"))
+        _source_line(con, d)
+
+    _emit(ans, labels, json_, render)

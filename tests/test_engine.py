@@ -1,0 +1,162 @@
+"""Sweep engine: each shortcut against the brute-force answer it replaces."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from designkit import InputError
+from designkit.engine import (
+    SweepConfig,
+    _ideal_staircase,
+    delta_from_staircase,
+    run_chunk,
+    run_scene,
+    staircase_search,
+)
+from designkit.ideal import ideal_scores, projection_noise
+
+
+@st.composite
+def monotone_staircases(draw):
+    n = draw(st.integers(2, 60))
+    steps = draw(st.lists(st.integers(0, 3), min_size=n, max_size=n))
+    start = draw(st.integers(1, 5))
+    J = np.minimum(np.maximum(np.cumsum(steps) + start, np.arange(n) + 1), n)
+    J = np.maximum.accumulate(J)
+    return n, J
+
+
+@settings(max_examples=200, deadline=None)
+@given(monotone_staircases(), st.integers(0, 2**16))
+def test_staircase_finds_every_monotone_boundary(case, seed):
+    n, J_true = case
+    rng = np.random.default_rng(seed)
+    calls = []
+
+    def decide(i, j):
+        calls.append((i, j))
+        return j >= J_true[i]
+
+    # floors at or below the truth and arbitrary hints must not change the answer
+    floor = np.maximum(J_true - rng.integers(0, 4, n), 0)
+    hint = np.minimum(J_true + rng.integers(-3, 6, n), n)
+    for kw in ({}, {"floor": floor}, {"hint": hint}, {"floor": floor, "hint": hint}):
+        calls.clear()
+        got = staircase_search(decide, range(n), n, **kw)
+        np.testing.assert_array_equal(got, J_true)
+        # never asks twice, and far fewer questions than the n^2/2 full matrix
+        assert len(calls) == len(set(calls))
+        assert len(calls) <= 2 * n + 2 * n * np.log2(n + 1)
+
+
+def test_delta_from_staircase_matches_the_decision_matrix():
+    rng = np.random.default_rng(0)
+    n, width = 30, 80.0
+    J = np.maximum.accumulate(np.minimum(np.arange(n) + 1 + rng.integers(0, 4, n).cumsum() // 3, n))
+    D = np.array([[j > i and j >= J[i] for j in range(n)] for i in range(n)])  # distinguishable (i < j)
+    up, down = delta_from_staircase(J, width)
+    for i in range(n):
+        partners = [j for j in range(i + 1, n) if D[i, j]]
+        assert (np.isnan(up[i]) and not partners) or up[i] == (partners[0] - i) * width
+        lower = [k for k in range(i) if D[k, i]]
+        assert (np.isnan(down[i]) and not lower) or down[i] == (i - max(lower)) * width
+
+
+def test_ideal_staircase_equals_the_full_closed_form_matrix(paper_sensor):
+    cfg = SweepConfig(intervals=60, fidelity="ideal", contact_s=(1.5,))
+    scene = cfg.scene((0,), 1.5)
+    s = projection_noise(paper_sensor, scene)
+    e = cfg.edges
+    n = cfg.intervals
+    ii, jj = np.triu_indices(n, 1)
+    f1, _ = ideal_scores(e[ii], e[ii + 1], e[jj], e[jj + 1], paper_sensor.effusivity, s, accuracy=False)
+    M = np.zeros((n, n), bool)
+    M[ii, jj] = f1 >= cfg.threshold
+    brute = np.array([next((j for j in range(i + 1, n) if M[i, j]), n) for i in range(n)])
+    np.testing.assert_array_equal(_ideal_staircase(cfg, paper_sensor, s, np.arange(n)), brute)
+
+
+@pytest.mark.slow
+def test_staircase_agrees_with_the_full_matrix(paper_sensor):
+    """Same delta(e) to within one interval; the full matrix's answer inside the Monte Carlo interval."""
+    kw = dict(intervals=24, trials=40, noise_ratio=(0.005,), contact_s=(1.0,), max_repeats=3)
+    fast = run_scene(SweepConfig(**kw))[0]
+    full = run_scene(SweepConfig(full_matrix=True, **kw))[0]
+    assert full.fits > 2.5 * fast.fits
+    within_one = np.abs(fast.J - full.J) <= 1
+    assert within_one.mean() >= 0.9, (fast.J, full.J)
+    inside = (full.J >= fast.J_lo - 1) & (full.J <= fast.J_hi + 1)
+    assert inside.mean() >= 0.9
+    assert np.all(fast.J_lo <= fast.J) and np.all(fast.J <= fast.J_hi)
+    # no SVM fit below the ideal observer's staircase
+    cells = fast.cells
+    assert np.all(cells[:, 1] >= fast.J_ideal[cells[:, 0].astype(int)])
+
+
+@pytest.mark.slow
+def test_noise_ratio_shortcut_equals_sweeping_noise_and_delta_t(paper_sensor):
+    """The sigma/dT invariance used to collapse two axes into one gives the same staircase."""
+    common = dict(intervals=20, trials=30, contact_s=(1.5,), max_repeats=2)
+    by_ratio = run_chunk(SweepConfig(noise_ratio=(0.005,), **common), (0,), 0, 0)
+    by_pair = run_chunk(SweepConfig(noise_ratio=None, noise_c=(0.05,), delta_t_c=(10.0,), **common), (0, 0), 0, 0)
+    np.testing.assert_array_equal(by_ratio.J, by_pair.J)
+    np.testing.assert_array_equal(by_ratio.J_hi, by_pair.J_hi)
+    np.testing.assert_allclose(by_ratio.cells, by_pair.cells, atol=1e-12)
+
+
+@pytest.mark.slow
+def test_warm_start_across_contact_times_gives_the_cold_answer(paper_sensor):
+    cfg = SweepConfig(intervals=20, trials=30, noise_ratio=(0.005,), contact_s=(1.0, 2.0), max_repeats=2)
+    warm = run_scene(cfg)[1]
+    cold = run_chunk(cfg, (0,), 0, 1)  # no hint from the 1 s staircase
+    assert np.mean(np.abs(warm.J - cold.J) <= 1) >= 0.95
+    assert warm.fits <= cold.fits
+
+
+def test_delta_shrinks_with_contact_time_and_grows_with_noise(paper_sensor):
+    cfg = SweepConfig(intervals=80, fidelity="ideal", noise_ratio=(0.002, 0.01), contact_s=(0.5, 1.0, 4.0))
+    J = {(p, k): run_chunk(cfg, (p,), 0, k).J for p in range(2) for k in range(3)}
+    for p in range(2):
+        assert np.all(J[(p, 0)] >= J[(p, 1)]) and np.all(J[(p, 1)] >= J[(p, 2)])
+    for k in range(3):
+        assert np.all(J[(1, k)] >= J[(0, k)])
+
+
+@pytest.mark.parametrize("kwargs,match", [
+    ({"fidelity": "best"}, "fidelity"),
+    ({"intervals": 1}, "intervals"),
+    ({"trials": 2}, "trials"),
+    ({"folds": 1}, "folds"),
+    ({"threshold": 0.5}, "threshold"),
+    ({"contact_s": (2.0, 1.0)}, "contact"),
+    ({"contact_s": (0.0,)}, "contact"),
+    ({"noise_ratio": (-1.0,)}, "noise_ratio"),
+    ({"sensor_temp_spread_c": 2.0}, "varied"),
+    ({"noise_ratio": None}, "noise axis"),
+    ({"e_min": 100.0, "e_max": 50.0}, "effusivity range"),
+])
+def test_config_rejects_bad_values(kwargs, match):
+    with pytest.raises(InputError, match=match):
+        SweepConfig(**kwargs)
+
+
+def test_config_from_yaml_with_overrides(tmp_path):
+    p = tmp_path / "c.yaml"
+    p.write_text("name: t\nfidelity: ideal\neffusivity: {min: 0, max: 4000, intervals: 50}\n"
+                 "noise_ratio: [0.001, 0.01]\ncontact_s: [1, 2]\n")
+    cfg = SweepConfig.from_yaml(p, intervals=25, seed=None)
+    assert (cfg.name, cfg.fidelity, cfg.e_max, cfg.intervals, cfg.noise_ratio) == ("t", "ideal", 4000, 25, (0.001, 0.01))
+    p.write_text("name: t\nbogus: 1\n")
+    with pytest.raises(InputError, match="unknown key"):
+        SweepConfig.from_yaml(p)
+    p.write_text("name: [unclosed\n")
+    with pytest.raises(InputError, match="not valid YAML"):
+        SweepConfig.from_yaml(p)
+    with pytest.raises(InputError, match="cannot read"):
+        SweepConfig.from_yaml(tmp_path / "missing.yaml")
+    # the digest (what --resume checks) follows every result-changing key and only those
+    assert cfg.digest() == SweepConfig(**{**cfg.to_dict(), "noise_ratio": (0.001, 0.01)}).digest()
+    assert cfg.digest() != SweepConfig(**{**cfg.to_dict(), "seed": 1}).digest()

@@ -287,12 +287,12 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, noise_c: fl
         to the table's longest suffices; ``interval``: Monte Carlo interval;
         ``ideal``: the ideal observer's contact time.
     """
+    noise, dt = _scene_inputs(noise_c, delta_t_c)
+    pairs = _pairs_for(e1, e2, ranges)
     tab = _as_table(table)
     phi = _check_threshold(tab, threshold)
     _check_sensor(tab, sensor)
-    noise, dt = _scene_inputs(noise_c, delta_t_c)
     view = _View(tab)
-    pairs = _pairs_for(e1, e2, ranges)
     combos, flags = view.scene_weights(noise, dt)
     flags["effusivity"] = all(view.e_in_grid(lo, hi) for lo, hi in pairs)
     inputs = _inputs(e1, e2, noise, dt, phi, tab, ranges)
@@ -398,24 +398,26 @@ def _max_ratio(view: _View, kind: str, contact_s: float, pairs, dt: float) -> tu
 
 def _ratio_question(question: str, e1, e2, contact_s, noise_c, delta_t_c, threshold, table, ideal_table,
                     sensor, ranges) -> Answer:
-    tab = _as_table(table)
-    phi = _check_threshold(tab, threshold)
-    _check_sensor(tab, sensor)
     contact = check_positive("contact time [s]", contact_s)
-    if "noise_ratio" not in tab.axes:
-        raise InputError(f"table {tab.name} has separate noise and temperature axes (varied initial "
-                         f"conditions); use --exact for {question}")
-    view = _View(tab)
     pairs = _pairs_for(e1, e2, ranges)
-    _, c_ok = _contact_index_weights(view, contact)
-    flags = {"contact_s": c_ok, "effusivity": all(view.e_in_grid(lo, hi) for lo, hi in pairs)}
     if question == "max-noise":
         dt = check_finite("temperature difference [degC]", delta_t_c)
         if dt == 0:
             raise InputError("temperature difference is 0: no noise level is small enough")
-        inputs = _inputs(e1, e2, None, dt, phi, tab, ranges, contact_s=contact)
     else:
         noise = check_positive("noise sigma [degC]", noise_c)
+    tab = _as_table(table)
+    phi = _check_threshold(tab, threshold)
+    _check_sensor(tab, sensor)
+    if "noise_ratio" not in tab.axes:
+        raise InputError(f"table {tab.name} has separate noise and temperature axes (varied initial "
+                         f"conditions); use --exact for {question}")
+    view = _View(tab)
+    _, c_ok = _contact_index_weights(view, contact)
+    flags = {"contact_s": c_ok, "effusivity": all(view.e_in_grid(lo, hi) for lo, hi in pairs)}
+    if question == "max-noise":
+        inputs = _inputs(e1, e2, None, dt, phi, tab, ranges, contact_s=contact)
+    else:
         inputs = _inputs(e1, e2, noise, None, phi, tab, ranges, contact_s=contact)
     inputs.pop("noise_ratio", None)
     if not all(flags.values()):
@@ -474,12 +476,12 @@ def delta_e(e: float, *, contact_s: float, noise_c: float = 0.05, delta_t_c: flo
     ``delta_e_upper`` and their intervals (None: nothing distinguishable in the
     grid in that direction).
     """
-    tab = _as_table(table)
-    phi = _check_threshold(tab, threshold)
-    _check_sensor(tab, sensor)
     e = check_effusivity("e", e)
     contact = check_positive("contact time [s]", contact_s)
     noise, dt = _scene_inputs(noise_c, delta_t_c)
+    tab = _as_table(table)
+    phi = _check_threshold(tab, threshold)
+    _check_sensor(tab, sensor)
     view = _View(tab)
     combos, flags = view.scene_weights(noise, dt)
     cw, flags["contact_s"] = _contact_index_weights(view, contact)
@@ -528,13 +530,13 @@ def distinguishable(e1=None, e2=None, *, contact_s: float, noise_c: float = 0.05
     ``value`` is 1.0 (yes) or 0.0 (no); the SVM's F1 of the pair itself is not
     in a table (``svm_f1`` None): use :func:`exact_distinguishable`.
     """
+    contact = check_positive("contact time [s]", contact_s)
+    noise, dt = _scene_inputs(noise_c, delta_t_c)
+    pairs = _pairs_for(e1, e2, ranges)
     tab = _as_table(table)
     phi = _check_threshold(tab, threshold)
     _check_sensor(tab, sensor)
-    contact = check_positive("contact time [s]", contact_s)
-    noise, dt = _scene_inputs(noise_c, delta_t_c)
     view = _View(tab)
-    pairs = _pairs_for(e1, e2, ranges)
     combos, flags = view.scene_weights(noise, dt)
     cw, flags["contact_s"] = _contact_index_weights(view, contact)
     flags["effusivity"] = all(view.e_in_grid(lo, hi) for lo, hi in pairs)

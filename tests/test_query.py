@@ -1,0 +1,240 @@
+"""Queries: interpolation against closed forms on synthetic tables, the shipped tables,
+the exact route, and the CLI contract."""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from designkit import InputError
+from designkit import query as q
+from designkit.engine import SweepConfig
+from designkit.tables import load_table, table_header, write_table
+
+RATIOS = (0.001, 0.002, 0.005, 0.01, 0.02)
+CONTACTS = (0.5, 1.0, 2.0, 4.0)
+A, B, K = 9000.0, 2000.0, 0.4  # delta = (A - B t) * (1 + K ln(r / 0.001)), any e
+
+
+def _delta(t, r):
+    return (A - B * t) * (1 + K * math.log(r / 0.001))
+
+
+@pytest.fixture(scope="module")
+def linear_table(tmp_path_factory):
+    """A table whose delta is linear in contact time and in log(sigma/dT): interpolation is exact."""
+    cfg = SweepConfig(name="linear", intervals=40, noise_ratio=RATIOS, contact_s=CONTACTS)
+    d = np.array([[[_delta(t, r)] * 40 for t in CONTACTS] for r in RATIOS])
+    arrays = {name: d.copy() for name in ("delta_up", "delta_down", "delta_up_ideal", "delta_down_ideal")}
+    arrays.update(delta_up_lo=d * 0.9, delta_down_lo=d * 0.9, delta_up_hi=d * 1.1, delta_down_hi=d * 1.1,
+                  fits=np.zeros((5, 4), dtype=np.int64), chunk_wall_s=np.zeros((5, 4)))
+    path = write_table(tmp_path_factory.mktemp("t") / "linear.npz", table_header(cfg, arrays), arrays)
+    return load_table(path)
+
+
+@settings(max_examples=60, deadline=None)
+@given(noise=st.floats(0.011, 0.19), gap=st.floats(2500, 9000), base=st.floats(100, 20000))
+def test_min_contact_interpolates_exactly(linear_table, noise, gap, base):
+    r = noise / 10.0
+    ans = q.min_contact(base, base + gap, noise_c=noise, delta_t_c=10.0, table=linear_table, ideal_table=None)
+    scale = 1 + K * math.log(r / 0.001)
+    exact = (A - gap / scale) / B  # solves delta(t, r) = gap
+    if exact <= CONTACTS[0]:
+        assert ans.value == CONTACTS[0]
+    elif exact > CONTACTS[-1]:
+        assert ans.value is None
+    else:
+        assert ans.value == pytest.approx(exact, rel=1e-9)
+        lo = (A - gap / (0.9 * scale)) / B
+        hi = (A - gap / (1.1 * scale)) / B
+        assert ans.interval[0] == pytest.approx(max(lo, CONTACTS[0]), rel=1e-9) or lo < CONTACTS[0]
+        if hi <= CONTACTS[-1]:
+            assert ans.interval[1] == pytest.approx(max(hi, CONTACTS[0]), rel=1e-9)
+    assert ans.in_grid == {"noise_ratio": True, "effusivity": True}
+
+
+def test_max_noise_and_min_delta_t_interpolate_exactly(linear_table):
+    t, gap = 2.0, 9000.0
+    # delta(t, r) = gap  =>  ln(r/0.001) = (gap / (A - B t) - 1) / K
+    r_star = 0.001 * math.exp((gap / (A - B * t) - 1) / K)
+    mn = q.max_noise(1000, 1000 + gap, contact_s=t, delta_t_c=10.0, table=linear_table, ideal_table=None)
+    assert mn.value == pytest.approx(r_star * 10.0, rel=1e-9)
+    md = q.min_delta_t(1000, 1000 + gap, contact_s=t, noise_c=0.05, table=linear_table, ideal_table=None)
+    assert md.value == pytest.approx(0.05 / r_star, rel=1e-9)
+    de = q.delta_e(20000, contact_s=3.0, noise_c=0.05, delta_t_c=10.0, table=linear_table, ideal_table=None)
+    assert de.extra["delta_e_lower"] == pytest.approx(_delta(3.0, 0.005), rel=1e-12)
+
+
+def test_outside_the_grid_is_refused_not_extrapolated(linear_table):
+    far = q.min_contact(1000, 9000, noise_c=1.0, delta_t_c=10.0, table=linear_table, ideal_table=None)
+    assert far.value is None and far.in_grid["noise_ratio"] is False and "no extrapolation" in far.note
+    out = q.min_contact(1000, 45000, noise_c=0.05, delta_t_c=10.0, table=linear_table, ideal_table=None)
+    assert out.value is None and out.in_grid["effusivity"] is False
+    assert q.delta_e(2000, contact_s=20.0, table=linear_table, ideal_table=None).in_grid["contact_s"] is False
+
+
+def test_nan_means_beyond_the_grid_and_is_never_interpolated_into(tmp_path):
+    cfg = SweepConfig(name="nan", intervals=10, noise_ratio=(0.005,), contact_s=(1.0, 2.0, 3.0))
+    d = np.array([[[np.nan] * 10, [3000.0] * 10, [1000.0] * 10]])
+    arrays = {"delta_up": d, "delta_down": d, "fits": np.zeros((1, 3), dtype=np.int64),
+              "chunk_wall_s": np.zeros((1, 3))}
+    t = load_table(write_table(tmp_path / "nan.npz", table_header(cfg, arrays), arrays))
+    ans = q.min_contact(1000, 5000, table=t, ideal_table=None)
+    assert ans.value == 2.0  # 1 s has no answer: 2 s is the first that suffices, no interpolation into NaN
+    assert q.min_contact(1000, 3000, table=t, ideal_table=None).value == pytest.approx(2.5)  # 3000 -> 1000 over 2-3 s
+
+
+def test_table_threshold_and_sensor_must_match(linear_table, tmp_path):
+    with pytest.raises(InputError, match="threshold 0.9"):
+        q.min_contact(1000, 5000, threshold=0.95, table=linear_table)
+    other = tmp_path / "s.yaml"
+    from designkit import Sensor
+
+    Sensor(1000.0, 1e-9, name="other").to_yaml(other)
+    with pytest.raises(InputError, match="built for sensor"):
+        q.min_contact(1000, 5000, table=linear_table, sensor=other)
+
+
+@pytest.mark.parametrize("kwargs,match", [
+    ({"e1": 1000, "e2": 1000}, "equal"),
+    ({"e1": -5, "e2": 1000}, "positive"),
+    ({"e1": float("nan"), "e2": 1000}, "number"),
+    ({"e1": 1000, "e2": 5000, "delta_t_c": 0}, "temperature difference is 0"),
+    ({"e1": 1000, "e2": 5000, "noise_c": -1}, "noise"),
+])
+def test_query_rejects_bad_input(kwargs, match):
+    with pytest.raises(InputError, match=match):
+        q.min_contact(table="ideal-paper", **kwargs)
+
+
+def test_ideal_table_agrees_with_the_closed_form(paper_sensor):
+    """Shipped ideal table vs bisection on the exact closed form: within its grid step."""
+    from designkit.ideal import ideal_pair
+    from designkit.scene import Scene
+
+    t = load_table("ideal-paper")
+    rng = np.random.default_rng(1)
+    for _ in range(6):
+        e1 = rng.uniform(200, 30000)
+        e2 = e1 * rng.uniform(1.2, 3.0)
+        if e2 > 39000:
+            continue
+        noise = rng.uniform(0.01, 0.15)
+        ans = q.min_contact(e1, e2, noise_c=noise, delta_t_c=10.0, table=t, ideal_table=t)
+        lo, hi = (e1, e1 + 80), (e2, e2 + 80)
+
+        def ok(c):
+            return ideal_pair(lo, hi, paper_sensor, Scene.from_delta_t(contact_s=c, noise_c=noise,
+                                                                       delta_t_c=10.0)).f1 >= 0.9
+
+        if ans.value is None:
+            assert not ok(9.75)
+            continue
+        a, b = 0.05, 10.0
+        if ok(a):
+            exact = a
+        else:
+            for _ in range(30):
+                m = 0.5 * (a + b)
+                a, b = (a, m) if ok(m) else (m, b)
+            exact = b
+        # one contact step (0.25 s) plus the effusivity interval width of the table
+        assert abs(ans.value - exact) <= 0.3, (e1, e2, noise, ans.value, exact)
+
+
+@settings(max_examples=40, deadline=None)
+@given(e1=st.floats(100, 30000), ratio=st.floats(1.05, 4.0), n1=st.floats(0.005, 0.1), dn=st.floats(0.001, 0.08))
+def test_more_noise_never_needs_less_contact(e1, ratio, n1, dn):
+    e2 = min(e1 * ratio, 39900.0)
+    t = load_table("ideal-paper")
+    a = q.min_contact(e1, e2, noise_c=n1, table=t, ideal_table=t).value
+    b = q.min_contact(e1, e2, noise_c=n1 + dn, table=t, ideal_table=t).value
+    if a is None:
+        assert b is None
+    elif b is not None:
+        assert b >= a - 1e-9
+
+
+def test_materials_worst_case(cli):
+    from designkit.materials import get_material
+
+    cu, ss = get_material("copper"), get_material("stainless steel")
+    ans = q.min_contact(ranges=(cu.effusivity_range, ss.effusivity_range), table="ideal-paper",
+                        ideal_table="ideal-paper")
+    closest = q.min_contact(ss.effusivity_range[1], cu.effusivity_range[0], table="ideal-paper",
+                            ideal_table="ideal-paper")
+    assert ans.value is not None and ans.value >= closest.value - 1e-12
+    assert "worst case" in ans.inputs["rule"]
+    overlap = q.min_contact(ranges=((300, 600), (500, 900)), table="ideal-paper", ideal_table="ideal-paper")
+    assert overlap.value is None and "overlap" in overlap.note
+    r = cli("min-contact", "--m1", "copper", "--m2", "stainless steel", "--table", "ideal-paper", "--json")
+    assert r.exit_code == 0 and json.loads(r.stdout)["rule"].startswith("worst case")
+    r = cli("min-contact", "--m1", "unobtainium", "--m2", "copper")
+    assert r.exit_code == 2 and len(r.stderr.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("cmd,key", [
+    (["min-contact", "--e1", "35000", "--e2", "20000"], "contact_time_s"),
+    (["max-noise", "--e1", "35000", "--e2", "20000", "--contact", "2"], "max_noise_c"),
+    (["min-delta-t", "--e1", "35000", "--e2", "20000", "--contact", "2"], "min_delta_t_c"),
+    (["delta-e", "--e", "20000", "--contact", "2"], "delta_e_lower"),
+    (["distinguishable", "--e1", "35000", "--e2", "20000", "--contact", "2"], "distinguishable"),
+])
+def test_query_cli_json_keys(cli, cmd, key):
+    r = cli(*cmd, "--table", "ideal-paper", "--json")
+    assert r.exit_code == 0, r.output
+    p = json.loads(r.stdout)
+    assert key in p and p["source"] == "table" and p["table"] == "ideal-paper"
+    for k in ("threshold", "fidelity", "in_grid", "sensor"):
+        assert k in p
+    if cmd[0] == "min-contact":
+        for k in ("contact_time_interval_s", "ideal_contact_time_s", "e1", "e2", "noise_c", "delta_t_c"):
+            assert k in p
+    if cmd[0] == "delta-e":
+        assert "delta_e_upper" in p
+    if cmd[0] == "distinguishable":
+        assert "svm_f1" in p and "ideal_f1" in p
+
+
+@pytest.mark.parametrize("args,needle", [
+    (["min-contact", "--e1", "20000", "--e2", "20000"], "equal"),
+    (["min-contact", "--e1", "-1", "--e2", "20000"], "positive"),
+    (["min-contact", "--e1", "nan", "--e2", "20000"], "number"),
+    (["min-contact", "--e1", "35000"], "two objects"),
+    (["distinguishable", "--e1", "1", "--e2", "2", "--contact", "0"], "contact"),
+    (["min-contact", "--e1", "1", "--e2", "2", "--table", "/nonexistent/t"], "no table"),
+    (["min-contact", "--e1", "1", "--e2", "2", "--threshold", "0.95"], "threshold"),
+])
+def test_query_cli_bad_input(cli, args, needle):
+    r = cli(*args)
+    assert r.exit_code == 2, r.output
+    assert len(r.stderr.strip().splitlines()) == 1 and needle in r.stderr
+
+
+def test_table_query_path_never_imports_scikit_learn():
+    code = ("import sys; from typer.testing import CliRunner; from designkit.cli import app;"
+            "r = CliRunner().invoke(app, ['min-contact', '--e1', '35000', '--e2', '20000', '--table', 'ideal-paper', '--json']);"
+            "assert r.exit_code == 0, r.output;"
+            "print(','.join(m for m in ('sklearn', 'matplotlib', 'dask', 'joblib') if m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == ""
+
+
+@pytest.mark.slow
+def test_exact_min_contact_cli(cli):
+    r = cli("min-contact", "--e1", "35000", "--e2", "20000", "--exact", "--trials", "30", "--repeats", "2",
+            "--jobs", "1", "--json")
+    assert r.exit_code == 0, r.output
+    p = json.loads(r.stdout)
+    assert p["source"] == "computed" and p["table"] is None
+    assert 0.5 < p["contact_time_s"] < 3.0
+    lo, hi = p["contact_time_interval_s"]
+    assert lo <= p["contact_time_s"] and (hi is None or hi >= p["contact_time_s"] - 0.06)
+    assert p["ideal_contact_time_s"] <= p["contact_time_s"] + 0.05

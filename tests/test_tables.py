@@ -1,0 +1,124 @@
+"""Table format: round trip, integrity checks, and the shipped tables' grids."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from designkit import InputError
+from designkit.engine import SweepConfig
+from designkit.tables import SCHEMA_VERSION, content_hash, list_tables, load_table, table_header, write_table
+
+
+def _small(tmp_path, name="t"):
+    cfg = SweepConfig(name=name, intervals=10, noise_ratio=(0.001, 0.01), contact_s=(1.0, 2.0), fidelity="ideal")
+    rng = np.random.default_rng(0)
+    arrays = {"delta_up": rng.uniform(100, 1000, (2, 2, 10)), "delta_down": rng.uniform(100, 1000, (2, 2, 10)),
+              "fits": np.zeros((2, 2), dtype=np.int64), "chunk_wall_s": np.zeros((2, 2))}
+    return write_table(tmp_path / f"{name}.npz", table_header(cfg, arrays), arrays), arrays
+
+
+def test_round_trip_and_header(tmp_path):
+    path, arrays = _small(tmp_path)
+    t = load_table(path)
+    for k, v in arrays.items():
+        np.testing.assert_array_equal(t.arrays[k], v)
+    h = t.header
+    assert h["schema_version"] == SCHEMA_VERSION and h["format"] == "designkit-table"
+    assert [a["name"] for a in h["axes"]] == ["noise_ratio", "contact_s", "e_ref"]
+    assert h["axes"][1]["units"] == "s" and "J s^-1/2" in h["axes"][2]["units"]
+    assert h["content_hash"] == content_hash(arrays)
+    assert h["sensor"]["effusivity"] == 892.0 and h["designkit_version"]
+    assert t.sensor.name == "paper"
+    # loaded without pickle: the npz holds plain numeric arrays only
+    with np.load(path, allow_pickle=False) as z:
+        assert all(z[k].dtype != object for k in z.files)
+
+
+def test_corrupted_truncated_or_edited_tables_are_refused(tmp_path):
+    path, _ = _small(tmp_path)
+    data = bytearray(path.read_bytes())
+    # flip one byte inside the compressed payload
+    data[len(data) // 2] ^= 0xFF
+    path.write_bytes(bytes(data))
+    with pytest.raises(InputError, match="corrupted|content check"):
+        load_table(path)
+    path, _ = _small(tmp_path)
+    path.write_bytes(path.read_bytes()[:200])  # truncated
+    with pytest.raises(InputError, match="corrupted or truncated"):
+        load_table(path)
+    path, arrays = _small(tmp_path)
+    # valid npz, different numbers: the hash catches it
+    edited = dict(arrays, delta_up=arrays["delta_up"] + 1)
+    np.savez_compressed(path, **edited)
+    with pytest.raises(InputError, match="content check"):
+        load_table(path)
+    path, _ = _small(tmp_path)
+    header = json.loads(path.with_suffix(".json").read_text())
+    header["schema_version"] = 99
+    path.with_suffix(".json").write_text(json.dumps(header))
+    with pytest.raises(InputError, match="schema version 99"):
+        load_table(path)
+    path.with_suffix(".json").write_text("{ not json")
+    with pytest.raises(InputError, match="not valid JSON"):
+        load_table(path)
+    with pytest.raises(InputError, match="no table"):
+        load_table(tmp_path / "missing")
+
+
+def test_object_arrays_are_refused(tmp_path):
+    cfg = SweepConfig(name="x", intervals=2, fidelity="ideal", contact_s=(1.0,))
+    with pytest.raises(InputError, match="object"):
+        write_table(tmp_path / "x.npz", table_header(cfg, {}), {"bad": np.array([{"a": 1}], dtype=object)})
+
+
+def test_shipped_ideal_table_grid():
+    assert "ideal-paper" in list_tables()
+    t = load_table("ideal-paper")
+    ax = t.axes
+    assert t.fidelity == "ideal" and t.threshold == 0.9 and t.sensor.name == "paper"
+    assert ax["noise_ratio"].min() == pytest.approx(0.0005) and ax["noise_ratio"].max() == pytest.approx(0.02)
+    for r in (0.001, 0.002, 0.005, 0.01, 0.02):
+        assert np.isclose(ax["noise_ratio"], r).any()
+    assert ax["contact_s"].min() == 0.5 and ax["contact_s"].max() == 10
+    assert ax["e_ref"].size == 500 and t.header["effusivity"]["max"] == 40000
+    assert np.all(np.diff(np.log(ax["noise_ratio"])) > 0)
+
+
+def test_shipped_svm_table_grid():
+    if "svm-paper" not in list_tables():
+        pytest.skip("svm-paper is still being built (tables/svm-paper.yaml)")
+    t = load_table("svm-paper")
+    ax = t.axes
+    ideal = load_table("ideal-paper").axes
+    assert t.fidelity == "svm" and t.header["trials"] == 100 and t.header["folds"] == 3
+    assert ax["noise_ratio"].size >= 8 and ax["contact_s"].size >= 12 and ax["e_ref"].size == 500
+    for r in (0.001, 0.002, 0.005, 0.01, 0.02):
+        assert np.isclose(ax["noise_ratio"], r).any()
+    for c in (1, 2, 3, 4):
+        assert np.isclose(ax["contact_s"], c).any()
+    assert ax["contact_s"].min() == 0.5 and ax["contact_s"].max() == 10
+    # the ideal table is the denser grid of the same axes
+    assert ideal["noise_ratio"].size > ax["noise_ratio"].size and ideal["contact_s"].size > ax["contact_s"].size
+    # its Monte Carlo interval brackets delta, and the ideal bound is never above the SVM's delta
+    a = t.arrays
+    ok = ~np.isnan(a["delta_up"]) & ~np.isnan(a["delta_up_lo"])
+    assert np.all(a["delta_up_lo"][ok] <= a["delta_up"][ok])
+    both = ~np.isnan(a["delta_up"]) & ~np.isnan(a["delta_up_ideal"])
+    assert np.all(a["delta_up_ideal"][both] <= a["delta_up"][both])
+
+
+def test_tables_cli(cli, tmp_path):
+    r = cli("tables", "list", "--json")
+    assert r.exit_code == 0
+    names = [row["name"] for row in json.loads(r.stdout)]
+    assert "ideal-paper" in names
+    r = cli("tables", "show", "ideal-paper", "--json")
+    s = json.loads(r.stdout)
+    assert s["fidelity"] == "ideal" and s["content_hash"].startswith("sha256:")
+    r = cli("tables", "show", "ideal-paper")
+    assert r.exit_code == 0 and "noise_ratio" in r.stdout and "[s, linear]" in r.stdout
+    r = cli("tables", "show", "nope")
+    assert r.exit_code == 2 and r.stderr.startswith("Error: no table")

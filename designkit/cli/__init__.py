@@ -5,6 +5,7 @@ from ._app import app, main
 # Each module registers its commands on ``app``; keep imports cheap (no numpy work,
 # no scikit-learn) at module level.
 from . import core  # noqa: E402,F401  simulate, f1
+from . import export  # noqa: E402,F401  export
 from . import materials  # noqa: E402,F401  materials list, materials show
 from . import query  # noqa: E402,F401  min-contact, max-noise, min-delta-t, delta-e, distinguishable
 from . import sweep  # noqa: E402,F401  sweep

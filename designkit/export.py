@@ -1356,16 +1356,17 @@ def min_contact_s(e1, e2, noise_c, delta_t_c):
     combos = _scene(noise, dt)
     _check_e(lo, hi)
     gap = hi - lo
-    needs = [_need(combos, k, lo, hi) for k in range(_NC)]
-    for k, nd in enumerate(needs):
+    prev = _math.nan
+    for k in range(_NC):  # designkit.query._crossing, stopping at the first column that suffices
+        nd = _need(combos, k, lo, hi)
         if not _math.isnan(nd) and nd <= gap:
             if k == 0:
                 return float(CONTACT_S[0])
-            prev = needs[k - 1]
             if not _CONTACT_ADJACENT[k - 1] or _math.isnan(prev):
                 return float(CONTACT_S[k])
             w = (prev - gap) / (prev - nd) if prev != nd else 1.0
             return float(CONTACT_S[k - 1] + w * (CONTACT_S[k] - CONTACT_S[k - 1]))
+        prev = nd
     return None
 
 

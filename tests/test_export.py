@@ -506,17 +506,17 @@ def test_stdlib_module_checks_its_data(tmp_path):
                     "(tables/svm-paper.npz appears when its sweep finishes)")
 def test_shipped_svm_paper_exports_like_its_query(tmp_path):
     tab = load_table("svm-paper")
-    exp = slice_table(tab, noise_c=0.05, delta_t_c=10.0)
-    path = tmp_path / "table_module.py"
-    path.write_bytes(to_python(exp))
-    queries = [(op, args) for op, args in random_queries(slice_table(tab), np.random.default_rng(11), 100)]
-    queries += [("min_contact", (35000.0, 20000.0, 0.05, 10.0))]
-    got = run_module(path, queries, tmp_path)
-    for (op, args), g in zip(queries, got):
-        if g == "outside" and _beyond_slice(exp, op, args):
-            continue
-        want = reference(tab, "svm", op, args if op == "min_contact" and args[2:] == (0.05, 10.0) else args)
-        assert agree(g, want, 1e-9), (op, args, g, want)
+    for label, exp in (("whole", slice_table(tab)), ("row", slice_table(tab, noise_c=ON_ROW[0], delta_t_c=ON_ROW[1]))):
+        path = tmp_path / f"table_module_{label}.py"
+        path.write_bytes(to_python(exp))
+        queries = random_queries(exp, np.random.default_rng(11), 100)
+        queries.append(("min_contact", (35000.0, 20000.0, 0.05, 10.0)))  # 0.05 / 10 is the row 0.005
+        got = run_module(path, queries, tmp_path)
+        for (op, args), g in zip(queries, got):
+            if g == "outside" and _beyond_slice(exp, op, args):
+                continue
+            want = reference(tab, "svm", op, args)
+            assert agree(g, want, 1e-9), (label, op, args, g, want)
 
 
 # ============================================================ CLI

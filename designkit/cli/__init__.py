@@ -4,6 +4,7 @@ from ._app import app, main
 
 # Each module registers its commands on ``app``; keep imports cheap (no numpy work,
 # no scikit-learn) at module level.
+from . import bench  # noqa: E402,F401  bench
 from . import core  # noqa: E402,F401  simulate, f1
 from . import export  # noqa: E402,F401  export
 from . import materials  # noqa: E402,F401  materials list, materials show

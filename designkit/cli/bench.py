@@ -1,0 +1,119 @@
+"""``designkit bench``: accuracy against run time across the pipeline, and the sweep's cost curve."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, List, Optional
+
+import typer
+
+from ._app import app, console, emit_json
+from ._options import Json
+
+SECTION_HELP = "Only these sections (repeatable): physics, recognition, delta, queries, cost. Default: all."
+
+
+@app.command("bench")
+def bench_cmd(
+    quick: Annotated[bool, typer.Option("--quick", help="Fewer cases and smaller references: a few minutes on 2 cores.")] = False,
+    out: Annotated[Optional[Path], typer.Option("--out", help="Folder to write accuracy.md, its figures and accuracy.json into (docs/ for the shipped page).")] = None,
+    section: Annotated[Optional[List[str]], typer.Option("--section", "-s", help=SECTION_HELP)] = None,
+    seed: Annotated[int, typer.Option("--seed", help="Seed of every random draw (same seed, same errors).")] = 0,
+    table: Annotated[str, typer.Option("--table", help="SVM table whose queries are checked against --exact (skipped if absent).")] = "svm-paper",
+    ideal_table: Annotated[str, typer.Option("--ideal-table", help="Ideal-observer table checked against the closed form.")] = "ideal-paper",
+    jobs: Annotated[int, typer.Option("--jobs", "-j", help="Processes for the exact SVM queries (1 keeps timings sequential).")] = 1,
+    json_: Json = False,
+) -> None:
+    """Measure every way designkit answers a question against a high-fidelity reference, in one run.
+
+    Prints one row per method and setting: error against the reference, time
+    per answer, speed-up; then the sweep's cost curves with fitted exponents.
+    `--quick` takes a few minutes on 2 cores; the full run about half an hour.
+    """
+    import time
+
+    from .. import bench
+
+    sections = tuple(section) if section else bench.SECTIONS
+    bad = [s for s in sections if s not in bench.SECTIONS]
+    if bad:
+        raise ValueError(f"unknown section(s) {', '.join(bad)}: choose from {', '.join(bench.SECTIONS)}")
+    err = console(stderr=True)
+    started = time.perf_counter()
+    if err.is_terminal and not json_:
+        from rich.progress import Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
+
+        progress = Progress(SpinnerColumn(), TextColumn("{task.description}"), TimeElapsedColumn(), console=err,
+                            transient=True)
+        task = progress.add_task("starting", total=None)
+        progress.start()
+
+        def say(msg: str) -> None:
+            progress.update(task, description=msg)
+    else:
+        progress = None
+
+        def say(msg: str) -> None:
+            if not json_:
+                err.print(f"[{time.perf_counter() - started:6.1f} s] {msg}", highlight=False)
+    try:
+        report = bench.run_bench(quick=quick, seed=seed, sections=sections, svm_table=table, ideal_table=ideal_table,
+                                 jobs=jobs, progress=say)
+    finally:
+        if progress is not None:
+            progress.stop()
+    written = bench.write_report(report, out) if out is not None else {}
+    if json_:
+        payload = report.to_dict()
+        payload["written"] = {k: str(v) for k, v in written.items()}
+        emit_json(payload)
+        return
+    _print_report(report, written)
+
+
+def _print_report(report, written) -> None:
+    from rich.table import Table
+
+    from ..bench import _fmt, _fmt_time
+
+    con = console()
+    if not con.is_terminal:
+        con.width = max(con.width, 160)  # piped into a file: do not squeeze the table to 80 columns
+    con.print(f"[bold]designkit bench{' --quick' if report.quick else ''}: error against run time[/] "
+              f"(seed {report.seed}; time per answer; speed-up = reference time / method time)")
+    groups: dict = {}
+    for r in report.rows:
+        groups.setdefault(r.question, []).append(r)
+    for question, rows in groups.items():
+        refs: dict = {}
+        for r in rows:
+            refs.setdefault(r.reference, r.reference_wall_s)
+        ref_text = "; ".join(f"{name} ({_fmt_time(t)})" for name, t in refs.items())
+        t = Table(title=f"{question} — reference: {ref_text}", title_justify="left", title_style="bold")
+        for col, kw in (("method", {}), ("setting", {"max_width": 44}), ("metric", {"max_width": 30}),
+                        ("p95/value", {"justify": "right"}), ("worst", {"justify": "right"}),
+                        ("time/answer", {"justify": "right"}), ("speed-up", {"justify": "right"}),
+                        ("n", {"justify": "right"})):
+            t.add_column(col, **kw)
+        for r in rows:
+            t.add_row(r.method, r.setting, r.metric, _fmt(r.error, 3), _fmt(r.worst, 3), _fmt_time(r.wall_s),
+                      _fmt(r.speedup, 3), str(r.n))
+        con.print(t)
+    if report.curves:
+        c = Table(title="Sweep cost curves (one scene point; exponent p of cost ~ size^p)", title_justify="left",
+                  title_style="bold")
+        for col in ("curve", "x", "wall time [s]", "SVM fits", "peak MB above start", "p time", "p fits", "p memory"):
+            c.add_column(col)
+        for cur in report.curves:
+            c.add_row(cur.name, ", ".join(f"{x:g}" for x in cur.x), ", ".join(f"{w:.3g}" for w in cur.wall_s),
+                      ", ".join(str(f) for f in cur.fits), ", ".join(f"{m:.1f}" for m in cur.peak_mb),
+                      _fmt(cur.time_exponent, 3),
+                      "—" if cur.fits_exponent is None else _fmt(cur.fits_exponent, 3),
+                      "—" if cur.memory_exponent is None else _fmt(cur.memory_exponent, 3))
+        con.print(c)
+    for s in report.skipped:
+        con.print(f"[yellow]skipped:[/] {s}")
+    con.print(f"total {report.wall_s:.0f} s (" + ", ".join(f"{k} {v:.0f} s" for k, v in report.section_wall_s.items())
+              + ")")
+    for v in written.values():
+        con.print(f"[bold green]wrote[/] {v}")

@@ -1,0 +1,216 @@
+"""designkit.bench and `designkit bench`: the measuring instruments themselves.
+
+The exact references the benchmark compares tables against are checked here against
+their definitions (the ideal observer's F1 just above and just below each answer), so
+that a table error in docs/accuracy.md is the table's, not the reference's.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from designkit import Scene, bench
+from designkit.ideal import ideal_pair
+from designkit.sensor import SENSORS
+
+PAPER = SENSORS["paper"]
+W = 80.0
+
+
+def _f1(lo, hi, contact, ratio, width=W):
+    return ideal_pair((lo, lo + width), (hi, hi + width), PAPER,
+                      Scene(contact_s=contact, noise_c=ratio, sensor_temp_c=26.0, ambient_temp_c=25.0)).f1
+
+
+# ------------------------------------------------------------------ helpers
+def test_fit_exponent_recovers_power_laws_and_ignores_unusable_points():
+    x = np.array([10.0, 20.0, 40.0, 80.0])
+    assert bench.fit_exponent(x, 3.0 * x ** 1.5) == pytest.approx(1.5)
+    assert bench.fit_exponent(x, 7.0 * x ** -0.5) == pytest.approx(-0.5)
+    assert bench.fit_exponent(x, [0.0, 2.0, 4.0, np.nan]) == pytest.approx(1.0)  # zeros and NaN dropped
+    assert math.isnan(bench.fit_exponent([5.0, 5.0], [1.0, 2.0]))  # no spread in x: no slope
+
+
+def test_process_cost_reports_the_childs_own_peak_memory_and_exit_status():
+    big = bench.process_cost([sys.executable, "-c", "import numpy; a = numpy.ones(40_000_000); a += 1"])
+    small = bench.process_cost([sys.executable, "-c", "import numpy"])
+    assert big.returncode == 0 and small.returncode == 0
+    # 40e6 float64 = 305 MiB on top of the interpreter and numpy
+    assert big.max_rss_mb - small.max_rss_mb == pytest.approx(305, rel=0.15)
+    assert big.wall_s > 0
+    bad = bench.process_cost([sys.executable, "-c", "import sys; print('x'); sys.exit(3)"])
+    assert bad.returncode == 3 and bad.stdout.strip() == "x"
+
+
+@pytest.mark.skipif(bench._reset_peak_memory() is None, reason="needs Linux /proc/self/clear_refs")
+def test_measure_reports_each_calls_own_peak():
+    def alloc(mb):
+        a = np.ones(int(mb * 2**20 / 8))
+        a += 1.0
+        return float(a[0])
+
+    _, _, _, first = bench.measure(lambda: alloc(200))
+    _, _, _, second = bench.measure(lambda: alloc(20))
+    assert first == pytest.approx(200, rel=0.2)
+    assert second < 100  # the earlier, larger peak is not carried over
+
+
+# ------------------------------------------------------------------ exact ideal references
+def test_exact_ideal_min_contact_is_the_first_sample_time_that_separates():
+    lo = np.array([20000.0, 5000.0, 1000.0])
+    hi = np.array([35000.0, 5400.0, 1100.0])
+    ratio = np.array([0.005, 0.002, 0.01])
+    t = bench.exact_ideal_min_contact(PAPER, lo, hi, ratio)
+    dt = 1.0 / PAPER.sample_rate_hz
+    for a, b, r, c in zip(lo, hi, ratio, t):
+        assert _f1(a, b, c, r) >= 0.9 > _f1(a, b, c - dt, r)
+    # the paper's guideline pair: about 1 s for the ideal observer (DOMAIN.md: accuracy 0.87 at 1 s)
+    assert 0.9 < t[0] < 1.3
+
+
+def test_exact_ideal_min_contact_is_nan_when_nothing_up_to_the_limit_separates():
+    t = bench.exact_ideal_min_contact(PAPER, 20000.0, 20050.0, 0.02, max_contact_s=2.0)
+    assert np.isnan(t)
+
+
+def test_exact_ideal_max_ratio_brackets_the_threshold():
+    lo, hi, c = np.array([20000.0, 3000.0]), np.array([35000.0, 3400.0]), np.array([2.0, 1.5])
+    r = bench.exact_ideal_max_ratio(PAPER, lo, hi, c)
+    for a, b, ci, ri in zip(lo, hi, c, r):
+        assert _f1(a, b, ci, ri) >= 0.9 > _f1(a, b, ci, ri * 1.001)
+
+
+def test_exact_ideal_delta_brackets_the_threshold_in_both_directions():
+    e = np.array([20000.0, 2000.0])
+    for direction in (+1, -1):
+        d = bench.exact_ideal_delta(PAPER, e, 2.0, 0.005, direction=direction)
+        for ei, di in zip(e, d):
+            near, far = sorted([ei + direction * (di - 1.0), ei + direction * di])
+            p = ei + direction * di
+            assert _f1(min(ei, p), max(ei, p), 2.0, 0.005) >= 0.9
+            q = ei + direction * (di - 1.0)
+            assert _f1(min(ei, q), max(ei, q), 2.0, 0.005) < 0.9
+
+
+# ------------------------------------------------------------------ tables
+@pytest.fixture(scope="module")
+def ideal_table():
+    from designkit.tables import load_table
+
+    return load_table("ideal-paper")
+
+
+def test_subsampled_table_answers_like_the_full_table_at_kept_points(ideal_table):
+    from designkit import query
+
+    ax = ideal_table.axes
+    keep = {"noise_ratio": [0, 6, 10, 16], "contact_s": list(range(0, len(ax["contact_s"]), 4))}
+    sub = bench.subsample_table(ideal_table, keep)
+    assert list(sub.axes["noise_ratio"]) == [ax["noise_ratio"][i] for i in keep["noise_ratio"]]
+    for r_i in keep["noise_ratio"]:
+        for c_i in keep["contact_s"]:
+            kw = dict(contact_s=float(ax["contact_s"][c_i]), noise_c=float(ax["noise_ratio"][r_i]) * 10,
+                      delta_t_c=10.0)
+            a = query.delta_e(12345.0, table=ideal_table, ideal_table=ideal_table, **kw)
+            b = query.delta_e(12345.0, table=sub, ideal_table=sub, **kw)
+            assert a.extra["delta_e_upper"] == b.extra["delta_e_upper"]
+            assert a.extra["delta_e_lower"] == b.extra["delta_e_lower"]
+    with pytest.raises(ValueError):
+        bench.subsample_table(ideal_table, {"contact_s": [3, 1]})
+
+
+def test_query_rows_measure_a_conservative_ideal_table(ideal_table):
+    rows, facts = bench.query_rows(ideal_table, quick=True, n=16, questions=("min-contact", "delta-e"))
+    assert [r.question for r in rows] == ["min-contact", "delta-e"]
+    for r in rows:
+        assert math.isfinite(r.error) and r.worst >= r.error >= 0 and r.wall_s > 0 and r.n > 0
+    # the table's delta is a whole number of intervals at or above the exact one, and linear
+    # interpolation of a convex need overestimates it: table answers never claim too short a contact
+    assert facts["min-contact"]["conservative_fraction"] == 1.0
+    assert facts["delta-e"]["worst"] >= 0
+
+
+def test_staircase_and_full_matrix_agree_on_a_tiny_grid():
+    r = bench.staircase_vs_full(6, contact_s=0.5, trials=12, max_repeats=2)
+    assert r["pairs_full"] == 15
+    assert r["fits_full"] >= 15 and r["fits_staircase"] <= r["fits_full"]
+    assert r["max_diff_intervals"] <= 1
+
+
+def test_cost_curve_of_the_ideal_engine_grows_about_linearly_in_intervals():
+    c = bench.cost_curve("ideal: intervals", "intervals", (100, 400),
+                         dict(name="t", fidelity="ideal", noise_ratio=(0.005,), contact_s=(1.0,)))
+    assert c.x == (100.0, 400.0) and all(w > 0 for w in c.wall_s) and c.fits == (0, 0)
+    assert 0.3 < c.time_exponent < 2.0
+
+
+# ------------------------------------------------------------------ report and CLI
+@pytest.fixture(scope="module")
+def physics_report():
+    return bench.run_bench(quick=True, sections=("physics",))
+
+
+def test_physics_rows_are_accurate_and_faster_than_mpmath(physics_report):
+    rows = {r.method: r for r in physics_report.rows}
+    for name in ("response_shape (scipy erfc)", "temperature_change"):
+        assert rows[name].worst < 1e-12 and rows[name].speedup > 10
+    assert rows["log_response_shape (log_ndtr)"].worst < 1e-8
+    fv = rows["finite volumes"]
+    assert fv.worst < 1e-2  # degC at a 10 degC difference (bench_slab's default resolution study)
+    assert rows["semi-infinite (paper eq. 2)"].worst > 0.1  # the thin samples are really not semi-infinite
+
+
+def test_report_renders_markdown_json_and_figures(physics_report, tmp_path):
+    paths = bench.write_report(physics_report, tmp_path)
+    md = paths["markdown"].read_text()
+    assert md.startswith("# Accuracy against run time") and "GENERATED" in md
+    assert "response_shape (scipy erfc)" in md and "How to buy more accuracy with time" in md
+    assert (tmp_path / "accuracy_pareto.png").stat().st_size > 10_000
+    data = json.loads(paths["json"].read_text())
+    assert len(data["rows"]) == len(physics_report.rows)
+
+
+def test_cli_bench_json_and_out(cli, tmp_path):
+    r = cli("bench", "--quick", "--section", "physics", "--json", "--out", str(tmp_path))
+    assert r.exit_code == 0, r.output
+    data = json.loads(r.output)
+    assert data["quick"] is True and {row["question"] for row in data["rows"]} >= {"physics: eq. 2"}
+    assert (tmp_path / "accuracy.md").is_file()
+
+
+def test_cli_bench_rejects_an_unknown_section(cli):
+    r = cli("bench", "--section", "nonsense")
+    assert r.exit_code == 2 and r.output.strip().startswith("Error:") and "nonsense" in r.output
+
+
+@pytest.mark.slow
+def test_console_script_bench_prints_the_table(tmp_path):
+    exe = Path(sys.executable).with_name("designkit")
+    cmd = [str(exe)] if exe.exists() else [sys.executable, "-m", "designkit"]
+    p = subprocess.run(cmd + ["bench", "--quick", "-s", "physics", "--out", str(tmp_path)], capture_output=True,
+                       text=True, timeout=300)
+    assert p.returncode == 0, p.stderr
+    assert "error against run time" in p.stdout and "response_shape" in p.stdout
+    assert (tmp_path / "accuracy.md").is_file()
+
+
+@pytest.mark.slow
+def test_svm_query_rows_against_exact_on_a_tiny_svm_table(tmp_path):
+    from designkit.engine import SweepConfig, run_sweep
+    from designkit.tables import load_table
+
+    cfg = SweepConfig(name="tiny-svm", fidelity="svm", intervals=5, e_max=40000.0, trials=12, max_repeats=1,
+                      noise_ratio=(0.002, 0.005), contact_s=(0.5, 1.0, 2.0))
+    tab = load_table(run_sweep(cfg, tmp_path / "w", out=tmp_path / "tiny-svm.npz", backend="sequential"))
+    rows, facts = bench.svm_query_rows(tab, quick=True, n=1, repeats=1)
+    assert [r.question for r in rows] == ["min-contact", "distinguishable"]
+    case = facts["min-contact"][0]
+    assert case["exact_wall_s"] > case["table_wall_s"]
+    assert 0.0 <= rows[1].error <= 1.0

@@ -1,0 +1,831 @@
+"""Device profiles: how a sensor rig speaks over serial, and how to read it.
+
+A profile (YAML, see ``calibration/README.md``) says which serial settings to
+use, how one text line is split into fields, which field carries which
+channel (heated sensor temperature, object/passive temperature, force,
+optional timestamp), how each raw field converts to engineering units, how a
+touch is detected and which window around it is a trial.
+
+Conversions are pairs of exact inverses: :meth:`Conversion.to_value` reads a
+raw wire number, :meth:`Conversion.to_raw` gives the raw number a device would
+send (the emulator uses it). Thermistor channels go through the voltage
+divider and either the B-parameter equation
+``1/T = 1/T0 + ln(R/R0)/B`` or the Steinhart-Hart equation
+``1/T = A + B ln R + C (ln R)^3`` (Steinhart and Hart, Deep-Sea Research 15,
+497, 1968), whose inverse is the one real root of an increasing cubic, found
+by Newton's method from the ``C = 0`` root (monotone convergence).
+
+Everything is validated on load; a bad profile raises
+:class:`~designkit._validation.InputError` with one line naming the file and
+the key.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Mapping, Sequence
+
+import numpy as np
+
+from .._validation import InputError
+
+__all__ = [
+    "ROLES",
+    "Channel",
+    "ContactRule",
+    "Conversion",
+    "DeviceProfile",
+    "Identity",
+    "Linear",
+    "ParsedLines",
+    "SerialSettings",
+    "Thermistor",
+    "TrialWindow",
+    "list_profiles",
+    "load_profile",
+]
+
+PROFILE_FILE_VERSION = 1
+KELVIN = 273.15
+
+#: Channel roles a profile can map, in the order the recorder keeps them.
+ROLES = ("sensor", "object", "force", "timestamp")
+
+_PARITY = {"none": "N", "even": "E", "odd": "O", "mark": "M", "space": "S",
+           "n": "N", "e": "E", "o": "O", "m": "M", "s": "S"}
+
+
+# ---------------------------------------------------------------------- helpers
+class _Reader:
+    """Walks a YAML mapping, remembering the key path for error messages."""
+
+    def __init__(self, source: str, data: Any, path: str = "") -> None:
+        self.source = source
+        self.path = path
+        if not isinstance(data, Mapping):
+            where = f" {path}" if path else ""
+            raise InputError(f"{source}:{where} must be a mapping of keys, got {type(data).__name__}")
+        self.data = data
+        self.used: set[str] = set()
+
+    def _key(self, key: str) -> str:
+        return f"{self.path}.{key}" if self.path else key
+
+    def err(self, key: str, message: str) -> InputError:
+        return InputError(f"{self.source}: {self._key(key)} {message}")
+
+    def has(self, key: str) -> bool:
+        return key in self.data and self.data[key] is not None
+
+    def raw(self, key: str, default: Any = ..., *, required: bool = False) -> Any:
+        self.used.add(key)
+        if key not in self.data or self.data[key] is None:
+            if required or default is ...:
+                raise InputError(f"{self.source}: missing key {self._key(key)}")
+            return default
+        return self.data[key]
+
+    def sub(self, key: str, *, required: bool = False) -> "_Reader | None":
+        value = self.raw(key, None, required=required)
+        if value is None:
+            return None
+        return _Reader(self.source, value, self._key(key))
+
+    def number(self, key: str, default: Any = ..., *, positive: bool = False,
+               nonnegative: bool = False, required: bool = False) -> float:
+        value = self.raw(key, default, required=required)
+        if isinstance(value, bool):
+            raise self.err(key, f"must be a number, got {value!r}")
+        try:
+            v = float(value)
+        except (TypeError, ValueError):
+            raise self.err(key, f"must be a number, got {value!r}") from None
+        if not math.isfinite(v):
+            raise self.err(key, f"must be finite, got {value!r}")
+        if positive and v <= 0:
+            raise self.err(key, f"must be > 0, got {v:g}")
+        if nonnegative and v < 0:
+            raise self.err(key, f"must be >= 0, got {v:g}")
+        return v
+
+    def integer(self, key: str, default: Any = ..., *, low: int | None = None,
+                high: int | None = None) -> int:
+        value = self.raw(key, default)
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or int(value) != value:
+            raise self.err(key, f"must be an integer, got {value!r}")
+        v = int(value)
+        if (low is not None and v < low) or (high is not None and v > high):
+            raise self.err(key, f"must be between {low} and {high}, got {v}")
+        return v
+
+    def text(self, key: str, default: Any = ..., *, choices: Sequence[str] | None = None) -> str:
+        value = self.raw(key, default)
+        if not isinstance(value, str):
+            raise self.err(key, f"must be text, got {value!r}")
+        if choices is not None and value not in choices:
+            raise self.err(key, f"must be one of {', '.join(choices)}; got {value!r}")
+        return value
+
+    def pair(self, key: str, default: Any = ...) -> tuple[float, float] | None:
+        value = self.raw(key, default)
+        if value is None:
+            return None
+        if not isinstance(value, (list, tuple)) or len(value) != 2:
+            raise self.err(key, f"must be a pair [min, max], got {value!r}")
+        try:
+            lo, hi = float(value[0]), float(value[1])
+        except (TypeError, ValueError):
+            raise self.err(key, f"must be a pair of numbers [min, max], got {value!r}") from None
+        if not (math.isfinite(lo) and math.isfinite(hi)) or not lo < hi:
+            raise self.err(key, f"must be finite with min < max, got {value!r}")
+        return lo, hi
+
+    def done(self) -> None:
+        unknown = sorted(str(k) for k in self.data if k not in self.used)
+        if unknown:
+            where = f" in {self.path}" if self.path else ""
+            raise InputError(f"{self.source}: unknown key(s) {', '.join(unknown)}{where}")
+
+
+def _fmt_fixed(values: np.ndarray, decimals: int) -> list[str]:
+    if decimals <= 0:
+        return [str(int(v)) for v in np.rint(values)]
+    return [f"{v:.{decimals}f}" for v in values.tolist()]
+
+
+# ------------------------------------------------------------------ conversions
+class Conversion:
+    """Raw wire number <-> engineering value, exact inverses of each other."""
+
+    kind = "conversion"
+    #: Raw values are integer ADC counts (checked when read).
+    integer_raw = False
+
+    def to_value(self, raw):  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def to_raw(self, value):  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def raw_invalid(self, raw: np.ndarray) -> np.ndarray:
+        """Mask of raw numbers the conversion cannot accept (never NaN here)."""
+        return np.zeros(np.shape(raw), dtype=bool)
+
+    def encode(self, value) -> np.ndarray:
+        """The raw number a device sends for ``value`` (rounded as it would be)."""
+        return np.asarray(self.to_raw(value), dtype=np.float64)
+
+    def format(self, raw: np.ndarray) -> list[str]:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def to_dict(self) -> dict[str, Any]:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+
+@dataclass(frozen=True)
+class Identity(Conversion):
+    """Already in engineering units. ``decimals``: how the emulator prints them."""
+
+    decimals: int = 4
+    kind = "none"
+
+    def to_value(self, raw):
+        return np.asarray(raw, dtype=np.float64)
+
+    def to_raw(self, value):
+        return np.asarray(value, dtype=np.float64)
+
+    def encode(self, value):
+        return np.round(np.asarray(value, dtype=np.float64), self.decimals)
+
+    def format(self, raw):
+        return _fmt_fixed(np.asarray(raw), self.decimals)
+
+    def to_dict(self):
+        return {"type": "none", "decimals": self.decimals}
+
+
+@dataclass(frozen=True)
+class Linear(Conversion):
+    """``value = gain * raw + offset``; with ``adc_bits`` the raw numbers are
+    integer counts in ``[0, 2^bits - 1]``."""
+
+    gain: float
+    offset: float = 0.0
+    decimals: int = 0
+    adc_bits: int | None = None
+    kind = "linear"
+
+    @property
+    def integer_raw(self) -> bool:  # type: ignore[override]
+        return self.adc_bits is not None
+
+    def to_value(self, raw):
+        return self.gain * np.asarray(raw, dtype=np.float64) + self.offset
+
+    def to_raw(self, value):
+        return (np.asarray(value, dtype=np.float64) - self.offset) / self.gain
+
+    def raw_invalid(self, raw):
+        raw = np.asarray(raw, dtype=np.float64)
+        if self.adc_bits is None:
+            return np.zeros(raw.shape, dtype=bool)
+        full = 2 ** self.adc_bits - 1
+        return (raw != np.rint(raw)) | (raw < 0) | (raw > full)
+
+    def encode(self, value):
+        raw = self.to_raw(value)
+        if self.adc_bits is not None:
+            return np.clip(np.rint(raw), 0, 2 ** self.adc_bits - 1)
+        return np.round(raw, self.decimals)
+
+    def format(self, raw):
+        return _fmt_fixed(np.asarray(raw), 0 if self.adc_bits is not None else self.decimals)
+
+    def to_dict(self):
+        out = {"type": "linear", "gain": self.gain, "offset": self.offset, "decimals": self.decimals}
+        if self.adc_bits is not None:
+            out["adc_bits"] = self.adc_bits
+        return out
+
+
+@dataclass(frozen=True)
+class Thermistor(Conversion):
+    """NTC thermistor in a voltage divider, read by an ADC.
+
+    The divider is fed with ``v_supply`` [V]; the ADC has ``adc_bits`` bits and
+    reference ``v_ref`` [V], so ``counts = V / v_ref * (2^bits - 1)``.
+    ``thermistor_side="high"``: thermistor between supply and the ADC node,
+    series resistor to ground (``V = Vs Rs / (Rs + Rt)``); ``"low"``: the other
+    way round (``V = Vs Rt / (Rs + Rt)``). The thermistor is described either
+    by ``beta_k``, ``r0_ohm`` at ``t0_c`` (B-parameter equation) or by
+    Steinhart-Hart coefficients ``sh = (A, B, C)``.
+
+    Counts at the rails (0 and full scale) mean an open or shorted thermistor
+    and are refused, as are counts the divider cannot produce.
+    """
+
+    adc_bits: int
+    v_ref: float
+    series_ohm: float
+    thermistor_side: str = "high"
+    v_supply: float | None = None
+    beta_k: float | None = None
+    r0_ohm: float | None = None
+    t0_c: float | None = None
+    sh: tuple[float, float, float] | None = None
+    kind = "thermistor"
+    integer_raw = True
+
+    @property
+    def full_scale(self) -> int:
+        return 2 ** self.adc_bits - 1
+
+    @property
+    def supply(self) -> float:
+        return self.v_ref if self.v_supply is None else self.v_supply
+
+    # divider fraction r = V / Vs from counts, and back
+    def _fraction(self, counts):
+        return np.asarray(counts, dtype=np.float64) * (self.v_ref / self.full_scale) / self.supply
+
+    def resistance_ohm(self, counts):
+        """Thermistor resistance [ohm] from ADC counts (inf/0 outside the divider's range)."""
+        r = self._fraction(counts)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            if self.thermistor_side == "high":
+                return self.series_ohm * (1.0 - r) / r
+            return self.series_ohm * r / (1.0 - r)
+
+    def _counts_from_resistance(self, rt):
+        rt = np.asarray(rt, dtype=np.float64)
+        # r = Rs/(Rs+Rt) or Rt/(Rs+Rt), written without cancellation
+        if self.thermistor_side == "high":
+            r = 1.0 / (1.0 + rt / self.series_ohm)
+        else:
+            r = 1.0 / (1.0 + self.series_ohm / rt)
+        return r * self.supply / self.v_ref * self.full_scale
+
+    def log_resistance_from_c(self, temp_c):
+        """ln R [ln ohm] at temperature [degC]: the exact inverse of the thermistor equation."""
+        inv_t = 1.0 / (np.asarray(temp_c, dtype=np.float64) + KELVIN)
+        if self.sh is None:
+            return math.log(self.r0_ohm) + self.beta_k * (inv_t - 1.0 / (self.t0_c + KELVIN))
+        a, b, c = self.sh
+        # C L^3 + B L = 1/T - A with B > 0, C >= 0: increasing in L, one real root. Newton from the
+        # C = 0 root converges monotonically (the cubic is convex on that side of the root).
+        y = inv_t - a
+        log_r = y / b
+        for _ in range(60):
+            step = (c * log_r ** 3 + b * log_r - y) / (3.0 * c * log_r ** 2 + b)
+            log_r = log_r - step
+            if np.all(np.abs(step) <= 1e-15 * np.maximum(1.0, np.abs(log_r))):
+                break
+        return log_r
+
+    def c_from_log_resistance(self, log_r):
+        """Temperature [degC] from ln R (B-parameter or Steinhart-Hart)."""
+        log_r = np.asarray(log_r, dtype=np.float64)
+        if self.sh is None:
+            inv_t = 1.0 / (self.t0_c + KELVIN) + (log_r - math.log(self.r0_ohm)) / self.beta_k
+        else:
+            a, b, c = self.sh
+            inv_t = a + b * log_r + c * log_r ** 3
+        with np.errstate(divide="ignore"):
+            return 1.0 / inv_t - KELVIN
+
+    def to_value(self, raw):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return self.c_from_log_resistance(np.log(self.resistance_ohm(raw)))
+
+    def to_raw(self, value):
+        return self._counts_from_resistance(np.exp(self.log_resistance_from_c(value)))
+
+    def raw_invalid(self, raw):
+        raw = np.asarray(raw, dtype=np.float64)
+        r = self._fraction(raw)
+        return (raw != np.rint(raw)) | (raw <= 0) | (raw >= self.full_scale) | (r >= 1.0)
+
+    @property
+    def max_count(self) -> int:
+        """Largest count the recorder accepts (below full scale and below the supply)."""
+        top = min(self.full_scale - 1, int(math.ceil(self.full_scale * self.supply / self.v_ref)))
+        while top > 1 and self.raw_invalid(np.array([float(top)]))[0]:
+            top -= 1
+        return top
+
+    def encode(self, value):
+        return np.clip(np.rint(self.to_raw(value)), 1, self.max_count)
+
+    def format(self, raw):
+        return [str(int(v)) for v in np.rint(np.asarray(raw))]
+
+    def to_dict(self):
+        out: dict[str, Any] = {"type": "thermistor", "adc_bits": self.adc_bits, "v_ref": self.v_ref,
+                               "series_ohm": self.series_ohm, "thermistor_side": self.thermistor_side}
+        if self.v_supply is not None:
+            out["v_supply"] = self.v_supply
+        if self.sh is None:
+            out["beta"] = {"beta_k": self.beta_k, "r0_ohm": self.r0_ohm, "t0_c": self.t0_c}
+        else:
+            out["steinhart_hart"] = {"a": self.sh[0], "b": self.sh[1], "c": self.sh[2]}
+        return out
+
+
+def _conversion(rd: _Reader | None) -> Conversion:
+    if rd is None:
+        return Identity()
+    kind = rd.text("type", "none", choices=("none", "linear", "thermistor"))
+    if kind == "none":
+        conv: Conversion = Identity(decimals=rd.integer("decimals", 4, low=0, high=12))
+    elif kind == "linear":
+        gain = rd.number("gain", required=True)
+        if gain == 0:
+            raise rd.err("gain", "must not be 0")
+        bits = rd.integer("adc_bits", None, low=1, high=32) if rd.has("adc_bits") else None
+        rd.used.add("adc_bits")
+        conv = Linear(gain=gain, offset=rd.number("offset", 0.0),
+                      decimals=rd.integer("decimals", 0, low=0, high=12), adc_bits=bits)
+    else:
+        bits = rd.integer("adc_bits", low=1, high=32)
+        side = rd.text("thermistor_side", "high", choices=("high", "low"))
+        v_supply = rd.number("v_supply", None, positive=True) if rd.has("v_supply") else None
+        rd.used.add("v_supply")
+        beta = rd.sub("beta")
+        sh = rd.sub("steinhart_hart")
+        if (beta is None) == (sh is None):
+            raise InputError(f"{rd.source}: {rd.path} needs exactly one of beta or steinhart_hart")
+        kwargs: dict[str, Any] = {}
+        if beta is not None:
+            kwargs = {"beta_k": beta.number("beta_k", required=True, positive=True),
+                      "r0_ohm": beta.number("r0_ohm", required=True, positive=True),
+                      "t0_c": beta.number("t0_c", required=True)}
+            if kwargs["t0_c"] <= -KELVIN:
+                raise beta.err("t0_c", "must be above absolute zero")
+            beta.done()
+        else:
+            coeffs = (sh.number("a", required=True), sh.number("b", required=True, positive=True),
+                      sh.number("c", required=True, nonnegative=True))
+            sh.done()
+            kwargs = {"sh": coeffs}
+        conv = Thermistor(adc_bits=bits, v_ref=rd.number("v_ref", required=True, positive=True),
+                          series_ohm=rd.number("series_ohm", required=True, positive=True),
+                          thermistor_side=side, v_supply=v_supply, **kwargs)
+    rd.done()
+    return conv
+
+
+# ----------------------------------------------------------------------- parts
+@dataclass(frozen=True)
+class Channel:
+    """One channel: which field of a line, how it converts, what is plausible.
+
+    ``valid``: (min, max) in engineering units; readings outside are refused
+    as out of range (a loose connector, an open thermistor).
+    """
+
+    role: str
+    field_name: str
+    field_index: int
+    conversion: Conversion
+    valid: tuple[float, float] | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        out: dict[str, Any] = {"field": self.field_name, "conversion": self.conversion.to_dict()}
+        if self.valid is not None:
+            out["valid"] = list(self.valid)
+        return out
+
+
+@dataclass(frozen=True)
+class SerialSettings:
+    """pyserial settings and the recorder's time limits (real seconds)."""
+
+    baudrate: int = 115200
+    bytesize: int = 8
+    parity: str = "N"
+    stopbits: float = 1
+    read_timeout_s: float = 0.05
+    no_data_timeout_s: float = 5.0
+    stall_s: float = 0.25
+    reconnect_s: float = 2.0
+
+    def to_dict(self) -> dict[str, Any]:
+        names = {"N": "none", "E": "even", "O": "odd", "M": "mark", "S": "space"}
+        return {"baudrate": self.baudrate, "bytesize": self.bytesize, "parity": names[self.parity],
+                "stopbits": self.stopbits, "read_timeout_s": self.read_timeout_s,
+                "no_data_timeout_s": self.no_data_timeout_s, "stall_s": self.stall_s,
+                "reconnect_s": self.reconnect_s}
+
+
+@dataclass(frozen=True)
+class ContactRule:
+    """How a touch is detected.
+
+    ``rule="force"``: contact starts at the first sample with force >=
+    ``force_threshold_n`` (5 N as in the paper), and the detector re-arms
+    once force falls below ``release_n``. ``rule="temperature_slope"`` (rigs
+    without a force sensor): contact starts where the sensor temperature,
+    smoothed over ``slope_window_s``, falls faster than ``slope_c_per_s``;
+    the detector re-arms after the trial once the slope has been within a
+    quarter of that for ``pre_s``. Either way the fit's time offset absorbs
+    the detection delay.
+    """
+
+    rule: str = "force"
+    force_threshold_n: float = 5.0
+    release_n: float = 2.5
+    slope_c_per_s: float = 0.3
+    slope_window_s: float = 0.5
+
+    def to_dict(self) -> dict[str, Any]:
+        if self.rule == "force":
+            return {"rule": "force", "force_threshold_n": self.force_threshold_n, "release_n": self.release_n}
+        return {"rule": "temperature_slope", "slope_c_per_s": self.slope_c_per_s,
+                "slope_window_s": self.slope_window_s}
+
+
+@dataclass(frozen=True)
+class TrialWindow:
+    """Seconds kept before and after the detected contact onset."""
+
+    pre_s: float = 1.0
+    post_s: float = 7.0
+
+
+@dataclass(frozen=True)
+class ParsedLines:
+    """A batch of lines read into raw numbers.
+
+    Attributes
+    ----------
+    raw : ndarray, shape (n, len(ROLES))
+        Raw numbers of the mapped channels (NaN for an unmapped role), one row
+        per line that split into numbers.
+    rows : list of int
+        Index of each row's line in the batch.
+    errors : list of (int, str, str)
+        (line index, kind, line text) of lines that did not parse; kind is
+        ``garbled``, ``field_count`` or ``non_numeric``.
+    messages : list of str
+        Device messages (comment lines), skipped.
+    slots : ndarray of int, shape (n,)
+        Sample slot of each row: every non-empty line that is not a device
+        message counts as one sample, readable or not, so that a clock made
+        by counting lines stays right when some lines are lost to garbling.
+    n_slots : int
+        Sample slots in the batch.
+    """
+
+    raw: np.ndarray
+    rows: list[int]
+    errors: list[tuple[int, str, str]]
+    messages: list[str]
+    slots: np.ndarray
+    n_slots: int
+
+
+@dataclass(frozen=True)
+class DeviceProfile:
+    """A device profile (see the module docstring and ``calibration/README.md``)."""
+
+    name: str
+    description: str
+    serial: SerialSettings
+    delimiter: str | None
+    comment: str | None
+    encoding: str
+    fields: tuple[str, ...]
+    channels: Mapping[str, Channel]
+    sample_rate_hz: float
+    contact: ContactRule
+    trial: TrialWindow
+    source: str = "profile"
+    _index: tuple[int, ...] = field(default=(), repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "channels", dict(self.channels))
+        object.__setattr__(self, "_index", tuple(
+            self.channels[r].field_index if r in self.channels else -1 for r in ROLES))
+
+    @property
+    def has_timestamp(self) -> bool:
+        return "timestamp" in self.channels
+
+    @property
+    def has_object(self) -> bool:
+        return "object" in self.channels
+
+    @property
+    def has_force(self) -> bool:
+        return "force" in self.channels
+
+    # ------------------------------------------------------------- reading
+    def parse_lines(self, lines: Sequence[bytes]) -> ParsedLines:
+        """Split lines into raw numbers; report the ones that do not parse.
+
+        A line must decode in the profile's encoding, be printable, have
+        exactly ``len(fields)`` fields, and every mapped field must be a
+        finite number. Empty lines are ignored.
+        """
+        nf = len(self.fields)
+        idx = self._index
+        rows: list[list[float]] = []
+        where: list[int] = []
+        errors: list[tuple[int, str, str]] = []
+        messages: list[str] = []
+        slots: list[int] = []
+        slot = -1
+        delim = self.delimiter
+        comment = self.comment.encode(self.encoding) if self.comment else None
+        for i, line in enumerate(lines):
+            stripped = line.strip()
+            if not stripped:
+                continue
+            if comment and stripped.startswith(comment):
+                messages.append(stripped.decode(self.encoding, "replace"))
+                continue
+            slot += 1
+            try:
+                text = stripped.decode(self.encoding)
+            except UnicodeDecodeError:
+                errors.append((i, "garbled", stripped[:60].decode(self.encoding, "replace")))
+                continue
+            if not text.isprintable():
+                errors.append((i, "garbled", text[:60]))
+                continue
+            parts = text.split(delim) if delim is not None else text.split()
+            if len(parts) != nf:
+                errors.append((i, "field_count", text[:60]))
+                continue
+            try:
+                vals = [float(parts[j]) if j >= 0 else math.nan for j in idx]
+            except ValueError:
+                errors.append((i, "non_numeric", text[:60]))
+                continue
+            if any(j >= 0 and not math.isfinite(v) for j, v in zip(idx, vals)):
+                errors.append((i, "non_numeric", text[:60]))
+                continue
+            rows.append(vals)
+            where.append(i)
+            slots.append(slot)
+        raw = np.array(rows, dtype=np.float64).reshape(len(rows), len(ROLES))
+        return ParsedLines(raw, where, errors, messages, np.array(slots, dtype=np.int64), slot + 1)
+
+    def convert(self, raw: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Raw numbers (from :meth:`parse_lines`) to engineering units.
+
+        Returns
+        -------
+        values : ndarray, shape (n, len(ROLES))
+            sensor [degC], object [degC], force [N], timestamp [s]; NaN for a
+            role the profile does not map.
+        bad : ndarray of bool, shape (n,)
+            Rows with an out-of-range reading (raw counts the conversion
+            cannot take, or a value outside the channel's ``valid`` range).
+        """
+        raw = np.asarray(raw, dtype=np.float64).reshape(-1, len(ROLES))
+        values = np.full(raw.shape, np.nan)
+        bad = np.zeros(raw.shape[0], dtype=bool)
+        for k, role in enumerate(ROLES):
+            ch = self.channels.get(role)
+            if ch is None:
+                continue
+            col = raw[:, k]
+            invalid = ch.conversion.raw_invalid(col)
+            safe = np.where(invalid, np.nan, col)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                v = ch.conversion.to_value(safe)
+            invalid |= ~np.isfinite(v)
+            if ch.valid is not None:
+                with np.errstate(invalid="ignore"):
+                    invalid |= (v < ch.valid[0]) | (v > ch.valid[1])
+            values[:, k] = v
+            bad |= invalid
+        return values, bad
+
+    # ------------------------------------------------------------- writing
+    def format_lines(self, values: Mapping[str, np.ndarray]) -> list[str]:
+        """Wire lines (without newline) for engineering values per role.
+
+        Roles the profile maps but ``values`` lacks, and unmapped fields, are
+        sent as ``0``. The emulator's only way of speaking.
+        """
+        n = len(next(iter(values.values())))
+        cols: list[list[str]] = [["0"] * n for _ in self.fields]
+        for role, ch in self.channels.items():
+            if role in values:
+                raw = ch.conversion.encode(np.asarray(values[role], dtype=np.float64))
+                cols[ch.field_index] = ch.conversion.format(raw)
+        delim = self.delimiter if self.delimiter is not None else " "
+        return [delim.join(parts) for parts in zip(*cols)]
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain-data form (the YAML schema)."""
+        return {
+            "designkit_profile": PROFILE_FILE_VERSION,
+            "name": self.name,
+            "description": self.description,
+            "serial": self.serial.to_dict(),
+            "line": {"delimiter": "whitespace" if self.delimiter is None else self.delimiter,
+                     "comment": self.comment, "encoding": self.encoding, "fields": list(self.fields)},
+            "sample_rate_hz": self.sample_rate_hz,
+            "channels": {r: self.channels[r].to_dict() for r in ROLES if r in self.channels},
+            "contact": self.contact.to_dict(),
+            "trial": {"pre_s": self.trial.pre_s, "post_s": self.trial.post_s},
+        }
+
+
+# ---------------------------------------------------------------------- loading
+def _parse_profile(data: Any, source: str) -> DeviceProfile:
+    rd = _Reader(source, data)
+    version = rd.raw("designkit_profile", PROFILE_FILE_VERSION)
+    if version != PROFILE_FILE_VERSION:
+        raise InputError(f"{source}: unsupported profile version {version!r} "
+                         f"(this designkit reads version {PROFILE_FILE_VERSION})")
+    name = rd.text("name")
+    description = rd.text("description", "")
+
+    ser = rd.sub("serial") or _Reader(source, {}, "serial")
+    parity_text = ser.text("parity", "none").strip().lower()
+    if parity_text not in _PARITY:
+        raise ser.err("parity", f"must be one of none, even, odd, mark, space; got {parity_text!r}")
+    stopbits = ser.number("stopbits", 1)
+    if stopbits not in (1, 1.5, 2):
+        raise ser.err("stopbits", f"must be 1, 1.5 or 2, got {stopbits:g}")
+    serial = SerialSettings(
+        baudrate=ser.integer("baudrate", 115200, low=50, high=20_000_000),
+        bytesize=ser.integer("bytesize", 8, low=5, high=8),
+        parity=_PARITY[parity_text],
+        stopbits=stopbits,
+        read_timeout_s=ser.number("read_timeout_s", 0.05, positive=True),
+        no_data_timeout_s=ser.number("no_data_timeout_s", 5.0, positive=True),
+        stall_s=ser.number("stall_s", 0.25, positive=True),
+        reconnect_s=ser.number("reconnect_s", 2.0, nonnegative=True),
+    )
+    ser.done()
+
+    line = rd.sub("line", required=True)
+    delim_text = line.text("delimiter", ",")
+    delimiter = None if delim_text == "whitespace" else delim_text
+    if delimiter is not None and (delimiter == "" or "\n" in delimiter or "\r" in delimiter):
+        raise line.err("delimiter", f"must be a non-empty string without newlines or 'whitespace', got {delim_text!r}")
+    comment = line.text("comment") if line.has("comment") else None
+    line.used.add("comment")
+    encoding = line.text("encoding", "ascii")
+    try:
+        "x".encode(encoding)
+    except LookupError:
+        raise line.err("encoding", f"is not a known text encoding: {encoding!r}") from None
+    fields_raw = line.raw("fields", required=True)
+    if not isinstance(fields_raw, list) or not fields_raw:
+        raise line.err("fields", f"must be a non-empty list of field names, got {fields_raw!r}")
+    fields = tuple("_" if f is None else str(f) for f in fields_raw)
+    named = [f for f in fields if f != "_"]
+    dupes = sorted({f for f in named if named.count(f) > 1})
+    if dupes:
+        raise line.err("fields", f"has duplicate name(s) {', '.join(dupes)}")
+    line.done()
+
+    ch_rd = rd.sub("channels", required=True)
+    channels: dict[str, Channel] = {}
+    default_valid = {"sensor": (-40.0, 150.0), "object": (-40.0, 150.0), "force": None, "timestamp": None}
+    for role in ROLES:
+        sub = ch_rd.sub(role)
+        if sub is None:
+            continue
+        fname = sub.text("field")
+        if fname not in named:
+            raise sub.err("field", f"names no field of line.fields ({', '.join(named)}): {fname!r}")
+        conv = _conversion(sub.sub("conversion"))
+        valid = sub.pair("valid", default_valid[role])
+        sub.done()
+        if role == "timestamp" and isinstance(conv, Thermistor):
+            raise sub.err("conversion", "of a timestamp cannot be a thermistor")
+        channels[role] = Channel(role, fname, fields.index(fname), conv, valid)
+    ch_rd.done()
+    if "sensor" not in channels:
+        raise InputError(f"{source}: channels.sensor (the heated sensor's temperature) is required")
+    used = [c.field_name for c in channels.values()]
+    twice = sorted({f for f in used if used.count(f) > 1})
+    if twice:
+        raise InputError(f"{source}: field(s) {', '.join(twice)} mapped to more than one channel")
+
+    sample_rate = rd.number("sample_rate_hz", required=True, positive=True)
+
+    con = rd.sub("contact") or _Reader(source, {}, "contact")
+    rule = con.text("rule", "force", choices=("force", "temperature_slope"))
+    threshold = con.number("force_threshold_n", 5.0, positive=True)
+    release = con.number("release_n", threshold / 2.0, nonnegative=True)
+    if release >= threshold:
+        raise con.err("release_n", f"must be below force_threshold_n ({threshold:g}), got {release:g}")
+    contact = ContactRule(rule=rule, force_threshold_n=threshold, release_n=release,
+                          slope_c_per_s=con.number("slope_c_per_s", 0.3, positive=True),
+                          slope_window_s=con.number("slope_window_s", 0.5, positive=True))
+    con.done()
+    if rule == "force" and "force" not in channels:
+        raise InputError(f"{source}: contact.rule force needs a channels.force entry "
+                         "(or use rule: temperature_slope)")
+    if rule == "temperature_slope" and contact.slope_window_s * sample_rate < 4:
+        raise InputError(f"{source}: contact.slope_window_s must span at least 4 samples "
+                         f"at {sample_rate:g} Hz, got {contact.slope_window_s:g} s")
+
+    tr = rd.sub("trial") or _Reader(source, {}, "trial")
+    trial = TrialWindow(pre_s=tr.number("pre_s", 1.0, positive=True),
+                        post_s=tr.number("post_s", 7.0, positive=True))
+    tr.done()
+    if trial.pre_s * sample_rate < 3:
+        raise InputError(f"{source}: trial.pre_s must hold at least 3 samples at {sample_rate:g} Hz")
+    rd.done()
+    return DeviceProfile(name=str(name), description=description, serial=serial, delimiter=delimiter,
+                         comment=comment, encoding=encoding, fields=fields, channels=channels,
+                         sample_rate_hz=sample_rate, contact=contact, trial=trial, source=source)
+
+
+def list_profiles() -> dict[str, Path]:
+    """Shipped profiles: name -> file."""
+    from .._resources import profiles_dir
+
+    folder = profiles_dir()
+    if not folder.is_dir():
+        return {}
+    return {p.stem: p for p in sorted(folder.glob("*.yaml"))}
+
+
+def load_profile(name_or_path: "str | Path | DeviceProfile") -> DeviceProfile:
+    """A device profile from a shipped name (``designkit``, ``adc12-thermistor``) or a YAML path."""
+    if isinstance(name_or_path, DeviceProfile):
+        return name_or_path
+    import yaml
+
+    key = str(name_or_path)
+    shipped = list_profiles()
+    if key in shipped:
+        path = shipped[key]
+    else:
+        path = Path(key)
+        if not path.exists():
+            names = ", ".join(shipped) or "none found"
+            raise InputError(f"unknown device profile {key!r}: use a shipped name ({names}) or a profile YAML file")
+    source = f"profile {path}"
+    try:
+        text = path.read_text()
+    except OSError as exc:
+        raise InputError(f"cannot read {source}: {exc.strerror or exc}") from None
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f" (line {mark.line + 1})" if mark is not None else ""
+        raise InputError(f"{source} is not valid YAML{where}") from None
+    return _parse_profile(data, source)
+
+
+def profile_from_dict(data: Mapping[str, Any], source: str = "profile") -> DeviceProfile:
+    """Build and validate a profile from plain data (the YAML content)."""
+    return _parse_profile(data, source)
+
+
+__all__.append("profile_from_dict")

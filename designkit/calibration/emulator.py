@@ -1,0 +1,539 @@
+"""A simulated sensor rig on a pseudo-terminal, speaking a device profile's wire format.
+
+:class:`Emulator` opens a pseudo-terminal (:func:`os.openpty`), and a thread
+streams what a real rig would send: the heated sensor's temperature from the
+semi-infinite model (paper eqs. 1-2) with Gaussian noise (eq. 4), a passive
+thermistor, a force sensor, and periodic touches of the objects it is given.
+Any serial client (pyserial, ``designkit calibrate record``, a terminal) can
+open :attr:`Emulator.port` as if it were ``/dev/ttyACM0``.
+
+Timing. Sample ``k`` belongs to device time ``k / fs``. A touch starts every
+``touch_every_s`` seconds (the first at ``first_touch_s``); heat starts to
+flow when force leaves zero, force ramps to ``press_force_n`` over ``ramp_s``,
+holds, and ramps down so that contact lasts ``contact_s``. The detected onset
+(force crossing the profile's threshold) therefore comes ``ramp_s *
+threshold / press_force_n`` after heat starts to flow: the time offset the
+fit has to find, like the paper's 0.5 s. After release the regulated heater
+brings the sensor back to its set temperature with time constant
+``recover_s``; the passive thermistor relaxes back to room temperature.
+
+``speed`` runs the device clock faster than real time (tests, demos). Writes
+never block the thread: when nobody reads the pty, the emulator pauses (as a
+device's USB buffer would fill) and resumes at the current time, without a
+catch-up burst.
+
+Faults (:class:`Faults`) inject what real serial links do: garbled bytes,
+partial lines, non-numeric fields, wrong field counts, out-of-range counts,
+bursts (output held back, then delivered at once), gaps (samples lost while
+the line is silent), a device that vanishes, and one that never speaks.
+"""
+
+from __future__ import annotations
+
+import fcntl
+import math
+import os
+import select
+import threading
+import time
+import tty
+from dataclasses import dataclass, field, replace
+from typing import Sequence
+
+import numpy as np
+
+from .._validation import InputError, as_generator, check_effusivity, check_nonnegative, check_positive
+from ..physics import object_weight, response_shape
+from ..sensor import Sensor
+from .profiles import DeviceProfile, Identity, Linear, Thermistor
+
+__all__ = ["EmulatedMaterial", "Emulator", "Faults", "TouchPlan", "TouchRecord"]
+
+_MAX_PENDING = 1 << 16
+
+
+@dataclass(frozen=True)
+class EmulatedMaterial:
+    """An object the emulated rig touches.
+
+    Parameters
+    ----------
+    label : str
+        Name shown and logged.
+    effusivity : float
+        e_o [J s^-1/2 K^-1 m^-2].
+    object_temp_c : float or None
+        Object temperature [degC]; None: room temperature (the emulator's
+        ambient).
+    """
+
+    label: str
+    effusivity: float
+    object_temp_c: float | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "effusivity", check_effusivity(self.label, self.effusivity))
+
+
+@dataclass(frozen=True)
+class Faults:
+    """Serial-link faults to inject (all off by default).
+
+    Per-line probabilities: ``garbled`` (random non-ASCII bytes), ``partial``
+    (line cut short, fields missing), ``non_numeric`` (a field replaced by
+    text such as ``nan`` or ``ERR``), ``field_count`` (a field added or
+    dropped), ``out_of_range`` (a sensor reading at the ADC rails or outside
+    the channel's valid range). Each faulty line replaces one sample.
+
+    Timed faults (device seconds, 0 = off): every ``burst_every_s`` the
+    output is held back for ``burst_hold_s`` real seconds and then delivered
+    at once (no data lost); every ``gap_every_s`` the device goes silent for
+    ``gap_s`` real seconds and the samples of that time are lost; after
+    ``vanish_after_s`` the device disappears (the pty closes). ``silent``:
+    the port opens but nothing is ever sent.
+    """
+
+    garbled: float = 0.0
+    partial: float = 0.0
+    non_numeric: float = 0.0
+    field_count: float = 0.0
+    out_of_range: float = 0.0
+    burst_every_s: float = 0.0
+    burst_hold_s: float = 0.1
+    gap_every_s: float = 0.0
+    gap_s: float = 0.5
+    vanish_after_s: float = 0.0
+    silent: bool = False
+
+    def __post_init__(self) -> None:
+        for name in ("garbled", "partial", "non_numeric", "field_count", "out_of_range"):
+            p = check_nonnegative(f"fault {name} probability", getattr(self, name))
+            if p > 1:
+                raise InputError(f"fault {name} probability must be <= 1, got {p:g}")
+        for name in ("burst_every_s", "burst_hold_s", "gap_every_s", "gap_s", "vanish_after_s"):
+            check_nonnegative(f"fault {name}", getattr(self, name))
+
+    @property
+    def line_faults(self) -> bool:
+        return any((self.garbled, self.partial, self.non_numeric, self.field_count, self.out_of_range))
+
+    @classmethod
+    def parse(cls, specs: Sequence[str]) -> "Faults":
+        """From CLI specs: ``garbled=0.01``, ``partial=P``, ``non-numeric=P``,
+        ``field-count=P``, ``out-of-range=P``, ``burst=EVERY_S[:HOLD_S]``,
+        ``gap=EVERY_S[:SILENT_S]``, ``vanish=AFTER_S``, ``silent``."""
+        kw: dict[str, float | bool] = {}
+        probs = {"garbled", "partial", "non-numeric", "field-count", "out-of-range"}
+        known = sorted(probs | {"burst", "gap", "vanish", "silent"})
+        for spec in specs:
+            name, _, value = str(spec).partition("=")
+            name = name.strip().lower().replace("_", "-")
+            if name not in known:
+                raise InputError(f"unknown fault {name!r}: use one of {', '.join(known)}")
+            try:
+                if name in probs:
+                    kw[name.replace("-", "_")] = float(value)
+                elif name in ("burst", "gap"):
+                    every, _, second = value.partition(":")
+                    kw[f"{name}_every_s"] = float(every)
+                    if second:
+                        kw["burst_hold_s" if name == "burst" else "gap_s"] = float(second)
+                elif name == "vanish":
+                    kw["vanish_after_s"] = float(value)
+                else:
+                    kw["silent"] = True
+            except ValueError:
+                raise InputError(f"fault {spec!r} needs a number, e.g. garbled=0.01, gap=30:0.5, "
+                                 "vanish=45") from None
+        return cls(**kw)  # type: ignore[arg-type]
+
+
+@dataclass(frozen=True)
+class TouchPlan:
+    """When and how the emulated rig touches.
+
+    ``contact_s`` defaults to the profile's trial window plus half a second,
+    ``press_force_n`` to twice the contact threshold.
+    """
+
+    touch_every_s: float = 20.0
+    first_touch_s: float = 2.0
+    contact_s: float | None = None
+    press_force_n: float | None = None
+    ramp_s: float = 0.5
+    recover_s: float = 0.4
+    touches_per_material: int = 1
+
+
+@dataclass(frozen=True)
+class TouchRecord:
+    """Ground truth of one emulated touch (device time)."""
+
+    index: int
+    material: str
+    effusivity: float
+    start_s: float
+    expected_onset_s: float
+
+
+class Emulator:
+    """A simulated rig streaming a profile's wire format on a pseudo-terminal.
+
+    Parameters
+    ----------
+    profile : DeviceProfile
+        Wire format (and contact threshold, trial window).
+    sensor : Sensor
+        e_s and tau of the emulated sensor; noise from ``noise_c``.
+    materials : sequence of EmulatedMaterial
+        Objects touched, ``plan.touches_per_material`` touches each, in turn.
+    noise_c : float
+        Temperature noise sigma per sample [degC] (both thermistors).
+    sensor_temp_c, ambient_c : float
+        Heater set point and room temperature [degC].
+    plan : TouchPlan
+    speed : float
+        Device seconds per real second (1 = real time).
+    faults : Faults
+    seed : int or Generator
+        Noise and fault draws.
+    force_noise_n : float
+        Force noise sigma [N].
+
+    Examples
+    --------
+    >>> with Emulator(load_profile("designkit"), SENSORS["paper"],
+    ...               [EmulatedMaterial("wood", 400)], speed=20) as emu:  # doctest: +SKIP
+    ...     print(emu.port)
+    /dev/pts/3
+    """
+
+    def __init__(self, profile: DeviceProfile, sensor: Sensor,
+                 materials: Sequence[EmulatedMaterial], *, noise_c: float = 0.05,
+                 sensor_temp_c: float = 35.0, ambient_c: float = 25.0, plan: TouchPlan = TouchPlan(),
+                 speed: float = 1.0, faults: Faults = Faults(), seed=0, force_noise_n: float = 0.02) -> None:
+        if not materials:
+            raise InputError("the emulator needs at least one material to touch")
+        self.profile = profile
+        self.sensor = sensor
+        self.materials = tuple(materials)
+        self.noise_c = check_nonnegative("noise sigma [degC]", noise_c)
+        self.sensor_temp_c = float(sensor_temp_c)
+        self.ambient_c = float(ambient_c)
+        self.speed = check_positive("speed", speed)
+        self.faults = faults
+        self.force_noise_n = check_nonnegative("force noise [N]", force_noise_n)
+        self._seed = seed if isinstance(seed, (int, np.integer)) else int(as_generator(seed).integers(2 ** 31))
+        if int(self._seed) < 0:
+            raise InputError(f"seed must be a non-negative integer, got {seed}")
+        self._rng = as_generator([int(self._seed), 1 << 30])  # fault draws
+        self._blocks: dict[int, np.ndarray] = {}
+        fs = profile.sample_rate_hz
+        threshold = profile.contact.force_threshold_n if profile.contact.rule == "force" else 5.0
+        contact = plan.contact_s if plan.contact_s is not None else profile.trial.post_s + 0.5
+        force = plan.press_force_n if plan.press_force_n is not None else 2.0 * threshold
+        plan = replace(plan, contact_s=float(contact), press_force_n=float(force))
+        check_positive("touch interval [s]", plan.touch_every_s)
+        check_positive("contact time [s]", plan.contact_s)
+        check_positive("press force [N]", plan.press_force_n)
+        check_positive("force ramp [s]", plan.ramp_s)
+        check_positive("heater recovery time constant [s]", plan.recover_s)
+        if plan.touches_per_material < 1:
+            raise InputError(f"touches per material must be >= 1, got {plan.touches_per_material}")
+        if 2 * plan.ramp_s >= plan.contact_s:
+            raise InputError(f"contact ({plan.contact_s:g} s) must outlast the force ramps (2 x {plan.ramp_s:g} s)")
+        if plan.press_force_n <= threshold and profile.contact.rule == "force":
+            raise InputError(f"press force {plan.press_force_n:g} N never reaches the profile's contact "
+                             f"threshold {threshold:g} N")
+        needed = plan.contact_s + 10 * plan.recover_s + profile.trial.pre_s
+        if plan.touch_every_s < needed:
+            raise InputError(f"touch interval {plan.touch_every_s:g} s is too short: contact {plan.contact_s:g} s, "
+                             f"heater recovery and {profile.trial.pre_s:g} s before the next touch need "
+                             f">= {needed:.1f} s")
+        if plan.first_touch_s < profile.trial.pre_s + 1.0 / fs:
+            raise InputError(f"the first touch must come after {profile.trial.pre_s:g} s of quiet data")
+        self.plan = plan
+        self._threshold = threshold
+        self._master: int | None = None
+        self._slave: int | None = None
+        self._port: str | None = None
+        self._thread: threading.Thread | None = None
+        self._stop = threading.Event()
+        self._closed = threading.Event()
+        self.error: BaseException | None = None
+        self.samples_sent = 0
+        self.lines_faulty = 0
+        self.vanished = False
+
+    # ----------------------------------------------------------------- truth
+    def material_of_touch(self, j: int) -> EmulatedMaterial:
+        return self.materials[(j // self.plan.touches_per_material) % len(self.materials)]
+
+    def touch(self, j: int) -> TouchRecord:
+        """Ground truth of touch ``j`` (0-based)."""
+        p = self.plan
+        fs = self.profile.sample_rate_hz
+        start = p.first_touch_s + j * p.touch_every_s
+        delay = p.ramp_s * self._threshold / p.press_force_n
+        onset = math.ceil((start + delay) * fs - 1e-9) / fs
+        m = self.material_of_touch(j)
+        return TouchRecord(j, m.label, m.effusivity, start, onset)
+
+    @property
+    def expected_time_offset_s(self) -> float:
+        """Heat-flow start minus detected onset for a noise-free force signal [s] (negative)."""
+        t = self.touch(0)
+        return t.start_s - t.expected_onset_s
+
+    def values(self, k0: int, k1: int) -> dict[str, np.ndarray]:
+        """Noisy engineering values of samples ``k0 .. k1-1`` per role (device time ``k / fs``)."""
+        p = self.plan
+        fs = self.profile.sample_rate_hz
+        t = np.arange(k0, k1, dtype=np.float64) / fs
+        n = t.size
+        j = np.floor((t - p.first_touch_s) / p.touch_every_s)
+        touching = j >= 0
+        j = np.where(touching, j, 0).astype(np.int64)
+        rel = np.where(touching, t - (p.first_touch_s + j * p.touch_every_s), -1.0)
+        mats = [self.material_of_touch(int(x)) for x in range(int(j.min()), int(j.max()) + 1)] if n else []
+        base = int(j.min()) if n else 0
+        e_o = np.array([mats[x - base].effusivity for x in j]) if n else np.zeros(0)
+        t_obj = np.array([self.ambient_c if mats[x - base].object_temp_c is None else mats[x - base].object_temp_c
+                          for x in j]) if n else np.zeros(0)
+        w = object_weight(self.sensor.effusivity, e_o)
+        tau = self.sensor.tau_s
+        c = p.contact_s
+
+        def curve(start_c):
+            in_contact = (rel >= 0) & (rel < c)
+            after = rel >= c
+            g = response_shape(np.clip(rel, 0.0, c), tau)
+            during = start_c + (t_obj - start_c) * w * g
+            released = start_c + (t_obj - start_c) * w * response_shape(c, tau)
+            decay = np.exp(-np.clip(rel - c, 0.0, None) / p.recover_s)
+            out = np.full(n, start_c, dtype=np.float64)
+            out = np.where(in_contact, during, out)
+            return np.where(after, start_c + (released - start_c) * decay, out)
+
+        sensor = curve(self.sensor_temp_c)
+        passive = curve(self.ambient_c)
+        f = p.press_force_n
+        force = np.where((rel >= 0) & (rel < c),
+                         f * np.clip(np.minimum(rel, c - rel) / p.ramp_s, 0.0, 1.0), 0.0)
+        z = self._noise(k0, k1)
+        if self.noise_c > 0:
+            sensor = sensor + self.noise_c * z[0]
+            passive = passive + self.noise_c * z[1]
+        if self.force_noise_n > 0:
+            force = np.maximum(force + self.force_noise_n * z[2], 0.0)
+        return {"sensor": sensor, "object": passive, "force": force, "timestamp": t}
+
+    _BLOCK = 8192
+
+    def _noise(self, k0: int, k1: int) -> np.ndarray:
+        """Standard normal draws (3 channels) of samples k0..k1-1, the same however the stream is chunked."""
+        out = np.empty((3, max(k1 - k0, 0)))
+        k = k0
+        while k < k1:
+            b, off = divmod(k, self._BLOCK)
+            if b not in self._blocks:
+                if len(self._blocks) > 4:
+                    self._blocks.pop(min(self._blocks))
+                self._blocks[b] = as_generator([int(self._seed), b]).standard_normal((3, self._BLOCK))
+            take = min(k1 - k, self._BLOCK - off)
+            out[:, k - k0:k - k0 + take] = self._blocks[b][:, off:off + take]
+            k += take
+        return out
+
+    # ----------------------------------------------------------------- wire
+    def _bad_token(self, role: str) -> str:
+        conv = self.profile.channels[role].conversion
+        rng = self._rng
+        if isinstance(conv, Thermistor):
+            choices = ["0", str(conv.full_scale), str(conv.full_scale + 7), "-3"]
+        elif isinstance(conv, Linear) and conv.adc_bits is not None:
+            choices = [str(2 ** conv.adc_bits + 5), "-1"]
+        else:
+            valid = self.profile.channels[role].valid or (-40.0, 150.0)
+            raw = conv.to_raw(np.array([valid[1] + 100.0, valid[0] - 100.0]))
+            choices = [f"{v:.2f}" for v in np.asarray(raw)]
+        return choices[int(rng.integers(len(choices)))]
+
+    def lines(self, k0: int, k1: int) -> bytes:
+        """Wire bytes of samples ``k0 .. k1-1`` (faults applied)."""
+        prof = self.profile
+        text = prof.format_lines(self.values(k0, k1))
+        fl = self.faults
+        if fl.line_faults and text:
+            rng = self._rng
+            n = len(text)
+            draws = rng.random((5, n))
+            delim = prof.delimiter if prof.delimiter is not None else " "
+            mapped = [ch.field_index for ch in prof.channels.values()]
+            out: list[bytes] = []
+            for i, line in enumerate(text):
+                if draws[0, i] < fl.garbled:
+                    out.append(bytes(rng.integers(0x80, 0x100, int(rng.integers(4, 30))).astype(np.uint8)))
+                    self.lines_faulty += 1
+                    continue
+                parts = line.split(delim)
+                if draws[1, i] < fl.partial and len(parts) > 1:
+                    cut = len(delim.join(parts[:-1]))
+                    line = line[:int(rng.integers(1, cut + 1))]
+                    self.lines_faulty += 1
+                elif draws[2, i] < fl.non_numeric:
+                    parts[mapped[int(rng.integers(len(mapped)))]] = ["nan", "ERR", "--", "1.2.3", "inf", "x"][
+                        int(rng.integers(6))]
+                    line = delim.join(parts)
+                    self.lines_faulty += 1
+                elif draws[3, i] < fl.field_count:
+                    line = delim.join(parts[:-1]) if rng.random() < 0.5 else line + delim + "0"
+                    self.lines_faulty += 1
+                elif draws[4, i] < fl.out_of_range:
+                    parts[prof.channels["sensor"].field_index] = self._bad_token("sensor")
+                    line = delim.join(parts)
+                    self.lines_faulty += 1
+                out.append(line.encode(prof.encoding))
+            return b"\n".join(out) + b"\n"
+        return ("\n".join(text) + "\n").encode(prof.encoding) if text else b""
+
+    # ---------------------------------------------------------------- pty
+    @property
+    def port(self) -> str:
+        """Path of the pseudo-terminal's device end (after :meth:`start`)."""
+        if self._port is None:
+            raise InputError("the emulator has not been started")
+        return self._port
+
+    def start(self) -> str:
+        """Open the pseudo-terminal, start streaming in a thread, return the port path."""
+        if self._thread is not None:
+            raise InputError("the emulator is already running")
+        master, slave = os.openpty()
+        tty.setraw(slave)  # no echo, no newline translation, whoever opens it
+        flags = fcntl.fcntl(master, fcntl.F_GETFL)
+        fcntl.fcntl(master, fcntl.F_SETFL, flags | os.O_NONBLOCK)
+        self._master, self._slave = master, slave
+        self._port = os.ttyname(slave)
+        self._thread = threading.Thread(target=self._run_safe, name="designkit-emulator", daemon=True)
+        self._thread.start()
+        return self._port
+
+    def stop(self, timeout: float = 5.0) -> None:
+        """Stop streaming and close the pseudo-terminal."""
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join(timeout)
+        self._close()
+
+    def wait(self, timeout: float | None = None) -> bool:
+        """Block until the stream ends (vanish, :meth:`stop`); True if it did."""
+        if self._thread is None:
+            return True
+        self._thread.join(timeout)
+        return not self._thread.is_alive()
+
+    def __enter__(self) -> "Emulator":
+        self.start()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.stop()
+
+    def _close(self) -> None:
+        for name in ("_master", "_slave"):
+            fd = getattr(self, name)
+            if fd is not None:
+                try:
+                    os.close(fd)
+                except OSError:
+                    pass
+                setattr(self, name, None)
+        self._closed.set()
+
+    def _run_safe(self) -> None:
+        try:
+            self._run()
+        except BaseException as exc:  # surfaced through .error; the pty closes
+            self.error = exc
+            self._close()
+
+    def _run(self) -> None:
+        fl = self.faults
+        if fl.silent:
+            self._stop.wait()
+            return
+        fs = self.profile.sample_rate_hz
+        rate = fs * self.speed  # samples per real second
+        chunk = max(1, int(rate * 0.02))
+        pending = bytearray()
+        if self.profile.comment:
+            pending += f"{self.profile.comment} designkit emulator, profile {self.profile.name}\n".encode(
+                self.profile.encoding)
+        k = 0
+        anchor = time.monotonic()
+        hold_until = 0.0
+        next_burst = fl.burst_every_s if fl.burst_every_s > 0 else math.inf
+        next_gap = fl.gap_every_s if fl.gap_every_s > 0 else math.inf
+        vanish = fl.vanish_after_s if fl.vanish_after_s > 0 else math.inf
+        master = self._master
+        while not self._stop.is_set():
+            now = time.monotonic()
+            due = int((now - anchor) * rate)
+            if due > k and len(pending) < _MAX_PENDING:
+                k1 = min(due, k + chunk)
+                t1 = k1 / fs
+                if t1 >= vanish:
+                    pending += self.lines(k, int(math.ceil(vanish * fs)))
+                    self._flush(pending, deadline=time.monotonic() + 1.0)
+                    self.vanished = True
+                    self._close()
+                    return
+                if t1 >= next_gap:
+                    kg = int(math.ceil(next_gap * fs))
+                    pending += self.lines(k, kg)
+                    self._flush(pending, deadline=time.monotonic() + 1.0)
+                    if self._stop.wait(fl.gap_s):
+                        return
+                    k = kg + int(round(fl.gap_s * rate))  # the samples of the silence are lost
+                    anchor = time.monotonic() - k / rate
+                    while next_gap <= k / fs:
+                        next_gap += fl.gap_every_s
+                    continue
+                if t1 >= next_burst:
+                    hold_until = now + fl.burst_hold_s
+                    next_burst += fl.burst_every_s
+                pending += self.lines(k, k1)
+                self.samples_sent += k1 - k
+                k = k1
+            if pending and now >= hold_until:
+                try:
+                    _, writable, _ = select.select([], [master], [], 0.01)
+                except (OSError, ValueError):
+                    return
+                if writable:
+                    try:
+                        written = os.write(master, bytes(pending[:_MAX_PENDING]))
+                    except BlockingIOError:
+                        written = 0
+                    except OSError:
+                        return
+                    del pending[:written]
+            else:
+                wait = (k + 1) / rate - (now - anchor)
+                self._stop.wait(min(max(wait, 0.001), 0.01))
+            # nobody reading (or a slow reader): pause instead of catching up later
+            if (time.monotonic() - anchor) * rate - k > 0.5 * rate + chunk and len(pending) >= _MAX_PENDING:
+                anchor = time.monotonic() - k / rate
+
+    def _flush(self, pending: bytearray, deadline: float) -> None:
+        master = self._master
+        while pending and time.monotonic() < deadline and not self._stop.is_set():
+            try:
+                _, writable, _ = select.select([], [master], [], 0.01)
+                if writable:
+                    del pending[:os.write(master, bytes(pending))]
+            except BlockingIOError:
+                continue
+            except OSError:
+                return

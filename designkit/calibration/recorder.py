@@ -1,0 +1,589 @@
+"""Recording touches from a serial device: detect each contact, cut the trial, write it at once.
+
+Two layers:
+
+- :class:`TrialCutter` is pure logic. It is fed samples (time [s], sensor
+  [degC], object [degC], force [N]), detects contact with the profile's rule
+  (force threshold, 5 N by default as in the paper, or a temperature-slope
+  rule), cuts ``pre_s`` before to ``post_s`` after the onset and writes the
+  trial (CSV + JSON sidecar, atomically, then the folder index) as soon as
+  the window is complete. A discontinuity (samples lost, device reset,
+  reconnect) discards the trial in progress and waits for a full clean
+  ``pre_s`` before the next onset.
+- :class:`SerialRecorder` reads a serial port with pyserial, splits the byte
+  stream into lines, parses them with the profile and feeds the cutter. It
+  survives garbled, partial or non-numeric lines, wrong field counts,
+  out-of-range readings (each reported once per kind with an example, then
+  counted), bursts, gaps (from the device clock, or from silences longer than
+  the profile's ``stall_s`` when there is no timestamp), a device that
+  disappears (it tries to reopen the port for ``reconnect_s``) and a device
+  that never speaks (``no_data_timeout_s``). Trials already written are never
+  touched again; Ctrl-C (KeyboardInterrupt) leaves them all in place.
+
+Without a timestamp channel, time is the count of lines received divided by
+the sample rate; a line that cannot be read still counts (its sample is
+missing from the trial, the times of the others stay right).
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
+
+from .._validation import InputError
+from .profiles import ROLES, DeviceProfile
+from .trials import write_trial
+
+__all__ = ["RecordEvent", "RecorderStatus", "SerialRecorder", "TrialCutter"]
+
+_S, _O, _F = 0, 1, 2  # columns of the cutter's value buffer
+_BAD_KIND_TEXT = {
+    "garbled": "garbled bytes (not text in the profile's encoding)",
+    "field_count": "wrong number of fields",
+    "non_numeric": "a field that is not a finite number",
+    "out_of_range": "a reading out of range (ADC rail, open/shorted thermistor, or outside 'valid')",
+    "too_long": "a line far too long (no newline)",
+}
+_EXAMPLES_PER_KIND = 3
+
+
+@dataclass(frozen=True)
+class RecordEvent:
+    """Something worth telling the user.
+
+    ``kind``: ``trial`` (written; ``path`` set), ``skipped`` (a touch not
+    recorded, with the reason), ``bad_line``, ``gap``, ``reconnect``,
+    ``device`` (a device message line), ``info``.
+    """
+
+    kind: str
+    message: str
+    path: Path | None = None
+
+
+@dataclass
+class RecorderStatus:
+    """Live numbers for a display."""
+
+    port: str = ""
+    material: str = ""
+    state: str = "connecting"
+    trials: int = 0
+    target: int = 0
+    sensor_c: float = float("nan")
+    object_c: float = float("nan")
+    force_n: float = float("nan")
+    device_time_s: float = 0.0
+    lines_ok: int = 0
+    lines_bad: int = 0
+    bad_by_kind: dict[str, int] = field(default_factory=dict)
+    gaps: int = 0
+    skipped: int = 0
+    last_message: str = ""
+
+
+class TrialCutter:
+    """Detect touches in a sample stream and write each trial as soon as it is complete.
+
+    Parameters
+    ----------
+    profile : DeviceProfile
+        Contact rule, trial window, sample rate.
+    out_dir : Path
+        Folder for the trials (created).
+    material : str
+        Label written with each trial.
+    meta : dict
+        Extra sidecar fields (port, profile name...).
+    """
+
+    WAIT_RELEASE, ARMED, COLLECT, WAIT_STEADY = "waiting for release", "armed", "in contact", "waiting for steady"
+
+    def __init__(self, profile: DeviceProfile, out_dir: Path, material: str,
+                 meta: dict[str, Any] | None = None) -> None:
+        self.profile = profile
+        self.out_dir = Path(out_dir)
+        self.material = material
+        self.meta = dict(meta or {})
+        self.fs = profile.sample_rate_hz
+        self.pre = profile.trial.pre_s
+        self.post = profile.trial.post_s
+        self.rule = profile.contact
+        self.written: list[Path] = []
+        self.events: list[RecordEvent] = []
+        self._t = np.zeros(0)
+        self._v = np.zeros((0, 3))
+        self._scan = 0
+        self._clean_since = -np.inf
+        self._onset = np.nan
+        self._state = self.WAIT_RELEASE if self.rule.rule == "force" else self.WAIT_STEADY
+
+    @property
+    def state(self) -> str:
+        return self._state
+
+    @property
+    def in_trial(self) -> bool:
+        return self._state == self.COLLECT
+
+    # ------------------------------------------------------------- input
+    def feed(self, time_s: np.ndarray, values: np.ndarray) -> list[RecordEvent]:
+        """Add samples (times increasing, continuing the stream) and act on them.
+
+        ``values`` has columns sensor [degC], object [degC], force [N] (NaN
+        where the rig has no such channel). Returns the events raised.
+        """
+        t = np.asarray(time_s, dtype=np.float64)
+        if t.size == 0:
+            return []
+        if not np.isfinite(self._clean_since):
+            self._clean_since = float(t[0])
+        self._t = np.concatenate([self._t, t])
+        self._v = np.concatenate([self._v, np.asarray(values, dtype=np.float64).reshape(-1, 3)])
+        events: list[RecordEvent] = []
+        self._advance(events)
+        self._trim()
+        self.events.extend(events)
+        return events
+
+    def discontinuity(self, reason: str) -> list[RecordEvent]:
+        """Samples were lost or the clock restarted: drop the buffer and any trial in progress."""
+        events = []
+        if self._state == self.COLLECT:
+            events.append(RecordEvent("skipped", f"trial in progress discarded: {reason}"))
+        self._state = self.WAIT_RELEASE if self.rule.rule == "force" else self.WAIT_STEADY
+        self._t = np.zeros(0)
+        self._v = np.zeros((0, 3))
+        self._scan = 0
+        self._clean_since = -np.inf
+        self.events.extend(events)
+        return events
+
+    # ------------------------------------------------------------- logic
+    def _slope(self) -> np.ndarray:
+        """Smoothed temperature slope [degC/s] at each buffered sample (NaN where too early)."""
+        h = max(2, int(round(self.rule.slope_window_s * self.fs / 2)))
+        s = self._v[:, _S]
+        out = np.full(s.size, np.nan)
+        if s.size >= 2 * h:
+            c = np.concatenate([[0.0], np.cumsum(s)])
+            mean_new = (c[2 * h:] - c[h:-h]) / h
+            mean_old = (c[h:-h] - c[:-2 * h]) / h
+            out[2 * h - 1:] = (mean_new - mean_old) / (h / self.fs)
+        return out
+
+    def _advance(self, events: list[RecordEvent]) -> None:
+        t, v = self._t, self._v
+        eps = 0.5 / self.fs
+        while True:
+            if self._state == self.COLLECT:
+                if t[-1] >= self._onset + self.post - eps:
+                    self._finish(events)
+                    self._state = self.WAIT_RELEASE if self.rule.rule == "force" else self.WAIT_STEADY
+                    continue
+                return
+            if self._scan >= t.size:
+                return
+            if self._state == self.WAIT_RELEASE:
+                below = np.flatnonzero(v[self._scan:, _F] < self.rule.release_n)
+                if below.size == 0:
+                    self._scan = t.size
+                    return
+                self._scan += int(below[0])
+                self._state = self.ARMED
+                continue
+            if self._state == self.WAIT_STEADY:
+                slope = self._slope()[self._scan:]
+                steady = np.abs(slope) < self.rule.slope_c_per_s / 2  # NaN -> False
+                need = max(1, int(round(self.pre * self.fs)))
+                run = np.convolve(steady.astype(np.int64), np.ones(need, dtype=np.int64), "valid")
+                hit = np.flatnonzero(run == need)
+                if hit.size == 0:
+                    self._scan = max(self._scan, t.size - need + 1)
+                    return
+                self._scan += int(hit[0]) + need - 1
+                self._state = self.ARMED
+                continue
+            # ARMED
+            if self.rule.rule == "force":
+                cross = np.flatnonzero(v[self._scan:, _F] >= self.rule.force_threshold_n)
+            else:
+                cross = np.flatnonzero(self._slope()[self._scan:] <= -self.rule.slope_c_per_s)
+            if cross.size == 0:
+                self._scan = t.size
+                return
+            i = self._scan + int(cross[0])
+            onset = float(t[i])
+            self._scan = i + 1
+            if onset - self.pre < self._clean_since - eps:
+                have = max(0.0, onset - self._clean_since)
+                events.append(RecordEvent(
+                    "skipped", f"touch at device time {onset:.2f} s skipped: only {have:.2f} s of clean data "
+                               f"before contact (need {self.pre:g} s)"))
+                self._state = self.WAIT_RELEASE if self.rule.rule == "force" else self.WAIT_STEADY
+                continue
+            self._onset = onset
+            self._state = self.COLLECT
+
+    def _finish(self, events: list[RecordEvent]) -> None:
+        t, v = self._t, self._v
+        eps = 0.5 / self.fs
+        onset = self._onset
+        sel = (t >= onset - self.pre - eps) & (t <= onset + self.post + eps)
+        tt = t[sel] - onset
+        vv = v[sel]
+        expected = int(round((self.pre + self.post) * self.fs)) + 1
+        if tt.size < 0.8 * expected:
+            events.append(RecordEvent(
+                "skipped", f"touch at device time {onset:.2f} s skipped: only {tt.size} of {expected} samples "
+                           "readable"))
+            return
+        pre = tt < 0
+        release_s = None
+        if self.rule.rule == "force":
+            after = np.flatnonzero((tt > 0) & (vv[:, _F] < self.rule.release_n))
+            if after.size:
+                release_s = float(tt[after[0]])
+        ts0 = float(np.mean(vv[pre, _S]))
+        to0 = float(np.mean(vv[pre, _O])) if np.isfinite(vv[pre, _O]).any() else None
+        meta = {
+            **self.meta,
+            "recorded_at": _dt.datetime.now().astimezone().isoformat(timespec="seconds"),
+            "sensor_temp_before_c": ts0,
+            "object_temp_before_c": to0,
+            "onset_device_time_s": onset,
+            "contact_rule": self.rule.to_dict(),
+            "pre_s": self.pre,
+            "post_s": self.post,
+            "release_s": release_s,
+            "sample_rate_hz": self.fs,
+            "n_samples": int(tt.size),
+            "n_missing": int(expected - tt.size),
+        }
+        path = write_trial(self.out_dir, self.material, tt, vv[:, _S], vv[:, _O], vv[:, _F], meta)
+        self.written.append(path)
+        note = f", released at {release_s:.2f} s" if release_s is not None else ""
+        obj = f", object {to0:.2f} °C" if to0 is not None else ""
+        events.append(RecordEvent("trial", f"trial {len(self.written)}: {path.name} (sensor {ts0:.2f} °C{obj}"
+                                           f" before contact{note})", path))
+
+    def _trim(self) -> None:
+        if self._state == self.COLLECT or self._t.size == 0:
+            return
+        keep_from = self._t[-1] - self.pre - max(1.0, 2 * self.rule.slope_window_s)
+        cut = int(np.searchsorted(self._t, keep_from))
+        if self._state == self.WAIT_STEADY:
+            need = max(1, int(round(self.pre * self.fs))) + int(round(self.rule.slope_window_s * self.fs)) + 2
+            cut = min(cut, max(0, self._scan - need))
+        cut = min(cut, self._scan)
+        if cut > 0:
+            self._t = self._t[cut:]
+            self._v = self._v[cut:]
+            self._scan -= cut
+
+
+class DeviceGone(InputError):
+    """The port disappeared and could not be reopened."""
+
+
+class NoData(InputError):
+    """Nothing usable arrived within the time limit."""
+
+
+class SerialRecorder:
+    """Record touches from a serial port into a folder.
+
+    Parameters
+    ----------
+    port : str
+        Serial device (``/dev/ttyACM0``, ``COM3``, a pty from the emulator).
+    profile : DeviceProfile
+    out_dir : Path
+    no_data_timeout_s : float, optional
+        Overrides the profile's limit for a device that never speaks.
+    on_event : callable(RecordEvent), optional
+    on_status : callable(RecorderStatus), optional
+        Called a few times a second with live numbers.
+    """
+
+    def __init__(self, port: str, profile: DeviceProfile, out_dir: Path, *,
+                 no_data_timeout_s: float | None = None,
+                 on_event: Callable[[RecordEvent], None] | None = None,
+                 on_status: Callable[[RecorderStatus], None] | None = None) -> None:
+        self.port = str(port)
+        self.profile = profile
+        self.out_dir = Path(out_dir)
+        self.no_data_timeout_s = no_data_timeout_s or profile.serial.no_data_timeout_s
+        self.on_event = on_event or (lambda e: None)
+        self.on_status = on_status or (lambda s: None)
+        self.status = RecorderStatus(port=self.port)
+        self.written: list[Path] = []
+        self.events: list[RecordEvent] = []
+        self._ser = None
+        self._buf = b""
+        self._first_line = True
+        self._slot = 0  # sample slots seen since the clock started (no timestamp)
+        self._last_t: float | None = None
+        self._examples: dict[str, int] = {}
+        self._valid_seen = False
+        self._lines_seen = 0
+
+    # ------------------------------------------------------------ port
+    def open(self) -> None:
+        """Open the port with the profile's settings (one-line error if it cannot)."""
+        import serial
+
+        s = self.profile.serial
+        try:
+            self._ser = serial.Serial(self.port, baudrate=s.baudrate, bytesize=s.bytesize, parity=s.parity,
+                                      stopbits=s.stopbits, timeout=s.read_timeout_s)
+        except (serial.SerialException, OSError, ValueError) as exc:
+            raise InputError(f"cannot open serial port {self.port}: {_short(exc)}") from None
+        self._restart_stream()
+
+    def close(self) -> None:
+        if self._ser is not None:
+            try:
+                self._ser.close()
+            except Exception:  # noqa: BLE001 - closing a vanished port may fail any way
+                pass
+            self._ser = None
+
+    def __enter__(self) -> "SerialRecorder":
+        self.open()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def flush_input(self) -> None:
+        """Drop what the device sent while nobody was looking (between materials)."""
+        if self._ser is not None:
+            self._ser.reset_input_buffer()
+        self._restart_stream()
+
+    def _restart_stream(self) -> None:
+        self._buf = b""
+        self._first_line = True
+        self._last_t = None
+
+    def _emit(self, event: RecordEvent) -> None:
+        self.events.append(event)
+        self.status.last_message = event.message
+        self.on_event(event)
+
+    # ------------------------------------------------------------ main loop
+    def record(self, material: str, trials: int) -> list[Path]:
+        """Record ``trials`` touches of ``material``; returns the CSV paths written.
+
+        Raises
+        ------
+        NoData
+            Nothing (or nothing readable) within the time limit.
+        DeviceGone
+            The port vanished and did not come back within ``reconnect_s``.
+        KeyboardInterrupt
+            Passed on; everything written so far stays.
+        """
+        import serial
+
+        if trials < 1:
+            raise InputError(f"trials must be >= 1, got {trials}")
+        if self._ser is None:
+            self.open()
+        cutter = TrialCutter(self.profile, self.out_dir, material,
+                             meta={"profile": self.profile.name, "port": self.port,
+                                   "timestamps": "device" if self.profile.has_timestamp else "line count"})
+        self._cutter = cutter
+        st = self.status
+        st.material, st.target, st.trials, st.state = material, trials, 0, cutter.state
+        start_written = len(self.written)
+        last_data = time.monotonic()
+        last_status = 0.0
+        stall = self.profile.serial.stall_s
+        while len(cutter.written) < trials:
+            try:
+                waiting = self._ser.in_waiting
+                chunk = self._ser.read(waiting or 1)
+            except (serial.SerialException, OSError, TypeError) as exc:
+                # pyserial raises TypeError from in_waiting once the fd is gone
+                self._device_lost(cutter, exc)
+                last_data = time.monotonic()
+                continue
+            now = time.monotonic()
+            if not chunk:
+                silent = now - last_data
+                if silent > self.no_data_timeout_s:
+                    kept = self._kept(cutter)
+                    what = ("never sent anything" if self._lines_seen == 0 else
+                            "sent nothing readable" if not self._valid_seen else "stopped sending")
+                    raise NoData(f"the device on {self.port} {what} for {silent:.1f} s (check the port, the baud "
+                                 f"rate {self.profile.serial.baudrate} and that it is streaming); {kept}")
+                if now - last_status > 0.2:
+                    self._publish(cutter)
+                    last_status = now
+                continue
+            if not self.profile.has_timestamp and self._lines_seen and now - last_data > stall:
+                self.status.gaps += 1
+                self._discontinuity(cutter, f"the stream stalled for {now - last_data:.2f} s (samples may be lost)")
+            last_data = now
+            self._consume(chunk, cutter)
+            self._sync(cutter)
+            if now - last_status > 0.2:
+                self._publish(cutter)
+                last_status = now
+        self._publish(cutter)
+        return self.written[start_written:]
+
+    def _sync(self, cutter: TrialCutter) -> None:
+        for p in cutter.written:
+            if p not in self.written:
+                self.written.append(p)
+
+    def _kept(self, cutter: TrialCutter) -> str:
+        self._sync(cutter)
+        n = len(self.written)
+        where = f" in {self.out_dir}" if n else ""
+        lost = " (the trial in progress was discarded)" if cutter.in_trial else ""
+        return f"{n} trial(s) kept{where}{lost}"
+
+    def _publish(self, cutter: TrialCutter) -> None:
+        self.status.state = cutter.state
+        self.status.trials = len(cutter.written)
+        self.on_status(self.status)
+
+    def _discontinuity(self, cutter: TrialCutter, reason: str) -> None:
+        self._emit(RecordEvent("gap", reason))
+        for e in cutter.discontinuity(reason):
+            self.status.skipped += 1
+            self._emit(e)
+        self._last_t = None
+
+    def _device_lost(self, cutter: TrialCutter, exc: BaseException) -> None:
+        import serial
+
+        in_trial = cutter.in_trial
+        self._discontinuity(cutter, "the device disconnected")
+        self.close()
+        deadline = time.monotonic() + self.profile.serial.reconnect_s
+        while True:
+            try:
+                self.open()
+                self._emit(RecordEvent("reconnect", f"reopened {self.port}"))
+                return
+            except InputError:
+                if time.monotonic() >= deadline:
+                    break
+                time.sleep(0.1)
+        self._sync(cutter)
+        n = len(self.written)
+        lost = "; the trial in progress was discarded" if in_trial else ""
+        where = f" in {self.out_dir}" if n else ""
+        raise DeviceGone(f"the device on {self.port} disappeared ({_short(exc)}) and did not come back within "
+                         f"{self.profile.serial.reconnect_s:g} s; {n} trial(s) kept{where}{lost}")
+
+    def _consume(self, chunk: bytes, cutter: TrialCutter) -> None:
+        prof = self.profile
+        data = self._buf + chunk
+        lines = data.split(b"\n")
+        self._buf = lines.pop()
+        if len(self._buf) > 4096:
+            self._bad("too_long", self._buf[:40].decode("ascii", "replace"))
+            self._buf = b""
+            self._slot += 1
+        if self._first_line and lines:
+            lines = lines[1:]  # the port may have opened in the middle of a line
+            self._first_line = False
+        if not lines:
+            return
+        parsed = prof.parse_lines(lines)
+        self._lines_seen += parsed.n_slots
+        for msg in parsed.messages:
+            self._emit(RecordEvent("device", f"device: {msg}"))
+        for _, kind, text in parsed.errors:
+            self._bad(kind, text)
+        values, bad = prof.convert(parsed.raw)
+        for row in np.flatnonzero(bad):
+            self._bad("out_of_range", lines[parsed.rows[row]].strip()[:60].decode(prof.encoding, "replace"))
+        good = ~bad
+        if prof.has_timestamp:
+            t = values[good, ROLES.index("timestamp")]
+        else:
+            t = (self._slot + parsed.slots[good]) / prof.sample_rate_hz
+        self._slot += parsed.n_slots
+        vals = values[good][:, :3]
+        self.status.lines_ok += int(good.sum())
+        if t.size == 0:
+            if not self._valid_seen and self._lines_seen >= 200:
+                example = lines[-1].strip()[:60].decode(prof.encoding, "replace")
+                raise NoData(f"none of the first {self._lines_seen} lines from {self.port} matches profile "
+                             f"{prof.name!r} (e.g. {example!r}): wrong profile or baud rate?")
+            return
+        self._valid_seen = True
+        self._feed_checked(t, vals, cutter)
+        last = vals[-1]
+        self.status.sensor_c, self.status.object_c, self.status.force_n = (float(x) for x in last)
+        self.status.device_time_s = float(t[-1])
+
+    def _feed_checked(self, t: np.ndarray, vals: np.ndarray, cutter: TrialCutter) -> None:
+        """Feed in runs without clock trouble.
+
+        With device timestamps, a step back (device reset) or a hole longer
+        than the profile's ``stall_s`` is a discontinuity; shorter holes are
+        samples lost to unreadable lines and are tolerated. Counted time
+        (no timestamp) has no holes to check: lost samples are found from
+        silences instead (see :meth:`record`).
+        """
+        fs = self.profile.sample_rate_hz
+        if not self.profile.has_timestamp:
+            self._feed(t, vals, cutter)
+            self._last_t = float(t[-1])
+            return
+        prev = self._last_t
+        full_t = t if prev is None else np.concatenate([[prev], t])
+        dt = np.diff(full_t)
+        hole = max(self.profile.serial.stall_s, 1.5 / fs)
+        breaks = np.flatnonzero((dt <= 0) | (dt > hole)) if dt.size else np.zeros(0, int)
+        start = 0
+        offset = 0 if prev is None else 1
+        for b in breaks:
+            i = int(b) + 1 - offset  # index in t of the sample after the break
+            if i > start:
+                self._feed(t[start:i], vals[start:i], cutter)
+            step = full_t[b + 1] - full_t[b]
+            if step <= 0:
+                reason = f"the device clock went back by {-step:.3f} s (device reset?)"
+            else:
+                reason = f"{step - 1.0 / fs:.3f} s of samples missing at device time {full_t[b]:.2f} s"
+            self.status.gaps += 1
+            self._discontinuity(cutter, reason)
+            start = i
+        if start < t.size:
+            self._feed(t[start:], vals[start:], cutter)
+        self._last_t = float(t[-1])
+
+    def _feed(self, t, vals, cutter: TrialCutter) -> None:
+        for e in cutter.feed(t, vals):
+            if e.kind == "skipped":
+                self.status.skipped += 1
+            self._emit(e)
+
+    def _bad(self, kind: str, text: str) -> None:
+        st = self.status
+        st.lines_bad += 1
+        st.bad_by_kind[kind] = st.bad_by_kind.get(kind, 0) + 1
+        seen = self._examples.get(kind, 0)
+        self._examples[kind] = seen + 1
+        if seen < _EXAMPLES_PER_KIND:
+            more = " (further ones are only counted)" if seen == _EXAMPLES_PER_KIND - 1 else ""
+            self._emit(RecordEvent("bad_line", f"skipped a line with {_BAD_KIND_TEXT[kind]}: {text!r}{more}"))
+
+
+def _short(exc: BaseException) -> str:
+    text = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+    return text

@@ -1,0 +1,220 @@
+"""Recorded touches on disk: one CSV per trial, a JSON sidecar, an index.
+
+The CSV has the columns of the shared robot recordings,
+``time_s,passive_temp_c,active_temp_c,unused_channel,force_n``: time relative
+to the detected contact onset [s], the object (passive) thermistor [degC],
+the heated sensor [degC], an always-empty channel kept for compatibility
+(``nan``), and force [N]. A channel the rig does not have is written as
+``nan``. Rows of lines that could not be read are left out (``time_s`` stays
+right: it comes from the device clock or the sample count).
+
+The sidecar ``<trial>.json`` records the profile, material, time, the sensor
+and object temperatures before contact, and how the trial was cut. The folder's
+``index.csv`` (columns ``file,material,trial_index``) is rebuilt from the
+sidecars after every trial, so it is always consistent with what is on disk
+and can be given to ``designkit calibrate fit`` as it is.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Mapping, Sequence
+
+import numpy as np
+
+from .._io import atomic_write_text
+from .._validation import InputError
+
+__all__ = ["COLUMNS", "Trial", "load_index", "read_trial_csv", "rebuild_index", "write_trial"]
+
+COLUMNS = ("time_s", "passive_temp_c", "active_temp_c", "unused_channel", "force_n")
+TRIAL_FILE_VERSION = 1
+
+
+@dataclass(frozen=True)
+class Trial:
+    """One touch.
+
+    Attributes
+    ----------
+    time_s : ndarray, shape (m,)
+        Time relative to the detected contact onset [s], increasing.
+    sensor_c : ndarray, shape (m,)
+        Heated sensor temperature [degC].
+    object_c : ndarray, shape (m,)
+        Object (passive thermistor) temperature [degC]; all NaN without one.
+    force_n : ndarray, shape (m,)
+        Contact force [N]; all NaN without a force sensor.
+    material : str
+        Material label.
+    source : str
+        Where it came from (file path).
+    meta : mapping
+        Sidecar content, when there is one.
+    """
+
+    time_s: np.ndarray
+    sensor_c: np.ndarray
+    object_c: np.ndarray
+    force_n: np.ndarray
+    material: str
+    source: str = ""
+    meta: Mapping[str, Any] = field(default_factory=dict, compare=False)
+
+    @property
+    def has_object(self) -> bool:
+        return bool(np.isfinite(self.object_c).any())
+
+    @property
+    def n_samples(self) -> int:
+        return int(self.time_s.size)
+
+
+def _slug(name: str) -> str:
+    slug = re.sub(r"[^A-Za-z0-9]+", "_", name).strip("_").lower()
+    return slug or "material"
+
+
+def trial_csv_text(time_s, sensor_c, object_c, force_n) -> str:
+    """CSV text of one trial in the shared recordings' columns."""
+    n = len(time_s)
+    table = np.column_stack([time_s, object_c, sensor_c, np.full(n, np.nan), force_n])
+    buf = io.StringIO()
+    np.savetxt(buf, table, delimiter=",", header=",".join(COLUMNS), comments="",
+               fmt=["%.6f", "%.6f", "%.6f", "%.6f", "%.6f"])
+    return buf.getvalue()
+
+
+def write_trial(folder: Path, material: str, time_s, sensor_c, object_c, force_n,
+                meta: Mapping[str, Any]) -> Path:
+    """Write one trial (CSV, then its sidecar, each atomically) and rebuild the index.
+
+    The trial number is the next free one for ``material`` in ``folder``.
+    Returns the CSV path.
+    """
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    slug = _slug(material)
+    taken = {int(m.group(1)) for p in folder.glob(f"{slug}_*.json")
+             if (m := re.fullmatch(rf"{re.escape(slug)}_(\d+)\.json", p.name))}
+    taken |= {int(m.group(1)) for p in folder.glob(f"{slug}_*.csv")
+              if (m := re.fullmatch(rf"{re.escape(slug)}_(\d+)\.csv", p.name))}
+    k = max(taken, default=0) + 1
+    csv_path = folder / f"{slug}_{k:03d}.csv"
+    atomic_write_text(csv_path, trial_csv_text(time_s, sensor_c, object_c, force_n))
+    side = {"designkit_trial": TRIAL_FILE_VERSION, "file": csv_path.name, "material": material,
+            "trial_index": k, **dict(meta)}
+    atomic_write_text(csv_path.with_suffix(".json"), json.dumps(_plain(side), indent=2) + "\n")
+    rebuild_index(folder)
+    return csv_path
+
+
+def _plain(obj: Any) -> Any:
+    if isinstance(obj, dict):
+        return {str(k): _plain(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_plain(v) for v in obj]
+    if hasattr(obj, "tolist"):
+        return _plain(obj.tolist())
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    return obj
+
+
+def rebuild_index(folder: Path) -> Path:
+    """Write ``folder/index.csv`` (file, material, trial_index) from the sidecars."""
+    folder = Path(folder)
+    rows = []
+    for side in sorted(folder.glob("*.json")):
+        try:
+            meta = json.loads(side.read_text())
+        except (OSError, ValueError):
+            continue
+        if not isinstance(meta, dict) or "designkit_trial" not in meta:
+            continue
+        csv_path = folder / str(meta.get("file", side.with_suffix(".csv").name))
+        if csv_path.is_file():
+            rows.append((csv_path.name, str(meta.get("material", "")), meta.get("trial_index", "")))
+    rows.sort(key=lambda r: (r[1], r[2] if isinstance(r[2], int) else 0, r[0]))
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\n")
+    writer.writerow(["file", "material", "trial_index"])
+    writer.writerows(rows)
+    return atomic_write_text(folder / "index.csv", buf.getvalue())
+
+
+def read_trial_csv(path: Path, material: str = "") -> Trial:
+    """Read a trial CSV (the shared recordings' columns; passive and force optional)."""
+    path = Path(path)
+    try:
+        with path.open(newline="") as fh:
+            header = next(csv.reader(fh), None)
+    except OSError as exc:
+        raise InputError(f"cannot read trial {path}: {exc.strerror or exc}") from None
+    if not header:
+        raise InputError(f"trial {path} is empty")
+    header = [h.strip() for h in header]
+    missing = [c for c in ("time_s", "active_temp_c") if c not in header]
+    if missing:
+        raise InputError(f"trial {path} lacks column(s) {', '.join(missing)} "
+                         f"(expected {','.join(COLUMNS)})")
+    try:
+        data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2, dtype=np.float64)
+    except ValueError as exc:
+        raise InputError(f"trial {path} has a value that is not a number ({str(exc).splitlines()[0]})") from None
+    if data.shape[0] < 3 or data.shape[1] != len(header):
+        raise InputError(f"trial {path}: need at least 3 rows of {len(header)} columns, got {data.shape}")
+
+    def col(name):
+        return data[:, header.index(name)] if name in header else np.full(data.shape[0], np.nan)
+
+    t = col("time_s")
+    keep = np.isfinite(t) & np.isfinite(col("active_temp_c"))
+    t = t[keep]
+    if t.size < 3 or np.any(np.diff(t) <= 0):
+        raise InputError(f"trial {path}: time_s must increase from row to row")
+    meta: dict[str, Any] = {}
+    side = path.with_suffix(".json")
+    if side.is_file():
+        try:
+            meta = json.loads(side.read_text())
+        except (OSError, ValueError):
+            raise InputError(f"trial sidecar {side} is not valid JSON") from None
+    return Trial(time_s=t, sensor_c=col("active_temp_c")[keep], object_c=col("passive_temp_c")[keep],
+                 force_n=col("force_n")[keep], material=material or str(meta.get("material", "")),
+                 source=str(path), meta=meta)
+
+
+def load_index(index_csv: Path, only: Sequence[str] | None = None) -> list[Trial]:
+    """Read every trial an index lists (columns ``file`` and ``material``; others ignored).
+
+    Paths are relative to the index's folder. ``only`` keeps those materials
+    (an unknown name in it is an error).
+    """
+    index_csv = Path(index_csv)
+    try:
+        with index_csv.open(newline="") as fh:
+            rows = list(csv.DictReader(fh))
+    except OSError as exc:
+        raise InputError(f"cannot read index {index_csv}: {exc.strerror or exc}") from None
+    if not rows or not {"file", "material"} <= set(rows[0]):
+        raise InputError(f"index {index_csv} needs columns file and material")
+    materials = sorted({r["material"] for r in rows})
+    if only:
+        unknown = [m for m in only if m not in materials]
+        if unknown:
+            raise InputError(f"--only names material(s) not in {index_csv.name}: {', '.join(unknown)} "
+                             f"(it has {', '.join(materials)})")
+        rows = [r for r in rows if r["material"] in set(only)]
+    trials = []
+    for line_no, r in enumerate(rows, start=2):
+        if not r.get("file") or not r.get("material"):
+            raise InputError(f"index {index_csv} line {line_no}: empty file or material")
+        trials.append(read_trial_csv(index_csv.parent / r["file"], r["material"]))
+    return trials

@@ -1,0 +1,472 @@
+"""``designkit calibrate`` (record, fit, and the guided run) and ``designkit emulate``.
+
+Turning one's own sensor into a sensor file that ``--sensor`` accepts:
+record touches of materials with known effusivity ranges over serial, then
+identify e_s and alpha_s (paper appendix). ``designkit emulate`` plays a
+simulated rig on a pseudo-terminal, for trying all of this without hardware.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+from pathlib import Path
+from typing import Annotated, Any, Optional
+
+import typer
+
+from ._app import EXIT_INTERRUPTED, app, console, emit_json, sub_app
+from ._options import Json, Noise, Seed, SensorOpt
+
+calibrate_app = sub_app(
+    "calibrate",
+    "Calibrate your sensor: record touches over serial ('record'), identify e_s and alpha_s ('fit'), "
+    "or both in one guided run ('designkit calibrate --port PORT --material NAME ...').",
+)
+
+PortOpt = Annotated[Optional[str], typer.Option(
+    "--port", help="Serial port of the rig (/dev/ttyACM0, COM3, or the pty 'designkit emulate' prints).")]
+ProfileOpt = Annotated[str, typer.Option(
+    "--profile", help="Device profile: a shipped name ('designkit', 'adc12-thermistor') or a profile YAML file.")]
+TrialsOpt = Annotated[int, typer.Option("--trials", help="Touches to record per material.")]
+TimeoutOpt = Annotated[Optional[float], typer.Option(
+    "--timeout", help="Give up when the device sends nothing for this long [s] (default: the profile's).")]
+RangeOpt = Annotated[Optional[list[str]], typer.Option(
+    "--range", help="Effusivity range of a material: NAME=MIN:MAX [J s^-1/2 K^-1 m^-2] or NAME=DATABASE_NAME "
+                    "(repeatable); materials without one are looked up in the materials database.")]
+ObjectTempOpt = Annotated[Optional[list[str]], typer.Option(
+    "--object-temp", help="Object temperature of a material: NAME=passive (pre-contact passive channel, the "
+                          "default), NAME=passive-end, NAME=free (unknown: fitted per trial) or NAME=DEGC.")]
+DepthOpt = Annotated[float, typer.Option(
+    "--depth-um", help="Thermistor depth below the contact surface [um], held fixed (only x^2/alpha_s is "
+                       "identifiable).")]
+BootstrapOpt = Annotated[int, typer.Option(
+    "--bootstrap", help="Bootstrap replicates over trials for the uncertainties (0: Jacobian instead).")]
+
+
+# ---------------------------------------------------------------- helpers
+def _fit_settings(depth_um: float, bootstrap: int, seed: int, baseline: str = "mean",
+                  offset_range: str = "-1.5:1.5", fit_to: Optional[float] = None):
+    from .._validation import InputError
+    from ..calibration.fit import FitSettings
+
+    lo, sep, hi = offset_range.partition(":")
+    try:
+        bounds = (float(lo), float(hi))
+    except ValueError:
+        raise InputError(f"--offset-range must look like MIN:MAX in seconds, got {offset_range!r}") from None
+    if not sep:
+        raise InputError(f"--offset-range must look like MIN:MAX in seconds, got {offset_range!r}")
+    if not (depth_um > 0 and math.isfinite(depth_um)):
+        raise InputError(f"--depth-um must be positive, got {depth_um:g}")
+    return FitSettings(depth_m=depth_um * 1e-6, bootstrap=bootstrap, seed=seed, baseline=baseline,
+                       offset_bounds_s=bounds, fit_to_s=fit_to)
+
+
+def _status_table(st) -> Any:
+    from rich.table import Table
+
+    table = Table.grid(padding=(0, 2))
+    table.add_column(style="dim")
+    table.add_column()
+
+    def num(v, fmt, unit):
+        return "–" if v is None or not math.isfinite(v) else f"{v:{fmt}} {unit}"
+
+    table.add_row("port", f"{st.port}   material [bold]{st.material}[/]")
+    table.add_row("trials", f"[bold]{st.trials}[/] / {st.target}   ({st.state})")
+    table.add_row("sensor", num(st.sensor_c, ".3f", "°C"))
+    table.add_row("object", num(st.object_c, ".3f", "°C"))
+    table.add_row("force", num(st.force_n, ".2f", "N"))
+    bad = ", ".join(f"{k} {v}" for k, v in sorted(st.bad_by_kind.items())) or "none"
+    table.add_row("lines", f"{st.lines_ok} ok, bad: {bad}; gaps {st.gaps}, touches skipped {st.skipped}")
+    table.add_row("device time", f"{st.device_time_s:.1f} s")
+    return table
+
+
+class _Display:
+    """Live rich display on stderr when it is a terminal; plain event lines otherwise."""
+
+    def __init__(self, quiet: bool) -> None:
+        self.con = console(stderr=True)
+        self.quiet = quiet
+        self.live = None
+        self.last = 0.0
+
+    def __enter__(self) -> "_Display":
+        if not self.quiet and self.con.is_terminal:
+            from rich.live import Live
+
+            self.live = Live(console=self.con, refresh_per_second=6, transient=False)
+            self.live.__enter__()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self.live is not None:
+            self.live.__exit__(*exc)
+
+    def event(self, e) -> None:
+        if self.quiet:
+            return
+        style = {"trial": "green", "skipped": "yellow", "bad_line": "yellow", "gap": "yellow",
+                 "reconnect": "cyan"}.get(e.kind, "dim")
+        self.con.print(f"[{style}]{e.message}[/]", markup=True, highlight=False)
+
+    def status(self, st) -> None:
+        if self.live is not None:
+            self.live.update(_status_table(st))
+
+
+def _record_materials(port: str, profile, out: Path, materials: list[str], trials: int, timeout: Optional[float],
+                      quiet: bool, prompt: bool):
+    """Record each material in turn on one open connection; returns (recorder, paths, interrupted)."""
+    from ..calibration.recorder import SerialRecorder
+
+    display = _Display(quiet)
+    rec = SerialRecorder(port, profile, out, no_data_timeout_s=timeout, on_event=display.event,
+                         on_status=display.status)
+    paths: list[Path] = []
+    interrupted = False
+    try:
+        rec.open()
+        for i, material in enumerate(materials):
+            if prompt:
+                con = console(stderr=True)
+                con.print(f"[bold]Next: {trials} touches of {material}.[/] Put the sample under the sensor, "
+                          "then press Enter.")
+                sys.stdin.readline()
+                rec.flush_input()
+            elif i > 0:
+                rec.flush_input()
+            with display:
+                paths += rec.record(material, trials)
+    except KeyboardInterrupt:
+        interrupted = True
+    finally:
+        rec.close()
+    return rec, paths, interrupted
+
+
+def _record_payload(rec, paths, out: Path, interrupted: bool) -> dict:
+    st = rec.status
+    return {
+        "trials": [str(p) for p in paths],
+        "n_trials": len(paths),
+        "out": str(out),
+        "index": str(out / "index.csv") if paths else None,
+        "interrupted": interrupted,
+        "lines_ok": st.lines_ok,
+        "bad_lines": dict(st.bad_by_kind),
+        "gaps": st.gaps,
+        "touches_skipped": st.skipped,
+        "events": [{"kind": e.kind, "message": e.message} for e in rec.events],
+    }
+
+
+def _print_fit(result, out: Optional[Path], plot: Optional[Path]) -> None:
+    from rich.table import Table
+
+    from ..calibration.fit import PAPER_ALPHA_S, PAPER_E_S
+
+    con = console()
+
+    def ci(p, fmt):
+        lo, hi = p.ci95
+        return f"[{lo:{fmt}}, {hi:{fmt}}]" if math.isfinite(lo) and math.isfinite(hi) else "–"
+
+    def flag(p):
+        return f" [red](at {p.at_bound} bound)[/]" if p.at_bound else ""
+
+    t = Table(title=f"Sensor identified from {result.n_trials} trials ({result.identification})",
+              title_justify="left")
+    for c in ("parameter", "value", "± std. error", "95 % interval", "paper"):
+        t.add_column(c, justify="right" if c != "parameter" else "left")
+    e, a, tau, off = result.effusivity, result.diffusivity_m2_s, result.tau_s, result.time_offset_s
+    t.add_row("e_s [J s^-1/2 K^-1 m^-2]", f"{e.value:.4g}{flag(e)}", f"{e.std_error:.3g}", ci(e, ".4g"),
+              f"{PAPER_E_S:g}")
+    t.add_row("alpha_s [m^2/s]", f"{a.value:.4g}{flag(a)}", f"{a.std_error:.3g}", ci(a, ".4g"),
+              f"{PAPER_ALPHA_S:g}")
+    t.add_row(f"tau = x^2/(4 alpha_s) [s], x = {result.depth_m * 1e6:g} um", f"{tau.value:.4g}{flag(tau)}",
+              f"{tau.std_error:.3g}", ci(tau, ".4g"), "")
+    t.add_row("time offset of contact [s]", f"{off.value:+.3f}{flag(off)}", f"{off.std_error:.3g}",
+              ci(off, "+.3f"), "")
+    con.print(t)
+    m = Table(title="Materials", title_justify="left")
+    for c in ("material", "trials", "range", "e_o fitted", "e_o / e_s", "e_s allowed", "object temp.",
+              "residual RMS"):
+        m.add_column(c, justify="left" if c in ("material", "object temp.") else "right")
+    for mf in result.materials:
+        eo = "not identified" if mf.effusivity is None else f"{mf.effusivity.value:.4g}{flag(mf.effusivity)}"
+        rho = "–" if mf.ratio is None else f"{mf.ratio.value:.4g} ± {mf.ratio.std_error:.2g}"
+        allowed = "–" if mf.es_interval is None else f"{mf.es_interval[0]:.4g} – {mf.es_interval[1]:.4g}"
+        m.add_row(mf.name, str(mf.n_trials), f"{mf.range.e_min:.4g} – {mf.range.e_max:.4g}", eo, rho, allowed,
+                  mf.object_temp, f"{mf.rms_c:.4f} °C")
+    con.print(m)
+    con.print(f"noise sigma before contact {result.noise_c:.4g} °C; overall residual RMS {result.rms_c:.4f} °C; "
+              f"sample rate {result.sample_rate_hz:.4g} Hz")
+    con.print(f"[dim]uncertainty: {result.uncertainty_method}[/]")
+    for note in result.notes:
+        con.print(f"[yellow]note:[/] {note}")
+    if out is not None:
+        con.print(f"wrote {out}  (use it with --sensor {out})")
+    if plot is not None:
+        con.print(f"wrote {plot}")
+
+
+def _run_fit(index: Path, ranges: list[str], only: Optional[list[str]], object_temps: list[str], settings,
+             out: Optional[Path], name: Optional[str], plot: Optional[Path], quiet: bool):
+    from ..calibration.fit import fit_sensor, parse_object_temps, parse_ranges, plot_fit, resolve_ranges
+    from ..calibration.trials import load_index
+
+    overrides = parse_ranges(ranges)
+    temps = parse_object_temps(object_temps)
+    trials = load_index(index, only=only)
+    if not trials:
+        raise ValueError(f"index {index} lists no trials")
+    names = sorted({tr.material for tr in trials})
+    rng = resolve_ranges(names, overrides)
+    unknown = sorted(set(temps) - set(names))
+    if unknown:
+        raise ValueError(f"--object-temp names material(s) not being fitted: {', '.join(unknown)}")
+    total = settings.bootstrap + settings.profile_points
+    con = console(stderr=True)
+    if not quiet and con.is_terminal and total:
+        from rich.progress import Progress
+
+        with Progress(console=con, transient=True) as progress:
+            task = progress.add_task("fitting (bootstrap and e_s profile)", total=total)
+            result = fit_sensor(trials, rng, object_temps=temps, settings=settings,
+                                progress=lambda done, tot: progress.update(task, completed=done))
+    else:
+        result = fit_sensor(trials, rng, object_temps=temps, settings=settings)
+    if out is not None:
+        sensor = result.sensor(name=name or out.stem, provenance={"index": str(index), "materials_fitted": names})
+        sensor.to_yaml(out)
+    if plot is not None:
+        plot_fit(result, plot)
+    return result
+
+
+# ------------------------------------------------------------------ record
+@calibrate_app.command()
+def record(
+    port: PortOpt = None,
+    profile: ProfileOpt = "designkit",
+    material: Annotated[Optional[str], typer.Option("--material", help="Label of the material being touched.")] = None,
+    trials: TrialsOpt = 10,
+    out: Annotated[Optional[Path], typer.Option("--out", help="Folder for the trials (CSV + JSON each, index.csv).")] = None,
+    timeout: TimeoutOpt = None,
+    json_: Json = False,
+) -> None:
+    """Record touches from a serial device: detect each contact, write each trial at once."""
+    from .._validation import InputError
+    from ..calibration.profiles import load_profile
+
+    if port is None or material is None or out is None:
+        raise InputError("give --port, --material and --out")
+    if trials < 1:
+        raise InputError(f"--trials must be >= 1, got {trials}")
+    prof = load_profile(profile)
+    rec, paths, interrupted = _record_materials(port, prof, out, [material], trials, timeout, quiet=json_,
+                                                prompt=False)
+    payload = _record_payload(rec, paths, out, interrupted)
+    if json_:
+        emit_json(payload)
+    else:
+        con = console(stderr=interrupted)
+        con.print(f"{'Interrupted: ' if interrupted else ''}{len(paths)} trial(s) of {material} written to {out}"
+                  + (f" (index {out / 'index.csv'})" if paths else ""))
+    if interrupted:
+        raise typer.Exit(EXIT_INTERRUPTED)
+
+
+# --------------------------------------------------------------------- fit
+@calibrate_app.command()
+def fit(
+    index: Annotated[Path, typer.Argument(help="CSV with columns file and material (e.g. the index.csv that "
+                                               "'calibrate record' writes, or the shared recordings').")],
+    range_: RangeOpt = None,
+    only: Annotated[Optional[str], typer.Option("--only", help="Fit only these materials (comma-separated).")] = None,
+    object_temp: ObjectTempOpt = None,
+    depth_um: DepthOpt = 80.0,
+    out: Annotated[Optional[Path], typer.Option("--out", help="Write the sensor YAML here (for --sensor).")] = None,
+    name: Annotated[Optional[str], typer.Option("--name", help="Sensor name in the file (default: file stem).")] = None,
+    bootstrap: BootstrapOpt = 100,
+    seed: Seed = 0,
+    baseline: Annotated[str, typer.Option(
+        "--baseline", help="Initial sensor temperature: 'mean' of the samples before contact, or 'trend' "
+                           "(a line through them, at the onset; for heaters that drift).")] = "mean",
+    offset_range: Annotated[str, typer.Option(
+        "--offset-range", help="Search range of the contact-time offset MIN:MAX [s].")] = "-1.5:1.5",
+    fit_to: Annotated[Optional[float], typer.Option(
+        "--fit-to", help="Use samples up to this time after onset [s] (default: all, or to release).")] = None,
+    plot: Annotated[Optional[Path], typer.Option("--plot", help="Write a PNG of the fit (needs matplotlib).")] = None,
+    json_: Json = False,
+) -> None:
+    """Identify e_s and alpha_s (and each e_o, the time offset) from recorded touches (paper appendix)."""
+    settings = _fit_settings(depth_um, bootstrap, seed, baseline, offset_range, fit_to)
+    only_list = [s.strip() for s in only.split(",") if s.strip()] if only else None
+    result = _run_fit(index, range_ or [], only_list, object_temp or [], settings, out, name, plot, quiet=json_)
+    if json_:
+        payload = result.to_dict()
+        payload.update({"out": str(out) if out else None, "plot": str(plot) if plot else None, "index": str(index)})
+        emit_json(payload)
+        return
+    _print_fit(result, out, plot)
+
+
+# ------------------------------------------------------------ guided run
+@calibrate_app.callback(invoke_without_command=True)
+def guided(
+    ctx: typer.Context,
+    port: PortOpt = None,
+    profile: ProfileOpt = "designkit",
+    material: Annotated[Optional[list[str]], typer.Option(
+        "--material", help="A material to touch (repeatable; recorded in this order).")] = None,
+    trials: TrialsOpt = 10,
+    out: Annotated[Optional[Path], typer.Option("--out", help="Folder for the trials.")] = None,
+    sensor_out: Annotated[Optional[Path], typer.Option(
+        "--sensor-out", help="Sensor YAML to write (default: OUT/sensor.yaml).")] = None,
+    range_: RangeOpt = None,
+    object_temp: ObjectTempOpt = None,
+    depth_um: DepthOpt = 80.0,
+    bootstrap: BootstrapOpt = 100,
+    timeout: TimeoutOpt = None,
+    yes: Annotated[bool, typer.Option("--yes", "-y", help="Do not wait for Enter before each material.")] = False,
+    json_: Json = False,
+) -> None:
+    """Guided calibration: record every material over serial, then fit and write the sensor file."""
+    from .._validation import InputError
+
+    if ctx.invoked_subcommand is not None:
+        if port is not None or material:
+            raise InputError(f"options like --port go after '{ctx.invoked_subcommand}', not before it")
+        return
+    if port is None or not material or out is None:
+        raise InputError("the guided run needs --port, at least one --material and --out "
+                         "(or use 'calibrate record' and 'calibrate fit')")
+    if trials < 1:
+        raise InputError(f"--trials must be >= 1, got {trials}")
+    from ..calibration.fit import parse_object_temps, parse_ranges, resolve_ranges
+    from ..calibration.profiles import load_profile
+
+    prof = load_profile(profile)
+    settings = _fit_settings(depth_um, bootstrap, 0)
+    resolve_ranges(list(dict.fromkeys(material)), parse_ranges(range_ or []))  # fail before recording
+    parse_object_temps(object_temp or [])
+    materials = list(dict.fromkeys(material))
+    rec, paths, interrupted = _record_materials(port, prof, out, materials, trials, timeout, quiet=json_,
+                                                prompt=not yes)
+    if interrupted:
+        if json_:
+            emit_json(_record_payload(rec, paths, out, True))
+        console(stderr=True).print(f"Interrupted: {len(paths)} trial(s) kept in {out}; fit them later with "
+                                   f"'designkit calibrate fit {out / 'index.csv'}'")
+        raise typer.Exit(EXIT_INTERRUPTED)
+    sensor_path = sensor_out or out / "sensor.yaml"
+    result = _run_fit(out / "index.csv", range_ or [], materials, object_temp or [], settings, sensor_path, None,
+                      None, quiet=json_)
+    if json_:
+        payload = {"record": _record_payload(rec, paths, out, False), "fit": result.to_dict(),
+                   "sensor": str(sensor_path)}
+        emit_json(payload)
+        return
+    console().print(f"Recorded {len(paths)} trial(s) in {out}")
+    _print_fit(result, sensor_path, None)
+
+
+# ----------------------------------------------------------------- emulate
+@app.command()
+def emulate(
+    profile: ProfileOpt = "designkit",
+    material: Annotated[Optional[list[str]], typer.Option(
+        "--material", help="Object to touch: a materials database name, or LABEL=E with E the effusivity "
+                           "[J s^-1/2 K^-1 m^-2] (repeatable: touched in turn).")] = None,
+    e: Annotated[Optional[float], typer.Option("--e", help="Effusivity of the object [J s^-1/2 K^-1 m^-2].")] = None,
+    touch_every: Annotated[float, typer.Option("--touch-every", help="Seconds (device time) between touches.")] = 20.0,
+    touches_per_material: Annotated[int, typer.Option(
+        "--touches-per-material", help="Touches of each material before the next one.")] = 1,
+    noise: Noise = 0.05,
+    sensor: SensorOpt = "paper",
+    sensor_temp: Annotated[float, typer.Option("--sensor-temp", help="Heater set point [°C].")] = 35.0,
+    ambient: Annotated[float, typer.Option("--ambient", help="Room temperature [°C].")] = 25.0,
+    object_temp: Annotated[Optional[float], typer.Option(
+        "--object-temp", help="Object temperature [°C] (default: room temperature).")] = None,
+    speed: Annotated[float, typer.Option("--speed", help="Device seconds per real second (20: 20x real time).")] = 1.0,
+    fault: Annotated[Optional[list[str]], typer.Option(
+        "--fault", help="Inject a fault (repeatable): garbled=P, partial=P, non-numeric=P, field-count=P, "
+                        "out-of-range=P (per-line probabilities), burst=EVERY_S[:HOLD_S], gap=EVERY_S[:SILENT_S], "
+                        "vanish=AFTER_S, silent.")] = None,
+    duration: Annotated[Optional[float], typer.Option(
+        "--duration", help="Stop after this many real seconds (default: run until Ctrl-C).")] = None,
+    seed: Seed = 0,
+    json_: Json = False,
+) -> None:
+    """Emulate a sensor rig on a pseudo-terminal: prints its path, streams the profile's wire format."""
+    from .._validation import InputError
+    from ..calibration.emulator import EmulatedMaterial, Emulator, Faults, TouchPlan
+    from ..calibration.profiles import load_profile
+    from ..sensor import load_sensor
+
+    mats = []
+    for spec in material or []:
+        label, sep, value = spec.partition("=")
+        if sep:
+            try:
+                mats.append(EmulatedMaterial(label.strip(), float(value), object_temp))
+            except ValueError:
+                raise InputError(f"--material {spec!r}: use NAME or LABEL=EFFUSIVITY") from None
+        else:
+            from ..materials import get_material
+
+            m = get_material(spec)
+            eo = m.identified if m.identified is not None else math.sqrt(m.e_min * m.e_max)
+            mats.append(EmulatedMaterial(m.name, eo, object_temp))
+    if e is not None:
+        mats.append(EmulatedMaterial(f"e={e:g}", e, object_temp))
+    if not mats:
+        raise InputError("give --material NAME (or LABEL=E) or --e E: what should the rig touch?")
+    if duration is not None and not duration > 0:
+        raise InputError(f"--duration must be positive, got {duration:g}")
+    prof = load_profile(profile)
+    emu = Emulator(prof, load_sensor(sensor), mats, noise_c=noise, sensor_temp_c=sensor_temp, ambient_c=ambient,
+                   plan=TouchPlan(touch_every_s=touch_every, touches_per_material=touches_per_material),
+                   speed=speed, faults=Faults.parse(fault or []), seed=seed)
+    port = emu.start()
+    info = {"port": port, "profile": prof.name, "speed": speed, "touch_every_s": touch_every,
+            "materials": [{"label": m.label, "effusivity": m.effusivity} for m in mats],
+            "noise_c": noise, "sensor": emu.sensor.to_dict(), "time_offset_s": emu.expected_time_offset_s,
+            "faults": [str(f) for f in fault or []]}
+    if json_:
+        emit_json(info)
+    else:
+        con = console()
+        con.print(f"Emulating a '{prof.name}' rig on [bold]{port}[/]  (speed {speed:g}x; Ctrl-C to stop)")
+        con.print("  touching " + ", ".join(f"{m.label} (e = {m.effusivity:g})" for m in mats)
+                  + f" every {touch_every:g} s; noise {noise:g} °C; sensor e_s = {emu.sensor.effusivity:g}, "
+                    f"tau = {emu.sensor.tau_s:.3f} s")
+        con.print(f"  try: designkit calibrate record --port {port} --profile {profile} "
+                  f"--material {mats[0].label} --out trials/")
+        sys.stdout.flush()
+    start = time.monotonic()
+    announced = -1
+    try:
+        while duration is None or time.monotonic() - start < duration:
+            if emu.wait(0.2):
+                break
+            if not json_:
+                device_t = emu.samples_sent / prof.sample_rate_hz
+                j = int(math.floor((device_t - emu.plan.first_touch_s) / emu.plan.touch_every_s))
+                if j > announced and j >= 0:
+                    tr = emu.touch(j)
+                    console().print(f"[dim]touch {j + 1}: {tr.material} at device time {tr.start_s:g} s[/]")
+                    announced = j
+    except KeyboardInterrupt:
+        pass
+    finally:
+        emu.stop()
+    if emu.error is not None:
+        raise InputError(f"the emulator failed: {emu.error}")
+    if emu.vanished and not json_:
+        console().print("the emulated device vanished (fault injected)")

@@ -1,0 +1,268 @@
+"""Recording over a real pseudo-terminal: the emulator speaks a profile's wire format, the
+recorder reads it with pyserial. No mocks of the serial layer. Recorded temperatures are
+checked against the physics model evaluated directly (designkit.physics), not against the
+emulator's own output."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from designkit import SENSORS
+from designkit._validation import InputError
+from designkit.calibration.emulator import EmulatedMaterial, Emulator, Faults, TouchPlan
+from designkit.calibration.profiles import ROLES, list_profiles, load_profile, profile_from_dict
+from designkit.calibration.recorder import DeviceGone, NoData, SerialRecorder, TrialCutter
+from designkit.calibration.trials import load_index, read_trial_csv
+from designkit.physics import sensor_temperature
+
+PAPER = SENSORS["paper"]
+SENSOR_T, AMBIENT = 35.0, 25.0
+PLAN = TouchPlan(touch_every_s=13.0)
+
+
+def _profile(name: str, **serial) -> "object":
+    data = yaml.safe_load(list_profiles()[name].read_text())
+    data["serial"].update(serial)
+    return profile_from_dict(data, source=f"profile {name} (test)")
+
+
+def _emulator(profile, e=400.0, *, speed=50.0, faults=Faults(), seed=0, noise=0.05):
+    return Emulator(profile, PAPER, [EmulatedMaterial("wood", e)], noise_c=noise, sensor_temp_c=SENSOR_T,
+                    ambient_c=AMBIENT, plan=PLAN, speed=speed, faults=faults, seed=seed)
+
+
+def _expected_onsets(emu, n=40):
+    return np.array([emu.touch(j).expected_onset_s for j in range(n)])
+
+
+def _check_trial_against_physics(path: Path, emu, e: float, noise: float, tol_extra: float = 0.0):
+    """The trial's samples are the model at their times plus noise: right times, no corrupted sample.
+
+    Heat starts to flow ``-emu.expected_time_offset_s`` before the noise-free detected onset; force
+    noise may move the detection by a sample, so the best of -1, 0, +1 samples is checked.
+    """
+    tr = read_trial_csv(path)
+    meta = tr.meta
+    dt = 1.0 / emu.profile.sample_rate_hz
+    if emu.profile.has_timestamp:  # device time: the onset is one of the emulated touches'
+        onsets = _expected_onsets(emu)
+        assert np.min(np.abs(onsets - meta["onset_device_time_s"])) <= 1.01 * dt
+    best = None
+    for shift in (-dt, 0.0, dt):
+        t_contact = tr.time_s - emu.expected_time_offset_s + shift
+        model = sensor_temperature(np.clip(t_contact, 0, None), e, SENSOR_T, AMBIENT, PAPER.effusivity,
+                                   PAPER.tau_s)
+        resid = tr.sensor_c - model
+        if best is None or np.sum(resid ** 2) < np.sum(best ** 2):
+            best = resid
+    assert abs(np.mean(best)) < 4 * noise / np.sqrt(best.size) + tol_extra
+    assert np.max(np.abs(best)) < 6 * noise + tol_extra
+    assert np.std(best) == pytest.approx(noise, rel=0.15, abs=tol_extra)
+    return tr
+
+
+# ------------------------------------------------------------------ happy path
+def test_records_trials_with_sidecars_and_index(tmp_path):
+    prof = load_profile("designkit")
+    with _emulator(prof) as emu, SerialRecorder(emu.port, prof, tmp_path) as rec:
+        paths = rec.record("wood", 3)
+    assert len(paths) == 3
+    idx = (tmp_path / "index.csv").read_text().splitlines()
+    assert idx[0] == "file,material,trial_index" and len(idx) == 4
+    for p in paths:
+        header = p.read_text().splitlines()[0]
+        assert header == "time_s,passive_temp_c,active_temp_c,unused_channel,force_n"
+        tr = _check_trial_against_physics(p, emu, 400.0, 0.05)
+        assert tr.time_s[0] == pytest.approx(-1.0) and tr.time_s[-1] == pytest.approx(7.0)
+        assert np.allclose(np.diff(tr.time_s), 0.005, atol=2e-4)
+        side = json.loads(p.with_suffix(".json").read_text())
+        for key in ("profile", "material", "recorded_at", "sensor_temp_before_c", "object_temp_before_c",
+                    "pre_s", "post_s", "sample_rate_hz"):
+            assert key in side
+        assert side["sensor_temp_before_c"] == pytest.approx(SENSOR_T, abs=0.02)
+        assert side["object_temp_before_c"] == pytest.approx(AMBIENT, abs=0.02)
+    assert len(load_index(tmp_path / "index.csv")) == 3
+
+
+def test_line_faults_are_reported_skipped_and_do_not_shift_counted_time(tmp_path):
+    # The ADC profile has no timestamp: time is the line count, so a skipped line must still count.
+    prof = load_profile("adc12-thermistor")
+    faults = Faults(garbled=0.01, partial=0.01, non_numeric=0.01, field_count=0.01, out_of_range=0.01)
+    with _emulator(prof, faults=faults, seed=3) as emu, SerialRecorder(emu.port, prof, tmp_path) as rec:
+        paths = rec.record("wood", 3)
+    kinds = rec.status.bad_by_kind
+    assert set(kinds) == {"garbled", "field_count", "non_numeric", "out_of_range"}  # partial -> field count
+    messages = [e.message for e in rec.events if e.kind == "bad_line"]
+    assert any("wrong number of fields" in m for m in messages)
+    assert any("out of range" in m for m in messages)
+    assert any("garbled" in m for m in messages)
+    # a 12-bit count is ~0.015 degC here: allow for quantization on top of the noise
+    for p in paths:
+        tr = _check_trial_against_physics(p, emu, 400.0, 0.05, tol_extra=0.01)
+        assert json.loads(p.with_suffix(".json").read_text())["n_missing"] > 0
+
+
+def test_bursts_lose_no_samples(tmp_path):
+    prof = load_profile("designkit")
+    with _emulator(prof, faults=Faults(burst_every_s=1.0, burst_hold_s=0.1)) as emu, \
+            SerialRecorder(emu.port, prof, tmp_path) as rec:
+        paths = rec.record("wood", 2)
+    for p in paths:
+        assert json.loads(p.with_suffix(".json").read_text())["n_missing"] == 0
+        _check_trial_against_physics(p, emu, 400.0, 0.05)
+
+
+def test_gap_in_a_stream_without_timestamps_discards_that_trial_only(tmp_path):
+    prof = load_profile("adc12-thermistor")
+    # silent 0.3 s (real; 6 s of device time at speed 20) from device time 32 s: inside the trial
+    # of the touch at 28 s; touches at 2, 15 and 41 s are whole
+    with _emulator(prof, speed=20.0, faults=Faults(gap_every_s=32.0, gap_s=0.3)) as emu, \
+            SerialRecorder(emu.port, prof, tmp_path) as rec:
+        paths = rec.record("wood", 3)
+    gaps = [e.message for e in rec.events if e.kind == "gap"]
+    assert any("stalled" in m for m in gaps)
+    assert any("discarded" in e.message for e in rec.events if e.kind == "skipped")
+    for p in paths:  # the trials kept have the right times: the clock restarted cleanly
+        _check_trial_against_physics(p, emu, 400.0, 0.05, tol_extra=0.01)
+
+
+def test_gap_in_device_time_is_found_from_timestamps(tmp_path):
+    prof = load_profile("designkit")
+    with _emulator(prof, speed=20.0, faults=Faults(gap_every_s=32.0, gap_s=0.3)) as emu, \
+            SerialRecorder(emu.port, prof, tmp_path) as rec:
+        paths = rec.record("wood", 3)
+    assert any("missing at device time 32" in e.message for e in rec.events if e.kind == "gap")
+    assert any("discarded" in e.message for e in rec.events if e.kind == "skipped")
+    for p in paths:
+        _check_trial_against_physics(p, emu, 400.0, 0.05)
+
+
+# ------------------------------------------------------------------ failures
+def test_device_vanishing_mid_trial_keeps_what_was_written(tmp_path):
+    prof = _profile("designkit", reconnect_s=0.3)
+    # touches start at 2, 15, 28 s: vanish 3 s into the third touch
+    with _emulator(prof, faults=Faults(vanish_after_s=31.0)) as emu, \
+            SerialRecorder(emu.port, prof, tmp_path) as rec:
+        with pytest.raises(DeviceGone) as exc:
+            rec.record("wood", 5)
+    msg = str(exc.value)
+    assert "disappeared" in msg and "trial in progress was discarded" in msg and "\n" not in msg
+    written = rec.written
+    assert 1 <= len(written) <= 2 and f"{len(written)} trial(s) kept" in msg
+    kept = load_index(tmp_path / "index.csv")
+    assert [Path(t.source).name for t in kept] == [p.name for p in written]
+    for p in written:
+        _check_trial_against_physics(p, emu, 400.0, 0.05)
+    assert not list(tmp_path.glob(".*.tmp"))  # no half-written file left behind
+
+
+def test_silent_device_times_out_with_a_clear_message(tmp_path):
+    prof = load_profile("designkit")
+    with _emulator(prof, faults=Faults(silent=True)) as emu:
+        rec = SerialRecorder(emu.port, prof, tmp_path, no_data_timeout_s=0.4)
+        t0 = time.monotonic()
+        with pytest.raises(NoData, match="never sent anything for .* baud rate 115200"):
+            with rec:
+                rec.record("wood", 1)
+        assert time.monotonic() - t0 < 5
+
+
+def test_wrong_profile_is_named_as_the_likely_cause(tmp_path):
+    with _emulator(load_profile("adc12-thermistor")) as emu:
+        with pytest.raises(NoData, match="matches profile 'designkit'.*wrong profile or baud rate"):
+            with SerialRecorder(emu.port, load_profile("designkit"), tmp_path) as rec:
+                rec.record("wood", 1)
+
+
+def test_missing_port_is_a_one_line_error(tmp_path):
+    with pytest.raises(InputError, match="cannot open serial port /dev/nonexistent-designkit"):
+        SerialRecorder("/dev/nonexistent-designkit", load_profile("designkit"), tmp_path).open()
+
+
+# ------------------------------------------------------- cutter without serial
+def _slope_profile():
+    data = yaml.safe_load(list_profiles()["designkit"].read_text())
+    data["contact"] = {"rule": "temperature_slope", "slope_c_per_s": 0.3, "slope_window_s": 0.5}
+    data["channels"].pop("force")
+    data["line"]["fields"] = ["time_s", "sensor_c", "object_c", "_"]
+    return profile_from_dict(data, source="slope profile")
+
+
+def test_temperature_slope_rule_finds_contact_after_it_starts(tmp_path):
+    prof = _slope_profile()
+    emu = _emulator(load_profile("designkit"), e=17000.0)  # values only, no pty
+    v = emu.values(0, int(45 * 200))
+    cutter = TrialCutter(prof, tmp_path, "metal")
+    vals = np.column_stack([v["sensor"], v["object"], np.full(v["sensor"].size, np.nan)])
+    for k in range(0, v["timestamp"].size, 500):  # fed in chunks, as from a port
+        cutter.feed(v["timestamp"][k:k + 500], vals[k:k + 500])
+    onsets = [json.loads(p.with_suffix(".json").read_text())["onset_device_time_s"] for p in cutter.written]
+    starts = [emu.touch(j).start_s for j in range(3)]
+    assert len(onsets) == 3
+    for onset, start in zip(onsets, starts):
+        assert 0.0 < onset - start < 1.0  # after heat starts to flow, within the slope window's reach
+
+
+def test_discontinuity_discards_the_trial_in_progress(tmp_path):
+    prof = load_profile("designkit")
+    emu = _emulator(prof)
+    v = emu.values(0, int(14 * 200))
+    vals = np.column_stack([v["sensor"], v["object"], v["force"]])
+    cutter = TrialCutter(prof, tmp_path, "wood")
+    cutter.feed(v["timestamp"][:1000], vals[:1000])  # up to 5 s: in the first trial
+    assert cutter.in_trial
+    events = cutter.discontinuity("test")
+    assert [e.kind for e in events] == ["skipped"]
+    cutter.feed(v["timestamp"][1000:], vals[1000:])
+    assert cutter.written == []
+
+
+def test_touch_without_enough_quiet_data_before_it_is_skipped(tmp_path):
+    prof = load_profile("designkit")
+    emu = _emulator(prof)
+    v = emu.values(int(1.8 * 200), int(12 * 200))  # starts 0.2 s before the first touch
+    cutter = TrialCutter(prof, tmp_path, "wood")
+    events = cutter.feed(v["timestamp"], np.column_stack([v["sensor"], v["object"], v["force"]]))
+    assert any(e.kind == "skipped" and "clean data before contact" in e.message for e in events)
+    assert cutter.written == []
+
+
+# ------------------------------------------------------------ Ctrl-C (process)
+def _designkit_exe() -> list[str]:
+    exe = Path(sys.executable).with_name("designkit")
+    return [str(exe)] if exe.exists() else [sys.executable, "-m", "designkit"]
+
+
+@pytest.mark.slow
+def test_ctrl_c_keeps_every_trial_recorded(tmp_path):
+    prof = load_profile("designkit")
+    out = tmp_path / "trials"
+    with _emulator(prof, speed=20.0) as emu:
+        proc = subprocess.Popen(_designkit_exe() + ["calibrate", "record", "--port", emu.port, "--profile",
+                                                    "designkit", "--material", "wood", "--trials", "50",
+                                                    "--out", str(out)],
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline and len(list(out.glob("wood_*.json"))) < 1:
+            time.sleep(0.05)
+        proc.send_signal(signal.SIGINT)
+        stdout, stderr = proc.communicate(timeout=30)
+    assert proc.returncode == 130, stderr
+    assert "Interrupted" in stderr
+    kept = load_index(out / "index.csv")
+    assert len(kept) >= 1
+    for tr in kept:
+        assert tr.n_samples == 1601
+        _check_trial_against_physics(Path(tr.source), emu, 400.0, 0.05)
+    assert not [p for p in out.iterdir() if p.name.startswith(".")]
+    assert os.path.getsize(out / "index.csv") > 0

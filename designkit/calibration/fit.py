@@ -113,7 +113,10 @@ def _range_from_spec(name: str, spec: str) -> MaterialRange:
         return MaterialRange(name, lo, hi, "--range")
     from ..materials import get_material
 
-    m = get_material(spec)
+    try:
+        m = get_material(spec)
+    except InputError as exc:
+        raise InputError(f"--range {name}={spec}: not MIN:MAX and {exc}") from None
     return MaterialRange(name, m.e_min, m.e_max, f"materials database: {m.name}")
 
 

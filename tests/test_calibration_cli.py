@@ -1,0 +1,224 @@
+"""The calibrate and emulate commands, through the CLI: in-process (typer's CliRunner) and as
+real processes of the designkit console script, over real pseudo-terminals."""
+
+from __future__ import annotations
+
+import json
+import os
+import select
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from designkit import SENSORS
+from designkit.calibration.emulator import EmulatedMaterial, Emulator, TouchPlan
+from designkit.calibration.profiles import load_profile
+from designkit.calibration.trials import write_trial
+from designkit.sensor import load_sensor
+
+PAPER = SENSORS["paper"]
+METAL, WOOD = 17530.0, 400.0
+# objects whose effusivity is known to about 5 %, as from an effusivity meter (asymmetric on purpose)
+METER_RANGES = [f"metal={METAL * 0.97:.1f}:{METAL * 1.08:.1f}", f"wood={WOOD * 0.93:.1f}:{WOOD * 1.02:.1f}"]
+
+
+def _exe() -> list[str]:
+    exe = Path(sys.executable).with_name("designkit")
+    return [str(exe)] if exe.exists() else [sys.executable, "-m", "designkit"]
+
+
+def _emulator(e: float, label: str, seed: int = 0, speed: float = 100.0) -> Emulator:
+    return Emulator(load_profile("designkit"), PAPER, [EmulatedMaterial(label, e)], noise_c=0.05,
+                    plan=TouchPlan(touch_every_s=13.0), speed=speed, seed=seed)
+
+
+def _synthetic_index(folder: Path, n: int = 4, seed: int = 0) -> Path:
+    """Trials written as the recorder writes them, from the closed-form model."""
+    from scipy.special import erfc
+
+    rng = np.random.default_rng(seed)
+    t = np.arange(-200, 1401) / 200.0
+    for name, e in (("metal", METAL), ("wood", WOOD)):
+        w = e / (PAPER.effusivity + e)
+        tt = t + 0.25
+        g = np.where(tt > 0, erfc(np.sqrt(PAPER.tau_s / np.where(tt > 0, tt, 1.0))), 0.0)
+        for _ in range(n):
+            sensor = 35.0 - 10.0 * w * g + 0.05 * rng.standard_normal(t.size)
+            obj = 25.0 + 0.05 * rng.standard_normal(t.size)
+            write_trial(folder, name, t, sensor, obj, np.full(t.size, 8.0), {"profile": "test"})
+    return folder / "index.csv"
+
+
+# -------------------------------------------------------------------- fit
+def test_fit_writes_a_sensor_that_other_commands_accept(cli, tmp_path):
+    index = _synthetic_index(tmp_path / "trials")
+    out = tmp_path / "my-sensor.yaml"
+    r = cli("calibrate", "fit", index, *sum((["--range", x] for x in METER_RANGES), []), "--out", out,
+            "--bootstrap", "10", "--json")
+    assert r.exit_code == 0, r.output
+    d = json.loads(r.stdout)
+    assert d["identification"] == "interval"
+    assert d["effusivity"]["ci95"][0] <= d["effusivity"]["value"] <= d["effusivity"]["ci95"][1]
+    assert {m["name"] for m in d["materials"]} == {"metal", "wood"}
+    assert d["paper"] == {"effusivity": 892.0, "diffusivity_m2_s": 1.19e-9}
+    sen = load_sensor(out)
+    assert sen.effusivity == pytest.approx(d["effusivity"]["value"])
+    sim = cli("simulate", "--e", "400", "--sensor", out, "--contact", "1", "--json")
+    assert sim.exit_code == 0, sim.output
+    assert json.loads(sim.stdout)["sensor"]["effusivity"] == pytest.approx(sen.effusivity)
+
+
+def test_fit_human_output_and_plot(cli, tmp_path):
+    index = _synthetic_index(tmp_path / "trials", n=3)
+    plot = tmp_path / "fit.png"
+    r = cli("calibrate", "fit", index, *sum((["--range", x] for x in METER_RANGES), []), "--bootstrap", "0",
+            "--plot", plot)
+    assert r.exit_code == 0, r.output
+    assert "e_s" in r.stdout and "paper" in r.stdout and "only tau" in r.stdout
+    assert plot.read_bytes()[:4] == b"\x89PNG"
+
+
+@pytest.mark.parametrize("args, message", [
+    ([], "no effusivity range for metal"),
+    (["--range", "metal=1:2", "--range", "wood=3"], "wood=3"),
+    (["--range", "metal"], "--range must look like NAME=MIN:MAX"),
+    (["--only", "glass"], "--only names material(s) not in index.csv: glass"),
+    (["--range", "metal=1:2", "--range", "wood=331:506", "--object-temp", "wood=tepid"], "--object-temp"),
+    (["--range", "metal=1:2", "--range", "wood=331:506", "--offset-range", "x"], "--offset-range"),
+])
+def test_fit_errors_are_one_line(cli, tmp_path, args, message):
+    index = _synthetic_index(tmp_path / "trials", n=1)
+    r = cli("calibrate", "fit", index, "--bootstrap", "0", *args)
+    assert r.exit_code == 2
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("Error:") and message in lines[0], r.stderr
+
+
+def test_record_and_guided_need_their_options(cli, tmp_path):
+    r = cli("calibrate", "record", "--port", "/dev/null-x")
+    assert r.exit_code == 2 and "give --port, --material and --out" in r.stderr
+    r = cli("calibrate", "--port", "/dev/null-x", "--out", tmp_path)
+    assert r.exit_code == 2 and "at least one --material" in r.stderr
+    r = cli("calibrate", "--port", "x", "record", "--port", "y")
+    assert r.exit_code == 2 and "go after 'record'" in r.stderr
+    r = cli("calibrate", "record", "--port", "/dev/nonexistent-designkit", "--material", "wood", "--out", tmp_path)
+    assert r.exit_code == 2 and "cannot open serial port" in r.stderr
+
+
+def test_guided_run_records_then_fits(cli, tmp_path):
+    out = tmp_path / "run"
+    with _emulator(WOOD, "wood", seed=2) as emu:
+        r = cli("calibrate", "--port", emu.port, "--profile", "designkit", "--material", "wood", "--trials", "3",
+                "--range", f"wood={WOOD * 0.95}:{WOOD * 1.05}", "--out", out, "--bootstrap", "0", "--yes", "--json")
+    assert r.exit_code == 0, r.output
+    d = json.loads(r.stdout)
+    assert d["record"]["n_trials"] == 3 and d["sensor"] == str(out / "sensor.yaml")
+    sen = load_sensor(out / "sensor.yaml")
+    # one material: e_s is known only to the width of wood's range
+    lo, hi = d["fit"]["es_interval"]
+    assert lo <= PAPER.effusivity <= hi and sen.tau_s == pytest.approx(PAPER.tau_s, rel=0.05)
+
+
+def test_guided_run_stops_before_recording_when_a_range_is_missing(cli, tmp_path):
+    r = cli("calibrate", "--port", "/dev/whatever", "--material", "unobtainium", "--out", tmp_path, "--yes")
+    assert r.exit_code == 2 and "no effusivity range for unobtainium" in r.stderr
+    assert not list(tmp_path.iterdir())
+
+
+# ---------------------------------------------------------------- emulate
+def _read_json_object(stream, timeout: float = 30.0) -> dict:
+    """Read one (pretty-printed) JSON object from a pipe without waiting for EOF."""
+    text, depth, deadline = "", 0, time.monotonic() + timeout
+    fd = stream.fileno()
+    while time.monotonic() < deadline:
+        ready, _, _ = select.select([fd], [], [], 0.1)
+        if not ready:
+            continue
+        chunk = os.read(fd, 4096).decode()
+        if not chunk:
+            break
+        text += chunk
+        depth = text.count("{") - text.count("}")
+        if text.strip() and depth == 0:
+            return json.loads(text)
+    raise AssertionError(f"no JSON from the emulator: {text!r}")
+
+
+@pytest.mark.slow
+def test_emulate_process_feeds_calibrate_record(cli, tmp_path):
+    proc = subprocess.Popen(_exe() + ["emulate", "--profile", "adc12-thermistor", "--material", "wood=400",
+                                      "--touch-every", "13", "--speed", "50", "--duration", "60", "--json"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    try:
+        info = _read_json_object(proc.stdout)
+        assert info["profile"] == "adc12-thermistor" and info["port"].startswith("/dev/")
+        r = cli("calibrate", "record", "--port", info["port"], "--profile", "adc12-thermistor", "--material",
+                "wood", "--trials", "2", "--out", tmp_path, "--json")
+        assert r.exit_code == 0, r.output
+        assert json.loads(r.stdout)["n_trials"] == 2
+    finally:
+        proc.send_signal(signal.SIGINT)
+        proc.communicate(timeout=20)
+    assert proc.returncode == 0
+
+
+def test_emulate_rejects_bad_input(cli):
+    r = cli("emulate", "--profile", "designkit")
+    assert r.exit_code == 2 and "--material" in r.stderr
+    r = cli("emulate", "--e", "400", "--touch-every", "3")
+    assert r.exit_code == 2 and "too short" in r.stderr
+    r = cli("emulate", "--e", "400", "--fault", "sparks=1")
+    assert r.exit_code == 2 and "unknown fault 'sparks'" in r.stderr
+
+
+# ------------------------------------------------ round trip (done-when)
+@pytest.mark.slow
+def test_round_trip_over_a_pty_recovers_the_sensor(cli, tmp_path):
+    """Emulate e_s = 892, alpha_s = 1.19e-9 at sigma 0.05 degC, 10 trials per material, record
+    each material over a real pty, fit: recovered within the reported uncertainty and within 5 %."""
+    out = tmp_path / "trials"
+    for seed, (label, e) in enumerate((("metal", METAL), ("wood", WOOD))):
+        with _emulator(e, label, seed=10 + seed) as emu:
+            r = cli("calibrate", "record", "--port", emu.port, "--profile", "designkit", "--material", label,
+                    "--trials", "10", "--out", out, "--json")
+            assert r.exit_code == 0, r.output
+            offset = emu.expected_time_offset_s
+    r = cli("calibrate", "fit", out / "index.csv", *sum((["--range", x] for x in METER_RANGES), []),
+            "--out", tmp_path / "sensor.yaml", "--bootstrap", "50", "--json")
+    assert r.exit_code == 0, r.output
+    d = json.loads(r.stdout)
+    assert d["n_trials"] == 20
+    for key, truth in (("effusivity", PAPER.effusivity), ("diffusivity_m2_s", PAPER.diffusivity_m2_s),
+                       ("tau_s", PAPER.tau_s), ("time_offset_s", offset)):
+        lo, hi = d[key]["ci95"]
+        assert lo <= truth <= hi, (key, d[key], truth)
+    assert d["effusivity"]["value"] == pytest.approx(PAPER.effusivity, rel=0.05)
+    assert d["diffusivity_m2_s"]["value"] == pytest.approx(PAPER.diffusivity_m2_s, rel=0.05)
+    assert d["noise_c"] == pytest.approx(0.05, rel=0.1)
+
+
+# --------------------------------------------------------- real recordings
+@pytest.mark.slow
+def test_fit_of_the_shared_robot_recordings(cli, robot_data_dir, tmp_path):
+    """The README of the recordings: e_s of order 1e3, alpha_s of order 1e-9 at 80 um, residual of
+    order 0.1 degC. Metal and wood with the paper's aluminium and wood ranges."""
+    r = cli("calibrate", "fit", robot_data_dir / "index.csv", "--only", "metal,wood",
+            "--range", "metal=12767:25972", "--range", "wood=331:506", "--bootstrap", "10",
+            "--out", tmp_path / "robot.yaml", "--json")
+    assert r.exit_code == 0, r.output
+    d = json.loads(r.stdout)
+    assert d["n_trials"] == 120
+    assert 300 < d["effusivity"]["value"] < 3000
+    assert 3e-10 < d["diffusivity_m2_s"]["value"] < 3e-9
+    assert 0.03 < d["rms_c"] < 0.3
+    assert abs(d["time_offset_s"]["value"]) < 1.5
+    # whatever the verdict, it is consistent with the per-material intervals it reports
+    iv = {m["name"]: m["es_interval"] for m in d["materials"]}
+    disjoint = iv["metal"][1] < iv["wood"][0] or iv["wood"][1] < iv["metal"][0]
+    assert d["identification"] == ("conflict" if disjoint else "interval")
+    assert load_sensor(tmp_path / "robot.yaml").provenance["materials_fitted"] == ["metal", "wood"]

@@ -2,7 +2,9 @@
 
 Answered from the shipped tables in milliseconds (this module and the table
 path import neither scikit-learn nor matplotlib), or with ``--exact`` computed
-for the one pair and scene.
+for the one pair and scene. With ``--thickness`` the object is a slab on a
+``--backing`` and the question is computed for that scene
+(:mod:`designkit.thin_query`).
 """
 
 from __future__ import annotations
@@ -27,6 +29,33 @@ RepeatsQ = Annotated[int, typer.Option("--repeats", help="--exact: seeds per eva
 SeedQ = Annotated[int, typer.Option("--seed", help="--exact: random seed.")]
 WidthQ = Annotated[float, typer.Option("--width", help="--exact: class width [J s^-1/2 K^-1 m^-2] around each effusivity.")]
 JobsQ = Annotated[int, typer.Option("--jobs", "-j", help="--exact: worker processes (-1: all cores).")]
+ThicknessQ = Annotated[Optional[float], typer.Option(
+    "--thickness", help="Object thickness \\[m] (e.g. 0.003 for a 3 mm sheet): answer for a slab of this thickness "
+                        "lying on --backing, computed on demand like --exact (the tables assume semi-infinite "
+                        "objects); says whether a semi-infinite table would have held.")]
+BackingQ = Annotated[Optional[str], typer.Option(
+    "--backing", help="With --thickness: what the slab lies on: table (default: a hardwood table top), insulated "
+                      "(nothing), air, steel, wood, or a material name.")]
+DiffusivityQ = Annotated[Optional[float], typer.Option(
+    "--diffusivity", help="With --thickness: diffusivity \\[m^2/s] of the objects given as numbers (--e1/--e2/--e); "
+                          "materials take theirs from the database.")]
+
+
+def _thin(question: str, thickness, backing, diffusivity, e1, e2, m1, m2, width, **kw):
+    """A question with --thickness: computed for the slab scene by designkit.thin_query."""
+    from .. import thin_query
+
+    o1, o2 = thin_query.slab_objects(e1, e2, m1, m2, diffusivity_m2_s=diffusivity, width=width)
+    fn = {"min-contact": thin_query.thin_min_contact, "max-noise": thin_query.thin_max_noise,
+          "min-delta-t": thin_query.thin_min_delta_t, "distinguishable": thin_query.thin_distinguishable}[question]
+    return fn(o1, o2, thickness_m=thickness, backing=backing, **kw), {"e1": o1.label, "e2": o2.label}
+
+
+def _slab_options(thickness, backing, diffusivity) -> None:
+    from .._validation import InputError
+
+    if thickness is None and (backing is not None or diffusivity is not None):
+        raise InputError("--backing and --diffusivity describe a thin sample: give its --thickness too")
 
 
 def _sides(e1, e2, m1, m2, *, exact: bool, width: float) -> tuple[Optional[float], Optional[float], Any, dict]:
@@ -92,6 +121,9 @@ def _source_line(con, d):
                   f"{d['inputs'].get('trials')} trials per class{f', {wall:.1f} s' if wall else ''})[/]")
     if d.get("note"):
         con.print(f"  [yellow]{d['note']}[/]")
+    slab = d["extra"].get("slab")
+    if slab:
+        con.print(f"  {'[dim]' if slab['holds'] else '[yellow]'}{slab['message']}[/]")
 
 
 def _common(d: dict) -> dict:
@@ -102,7 +134,8 @@ def _common(d: dict) -> dict:
             "noise_c": inp.get("noise_c"), "delta_t_c": inp.get("delta_t_c"),
             "contact_s": inp.get("contact_s"), "threshold": inp["threshold"],
             "fidelity": d["extra"].get("fidelity", "svm"), "sensor": inp.get("sensor"),
-            "in_grid": d["in_grid"], "note": d["note"], "inputs": inp, "details": d["extra"]}
+            "in_grid": d["in_grid"], "note": d["note"], "slab": d["extra"].get("slab"), "inputs": inp,
+            "details": d["extra"]}
 
 
 # ============================================================ min-contact
@@ -113,13 +146,20 @@ def min_contact_cmd(
     exact: Exact = False, table: TableOpt = "svm-paper", ideal_table: IdealTableOpt = "ideal-paper",
     trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
     max_contact: Annotated[float, typer.Option("--max-contact", help="--exact: longest contact time to consider [s].")] = 10.0,
+    thickness: ThicknessQ = None, backing: BackingQ = None, diffusivity: DiffusivityQ = None,
     json_: Json = False,
 ) -> None:
     """Shortest contact time that separates two materials (e.g. --e1 35000 --e2 20000)."""
     from .. import query
 
-    v1, v2, ranges, labels = _sides(e1, e2, m1, m2, exact=exact, width=width)
-    if exact:
+    _slab_options(thickness, backing, diffusivity)
+    v1, v2, ranges, labels = ((None, None, None, {}) if thickness is not None
+                              else _sides(e1, e2, m1, m2, exact=exact, width=width))
+    if thickness is not None:
+        ans, labels = _thin("min-contact", thickness, backing, diffusivity, e1, e2, m1, m2, width, noise_c=noise,
+                            delta_t_c=delta_t, threshold=threshold, sensor=sensor, trials=trials, seed=seed,
+                            repeats=repeats, jobs=jobs, max_contact_s=max_contact)
+    elif exact:
         ans = query.exact_min_contact(v1, v2, noise_c=noise, delta_t_c=delta_t, threshold=threshold, sensor=sensor,
                                       width=width, trials=trials, folds=3, seed=seed, repeats=repeats, jobs=jobs,
                                       max_contact_s=max_contact, ranges=ranges)
@@ -157,13 +197,20 @@ def max_noise_cmd(
     contact: ContactQ = 2.0, delta_t: DeltaTQ = 10.0, threshold: Threshold = 0.9, sensor: SensorOpt = "paper",
     exact: Exact = False, table: TableOpt = "svm-paper", ideal_table: IdealTableOpt = "ideal-paper",
     trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
+    thickness: ThicknessQ = None, backing: BackingQ = None, diffusivity: DiffusivityQ = None,
     json_: Json = False,
 ) -> None:
     """Largest sensor noise at which a contact time still separates two materials."""
     from .. import query
 
-    v1, v2, ranges, labels = _sides(e1, e2, m1, m2, exact=exact, width=width)
-    if exact:
+    _slab_options(thickness, backing, diffusivity)
+    v1, v2, ranges, labels = ((None, None, None, {}) if thickness is not None
+                              else _sides(e1, e2, m1, m2, exact=exact, width=width))
+    if thickness is not None:
+        ans, labels = _thin("max-noise", thickness, backing, diffusivity, e1, e2, m1, m2, width, contact_s=contact,
+                            delta_t_c=delta_t, threshold=threshold, sensor=sensor, trials=trials, seed=seed,
+                            repeats=repeats, jobs=jobs)
+    elif exact:
         ans = query.exact_max_noise(v1, v2, contact_s=contact, delta_t_c=delta_t, threshold=threshold, sensor=sensor,
                                     width=width, trials=trials, seed=seed, repeats=repeats, jobs=jobs, ranges=ranges)
     else:
@@ -178,13 +225,20 @@ def min_delta_t_cmd(
     contact: ContactQ = 2.0, noise: NoiseQ = 0.05, threshold: Threshold = 0.9, sensor: SensorOpt = "paper",
     exact: Exact = False, table: TableOpt = "svm-paper", ideal_table: IdealTableOpt = "ideal-paper",
     trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
+    thickness: ThicknessQ = None, backing: BackingQ = None, diffusivity: DiffusivityQ = None,
     json_: Json = False,
 ) -> None:
     """Smallest sensor-object temperature difference that separates two materials."""
     from .. import query
 
-    v1, v2, ranges, labels = _sides(e1, e2, m1, m2, exact=exact, width=width)
-    if exact:
+    _slab_options(thickness, backing, diffusivity)
+    v1, v2, ranges, labels = ((None, None, None, {}) if thickness is not None
+                              else _sides(e1, e2, m1, m2, exact=exact, width=width))
+    if thickness is not None:
+        ans, labels = _thin("min-delta-t", thickness, backing, diffusivity, e1, e2, m1, m2, width, contact_s=contact,
+                            noise_c=noise, threshold=threshold, sensor=sensor, trials=trials, seed=seed,
+                            repeats=repeats, jobs=jobs)
+    elif exact:
         ans = query.exact_min_delta_t(v1, v2, contact_s=contact, noise_c=noise, threshold=threshold, sensor=sensor,
                                       width=width, trials=trials, seed=seed, repeats=repeats, jobs=jobs, ranges=ranges)
     else:
@@ -220,12 +274,14 @@ def delta_e_cmd(
     contact: ContactQ = 2.0, noise: NoiseQ = 0.05, delta_t: DeltaTQ = 10.0, threshold: Threshold = 0.9,
     sensor: SensorOpt = "paper", exact: Exact = False, table: TableOpt = "svm-paper",
     ideal_table: IdealTableOpt = "ideal-paper", trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0,
-    width: WidthQ = 80.0, jobs: JobsQ = -1, json_: Json = False,
+    width: WidthQ = 80.0, jobs: JobsQ = -1,
+    thickness: ThicknessQ = None, backing: BackingQ = None, diffusivity: DiffusivityQ = None, json_: Json = False,
 ) -> None:
     """Smallest distinguishable effusivity difference delta(e), towards lower and higher effusivity."""
     from .. import query
     from .._validation import InputError
 
+    _slab_options(thickness, backing, diffusivity)
     if (e is None) == (m is None):
         raise InputError("give the reference as --e NUMBER or --m MATERIAL")
     label = f"{e:g}" if e is not None else m
@@ -235,7 +291,14 @@ def delta_e_cmd(
         mat = get_material(m)
         e = 0.5 * (mat.effusivity_range[0] + mat.effusivity_range[1])
         label = f"{mat.name} (midpoint {e:.0f})"
-    if exact:
+    if thickness is not None:
+        from .. import thin_query
+
+        ans = thin_query.thin_delta_e(e, thickness_m=thickness, diffusivity_m2_s=diffusivity, material=m,
+                                      backing=backing, contact_s=contact, noise_c=noise, delta_t_c=delta_t,
+                                      threshold=threshold, sensor=sensor, width=width, trials=trials, seed=seed,
+                                      repeats=repeats, jobs=jobs, label=label)
+    elif exact:
         ans = query.exact_delta_e(e, contact_s=contact, noise_c=noise, delta_t_c=delta_t, threshold=threshold,
                                   sensor=sensor, width=width, trials=trials, seed=seed, repeats=repeats, jobs=jobs)
     else:
@@ -271,13 +334,20 @@ def distinguishable_cmd(
     contact: ContactQ = 2.0, noise: NoiseQ = 0.05, delta_t: DeltaTQ = 10.0, threshold: Threshold = 0.9,
     sensor: SensorOpt = "paper", exact: Exact = False, table: TableOpt = "svm-paper",
     ideal_table: IdealTableOpt = "ideal-paper", trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0,
-    width: WidthQ = 80.0, jobs: JobsQ = -1, json_: Json = False,
+    width: WidthQ = 80.0, jobs: JobsQ = -1,
+    thickness: ThicknessQ = None, backing: BackingQ = None, diffusivity: DiffusivityQ = None, json_: Json = False,
 ) -> None:
     """Whether a scene separates two materials, with the SVM's and the ideal observer's F1."""
     from .. import query
 
-    v1, v2, ranges, labels = _sides(e1, e2, m1, m2, exact=exact, width=width)
-    if exact:
+    _slab_options(thickness, backing, diffusivity)
+    v1, v2, ranges, labels = ((None, None, None, {}) if thickness is not None
+                              else _sides(e1, e2, m1, m2, exact=exact, width=width))
+    if thickness is not None:
+        ans, labels = _thin("distinguishable", thickness, backing, diffusivity, e1, e2, m1, m2, width,
+                            contact_s=contact, noise_c=noise, delta_t_c=delta_t, threshold=threshold, sensor=sensor,
+                            trials=trials, seed=seed, repeats=repeats, jobs=jobs)
+    elif exact:
         ans = query.exact_distinguishable(v1, v2, contact_s=contact, noise_c=noise, delta_t_c=delta_t,
                                           threshold=threshold, sensor=sensor, width=width, trials=trials, seed=seed,
                                           repeats=repeats, jobs=jobs, ranges=ranges)

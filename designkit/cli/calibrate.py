@@ -164,7 +164,15 @@ def _record_payload(rec, paths, out: Path, interrupted: bool) -> dict:
     }
 
 
+def _interval(ci) -> str:
+    lo, hi = ci
+    if not (math.isfinite(lo) and math.isfinite(hi)):
+        return ""
+    return f"[{lo:.3g}, {'∞' if hi > 1e9 else f'{hi:.3g}'}]"
+
+
 def _print_fit(result, out: Optional[Path], plot: Optional[Path]) -> None:
+    from rich.markup import escape
     from rich.table import Table
 
     from ..calibration.fit import PAPER_ALPHA_S, PAPER_E_S
@@ -183,31 +191,31 @@ def _print_fit(result, out: Optional[Path], plot: Optional[Path]) -> None:
     for c in ("parameter", "value", "± std. error", "95 % interval", "paper"):
         t.add_column(c, justify="right" if c != "parameter" else "left")
     e, a, tau, off = result.effusivity, result.diffusivity_m2_s, result.tau_s, result.time_offset_s
-    t.add_row("e_s [J s^-1/2 K^-1 m^-2]", f"{e.value:.4g}{flag(e)}", f"{e.std_error:.3g}", ci(e, ".4g"),
+    t.add_row(escape("e_s [J s^-1/2 K^-1 m^-2]"), f"{e.value:.4g}{flag(e)}", f"{e.std_error:.3g}", ci(e, ".4g"),
               f"{PAPER_E_S:g}")
-    t.add_row("alpha_s [m^2/s]", f"{a.value:.4g}{flag(a)}", f"{a.std_error:.3g}", ci(a, ".4g"),
+    t.add_row(escape("alpha_s [m^2/s]"), f"{a.value:.4g}{flag(a)}", f"{a.std_error:.3g}", ci(a, ".4g"),
               f"{PAPER_ALPHA_S:g}")
-    t.add_row(f"tau = x^2/(4 alpha_s) [s], x = {result.depth_m * 1e6:g} um", f"{tau.value:.4g}{flag(tau)}",
+    t.add_row(escape(f"tau = x^2/(4 alpha_s) [s], x = {result.depth_m * 1e6:g} um"), f"{tau.value:.4g}{flag(tau)}",
               f"{tau.std_error:.3g}", ci(tau, ".4g"), "")
-    t.add_row("time offset of contact [s]", f"{off.value:+.3f}{flag(off)}", f"{off.std_error:.3g}",
+    t.add_row(escape("time offset of contact [s]"), f"{off.value:+.3f}{flag(off)}", f"{off.std_error:.3g}",
               ci(off, "+.3f"), "")
     con.print(t)
     m = Table(title="Materials", title_justify="left")
-    for c in ("material", "trials", "range", "e_o fitted", "e_o / e_s", "e_s allowed", "object temp.",
+    for c in ("material", "trials", "range", "e_o fitted", "e_o / e_s [95 %]", "e_s allowed", "object temp.",
               "residual RMS"):
-        m.add_column(c, justify="left" if c in ("material", "object temp.") else "right")
+        m.add_column(escape(c), justify="left" if c in ("material", "object temp.") else "right")
     for mf in result.materials:
         eo = "not identified" if mf.effusivity is None else f"{mf.effusivity.value:.4g}{flag(mf.effusivity)}"
-        rho = "–" if mf.ratio is None else f"{mf.ratio.value:.4g} ± {mf.ratio.std_error:.2g}"
+        rho = "–" if mf.ratio is None else f"{mf.ratio.value:.4g} {_interval(mf.ratio.ci95)}"
         allowed = "–" if mf.es_interval is None else f"{mf.es_interval[0]:.4g} – {mf.es_interval[1]:.4g}"
-        m.add_row(mf.name, str(mf.n_trials), f"{mf.range.e_min:.4g} – {mf.range.e_max:.4g}", eo, rho, allowed,
-                  mf.object_temp, f"{mf.rms_c:.4f} °C")
+        m.add_row(escape(mf.name), str(mf.n_trials), f"{mf.range.e_min:.4g} – {mf.range.e_max:.4g}", eo,
+                  escape(rho), allowed, mf.object_temp, f"{mf.rms_c:.4f} °C")
     con.print(m)
     con.print(f"noise sigma before contact {result.noise_c:.4g} °C; overall residual RMS {result.rms_c:.4f} °C; "
               f"sample rate {result.sample_rate_hz:.4g} Hz")
     con.print(f"[dim]uncertainty: {result.uncertainty_method}[/]")
     for note in result.notes:
-        con.print(f"[yellow]note:[/] {note}")
+        con.print(f"[yellow]note:[/] {escape(note)}")
     if out is not None:
         con.print(f"wrote {out}  (use it with --sensor {out})")
     if plot is not None:

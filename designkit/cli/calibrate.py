@@ -432,7 +432,7 @@ def emulate(
             eo = m.identified if m.identified is not None else math.sqrt(m.e_min * m.e_max)
             mats.append(EmulatedMaterial(m.name, eo, object_temp))
     if e is not None:
-        mats.append(EmulatedMaterial(f"e={e:g}", e, object_temp))
+        mats.append(EmulatedMaterial("object", e, object_temp))
     if not mats:
         raise InputError("give --material NAME (or LABEL=E) or --e E: what should the rig touch?")
     if duration is not None and not duration > 0:

@@ -184,11 +184,13 @@ def _interp_e(row: np.ndarray, centres: np.ndarray, e: float) -> float:
         return float(row[0])
     if e >= centres[-1]:
         return float(row[-1])
-    j = int(np.searchsorted(centres, e) - 1)
+    j = int(np.searchsorted(centres, e, side="right") - 1)  # centres[j] <= e < centres[j + 1]
     a, b = row[j], row[j + 1]
+    w = (e - centres[j]) / (centres[j + 1] - centres[j])
+    if w == 0.0:  # on a grid point: its own value, whatever the neighbour holds
+        return float(a)
     if math.isnan(a) or math.isnan(b):
         return math.nan
-    w = (e - centres[j]) / (centres[j + 1] - centres[j])
     return float(a + w * (b - a))
 
 

@@ -484,9 +484,6 @@ def test_tiny_table_verdicts_just_off_grid_points_are_the_closed_form(tmp_path):
         assert got == want, where
 
 
-@pytest.mark.xfail(strict=True, reason="bug in designkit.query._interp_e (reported): at an effusivity exactly on a "
-                                       "grid centre it interpolates from the left neighbour with weight 0, and a "
-                                       "NaN there (no partner in the grid) poisons the answer")
 def test_tiny_table_verdicts_at_grid_points_are_the_closed_form(tmp_path):
     ratios, contacts = (0.002, 0.005, 0.01), (0.5, 1.0, 2.0)
     tab, cfg = _tiny_table(tmp_path, "tiny", ratios, contacts)
@@ -494,8 +491,6 @@ def test_tiny_table_verdicts_at_grid_points_are_the_closed_form(tmp_path):
     assert not wrong
 
 
-@pytest.mark.xfail(strict=True, reason="bug in designkit.query._interp_e (reported): see above; minimal "
-                                       "reproduction on the shipped ideal table")
 def test_shipped_table_answer_does_not_jump_at_a_grid_centre(ideal_table):
     from designkit import query
 

@@ -153,8 +153,8 @@ class CostCurve:
 
     ``cost ~ x^p`` with ``p`` from a least-squares line through
     ``(log x, log cost)``. ``peak_mb`` is each point's peak resident set above
-    the resident set at its start (Linux's resettable high-water mark; NaN
-    where unavailable); ``base_mb`` the largest resident set at a start.
+    the resident set of its process after imports (Linux's resettable
+    high-water mark; NaN where unavailable); ``base_mb`` that baseline.
     """
 
     name: str
@@ -569,7 +569,7 @@ def grid_rows(quick: bool = True, coarse: Sequence[int] = (125, 250, 500),
 def delta_rows(quick: bool = True, seed: int = 0,
                progress: Callable[[str], None] | None = None) -> list[Row]:
     """Staircase search against the full matrix (SVM), and grid coarseness (ideal)."""
-    sizes = (20,) if quick else (20, 40)
+    sizes = (16,) if quick else (20, 40)
     rows = []
     for n in sizes:
         if progress:
@@ -1135,13 +1135,16 @@ def process_cost(cmd: Sequence[str], *, env: Mapping[str, str] | None = None, ti
 
 
 def cost_curve(name: str, variable: str, values: Sequence[float], base: Mapping[str, Any],
-               setting: str = "") -> CostCurve:
+               setting: str = "", relative_to_mb: float | None = None) -> CostCurve:
     """Run the engine on one scene point for each value of ``variable`` and fit the exponents.
 
     ``variable`` is a :class:`~designkit.engine.SweepConfig` field (``intervals``,
     ``trials``), ``contact_s`` (one contact time of that length) or ``contacts``
     (that many contact times from 0.5 s to 10 s, swept with warm starts).
     Each point is ``run_scene`` + ``assemble`` (what a sweep does per scene).
+    Memory: each point's peak resident set above ``relative_to_mb`` (the
+    process after its imports, see :func:`cost_curves`), else above the
+    resident set when the point started.
     """
     from .engine import SweepConfig, assemble, run_scene
 
@@ -1166,6 +1169,8 @@ def cost_curve(name: str, variable: str, values: Sequence[float], base: Mapping[
         walls.append(wall)
         fits.append(int(sum(c.fits for c in chunks)))
         peaks.append(math.nan if peak is None else peak)
+        if relative_to_mb is not None and peak is not None:
+            above = max(peak - relative_to_mb, 0.0)
         extra.append(math.nan if above is None else above)
     svm = base.get("fidelity") == "svm"
     mem = np.asarray(extra)
@@ -1178,21 +1183,37 @@ def cost_curve(name: str, variable: str, values: Sequence[float], base: Mapping[
     return CostCurve(
         name=name, variable=variable, fidelity=str(base.get("fidelity")), x=tuple(xs), wall_s=tuple(walls),
         fits=tuple(fits), peak_mb=tuple(float(m) for m in mem),
-        base_mb=float(np.nanmax(np.asarray(peaks) - mem)) if np.isfinite(mem).any() else math.nan,
+        base_mb=float(relative_to_mb) if relative_to_mb is not None else
+        (float(np.nanmax(np.asarray(peaks) - mem)) if np.isfinite(mem).any() else math.nan),
         time_exponent=fit_exponent(xs, walls),
         fits_exponent=fit_exponent(xs, fits) if svm else None,
         memory_exponent=fit_exponent(np.asarray(xs)[usable], mem[usable]) if np.count_nonzero(usable) >= 2 else None,
         setting=setting, note=note)
 
 
-def cost_curves(quick: bool = True, seed: int = 0,
+def _curve_in_fresh_process(name, variable, values, base, setting) -> CostCurve:
+    """Body of :func:`cost_curves` in a child: warm up, take the baseline, run the curve."""
+    from .engine import SweepConfig, assemble, run_scene
+
+    warm = SweepConfig(**{**base, "intervals": 4, "trials": 6, "contact_s": (0.5,)})
+    assemble(warm, run_scene(warm))  # imports, BLAS and libsvm loaded before the baseline
+    import gc
+
+    gc.collect()
+    return cost_curve(name, variable, values, base, setting, relative_to_mb=_proc_status_mb("VmRSS"))
+
+
+def cost_curves(quick: bool = True, seed: int = 0, *, isolated: bool = True,
                 progress: Callable[[str], None] | None = None) -> list[CostCurve]:
     """Wall time, SVM fits and peak memory of the engine against the size of the work.
 
     Ideal fidelity for the big ranges (intervals up to 2000-4000, up to 16
     contact times), SVM on small ones (intervals, trials per interval,
     contact time). One scene point each (sigma/dT 0.005); a whole table
-    multiplies by the number of scene points.
+    multiplies by the number of scene points. With ``isolated`` each curve
+    runs in a fresh process, and its memory is the peak resident set above
+    that process's resident set after imports (the points run in increasing
+    order, so each peak is that point's).
     """
     ideal = dict(name="bench", fidelity="ideal", noise_ratio=(PAPER_RATIO,), contact_s=(2.0,), seed=seed)
     svm = dict(name="bench", fidelity="svm", noise_ratio=(PAPER_RATIO,), contact_s=(1.0,), seed=seed,
@@ -1221,7 +1242,15 @@ def cost_curves(quick: bool = True, seed: int = 0,
     for name, var, values, base, setting in specs:
         if progress:
             progress(f"cost curve: {name}")
-        out.append(cost_curve(name, var, values, base, setting))
+        if isolated:
+            import multiprocessing as mp
+            from concurrent.futures import ProcessPoolExecutor
+
+            # a fresh process per curve: its resident set holds nothing but the curve's own work
+            with ProcessPoolExecutor(max_workers=1, mp_context=mp.get_context("spawn")) as ex:
+                out.append(ex.submit(_curve_in_fresh_process, name, var, values, base, setting).result())
+        else:
+            out.append(cost_curve(name, var, values, base, setting))
     return out
 
 
@@ -1347,15 +1376,20 @@ def _fmt_time(s: float) -> str:
     return f"{s:.3g} s"
 
 
+def _cell(text: Any) -> str:
+    """A markdown table cell: pipes escaped (metrics like |t - t_exact| contain them)."""
+    return str(text).replace("|", "\\|")
+
+
 def rows_markdown(rows: Sequence[Row]) -> str:
-    """Markdown table of rows."""
-    head = "| question | method | setting | metric | p95 / value | worst | time per answer | reference | " \
+    """Markdown table of rows (one question's rows: the question is the section heading)."""
+    head = "| method | setting | metric | p95 / value | worst | time per answer | reference | " \
            "reference time | speed-up | n | note |"
-    lines = [head, "|" + "---|" * 12]
+    lines = [head, "|" + "---|" * 11]
     for r in rows:
-        lines.append(f"| {r.question} | {r.method} | {r.setting} | {r.metric} | {_fmt(r.error, 3)} | "
-                     f"{_fmt(r.worst, 3)} | {_fmt_time(r.wall_s)} | {r.reference} | {_fmt_time(r.reference_wall_s)} | "
-                     f"{_fmt(r.speedup, 3)} | {r.n} | {r.note} |")
+        cells = [r.method, r.setting, r.metric, _fmt(r.error, 3), _fmt(r.worst, 3), _fmt_time(r.wall_s), r.reference,
+                 _fmt_time(r.reference_wall_s), _fmt(r.speedup, 3), r.n, r.note]
+        lines.append("| " + " | ".join(_cell(c) for c in cells) + " |")
     return "\n".join(lines)
 
 
@@ -1365,7 +1399,7 @@ def curves_markdown(curves: Sequence[CostCurve]) -> str:
              "time exponent | fits exponent | memory exponent | note |", "|" + "---|" * 10]
     for c in curves:
         lines.append(
-            f"| {c.name} | {c.setting} | {', '.join(f'{x:g}' for x in c.x)} | "
+            f"| {_cell(c.name)} | {_cell(c.setting)} | {', '.join(f'{x:g}' for x in c.x)} | "
             f"{', '.join(f'{w:.3g}' for w in c.wall_s)} | {', '.join(str(f) for f in c.fits)} | "
             f"{', '.join(f'{m:.1f}' for m in c.peak_mb)} (process at {c.base_mb:.0f}) | {_fmt(c.time_exponent, 3)} | "
             f"{_fmt(c.fits_exponent, 3) if c.fits_exponent is not None else '—'} | "
@@ -1380,6 +1414,8 @@ def plot_pareto(report: BenchReport, path) -> Any:
     from .figures import pyplot
 
     plt = pyplot()
+    from matplotlib.ticker import NullFormatter
+
     groups: dict[str, list[Row]] = {}
     for r in report.rows:
         groups.setdefault(r.question, []).append(r)
@@ -1400,20 +1436,29 @@ def plot_pareto(report: BenchReport, path) -> Any:
                        marker="o" if all(r.error > 0 for r in sel) else "v")
             for r, x, y in zip(sel, xs, ys):
                 ax.annotate(r.setting[:22], (x, y), fontsize=5.5, xytext=(3, 2), textcoords="offset points")
-        refs = {(r.reference, r.reference_wall_s) for r in rows if math.isfinite(r.reference_wall_s)}
-        for _, t in refs:
-            ax.axvline(t, color="grey", lw=0.6, ls=":")
+        refs: dict[str, float] = {}
+        for r in rows:
+            if math.isfinite(r.reference_wall_s):
+                refs.setdefault(r.reference, r.reference_wall_s)
+        for k, (name, t) in enumerate(refs.items()):
+            ax.scatter([t], [floor], marker="*", s=70, color="k", zorder=4,
+                       label="reference" if k == 0 else None)
+            ax.annotate(name[:26], (t, floor), fontsize=5.5, xytext=(3, 4), textcoords="offset points",
+                        color="0.3")
         ax.set_xscale("log")
         ax.set_yscale("log")
+        ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.yaxis.set_minor_formatter(NullFormatter())
         ax.set_title(question, fontsize=9)
-        ax.set_xlabel("time per answer [s] (dotted: reference)", fontsize=7)
+        ax.set_xlabel("time per answer [s]", fontsize=7)
         ax.set_ylabel(rows[0].metric[:48], fontsize=7)
         ax.tick_params(labelsize=7)
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=5.5, loc="best")
     for ax in axes.ravel()[k:]:
         ax.set_visible(False)
-    fig.suptitle("designkit: error against run time (▼: error 0, drawn at the panel's floor)", fontsize=10)
+    fig.suptitle("designkit: error against run time per answer (★ reference, drawn at the panel's floor; "
+                 "▼ error 0)", fontsize=10)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=110)
@@ -1498,7 +1543,7 @@ def render_markdown(report: BenchReport, figures: Mapping[str, str] | None = Non
         for q in ("min-contact", "max-noise", "min-delta-t", "delta-e"):
             if q in mc:
                 d = mc[q]
-                out.append(f"| `{q}` | {d['metric']} | {_fmt(d['median'], 3)} | {_fmt(d['p95'], 3)} | "
+                out.append(f"| `{q}` | {_cell(d['metric'])} | {_fmt(d['median'], 3)} | {_fmt(d['p95'], 3)} | "
                            f"{_fmt(d['worst'], 3)} |")
         if "min-contact" in mc and "relative_p95" in mc["min-contact"]:
             d = mc["min-contact"]
@@ -1516,6 +1561,35 @@ def render_markdown(report: BenchReport, figures: Mapping[str, str] | None = Non
         out += ["",
                 f"A table query takes {_fmt_time(mc.get('time_per_table_query_s', math.nan))} in-process with the "
                 "table loaded (see `benchmarks/bench_query.py` for the fresh-shell time).", ""]
+        unres = mc.get("unresolved_fraction")
+        if "min-contact" in mc and "by_gap" in mc["min-contact"]:
+            out += ["**Where the error comes from.** A table's delta(e) is a whole number of effusivity intervals "
+                    f"(80 wide for the shipped tables): the first interval that is distinguishable. For pairs only a "
+                    "few intervals apart this rounding dominates, and because delta falls slowly with contact at "
+                    "long contacts, a fraction of an interval becomes seconds of contact time. The error by the "
+                    "pair's distance:", "",
+                    "| distance [intervals] | pairs | with a table answer | `min-contact` median [s] | p95 [s] | "
+                    "worst [s] | `max-noise` median | p95 |",
+                    "|---|---|---|---|---|---|---|---|"]
+            mn = {tuple(b["gap_intervals"]): b for b in mc.get("max-noise", {}).get("by_gap", [])}
+            for b in mc["min-contact"]["by_gap"]:
+                a_, z_ = b["gap_intervals"]
+                m = mn.get((a_, z_), {})
+                out.append(f"| {a_:g} – {'∞' if not math.isfinite(z_) else f'{z_:g}'} | {b['pairs']} | "
+                           f"{b['answered']} | {_fmt(b['median'], 3)} | {_fmt(b['p95'], 3)} | {_fmt(b['worst'], 3)} | "
+                           f"{_fmt(m.get('median', math.nan), 3)} | {_fmt(m.get('p95', math.nan), 3)} |")
+            cons = mc["min-contact"].get("conservative_fraction")
+            out += ["",
+                    f"The table errs on the safe side: its `min-contact` was at or above the exact answer for "
+                    f"{100 * cons:.0f} % of the pairs" + (
+                        f" and its `max-noise` at or below for {100 * mc['max-noise']['conservative_fraction']:.0f} %"
+                        if "conservative_fraction" in mc.get("max-noise", {}) else "") +
+                    ". Pairs closer than one interval cannot be resolved by a table at all: "
+                    + (f"{100 * unres:.0f} % of the random boundary pairs drawn were (they were drawn again; "
+                       "use `--exact` for such pairs). " if unres is not None and math.isfinite(unres) else "")
+                    + "A second, smaller source is linear interpolation in contact time of a need that is convex in "
+                    "it, and a neighbouring grid point with no answer (beyond the grid), which makes the query fall "
+                    "back to the next grid point.", ""]
     if svm:
         s = f[f"queries:{svm}"]
         mcs = s.get("min-contact-summary", {})
@@ -1571,8 +1645,9 @@ def render_markdown(report: BenchReport, figures: Mapping[str, str] | None = Non
     if report.curves:
         out += ["## The sweep's cost curve", "",
                 "One scene point; a table costs this times its number of scene points. Exponents are "
-                "least-squares slopes of log cost against log size. Memory: each point's peak resident set above "
-                "the resident set when it started (Linux's resettable high-water mark).", ""]
+                "least-squares slopes of log cost against log size. Memory: each point's peak resident set (Linux's "
+                "resettable high-water mark) above the resident set of a fresh process after its imports; each "
+                "curve runs in its own process, points in increasing order.", ""]
         if "cost" in figures:
             out += [f"![cost curves]({figures['cost']})", ""]
         out += [curves_markdown(report.curves), ""]

@@ -268,6 +268,8 @@ class _Rows:
     trial: np.ndarray      # trial per row (-1 when rows are sums over trials)
     const: float           # sum of squares the compression took out
     n_samples: float       # samples represented (with multiplicity)
+    t_unique: np.ndarray   # distinct times (trials share a time grid: the shape is computed once per time)
+    t_index: np.ndarray    # row -> index into t_unique
 
 
 def _rows(data: _Data, weights: np.ndarray | None = None, *, compress: bool = True) -> _Rows:
@@ -305,8 +307,9 @@ def _rows(data: _Data, weights: np.ndarray | None = None, *, compress: bool = Tr
         sw = np.sqrt(ks[fr])
         parts.append((data.t[fr], data.mat[data.trial][fr], sw, sw * dev[fr], ginv, data.trial[fr]))
     cols = [np.concatenate([p[j] for p in parts]) for j in range(6)]
+    t_u, t_inv = np.unique(cols[0], return_inverse=True)
     return _Rows(cols[0], cols[1].astype(np.int64), cols[2], cols[3], cols[4].astype(np.int64), n_groups,
-                 cols[5].astype(np.int64), const, float(np.sum(ks[keep])))
+                 cols[5].astype(np.int64), const, float(np.sum(ks[keep])), t_u, t_inv.astype(np.int64))
 
 
 def _pre_stats(trial: Trial, baseline: str, until_s: float = 0.0) -> tuple[float, float, float, int]:
@@ -387,7 +390,7 @@ class _Problem:
         if self._cache is not None and self._cache[0] == key:
             return self._cache[1]
         rw = self.rows
-        g, g_lt, g_off = _shape(rw.t, math.exp(x[0]), x[1])
+        g, g_lt, g_off = (a[rw.t_index] for a in _shape(rw.t_unique, math.exp(x[0]), x[1]))
         w_m = special.expit(x[2:2 + self.m] - self._les(x))           # e_o / (e_s + e_o)
         w = w_m[rw.mat]
         amp = rw.c * w
@@ -455,7 +458,7 @@ class _Problem:
 
 def _initial_log_rho(rows: _Rows, n_mat: int, tau: float, off: float) -> np.ndarray:
     """Closed-form amplitude fit of each material for a given shape -> log(e_o/e_s)."""
-    g, _, _ = _shape(rows.t, tau, off)
+    g = _shape(rows.t_unique, tau, off)[0][rows.t_index]
     out = np.zeros(n_mat)
     for k in range(n_mat):
         sel = (rows.mat == k) & (rows.group < 0)

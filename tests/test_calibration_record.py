@@ -266,3 +266,21 @@ def test_ctrl_c_keeps_every_trial_recorded(tmp_path):
         _check_trial_against_physics(Path(tr.source), emu, 400.0, 0.05)
     assert not [p for p in out.iterdir() if p.name.startswith(".")]
     assert os.path.getsize(out / "index.csv") > 0
+
+
+def test_index_and_trial_files_are_checked(tmp_path):
+    (tmp_path / "index.csv").write_text("file,material\na.csv,wood\n,wood\n")
+    (tmp_path / "a.csv").write_text("time_s,active_temp_c\n-1,35\n0,35\n1,34\n")
+    with pytest.raises(InputError, match="line 3: empty file or material"):
+        load_index(tmp_path / "index.csv")
+    (tmp_path / "index.csv").write_text("file,material\na.csv,wood\nmissing.csv,wood\n")
+    with pytest.raises(InputError, match="cannot read trial .*missing.csv"):
+        load_index(tmp_path / "index.csv")
+    (tmp_path / "b.csv").write_text("time_s,active_temp_c\n0,35\n-1,35\n1,34\n")
+    with pytest.raises(InputError, match="time_s must increase"):
+        read_trial_csv(tmp_path / "b.csv")
+    (tmp_path / "c.csv").write_text("t,temp\n0,35\n")
+    with pytest.raises(InputError, match="lacks column"):
+        read_trial_csv(tmp_path / "c.csv")
+    tr = read_trial_csv(tmp_path / "a.csv", "wood")  # passive and force channels are optional
+    assert not tr.has_object and np.isnan(tr.force_n).all()

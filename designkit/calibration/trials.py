@@ -205,15 +205,16 @@ def load_index(index_csv: Path, only: Sequence[str] | None = None) -> list[Trial
         raise InputError(f"cannot read index {index_csv}: {exc.strerror or exc}") from None
     if not rows or not {"file", "material"} <= set(rows[0]):
         raise InputError(f"index {index_csv} needs columns file and material")
-    materials = sorted({r["material"] for r in rows})
+    materials = sorted({r["material"] or "" for r in rows})
+    numbered = list(enumerate(rows, start=2))  # CSV line numbers, header = line 1
     if only:
         unknown = [m for m in only if m not in materials]
         if unknown:
             raise InputError(f"--only names material(s) not in {index_csv.name}: {', '.join(unknown)} "
                              f"(it has {', '.join(materials)})")
-        rows = [r for r in rows if r["material"] in set(only)]
+        numbered = [(n, r) for n, r in numbered if r["material"] in set(only)]
     trials = []
-    for line_no, r in enumerate(rows, start=2):
+    for line_no, r in numbered:
         if not r.get("file") or not r.get("material"):
             raise InputError(f"index {index_csv} line {line_no}: empty file or material")
         trials.append(read_trial_csv(index_csv.parent / r["file"], r["material"]))

@@ -708,6 +708,8 @@ _C_HEADER = r'''/*
  * compute in float (for FPUs without double; answers then agree to about 1e-6
  * relative). Needs only <math.h> (link with -lm). All symbols are static: include it
  * in one .c file of a program (each inclusion carries its own copy of the data).
+ * "None within the grid" is stored as -1, not NaN, so -ffast-math keeps the lookups
+ * right; only the detection of NaN arguments (@P@_INVALID) relies on isnan().
  */
 #ifndef @P@_LOOKUP_H_INCLUDED
 #define @P@_LOOKUP_H_INCLUDED

@@ -9,6 +9,7 @@ from . import core  # noqa: E402,F401  simulate, f1
 from . import export  # noqa: E402,F401  export
 from . import materials  # noqa: E402,F401  materials list, materials show
 from . import query  # noqa: E402,F401  min-contact, max-noise, min-delta-t, delta-e, distinguishable
+from . import reproduce  # noqa: E402,F401  reproduce
 from . import sweep  # noqa: E402,F401  sweep
 from . import tables  # noqa: E402,F401  tables list, tables show
 from . import thin  # noqa: E402,F401  validity

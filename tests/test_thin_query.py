@@ -360,10 +360,10 @@ def test_cli_refuses_incomplete_thin_scenes(cli, args, message):
 def test_console_script_distinguishable_with_thickness():
     exe = os.path.join(os.path.dirname(sys.executable), "designkit")
     out = subprocess.run([exe, "distinguishable", "--e1", "583", "--e2", "700", "--diffusivity", "1.2e-7",
-                          "--thickness", "0.0005", "--backing", "steel", "--contact", "1", "--trials", "30",
+                          "--thickness", "0.0003", "--backing", "steel", "--contact", "0.6", "--trials", "30",
                           "--repeats", "1", "--jobs", "1", "--json"],
                          capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr
     d = json.loads(out.stdout)
     assert d["distinguishable"] in (True, False) and 0 <= d["ideal_f1"] <= 1
-    assert d["slab"]["thickness_m"] == 0.0005 and d["inputs"]["objects"][0]["alpha_range_m2_s"] == [1.2e-7, 1.2e-7]
+    assert d["slab"]["thickness_m"] == 0.0003 and d["inputs"]["objects"][0]["alpha_range_m2_s"] == [1.2e-7, 1.2e-7]

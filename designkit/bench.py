@@ -1651,6 +1651,13 @@ def render_markdown(report: BenchReport, figures: Mapping[str, str] | None = Non
         if "cost" in figures:
             out += [f"![cost curves]({figures['cost']})", ""]
         out += [curves_markdown(report.curves), ""]
+    out += ["## Related benchmarks", "",
+            "Scripts in `benchmarks/` measure the performance targets against baselines in the same run:",
+            "`bench_query.py` (a table query from a fresh shell against `python -c pass` and `import numpy`, "
+            "what it imports, in-process time, memory), `bench_exact.py` (`--exact` min-contact for one pair "
+            "against the table), `bench_delta_e.py` (staircase search against the full F1 matrix as the grid "
+            "grows), `bench_memory.py` (peak memory of sweeps and queries), `bench_slab.py` (thin-sample "
+            "solvers, see thin_samples.md) and `bench_export.py` (exported tables).", ""]
     out += ["## Section wall times", "",
             ", ".join(f"{k} {v:.0f} s" for k, v in report.section_wall_s.items()) +
             f"; total {report.wall_s:.0f} s.", ""]

@@ -56,16 +56,25 @@ def main(argv=None):
     print(f"### delta(e) for all references at one scene: sigma/dT {args.noise_ratio:g}, contact "
           f"{args.contact:g} s, {args.trials} trials per interval, (0, 40000]\n")
     print("| intervals | pairs | full matrix: fits | time [s] | staircase: fits | time [s] | fewer fits | "
-          "less time | max delta difference [intervals] | references differing |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+          "less time | max delta difference [intervals] | answers differing | matrix inside the staircase's "
+          "MC interval |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
     for r in rows:
         n = r["intervals"]
         print(f"| {n} | {r['pairs_full']} | {r['fits_full']} | {r['wall_full_s']:.1f} | {r['fits_staircase']} | "
               f"{r['wall_staircase_s']:.1f} | {r['fits_full'] / r['fits_staircase']:.1f}x | "
               f"{r['wall_full_s'] / r['wall_staircase_s']:.1f}x | {r['max_diff_intervals']:g} | "
-              f"{r['n_differ']} of {2 * n} |")
+              f"{r['n_differ']} of {2 * n} | {r['full_in_staircase_interval']} of {n} |")
     ok = all(r["max_diff_intervals"] <= 1 for r in rows)
     print(f"\nSame delta(e) within one interval for every reference and both directions: {ok}.")
+    for r in rows:
+        if r["differing_references"]:
+            print(f"\n{r['intervals']} intervals, references whose first distinguishable partner differs "
+                  f"(J: partner index; [J_lo, J_hi]: the staircase's Monte Carlo interval):\n")
+            print("| reference i | centre | J staircase | J full matrix | J_lo | J_hi |\n|---|---|---|---|---|---|")
+            for d in r["differing_references"]:
+                print(f"| {d['i']} | {d['e_centre']:.0f} | {d['J_staircase']} | {d['J_full']} | {d['J_lo']} | "
+                      f"{d['J_hi']} |")
     n = np.array([r["intervals"] for r in rows], dtype=float)
     out = {"rows": rows, "same_within_one_interval": ok}
     if len(rows) >= 2:

@@ -1490,11 +1490,17 @@ def plot_costs(report: BenchReport, path) -> Any:
         x = np.asarray(c.x) / c.x[0]
         a1.plot(x, c.wall_s, "o-", color=f"C{i}", ms=3, label=f"{c.name} (p = {c.time_exponent:.2f})")
         mem = np.asarray(c.peak_mb)
-        if np.any(mem > 0):
-            a2.plot(x[mem > 0], mem[mem > 0], "o-", color=f"C{i}", ms=3, label=c.name)
+        ok = np.isfinite(mem) & (mem > 0.5)  # below about 1 MB the high-water mark is noise
+        if np.any(ok):
+            exp = "" if c.memory_exponent is None else f" (p = {c.memory_exponent:.2f})"
+            a2.plot(x[ok], mem[ok], "o-", color=f"C{i}", ms=3, label=c.name + exp)
+    from matplotlib.ticker import NullFormatter
+
     for ax, lab in ((a1, "wall time [s]"), (a2, "peak memory above baseline [MB]")):
         ax.set_xscale("log")
         ax.set_yscale("log")
+        ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.yaxis.set_minor_formatter(NullFormatter())
         ax.set_xlabel("size relative to the curve's first point")
         ax.set_ylabel(lab)
         ax.grid(alpha=0.3, which="both")

@@ -117,10 +117,10 @@ _KIND_MEANING = {
     "ideal": "ideal observer's delta (the bound no classifier can beat)",
 }
 _PREFIX_RE = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,39}$")
-# C: axis edges and single-point axes are matched to float32 precision (query.py uses
-# 1e-12 / isclose(rtol=1e-9) on doubles; a float argument such as 0.2f / 10.0f cannot
-# hit a sigma/dT grid edge of 0.02 more closely than about 1e-7).
-C_EDGE_RTOL = 1e-6
+# A value within this relative distance of a grid value is that grid value (the rule of
+# designkit.query.GRID_RTOL: a float argument such as 0.2f / 10.0f cannot hit a sigma/dT
+# grid value of 0.02 more closely than about 1e-7).
+from .query import GRID_RTOL as C_EDGE_RTOL  # noqa: E402
 
 
 # ============================================================ the sliced data
@@ -270,12 +270,12 @@ def _kept_contacts(contacts: np.ndarray, request) -> list[int]:
 def _kept_centres(centres: np.ndarray, a: float, b: float) -> tuple[int, int]:
     """First and last reference interval needed to interpolate delta(e) like ``_interp_e`` on [a, b].
 
-    ``_interp_e`` uses the centres j, j + 1 with ``centres[j] < e <= centres[j + 1]``
-    (so an ``e`` on a centre also reads the centre below it), clamps at the ends.
+    ``_interp_e`` uses the centres j, j + 1 with ``centres[j] <= e < centres[j + 1]``
+    (an ``e`` on a centre reads that centre only), and clamps at the ends.
     """
     n = centres.size
-    i0 = max(int(np.searchsorted(centres, a, side="left")) - 1, 0)
-    i1 = min(int(np.searchsorted(centres, b, side="right")), n - 1)
+    i0 = max(int(np.searchsorted(centres, a, side="right")) - 1, 0)
+    i1 = min(int(np.searchsorted(centres, b, side="left")), n - 1)
     return i0, i1
 
 
@@ -789,8 +789,20 @@ static inline int @p@_lower_bound_(const @p@_real_ *v, int n, @p@_real_ x)
     return lo;
 }
 
+/* numpy.searchsorted(v, x, side="right"): first i in [0, n] with v[i] > x */
+static inline int @p@_upper_bound_(const @p@_real_ *v, int n, @p@_real_ x)
+{
+    int lo = 0, hi = n;
+    while (lo < hi) {
+        int mid = lo + (hi - lo) / 2;
+        if (v[mid] <= x) lo = mid + 1; else hi = mid;
+    }
+    return lo;
+}
+
 /* Weights of x on axis v (grid g: log(v) or v): 0 outside; else *j and *w with
-   x = (1 - w) at j + w at j + 1 (n == 1: j = 0, w = 0). */
+   x = (1 - w) at j + w at j + 1 (n == 1: j = 0, w = 0). A value within a relative
+   RTOL of a grid value is that grid value (designkit.query.GRID_RTOL). */
 static inline int @p@_axis_(const @p@_real_ *v, const @p@_real_ *g, int n, int logscale,
                              @p@_real_ x, int *j, @p@_real_ *w)
 {
@@ -798,14 +810,19 @@ static inline int @p@_axis_(const @p@_real_ *v, const @p@_real_ *g, int n, int l
     int k;
     *j = 0;
     *w = 0;
-    if (n == 1)
-        return @P@_FABS_(x - v[0]) <= (@p@_real_)1e-8 + @P@_RTOL_ * @P@_FABS_(v[0]);
-    if (x < v[0] * (1 - @P@_RTOL_) || x > v[n - 1] * (1 + @P@_RTOL_))
+    for (k = 0; k < n; k++) {
+        if (@P@_FABS_(x - v[k]) <= @P@_RTOL_ * @P@_FABS_(v[k])) {
+            if (k < n - 1) { *j = k; *w = 0; }
+            else if (n > 1) { *j = n - 2; *w = 1; }
+            return 1;
+        }
+    }
+    if (n == 1 || x < v[0] || x > v[n - 1])
         return 0;
     u = x;
     if (logscale) {
         if (x <= 0 || v[0] <= 0)
-            return x == v[0];
+            return 0;
         u = @P@_LOG_(x);
     }
     k = @p@_lower_bound_(g, n, u) - 1;
@@ -814,11 +831,6 @@ static inline int @p@_axis_(const @p@_real_ *v, const @p@_real_ *g, int n, int l
     ww = (u - g[k]) / (g[k + 1] - g[k]);
     if (ww < 0) ww = 0;
     if (ww > 1) ww = 1;
-    /* a float argument cannot hit a grid value such as 0.005 exactly: take a value within
-       the tolerance as the grid value itself (query.py's NaN rule would otherwise let an
-       infinitesimal weight on the next row decide) */
-    if (@P@_FABS_(x - v[k]) <= @P@_RTOL_ * @P@_FABS_(v[k])) ww = 0;
-    else if (@P@_FABS_(x - v[k + 1]) <= @P@_RTOL_ * @P@_FABS_(v[k + 1])) ww = 1;
     *j = k;
     *w = ww;
     return 1;
@@ -831,11 +843,12 @@ static inline @p@_real_ @p@_interp_e_(const float *row, @p@_real_ e)
     @p@_real_ a, b, w;
     if (e <= @p@_e_ref_[0]) return row[0];
     if (e >= @p@_e_ref_[@NE@ - 1]) return row[@NE@ - 1];
-    j = @p@_lower_bound_(@p@_e_ref_, @NE@, e) - 1; /* e_ref[j] < e <= e_ref[j + 1] */
+    j = @p@_upper_bound_(@p@_e_ref_, @NE@, e) - 1; /* e_ref[j] <= e < e_ref[j + 1] */
     a = row[j];
     b = row[j + 1];
-    if (a < 0 || b < 0) return -1;
     w = (e - @p@_e_ref_[j]) / (@p@_e_ref_[j + 1] - @p@_e_ref_[j]);
+    if (w == 0) return a; /* on a grid point: its own value */
+    if (a < 0 || b < 0) return -1;
     return a + w * (b - a);
 }
 
@@ -1147,6 +1160,8 @@ EXPORT_HASH = PROVENANCE["export_hash"]
 THRESHOLD = PROVENANCE["threshold"]
 FIDELITY = PROVENANCE["fidelity"]
 KIND = PROVENANCE["kind"]
+# a value within this relative distance of a grid value is that value (designkit.query.GRID_RTOL)
+GRID_RTOL = @GRID_RTOL@
 
 # axes: (name, scale, values, grid used for interpolation: log(values) for log axes, from numpy)
 _SCENE = @SCENE@
@@ -1226,13 +1241,14 @@ def _pair(e1, e2):
 def _axis(vals, grid, x, log):
     """designkit.query._axis_weights: [(index, weight)], or None outside."""
     n = len(vals)
-    if n == 1:
-        return [(0, 1.0)] if abs(x - vals[0]) <= 1e-8 + 1e-9 * abs(vals[0]) else None
-    if x < vals[0] * (1 - 1e-12) or x > vals[-1] * (1 + 1e-12):
+    for k, v in enumerate(vals):  # within GRID_RTOL of a grid value: that value
+        if abs(x - v) <= GRID_RTOL * abs(v):
+            return [(k, 1.0)]
+    if n == 1 or x < vals[0] or x > vals[-1]:
         return None
     if log:
         if x <= 0 or vals[0] <= 0:
-            return [(0, 1.0)] if x == vals[0] else None
+            return None
         u = _math.log(x)
     else:
         u = x
@@ -1285,11 +1301,13 @@ def _interp_e(arr, start, e):
         return arr[start]
     if e >= E_REF[-1]:
         return arr[start + _NE - 1]
-    j = _bisect.bisect_left(E_REF, e) - 1
+    j = _bisect.bisect_right(E_REF, e) - 1  # E_REF[j] <= e < E_REF[j + 1]
     a, b = arr[start + j], arr[start + j + 1]
+    w = (e - E_REF[j]) / (E_REF[j + 1] - E_REF[j])
+    if w == 0:  # on a grid point: its own value
+        return a
     if _math.isnan(a) or _math.isnan(b):
         return _math.nan
-    w = (e - E_REF[j]) / (E_REF[j + 1] - E_REF[j])
     return a + w * (b - a)
 
 
@@ -1410,7 +1428,7 @@ def to_python(exp: Exported) -> bytes:
                             f"Export hash: {p['export_hash']}"] + [line.replace("\\", "/") for line in _slice_lines(exp)])
     text = _fill(_PY_MODULE, {
         "TITLE": title, "VERSION": p["designkit_version"], "COMMAND": _regenerate_command(exp, "python", None),
-        "SLICE": slice_text, "PROVENANCE": pprint.pformat(p, width=100, sort_dicts=False),
+        "SLICE": slice_text, "GRID_RTOL": repr(C_EDGE_RTOL), "PROVENANCE": pprint.pformat(p, width=100, sort_dicts=False),
         "SCENE": scene, "CONTACTS": _py_list(exp.contact.values),
         "ADJACENT": repr([bool(x) for x in exp.contact_adjacent]), "CENTRES": _py_list(exp.e_ref.values),
         "E_MIN": repr(exp.e_lo), "E_INCL": repr(bool(exp.e_lo_inclusive)), "E_MAX": repr(exp.e_hi),

@@ -160,16 +160,26 @@ class _View:
         return all(self.e_lo < e <= self.e_hi for e in es)
 
 
+#: A value within this relative distance of a grid value is that grid value. A float32
+#: argument (0.05f / 10.0f, as on a microcontroller) cannot hit 0.005 exactly, and the
+#: exported C and Python lookups use the same rule, so all three answer alike.
+GRID_RTOL = 1e-6
+
+
 def _axis_weights(vals: np.ndarray, x: float, *, log: bool) -> tuple[list[tuple[int, float]], bool]:
-    """Linear (or log-linear) weights of ``x`` between grid values; clamps outside, flagged."""
+    """Linear (or log-linear) weights of ``x`` between grid values; clamps outside, flagged.
+
+    Within :data:`GRID_RTOL` of a grid value, ``x`` is that value (weight 1).
+    """
     n = vals.size
-    if n == 1:
-        return [(0, 1.0)], bool(np.isclose(x, vals[0], rtol=1e-9))
-    if x < vals[0] * (1 - 1e-12) or x > vals[-1] * (1 + 1e-12):
+    near = np.abs(x - vals) <= GRID_RTOL * np.abs(vals)
+    if near.any():
+        return [(int(np.argmax(near)), 1.0)], True
+    if n == 1 or x < vals[0] or x > vals[-1]:
         return [(0 if x < vals[0] else n - 1, 1.0)], False
     if log:
         if x <= 0 or vals[0] <= 0:
-            return [(0, 1.0)], x == vals[0]
+            return [(0, 1.0)], False
         u, grid = math.log(x), np.log(vals)
     else:
         u, grid = x, vals

@@ -210,7 +210,7 @@ def test_query_cli_json_keys(cli, cmd, key):
     (["min-contact", "--e1", "35000"], "two objects"),
     (["distinguishable", "--e1", "1", "--e2", "2", "--contact", "0"], "contact"),
     (["min-contact", "--e1", "1", "--e2", "2", "--table", "/nonexistent/t"], "no table"),
-    (["min-contact", "--e1", "1", "--e2", "2", "--threshold", "0.95"], "threshold"),
+    (["min-contact", "--e1", "1", "--e2", "2", "--table", "ideal-paper", "--threshold", "0.95"], "threshold"),
 ])
 def test_query_cli_bad_input(cli, args, needle):
     r = cli(*args)

@@ -197,6 +197,14 @@ class SimToRealSetup:
     details: dict
 
 
+def _paper_setup(why: str) -> SimToRealSetup:
+    from ..sensor import SENSORS
+
+    return SimToRealSetup(SENSORS["paper"], PAPER_FALLBACK["time_offset_s"], {k: PAPER_FALLBACK[k] for k in CLASSES},
+                          f"the paper's sensor and identified effusivities, heat flow 0.5 s before onset ({why})",
+                          None, None, {})
+
+
 def calibrate(touches: RealTouches, *, seed: int) -> SimToRealSetup:
     """Identify the sensor on the calibration subset (trial sets 1-4) with designkit's calibration.
 
@@ -209,26 +217,30 @@ def calibrate(touches: RealTouches, *, seed: int) -> SimToRealSetup:
         sub = touches.select(np.isin(touches.material, CALIBRATED))
     try:
         from ..calibration.fit import FitSettings, fit_sensor, resolve_ranges
-    except ImportError as exc:
-        from ..sensor import SENSORS
-
-        return SimToRealSetup(SENSORS["paper"], PAPER_FALLBACK["time_offset_s"],
-                              {k: PAPER_FALLBACK[k] for k in CLASSES}, f"paper (calibration unavailable: {exc})",
-                              None, None, {})
+    except ImportError as exc:  # pragma: no cover - calibration ships with designkit
+        return _paper_setup(f"calibration unavailable: {exc}")
     names = sorted(set(sub.material))
-    ranges = resolve_ranges(names, {k: v for k, v in CALIBRATION_RANGES.items() if k in names})
-    res = fit_sensor(list(sub.trials), ranges, settings=FitSettings(bootstrap=0, profile_points=0, seed=seed))
+    try:
+        ranges = resolve_ranges(names, {k: v for k, v in CALIBRATION_RANGES.items() if k in names})
+        res = fit_sensor(list(sub.trials), ranges, settings=FitSettings(bootstrap=0, profile_points=0, seed=seed))
+    except InputError as exc:
+        return _paper_setup(f"calibration failed on these recordings: {exc}")
     eff = {}
     for m in res.materials:
         if m.effusivity is not None and m.object_temp != "free":
             eff[m.name] = float(m.effusivity.value)
     if "wood" in eff:
         eff.setdefault("cold_wood", eff["wood"])  # the same wood, cooled
+    missing = [k for k in CLASSES if k not in eff]
+    for k in missing:  # not identified by the fit: the paper's value for that material
+        eff[k] = PAPER_FALLBACK[k]
     d = res.to_dict()
     d.pop("profile", None)
     return SimToRealSetup(res.sensor(name="calibrated (shared recordings, sets 1-4)"), float(res.time_offset_s.value),
                           eff, "designkit.calibration.fit.fit_sensor on trial sets "
-                          f"{CALIBRATION_SETS[0]}-{CALIBRATION_SETS[-1]} ({sub.material.size} touches)",
+                          f"{CALIBRATION_SETS[0]}-{CALIBRATION_SETS[-1]} ({sub.material.size} touches of "
+                          f"{' and '.join(names)})"
+                          + (f"; the paper's effusivity for {', '.join(missing)}" if missing else ""),
                           float(res.rms_c), float(res.noise_c), d)
 
 

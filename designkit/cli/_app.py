@@ -79,11 +79,19 @@ app = typer.Typer(
 )
 
 
-def sub_app(name: str, help: str) -> typer.Typer:
-    """A command group (``designkit NAME ...``) registered on the main app."""
+# Help panels of ``designkit --help``, in the order a new user needs them.
+ASK = "Ask a design question"
+TABLES = "Lookup tables and embedding"
+SENSOR = "Your sensor"
+MODEL = "Model and sweeps"
+REPORTS = "The paper and accuracy"
+
+
+def sub_app(name: str, help: str, panel: str) -> typer.Typer:
+    """A command group (``designkit NAME ...``) registered on the main app in help ``panel``."""
     group = typer.Typer(cls=_Group, help=help, no_args_is_help=True, add_completion=False,
                         pretty_exceptions_enable=False, rich_markup_mode="markdown")
-    app.add_typer(group, name=name)
+    app.add_typer(group, name=name, rich_help_panel=panel)
     return group
 
 

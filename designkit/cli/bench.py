@@ -8,12 +8,13 @@ from typing import Annotated, List, Optional
 import typer
 
 from ._app import app, console, emit_json
+from . import _app
 from ._options import Json
 
 SECTION_HELP = "Only these sections (repeatable): physics, recognition, delta, queries, cost. Default: all."
 
 
-@app.command("bench")
+@app.command("bench", rich_help_panel=_app.REPORTS)
 def bench_cmd(
     quick: Annotated[bool, typer.Option("--quick", help="Fewer cases and smaller references: a few minutes on 2 cores.")] = False,
     out: Annotated[Optional[Path], typer.Option("--out", help="Folder to write accuracy.md, its figures and accuracy.json into (docs/ for the shipped page).")] = None,

@@ -17,12 +17,14 @@ from typing import Annotated, Any, Optional
 import typer
 
 from ._app import EXIT_INTERRUPTED, app, console, emit_json, sub_app
+from . import _app
 from ._options import Json, Noise, Seed, SensorOpt
 
 calibrate_app = sub_app(
     "calibrate",
     "Calibrate your sensor: record touches over serial ('record'), identify e_s and alpha_s ('fit'), "
     "or both in one guided run ('designkit calibrate --port PORT --material NAME ...').",
+    panel=_app.SENSOR,
 )
 
 PortOpt = Annotated[Optional[str], typer.Option(
@@ -385,7 +387,7 @@ def guided(
 
 
 # ----------------------------------------------------------------- emulate
-@app.command()
+@app.command(rich_help_panel=_app.SENSOR)
 def emulate(
     profile: ProfileOpt = "designkit",
     material: Annotated[Optional[list[str]], typer.Option(

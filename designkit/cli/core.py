@@ -9,10 +9,11 @@ from typing import Annotated, Optional
 import typer
 
 from ._app import app, console, emit_json
+from . import _app
 from ._options import E1, E2, Ambient, Contact, DeltaT, Folds, Json, Noise, Seed, SensorOpt, Threshold, Trials, Width
 
 
-@app.command()
+@app.command(rich_help_panel=_app.MODEL)
 def simulate(
     e: Annotated[float, typer.Option("--e", help="Object effusivity [J s^-1/2 K^-1 m^-2] (0 and inf allowed).")],
     contact: Contact = 4.0,
@@ -85,7 +86,7 @@ def _write_curves_csv(path: Path, time_s, temps) -> None:
     atomic_write_text(path, buf.getvalue())
 
 
-@app.command()
+@app.command(rich_help_panel=_app.MODEL)
 def f1(
     e1: E1 = None,
     e2: E2 = None,

@@ -14,12 +14,13 @@ from typing import Annotated, List, Optional
 import typer
 
 from ._app import app, console, emit_json
+from . import _app
 from ._options import Json
 
 _FORMATS = "json, csv, npz, c (a C99 header) or python (a module needing only the standard library)"
 
 
-@app.command("export")
+@app.command("export", rich_help_panel=_app.TABLES)
 def export_cmd(
     out: Annotated[Path, typer.Option("--out", "-o", help="File to write (.json, .csv, .npz, .h or .py).")],
     table: Annotated[str, typer.Option("--table", help="Lookup table (name or path).")] = "svm-paper",

@@ -6,6 +6,7 @@ from typing import Annotated, Optional
 
 import typer
 
+from . import _app
 from ._app import console, emit_json, sub_app
 from ._options import Json
 
@@ -13,6 +14,7 @@ materials_app = sub_app(
     "materials",
     "Materials: effusivity and diffusivity ranges of engineering material families "
     "(public handbook table) and of the paper's 12 experiment materials.",
+    panel=_app.ASK,
 )
 
 SetOpt = Annotated[str, typer.Option(

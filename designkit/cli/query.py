@@ -14,6 +14,7 @@ from typing import Annotated, Any, Optional
 import typer
 
 from ._app import app, console, emit_json
+from . import _app
 from ._options import E1, E2, Json, SensorOpt, Threshold
 
 M1 = Annotated[Optional[str], typer.Option("--m1", help="First material by name (instead of --e1); see 'designkit materials list'.")]
@@ -139,7 +140,7 @@ def _common(d: dict) -> dict:
 
 
 # ============================================================ min-contact
-@app.command("min-contact")
+@app.command("min-contact", rich_help_panel=_app.ASK)
 def min_contact_cmd(
     e1: E1 = None, e2: E2 = None, m1: M1 = None, m2: M2 = None,
     noise: NoiseQ = 0.05, delta_t: DeltaTQ = 10.0, threshold: Threshold = 0.9, sensor: SensorOpt = "paper",
@@ -191,7 +192,7 @@ def min_contact_cmd(
 
 
 # ============================================================ max-noise / min-delta-t
-@app.command("max-noise")
+@app.command("max-noise", rich_help_panel=_app.ASK)
 def max_noise_cmd(
     e1: E1 = None, e2: E2 = None, m1: M1 = None, m2: M2 = None,
     contact: ContactQ = 2.0, delta_t: DeltaTQ = 10.0, threshold: Threshold = 0.9, sensor: SensorOpt = "paper",
@@ -219,7 +220,7 @@ def max_noise_cmd(
     _emit(ans, labels, json_, _render_scalar("max_noise_c", "largest noise", " °C"))
 
 
-@app.command("min-delta-t")
+@app.command("min-delta-t", rich_help_panel=_app.ASK)
 def min_delta_t_cmd(
     e1: E1 = None, e2: E2 = None, m1: M1 = None, m2: M2 = None,
     contact: ContactQ = 2.0, noise: NoiseQ = 0.05, threshold: Threshold = 0.9, sensor: SensorOpt = "paper",
@@ -267,7 +268,7 @@ def _render_scalar(key: str, words: str, unit: str):
 
 
 # ============================================================ delta-e
-@app.command("delta-e")
+@app.command("delta-e", rich_help_panel=_app.ASK)
 def delta_e_cmd(
     e: Annotated[Optional[float], typer.Option("--e", help="Reference effusivity [J s^-1/2 K^-1 m^-2].")] = None,
     m: Annotated[Optional[str], typer.Option("--m", help="Reference material (its range's midpoint).")] = None,
@@ -328,7 +329,7 @@ def delta_e_cmd(
 
 
 # ============================================================ distinguishable
-@app.command("distinguishable")
+@app.command("distinguishable", rich_help_panel=_app.ASK)
 def distinguishable_cmd(
     e1: E1 = None, e2: E2 = None, m1: M1 = None, m2: M2 = None,
     contact: ContactQ = 2.0, noise: NoiseQ = 0.05, delta_t: DeltaTQ = 10.0, threshold: Threshold = 0.9,

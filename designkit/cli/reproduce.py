@@ -8,13 +8,14 @@ from typing import Annotated, List, Optional
 import typer
 
 from ._app import app, console, emit_json
+from . import _app
 from ._options import Json, Seed
 
 _SECTIONS_HELP = ("f1-matrices, delta-curves, effusivity, node-graphs, table1, guideline, real-robot, "
                   "sim-to-real, multiclass")
 
 
-@app.command()
+@app.command(rich_help_panel=_app.REPORTS)
 def reproduce(
     out: Annotated[Path, typer.Option("--out", help="Report folder: report.md, report.json, figures/, data/.")],
     only: Annotated[Optional[List[str]], typer.Option(

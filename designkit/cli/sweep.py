@@ -9,6 +9,7 @@ from typing import Annotated, Optional
 import typer
 
 from ._app import EXIT_INTERRUPTED, app, console, emit_json
+from . import _app
 from ._options import Json
 
 
@@ -24,7 +25,7 @@ def _floats(text: Optional[str], name: str) -> Optional[tuple[float, ...]]:
     return vals
 
 
-@app.command()
+@app.command(rich_help_panel=_app.MODEL)
 def sweep(
     config: Annotated[Optional[Path], typer.Option("--config", help="Sweep config YAML (tables/*.yaml); options below override it.")] = None,
     name: Annotated[Optional[str], typer.Option("--name", help="Table name.")] = None,

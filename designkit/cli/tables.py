@@ -7,10 +7,12 @@ from typing import Annotated, Optional
 
 import typer
 
+from . import _app
 from ._app import console, emit_json, sub_app
 from ._options import Json
 
-tables_app = sub_app("tables", "Shipped lookup tables: list them, or show one's grid and provenance.")
+tables_app = sub_app("tables", "Shipped lookup tables: list them, or show one's grid and provenance.",
+                     panel=_app.TABLES)
 
 
 @tables_app.command("list")

@@ -9,13 +9,14 @@ from typing import Annotated, Optional
 import typer
 
 from ._app import app, console, emit_json
+from . import _app
 from ._options import DeltaT, Json, SensorOpt
 
 #: Contact times [s] at which the deviation is reported (the paper's 1-4 s, and longer).
 REPORT_TIMES_S = (1.0, 2.0, 3.0, 4.0, 10.0, 30.0, 60.0)
 
 
-@app.command()
+@app.command(rich_help_panel=_app.ASK)
 def validity(
     thickness: Annotated[float, typer.Option("--thickness", help="Object thickness \\[m] (e.g. 0.003 for 3 mm).")],
     material: Annotated[Optional[str], typer.Option(

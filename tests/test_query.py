@@ -238,3 +238,22 @@ def test_exact_min_contact_cli(cli):
     lo, hi = p["contact_time_interval_s"]
     assert lo <= p["contact_time_s"] and (hi is None or hi >= p["contact_time_s"] - 0.06)
     assert p["ideal_contact_time_s"] <= p["contact_time_s"] + 0.05
+
+
+@pytest.mark.slow
+def test_exact_routes_of_the_other_pair_questions_through_the_cli(cli):
+    """max-noise, min-delta-t and distinguishable --exact: the CLI gives the library's computed answer,
+    and the answers agree with each other (the noise that is just tolerated at dT 10 °C is the
+    noise/dT ratio min-delta-t finds at that noise)."""
+    small = ("--exact", "--trials", "30", "--repeats", "1", "--jobs", "1", "--json")
+    pair = ("--e1", "35000", "--e2", "20000", "--contact", "1.5")
+    mn = json.loads(cli("max-noise", *pair, "--delta-t", "10", *small).stdout)
+    lib = q.exact_max_noise(35000, 20000, contact_s=1.5, delta_t_c=10, trials=30, repeats=1, jobs=1)
+    assert mn["source"] == "computed" and mn["max_noise_c"] == pytest.approx(lib.value)
+    assert mn["ideal_max_noise_c"] >= mn["max_noise_c"]  # no classifier beats the ideal observer
+    dt = json.loads(cli("min-delta-t", *pair, "--noise", str(mn["max_noise_c"]), *small).stdout)
+    assert dt["min_delta_t_c"] == pytest.approx(10.0, rel=0.1)
+    yes = json.loads(cli("distinguishable", *pair, "--noise", str(0.5 * mn["max_noise_c"]), *small).stdout)
+    no = json.loads(cli("distinguishable", *pair, "--noise", str(4 * mn["max_noise_c"]), *small).stdout)
+    assert yes["distinguishable"] is True and no["distinguishable"] is False
+    assert yes["svm_f1"] >= 0.9 > no["svm_f1"]

@@ -59,6 +59,29 @@ def _slab_options(thickness, backing, diffusivity) -> None:
         raise InputError("--backing and --diffusivity describe a thin sample: give its --thickness too")
 
 
+def _pair_answer(question: str, e1, e2, m1, m2, scene: dict, *, thickness, backing, diffusivity, exact: bool,
+                 table: str, ideal_table: str, threshold: float, sensor: str, width: float, trials: int, seed: int,
+                 repeats: int, jobs: int, exact_extra: Optional[dict] = None):
+    """Answer a two-object question (``scene``: its scene keywords) from the thin-sample model
+    (--thickness), by computing it for this pair (--exact), or from the tables; with the labels."""
+    from .. import query
+
+    _slab_options(thickness, backing, diffusivity)
+    common = dict(threshold=threshold, sensor=sensor, trials=trials, seed=seed, repeats=repeats, jobs=jobs)
+    if thickness is not None:
+        return _thin(question, thickness, backing, diffusivity, e1, e2, m1, m2, width, **scene, **common,
+                     **(exact_extra or {}))
+    v1, v2, ranges, labels = _sides(e1, e2, m1, m2, exact=exact, width=width)
+    name = question.replace("-", "_")
+    if exact:
+        ans = getattr(query, f"exact_{name}")(v1, v2, **scene, **common, width=width, ranges=ranges,
+                                                **(exact_extra or {}))
+    else:
+        ans = getattr(query, name)(v1, v2, **scene, threshold=threshold, table=table, ideal_table=ideal_table,
+                                   sensor=None if sensor == "paper" else sensor, ranges=ranges)
+    return ans, labels
+
+
 def _sides(e1, e2, m1, m2, *, exact: bool, width: float) -> tuple[Optional[float], Optional[float], Any, dict]:
     """Resolve numbers or material names to (e1, e2, ranges, labels)."""
     from .._validation import InputError, check_effusivity
@@ -151,23 +174,11 @@ def min_contact_cmd(
     json_: Json = False,
 ) -> None:
     """Shortest contact time that separates two materials (e.g. --e1 35000 --e2 20000)."""
-    from .. import query
-
-    _slab_options(thickness, backing, diffusivity)
-    v1, v2, ranges, labels = ((None, None, None, {}) if thickness is not None
-                              else _sides(e1, e2, m1, m2, exact=exact, width=width))
-    if thickness is not None:
-        ans, labels = _thin("min-contact", thickness, backing, diffusivity, e1, e2, m1, m2, width, noise_c=noise,
-                            delta_t_c=delta_t, threshold=threshold, sensor=sensor, trials=trials, seed=seed,
-                            repeats=repeats, jobs=jobs, max_contact_s=max_contact)
-    elif exact:
-        ans = query.exact_min_contact(v1, v2, noise_c=noise, delta_t_c=delta_t, threshold=threshold, sensor=sensor,
-                                      width=width, trials=trials, folds=3, seed=seed, repeats=repeats, jobs=jobs,
-                                      max_contact_s=max_contact, ranges=ranges)
-    else:
-        ans = query.min_contact(v1, v2, noise_c=noise, delta_t_c=delta_t, threshold=threshold, table=table,
-                                ideal_table=ideal_table, sensor=None if sensor == "paper" else sensor,
-                                ranges=ranges)
+    ans, labels = _pair_answer("min-contact", e1, e2, m1, m2, dict(noise_c=noise, delta_t_c=delta_t),
+                               thickness=thickness, backing=backing, diffusivity=diffusivity, exact=exact,
+                               table=table, ideal_table=ideal_table, threshold=threshold, sensor=sensor, width=width,
+                               trials=trials, seed=seed, repeats=repeats, jobs=jobs,
+                               exact_extra=dict(max_contact_s=max_contact))
 
     def render(d, json_, labels=None):
         if json_:
@@ -202,21 +213,10 @@ def max_noise_cmd(
     json_: Json = False,
 ) -> None:
     """Largest sensor noise at which a contact time still separates two materials."""
-    from .. import query
-
-    _slab_options(thickness, backing, diffusivity)
-    v1, v2, ranges, labels = ((None, None, None, {}) if thickness is not None
-                              else _sides(e1, e2, m1, m2, exact=exact, width=width))
-    if thickness is not None:
-        ans, labels = _thin("max-noise", thickness, backing, diffusivity, e1, e2, m1, m2, width, contact_s=contact,
-                            delta_t_c=delta_t, threshold=threshold, sensor=sensor, trials=trials, seed=seed,
-                            repeats=repeats, jobs=jobs)
-    elif exact:
-        ans = query.exact_max_noise(v1, v2, contact_s=contact, delta_t_c=delta_t, threshold=threshold, sensor=sensor,
-                                    width=width, trials=trials, seed=seed, repeats=repeats, jobs=jobs, ranges=ranges)
-    else:
-        ans = query.max_noise(v1, v2, contact_s=contact, delta_t_c=delta_t, threshold=threshold, table=table,
-                              ideal_table=ideal_table, sensor=None if sensor == "paper" else sensor, ranges=ranges)
+    ans, labels = _pair_answer("max-noise", e1, e2, m1, m2, dict(contact_s=contact, delta_t_c=delta_t),
+                               thickness=thickness, backing=backing, diffusivity=diffusivity, exact=exact,
+                               table=table, ideal_table=ideal_table, threshold=threshold, sensor=sensor, width=width,
+                               trials=trials, seed=seed, repeats=repeats, jobs=jobs)
     _emit(ans, labels, json_, _render_scalar("max_noise_c", "largest noise", " °C"))
 
 
@@ -230,21 +230,10 @@ def min_delta_t_cmd(
     json_: Json = False,
 ) -> None:
     """Smallest sensor-object temperature difference that separates two materials."""
-    from .. import query
-
-    _slab_options(thickness, backing, diffusivity)
-    v1, v2, ranges, labels = ((None, None, None, {}) if thickness is not None
-                              else _sides(e1, e2, m1, m2, exact=exact, width=width))
-    if thickness is not None:
-        ans, labels = _thin("min-delta-t", thickness, backing, diffusivity, e1, e2, m1, m2, width, contact_s=contact,
-                            noise_c=noise, threshold=threshold, sensor=sensor, trials=trials, seed=seed,
-                            repeats=repeats, jobs=jobs)
-    elif exact:
-        ans = query.exact_min_delta_t(v1, v2, contact_s=contact, noise_c=noise, threshold=threshold, sensor=sensor,
-                                      width=width, trials=trials, seed=seed, repeats=repeats, jobs=jobs, ranges=ranges)
-    else:
-        ans = query.min_delta_t(v1, v2, contact_s=contact, noise_c=noise, threshold=threshold, table=table,
-                                ideal_table=ideal_table, sensor=None if sensor == "paper" else sensor, ranges=ranges)
+    ans, labels = _pair_answer("min-delta-t", e1, e2, m1, m2, dict(contact_s=contact, noise_c=noise),
+                               thickness=thickness, backing=backing, diffusivity=diffusivity, exact=exact,
+                               table=table, ideal_table=ideal_table, threshold=threshold, sensor=sensor, width=width,
+                               trials=trials, seed=seed, repeats=repeats, jobs=jobs)
     _emit(ans, labels, json_, _render_scalar("min_delta_t_c", "smallest temperature difference", " °C"))
 
 
@@ -339,23 +328,10 @@ def distinguishable_cmd(
     thickness: ThicknessQ = None, backing: BackingQ = None, diffusivity: DiffusivityQ = None, json_: Json = False,
 ) -> None:
     """Whether a scene separates two materials, with the SVM's and the ideal observer's F1."""
-    from .. import query
-
-    _slab_options(thickness, backing, diffusivity)
-    v1, v2, ranges, labels = ((None, None, None, {}) if thickness is not None
-                              else _sides(e1, e2, m1, m2, exact=exact, width=width))
-    if thickness is not None:
-        ans, labels = _thin("distinguishable", thickness, backing, diffusivity, e1, e2, m1, m2, width,
-                            contact_s=contact, noise_c=noise, delta_t_c=delta_t, threshold=threshold, sensor=sensor,
-                            trials=trials, seed=seed, repeats=repeats, jobs=jobs)
-    elif exact:
-        ans = query.exact_distinguishable(v1, v2, contact_s=contact, noise_c=noise, delta_t_c=delta_t,
-                                          threshold=threshold, sensor=sensor, width=width, trials=trials, seed=seed,
-                                          repeats=repeats, jobs=jobs, ranges=ranges)
-    else:
-        ans = query.distinguishable(v1, v2, contact_s=contact, noise_c=noise, delta_t_c=delta_t, threshold=threshold,
-                                    table=table, ideal_table=ideal_table,
-                                    sensor=None if sensor == "paper" else sensor, ranges=ranges)
+    ans, labels = _pair_answer("distinguishable", e1, e2, m1, m2, dict(contact_s=contact, noise_c=noise, delta_t_c=delta_t),
+                               thickness=thickness, backing=backing, diffusivity=diffusivity, exact=exact,
+                               table=table, ideal_table=ideal_table, threshold=threshold, sensor=sensor, width=width,
+                               trials=trials, seed=seed, repeats=repeats, jobs=jobs)
 
     def render(d, json_, labels=None):
         x = d["extra"]

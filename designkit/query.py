@@ -677,21 +677,9 @@ def exact_min_contact(e1=None, e2=None, *, noise_c: float = 0.05, delta_t_c: flo
     def scene(c):
         return Scene.from_delta_t(contact_s=c, noise_c=noise, delta_t_c=dt)
 
-    evaluated: dict[float, tuple[float, float]] = {}
-
-    def svm_ok(c):
-        evaluated[c] = _svm_f1(ex, cls, scene(c))
-        return evaluated[c][0] >= phi
-
     floor = 1.0 / ex.sensor.sample_rate_hz
-    value: float | None
-    if not svm_ok(tmax):
-        value = None
-    else:
-        value = _bisect(svm_ok, floor, tmax, tolerance_s)
-    below = [c for c, (m, s) in evaluated.items() if m + z * s < phi]
-    above = [c for c, (m, s) in evaluated.items() if m - z * s >= phi]
-    interval = (max(below) if below else floor, min(above) if above else None)
+    value, interval, evaluations = _contact_search(lambda c: _svm_f1(ex, cls, scene(c)), phi, floor, tmax,
+                                                   tolerance_s, z)
     ideal_ok = lambda c: _ideal_f1(ex, cls, scene(c)) >= phi  # noqa: E731
     ideal = _bisect(ideal_ok, floor, tmax, 1e-3) if ideal_ok(tmax) else None
     inputs = {"e1": e1, "e2": e2, "noise_c": noise, "delta_t_c": dt, "threshold": phi, "classes": [list(c) for c in cls],
@@ -699,9 +687,30 @@ def exact_min_contact(e1=None, e2=None, *, noise_c: float = 0.05, delta_t_c: flo
               "sensor": ex.sensor.name}
     note = "" if value is not None else f"not separable by any contact time up to {tmax:g} s"
     return Answer("min-contact", value, interval, ideal, "computed", None, None, inputs, {},
-                  {"fidelity": "svm", "evaluations": [{"contact_s": c, "svm_f1": m, "standard_error": s}
-                                                      for c, (m, s) in sorted(evaluated.items())],
-                   "wall_s": time.perf_counter() - t0}, note)
+                  {"fidelity": "svm", "evaluations": evaluations, "wall_s": time.perf_counter() - t0}, note)
+
+
+def _contact_search(svm_f1, phi: float, floor_s: float, max_contact_s: float, tolerance_s: float, z: float):
+    """Shortest contact time whose mean SVM F1 reaches ``phi``, by bisection, with its Monte Carlo interval.
+
+    ``svm_f1(contact_s)`` returns ``(mean F1, standard error)``. The interval runs
+    from the longest evaluated contact clearly below ``phi`` (mean + z SE < phi)
+    to the shortest clearly above (mean - z SE >= phi; None when none is).
+
+    Returns ``(value or None, (lo, hi), evaluations)``.
+    """
+    evaluated: dict[float, tuple[float, float]] = {}
+
+    def ok(c):
+        evaluated[c] = svm_f1(c)
+        return evaluated[c][0] >= phi
+
+    value = _bisect(ok, floor_s, max_contact_s, tolerance_s) if ok(max_contact_s) else None
+    below = [c for c, (m, s) in evaluated.items() if m + z * s < phi]
+    above = [c for c, (m, s) in evaluated.items() if m - z * s >= phi]
+    interval = (max(below) if below else floor_s, min(above) if above else None)
+    evaluations = [{"contact_s": c, "svm_f1": m, "standard_error": s} for c, (m, s) in sorted(evaluated.items())]
+    return value, interval, evaluations
 
 
 def _threshold(threshold: float) -> float:

@@ -792,7 +792,7 @@ def thin_min_contact(obj1: SlabObject, obj2: SlabObject, *, thickness_m: float, 
     -------
     designkit.query.Answer
     """
-    from .query import Answer, _bisect, _scene_inputs, _threshold
+    from .query import Answer, _bisect, _contact_search, _scene_inputs, _threshold
 
     noise, dt = _scene_inputs(noise_c, delta_t_c)
     phi = _threshold(threshold)
@@ -803,17 +803,9 @@ def thin_min_contact(obj1: SlabObject, obj2: SlabObject, *, thickness_m: float, 
     def scene(c):
         return Scene.from_delta_t(contact_s=c, noise_c=noise, delta_t_c=dt)
 
-    evaluated: dict[float, tuple[float, float]] = {}
-
-    def svm_ok(c):
-        evaluated[c] = _svm_f1(ex, objs, scene(c), slab)
-        return evaluated[c][0] >= phi
-
     floor = 1.0 / ex.sensor.sample_rate_hz
-    value = _bisect(svm_ok, floor, tmax, tolerance_s) if svm_ok(tmax) else None
-    below = [c for c, (m, s) in evaluated.items() if m + z * s < phi]
-    above = [c for c, (m, s) in evaluated.items() if m - z * s >= phi]
-    interval = (max(below) if below else floor, min(above) if above else None)
+    value, interval, evaluations = _contact_search(lambda c: _svm_f1(ex, objs, scene(c), slab), phi, floor, tmax,
+                                                   tolerance_s, z)
     ilog = _IdealLog(ex, objs, slab, n_mc)
     ideal_ok = lambda c: ilog.f1(scene(c)) >= phi  # noqa: E731
     # the ideal observer needs no more contact than the SVM: bracket with the SVM's answer first (long
@@ -831,8 +823,7 @@ def thin_min_contact(obj1: SlabObject, obj2: SlabObject, *, thickness_m: float, 
                                 fraction=fraction)
     inputs = _thin_inputs(objs, slab, ex, noise_c=noise, delta_t_c=dt, threshold=phi, max_contact_s=tmax)
     note = "" if value is not None else f"not separable by any contact time up to {tmax:g} s"
-    extra = _extra(check, slab, ilog, t0, evaluations=[{"contact_s": c, "svm_f1": m, "standard_error": s}
-                                                       for c, (m, s) in sorted(evaluated.items())])
+    extra = _extra(check, slab, ilog, t0, evaluations=evaluations)
     return Answer("min-contact", value, interval, ideal, "computed", None, None, inputs, {}, extra, note)
 
 

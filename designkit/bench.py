@@ -48,7 +48,6 @@ from __future__ import annotations
 import math
 import os
 import platform
-import sys
 import time
 from dataclasses import asdict, dataclass, field, replace
 from typing import Any, Callable, Iterable, Mapping, Sequence
@@ -1580,7 +1579,7 @@ def render_markdown(report: BenchReport, figures: Mapping[str, str] | None = Non
         unres = mc.get("unresolved_fraction")
         if "min-contact" in mc and "by_gap" in mc["min-contact"]:
             out += ["**Where the error comes from.** A table's delta(e) is a whole number of effusivity intervals "
-                    f"(80 wide for the shipped tables): the first interval that is distinguishable. For pairs only a "
+                    "(80 wide for the shipped tables): the first interval that is distinguishable. For pairs only a "
                     "few intervals apart this rounding dominates, and because delta falls slowly with contact at "
                     "long contacts, a fraction of an interval becomes seconds of contact time. The error by the "
                     "pair's distance:", "",

@@ -75,7 +75,6 @@ __all__ = [
     "SweepConfig",
     "SweepInterrupted",
     "delta_from_staircase",
-    "full_matrix_staircase",
     "run_scene",
     "run_sweep",
     "staircase_search",

@@ -443,7 +443,6 @@ def integrate_crank_nicolson(grid: Grid, times_s, step_ratio: float = 0.05, *,
     shape = m.shape
     m_band = _banded(m, g, 0.0)  # M in banded storage
     a_band = _banded(np.zeros_like(m), g, 1.0)  # A in banded storage
-    mf = m.ravel()
     u = np.broadcast_to(grid.initial, shape).astype(np.float64).ravel()
     i_p, w_p = grid.probe_weights()
 

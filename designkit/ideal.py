@@ -53,7 +53,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import special
 
-from ._validation import InputError, as_generator, check_effusivity_range
+from ._validation import InputError, check_effusivity_range
 from .physics import object_weight, response_shape
 from .scene import Scene
 from .sensor import Sensor

@@ -20,7 +20,7 @@ import yaml
 from designkit import SENSORS
 from designkit._validation import InputError
 from designkit.calibration.emulator import EmulatedMaterial, Emulator, Faults, TouchPlan
-from designkit.calibration.profiles import ROLES, list_profiles, load_profile, profile_from_dict
+from designkit.calibration.profiles import list_profiles, load_profile, profile_from_dict
 from designkit.calibration.recorder import DeviceGone, NoData, SerialRecorder, TrialCutter
 from designkit.calibration.trials import load_index, read_trial_csv
 from designkit.physics import sensor_temperature
@@ -108,7 +108,7 @@ def test_line_faults_are_reported_skipped_and_do_not_shift_counted_time(tmp_path
     assert any("garbled" in m for m in messages)
     # a 12-bit count is ~0.015 degC here: allow for quantization on top of the noise
     for p in paths:
-        tr = _check_trial_against_physics(p, emu, 400.0, 0.05, tol_extra=0.01)
+        _check_trial_against_physics(p, emu, 400.0, 0.05, tol_extra=0.01)
         assert json.loads(p.with_suffix(".json").read_text())["n_missing"] > 0
 
 

@@ -37,7 +37,7 @@ import select
 import threading
 import time
 import tty
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from typing import Sequence
 
 import numpy as np
@@ -45,7 +45,7 @@ import numpy as np
 from .._validation import InputError, as_generator, check_effusivity, check_nonnegative, check_positive
 from ..physics import object_weight, response_shape
 from ..sensor import Sensor
-from .profiles import DeviceProfile, Identity, Linear, Thermistor
+from .profiles import DeviceProfile, Linear, Thermistor
 
 __all__ = ["EmulatedMaterial", "Emulator", "Faults", "TouchPlan", "TouchRecord"]
 

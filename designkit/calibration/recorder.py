@@ -465,8 +465,6 @@ class SerialRecorder:
         self._last_t = None
 
     def _device_lost(self, cutter: TrialCutter, exc: BaseException) -> None:
-        import serial
-
         in_trial = cutter.in_trial
         self._discontinuity(cutter, "the device disconnected")
         self.close()

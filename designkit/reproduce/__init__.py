@@ -31,7 +31,7 @@ from pathlib import Path
 from typing import Callable, Sequence
 
 from .._validation import InputError
-from ._report import Comparison, Context, ReproduceSettings, SectionResult, default_robot_data_dir, fmt, md_table
+from ._report import Context, ReproduceSettings, SectionResult, default_robot_data_dir, fmt, md_table
 
 __all__ = [
     "SECTIONS",

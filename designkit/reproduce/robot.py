@@ -466,7 +466,6 @@ def section_sim_to_real(ctx: Context) -> SectionResult:
                                   ("sim-to-real, cold wood at its passive end reading", end["multiclass"]["confusion"])],
                             CLASSES, "sim_to_real_confusion")
     s = setup.sensor
-    cold = test.material == "cold_wood"
     pair_names = [PAIR_LABELS[p] for p in PAIRS]
 
     def row(label, r):

@@ -21,7 +21,7 @@ from designkit import InputError
 from designkit import query as q
 from designkit.engine import SweepConfig, run_sweep
 from designkit.export import (FORMATS, export_table, parse_contact, read_export, render, slice_table, to_python)
-from designkit.tables import content_hash, list_tables, load_table, table_header, write_table
+from designkit.tables import content_hash, load_table, table_header, write_table
 
 REPO = Path(__file__).resolve().parent.parent
 EXAMPLES = REPO / "examples"
@@ -499,8 +499,6 @@ def test_stdlib_module_checks_its_data(tmp_path):
     assert "corrupted" in proc.stderr or "Error" in proc.stderr
 
 
-@pytest.mark.skipif("svm-paper" not in list_tables(), reason="the shipped svm-paper table is not built yet "
-                    "(tables/svm-paper.npz appears when its sweep finishes)")
 def test_shipped_svm_paper_exports_like_its_query(tmp_path):
     tab = load_table("svm-paper")
     for label, exp in (("whole", slice_table(tab)), ("row", slice_table(tab, noise_c=ON_ROW[0], delta_t_c=ON_ROW[1]))):

@@ -17,7 +17,7 @@ import pytest
 
 from designkit import query as q
 from designkit.export import slice_table, to_c
-from designkit.tables import list_tables, load_table
+from designkit.tables import load_table
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from test_export import (CASES, EXAMPLES, ON_ROW, _beyond_slice, agree, case, ideal_table,  # noqa: E402
@@ -119,8 +119,6 @@ def test_c_header_of_the_whole_ideal_table(tmp_path):
     check_example_answer(exe, tab, want)  # the example program on the whole table
 
 
-@pytest.mark.skipif("svm-paper" not in list_tables(), reason="the shipped svm-paper table is not built yet "
-                    "(tables/svm-paper.npz appears when its sweep finishes)")
 def test_c_header_of_the_shipped_svm_paper_table(tmp_path):
     tab = load_table("svm-paper")
     exp = slice_table(tab)

@@ -194,6 +194,12 @@ def min_contact_cmd(
         else:
             con.print(f"  SVM (the paper's classifier): [bold green]{d['value']:.2f} s[/] of contact at least "
                       f"(Monte Carlo interval {_fmt(lo, ' s')} to {_fmt(hi, ' s')})")
+            grid = d["extra"].get("table_contacts_s") or []
+            if d["value"] in grid and grid.index(d["value"]) > 0:
+                prev = grid[grid.index(d["value"]) - 1]
+                con.print(f"  [dim]{d['value']:g} s is the table's next contact time after {prev:g} s, where they are "
+                          f"not separable: the shortest time lies in ({prev:g}, {d['value']:g}] s; --exact resolves "
+                          f"it[/]")
         ideal = d["ideal"]
         con.print(f"  ideal observer bound:         {_fmt(ideal, ' s')}"
                   + ("  (no classifier can do with less)" if ideal is not None else ""))

@@ -1422,17 +1422,31 @@ def plot_pareto(report: BenchReport, path) -> Any:
 
     from .figures import pyplot
 
+    fig = pareto_figure(report)
+    if fig is None:
+        return None
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
+    pyplot().close(fig)
+    return path
+
+
+def pareto_figure(report: BenchReport) -> Any:
+    """The matplotlib figure of :func:`plot_pareto` (None without rows)."""
+    from .figures import pyplot
+
     plt = pyplot()
     from matplotlib.ticker import NullFormatter
 
     groups: dict[str, list[Row]] = {}
     for r in report.rows:
         groups.setdefault(r.question, []).append(r)
-    k = len(groups)
-    if k == 0:
+    n_panels = len(groups)
+    if n_panels == 0:
         return None
     ncol = 3
-    nrow = math.ceil(k / ncol)
+    nrow = math.ceil(n_panels / ncol)
     fig, axes = plt.subplots(nrow, ncol, figsize=(4.2 * ncol, 3.4 * nrow), constrained_layout=True, squeeze=False)
     for ax, (question, rows) in zip(axes.ravel(), groups.items()):
         methods = sorted({r.method for r in rows})
@@ -1449,9 +1463,9 @@ def plot_pareto(report: BenchReport, path) -> Any:
         for r in rows:
             if math.isfinite(r.reference_wall_s):
                 refs.setdefault(r.reference, r.reference_wall_s)
-        for k, (name, t) in enumerate(refs.items()):
+        for ref_i, (name, t) in enumerate(refs.items()):
             ax.scatter([t], [floor], marker="*", s=70, color="k", zorder=4,
-                       label="reference" if k == 0 else None)
+                       label="reference" if ref_i == 0 else None)
             ax.annotate(name[:26], (t, floor), fontsize=5.5, xytext=(3, 4), textcoords="offset points",
                         color="0.3")
         ax.set_xscale("log")
@@ -1464,15 +1478,11 @@ def plot_pareto(report: BenchReport, path) -> Any:
         ax.tick_params(labelsize=7)
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=5.5, loc="best")
-    for ax in axes.ravel()[k:]:
+    for ax in axes.ravel()[n_panels:]:
         ax.set_visible(False)
     fig.suptitle("designkit: error against run time per answer (★ reference, drawn at the panel's floor; "
                  "▼ error 0)", fontsize=10)
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return fig
 
 
 def plot_costs(report: BenchReport, path) -> Any:

@@ -218,3 +218,18 @@ def test_svm_query_rows_against_exact_on_a_tiny_svm_table(tmp_path):
     case = facts["min-contact"][0]
     assert case["exact_wall_s"] > case["table_wall_s"]
     assert 0.0 <= rows[1].error <= 1.0
+
+
+def test_pareto_figure_has_one_visible_panel_with_points_per_question():
+    """Every question gets its own panel with its methods and its reference (a reused loop variable
+    once hid all panels but the first)."""
+    rows = tuple(bench.Row(question=q, method=m, setting="s", metric="err", error=e, worst=e, wall_s=t,
+                           reference="ref", reference_wall_s=1.0, n=1, note="")
+                 for q in ("A", "B", "C", "D") for m, e, t in (("fast", 0.1, 1e-3), ("slow", 0.0, 1e-1)))
+    report = bench.BenchReport(rows=rows, curves=(), facts={}, quick=True, seed=0, wall_s=0.0, environment={})
+    fig = bench.pareto_figure(report)
+    visible = [ax for ax in fig.axes if ax.get_visible()]
+    assert sorted(ax.get_title() for ax in visible) == ["A", "B", "C", "D"]
+    for ax in visible:  # two methods and the reference star
+        assert len(ax.collections) == 3
+    assert bench.pareto_figure(bench.BenchReport((), (), {}, True, 0, 0.0, {})) is None

@@ -222,3 +222,10 @@ def test_fit_of_the_shared_robot_recordings(cli, robot_data_dir, tmp_path):
     disjoint = iv["metal"][1] < iv["wood"][0] or iv["wood"][1] < iv["metal"][0]
     assert d["identification"] == ("conflict" if disjoint else "interval")
     assert load_sensor(tmp_path / "robot.yaml").provenance["materials_fitted"] == ["metal", "wood"]
+    # --only repeated means the same as comma-separated (users repeat options like --range)
+    again = cli("calibrate", "fit", robot_data_dir / "index.csv", "--only", "metal", "--only", "wood",
+                "--range", "metal=12767:25972", "--range", "wood=331:506", "--bootstrap", "0",
+                "--out", tmp_path / "robot2.yaml", "--json")
+    assert again.exit_code == 0, again.output
+    d2 = json.loads(again.stdout)
+    assert d2["n_trials"] == 120 and d2["effusivity"]["value"] == pytest.approx(d["effusivity"]["value"])

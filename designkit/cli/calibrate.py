@@ -297,7 +297,8 @@ def fit(
     index: Annotated[Path, typer.Argument(help="CSV with columns file and material (e.g. the index.csv that "
                                                "'calibrate record' writes, or the shared recordings').")],
     range_: RangeOpt = None,
-    only: Annotated[Optional[str], typer.Option("--only", help="Fit only these materials (comma-separated).")] = None,
+    only: Annotated[Optional[list[str]], typer.Option(
+        "--only", help="Fit only these materials (repeatable, or comma-separated).")] = None,
     object_temp: ObjectTempOpt = None,
     depth_um: DepthOpt = 80.0,
     out: Annotated[Optional[Path], typer.Option("--out", help="Write the sensor YAML here (for --sensor).")] = None,
@@ -316,7 +317,7 @@ def fit(
 ) -> None:
     """Identify e_s and alpha_s (and each e_o, the time offset) from recorded touches (paper appendix)."""
     settings = _fit_settings(depth_um, bootstrap, seed, baseline, offset_range, fit_to)
-    only_list = [s.strip() for s in only.split(",") if s.strip()] if only else None
+    only_list = [s.strip() for item in only for s in item.split(",") if s.strip()] if only else None
     result = _run_fit(index, range_ or [], only_list, object_temp or [], settings, out, name, plot, quiet=json_)
     if json_:
         payload = result.to_dict()

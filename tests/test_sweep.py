@@ -1,0 +1,179 @@
+"""``designkit sweep`` end to end: tables written through the CLI, interrupted sweeps (kill -9 and
+Ctrl-C) resumed without recomputing finished chunks, and the same sweep on a real dask
+``LocalCluster`` on loopback giving the same table as local processes."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from designkit.tables import load_table
+
+# 2 scene points x 4 contact times = 8 chunks of about a second each (40 intervals, 50 trials)
+CONFIG = """\
+name: tiny
+sensor: paper
+fidelity: svm
+effusivity: {min: 0, max: 40000, intervals: 40}
+trials: 50
+folds: 3
+threshold: 0.9
+seed: 3
+max_repeats: 2
+noise_ratio: [0.005, 0.01]
+contact_s: [1, 2, 4, 8]
+blocks: 1
+"""
+N_CHUNKS = 8
+TIMING = {"chunk_wall_s"}  # the only arrays that may differ between two runs of one sweep
+
+
+def _sweep_cmd(cfg: Path, workdir: Path, out: Path, *extra: str) -> list[str]:
+    return [sys.executable, "-m", "designkit", "sweep", "--config", str(cfg), "--workdir", str(workdir),
+            "--out", str(out), *extra]
+
+
+def _run(cmd, **kw) -> subprocess.CompletedProcess:
+    return subprocess.run(cmd, capture_output=True, text=True, timeout=600, **kw)
+
+
+def _arrays(path: Path) -> dict[str, np.ndarray]:
+    with np.load(path, allow_pickle=False) as z:
+        return {k: z[k] for k in z.files}
+
+
+def _same_table(a: Path, b: Path) -> None:
+    x, y = _arrays(a), _arrays(b)
+    assert set(x) == set(y)
+    for k in x:
+        if k not in TIMING:
+            np.testing.assert_array_equal(x[k], y[k], err_msg=k)
+
+
+def _chunks(workdir: Path) -> dict[str, int]:
+    return {p.name: p.stat().st_mtime_ns for p in (workdir / "chunks").glob("*.npz")}
+
+
+def _wait_for_chunks(proc: subprocess.Popen, workdir: Path, n: int) -> dict[str, int]:
+    deadline = time.monotonic() + 300
+    while time.monotonic() < deadline:
+        if (workdir / "chunks").is_dir() and len(_chunks(workdir)) >= n:
+            return _chunks(workdir)
+        if proc.poll() is not None:
+            pytest.fail(f"the sweep ended before it could be interrupted: {proc.stderr.read()}")
+        time.sleep(0.02)
+    pytest.fail("no chunk appeared")
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory) -> tuple[Path, Path]:
+    """The config, and its table from one uninterrupted run with local processes."""
+    d = tmp_path_factory.mktemp("sweep-ref")
+    cfg = d / "tiny.yaml"
+    cfg.write_text(CONFIG)
+    r = _run(_sweep_cmd(cfg, d / "work", d / "tiny.npz", "--jobs", "2", "--json"))
+    assert r.returncode == 0, r.stderr
+    summary = json.loads(r.stdout)
+    assert summary["chunks_total"] == summary["chunks_computed"] == N_CHUNKS
+    return cfg, d / "tiny.npz"
+
+
+@pytest.mark.slow
+def test_sweep_cli_writes_a_loadable_table_that_tables_show_describes(reference, cli):
+    cfg, table = reference
+    t = load_table(table)
+    assert t.name == "tiny" and t.fidelity == "svm" and t.header["trials"] == 50
+    assert t.arrays["delta_up"].shape == (2, 4, 40)
+    a = t.arrays
+    finite = np.isfinite(a["delta_up"])
+    assert finite.any() and np.all(a["delta_up"][finite] % t.header["effusivity"]["width"] == 0)
+    lo_ok = finite & np.isfinite(a["delta_up_lo"])
+    assert np.all(a["delta_up_lo"][lo_ok] <= a["delta_up"][lo_ok])  # each interval holds its estimate
+    assert a["fits"].shape == (2, 4) and np.all(a["fits"] > 0)
+    r = cli("tables", "show", str(table), "--json")
+    assert r.exit_code == 0, r.output
+    shown = json.loads(r.stdout)
+    assert shown["name"] == "tiny" and shown["content_hash"] == t.header["content_hash"]
+
+
+@pytest.mark.slow
+def test_kill_9_then_resume_recomputes_nothing_finished_and_gives_the_same_table(reference, tmp_path):
+    cfg, ref = reference
+    work, out = tmp_path / "work", tmp_path / "tiny.npz"
+    proc = subprocess.Popen(_sweep_cmd(cfg, work, out, "--jobs", "1"), stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    before = _wait_for_chunks(proc, work, 2)
+    proc.send_signal(signal.SIGKILL)
+    proc.wait(timeout=60)
+    proc.stdout.close()
+    proc.stderr.close()
+    assert proc.returncode == -signal.SIGKILL and not out.exists()
+    before = _chunks(work)  # what the kill left: every chunk file complete (written atomically)
+    assert 2 <= len(before) < N_CHUNKS
+    for name in before:
+        with np.load(work / "chunks" / name, allow_pickle=False) as z:
+            assert "J" in z.files
+
+    r = _run(_sweep_cmd(cfg, work, out, "--jobs", "2", "--resume", "--json"))
+    assert r.returncode == 0, r.stderr
+    summary = json.loads(r.stdout)
+    assert summary["chunks_computed"] == N_CHUNKS - len(before)
+    after = _chunks(work)
+    assert all(after[name] == mtime for name, mtime in before.items())  # not rewritten
+    _same_table(out, ref)
+
+
+@pytest.mark.slow
+def test_ctrl_c_keeps_finished_chunks_and_says_how_to_resume(reference, tmp_path):
+    cfg, ref = reference
+    work, out = tmp_path / "work", tmp_path / "tiny.npz"
+    proc = subprocess.Popen(_sweep_cmd(cfg, work, out, "--jobs", "1"), stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    _wait_for_chunks(proc, work, 1)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130, err
+    lines = [ln for ln in err.strip().splitlines() if ln.startswith("Interrupted")]
+    assert len(lines) == 1 and "--resume" in lines[0] and "Traceback" not in err
+    kept = _chunks(work)
+    assert 1 <= len(kept) < N_CHUNKS and f"{len(kept)} of {N_CHUNKS} chunks" in lines[0]
+
+    # resuming with a config that would change the results is refused, and loses nothing
+    r = _run(_sweep_cmd(cfg, work, out, "--jobs", "1", "--resume", "--seed", "4"))
+    assert r.returncode == 2 and r.stderr.startswith("Error:") and len(r.stderr.strip().splitlines()) == 1
+    assert _chunks(work) == kept
+
+    r = _run(_sweep_cmd(cfg, work, out, "--jobs", "2", "--resume", "--json"))
+    assert r.returncode == 0, r.stderr
+    assert json.loads(r.stdout)["chunks_computed"] == N_CHUNKS - len(kept)
+    _same_table(out, ref)
+
+
+@pytest.mark.slow
+def test_the_same_sweep_on_a_dask_local_cluster_gives_the_same_table(reference, tmp_path):
+    distributed = pytest.importorskip("distributed", reason="dask.distributed is in the test extra")
+    cfg, ref = reference
+    out = tmp_path / "tiny.npz"
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                  dashboard_address=":0") as cluster:
+        address = cluster.scheduler_address
+        assert address.startswith("tcp://127.0.0.1:")
+        with distributed.Client(address) as client:
+            r = _run(_sweep_cmd(cfg, tmp_path / "work", out, "--backend", "dask", "--scheduler", address,
+                                "--json"), env={**os.environ, "PYTHONWARNINGS": "ignore"})
+            assert r.returncode == 0, r.stderr
+            # the chunks ran as tasks of this cluster's scheduler, not in the sweep's own process
+            prefixes = client.run_on_scheduler(lambda dask_scheduler: list(dask_scheduler.task_prefixes))
+            assert prefixes, "no task reached the cluster"
+    assert json.loads(r.stdout)["chunks_computed"] == N_CHUNKS
+    _same_table(out, ref)
+    header = json.loads(out.with_suffix(".json").read_text())
+    assert header["stats"]["run"]["backend"] == "dask"

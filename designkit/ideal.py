@@ -322,9 +322,6 @@ def _class_loglik(stats, e_range, sensor, scene, g, sigma, n_grid):
 
 
 def _ideal_monte_carlo(low, high, sensor: Sensor, scene: Scene, n_mc: int, seed) -> IdealResult:
-    from sklearn.metrics import precision_recall_curve
-
-    from .recognition import f1_standard_error
     from .simulation import simulate_interval
 
     n_mc = int(n_mc)
@@ -351,8 +348,25 @@ def _ideal_monte_carlo(low, high, sensor: Sensor, scene: Scene, n_mc: int, seed)
             n_grid = int(np.clip(math.ceil(4.0 * dw / max(s, 1e-300)), 16, 4096))
             ll.append(_class_loglik(chunk, rng_, sensor, mc_scene, g, sigma, n_grid))
         llr[sl] = ll[1] - ll[0]
-    pred = llr > 0
-    acc = float(np.mean(pred == labels))
+    f1, se, acc, acc_se = score_llr(llr, labels, n_mc)
+    return IdealResult(f1=f1, accuracy=acc, method="monte-carlo", standard_error=se,
+                       accuracy_standard_error=acc_se, projection_noise=None, n_mc=n_mc)
+
+
+def score_llr(llr: np.ndarray, labels: np.ndarray, n_mc: int) -> tuple[float, float, float, float]:
+    """Best F1 over thresholds on a log-likelihood ratio, with Bayes accuracy, and their standard errors.
+
+    ``llr`` of ``n_mc`` simulated touches per class (``labels`` 1 for the positive
+    class). The F1 is the best over all thresholds (never below the trivial
+    2/3 of calling everything positive); the accuracy is the Bayes rule's
+    (threshold 0, equal priors). Returns ``(f1, f1 standard error, accuracy,
+    accuracy standard error)``.
+    """
+    from sklearn.metrics import precision_recall_curve
+
+    from .recognition import f1_standard_error
+
+    acc = float(np.mean((llr > 0) == labels))
     precision, recall, _ = precision_recall_curve(labels, llr)
     with np.errstate(invalid="ignore", divide="ignore"):
         f1s = np.where(precision + recall > 0, 2 * precision * recall / (precision + recall), 0.0)
@@ -361,15 +375,9 @@ def _ideal_monte_carlo(low, high, sensor: Sensor, scene: Scene, n_mc: int, seed)
     tpr = float(recall[best])
     # false-positive rate at that operating point: from precision and recall
     fpr = tpr * (1.0 / precision[best] - 1.0) if precision[best] > 0 else 1.0
-    return IdealResult(
-        f1=f1,
-        accuracy=acc,
-        method="monte-carlo",
-        standard_error=f1_standard_error(tpr, min(max(fpr, 0.0), 1.0), n_mc),
-        accuracy_standard_error=math.sqrt(max(acc * (1 - acc), 0.25 / n_mc) / (2 * n_mc)),
-        projection_noise=None,
-        n_mc=n_mc,
-    )
+    se = f1_standard_error(tpr, min(max(fpr, 0.0), 1.0), n_mc)
+    acc_se = math.sqrt(max(acc * (1 - acc), 0.25 / n_mc) / (2 * n_mc))
+    return f1, se, acc, acc_se
 
 
 # ----------------------------------------------------------------- public entry

@@ -479,21 +479,9 @@ def _grid_coefficients(grid: _ClassGrid, basis, t, slab, sensor, tol):
 
 def _score(llr: np.ndarray, labels: np.ndarray, n_mc: int) -> tuple[float, float, float, float]:
     """Best F1 over thresholds on the log-likelihood ratio, its standard error, Bayes accuracy and its error."""
-    from sklearn.metrics import precision_recall_curve
+    from .ideal import score_llr
 
-    from .recognition import f1_standard_error
-
-    acc = float(np.mean((llr > 0) == labels))
-    precision, recall, _ = precision_recall_curve(labels, llr)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        f1s = np.where(precision + recall > 0, 2 * precision * recall / (precision + recall), 0.0)
-    best = int(np.argmax(f1s))
-    f1 = max(float(f1s[best]), _TRIVIAL_F1)
-    tpr = float(recall[best])
-    fpr = tpr * (1.0 / precision[best] - 1.0) if precision[best] > 0 else 1.0
-    se = f1_standard_error(tpr, min(max(fpr, 0.0), 1.0), n_mc)
-    acc_se = math.sqrt(max(acc * (1 - acc), 0.25 / n_mc) / (2 * n_mc))
-    return f1, se, acc, acc_se
+    return score_llr(llr, labels, n_mc)
 
 
 @dataclass(frozen=True)

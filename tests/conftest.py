@@ -41,3 +41,19 @@ def cli():
         return runner.invoke(app, [str(a) for a in args], input=input)
 
     return invoke
+
+
+def _default_sigint() -> None:
+    import signal
+
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
+@pytest.fixture
+def ctrl_c_able() -> dict:
+    """``subprocess.Popen`` keywords for a child that a test interrupts with SIGINT (Ctrl-C).
+
+    A shell starts background jobs with SIGINT ignored and children inherit that; Python then
+    never raises KeyboardInterrupt. The child gets the default disposition back, so that the
+    test checks designkit's Ctrl-C handling wherever the suite runs."""
+    return {"preexec_fn": _default_sigint}

@@ -150,10 +150,10 @@ def _read_json_object(stream, timeout: float = 30.0) -> dict:
 
 
 @pytest.mark.slow
-def test_emulate_process_feeds_calibrate_record(cli, tmp_path):
+def test_emulate_process_feeds_calibrate_record(cli, tmp_path, ctrl_c_able):
     proc = subprocess.Popen(_exe() + ["emulate", "--profile", "adc12-thermistor", "--material", "wood=400",
                                       "--touch-every", "13", "--speed", "50", "--duration", "60", "--json"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, **ctrl_c_able)
     try:
         info = _read_json_object(proc.stdout)
         assert info["profile"] == "adc12-thermistor" and info["port"].startswith("/dev/")

@@ -244,14 +244,14 @@ def _designkit_exe() -> list[str]:
 
 
 @pytest.mark.slow
-def test_ctrl_c_keeps_every_trial_recorded(tmp_path):
+def test_ctrl_c_keeps_every_trial_recorded(tmp_path, ctrl_c_able):
     prof = load_profile("designkit")
     out = tmp_path / "trials"
     with _emulator(prof, speed=20.0) as emu:
         proc = subprocess.Popen(_designkit_exe() + ["calibrate", "record", "--port", emu.port, "--profile",
                                                     "designkit", "--material", "wood", "--trials", "50",
                                                     "--out", str(out)],
-                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **ctrl_c_able)
         deadline = time.monotonic() + 60
         while time.monotonic() < deadline and len(list(out.glob("wood_*.json"))) < 1:
             time.sleep(0.05)

@@ -132,11 +132,11 @@ def test_kill_9_then_resume_recomputes_nothing_finished_and_gives_the_same_table
 
 
 @pytest.mark.slow
-def test_ctrl_c_keeps_finished_chunks_and_says_how_to_resume(reference, tmp_path):
+def test_ctrl_c_keeps_finished_chunks_and_says_how_to_resume(reference, tmp_path, ctrl_c_able):
     cfg, ref = reference
     work, out = tmp_path / "work", tmp_path / "tiny.npz"
     proc = subprocess.Popen(_sweep_cmd(cfg, work, out, "--jobs", "1"), stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True)
+                            stderr=subprocess.PIPE, text=True, **ctrl_c_able)
     _wait_for_chunks(proc, work, 1)
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=120)

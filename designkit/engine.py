@@ -500,8 +500,12 @@ def delta_from_staircase(J: np.ndarray, width: float) -> tuple[np.ndarray, np.nd
     n = J.size
     idx = np.arange(n)
     up = np.where(J < n, (J - idx) * width, np.nan)
-    ok = (idx[None, :] < idx[:, None]) & (J[None, :] <= idx[:, None])  # row j, column i
-    I = np.where(ok.any(axis=1), np.where(ok, idx[None, :], -1).max(axis=1), -1)
+    # I(j) = max{i : max(J(i), i + 1) <= j}: a running maximum over the first j each i reaches,
+    # O(n) memory (an n x n comparison would need gigabytes at tens of thousands of intervals)
+    first = np.maximum(J, idx + 1)
+    best = np.full(n + 1, -1, dtype=np.int64)
+    np.maximum.at(best, np.minimum(first, n), idx)
+    I = np.maximum.accumulate(best[:n])
     down = np.where(I >= 0, (idx - I) * width, np.nan)
     return up.astype(np.float64), down.astype(np.float64)
 

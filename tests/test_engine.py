@@ -180,3 +180,18 @@ def test_assembled_monte_carlo_interval_always_holds_its_estimate():
         assert np.all(lo[both] <= est[both]) and np.all(np.isnan(hi[both]) | (hi[both] >= est[both]))
     # row 3's lower end stays where its own walk put it (below the estimate)
     assert out["delta_up_lo"][0, 0, 3] == 1 * cfg.width < out["delta_up"][0, 0, 3]
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.integers(min_value=0, max_value=40), min_size=1, max_size=40), st.floats(1.0, 500.0))
+def test_delta_from_staircase_matches_its_definition(raw, width):
+    """delta_up[i] = (J(i) - i) w; delta_down[j] = (j - I(j)) w with I(j) = max{i < j : J(i) <= j};
+    for any J, monotone or not (full-matrix rows need not be), checked by brute force."""
+    n = len(raw)
+    J = np.minimum(np.asarray(raw), n)
+    up, down = delta_from_staircase(J, width)
+    for i in range(n):
+        assert (np.isnan(up[i]) if J[i] >= n else up[i] == (J[i] - i) * width)
+    for j in range(n):
+        cands = [i for i in range(j) if J[i] <= j]
+        assert (np.isnan(down[j]) if not cands else down[j] == (j - max(cands)) * width)

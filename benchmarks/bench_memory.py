@@ -133,10 +133,12 @@ def main(argv=None):
         for r, a in zip(ideal_rows, above):
             print(f"| {r['intervals']} | {r['rss_mb']:.0f} | {a:.0f} | {r['wall_s']:.1f} |")
         last = ideal_rows[-1]
-        n2g = last["intervals"] * ((2048 - base_help) / max(above[-1], 1e-9)) ** (1 / e_mem) if e_mem > 0 else None
+        # below an exponent of 0.2 the growth is within the noise of a process's resident set
+        n2g = last["intervals"] * ((2048 - base_help) / max(above[-1], 1e-9)) ** (1 / e_mem) if e_mem > 0.2 else None
         out["ideal_fit"] = {"memory_exponent": e_mem, "intervals_at_2gb": n2g}
         print(f"\nMemory above the CLI's own grows as n^{e_mem:.2f}"
-              + (f"; 2 GB is reached near {n2g:,.0f} intervals." if n2g else "."))
+              + (f"; 2 GB is reached near {n2g:,.0f} intervals." if n2g else
+                 ": flat within measurement noise (no extrapolation to 2 GB)."))
     if args.json is not None:
         from designkit._io import atomic_write_text
 

@@ -100,8 +100,13 @@ def main(argv=None):
         for r in sorted(svm_rows, key=lambda r: (r["contact_s"], r["intervals"])):
             print(f"| {r['intervals']} | {r['contact_s']:g} | {r['rss_mb']:.0f} | {r['fits']} | {r['wall_s']:.1f} |")
         at10 = [r for r in svm_rows if r["contact_s"] == contact]
-        slope, icpt = np.polyfit([r["intervals"] for r in at10], [r["rss_mb"] for r in at10], 1)
         per_interval_theory = 100 * 2 * (int(contact * 200) + 1) * 8 / 2**20
+        from designkit.engine import FEATURE_CACHE_MB
+
+        cap = FEATURE_CACHE_MB / per_interval_theory  # intervals the chunk's feature cache holds at most
+        uncapped = [r for r in at10 if r["intervals"] * 1.2 <= cap]
+        fit_rows = uncapped if len(uncapped) >= 2 else at10
+        slope, icpt = np.polyfit([r["intervals"] for r in fit_rows], [r["rss_mb"] for r in fit_rows], 1)
         fixed = [r for r in svm_rows if r["intervals"] == n_fixed]
         c_exp = fit_exponent([r["contact_s"] for r in fixed], [r["rss_mb"] - icpt for r in fixed])
         out["svm_fit"] = {"mb_per_interval_at_10s": slope, "intercept_mb": icpt,
@@ -111,10 +116,12 @@ def main(argv=None):
               f"Above that base, memory grows with the contact time as t^{c_exp:.2f}.")
         # prediction for the shipped grid: 500 intervals in 2 blocks -> 250 references per chunk, their partners too
         for rows_per_chunk, label in ((250, "svm-paper (blocks: 2)"), (500, "blocks: 1")):
-            pred = icpt + slope * rows_per_chunk * 1.2  # ~20 % more intervals touched as partners / repeats
+            # ~20 % more intervals touched as partners / repeats, at most what the feature cache keeps
+            pred = icpt + slope * min(rows_per_chunk * 1.2, cap)
             print(f"Predicted peak of one worker at 10 s for {label}: about {pred:.0f} MB "
-                  f"({rows_per_chunk} references per chunk, +20 % partners and repeated seeds); with --jobs 2: "
-                  f"about {2 * pred:.0f} MB in the workers.")
+                  f"({rows_per_chunk} references per chunk, +20 % partners and repeated seeds, the feature cache "
+                  f"capped at {FEATURE_CACHE_MB} MiB = {cap:.0f} intervals); with --jobs 2: about {2 * pred:.0f} MB "
+                  f"in the workers.")
             out.setdefault("prediction", {})[label] = pred
         # ---- ideal: n x n arrays in delta_from_staircase
         ns_i = [1000, 2000, 4000] if args.quick else [1000, 2000, 4000, 8000]

@@ -57,6 +57,7 @@ import hashlib
 import json
 import math
 import time
+from collections import OrderedDict
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Iterator, Mapping, Sequence
@@ -329,6 +330,11 @@ class _Cell:
         return math.sqrt(max(var_fold, var_rep) / r)
 
 
+#: Feature cache of one chunk [MiB]: bounds a sweep worker's memory whatever the grid (at 10 s,
+#: 200 Hz and 100 trials an interval's features take 3 MiB, so 500 intervals would take 1.5 GiB).
+FEATURE_CACHE_MB = 512
+
+
 class _PairScorer:
     """SVM F1 of interval pairs for one scene, with repeats and caches local to a chunk."""
 
@@ -338,14 +344,20 @@ class _PairScorer:
         self.scene = scene
         self.n_samples = sensor.times_s(scene.contact_s).size
         self.edges = cfg.edges
-        self._features: dict[tuple[int, int], np.ndarray] = {}
+        # features of (interval, seed), least recently used first; they are a deterministic function
+        # of their key, so evicting one only costs its regeneration, never changes a result
+        self._features: OrderedDict[tuple[int, int], np.ndarray] = OrderedDict()
+        per_entry = cfg.trials * 2 * self.n_samples * 8  # raw samples + slope, float64
+        self._max_features = max(8, int(FEATURE_CACHE_MB * 2**20 // max(per_entry, 1)))
         self.cells: dict[tuple[int, int], _Cell] = {}
         self.fits = 0
 
     def features(self, k: int, rep: int) -> np.ndarray:
         key = (k, rep)
         feats = self._features.get(key)
-        if feats is None:
+        if feats is not None:
+            self._features.move_to_end(key)
+        else:
             cfg = self.cfg
             draws = draw_trials(self.edges[k], self.edges[k + 1], cfg.trials, self.n_samples,
                                 seed=[cfg.seed, k, rep],
@@ -354,6 +366,8 @@ class _PairScorer:
             temps = render_trials(draws, self.sensor, self.scene).temperature_c
             feats = feature_matrix(temps, self.sensor.sample_rate_hz, cfg.slope_window_s)
             self._features[key] = feats
+            while len(self._features) > self._max_features:
+                self._features.popitem(last=False)
         return feats
 
     def score(self, i: int, j: int, rep: int) -> tuple[float, float]:

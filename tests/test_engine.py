@@ -195,3 +195,18 @@ def test_delta_from_staircase_matches_its_definition(raw, width):
     for j in range(n):
         cands = [i for i in range(j) if J[i] <= j]
         assert (np.isnan(down[j]) if not cands else down[j] == (j - max(cands)) * width)
+
+
+def test_bounded_feature_cache_changes_no_result(monkeypatch):
+    """A chunk's feature cache is bounded (a worker's memory whatever the grid); features are a
+    function of (interval, seed), so a cache that must evict and regenerate gives the same table."""
+    import designkit.engine as engine
+
+    cfg = SweepConfig(intervals=24, trials=30, noise_ratio=(0.005,), contact_s=(1.0,), max_repeats=2, seed=5)
+    full = run_chunk(cfg, (0,), 0, 0)
+    monkeypatch.setattr(engine, "FEATURE_CACHE_MB", 0)  # the floor: 8 entries for 24 intervals x 2 seeds
+    small = run_chunk(cfg, (0,), 0, 0)
+    for name in ("J", "J_lo", "J_hi", "J_ideal"):
+        np.testing.assert_array_equal(getattr(small, name), getattr(full, name), err_msg=name)
+    np.testing.assert_array_equal(small.cells, full.cells)
+    assert small.fits == full.fits

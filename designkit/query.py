@@ -713,6 +713,35 @@ def _contact_search(svm_f1, phi: float, floor_s: float, max_contact_s: float, to
     return value, interval, evaluations
 
 
+def _ratio_search(svm_f1, phi: float, lo_r: float, hi_r: float, z: float):
+    """Largest sigma/dT at which the mean SVM F1 still reaches ``phi``, by bisection in log sigma/dT.
+
+    ``svm_f1(ratio)`` returns ``(mean F1, standard error)``. The Monte Carlo interval
+    runs from the largest evaluated ratio clearly separable (mean - z SE >= phi) to the
+    smallest clearly not (mean + z SE < phi); None where no evaluation is clear.
+
+    Returns ``(ratio or None, (lo, hi), evaluations)``; ``hi_r`` itself when even it
+    separates, None when not even ``lo_r`` does.
+    """
+    evaluated: dict[float, tuple[float, float]] = {}
+
+    def ok(r):  # still separable at this noise ratio
+        evaluated[r] = svm_f1(r)
+        return evaluated[r][0] >= phi
+
+    if not ok(lo_r):
+        r = None
+    elif ok(hi_r):
+        r = hi_r
+    else:  # largest ratio that is ok == bisection on "not ok" from above
+        r = _bisect(lambda x: not ok(x), lo_r, hi_r, 0.02, log=True)
+    ok_conf = [x for x, (m, s) in evaluated.items() if m - z * s >= phi]
+    bad_conf = [x for x, (m, s) in evaluated.items() if m + z * s < phi]
+    interval = (max(ok_conf) if ok_conf else None, min(bad_conf) if bad_conf else None)
+    evaluations = [{"noise_ratio": x, "svm_f1": m, "standard_error": s} for x, (m, s) in sorted(evaluated.items())]
+    return r, interval, evaluations
+
+
 def _threshold(threshold: float) -> float:
     phi = check_finite("threshold", threshold)
     if not 2 / 3 < phi < 1:
@@ -734,26 +763,10 @@ def _exact_ratio(question: str, e1, e2, contact_s, noise_c, delta_t_c, threshold
     def scene(r):
         return Scene.from_delta_t(contact_s=contact, noise_c=r, delta_t_c=1.0)
 
-    evaluated: dict[float, tuple[float, float]] = {}
-
-    def svm_ok(r):  # ok means "still separable at this noise ratio"
-        evaluated[r] = _svm_f1(ex, cls, scene(r))
-        return evaluated[r][0] >= phi
-
-    # largest ratio that is ok == bisection on "not ok" from above
-    if not svm_ok(lo_r):
-        r = None
-    elif svm_ok(hi_r):
-        r = hi_r
-    else:
-        r = _bisect(lambda x: not svm_ok(x), lo_r, hi_r, 0.02, log=True)
+    r, (r_lo, r_hi), evaluations = _ratio_search(lambda x: _svm_f1(ex, cls, scene(x)), phi, lo_r, hi_r, z)
     ideal_r = None
     if _ideal_f1(ex, cls, scene(lo_r)) >= phi:
         ideal_r = _bisect(lambda x: _ideal_f1(ex, cls, scene(x)) < phi, lo_r, hi_r, 1e-3, log=True)
-    ok_conf = [x for x, (m, s) in evaluated.items() if m - z * s >= phi]
-    bad_conf = [x for x, (m, s) in evaluated.items() if m + z * s < phi]
-    r_lo = max(ok_conf) if ok_conf else None
-    r_hi = min(bad_conf) if bad_conf else None
     if question == "max-noise":
         dt = check_finite("temperature difference [degC]", delta_t_c)
         conv = lambda x: None if x is None else x * abs(dt)  # noqa: E731
@@ -769,9 +782,7 @@ def _exact_ratio(question: str, e1, e2, contact_s, noise_c, delta_t_c, threshold
                    "seed": ex.seed, "sensor": ex.sensor.name})
     note = "" if r is not None else "not separable even at sigma/dT = 1e-5"
     return Answer(question, conv(r), interval, conv(ideal_r), "computed", None, None, inputs, {},
-                  {"fidelity": "svm", "wall_s": time.perf_counter() - t0,
-                   "evaluations": [{"noise_ratio": x, "svm_f1": m, "standard_error": s}
-                                   for x, (m, s) in sorted(evaluated.items())]}, note)
+                  {"fidelity": "svm", "wall_s": time.perf_counter() - t0, "evaluations": evaluations}, note)
 
 
 def exact_max_noise(e1=None, e2=None, *, contact_s: float, delta_t_c: float = 10.0, threshold: float = 0.9,

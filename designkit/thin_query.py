@@ -817,7 +817,7 @@ def thin_min_contact(obj1: SlabObject, obj2: SlabObject, *, thickness_m: float, 
 
 def _thin_ratio(question, obj1, obj2, thickness_m, backing, contact_s, noise_c, delta_t_c, threshold, sensor,
                 trials, folds, seed, repeats, z, jobs, n_mc, fraction):
-    from .query import Answer, _bisect, _threshold
+    from .query import Answer, _bisect, _ratio_search, _threshold
 
     phi = _threshold(threshold)
     contact = check_positive("contact time [s]", contact_s)
@@ -834,27 +834,12 @@ def _thin_ratio(question, obj1, obj2, thickness_m, backing, contact_s, noise_c, 
     def scene(r):  # readings depend on sigma and dT only through r (standardized features, fixed conditions)
         return Scene.from_delta_t(contact_s=contact, noise_c=r, delta_t_c=1.0)
 
-    evaluated: dict[float, tuple[float, float]] = {}
-
-    def svm_ok(r):
-        evaluated[r] = _svm_f1(ex, objs, scene(r), slab)
-        return evaluated[r][0] >= phi
-
-    if not svm_ok(lo_r):
-        r = None
-    elif svm_ok(hi_r):
-        r = hi_r
-    else:
-        r = _bisect(lambda x: not svm_ok(x), lo_r, hi_r, 0.02, log=True)
+    r, (r_lo, r_hi), evaluations = _ratio_search(lambda x: _svm_f1(ex, objs, scene(x), slab), phi, lo_r, hi_r, z)
     ilog = _IdealLog(ex, objs, slab, n_mc)
     ideal_r = None
     if ilog.f1(scene(lo_r)) >= phi:
         ideal_r = hi_r if ilog.f1(scene(hi_r)) >= phi else \
             _bisect(lambda x: ilog.f1(scene(x)) < phi, lo_r, hi_r, 2e-3, log=True)
-    ok_conf = [x for x, (m, s) in evaluated.items() if m - z * s >= phi]
-    bad_conf = [x for x, (m, s) in evaluated.items() if m + z * s < phi]
-    r_lo = max(ok_conf) if ok_conf else None
-    r_hi = min(bad_conf) if bad_conf else None
     if question == "max-noise":
         conv = lambda x: None if x is None else x * abs(dt)  # noqa: E731
         interval = (conv(r_lo), conv(r_hi))
@@ -871,8 +856,7 @@ def _thin_ratio(question, obj1, obj2, thickness_m, backing, contact_s, noise_c, 
                                 fraction=fraction)
     inputs = _thin_inputs(objs, slab, ex, contact_s=contact, threshold=phi, **scene_in)
     note = "" if r is not None else "not separable even at sigma/dT = 1e-5"
-    extra = _extra(check, slab, ilog, t0, evaluations=[{"noise_ratio": x, "svm_f1": m, "standard_error": s}
-                                                       for x, (m, s) in sorted(evaluated.items())])
+    extra = _extra(check, slab, ilog, t0, evaluations=evaluations)
     return Answer(question, conv(r), interval, conv(ideal_r), "computed", None, None, inputs, {}, extra, note)
 
 

@@ -69,7 +69,7 @@ from ._validation import (
     check_finite,
     check_positive,
 )
-from .ideal import IdealResult, ideal_pair
+from .ideal import IdealResult, ideal_pair, score_llr
 from .scene import Scene
 from .sensor import Sensor
 from .simulation import draw_trials
@@ -477,13 +477,6 @@ def _grid_coefficients(grid: _ClassGrid, basis, t, slab, sensor, tol):
     return np.vstack(coefs), worst, np.vstack(worst_rows)
 
 
-def _score(llr: np.ndarray, labels: np.ndarray, n_mc: int) -> tuple[float, float, float, float]:
-    """Best F1 over thresholds on the log-likelihood ratio, its standard error, Bayes accuracy and its error."""
-    from .ideal import score_llr
-
-    return score_llr(llr, labels, n_mc)
-
-
 @dataclass(frozen=True)
 class SlabIdeal:
     """Ideal-observer result for a thin-sample pair, with how it was computed.
@@ -584,7 +577,7 @@ def _slab_ideal_mc(low, high, sensor, scene, slab, n_mc, seed, dev) -> SlabIdeal
         ll = [special.logsumexp((yc @ c.T - h[None, :]) / (s_n * s_n), axis=1) - math.log(c.shape[0])
               for c, h in zip(cs, half_sq)]
         llr[i:i + 512] = ll[1] - ll[0]
-    f1, se, acc, acc_se = _score(llr, labels, n_mc)
+    f1, se, acc, acc_se = score_llr(llr, labels, n_mc)
     res = IdealResult(f1=f1, accuracy=acc, method="monte-carlo", standard_error=se, accuracy_standard_error=acc_se,
                       projection_noise=None, n_mc=n_mc)
     details = {"grid": [[g.e_nodes.size, g.alpha_nodes.size] for g in grids],

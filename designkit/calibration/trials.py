@@ -191,11 +191,10 @@ def read_trial_csv(path: Path, material: str = "") -> Trial:
                  source=str(path), meta=meta)
 
 
-def load_index(index_csv: Path, only: Sequence[str] | None = None) -> list[Trial]:
-    """Read every trial an index lists (columns ``file`` and ``material``; others ignored).
+def read_index_rows(index_csv: Path | str) -> list[dict[str, str]]:
+    """The rows of a trial index (a CSV with at least the columns ``file`` and ``material``).
 
-    Paths are relative to the index's folder. ``only`` keeps those materials
-    (an unknown name in it is an error).
+    Raises InputError, with the path, when it cannot be read or lacks those columns.
     """
     index_csv = Path(index_csv)
     try:
@@ -205,6 +204,17 @@ def load_index(index_csv: Path, only: Sequence[str] | None = None) -> list[Trial
         raise InputError(f"cannot read index {index_csv}: {exc.strerror or exc}") from None
     if not rows or not {"file", "material"} <= set(rows[0]):
         raise InputError(f"index {index_csv} needs columns file and material")
+    return rows
+
+
+def load_index(index_csv: Path, only: Sequence[str] | None = None) -> list[Trial]:
+    """Read every trial an index lists (columns ``file`` and ``material``; others ignored).
+
+    Paths are relative to the index's folder. ``only`` keeps those materials
+    (an unknown name in it is an error).
+    """
+    index_csv = Path(index_csv)
+    rows = read_index_rows(index_csv)
     materials = sorted({r["material"] or "" for r in rows})
     numbered = list(enumerate(rows, start=2))  # CSV line numbers, header = line 1
     if only:

@@ -19,7 +19,6 @@ tested on the real test touches.
 
 from __future__ import annotations
 
-import csv
 import math
 import time
 from dataclasses import dataclass
@@ -107,16 +106,10 @@ class RealTouches:
 
 def load_real(data_dir: Path, contact_s: float = CONTACT_S, sample_rate_hz: float = 200.0) -> RealTouches:
     """Read the recordings listed in ``data_dir/index.csv`` (file, material, trial_set)."""
-    from ..calibration.trials import read_trial_csv
+    from ..calibration.trials import read_index_rows, read_trial_csv
 
     index = Path(data_dir) / "index.csv"
-    try:
-        with index.open(newline="") as fh:
-            rows = list(csv.DictReader(fh))
-    except OSError as exc:
-        raise InputError(f"cannot read {index}: {exc.strerror or exc}") from None
-    if not rows or not {"file", "material"} <= set(rows[0]):
-        raise InputError(f"{index} needs columns file and material")
+    rows = read_index_rows(index)
     grid = np.arange(int(round(contact_s * sample_rate_hz)) + 1) / sample_rate_hz
     mats, sets, files, curves, ts0, ta, tend, trials = [], [], [], [], [], [], [], []
     for r in rows:

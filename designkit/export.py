@@ -1331,6 +1331,19 @@ def _need(combos, k, lo, hi):
     return max(up, down)
 
 
+def _over_contact(cw, value_at):
+    """Contact-weighted sum of value_at(k); None when a needed grid point has no value."""
+    total = 0.0
+    for k, w in cw:
+        if w == 0:
+            continue
+        x = value_at(k)
+        if _math.isnan(x):
+            return None
+        total += w * x
+    return total
+
+
 def _deltas(e, noise_c, delta_t_c, contact_s):
     e = _effusivity("e", e)
     contact = _contact_input(contact_s)
@@ -1338,19 +1351,7 @@ def _deltas(e, noise_c, delta_t_c, contact_s):
     combos = _scene(noise, dt)
     cw = _contact(contact)
     _check_e(e)
-    out = []
-    for arr in (_DOWN, _UP):
-        total = 0.0
-        for k, w in cw:
-            if w == 0:
-                continue
-            x = _delta_at(arr, combos, k, e)
-            if _math.isnan(x):
-                total = None
-                break
-            total += w * x
-        out.append(total)
-    return out
+    return [_over_contact(cw, lambda k, arr=arr: _delta_at(arr, combos, k, e)) for arr in (_DOWN, _UP)]
 
 
 def delta_e_lower(e, noise_c, delta_t_c, contact_s):
@@ -1398,15 +1399,8 @@ def distinguishable(e1, e2, noise_c, delta_t_c, contact_s):
     combos = _scene(noise, dt)
     cw = _contact(contact)
     _check_e(lo, hi)
-    total = 0.0
-    for k, w in cw:
-        if w == 0:
-            continue
-        nd = _need(combos, k, lo, hi)
-        if _math.isnan(nd):
-            return False
-        total += w * nd
-    return total <= hi - lo
+    total = _over_contact(cw, lambda k: _need(combos, k, lo, hi))
+    return total is not None and total <= hi - lo
 '''
 
 

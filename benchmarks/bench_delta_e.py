@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from designkit.bench import fit_exponent, staircase_vs_full
+from designkit.accuracy.report import fit_exponent, staircase_vs_full
 
 
 def main(argv=None):
@@ -102,7 +102,7 @@ def main(argv=None):
               f"({pred['full_fits'] / pred['staircase_fits']:.0f}x fewer fits, "
               f"{pred['full_wall_s'] / pred['staircase_wall_s']:.0f}x less time).")
     try:
-        from designkit.tables import load_table
+        from designkit.tables.store import load_table
 
         t = load_table("svm-paper")
         ax = t.axes

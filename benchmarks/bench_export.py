@@ -38,9 +38,9 @@ from pathlib import Path
 
 import numpy as np
 
-from designkit import query as q
-from designkit.export import FORMATS, render, slice_table, to_c, to_python
-from designkit.tables import list_tables, load_table
+from designkit.query import table as q
+from designkit.export.core import FORMATS, render, slice_table, to_c, to_python
+from designkit.tables.store import list_tables, load_table
 
 NOISE_C, DELTA_T_C = 0.05, 10.0
 

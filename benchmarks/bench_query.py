@@ -36,7 +36,7 @@ import sys
 import timeit
 from pathlib import Path
 
-from designkit.bench import process_cost
+from designkit.accuracy.report import process_cost
 
 PAIR = ["--e1", "35000", "--e2", "20000"]
 NUMPY = "python -c 'import numpy'"
@@ -54,7 +54,7 @@ def console_script() -> list[str]:
 
 
 def svm_table_available() -> bool:
-    from designkit.tables import list_tables
+    from designkit.tables.store import list_tables
 
     return "svm-paper" in list_tables()
 
@@ -107,8 +107,8 @@ def imports(table_args: list[str]) -> dict:
 
 
 def in_process(table: str, ideal_table: str, number: int = 200) -> dict:
-    from designkit import query
-    from designkit.tables import load_table
+    from designkit.query import table as query
+    from designkit.tables.store import load_table
 
     tab = load_table(table)
     itab = load_table(ideal_table)

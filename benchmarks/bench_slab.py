@@ -39,7 +39,8 @@ from pathlib import Path
 
 import numpy as np
 
-from designkit import SENSORS, fv, slab
+from designkit import SENSORS
+from designkit.models import fv, slab
 
 SENSOR = SENSORS["paper"]
 DT_C = 10.0  # sensor - object temperature difference [degC]
@@ -143,7 +144,7 @@ def cross_check(refs):
 def convergence():
     """Observed orders: space (thick acrylic vs eq. 2, BDF far tighter than space) and
     time (Crank-Nicolson vs a tight BDF solution of the same semi-discrete system)."""
-    from designkit.physics import object_weight, response_shape
+    from designkit.models.semi_infinite import object_weight, response_shape
 
     e, a = ACRYLIC
     t = np.array([0.5, 1.0, 2.0, 4.0])

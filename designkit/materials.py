@@ -372,7 +372,7 @@ def _check_names(source: str, set_name: str, materials: Iterable[Material]) -> N
 
 
 def _parse_table(data: Any, source: str) -> MaterialTable:
-    from .physics import effusivity
+    from .models.semi_infinite import effusivity
 
     if not isinstance(data, Mapping):
         raise InputError(f"{source}: a materials file must be a mapping, got {type(data).__name__}")

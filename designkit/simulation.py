@@ -1,4 +1,4 @@
-"""Simulated touches: noisy sensor readings from the physics model (paper eq. 4).
+"""Simulated touches: noisy sensor readings from any forward model (paper eq. 4).
 
 Random draws follow one fixed protocol so that results are reproducible and
 the engine's shortcuts are exact:
@@ -12,10 +12,16 @@ the engine's shortcuts are exact:
    shorter contact time (as the paper did) is therefore identical to
    simulating the shorter contact directly.
 
-With fixed initial conditions the readings are ``Ts0 + dT * (-w g + (sigma/dT) Z)``:
+5. where the forward model needs the object's diffusivity (a slab), one
+   uniform draw per trial in the class's diffusivity range, from the
+   independent stream ``seed + [7]``.
+
+The noise-free reading is ``Ts0 + (Ta - Ts0) u(t)`` with ``u`` from the forward
+model (:mod:`designkit.models`; the paper's semi-infinite one by default).
+With fixed initial conditions the readings are ``Ts0 + dT * (-u + (sigma/dT) Z)``:
 an affine image of a dataset that depends on sigma and dT only through
 sigma/dT, which is why standardized-feature recognition depends only on that
-ratio.
+ratio, for every (linear) model.
 """
 
 from __future__ import annotations
@@ -24,6 +30,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+import math
+
 from ._validation import (
     InputError,
     as_generator,
@@ -31,19 +39,28 @@ from ._validation import (
     check_effusivity_range,
     check_nonnegative,
 )
-from .physics import object_weight, response_shape
+from .models import ForwardModel, get_model
+from .models.semi_infinite import object_weight, response_shape
+from .objects import ObjectClass
 from .scene import Scene
 from .sensor import Sensor
 
 __all__ = [
+    "DIFFUSIVITY_STREAM",
     "TrialDraws",
     "Trials",
     "draw_trials",
     "noisy_readings",
     "render_trials",
+    "response_tolerance",
+    "seed_key",
+    "simulate_class",
     "simulate_interval",
     "simulate_trials",
 ]
+
+#: Seed-key suffix of the per-trial diffusivity draws (independent of the noise).
+DIFFUSIVITY_STREAM = 7
 
 
 @dataclass(frozen=True)
@@ -99,6 +116,10 @@ class Trials:
         Object effusivity of each trial [J s^-1/2 K^-1 m^-2].
     sensor_temp_c, ambient_temp_c : ndarray, shape (n,)
         Initial sensor and object temperatures of each trial [degC].
+    diffusivity_m2_s : ndarray, shape (n,), or None
+        Object diffusivity of each trial [m^2 s^-1], where the model needs it.
+    model : str
+        Forward model that made the readings.
     """
 
     time_s: np.ndarray
@@ -106,6 +127,8 @@ class Trials:
     effusivity: np.ndarray
     sensor_temp_c: np.ndarray
     ambient_temp_c: np.ndarray
+    diffusivity_m2_s: np.ndarray | None = None
+    model: str = "semi-infinite"
 
 
 def draw_trials(e_low: float, e_high: float, n_trials: int, n_samples: int, seed,
@@ -143,7 +166,7 @@ def draw_trials(e_low: float, e_high: float, n_trials: int, n_samples: int, seed
 
 
 def noisy_readings(time_s, e_object, sensor_temp_c, ambient_temp_c, sensor: Sensor,
-                   noise_c: float, noise) -> np.ndarray:
+                   noise_c: float, noise, model: "ForwardModel | None" = None) -> np.ndarray:
     """Thermistor readings with additive Gaussian noise (paper eq. 4).
 
     Parameters
@@ -159,6 +182,8 @@ def noisy_readings(time_s, e_object, sensor_temp_c, ambient_temp_c, sensor: Sens
         Noise standard deviation sigma [degC].
     noise : array_like, shape (n, m)
         Standard normal draws (scaled here by ``noise_c``).
+    model : ForwardModel, optional
+        A shared-shape forward model (default: the paper's semi-infinite one).
 
     Returns
     -------
@@ -166,24 +191,105 @@ def noisy_readings(time_s, e_object, sensor_temp_c, ambient_temp_c, sensor: Sens
         Readings [degC].
     """
     sigma = check_nonnegative("noise sigma [degC]", noise_c)
-    g = response_shape(np.asarray(time_s, dtype=np.float64), sensor.tau_s)
+    t = np.asarray(time_s, dtype=np.float64)
     e = np.atleast_1d(np.asarray(e_object, dtype=np.float64))
     ts = np.atleast_1d(np.asarray(sensor_temp_c, dtype=np.float64))
     ta = np.atleast_1d(np.asarray(ambient_temp_c, dtype=np.float64))
-    amp = (ta - ts) * object_weight(sensor.effusivity, e)  # Tc - Ts0 per trial
+    if model is None:
+        g, w = response_shape(t, sensor.tau_s), object_weight(sensor.effusivity, e)
+    else:
+        g, w = model.shape(t, sensor), model.weight(e, sensor)
+    amp = (ta - ts) * w  # Tc - Ts0 per trial
     out = ts[:, None] + amp[:, None] * g[None, :]
     if sigma > 0:
         out = out + sigma * np.asarray(noise, dtype=np.float64)
     return out
 
 
-def render_trials(draws: TrialDraws, sensor: Sensor, scene: Scene) -> Trials:
-    """Apply a scene to drawn trials: readings of ``draws.n_samples`` samples."""
+def response_tolerance(noise_ratio: float, n_samples: int) -> float:
+    """Tolerance asked of a numerically solved model: 1 % of the noise over the whole curve, at most 1e-5.
+
+    Normalized units (times ``|Ts0 - Ta|`` for degC); ``noise_ratio`` is sigma/dT.
+    """
+    if not math.isfinite(noise_ratio):
+        return 1e-5
+    return float(np.clip(0.01 * noise_ratio / math.sqrt(max(n_samples, 1)), 1e-10, 1e-5))
+
+
+def render_trials(draws: TrialDraws, sensor: Sensor, scene: Scene, model: "ForwardModel | str | None" = None,
+                  diffusivity_m2_s=None) -> Trials:
+    """Apply a scene to drawn trials: readings of ``draws.n_samples`` samples.
+
+    Parameters
+    ----------
+    draws : TrialDraws
+    sensor : Sensor
+    scene : Scene
+    model : ForwardModel, name or None
+        Forward model (default: the paper's semi-infinite model).
+    diffusivity_m2_s : array_like, shape (n,), optional
+        Per-trial object diffusivity, for models that need it.
+    """
+    fm = get_model(model)
     time_s = np.arange(draws.n_samples, dtype=np.float64) / sensor.sample_rate_hz
     ts = scene.sensor_temp_c + scene.sensor_temp_spread_c * draws.sensor_offset
     ta = scene.ambient_temp_c + scene.ambient_temp_spread_c * draws.ambient_offset
-    temps = noisy_readings(time_s, draws.effusivity, ts, ta, sensor, scene.noise_c, draws.noise)
-    return Trials(time_s, temps, draws.effusivity, ts, ta)
+    if fm.shared_shape:
+        # amplitude times shape, in this order: the paper's readings to the last bit
+        temps = noisy_readings(time_s, draws.effusivity, ts, ta, sensor, scene.noise_c, draws.noise, model=fm)
+    else:
+        tol = response_tolerance(scene.noise_ratio, draws.n_samples)
+        u = fm.response(time_s, draws.effusivity, sensor, diffusivity_m2_s=diffusivity_m2_s, tolerance=tol)
+        temps = ts[:, None] + (ta - ts)[:, None] * u
+        if scene.noise_c > 0:
+            temps = temps + scene.noise_c * draws.noise
+    return Trials(time_s, temps, draws.effusivity, ts, ta,
+                  None if diffusivity_m2_s is None else np.asarray(diffusivity_m2_s, dtype=np.float64), fm.name)
+
+
+def seed_key(seed) -> list[int]:
+    """A seed as a list of integers, so that sub-streams (``key + [k]``) can be derived from it."""
+    if isinstance(seed, (list, tuple)):
+        key = [int(s) for s in seed]
+        as_generator(key)  # validates
+        return key
+    if isinstance(seed, (np.random.Generator, np.random.SeedSequence)):
+        raise InputError("this simulation needs an integer seed or a list of integers "
+                         "(its sub-streams are derived from it)")
+    as_generator(seed)  # validates (refuses None and negatives)
+    return [int(seed)]
+
+
+def simulate_class(obj: ObjectClass, n_trials: int, sensor: Sensor, scene: Scene, seed,
+                   model: "ForwardModel | str | None" = None) -> Trials:
+    """``n_trials`` touches of one object class under any forward model.
+
+    Draws follow the module's protocol (:func:`draw_trials` with ``seed``);
+    the diffusivity, where the model needs it, is uniform in the class's
+    range from the stream ``seed + [7]``.
+
+    Examples
+    --------
+    >>> from designkit import SENSORS, Scene
+    >>> from designkit.objects import object_class
+    >>> t = simulate_class(object_class(20000), 100, SENSORS["paper"], Scene(contact_s=2), seed=0,
+    ...                    model="contact")
+    >>> t.temperature_c.shape, t.model
+    ((100, 401), 'contact')
+    """
+    fm = get_model(model)
+    obj.require(fm.object_properties)
+    key = seed_key(seed)
+    n_samples = sensor.times_s(scene.contact_s).size
+    draws = draw_trials(*obj.e_range, n_trials, n_samples, key,
+                        vary_sensor=scene.sensor_temp_spread_c > 0,
+                        vary_ambient=scene.ambient_temp_spread_c > 0)
+    alpha = None
+    if "diffusivity_m2_s" in fm.object_properties:
+        a_lo, a_hi = obj.diffusivity_range_m2_s
+        alpha = (as_generator(key + [DIFFUSIVITY_STREAM]).uniform(a_lo, a_hi, draws.n_trials) if a_hi > a_lo
+                 else np.full(draws.n_trials, a_lo))
+    return render_trials(draws, sensor, scene, fm, alpha)
 
 
 def simulate_interval(e_low: float, e_high: float, n_trials: int, sensor: Sensor,

@@ -16,8 +16,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from designkit import Scene, bench
-from designkit.ideal import ideal_pair
+from designkit import Scene
+from designkit.accuracy import report as bench
+from designkit.query import ideal_bound
+from designkit.recognition.ideal import ideal_pair
 from designkit.sensor import SENSORS
 
 PAPER = SENSORS["paper"]
@@ -71,7 +73,7 @@ def test_exact_ideal_min_contact_is_the_first_sample_time_that_separates():
     lo = np.array([20000.0, 5000.0, 1000.0])
     hi = np.array([35000.0, 5400.0, 1100.0])
     ratio = np.array([0.005, 0.002, 0.01])
-    t = bench.exact_ideal_min_contact(PAPER, lo, hi, ratio)
+    t = ideal_bound.exact_ideal_min_contact(PAPER, lo, hi, ratio)
     dt = 1.0 / PAPER.sample_rate_hz
     for a, b, r, c in zip(lo, hi, ratio, t):
         assert _f1(a, b, c, r) >= 0.9 > _f1(a, b, c - dt, r)
@@ -80,13 +82,13 @@ def test_exact_ideal_min_contact_is_the_first_sample_time_that_separates():
 
 
 def test_exact_ideal_min_contact_is_nan_when_nothing_up_to_the_limit_separates():
-    t = bench.exact_ideal_min_contact(PAPER, 20000.0, 20050.0, 0.02, max_contact_s=2.0)
+    t = ideal_bound.exact_ideal_min_contact(PAPER, 20000.0, 20050.0, 0.02, max_contact_s=2.0)
     assert np.isnan(t)
 
 
 def test_exact_ideal_max_ratio_brackets_the_threshold():
     lo, hi, c = np.array([20000.0, 3000.0]), np.array([35000.0, 3400.0]), np.array([2.0, 1.5])
-    r = bench.exact_ideal_max_ratio(PAPER, lo, hi, c)
+    r = ideal_bound.exact_ideal_max_ratio(PAPER, lo, hi, c)
     for a, b, ci, ri in zip(lo, hi, c, r):
         assert _f1(a, b, ci, ri) >= 0.9 > _f1(a, b, ci, ri * 1.001)
 
@@ -94,7 +96,7 @@ def test_exact_ideal_max_ratio_brackets_the_threshold():
 def test_exact_ideal_delta_brackets_the_threshold_in_both_directions():
     e = np.array([20000.0, 2000.0])
     for direction in (+1, -1):
-        d = bench.exact_ideal_delta(PAPER, e, 2.0, 0.005, direction=direction)
+        d = ideal_bound.exact_ideal_delta(PAPER, e, 2.0, 0.005, direction=direction)
         for ei, di in zip(e, d):
             near, far = sorted([ei + direction * (di - 1.0), ei + direction * di])
             p = ei + direction * di
@@ -106,13 +108,13 @@ def test_exact_ideal_delta_brackets_the_threshold_in_both_directions():
 # ------------------------------------------------------------------ tables
 @pytest.fixture(scope="module")
 def ideal_table():
-    from designkit.tables import load_table
+    from designkit.tables.store import load_table
 
     return load_table("ideal-paper")
 
 
 def test_subsampled_table_answers_like_the_full_table_at_kept_points(ideal_table):
-    from designkit import query
+    from designkit.query import table as query
 
     ax = ideal_table.axes
     keep = {"noise_ratio": [0, 6, 10, 16], "contact_s": list(range(0, len(ax["contact_s"]), 4))}
@@ -207,8 +209,8 @@ def test_console_script_bench_prints_the_table(tmp_path):
 
 @pytest.mark.slow
 def test_svm_query_rows_against_exact_on_a_tiny_svm_table(tmp_path):
-    from designkit.engine import SweepConfig, run_sweep
-    from designkit.tables import load_table
+    from designkit.sweep.engine import SweepConfig, run_sweep
+    from designkit.tables.store import load_table
 
     cfg = SweepConfig(name="tiny-svm", fidelity="svm", intervals=5, e_max=40000.0, trials=12, max_repeats=1,
                       noise_ratio=(0.002, 0.005), contact_s=(0.5, 1.0, 2.0))

@@ -23,7 +23,7 @@ from designkit.calibration.emulator import EmulatedMaterial, Emulator, Faults, T
 from designkit.calibration.profiles import list_profiles, load_profile, profile_from_dict
 from designkit.calibration.recorder import DeviceGone, NoData, SerialRecorder, TrialCutter
 from designkit.calibration.trials import load_index, read_trial_csv
-from designkit.physics import sensor_temperature
+from designkit.models.semi_infinite import sensor_temperature
 
 PAPER = SENSORS["paper"]
 SENSOR_T, AMBIENT = 35.0, 25.0

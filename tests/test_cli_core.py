@@ -30,7 +30,7 @@ def test_simulate_csv_json_and_plot(cli, tmp_path):
 
 
 def test_simulate_noise_free_matches_physics(cli):
-    from designkit.physics import sensor_temperature
+    from designkit.models.semi_infinite import sensor_temperature
 
     r = cli("simulate", "--e", 5000, "--contact", 2, "--noise", 0, "--sensor-temp", 30, "--ambient", 20, "--json")
     p = json.loads(r.stdout)

@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from designkit import InputError
-from designkit.engine import (
+from designkit.sweep.engine import (
     ChunkResult,
     SweepConfig,
     assemble,
@@ -18,7 +18,7 @@ from designkit.engine import (
     run_scene,
     staircase_search,
 )
-from designkit.ideal import ideal_scores, projection_noise
+from designkit.recognition.ideal import ideal_scores, projection_noise
 
 
 @st.composite
@@ -200,7 +200,7 @@ def test_delta_from_staircase_matches_its_definition(raw, width):
 def test_bounded_feature_cache_changes_no_result(monkeypatch):
     """A chunk's feature cache is bounded (a worker's memory whatever the grid); features are a
     function of (interval, seed), so a cache that must evict and regenerate gives the same table."""
-    import designkit.engine as engine
+    import designkit.sweep.engine as engine
 
     cfg = SweepConfig(intervals=24, trials=30, noise_ratio=(0.005,), contact_s=(1.0,), max_repeats=2, seed=5)
     full = run_chunk(cfg, (0,), 0, 0)

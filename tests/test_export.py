@@ -18,10 +18,10 @@ import numpy as np
 import pytest
 
 from designkit import InputError
-from designkit import query as q
-from designkit.engine import SweepConfig, run_sweep
-from designkit.export import (FORMATS, export_table, parse_contact, read_export, render, slice_table, to_python)
-from designkit.tables import content_hash, load_table, table_header, write_table
+from designkit.query import table as q
+from designkit.sweep.engine import SweepConfig, run_sweep
+from designkit.export.core import (FORMATS, export_table, parse_contact, read_export, render, slice_table, to_python)
+from designkit.tables.store import content_hash, load_table, table_header, write_table
 
 REPO = Path(__file__).resolve().parent.parent
 EXAMPLES = REPO / "examples"
@@ -112,7 +112,7 @@ OPS = ("min_contact", "delta_e", "delta_e_lower", "delta_e_upper", "distinguisha
 
 
 def reference(tab, kind: str, op: str, args):
-    """designkit.query's answer: float, None (nothing suffices), bool, or 'outside' / 'invalid'."""
+    """designkit.query.table's answer: float, None (nothing suffices), bool, or 'outside' / 'invalid'."""
     try:
         if op == "min_contact":
             e1, e2, noise, dt = args

@@ -15,9 +15,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from designkit import query as q
-from designkit.export import slice_table, to_c
-from designkit.tables import load_table
+from designkit.query import table as q
+from designkit.export.core import slice_table, to_c
+from designkit.tables.store import load_table
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from test_export import (CASES, EXAMPLES, ON_ROW, _beyond_slice, agree, case, ideal_table,  # noqa: E402

@@ -13,8 +13,8 @@ from hypothesis import strategies as st
 from scipy import optimize, stats
 
 from designkit import Scene
-from designkit.ideal import class_survival, ideal_pair, ideal_scores, projection_noise
-from designkit.physics import object_weight, response_shape
+from designkit.recognition.ideal import class_survival, ideal_pair, ideal_scores, projection_noise
+from designkit.models.semi_infinite import object_weight, response_shape
 
 E_S = 892.0
 mpmath.mp.dps = 30

@@ -12,7 +12,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from designkit import SENSORS, Scene, Sensor
-from designkit.physics import (
+from designkit.models.semi_infinite import (
     contact_temperature,
     effusivity,
     effusivity_from_conductivity_diffusivity,

@@ -14,9 +14,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from designkit import InputError
-from designkit import query as q
-from designkit.engine import SweepConfig
-from designkit.tables import load_table, table_header, write_table
+from designkit.query import table as q
+from designkit.sweep.engine import SweepConfig
+from designkit.tables.store import load_table, table_header, write_table
 
 RATIOS = (0.001, 0.002, 0.005, 0.01, 0.02)
 CONTACTS = (0.5, 1.0, 2.0, 4.0)
@@ -116,7 +116,7 @@ def test_query_rejects_bad_input(kwargs, match):
 
 def test_ideal_table_agrees_with_the_closed_form(paper_sensor):
     """Shipped ideal table vs bisection on the exact closed form: within its grid step."""
-    from designkit.ideal import ideal_pair
+    from designkit.recognition.ideal import ideal_pair
     from designkit.scene import Scene
 
     t = load_table("ideal-paper")

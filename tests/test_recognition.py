@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from designkit import InputError, Scene
-from designkit.features import feature_matrix, local_slope
-from designkit.ideal import ideal_pair
-from designkit.recognition import cross_validated_f1, f1_standard_error, interval_pair_f1
+from designkit.recognition.features import feature_matrix, local_slope
+from designkit.recognition.ideal import ideal_pair
+from designkit.recognition.svm import cross_validated_f1, f1_standard_error, interval_pair_f1
 
 
 def test_slope_is_exact_on_quadratics_including_edges():
@@ -44,7 +44,7 @@ def test_gram_matrix_svm_equals_scikit_learns_linear_kernel_svm(paper_sensor):
     from sklearn.preprocessing import StandardScaler
     from sklearn.svm import SVC
 
-    from designkit.recognition import make_classifier
+    from designkit.recognition.svm import make_classifier
     from designkit.simulation import simulate_interval
 
     for (a, b), contact in [((35000, 20000), 1.0), ((500, 560), 2.0), ((1000, 1080), 4.0)]:
@@ -118,7 +118,7 @@ def test_svm_never_beats_the_ideal_observer_with_varied_initial_conditions(paper
 def test_binary_f1_equals_scikit_learn():
     from sklearn.metrics import f1_score
 
-    from designkit.recognition import binary_f1
+    from designkit.recognition.svm import binary_f1
 
     rng = np.random.default_rng(0)
     for n in (1, 2, 7, 50):

@@ -21,7 +21,7 @@ from designkit.reproduce import SECTIONS, ReproduceSettings, parse_only, reprodu
 from designkit.reproduce.matrices import (covering_intervals, matrix_delta_up, matrix_stats,
                                           staircase_percent)
 from designkit.reproduce.multiclass import bayes_accuracy
-from designkit.tables import Table
+from designkit.tables.store import Table
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
@@ -116,7 +116,7 @@ def test_covering_intervals_cover_the_range_and_only_it(lo, span, width):
 def test_bayes_accuracy_two_classes_equals_the_ideal_observer(paper_sensor):
     """Two ordered classes: the binned Bayes rule must reach the closed-form optimum of designkit.ideal."""
     from designkit import Scene
-    from designkit.ideal import ideal_pair
+    from designkit.recognition.ideal import ideal_pair
 
     for contact, ranges in ((1.0, [(20000, 20080), (35000, 35080)]), (2.0, [(400, 600), (550, 900)])):
         scene = Scene.from_delta_t(contact_s=contact, noise_c=0.05, delta_t_c=10.0)
@@ -138,7 +138,7 @@ def test_bayes_accuracy_limits(paper_sensor):
 @pytest.fixture(scope="session")
 def small_tables(tmp_path_factory) -> Path:
     """Tiny versions of the shipped tables the report reads (same names, real sweeps)."""
-    from designkit.engine import SweepConfig, run_sweep
+    from designkit.sweep.engine import SweepConfig, run_sweep
 
     out = tmp_path_factory.mktemp("tables")
     common = dict(trials=6, folds=3, max_repeats=1, seed=0)
@@ -181,7 +181,7 @@ def test_report_is_written_with_every_section_and_real_figures(small_report):
 
 @pytest.mark.slow
 def test_table1_numbers_agree_with_the_tables(small_report, small_tables):
-    from designkit.tables import load_table
+    from designkit.tables.store import load_table
 
     rows = small_report.section("table1").numbers["rows"]
     svm = load_table(small_tables / "svm-paper.npz")
@@ -208,8 +208,8 @@ def test_table1_numbers_agree_with_the_tables(small_report, small_tables):
 
 @pytest.mark.slow
 def test_delta_numbers_are_the_query_answers(small_report, small_tables):
-    from designkit.query import delta_e
-    from designkit.tables import load_table
+    from designkit.query.table import delta_e
+    from designkit.tables.store import load_table
 
     svm = load_table(small_tables / "svm-paper.npz")
     rows = small_report.section("delta-curves").numbers["ts0_35_sigma_0.05"]
@@ -223,7 +223,7 @@ def test_delta_numbers_are_the_query_answers(small_report, small_tables):
 def test_material_pairs_use_the_papers_mean_over_covering_intervals(small_report, small_tables):
     """Recompute one graph edge's F1 from the table: mean over the covering interval pairs."""
     from designkit.materials import get_material
-    from designkit.tables import load_table
+    from designkit.tables.store import load_table
 
     edges_csv = small_report.out_dir / small_report.section("node-graphs").numbers["ts0_35"]["edges_csv"]
     lines = edges_csv.read_text().splitlines()[1:]
@@ -256,7 +256,7 @@ def test_real_robot_sections_skip_cleanly_without_data(small_report):
 @pytest.mark.slow
 def test_real_robot_on_the_shared_recordings(robot_data_dir, tmp_path):
     """Train real / test real on the recordings: numbers equal a direct cross-validation."""
-    from designkit.recognition import cross_validated_f1
+    from designkit.recognition.svm import cross_validated_f1
     from designkit.reproduce.robot import load_real
 
     res = reproduce(tmp_path / "r", ["real-robot"], ReproduceSettings(robot_data=robot_data_dir, quick=True))

@@ -12,7 +12,7 @@ import pytest
 from scipy import stats
 
 from designkit import InputError, Scene
-from designkit.physics import sensor_temperature
+from designkit.models.semi_infinite import sensor_temperature
 from designkit.simulation import draw_trials, render_trials, simulate_interval, simulate_trials
 
 

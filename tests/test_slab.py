@@ -16,8 +16,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from designkit import SENSORS, InputError
-from designkit.physics import object_weight, response_shape, sensor_temperature
-from designkit.slab import (
+from designkit.models.semi_infinite import object_weight, response_shape, sensor_temperature
+from designkit.models.slab import (
     Backing,
     fourier_number,
     image_series,

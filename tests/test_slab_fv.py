@@ -9,9 +9,10 @@ import math
 import numpy as np
 import pytest
 
-from designkit import SENSORS, InputError, fv
-from designkit.physics import object_weight, response_shape
-from designkit.slab import FV_DEFAULTS, Backing, slab_response
+from designkit import SENSORS, InputError
+from designkit.models import fv
+from designkit.models.semi_infinite import object_weight, response_shape
+from designkit.models.slab import FV_DEFAULTS, Backing, slab_response
 
 SENSOR = SENSORS["paper"]
 COPPER = (36800.0, 1.17e-4)

@@ -21,7 +21,7 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from designkit import InputError, Scene
-from designkit.physics import log_response_shape, response_shape, sensor_temperature, time_constant
+from designkit.models.semi_infinite import log_response_shape, response_shape, sensor_temperature, time_constant
 from designkit.sensor import SENSORS, Sensor
 
 PAPER = SENSORS["paper"]
@@ -95,7 +95,7 @@ def test_simulated_touches_are_finite_everywhere(le, sigma, dt, fs, frac, seed):
 
 # ================================================================== ideal observer
 def _ideal(lo, hi, width, fs, contact, sigma, dt):
-    from designkit.ideal import ideal_pair
+    from designkit.recognition.ideal import ideal_pair
 
     return ideal_pair((lo, lo + width), (hi, hi + width), sensor_at(fs),
                       Scene.from_delta_t(contact_s=contact, noise_c=sigma, delta_t_c=dt))
@@ -162,7 +162,7 @@ def test_ideal_larger_temperature_difference_never_makes_a_pair_harder(p, sigma,
 @given(sigma=noise, dt=delta_t, fs=rate, frac=st.floats(0.0, 0.6), le=st.floats(2.0, 4.6),
        seed=st.integers(0, 1000))
 def test_svm_is_finite_at_the_extremes(sigma, dt, fs, frac, le, seed):
-    from designkit.recognition import interval_pair_f1
+    from designkit.recognition.svm import interval_pair_f1
 
     contact = contact_for(frac, fs)
     assume(contact * fs <= 2e4)
@@ -174,7 +174,7 @@ def test_svm_is_finite_at_the_extremes(sigma, dt, fs, frac, le, seed):
 
 
 def _svm_mean(ra, rb, scene, seeds, trials=60):
-    from designkit.recognition import interval_pair_f1
+    from designkit.recognition.svm import interval_pair_f1
 
     res = [interval_pair_f1(ra, rb, PAPER, scene, trials=trials, seed=[7, s]) for s in seeds]
     f1 = np.array([r.f1 for r in res])
@@ -207,13 +207,13 @@ def test_svm_easier_scene_is_not_harder_beyond_monte_carlo_error(case, c1, facto
 
 # ================================================================== bad input
 BAD_CALLS = {
-    "nan effusivity (ideal)": lambda: __import__("designkit.ideal", fromlist=["x"]).ideal_pair(
+    "nan effusivity (ideal)": lambda: __import__("designkit.recognition.ideal", fromlist=["x"]).ideal_pair(
         (math.nan, 1.0), (2.0, 3.0), PAPER, Scene()),
-    "negative effusivity (ideal)": lambda: __import__("designkit.ideal", fromlist=["x"]).ideal_pair(
+    "negative effusivity (ideal)": lambda: __import__("designkit.recognition.ideal", fromlist=["x"]).ideal_pair(
         (-5.0, 1.0), (2.0, 3.0), PAPER, Scene()),
-    "infinite class (ideal)": lambda: __import__("designkit.ideal", fromlist=["x"]).ideal_pair(
+    "infinite class (ideal)": lambda: __import__("designkit.recognition.ideal", fromlist=["x"]).ideal_pair(
         (1.0, math.inf), (2.0, 3.0), PAPER, Scene()),
-    "identical classes (svm)": lambda: __import__("designkit.recognition", fromlist=["x"]).interval_pair_f1(
+    "identical classes (svm)": lambda: __import__("designkit.recognition.svm", fromlist=["x"]).interval_pair_f1(
         (1.0, 2.0), (1.0, 2.0), PAPER, Scene()),
     "zero contact": lambda: Scene(contact_s=0.0),
     "negative contact": lambda: Scene(contact_s=-1.0),
@@ -238,8 +238,8 @@ BAD_CALLS = {
                                                          table="ideal-paper"),
     "wrong threshold (query)": lambda: _q().min_contact(35000.0, 20000.0, threshold=0.8, table="ideal-paper"),
     "unknown table": lambda: _q().min_contact(35000.0, 20000.0, table="no-such-table"),
-    "one interval (sweep)": lambda: __import__("designkit.engine", fromlist=["x"]).SweepConfig(intervals=1),
-    "decreasing contacts (sweep)": lambda: __import__("designkit.engine", fromlist=["x"]).SweepConfig(
+    "one interval (sweep)": lambda: __import__("designkit.sweep.engine", fromlist=["x"]).SweepConfig(intervals=1),
+    "decreasing contacts (sweep)": lambda: __import__("designkit.sweep.engine", fromlist=["x"]).SweepConfig(
         contact_s=(2.0, 1.0)),
     "unseeded draw": lambda: __import__("designkit.simulation", fromlist=["x"]).simulate_trials(
         1000.0, PAPER, Scene(), seed=None),
@@ -247,7 +247,7 @@ BAD_CALLS = {
 
 
 def _q():
-    from designkit import query
+    from designkit.query import table as query
 
     return query
 
@@ -287,7 +287,7 @@ def test_console_script_bad_input_has_no_traceback():
 @pytest.mark.parametrize("fs,contact", [(10.0, 0.05), (10.0, 60.0), (10_000.0, 1e-4), (10_000.0, 2.0)])
 @pytest.mark.parametrize("ratio", [0.0, 1e-4, 10.0])
 def test_ideal_sweep_chunk_is_sane_at_extremes(fs, contact, ratio):
-    from designkit.engine import SweepConfig, delta_from_staircase, run_chunk
+    from designkit.sweep.engine import SweepConfig, delta_from_staircase, run_chunk
 
     n = 12
     cfg = SweepConfig(fidelity="ideal", intervals=n, e_min=0.0, e_max=1e6, noise_ratio=(ratio,),
@@ -308,7 +308,7 @@ def test_ideal_sweep_chunk_is_sane_at_extremes(fs, contact, ratio):
 
 # ================================================================== table queries: edges, corners
 def _ideal_table():
-    from designkit.tables import load_table
+    from designkit.tables.store import load_table
 
     return load_table("ideal-paper")
 
@@ -336,7 +336,7 @@ def _assert_answer_sane(ans, lo_contact=None, hi_contact=None):
        ir=st.sampled_from([0, -1]), ic=st.sampled_from([0, -1]), nudge=st.sampled_from([0.0, 1e-9, -1e-9]))
 def test_queries_at_table_corners_are_finite_or_refused(i1, i2, ir, ic, nudge):
     tab = _ideal_table_cached()
-    from designkit import query
+    from designkit.query import table as query
 
     ax = tab.axes
     es = [1e-3, 80.0, 40000.0 - 80.0, 40000.0]  # grid's lower edge (0, ...] and upper edge 40000
@@ -368,7 +368,7 @@ def _ideal_table_cached():
 
 @pytest.mark.parametrize("where", ["noise below", "noise above", "contact below", "contact above", "e above"])
 def test_queries_just_outside_the_grid_are_refused_not_extrapolated(ideal_table, where):
-    from designkit import query
+    from designkit.query import table as query
 
     ax = ideal_table.axes
     kw = dict(table=ideal_table, ideal_table=ideal_table)
@@ -395,7 +395,7 @@ def test_queries_just_outside_the_grid_are_refused_not_extrapolated(ideal_table,
 @given(le1=st.floats(1.0, 4.6), gap=st.floats(0.02, 2.0), r1=st.floats(-3.3, -1.7), r2=st.floats(-3.3, -1.7))
 def test_table_min_contact_is_monotone_in_noise(le1, gap, r1, r2):
     """A noisier scene never needs a shorter contact (table answers, None = beyond the grid)."""
-    from designkit import query
+    from designkit.query import table as query
 
     tab = _ideal_table_cached()
     e1 = 10.0 ** le1
@@ -414,8 +414,8 @@ def test_table_min_contact_is_monotone_in_noise(le1, gap, r1, r2):
 
 # ================================================================== tiny tables
 def _tiny_table(tmp_path, name, ratios, contacts, intervals=8, e_max=8000.0):
-    from designkit.engine import SweepConfig, run_sweep
-    from designkit.tables import load_table
+    from designkit.sweep.engine import SweepConfig, run_sweep
+    from designkit.tables.store import load_table
 
     cfg = SweepConfig(name=name, fidelity="ideal", intervals=intervals, e_max=e_max, noise_ratio=tuple(ratios),
                       contact_s=tuple(contacts))
@@ -428,7 +428,7 @@ TINY_AXES = [((0.005,), (0.5, 1.0, 2.0)), ((0.002, 0.005, 0.01), (1.0,)), ((0.00
 
 @pytest.mark.parametrize("ratios,contacts", TINY_AXES)
 def test_tables_with_one_point_on_an_axis(tmp_path, ratios, contacts):
-    from designkit import query
+    from designkit.query import table as query
 
     tab, cfg = _tiny_table(tmp_path, "tiny", ratios, contacts)
     kw = dict(table=tab, ideal_table=tab)
@@ -459,8 +459,8 @@ def test_tables_with_one_point_on_an_axis(tmp_path, ratios, contacts):
 def test_tiny_table_verdicts_at_and_just_off_grid_points_are_the_closed_form(tmp_path):
     """At each interval centre, and a hair above it (1e-6 of an interval), the table's verdict is the
     closed form's for the two intervals, exactly (regression: an answer used to jump at every centre)."""
-    from designkit import query
-    from designkit.ideal import ideal_scores, projection_noise
+    from designkit.query import table as query
+    from designkit.recognition.ideal import ideal_scores, projection_noise
 
     ratios, contacts = (0.002, 0.01), (0.5, 2.0)
     tab, cfg = _tiny_table(tmp_path, "tiny", ratios, contacts, intervals=8)  # width 1000: exact centres
@@ -479,7 +479,7 @@ def test_tiny_table_verdicts_at_and_just_off_grid_points_are_the_closed_form(tmp
 
 
 def test_shipped_table_answer_does_not_jump_at_a_grid_centre(ideal_table):
-    from designkit import query
+    from designkit.query import table as query
 
     kw = dict(contact_s=1.5, noise_c=0.05, delta_t_c=10.0, table=ideal_table, ideal_table=ideal_table)
     at = query.distinguishable(40.0, 120.0, **kw)          # 120 is the centre of the second interval

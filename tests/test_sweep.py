@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from designkit.tables import load_table
+from designkit.tables.store import load_table
 
 # 2 scene points x 4 contact times = 8 chunks of about a second each (40 intervals, 50 trials)
 CONFIG = """\

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from designkit import InputError
-from designkit.engine import SweepConfig
-from designkit import query as q
-from designkit.tables import SCHEMA_VERSION, content_hash, list_tables, load_table, table_header, write_table
+from designkit.sweep.engine import SweepConfig
+from designkit.query import table as q
+from designkit.tables.store import SCHEMA_VERSION, content_hash, list_tables, load_table, table_header, write_table
 
 
 def _small(tmp_path, name="t"):

@@ -16,11 +16,11 @@ from hypothesis import strategies as st
 from scipy import optimize, stats
 
 from designkit import SENSORS, InputError, Scene
-from designkit.ideal import ideal_pair
-from designkit.recognition import interval_pair_f1
+from designkit.recognition.ideal import ideal_pair
+from designkit.recognition.svm import interval_pair_f1
 from designkit.simulation import simulate_interval
-from designkit.slab import slab_response
-from designkit.thin_query import (
+from designkit.models.slab import slab_response
+from designkit.query.thin import (
     SlabObject,
     SlabScene,
     semi_infinite_check,
@@ -254,7 +254,7 @@ def test_objects_from_numbers_and_materials():
 
 # ----------------------------------------------------------------------------- queries
 def test_min_contact_of_a_thick_slab_is_the_exact_semi_infinite_answer():
-    from designkit.query import exact_min_contact
+    from designkit.query.table import exact_min_contact
 
     acrylic, ptfe = slab_objects(m1="acrylic", m2="PTFE")
     kw = dict(noise_c=0.05, delta_t_c=10.0, max_contact_s=2.0, seed=1, **FAST)
@@ -315,7 +315,7 @@ def test_delta_e_of_a_thin_sheet_needs_its_diffusivity():
 
 
 def test_delta_e_of_a_thick_slab_is_the_exact_semi_infinite_answer():
-    from designkit.query import exact_delta_e
+    from designkit.query.table import exact_delta_e
 
     kw = dict(contact_s=0.5, noise_c=0.05, delta_t_c=10.0, width=80.0, e_max=2000.0, seed=2, **FAST)
     thin = thin_delta_e(1000.0, thickness_m=math.inf, diffusivity_m2_s=3e-7, **kw)

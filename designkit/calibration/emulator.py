@@ -43,7 +43,7 @@ from typing import Sequence
 import numpy as np
 
 from .._validation import InputError, as_generator, check_effusivity, check_nonnegative, check_positive
-from ..physics import object_weight, response_shape
+from ..models.semi_infinite import object_weight, response_shape
 from ..sensor import Sensor
 from .profiles import DeviceProfile, Linear, Thermistor
 

@@ -33,7 +33,7 @@ def bench_cmd(
     """
     import time
 
-    from .. import bench
+    from ..accuracy import report as bench
 
     sections = tuple(section) if section else bench.SECTIONS
     bad = [s for s in sections if s not in bench.SECTIONS]
@@ -75,7 +75,7 @@ def bench_cmd(
 def _print_report(report, written) -> None:
     from rich.table import Table
 
-    from ..bench import _fmt, _fmt_time
+    from ..accuracy.report import _fmt, _fmt_time
 
     con = console()
     if not con.is_terminal:

@@ -28,7 +28,7 @@ def simulate(
     json_: Json = False,
 ) -> None:
     """Simulate touches of one object (paper eq. 4): sensor temperature against time."""
-    from ..physics import contact_temperature
+    from ..models.semi_infinite import contact_temperature
     from ..scene import Scene
     from ..sensor import load_sensor
     from ..simulation import simulate_trials
@@ -104,8 +104,8 @@ def f1(
 ) -> None:
     """F1 of the paper's SVM and of the ideal observer for classes [e1, e1+width) and [e2, e2+width)."""
     from .._validation import InputError, check_effusivity
-    from ..ideal import ideal_pair
-    from ..recognition import interval_pair_f1
+    from ..recognition.ideal import ideal_pair
+    from ..recognition.svm import interval_pair_f1
     from ..scene import Scene
     from ..sensor import load_sensor
 

@@ -40,7 +40,7 @@ def export_cmd(
     writes a C99 header with `designkit_min_contact_s`, `designkit_delta_e` and
     `designkit_distinguishable` for one sensor noise and temperature difference.
     """
-    from ..export import export_table
+    from ..export.core import export_table
 
     res = export_table(table, out, fmt, prefix=prefix, noise_c=noise, delta_t_c=delta_t, contact=contact,
                        e_min=e_min, e_max=e_max, kind=kind)

@@ -44,7 +44,7 @@ DiffusivityQ = Annotated[Optional[float], typer.Option(
 
 def _thin(question: str, thickness, backing, diffusivity, e1, e2, m1, m2, width, **kw):
     """A question with --thickness: computed for the slab scene by designkit.thin_query."""
-    from .. import thin_query
+    from ..query import thin as thin_query
 
     o1, o2 = thin_query.slab_objects(e1, e2, m1, m2, diffusivity_m2_s=diffusivity, width=width)
     fn = {"min-contact": thin_query.thin_min_contact, "max-noise": thin_query.thin_max_noise,
@@ -64,7 +64,7 @@ def _pair_answer(question: str, e1, e2, m1, m2, scene: dict, *, thickness, backi
                  repeats: int, jobs: int, exact_extra: Optional[dict] = None):
     """Answer a two-object question (``scene``: its scene keywords) from the thin-sample model
     (--thickness), by computing it for this pair (--exact), or from the tables; with the labels."""
-    from .. import query
+    from ..query import table as query
 
     _slab_options(thickness, backing, diffusivity)
     common = dict(threshold=threshold, sensor=sensor, trials=trials, seed=seed, repeats=repeats, jobs=jobs)
@@ -274,7 +274,7 @@ def delta_e_cmd(
     thickness: ThicknessQ = None, backing: BackingQ = None, diffusivity: DiffusivityQ = None, json_: Json = False,
 ) -> None:
     """Smallest distinguishable effusivity difference delta(e), towards lower and higher effusivity."""
-    from .. import query
+    from ..query import table as query
     from .._validation import InputError
 
     _slab_options(thickness, backing, diffusivity)
@@ -288,7 +288,7 @@ def delta_e_cmd(
         e = 0.5 * (mat.effusivity_range[0] + mat.effusivity_range[1])
         label = f"{mat.name} (midpoint {e:.0f})"
     if thickness is not None:
-        from .. import thin_query
+        from ..query import thin as thin_query
 
         ans = thin_query.thin_delta_e(e, thickness_m=thickness, diffusivity_m2_s=diffusivity, material=m,
                                       backing=backing, contact_s=contact, noise_c=noise, delta_t_c=delta_t,

@@ -60,7 +60,7 @@ def sweep(
     """Sweep the physics + classifier model and write a delta(e) lookup table (resumable)."""
     import time
 
-    from ..engine import SweepConfig, SweepInterrupted, run_sweep
+    from ..sweep.engine import SweepConfig, SweepInterrupted, run_sweep
 
     overrides = dict(name=name, sensor=sensor, fidelity=fidelity, e_min=e_min, e_max=e_max, intervals=intervals,
                      trials=trials, folds=folds, threshold=threshold, seed=seed, max_repeats=max_repeats,

@@ -21,7 +21,7 @@ def tables_list(
     json_: Json = False,
 ) -> None:
     """List the lookup tables (shipped, or in --folder)."""
-    from ..tables import list_tables, load_table
+    from ..tables.store import list_tables, load_table
 
     rows = []
     for name in list_tables(folder):
@@ -53,7 +53,7 @@ def tables_show(
     json_: Json = False,
 ) -> None:
     """Describe one table: grid, units, sensor, fidelity, provenance, content hash."""
-    from ..tables import load_table
+    from ..tables.store import load_table
 
     from rich.markup import escape
 

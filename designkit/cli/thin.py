@@ -48,7 +48,7 @@ def validity(
 
     from .._validation import InputError, check_positive
     from ..sensor import load_sensor
-    from ..slab import material_validity, resolve_backing, semi_infinite_deviation, semi_infinite_validity
+    from ..models.slab import material_validity, resolve_backing, semi_infinite_deviation, semi_infinite_validity
 
     L = check_positive("thickness [m]", thickness)
     sen = load_sensor(sensor)
@@ -124,7 +124,7 @@ def _plot(path: Path, v, L, back, sen, delta_t, tolerance, name) -> None:
     import numpy as np
 
     from ..figures import pyplot
-    from ..slab import semi_infinite_deviation
+    from ..models.slab import semi_infinite_deviation
 
     plt = pyplot()
     t_end = v.time_s * 3 if math.isfinite(v.time_s) else v.horizon_s

@@ -183,7 +183,7 @@ class Context:
         Why a table is missing or unusable is kept for the report (:meth:`table_problem`).
         """
         if name not in self._tables:
-            from ..tables import load_table
+            from ..tables.store import load_table
 
             found, problem = None, None
             cands: list[Any] = []

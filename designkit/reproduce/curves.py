@@ -60,7 +60,7 @@ def _panel(ax, svm, ideal, ratio: float, label: str) -> None:
 
 
 def _delta_numbers(ctx: Context, ts0: float, sigma: float, svm_ok: bool) -> list[dict]:
-    from ..query import delta_e
+    from ..query.table import delta_e
 
     out = []
     dt = ts0 - AMBIENT_C
@@ -212,7 +212,7 @@ def section_effusivity(ctx: Context) -> SectionResult:
 def section_guideline(ctx: Context) -> SectionResult:
     """The design guideline: contact time to separate e = 35,000 from 20,000 (sigma 0.05, dT 10)."""
     t0 = time.perf_counter()
-    from .. import query
+    from ..query import table as query
 
     title = "Guideline: 35,000 vs 20,000 needs how long a contact?"
     e1, e2, sigma, dt = GUIDELINE["e1"], GUIDELINE["e2"], GUIDELINE["noise_c"], GUIDELINE["delta_t_c"]

@@ -177,7 +177,7 @@ def chance_f1(ctx: Context) -> dict:
     """
     if "chance_f1" in ctx.cache:
         return ctx.cache["chance_f1"]
-    from ..recognition import cross_validated_f1
+    from ..recognition.svm import cross_validated_f1
     from ..scene import Scene
     from ..sensor import SENSORS
     from ..simulation import simulate_interval

@@ -45,8 +45,8 @@ def bayes_accuracy(ranges, sensor, scene) -> float:
     scene : Scene
         Fixed initial conditions.
     """
-    from ..ideal import class_survival, projection_noise
-    from ..physics import object_weight
+    from ..recognition.ideal import class_survival, projection_noise
+    from ..models.semi_infinite import object_weight
 
     r = np.asarray(ranges, dtype=np.float64)
     s = projection_noise(sensor, scene)
@@ -65,7 +65,7 @@ def bayes_accuracy(ranges, sensor, scene) -> float:
 
 
 def _simulate_classes(ranges, trials: int, sensor, scene, seed) -> tuple[np.ndarray, np.ndarray]:
-    from ..features import feature_matrix
+    from ..recognition.features import feature_matrix
     from ..simulation import simulate_interval
 
     X, y = [], []
@@ -83,7 +83,7 @@ def svm_multiclass(ranges, trials: int, sensor, scene, seed) -> dict:
     from sklearn.model_selection import StratifiedKFold, cross_val_predict
 
     from .._validation import as_generator
-    from ..recognition import make_classifier
+    from ..recognition.svm import make_classifier
 
     seed = list(seed)
     X, y = _simulate_classes(ranges, trials, sensor, scene, seed + [1])

@@ -133,7 +133,7 @@ def load_real(data_dir: Path, contact_s: float = CONTACT_S, sample_rate_hz: floa
 # ============================================================ train real, test real
 def real_pair_f1(touches: RealTouches, pair: tuple[str, str], *, repeats: int, seed: int) -> dict:
     """Cross-validated F1 (3 folds, ``repeats`` shuffles) of the paper's SVM on one real pair."""
-    from ..recognition import cross_validated_f1
+    from ..recognition.svm import cross_validated_f1
 
     lo, hi = touches.of(pair[0]), touches.of(pair[1])
     fs = 1.0 / (touches.time_s[1] - touches.time_s[0])
@@ -157,8 +157,8 @@ def real_multiclass(touches: RealTouches, *, repeats: int, seed: int) -> dict:
     from sklearn.model_selection import StratifiedKFold, cross_val_predict
 
     from .._validation import as_generator
-    from ..features import feature_matrix
-    from ..recognition import make_classifier
+    from ..recognition.features import feature_matrix
+    from ..recognition.svm import make_classifier
 
     fs = 1.0 / (touches.time_s[1] - touches.time_s[0])
     X = feature_matrix(touches.sensor_c, fs)
@@ -261,8 +261,8 @@ def sim_to_real(test: RealTouches, setup: SimToRealSetup, noise_c: float, *, per
     """Train on simulated touches, test on the real ones: binary F1 per pair and the 3-class confusion."""
     import sklearn
 
-    from ..features import feature_matrix
-    from ..recognition import binary_f1, make_classifier
+    from ..recognition.features import feature_matrix
+    from ..recognition.svm import binary_f1, make_classifier
 
     fs = 1.0 / (test.time_s[1] - test.time_s[0])
     sim, labels = _simulate_like(test, setup, noise_c, per_trial, seed, object_temp)

@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.signal import savgol_filter
 
-from ._validation import check_positive
+from .._validation import check_positive
 
 __all__ = ["DEFAULT_SLOPE_WINDOW_S", "feature_matrix", "local_slope"]
 

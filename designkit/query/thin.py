@@ -61,7 +61,7 @@ from typing import Any
 import numpy as np
 from scipy import special
 
-from ._validation import (
+from .._validation import (
     InputError,
     as_generator,
     check_effusivity,
@@ -69,11 +69,11 @@ from ._validation import (
     check_finite,
     check_positive,
 )
-from .ideal import IdealResult, ideal_pair, score_llr
-from .scene import Scene
-from .sensor import Sensor
-from .simulation import draw_trials
-from .slab import Backing, resolve_backing, semi_infinite_error_bound, semi_infinite_validity, slab_response
+from ..recognition.ideal import IdealResult, ideal_pair, score_llr
+from ..scene import Scene
+from ..sensor import Sensor
+from ..simulation import draw_trials
+from ..models.slab import Backing, resolve_backing, semi_infinite_error_bound, semi_infinite_validity, slab_response
 
 __all__ = [
     "DEFAULT_BACKING",
@@ -183,7 +183,7 @@ def slab_object(e: float | None = None, material: str | None = None, *, diffusiv
         if diffusivity_m2_s is not None:
             raise InputError(f"the diffusivity of {material!r} comes from the materials database; "
                              "--diffusivity is for objects given as an effusivity")
-        from .slab import material_properties
+        from ..models.slab import material_properties
 
         mat = material_properties(material)
         return SlabObject(f"{mat.name} ({mat.e_min:.0f}–{mat.e_max:.0f})", (mat.e_min, mat.e_max),
@@ -358,7 +358,7 @@ def slab_pair_f1(obj_a: SlabObject, obj_b: SlabObject, sensor: Sensor, scene: Sc
     -------
     designkit.recognition.F1Result
     """
-    from .recognition import cross_validated_f1
+    from ..recognition.svm import cross_validated_f1
 
     low, high = _ordered(obj_a, obj_b)
     base = _seed_key(seed)
@@ -725,7 +725,7 @@ class _IdealLog:
 
 
 def _setup(objs, thickness_m, backing, sensor, trials, folds, seed, repeats, z, jobs, width=80.0):
-    from .query import _exact_setup
+    from .table import _exact_setup
 
     ex = _exact_setup(sensor, width, trials, folds, seed, repeats, z, jobs)
     slab = SlabScene.make(thickness_m, backing)
@@ -773,7 +773,7 @@ def thin_min_contact(obj1: SlabObject, obj2: SlabObject, *, thickness_m: float, 
     -------
     designkit.query.Answer
     """
-    from .query import Answer, _bisect, _contact_search, _scene_inputs, _threshold
+    from .table import Answer, _bisect, _contact_search, _scene_inputs, _threshold
 
     noise, dt = _scene_inputs(noise_c, delta_t_c)
     phi = _threshold(threshold)
@@ -810,7 +810,7 @@ def thin_min_contact(obj1: SlabObject, obj2: SlabObject, *, thickness_m: float, 
 
 def _thin_ratio(question, obj1, obj2, thickness_m, backing, contact_s, noise_c, delta_t_c, threshold, sensor,
                 trials, folds, seed, repeats, z, jobs, n_mc, fraction):
-    from .query import Answer, _bisect, _ratio_search, _threshold
+    from .table import Answer, _bisect, _ratio_search, _threshold
 
     phi = _threshold(threshold)
     contact = check_positive("contact time [s]", contact_s)
@@ -877,7 +877,7 @@ def thin_distinguishable(obj1: SlabObject, obj2: SlabObject, *, thickness_m: flo
                          repeats: int = 4, z: float = 2.0, jobs: int = -1, n_mc: int = 1000,
                          fraction: float = NOISE_FRACTION):
     """SVM F1 (mean of ``repeats`` seeds) and ideal F1 of two thin-sample objects at this scene."""
-    from .query import Answer, _scene_inputs, _threshold
+    from .table import Answer, _scene_inputs, _threshold
 
     phi = _threshold(threshold)
     noise, dt = _scene_inputs(noise_c, delta_t_c)
@@ -915,7 +915,7 @@ def thin_delta_e(e: float | None = None, *, thickness_m: float, diffusivity_m2_s
     diffusivity, thickness and backing (nothing gives a diffusivity to a bare
     effusivity). Bisection on ``d`` as :func:`designkit.query.exact_delta_e`.
     """
-    from .query import Answer, _bisect, _exact_setup, _scene_inputs, _threshold
+    from .table import Answer, _bisect, _exact_setup, _scene_inputs, _threshold
 
     phi = _threshold(threshold)
     noise, dt = _scene_inputs(noise_c, delta_t_c)
@@ -925,7 +925,7 @@ def thin_delta_e(e: float | None = None, *, thickness_m: float, diffusivity_m2_s
         if diffusivity_m2_s is not None:
             raise InputError(f"the diffusivity of {material!r} comes from the materials database; "
                              "--diffusivity is for a reference given as an effusivity")
-        from .slab import material_properties
+        from ..models.slab import material_properties
 
         mat = material_properties(material)
         diffusivity_m2_s = (mat.diffusivity_min_m2_s, mat.diffusivity_max_m2_s)

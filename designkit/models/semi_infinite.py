@@ -28,9 +28,14 @@ tail, available in log form through :func:`log_response_shape`).
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
+from .base import ForwardModel
+
 __all__ = [
+    "SemiInfinite",
     "contact_temperature",
     "effusivity",
     "effusivity_from_conductivity_diffusivity",
@@ -281,11 +286,42 @@ def sensor_temperature(time_s, e_object, sensor_temp_c, object_temp_c, e_sensor,
 
     Examples
     --------
-    >>> from designkit.physics import sensor_temperature, time_constant
+    >>> from designkit.models.semi_infinite import sensor_temperature, time_constant
     >>> tau = time_constant(80e-6, 1.19e-9)
     >>> round(float(sensor_temperature(4.0, 20000.0, 35.0, 25.0, 892.0, tau)), 4)
-    29.4049
+    31.0534
     """
     ts = np.asarray(sensor_temp_c, dtype=np.float64)
     return ts + temperature_change(time_s, e_object, sensor_temp_c, object_temp_c,
                                    e_sensor, tau_s)
+
+
+@dataclass(frozen=True)
+class SemiInfinite(ForwardModel):
+    """The paper's model: sensor and object as semi-infinite solids in perfect contact.
+
+    ``u(t) = w(e_o) g(t)`` with ``w = e_o / (e_s + e_o)`` (:func:`object_weight`,
+    paper eq. 1) and ``g = erfc(sqrt(tau / t))`` (:func:`response_shape`, eq. 2):
+    one shape for every object of a scene. No parameters beyond the sensor's.
+
+    Validity: objects thick enough that heat has not reached their far side
+    (Fourier number ``alpha_o t / L^2`` small; :class:`designkit.models.slab.Slab`
+    says when), perfect thermal contact (:class:`designkit.models.contact.Contact`
+    relaxes it), temperature-independent properties.
+
+    Examples
+    --------
+    >>> from designkit import SENSORS
+    >>> u = SemiInfinite().response([0.0, 1.0, 4.0], [892.0], SENSORS["paper"])
+    >>> [round(float(x), 4) for x in u[0]]
+    [0.0, 0.0505, 0.2061]
+    """
+
+    name = "semi-infinite"
+    shared_shape = True
+
+    def shape(self, time_s, sensor) -> np.ndarray:
+        return response_shape(np.asarray(time_s, dtype=np.float64), sensor.tau_s)
+
+    def weight(self, e_object, sensor) -> np.ndarray:
+        return object_weight(sensor.effusivity, e_object)

@@ -30,8 +30,8 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ._validation import InputError, check_effusivity, check_finite, check_nonnegative, check_positive
-from .tables import Table, load_table
+from .._validation import InputError, check_effusivity, check_finite, check_nonnegative, check_positive
+from ..tables.store import Table, load_table
 
 __all__ = [
     "DEFAULT_IDEAL_TABLE",
@@ -248,7 +248,7 @@ def _check_threshold(table: Table, threshold: float | None) -> float:
 def _check_sensor(table: Table, sensor) -> None:
     if sensor is None:
         return
-    from .sensor import load_sensor
+    from ..sensor import load_sensor
 
     s = load_sensor(sensor)
     if s != table.sensor:
@@ -573,8 +573,8 @@ def distinguishable(e1=None, e2=None, *, contact_s: float, noise_c: float = 0.05
 
 def _ideal_f1_pairs(pairs, tab: Table, contact, noise, dt, ranges) -> float:
     """Worst (smallest) ideal-observer F1 over the pairs, classes one table interval wide."""
-    from .ideal import ideal_scores, projection_noise
-    from .scene import Scene
+    from ..recognition.ideal import ideal_scores, projection_noise
+    from ..scene import Scene
 
     sensor = tab.sensor
     width = float(tab.header["effusivity"]["width"])
@@ -599,7 +599,7 @@ class _Exact:
 
 
 def _exact_setup(sensor, width, trials, folds, seed, repeats, z, jobs) -> _Exact:
-    from .sensor import load_sensor
+    from ..sensor import load_sensor
 
     if int(folds) < 2:
         raise InputError(f"folds must be >= 2, got {folds}")
@@ -615,7 +615,7 @@ def _svm_f1(ex: _Exact, ranges, scene_for) -> tuple[float, float]:
     """Mean SVM F1 over ex.repeats seeds and its standard error, for the pair's classes."""
     from joblib import Parallel, delayed
 
-    from .recognition import interval_pair_f1
+    from ..recognition.svm import interval_pair_f1
 
     (a, b) = ranges
     jobs = ex.jobs if ex.repeats > 1 else 1
@@ -629,7 +629,7 @@ def _svm_f1(ex: _Exact, ranges, scene_for) -> tuple[float, float]:
 
 
 def _ideal_f1(ex: _Exact, ranges, scene) -> float:
-    from .ideal import ideal_pair
+    from ..recognition.ideal import ideal_pair
 
     return ideal_pair(ranges[0], ranges[1], ex.sensor, scene, seed=ex.seed).f1
 
@@ -665,7 +665,7 @@ def exact_min_contact(e1=None, e2=None, *, noise_c: float = 0.05, delta_t_c: flo
     ``repeats`` seeds; the interval collects the contact times whose mean F1 is
     within ``z`` standard errors of ``threshold``.
     """
-    from .scene import Scene
+    from ..scene import Scene
 
     noise, dt = _scene_inputs(noise_c, delta_t_c)
     phi = _threshold(threshold)
@@ -751,7 +751,7 @@ def _threshold(threshold: float) -> float:
 
 def _exact_ratio(question: str, e1, e2, contact_s, noise_c, delta_t_c, threshold, sensor, width, trials,
                  folds, seed, repeats, z, jobs, ranges) -> Answer:
-    from .scene import Scene
+    from ..scene import Scene
 
     phi = _threshold(threshold)
     contact = check_positive("contact time [s]", contact_s)
@@ -806,7 +806,7 @@ def exact_distinguishable(e1=None, e2=None, *, contact_s: float, noise_c: float 
                           folds: int = 3, seed: int = 0, repeats: int = 4, z: float = 2.0, jobs: int = -1,
                           ranges=None) -> Answer:
     """SVM F1 (mean of ``repeats`` seeds) and ideal F1 of the pair's classes at this scene."""
-    from .scene import Scene
+    from ..scene import Scene
 
     phi = _threshold(threshold)
     noise, dt = _scene_inputs(noise_c, delta_t_c)
@@ -832,7 +832,7 @@ def exact_delta_e(e: float, *, contact_s: float, noise_c: float = 0.05, delta_t_
                   seed: int = 0, repeats: int = 4, z: float = 2.0, jobs: int = -1,
                   e_max: float = 40000.0) -> Answer:
     """delta(e) computed for this reference: bisection on the partner's distance, both directions."""
-    from .scene import Scene
+    from ..scene import Scene
 
     phi = _threshold(threshold)
     e = check_effusivity("e", e)

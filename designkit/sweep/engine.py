@@ -64,12 +64,12 @@ from typing import Any, Callable, Iterator, Mapping, Sequence
 
 import numpy as np
 
-from ._validation import InputError, check_positive
-from .features import DEFAULT_SLOPE_WINDOW_S, feature_matrix
-from .ideal import ideal_scores, projection_noise
-from .scene import Scene
-from .sensor import Sensor, load_sensor
-from .simulation import draw_trials, render_trials
+from .._validation import InputError, check_positive
+from ..recognition.features import DEFAULT_SLOPE_WINDOW_S, feature_matrix
+from ..recognition.ideal import ideal_scores, projection_noise
+from ..scene import Scene
+from ..sensor import Sensor, load_sensor
+from ..simulation import draw_trials, render_trials
 
 __all__ = [
     "ChunkResult",
@@ -371,7 +371,7 @@ class _PairScorer:
         return feats
 
     def score(self, i: int, j: int, rep: int) -> tuple[float, float]:
-        from .recognition import f1_from_features
+        from ..recognition.svm import f1_from_features
 
         r = f1_from_features(self.features(i, rep), self.features(j, rep), folds=self.cfg.folds,
                              seed=[self.cfg.seed, i, j, rep, _CV_KEY])
@@ -642,7 +642,7 @@ def _first_crossing(scorer: _PairScorer, rows, n, ok: Callable[[_Cell], bool]) -
 
 def _ideal_mc_staircase(cfg, sensor, scene, rows, floor, hint) -> np.ndarray:
     """Ideal observer with varied initial conditions: Monte Carlo F1 per pair on the staircase."""
-    from .ideal import ideal_pair
+    from ..recognition.ideal import ideal_pair
 
     edges = cfg.edges
     cache: dict[tuple[int, int], float] = {}
@@ -689,7 +689,7 @@ def _chunk_path(workdir: Path, point, block, k) -> Path:
 def _save_chunk(path: Path, res: ChunkResult) -> None:
     import io
 
-    from ._io import atomic_write_bytes
+    from .._io import atomic_write_bytes
 
     buf = io.BytesIO()
     np.savez(buf, **res.to_arrays())
@@ -706,7 +706,7 @@ def _load_chunk(path: Path) -> ChunkResult:
 
 def prepare_workdir(cfg: SweepConfig, workdir: Path, *, resume: bool, fresh: bool) -> None:
     """Create or check a sweep's working folder (its config and chunks)."""
-    from ._io import atomic_write_text
+    from .._io import atomic_write_text
 
     workdir = Path(workdir)
     meta = workdir / "sweep.json"
@@ -857,7 +857,7 @@ def run_sweep(cfg: SweepConfig, workdir: str | Path, *, out: str | Path | None =
         Called as ``on_chunk(chunk, computed, done, total)`` after each chunk
         (progress display).
     """
-    from .tables import table_header, write_table
+    from ..tables.store import table_header, write_table
 
     workdir = Path(workdir)
     prepare_workdir(cfg, workdir, resume=resume, fresh=fresh)

@@ -88,8 +88,8 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ._validation import InputError, check_finite, check_nonnegative, check_positive
-from .tables import E_UNITS, Table, content_hash, load_table
+from .._validation import InputError, check_finite, check_nonnegative, check_positive
+from ..tables.store import E_UNITS, Table, content_hash, load_table
 
 __all__ = [
     "EXPORT_FORMAT",
@@ -120,7 +120,7 @@ _PREFIX_RE = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,39}$")
 # A value within this relative distance of a grid value is that grid value (the rule of
 # designkit.query.GRID_RTOL: a float argument such as 0.2f / 10.0f cannot hit a sigma/dT
 # grid value of 0.02 more closely than about 1e-7).
-from .query import GRID_RTOL as C_EDGE_RTOL  # noqa: E402
+from ..query.table import GRID_RTOL as C_EDGE_RTOL  # noqa: E402
 
 
 # ============================================================ the sliced data
@@ -248,7 +248,7 @@ def parse_contact(items: Sequence[Any] | str | float | None) -> tuple[float | tu
 
 def _kept_contacts(contacts: np.ndarray, request) -> list[int]:
     """Source contact columns needed to answer at every requested contact time."""
-    from .query import _axis_weights
+    from ..query.table import _axis_weights
 
     def needed(c: float) -> list[int]:
         pts, ok = _axis_weights(contacts, c, log=False)
@@ -315,8 +315,8 @@ def slice_table(table: "Table | str", *, noise_c: float | None = None, delta_t_c
     -------
     Exported
     """
-    from . import __version__
-    from .query import _View
+    from .. import __version__
+    from ..query.table import _View
 
     tab = table if isinstance(table, Table) else load_table(table)
     up_name, down_name = _array_names(tab, kind)
@@ -1464,7 +1464,7 @@ def export_table(table: "Table | str", out: str | Path, fmt: str | None = None, 
                  noise_c: float | None = None, delta_t_c: float | None = None, contact=None,
                  e_min: float | None = None, e_max: float | None = None, kind: str = "svm") -> ExportResult:
     """Slice ``table`` (see :func:`slice_table`) and write it to ``out`` atomically in format ``fmt``."""
-    from ._io import atomic_write_bytes
+    from .._io import atomic_write_bytes
 
     fmt = format_for(out, fmt)
     if fmt == "c" and not _PREFIX_RE.match(prefix or ""):

@@ -57,7 +57,7 @@ from typing import Sequence
 import numpy as np
 from scipy import linalg, sparse, special
 
-from ._validation import InputError, check_nonnegative, check_positive
+from .._validation import InputError, check_nonnegative, check_positive
 
 __all__ = [
     "Grid",

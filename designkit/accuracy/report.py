@@ -54,7 +54,8 @@ from typing import Any, Callable, Iterable, Mapping, Sequence
 
 import numpy as np
 
-from ._validation import InputError, as_generator
+from .._validation import InputError, as_generator
+from ..query.ideal_bound import _ideal_ok, _projection_noises, exact_ideal_delta, exact_ideal_max_ratio, exact_ideal_min_contact
 
 __all__ = [
     "SECTIONS",
@@ -63,9 +64,6 @@ __all__ = [
     "Row",
     "cost_curves",
     "delta_rows",
-    "exact_ideal_delta",
-    "exact_ideal_max_ratio",
-    "exact_ideal_min_contact",
     "fit_exponent",
     "process_cost",
     "ProcessCost",
@@ -228,7 +226,7 @@ def _max(x) -> float:
 
 
 def _paper_sensor():
-    from .sensor import SENSORS
+    from ..sensor import SENSORS
 
     return SENSORS["paper"]
 
@@ -247,7 +245,7 @@ def physics_rows(quick: bool = True, seed: int = 0) -> list[Row]:
     """
     import mpmath
 
-    from .physics import log_response_shape, response_shape, temperature_change
+    from ..models.semi_infinite import log_response_shape, response_shape, temperature_change
 
     rng = as_generator([seed, 801])
     n = 300 if quick else 3000
@@ -305,7 +303,7 @@ def slab_rows(quick: bool = True) -> list[Row]:
     foam on copper for 10 s. ``benchmarks/bench_slab.py`` has the full study
     (every resolution, orders of convergence, stability).
     """
-    from . import slab
+    from ..models import slab
 
     sensor = _paper_sensor()
     dt_c = 10.0
@@ -363,8 +361,8 @@ def recognition_rows(quick: bool = True, seed: int = 0, *, pairs=None,
     large-sample SVM, so the error includes the bias of training on fewer
     trials as well as Monte Carlo noise.
     """
-    from .recognition import interval_pair_f1
-    from .scene import Scene
+    from ..recognition.svm import interval_pair_f1
+    from ..scene import Scene
 
     sensor = _paper_sensor()
     pairs = RECOGNITION_PAIRS[:2] if (pairs is None and quick) else (pairs or RECOGNITION_PAIRS)
@@ -422,8 +420,8 @@ def ideal_mc_rows(quick: bool = True, seed: int = 0, *, pairs=None,
     against the closed form), and the closed form (error against the largest
     Monte Carlo run, with that run's standard error in the note).
     """
-    from .ideal import ideal_pair
-    from .scene import Scene
+    from ..recognition.ideal import ideal_pair
+    from ..scene import Scene
 
     sensor = _paper_sensor()
     pairs = pairs or RECOGNITION_PAIRS
@@ -484,7 +482,7 @@ def staircase_vs_full(intervals: int, *, contact_s: float = 1.0, noise_ratio: fl
         both directions), ``n_differ`` (references whose answer differs),
         ``J_staircase``, ``J_full``.
     """
-    from .engine import SweepConfig, delta_from_staircase, run_chunk
+    from ..sweep.engine import SweepConfig, delta_from_staircase, run_chunk
 
     base = SweepConfig(name="bench", fidelity="svm", intervals=int(intervals), e_max=e_max, trials=trials,
                        seed=seed, max_repeats=max_repeats, noise_ratio=(noise_ratio,), contact_s=(contact_s,))
@@ -529,7 +527,7 @@ def grid_rows(quick: bool = True, coarse: Sequence[int] = (125, 250, 500),
     An SVM sweep of 2000+ intervals is unaffordable; the ideal observer
     shows what the grid alone costs.
     """
-    from .engine import SweepConfig, delta_from_staircase, run_chunk
+    from ..sweep.engine import SweepConfig, delta_from_staircase, run_chunk
 
     fine = 2000 if quick else 4000
     scenes = [(PAPER_RATIO, 1.0), (PAPER_RATIO, 4.0)] if quick else \
@@ -594,95 +592,6 @@ def delta_rows(quick: bool = True, seed: int = 0,
     return rows
 
 
-# ============================================================ queries: exact ideal answers
-def _projection_noises(sensor, contacts, ratios) -> np.ndarray:
-    """:func:`designkit.ideal.projection_noise` for arrays of contact times and sigma/dT (dT = 1)."""
-    from .ideal import projection_noise
-    from .scene import Scene
-
-    c, r = np.broadcast_arrays(np.asarray(contacts, dtype=np.float64), np.asarray(ratios, dtype=np.float64))
-    s = [projection_noise(sensor, Scene(contact_s=float(ci), noise_c=float(ri), sensor_temp_c=26.0,
-                                        ambient_temp_c=25.0)) for ci, ri in zip(c.ravel(), r.ravel())]
-    return np.asarray(s, dtype=np.float64).reshape(c.shape)
-
-
-def _ideal_ok(sensor, lo, hi, width, s, threshold) -> np.ndarray:
-    from .ideal import ideal_scores
-
-    f1, _ = ideal_scores(lo, lo + width, hi, hi + width, sensor.effusivity, s, accuracy=False)
-    return f1 >= threshold
-
-
-def exact_ideal_min_contact(sensor, lo, hi, ratio, *, width: float = 80.0, threshold: float = 0.9,
-                            max_contact_s: float = 10.0) -> np.ndarray:
-    """Ideal observer's shortest contact [s] for classes ``[lo, lo+w)``, ``[hi, hi+w)``, vectorized.
-
-    Bisection on the contact time (F1 never falls with more samples) to one
-    sample period; NaN where ``max_contact_s`` does not suffice. Same classes
-    and answer as the ideal part of :func:`designkit.query.exact_min_contact`.
-    """
-    lo, hi, ratio = (np.asarray(x, dtype=np.float64) for x in np.broadcast_arrays(lo, hi, ratio))
-    floor = 1.0 / sensor.sample_rate_hz
-    a = np.full(lo.shape, floor)
-    b = np.full(lo.shape, float(max_contact_s))
-    top = _ideal_ok(sensor, lo, hi, width, _projection_noises(sensor, b, ratio), threshold)
-    while np.any(b - a > 0.5 * floor):
-        mid = 0.5 * (a + b)
-        ok = _ideal_ok(sensor, lo, hi, width, _projection_noises(sensor, mid, ratio), threshold)
-        b, a = np.where(ok, mid, b), np.where(ok, a, mid)
-    return np.where(top, b, np.nan)
-
-
-def exact_ideal_max_ratio(sensor, lo, hi, contact_s, *, width: float = 80.0, threshold: float = 0.9,
-                          bracket=(1e-6, 1.0), rel_tol: float = 1e-5) -> np.ndarray:
-    """Ideal observer's largest sigma/dT that still separates the classes, vectorized (log bisection).
-
-    NaN where even ``bracket[0]`` does not separate them; ``bracket[1]`` when
-    it still does.
-    """
-    lo, hi, contact = (np.asarray(x, dtype=np.float64) for x in np.broadcast_arrays(lo, hi, contact_s))
-    g_over = _projection_noises(sensor, contact, np.ones(lo.shape))  # s = ratio * this
-    la = np.full(lo.shape, math.log(bracket[0]))
-    lb = np.full(lo.shape, math.log(bracket[1]))
-    ok_lo = _ideal_ok(sensor, lo, hi, width, np.exp(la) * g_over, threshold)
-    ok_hi = _ideal_ok(sensor, lo, hi, width, np.exp(lb) * g_over, threshold)
-    while np.any(lb - la > rel_tol):
-        mid = 0.5 * (la + lb)
-        ok = _ideal_ok(sensor, lo, hi, width, np.exp(mid) * g_over, threshold)
-        la, lb = np.where(ok, mid, la), np.where(ok, lb, mid)
-    out = np.exp(la)
-    out = np.where(ok_hi, bracket[1], out)
-    return np.where(ok_lo, out, np.nan)
-
-
-def exact_ideal_delta(sensor, e, contact_s, ratio, *, direction: int = +1, width: float = 80.0,
-                      threshold: float = 0.9, e_max: float = 40000.0, tol: float = 0.5) -> np.ndarray:
-    """Ideal observer's delta(e) towards higher (+1) or lower (-1) e, vectorized.
-
-    Reference class ``[e, e+w)``, partner ``[e +- d, e +- d + w)`` (as
-    :func:`designkit.query.exact_delta_e`); bisection on ``d`` to ``tol``.
-    NaN where no partner inside ``(0, e_max]`` is distinguishable.
-    """
-    e, contact, ratio = (np.asarray(x, dtype=np.float64) for x in np.broadcast_arrays(e, contact_s, ratio))
-    s = _projection_noises(sensor, contact, ratio)
-    limit = (e_max - e - width) if direction > 0 else (e - width)
-
-    def ok(d):
-        p = e + direction * d
-        lo, hi = np.minimum(e, p), np.maximum(e, p)
-        return _ideal_ok(sensor, lo, hi, width, s, threshold)
-
-    valid = limit >= width
-    lim = np.where(valid, limit, width)
-    top = ok(lim) & valid
-    a, b = np.zeros(e.shape), lim.copy()
-    while np.any(b - a > tol):
-        mid = 0.5 * (a + b)
-        good = ok(mid)
-        b, a = np.where(good, mid, b), np.where(good, a, mid)
-    return np.where(top, b, np.nan)
-
-
 # ============================================================ queries: tables
 def subsample_table(table, keep: Mapping[str, Sequence[int]], name: str | None = None):
     """An in-memory :class:`~designkit.tables.Table` restricted to some points of its axes.
@@ -691,7 +600,7 @@ def subsample_table(table, keep: Mapping[str, Sequence[int]], name: str | None =
     indices to keep; used to measure what a sparser table of the same
     sweep would answer (no recomputation: the kept points are exact).
     """
-    from .tables import Table
+    from ..tables.store import Table
 
     names = table.axis_names
     idx = []
@@ -759,7 +668,7 @@ def _query_samples(table, n: int, seed, min_gap_intervals: float = 1.0) -> dict[
 
 def _table_answers(table, samples, dt_c: float = 10.0) -> tuple[dict[str, np.ndarray], float]:
     """Answers of every table query for the samples; seconds per query (mean over all)."""
-    from . import query
+    from ..query import table as query
 
     ans = {k: [] for k in ("min_contact", "max_noise", "min_delta_t", "delta_up", "delta_down", "dist")}
     n_queries = 0
@@ -783,7 +692,7 @@ def _table_answers(table, samples, dt_c: float = 10.0) -> tuple[dict[str, np.nda
 
 def _distinguishable_check(table, samples, seed, dt_c=10.0):
     """Table verdicts against the exact ideal verdict, for pairs near the boundary."""
-    from . import query
+    from ..query import table as query
 
     sensor = table.sensor
     width = float(table.header["effusivity"]["width"])
@@ -973,7 +882,7 @@ def svm_query_rows(svm_table, quick: bool = True, seed: int = 0, *, n: int | Non
     near the target). Exact answers use the table's trials, ``repeats`` seeds
     per evaluation (quick 2, full 4) and bisection to 0.05 s.
     """
-    from . import query
+    from ..query import table as query
 
     n = n or (3 if quick else 16)
     repeats = repeats or (2 if quick else 4)
@@ -1155,7 +1064,7 @@ def cost_curve(name: str, variable: str, values: Sequence[float], base: Mapping[
     process after its imports, see :func:`cost_curves`), else above the
     resident set when the point started.
     """
-    from .engine import SweepConfig, assemble, run_scene
+    from ..sweep.engine import SweepConfig, assemble, run_scene
 
     xs, walls, fits, peaks, extra = [], [], [], [], []
     for v in values:
@@ -1202,7 +1111,7 @@ def cost_curve(name: str, variable: str, values: Sequence[float], base: Mapping[
 
 def _curve_in_fresh_process(name, variable, values, base, setting) -> CostCurve:
     """Body of :func:`cost_curves` in a child: warm up, take the baseline, run the curve."""
-    from .engine import SweepConfig, assemble, run_scene
+    from ..sweep.engine import SweepConfig, assemble, run_scene
 
     warm = SweepConfig(**{**base, "intervals": 4, "trials": 6, "contact_s": (0.5,)})
     assemble(warm, run_scene(warm))  # imports, BLAS and libsvm loaded before the baseline
@@ -1280,7 +1189,7 @@ def _environment() -> dict[str, Any]:
         env["load_average_at_start"] = [round(x, 2) for x in os.getloadavg()]
     except OSError:  # pragma: no cover
         pass
-    from . import __version__
+    from .. import __version__
 
     env["designkit"] = __version__
     return env
@@ -1336,7 +1245,7 @@ def run_bench(*, quick: bool = True, seed: int = 0, sections: Iterable[str] = SE
         elif sec == "delta":
             rows += delta_rows(quick, seed, progress=say)
         elif sec == "queries":
-            from .tables import load_table
+            from ..tables.store import load_table
 
             say(f"queries: {ideal_table} against the exact ideal observer")
             itab = load_table(ideal_table)
@@ -1420,7 +1329,7 @@ def plot_pareto(report: BenchReport, path) -> Any:
     """Error against time per answer, one panel per question (log-log), saved as PNG."""
     from pathlib import Path
 
-    from .figures import pyplot
+    from ..figures import pyplot
 
     fig = pareto_figure(report)
     if fig is None:
@@ -1434,7 +1343,7 @@ def plot_pareto(report: BenchReport, path) -> Any:
 
 def pareto_figure(report: BenchReport) -> Any:
     """The matplotlib figure of :func:`plot_pareto` (None without rows)."""
-    from .figures import pyplot
+    from ..figures import pyplot
 
     plt = pyplot()
     from matplotlib.ticker import NullFormatter
@@ -1489,7 +1398,7 @@ def plot_costs(report: BenchReport, path) -> Any:
     """The sweep's cost curves (time and memory against size), log-log, saved as PNG."""
     from pathlib import Path
 
-    from .figures import pyplot
+    from ..figures import pyplot
 
     if not report.curves:
         return None
@@ -1694,7 +1603,7 @@ def write_report(report: BenchReport, out_dir) -> dict[str, Any]:
     import json
     from pathlib import Path
 
-    from ._io import atomic_write_text
+    from .._io import atomic_write_text
 
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)

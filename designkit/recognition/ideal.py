@@ -53,10 +53,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import special
 
-from ._validation import InputError, check_effusivity_range
-from .physics import object_weight, response_shape
-from .scene import Scene
-from .sensor import Sensor
+from .._validation import InputError, check_effusivity_range
+from ..models.semi_infinite import object_weight, response_shape
+from ..scene import Scene
+from ..sensor import Sensor
 
 __all__ = [
     "IdealResult",
@@ -322,7 +322,7 @@ def _class_loglik(stats, e_range, sensor, scene, g, sigma, n_grid):
 
 
 def _ideal_monte_carlo(low, high, sensor: Sensor, scene: Scene, n_mc: int, seed) -> IdealResult:
-    from .simulation import simulate_interval
+    from ..simulation import simulate_interval
 
     n_mc = int(n_mc)
     if n_mc < 10:
@@ -364,7 +364,7 @@ def score_llr(llr: np.ndarray, labels: np.ndarray, n_mc: int) -> tuple[float, fl
     """
     from sklearn.metrics import precision_recall_curve
 
-    from .recognition import f1_standard_error
+    from .svm import f1_standard_error
 
     acc = float(np.mean((llr > 0) == labels))
     precision, recall, _ = precision_recall_curve(labels, llr)
@@ -381,20 +381,34 @@ def score_llr(llr: np.ndarray, labels: np.ndarray, n_mc: int) -> tuple[float, fl
 
 
 # ----------------------------------------------------------------- public entry
-def ideal_pair(range_a: tuple[float, float], range_b: tuple[float, float], sensor: Sensor,
-               scene: Scene, *, n_mc: int = 2000, seed=0) -> IdealResult:
-    """Best achievable F1 and accuracy for two effusivity classes.
+def _as_class(x, name: str):
+    from ..objects import ObjectClass
 
-    Closed form for fixed initial conditions; Monte Carlo on the exact
-    likelihood (``n_mc`` simulated touches per class, ``seed``) when the scene
-    varies Ts0 or Ta.
+    if isinstance(x, ObjectClass):
+        return x
+    lo, hi = check_effusivity_range(name, *x)
+    return ObjectClass(name, (lo, hi))
+
+
+def ideal_pair(range_a, range_b, sensor: Sensor, scene: Scene, *, n_mc: int = 2000, seed=0,
+               model=None) -> IdealResult:
+    """Best achievable F1 and accuracy for two object classes, under any forward model.
+
+    Closed form for fixed initial conditions and a shared-shape model (or one
+    whose extra physics is invisible here, :meth:`ForwardModel.equivalent_shared_shape`);
+    Monte Carlo on the exact likelihood (``n_mc`` simulated touches per class,
+    ``seed``) when the scene varies Ts0 or Ta, or the model's curves differ in
+    shape per object (:mod:`designkit.recognition.ideal_mc`).
 
     Parameters
     ----------
-    range_a, range_b : (float, float)
-        Class ranges ``[low, high)`` [J s^-1/2 K^-1 m^-2]; order does not matter.
+    range_a, range_b : (float, float) or ObjectClass
+        Class ranges ``[low, high)`` [J s^-1/2 K^-1 m^-2] or object classes;
+        order does not matter.
     sensor : Sensor
     scene : Scene
+    model : ForwardModel or name, optional
+        Default: the paper's semi-infinite model.
 
     Examples
     --------
@@ -403,14 +417,38 @@ def ideal_pair(range_a: tuple[float, float], range_b: tuple[float, float], senso
     >>> round(r.accuracy, 3)
     0.874
     """
-    a = check_effusivity_range("e1", *range_a)
-    b = check_effusivity_range("e2", *range_b)
-    if a == b:
-        raise InputError(f"the two effusivity ranges are identical ([{a[0]:g}, {a[1]:g})): nothing to separate")
-    low, high = sorted([a, b])
+    from ..models import get_model
+
+    fm = get_model(model)
+    a, b = _as_class(range_a, "e1"), _as_class(range_b, "e2")
+    if a.e_range == b.e_range and a.diffusivity_range_m2_s == b.diffusivity_range_m2_s:
+        lo_, hi_ = a.e_range
+        raise InputError(f"the two effusivity ranges are identical ([{lo_:g}, {hi_:g})): nothing to separate")
+    if not fm.shared_shape:
+        eq = fm.equivalent_shared_shape((a, b), sensor, contact_s=scene.contact_s,
+                                        tolerance=_invisible_tolerance(sensor, scene))
+        if eq is None:
+            from .ideal_mc import ideal_pair_mc
+
+            return ideal_pair_mc(a, b, sensor, scene, model=fm, n_mc=n_mc, seed=seed)
+    low, high = sorted([a.e_range, b.e_range])
     if scene.fixed_initial_conditions:
         s = projection_noise(sensor, scene)
         f1, acc = ideal_scores(low[0], low[1], high[0], high[1], sensor.effusivity, s)
         return IdealResult(f1=float(f1), accuracy=float(acc), method="closed-form",
                            projection_noise=s)
     return _ideal_monte_carlo(low, high, sensor, scene, n_mc, seed)
+
+
+#: A model's extra physics below this fraction of the noise over the whole
+#: touch (in norm) leaves the closed-form answer as it is.
+INVISIBLE_NOISE_FRACTION = 0.01
+
+
+def _invisible_tolerance(sensor: Sensor, scene: Scene) -> float:
+    """Largest per-sample normalized deviation whose curve norm stays below 1 % of the noise."""
+    m = sensor.times_s(scene.contact_s).size
+    ratio = scene.noise_ratio
+    if not math.isfinite(ratio):
+        return math.inf
+    return INVISIBLE_NOISE_FRACTION * ratio / math.sqrt(m)

@@ -45,7 +45,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from ._validation import InputError
+from .._validation import InputError
 
 __all__ = [
     "SCHEMA_VERSION",
@@ -99,7 +99,7 @@ def content_hash(arrays: Mapping[str, np.ndarray]) -> str:
 
 def table_header(cfg, arrays: Mapping[str, np.ndarray], *, run: Mapping[str, Any] | None = None) -> dict:
     """The JSON header of a table built from sweep config ``cfg``."""
-    from . import __version__
+    from .. import __version__
 
     sensor = cfg.resolved_sensor()
     axes = []
@@ -152,7 +152,7 @@ def write_table(path: str | Path, header: dict, arrays: Mapping[str, np.ndarray]
     a crash leaves either the old table or a header-less npz that loading
     refuses.
     """
-    from ._io import atomic_write_bytes, atomic_write_text
+    from .._io import atomic_write_bytes, atomic_write_text
 
     path = Path(path)
     if path.suffix != ".npz":
@@ -197,7 +197,7 @@ class Table:
 
     @property
     def sensor(self):
-        from .sensor import Sensor
+        from ..sensor import Sensor
 
         return Sensor.from_dict(self.header["sensor"], source=f"table {self.name}")
 
@@ -232,7 +232,7 @@ class Table:
 
 def list_tables(folder: Path | None = None) -> list[str]:
     """Names of the tables in ``folder`` (default: the shipped tables)."""
-    from ._resources import shipped_tables_dir
+    from .._resources import shipped_tables_dir
 
     folder = shipped_tables_dir() if folder is None else Path(folder)
     return sorted(p.stem for p in folder.glob("*.json")
@@ -249,7 +249,7 @@ def _looks_like_table(p: Path) -> bool:
 
 def resolve_table(name_or_path: str | Path) -> Path:
     """The .npz path of a shipped table name or of a path (with or without suffix)."""
-    from ._resources import shipped_tables_dir
+    from .._resources import shipped_tables_dir
 
     s = str(name_or_path)
     p = Path(s)

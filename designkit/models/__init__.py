@@ -1,0 +1,106 @@
+"""Forward models of a touch: the catalogue, by name.
+
+Every model answers one question, the normalized reading ``u(t)`` of a touch
+for an object and a sensor (:class:`~designkit.models.base.ForwardModel`);
+simulation, recognition, sweeps, tables, questions and exports are written
+once against that seam.
+
+==================  =======================================  ==============
+name                model                                    shared shape
+==================  =======================================  ==============
+``semi-infinite``   the paper's (eqs. 1-2), perfect contact  yes
+``slab``            an object of finite thickness on a       no
+                    backing (image series / finite volumes)
+``contact``         finite interface conductance h_c         no
+==================  =======================================  ==============
+
+Adding a model is one module defining a :class:`ForwardModel` subclass plus
+one line in :data:`MODELS`. Modules load on first use, so naming a model costs
+nothing until it is used.
+
+Examples
+--------
+>>> from designkit.models import get_model
+>>> get_model("contact", conductance_w_m2k=1500).describe()
+'contact (conductance_w_m2k = 1500 W m^-2 K^-1)'
+>>> get_model().name
+'semi-infinite'
+"""
+
+from __future__ import annotations
+
+import difflib
+import importlib
+from typing import Any, Mapping
+
+from .._validation import InputError
+from .base import ForwardModel, ModelCheck
+
+__all__ = ["MODELS", "ForwardModel", "ModelCheck", "get_model", "model_names"]
+
+#: name -> (module, class): the registry of forward models (pvlib-style catalogue).
+MODELS: dict[str, tuple[str, str]] = {
+    "semi-infinite": ("designkit.models.semi_infinite", "SemiInfinite"),
+    "slab": ("designkit.models.slab", "Slab"),
+    "contact": ("designkit.models.contact", "Contact"),
+}
+
+_CLASSES = {cls: name for name, (_, cls) in MODELS.items()}
+
+
+def model_names() -> tuple[str, ...]:
+    """Names of the registered models."""
+    return tuple(MODELS)
+
+
+def model_class(name: str) -> type[ForwardModel]:
+    """The class registered as ``name`` (unknown names: an error listing the valid ones)."""
+    key = str(name).strip().lower()
+    if key not in MODELS:
+        close = difflib.get_close_matches(key, MODELS, n=1)
+        hint = f" (did you mean {close[0]!r}?)" if close else ""
+        raise InputError(f"unknown forward model {name!r}{hint}; known: {', '.join(MODELS)}")
+    module, cls = MODELS[key]
+    return getattr(importlib.import_module(module), cls)
+
+
+def get_model(spec: "str | Mapping[str, Any] | ForwardModel | None" = None, **parameters: Any) -> ForwardModel:
+    """A forward model from a name (and parameters), a dict like a table header's, or a model.
+
+    Parameters
+    ----------
+    spec : str, dict, ForwardModel or None
+        ``None`` is the paper's semi-infinite model; a dict is
+        ``{"name": ..., **parameters}`` (what :meth:`ForwardModel.to_dict` writes).
+    **parameters
+        The model's parameters (with a name), e.g. ``conductance_w_m2k=2000``.
+    """
+    if isinstance(spec, ForwardModel):
+        if parameters:
+            raise InputError(f"parameters {sorted(parameters)} given with a model object; "
+                             "use dataclasses.replace on the model instead")
+        return spec
+    if spec is None:
+        spec = "semi-infinite"
+    if isinstance(spec, Mapping):
+        params = {k: v for k, v in spec.items() if k != "name"}
+        if "name" not in spec:
+            raise InputError(f"a model needs a name (one of {', '.join(MODELS)}), got keys {sorted(spec)}")
+        return get_model(str(spec["name"]), **params, **parameters)
+    cls = model_class(str(spec))
+    fields = {f for f in getattr(cls, "__dataclass_fields__", {})}
+    unknown = sorted(set(parameters) - fields)
+    if unknown:
+        raise InputError(f"model {cls.name!r} has no parameter {', '.join(unknown)}; "
+                         f"its parameters: {', '.join(sorted(fields)) or 'none'}")
+    try:
+        return cls(**parameters)
+    except TypeError as exc:  # pragma: no cover - a missing required parameter
+        raise InputError(f"model {cls.name!r}: {exc}") from None
+
+
+def __getattr__(name: str):
+    # ``from designkit.models import Contact`` loads its module on first use.
+    if name in _CLASSES:
+        return model_class(_CLASSES[name])
+    raise AttributeError(f"module 'designkit.models' has no attribute {name!r}")

@@ -12,6 +12,8 @@ The top-level namespace is kept light (no scikit-learn, no scipy.optimize):
 from their modules (``designkit.recognition``, ``designkit.query`` ...).
 """
 
+# The one place the version is written: pyproject.toml reads it from here (setuptools
+# dynamic metadata), the CLI prints it (designkit --version), CHANGELOG.md names it.
 __version__ = "0.1.0"
 
 _LAZY = {

@@ -37,3 +37,18 @@ def test_cli_import_stays_light():
             " if m in sys.modules]; print(','.join(bad))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == ""
+
+
+def test_every_named_package_data_file_exists():
+    """A package-data file named without a wildcard that does not exist is silently left
+    out of the wheel; tables/README.md was once such an entry."""
+    pyproject = REPO / "pyproject.toml"
+    if not pyproject.is_file():
+        pytest.skip("not running from a source checkout")
+    cfg = tomllib.loads(pyproject.read_text())["tool"]["setuptools"]
+    folders = cfg.get("package-dir", {})
+    for pkg, patterns in cfg["package-data"].items():
+        folder = REPO / folders.get(pkg, pkg.replace(".", "/"))
+        for name in patterns:
+            if not any(c in name for c in "*?["):
+                assert (folder / name).is_file(), f"package-data {pkg}: {name} does not exist in {folder}"

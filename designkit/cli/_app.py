@@ -79,6 +79,23 @@ app = typer.Typer(
 )
 
 
+def _show_version(value: bool) -> None:
+    # Eager: click runs it while parsing, before any command (or its library layer) runs.
+    if value:
+        from designkit import __version__  # the package is already imported; nothing to load
+
+        typer.echo(f"designkit {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _root(
+    version: bool = typer.Option(False, "--version", "-V", callback=_show_version, is_eager=True,
+                                 help="Print designkit's version and exit."),
+) -> None:
+    """The top-level options (only --version): typer's group callback."""
+
+
 # Help panels of ``designkit --help``, in the order a new user needs them.
 ASK = "Ask a design question"
 TABLES = "Lookup tables and embedding"

@@ -23,3 +23,61 @@ Width = Annotated[float, typer.Option(
     "--width", help="Width of each effusivity class [e, e+width) [J s^-1/2 K^-1 m^-2] (paper: 80).")]
 Trials = Annotated[int, typer.Option("--trials", help="Simulated touches per class.")]
 Folds = Annotated[int, typer.Option("--folds", help="Cross-validation folds.")]
+
+# ---------------------------------------------------------------- objects and forward models (one vocabulary)
+M1 = Annotated[Optional[str], typer.Option(
+    "--m1", help="First material by name (instead of --e1); see 'designkit materials list'.")]
+M2 = Annotated[Optional[str], typer.Option("--m2", help="Second material by name (instead of --e2).")]
+ModelOpt = Annotated[Optional[str], typer.Option(
+    "--model", help="Forward model: semi-infinite (the paper's, default), slab (a thin object: give --thickness) "
+                    "or contact (finite interface conductance: give --conductance); see docs/models.md.")]
+Conductance = Annotated[Optional[float], typer.Option(
+    "--conductance", help="Sensor-object interface conductance h_c \\[W m^-2 K^-1] (contact model; implies "
+                          "--model contact).")]
+Thickness = Annotated[Optional[float], typer.Option(
+    "--thickness", help="Object thickness \\[m] (e.g. 0.003 for a 3 mm sheet; slab model; implies --model slab).")]
+BackingOpt = Annotated[Optional[str], typer.Option(
+    "--backing", help="Slab model: what the object lies on: table (default: a hardwood table top), insulated, "
+                      "air, steel, or a material name.")]
+Diffusivity = Annotated[Optional[float], typer.Option(
+    "--diffusivity", help="Diffusivity \\[m^2/s] of objects given as numbers (--e1/--e2/--e), for models that "
+                          "need it (slab).")]
+
+
+def model_from_options(model: Optional[str], *, conductance: Optional[float] = None,
+                       thickness: Optional[float] = None, backing: Optional[str] = None):
+    """The forward model the options name (None, None, ... is the paper's semi-infinite model).
+
+    ``--thickness`` implies ``--model slab`` and ``--conductance`` implies
+    ``--model contact``; a parameter given with another model is refused.
+    """
+    from .._validation import InputError
+    from ..models import get_model
+
+    implied = {"slab": thickness is not None or backing is not None, "contact": conductance is not None}
+    wanted = [name for name, yes in implied.items() if yes]
+    if len(wanted) > 1:
+        raise InputError("--thickness/--backing (slab model) and --conductance (contact model) "
+                         "describe different models: give one")
+    name = model or (wanted[0] if wanted else "semi-infinite")
+    if wanted and wanted[0] != get_model_name(name):
+        flag = "--conductance" if wanted[0] == "contact" else "--thickness/--backing"
+        raise InputError(f"{flag} belongs to the {wanted[0]} model, not --model {name}")
+    params = {}
+    if thickness is not None:
+        params["thickness_m"] = thickness
+    if backing is not None:
+        params["backing"] = backing
+    if conductance is not None:
+        params["conductance_w_m2k"] = conductance
+    if get_model_name(name) == "slab" and thickness is None:
+        raise InputError("the slab model needs the object's --thickness [m]")
+    if get_model_name(name) == "contact" and conductance is None:
+        raise InputError("the contact model needs the interface --conductance [W m^-2 K^-1]")
+    return get_model(name, **params)
+
+
+def get_model_name(name: str) -> str:
+    from ..models import model_class
+
+    return model_class(name).name

@@ -118,6 +118,7 @@ def table_header(cfg, arrays: Mapping[str, np.ndarray], *, run: Mapping[str, Any
         "name": cfg.name,
         "fidelity": cfg.fidelity,
         "sensor": sensor.to_dict(),
+        "model": _model_of(cfg).to_dict(),
         "effusivity": {"min": cfg.e_min, "max": cfg.e_max, "intervals": cfg.intervals,
                        "width": cfg.width, "units": E_UNITS},
         "fixed_initial_conditions": not cfg.varied,
@@ -143,6 +144,13 @@ def table_header(cfg, arrays: Mapping[str, np.ndarray], *, run: Mapping[str, Any
             **({"run": dict(run)} if run else {}),
         },
     }
+
+
+def _model_of(cfg):
+    """The forward model a sweep config names (configs from before the seam: the semi-infinite model)."""
+    from ..models import get_model
+
+    return get_model(getattr(cfg, "model", None))
 
 
 def write_table(path: str | Path, header: dict, arrays: Mapping[str, np.ndarray]) -> Path:
@@ -205,6 +213,14 @@ class Table:
     def fixed_initial_conditions(self) -> bool:
         return bool(self.header.get("fixed_initial_conditions", True))
 
+    @property
+    def model(self):
+        """The forward model the table was built with (tables from before the header recorded it:
+        the paper's semi-infinite model, the only one there was)."""
+        from ..models import get_model
+
+        return get_model(self.header.get("model"))
+
     def summary(self) -> dict[str, Any]:
         """What `designkit tables show` prints."""
         h = self.header
@@ -213,6 +229,7 @@ class Table:
             "path": str(self.path),
             "fidelity": h["fidelity"],
             "sensor": h["sensor"],
+            "model": self.model.to_dict(),
             "effusivity": h["effusivity"],
             "axes": [{k: a[k] for k in ("name", "units", "scale")} | {
                 "min": min(a["values"]), "max": max(a["values"]), "points": len(a["values"]),

@@ -80,7 +80,7 @@ class Contact(ForwardModel):
     def beta(self, e_object, sensor) -> np.ndarray:
         """``beta = h_c (1/e_s + 1/e_o)`` [s^-1/2]; inf for perfect contact or an insulator."""
         eo = np.asarray(e_object, dtype=np.float64)
-        with np.errstate(divide="ignore", invalid="ignore"):
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             b = self.conductance_w_m2k * (1.0 / sensor.effusivity + 1.0 / eo)
         return np.where(np.isnan(b), np.inf, b)
 

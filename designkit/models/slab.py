@@ -129,7 +129,7 @@ class Backing:
     name: str
     effusivity: float
     diffusivity_m2_s: float = 1e-7
-    source: str = ""
+    source: str = field(default="", compare=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "effusivity",

@@ -48,7 +48,7 @@ when the classes cannot be told apart; the best *accuracy* is 0.5 then.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy import special
@@ -93,6 +93,8 @@ class IdealResult:
         ``s``: noise of the projected statistic in units of ``w`` (closed form).
     n_mc : int or None
         Simulated test touches per class (Monte Carlo).
+    details : dict
+        How a Monte Carlo answer was computed (grid sizes, basis rank ...).
     """
 
     f1: float
@@ -102,6 +104,7 @@ class IdealResult:
     accuracy_standard_error: float = 0.0
     projection_noise: float | None = None
     n_mc: int | None = None
+    details: dict = field(default_factory=dict, compare=False)
 
     def to_dict(self) -> dict:
         return {
@@ -112,6 +115,7 @@ class IdealResult:
             "accuracy_standard_error": self.accuracy_standard_error,
             "projection_noise": self.projection_noise,
             "n_mc": self.n_mc,
+            "details": dict(self.details),
         }
 
 

@@ -10,7 +10,8 @@ import typer
 
 from ._app import app, console, emit_json
 from . import _app
-from ._options import E1, E2, Ambient, Contact, DeltaT, Folds, Json, Noise, Seed, SensorOpt, Threshold, Trials, Width
+from ._options import (E1, E2, Ambient, BackingOpt, Conductance, Contact, DeltaT, Diffusivity, Folds, Json,
+                       ModelOpt, Noise, Seed, SensorOpt, Thickness, Threshold, Trials, Width, model_from_options)
 
 
 @app.command(rich_help_panel=_app.MODEL)
@@ -25,20 +26,27 @@ def simulate(
     sensor: SensorOpt = "paper",
     out: Annotated[Optional[Path], typer.Option("--out", help="Write a CSV: time_s, then one column per trial.")] = None,
     plot: Annotated[Optional[Path], typer.Option("--plot", help="Write a PNG of the curves (needs designkit[figures]).")] = None,
+    model: ModelOpt = None,
+    conductance: Conductance = None,
+    thickness: Thickness = None,
+    backing: BackingOpt = None,
+    diffusivity: Diffusivity = None,
     json_: Json = False,
 ) -> None:
-    """Simulate touches of one object (paper eq. 4): sensor temperature against time."""
+    """Simulate touches of one object (paper eq. 4): sensor temperature against time, under any forward model."""
     from ..models.semi_infinite import contact_temperature
     from ..scene import Scene
     from ..sensor import load_sensor
-    from ..simulation import simulate_trials
 
     if trials < 1:
         raise ValueError(f"trials must be >= 1, got {trials}")
+    fm = model_from_options(model, conductance=conductance, thickness=thickness, backing=backing)
     sen = load_sensor(sensor)
     scene = Scene(contact_s=contact, noise_c=noise, sensor_temp_c=sensor_temp, ambient_temp_c=ambient)
-    result = simulate_trials(e, sen, scene, n_trials=trials, seed=seed)
-    tc = float(contact_temperature(sensor_temp, ambient, sen.effusivity, e))
+    result = _touches(e, sen, scene, trials, seed, fm, diffusivity)
+    # the paper's contact temperature (eq. 1): where the surface jumps at once under a shared-shape
+    # model; other models reach it later (a contact's lag) or never (a slab on its backing)
+    tc = float(contact_temperature(sensor_temp, ambient, sen.effusivity, e)) if fm.shared_shape else None
     if out is not None:
         _write_curves_csv(out, result.time_s, result.temperature_c)
     if plot is not None:
@@ -54,22 +62,54 @@ def simulate(
             "contact_temperature_c": tc,
             "scene": scene.to_dict(),
             "sensor": sen.to_dict(),
+            "model": fm.to_dict(),
+            "diffusivity_m2_s": diffusivity,
             "seed": seed,
             "out": str(out) if out else None,
             "plot": str(plot) if plot else None,
         })
         return
+    from rich.markup import escape
+
     con = console()
     final = result.temperature_c[:, -1]
     con.print(f"[bold]{trials} touch(es)[/] of e = {e:g} J s^-1/2 K^-1 m^-2 for {contact:g} s "
               f"({result.time_s.size} samples at {sen.sample_rate_hz:g} Hz, {sen.name} sensor, tau = {sen.tau_s:.3f} s)")
-    con.print(f"  sensor {sensor_temp:g} °C, object {ambient:g} °C, contact surface Tc = {tc:.4f} °C")
+    con.print(escape(f"  model {fm.describe()}"
+                     + (f", object diffusivity {diffusivity:g} m^2/s" if diffusivity is not None else "")))
+    con.print(f"  sensor {sensor_temp:g} °C, object {ambient:g} °C"
+              + (f", contact surface Tc = {tc:.4f} °C" if tc is not None else ""))
     con.print(f"  reading at {result.time_s[-1]:g} s: {final.mean():.4f} °C"
               + (f" (trials {final.min():.4f} to {final.max():.4f})" if trials > 1 else ""))
     if out is not None:
         con.print(f"  wrote {out}")
     if plot is not None:
         con.print(f"  wrote {plot}")
+
+
+def _touches(e: float, sensor, scene, trials: int, seed: int, model, diffusivity_m2_s: Optional[float]):
+    """``trials`` touches of one object of effusivity ``e`` (0 and inf allowed) under ``model``.
+
+    The draws of :func:`designkit.simulation.simulate_trials` (so the semi-infinite readings are
+    its readings to the bit), rendered by the model, with the object's diffusivity where the
+    model needs it.
+    """
+    import numpy as np
+
+    from .._validation import InputError, check_effusivity, check_positive
+    from ..simulation import TrialDraws, draw_trials, render_trials
+
+    e = check_effusivity("e", e, allow_zero=True, allow_inf=True)
+    alpha = None
+    if "diffusivity_m2_s" in model.object_properties:
+        if diffusivity_m2_s is None:
+            raise InputError(f"the {model.name} model needs the object's --diffusivity [m^2/s]")
+        alpha = np.full(trials, check_positive("diffusivity [m^2/s]", diffusivity_m2_s))
+    elif diffusivity_m2_s is not None:
+        raise InputError(f"--diffusivity is for models that need it (slab), not the {model.name} model")
+    draws = draw_trials(0.0, 0.0, trials, sensor.times_s(scene.contact_s).size, seed)
+    draws = TrialDraws(np.full(trials, e), draws.sensor_offset, draws.ambient_offset, draws.noise)
+    return render_trials(draws, sensor, scene, model, alpha)
 
 
 def _write_curves_csv(path: Path, time_s, temps) -> None:
@@ -100,12 +140,19 @@ def f1(
     seed: Seed = 0,
     threshold: Threshold = 0.9,
     sensor: SensorOpt = "paper",
+    model: ModelOpt = None,
+    conductance: Conductance = None,
+    thickness: Thickness = None,
+    backing: BackingOpt = None,
+    diffusivity: Diffusivity = None,
     json_: Json = False,
 ) -> None:
-    """F1 of the paper's SVM and of the ideal observer for classes [e1, e1+width) and [e2, e2+width)."""
+    """F1 of the paper's SVM and of the ideal observer for classes [e1, e1+width) and [e2, e2+width), under any
+    forward model."""
     from .._validation import InputError, check_effusivity
+    from ..objects import object_class
     from ..recognition.ideal import ideal_pair
-    from ..recognition.svm import interval_pair_f1
+    from ..recognition.svm import pair_f1
     from ..scene import Scene
     from ..sensor import load_sensor
 
@@ -119,13 +166,20 @@ def f1(
         raise InputError(f"folds must be >= 2, got {folds}")
     if trials < folds:
         raise InputError(f"trials per class ({trials}) must be at least the number of folds ({folds})")
+    fm = model_from_options(model, conductance=conductance, thickness=thickness, backing=backing)
+    if diffusivity is not None and "diffusivity_m2_s" not in fm.object_properties:
+        raise InputError(f"--diffusivity is for models that need it (slab), not the {fm.name} model")
+    if diffusivity is None and "diffusivity_m2_s" in fm.object_properties:
+        raise InputError(f"the {fm.name} model needs the objects' --diffusivity [m^2/s]")
     sen = load_sensor(sensor)
     scene = Scene.from_delta_t(contact_s=contact, noise_c=noise, delta_t_c=delta_t, ambient_temp_c=ambient)
-    ra, rb = (e1, e1 + width), (e2, e2 + width)
+    obj1 = object_class(e1, width=width, diffusivity_m2_s=diffusivity)
+    obj2 = object_class(e2, width=width, diffusivity_m2_s=diffusivity)
+    ra, rb = obj1.e_range, obj2.e_range
     t0 = time.perf_counter()
-    svm = interval_pair_f1(ra, rb, sen, scene, trials=trials, folds=folds, seed=seed)
+    svm = pair_f1(obj1, obj2, sen, scene, model=fm, trials=trials, folds=folds, seed=seed)
     t1 = time.perf_counter()
-    ideal = ideal_pair(ra, rb, sen, scene, seed=seed)
+    ideal = ideal_pair(obj1, obj2, sen, scene, seed=seed, model=fm)
     t2 = time.perf_counter()
     payload = {
         "svm_f1": svm.f1,
@@ -146,15 +200,21 @@ def f1(
         "seed": seed,
         "scene": scene.to_dict(),
         "sensor": sen.to_dict(),
+        "model": fm.to_dict(),
+        "diffusivity_m2_s": diffusivity,
         "svm_time_s": t1 - t0,
         "ideal_time_s": t2 - t1,
     }
     if json_:
         emit_json(payload)
         return
+    from rich.markup import escape
+
     con = console()
     con.print(f"[bold]{e1:g}[/] vs [bold]{e2:g}[/] J s^-1/2 K^-1 m^-2 (classes {width:g} wide), contact {contact:g} s, "
               f"noise {noise:g} °C, dT {delta_t:g} °C, {sen.name} sensor")
+    con.print(escape(f"  model {fm.describe()}"
+                     + (f", object diffusivity {diffusivity:g} m^2/s" if diffusivity is not None else "")))
     verdict = "[green]distinguishable[/]" if svm.f1 >= threshold else "[red]not distinguishable[/]"
     folds_txt = ", ".join(f"{f:.3f}" for f in svm.fold_f1)
     con.print(f"  SVM F1    {svm.f1:.3f} ± {svm.standard_error:.3f}  (folds {folds_txt}; {trials} trials/class)"

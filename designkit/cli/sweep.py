@@ -10,7 +10,7 @@ import typer
 
 from ._app import EXIT_INTERRUPTED, app, console, emit_json
 from . import _app
-from ._options import Json
+from ._options import BackingOpt, Conductance, Diffusivity, Json, ModelOpt, Thickness, model_from_options
 
 
 def _floats(text: Optional[str], name: str) -> Optional[tuple[float, ...]]:
@@ -48,6 +48,11 @@ def sweep(
     sample_rate: Annotated[Optional[float], typer.Option("--sample-rate", help="Sampling rate [Hz] (default: the sensor's).")] = None,
     blocks: Annotated[Optional[int], typer.Option("--blocks", help="Split each scene's references into this many parallel blocks.")] = None,
     full_matrix: Annotated[Optional[bool], typer.Option("--full-matrix/--no-full-matrix", help="Score every pair (slow; stores F1 matrices).")] = None,
+    model: ModelOpt = None,
+    conductance: Conductance = None,
+    thickness: Thickness = None,
+    backing: BackingOpt = None,
+    diffusivity: Diffusivity = None,
     jobs: Annotated[int, typer.Option("--jobs", "-j", help="Local worker processes (-1: all cores).")] = -1,
     backend: Annotated[str, typer.Option("--backend", help="loky (local processes) or dask.")] = "loky",
     scheduler: Annotated[Optional[str], typer.Option("--scheduler", help="Dask scheduler address (with --backend dask).")] = None,
@@ -57,17 +62,27 @@ def sweep(
     fresh: Annotated[bool, typer.Option("--fresh", help="Discard WORKDIR's finished chunks first.")] = False,
     json_: Json = False,
 ) -> None:
-    """Sweep the physics + classifier model and write a delta(e) lookup table (resumable)."""
+    """Sweep the physics + classifier model and write a delta(e) lookup table (resumable).
+
+    The forward model comes from the config's `model:` key (default: the paper's semi-infinite
+    model); the model options, when given, replace it as a whole (`--thickness 0.002` is a 2 mm
+    slab on the default backing, whatever the config said). A slab also needs `--diffusivity`
+    (or `diffusivity_m2_s:` in the config): one object diffusivity for every interval.
+    """
     import time
 
     from ..sweep.engine import SweepConfig, SweepInterrupted, run_sweep
 
+    fm = None
+    if any(v is not None for v in (model, conductance, thickness, backing)):
+        fm = model_from_options(model, conductance=conductance, thickness=thickness, backing=backing)
     overrides = dict(name=name, sensor=sensor, fidelity=fidelity, e_min=e_min, e_max=e_max, intervals=intervals,
                      trials=trials, folds=folds, threshold=threshold, seed=seed, max_repeats=max_repeats,
                      noise_ratio=_floats(noise_ratio, "--noise-ratio"), noise_c=_floats(noise, "--noise"),
                      delta_t_c=_floats(delta_t, "--delta-t"), sensor_temp_spread_c=sensor_temp_spread,
                      ambient_temp_spread_c=ambient_temp_spread, contact_s=_floats(contact, "--contact"),
-                     sample_rate_hz=sample_rate, blocks=blocks, full_matrix=full_matrix)
+                     sample_rate_hz=sample_rate, blocks=blocks, full_matrix=full_matrix, model=fm,
+                     diffusivity_m2_s=diffusivity)
     if overrides["noise_c"] is not None or overrides["delta_t_c"] is not None:
         overrides.setdefault("noise_ratio", None)
     if config is not None:
@@ -125,11 +140,14 @@ def sweep(
     elapsed = time.perf_counter() - started
     summary = {"table": str(path), "header": str(path.with_suffix(".json")), "workdir": str(wd),
                "chunks_total": total, "chunks_computed": stats["computed"], "svm_fits": stats["fits"],
-               "elapsed_s": elapsed, "config": cfg.to_dict()}
+               "elapsed_s": elapsed, "model": cfg.model.to_dict(), "config": cfg.to_dict()}
     if json_:
         emit_json(summary)
         return
+    from rich.markup import escape
+
     out_con = console()
     out_con.print(f"[bold green]Wrote[/] {path} (+ .json): {total} chunks "
-                  f"({stats['computed']} computed now), {stats['fits']} SVM fits, {elapsed:.1f} s")
+                  f"({stats['computed']} computed now), {stats['fits']} SVM fits, {elapsed:.1f} s; "
+                  f"model {escape(cfg.model.describe())}")
     sys.stdout.flush()

@@ -27,7 +27,7 @@ def tables_list(
     for name in list_tables(folder):
         t = load_table(name if folder is None else folder / f"{name}.npz")
         s = t.summary()
-        rows.append({"name": name, "fidelity": s["fidelity"], "sensor": s["sensor"]["name"],
+        rows.append({"name": name, "fidelity": s["fidelity"], "sensor": s["sensor"]["name"], "model": s["model"],
                      "axes": {a["name"]: [a["min"], a["max"], a["points"]] for a in s["axes"]},
                      "size_bytes": s["size_bytes"], "path": s["path"]})
     if json_:
@@ -36,12 +36,13 @@ def tables_list(
     from rich.table import Table as RichTable
 
     tab = RichTable(title="designkit lookup tables")
-    for col in ("name", "fidelity", "sensor", "sigma/dT", "contact [s]", "intervals", "size"):
+    for col in ("name", "fidelity", "sensor", "model", "sigma/dT", "contact [s]", "intervals", "size"):
         tab.add_column(col)
     for r in rows:
         ax = r["axes"]
         noise = ax.get("noise_ratio") or ax.get("noise_c")
-        tab.add_row(r["name"], r["fidelity"], r["sensor"], f"{noise[0]:g}–{noise[1]:g} ({noise[2]})",
+        tab.add_row(r["name"], r["fidelity"], r["sensor"], r["model"]["name"],
+                    f"{noise[0]:g}–{noise[1]:g} ({noise[2]})",
                     f"{ax['contact_s'][0]:g}–{ax['contact_s'][1]:g} ({ax['contact_s'][2]})",
                     str(ax["e_ref"][2]), f"{r['size_bytes'] / 1024:.0f} KiB")
     console().print(tab)
@@ -57,12 +58,14 @@ def tables_show(
 
     from rich.markup import escape
 
-    s = load_table(name).summary()
+    table = load_table(name)
+    s = table.summary()
     if json_:
         emit_json(s)
         return
     con = console()
     con.print(f"[bold]{s['name']}[/]  ({s['fidelity']} fidelity, {s['path']})")
+    con.print(escape(f"  model {table.model.describe()}"))
     sen = s["sensor"]
     con.print(f"  sensor {sen['name']}: e_s = {sen['effusivity']:g} J s^-1/2 K^-1 m^-2, alpha_s = "
               f"{sen['diffusivity_m2_s']:.3g} m^2/s, depth {sen['depth_m'] * 1e6:g} um, tau = {sen['tau_s']:.4g} s, "

@@ -65,11 +65,13 @@ from typing import Any, Callable, Iterator, Mapping, Sequence
 import numpy as np
 
 from .._validation import InputError, check_positive
+from ..models import ForwardModel, get_model
+from ..objects import ObjectClass
 from ..recognition.features import DEFAULT_SLOPE_WINDOW_S, feature_matrix
 from ..recognition.ideal import ideal_scores, projection_noise
 from ..scene import Scene
 from ..sensor import Sensor, load_sensor
-from ..simulation import draw_trials, render_trials
+from ..simulation import draw_trials, render_trials, response_tolerance
 
 __all__ = [
     "ChunkResult",
@@ -93,7 +95,26 @@ class SweepConfig:
     Fixed initial conditions use the ``noise_ratio`` axis (sigma / dT); varied
     initial conditions (``sensor_temp_spread_c`` or ``ambient_temp_spread_c``
     > 0) need the ``noise_c`` and ``delta_t_c`` axes, because the invariance
-    no longer holds.
+    no longer holds. The invariance holds for every forward model here (all
+    are linear in the temperatures), so the ``noise_ratio`` axis serves them all.
+
+    ``model`` is the forward model of the touches: a name, a mapping
+    ``{name: contact, conductance_w_m2k: 2000}`` (what a YAML config holds)
+    or a :class:`~designkit.models.ForwardModel`; default the paper's
+    semi-infinite model. Models that need the object's diffusivity (``slab``)
+    take ``diffusivity_m2_s`` [m^2 s^-1], one value for every interval.
+    ``fidelity: ideal`` needs a closed-form ideal observer, which exists only
+    for shared-shape models.
+
+    Examples
+    --------
+    >>> cfg = SweepConfig(model={"name": "contact", "conductance_w_m2k": 2000}, intervals=10)
+    >>> cfg.model.describe()
+    'contact (conductance_w_m2k = 2000 W m^-2 K^-1)'
+    >>> cfg.to_dict()["model"]
+    {'name': 'contact', 'conductance_w_m2k': 2000.0}
+    >>> SweepConfig(model="slab", diffusivity_m2_s=1e-7).model.name
+    'slab'
     """
 
     name: str = "sweep"
@@ -120,6 +141,8 @@ class SweepConfig:
     blocks: int = 1
     full_matrix: bool = False
     ideal_bound: bool = True
+    model: Any = None
+    diffusivity_m2_s: float | None = None
 
     def __post_init__(self) -> None:
         def tup(name: str) -> None:
@@ -180,6 +203,29 @@ class SweepConfig:
         for name in ("sensor_temp_spread_c", "ambient_temp_spread_c"):
             if getattr(self, name) < 0:
                 raise InputError(f"{name} must be >= 0")
+        self._check_model()
+
+    def _check_model(self) -> None:
+        """Resolve ``model`` to a ForwardModel and check what it needs from the config."""
+        try:
+            model = get_model(self.model)
+        except InputError as exc:
+            raise InputError(f"model: {exc}") from None
+        object.__setattr__(self, "model", model)
+        needs_alpha = "diffusivity_m2_s" in model.object_properties
+        if self.diffusivity_m2_s is not None:
+            if not needs_alpha:
+                raise InputError(f"diffusivity_m2_s: the {model.name} model does not use the objects' "
+                                 "diffusivity; leave it out")
+            object.__setattr__(self, "diffusivity_m2_s",
+                               check_positive("diffusivity_m2_s [m^2/s]", self.diffusivity_m2_s))
+        elif needs_alpha:
+            raise InputError(f"model: the {model.name} model needs the objects' diffusivity; give "
+                             "diffusivity_m2_s [m^2/s] (one value for every interval)")
+        if self.fidelity == "ideal" and not model.shared_shape:
+            raise InputError(f"fidelity ideal needs the closed-form ideal observer, which exists only for "
+                             f"shared-shape models; the {model.name} model's curves differ per object "
+                             "(use fidelity svm)")
 
     # ----------------------------------------------------------------- derived
     @property
@@ -232,17 +278,38 @@ class SweepConfig:
     def blocks_of(self) -> list[np.ndarray]:
         return [b for b in np.array_split(np.arange(self.intervals), self.blocks) if b.size]
 
+    def grid_class(self) -> ObjectClass:
+        """The whole effusivity grid as one object class (what a model's validity checks take)."""
+        alpha = self.diffusivity_m2_s
+        return ObjectClass("sweep grid", (self.e_min, self.e_max), None if alpha is None else (alpha, alpha))
+
+    def trial_diffusivity(self) -> np.ndarray | None:
+        """Per-trial object diffusivity [m^2 s^-1] for models that need it, else None."""
+        if self.diffusivity_m2_s is None:
+            return None
+        return np.full(self.trials, self.diffusivity_m2_s)
+
     # --------------------------------------------------------------------- I/O
     def to_dict(self) -> dict[str, Any]:
-        d = dataclasses.asdict(self)
-        for k, v in d.items():
-            if isinstance(v, tuple):
-                d[k] = list(v)
+        """The config as plain JSON-ready data (``model`` as :meth:`ForwardModel.to_dict`)."""
+        d: dict[str, Any] = {}
+        for f in dataclasses.fields(self):
+            v = getattr(self, f.name)
+            d[f.name] = list(v) if isinstance(v, tuple) else v
+        d["model"] = self.model.to_dict()
         return d
 
     def digest(self) -> str:
-        """Hash of everything that determines the result (sensor file content included)."""
+        """Hash of everything that determines the result (sensor file content included).
+
+        Keys added after the first tables were built are left out at their
+        defaults (the semi-infinite model, no diffusivity), so a working folder
+        started before the forward-model seam still resumes.
+        """
         payload = self.to_dict()
+        for key, default in _DIGEST_DEFAULTS.items():
+            if payload.get(key) == default:
+                del payload[key]
         payload["sensor_resolved"] = self.resolved_sensor().to_dict()
         payload["sensor_resolved"].pop("provenance", None)
         text = json.dumps(payload, sort_keys=True, separators=(",", ":"))
@@ -286,6 +353,10 @@ class SweepConfig:
             data["sensor"] = str((p.parent / data["sensor"]).resolve())  # relative to the config
         data.update({k: v for k, v in overrides.items() if v is not None})
         return cls.from_mapping(data, source=f"sweep config {p}")
+
+
+#: Config keys newer than the first tables, with the default that keeps an older digest.
+_DIGEST_DEFAULTS: dict[str, Any] = {"model": {"name": "semi-infinite"}, "diffusivity_m2_s": None}
 
 
 def _flatten(data: Mapping[str, Any], source: str) -> dict[str, Any]:
@@ -363,7 +434,7 @@ class _PairScorer:
                                 seed=[cfg.seed, k, rep],
                                 vary_sensor=cfg.sensor_temp_spread_c > 0,
                                 vary_ambient=cfg.ambient_temp_spread_c > 0)
-            temps = render_trials(draws, self.sensor, self.scene).temperature_c
+            temps = render_trials(draws, self.sensor, self.scene, cfg.model, cfg.trial_diffusivity()).temperature_c
             feats = feature_matrix(temps, self.sensor.sample_rate_hz, cfg.slope_window_s)
             self._features[key] = feats
             while len(self._features) > self._max_features:
@@ -489,6 +560,27 @@ def _ideal_staircase(cfg: SweepConfig, sensor: Sensor, s: float, rows: np.ndarra
     return J
 
 
+#: ``J_ideal`` of a reference whose ideal observer has no closed form (model and scene).
+IDEAL_UNKNOWN = -1
+
+
+def closed_form_model(cfg: SweepConfig, sensor: Sensor, scene: Scene) -> ForwardModel | None:
+    """The shared-shape model whose closed-form ideal observer holds for this sweep's scene, or None.
+
+    The config's model when it has a shared shape; otherwise the shared-shape
+    model it cannot be told from here (its extra physics below
+    :func:`~designkit.simulation.response_tolerance` at every sample of every
+    interval: a contact too good to lag, a slab too thick to matter), if any.
+    Only then is the ideal observer's staircase a certificate (the floor of
+    the SVM search, and ``J_ideal``).
+    """
+    model = cfg.model
+    if model.shared_shape:
+        return model
+    tol = response_tolerance(scene.noise_ratio, sensor.times_s(scene.contact_s).size)
+    return model.equivalent_shared_shape((cfg.grid_class(),), sensor, contact_s=scene.contact_s, tolerance=tol)
+
+
 def _ideal_bound_s(cfg: SweepConfig, sensor: Sensor, scene: Scene) -> float:
     """Projection noise of an observer at least as good as any at this scene.
 
@@ -585,8 +677,12 @@ def _run_chunk(cfg, point, block, contact_index, hint_J, hint_J_hi) -> ChunkResu
     rows = cfg.blocks_of()[block]
     n = cfg.intervals
     floor_full = np.zeros(n, dtype=np.int64)
-    J_ideal_rows = _ideal_staircase(cfg, sensor, _ideal_bound_s(cfg, sensor, scene), rows)
-    floor_full[rows] = J_ideal_rows
+    closed_form = closed_form_model(cfg, sensor, scene) is not None
+    if closed_form:
+        J_ideal_rows = _ideal_staircase(cfg, sensor, _ideal_bound_s(cfg, sensor, scene), rows)
+        floor_full[rows] = J_ideal_rows
+    else:  # no closed-form ideal observer for this model and scene: no floor, J_ideal unknown
+        J_ideal_rows = np.full(rows.size, IDEAL_UNKNOWN, dtype=np.int64)
 
     if cfg.fidelity == "ideal":
         if cfg.varied:
@@ -607,7 +703,7 @@ def _run_chunk(cfg, point, block, contact_index, hint_J, hint_J_hi) -> ChunkResu
         J, J_lo, J_hi = (_first_crossing(scorer, rows, n, lambda c, k=k: c.mean + k * c.stderr >= phi)
                          for k in (0.0, z, -z))
     else:
-        floor = floor_full if cfg.ideal_bound else None
+        floor = floor_full if cfg.ideal_bound and closed_form else None
         J = staircase_search(lambda i, j: scorer.cell(i, j).mean >= phi, rows, n, floor=floor,
                              hint=_full(hint_J, rows, n))
         J_full = _full(J, rows, n)
@@ -650,7 +746,7 @@ def _ideal_mc_staircase(cfg, sensor, scene, rows, floor, hint) -> np.ndarray:
     def decide(i, j):
         if (i, j) not in cache:
             r = ideal_pair((edges[i], edges[i + 1]), (edges[j], edges[j + 1]), sensor, scene,
-                           n_mc=max(200, cfg.trials * 5), seed=[cfg.seed, i, j])
+                           n_mc=max(200, cfg.trials * 5), seed=[cfg.seed, i, j], model=cfg.model)
             cache[(i, j)] = r.f1
         return cache[(i, j)] >= cfg.threshold
 
@@ -717,7 +813,8 @@ def prepare_workdir(cfg: SweepConfig, workdir: Path, *, resume: bool, fresh: boo
         except (OSError, ValueError):
             raise InputError(f"{meta} is unreadable; use --fresh to start over") from None
         if old.get("digest") != cfg.digest():
-            raise InputError(f"{workdir} holds a different sweep (config changed); use another --workdir or --fresh")
+            changed = _changed_keys(old.get("config"), cfg.to_dict())
+            raise InputError(f"{workdir} holds a different sweep ({changed}); use another --workdir or --fresh")
         if not resume and any(chunks.glob("*.npz")):
             raise InputError(f"{workdir} already has finished chunks; use --resume to continue or --fresh to discard them")
     if fresh and chunks.exists():
@@ -725,6 +822,17 @@ def prepare_workdir(cfg: SweepConfig, workdir: Path, *, resume: bool, fresh: boo
             f.unlink()
     chunks.mkdir(parents=True, exist_ok=True)
     atomic_write_text(meta, json.dumps({"digest": cfg.digest(), "config": cfg.to_dict()}, indent=2))
+
+
+def _changed_keys(old: Any, new: Mapping[str, Any]) -> str:
+    """What differs between a working folder's recorded config and this one, for the refusal."""
+    if not isinstance(old, Mapping):
+        return "config changed"
+    keys = sorted(k for k in set(old) | set(new)
+                  if old.get(k, _DIGEST_DEFAULTS.get(k)) != new.get(k, _DIGEST_DEFAULTS.get(k)))
+    if not keys:
+        return "sensor file changed"
+    return f"{', '.join(keys)} changed"
 
 
 def iter_sweep(cfg: SweepConfig, workdir: Path, *, jobs: int = 1, backend: str = "loky",
@@ -810,8 +918,13 @@ def assemble(cfg: SweepConfig, chunks: Sequence[ChunkResult]) -> dict[str, np.nd
     # (about 1 in 1,600 references of svm-paper did): clip them.
     J["J_lo"] = np.minimum(J["J_lo"], J["J"])
     J["J_hi"] = np.maximum(J["J_hi"], J["J"])
+    # The ideal arrays only where every chunk had a closed-form ideal observer: a partial array
+    # would mix "unknown" with the NaN that means "no distinguishable partner in the grid".
+    with_ideal = not np.any(J["J_ideal"] == IDEAL_UNKNOWN)
     out: dict[str, np.ndarray] = {}
     for tag, name in (("", "J"), ("_lo", "J_lo"), ("_hi", "J_hi"), ("_ideal", "J_ideal")):
+        if name == "J_ideal" and not with_ideal:
+            continue
         up = np.empty(shape + (n,))
         down = np.empty(shape + (n,))
         for key in np.ndindex(*shape):
@@ -820,8 +933,8 @@ def assemble(cfg: SweepConfig, chunks: Sequence[ChunkResult]) -> dict[str, np.nd
         out[f"delta_down{tag}"] = down
     if cfg.fidelity == "ideal":
         for tag in ("_lo", "_hi", "_ideal"):  # identical to delta: leave them out
-            out.pop(f"delta_up{tag}")
-            out.pop(f"delta_down{tag}")
+            out.pop(f"delta_up{tag}", None)
+            out.pop(f"delta_down{tag}", None)
     out["fits"] = fits
     out["chunk_wall_s"] = wall
     if f1 is not None:

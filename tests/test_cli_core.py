@@ -88,3 +88,60 @@ def test_console_script_end_to_end(tmp_path):
     assert json.loads(ok.stdout)["svm_f1"] >= 0.9
     bad = subprocess.run([exe, "f1", "--e1", "-1", "--e2", "3"], capture_output=True, text=True, timeout=60)
     assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and "Traceback" not in bad.stderr
+
+
+# ------------------------------------------------------------------ forward models
+def test_simulate_with_a_contact_model_lags_by_the_models_own_response(cli, paper_sensor):
+    from designkit.models import Contact, SemiInfinite
+
+    args = ("simulate", "--e", 20000, "--contact", 2, "--noise", 0, "--sensor-temp", 35, "--ambient", 25, "--json")
+    semi = json.loads(cli(*args).stdout)
+    r = cli(*args, "--model", "contact", "--conductance", 800)
+    assert r.exit_code == 0, r.output
+    lag = json.loads(r.stdout)
+    assert lag["model"] == {"name": "contact", "conductance_w_m2k": 800.0} and semi["model"] == {"name": "semi-infinite"}
+    t = np.array(lag["time_s"])
+    u_contact = Contact(800.0).response(t, [20000.0], paper_sensor)[0]
+    u_semi = SemiInfinite().response(t, [20000.0], paper_sensor)[0]
+    got = np.array(lag["temperature_c"][0]) - np.array(semi["temperature_c"][0])
+    np.testing.assert_allclose(got, (25 - 35) * (u_contact - u_semi), rtol=0, atol=1e-12)
+    assert got[-1] > 0.01  # the sensor cools more slowly through the imperfect contact
+    assert lag["contact_temperature_c"] is None and semi["contact_temperature_c"] is not None
+    text = cli(*args[:-1], "--conductance", 800)
+    assert text.exit_code == 0 and "model contact (conductance_w_m2k = 800 W m^-2 K^-1)" in text.stdout
+
+
+def test_simulate_semi_infinite_readings_are_simulate_trials_readings(cli, paper_sensor):
+    from designkit import Scene
+    from designkit.simulation import simulate_trials
+
+    p = json.loads(cli("simulate", "--e", 3000, "--contact", 1, "--trials", 2, "--seed", 4, "--json").stdout)
+    ref = simulate_trials(3000, paper_sensor, Scene(contact_s=1, noise_c=0.05), n_trials=2, seed=4)
+    np.testing.assert_array_equal(np.array(p["temperature_c"]), ref.temperature_c)
+
+
+def test_f1_with_a_slab_model(cli):
+    r = cli("f1", "--e1", 600, "--e2", 1400, "--contact", 2, "--trials", 30, "--model", "slab", "--thickness", 0.003,
+            "--diffusivity", 1e-7, "--json")
+    assert r.exit_code == 0, r.output
+    p = json.loads(r.stdout)
+    assert p["model"]["name"] == "slab" and p["model"]["thickness_m"] == 0.003 and p["diffusivity_m2_s"] == 1e-7
+    assert 0 <= p["svm_f1"] <= 1 and p["ideal_f1"] >= 2 / 3
+    text = cli("f1", "--e1", 600, "--e2", 1400, "--trials", 30, "--thickness", 0.003, "--diffusivity", 1e-7)
+    assert text.exit_code == 0 and "model slab (3 mm on" in text.stdout
+
+
+@pytest.mark.parametrize("args,needle", [
+    (["f1", "--e1", "600", "--e2", "1400", "--thickness", "0.003"], "diffusivity"),
+    (["f1", "--e1", "600", "--e2", "1400", "--diffusivity", "1e-7"], "not the semi-infinite model"),
+    (["f1", "--e1", "600", "--e2", "1400", "--model", "contcat"], "unknown forward model"),
+    (["f1", "--e1", "600", "--e2", "1400", "--conductance", "-3"], "conductance"),
+    (["simulate", "--e", "600", "--model", "slab", "--thickness", "0.003"], "diffusivity"),
+    (["simulate", "--e", "600", "--thickness", "0.003", "--conductance", "100"], "different models"),
+    (["simulate", "--e", "600", "--diffusivity", "1e-7"], "not the semi-infinite model"),
+])
+def test_bad_model_options_are_one_line_and_exit_2(cli, args, needle):
+    r = cli(*args)
+    assert r.exit_code == 2, r.output
+    err = r.stderr.strip()
+    assert len(err.splitlines()) == 1 and err.startswith("Error:") and needle in err, err

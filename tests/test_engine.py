@@ -210,3 +210,61 @@ def test_bounded_feature_cache_changes_no_result(monkeypatch):
         np.testing.assert_array_equal(getattr(small, name), getattr(full, name), err_msg=name)
     np.testing.assert_array_equal(small.cells, full.cells)
     assert small.fits == full.fits
+
+
+# ------------------------------------------------------------------ the forward model of a sweep
+def test_config_model_from_name_mapping_or_model_and_in_the_identity(tmp_path):
+    from designkit.models import get_model
+
+    contact = {"name": "contact", "conductance_w_m2k": 2000.0}
+    by_map = SweepConfig(model=contact)
+    assert SweepConfig(model=get_model(contact)) == by_map == SweepConfig(model="contact")
+    assert by_map.to_dict()["model"] == contact
+    assert SweepConfig.from_mapping(by_map.to_dict()) == by_map  # round trip through a header's config
+    default = SweepConfig()
+    assert default.model.name == "semi-infinite" and default.to_dict()["model"] == {"name": "semi-infinite"}
+    # a config recorded before the seam (no model key) is the semi-infinite sweep, with the same digest,
+    # so its working folder still resumes; another model is another sweep
+    old = {k: v for k, v in default.to_dict().items() if k not in ("model", "diffusivity_m2_s")}
+    assert SweepConfig.from_mapping(old).digest() == default.digest() == SweepConfig(model="semi-infinite").digest()
+    assert by_map.digest() != default.digest() != SweepConfig(model={**contact, "conductance_w_m2k": 3000}).digest()
+    slab = SweepConfig(model={"name": "slab", "thickness_m": 0.003}, diffusivity_m2_s=1e-7)
+    assert slab.digest() != SweepConfig(model=slab.model, diffusivity_m2_s=2e-7).digest()
+    p = tmp_path / "m.yaml"
+    p.write_text("model: {name: contact, conductance_w_m2k: 1500}\n")
+    assert SweepConfig.from_yaml(p).model == get_model("contact", conductance_w_m2k=1500)
+    assert SweepConfig.from_yaml(p, model="semi-infinite").model.name == "semi-infinite"  # overrides win
+    p.write_text("model: {name: contact, bogus: 1}\n")
+    with pytest.raises(InputError, match=r"m\.yaml: model: model 'contact' has no parameter bogus"):
+        SweepConfig.from_yaml(p)
+
+
+@pytest.mark.parametrize("kwargs,match", [
+    ({"model": "nope"}, "model: unknown forward model"),
+    ({"model": {"conductance_w_m2k": 5}}, "model: a model needs a name"),
+    ({"model": "slab"}, "needs the objects' diffusivity"),
+    ({"model": "slab", "diffusivity_m2_s": -1.0}, "diffusivity_m2_s"),
+    ({"diffusivity_m2_s": 1e-7}, "does not use the objects' diffusivity"),
+    ({"model": "contact", "fidelity": "ideal"}, "fidelity ideal needs the closed-form ideal observer"),
+])
+def test_config_rejects_bad_models(kwargs, match):
+    with pytest.raises(InputError, match=match) as err:
+        SweepConfig(**kwargs)
+    assert "\n" not in str(err.value)
+
+
+def test_the_ideal_floor_only_where_a_closed_form_holds(paper_sensor):
+    from designkit.sweep.engine import IDEAL_UNKNOWN, closed_form_model
+
+    kw = dict(intervals=10, trials=12, noise_ratio=(0.005,), contact_s=(1.5,), max_repeats=1, seed=1)
+    scene = SweepConfig(**kw).scene((0,), 1.5)
+    assert closed_form_model(SweepConfig(**kw), paper_sensor, scene).name == "semi-infinite"
+    assert closed_form_model(SweepConfig(model={"name": "contact", "conductance_w_m2k": 1e12}, **kw),
+                             paper_sensor, scene).name == "semi-infinite"  # a contact too good to lag
+    lagging = SweepConfig(model={"name": "contact", "conductance_w_m2k": 2000}, **kw)
+    assert closed_form_model(lagging, paper_sensor, scene) is None
+    res = run_chunk(lagging, (0,), 0, 0)
+    assert np.all(res.J_ideal == IDEAL_UNKNOWN) and res.fits > 0
+    assert np.all(res.J_lo <= res.J) and np.all(res.J <= res.J_hi)
+    out = assemble(lagging, [res])
+    assert "delta_up_ideal" not in out and "delta_down_ideal" not in out and "delta_up" in out

@@ -177,3 +177,83 @@ def test_the_same_sweep_on_a_dask_local_cluster_gives_the_same_table(reference, 
     _same_table(out, ref)
     header = json.loads(out.with_suffix(".json").read_text())
     assert header["stats"]["run"]["backend"] == "dask"
+
+
+# ------------------------------------------------------------------ forward models through the sweep
+# One scene, one contact, 10 intervals: a second or two per sweep, in-process.
+MODEL_CONFIG = """\
+name: {name}
+sensor: paper
+fidelity: svm
+effusivity: {{min: 0, max: 40000, intervals: 10}}
+trials: 12
+folds: 3
+seed: 1
+max_repeats: 1
+noise_ratio: [0.005]
+contact_s: [1.5]
+{extra}"""
+
+
+def _model_sweep(cli, tmp_path: Path, name: str, extra: str = "", *options: str):
+    cfg = tmp_path / f"{name}.yaml"
+    cfg.write_text(MODEL_CONFIG.format(name=name, extra=extra))
+    r = cli("sweep", "--config", cfg, "--workdir", tmp_path / f"work-{name}", "--out", tmp_path / f"{name}.npz",
+            "--jobs", "1", "--json", *options)
+    return r, tmp_path / f"{name}.npz"
+
+
+def test_a_contact_model_sweep_end_to_end(cli, tmp_path):
+    r, path = _model_sweep(cli, tmp_path, "small", "model: {name: contact, conductance_w_m2k: 2000}\n")
+    assert r.exit_code == 0, r.output
+    summary = json.loads(r.stdout)
+    assert summary["model"] == {"name": "contact", "conductance_w_m2k": 2000.0}
+    t = load_table(path)
+    assert t.header["model"] == {"name": "contact", "conductance_w_m2k": 2000.0}
+    assert t.header["config"]["model"] == t.header["model"] and t.model.name == "contact"
+    # no closed-form ideal observer for a lagging contact: no floor, and no ideal arrays in the table
+    assert "delta_up_ideal" not in t.arrays and np.all(t.arrays["fits"] > 0)
+    assert np.isfinite(t.arrays["delta_up"]).any()
+    shown = cli("tables", "show", str(path))
+    assert shown.exit_code == 0 and "model contact (conductance_w_m2k = 2000 W m^-2 K^-1)" in shown.stdout
+    assert json.loads(cli("tables", "show", str(path), "--json").stdout)["model"]["name"] == "contact"
+
+
+def test_a_near_perfect_contact_gives_the_semi_infinite_table(cli, tmp_path):
+    """h_c -> inf is the paper's model: with the same seeds the readings differ by < 1e-9 degC, so every
+    SVM decision, hence every array, is the semi-infinite sweep's (the model option overrides the file)."""
+    r_semi, semi = _model_sweep(cli, tmp_path, "semi")
+    r_contact, contact = _model_sweep(cli, tmp_path, "contact", "", "--conductance", "1e12")
+    assert r_semi.exit_code == 0 and r_contact.exit_code == 0, (r_semi.output, r_contact.output)
+    assert load_table(semi).model.name == "semi-infinite"
+    assert load_table(contact).header["model"] == {"name": "contact", "conductance_w_m2k": 1e12}
+    _same_table(contact, semi)
+
+
+def test_a_changed_model_is_refused_on_resume_and_bad_models_are_one_line(cli, tmp_path):
+    r, _ = _model_sweep(cli, tmp_path, "m", "model: contact\n")
+    assert r.exit_code == 0, r.output
+    again, _ = _model_sweep(cli, tmp_path, "m", "model: contact\n", "--resume", "--conductance", "3000")
+    assert again.exit_code == 2 and "model changed" in again.stderr
+    cases = [
+        ("model: contcat\n", (), "model: unknown forward model 'contcat'"),
+        ("model: {name: contact, conductance_w_m2k: -5}\n", (), "model: interface conductance"),
+        ("model: slab\n", (), "needs the objects' diffusivity"),
+        ("", ("--thickness", "0.003"), "needs the objects' diffusivity"),
+        ("diffusivity_m2_s: 1.0e-7\n", (), "does not use the objects' diffusivity"),
+        ("model: contact\nfidelity: ideal\n", (), "fidelity ideal needs the closed-form"),
+    ]
+    for k, (extra, options, needle) in enumerate(cases):
+        bad, _ = _model_sweep(cli, tmp_path, f"bad{k}", extra, *options)
+        err = bad.stderr.strip()
+        assert bad.exit_code == 2 and len(err.splitlines()) == 1 and needle in err, (extra, options, err)
+        if not options:
+            assert f"bad{k}.yaml" in err  # the file is named
+
+
+def test_a_slab_sweep_takes_one_diffusivity_for_every_interval(cli, tmp_path):
+    r, path = _model_sweep(cli, tmp_path, "slab", "", "--thickness", "0.0005", "--diffusivity", "1e-7")
+    assert r.exit_code == 0, r.output
+    t = load_table(path)
+    assert t.model.name == "slab" and t.header["model"]["thickness_m"] == 0.0005
+    assert t.header["config"]["diffusivity_m2_s"] == 1e-7

@@ -134,3 +134,26 @@ def test_shipped_svm_table_reproduces_the_papers_guideline():
     lo, hi = ans.interval
     assert lo <= ans.value and (hi is None or ans.value <= hi)
     assert ans.ideal is not None and ans.ideal <= ans.value
+
+
+def test_the_header_records_the_model_and_tables_show_prints_it(tmp_path, cli):
+    cfg = SweepConfig(name="c", intervals=4, noise_ratio=(0.005,), contact_s=(1.0,),
+                      model={"name": "contact", "conductance_w_m2k": 1500})
+    arrays = {"delta_up": np.full((1, 1, 4), 80.0), "delta_down": np.full((1, 1, 4), 80.0)}
+    path = write_table(tmp_path / "c.npz", table_header(cfg, arrays), arrays)
+    t = load_table(path)
+    assert t.header["model"] == t.header["config"]["model"] == {"name": "contact", "conductance_w_m2k": 1500.0}
+    assert t.model == cfg.model and SweepConfig.from_mapping(t.header["config"]) == cfg
+    r = cli("tables", "show", str(path))
+    assert r.exit_code == 0 and "model contact (conductance_w_m2k = 1500 W m^-2 K^-1)" in r.stdout
+    assert json.loads(cli("tables", "show", str(path), "--json").stdout)["model"]["conductance_w_m2k"] == 1500
+    rows = json.loads(cli("tables", "list", "--folder", str(tmp_path), "--json").stdout)
+    assert [row["model"]["name"] for row in rows] == ["contact"]
+
+
+def test_tables_from_before_the_seam_are_semi_infinite(cli):
+    t = load_table("svm-paper")
+    assert "model" not in t.header["config"]  # built before the header recorded a model
+    assert t.model.name == "semi-infinite" and SweepConfig.from_mapping(t.header["config"]).model.name == "semi-infinite"
+    r = cli("tables", "show", "svm-paper")
+    assert r.exit_code == 0 and "model semi-infinite" in r.stdout

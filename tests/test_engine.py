@@ -8,12 +8,12 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from designkit import InputError
-from designkit.sweep.engine import (
+from designkit.sweep import (
     ChunkResult,
     SweepConfig,
     assemble,
-    _ideal_staircase,
     delta_from_staircase,
+    ideal_staircase,
     run_chunk,
     run_scene,
     staircase_search,
@@ -78,7 +78,7 @@ def test_ideal_staircase_equals_the_full_closed_form_matrix(paper_sensor):
     M = np.zeros((n, n), bool)
     M[ii, jj] = f1 >= cfg.threshold
     brute = np.array([next((j for j in range(i + 1, n) if M[i, j]), n) for i in range(n)])
-    np.testing.assert_array_equal(_ideal_staircase(cfg, paper_sensor, s, np.arange(n)), brute)
+    np.testing.assert_array_equal(ideal_staircase(cfg, paper_sensor, s, np.arange(n)), brute)
 
 
 @pytest.mark.slow
@@ -200,11 +200,11 @@ def test_delta_from_staircase_matches_its_definition(raw, width):
 def test_bounded_feature_cache_changes_no_result(monkeypatch):
     """A chunk's feature cache is bounded (a worker's memory whatever the grid); features are a
     function of (interval, seed), so a cache that must evict and regenerate gives the same table."""
-    import designkit.sweep.engine as engine
+    import designkit.sweep.scorer as scorer
 
     cfg = SweepConfig(intervals=24, trials=30, noise_ratio=(0.005,), contact_s=(1.0,), max_repeats=2, seed=5)
     full = run_chunk(cfg, (0,), 0, 0)
-    monkeypatch.setattr(engine, "FEATURE_CACHE_MB", 0)  # the floor: 8 entries for 24 intervals x 2 seeds
+    monkeypatch.setattr(scorer, "FEATURE_CACHE_MB", 0)  # the floor: 8 entries for 24 intervals x 2 seeds
     small = run_chunk(cfg, (0,), 0, 0)
     for name in ("J", "J_lo", "J_hi", "J_ideal"):
         np.testing.assert_array_equal(getattr(small, name), getattr(full, name), err_msg=name)
@@ -254,7 +254,8 @@ def test_config_rejects_bad_models(kwargs, match):
 
 
 def test_the_ideal_floor_only_where_a_closed_form_holds(paper_sensor):
-    from designkit.sweep.engine import IDEAL_UNKNOWN, closed_form_model
+    from designkit.sweep import closed_form_model
+    from designkit.sweep.search import IDEAL_UNKNOWN
 
     kw = dict(intervals=10, trials=12, noise_ratio=(0.005,), contact_s=(1.5,), max_repeats=1, seed=1)
     scene = SweepConfig(**kw).scene((0,), 1.5)
@@ -268,3 +269,16 @@ def test_the_ideal_floor_only_where_a_closed_form_holds(paper_sensor):
     assert np.all(res.J_lo <= res.J) and np.all(res.J <= res.J_hi)
     out = assemble(lagging, [res])
     assert "delta_up_ideal" not in out and "delta_down_ideal" not in out and "delta_up" in out
+
+
+def test_the_package_exports_the_engine_and_the_old_module_still_imports():
+    import importlib
+
+    import designkit.sweep as sweep
+    import designkit.sweep.engine as engine
+
+    for name in sweep.__all__:
+        assert getattr(sweep, name) is getattr(engine, name)
+    for mod in ("config", "scorer", "search", "chunk", "run"):
+        m = importlib.import_module(f"designkit.sweep.{mod}")
+        assert m.__all__ and all(hasattr(m, name) for name in m.__all__), mod

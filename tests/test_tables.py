@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from designkit import InputError
-from designkit.sweep.engine import SweepConfig
+from designkit.sweep import SweepConfig
 from designkit.query import table as q
 from designkit.tables.store import SCHEMA_VERSION, content_hash, list_tables, load_table, table_header, write_table
 

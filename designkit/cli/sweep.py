@@ -71,7 +71,7 @@ def sweep(
     """
     import time
 
-    from ..sweep.engine import SweepConfig, SweepInterrupted, run_sweep
+    from ..sweep import SweepConfig, SweepInterrupted, run_sweep
 
     fm = None
     if any(v is not None for v in (model, conductance, thickness, backing)):

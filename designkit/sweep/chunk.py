@@ -1,0 +1,209 @@
+"""One chunk of a sweep: the staircases of one (scene point, block of references, contact time).
+
+A chunk is the unit of parallelism and of resumable state. It finds the
+ideal observer's staircase where the forward model allows a closed form (the
+floor of the SVM search), then walks three staircases on one cache of SVM
+scores: ``mean >= Phi`` gives delta, ``mean + z se >= Phi`` its lower end and
+``mean - z se >= Phi`` its upper end. The previous (shorter) contact time's
+staircase is the first guess for this one.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Callable, Mapping, Sequence
+
+import numpy as np
+
+from ..scene import Scene
+from ..sensor import Sensor
+from .config import SweepConfig
+from .scorer import PairCell, PairScorer
+from .search import IDEAL_UNKNOWN, closed_form_model, ideal_bound_s, ideal_staircase, staircase_search
+
+__all__ = ["ChunkResult", "run_chunk", "run_scene"]
+
+
+@dataclass(frozen=True)
+class ChunkResult:
+    """Staircases of one (scene point, block, contact) chunk.
+
+    Attributes
+    ----------
+    point : tuple of int
+        Index on the scene axes (:attr:`SweepConfig.scene_axes`).
+    block : int
+        Block of references (:meth:`SweepConfig.blocks_of`).
+    contact_index : int
+        Index in :attr:`SweepConfig.contact_s`.
+    rows : ndarray of int
+        The block's reference intervals.
+    J, J_lo, J_hi : ndarray of int
+        First distinguishable partner of each row, and its Monte Carlo interval
+        (``intervals`` where none is in the grid).
+    J_ideal : ndarray of int
+        The ideal observer's ``J`` (:data:`~designkit.sweep.search.IDEAL_UNKNOWN`
+        where the model has no closed form here).
+    fits : int
+        SVM fits made (repeats included).
+    cells : ndarray, shape (k, 5)
+        Every scored pair: ``i, j``, mean F1, standard error, repeats.
+    wall_s : float
+        Compute time [s].
+    f1_rows : ndarray, optional
+        Full-matrix mode: F1 of ``(row, j)`` for every ``j``.
+    """
+
+    point: tuple[int, ...]
+    block: int
+    contact_index: int
+    rows: np.ndarray
+    J: np.ndarray
+    J_lo: np.ndarray
+    J_hi: np.ndarray
+    J_ideal: np.ndarray
+    fits: int
+    cells: np.ndarray
+    wall_s: float
+    f1_rows: np.ndarray | None = None
+
+    def to_arrays(self) -> dict[str, np.ndarray]:
+        out = {
+            "point": np.asarray(self.point, dtype=np.int64),
+            "block": np.asarray(self.block),
+            "contact_index": np.asarray(self.contact_index),
+            "rows": self.rows, "J": self.J, "J_lo": self.J_lo, "J_hi": self.J_hi,
+            "J_ideal": self.J_ideal, "fits": np.asarray(self.fits), "cells": self.cells,
+            "wall_s": np.asarray(self.wall_s),
+        }
+        if self.f1_rows is not None:
+            out["f1_rows"] = self.f1_rows
+        return out
+
+    @classmethod
+    def from_arrays(cls, a: Mapping[str, np.ndarray]) -> "ChunkResult":
+        return cls(point=tuple(int(x) for x in a["point"]), block=int(a["block"]),
+                   contact_index=int(a["contact_index"]), rows=a["rows"], J=a["J"], J_lo=a["J_lo"],
+                   J_hi=a["J_hi"], J_ideal=a["J_ideal"], fits=int(a["fits"]), cells=a["cells"],
+                   wall_s=float(a["wall_s"]), f1_rows=a["f1_rows"] if "f1_rows" in a else None)
+
+
+def run_chunk(cfg: SweepConfig, point: tuple[int, ...], block: int, contact_index: int,
+              hint_J: np.ndarray | None = None, hint_J_hi: np.ndarray | None = None) -> ChunkResult:
+    """Compute one chunk (a picklable top-level function for joblib/dask workers).
+
+    A chunk is the unit of parallelism: everything inside it runs sequentially in its
+    worker. (On a dask worker joblib's active backend is dask, and scikit-learn's own
+    joblib calls, such as the folds of cross-validation, would otherwise be sent back to
+    the cluster one by one: measured 5x slower per chunk.)
+    """
+    from joblib import parallel_config
+
+    with parallel_config(backend="sequential"):
+        return _run_chunk(cfg, point, block, contact_index, hint_J, hint_J_hi)
+
+
+def _run_chunk(cfg: SweepConfig, point, block: int, contact_index: int, hint_J, hint_J_hi) -> ChunkResult:
+    t0 = time.perf_counter()
+    sensor = cfg.resolved_sensor()
+    scene = cfg.scene(point, cfg.contact_s[contact_index])
+    rows = cfg.blocks_of()[block]
+    floor = None  # the ideal observer's staircase, a lower bound of every J, where it has a closed form
+    if closed_form_model(cfg, sensor, scene) is not None:
+        J_ideal = ideal_staircase(cfg, sensor, ideal_bound_s(cfg, sensor, scene), rows)
+        floor = np.zeros(cfg.intervals, dtype=np.int64)
+        floor[rows] = J_ideal
+    else:
+        J_ideal = np.full(rows.size, IDEAL_UNKNOWN, dtype=np.int64)
+
+    if cfg.fidelity == "ideal":
+        J = _ideal_mc_staircase(cfg, sensor, scene, rows, floor, hint_J) if cfg.varied else J_ideal
+        return ChunkResult(point, block, contact_index, rows, J, J.copy(), J.copy(), J_ideal, 0,
+                           np.zeros((0, 5)), time.perf_counter() - t0)
+
+    scorer = PairScorer(cfg, sensor, scene)
+    f1_rows = None
+    if cfg.full_matrix:
+        f1_rows, (J, J_lo, J_hi) = _full_matrix(cfg, scorer, rows)
+    else:
+        J, J_lo, J_hi = _svm_staircases(cfg, scorer, rows, floor if cfg.ideal_bound else None, hint_J, hint_J_hi)
+    cells = np.array([(i, j, c.mean, c.stderr, c.reps) for (i, j), c in sorted(scorer.cells.items())],
+                     dtype=np.float64).reshape(-1, 5)
+    return ChunkResult(point, block, contact_index, rows, J, J_lo, J_hi, J_ideal, scorer.fits,
+                       cells, time.perf_counter() - t0, f1_rows)
+
+
+def _svm_staircases(cfg: SweepConfig, scorer: PairScorer, rows, floor, hint_J, hint_J_hi):
+    """``J``, ``J_lo``, ``J_hi`` of the SVM by staircase search on one cache of scores."""
+    n, phi, z = cfg.intervals, cfg.threshold, cfg.z
+    J = staircase_search(lambda i, j: scorer.cell(i, j).mean >= phi, rows, n, floor=floor,
+                         hint=_full(hint_J, rows, n))
+    J_full = _full(J, rows, n)
+    J_lo = staircase_search(lambda i, j: scorer.cell(i, j).mean + z * scorer.cell(i, j).stderr >= phi,
+                            rows, n, floor=floor, hint=J_full)
+    J_hi = staircase_search(lambda i, j: scorer.cell(i, j).mean - z * scorer.cell(i, j).stderr >= phi,
+                            rows, n, floor=J_full, hint=_full(hint_J_hi, rows, n))
+    return J, J_lo, J_hi
+
+
+def _full_matrix(cfg: SweepConfig, scorer: PairScorer, rows):
+    """Score every pair above each row; ``(f1_rows, (J, J_lo, J_hi))`` without assuming monotonicity."""
+    n, phi, z = cfg.intervals, cfg.threshold, cfg.z
+    f1_rows = np.full((rows.size, n), np.nan, dtype=np.float32)
+    for r, i in enumerate(rows):
+        for j in range(i + 1, n):
+            f1_rows[r, j] = scorer.cell(i, j).mean  # same repeat rule as the search
+    staircases = tuple(_first_crossing(scorer, rows, n, lambda c, k=k: c.mean + k * c.stderr >= phi)
+                       for k in (0.0, z, -z))
+    return f1_rows, staircases
+
+
+def _full(J_rows: np.ndarray | None, rows: np.ndarray, n: int) -> np.ndarray | None:
+    if J_rows is None:
+        return None
+    out = np.full(n, n, dtype=np.int64)
+    out[rows] = J_rows
+    return out
+
+
+def _first_crossing(scorer: PairScorer, rows, n, ok: Callable[[PairCell], bool]) -> np.ndarray:
+    """Full-matrix rule: the first partner above i whose score passes, no monotonicity assumed."""
+    out = np.full(len(rows), n, dtype=np.int64)
+    for r, i in enumerate(rows):
+        for j in range(i + 1, n):
+            if ok(scorer.cells[(i, j)]):
+                out[r] = j
+                break
+    return out
+
+
+def _ideal_mc_staircase(cfg: SweepConfig, sensor: Sensor, scene: Scene, rows, floor, hint) -> np.ndarray:
+    """Ideal observer with varied initial conditions: Monte Carlo F1 per pair on the staircase."""
+    from ..recognition.ideal import ideal_pair
+
+    edges = cfg.edges
+    cache: dict[tuple[int, int], float] = {}
+
+    def decide(i, j):
+        if (i, j) not in cache:
+            r = ideal_pair((edges[i], edges[i + 1]), (edges[j], edges[j + 1]), sensor, scene,
+                           n_mc=max(200, cfg.trials * 5), seed=[cfg.seed, i, j], model=cfg.model)
+            cache[(i, j)] = r.f1
+        return cache[(i, j)] >= cfg.threshold
+
+    return staircase_search(decide, rows, cfg.intervals, floor=floor, hint=_full(hint, rows, cfg.intervals))
+
+
+def run_scene(cfg: SweepConfig, point: tuple[int, ...] = (0,), *,
+              contact_indices: Sequence[int] | None = None) -> list[ChunkResult]:
+    """All blocks and contact times of one scene point, in-process (library convenience)."""
+    out = []
+    prev: dict[int, ChunkResult] = {}
+    for k in (range(len(cfg.contact_s)) if contact_indices is None else contact_indices):
+        for b in range(len(cfg.blocks_of())):
+            p = prev.get(b)
+            res = run_chunk(cfg, tuple(point), b, k, None if p is None else p.J, None if p is None else p.J_hi)
+            prev[b] = res
+            out.append(res)
+    return out

@@ -1,0 +1,198 @@
+"""Running a whole sweep: chunks in parallel (joblib processes or a dask cluster), resumable.
+
+Work is cut into chunks, one per (scene point, block of references, contact
+time), run through joblib (local processes, or a dask cluster) and written
+atomically as they finish; an interrupted sweep resumes without recomputing
+finished chunks and gives bit-identical results. A working folder records its
+sweep's :meth:`~designkit.sweep.config.SweepConfig.digest`: resuming it with
+a config that would change the results (another seed, another forward model)
+is refused, naming what changed.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Callable, Iterator
+
+import numpy as np
+
+from .._validation import InputError
+from .chunk import ChunkResult, run_chunk
+from .config import SweepConfig
+from .search import assemble
+
+__all__ = ["BACKENDS", "SweepInterrupted", "iter_sweep", "prepare_workdir", "run_sweep"]
+
+#: Where chunks run: local processes, this process, or a dask cluster.
+BACKENDS = ("loky", "sequential", "dask")
+
+
+class SweepInterrupted(Exception):
+    """Raised when a sweep is interrupted; finished chunks are on disk."""
+
+    def __init__(self, done: int, total: int, workdir: Path):
+        super().__init__(f"interrupted: {done} of {total} chunks saved in {workdir}; "
+                         f"run the same command with --resume to continue")
+        self.done, self.total, self.workdir = done, total, workdir
+
+
+def _chunk_path(workdir: Path, point, block, k) -> Path:
+    p = "-".join(f"{x:03d}" for x in point)
+    return workdir / "chunks" / f"p{p}-b{block:03d}-c{k:03d}.npz"
+
+
+def _save_chunk(path: Path, res: ChunkResult) -> None:
+    import io
+
+    from .._io import atomic_write_bytes
+
+    buf = io.BytesIO()
+    np.savez(buf, **res.to_arrays())
+    atomic_write_bytes(path, buf.getvalue())
+
+
+def _load_chunk(path: Path) -> ChunkResult:
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            return ChunkResult.from_arrays({k: z[k] for k in z.files})
+    except Exception as exc:  # a damaged chunk is recomputed, never trusted
+        raise InputError(f"chunk {path.name} is unreadable ({exc}); delete it and resume") from None
+
+
+def prepare_workdir(cfg: SweepConfig, workdir: Path, *, resume: bool, fresh: bool) -> None:
+    """Create or check a sweep's working folder (its config and chunks)."""
+    from .._io import atomic_write_text
+
+    workdir = Path(workdir)
+    meta = workdir / "sweep.json"
+    chunks = workdir / "chunks"
+    if meta.exists() and not fresh:
+        try:
+            old = json.loads(meta.read_text())
+        except (OSError, ValueError):
+            raise InputError(f"{meta} is unreadable; use --fresh to start over") from None
+        if old.get("digest") != cfg.digest():
+            changed = cfg.changes_from(old.get("config")) or ["sensor file"]
+            raise InputError(f"{workdir} holds a different sweep ({', '.join(changed)} changed); "
+                             "use another --workdir or --fresh")
+        if not resume and any(chunks.glob("*.npz")):
+            raise InputError(f"{workdir} already has finished chunks; use --resume to continue or --fresh to discard them")
+    if fresh and chunks.exists():
+        for f in chunks.glob("*.npz"):
+            f.unlink()
+    chunks.mkdir(parents=True, exist_ok=True)
+    atomic_write_text(meta, json.dumps({"digest": cfg.digest(), "config": cfg.to_dict()}, indent=2))
+
+
+def iter_sweep(cfg: SweepConfig, workdir: Path, *, jobs: int = 1, backend: str = "loky",
+               scheduler: str | None = None) -> Iterator[tuple[ChunkResult, bool]]:
+    """Run the missing chunks, wave by wave (one wave per contact time).
+
+    Yields ``(chunk, computed)`` for every chunk of the sweep, reading the
+    finished ones from ``workdir`` and computing the rest in parallel; each
+    computed chunk is written atomically before it is yielded. A chunk's first
+    guess is the same (scene point, block)'s staircase at the previous contact.
+    """
+    from joblib import Parallel, delayed
+
+    workdir = Path(workdir)
+    blocks = range(len(cfg.blocks_of()))
+    points = cfg.scene_points()
+    prev: dict[tuple, ChunkResult] = {}
+    with _executor(backend, jobs, scheduler) as (ctx, n_jobs):
+        for k in range(len(cfg.contact_s)):
+            todo = []
+            for p in points:
+                for b in blocks:
+                    path = _chunk_path(workdir, p, b, k)
+                    if path.exists():
+                        res = _load_chunk(path)
+                        prev[(p, b)] = res
+                        yield res, False
+                    else:
+                        todo.append((p, b))
+            if not todo:
+                continue
+            calls = []
+            for p, b in todo:
+                h = prev.get((p, b))
+                calls.append(delayed(run_chunk)(cfg, p, b, k, None if h is None else h.J,
+                                                None if h is None else h.J_hi))
+            with ctx():
+                for res in Parallel(n_jobs=n_jobs, return_as="generator_unordered")(calls):
+                    _save_chunk(_chunk_path(workdir, res.point, res.block, res.contact_index), res)
+                    prev[(res.point, res.block)] = res
+                    yield res, True
+
+
+@contextmanager
+def _executor(backend: str, jobs: int, scheduler: str | None):
+    """``(joblib context factory, n_jobs)`` for a backend; a dask client lives as long as the sweep."""
+    from joblib import parallel_config
+
+    if backend not in BACKENDS:
+        raise InputError(f"backend must be loky, sequential or dask, got {backend!r}")
+    if backend != "dask":
+        local = "loky" if backend == "loky" and jobs != 1 else "sequential"
+        yield (lambda: parallel_config(backend=local)), jobs
+        return
+    try:
+        from dask.distributed import Client
+    except ImportError:
+        raise InputError("the dask backend needs dask.distributed: pip install 'designkit[distributed]'") from None
+    client = Client(scheduler) if scheduler else Client(processes=True, n_workers=max(jobs, 1), threads_per_worker=1)
+    try:
+        yield (lambda: parallel_config(backend="dask")), -1
+    finally:
+        client.close()
+
+
+def run_sweep(cfg: SweepConfig, workdir: str | Path, *, out: str | Path | None = None, jobs: int = 1,
+              backend: str = "loky", scheduler: str | None = None, resume: bool = False,
+              fresh: bool = False, on_chunk: Callable[[ChunkResult, bool, int, int], None] | None = None) -> Path:
+    """Run (or resume) a sweep and write its table; returns the table's path.
+
+    Parameters
+    ----------
+    cfg : SweepConfig
+    workdir : path
+        Folder for the sweep's chunks (resumable state).
+    out : path, optional
+        Table path (``.npz``; a ``.json`` header is written beside it).
+        Default: ``workdir / f"{cfg.name}.npz"``.
+    jobs : int
+        Local worker processes (``-1``: all cores).
+    backend : {"loky", "sequential", "dask"}
+    scheduler : str, optional
+        Address of a dask scheduler (with ``backend="dask"``).
+    resume, fresh : bool
+        Continue a previous run in ``workdir`` / discard its chunks.
+    on_chunk : callable, optional
+        Called as ``on_chunk(chunk, computed, done, total)`` after each chunk
+        (progress display).
+    """
+    from ..tables.store import table_header, write_table
+
+    workdir = Path(workdir)
+    prepare_workdir(cfg, workdir, resume=resume, fresh=fresh)
+    total = len(cfg.scene_points()) * len(cfg.blocks_of()) * len(cfg.contact_s)
+    chunks: list[ChunkResult] = []
+    t0 = time.perf_counter()
+    computed = 0
+    try:
+        for res, was_computed in iter_sweep(cfg, workdir, jobs=jobs, backend=backend, scheduler=scheduler):
+            chunks.append(res)
+            computed += was_computed
+            if on_chunk is not None:
+                on_chunk(res, was_computed, len(chunks), total)
+    except KeyboardInterrupt:
+        raise SweepInterrupted(len(list((workdir / "chunks").glob("*.npz"))), total, workdir) from None
+    arrays = assemble(cfg, chunks)
+    elapsed = time.perf_counter() - t0
+    header = table_header(cfg, arrays, run={"elapsed_s": elapsed, "chunks_computed": computed,
+                                            "chunks_total": total, "jobs": jobs, "backend": backend})
+    path = Path(out) if out is not None else workdir / f"{cfg.name}.npz"
+    return write_table(path, header, arrays)

@@ -15,7 +15,7 @@ This engine scores a few per reference, and each shortcut is exact or tested:
 
 * **sigma/dT invariance.** With fixed initial conditions and standardized
   features the F1 depends on noise and temperature difference only through
-  ``sigma / dT`` (DOMAIN.md; tests/test_recognition.py), so one axis replaces
+  ``sigma / dT`` (docs/physics.md, "Invariance"; tests/test_recognition.py), so one axis replaces
   two and every sweep is run at ``dT = 1``.
 * **Staircase search.** Distinguishability is monotone in the pair's distance:
   if ``(i, j)`` is distinguishable so is ``(i - 1, j)`` and ``(i, j + 1)``. Hence

@@ -22,7 +22,7 @@ from designkit._validation import InputError
 from designkit.calibration.emulator import EmulatedMaterial, Emulator, Faults, TouchPlan
 from designkit.calibration.profiles import list_profiles, load_profile, profile_from_dict
 from designkit.calibration.recorder import DeviceGone, NoData, SerialRecorder, TrialCutter
-from designkit.calibration.trials import load_index, read_trial_csv
+from designkit.calibration.trials import load_index, read_trial_csv, write_trial
 from designkit.physics import sensor_temperature
 
 PAPER = SENSORS["paper"]
@@ -284,3 +284,54 @@ def test_index_and_trial_files_are_checked(tmp_path):
         read_trial_csv(tmp_path / "c.csv")
     tr = read_trial_csv(tmp_path / "a.csv", "wood")  # passive and force channels are optional
     assert not tr.has_object and np.isnan(tr.force_n).all()
+
+
+# ------------------------------------------------------ recorded <=> indexed
+@pytest.fixture
+def python_sigint():
+    """SIGINT raises KeyboardInterrupt here, as in an interactive run (the suite may inherit it ignored)."""
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, previous)
+
+
+def _write_one(folder: Path, material: str = "wood") -> Path:
+    t = np.arange(-200, 1401) / 200.0
+    return write_trial(folder, material, t, np.full(t.size, 35.0), np.full(t.size, 25.0), np.full(t.size, 8.0),
+                       {"profile": "test"})
+
+
+def test_ctrl_c_between_sidecar_and_index_still_records_the_trial(tmp_path, monkeypatch, python_sigint):
+    """The CI race, made certain: a real SIGINT arrives right after the sidecar is written, before
+    the index. Ctrl-C is held until the index lists the trial, then raised."""
+    from designkit.calibration import trials as trials_module
+
+    real_write = trials_module.atomic_write_text
+
+    def write_then_ctrl_c(path, text):
+        done = real_write(path, text)
+        if Path(path).suffix == ".json":
+            os.kill(os.getpid(), signal.SIGINT)
+        return done
+
+    _write_one(tmp_path)
+    monkeypatch.setattr(trials_module, "atomic_write_text", write_then_ctrl_c)
+    with pytest.raises(KeyboardInterrupt):
+        _write_one(tmp_path)
+    monkeypatch.undo()
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler  # handler given back
+    on_disk = sorted(p.name for p in tmp_path.glob("wood_*.csv"))
+    assert on_disk == ["wood_001.csv", "wood_002.csv"]
+    assert sorted(Path(t.source).name for t in load_index(tmp_path / "index.csv")) == on_disk
+
+
+def test_a_failed_trial_write_leaves_nothing_behind(tmp_path):
+    _write_one(tmp_path)
+    before = sorted(p.name for p in tmp_path.iterdir())
+    index = tmp_path / "index.csv"
+    index.unlink()
+    index.mkdir()  # the commit (replacing the index) fails for real: it is a folder
+    with pytest.raises(OSError):
+        _write_one(tmp_path)
+    index.rmdir()
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(set(before) - {"index.csv"})

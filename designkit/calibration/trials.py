@@ -11,17 +11,29 @@ right: it comes from the device clock or the sample count).
 The sidecar ``<trial>.json`` records the profile, material, time, the sensor
 and object temperatures before contact, and how the trial was cut. The folder's
 ``index.csv`` (columns ``file,material,trial_index``) is rebuilt from the
-sidecars after every trial, so it is always consistent with what is on disk
-and can be given to ``designkit calibrate fit`` as it is.
+sidecars after every trial and can be given to ``designkit calibrate fit`` as
+it is.
+
+A trial is recorded when, and only when, the index lists it. Writing one is
+three atomic file replacements: the CSV, the sidecar, then the index, whose
+replacement is the commit point. Ctrl-C (SIGINT) during those steps is held
+until the index is written, so an interrupt never leaves a trial on disk that
+no index lists; a write that fails (disk full) removes the files it wrote. Only
+a hard kill between the steps can leave a complete CSV and sidecar unlisted;
+the next trial written to the folder lists them (the index is rebuilt from the
+sidecars).
 """
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import io
 import json
 import math
 import re
+import signal
+import threading
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping, Sequence
@@ -93,10 +105,13 @@ def trial_csv_text(time_s, sensor_c, object_c, force_n) -> str:
 
 def write_trial(folder: Path, material: str, time_s, sensor_c, object_c, force_n,
                 meta: Mapping[str, Any]) -> Path:
-    """Write one trial (CSV, then its sidecar, each atomically) and rebuild the index.
+    """Record one trial: write its CSV and sidecar, then the index that lists it (each atomically).
 
     The trial number is the next free one for ``material`` in ``folder``.
-    Returns the CSV path.
+    Ctrl-C arriving meanwhile is held until the index is written (see the
+    module docstring), so on return, or on KeyboardInterrupt raised from here,
+    the trial is recorded; on any other error nothing of it is left. Returns
+    the CSV path.
     """
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
@@ -107,12 +122,48 @@ def write_trial(folder: Path, material: str, time_s, sensor_c, object_c, force_n
               if (m := re.fullmatch(rf"{re.escape(slug)}_(\d+)\.csv", p.name))}
     k = max(taken, default=0) + 1
     csv_path = folder / f"{slug}_{k:03d}.csv"
-    atomic_write_text(csv_path, trial_csv_text(time_s, sensor_c, object_c, force_n))
+    csv_text = trial_csv_text(time_s, sensor_c, object_c, force_n)
     side = {"designkit_trial": TRIAL_FILE_VERSION, "file": csv_path.name, "material": material,
             "trial_index": k, **dict(meta)}
-    atomic_write_text(csv_path.with_suffix(".json"), json.dumps(_plain(side), indent=2) + "\n")
-    rebuild_index(folder)
+    side_text = json.dumps(_plain(side), indent=2) + "\n"
+    written: list[Path] = []
+    with _sigint_held():
+        try:
+            written.append(atomic_write_text(csv_path, csv_text))
+            written.append(atomic_write_text(csv_path.with_suffix(".json"), side_text))
+            rebuild_index(folder)  # the commit point: from here on the trial is recorded
+        except BaseException:
+            for path in reversed(written):
+                with contextlib.suppress(OSError):
+                    path.unlink()
+            raise
     return csv_path
+
+
+@contextlib.contextmanager
+def _sigint_held():
+    """Hold Ctrl-C (SIGINT) while the block runs, then deliver it.
+
+    The handler in place when the block starts (Python's, which raises
+    KeyboardInterrupt, or the program's own) is called once the block is done
+    if SIGINT arrived meanwhile. A no-op outside the main thread (signals are
+    only handled there) and where SIGINT is ignored or has no Python handler.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.getsignal(signal.SIGINT)
+    if not callable(previous):
+        yield
+        return
+    pending: list[tuple[int, Any]] = []
+    signal.signal(signal.SIGINT, lambda signum, frame: pending.append((signum, frame)))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+        if pending:
+            previous(*pending[0])
 
 
 def _plain(obj: Any) -> Any:

@@ -229,3 +229,13 @@ def test_fit_of_the_shared_robot_recordings(cli, robot_data_dir, tmp_path):
     assert again.exit_code == 0, again.output
     d2 = json.loads(again.stdout)
     assert d2["n_trials"] == 120 and d2["effusivity"]["value"] == pytest.approx(d["effusivity"]["value"])
+
+
+def test_fit_names_a_file_that_is_not_utf8(cli, tmp_path):
+    index = _synthetic_index(tmp_path / "trials", n=1)
+    trial = tmp_path / "trials" / "wood_001.csv"
+    trial.write_bytes(trial.read_bytes().replace(b"time_s", b"t\xefme_s"))
+    r = cli("calibrate", "fit", index, "--range", "metal=1:2", "--range", "wood=331:506", "--bootstrap", "0")
+    assert r.exit_code == 2
+    lines = r.stderr.strip().splitlines()
+    assert lines == [f"Error: trial {trial} is not UTF-8 text (byte 0xef on line 1)"], r.stderr

@@ -335,3 +335,23 @@ def test_a_failed_trial_write_leaves_nothing_behind(tmp_path):
         _write_one(tmp_path)
     index.rmdir()
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(set(before) - {"index.csv"})
+
+
+@pytest.mark.parametrize("which", ["index", "trial", "sidecar"])
+def test_a_file_that_is_not_utf8_is_named(tmp_path, which):
+    path = _write_one(tmp_path)
+    target = {"index": tmp_path / "index.csv", "trial": path, "sidecar": path.with_suffix(".json")}[which]
+    data = target.read_bytes()
+    target.write_bytes(data.replace(b"\n", b"\n\xff\xfe", 1))  # Latin-1/UTF-16 bytes on line 2
+    with pytest.raises(InputError) as exc:
+        load_index(tmp_path / "index.csv")
+    message = str(exc.value)
+    assert str(target) in message and "not UTF-8" in message and "line 2" in message and "\n" not in message
+
+
+def test_a_byte_order_mark_is_read(tmp_path):
+    """Spreadsheets save UTF-8 with a byte-order mark: the header is still found."""
+    path = _write_one(tmp_path)
+    for target in (tmp_path / "index.csv", path):
+        target.write_bytes(b"\xef\xbb\xbf" + target.read_bytes())
+    assert load_index(tmp_path / "index.csv")[0].n_samples == 1601

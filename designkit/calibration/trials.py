@@ -184,7 +184,7 @@ def rebuild_index(folder: Path) -> Path:
     rows = []
     for side in sorted(folder.glob("*.json")):
         try:
-            meta = json.loads(side.read_text())
+            meta = json.loads(side.read_text(encoding="utf-8"))
         except (OSError, ValueError):
             continue
         if not isinstance(meta, dict) or "designkit_trial" not in meta:
@@ -200,14 +200,24 @@ def rebuild_index(folder: Path) -> Path:
     return atomic_write_text(folder / "index.csv", buf.getvalue())
 
 
+def _read_text(path: Path, what: str) -> str:
+    """The text of a UTF-8 file (a byte-order mark is allowed); InputError naming ``path`` otherwise."""
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise InputError(f"cannot read {what} {path}: {exc.strerror or exc}") from None
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = data[:exc.start].count(b"\n") + 1
+        raise InputError(f"{what} {path} is not UTF-8 text (byte 0x{data[exc.start]:02x} on line {line})") from None
+
+
 def read_trial_csv(path: Path, material: str = "") -> Trial:
     """Read a trial CSV (the shared recordings' columns; passive and force optional)."""
     path = Path(path)
-    try:
-        with path.open(newline="") as fh:
-            header = next(csv.reader(fh), None)
-    except OSError as exc:
-        raise InputError(f"cannot read trial {path}: {exc.strerror or exc}") from None
+    text = _read_text(path, "trial")
+    header = next(csv.reader(io.StringIO(text, newline="")), None)
     if not header:
         raise InputError(f"trial {path} is empty")
     header = [h.strip() for h in header]
@@ -216,7 +226,7 @@ def read_trial_csv(path: Path, material: str = "") -> Trial:
         raise InputError(f"trial {path} lacks column(s) {', '.join(missing)} "
                          f"(expected {','.join(COLUMNS)})")
     try:
-        data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2, dtype=np.float64)
+        data = np.loadtxt(io.StringIO(text, newline=None), delimiter=",", skiprows=1, ndmin=2, dtype=np.float64)
     except ValueError as exc:
         raise InputError(f"trial {path} has a value that is not a number ({str(exc).splitlines()[0]})") from None
     if data.shape[0] < 3 or data.shape[1] != len(header):
@@ -233,9 +243,10 @@ def read_trial_csv(path: Path, material: str = "") -> Trial:
     meta: dict[str, Any] = {}
     side = path.with_suffix(".json")
     if side.is_file():
+        side_text = _read_text(side, "trial sidecar")
         try:
-            meta = json.loads(side.read_text())
-        except (OSError, ValueError):
+            meta = json.loads(side_text)
+        except ValueError:
             raise InputError(f"trial sidecar {side} is not valid JSON") from None
     return Trial(time_s=t, sensor_c=col("active_temp_c")[keep], object_c=col("passive_temp_c")[keep],
                  force_n=col("force_n")[keep], material=material or str(meta.get("material", "")),
@@ -243,16 +254,12 @@ def read_trial_csv(path: Path, material: str = "") -> Trial:
 
 
 def read_index_rows(index_csv: Path | str) -> list[dict[str, str]]:
-    """The rows of a trial index (a CSV with at least the columns ``file`` and ``material``).
+    """The rows of a trial index (a UTF-8 CSV with at least the columns ``file`` and ``material``).
 
-    Raises InputError, with the path, when it cannot be read or lacks those columns.
+    Raises InputError, with the path, when it cannot be read, is not UTF-8 or lacks those columns.
     """
     index_csv = Path(index_csv)
-    try:
-        with index_csv.open(newline="") as fh:
-            rows = list(csv.DictReader(fh))
-    except OSError as exc:
-        raise InputError(f"cannot read index {index_csv}: {exc.strerror or exc}") from None
+    rows = list(csv.DictReader(io.StringIO(_read_text(index_csv, "index"), newline="")))
     if not rows or not {"file", "material"} <= set(rows[0]):
         raise InputError(f"index {index_csv} needs columns file and material")
     return rows

@@ -355,3 +355,19 @@ def test_a_byte_order_mark_is_read(tmp_path):
     for target in (tmp_path / "index.csv", path):
         target.write_bytes(b"\xef\xbb\xbf" + target.read_bytes())
     assert load_index(tmp_path / "index.csv")[0].n_samples == 1601
+
+
+# ------------------------------------------------------------- bad input
+@pytest.mark.parametrize("kind", ["regular file", "folder", "/dev/null"])
+def test_a_path_that_is_not_a_serial_device_is_named(tmp_path, kind):
+    if kind == "regular file":
+        port, what = tmp_path / "notes.txt", "a regular file"
+        port.write_text("hello\n")
+    elif kind == "folder":
+        port, what = tmp_path, "a folder"
+    else:
+        port, what = Path("/dev/null"), "not a terminal"
+    rec = SerialRecorder(str(port), load_profile("designkit"), tmp_path / "out")
+    with pytest.raises(InputError) as exc:
+        rec.open()
+    assert str(exc.value) == f"{port} is not a serial device ({what})"

@@ -28,6 +28,9 @@ missing from the trial, the times of the others stay right).
 from __future__ import annotations
 
 import datetime as _dt
+import errno
+import os
+import stat
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -335,14 +338,23 @@ class SerialRecorder:
 
     # ------------------------------------------------------------ port
     def open(self) -> None:
-        """Open the port with the profile's settings (one-line error if it cannot)."""
+        """Open the port with the profile's settings (one-line error if it cannot).
+
+        A path that is a regular file, a folder, or a device that is not a
+        terminal (``/dev/null``) is refused as not a serial device.
+        """
         import serial
 
+        kind = _not_a_serial_device(self.port)
+        if kind:
+            raise InputError(f"{self.port} is not a serial device ({kind})")
         s = self.profile.serial
         try:
             self._ser = serial.Serial(self.port, baudrate=s.baudrate, bytesize=s.bytesize, parity=s.parity,
                                       stopbits=s.stopbits, timeout=s.read_timeout_s)
         except (serial.SerialException, OSError, ValueError) as exc:
+            if _is_enotty(exc):
+                raise InputError(f"{self.port} is not a serial device (not a terminal)") from None
             raise InputError(f"cannot open serial port {self.port}: {_short(exc)}") from None
         self._restart_stream()
 
@@ -580,6 +592,45 @@ class SerialRecorder:
         if seen < _EXAMPLES_PER_KIND:
             more = " (further ones are only counted)" if seen == _EXAMPLES_PER_KIND - 1 else ""
             self._emit(RecordEvent("bad_line", f"skipped a line with {_BAD_KIND_TEXT[kind]}: {text!r}{more}"))
+
+
+def _not_a_serial_device(port: str) -> str:
+    """What ``port`` is instead, when it is a path to something that cannot be a serial device ("" otherwise).
+
+    Names that are not paths (``COM3``, pyserial URLs) are left to pyserial.
+    """
+    try:
+        mode = os.stat(port).st_mode
+    except (OSError, ValueError):
+        return ""
+    if stat.S_ISCHR(mode):
+        return ""
+    if stat.S_ISDIR(mode):
+        return "a folder"
+    if stat.S_ISREG(mode):
+        return "a regular file"
+    return "not a character device"
+
+
+def _is_enotty(exc: BaseException | None) -> bool:
+    """Whether ``exc`` or an exception it was raised from is "not a terminal" (ENOTTY).
+
+    pyserial turns the termios error into ``SerialException("Could not
+    configure port: (25, ...)")``; the original stays as its context.
+    """
+    try:
+        import termios
+    except ImportError:  # pragma: no cover - Windows
+        termios = None
+    seen: set[int] = set()
+    while exc is not None and id(exc) not in seen:
+        seen.add(id(exc))
+        if isinstance(exc, OSError) and exc.errno == errno.ENOTTY:
+            return True
+        if termios is not None and isinstance(exc, termios.error) and exc.args[:1] == (errno.ENOTTY,):
+            return True
+        exc = exc.__cause__ or exc.__context__
+    return False
 
 
 def _short(exc: BaseException) -> str:

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from designkit import SENSORS
-from designkit.calibration.emulator import EmulatedMaterial, Emulator, TouchPlan
+from designkit.calibration.emulator import EmulatedMaterial, Emulator, Faults, TouchPlan
 from designkit.calibration.profiles import load_profile
 from designkit.calibration.trials import write_trial
 from designkit.sensor import load_sensor
@@ -239,3 +239,20 @@ def test_fit_names_a_file_that_is_not_utf8(cli, tmp_path):
     assert r.exit_code == 2
     lines = r.stderr.strip().splitlines()
     assert lines == [f"Error: trial {trial} is not UTF-8 text (byte 0xef on line 1)"], r.stderr
+
+
+@pytest.mark.parametrize("command, extra", [(["record"], []), ([], ["--range", "wood=331:506", "--yes"])],
+                         ids=["record", "guided"])
+@pytest.mark.parametrize("value", ["nan", "inf", "-1", "0"])
+def test_a_timeout_that_can_never_fire_is_refused(cli, tmp_path, command, extra, value):
+    """--timeout nan on a silent device waited forever (NaN compares false)."""
+    with Emulator(load_profile("designkit"), PAPER, [EmulatedMaterial("wood", WOOD)],
+                  faults=Faults(silent=True)) as emu:
+        t0 = time.monotonic()
+        r = cli("calibrate", *command, "--port", emu.port, "--material", "wood", "--out", tmp_path / "out",
+                *extra, "--timeout", value)
+        assert time.monotonic() - t0 < 5
+    assert r.exit_code == 2
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and "--timeout must be a positive, finite number of seconds" in lines[0], r.stderr
+    assert not (tmp_path / "out").exists()

@@ -358,6 +358,12 @@ def test_a_byte_order_mark_is_read(tmp_path):
 
 
 # ------------------------------------------------------------- bad input
+@pytest.mark.parametrize("timeout_s", [float("nan"), float("inf"), -1.0, 0.0])
+def test_timeout_must_be_positive_and_finite(tmp_path, timeout_s):
+    with pytest.raises(InputError, match=r"no_data_timeout_s \[s\] must be positive and finite"):
+        SerialRecorder("/dev/whatever", load_profile("designkit"), tmp_path, no_data_timeout_s=timeout_s)
+
+
 @pytest.mark.parametrize("kind", ["regular file", "folder", "/dev/null"])
 def test_a_path_that_is_not_a_serial_device_is_named(tmp_path, kind):
     if kind == "regular file":

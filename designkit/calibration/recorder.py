@@ -38,7 +38,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .._validation import InputError
+from .._validation import InputError, check_positive
 from .profiles import ROLES, DeviceProfile
 from .trials import write_trial
 
@@ -308,7 +308,8 @@ class SerialRecorder:
     profile : DeviceProfile
     out_dir : Path
     no_data_timeout_s : float, optional
-        Overrides the profile's limit for a device that never speaks.
+        Overrides the profile's limit for a device that never speaks [s]
+        (positive and finite).
     on_event : callable(RecordEvent), optional
     on_status : callable(RecorderStatus), optional
         Called a few times a second with live numbers.
@@ -321,7 +322,9 @@ class SerialRecorder:
         self.port = str(port)
         self.profile = profile
         self.out_dir = Path(out_dir)
-        self.no_data_timeout_s = no_data_timeout_s or profile.serial.no_data_timeout_s
+        if no_data_timeout_s is None:
+            no_data_timeout_s = profile.serial.no_data_timeout_s
+        self.no_data_timeout_s = check_positive("no_data_timeout_s [s]", no_data_timeout_s)
         self.on_event = on_event or (lambda e: None)
         self.on_status = on_status or (lambda s: None)
         self.status = RecorderStatus(port=self.port)

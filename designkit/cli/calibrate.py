@@ -66,6 +66,14 @@ def _fit_settings(depth_um: float, bootstrap: int, seed: int, baseline: str = "m
                        offset_bounds_s=bounds, fit_to_s=fit_to)
 
 
+def _check_timeout(timeout: Optional[float]) -> None:
+    """Refuse a --timeout the recorder could never reach (NaN compares false: it waited forever)."""
+    from .._validation import InputError
+
+    if timeout is not None and not (math.isfinite(timeout) and timeout > 0):
+        raise InputError(f"--timeout must be a positive, finite number of seconds, got {timeout:g}")
+
+
 def _status_table(st) -> Any:
     from rich.table import Table
 
@@ -277,6 +285,7 @@ def record(
         raise InputError("give --port, --material and --out")
     if trials < 1:
         raise InputError(f"--trials must be >= 1, got {trials}")
+    _check_timeout(timeout)
     prof = load_profile(profile)
     rec, paths, interrupted = _record_materials(port, prof, out, [material], trials, timeout, quiet=json_,
                                                 prompt=False)
@@ -359,6 +368,7 @@ def guided(
                          "(or use 'calibrate record' and 'calibrate fit')")
     if trials < 1:
         raise InputError(f"--trials must be >= 1, got {trials}")
+    _check_timeout(timeout)
     from ..calibration.fit import parse_object_temps, parse_ranges, resolve_ranges
     from ..calibration.profiles import load_profile
 

@@ -256,3 +256,14 @@ def test_a_timeout_that_can_never_fire_is_refused(cli, tmp_path, command, extra,
     lines = r.stderr.strip().splitlines()
     assert len(lines) == 1 and "--timeout must be a positive, finite number of seconds" in lines[0], r.stderr
     assert not (tmp_path / "out").exists()
+
+
+def test_record_gives_up_on_a_mostly_unreadable_stream(cli, tmp_path):
+    with Emulator(load_profile("designkit"), PAPER, [EmulatedMaterial("wood", WOOD)], speed=50.0,
+                  plan=TouchPlan(touch_every_s=13.0), faults=Faults(garbled=0.4)) as emu:
+        r = cli("calibrate", "record", "--port", emu.port, "--material", "wood", "--out", tmp_path, "--trials", "3")
+    assert r.exit_code == 2
+    errors = [line for line in r.stderr.splitlines() if line.startswith("Error:")]  # after the event lines
+    assert len(errors) == 1 and r.stderr.strip().splitlines()[-1] == errors[0], r.stderr
+    assert "% of the last 1601 lines" in errors[0] and "0 trial(s) kept" in errors[0]
+    assert "Traceback" not in r.stderr

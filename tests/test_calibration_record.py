@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -21,7 +22,7 @@ from designkit import SENSORS
 from designkit._validation import InputError
 from designkit.calibration.emulator import EmulatedMaterial, Emulator, Faults, TouchPlan
 from designkit.calibration.profiles import list_profiles, load_profile, profile_from_dict
-from designkit.calibration.recorder import DeviceGone, NoData, SerialRecorder, TrialCutter
+from designkit.calibration.recorder import DeviceGone, NoData, SerialRecorder, TooManyBadLines, TrialCutter
 from designkit.calibration.trials import load_index, read_trial_csv, write_trial
 from designkit.physics import sensor_temperature
 
@@ -358,6 +359,53 @@ def test_a_byte_order_mark_is_read(tmp_path):
 
 
 # ------------------------------------------------------------- bad input
+@pytest.mark.parametrize("profile_name", ["designkit", "adc12-thermistor"])
+def test_forty_percent_unreadable_lines_give_up_with_the_fraction_and_an_example(tmp_path, profile_name):
+    """The reported case: 40 % bad lines skipped every touch (a trial needs 80 % of its samples) forever."""
+    prof = load_profile(profile_name)
+    with _emulator(prof, faults=Faults(garbled=0.4), seed=1) as emu, SerialRecorder(emu.port, prof, tmp_path) as rec:
+        t0 = time.monotonic()
+        with pytest.raises(TooManyBadLines) as exc:
+            rec.record("wood", 3)
+        assert time.monotonic() - t0 < 10
+    msg = str(exc.value)
+    m = re.fullmatch(r"(\d+\.\d) % of the last 1601 lines from (\S+) were unreadable \(e\.g\. '(.+)'\): a trial "
+                     r"needs 80 % of its samples readable, so none can be kept; check the cable, the baud rate "
+                     r"\d+ and the profile '[\w-]+'; 0 trial\(s\) kept.*", msg)
+    assert m, msg
+    assert 35.0 < float(m.group(1)) < 45.0 and m.group(2) == emu.port
+    assert rec.written == [] and not list(tmp_path.glob("wood_*"))
+
+
+def test_a_stream_going_bad_gives_up_and_keeps_the_trials_recorded(tmp_path):
+    prof = load_profile("designkit")
+    # touches at 2 and 15 s are cut by 23 s; from 25 s on about 36 % of the lines are unreadable
+    faults = Faults(garbled=0.2, non_numeric=0.2, line_faults_after_s=25.0)
+    with _emulator(prof, faults=faults) as emu, SerialRecorder(emu.port, prof, tmp_path) as rec:
+        with pytest.raises(TooManyBadLines) as exc:
+            rec.record("wood", 10)
+    msg = str(exc.value)
+    assert "\n" not in msg and f"2 trial(s) kept in {tmp_path}" in msg
+    assert [Path(t.source).name for t in load_index(tmp_path / "index.csv")] == ["wood_001.csv", "wood_002.csv"]
+    for p in rec.written:
+        _check_trial_against_physics(p, emu, 400.0, 0.05)
+
+
+def test_line_faults_can_start_later():
+    assert Faults.parse(["garbled=0.2", "line-faults-after=25"]) == Faults(garbled=0.2, line_faults_after_s=25.0)
+    prof = load_profile("designkit")
+    emu = _emulator(prof, faults=Faults(garbled=1.0, line_faults_after_s=1.0))
+    lines = emu.lines(150, 250).split(b"\n")[:-1]  # device time 0.75 to 1.245 s
+    clean = [b"".join(line.split()).isascii() for line in lines]
+    assert clean == [True] * 50 + [False] * 50
+
+
+def test_a_few_unreadable_lines_do_not_stop_the_recorder(tmp_path):
+    prof = load_profile("designkit")
+    with _emulator(prof, faults=Faults(garbled=0.1), seed=2) as emu, SerialRecorder(emu.port, prof, tmp_path) as rec:
+        assert len(rec.record("wood", 2)) == 2
+
+
 @pytest.mark.parametrize("timeout_s", [float("nan"), float("inf"), -1.0, 0.0])
 def test_timeout_must_be_positive_and_finite(tmp_path, timeout_s):
     with pytest.raises(InputError, match=r"no_data_timeout_s \[s\] must be positive and finite"):

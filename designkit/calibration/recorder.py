@@ -23,6 +23,15 @@ Two layers:
 Without a timestamp channel, time is the count of lines received divided by
 the sample rate; a line that cannot be read still counts (its sample is
 missing from the trial, the times of the others stay right).
+
+Give-up rule for unreadable lines: a trial is kept only when at least
+``MIN_READABLE_FRACTION`` (80 %) of its samples could be read, so once the
+last trial-length of lines (``(pre_s + post_s) * sample_rate_hz + 1``, at
+least 200) holds more than 20 % unreadable ones, a trial over them could not
+be kept and the recorder stops (:class:`TooManyBadLines`, naming the fraction
+and an example line; trials already written stay). A stream none of whose first
+200 lines is readable stops sooner (:class:`NoData`: wrong profile or baud
+rate).
 """
 
 from __future__ import annotations
@@ -42,7 +51,10 @@ from .._validation import InputError, check_positive
 from .profiles import ROLES, DeviceProfile
 from .trials import write_trial
 
-__all__ = ["RecordEvent", "RecorderStatus", "SerialRecorder", "TrialCutter"]
+__all__ = ["MIN_READABLE_FRACTION", "RecordEvent", "RecorderStatus", "SerialRecorder", "TrialCutter"]
+
+#: Fewest samples of a trial's window that must be readable for the trial to be kept.
+MIN_READABLE_FRACTION = 0.8
 
 _S, _O, _F = 0, 1, 2  # columns of the cutter's value buffer
 _BAD_KIND_TEXT = {
@@ -241,7 +253,7 @@ class TrialCutter:
         tt = t[sel] - onset
         vv = v[sel]
         expected = int(round((self.pre + self.post) * self.fs)) + 1
-        if tt.size < 0.8 * expected:
+        if tt.size < MIN_READABLE_FRACTION * expected:
             events.append(RecordEvent(
                 "skipped", f"touch at device time {onset:.2f} s skipped: only {tt.size} of {expected} samples "
                            "readable"))
@@ -298,6 +310,10 @@ class NoData(InputError):
     """Nothing usable arrived within the time limit."""
 
 
+class TooManyBadLines(InputError):
+    """So many lines are unreadable that no trial can be kept (see the module docstring)."""
+
+
 class SerialRecorder:
     """Record touches from a serial port into a folder.
 
@@ -338,6 +354,10 @@ class SerialRecorder:
         self._examples: dict[str, int] = {}
         self._valid_seen = False
         self._lines_seen = 0
+        fs, window = profile.sample_rate_hz, profile.trial.pre_s + profile.trial.post_s
+        self._bad_window = max(200, int(round(window * fs)) + 1)  # lines the give-up rule looks at
+        self._recent_bad = np.zeros(0, dtype=bool)
+        self._last_bad_text = ""
 
     # ------------------------------------------------------------ port
     def open(self) -> None:
@@ -386,6 +406,7 @@ class SerialRecorder:
         self._buf = b""
         self._first_line = True
         self._last_t = None
+        self._recent_bad = np.zeros(0, dtype=bool)
 
     def _emit(self, event: RecordEvent) -> None:
         self.events.append(event)
@@ -505,10 +526,12 @@ class SerialRecorder:
         data = self._buf + chunk
         lines = data.split(b"\n")
         self._buf = lines.pop()
+        unreadable = []
         if len(self._buf) > 4096:
             self._bad("too_long", self._buf[:40].decode("ascii", "replace"))
             self._buf = b""
             self._slot += 1
+            unreadable.append(np.ones(1, dtype=bool))
         if self._first_line and lines:
             lines = lines[1:]  # the port may have opened in the middle of a line
             self._first_line = False
@@ -529,6 +552,9 @@ class SerialRecorder:
         else:
             t = (self._slot + parsed.slots[good]) / prof.sample_rate_hz
         self._slot += parsed.n_slots
+        flags = np.ones(parsed.n_slots, dtype=bool)
+        flags[parsed.slots[good]] = False
+        unreadable = np.concatenate(unreadable + [flags])
         vals = values[good][:, :3]
         self.status.lines_ok += int(good.sum())
         if t.size == 0:
@@ -536,12 +562,28 @@ class SerialRecorder:
                 example = lines[-1].strip()[:60].decode(prof.encoding, "replace")
                 raise NoData(f"none of the first {self._lines_seen} lines from {self.port} matches profile "
                              f"{prof.name!r} (e.g. {example!r}): wrong profile or baud rate?")
+            self._check_readable(unreadable, cutter)
             return
         self._valid_seen = True
-        self._feed_checked(t, vals, cutter)
+        self._feed_checked(t, vals, cutter)  # first, so that a trial this completes is kept
         last = vals[-1]
         self.status.sensor_c, self.status.object_c, self.status.force_n = (float(x) for x in last)
         self.status.device_time_s = float(t[-1])
+        self._check_readable(unreadable, cutter)
+
+    def _check_readable(self, unreadable: np.ndarray, cutter: TrialCutter) -> None:
+        """Apply the give-up rule (module docstring) to the lines just read (True: unreadable)."""
+        n = self._bad_window
+        self._recent_bad = np.concatenate([self._recent_bad, unreadable])[-n:]
+        if self._recent_bad.size < n or not self._valid_seen:
+            return  # not a full window yet; or nothing readable yet: NoData names the likely cause
+        frac = float(self._recent_bad.mean())
+        if frac > 1.0 - MIN_READABLE_FRACTION:
+            raise TooManyBadLines(
+                f"{100 * frac:.1f} % of the last {n} lines from {self.port} were unreadable (e.g. "
+                f"{self._last_bad_text!r}): a trial needs {100 * MIN_READABLE_FRACTION:.0f} % of its samples "
+                f"readable, so none can be kept; check the cable, the baud rate {self.profile.serial.baudrate} "
+                f"and the profile {self.profile.name!r}; {self._kept(cutter)}")
 
     def _feed_checked(self, t: np.ndarray, vals: np.ndarray, cutter: TrialCutter) -> None:
         """Feed in runs without clock trouble.
@@ -587,6 +629,7 @@ class SerialRecorder:
             self._emit(e)
 
     def _bad(self, kind: str, text: str) -> None:
+        self._last_bad_text = text
         st = self.status
         st.lines_bad += 1
         st.bad_by_kind[kind] = st.bad_by_kind.get(kind, 0) + 1

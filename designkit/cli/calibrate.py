@@ -417,8 +417,8 @@ def emulate(
     speed: Annotated[float, typer.Option("--speed", help="Device seconds per real second (20: 20x real time).")] = 1.0,
     fault: Annotated[Optional[list[str]], typer.Option(
         "--fault", help="Inject a fault (repeatable): garbled=P, partial=P, non-numeric=P, field-count=P, "
-                        "out-of-range=P (per-line probabilities), burst=EVERY_S[:HOLD_S], gap=EVERY_S[:SILENT_S], "
-                        "vanish=AFTER_S, silent.")] = None,
+                        "out-of-range=P (per-line probabilities, from device time line-faults-after=S on), "
+                        "burst=EVERY_S[:HOLD_S], gap=EVERY_S[:SILENT_S], vanish=AFTER_S, silent.")] = None,
     duration: Annotated[Optional[float], typer.Option(
         "--duration", help="Stop after this many real seconds (default: run until Ctrl-C).")] = None,
     seed: Seed = 0,

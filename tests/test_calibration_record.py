@@ -23,7 +23,7 @@ from designkit._validation import InputError
 from designkit.calibration.emulator import EmulatedMaterial, Emulator, Faults, TouchPlan
 from designkit.calibration.profiles import list_profiles, load_profile, profile_from_dict
 from designkit.calibration.recorder import DeviceGone, NoData, SerialRecorder, TooManyBadLines, TrialCutter
-from designkit.calibration.trials import load_index, read_trial_csv, write_trial
+from designkit.calibration.trials import load_index, read_trial_csv, recorded_trials, write_trial
 from designkit.physics import sensor_temperature
 
 PAPER = SENSORS["paper"]
@@ -244,29 +244,60 @@ def _designkit_exe() -> list[str]:
     return [str(exe)] if exe.exists() else [sys.executable, "-m", "designkit"]
 
 
-@pytest.mark.slow
-def test_ctrl_c_keeps_every_trial_recorded(tmp_path, ctrl_c_able):
-    prof = load_profile("designkit")
-    out = tmp_path / "trials"
-    with _emulator(prof, speed=20.0) as emu:
-        proc = subprocess.Popen(_designkit_exe() + ["calibrate", "record", "--port", emu.port, "--profile",
-                                                    "designkit", "--material", "wood", "--trials", "50",
-                                                    "--out", str(out)],
-                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **ctrl_c_able)
-        deadline = time.monotonic() + 60
-        while time.monotonic() < deadline and len(list(out.glob("wood_*.json"))) < 1:
-            time.sleep(0.05)
-        proc.send_signal(signal.SIGINT)
-        stdout, stderr = proc.communicate(timeout=30)
-    assert proc.returncode == 130, stderr
-    assert "Interrupted" in stderr
+def _record_until_trials_then_ctrl_c(emu, out: Path, n_trials: int, ctrl_c_able, *extra: str):
+    """Run 'designkit calibrate record' as a process; Ctrl-C once ``n_trials`` sidecars are on disk."""
+    proc = subprocess.Popen(_designkit_exe() + ["calibrate", "record", "--port", emu.port, "--profile",
+                                                "designkit", "--material", "wood", "--trials", "50",
+                                                "--out", str(out), *extra],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **ctrl_c_able)
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and len(list(out.glob("wood_*.json"))) < n_trials:
+        time.sleep(0.05)
+    proc.send_signal(signal.SIGINT)
+    stdout, stderr = proc.communicate(timeout=30)
+    return proc.returncode, stdout, stderr
+
+
+def _check_recorded_folder(out: Path, emu) -> list[str]:
+    """Every trial on disk is intact and listed by the index, and nothing else is there."""
     kept = load_index(out / "index.csv")
-    assert len(kept) >= 1
+    names = sorted(Path(tr.source).name for tr in kept)
+    assert names == sorted(p.name for p in out.glob("*.csv") if p.name != "index.csv")
+    assert names == sorted(p.with_suffix(".csv").name for p in out.glob("*.json"))
     for tr in kept:
         assert tr.n_samples == 1601
         _check_trial_against_physics(Path(tr.source), emu, 400.0, 0.05)
     assert not [p for p in out.iterdir() if p.name.startswith(".")]
-    assert os.path.getsize(out / "index.csv") > 0
+    return names
+
+
+@pytest.mark.slow
+def test_ctrl_c_keeps_every_trial_recorded(tmp_path, ctrl_c_able):
+    """Ctrl-C right after a trial's sidecar appears: that trial is in the index too (the race of issue 15)."""
+    prof = load_profile("designkit")
+    out = tmp_path / "trials"
+    with _emulator(prof, speed=20.0) as emu:
+        code, stdout, stderr = _record_until_trials_then_ctrl_c(emu, out, 1, ctrl_c_able)
+    assert code == 130, stderr
+    names = _check_recorded_folder(out, emu)
+    assert len(names) >= 1
+    said = f"Interrupted: {len(names)} trial(s) of wood written to {out}"
+    assert "".join(said.split()) in "".join(stderr.split())  # rich may wrap the line anywhere
+
+
+@pytest.mark.slow
+def test_ctrl_c_reports_the_trials_on_disk(tmp_path, ctrl_c_able):
+    """After Ctrl-C, --json said n_trials 0 (and the text '0 trial(s) written') with three trials on disk."""
+    prof = load_profile("designkit")
+    out = tmp_path / "trials"
+    with _emulator(prof, speed=20.0) as emu:
+        code, stdout, stderr = _record_until_trials_then_ctrl_c(emu, out, 3, ctrl_c_able, "--json")
+    assert code == 130, stderr
+    names = _check_recorded_folder(out, emu)
+    report = json.loads(stdout)
+    assert len(names) >= 3 and report["interrupted"] is True
+    assert report["n_trials"] == len(names) and sorted(Path(p).name for p in report["trials"]) == names
+    assert report["index"] == str(out / "index.csv")
 
 
 def test_index_and_trial_files_are_checked(tmp_path):
@@ -425,3 +456,11 @@ def test_a_path_that_is_not_a_serial_device_is_named(tmp_path, kind):
     with pytest.raises(InputError) as exc:
         rec.open()
     assert str(exc.value) == f"{port} is not a serial device ({what})"
+
+
+def test_recorded_trials_are_what_the_index_lists(tmp_path):
+    assert recorded_trials(tmp_path) == []
+    (tmp_path / "index.csv").write_text("file,material,trial_index\n")  # an index with no trials yet
+    assert recorded_trials(tmp_path) == [] and load_index(tmp_path / "index.csv") == []
+    first, second = _write_one(tmp_path), _write_one(tmp_path)
+    assert recorded_trials(tmp_path) == [first, second]

@@ -43,7 +43,7 @@ import numpy as np
 from .._io import atomic_write_text
 from .._validation import InputError
 
-__all__ = ["COLUMNS", "Trial", "load_index", "read_trial_csv", "rebuild_index", "write_trial"]
+__all__ = ["COLUMNS", "Trial", "load_index", "read_trial_csv", "rebuild_index", "recorded_trials", "write_trial"]
 
 COLUMNS = ("time_s", "passive_temp_c", "active_temp_c", "unused_channel", "force_n")
 TRIAL_FILE_VERSION = 1
@@ -259,10 +259,23 @@ def read_index_rows(index_csv: Path | str) -> list[dict[str, str]]:
     Raises InputError, with the path, when it cannot be read, is not UTF-8 or lacks those columns.
     """
     index_csv = Path(index_csv)
-    rows = list(csv.DictReader(io.StringIO(_read_text(index_csv, "index"), newline="")))
-    if not rows or not {"file", "material"} <= set(rows[0]):
+    reader = csv.DictReader(io.StringIO(_read_text(index_csv, "index"), newline=""))
+    rows = list(reader)
+    if not {"file", "material"} <= set(reader.fieldnames or ()):
         raise InputError(f"index {index_csv} needs columns file and material")
     return rows
+
+
+def recorded_trials(folder: Path | str) -> list[Path]:
+    """The trials recorded in ``folder``: the CSVs its ``index.csv`` lists, in its order.
+
+    Empty when there is no index yet. This, not what a recorder remembers
+    writing, is what is on disk (a trial is recorded when the index lists it).
+    """
+    index_csv = Path(folder) / "index.csv"
+    if not index_csv.exists():
+        return []
+    return [index_csv.parent / r["file"] for r in read_index_rows(index_csv) if r.get("file")]
 
 
 def load_index(index_csv: Path, only: Sequence[str] | None = None) -> list[Trial]:

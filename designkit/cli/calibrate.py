@@ -130,13 +130,19 @@ class _Display:
 
 def _record_materials(port: str, profile, out: Path, materials: list[str], trials: int, timeout: Optional[float],
                       quiet: bool, prompt: bool):
-    """Record each material in turn on one open connection; returns (recorder, paths, interrupted)."""
+    """Record each material in turn on one open connection; returns (recorder, paths, interrupted).
+
+    ``paths`` are the trials this run added to the folder's index, read back
+    from disk: after Ctrl-C the recorder cannot know how far it got (the
+    interrupt may come between a trial's commit and its being remembered).
+    """
     from ..calibration.recorder import SerialRecorder
+    from ..calibration.trials import recorded_trials
 
     display = _Display(quiet)
     rec = SerialRecorder(port, profile, out, no_data_timeout_s=timeout, on_event=display.event,
                          on_status=display.status)
-    paths: list[Path] = []
+    before = set(recorded_trials(out))
     interrupted = False
     try:
         rec.open()
@@ -150,11 +156,13 @@ def _record_materials(port: str, profile, out: Path, materials: list[str], trial
             elif i > 0:
                 rec.flush_input()
             with display:
-                paths += rec.record(material, trials)
+                rec.record(material, trials)
     except KeyboardInterrupt:
         interrupted = True
     finally:
         rec.close()
+    order = {p: i for i, p in enumerate(rec.written)}  # recording order; index order for any other
+    paths = sorted((p for p in recorded_trials(out) if p not in before), key=lambda p: order.get(p, len(order)))
     return rec, paths, interrupted
 
 

@@ -90,6 +90,8 @@ def test_fit_human_output_and_plot(cli, tmp_path):
     (["--only", "glass"], "--only names material(s) not in index.csv: glass"),
     (["--range", "metal=1:2", "--range", "wood=331:506", "--object-temp", "wood=tepid"], "--object-temp"),
     (["--range", "metal=1:2", "--range", "wood=331:506", "--offset-range", "x"], "--offset-range"),
+    (["--range", "metal=1:2", "--range", "wood=331:506", "--fit-to", "nan"], "--fit-to must be a positive"),
+    (["--range", "metal=1:2", "--range", "wood=331:506", "--fit-to", "-1"], "--fit-to must be a positive"),
 ])
 def test_fit_errors_are_one_line(cli, tmp_path, args, message):
     index = _synthetic_index(tmp_path / "trials", n=1)
@@ -267,3 +269,35 @@ def test_record_gives_up_on_a_mostly_unreadable_stream(cli, tmp_path):
     assert len(errors) == 1 and r.stderr.strip().splitlines()[-1] == errors[0], r.stderr
     assert "% of the last 1601 lines" in errors[0] and "0 trial(s) kept" in errors[0]
     assert "Traceback" not in r.stderr
+
+
+@pytest.mark.parametrize("value", ["100000000", "10001", "1", "-5"])
+def test_fit_bounds_the_bootstrap(cli, tmp_path, value):
+    """--bootstrap 100000000 ran for days; now it is refused at once, naming the limit."""
+    index = _synthetic_index(tmp_path / "trials", n=1)
+    t0 = time.monotonic()
+    r = cli("calibrate", "fit", index, "--range", "metal=1:2", "--range", "wood=331:506", "--bootstrap", value)
+    assert time.monotonic() - t0 < 5
+    assert r.exit_code == 2
+    assert r.stderr.strip().splitlines() == [
+        f"Error: --bootstrap must be 0 (none) or 2 to 10000 replicates, got {value}"], r.stderr
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--trials", "1000000000"], "--trials must be 1 to 1000 touches per material, got 1000000000"),
+    (["--trials", "0"], "--trials must be 1 to 1000 touches per material, got 0"),
+    (["--bootstrap", "100000000"], "--bootstrap must be 0 (none) or 2 to 10000 replicates, got 100000000"),
+])
+def test_guided_run_bounds_its_counts_before_recording(cli, tmp_path, args, message):
+    r = cli("calibrate", "--port", "/dev/whatever", "--material", "wood", "--range", "wood=331:506",
+            "--out", tmp_path / "out", "--yes", *args)
+    assert r.exit_code == 2 and r.stderr.strip().splitlines() == [f"Error: {message}"], r.stderr
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("value", ["1000000000", "1001", "0"])
+def test_record_bounds_trials(cli, tmp_path, value):
+    r = cli("calibrate", "record", "--port", "/dev/whatever", "--material", "wood", "--out", tmp_path / "out",
+            "--trials", value)
+    assert r.exit_code == 2
+    assert r.stderr.strip().splitlines() == [f"Error: --trials must be 1 to 1000 touches per material, got {value}"]

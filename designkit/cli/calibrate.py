@@ -31,7 +31,7 @@ PortOpt = Annotated[Optional[str], typer.Option(
     "--port", help="Serial port of the rig (/dev/ttyACM0, COM3, or the pty 'designkit emulate' prints).")]
 ProfileOpt = Annotated[str, typer.Option(
     "--profile", help="Device profile: a shipped name ('designkit', 'adc12-thermistor') or a profile YAML file.")]
-TrialsOpt = Annotated[int, typer.Option("--trials", help="Touches to record per material.")]
+TrialsOpt = Annotated[int, typer.Option("--trials", help="Touches to record per material (at most 1000).")]
 TimeoutOpt = Annotated[Optional[float], typer.Option(
     "--timeout", help="Give up when the device sends nothing for this long [s] (default: the profile's).")]
 RangeOpt = Annotated[Optional[list[str]], typer.Option(
@@ -44,7 +44,14 @@ DepthOpt = Annotated[float, typer.Option(
     "--depth-um", help="Thermistor depth below the contact surface [um], held fixed (only x^2/alpha_s is "
                        "identifiable).")]
 BootstrapOpt = Annotated[int, typer.Option(
-    "--bootstrap", help="Bootstrap replicates over trials for the uncertainties (0: Jacobian instead).")]
+    "--bootstrap", help="Bootstrap replicates over trials for the uncertainties (0: Jacobian instead; at most "
+                        "10000).")]
+
+#: Most touches per material one run records (a touch takes at least the trial window, 8 s by default).
+MAX_TRIALS = 1000
+#: Most bootstrap replicates (a replicate is a whole refit, ~10 ms per 100 trials; 1000-2000 suffice for a
+#: 95 % interval, so more only costs time).
+MAX_BOOTSTRAP = 10_000
 
 
 # ---------------------------------------------------------------- helpers
@@ -62,8 +69,19 @@ def _fit_settings(depth_um: float, bootstrap: int, seed: int, baseline: str = "m
         raise InputError(f"--offset-range must look like MIN:MAX in seconds, got {offset_range!r}")
     if not (depth_um > 0 and math.isfinite(depth_um)):
         raise InputError(f"--depth-um must be positive, got {depth_um:g}")
+    if fit_to is not None and not (math.isfinite(fit_to) and fit_to > 0):
+        raise InputError(f"--fit-to must be a positive, finite time after onset [s], got {fit_to:g}")
+    if bootstrap != 0 and not 2 <= bootstrap <= MAX_BOOTSTRAP:
+        raise InputError(f"--bootstrap must be 0 (none) or 2 to {MAX_BOOTSTRAP} replicates, got {bootstrap}")
     return FitSettings(depth_m=depth_um * 1e-6, bootstrap=bootstrap, seed=seed, baseline=baseline,
                        offset_bounds_s=bounds, fit_to_s=fit_to)
+
+
+def _check_trials(trials: int) -> None:
+    from .._validation import InputError
+
+    if not 1 <= trials <= MAX_TRIALS:
+        raise InputError(f"--trials must be 1 to {MAX_TRIALS} touches per material, got {trials}")
 
 
 def _check_timeout(timeout: Optional[float]) -> None:
@@ -291,8 +309,7 @@ def record(
 
     if port is None or material is None or out is None:
         raise InputError("give --port, --material and --out")
-    if trials < 1:
-        raise InputError(f"--trials must be >= 1, got {trials}")
+    _check_trials(trials)
     _check_timeout(timeout)
     prof = load_profile(profile)
     rec, paths, interrupted = _record_materials(port, prof, out, [material], trials, timeout, quiet=json_,
@@ -374,8 +391,7 @@ def guided(
     if port is None or not material or out is None:
         raise InputError("the guided run needs --port, at least one --material and --out "
                          "(or use 'calibrate record' and 'calibrate fit')")
-    if trials < 1:
-        raise InputError(f"--trials must be >= 1, got {trials}")
+    _check_trials(trials)
     _check_timeout(timeout)
     from ..calibration.fit import parse_object_temps, parse_ranges, resolve_ranges
     from ..calibration.profiles import load_profile

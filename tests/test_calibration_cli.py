@@ -301,3 +301,16 @@ def test_record_bounds_trials(cli, tmp_path, value):
             "--trials", value)
     assert r.exit_code == 2
     assert r.stderr.strip().splitlines() == [f"Error: --trials must be 1 to 1000 touches per material, got {value}"]
+
+
+def test_record_refuses_a_folder_whose_index_it_would_spoil(cli, tmp_path):
+    index = tmp_path / "index.csv"
+    index.write_text("file,material,trial_set,trial_index\nset01_wood_1.csv,wood,1,1\n")
+    (tmp_path / "set01_wood_1.csv").write_text("time_s,active_temp_c\n-1,35\n0,35\n1,34\n")
+    with _emulator(WOOD, "wood") as emu:
+        r = cli("calibrate", "record", "--port", emu.port, "--material", "wood", "--out", tmp_path, "--trials", "1")
+    assert r.exit_code == 2
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and "not designkit recordings (e.g. set01_wood_1.csv)" in lines[0], r.stderr
+    assert index.read_text() == "file,material,trial_set,trial_index\nset01_wood_1.csv,wood,1,1\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["index.csv", "set01_wood_1.csv"]

@@ -357,16 +357,25 @@ def test_ctrl_c_between_sidecar_and_index_still_records_the_trial(tmp_path, monk
     assert sorted(Path(t.source).name for t in load_index(tmp_path / "index.csv")) == on_disk
 
 
-def test_a_failed_trial_write_leaves_nothing_behind(tmp_path):
+def test_a_failed_trial_write_leaves_nothing_behind(tmp_path, monkeypatch):
+    """The disk fills up at the commit (injected: a full disk cannot be had portably in a test)."""
+    import errno
+
+    from designkit.calibration import trials as trials_module
+
+    real_write = trials_module.atomic_write_text
+
+    def full_at_index(path, text):
+        if Path(path).name == "index.csv":
+            raise OSError(errno.ENOSPC, "No space left on device", str(path))
+        return real_write(path, text)
+
     _write_one(tmp_path)
     before = sorted(p.name for p in tmp_path.iterdir())
-    index = tmp_path / "index.csv"
-    index.unlink()
-    index.mkdir()  # the commit (replacing the index) fails for real: it is a folder
-    with pytest.raises(OSError):
+    monkeypatch.setattr(trials_module, "atomic_write_text", full_at_index)
+    with pytest.raises(OSError, match="No space left"):
         _write_one(tmp_path)
-    index.rmdir()
-    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(set(before) - {"index.csv"})
+    assert sorted(p.name for p in tmp_path.iterdir()) == before
 
 
 @pytest.mark.parametrize("which", ["index", "trial", "sidecar"])
@@ -464,3 +473,32 @@ def test_recorded_trials_are_what_the_index_lists(tmp_path):
     assert recorded_trials(tmp_path) == [] and load_index(tmp_path / "index.csv") == []
     first, second = _write_one(tmp_path), _write_one(tmp_path)
     assert recorded_trials(tmp_path) == [first, second]
+
+
+def test_recording_into_a_folder_with_someone_elses_index_is_refused(tmp_path):
+    """The index is rebuilt from the sidecars: it would have dropped every row of the shared recordings'."""
+    index = tmp_path / "index.csv"
+    index.write_text("file,material,trial_set,trial_index\nset01_wood_1.csv,wood,1,1\n")
+    (tmp_path / "set01_wood_1.csv").write_text("time_s,active_temp_c\n-1,35\n0,35\n1,34\n")
+    before = index.read_bytes()
+    with pytest.raises(InputError) as exc:
+        SerialRecorder("/dev/whatever", load_profile("designkit"), tmp_path)
+    assert str(exc.value) == (f"index {index} lists 1 file(s) that are not designkit recordings (e.g. "
+                              f"set01_wood_1.csv); recording into {tmp_path} would drop them from it: use "
+                              "another folder")
+    with pytest.raises(InputError, match="not designkit recordings"):
+        _write_one(tmp_path)
+    assert index.read_bytes() == before and sorted(p.name for p in tmp_path.iterdir()) == [
+        "index.csv", "set01_wood_1.csv"]
+    index.write_text("no,index,here\n")
+    with pytest.raises(InputError, match=f"needs columns file and material; recording into {tmp_path} would "
+                                         "replace it"):
+        _write_one(tmp_path)
+
+
+def test_an_index_of_designkit_trials_is_added_to(tmp_path):
+    first = _write_one(tmp_path)
+    (tmp_path / "notes.txt").write_text("not listed, not touched\n")
+    second = _write_one(tmp_path, "metal")
+    assert recorded_trials(tmp_path) == [second, first]  # index order: by material
+    assert (tmp_path / "notes.txt").exists()

@@ -49,7 +49,7 @@ import numpy as np
 
 from .._validation import InputError, check_positive
 from .profiles import ROLES, DeviceProfile
-from .trials import write_trial
+from .trials import check_trial_folder, write_trial
 
 __all__ = ["MIN_READABLE_FRACTION", "RecordEvent", "RecorderStatus", "SerialRecorder", "TrialCutter"]
 
@@ -329,6 +329,13 @@ class SerialRecorder:
     on_event : callable(RecordEvent), optional
     on_status : callable(RecorderStatus), optional
         Called a few times a second with live numbers.
+
+    Raises
+    ------
+    InputError
+        ``out_dir`` has an index that recording would spoil (see
+        :func:`~designkit.calibration.trials.check_trial_folder`), or a bad
+        ``no_data_timeout_s``.
     """
 
     def __init__(self, port: str, profile: DeviceProfile, out_dir: Path, *,
@@ -338,6 +345,7 @@ class SerialRecorder:
         self.port = str(port)
         self.profile = profile
         self.out_dir = Path(out_dir)
+        check_trial_folder(self.out_dir)
         if no_data_timeout_s is None:
             no_data_timeout_s = profile.serial.no_data_timeout_s
         self.no_data_timeout_s = check_positive("no_data_timeout_s [s]", no_data_timeout_s)

@@ -12,7 +12,9 @@ The sidecar ``<trial>.json`` records the profile, material, time, the sensor
 and object temperatures before contact, and how the trial was cut. The folder's
 ``index.csv`` (columns ``file,material,trial_index``) is rebuilt from the
 sidecars after every trial and can be given to ``designkit calibrate fit`` as
-it is.
+it is. A folder whose index lists files without a designkit sidecar (another
+index, like the shared recordings') is refused rather than having those rows
+dropped (:func:`check_trial_folder`).
 
 A trial is recorded when, and only when, the index lists it. Writing one is
 three atomic file replacements: the CSV, the sidecar, then the index, whose
@@ -43,7 +45,8 @@ import numpy as np
 from .._io import atomic_write_text
 from .._validation import InputError
 
-__all__ = ["COLUMNS", "Trial", "load_index", "read_trial_csv", "rebuild_index", "recorded_trials", "write_trial"]
+__all__ = ["COLUMNS", "Trial", "check_trial_folder", "load_index", "read_trial_csv", "rebuild_index",
+           "recorded_trials", "write_trial"]
 
 COLUMNS = ("time_s", "passive_temp_c", "active_temp_c", "unused_channel", "force_n")
 TRIAL_FILE_VERSION = 1
@@ -114,6 +117,7 @@ def write_trial(folder: Path, material: str, time_s, sensor_c, object_c, force_n
     the CSV path.
     """
     folder = Path(folder)
+    check_trial_folder(folder)  # before writing anything
     folder.mkdir(parents=True, exist_ok=True)
     slug = _slug(material)
     taken = {int(m.group(1)) for p in folder.glob(f"{slug}_*.json")
@@ -131,7 +135,7 @@ def write_trial(folder: Path, material: str, time_s, sensor_c, object_c, force_n
         try:
             written.append(atomic_write_text(csv_path, csv_text))
             written.append(atomic_write_text(csv_path.with_suffix(".json"), side_text))
-            rebuild_index(folder)  # the commit point: from here on the trial is recorded
+            _write_index(folder)  # the commit point: from here on the trial is recorded
         except BaseException:
             for path in reversed(written):
                 with contextlib.suppress(OSError):
@@ -179,8 +183,49 @@ def _plain(obj: Any) -> Any:
 
 
 def rebuild_index(folder: Path) -> Path:
-    """Write ``folder/index.csv`` (file, material, trial_index) from the sidecars."""
+    """Write ``folder/index.csv`` (file, material, trial_index) from the sidecars.
+
+    Refuses (see :func:`check_trial_folder`) to replace an index that lists
+    files which are not designkit recordings.
+    """
     folder = Path(folder)
+    check_trial_folder(folder)
+    return _write_index(folder)
+
+
+def _write_index(folder: Path) -> Path:
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\n")
+    writer.writerow(["file", "material", "trial_index"])
+    writer.writerows(_sidecar_rows(folder))
+    return atomic_write_text(folder / "index.csv", buf.getvalue())
+
+
+def check_trial_folder(folder: Path | str) -> None:
+    """Refuse to record into a folder whose ``index.csv`` this module would not rewrite faithfully.
+
+    The index is rebuilt from the sidecars after every trial, so an index
+    listing files that have no designkit sidecar (the shared recordings', a
+    hand-made one) would lose those rows, and one that cannot be read would be
+    replaced. Raises InputError naming the index and a file it lists.
+    """
+    folder = Path(folder)
+    index_csv = folder / "index.csv"
+    if not index_csv.exists():
+        return
+    try:
+        rows = read_index_rows(index_csv)
+    except InputError as exc:
+        raise InputError(f"{exc}; recording into {folder} would replace it: use another folder") from None
+    ours = {name for name, _, _ in _sidecar_rows(folder)}
+    foreign = [r["file"] for r in rows if r.get("file") and r["file"] not in ours and (folder / r["file"]).exists()]
+    if foreign:
+        raise InputError(f"index {index_csv} lists {len(foreign)} file(s) that are not designkit recordings (e.g. "
+                         f"{foreign[0]}); recording into {folder} would drop them from it: use another folder")
+
+
+def _sidecar_rows(folder: Path) -> list[tuple[str, str, Any]]:
+    """(file, material, trial_index) of every trial in ``folder`` with a sidecar and its CSV, sorted."""
     rows = []
     for side in sorted(folder.glob("*.json")):
         try:
@@ -193,11 +238,7 @@ def rebuild_index(folder: Path) -> Path:
         if csv_path.is_file():
             rows.append((csv_path.name, str(meta.get("material", "")), meta.get("trial_index", "")))
     rows.sort(key=lambda r: (r[1], r[2] if isinstance(r[2], int) else 0, r[0]))
-    buf = io.StringIO()
-    writer = csv.writer(buf, lineterminator="\n")
-    writer.writerow(["file", "material", "trial_index"])
-    writer.writerows(rows)
-    return atomic_write_text(folder / "index.csv", buf.getvalue())
+    return rows
 
 
 def _read_text(path: Path, what: str) -> str:

@@ -314,3 +314,27 @@ def test_record_refuses_a_folder_whose_index_it_would_spoil(cli, tmp_path):
     assert len(lines) == 1 and "not designkit recordings (e.g. set01_wood_1.csv)" in lines[0], r.stderr
     assert index.read_text() == "file,material,trial_set,trial_index\nset01_wood_1.csv,wood,1,1\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["index.csv", "set01_wood_1.csv"]
+
+
+@pytest.mark.parametrize("command, extra", [(["record"], []), ([], ["--material", "wood", "--yes"])],
+                         ids=["record", "guided"])
+def test_record_refuses_an_empty_material(cli, tmp_path, command, extra):
+    """An empty label was recorded as 'material_001.csv' into an index that 'calibrate fit' then refused."""
+    r = cli("calibrate", *command, "--port", "/dev/whatever", "--material", " ", "--out", tmp_path / "out", *extra)
+    assert r.exit_code == 2
+    assert r.stderr.strip().splitlines() == ["Error: --material must not be empty (it names the trials in the index)"]
+
+
+def test_record_checks_the_out_folder_before_waiting_for_touches(cli, tmp_path):
+    not_a_folder = tmp_path / "notes.txt"
+    not_a_folder.write_text("hello\n")
+    blocked = not_a_folder / "trials"  # its parent is a file: the folder cannot be created
+    with _emulator(WOOD, "wood", speed=1.0) as emu:  # real time: the first touch is 10 s away
+        t0 = time.monotonic()
+        r1 = cli("calibrate", "record", "--port", emu.port, "--material", "wood", "--out", not_a_folder)
+        r2 = cli("calibrate", "record", "--port", emu.port, "--material", "wood", "--out", blocked)
+        assert time.monotonic() - t0 < 5
+    assert r1.exit_code == 2 and r1.stderr.strip().splitlines() == [
+        f"Error: {not_a_folder} is not a folder (the trials and their index.csv go in one)"]
+    assert r2.exit_code == 2 and r2.stderr.strip().splitlines() == [
+        f"Error: cannot create the trial folder {blocked}: Not a directory"]

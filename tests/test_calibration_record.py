@@ -502,3 +502,10 @@ def test_an_index_of_designkit_trials_is_added_to(tmp_path):
     second = _write_one(tmp_path, "metal")
     assert recorded_trials(tmp_path) == [second, first]  # index order: by material
     assert (tmp_path / "notes.txt").exists()
+
+
+def test_record_refuses_an_empty_material_label(tmp_path):
+    prof = load_profile("designkit")
+    with _emulator(prof) as emu, SerialRecorder(emu.port, prof, tmp_path) as rec:
+        with pytest.raises(InputError, match="material label must not be empty"):
+            rec.record("  ", 1)

@@ -431,6 +431,10 @@ class SerialRecorder:
             Nothing (or nothing readable) within the time limit.
         DeviceGone
             The port vanished and did not come back within ``reconnect_s``.
+        TooManyBadLines
+            Too many lines unreadable to keep any trial (module docstring).
+        InputError
+            An empty material label, or the trial folder cannot be created.
         KeyboardInterrupt
             Passed on; everything written so far stays.
         """
@@ -438,8 +442,14 @@ class SerialRecorder:
 
         if trials < 1:
             raise InputError(f"trials must be >= 1, got {trials}")
+        if not str(material).strip():
+            raise InputError("the material label must not be empty (it names the trials in the index)")
         if self._ser is None:
             self.open()
+        try:  # now, not when the first touch is complete
+            self.out_dir.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise InputError(f"cannot create the trial folder {self.out_dir}: {exc.strerror or exc}") from None
         cutter = TrialCutter(self.profile, self.out_dir, material,
                              meta={"profile": self.profile.name, "port": self.port,
                                    "timestamps": "device" if self.profile.has_timestamp else "line count"})

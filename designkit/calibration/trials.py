@@ -207,9 +207,12 @@ def check_trial_folder(folder: Path | str) -> None:
     The index is rebuilt from the sidecars after every trial, so an index
     listing files that have no designkit sidecar (the shared recordings', a
     hand-made one) would lose those rows, and one that cannot be read would be
-    replaced. Raises InputError naming the index and a file it lists.
+    replaced. Raises InputError naming the index and a file it lists (or
+    ``folder``, when it is a file).
     """
     folder = Path(folder)
+    if folder.exists() and not folder.is_dir():
+        raise InputError(f"{folder} is not a folder (the trials and their index.csv go in one)")
     index_csv = folder / "index.csv"
     if not index_csv.exists():
         return

@@ -309,6 +309,8 @@ def record(
 
     if port is None or material is None or out is None:
         raise InputError("give --port, --material and --out")
+    if not material.strip():
+        raise InputError("--material must not be empty (it names the trials in the index)")
     _check_trials(trials)
     _check_timeout(timeout)
     prof = load_profile(profile)
@@ -391,6 +393,8 @@ def guided(
     if port is None or not material or out is None:
         raise InputError("the guided run needs --port, at least one --material and --out "
                          "(or use 'calibrate record' and 'calibrate fit')")
+    if not all(m.strip() for m in material):
+        raise InputError("--material must not be empty (it names the trials in the index)")
     _check_trials(trials)
     _check_timeout(timeout)
     from ..calibration.fit import parse_object_temps, parse_ranges, resolve_ranges

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from designkit import Scene
-from designkit.accuracy import report as bench
+from designkit import accuracy as bench
 from designkit.query import ideal_bound
 from designkit.recognition.ideal import ideal_pair
 from designkit.sensor import SENSORS
@@ -55,7 +55,7 @@ def test_process_cost_reports_the_childs_own_peak_memory_and_exit_status():
     assert bad.returncode == 3 and bad.stdout.strip() == "x"
 
 
-@pytest.mark.skipif(bench._reset_peak_memory() is None, reason="needs Linux /proc/self/clear_refs")
+@pytest.mark.skipif(bench.reset_peak_memory() is None, reason="needs Linux /proc/self/clear_refs")
 def test_measure_reports_each_calls_own_peak():
     def alloc(mb):
         a = np.ones(int(mb * 2**20 / 8))

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from designkit.query import table as q
-from designkit.export.core import slice_table, to_c
+from designkit.export import render, slice_table
 from designkit.tables.store import load_table
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -28,6 +28,10 @@ pytestmark = pytest.mark.skipif(CC is None, reason="no C compiler (cc, gcc or cl
                                 "cannot be compiled here")
 STRICT = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic"]
 SENTINELS = {-1.0: None, -2.0: "outside", -3.0: "invalid"}
+
+
+def to_c(exp, prefix: str = "designkit") -> bytes:
+    return render(exp, "c", prefix=prefix)
 
 
 def build(tmp_path: Path, header: bytes, *, flags=("-O2",), name="lookup", source: Path | None = None) -> Path:

@@ -385,7 +385,7 @@ class Lookup:
             if math.isnan(x):
                 return None
             total += w * x
-        return total
+        return float(total)
 
     # ---- the questions
     def _deltas(self, e, noise_c, delta_t_c, contact_s):
@@ -430,4 +430,4 @@ class Lookup:
         cw = self.contact_weights(contact)
         self._check_e(lo, hi)
         total = self._over_contact(cw, lambda k: self.need(combos, k, lo, hi))
-        return total is not None and total <= hi - lo
+        return total is not None and bool(total <= hi - lo)

@@ -522,7 +522,7 @@ def test_shipped_svm_paper_exports_like_its_query(tmp_path):
 
 
 # ============================================================ CLI
-@pytest.mark.parametrize("fmt,suffix", [("json", ".json"), ("csv", ".csv"), ("npz", ".npz"), ("c", ".h"),
+@pytest.mark.parametrize("fmt,suffix", [("json", ".json"), ("csv", ".csv"), ("npz", ".npz"), ("mat", ".mat"), ("c", ".h"),
                                         ("python", ".py")])
 def test_cli_export_every_format(cli, tmp_path, fmt, suffix):
     out = tmp_path / f"table{suffix}"

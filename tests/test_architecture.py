@@ -52,8 +52,12 @@ def _imports(mod: str) -> list[tuple[str, list[str], int]]:
     path = _path(mod)
     tree = ast.parse(path.read_text(encoding="utf-8"))
     pkg = mod if path.name == "__init__.py" else mod.rpartition(".")[0]
+    typing_only = {id(n) for block in ast.walk(tree) if isinstance(block, ast.If)
+                   and "TYPE_CHECKING" in ast.unparse(block.test) for n in ast.walk(block)}
     out = []
     for node in ast.walk(tree):
+        if id(node) in typing_only:  # annotations only: never imported at run time
+            continue
         if isinstance(node, ast.ImportFrom):
             if node.level:
                 base = pkg.split(".")[: len(pkg.split(".")) - (node.level - 1)]

@@ -34,6 +34,8 @@ from typing import Any, Sequence
 import numpy as np
 
 from .._validation import InputError
+from ..tables import lookup
+from ..tables.lookup import GRID_RTOL
 from ..tables.store import Table, load_table
 from .answer import Answer, IdealBound, number
 from .exact import (  # noqa: F401  importable from here for callers written before the route split
@@ -136,67 +138,23 @@ class _View:
         return all(self.e_lo < e <= self.e_hi for e in es)
 
 
-#: A value within this relative distance of a grid value is that grid value. A float32
-#: argument (0.05f / 10.0f, as on a microcontroller) cannot hit 0.005 exactly, and the
-#: exported C and Python lookups use the same rule, so all three answer alike.
-GRID_RTOL = 1e-6
-
-
 def _axis_weights(vals: np.ndarray, x: float, *, log: bool) -> tuple[list[tuple[int, float]], bool]:
-    """Linear (or log-linear) weights of ``x`` between grid values; clamps outside, flagged.
-
-    Within :data:`GRID_RTOL` of a grid value, ``x`` is that value (weight 1).
-    """
-    n = vals.size
-    near = np.abs(x - vals) <= GRID_RTOL * np.abs(vals)
-    if near.any():
-        return [(int(np.argmax(near)), 1.0)], True
-    if n == 1 or x < vals[0] or x > vals[-1]:
-        return [(0 if x < vals[0] else n - 1, 1.0)], False
-    if log:
-        if x <= 0 or vals[0] <= 0:
-            return [(0, 1.0)], False
-        u, grid = math.log(x), np.log(vals)
-    else:
-        u, grid = x, vals
-    j = int(np.clip(np.searchsorted(grid, u) - 1, 0, n - 2))
-    w = float(np.clip((u - grid[j]) / (grid[j + 1] - grid[j]), 0.0, 1.0))
-    return [(j, 1.0 - w), (j + 1, w)], True
+    """Weights of ``x`` on one axis (:func:`designkit.tables.lookup.axis_weights`, the one lookup),
+    plus an in-grid flag; outside the grid the nearest end, flagged (nothing is extrapolated)."""
+    pts = lookup.axis_weights(vals, x, log=log, grid=np.log(vals) if log and vals[0] > 0 else vals)
+    if pts is not None:
+        return pts, True
+    return [(0 if (x < vals[0] or (log and x <= 0)) else vals.size - 1, 1.0)], False
 
 
 def _interp_e(row: np.ndarray, centres: np.ndarray, e: float) -> float:
-    """delta at effusivity e from values at interval centres; NaN if a neighbour is NaN."""
-    if e <= centres[0]:
-        return float(row[0])
-    if e >= centres[-1]:
-        return float(row[-1])
-    j = int(np.searchsorted(centres, e, side="right") - 1)  # centres[j] <= e < centres[j + 1]
-    a, b = row[j], row[j + 1]
-    w = (e - centres[j]) / (centres[j + 1] - centres[j])
-    if w == 0.0:  # on a grid point: its own value, whatever the neighbour holds
-        return float(a)
-    if math.isnan(a) or math.isnan(b):
-        return math.nan
-    return float(a + w * (b - a))
+    """delta at effusivity e (:func:`designkit.tables.lookup.interp_e`); NaN if a neighbour is NaN."""
+    return float(lookup.interp_e(row, centres, e))
 
 
 def _crossing(xs: Sequence[float], needs: Sequence[float], gap: float) -> tuple[float | None, int | None]:
-    """First x where need(x) <= gap, linearly interpolated between grid points.
-
-    ``needs`` decreases along ``xs`` (more contact, less noise); NaN means the
-    need is beyond the grid. Returns (x, index of the first grid point that
-    suffices) or (None, None).
-    """
-    for k, nd in enumerate(needs):
-        if not math.isnan(nd) and nd <= gap:
-            if k == 0:
-                return float(xs[0]), 0
-            prev = needs[k - 1]
-            if math.isnan(prev):
-                return float(xs[k]), k  # cannot interpolate into "beyond the grid": conservative
-            w = (prev - gap) / (prev - nd) if prev != nd else 1.0
-            return float(xs[k - 1] + w * (xs[k] - xs[k - 1])), k
-    return None, None
+    """First x where need(x) <= gap, interpolated (:func:`designkit.tables.lookup.crossing`)."""
+    return lookup.crossing(xs, needs, gap)
 
 
 # ============================================================ opening a table for a question
@@ -412,6 +370,11 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
     note = "" if value is not None else (
         f"no tabulated contact time up to {view.contacts[-1]:g} s separates them "
         "(the exact route examines longer contacts)")
+    grid = [float(c) for c in view.contacts]
+    if value is not None and value in grid and grid.index(value) > 0:
+        prev = grid[grid.index(value) - 1]
+        note = (f"{value:g} s is the table's next contact time after {prev:g} s, where they are not separable: "
+                f"the shortest time lies in ({prev:g}, {value:g}] s (the exact route resolves it)")
     needed = value if value is not None else float(view.contacts[-1])
     return _answer("min-contact", op, value=value, interval=interval, ideal=ideal, in_grid=flags, details={},
                    notes=[note], check_at=(needed, noise, dt), **common)

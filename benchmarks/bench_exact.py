@@ -29,7 +29,7 @@ import statistics
 import sys
 from pathlib import Path
 
-from designkit.accuracy.report import process_cost
+from designkit.accuracy import process_cost
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_query import console_script, svm_table_available  # noqa: E402
@@ -69,6 +69,12 @@ def main(argv=None):
         t_ex.append(r.wall_s)
         answers.append(json.loads(r.stdout))
     ex = answers[-1]
+
+    def flat(d):  # the answer schema's min-contact figures
+        return {"value": d["value"], "interval": [d["interval"]["low"], d["interval"]["high"]],
+                "ideal": d["ideal"]["value"]}
+
+    tab_f, ex_f = flat(tab_ans), flat(ex)
     med_ex, med_tab = statistics.median(t_ex), statistics.median(t_tab)
     print(f"### --exact min-contact, {args.e1:g} vs {args.e2:g}, noise {args.noise:g} °C, dT {args.delta_t:g} °C\n")
     if not svm:
@@ -81,34 +87,33 @@ def main(argv=None):
           f"{med_ex:.2f} | {min(t_ex):.2f} | {max(t_ex):.2f} |")
     print(f"\nTarget < 10 s: median {med_ex:.2f} s ({'met' if med_ex < 10 else 'NOT met'}); "
           f"exact / table = {med_ex / med_tab:.0f}x. Compute inside the exact run: "
-          f"{ex['details'].get('wall_s', float('nan')):.2f} s (the rest is process start-up and imports).")
+          f"{ex['computation'].get('wall_s', float('nan')):.2f} s (the rest is process start-up and imports).")
 
     def inside(v, iv):
         lo, hi = iv
         return v is not None and (lo is None or v >= lo - 1e-9) and (hi is None or v <= hi + 1e-9)
 
     print("\n| answer | contact time [s] | interval [s] | ideal observer [s] |\n|---|---|---|---|")
-    print(f"| table {table} | {tab_ans['contact_time_s']} | {tab_ans['contact_time_interval_s']} | "
-          f"{tab_ans['ideal_contact_time_s']} |")
-    print(f"| --exact | {ex['contact_time_s']} | {ex['contact_time_interval_s']} | {ex['ideal_contact_time_s']} |")
+    print(f"| table {table} | {tab_f['value']} | {tab_f['interval']} | {tab_f['ideal']} |")
+    print(f"| --exact | {ex_f['value']} | {ex_f['interval']} | {ex_f['ideal']} |")
     facts = {}
-    if svm and tab_ans["contact_time_s"] is not None and ex["contact_time_s"] is not None:
-        facts = {"exact_in_table_interval": inside(ex["contact_time_s"], tab_ans["contact_time_interval_s"]),
-                 "table_in_exact_interval": inside(tab_ans["contact_time_s"], ex["contact_time_interval_s"]),
-                 "difference_s": tab_ans["contact_time_s"] - ex["contact_time_s"]}
+    if svm and tab_f["value"] is not None and ex_f["value"] is not None:
+        facts = {"exact_in_table_interval": inside(ex_f["value"], tab_f["interval"]),
+                 "table_in_exact_interval": inside(tab_f["value"], ex_f["interval"]),
+                 "difference_s": tab_f["value"] - ex_f["value"]}
         print(f"\nexact inside the table's interval: {facts['exact_in_table_interval']}; table inside the exact "
               f"interval: {facts['table_in_exact_interval']}; table - exact = {facts['difference_s']:+.3f} s "
               f"(the table's interpolation plus Monte Carlo error for this pair).")
-    ti, ei = tab_ans["ideal_contact_time_s"], ex["ideal_contact_time_s"]
+    ti, ei = tab_f["ideal"], ex_f["ideal"]
     if ti is not None and ei is not None:
         facts["ideal_difference_s"] = ti - ei
         print(f"Ideal observer: table {ti:.3f} s vs exact closed form {ei:.3f} s ({ti - ei:+.3f} s: the table's "
               f"interpolation error alone, no Monte Carlo).")
     print("\nSVM evaluations of the exact run (contact time, mean F1 over seeds, standard error):\n")
-    for ev in ex["details"].get("evaluations", []):
+    for ev in ex["computation"].get("evaluations", []):
         print(f"    {ev['contact_s']:7.3f} s   F1 {ev['svm_f1']:.3f} ± {ev['standard_error']:.3f}")
-    print(f"\n{len(ex['details'].get('evaluations', []))} contact times x {args.repeats} seeds = "
-          f"{len(ex['details'].get('evaluations', [])) * args.repeats} SVM fits (3-fold cross-validation each).")
+    print(f"\n{len(ex['computation'].get('evaluations', []))} contact times x {args.repeats} seeds = "
+          f"{len(ex['computation'].get('evaluations', [])) * args.repeats} SVM fits (3-fold cross-validation each).")
     if args.json is not None:
         from designkit._io import atomic_write_text
 

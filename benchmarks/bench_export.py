@@ -39,7 +39,7 @@ from pathlib import Path
 import numpy as np
 
 from designkit.query import table as q
-from designkit.export.core import FORMATS, render, slice_table, to_c, to_python
+from designkit.export import FORMATS, render, slice_table
 from designkit.tables.store import list_tables, load_table
 
 NOISE_C, DELTA_T_C = 0.05, 10.0
@@ -212,13 +212,13 @@ def main(argv=None) -> int:
                     "exports do not carry: most of its time")
             for label, exp in (("whole table", slice_table(tab)),
                                ("one scene", slice_table(tab, noise_c=NOISE_C, delta_t_c=DELTA_T_C))):
-                mod = module_from(to_python(exp), tmp, f"mod_{len(exp.shape)}_{exp.shape[0]}")
+                mod = module_from(render(exp, "python"), tmp, f"mod_{len(exp.shape)}_{exp.shape[0]}")
                 t_py = time_python(stdlib_calls(mod), x_c[: 20 * args.py_calls], args.reps)
                 print(f"| stdlib module, {label} | " + " | ".join(f"{t:,.0f}" for t in t_py) + " | "
                       + " / ".join(f"{b / t:.0f}x" for b, t in zip(base, t_py)) + " |")
                 sub = tmp / f"c_{label.replace(' ', '_')}"
                 sub.mkdir()
-                t_c = time_c(to_c(exp), x_c, args.reps, sub)
+                t_c = time_c(render(exp, "c"), x_c, args.reps, sub)
                 if t_c is None:
                     print(f"| C header, {label} | (no C compiler) | | | |")
                     continue

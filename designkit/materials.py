@@ -11,7 +11,7 @@ Two named sets are shipped in ``designkit/data/materials.yaml`` (described in
     diffusivity ranges are derived here at load time, never typed:
 
     - ``e = sqrt(k rho c)`` [J s^-1/2 K^-1 m^-2] (paper eq. 1,
-      :func:`designkit.physics.effusivity`); ``e_min`` from the three minima,
+      :func:`designkit.properties.effusivity`); ``e_min`` from the three minima,
       ``e_max`` from the three maxima. e grows with each property, so this
       "corner rule" gives the widest interval the ranges allow (properties
       correlate in real grades, so the true spread is narrower).
@@ -21,7 +21,7 @@ Two named sets are shipped in ``designkit/data/materials.yaml`` (described in
 
 ``paper12``
     The paper's 12 robot-experiment materials with the identified effusivity
-    and the range printed in its appendix table (DOMAIN.md section 3), k, rho
+    and the range printed in its appendix table (docs/physics.md section 3), k, rho
     and c unknown. Each names the ``database`` entry that supplies its
     diffusivity range and family (``diffusivity_from``).
 
@@ -372,7 +372,7 @@ def _check_names(source: str, set_name: str, materials: Iterable[Material]) -> N
 
 
 def _parse_table(data: Any, source: str) -> MaterialTable:
-    from .models.semi_infinite import effusivity
+    from .properties import effusivity
 
     if not isinstance(data, Mapping):
         raise InputError(f"{source}: a materials file must be a mapping, got {type(data).__name__}")

@@ -77,7 +77,7 @@ class Scene:
 
         With fixed initial conditions and standardized features, recognition
         depends on noise and temperature difference only through this ratio
-        (DOMAIN.md section 2). ``inf`` when there is no temperature difference.
+        (docs/physics.md section 2). ``inf`` when there is no temperature difference.
         """
         dt = abs(self.delta_t_c)
         if dt == 0:

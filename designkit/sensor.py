@@ -18,7 +18,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from ._validation import InputError, check_nonnegative, check_positive
-from .models.semi_infinite import time_constant
+from .properties import time_constant
 
 __all__ = ["SENSORS", "Sensor", "load_sensor", "sample_times_s"]
 

@@ -1,8 +1,11 @@
-"""designkit.bench and `designkit bench`: the measuring instruments themselves.
+"""designkit.accuracy and `designkit bench`: the measuring instruments themselves.
 
 The exact references the benchmark compares tables against are checked here against
 their definitions (the ideal observer's F1 just above and just below each answer), so
 that a table error in docs/accuracy.md is the table's, not the reference's.
+
+No test asserts on a measured time: timings are checked to be positive and reported,
+and scaling claims are printed by benchmarks/bench_cost.py, not asserted here.
 """
 
 from __future__ import annotations
@@ -17,7 +20,7 @@ import numpy as np
 import pytest
 
 from designkit import Scene
-from designkit.accuracy import report as bench
+from designkit import accuracy as bench
 from designkit.query import ideal_bound
 from designkit.recognition.ideal import ideal_pair
 from designkit.sensor import SENSORS
@@ -55,7 +58,7 @@ def test_process_cost_reports_the_childs_own_peak_memory_and_exit_status():
     assert bad.returncode == 3 and bad.stdout.strip() == "x"
 
 
-@pytest.mark.skipif(bench._reset_peak_memory() is None, reason="needs Linux /proc/self/clear_refs")
+@pytest.mark.skipif(bench.reset_peak_memory() is None, reason="needs Linux /proc/self/clear_refs")
 def test_measure_reports_each_calls_own_peak():
     def alloc(mb):
         a = np.ones(int(mb * 2**20 / 8))
@@ -150,11 +153,30 @@ def test_staircase_and_full_matrix_agree_on_a_tiny_grid():
     assert r["max_diff_intervals"] <= 1
 
 
-def test_cost_curve_of_the_ideal_engine_grows_about_linearly_in_intervals():
+def test_cost_curve_of_the_ideal_engine_reports_every_point_and_its_exponents():
     c = bench.cost_curve("ideal: intervals", "intervals", (100, 400),
                          dict(name="t", fidelity="ideal", noise_ratio=(0.005,), contact_s=(1.0,)))
-    assert c.x == (100.0, 400.0) and all(w > 0 for w in c.wall_s) and c.fits == (0, 0)
-    assert 0.3 < c.time_exponent < 2.0
+    assert c.x == (100.0, 400.0) and c.fits == (0, 0)  # the ideal engine fits no SVM
+    assert len(c.wall_s) == len(c.peak_mb) == 2 and all(w > 0 for w in c.wall_s)
+    assert math.isfinite(c.time_exponent)  # reported; its size is benchmarks/bench_cost.py's to print
+    assert c.fits_exponent is None and c.note == ""
+
+
+def test_cost_curve_of_the_svm_engine_counts_its_fits():
+    base = dict(name="t", fidelity="svm", noise_ratio=(0.005,), contact_s=(0.5,), intervals=4, trials=8,
+                max_repeats=1)
+    c = bench.cost_curve("SVM: intervals", "intervals", (8, 16), base)
+    a = bench.cost_curve("SVM: intervals", "intervals", (8, 16), base)
+    assert c.fits == a.fits and all(f > 0 for f in c.fits)  # seeded: the same work twice
+    assert c.fits_exponent == pytest.approx(bench.fit_exponent(c.x, c.fits))
+    assert c.note.startswith("time per SVM fit")
+
+
+def test_cost_curves_follow_their_specs_and_only_selects():
+    names = [s[0] for s in bench.cost_curve_specs(quick=True)]
+    assert names == ["ideal: intervals", "ideal: contact times per table", "SVM: intervals",
+                     "SVM: trials per interval", "SVM: contact time"]
+    assert bench.cost_curves(quick=True, isolated=False, only=()) == []
 
 
 # ------------------------------------------------------------------ report and CLI
@@ -166,7 +188,9 @@ def physics_report():
 def test_physics_rows_are_accurate_and_faster_than_mpmath(physics_report):
     rows = {r.method: r for r in physics_report.rows}
     for name in ("response_shape (scipy erfc)", "temperature_change"):
-        assert rows[name].worst < 1e-12 and rows[name].speedup > 10
+        assert rows[name].worst < 1e-12
+    for r in physics_report.rows:  # timed and reported (how much faster is the page's to say, not a test's)
+        assert r.wall_s > 0 and r.reference_wall_s > 0 and r.speedup > 0
     assert rows["log_response_shape (log_ndtr)"].worst < 1e-8
     fv = rows["finite volumes"]
     assert fv.worst < 1e-2  # degC at a 10 degC difference (bench_slab's default resolution study)
@@ -218,7 +242,7 @@ def test_svm_query_rows_against_exact_on_a_tiny_svm_table(tmp_path):
     rows, facts = bench.svm_query_rows(tab, quick=True, n=1, repeats=1)
     assert [r.question for r in rows] == ["min-contact", "distinguishable"]
     case = facts["min-contact"][0]
-    assert case["exact_wall_s"] > case["table_wall_s"]
+    assert case["exact_wall_s"] > 0 and case["table_wall_s"] > 0
     assert 0.0 <= rows[1].error <= 1.0
 
 
@@ -235,3 +259,92 @@ def test_pareto_figure_has_one_visible_panel_with_points_per_question():
     for ax in visible:  # two methods and the reference star
         assert len(ax.collections) == 3
     assert bench.pareto_figure(bench.BenchReport((), (), {}, True, 0, 0.0, {})) is None
+
+
+def test_query_rows_check_distinguishable_verdicts_against_the_closed_form(ideal_table):
+    rows, facts = bench.query_rows(ideal_table, quick=True, n=12, questions=("distinguishable",))
+    assert [r.question for r in rows] == ["distinguishable"]
+    d = facts["distinguishable"]
+    assert d["n"] == 12 and 0.0 <= d["wrong_fraction"] <= 1.0 and rows[0].error == d["wrong_fraction"]
+    assert rows[0].wall_s > 0 and rows[0].reference_wall_s > 0
+
+
+# ------------------------------------------------------------------ the page, and what the package promises
+REPO = Path(__file__).resolve().parent.parent
+
+
+def _report_from_json(path: Path) -> bench.BenchReport:
+    """A report read back from accuracy.json (null: NaN, except an open gap bin's upper end: inf)."""
+    def back(obj, key=""):
+        if isinstance(obj, dict):
+            return {k: back(v, k) for k, v in obj.items()}
+        if isinstance(obj, list):
+            return [back(v, key) for v in obj]
+        return (math.inf if key == "gap_intervals" else math.nan) if obj is None else obj
+
+    d = back(json.loads(path.read_text()))
+    rows = tuple(bench.Row(**{k: v for k, v in r.items() if k != "speedup"}) for r in d["rows"])
+    curves = tuple(bench.CostCurve(**{k: tuple(v) if isinstance(v, list) else v for k, v in c.items()})
+                   for c in d["curves"])
+    return bench.BenchReport(rows, curves, d["facts"], d["quick"], d["seed"], d["wall_s"], d["environment"],
+                             tuple(d["skipped"]), d["section_wall_s"])
+
+
+@pytest.mark.skipif(not (REPO / "docs" / "accuracy.json").is_file(), reason="needs the repository's docs/")
+def test_the_shipped_page_renders_from_its_own_json():
+    """docs/accuracy.md is exactly what the renderer makes of docs/accuracy.json (same rows, same markdown)."""
+    report = _report_from_json(REPO / "docs" / "accuracy.json")
+    md = bench.render_markdown(report, {"pareto": "accuracy_pareto.png", "cost": "accuracy_cost.png"})
+    assert md == (REPO / "docs" / "accuracy.md").read_text()
+
+
+def test_every_accuracy_module_declares_its_public_names_and_imports_no_private_ones():
+    import ast
+    import importlib
+    import pkgutil
+
+    import designkit.accuracy as pkg
+
+    modules = [pkg] + [importlib.import_module(f"designkit.accuracy.{m.name}") for m in pkgutil.iter_modules(pkg.__path__)]
+    for mod in modules:
+        assert all(hasattr(mod, n) for n in mod.__all__), mod.__name__
+        tree = ast.parse(Path(mod.__file__).read_text())
+        private = [f"{n.module}.{a.name}" for n in ast.walk(tree) if isinstance(n, ast.ImportFrom)
+                   for a in n.names if a.name.startswith("_") and a.name != "__version__"]
+        assert private == [], mod.__name__
+    public = {n for mod in modules[1:] for n in mod.__all__}
+    assert public == set(pkg.__all__)  # the package exports every module's public names
+
+
+def test_mpmath_is_a_declared_dependency():
+    """`designkit bench` (section physics) needs mpmath: a plain install must have it, not only the test extra."""
+    text = (REPO / "pyproject.toml").read_text()
+    deps = text.split("dependencies = [", 1)[1].split("]", 1)[0]
+    assert '"mpmath' in deps
+
+
+@pytest.fixture
+def no_matplotlib(monkeypatch):
+    import importlib.util
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "matplotlib" else real(name, *a))
+
+
+def test_figures_refuse_in_one_line_naming_the_extra(no_matplotlib, tmp_path):
+    with pytest.raises(ValueError, match=r"pip install 'designkit\[figures\]'"):
+        bench.require_figures()
+    report = bench.BenchReport((), (), {}, True, 0, 0.0, {})
+    with pytest.raises(ValueError):
+        bench.write_report(report, tmp_path / "out")
+    assert not (tmp_path / "out").exists()  # refused before writing anything
+
+
+def test_cli_bench_out_refuses_before_measuring_without_matplotlib(cli, no_matplotlib, monkeypatch, tmp_path):
+    def must_not_run(**_):
+        raise AssertionError("measured before refusing")
+
+    monkeypatch.setattr(bench, "run_bench", must_not_run)
+    r = cli("bench", "--quick", "-s", "physics", "--out", str(tmp_path))
+    assert r.exit_code == 2
+    assert r.output.strip() == "Error: figures need matplotlib: pip install 'designkit[figures]'"

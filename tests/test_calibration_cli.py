@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from designkit import SENSORS
-from designkit.calibration.emulator import EmulatedMaterial, Emulator, TouchPlan
+from designkit.calibration.emulator import EmulatedMaterial, Emulator, Faults, TouchPlan
 from designkit.calibration.profiles import load_profile
 from designkit.calibration.trials import write_trial
 from designkit.sensor import load_sensor
@@ -90,6 +90,8 @@ def test_fit_human_output_and_plot(cli, tmp_path):
     (["--only", "glass"], "--only names material(s) not in index.csv: glass"),
     (["--range", "metal=1:2", "--range", "wood=331:506", "--object-temp", "wood=tepid"], "--object-temp"),
     (["--range", "metal=1:2", "--range", "wood=331:506", "--offset-range", "x"], "--offset-range"),
+    (["--range", "metal=1:2", "--range", "wood=331:506", "--fit-to", "nan"], "--fit-to must be a positive"),
+    (["--range", "metal=1:2", "--range", "wood=331:506", "--fit-to", "-1"], "--fit-to must be a positive"),
 ])
 def test_fit_errors_are_one_line(cli, tmp_path, args, message):
     index = _synthetic_index(tmp_path / "trials", n=1)
@@ -229,3 +231,110 @@ def test_fit_of_the_shared_robot_recordings(cli, robot_data_dir, tmp_path):
     assert again.exit_code == 0, again.output
     d2 = json.loads(again.stdout)
     assert d2["n_trials"] == 120 and d2["effusivity"]["value"] == pytest.approx(d["effusivity"]["value"])
+
+
+def test_fit_names_a_file_that_is_not_utf8(cli, tmp_path):
+    index = _synthetic_index(tmp_path / "trials", n=1)
+    trial = tmp_path / "trials" / "wood_001.csv"
+    trial.write_bytes(trial.read_bytes().replace(b"time_s", b"t\xefme_s"))
+    r = cli("calibrate", "fit", index, "--range", "metal=1:2", "--range", "wood=331:506", "--bootstrap", "0")
+    assert r.exit_code == 2
+    lines = r.stderr.strip().splitlines()
+    assert lines == [f"Error: trial {trial} is not UTF-8 text (byte 0xef on line 1)"], r.stderr
+
+
+@pytest.mark.parametrize("command, extra", [(["record"], []), ([], ["--range", "wood=331:506", "--yes"])],
+                         ids=["record", "guided"])
+@pytest.mark.parametrize("value", ["nan", "inf", "-1", "0"])
+def test_a_timeout_that_can_never_fire_is_refused(cli, tmp_path, command, extra, value):
+    """--timeout nan on a silent device waited forever (NaN compares false)."""
+    with Emulator(load_profile("designkit"), PAPER, [EmulatedMaterial("wood", WOOD)],
+                  faults=Faults(silent=True)) as emu:
+        t0 = time.monotonic()
+        r = cli("calibrate", *command, "--port", emu.port, "--material", "wood", "--out", tmp_path / "out",
+                *extra, "--timeout", value)
+        assert time.monotonic() - t0 < 5
+    assert r.exit_code == 2
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and "--timeout must be a positive, finite number of seconds" in lines[0], r.stderr
+    assert not (tmp_path / "out").exists()
+
+
+def test_record_gives_up_on_a_mostly_unreadable_stream(cli, tmp_path):
+    with Emulator(load_profile("designkit"), PAPER, [EmulatedMaterial("wood", WOOD)], speed=50.0,
+                  plan=TouchPlan(touch_every_s=13.0), faults=Faults(garbled=0.4)) as emu:
+        r = cli("calibrate", "record", "--port", emu.port, "--material", "wood", "--out", tmp_path, "--trials", "3")
+    assert r.exit_code == 2
+    errors = [line for line in r.stderr.splitlines() if line.startswith("Error:")]  # after the event lines
+    assert len(errors) == 1 and r.stderr.strip().splitlines()[-1] == errors[0], r.stderr
+    assert "% of the last 1601 lines" in errors[0] and "0 trial(s) kept" in errors[0]
+    assert "Traceback" not in r.stderr
+
+
+@pytest.mark.parametrize("value", ["100000000", "10001", "1", "-5"])
+def test_fit_bounds_the_bootstrap(cli, tmp_path, value):
+    """--bootstrap 100000000 ran for days; now it is refused at once, naming the limit."""
+    index = _synthetic_index(tmp_path / "trials", n=1)
+    t0 = time.monotonic()
+    r = cli("calibrate", "fit", index, "--range", "metal=1:2", "--range", "wood=331:506", "--bootstrap", value)
+    assert time.monotonic() - t0 < 5
+    assert r.exit_code == 2
+    assert r.stderr.strip().splitlines() == [
+        f"Error: --bootstrap must be 0 (none) or 2 to 10000 replicates, got {value}"], r.stderr
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--trials", "1000000000"], "--trials must be 1 to 1000 touches per material, got 1000000000"),
+    (["--trials", "0"], "--trials must be 1 to 1000 touches per material, got 0"),
+    (["--bootstrap", "100000000"], "--bootstrap must be 0 (none) or 2 to 10000 replicates, got 100000000"),
+])
+def test_guided_run_bounds_its_counts_before_recording(cli, tmp_path, args, message):
+    r = cli("calibrate", "--port", "/dev/whatever", "--material", "wood", "--range", "wood=331:506",
+            "--out", tmp_path / "out", "--yes", *args)
+    assert r.exit_code == 2 and r.stderr.strip().splitlines() == [f"Error: {message}"], r.stderr
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("value", ["1000000000", "1001", "0"])
+def test_record_bounds_trials(cli, tmp_path, value):
+    r = cli("calibrate", "record", "--port", "/dev/whatever", "--material", "wood", "--out", tmp_path / "out",
+            "--trials", value)
+    assert r.exit_code == 2
+    assert r.stderr.strip().splitlines() == [f"Error: --trials must be 1 to 1000 touches per material, got {value}"]
+
+
+def test_record_refuses_a_folder_whose_index_it_would_spoil(cli, tmp_path):
+    index = tmp_path / "index.csv"
+    index.write_text("file,material,trial_set,trial_index\nset01_wood_1.csv,wood,1,1\n")
+    (tmp_path / "set01_wood_1.csv").write_text("time_s,active_temp_c\n-1,35\n0,35\n1,34\n")
+    with _emulator(WOOD, "wood") as emu:
+        r = cli("calibrate", "record", "--port", emu.port, "--material", "wood", "--out", tmp_path, "--trials", "1")
+    assert r.exit_code == 2
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and "not designkit recordings (e.g. set01_wood_1.csv)" in lines[0], r.stderr
+    assert index.read_text() == "file,material,trial_set,trial_index\nset01_wood_1.csv,wood,1,1\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["index.csv", "set01_wood_1.csv"]
+
+
+@pytest.mark.parametrize("command, extra", [(["record"], []), ([], ["--material", "wood", "--yes"])],
+                         ids=["record", "guided"])
+def test_record_refuses_an_empty_material(cli, tmp_path, command, extra):
+    """An empty label was recorded as 'material_001.csv' into an index that 'calibrate fit' then refused."""
+    r = cli("calibrate", *command, "--port", "/dev/whatever", "--material", " ", "--out", tmp_path / "out", *extra)
+    assert r.exit_code == 2
+    assert r.stderr.strip().splitlines() == ["Error: --material must not be empty (it names the trials in the index)"]
+
+
+def test_record_checks_the_out_folder_before_waiting_for_touches(cli, tmp_path):
+    not_a_folder = tmp_path / "notes.txt"
+    not_a_folder.write_text("hello\n")
+    blocked = not_a_folder / "trials"  # its parent is a file: the folder cannot be created
+    with _emulator(WOOD, "wood", speed=1.0) as emu:  # real time: the first touch is 10 s away
+        t0 = time.monotonic()
+        r1 = cli("calibrate", "record", "--port", emu.port, "--material", "wood", "--out", not_a_folder)
+        r2 = cli("calibrate", "record", "--port", emu.port, "--material", "wood", "--out", blocked)
+        assert time.monotonic() - t0 < 5
+    assert r1.exit_code == 2 and r1.stderr.strip().splitlines() == [
+        f"Error: {not_a_folder} is not a folder (the trials and their index.csv go in one)"]
+    assert r2.exit_code == 2 and r2.stderr.strip().splitlines() == [
+        f"Error: cannot create the trial folder {blocked}: Not a directory"]

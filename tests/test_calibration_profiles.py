@@ -244,3 +244,15 @@ def test_unknown_profile_name_and_bad_yaml(tmp_path):
     bad.write_text("name: [unclosed\n")
     with pytest.raises(InputError, match="not valid YAML"):
         load_profile(bad)
+
+
+def test_profile_that_is_not_utf8_is_named(tmp_path):
+    shipped = list_profiles()["designkit"].read_bytes()
+    bad = tmp_path / "latin1.yaml"
+    bad.write_bytes(shipped.replace(b"\n", b"\n# caf\xe9\n", 1))  # a comment saved as Latin-1
+    with pytest.raises(InputError) as exc:
+        load_profile(bad)
+    assert str(exc.value) == f"profile {bad} is not UTF-8 text (byte 0xe9 on line 2)"
+    bom = tmp_path / "bom.yaml"
+    bom.write_bytes(b"\xef\xbb\xbf" + shipped)
+    assert load_profile(bom).name == load_profile("designkit").name

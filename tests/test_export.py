@@ -20,10 +20,15 @@ import pytest
 from designkit import InputError
 from designkit.query import table as q
 from designkit.sweep.engine import SweepConfig, run_sweep
-from designkit.export.core import (FORMATS, export_table, parse_contact, read_export, render, slice_table, to_python)
-from designkit.tables.store import content_hash, load_table, table_header, write_table
+from designkit.export import FORMATS, export_table, parse_contact, read_export, render, slice_table
+from designkit.export.formats.python import LOOKUP_BEGIN, LOOKUP_END, lookup_source
+from designkit.tables.store import Table, content_hash, load_table, table_header, write_table
 
 REPO = Path(__file__).resolve().parent.parent
+
+
+def to_python(exp) -> bytes:
+    return render(exp, "python")
 EXAMPLES = REPO / "examples"
 
 # Slice scenes are exactly representable in float32 (so that C's float arguments and the
@@ -329,8 +334,10 @@ def test_data_formats_read_with_plain_tools(tmp_path):
 def test_a_slice_is_much_smaller_than_the_full_table():
     tab = ideal_table()
     full, one = slice_table(tab), slice_table(tab, noise_c=ON_ROW[0], delta_t_c=ON_ROW[1])
+    fixed = {"python": len(lookup_source().encode())}  # the lookup code it carries, whatever the data
     for fmt in FORMATS:
-        assert len(render(one, fmt)) * 5 < len(render(full, fmt)), fmt
+        size = {label: len(render(exp, fmt)) - fixed.get(fmt, 0) for label, exp in (("one", one), ("full", full))}
+        assert size["one"] * 5 < size["full"], fmt
 
 
 # ============================================================ stdlib-only Python module
@@ -515,7 +522,7 @@ def test_shipped_svm_paper_exports_like_its_query(tmp_path):
 
 
 # ============================================================ CLI
-@pytest.mark.parametrize("fmt,suffix", [("json", ".json"), ("csv", ".csv"), ("npz", ".npz"), ("c", ".h"),
+@pytest.mark.parametrize("fmt,suffix", [("json", ".json"), ("csv", ".csv"), ("npz", ".npz"), ("mat", ".mat"), ("c", ".h"),
                                         ("python", ".py")])
 def test_cli_export_every_format(cli, tmp_path, fmt, suffix):
     out = tmp_path / f"table{suffix}"
@@ -587,3 +594,269 @@ def test_robot_loop_example_decides_from_the_table(tmp_path):
     human = subprocess.run([sys.executable, "-I", "-S", str(EXAMPLES / "robot_loop" / "robot_loop.py"),
                             "--table", str(module)], capture_output=True, text=True, timeout=120)
     assert human.returncode == 0 and "touch for" in human.stdout
+
+
+# ============================================================ one lookup implementation
+def test_lookup_module_is_stdlib_only_and_the_python_export_carries_it_verbatim():
+    from designkit.tables import lookup
+
+    text = Path(lookup.__file__).read_text(encoding="utf-8")
+    assert imports_of(text) <= set(sys.stdlib_module_names)
+    assert "from __future__" not in text  # it is pasted into the middle of a module
+    src = render(slice_table(random_ratio_table()), "python").decode()
+    begin, end = src.index(LOOKUP_BEGIN + "\n") + len(LOOKUP_BEGIN) + 1, src.index(LOOKUP_END)
+    assert src[begin:end] == text
+    assert lookup.GRID_RTOL == q.GRID_RTOL
+
+
+@pytest.mark.parametrize("name", ["rand-ratio-e", "rand-varied-full", "svm-small-lo-slice"])
+def test_lookup_on_numpy_arrays_answers_like_the_query(name):
+    """The same Lookup in-process on numpy rows (what the query will use) and on array.array rows."""
+    import array
+
+    from designkit.export._common import log_grid
+    from designkit.tables.lookup import Lookup, OutsideTable
+
+    tab, opts, exp = case(name)
+    scene = [(a.name, a.scale, np.asarray(a.values), np.asarray(log_grid(a))) for a in exp.scene_axes]
+    common = dict(e_min=exp.e_lo, e_max=exp.e_hi, e_min_inclusive=exp.e_lo_inclusive,
+                  contact_adjacent=exp.contact_adjacent, name=tab.name)
+    on_numpy = Lookup(scene, np.asarray(exp.contact.values), np.asarray(exp.e_ref.values), exp.delta_up.ravel(),
+                      exp.delta_down.ravel(), **common)
+    on_array = Lookup([(n, s, v.tolist(), g.tolist()) for n, s, v, g in scene], list(exp.contact.values),
+                      list(exp.e_ref.values), array.array("d", exp.delta_up.ravel().tolist()),
+                      array.array("d", exp.delta_down.ravel().tolist()), **common)
+    kind = opts.get("kind", "svm")
+    names = {"min_contact": "min_contact_s"}
+    seen = set()
+    for op, args in random_queries(exp, np.random.default_rng(23), 150):
+        if kind == "ideal" and op == "distinguishable":
+            continue
+        answers = []
+        for lk in (on_numpy, on_array):
+            try:
+                answers.append(getattr(lk, names.get(op, op))(*args))
+            except OutsideTable:
+                answers.append("outside")
+            except ValueError:
+                answers.append("invalid")
+        assert answers[0] == answers[1], (op, args, answers)
+        got = answers[0]
+        if got == "outside" and _beyond_slice(exp, op, args):
+            continue
+        want = on_contact_columns(exp, op, reference(tab, kind, op, args))
+        seen.add(type(want).__name__)
+        assert agree(float(got) if isinstance(got, np.floating) else got, want, 1e-9), (op, args, got, want)
+    assert "float" in seen
+
+
+# ============================================================ registry, formats
+def test_registry_names_every_format_and_refuses_others_in_one_line():
+    from designkit.export import SUFFIXES, WRITERS, format_for, get_writer
+
+    assert FORMATS == ("json", "csv", "npz", "mat", "c", "python") == tuple(WRITERS)
+    assert {SUFFIXES[s] for s in (".json", ".csv", ".npz", ".mat", ".h", ".py")} == set(FORMATS)
+    exp = slice_table(random_ratio_table(), noise_c=0.02, delta_t_c=10.0)
+    for fmt in FORMATS:
+        assert render(exp, fmt)  # every writer is a function of the slice returning bytes
+        assert format_for(f"x{WRITERS[fmt].suffixes[0]}", None) == fmt
+    with pytest.raises(InputError) as err:
+        get_writer("xlsx")
+    assert str(err.value) == "format must be one of json, csv, npz, mat, c, python, got 'xlsx'"
+
+
+def test_mat_file_holds_the_arrays_axes_and_provenance(tmp_path):
+    from scipy.io import loadmat
+
+    tab, _, exp = case("rand-varied-slice")
+    (tmp_path / "t.mat").write_bytes(render(exp, "mat"))
+    z = loadmat(str(tmp_path / "t.mat"))
+    np.testing.assert_array_equal(z["delta_up"].reshape(exp.shape), exp.delta_up)
+    assert z["axis_contact_s"].shape == (len(exp.contact.values), 1)
+    assert json.loads(str(z["provenance"][0]))["source_content_hash"] == tab.header["content_hash"]
+
+
+def test_csv_reads_with_default_readers_and_its_provenance_is_beside_it(tmp_path):
+    """issue 16: pandas.read_csv(path) with its defaults; the csv module where pandas is not installed."""
+    tab, _, exp = case("ideal-between-rows-e-contact")
+    res = export_table(tab, tmp_path / "t.csv", noise_c=OFF_ROW[0], delta_t_c=OFF_ROW[1], e_min=15000.0,
+                       e_max=36000.0, contact="1.1:4.1")
+    text = res.path.read_text()
+    assert "#" not in text
+    columns = ["noise_ratio", "contact_s", "e_ref", "delta_up", "delta_down"]
+    try:
+        import pandas
+    except ImportError:
+        import csv
+
+        with res.path.open(newline="") as fh:
+            rows = list(csv.reader(fh))
+        assert rows[0] == columns
+        assert all(len(r) == len(columns) for r in rows[1:]) and len(rows) - 1 == exp.delta_up.size
+        values = np.array([[float(x) for x in r] for r in rows[1:]])  # every field a number ("nan" included)
+    else:
+        frame = pandas.read_csv(res.path)
+        assert list(frame.columns) == columns and len(frame) == exp.delta_up.size
+        values = frame.to_numpy(dtype=float)
+    assert np.isnan(values[:, 3]).sum() == np.isnan(exp.delta_up).sum()
+    side = json.loads(res.sidecar.read_text())
+    assert res.sidecar == tmp_path / "t.csv.json" and side["sidecar_of"] == "t.csv"
+    assert side["provenance"]["source_table"] == "ideal-paper" and [c["name"] for c in side["columns"]] == columns
+    with pytest.raises(InputError, match="sidecar of the CSV export"):
+        read_export(res.sidecar)
+    res.sidecar.unlink()
+    with pytest.raises(InputError, match="sidecar t.csv.json is missing"):
+        read_export(res.path)
+
+
+@pytest.mark.parametrize("fmt", ["json", "npz", "mat", "csv", "c", "python"])
+def test_every_export_records_the_forward_model(tmp_path, fmt):
+    old = random_ratio_table()
+    header = {k: v for k, v in old.header.items() if k != "model"}  # a table from before the header said
+    tables = {"semi-infinite": Table(name="old", path=old.path, header=header, arrays=old.arrays),
+              "contact": Table(name="hc", path=old.path, arrays=old.arrays,
+                               header={**header, "model": {"name": "contact", "conductance_w_m2k": 1500.0}})}
+    for model, tab in tables.items():
+        res = export_table(tab, tmp_path / f"{model}{WRITER_SUFFIX[fmt]}", fmt)
+        assert res.provenance["model"]["name"] == model
+        data = res.path.read_bytes()
+        if fmt in ("json", "npz", "mat", "csv"):
+            assert read_export(res.path).provenance["model"] == tab.model.to_dict()
+        elif fmt == "c":
+            assert f'#define DESIGNKIT_MODEL "{model}"'.encode() in data
+            assert (b"conductance_w_m2k" in data) == (model == "contact")
+        else:
+            assert imported(res.path, tmp_path, "MODEL") == tab.model.to_dict()
+
+
+WRITER_SUFFIX = {"json": ".json", "csv": ".csv", "npz": ".npz", "mat": ".mat", "c": ".h", "python": ".py"}
+
+
+def imported(path: Path, cwd: Path, *names: str):
+    """Values of ``names`` (JSON) from importing the generated module ``path`` in `python -I -S`, run in ``cwd``."""
+    code = ("import importlib.util, json, sys; s = importlib.util.spec_from_file_location('m', sys.argv[1]); "
+            "m = importlib.util.module_from_spec(s); s.loader.exec_module(m); "
+            "json.dump([getattr(m, n) for n in sys.argv[2:]] + [m.__doc__], sys.stdout)")
+    proc = subprocess.run([sys.executable, "-I", "-S", "-c", code, str(path), *names], cwd=cwd, capture_output=True,
+                          text=True, timeout=60)
+    assert proc.returncode == 0, proc.stderr
+    out = json.loads(proc.stdout)
+    return out[0] if len(names) == 1 else out
+
+
+# ============================================================ injection (issue 15)
+PAYLOADS = [
+    'x */ int designkit_injected_c = 42; /*',
+    'x"; int designkit_injected_c = 42; //',
+    'x??/" int designkit_injected_c = 42; //',  # a C99 trigraph would turn ??/ into a backslash
+    'x\n#define designkit_injected_c 42\n',
+    'x\\\nint designkit_injected_c = 42;',
+    'x"""; import os; os.system("touch PWNED"); """',
+    "x'''; import os; os.system('touch PWNED'); '''",
+    'x\\\n__import__("os").system("touch PWNED")',
+    'x\r\n__import__("os").system("touch PWNED")',
+    '\u2028__import__("os").system("touch PWNED") # \u00b0C \u4e2d',
+    'x @P@ @DELTA_UP@ @LOOKUP_SOURCE@',
+    'x\x00\x1b[31m,"\n1,2,3',
+]
+
+
+def injected_table(payload: str, name: str = "inj") -> Table:
+    """A table whose every free-text header field holds ``payload`` (its names stay valid)."""
+    base = random_ratio_table()
+    header = json.loads(json.dumps(base.header))
+    header.update(created=payload, fidelity=payload, content_hash=payload, designkit_version=payload)
+    for a in header["axes"]:
+        a["units"] = payload
+    return Table(name=name, path=base.path, header=header, arrays=base.arrays)
+
+
+def with_model(exp, payload: str):
+    """``exp`` with a forward-model record holding ``payload`` in its name and a parameter (past the model
+    registry, which refuses unknown names and non-numbers: this checks the writers' own escaping)."""
+    import dataclasses
+
+    return dataclasses.replace(exp, provenance={**exp.provenance, "model": {"name": payload, "param": payload,
+                                                                            "n": 1.5}})
+
+
+@pytest.mark.parametrize("i", range(len(PAYLOADS)))
+def test_python_export_carries_any_text_and_runs_none(tmp_path, i):
+    payload = PAYLOADS[i]
+    exp = with_model(slice_table(injected_table(payload)), payload)
+    path = tmp_path / "table_module.py"
+    path.write_bytes(render(exp, "python"))
+    src = path.read_text()
+    assert src.isascii()  # every string from the table escaped
+    prov, fidelity, model, doc = imported(path, tmp_path, "PROVENANCE", "FIDELITY", "MODEL")
+    assert prov["source_created"] == payload and prov["source_content_hash"] == payload
+    assert [a["units"] for a in prov["axes"]][:2] == [payload, payload]
+    assert doc.startswith("designkit lookup table inj (")
+    assert fidelity == payload and model == {"name": payload, "param": payload, "n": 1.5}
+    assert not list(tmp_path.glob("PWNED*")) and not Path("PWNED").exists()
+    got = run_module(path, [("min_contact", (2000.0, 5000.0, 0.02, 10.0))], tmp_path)
+    assert got == [reference(random_ratio_table(), "svm", "min_contact", (2000.0, 5000.0, 0.02, 10.0))]
+
+
+@pytest.mark.parametrize("i", range(len(PAYLOADS)))
+def test_data_exports_carry_any_text_as_data(tmp_path, i):
+    payload = PAYLOADS[i]
+    exp = with_model(slice_table(injected_table(payload)), payload)
+    rows = exp.delta_up.size
+    csv_text = render(exp, "csv").decode()
+    assert csv_text.count("\n") == rows + 1 and len({line.count(",") for line in csv_text.splitlines()}) == 1
+    doc = json.loads(render(exp, "json"))
+    assert doc["provenance"]["source_created"] == payload and doc["provenance"]["model"]["param"] == payload
+    from designkit.export.formats.csv import sidecar
+
+    assert json.loads(sidecar(exp, "t.csv"))["provenance"]["fidelity"] == payload
+    (tmp_path / "t.npz").write_bytes(render(exp, "npz"))
+    assert read_export(tmp_path / "t.npz").provenance["axes"][0]["units"] == payload
+    (tmp_path / "t.mat").write_bytes(render(exp, "mat"))
+    assert read_export(tmp_path / "t.mat").provenance["model"]["name"] == payload
+
+
+@pytest.mark.parametrize("i", range(len(PAYLOADS)))
+def test_unsafe_table_and_sensor_names_are_refused_in_one_line(tmp_path, i):
+    payload = PAYLOADS[i]
+    sensor_tab = injected_table("x", name="ok")
+    sensor_tab.header["sensor"] = {**sensor_tab.header["sensor"], "name": payload}
+    for tab, what in ((injected_table("x", name=payload), "table name"), (sensor_tab, "sensor name")):
+        for fmt, suffix in (("c", ".h"), ("python", ".py"), ("csv", ".csv")):
+            with pytest.raises(InputError, match="cannot be exported safely") as err:
+                export_table(tab, tmp_path / f"t{suffix}", fmt)
+            assert "\n" not in str(err.value) and what in str(err.value)
+    assert not list(tmp_path.iterdir())
+
+
+def test_safe_names_with_every_allowed_character_export(tmp_path):
+    tab = injected_table("x", name="Lab table_v2.1+b-c 7")
+    tab.header["sensor"] = {**tab.header["sensor"], "name": "rig 3.b_x+y-z"}
+    path = tmp_path / "m.py"
+    export_table(tab, path, "python")
+    assert imported(path, tmp_path, "SOURCE_TABLE") == "Lab table_v2.1+b-c 7"
+
+
+def test_cli_refuses_an_injected_table_name_and_a_prefix_with_a_newline(cli, tmp_path):
+    base = random_ratio_table()
+    header = {**base.header, "name": 'x */ int designkit_injected_c = 42; /*'}
+    folder = tmp_path / "tables"
+    path = write_table(folder / "inj.npz", header, {k: v for k, v in base.arrays.items()})
+    out = tmp_path / "out"
+    out.mkdir()
+    r = cli("export", "--table", path, "--out", out / "t.h")
+    assert r.exit_code == 2 and "cannot be exported safely" in r.stderr and r.stderr.count("\n") == 1
+    r = cli("export", "--table", "ideal-paper", "--prefix", "designkit\n", "--out", out / "t.h")
+    assert r.exit_code == 2 and "prefix must be a C identifier" in r.stderr
+    assert not list(out.iterdir())
+
+
+def test_cli_writes_to_standard_output(cli, tmp_path):
+    r = cli("export", "--table", "ideal-paper", "--noise", "0.05", "--delta-t", "10", "--contact", "2",
+            "--format", "csv", "--out", "-")
+    assert r.exit_code == 0, r.output
+    lines = r.stdout.splitlines()
+    assert lines[0] == "noise_ratio,contact_s,e_ref,delta_up,delta_down" and len(lines) == 501
+    assert not Path("-").exists()
+    r = cli("export", "--table", "ideal-paper", "--out", "-")
+    assert r.exit_code == 2 and "needs --format" in r.stderr

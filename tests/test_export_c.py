@@ -4,6 +4,7 @@ every table edge; prefixes; float arithmetic."""
 
 from __future__ import annotations
 
+import json
 import math
 import os
 import re
@@ -16,18 +17,23 @@ import numpy as np
 import pytest
 
 from designkit.query import table as q
-from designkit.export.core import slice_table, to_c
+from designkit.export import render, slice_table
 from designkit.tables.store import load_table
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from test_export import (CASES, EXAMPLES, ON_ROW, _beyond_slice, agree, case, ideal_table,  # noqa: E402
-                         on_contact_columns, random_queries, random_ratio_table, reference)
+from test_export import (CASES, EXAMPLES, ON_ROW, PAYLOADS, _beyond_slice, agree, case, ideal_table,  # noqa: E402
+                         injected_table, on_contact_columns, random_queries, random_ratio_table, reference,
+                         with_model)
 
 CC = shutil.which(os.environ.get("CC", "cc")) or shutil.which("gcc") or shutil.which("clang")
 pytestmark = pytest.mark.skipif(CC is None, reason="no C compiler (cc, gcc or clang) on PATH: the C header "
                                 "cannot be compiled here")
 STRICT = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic"]
 SENTINELS = {-1.0: None, -2.0: "outside", -3.0: "invalid"}
+
+
+def to_c(exp, prefix: str = "designkit") -> bytes:
+    return render(exp, "c", prefix=prefix)
 
 
 def build(tmp_path: Path, header: bytes, *, flags=("-O2",), name="lookup", source: Path | None = None) -> Path:
@@ -300,3 +306,72 @@ def test_float_arithmetic_variant_agrees_to_float_precision(tmp_path):
         close += agree(g, want, 1e-4)
     assert close >= 0.99 * len(queries)  # float rounding may flip a value that sits on a NaN boundary
     assert got[-1] == pytest.approx(reference(tab, "svm", "min_contact", (35000.0, 20000.0, *ON_ROW)), rel=1e-4)
+
+
+# ============================================================ injection (issue 15)
+PRINT_STRINGS = r'''
+#include <stdio.h>
+#include "designkit_table.h"
+static void hex(const char *s)
+{
+    for (; *s; s++) printf("%02x", (unsigned char)*s);
+    printf("\n");
+}
+int main(void)
+{
+    hex(DESIGNKIT_SOURCE_CREATED);
+    hex(DESIGNKIT_SOURCE_HASH);
+    hex(DESIGNKIT_FIDELITY);
+    hex(DESIGNKIT_MODEL);
+    hex(DESIGNKIT_MODEL_PARAMETERS);
+    printf("%.9g\n", designkit_min_contact_s(2000.0f, 5000.0f, 0.05f, 10.0f));
+    return 0;
+}
+'''
+
+
+def _code_outside_strings(cc: str, header: Path) -> str:
+    """The header's tokens after the preprocessor (comments gone), string literals removed."""
+    pre = subprocess.run([cc, "-std=c99", "-E", "-P", "-dD", str(header)], capture_output=True, text=True)
+    assert pre.returncode == 0, pre.stderr
+    return re.sub(r'"(\\.|[^"\\])*"', '""', pre.stdout)
+
+
+@pytest.mark.parametrize("i", range(len(PAYLOADS)))
+def test_c_header_carries_any_text_compiles_and_injects_nothing(tmp_path, i):
+    payload = PAYLOADS[i]
+    exp = with_model(slice_table(injected_table(payload)), payload)
+    header = to_c(exp)
+    assert header.isascii()
+    folder = tmp_path / "inj"
+    folder.mkdir()
+    (folder / "designkit_table.h").write_bytes(header)
+    assert "injected" not in _code_outside_strings(CC, folder / "designkit_table.h")
+    (folder / "main.c").write_text(PRINT_STRINGS)
+    proc = subprocess.run([CC, *STRICT, "-O0", "-o", str(folder / "p"), str(folder / "main.c"), "-lm"],
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr  # valid C, no warning, whatever the table's text
+    lines = subprocess.run([str(folder / "p")], capture_output=True, text=True, timeout=60).stdout.splitlines()
+    # C strings end at the first NUL byte: the payload up to it, in UTF-8
+    want = payload.encode().split(b"\0")[0].hex()
+    params = json.dumps({"n": 1.5, "param": payload}, sort_keys=True).encode().hex()
+    assert lines[:5] == [want, want, want, want, params]
+    want = reference(random_ratio_table(), "svm", "min_contact", (2000.0, 5000.0, 0.05, 10.0))
+    assert float(lines[5]) == (-1.0 if want is None else pytest.approx(want, rel=1e-6))
+
+
+@pytest.mark.parametrize("prefix", ["designkit\n", "x;int y", "9lives", "a b", "", "x" * 41, "é"])
+def test_prefixes_that_are_not_c_identifiers_are_refused(prefix):
+    with pytest.raises(ValueError, match="prefix must be a C identifier") as err:
+        to_c(slice_table(random_ratio_table()), prefix)
+    assert "\n" not in str(err.value)
+
+
+def test_header_is_the_package_template_filled():
+    from designkit.export._common import read_template
+    from designkit.export.formats.c import TEMPLATE
+
+    template = read_template(TEMPLATE)
+    assert "@DELTA_UP@" in template and "static inline int @p@_axis_(" in template
+    header = to_c(slice_table(random_ratio_table())).decode()
+    assert not re.search(r"@[A-Za-z0-9_]+@", header)

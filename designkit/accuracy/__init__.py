@@ -1,1 +1,50 @@
-"""designkit.accuracy."""
+"""The accuracy report: every way designkit answers a question, against a reference, in one run.
+
+Each section is one module and returns :class:`Row` objects (the cost
+section :class:`CostCurve` objects); :func:`run_bench` runs a selection of
+them into a :class:`BenchReport`, and :func:`write_report` /
+:func:`render_markdown` turn that into ``docs/accuracy.md``
+(``designkit bench --out docs``).
+
+==============  ==========================================================
+module          what it holds
+==============  ==========================================================
+``physics``     eq. 2 against mpmath; thin-sample solvers against a tight
+                image series
+``recognition`` SVM F1 against a long run; ideal closed form against its
+                Monte Carlo
+``delta``       staircase search against the full F1 matrix; coarse
+                effusivity grids against a fine one
+``queries``     table answers (the question layer users call) against
+                exact answers
+``cost``        the sweep engine's wall time, fits and memory as work grows
+``instruments`` timing, peak memory, a child process's cost, power-law fits
+``results``     :class:`Row`, :class:`CostCurve` and the shared summaries
+``render``      the page, its figures and the JSON record
+``run``         :func:`run_bench` and :class:`BenchReport`
+==============  ==========================================================
+"""
+
+from __future__ import annotations
+
+from .cost import cost_curve, cost_curve_specs, cost_curves
+from .delta import delta_rows, grid_rows, staircase_vs_full
+from .instruments import ProcessCost, fit_exponent, measure, process_cost, reset_peak_memory, resident_mb, timed
+from .physics import physics_rows, slab_rows
+from .queries import GAP_BINS, QUESTIONS, density_rows, query_rows, subsample_table, svm_query_rows
+from .recognition import RECOGNITION_PAIRS, ideal_mc_rows, recognition_rows
+from .render import (FIGURES_HINT, curves_markdown, format_time, format_value, markdown_cell, pareto_figure,
+                     plot_costs, plot_pareto, render_markdown, require_figures, rows_markdown, write_report)
+from .results import PAPER_RATIO, CostCurve, Row, p95, paper_sensor, worst
+from .run import SECTIONS, BenchReport, check_sections, environment, run_bench
+
+__all__ = [
+    "FIGURES_HINT", "GAP_BINS", "PAPER_RATIO", "QUESTIONS", "RECOGNITION_PAIRS", "SECTIONS",
+    "BenchReport", "CostCurve", "ProcessCost", "Row",
+    "check_sections", "cost_curve", "cost_curve_specs", "cost_curves", "curves_markdown", "delta_rows",
+    "density_rows", "environment", "fit_exponent", "format_time", "format_value", "grid_rows", "ideal_mc_rows",
+    "markdown_cell", "measure", "p95", "paper_sensor", "pareto_figure", "physics_rows", "plot_costs",
+    "plot_pareto", "process_cost", "query_rows", "recognition_rows", "render_markdown", "require_figures",
+    "reset_peak_memory", "resident_mb", "rows_markdown", "run_bench", "slab_rows", "staircase_vs_full",
+    "subsample_table", "svm_query_rows", "timed", "worst", "write_report",
+]

@@ -83,7 +83,8 @@ class Faults:
     (line cut short, fields missing), ``non_numeric`` (a field replaced by
     text such as ``nan`` or ``ERR``), ``field_count`` (a field added or
     dropped), ``out_of_range`` (a sensor reading at the ADC rails or outside
-    the channel's valid range). Each faulty line replaces one sample.
+    the channel's valid range). Each faulty line replaces one sample. They
+    start at device time ``line_faults_after_s`` (0: from the first line).
 
     Timed faults (device seconds, 0 = off): every ``burst_every_s`` the
     output is held back for ``burst_hold_s`` real seconds and then delivered
@@ -98,6 +99,7 @@ class Faults:
     non_numeric: float = 0.0
     field_count: float = 0.0
     out_of_range: float = 0.0
+    line_faults_after_s: float = 0.0
     burst_every_s: float = 0.0
     burst_hold_s: float = 0.1
     gap_every_s: float = 0.0
@@ -110,7 +112,8 @@ class Faults:
             p = check_nonnegative(f"fault {name} probability", getattr(self, name))
             if p > 1:
                 raise InputError(f"fault {name} probability must be <= 1, got {p:g}")
-        for name in ("burst_every_s", "burst_hold_s", "gap_every_s", "gap_s", "vanish_after_s"):
+        for name in ("line_faults_after_s", "burst_every_s", "burst_hold_s", "gap_every_s", "gap_s",
+                     "vanish_after_s"):
             check_nonnegative(f"fault {name}", getattr(self, name))
 
     @property
@@ -120,11 +123,12 @@ class Faults:
     @classmethod
     def parse(cls, specs: Sequence[str]) -> "Faults":
         """From CLI specs: ``garbled=0.01``, ``partial=P``, ``non-numeric=P``,
-        ``field-count=P``, ``out-of-range=P``, ``burst=EVERY_S[:HOLD_S]``,
-        ``gap=EVERY_S[:SILENT_S]``, ``vanish=AFTER_S``, ``silent``."""
+        ``field-count=P``, ``out-of-range=P``, ``line-faults-after=S``,
+        ``burst=EVERY_S[:HOLD_S]``, ``gap=EVERY_S[:SILENT_S]``, ``vanish=AFTER_S``,
+        ``silent``."""
         kw: dict[str, float | bool] = {}
         probs = {"garbled", "partial", "non-numeric", "field-count", "out-of-range"}
-        known = sorted(probs | {"burst", "gap", "vanish", "silent"})
+        known = sorted(probs | {"line-faults-after", "burst", "gap", "vanish", "silent"})
         for spec in specs:
             name, _, value = str(spec).partition("=")
             name = name.strip().lower().replace("_", "-")
@@ -133,6 +137,8 @@ class Faults:
             try:
                 if name in probs:
                     kw[name.replace("-", "_")] = float(value)
+                elif name == "line-faults-after":
+                    kw["line_faults_after_s"] = float(value)
                 elif name in ("burst", "gap"):
                     every, _, second = value.partition(":")
                     kw[f"{name}_every_s"] = float(every)
@@ -370,8 +376,12 @@ class Emulator:
             draws = rng.random((5, n))
             delim = prof.delimiter if prof.delimiter is not None else " "
             mapped = [ch.field_index for ch in prof.channels.values()]
+            clean_until = int(math.ceil(fl.line_faults_after_s * prof.sample_rate_hz - 1e-9)) - k0
             out: list[bytes] = []
             for i, line in enumerate(text):
+                if i < clean_until:
+                    out.append(line.encode(prof.encoding))
+                    continue
                 if draws[0, i] < fl.garbled:
                     out.append(bytes(rng.integers(0x80, 0x100, int(rng.integers(4, 30))).astype(np.uint8)))
                     self.lines_faulty += 1

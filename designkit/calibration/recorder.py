@@ -23,11 +23,23 @@ Two layers:
 Without a timestamp channel, time is the count of lines received divided by
 the sample rate; a line that cannot be read still counts (its sample is
 missing from the trial, the times of the others stay right).
+
+Give-up rule for unreadable lines: a trial is kept only when at least
+``MIN_READABLE_FRACTION`` (80 %) of its samples could be read, so once the
+last trial-length of lines (``(pre_s + post_s) * sample_rate_hz + 1``, at
+least 200) holds more than 20 % unreadable ones, a trial over them could not
+be kept and the recorder stops (:class:`TooManyBadLines`, naming the fraction
+and an example line; trials already written stay). A stream none of whose first
+200 lines is readable stops sooner (:class:`NoData`: wrong profile or baud
+rate).
 """
 
 from __future__ import annotations
 
 import datetime as _dt
+import errno
+import os
+import stat
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -35,11 +47,14 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .._validation import InputError
+from .._validation import InputError, check_positive
 from .profiles import ROLES, DeviceProfile
-from .trials import write_trial
+from .trials import check_trial_folder, write_trial
 
-__all__ = ["RecordEvent", "RecorderStatus", "SerialRecorder", "TrialCutter"]
+__all__ = ["MIN_READABLE_FRACTION", "RecordEvent", "RecorderStatus", "SerialRecorder", "TrialCutter"]
+
+#: Fewest samples of a trial's window that must be readable for the trial to be kept.
+MIN_READABLE_FRACTION = 0.8
 
 _S, _O, _F = 0, 1, 2  # columns of the cutter's value buffer
 _BAD_KIND_TEXT = {
@@ -238,7 +253,7 @@ class TrialCutter:
         tt = t[sel] - onset
         vv = v[sel]
         expected = int(round((self.pre + self.post) * self.fs)) + 1
-        if tt.size < 0.8 * expected:
+        if tt.size < MIN_READABLE_FRACTION * expected:
             events.append(RecordEvent(
                 "skipped", f"touch at device time {onset:.2f} s skipped: only {tt.size} of {expected} samples "
                            "readable"))
@@ -295,6 +310,10 @@ class NoData(InputError):
     """Nothing usable arrived within the time limit."""
 
 
+class TooManyBadLines(InputError):
+    """So many lines are unreadable that no trial can be kept (see the module docstring)."""
+
+
 class SerialRecorder:
     """Record touches from a serial port into a folder.
 
@@ -305,10 +324,18 @@ class SerialRecorder:
     profile : DeviceProfile
     out_dir : Path
     no_data_timeout_s : float, optional
-        Overrides the profile's limit for a device that never speaks.
+        Overrides the profile's limit for a device that never speaks [s]
+        (positive and finite).
     on_event : callable(RecordEvent), optional
     on_status : callable(RecorderStatus), optional
         Called a few times a second with live numbers.
+
+    Raises
+    ------
+    InputError
+        ``out_dir`` has an index that recording would spoil (see
+        :func:`~designkit.calibration.trials.check_trial_folder`), or a bad
+        ``no_data_timeout_s``.
     """
 
     def __init__(self, port: str, profile: DeviceProfile, out_dir: Path, *,
@@ -318,7 +345,10 @@ class SerialRecorder:
         self.port = str(port)
         self.profile = profile
         self.out_dir = Path(out_dir)
-        self.no_data_timeout_s = no_data_timeout_s or profile.serial.no_data_timeout_s
+        check_trial_folder(self.out_dir)
+        if no_data_timeout_s is None:
+            no_data_timeout_s = profile.serial.no_data_timeout_s
+        self.no_data_timeout_s = check_positive("no_data_timeout_s [s]", no_data_timeout_s)
         self.on_event = on_event or (lambda e: None)
         self.on_status = on_status or (lambda s: None)
         self.status = RecorderStatus(port=self.port)
@@ -332,17 +362,30 @@ class SerialRecorder:
         self._examples: dict[str, int] = {}
         self._valid_seen = False
         self._lines_seen = 0
+        fs, window = profile.sample_rate_hz, profile.trial.pre_s + profile.trial.post_s
+        self._bad_window = max(200, int(round(window * fs)) + 1)  # lines the give-up rule looks at
+        self._recent_bad = np.zeros(0, dtype=bool)
+        self._last_bad_text = ""
 
     # ------------------------------------------------------------ port
     def open(self) -> None:
-        """Open the port with the profile's settings (one-line error if it cannot)."""
+        """Open the port with the profile's settings (one-line error if it cannot).
+
+        A path that is a regular file, a folder, or a device that is not a
+        terminal (``/dev/null``) is refused as not a serial device.
+        """
         import serial
 
+        kind = _not_a_serial_device(self.port)
+        if kind:
+            raise InputError(f"{self.port} is not a serial device ({kind})")
         s = self.profile.serial
         try:
             self._ser = serial.Serial(self.port, baudrate=s.baudrate, bytesize=s.bytesize, parity=s.parity,
                                       stopbits=s.stopbits, timeout=s.read_timeout_s)
         except (serial.SerialException, OSError, ValueError) as exc:
+            if _is_enotty(exc):
+                raise InputError(f"{self.port} is not a serial device (not a terminal)") from None
             raise InputError(f"cannot open serial port {self.port}: {_short(exc)}") from None
         self._restart_stream()
 
@@ -371,6 +414,7 @@ class SerialRecorder:
         self._buf = b""
         self._first_line = True
         self._last_t = None
+        self._recent_bad = np.zeros(0, dtype=bool)
 
     def _emit(self, event: RecordEvent) -> None:
         self.events.append(event)
@@ -387,6 +431,10 @@ class SerialRecorder:
             Nothing (or nothing readable) within the time limit.
         DeviceGone
             The port vanished and did not come back within ``reconnect_s``.
+        TooManyBadLines
+            Too many lines unreadable to keep any trial (module docstring).
+        InputError
+            An empty material label, or the trial folder cannot be created.
         KeyboardInterrupt
             Passed on; everything written so far stays.
         """
@@ -394,8 +442,14 @@ class SerialRecorder:
 
         if trials < 1:
             raise InputError(f"trials must be >= 1, got {trials}")
+        if not str(material).strip():
+            raise InputError("the material label must not be empty (it names the trials in the index)")
         if self._ser is None:
             self.open()
+        try:  # now, not when the first touch is complete
+            self.out_dir.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise InputError(f"cannot create the trial folder {self.out_dir}: {exc.strerror or exc}") from None
         cutter = TrialCutter(self.profile, self.out_dir, material,
                              meta={"profile": self.profile.name, "port": self.port,
                                    "timestamps": "device" if self.profile.has_timestamp else "line count"})
@@ -490,10 +544,12 @@ class SerialRecorder:
         data = self._buf + chunk
         lines = data.split(b"\n")
         self._buf = lines.pop()
+        unreadable = []
         if len(self._buf) > 4096:
             self._bad("too_long", self._buf[:40].decode("ascii", "replace"))
             self._buf = b""
             self._slot += 1
+            unreadable.append(np.ones(1, dtype=bool))
         if self._first_line and lines:
             lines = lines[1:]  # the port may have opened in the middle of a line
             self._first_line = False
@@ -514,6 +570,9 @@ class SerialRecorder:
         else:
             t = (self._slot + parsed.slots[good]) / prof.sample_rate_hz
         self._slot += parsed.n_slots
+        flags = np.ones(parsed.n_slots, dtype=bool)
+        flags[parsed.slots[good]] = False
+        unreadable = np.concatenate(unreadable + [flags])
         vals = values[good][:, :3]
         self.status.lines_ok += int(good.sum())
         if t.size == 0:
@@ -521,12 +580,28 @@ class SerialRecorder:
                 example = lines[-1].strip()[:60].decode(prof.encoding, "replace")
                 raise NoData(f"none of the first {self._lines_seen} lines from {self.port} matches profile "
                              f"{prof.name!r} (e.g. {example!r}): wrong profile or baud rate?")
+            self._check_readable(unreadable, cutter)
             return
         self._valid_seen = True
-        self._feed_checked(t, vals, cutter)
+        self._feed_checked(t, vals, cutter)  # first, so that a trial this completes is kept
         last = vals[-1]
         self.status.sensor_c, self.status.object_c, self.status.force_n = (float(x) for x in last)
         self.status.device_time_s = float(t[-1])
+        self._check_readable(unreadable, cutter)
+
+    def _check_readable(self, unreadable: np.ndarray, cutter: TrialCutter) -> None:
+        """Apply the give-up rule (module docstring) to the lines just read (True: unreadable)."""
+        n = self._bad_window
+        self._recent_bad = np.concatenate([self._recent_bad, unreadable])[-n:]
+        if self._recent_bad.size < n or not self._valid_seen:
+            return  # not a full window yet; or nothing readable yet: NoData names the likely cause
+        frac = float(self._recent_bad.mean())
+        if frac > 1.0 - MIN_READABLE_FRACTION:
+            raise TooManyBadLines(
+                f"{100 * frac:.1f} % of the last {n} lines from {self.port} were unreadable (e.g. "
+                f"{self._last_bad_text!r}): a trial needs {100 * MIN_READABLE_FRACTION:.0f} % of its samples "
+                f"readable, so none can be kept; check the cable, the baud rate {self.profile.serial.baudrate} "
+                f"and the profile {self.profile.name!r}; {self._kept(cutter)}")
 
     def _feed_checked(self, t: np.ndarray, vals: np.ndarray, cutter: TrialCutter) -> None:
         """Feed in runs without clock trouble.
@@ -572,6 +647,7 @@ class SerialRecorder:
             self._emit(e)
 
     def _bad(self, kind: str, text: str) -> None:
+        self._last_bad_text = text
         st = self.status
         st.lines_bad += 1
         st.bad_by_kind[kind] = st.bad_by_kind.get(kind, 0) + 1
@@ -580,6 +656,45 @@ class SerialRecorder:
         if seen < _EXAMPLES_PER_KIND:
             more = " (further ones are only counted)" if seen == _EXAMPLES_PER_KIND - 1 else ""
             self._emit(RecordEvent("bad_line", f"skipped a line with {_BAD_KIND_TEXT[kind]}: {text!r}{more}"))
+
+
+def _not_a_serial_device(port: str) -> str:
+    """What ``port`` is instead, when it is a path to something that cannot be a serial device ("" otherwise).
+
+    Names that are not paths (``COM3``, pyserial URLs) are left to pyserial.
+    """
+    try:
+        mode = os.stat(port).st_mode
+    except (OSError, ValueError):
+        return ""
+    if stat.S_ISCHR(mode):
+        return ""
+    if stat.S_ISDIR(mode):
+        return "a folder"
+    if stat.S_ISREG(mode):
+        return "a regular file"
+    return "not a character device"
+
+
+def _is_enotty(exc: BaseException | None) -> bool:
+    """Whether ``exc`` or an exception it was raised from is "not a terminal" (ENOTTY).
+
+    pyserial turns the termios error into ``SerialException("Could not
+    configure port: (25, ...)")``; the original stays as its context.
+    """
+    try:
+        import termios
+    except ImportError:  # pragma: no cover - Windows
+        termios = None
+    seen: set[int] = set()
+    while exc is not None and id(exc) not in seen:
+        seen.add(id(exc))
+        if isinstance(exc, OSError) and exc.errno == errno.ENOTTY:
+            return True
+        if termios is not None and isinstance(exc, termios.error) and exc.args[:1] == (errno.ENOTTY,):
+            return True
+        exc = exc.__cause__ or exc.__context__
+    return False
 
 
 def _short(exc: BaseException) -> str:

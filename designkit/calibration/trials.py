@@ -11,17 +11,31 @@ right: it comes from the device clock or the sample count).
 The sidecar ``<trial>.json`` records the profile, material, time, the sensor
 and object temperatures before contact, and how the trial was cut. The folder's
 ``index.csv`` (columns ``file,material,trial_index``) is rebuilt from the
-sidecars after every trial, so it is always consistent with what is on disk
-and can be given to ``designkit calibrate fit`` as it is.
+sidecars after every trial and can be given to ``designkit calibrate fit`` as
+it is. A folder whose index lists files without a designkit sidecar (another
+index, like the shared recordings') is refused rather than having those rows
+dropped (:func:`check_trial_folder`).
+
+A trial is recorded when, and only when, the index lists it. Writing one is
+three atomic file replacements: the CSV, the sidecar, then the index, whose
+replacement is the commit point. Ctrl-C (SIGINT) during those steps is held
+until the index is written, so an interrupt never leaves a trial on disk that
+no index lists; a write that fails (disk full) removes the files it wrote. Only
+a hard kill between the steps can leave a complete CSV and sidecar unlisted;
+the next trial written to the folder lists them (the index is rebuilt from the
+sidecars).
 """
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import io
 import json
 import math
 import re
+import signal
+import threading
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping, Sequence
@@ -31,7 +45,8 @@ import numpy as np
 from .._io import atomic_write_text
 from .._validation import InputError
 
-__all__ = ["COLUMNS", "Trial", "load_index", "read_trial_csv", "rebuild_index", "write_trial"]
+__all__ = ["COLUMNS", "Trial", "check_trial_folder", "load_index", "read_trial_csv", "rebuild_index",
+           "recorded_trials", "write_trial"]
 
 COLUMNS = ("time_s", "passive_temp_c", "active_temp_c", "unused_channel", "force_n")
 TRIAL_FILE_VERSION = 1
@@ -93,12 +108,16 @@ def trial_csv_text(time_s, sensor_c, object_c, force_n) -> str:
 
 def write_trial(folder: Path, material: str, time_s, sensor_c, object_c, force_n,
                 meta: Mapping[str, Any]) -> Path:
-    """Write one trial (CSV, then its sidecar, each atomically) and rebuild the index.
+    """Record one trial: write its CSV and sidecar, then the index that lists it (each atomically).
 
     The trial number is the next free one for ``material`` in ``folder``.
-    Returns the CSV path.
+    Ctrl-C arriving meanwhile is held until the index is written (see the
+    module docstring), so on return, or on KeyboardInterrupt raised from here,
+    the trial is recorded; on any other error nothing of it is left. Returns
+    the CSV path.
     """
     folder = Path(folder)
+    check_trial_folder(folder)  # before writing anything
     folder.mkdir(parents=True, exist_ok=True)
     slug = _slug(material)
     taken = {int(m.group(1)) for p in folder.glob(f"{slug}_*.json")
@@ -107,12 +126,48 @@ def write_trial(folder: Path, material: str, time_s, sensor_c, object_c, force_n
               if (m := re.fullmatch(rf"{re.escape(slug)}_(\d+)\.csv", p.name))}
     k = max(taken, default=0) + 1
     csv_path = folder / f"{slug}_{k:03d}.csv"
-    atomic_write_text(csv_path, trial_csv_text(time_s, sensor_c, object_c, force_n))
+    csv_text = trial_csv_text(time_s, sensor_c, object_c, force_n)
     side = {"designkit_trial": TRIAL_FILE_VERSION, "file": csv_path.name, "material": material,
             "trial_index": k, **dict(meta)}
-    atomic_write_text(csv_path.with_suffix(".json"), json.dumps(_plain(side), indent=2) + "\n")
-    rebuild_index(folder)
+    side_text = json.dumps(_plain(side), indent=2) + "\n"
+    written: list[Path] = []
+    with _sigint_held():
+        try:
+            written.append(atomic_write_text(csv_path, csv_text))
+            written.append(atomic_write_text(csv_path.with_suffix(".json"), side_text))
+            _write_index(folder)  # the commit point: from here on the trial is recorded
+        except BaseException:
+            for path in reversed(written):
+                with contextlib.suppress(OSError):
+                    path.unlink()
+            raise
     return csv_path
+
+
+@contextlib.contextmanager
+def _sigint_held():
+    """Hold Ctrl-C (SIGINT) while the block runs, then deliver it.
+
+    The handler in place when the block starts (Python's, which raises
+    KeyboardInterrupt, or the program's own) is called once the block is done
+    if SIGINT arrived meanwhile. A no-op outside the main thread (signals are
+    only handled there) and where SIGINT is ignored or has no Python handler.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.getsignal(signal.SIGINT)
+    if not callable(previous):
+        yield
+        return
+    pending: list[tuple[int, Any]] = []
+    signal.signal(signal.SIGINT, lambda signum, frame: pending.append((signum, frame)))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+        if pending:
+            previous(*pending[0])
 
 
 def _plain(obj: Any) -> Any:
@@ -128,12 +183,56 @@ def _plain(obj: Any) -> Any:
 
 
 def rebuild_index(folder: Path) -> Path:
-    """Write ``folder/index.csv`` (file, material, trial_index) from the sidecars."""
+    """Write ``folder/index.csv`` (file, material, trial_index) from the sidecars.
+
+    Refuses (see :func:`check_trial_folder`) to replace an index that lists
+    files which are not designkit recordings.
+    """
     folder = Path(folder)
+    check_trial_folder(folder)
+    return _write_index(folder)
+
+
+def _write_index(folder: Path) -> Path:
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\n")
+    writer.writerow(["file", "material", "trial_index"])
+    writer.writerows(_sidecar_rows(folder))
+    return atomic_write_text(folder / "index.csv", buf.getvalue())
+
+
+def check_trial_folder(folder: Path | str) -> None:
+    """Refuse to record into a folder whose ``index.csv`` this module would not rewrite faithfully.
+
+    The index is rebuilt from the sidecars after every trial, so an index
+    listing files that have no designkit sidecar (the shared recordings', a
+    hand-made one) would lose those rows, and one that cannot be read would be
+    replaced. Raises InputError naming the index and a file it lists (or
+    ``folder``, when it is a file).
+    """
+    folder = Path(folder)
+    if folder.exists() and not folder.is_dir():
+        raise InputError(f"{folder} is not a folder (the trials and their index.csv go in one)")
+    index_csv = folder / "index.csv"
+    if not index_csv.exists():
+        return
+    try:
+        rows = read_index_rows(index_csv)
+    except InputError as exc:
+        raise InputError(f"{exc}; recording into {folder} would replace it: use another folder") from None
+    ours = {name for name, _, _ in _sidecar_rows(folder)}
+    foreign = [r["file"] for r in rows if r.get("file") and r["file"] not in ours and (folder / r["file"]).exists()]
+    if foreign:
+        raise InputError(f"index {index_csv} lists {len(foreign)} file(s) that are not designkit recordings (e.g. "
+                         f"{foreign[0]}); recording into {folder} would drop them from it: use another folder")
+
+
+def _sidecar_rows(folder: Path) -> list[tuple[str, str, Any]]:
+    """(file, material, trial_index) of every trial in ``folder`` with a sidecar and its CSV, sorted."""
     rows = []
     for side in sorted(folder.glob("*.json")):
         try:
-            meta = json.loads(side.read_text())
+            meta = json.loads(side.read_text(encoding="utf-8"))
         except (OSError, ValueError):
             continue
         if not isinstance(meta, dict) or "designkit_trial" not in meta:
@@ -142,21 +241,27 @@ def rebuild_index(folder: Path) -> Path:
         if csv_path.is_file():
             rows.append((csv_path.name, str(meta.get("material", "")), meta.get("trial_index", "")))
     rows.sort(key=lambda r: (r[1], r[2] if isinstance(r[2], int) else 0, r[0]))
-    buf = io.StringIO()
-    writer = csv.writer(buf, lineterminator="\n")
-    writer.writerow(["file", "material", "trial_index"])
-    writer.writerows(rows)
-    return atomic_write_text(folder / "index.csv", buf.getvalue())
+    return rows
+
+
+def _read_text(path: Path, what: str) -> str:
+    """The text of a UTF-8 file (a byte-order mark is allowed); InputError naming ``path`` otherwise."""
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise InputError(f"cannot read {what} {path}: {exc.strerror or exc}") from None
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = data[:exc.start].count(b"\n") + 1
+        raise InputError(f"{what} {path} is not UTF-8 text (byte 0x{data[exc.start]:02x} on line {line})") from None
 
 
 def read_trial_csv(path: Path, material: str = "") -> Trial:
     """Read a trial CSV (the shared recordings' columns; passive and force optional)."""
     path = Path(path)
-    try:
-        with path.open(newline="") as fh:
-            header = next(csv.reader(fh), None)
-    except OSError as exc:
-        raise InputError(f"cannot read trial {path}: {exc.strerror or exc}") from None
+    text = _read_text(path, "trial")
+    header = next(csv.reader(io.StringIO(text, newline="")), None)
     if not header:
         raise InputError(f"trial {path} is empty")
     header = [h.strip() for h in header]
@@ -165,7 +270,7 @@ def read_trial_csv(path: Path, material: str = "") -> Trial:
         raise InputError(f"trial {path} lacks column(s) {', '.join(missing)} "
                          f"(expected {','.join(COLUMNS)})")
     try:
-        data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2, dtype=np.float64)
+        data = np.loadtxt(io.StringIO(text, newline=None), delimiter=",", skiprows=1, ndmin=2, dtype=np.float64)
     except ValueError as exc:
         raise InputError(f"trial {path} has a value that is not a number ({str(exc).splitlines()[0]})") from None
     if data.shape[0] < 3 or data.shape[1] != len(header):
@@ -182,9 +287,10 @@ def read_trial_csv(path: Path, material: str = "") -> Trial:
     meta: dict[str, Any] = {}
     side = path.with_suffix(".json")
     if side.is_file():
+        side_text = _read_text(side, "trial sidecar")
         try:
-            meta = json.loads(side.read_text())
-        except (OSError, ValueError):
+            meta = json.loads(side_text)
+        except ValueError:
             raise InputError(f"trial sidecar {side} is not valid JSON") from None
     return Trial(time_s=t, sensor_c=col("active_temp_c")[keep], object_c=col("passive_temp_c")[keep],
                  force_n=col("force_n")[keep], material=material or str(meta.get("material", "")),
@@ -192,19 +298,28 @@ def read_trial_csv(path: Path, material: str = "") -> Trial:
 
 
 def read_index_rows(index_csv: Path | str) -> list[dict[str, str]]:
-    """The rows of a trial index (a CSV with at least the columns ``file`` and ``material``).
+    """The rows of a trial index (a UTF-8 CSV with at least the columns ``file`` and ``material``).
 
-    Raises InputError, with the path, when it cannot be read or lacks those columns.
+    Raises InputError, with the path, when it cannot be read, is not UTF-8 or lacks those columns.
     """
     index_csv = Path(index_csv)
-    try:
-        with index_csv.open(newline="") as fh:
-            rows = list(csv.DictReader(fh))
-    except OSError as exc:
-        raise InputError(f"cannot read index {index_csv}: {exc.strerror or exc}") from None
-    if not rows or not {"file", "material"} <= set(rows[0]):
+    reader = csv.DictReader(io.StringIO(_read_text(index_csv, "index"), newline=""))
+    rows = list(reader)
+    if not {"file", "material"} <= set(reader.fieldnames or ()):
         raise InputError(f"index {index_csv} needs columns file and material")
     return rows
+
+
+def recorded_trials(folder: Path | str) -> list[Path]:
+    """The trials recorded in ``folder``: the CSVs its ``index.csv`` lists, in its order.
+
+    Empty when there is no index yet. This, not what a recorder remembers
+    writing, is what is on disk (a trial is recorded when the index lists it).
+    """
+    index_csv = Path(folder) / "index.csv"
+    if not index_csv.exists():
+        return []
+    return [index_csv.parent / r["file"] for r in read_index_rows(index_csv) if r.get("file")]
 
 
 def load_index(index_csv: Path, only: Sequence[str] | None = None) -> list[Trial]:

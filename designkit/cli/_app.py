@@ -6,7 +6,10 @@ never import scikit-learn, matplotlib or dask.
 
 Bad input anywhere below (``ValueError``, including designkit's ``InputError``,
 and ``OSError`` for unreadable files) is printed as one line on stderr and
-exits with status 2, never as a traceback.
+exits with status 2, never as a traceback. Anything else is a bug: one line
+naming what failed and where to report it, exit status 1, and the traceback
+only with ``designkit --debug ...``. With ``--json`` on the command, errors are
+JSON on stdout too (``{"error": {...}}``), so a script reads one format.
 """
 
 from __future__ import annotations
@@ -27,7 +30,22 @@ except ImportError:  # pragma: no cover - depends on the installed typer
     from click.exceptions import NoArgsIsHelpError as _NoArgsIsHelp
 
 EXIT_BAD_INPUT = 2
+EXIT_BUG = 1
 EXIT_INTERRUPTED = 130
+ISSUES_URL = "https://github.com/designkit-dev/designkit/issues"
+_DEBUG_KEY = "designkit.debug"
+
+
+def _wants_json(args: Any) -> bool:
+    return any(a == "--json" for a in (args or ()))
+
+
+def _report_error(kind: str, message: str, status: int, as_json: bool) -> None:
+    """Print one error: a line on stderr, and under --json also ``{"error": ...}`` on stdout."""
+    typer.echo(f"Error: {message}", err=True)
+    if as_json:
+        sys.stdout.write(json.dumps({"error": {"kind": kind, "message": message, "exit_status": status}}) + "\n")
+        sys.stdout.flush()
 
 
 class _Group(TyperGroup):
@@ -46,7 +64,8 @@ class _Group(TyperGroup):
             ctx = getattr(exc, "ctx", None)
             if ctx is not None:
                 hint = f" (see '{ctx.command_path} --help')"
-            typer.echo(f"Error: {exc.format_message()}{hint}", err=True)
+            argv = kwargs.get("args") if kwargs.get("args") is not None else (args[0] if args else sys.argv[1:])
+            _report_error("usage", f"{exc.format_message()}{hint}", exc.exit_code, _wants_json(argv))
             sys.exit(exc.exit_code)
         except typer.Abort:
             typer.echo("Aborted.", err=True)
@@ -54,14 +73,33 @@ class _Group(TyperGroup):
         sys.exit(rv if isinstance(rv, int) else 0)
 
     def invoke(self, ctx: Any) -> Any:
+        sub_args = list(getattr(ctx, "protected_args", []) or []) + list(ctx.args or [])
         try:
             return super().invoke(ctx)
+        except (typer.Exit, typer.Abort, _ClickException, KeyboardInterrupt, SystemExit):
+            raise
         except (ValueError, OSError) as exc:
             message = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
             if isinstance(exc, OSError) and exc.filename and str(exc.filename) not in message:
                 message = f"{message}: {exc.filename}"
-            typer.echo(f"Error: {message}", err=True)
+            _report_error("bad-input", message, EXIT_BAD_INPUT, _wants_json(sub_args))
             raise typer.Exit(EXIT_BAD_INPUT) from None
+        except MemoryError:
+            _report_error("bad-input", "out of memory: the request is too large for this machine "
+                          "(ask for fewer trials, intervals or a shorter contact)", EXIT_BAD_INPUT,
+                          _wants_json(sub_args))
+            raise typer.Exit(EXIT_BAD_INPUT) from None
+        except Exception as exc:  # a bug: say so in one line; the traceback only with --debug
+            if ctx.meta.get(_DEBUG_KEY):
+                raise
+            from designkit import __version__
+
+            where = f"{type(exc).__name__}: {str(exc).strip().splitlines()[0] if str(exc).strip() else ''}"
+            message = (f"internal error in designkit {__version__} ({where.rstrip(': ')}); this is a bug: "
+                       f"please report it at {ISSUES_URL} with the output of 'designkit --debug "
+                       f"{' '.join(str(a) for a in sub_args)}'")
+            _report_error("internal", message, EXIT_BUG, _wants_json(sub_args))
+            raise typer.Exit(EXIT_BUG) from None
 
 
 app = typer.Typer(
@@ -90,10 +128,13 @@ def _show_version(value: bool) -> None:
 
 @app.callback()
 def _root(
+    ctx: typer.Context,
     version: bool = typer.Option(False, "--version", "-V", callback=_show_version, is_eager=True,
                                  help="Print designkit's version and exit."),
+    debug: bool = typer.Option(False, "--debug", help="Show the full traceback of an internal error."),
 ) -> None:
-    """The top-level options (only --version): typer's group callback."""
+    """The top-level options (--version, --debug): typer's group callback."""
+    ctx.meta[_DEBUG_KEY] = debug
 
 
 # Help panels of ``designkit --help``, in the order a new user needs them.
@@ -131,10 +172,17 @@ def emit_json(payload: Any) -> None:
 
 
 def console(stderr: bool = False):
-    """A rich console (imported lazily: rich costs ~50 ms)."""
+    """A rich console (imported lazily: rich costs ~50 ms).
+
+    On a terminal it wraps to the window; piped or logged, nothing is hard-wrapped
+    (a line is a line, whatever its length) and tables take the width they need.
+    """
     from rich.console import Console
 
-    return Console(stderr=stderr, highlight=False)
+    stream = sys.stderr if stderr else sys.stdout
+    if hasattr(stream, "isatty") and stream.isatty():
+        return Console(stderr=stderr, highlight=False)
+    return Console(stderr=stderr, highlight=False, soft_wrap=True, width=100_000)
 
 
 def main() -> None:

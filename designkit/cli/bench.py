@@ -33,12 +33,11 @@ def bench_cmd(
     """
     import time
 
-    from ..accuracy import report as bench
+    from .. import accuracy
 
-    sections = tuple(section) if section else bench.SECTIONS
-    bad = [s for s in sections if s not in bench.SECTIONS]
-    if bad:
-        raise ValueError(f"unknown section(s) {', '.join(bad)}: choose from {', '.join(bench.SECTIONS)}")
+    sections = accuracy.check_sections(section or accuracy.SECTIONS)
+    if out is not None:
+        accuracy.require_figures()  # refuse now, not after minutes of measuring
     err = console(stderr=True)
     started = time.perf_counter()
     if err.is_terminal and not json_:
@@ -58,12 +57,12 @@ def bench_cmd(
             if not json_:
                 err.print(f"[{time.perf_counter() - started:6.1f} s] {msg}", highlight=False)
     try:
-        report = bench.run_bench(quick=quick, seed=seed, sections=sections, svm_table=table, ideal_table=ideal_table,
+        report = accuracy.run_bench(quick=quick, seed=seed, sections=sections, svm_table=table, ideal_table=ideal_table,
                                  jobs=jobs, progress=say)
     finally:
         if progress is not None:
             progress.stop()
-    written = bench.write_report(report, out) if out is not None else {}
+    written = accuracy.write_report(report, out) if out is not None else {}
     if json_:
         payload = report.to_dict()
         payload["written"] = {k: str(v) for k, v in written.items()}
@@ -75,7 +74,7 @@ def bench_cmd(
 def _print_report(report, written) -> None:
     from rich.table import Table
 
-    from ..accuracy.report import _fmt, _fmt_time
+    from ..accuracy import format_time, format_value
 
     con = console()
     if not con.is_terminal:
@@ -89,7 +88,7 @@ def _print_report(report, written) -> None:
         refs: dict = {}
         for r in rows:
             refs.setdefault(r.reference, r.reference_wall_s)
-        ref_text = "; ".join(f"{name} ({_fmt_time(t)})" for name, t in refs.items())
+        ref_text = "; ".join(f"{name} ({format_time(t)})" for name, t in refs.items())
         t = Table(title=f"{question} — reference: {ref_text}", title_justify="left", title_style="bold")
         for col, kw in (("method", {}), ("setting", {"max_width": 44}), ("metric", {"max_width": 30}),
                         ("p95/value", {"justify": "right"}), ("worst", {"justify": "right"}),
@@ -97,8 +96,8 @@ def _print_report(report, written) -> None:
                         ("n", {"justify": "right"})):
             t.add_column(col, **kw)
         for r in rows:
-            t.add_row(r.method, r.setting, r.metric, _fmt(r.error, 3), _fmt(r.worst, 3), _fmt_time(r.wall_s),
-                      _fmt(r.speedup, 3), str(r.n))
+            t.add_row(r.method, r.setting, r.metric, format_value(r.error, 3), format_value(r.worst, 3),
+                      format_time(r.wall_s), format_value(r.speedup, 3), str(r.n))
         con.print(t)
     if report.curves:
         c = Table(title="Sweep cost curves (one scene point; exponent p of cost ~ size^p)", title_justify="left",
@@ -108,9 +107,9 @@ def _print_report(report, written) -> None:
         for cur in report.curves:
             c.add_row(cur.name, ", ".join(f"{x:g}" for x in cur.x), ", ".join(f"{w:.3g}" for w in cur.wall_s),
                       ", ".join(str(f) for f in cur.fits), ", ".join(f"{m:.1f}" for m in cur.peak_mb),
-                      _fmt(cur.time_exponent, 3),
-                      "—" if cur.fits_exponent is None else _fmt(cur.fits_exponent, 3),
-                      "—" if cur.memory_exponent is None else _fmt(cur.memory_exponent, 3))
+                      format_value(cur.time_exponent, 3),
+                      "—" if cur.fits_exponent is None else format_value(cur.fits_exponent, 3),
+                      "—" if cur.memory_exponent is None else format_value(cur.memory_exponent, 3))
         con.print(c)
     for s in report.skipped:
         con.print(f"[yellow]skipped:[/] {s}")

@@ -31,7 +31,7 @@ PortOpt = Annotated[Optional[str], typer.Option(
     "--port", help="Serial port of the rig (/dev/ttyACM0, COM3, or the pty 'designkit emulate' prints).")]
 ProfileOpt = Annotated[str, typer.Option(
     "--profile", help="Device profile: a shipped name ('designkit', 'adc12-thermistor') or a profile YAML file.")]
-TrialsOpt = Annotated[int, typer.Option("--trials", help="Touches to record per material.")]
+TrialsOpt = Annotated[int, typer.Option("--trials", help="Touches to record per material (at most 1000).")]
 TimeoutOpt = Annotated[Optional[float], typer.Option(
     "--timeout", help="Give up when the device sends nothing for this long [s] (default: the profile's).")]
 RangeOpt = Annotated[Optional[list[str]], typer.Option(
@@ -44,7 +44,14 @@ DepthOpt = Annotated[float, typer.Option(
     "--depth-um", help="Thermistor depth below the contact surface [um], held fixed (only x^2/alpha_s is "
                        "identifiable).")]
 BootstrapOpt = Annotated[int, typer.Option(
-    "--bootstrap", help="Bootstrap replicates over trials for the uncertainties (0: Jacobian instead).")]
+    "--bootstrap", help="Bootstrap replicates over trials for the uncertainties (0: Jacobian instead; at most "
+                        "10000).")]
+
+#: Most touches per material one run records (a touch takes at least the trial window, 8 s by default).
+MAX_TRIALS = 1000
+#: Most bootstrap replicates (a replicate is a whole refit, ~10 ms per 100 trials; 1000-2000 suffice for a
+#: 95 % interval, so more only costs time).
+MAX_BOOTSTRAP = 10_000
 
 
 # ---------------------------------------------------------------- helpers
@@ -62,8 +69,27 @@ def _fit_settings(depth_um: float, bootstrap: int, seed: int, baseline: str = "m
         raise InputError(f"--offset-range must look like MIN:MAX in seconds, got {offset_range!r}")
     if not (depth_um > 0 and math.isfinite(depth_um)):
         raise InputError(f"--depth-um must be positive, got {depth_um:g}")
+    if fit_to is not None and not (math.isfinite(fit_to) and fit_to > 0):
+        raise InputError(f"--fit-to must be a positive, finite time after onset [s], got {fit_to:g}")
+    if bootstrap != 0 and not 2 <= bootstrap <= MAX_BOOTSTRAP:
+        raise InputError(f"--bootstrap must be 0 (none) or 2 to {MAX_BOOTSTRAP} replicates, got {bootstrap}")
     return FitSettings(depth_m=depth_um * 1e-6, bootstrap=bootstrap, seed=seed, baseline=baseline,
                        offset_bounds_s=bounds, fit_to_s=fit_to)
+
+
+def _check_trials(trials: int) -> None:
+    from .._validation import InputError
+
+    if not 1 <= trials <= MAX_TRIALS:
+        raise InputError(f"--trials must be 1 to {MAX_TRIALS} touches per material, got {trials}")
+
+
+def _check_timeout(timeout: Optional[float]) -> None:
+    """Refuse a --timeout the recorder could never reach (NaN compares false: it waited forever)."""
+    from .._validation import InputError
+
+    if timeout is not None and not (math.isfinite(timeout) and timeout > 0):
+        raise InputError(f"--timeout must be a positive, finite number of seconds, got {timeout:g}")
 
 
 def _status_table(st) -> Any:
@@ -122,13 +148,19 @@ class _Display:
 
 def _record_materials(port: str, profile, out: Path, materials: list[str], trials: int, timeout: Optional[float],
                       quiet: bool, prompt: bool):
-    """Record each material in turn on one open connection; returns (recorder, paths, interrupted)."""
+    """Record each material in turn on one open connection; returns (recorder, paths, interrupted).
+
+    ``paths`` are the trials this run added to the folder's index, read back
+    from disk: after Ctrl-C the recorder cannot know how far it got (the
+    interrupt may come between a trial's commit and its being remembered).
+    """
     from ..calibration.recorder import SerialRecorder
+    from ..calibration.trials import recorded_trials
 
     display = _Display(quiet)
     rec = SerialRecorder(port, profile, out, no_data_timeout_s=timeout, on_event=display.event,
                          on_status=display.status)
-    paths: list[Path] = []
+    before = set(recorded_trials(out))
     interrupted = False
     try:
         rec.open()
@@ -142,11 +174,13 @@ def _record_materials(port: str, profile, out: Path, materials: list[str], trial
             elif i > 0:
                 rec.flush_input()
             with display:
-                paths += rec.record(material, trials)
+                rec.record(material, trials)
     except KeyboardInterrupt:
         interrupted = True
     finally:
         rec.close()
+    order = {p: i for i, p in enumerate(rec.written)}  # recording order; index order for any other
+    paths = sorted((p for p in recorded_trials(out) if p not in before), key=lambda p: order.get(p, len(order)))
     return rec, paths, interrupted
 
 
@@ -275,8 +309,10 @@ def record(
 
     if port is None or material is None or out is None:
         raise InputError("give --port, --material and --out")
-    if trials < 1:
-        raise InputError(f"--trials must be >= 1, got {trials}")
+    if not material.strip():
+        raise InputError("--material must not be empty (it names the trials in the index)")
+    _check_trials(trials)
+    _check_timeout(timeout)
     prof = load_profile(profile)
     rec, paths, interrupted = _record_materials(port, prof, out, [material], trials, timeout, quiet=json_,
                                                 prompt=False)
@@ -357,8 +393,10 @@ def guided(
     if port is None or not material or out is None:
         raise InputError("the guided run needs --port, at least one --material and --out "
                          "(or use 'calibrate record' and 'calibrate fit')")
-    if trials < 1:
-        raise InputError(f"--trials must be >= 1, got {trials}")
+    if not all(m.strip() for m in material):
+        raise InputError("--material must not be empty (it names the trials in the index)")
+    _check_trials(trials)
+    _check_timeout(timeout)
     from ..calibration.fit import parse_object_temps, parse_ranges, resolve_ranges
     from ..calibration.profiles import load_profile
 
@@ -407,8 +445,8 @@ def emulate(
     speed: Annotated[float, typer.Option("--speed", help="Device seconds per real second (20: 20x real time).")] = 1.0,
     fault: Annotated[Optional[list[str]], typer.Option(
         "--fault", help="Inject a fault (repeatable): garbled=P, partial=P, non-numeric=P, field-count=P, "
-                        "out-of-range=P (per-line probabilities), burst=EVERY_S[:HOLD_S], gap=EVERY_S[:SILENT_S], "
-                        "vanish=AFTER_S, silent.")] = None,
+                        "out-of-range=P (per-line probabilities, from device time line-faults-after=S on), "
+                        "burst=EVERY_S[:HOLD_S], gap=EVERY_S[:SILENT_S], vanish=AFTER_S, silent.")] = None,
     duration: Annotated[Optional[float], typer.Option(
         "--duration", help="Stop after this many real seconds (default: run until Ctrl-C).")] = None,
     seed: Seed = 0,

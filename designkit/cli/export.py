@@ -1,13 +1,16 @@
-"""``designkit export``: a lookup table, or the slice a deployment needs, as JSON, CSV, NumPy, C or Python.
+"""``designkit export``: a lookup table, or the slice a deployment needs, in any format of the export registry.
 
 The C header and the Python module answer the same questions as ``designkit
 min-contact / delta-e / distinguishable`` (from a table) on a robot or a
-microcontroller where designkit does not run. Imports nothing heavy: the
-export path needs numpy only.
+microcontroller where designkit does not run. One library call
+(:func:`designkit.export.export_table`, or :func:`~designkit.export.export_bytes`
+for ``--out -``), then its result rendered. Imports nothing heavy: the export
+path needs numpy only (and scipy for ``.mat``).
 """
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 from typing import Annotated, List, Optional
 
@@ -17,12 +20,17 @@ from ._app import app, console, emit_json
 from . import _app
 from ._options import Json
 
-_FORMATS = "json, csv, npz, c (a C99 header) or python (a module needing only the standard library)"
+__all__ = ["export_cmd"]
+
+_FORMATS = ("json, csv (provenance in FILE.csv.json), npz, mat (MATLAB), c (a C99 header) or python "
+            "(a module needing only the standard library)")
+_WHAT = {"json": "JSON", "csv": "CSV", "npz": "NumPy npz", "mat": "MATLAB .mat", "c": "C99 header",
+         "python": "Python module (stdlib only)"}
 
 
 @app.command("export", rich_help_panel=_app.TABLES)
 def export_cmd(
-    out: Annotated[Path, typer.Option("--out", "-o", help="File to write (.json, .csv, .npz, .h or .py).")],
+    out: Annotated[str, typer.Option("--out", "-o", help="File to write (.json, .csv, .npz, .mat, .h or .py); - for standard output (give --format; a CSV then goes without its provenance sidecar).")],
     table: Annotated[str, typer.Option("--table", help="Lookup table (name or path).")] = "svm-paper",
     fmt: Annotated[Optional[str], typer.Option("--format", "-f", help=f"Format: {_FORMATS}. Default: from --out's suffix.")] = None,
     noise: Annotated[Optional[float], typer.Option("--noise", help="Keep one scene: noise sigma per sample [°C] (with --delta-t).")] = None,
@@ -40,32 +48,49 @@ def export_cmd(
     writes a C99 header with `designkit_min_contact_s`, `designkit_delta_e` and
     `designkit_distinguishable` for one sensor noise and temperature difference.
     """
-    from ..export.core import export_table
+    from ..export import export_bytes, export_table
 
-    res = export_table(table, out, fmt, prefix=prefix, noise_c=noise, delta_t_c=delta_t, contact=contact,
-                       e_min=e_min, e_max=e_max, kind=kind)
+    slice_opts = dict(prefix=prefix, noise_c=noise, delta_t_c=delta_t, contact=contact, e_min=e_min, e_max=e_max,
+                      kind=kind)
+    if out == "-":
+        _to_stdout(export_bytes, table, fmt, json_, slice_opts)
+        return
+    res = export_table(table, Path(out), fmt, **slice_opts)
     if json_:
         emit_json(res.to_dict())
         return
     from rich.markup import escape
 
     p = res.provenance
-    what = {"json": "JSON", "csv": "CSV", "npz": "NumPy npz", "c": "C99 header", "python": "Python module (stdlib only)"}
     con = console()
-    con.print(f"wrote [bold]{escape(str(res.path))}[/] ({what[res.format]}, {_size(res.size_bytes)})")
-    con.print(f"  from table {escape(p['source_table'])} ({p['fidelity']} fidelity, kind {p['kind']}, "
-              f"F1 >= {p['threshold']:g}, sensor {escape(str(p['sensor'].get('name')))}), {p['source_content_hash']}")
+    con.print(f"wrote [bold]{escape(str(res.path))}[/] ({_WHAT[res.format]}, {_size(res.size_bytes)})"
+              + (f" and its provenance {escape(str(res.sidecar))}" if res.sidecar else ""))
+    con.print(f"  from table {escape(p['source_table'])} ({escape(str(p['fidelity']))} fidelity, kind {p['kind']}, "
+              f"F1 >= {p['threshold']:g}, sensor {escape(str(p['sensor'].get('name')))}, "
+              f"model {escape(str(p['model'].get('name')))}), {escape(str(p['source_content_hash']))}")
     shape = " x ".join(f"{a['points']} {a['name']}" for a in p["axes"])
     con.print(f"  grid {shape}")
     for line in _lines_from(p):
         con.print("  " + escape(line))
     if res.format == "c":
-        pre = prefix
-        con.print(f"  [dim]#include it; call {pre}_min_contact_s, {pre}_delta_e, {pre}_distinguishable "
+        con.print(f"  [dim]#include it; call {prefix}_min_contact_s, {prefix}_delta_e, {prefix}_distinguishable "
                   f"(sentinels: -1 none suffices, -2 outside the grid, -3 invalid input)[/]")
     elif res.format == "python":
         con.print("  [dim]import it; call min_contact_s, delta_e, distinguishable (None: none suffices; "
                   "OutsideTable / ValueError otherwise)[/]")
+
+
+def _to_stdout(export_bytes, table: str, fmt: str | None, json_: bool, slice_opts: dict) -> None:
+    """``--out -``: the export's bytes on standard output, nothing else there."""
+    if fmt is None:
+        raise ValueError("--out - needs --format (there is no file suffix to tell it from)")
+    if json_:
+        raise ValueError("--json and --out - both write to standard output; give --out FILE for --json")
+    res = export_bytes(table, fmt, **slice_opts)
+    if res.format in ("npz", "mat") and sys.stdout.isatty():
+        raise ValueError(f"{res.format} is binary: redirect standard output to a file or give --out FILE")
+    sys.stdout.buffer.write(res.data)
+    sys.stdout.flush()
 
 
 def _lines_from(p: dict) -> list[str]:

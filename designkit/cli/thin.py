@@ -10,7 +10,7 @@ import typer
 
 from ._app import app, console, emit_json
 from . import _app
-from ._options import DeltaT, Json, SensorOpt
+from ._options import BackingOpt, DeltaT, Json, SensorOpt
 
 #: Contact times [s] at which the deviation is reported (the paper's 1-4 s, and longer).
 REPORT_TIMES_S = (1.0, 2.0, 3.0, 4.0, 10.0, 30.0, 60.0)
@@ -20,14 +20,13 @@ REPORT_TIMES_S = (1.0, 2.0, 3.0, 4.0, 10.0, 30.0, 60.0)
 def validity(
     thickness: Annotated[float, typer.Option("--thickness", help="Object thickness \\[m] (e.g. 0.003 for 3 mm).")],
     material: Annotated[Optional[str], typer.Option(
-        "--material", help="Object material (see 'designkit materials list'); its ranges give a worst case.")] = None,
+        "--m", "--material", help="Object material (see 'designkit materials list'); its ranges give a worst "
+                                  "case.")] = None,
     e: Annotated[Optional[float], typer.Option(
-        "--e", help="Object effusivity [J s^-1/2 K^-1 m^-2] (instead of --material; needs --alpha).")] = None,
+        "--e", help="Object effusivity [J s^-1/2 K^-1 m^-2] (instead of --m; needs --diffusivity).")] = None,
     alpha: Annotated[Optional[float], typer.Option(
-        "--alpha", help="Object diffusivity \\[m^2/s] (instead of --material; needs --e).")] = None,
-    backing: Annotated[str, typer.Option(
-        "--backing", help="What lies behind the object: insulated, air, steel, wood, table, or a material name.")
-    ] = "insulated",
+        "--diffusivity", "--alpha", help="Object diffusivity \\[m^2/s] (instead of --m; needs --e).")] = None,
+    backing: BackingOpt = None,
     tolerance: Annotated[float, typer.Option(
         "--tolerance", help="Acceptable deviation from the semi-infinite reading [°C] "
                             "(default 0.01: the paper's smallest noise level).")] = 0.01,
@@ -52,18 +51,18 @@ def validity(
 
     L = check_positive("thickness [m]", thickness)
     sen = load_sensor(sensor)
-    back = resolve_backing(backing)
+    back = resolve_backing("table" if backing is None else backing)  # the queries' default: on a table
     kw = dict(delta_t_c=delta_t, tolerance_c=tolerance, horizon_s=horizon)
     if material is not None:
         if e is not None or alpha is not None:
-            raise InputError("give either --material or --e with --alpha, not both")
+            raise InputError("give either --m or --e with --diffusivity, not both")
         mv = material_validity(material, L, back, sen, **kw)
         nominal, worst, name = mv.nominal, mv.worst, mv.material.name
         ranges = {"effusivity": [mv.material.e_min, mv.material.e_max],
                   "diffusivity_m2_s": [mv.material.diffusivity_min_m2_s, mv.material.diffusivity_max_m2_s]}
     else:
         if e is None or alpha is None:
-            raise InputError("give --material NAME, or both --e and --alpha")
+            raise InputError("give --m MATERIAL, or both --e and --diffusivity (formerly --alpha)")
         nominal = worst = semi_infinite_validity(e, alpha, L, back, sen, **kw)
         name, ranges = None, None
     t_report = np.array(REPORT_TIMES_S)

@@ -1,6 +1,6 @@
 """Thin samples: the sensor touching an object slab of finite thickness on a backing.
 
-The paper's model (:mod:`designkit.physics`, eqs. 1-2) treats sensor and object
+The paper's model (:mod:`designkit.models.semi_infinite`, eqs. 1-2) treats sensor and object
 as two semi-infinite solids. A real sample is a slab of thickness ``L`` lying
 on something (a wooden table, a steel plate, air); once heat has crossed it,
 what lies behind changes the reading. This module gives the sensor reading for

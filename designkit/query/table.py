@@ -1,49 +1,67 @@
-"""Design questions answered: contact time, noise, temperature difference, delta(e).
+"""The table route: design questions answered from a lookup table in milliseconds.
 
-Every question has two routes:
+delta(e) is interpolated linearly in effusivity and contact time and
+log-linearly in sigma/dT between the table's grid points. A question outside
+the grid gets no value (``in_grid`` says which axis, the notes say the range
+in the user's units), never an extrapolation. A table built for another
+forward model, sensor or threshold than the one asked is refused
+(:class:`~designkit.query.inputs.TableMismatch`). This route imports neither
+scikit-learn nor matplotlib.
 
-* **from a table** (milliseconds, no scikit-learn): delta(e) is interpolated
-  linearly in effusivity and contact time and log-linearly in sigma/dT between
-  the table's grid points. An answer outside the grid is refused (``in_grid``
-  says which axis), never extrapolated.
-* **exact** (seconds): the question is computed for this one pair and scene:
-  the SVM's F1 by simulation with repeated seeds and bisection on the asked
-  quantity, the ideal observer in closed form.
-
-Both report the SVM answer and the ideal-observer bound.
-
-Decision rule for a pair ``e1 < e2``: distinguishable when the distance
-``e2 - e1`` reaches both ``delta_up(e1)`` (seen from the lower effusivity) and
+Decision rule for a pair ``e1 < e2`` (the lower edges of the two classes,
+:mod:`designkit.query.inputs`): distinguishable when the distance ``e2 - e1``
+reaches both ``delta_up(e1)`` (seen from the lower effusivity) and
 ``delta_down(e2)`` (seen from the higher one); the two agree up to Monte Carlo
 noise, and requiring both is the conservative choice.
 
-Materials (a range of effusivities each) are answered for the worst case: the
-pair of effusivities, on a 9 x 9 grid over the two ranges, that needs the most.
+The ideal bound comes from an ideal-observer table (``ideal_table``) or the
+SVM table's own ideal arrays, interpolated the same way; ``distinguishable``
+computes the ideal F1 in closed form.
+
+Examples
+--------
+>>> a = min_contact(35000, 20000, noise_c=0.05, delta_t_c=10.0, table="ideal-paper")
+>>> a.route, a.table, 1.0 < a.value <= 2.0
+('table', 'ideal-paper', True)
 """
 
 from __future__ import annotations
 
 import math
-import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass
 from typing import Any, Sequence
 
 import numpy as np
 
-from .._validation import InputError, check_effusivity, check_finite, check_nonnegative, check_positive
+from .._validation import InputError
+from ..tables import lookup
+from ..tables.lookup import GRID_RTOL
 from ..tables.store import Table, load_table
+from .answer import Answer, IdealBound, number
+from .exact import (  # noqa: F401  importable from here for callers written before the route split
+    exact_delta_e,
+    exact_distinguishable,
+    exact_max_noise,
+    exact_min_contact,
+    exact_min_delta_t,
+)
+from .inputs import (
+    REFERENCE_RULE,
+    PairQuestion,
+    TableMismatch,
+    check_contact,
+    check_threshold,
+    pair_question,
+    reference_class,
+    scene_inputs,
+)
 
 __all__ = [
     "DEFAULT_IDEAL_TABLE",
     "DEFAULT_TABLE",
-    "Answer",
+    "GRID_RTOL",
     "delta_e",
     "distinguishable",
-    "exact_delta_e",
-    "exact_distinguishable",
-    "exact_max_noise",
-    "exact_min_contact",
-    "exact_min_delta_t",
     "max_noise",
     "min_contact",
     "min_delta_t",
@@ -51,46 +69,6 @@ __all__ = [
 
 DEFAULT_TABLE = "svm-paper"
 DEFAULT_IDEAL_TABLE = "ideal-paper"
-_GRID = 9  # worst case over material ranges: a 9 x 9 grid of effusivity pairs
-
-
-@dataclass(frozen=True)
-class Answer:
-    """A query's answer: the asked quantity, its interval, the ideal bound, and provenance."""
-
-    question: str
-    value: float | None
-    interval: tuple[float | None, float | None]
-    ideal: float | None
-    source: str
-    table: str | None
-    ideal_table: str | None
-    inputs: dict[str, Any]
-    in_grid: dict[str, bool] = field(default_factory=dict)
-    extra: dict[str, Any] = field(default_factory=dict)
-    note: str = ""
-
-    def to_dict(self) -> dict[str, Any]:
-        d = asdict(self)
-        d["interval"] = list(self.interval)
-        return d
-
-
-# ============================================================ input checks
-def _pair(e1: float, e2: float) -> tuple[float, float]:
-    a = check_effusivity("e1", e1)
-    b = check_effusivity("e2", e2)
-    if a == b:
-        raise InputError(f"e1 and e2 are equal ({a:g}): nothing to separate")
-    return (a, b) if a < b else (b, a)
-
-
-def _scene_inputs(noise_c: float, delta_t_c: float) -> tuple[float, float]:
-    noise = check_nonnegative("noise sigma [degC]", noise_c)
-    dt = check_finite("temperature difference [degC]", delta_t_c)
-    if dt == 0:
-        raise InputError("temperature difference is 0: an unheated sensor sees no contrast between materials")
-    return noise, dt
 
 
 def _as_table(table: "Table | str") -> Table:
@@ -160,208 +138,152 @@ class _View:
         return all(self.e_lo < e <= self.e_hi for e in es)
 
 
-#: A value within this relative distance of a grid value is that grid value. A float32
-#: argument (0.05f / 10.0f, as on a microcontroller) cannot hit 0.005 exactly, and the
-#: exported C and Python lookups use the same rule, so all three answer alike.
-GRID_RTOL = 1e-6
-
-
 def _axis_weights(vals: np.ndarray, x: float, *, log: bool) -> tuple[list[tuple[int, float]], bool]:
-    """Linear (or log-linear) weights of ``x`` between grid values; clamps outside, flagged.
-
-    Within :data:`GRID_RTOL` of a grid value, ``x`` is that value (weight 1).
-    """
-    n = vals.size
-    near = np.abs(x - vals) <= GRID_RTOL * np.abs(vals)
-    if near.any():
-        return [(int(np.argmax(near)), 1.0)], True
-    if n == 1 or x < vals[0] or x > vals[-1]:
-        return [(0 if x < vals[0] else n - 1, 1.0)], False
-    if log:
-        if x <= 0 or vals[0] <= 0:
-            return [(0, 1.0)], False
-        u, grid = math.log(x), np.log(vals)
-    else:
-        u, grid = x, vals
-    j = int(np.clip(np.searchsorted(grid, u) - 1, 0, n - 2))
-    w = float(np.clip((u - grid[j]) / (grid[j + 1] - grid[j]), 0.0, 1.0))
-    return [(j, 1.0 - w), (j + 1, w)], True
+    """Weights of ``x`` on one axis (:func:`designkit.tables.lookup.axis_weights`, the one lookup),
+    plus an in-grid flag; outside the grid the nearest end, flagged (nothing is extrapolated)."""
+    pts = lookup.axis_weights(vals, x, log=log, grid=np.log(vals) if log and vals[0] > 0 else vals)
+    if pts is not None:
+        return pts, True
+    return [(0 if (x < vals[0] or (log and x <= 0)) else vals.size - 1, 1.0)], False
 
 
 def _interp_e(row: np.ndarray, centres: np.ndarray, e: float) -> float:
-    """delta at effusivity e from values at interval centres; NaN if a neighbour is NaN."""
-    if e <= centres[0]:
-        return float(row[0])
-    if e >= centres[-1]:
-        return float(row[-1])
-    j = int(np.searchsorted(centres, e, side="right") - 1)  # centres[j] <= e < centres[j + 1]
-    a, b = row[j], row[j + 1]
-    w = (e - centres[j]) / (centres[j + 1] - centres[j])
-    if w == 0.0:  # on a grid point: its own value, whatever the neighbour holds
-        return float(a)
-    if math.isnan(a) or math.isnan(b):
-        return math.nan
-    return float(a + w * (b - a))
+    """delta at effusivity e (:func:`designkit.tables.lookup.interp_e`); NaN if a neighbour is NaN."""
+    return float(lookup.interp_e(row, centres, e))
 
 
 def _crossing(xs: Sequence[float], needs: Sequence[float], gap: float) -> tuple[float | None, int | None]:
-    """First x where need(x) <= gap, linearly interpolated between grid points.
-
-    ``needs`` decreases along ``xs`` (more contact, less noise); NaN means the
-    need is beyond the grid. Returns (x, index of the first grid point that
-    suffices) or (None, None).
-    """
-    for k, nd in enumerate(needs):
-        if not math.isnan(nd) and nd <= gap:
-            if k == 0:
-                return float(xs[0]), 0
-            prev = needs[k - 1]
-            if math.isnan(prev):
-                return float(xs[k]), k  # cannot interpolate into "beyond the grid": conservative
-            w = (prev - gap) / (prev - nd) if prev != nd else 1.0
-            return float(xs[k - 1] + w * (xs[k] - xs[k - 1])), k
-    return None, None
+    """First x where need(x) <= gap, interpolated (:func:`designkit.tables.lookup.crossing`)."""
+    return lookup.crossing(xs, needs, gap)
 
 
-# ============================================================ table answers
-def _ideal_view(svm: _View, ideal_table: "Table | str | None") -> tuple[_View, str, str | None]:
+# ============================================================ opening a table for a question
+@dataclass(frozen=True)
+class _Opened:
+    """A table checked against the question (threshold, sensor, model), and its ideal-bound view."""
+
+    tab: Table
+    view: _View
+    phi: float
+    model: Any
+    iview: _View
+    ikind: str
+    iname: str | None
+    ihash: str | None
+
+    @property
+    def width(self) -> float:
+        return float(self.tab.header["effusivity"]["width"])
+
+
+def _ideal_view(svm: _View, ideal_table: "Table | str | None") -> tuple[_View, str, Table | None]:
     """The view answering the ideal bound: a dedicated ideal table, else the SVM table's ideal arrays."""
     if ideal_table is not None:
         try:
             t = _as_table(ideal_table)
         except InputError:
             t = None
-        if t is not None and t.sensor == svm.t.sensor and t.fidelity == "ideal" and t.threshold == svm.t.threshold:
-            return _View(t), "svm", t.name
+        if (t is not None and t.sensor == svm.t.sensor and t.fidelity == "ideal" and t.threshold == svm.t.threshold
+                and t.model == svm.t.model):
+            return _View(t), "svm", t
     if "delta_up_ideal" in svm.t.arrays:
-        return svm, "ideal", svm.t.name
-    return svm, "svm", svm.t.name if svm.t.fidelity == "ideal" else None
+        return svm, "ideal", svm.t
+    return svm, "svm", svm.t if svm.t.fidelity == "ideal" else None
 
 
-def _check_threshold(table: Table, threshold: float | None) -> float:
-    if threshold is None or math.isclose(threshold, table.threshold, rel_tol=1e-9):
-        return table.threshold
-    raise InputError(f"table {table.name} was built for threshold {table.threshold:g}, not {threshold:g}: "
-                     f"use --exact, or build a table with designkit sweep --threshold {threshold:g}")
+def _open(table, ideal_table, *, threshold, sensor, model) -> _Opened:
+    """Load ``table`` and refuse it when it was built for another threshold, sensor or model."""
+    from ..models import get_model
 
-
-def _check_sensor(table: Table, sensor) -> None:
-    if sensor is None:
-        return
-    from ..sensor import load_sensor
-
-    s = load_sensor(sensor)
-    if s != table.sensor:
-        raise InputError(f"table {table.name} was built for sensor {table.sensor.name!r}, not {s.name!r}: "
-                         f"use --exact, or build a table for it with designkit sweep --sensor")
-
-
-def _pairs_for(e1, e2, ranges) -> list[tuple[float, float]]:
-    """The effusivity pairs a question covers: one pair, or a grid over two material ranges."""
-    if ranges is None:
-        return [_pair(e1, e2)]
-    (a0, a1), (b0, b1) = ranges
-    ga, gb = np.linspace(a0, a1, _GRID), np.linspace(b0, b1, _GRID)
-    return [(min(x, y), max(x, y)) for x in ga for y in gb]
-
-
-def _ranges_overlap(ranges) -> bool:
-    (a0, a1), (b0, b1) = ranges
-    return max(a0, b0) <= min(a1, b1)
-
-
-def min_contact(e1: float | None = None, e2: float | None = None, *, noise_c: float = 0.05,
-                delta_t_c: float = 10.0, threshold: float | None = None,
-                table: "Table | str" = DEFAULT_TABLE, ideal_table: "Table | str | None" = DEFAULT_IDEAL_TABLE,
-                sensor=None, ranges=None) -> Answer:
-    """Shortest contact time [s] that separates e1 from e2, from a table.
-
-    Parameters
-    ----------
-    e1, e2 : float
-        Effusivities [J s^-1/2 K^-1 m^-2] (or ``ranges``: two (min, max)
-        material ranges, answered for their worst-case pair).
-    noise_c : float
-        Noise sigma per sample [degC].
-    delta_t_c : float
-        Sensor minus object temperature before contact [degC].
-    threshold : float, optional
-        F1 threshold Phi; must be the table's (0.9 for the shipped tables).
-    table, ideal_table : Table or name or path
-        SVM table, and the table for the ideal bound.
-    sensor : name, path or Sensor, optional
-        Checked against the table's sensor.
-
-    Returns
-    -------
-    Answer
-        ``value``: contact time [s] or None when no tabulated contact time up
-        to the table's longest suffices; ``interval``: Monte Carlo interval;
-        ``ideal``: the ideal observer's contact time.
-    """
-    noise, dt = _scene_inputs(noise_c, delta_t_c)
-    pairs = _pairs_for(e1, e2, ranges)
     tab = _as_table(table)
-    phi = _check_threshold(tab, threshold)
-    _check_sensor(tab, sensor)
+    if threshold is not None and not math.isclose(check_threshold(threshold), tab.threshold, rel_tol=1e-9):
+        raise TableMismatch(f"table {tab.name} was built for threshold {tab.threshold:g}, not {threshold:g}")
+    if sensor is not None:
+        from ..sensor import load_sensor
+
+        s = load_sensor(sensor)
+        if s != tab.sensor:
+            raise TableMismatch(f"table {tab.name} was built for sensor {tab.sensor.name!r}, not {s.name!r}")
+    fm = tab.model
+    if model is not None:
+        asked = get_model(model)
+        if asked != fm:
+            raise TableMismatch(f"table {tab.name} was built for the {fm.describe()} model, "
+                                f"not the {asked.describe()} model")
     view = _View(tab)
-    combos, flags = view.scene_weights(noise, dt)
-    flags["effusivity"] = all(view.e_in_grid(lo, hi) for lo, hi in pairs)
-    inputs = _inputs(e1, e2, noise, dt, phi, tab, ranges)
-    if not all(flags.values()):
-        return _outside(inputs, flags, "min-contact", tab)
-    if ranges is not None and _ranges_overlap(ranges):
-        return Answer("min-contact", None, (None, None), None, "table", tab.name, None, inputs, flags,
-                      {"fidelity": tab.fidelity},
-                      note="the two effusivity ranges overlap: some objects of the two materials are identical "
-                           "to the sensor, so no contact time separates them in the worst case")
-    iview, ikind, iname = _ideal_view(view, ideal_table)
-    icombos, iflags = iview.scene_weights(noise, dt)
-
-    def contact_for(v: _View, kind: str, cmb) -> float | None:
-        worst = 0.0
-        for lo, hi in pairs:
-            needs = [v.need(kind, cmb, k, lo, hi) for k in range(v.contacts.size)]
-            x, _ = _crossing(v.contacts, needs, hi - lo)
-            if x is None:
-                return None
-            worst = max(worst, x)
-        return worst
-
-    value = contact_for(view, "svm", combos)
-    if tab.fidelity == "svm":
-        lo_t = contact_for(view, "lo", combos)
-        hi_t = contact_for(view, "hi", combos)
-    else:
-        lo_t = hi_t = value
-    ideal = contact_for(iview, ikind, icombos) if all(iflags.values()) else None
-    note = "" if value is not None else (
-        f"no tabulated contact time up to {view.contacts[-1]:g} s separates them; "
-        f"try --exact for longer contacts")
-    return Answer("min-contact", value, (lo_t, hi_t), ideal, "table", tab.name, iname, inputs, flags,
-                  {"fidelity": tab.fidelity, "table_contacts_s": view.contacts.tolist()}, note)
+    iview, ikind, it = _ideal_view(view, ideal_table)
+    return _Opened(tab, view, tab.threshold, fm, iview, ikind, None if it is None else it.name,
+                   None if it is None else it.header.get("content_hash"))
 
 
-def _inputs(e1, e2, noise, dt, phi, tab, ranges, **more) -> dict[str, Any]:
-    d = {"e1": e1, "e2": e2, "noise_c": noise, "delta_t_c": dt, "threshold": phi,
-         "sensor": tab.header["sensor"]["name"]}
-    if noise is not None and dt is not None:
-        d["noise_ratio"] = noise / abs(dt)
-    if ranges is not None:
-        d["e1_range"], d["e2_range"] = list(ranges[0]), list(ranges[1])
-        d["rule"] = "worst case over the two ranges (9 x 9 grid of effusivity pairs)"
-    d.update(more)
-    return d
+# ============================================================ in-grid flags, in the user's units
+def _axis_range(view: _View, name: str) -> tuple[float, float]:
+    vals = view.t.axes[name]
+    return float(vals.min()), float(vals.max())
 
 
-def _outside(inputs, flags, question, tab) -> Answer:
-    bad = [k for k, ok in flags.items() if not ok]
-    return Answer(question, None, (None, None), None, "table", tab.name, None, inputs, flags,
-                  {"fidelity": tab.fidelity},
-                  note=f"outside table {tab.name} along {', '.join(bad)} (no extrapolation): use --exact")
+_AXIS_WORDS = {"noise_ratio": ("sigma/dT", ""), "noise_c": ("noise sigma", " degC"),
+               "delta_t_c": ("temperature difference", " degC"), "contact_s": ("contact time", " s")}
 
 
-def _contact_index_weights(view: _View, contact_s: float) -> tuple[list[tuple[int, float]], bool]:
+def _outside_notes(view: _View, flags: dict[str, bool], wanted: dict[str, Any]) -> list[str]:
+    """One sentence per axis the question lies outside, with the asked value and the table's range."""
+    notes = []
+    for name, ok in flags.items():
+        if ok:
+            continue
+        if name == "effusivity":
+            es = ", ".join(f"{e:g}" for e in wanted.get("effusivity", ()))
+            notes.append(f"effusivity {es} outside table {view.t.name}'s ({view.e_lo:g}, {view.e_hi:g}] "
+                         "J s^-1/2 K^-1 m^-2 (no extrapolation)")
+        else:
+            word, unit = _AXIS_WORDS.get(name, (name, ""))
+            lo, hi = _axis_range(view, name)
+            x = wanted.get(name)
+            asked = f" {x:g}{unit}" if isinstance(x, (int, float)) else ""
+            notes.append(f"{word}{asked} outside table {view.t.name}'s [{lo:g}, {hi:g}]{unit} (no extrapolation)")
+    return notes
+
+
+def _scene_wanted(view: _View, noise, dt) -> dict[str, Any]:
+    if view.scene_axes == ["noise_ratio"]:
+        return {"noise_ratio": None if noise is None or dt is None else noise / abs(dt)}
+    return {"noise_c": noise, "delta_t_c": dt}
+
+
+# ============================================================ one answer builder for the route
+def _answer(question: str, op: _Opened, *, objects, limiting, rule: str, scene: dict, value, interval,
+            ideal, ideal_method: str = "table", in_grid: dict, details: dict, notes: Sequence[str] = (),
+            check_at: tuple[float, float, float] | None = None, classes=()) -> Answer:
+    check = None
+    if check_at is not None and classes:
+        c, n, d = check_at
+        check = op.model.check(classes, op.tab.sensor, contact_s=c, noise_c=n, delta_t_c=d).to_dict()
+    ideal_table = op.iname if ideal_method == "table" else None
+    return Answer(
+        question=question, route="table", value=value, interval=tuple(interval),
+        ideal_bound=IdealBound(number(ideal) if not isinstance(ideal, bool) else ideal,
+                               ideal_method if ideal is not None else "none"),
+        objects=tuple(objects), limiting_pair=tuple(limiting), materials_rule=rule, scene=scene,
+        sensor=op.tab.sensor.to_dict(), model=op.model.to_dict(), model_check=check, threshold=op.phi,
+        table=op.tab.name, table_hash=op.tab.header.get("content_hash"), ideal_table=ideal_table,
+        ideal_table_hash=op.ihash if ideal_table else None, in_grid=dict(in_grid), details=details,
+        computation={"fidelity": op.tab.fidelity, "table_contacts_s": op.view.contacts.tolist()},
+        notes=tuple(n for n in notes if n))
+
+
+def _scene(contact_s=None, noise_c=None, delta_t_c=None) -> dict[str, Any]:
+    ratio = None if noise_c is None or delta_t_c is None else noise_c / abs(delta_t_c)
+    return {"contact_s": contact_s, "noise_c": noise_c, "delta_t_c": delta_t_c, "noise_ratio": ratio}
+
+
+def _no_pair(question: str, op: _Opened, pq: PairQuestion, scene: dict, details: dict) -> Answer:
+    """The materials overlap: no answer, said so."""
+    return _answer(question, op, objects=pq.objects_dicts(), limiting=(), rule=pq.rule, scene=scene,
+                   value=None, interval=(None, None), ideal=None, in_grid={}, details=details, notes=[pq.note])
+
+
+def _contact_weights(view: _View, contact_s: float) -> tuple[list[tuple[int, float]], bool]:
     return _axis_weights(view.contacts, contact_s, log=False)
 
 
@@ -377,30 +299,104 @@ def _need_at_contact(view: _View, kind: str, combos, cw, lo: float, hi: float) -
     return total
 
 
-def _max_ratio(view: _View, kind: str, contact_s: float, pairs, dt: float) -> tuple[float | None, str]:
-    """Largest sigma/dT (fixed-condition table) at which all pairs separate."""
+# ============================================================ min-contact
+def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | None = None,
+                m2: str | None = None, objects=None, noise_c: float = 0.05, delta_t_c: float = 10.0,
+                threshold: float | None = None, table: "Table | str" = DEFAULT_TABLE,
+                ideal_table: "Table | str | None" = DEFAULT_IDEAL_TABLE, sensor=None, model=None) -> Answer:
+    """Shortest contact time [s] that separates two objects, from a table.
+
+    Parameters
+    ----------
+    e1, e2 : float, optional
+        Effusivities [J s^-1/2 K^-1 m^-2].
+    m1, m2 : str, optional
+        Material names instead (answered by the materials rule, :mod:`designkit.query.inputs`).
+    objects : (ObjectClass, ObjectClass), optional
+        The classes instead.
+    noise_c : float
+        Noise sigma per sample [degC].
+    delta_t_c : float
+        Sensor minus object temperature before contact [degC].
+    threshold : float, optional
+        F1 threshold Phi; must be the table's (0.9 for the shipped tables).
+    table, ideal_table : Table or name or path
+        SVM table, and the table for the ideal bound (None: the SVM table's own ideal arrays).
+    sensor : name, path or Sensor, optional
+        Must be the table's.
+    model : ForwardModel or name, optional
+        Must be the table's (default: whatever the table was built with).
+
+    Returns
+    -------
+    Answer
+        ``value``: contact time [s], None when no tabulated contact time up to
+        the table's longest suffices.
+
+    Examples
+    --------
+    >>> min_contact(35000, 20000, table="ideal-paper").to_dict()["quantity"]
+    'contact_s'
+    """
+    noise, dt = scene_inputs(noise_c, delta_t_c)
+    op = _open(table, ideal_table, threshold=threshold, sensor=sensor, model=model)
+    pq = pair_question(e1, e2, m1, m2, objects=objects, width=op.width, model=op.model)
+    scene = _scene(None, noise, dt)
+    if pq.classes is None:
+        return _no_pair("min-contact", op, pq, scene, {})
+    lo, hi = pq.points
+    view = op.view
+    combos, flags = view.scene_weights(noise, dt)
+    flags["effusivity"] = view.e_in_grid(lo, hi)
+    common = dict(objects=pq.objects_dicts(), limiting=pq.limiting_dicts(), rule=pq.rule, scene=scene,
+                  classes=pq.classes)
+    if not all(flags.values()):
+        wanted = {**_scene_wanted(view, noise, dt), "effusivity": (lo, hi)}
+        return _answer("min-contact", op, value=None, interval=(None, None), ideal=None, in_grid=flags,
+                       details={}, notes=_outside_notes(view, flags, wanted), **common)
+    icombos, iflags = op.iview.scene_weights(noise, dt)
+
+    def contact_for(v: _View, kind: str, cmb) -> float | None:
+        needs = [v.need(kind, cmb, k, lo, hi) for k in range(v.contacts.size)]
+        x, _ = _crossing(v.contacts, needs, hi - lo)
+        return x
+
+    value = contact_for(view, "svm", combos)
+    if op.tab.fidelity == "svm":
+        interval = (contact_for(view, "lo", combos), contact_for(view, "hi", combos))
+    else:
+        interval = (value, value)
+    ideal = contact_for(op.iview, op.ikind, icombos) if all(iflags.values()) else None
+    note = "" if value is not None else (
+        f"no tabulated contact time up to {view.contacts[-1]:g} s separates them "
+        "(the exact route examines longer contacts)")
+    grid = [float(c) for c in view.contacts]
+    if value is not None and value in grid and grid.index(value) > 0:
+        prev = grid[grid.index(value) - 1]
+        note = (f"{value:g} s is the table's next contact time after {prev:g} s, where they are not separable: "
+                f"the shortest time lies in ({prev:g}, {value:g}] s (the exact route resolves it)")
+    needed = value if value is not None else float(view.contacts[-1])
+    return _answer("min-contact", op, value=value, interval=interval, ideal=ideal, in_grid=flags, details={},
+                   notes=[note], check_at=(needed, noise, dt), **common)
+
+
+# ============================================================ max-noise / min-delta-t
+def _max_ratio(view: _View, kind: str, contact_s: float, lo: float, hi: float) -> tuple[float | None, str]:
+    """Largest sigma/dT (fixed-condition table) at which the pair separates, and where it lies."""
     ratios = view.t.axes["noise_ratio"]
-    cw, _ = _contact_index_weights(view, contact_s)
-    ok_rows = []
-    for r_idx in range(ratios.size):
-        combos = [((r_idx,), 1.0)]
-        ok_rows.append(all(not math.isnan(nd := _need_at_contact(view, kind, combos, cw, lo, hi))
-                           and nd <= hi - lo for lo, hi in pairs))
+    cw, _ = _contact_weights(view, contact_s)
+
+    def margin(r_idx):
+        nd = _need_at_contact(view, kind, [((r_idx,), 1.0)], cw, lo, hi)
+        return -math.inf if math.isnan(nd) else (hi - lo) - nd
+
+    ok_rows = [margin(i) >= 0 for i in range(ratios.size)]
     if not ok_rows[0]:
         return None, "below"
     last = max(i for i, ok in enumerate(ok_rows) if ok)
     if last == ratios.size - 1:
         return float(ratios[-1]), "above"
-    # interpolate the crossing in log(ratio) on the worst pair's margin
-    def margin(r_idx):
-        combos = [((r_idx,), 1.0)]
-        vals = []
-        for lo, hi in pairs:
-            nd = _need_at_contact(view, kind, combos, cw, lo, hi)
-            vals.append(-math.inf if math.isnan(nd) else (hi - lo) - nd)
-        return min(vals)
-
-    m0, m1 = margin(last), margin(last + 1)
+    m0, m1 = margin(last), margin(last + 1)  # interpolate the crossing in log(ratio)
     if not math.isfinite(m1):
         return float(ratios[last]), "inside"
     w = m0 / (m0 - m1) if m0 != m1 else 0.0
@@ -408,33 +404,34 @@ def _max_ratio(view: _View, kind: str, contact_s: float, pairs, dt: float) -> tu
     return math.exp(lr), "inside"
 
 
-def _ratio_question(question: str, e1, e2, contact_s, noise_c, delta_t_c, threshold, table, ideal_table,
-                    sensor, ranges) -> Answer:
-    contact = check_positive("contact time [s]", contact_s)
-    pairs = _pairs_for(e1, e2, ranges)
+def _ratio_question(question: str, e1, e2, m1, m2, objects, contact_s, noise_c, delta_t_c, threshold, table,
+                    ideal_table, sensor, model) -> Answer:
+    contact = check_contact(contact_s)
     if question == "max-noise":
-        dt = check_finite("temperature difference [degC]", delta_t_c)
-        if dt == 0:
-            raise InputError("temperature difference is 0: no noise level is small enough")
+        _, dt = scene_inputs(0.0, delta_t_c)
+        scene = _scene(contact, None, dt)
     else:
-        noise = check_positive("noise sigma [degC]", noise_c)
-    tab = _as_table(table)
-    phi = _check_threshold(tab, threshold)
-    _check_sensor(tab, sensor)
-    if "noise_ratio" not in tab.axes:
-        raise InputError(f"table {tab.name} has separate noise and temperature axes (varied initial "
-                         f"conditions); use --exact for {question}")
-    view = _View(tab)
-    _, c_ok = _contact_index_weights(view, contact)
-    flags = {"contact_s": c_ok, "effusivity": all(view.e_in_grid(lo, hi) for lo, hi in pairs)}
-    if question == "max-noise":
-        inputs = _inputs(e1, e2, None, dt, phi, tab, ranges, contact_s=contact)
-    else:
-        inputs = _inputs(e1, e2, noise, None, phi, tab, ranges, contact_s=contact)
-    inputs.pop("noise_ratio", None)
+        noise, _ = scene_inputs(noise_c, 1.0)
+        if noise == 0:
+            raise InputError("noise sigma is 0: any temperature difference separates them (no smallest one)")
+        scene = _scene(contact, noise, None)
+    op = _open(table, ideal_table, threshold=threshold, sensor=sensor, model=model)
+    if "noise_ratio" not in op.tab.axes:
+        raise TableMismatch(f"table {op.tab.name} has separate noise and temperature axes (varied initial "
+                            f"conditions): it cannot answer {question}; the exact route can")
+    pq = pair_question(e1, e2, m1, m2, objects=objects, width=op.width, model=op.model)
+    if pq.classes is None:
+        return _no_pair(question, op, pq, scene, {})
+    lo, hi = pq.points
+    view = op.view
+    _, c_ok = _contact_weights(view, contact)
+    flags = {"contact_s": c_ok, "effusivity": view.e_in_grid(lo, hi)}
+    common = dict(objects=pq.objects_dicts(), limiting=pq.limiting_dicts(), rule=pq.rule, scene=scene,
+                  classes=pq.classes)
     if not all(flags.values()):
-        return _outside(inputs, flags, question, tab)
-    iview, ikind, iname = _ideal_view(view, ideal_table)
+        notes = _outside_notes(view, flags, {"contact_s": contact, "effusivity": (lo, hi)})
+        return _answer(question, op, value=None, interval=(None, None), ideal=None, in_grid=flags, details={},
+                       notes=notes, **common)
 
     def to_answer(r):
         if r is None:
@@ -442,69 +439,83 @@ def _ratio_question(question: str, e1, e2, contact_s, noise_c, delta_t_c, thresh
         return r * abs(dt) if question == "max-noise" else noise / r
 
     out = {}
-    for kind, v in (("svm", view), ("lo", view), ("hi", view), ("ideal", iview)):
-        if tab.fidelity == "ideal" and kind in ("lo", "hi"):
+    for kind, v in (("svm", view), ("lo", view), ("hi", view), ("ideal", op.iview)):
+        if op.tab.fidelity == "ideal" and kind in ("lo", "hi"):
             out[kind] = out["svm"]
             continue
-        out[kind] = _max_ratio(v, ikind if kind == "ideal" else kind, contact, pairs, 1.0)
+        out[kind] = _max_ratio(v, op.ikind if kind == "ideal" else kind, contact, lo, hi)
     r, where = out["svm"]
     note = ""
     value = to_answer(r)
+    ratios = view.t.axes["noise_ratio"]
     if where == "below":
         value = None
-        note = (f"not separable even at the table's smallest noise ratio sigma/dT = "
-                f"{view.t.axes['noise_ratio'][0]:g}: use --exact")
+        note = f"not separable even at the table's smallest noise ratio sigma/dT = {ratios[0]:g}"
     elif where == "above":
-        note = (f"separable even at the table's largest noise ratio sigma/dT = "
-                f"{view.t.axes['noise_ratio'][-1]:g}: the answer is at least this (use --exact for more)")
+        note = (f"separable even at the table's largest noise ratio sigma/dT = {ratios[-1]:g}: "
+                "the answer is at least this (the exact route looks further)")
         flags["noise_ratio"] = False
     # with more noise allowed at the optimistic end: 'lo' (possibly) ratio >= 'svm' ratio
     ends = [to_answer(out[k][0]) if out[k][1] != "below" else None for k in ("hi", "lo")]
     interval = tuple(sorted(ends, key=lambda x: (x is None, x))) if all(e is not None for e in ends) else tuple(ends)
     ideal = to_answer(out["ideal"][0]) if out["ideal"][1] != "below" else None
-    return Answer(question, value, interval, ideal, "table", tab.name, iname, inputs, flags,
-                  {"fidelity": tab.fidelity}, note)
+    r_check = r if r is not None else float(ratios[0])
+    check_at = (contact, r_check * abs(dt), dt) if question == "max-noise" else (contact, noise, noise / r_check)
+    return _answer(question, op, value=value, interval=interval, ideal=ideal, in_grid=flags, details={},
+                   notes=[note], check_at=check_at, **common)
 
 
-def max_noise(e1=None, e2=None, *, contact_s: float, delta_t_c: float = 10.0, threshold=None,
-              table="svm-paper", ideal_table=DEFAULT_IDEAL_TABLE, sensor=None, ranges=None) -> Answer:
-    """Largest noise sigma [degC] at which ``contact_s`` still separates e1 from e2 (table)."""
-    return _ratio_question("max-noise", e1, e2, contact_s, None, delta_t_c, threshold, table, ideal_table,
-                           sensor, ranges)
+def max_noise(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact_s: float, delta_t_c: float = 10.0,
+              threshold=None, table=DEFAULT_TABLE, ideal_table=DEFAULT_IDEAL_TABLE, sensor=None,
+              model=None) -> Answer:
+    """Largest noise sigma [degC] at which ``contact_s`` still separates the objects (table).
+
+    Arguments as :func:`min_contact`; ``contact_s`` [s] is the contact time.
+    """
+    return _ratio_question("max-noise", e1, e2, m1, m2, objects, contact_s, None, delta_t_c, threshold, table,
+                           ideal_table, sensor, model)
 
 
-def min_delta_t(e1=None, e2=None, *, contact_s: float, noise_c: float = 0.05, threshold=None,
-                table="svm-paper", ideal_table=DEFAULT_IDEAL_TABLE, sensor=None, ranges=None) -> Answer:
-    """Smallest sensor-object temperature difference [degC] that separates e1 from e2 (table)."""
-    return _ratio_question("min-delta-t", e1, e2, contact_s, noise_c, None, threshold, table, ideal_table,
-                           sensor, ranges)
+def min_delta_t(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact_s: float, noise_c: float = 0.05,
+                threshold=None, table=DEFAULT_TABLE, ideal_table=DEFAULT_IDEAL_TABLE, sensor=None,
+                model=None) -> Answer:
+    """Smallest sensor-object temperature difference [degC] that separates the objects (table).
+
+    Arguments as :func:`min_contact`; ``contact_s`` [s] is the contact time.
+    """
+    return _ratio_question("min-delta-t", e1, e2, m1, m2, objects, contact_s, noise_c, None, threshold, table,
+                           ideal_table, sensor, model)
 
 
-def delta_e(e: float, *, contact_s: float, noise_c: float = 0.05, delta_t_c: float = 10.0,
-            threshold=None, table="svm-paper", ideal_table=DEFAULT_IDEAL_TABLE, sensor=None) -> Answer:
+# ============================================================ delta-e
+def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, noise_c: float = 0.05,
+            delta_t_c: float = 10.0, threshold=None, table=DEFAULT_TABLE, ideal_table=DEFAULT_IDEAL_TABLE,
+            sensor=None, model=None) -> Answer:
     """delta(e) towards lower and higher effusivity [J s^-1/2 K^-1 m^-2] (table).
 
-    ``value`` is the smaller of the two; ``extra`` holds ``delta_e_lower``,
-    ``delta_e_upper`` and their intervals (None: nothing distinguishable in the
-    grid in that direction).
+    ``value`` is the smaller of the two; ``details["lower"]`` and
+    ``details["upper"]`` hold each direction's value, interval and ideal
+    bound (None: nothing distinguishable within the grid that way). ``m``: a
+    material, its range's middle as the reference.
     """
-    e = check_effusivity("e", e)
-    contact = check_positive("contact time [s]", contact_s)
-    noise, dt = _scene_inputs(noise_c, delta_t_c)
-    tab = _as_table(table)
-    phi = _check_threshold(tab, threshold)
-    _check_sensor(tab, sensor)
-    view = _View(tab)
+    contact = check_contact(contact_s)
+    noise, dt = scene_inputs(noise_c, delta_t_c)
+    op = _open(table, ideal_table, threshold=threshold, sensor=sensor, model=model)
+    ref = reference_class(e, m, width=op.width, model=op.model)
+    x = ref.e_range[0]
+    view = op.view
     combos, flags = view.scene_weights(noise, dt)
-    cw, flags["contact_s"] = _contact_index_weights(view, contact)
-    flags["effusivity"] = view.e_in_grid(e)
-    inputs = {"e": e, "noise_c": noise, "delta_t_c": dt, "contact_s": contact, "threshold": phi,
-              "sensor": tab.header["sensor"]["name"]}
+    cw, flags["contact_s"] = _contact_weights(view, contact)
+    flags["effusivity"] = view.e_in_grid(x)
+    scene = _scene(contact, noise, dt)
+    common = dict(objects=(ref.to_dict(),), limiting=(ref.to_dict(),), rule=REFERENCE_RULE, scene=scene,
+                  classes=(ref,))
     if not all(flags.values()):
-        return _outside(inputs, flags, "delta-e", tab)
-    iview, ikind, iname = _ideal_view(view, ideal_table)
-    icombos, _ = iview.scene_weights(noise, dt)
-    icw, _ = _contact_index_weights(iview, contact)
+        wanted = {**_scene_wanted(view, noise, dt), "contact_s": contact, "effusivity": (x,)}
+        return _answer("delta-e", op, value=None, interval=(None, None), ideal=None, in_grid=flags,
+                       details=_delta_details(x, {}), notes=_outside_notes(view, flags, wanted), **common)
+    icombos, _ = op.iview.scene_weights(noise, dt)
+    icw, _ = _contact_weights(op.iview, contact)
 
     def at(v, cmb, cws, name):
         if name not in v.t.arrays:
@@ -513,348 +524,74 @@ def delta_e(e: float, *, contact_s: float, noise_c: float = 0.05, delta_t_c: flo
         for k, w in cws:
             if w == 0:
                 continue
-            x = v.delta_at(name, cmb, k, e)
-            if math.isnan(x):
+            y = v.delta_at(name, cmb, k, x)
+            if math.isnan(y):
                 return None
-            total += w * x
+            total += w * y
         return total
 
-    res = {}
-    for direction, key in (("down", "delta_e_lower"), ("up", "delta_e_upper")):
-        res[key] = at(view, combos, cw, f"delta_{direction}")
-        res[key + "_interval"] = [at(view, combos, cw, f"delta_{direction}_lo"),
-                                  at(view, combos, cw, f"delta_{direction}_hi")] if tab.fidelity == "svm" \
-            else [res[key], res[key]]
-        iname_arr = f"delta_{direction}_ideal" if ikind == "ideal" else f"delta_{direction}"
-        res[key + "_ideal"] = at(iview, icombos, icw, iname_arr)
-    finite = [v for v in (res["delta_e_lower"], res["delta_e_upper"]) if v is not None]
-    value = min(finite) if finite else None
-    ifinite = [v for v in (res["delta_e_lower_ideal"], res["delta_e_upper_ideal"]) if v is not None]
-    return Answer("delta-e", value, (None, None), min(ifinite) if ifinite else None, "table", tab.name, iname,
-                  inputs, flags, {"fidelity": tab.fidelity, **res})
+    sides = {}
+    for direction, side in (("down", "lower"), ("up", "upper")):
+        val = at(view, combos, cw, f"delta_{direction}")
+        iv = ([at(view, combos, cw, f"delta_{direction}_lo"), at(view, combos, cw, f"delta_{direction}_hi")]
+              if op.tab.fidelity == "svm" else [val, val])
+        iname = f"delta_{direction}_ideal" if op.ikind == "ideal" else f"delta_{direction}"
+        sides[side] = {"value": val, "interval": iv, "ideal": at(op.iview, icombos, icw, iname)}
+    finite = [s["value"] for s in sides.values() if s["value"] is not None]
+    ifinite = [s["ideal"] for s in sides.values() if s["ideal"] is not None]
+    return _answer("delta-e", op, value=min(finite) if finite else None, interval=(None, None),
+                   ideal=min(ifinite) if ifinite else None, in_grid=flags, details=_delta_details(x, sides),
+                   check_at=(contact, noise, dt), **common)
 
 
-def distinguishable(e1=None, e2=None, *, contact_s: float, noise_c: float = 0.05, delta_t_c: float = 10.0,
-                    threshold=None, table="svm-paper", ideal_table=DEFAULT_IDEAL_TABLE, sensor=None,
-                    ranges=None) -> Answer:
-    """Whether ``contact_s`` separates e1 from e2 (table), with the ideal observer's F1 (closed form).
+def _delta_details(e: float, sides: dict) -> dict[str, Any]:
+    empty = {"value": None, "interval": [None, None], "ideal": None}
+    return {"e": e, "lower": sides.get("lower", empty), "upper": sides.get("upper", empty)}
 
-    ``value`` is 1.0 (yes) or 0.0 (no); the SVM's F1 of the pair itself is not
-    in a table (``svm_f1`` None): use :func:`exact_distinguishable`.
+
+# ============================================================ distinguishable
+def distinguishable(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact_s: float, noise_c: float = 0.05,
+                    delta_t_c: float = 10.0, threshold=None, table=DEFAULT_TABLE, ideal_table=DEFAULT_IDEAL_TABLE,
+                    sensor=None, model=None) -> Answer:
+    """Whether ``contact_s`` separates the objects (table), with the ideal observer's F1 (closed form).
+
+    ``value`` is True or False; the SVM's F1 of the pair itself is not in a
+    table (``details["svm_f1"]`` None; the exact route computes it).
     """
-    contact = check_positive("contact time [s]", contact_s)
-    noise, dt = _scene_inputs(noise_c, delta_t_c)
-    pairs = _pairs_for(e1, e2, ranges)
-    tab = _as_table(table)
-    phi = _check_threshold(tab, threshold)
-    _check_sensor(tab, sensor)
-    view = _View(tab)
+    from ..recognition.ideal import ideal_pair
+    from ..scene import Scene
+
+    contact = check_contact(contact_s)
+    noise, dt = scene_inputs(noise_c, delta_t_c)
+    op = _open(table, ideal_table, threshold=threshold, sensor=sensor, model=model)
+    pq = pair_question(e1, e2, m1, m2, objects=objects, width=op.width, model=op.model)
+    scene = _scene(contact, noise, dt)
+    empty = {"distinguishable": None, "svm_f1": None, "svm_standard_error": None, "verdict": None,
+             "ideal_f1": None, "ideal_distinguishable": None}
+    if pq.classes is None:
+        return _no_pair("distinguishable", op, pq, scene, empty)
+    lo, hi = pq.points
+    view = op.view
     combos, flags = view.scene_weights(noise, dt)
-    cw, flags["contact_s"] = _contact_index_weights(view, contact)
-    flags["effusivity"] = all(view.e_in_grid(lo, hi) for lo, hi in pairs)
-    inputs = _inputs(e1, e2, noise, dt, phi, tab, ranges, contact_s=contact)
+    cw, flags["contact_s"] = _contact_weights(view, contact)
+    flags["effusivity"] = view.e_in_grid(lo, hi)
+    common = dict(objects=pq.objects_dicts(), limiting=pq.limiting_dicts(), rule=pq.rule, scene=scene,
+                  classes=pq.classes)
     if not all(flags.values()):
-        return _outside(inputs, flags, "distinguishable", tab)
+        wanted = {**_scene_wanted(view, noise, dt), "contact_s": contact, "effusivity": (lo, hi)}
+        return _answer("distinguishable", op, value=None, interval=(None, None), ideal=None, in_grid=flags,
+                       details=empty, notes=_outside_notes(view, flags, wanted), **common)
 
     def verdict(kind):
-        for lo, hi in pairs:
-            nd = _need_at_contact(view, kind, combos, cw, lo, hi)
-            if math.isnan(nd) or nd > hi - lo:
-                return False
-        return True
+        nd = _need_at_contact(view, kind, combos, cw, lo, hi)
+        return not math.isnan(nd) and nd <= hi - lo
 
     yes = verdict("svm")
-    interval = (float(verdict("hi")), float(verdict("lo"))) if tab.fidelity == "svm" else (float(yes), float(yes))
-    ideal_f1 = _ideal_f1_pairs(pairs, tab, contact, noise, dt, ranges)
-    return Answer("distinguishable", float(yes), interval, ideal_f1, "table", tab.name, None, inputs, flags,
-                  {"fidelity": tab.fidelity, "distinguishable": yes, "svm_f1": None,
-                   "ideal_f1": ideal_f1, "ideal_distinguishable": ideal_f1 >= phi})
-
-
-def _ideal_f1_pairs(pairs, tab: Table, contact, noise, dt, ranges) -> float:
-    """Worst (smallest) ideal-observer F1 over the pairs, classes one table interval wide."""
-    from ..recognition.ideal import ideal_scores, projection_noise
-    from ..scene import Scene
-
-    sensor = tab.sensor
-    width = float(tab.header["effusivity"]["width"])
-    s = projection_noise(sensor, Scene.from_delta_t(contact_s=contact, noise_c=noise, delta_t_c=dt))
-    lo = np.array([p[0] for p in pairs])
-    hi = np.array([p[1] for p in pairs])
-    f1, _ = ideal_scores(lo, lo + width, hi, hi + width, sensor.effusivity, s, accuracy=False)
-    return float(np.min(f1))
-
-
-# ============================================================ exact answers
-@dataclass(frozen=True)
-class _Exact:
-    sensor: Any
-    width: float
-    trials: int
-    folds: int
-    seed: int
-    repeats: int
-    z: float
-    jobs: int
-
-
-def _exact_setup(sensor, width, trials, folds, seed, repeats, z, jobs) -> _Exact:
-    from ..sensor import load_sensor
-
-    if int(folds) < 2:
-        raise InputError(f"folds must be >= 2, got {folds}")
-    if int(trials) < int(folds):
-        raise InputError(f"trials per class ({trials}) must be at least the number of folds ({folds})")
-    if int(repeats) < 1:
-        raise InputError(f"repeats must be >= 1, got {repeats}")
-    return _Exact(load_sensor(sensor if sensor is not None else "paper"), check_positive("class width", width),
-                  int(trials), int(folds), int(seed), int(repeats), check_positive("z", z), int(jobs))
-
-
-def _svm_f1(ex: _Exact, ranges, scene_for) -> tuple[float, float]:
-    """Mean SVM F1 over ex.repeats seeds and its standard error, for the pair's classes."""
-    from joblib import Parallel, delayed
-
-    from ..recognition.svm import interval_pair_f1
-
-    (a, b) = ranges
-    jobs = ex.jobs if ex.repeats > 1 else 1
-    results = Parallel(n_jobs=jobs, prefer="processes" if jobs != 1 else None)(
-        delayed(interval_pair_f1)(a, b, ex.sensor, scene_for, trials=ex.trials, folds=ex.folds,
-                                  seed=[ex.seed, r]) for r in range(ex.repeats))
-    f1 = np.array([r.f1 for r in results])
-    se_fold = math.sqrt(float(np.mean([r.standard_error ** 2 for r in results])))
-    se_rep = float(np.std(f1, ddof=1)) if f1.size > 1 else 0.0
-    return float(f1.mean()), max(se_fold, se_rep) / math.sqrt(f1.size)
-
-
-def _ideal_f1(ex: _Exact, ranges, scene) -> float:
-    from ..recognition.ideal import ideal_pair
-
-    return ideal_pair(ranges[0], ranges[1], ex.sensor, scene, seed=ex.seed).f1
-
-
-def _bisect(f_ok, lo: float, hi: float, tol: float, *, log: bool = False) -> float:
-    """Smallest x in (lo, hi] with f_ok(x) (monotone), to tolerance tol (relative if log)."""
-    for _ in range(60):
-        if (math.log(hi / lo) if log else hi - lo) <= tol:
-            break
-        mid = math.sqrt(lo * hi) if log else 0.5 * (lo + hi)
-        if f_ok(mid):
-            hi = mid
-        else:
-            lo = mid
-    return hi
-
-
-def _class_ranges(ex: _Exact, e1, e2, ranges):
-    if ranges is not None:
-        return tuple(tuple(float(x) for x in r) for r in ranges)
-    lo, hi = _pair(e1, e2)
-    return ((lo, lo + ex.width), (hi, hi + ex.width))
-
-
-def exact_min_contact(e1=None, e2=None, *, noise_c: float = 0.05, delta_t_c: float = 10.0,
-                      threshold: float = 0.9, sensor=None, width: float = 80.0, trials: int = 100,
-                      folds: int = 3, seed: int = 0, repeats: int = 4, z: float = 2.0, jobs: int = -1,
-                      max_contact_s: float = 10.0, tolerance_s: float = 0.05, ranges=None) -> Answer:
-    """Shortest contact time [s] computed for this pair: bisection on the SVM's F1.
-
-    Classes are ``[e, e + width)`` (or the material ranges, with the paper's
-    rule: the classes are the whole ranges). Each contact time is scored with
-    ``repeats`` seeds; the interval collects the contact times whose mean F1 is
-    within ``z`` standard errors of ``threshold``.
-    """
-    from ..scene import Scene
-
-    noise, dt = _scene_inputs(noise_c, delta_t_c)
-    phi = _threshold(threshold)
-    ex = _exact_setup(sensor, width, trials, folds, seed, repeats, z, jobs)
-    cls = _class_ranges(ex, e1, e2, ranges)
-    tmax = check_positive("maximum contact time [s]", max_contact_s)
-    t0 = time.perf_counter()
-
-    def scene(c):
-        return Scene.from_delta_t(contact_s=c, noise_c=noise, delta_t_c=dt)
-
-    floor = 1.0 / ex.sensor.sample_rate_hz
-    value, interval, evaluations = _contact_search(lambda c: _svm_f1(ex, cls, scene(c)), phi, floor, tmax,
-                                                   tolerance_s, z)
-    ideal_ok = lambda c: _ideal_f1(ex, cls, scene(c)) >= phi  # noqa: E731
-    ideal = _bisect(ideal_ok, floor, tmax, 1e-3) if ideal_ok(tmax) else None
-    inputs = {"e1": e1, "e2": e2, "noise_c": noise, "delta_t_c": dt, "threshold": phi, "classes": [list(c) for c in cls],
-              "trials": ex.trials, "folds": ex.folds, "seed": ex.seed, "repeats": ex.repeats,
-              "sensor": ex.sensor.name}
-    note = "" if value is not None else f"not separable by any contact time up to {tmax:g} s"
-    return Answer("min-contact", value, interval, ideal, "computed", None, None, inputs, {},
-                  {"fidelity": "svm", "evaluations": evaluations, "wall_s": time.perf_counter() - t0}, note)
-
-
-def _contact_search(svm_f1, phi: float, floor_s: float, max_contact_s: float, tolerance_s: float, z: float):
-    """Shortest contact time whose mean SVM F1 reaches ``phi``, by bisection, with its Monte Carlo interval.
-
-    ``svm_f1(contact_s)`` returns ``(mean F1, standard error)``. The interval runs
-    from the longest evaluated contact clearly below ``phi`` (mean + z SE < phi)
-    to the shortest clearly above (mean - z SE >= phi; None when none is).
-
-    Returns ``(value or None, (lo, hi), evaluations)``.
-    """
-    evaluated: dict[float, tuple[float, float]] = {}
-
-    def ok(c):
-        evaluated[c] = svm_f1(c)
-        return evaluated[c][0] >= phi
-
-    value = _bisect(ok, floor_s, max_contact_s, tolerance_s) if ok(max_contact_s) else None
-    below = [c for c, (m, s) in evaluated.items() if m + z * s < phi]
-    above = [c for c, (m, s) in evaluated.items() if m - z * s >= phi]
-    interval = (max(below) if below else floor_s, min(above) if above else None)
-    evaluations = [{"contact_s": c, "svm_f1": m, "standard_error": s} for c, (m, s) in sorted(evaluated.items())]
-    return value, interval, evaluations
-
-
-def _ratio_search(svm_f1, phi: float, lo_r: float, hi_r: float, z: float):
-    """Largest sigma/dT at which the mean SVM F1 still reaches ``phi``, by bisection in log sigma/dT.
-
-    ``svm_f1(ratio)`` returns ``(mean F1, standard error)``. The Monte Carlo interval
-    runs from the largest evaluated ratio clearly separable (mean - z SE >= phi) to the
-    smallest clearly not (mean + z SE < phi); None where no evaluation is clear.
-
-    Returns ``(ratio or None, (lo, hi), evaluations)``; ``hi_r`` itself when even it
-    separates, None when not even ``lo_r`` does.
-    """
-    evaluated: dict[float, tuple[float, float]] = {}
-
-    def ok(r):  # still separable at this noise ratio
-        evaluated[r] = svm_f1(r)
-        return evaluated[r][0] >= phi
-
-    if not ok(lo_r):
-        r = None
-    elif ok(hi_r):
-        r = hi_r
-    else:  # largest ratio that is ok == bisection on "not ok" from above
-        r = _bisect(lambda x: not ok(x), lo_r, hi_r, 0.02, log=True)
-    ok_conf = [x for x, (m, s) in evaluated.items() if m - z * s >= phi]
-    bad_conf = [x for x, (m, s) in evaluated.items() if m + z * s < phi]
-    interval = (max(ok_conf) if ok_conf else None, min(bad_conf) if bad_conf else None)
-    evaluations = [{"noise_ratio": x, "svm_f1": m, "standard_error": s} for x, (m, s) in sorted(evaluated.items())]
-    return r, interval, evaluations
-
-
-def _threshold(threshold: float) -> float:
-    phi = check_finite("threshold", threshold)
-    if not 2 / 3 < phi < 1:
-        raise InputError(f"threshold must be in (2/3, 1), got {phi:g}")
-    return phi
-
-
-def _exact_ratio(question: str, e1, e2, contact_s, noise_c, delta_t_c, threshold, sensor, width, trials,
-                 folds, seed, repeats, z, jobs, ranges) -> Answer:
-    from ..scene import Scene
-
-    phi = _threshold(threshold)
-    contact = check_positive("contact time [s]", contact_s)
-    ex = _exact_setup(sensor, width, trials, folds, seed, repeats, z, jobs)
-    cls = _class_ranges(ex, e1, e2, ranges)
-    t0 = time.perf_counter()
-    lo_r, hi_r = 1e-5, 1.0  # sigma/dT bracket: 10 uK per K to noise as large as the contrast
-
-    def scene(r):
-        return Scene.from_delta_t(contact_s=contact, noise_c=r, delta_t_c=1.0)
-
-    r, (r_lo, r_hi), evaluations = _ratio_search(lambda x: _svm_f1(ex, cls, scene(x)), phi, lo_r, hi_r, z)
-    ideal_r = None
-    if _ideal_f1(ex, cls, scene(lo_r)) >= phi:
-        ideal_r = _bisect(lambda x: _ideal_f1(ex, cls, scene(x)) < phi, lo_r, hi_r, 1e-3, log=True)
-    if question == "max-noise":
-        dt = check_finite("temperature difference [degC]", delta_t_c)
-        conv = lambda x: None if x is None else x * abs(dt)  # noqa: E731
-        interval = (conv(r_lo), conv(r_hi))
-        inputs = {"delta_t_c": dt}
-    else:
-        noise = check_positive("noise sigma [degC]", noise_c)
-        conv = lambda x: None if x is None else noise / x  # noqa: E731
-        interval = (conv(r_hi), conv(r_lo))
-        inputs = {"noise_c": noise}
-    inputs.update({"e1": e1, "e2": e2, "contact_s": contact, "threshold": phi,
-                   "classes": [list(c) for c in cls], "trials": ex.trials, "repeats": ex.repeats,
-                   "seed": ex.seed, "sensor": ex.sensor.name})
-    note = "" if r is not None else "not separable even at sigma/dT = 1e-5"
-    return Answer(question, conv(r), interval, conv(ideal_r), "computed", None, None, inputs, {},
-                  {"fidelity": "svm", "wall_s": time.perf_counter() - t0, "evaluations": evaluations}, note)
-
-
-def exact_max_noise(e1=None, e2=None, *, contact_s: float, delta_t_c: float = 10.0, threshold: float = 0.9,
-                    sensor=None, width: float = 80.0, trials: int = 100, folds: int = 3, seed: int = 0,
-                    repeats: int = 4, z: float = 2.0, jobs: int = -1, ranges=None) -> Answer:
-    """Largest noise sigma [degC] that still separates the pair, computed (bisection in log sigma/dT)."""
-    return _exact_ratio("max-noise", e1, e2, contact_s, None, delta_t_c, threshold, sensor, width, trials,
-                        folds, seed, repeats, z, jobs, ranges)
-
-
-def exact_min_delta_t(e1=None, e2=None, *, contact_s: float, noise_c: float = 0.05, threshold: float = 0.9,
-                      sensor=None, width: float = 80.0, trials: int = 100, folds: int = 3, seed: int = 0,
-                      repeats: int = 4, z: float = 2.0, jobs: int = -1, ranges=None) -> Answer:
-    """Smallest temperature difference [degC] that separates the pair, computed."""
-    return _exact_ratio("min-delta-t", e1, e2, contact_s, noise_c, None, threshold, sensor, width, trials,
-                        folds, seed, repeats, z, jobs, ranges)
-
-
-def exact_distinguishable(e1=None, e2=None, *, contact_s: float, noise_c: float = 0.05, delta_t_c: float = 10.0,
-                          threshold: float = 0.9, sensor=None, width: float = 80.0, trials: int = 100,
-                          folds: int = 3, seed: int = 0, repeats: int = 4, z: float = 2.0, jobs: int = -1,
-                          ranges=None) -> Answer:
-    """SVM F1 (mean of ``repeats`` seeds) and ideal F1 of the pair's classes at this scene."""
-    from ..scene import Scene
-
-    phi = _threshold(threshold)
-    noise, dt = _scene_inputs(noise_c, delta_t_c)
-    ex = _exact_setup(sensor, width, trials, folds, seed, repeats, z, jobs)
-    cls = _class_ranges(ex, e1, e2, ranges)
-    scene = Scene.from_delta_t(contact_s=check_positive("contact time [s]", contact_s), noise_c=noise, delta_t_c=dt)
-    t0 = time.perf_counter()
-    f1, se = _svm_f1(ex, cls, scene)
-    ideal = _ideal_f1(ex, cls, scene)
-    yes = f1 >= phi
-    conf = "confident" if abs(f1 - phi) >= z * se else "uncertain"
-    inputs = {"e1": e1, "e2": e2, "noise_c": noise, "delta_t_c": dt, "contact_s": scene.contact_s,
-              "threshold": phi, "classes": [list(c) for c in cls], "trials": ex.trials, "repeats": ex.repeats,
-              "seed": ex.seed, "sensor": ex.sensor.name}
-    return Answer("distinguishable", float(yes), (f1 - z * se, f1 + z * se), ideal, "computed", None, None,
-                  inputs, {}, {"fidelity": "svm", "distinguishable": yes, "svm_f1": f1, "svm_standard_error": se,
-                               "verdict": conf, "ideal_f1": ideal, "ideal_distinguishable": ideal >= phi,
-                               "wall_s": time.perf_counter() - t0})
-
-
-def exact_delta_e(e: float, *, contact_s: float, noise_c: float = 0.05, delta_t_c: float = 10.0,
-                  threshold: float = 0.9, sensor=None, width: float = 80.0, trials: int = 100, folds: int = 3,
-                  seed: int = 0, repeats: int = 4, z: float = 2.0, jobs: int = -1,
-                  e_max: float = 40000.0) -> Answer:
-    """delta(e) computed for this reference: bisection on the partner's distance, both directions."""
-    from ..scene import Scene
-
-    phi = _threshold(threshold)
-    e = check_effusivity("e", e)
-    noise, dt = _scene_inputs(noise_c, delta_t_c)
-    ex = _exact_setup(sensor, width, trials, folds, seed, repeats, z, jobs)
-    scene = Scene.from_delta_t(contact_s=check_positive("contact time [s]", contact_s), noise_c=noise, delta_t_c=dt)
-    ref = (e, e + ex.width)
-    t0 = time.perf_counter()
-    res: dict[str, Any] = {}
-    for key, sign, limit in (("delta_e_upper", +1, e_max - e - ex.width), ("delta_e_lower", -1, e - ex.width)):
-        if limit < ex.width:
-            res[key] = res[key + "_ideal"] = None
-            continue
-        part = lambda d: (e + sign * d, e + sign * d + ex.width)  # noqa: E731
-        ok = lambda d: _svm_f1(ex, (ref, part(d)), scene)[0] >= phi  # noqa: E731
-        res[key] = _bisect(ok, 0.0, limit, ex.width / 2) if ok(limit) else None
-        iok = lambda d: _ideal_f1(ex, (ref, part(d)), scene) >= phi  # noqa: E731
-        res[key + "_ideal"] = _bisect(iok, 0.0, limit, 1.0) if iok(limit) else None
-    finite = [v for v in (res["delta_e_lower"], res["delta_e_upper"]) if v is not None]
-    ifinite = [v for v in (res["delta_e_lower_ideal"], res["delta_e_upper_ideal"]) if v is not None]
-    inputs = {"e": e, "noise_c": noise, "delta_t_c": dt, "contact_s": scene.contact_s, "threshold": phi,
-              "width": ex.width, "trials": ex.trials, "repeats": ex.repeats, "seed": ex.seed,
-              "sensor": ex.sensor.name}
-    return Answer("delta-e", min(finite) if finite else None, (None, None), min(ifinite) if ifinite else None,
-                  "computed", None, None, inputs, {}, {"fidelity": "svm", **res, "wall_s": time.perf_counter() - t0})
+    interval = (float(verdict("hi")), float(verdict("lo"))) if op.tab.fidelity == "svm" else (float(yes),) * 2
+    res = ideal_pair(*pq.classes, op.tab.sensor, Scene.from_delta_t(contact_s=contact, noise_c=noise,
+                                                                     delta_t_c=dt), model=op.model)
+    ideal_f1 = res.f1
+    details = {"distinguishable": yes, "svm_f1": None, "svm_standard_error": None, "verdict": None,
+               "ideal_f1": ideal_f1, "ideal_distinguishable": ideal_f1 >= op.phi}
+    return _answer("distinguishable", op, value=yes, interval=interval, ideal=ideal_f1, ideal_method=res.method,
+                   in_grid=flags, details=details, check_at=(contact, noise, dt), **common)

@@ -4,7 +4,7 @@ The paper concatenates "raw temperature and estimated local slope" (section
 III) without saying how the slope is estimated. A two-point difference
 (``np.gradient``) of noisy 200 Hz samples has noise of order
 ``sigma * fs / sqrt(2)``, hundreds of times the signal's slope, and drowns the
-features (DOMAIN.md section 2). designkit uses the Savitzky-Golay derivative
+features (docs/physics.md section 2). designkit uses the Savitzky-Golay derivative
 (:func:`scipy.signal.savgol_filter` with ``deriv=1``): the slope of a local
 least-squares quadratic over a window of ``window_s`` seconds (0.25 s, 51
 samples at 200 Hz, by default). Its noise falls as ``window^-3/2``.

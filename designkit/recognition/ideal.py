@@ -48,12 +48,13 @@ when the classes cannot be told apart; the best *accuracy* is 0.5 then.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
 
 import numpy as np
 from scipy import special
 
 from .._validation import InputError, check_effusivity_range
+from .scores import TRIVIAL_F1
+from .scores import IdealResult, score_llr
 from ..models.semi_infinite import object_weight, response_shape
 from ..scene import Scene
 from ..sensor import Sensor
@@ -64,59 +65,12 @@ __all__ = [
     "ideal_pair",
     "ideal_scores",
     "projection_noise",
+    "score_llr",
 ]
 
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(40)
 _CUT = 8.5  # Phi(-8.5) = 9.5e-18: outside +-8.5 s the integrand is 0 or 1 to double precision
 _GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
-_TRIVIAL_F1 = 2.0 / 3.0  # F1 of "everything positive" with balanced classes
-
-
-@dataclass(frozen=True)
-class IdealResult:
-    """Best achievable recognition of one pair of classes.
-
-    Attributes
-    ----------
-    f1 : float
-        Best F1 over all classifiers (a likelihood-ratio threshold), positive
-        class = higher effusivity. At least 2/3.
-    accuracy : float
-        Bayes accuracy with equal priors.
-    method : str
-        ``"closed-form"`` (fixed initial conditions) or ``"monte-carlo"``.
-    standard_error : float
-        Monte Carlo standard error of ``f1`` (0 for the closed form).
-    accuracy_standard_error : float
-        Monte Carlo standard error of ``accuracy`` (0 for the closed form).
-    projection_noise : float or None
-        ``s``: noise of the projected statistic in units of ``w`` (closed form).
-    n_mc : int or None
-        Simulated test touches per class (Monte Carlo).
-    details : dict
-        How a Monte Carlo answer was computed (grid sizes, basis rank ...).
-    """
-
-    f1: float
-    accuracy: float
-    method: str
-    standard_error: float = 0.0
-    accuracy_standard_error: float = 0.0
-    projection_noise: float | None = None
-    n_mc: int | None = None
-    details: dict = field(default_factory=dict, compare=False)
-
-    def to_dict(self) -> dict:
-        return {
-            "f1": self.f1,
-            "accuracy": self.accuracy,
-            "method": self.method,
-            "standard_error": self.standard_error,
-            "accuracy_standard_error": self.accuracy_standard_error,
-            "projection_noise": self.projection_noise,
-            "n_mc": self.n_mc,
-            "details": dict(self.details),
-        }
 
 
 # ----------------------------------------------------------------- closed form
@@ -240,7 +194,7 @@ def ideal_scores(low_a, low_b, high_a, high_b, e_sensor: float, s, *, accuracy: 
                                              for x in (low_a, low_b, high_a, high_b, s)))
     shape = la.shape
     la, lb, ha, hb, s = (x.ravel() for x in (la, lb, ha, hb, s))
-    f1 = np.full(la.shape, _TRIVIAL_F1)
+    f1 = np.full(la.shape, TRIVIAL_F1)
     acc = np.full(la.shape, 0.5)
     ok = np.isfinite(s)
     if ok.any():
@@ -260,7 +214,7 @@ def ideal_scores(low_a, low_b, high_a, high_b, e_sensor: float, s, *, accuracy: 
             return 2.0 * tpr / (1.0 + tpr + fpr)
 
         f1_best, _ = _golden_max(f1_at, lo, hi)
-        f1[ok] = np.maximum(f1_best, _TRIVIAL_F1)
+        f1[ok] = np.maximum(f1_best, TRIVIAL_F1)
         if accuracy:
             acc[ok], _ = _golden_max(accuracy_at, lo, hi)
     return f1.reshape(shape), (acc.reshape(shape) if accuracy else None)
@@ -355,33 +309,6 @@ def _ideal_monte_carlo(low, high, sensor: Sensor, scene: Scene, n_mc: int, seed)
     f1, se, acc, acc_se = score_llr(llr, labels, n_mc)
     return IdealResult(f1=f1, accuracy=acc, method="monte-carlo", standard_error=se,
                        accuracy_standard_error=acc_se, projection_noise=None, n_mc=n_mc)
-
-
-def score_llr(llr: np.ndarray, labels: np.ndarray, n_mc: int) -> tuple[float, float, float, float]:
-    """Best F1 over thresholds on a log-likelihood ratio, with Bayes accuracy, and their standard errors.
-
-    ``llr`` of ``n_mc`` simulated touches per class (``labels`` 1 for the positive
-    class). The F1 is the best over all thresholds (never below the trivial
-    2/3 of calling everything positive); the accuracy is the Bayes rule's
-    (threshold 0, equal priors). Returns ``(f1, f1 standard error, accuracy,
-    accuracy standard error)``.
-    """
-    from sklearn.metrics import precision_recall_curve
-
-    from .svm import f1_standard_error
-
-    acc = float(np.mean((llr > 0) == labels))
-    precision, recall, _ = precision_recall_curve(labels, llr)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        f1s = np.where(precision + recall > 0, 2 * precision * recall / (precision + recall), 0.0)
-    best = int(np.argmax(f1s))
-    f1 = max(float(f1s[best]), _TRIVIAL_F1)
-    tpr = float(recall[best])
-    # false-positive rate at that operating point: from precision and recall
-    fpr = tpr * (1.0 / precision[best] - 1.0) if precision[best] > 0 else 1.0
-    se = f1_standard_error(tpr, min(max(fpr, 0.0), 1.0), n_mc)
-    acc_se = math.sqrt(max(acc * (1 - acc), 0.25 / n_mc) / (2 * n_mc))
-    return f1, se, acc, acc_se
 
 
 # ----------------------------------------------------------------- public entry

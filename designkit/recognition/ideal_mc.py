@@ -35,7 +35,7 @@ from ..objects import ObjectClass, ordered_pair
 from ..scene import Scene
 from ..sensor import Sensor
 from ..simulation import response_tolerance, seed_key, simulate_class
-from .ideal import IdealResult, score_llr
+from .scores import IdealResult, score_llr
 
 __all__ = ["ideal_pair_mc"]
 

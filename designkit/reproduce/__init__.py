@@ -47,7 +47,8 @@ __all__ = [
 def _registry() -> dict[str, tuple[Callable[[Context], SectionResult], float]]:
     """Section name -> (function, rough share of the run time, for progress bars)."""
     from .curves import section_delta_curves, section_effusivity, section_guideline
-    from .matrices import section_f1_matrices, section_node_graphs, section_table1
+    from .matrices import section_f1_matrices, section_node_graphs
+    from .table1 import section_table1
     from .multiclass import section_multiclass
     from .robot import section_real_robot, section_sim_to_real
 

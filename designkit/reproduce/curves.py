@@ -212,7 +212,7 @@ def section_effusivity(ctx: Context) -> SectionResult:
 def section_guideline(ctx: Context) -> SectionResult:
     """The design guideline: contact time to separate e = 35,000 from 20,000 (sigma 0.05, dT 10)."""
     t0 = time.perf_counter()
-    from ..query import table as query
+    from .. import query
 
     title = "Guideline: 35,000 vs 20,000 needs how long a contact?"
     e1, e2, sigma, dt = GUIDELINE["e1"], GUIDELINE["e2"], GUIDELINE["noise_c"], GUIDELINE["delta_t_c"]

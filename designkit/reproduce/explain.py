@@ -245,7 +245,7 @@ def explain_table1(quantity: str, row: dict, ev: dict) -> str:
                          f"{ev['depth'].get('0.001', {}).get('80', math.nan):.1f} % to "
                          f"{ev['depth'].get('0.02', {}).get('80', math.nan):.1f} %, so something other than "
                          f"noise limited it: its slope estimator and SVM settings are not given; ours uses a "
-                         f"Savitzky-Golay slope and standardized features, DOMAIN.md section 2)")
+                         f"Savitzky-Golay slope and standardized features, docs/physics.md section 2)")
         return "; ".join(parts)
     if quantity == "intervals mean F1":
         implied = row.get("evidence", {}).get("paper_implied_indistinguishable_f1")

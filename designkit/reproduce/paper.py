@@ -2,7 +2,7 @@
 
 Bai et al., "Analyzing Material Recognition Performance of Thermal Tactile
 Sensing using a Large Materials Database and a Real Robot" (the LaTeX source
-in ``shared/reference``; DOMAIN.md section 3 collects the same numbers).
+in ``shared/reference``; docs/physics.md section 3 collects the same numbers).
 Table I's noise row printed "0.5" is a typo for 0.05 (the text and figures
 use sigma = 0.05).
 """

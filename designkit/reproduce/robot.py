@@ -49,7 +49,7 @@ CLASSES = ("wood", "cold_wood", "metal")
 PAIRS = (("wood", "metal"), ("cold_wood", "metal"), ("wood", "cold_wood"))
 PAIR_LABELS = {("wood", "metal"): "metal vs wood", ("cold_wood", "metal"): "metal vs cold wood",
                ("wood", "cold_wood"): "wood vs cold wood"}
-#: Effusivity ranges given to calibration (the paper's aluminium and wood ranges, DOMAIN.md).
+#: Effusivity ranges given to calibration (the paper's aluminium and wood ranges, docs/physics.md section 3).
 CALIBRATION_RANGES = {"metal": "12767:25972", "wood": "331:506", "cold_wood": "331:506"}
 CALIBRATION_SETS = (1, 2, 3, 4)
 #: Materials calibration fits: cold wood's object temperature is unknown (its passive channel

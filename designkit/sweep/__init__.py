@@ -17,7 +17,7 @@ This engine scores a few per reference, and each shortcut is exact or tested:
 
 * **sigma/dT invariance.** With fixed initial conditions and standardized
   features the F1 depends on noise and temperature difference only through
-  ``sigma / dT`` (DOMAIN.md; tests/test_recognition.py) for every forward
+  ``sigma / dT`` (docs/physics.md, "Invariance"; tests/test_recognition.py) for every forward
   model here (all are linear in the temperatures), so one axis replaces two
   and every sweep is run at ``dT = 1``.
 * **Staircase search** (:mod:`~designkit.sweep.search`). Distinguishability is

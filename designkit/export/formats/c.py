@@ -1,0 +1,148 @@
+"""C99 export: one self-contained header, ``static const`` arrays and the lookup functions.
+
+The header is the template ``designkit/export/templates/designkit_lookup.h.in``
+(shipped in the package) with its ``@NAME@`` placeholders filled in one pass
+(:func:`designkit.export._common.fill_template`): the data as initializers,
+the provenance as macros and comments. It needs only ``<math.h>``, allocates
+nothing, and answers like :mod:`designkit.tables.lookup`:
+
+``PREFIX_delta_e``, ``PREFIX_delta_e_lower``, ``PREFIX_delta_e_upper``,
+``PREFIX_min_contact_s`` (floats) and ``PREFIX_distinguishable`` (int).
+
+==================  ============================================
+meaning             C (float / int functions)
+==================  ============================================
+answer              ``>= 0`` / ``PREFIX_YES`` (1) or ``PREFIX_NO`` (0)
+nothing suffices    ``PREFIX_NONE`` (-1)
+outside the grid    ``PREFIX_OUTSIDE`` (-2) / ``PREFIX_OUTSIDE_I``
+invalid input       ``PREFIX_INVALID`` (-3) / ``PREFIX_INVALID_I``
+==================  ============================================
+
+Every string from the table (names, creation time, units, hash, the forward
+model) reaches the header through :func:`~designkit.export._common.c_string`
+or :func:`~designkit.export._common.c_comment`; identifiers come only from the
+validated prefix and the fixed axis names.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+
+from ...tables.lookup import GRID_RTOL
+from .._common import (c_comment, c_double, c_string, check_prefix, fill_template, log_grid, read_template,
+                       regenerate_command, slice_lines)
+from ..slicing import Exported
+
+__all__ = ["TEMPLATE", "describe_model", "write"]
+
+#: The header template, a file in the package.
+TEMPLATE = "designkit_lookup.h.in"
+
+
+def _c_doubles(vals) -> str:
+    return ", ".join(c_double(v) for v in vals)
+
+
+def _c_float_rows(arr: np.ndarray, exp: Exported, per_line: int = 16) -> str:
+    """Float initializer text: one commented block per (scene, contact) row; NaN -> -1 (none)."""
+    a32 = arr.astype(np.float32)
+    flat = a32.ravel()
+    u, inv = np.unique(flat, return_inverse=True)
+    words = []
+    for x in u.tolist():
+        if math.isnan(x):
+            words.append("-1")
+        elif x.is_integer() and abs(x) < 2 ** 24:
+            words.append(str(int(x)))
+        else:
+            words.append(np.format_float_positional(np.float32(x), unique=True) + "f")
+    text = np.array(words, dtype=object)[inv.ravel()].reshape(a32.shape)
+    ne = a32.shape[-1]
+    blocks = []
+    for idx in np.ndindex(*a32.shape[:-1]):
+        label = c_comment(", ".join(f"{ax.name} {ax.values[i]:g}" for ax, i in zip(exp.axes, idx)))
+        row = text[idx].tolist()
+        lines = [", ".join(row[i:i + per_line]) for i in range(0, ne, per_line)]
+        blocks.append(f"    /* {label} */\n    " + ",\n    ".join(lines))
+    return ",\n".join(blocks)
+
+
+def describe_model(model: dict) -> str:
+    """One line naming a forward model and its parameters (``semi-infinite``, ``contact (conductance_w_m2k = 1500)``)."""
+    params = {k: v for k, v in model.items() if k != "name"}
+    inner = ", ".join(f"{k} = {json.dumps(v, sort_keys=True)}" for k, v in params.items())
+    return str(model.get("name")) + (f" ({inner})" if inner else "")
+
+
+def write(exp: Exported, prefix: str = "designkit") -> bytes:
+    """The C99 header text of ``exp``; every function, macro and constant starts with ``prefix``."""
+    prefix = check_prefix(prefix)
+    p = exp.provenance
+    sensor = p["sensor"]
+    model = p["model"]
+    scene = exp.scene_axes
+    nc, ne = len(exp.contact.values), len(exp.e_ref.values)
+    ndata = int(exp.delta_up.size)
+    P = prefix.upper()
+    defines, arrays, undefs = [], [], []
+    for a in scene:  # a.name is one of the fixed axis names (checked by slice_table)
+        big = a.name.upper()
+        defines.append(f"#define {P}_N_{big} {len(a.values)}")
+        defines.append(f"#define {P}_{big}_MIN {c_double(min(a.values))}")
+        defines.append(f"#define {P}_{big}_MAX {c_double(max(a.values))}")
+        defines.append(f"#define {P}_{big}_LOG_ {1 if a.scale == 'log' else 0}")
+        undefs.append(f"#undef {P}_{big}_LOG_")
+        arrays.append(f"/* {a.name} [{c_comment(a.units)}], {a.scale} */")
+        arrays.append(f"static const {prefix}_real_ {prefix}_{a.name}_[{len(a.values)}] = {{{_c_doubles(a.values)}}};")
+        arrays.append(f"static const {prefix}_real_ {prefix}_{a.name}_g_[{len(a.values)}] = "
+                      f"{{{_c_doubles(log_grid(a))}}};")
+    varied = [a.name for a in scene] != ["noise_ratio"]
+    nbytes = 8 * ndata + 8 * (nc + ne + 2 * sum(len(a.values) for a in scene)) + nc
+
+    def num(key: str) -> float:
+        v = sensor.get(key)
+        return float(v) if isinstance(v, (int, float)) and not isinstance(v, bool) else math.nan
+
+    text = fill_template(read_template(TEMPLATE), {
+        "P": P, "p": prefix,
+        "SCENE_VARIED": "1" if varied else "0",
+        "SCENE_DEFINES": "\n".join(defines),
+        "SCENE_ARRAYS": "\n".join(arrays),
+        "SCENE_UNDEFS": "\n".join(undefs),
+        "SCENE_WORDS": "sigma and linearly in dT" if varied else "sigma/dT",
+        "SLICE": "\n".join(" * " + c_comment(line) for line in slice_lines(exp)),
+        "COMMAND": c_comment(regenerate_command(exp, "c", prefix)),
+        "VERSION": c_comment(p["designkit_version"]), "TABLE": c_comment(p["source_table"]),
+        "HASH": c_comment(p["source_content_hash"]), "CREATED": c_comment(p["source_created"]),
+        "SENSOR": c_comment(sensor.get("name")),
+        "SENSOR_LINE": c_comment(f"e_s {num('effusivity')!r} J s^-1/2 K^-1 m^-2, alpha_s "
+                                 f"{num('diffusivity_m2_s')!r} m^2/s, depth {num('depth_m')!r} m, "
+                                 f"{num('sample_rate_hz')!r} Hz"),
+        "MODEL": c_comment(describe_model(model)),
+        "FIDELITY": c_comment(p["fidelity"]), "KIND": c_comment(p["kind"]),
+        "KIND_MEANING": c_comment(p["kind_meaning"]),
+        "THRESHOLD": c_comment(f"{p['threshold']:g}"), "EXPORT_HASH": c_comment(p["export_hash"]),
+        "BYTES": str(nbytes),
+        "S_TABLE": c_string(p["source_table"]), "S_HASH": c_string(p["source_content_hash"]),
+        "S_CREATED": c_string(p["source_created"]), "S_EXPORT_HASH": c_string(p["export_hash"]),
+        "S_VERSION": c_string(p["designkit_version"]), "S_FIDELITY": c_string(p["fidelity"]),
+        "S_KIND": c_string(p["kind"]), "THRESHOLD_D": c_double(p["threshold"]),
+        "S_SENSOR": c_string(sensor.get("name")),
+        "S_MODEL": c_string(model.get("name")),
+        "S_MODEL_PARAMETERS": c_string(json.dumps({k: v for k, v in model.items() if k != "name"},
+                                                  sort_keys=True, allow_nan=False)),
+        "SENSOR_E": c_double(num("effusivity")), "SENSOR_A": c_double(num("diffusivity_m2_s")),
+        "SENSOR_D": c_double(num("depth_m")), "SENSOR_F": c_double(num("sample_rate_hz")),
+        "S_SLICE": c_string("; ".join(slice_lines(exp))),
+        "E_MIN": c_double(exp.e_lo), "E_MAX": c_double(exp.e_hi), "E_INCL": "1" if exp.e_lo_inclusive else "0",
+        "C_MIN": c_double(exp.contact.values[0]), "C_MAX": c_double(exp.contact.values[-1]),
+        "NC": str(nc), "NE": str(ne), "NDATA": str(ndata), "RTOL": c_double(GRID_RTOL),
+        "CONTACTS": _c_doubles(exp.contact.values),
+        "ADJACENT": ", ".join(["1" if x else "0" for x in exp.contact_adjacent] + ["0"]),
+        "CENTRES": _c_doubles(exp.e_ref.values),
+        "DELTA_UP": _c_float_rows(exp.delta_up, exp), "DELTA_DOWN": _c_float_rows(exp.delta_down, exp),
+    })
+    return text.encode("ascii")

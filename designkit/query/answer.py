@@ -1,0 +1,230 @@
+"""Typed answers to design questions; :meth:`Answer.to_dict` *is* the ``--json`` schema.
+
+Every question (:mod:`designkit.query.questions`), through every route (a
+lookup table or the exact computation) and every forward model, answers with
+one :class:`Answer`. Its dictionary has the same keys whatever the question and
+route; question-specific figures sit under ``details`` with keys fixed per
+question, and what the route did (trials, evaluations, wall time, the table's
+grid) under ``computation``.
+
+Vocabulary (one name per concept, units in names): ``contact_s`` [s],
+``noise_c`` and ``delta_t_c`` [degC], ``noise_ratio`` (sigma/dT, [-]),
+effusivity [J s^-1/2 K^-1 m^-2], diffusivity ``*_m2_s`` [m^2 s^-1].
+
+Examples
+--------
+>>> sorted(ANSWER_KEYS)[:4]
+['computation', 'details', 'ideal', 'ideal_table']
+>>> QUANTITIES["min-contact"]
+('contact_s', 's')
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Mapping
+
+__all__ = ["ANSWER_KEYS", "INTERVAL_MEANING", "QUANTITIES", "Answer", "IdealBound", "number"]
+
+#: question -> (quantity name of ``value``, its unit).
+QUANTITIES: dict[str, tuple[str, str]] = {
+    "min-contact": ("contact_s", "s"),
+    "max-noise": ("noise_c", "degC"),
+    "min-delta-t": ("delta_t_c", "degC"),
+    "delta-e": ("delta_e", "J s^-1/2 K^-1 m^-2"),
+    "distinguishable": ("distinguishable", ""),
+}
+
+#: What ``interval`` means, per route.
+INTERVAL_MEANING = {
+    "table": "the answer at the two ends of the table's Monte Carlo interval of delta(e) "
+             "(optimistic, conservative); equal ends for an ideal-observer table",
+    "exact": "the evaluated values whose mean SVM F1 is clearly (z standard errors) on either side of "
+             "the threshold: the answer lies between them",
+    "distinguishable": "the SVM F1 plus and minus z standard errors (exact route), or the verdict at the "
+                       "ends of the table's Monte Carlo interval (table route, 1 = yes)",
+}
+
+#: The keys of every answer's dictionary (the ``--json`` schema), whatever the question and route.
+ANSWER_KEYS = frozenset({
+    "question", "route", "quantity", "unit", "value", "interval", "ideal", "objects", "limiting_pair",
+    "materials_rule", "scene", "sensor", "model", "model_check", "threshold", "table", "ideal_table",
+    "in_grid", "details", "computation", "notes",
+})
+
+
+def number(x: Any) -> float | None:
+    """``x`` as a Python float, or None for None, NaN and infinities (JSON-ready).
+
+    >>> number(float("nan")) is None, number(2)
+    (True, 2.0)
+    """
+    if x is None:
+        return None
+    v = float(x)
+    return v if math.isfinite(v) else None
+
+
+@dataclass(frozen=True)
+class IdealBound:
+    """The ideal observer's answer to the same question: what no classifier can beat.
+
+    Attributes
+    ----------
+    value : float or None
+        In the question's quantity and unit (None: not reachable within the range examined).
+    method : str
+        ``"closed-form"``, ``"monte-carlo"``, ``"closed-form+monte-carlo"`` (both were
+        used along the search), ``"table"`` (interpolated from a table) or
+        ``"none"`` (not available, see the answer's notes).
+    """
+
+    value: float | None
+    method: str
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"value": number(self.value) if not isinstance(self.value, bool) else self.value,
+                "method": self.method}
+
+
+@dataclass(frozen=True)
+class Answer:
+    """One answer to a design question.
+
+    Attributes
+    ----------
+    question : str
+        ``min-contact``, ``max-noise``, ``min-delta-t``, ``delta-e`` or ``distinguishable``.
+    route : str
+        ``"table"`` or ``"exact"``.
+    value : float, bool or None
+        The SVM's answer in :data:`QUANTITIES` ``[question]`` (None: no answer,
+        see ``notes``); a bool for ``distinguishable``.
+    interval : (low, high)
+        Monte Carlo interval of ``value`` (see :data:`INTERVAL_MEANING`).
+    ideal_bound : IdealBound
+        The ideal observer's answer.
+    objects : tuple of dict
+        The objects asked about (label, material, effusivity and diffusivity ranges).
+    limiting_pair : tuple of dict
+        The two classes the answer is for (the materials rule's hardest pair).
+    materials_rule : str
+        The rule that turned ``objects`` into ``limiting_pair``.
+    scene : dict
+        ``contact_s``, ``noise_c``, ``delta_t_c``, ``noise_ratio`` as asked (the
+        asked quantity None).
+    sensor, model, model_check : dict
+        The sensor (:meth:`designkit.Sensor.to_dict`), the forward model
+        (:meth:`~designkit.models.ForwardModel.to_dict`) and its check for this answer.
+    threshold : float
+        F1 threshold Phi.
+    table, table_hash, ideal_table, ideal_table_hash : str or None
+        Tables read (name and content hash; None on the exact route).
+    in_grid : dict
+        Per table axis, whether the question lies inside the grid (empty on the exact route).
+    details : dict
+        Question-specific figures (same keys on every route).
+    computation : dict
+        What the route did (route-specific).
+    notes : tuple of str
+        Sentences for people.
+    """
+
+    question: str
+    route: str
+    value: float | bool | None
+    interval: tuple[Any, Any]
+    ideal_bound: IdealBound
+    objects: tuple[Mapping[str, Any], ...]
+    limiting_pair: tuple[Mapping[str, Any], ...]
+    materials_rule: str
+    scene: Mapping[str, Any]
+    sensor: Mapping[str, Any]
+    model: Mapping[str, Any]
+    model_check: Mapping[str, Any] | None
+    threshold: float
+    table: str | None = None
+    table_hash: str | None = None
+    ideal_table: str | None = None
+    ideal_table_hash: str | None = None
+    in_grid: Mapping[str, bool] = field(default_factory=dict)
+    details: Mapping[str, Any] = field(default_factory=dict)
+    computation: Mapping[str, Any] = field(default_factory=dict)
+    notes: tuple[str, ...] = ()
+
+    # ------------------------------------------------------------ schema
+    @property
+    def quantity(self) -> str:
+        """Name of the quantity ``value`` is in (``contact_s``, ``noise_c`` ...)."""
+        return QUANTITIES[self.question][0]
+
+    @property
+    def unit(self) -> str:
+        return QUANTITIES[self.question][1]
+
+    @property
+    def ideal(self) -> float | None:
+        """The ideal observer's value (``ideal_bound.value``)."""
+        return self.ideal_bound.value
+
+    @property
+    def note(self) -> str:
+        """``notes`` as one string."""
+        return "; ".join(self.notes)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The ``--json`` schema: :data:`ANSWER_KEYS`, JSON-ready (no NaN, no infinities)."""
+        meaning = INTERVAL_MEANING["distinguishable" if self.question == "distinguishable" else self.route]
+        value = self.value if isinstance(self.value, bool) else number(self.value)
+        return {
+            "question": self.question,
+            "route": self.route,
+            "quantity": self.quantity,
+            "unit": self.unit,
+            "value": value,
+            "interval": {"low": number(self.interval[0]), "high": number(self.interval[1]), "meaning": meaning},
+            "ideal": self.ideal_bound.to_dict(),
+            "objects": [dict(o) for o in self.objects],
+            "limiting_pair": [dict(o) for o in self.limiting_pair],
+            "materials_rule": self.materials_rule,
+            "scene": dict(self.scene),
+            "sensor": dict(self.sensor),
+            "model": dict(self.model),
+            "model_check": None if self.model_check is None else dict(self.model_check),
+            "threshold": self.threshold,
+            "table": None if self.table is None else {"name": self.table, "content_hash": self.table_hash},
+            "ideal_table": None if self.ideal_table is None else {"name": self.ideal_table,
+                                                                  "content_hash": self.ideal_table_hash},
+            "in_grid": dict(self.in_grid),
+            "details": dict(self.details),
+            "computation": dict(self.computation),
+            "notes": list(self.notes),
+        }
+
+    # ------------------------------------------------------------ the pre-redesign view
+    @property
+    def source(self) -> str:
+        """``"table"`` or ``"computed"`` (the pre-redesign name of the route)."""
+        return "table" if self.route == "table" else "computed"
+
+    @property
+    def extra(self) -> dict[str, Any]:
+        """``details`` and ``computation`` flattened under their pre-redesign names.
+
+        Kept for callers written before the typed answer (``extra["svm_f1"]``,
+        ``extra["delta_e_upper"]``, ``extra["evaluations"]``, ``extra["wall_s"]``);
+        new code reads ``details`` and ``computation``.
+        """
+        out: dict[str, Any] = dict(self.computation)
+        d = dict(self.details)
+        if self.question == "delta-e":
+            for side in ("lower", "upper"):
+                part = d.get(side) or {}
+                key = f"delta_e_{side}"
+                out[key] = part.get("value")
+                out[key + "_interval"] = list(part.get("interval") or [None, None])
+                out[key + "_ideal"] = part.get("ideal")
+        else:
+            out.update(d)
+        return out

@@ -1,0 +1,496 @@
+"""The exact route: a design question computed for one pair and scene, under any forward model.
+
+The SVM's answer comes from simulated touches (:func:`designkit.recognition.svm.pair_f1`,
+``repeats`` seeds per evaluation, the model through the seam) and a bisection
+on the asked quantity; its interval collects the evaluations whose mean F1 is
+clearly (``z`` standard errors) on either side of the threshold.
+
+The ideal observer's bound: for a shared-shape model (the paper's) the
+vectorized closed-form answers of :mod:`designkit.query.ideal_bound`; for
+any other model a bisection on :func:`designkit.recognition.ideal.ideal_pair`,
+which is closed form where the model's extra physics is invisible and Monte
+Carlo on the exact likelihood otherwise (``n_mc`` touches per class).
+
+Readings depend on sigma and dT only through sigma/dT (standardized features,
+fixed initial conditions, every model linear in the temperatures), so
+``max-noise`` and ``min-delta-t`` are one search over sigma/dT.
+
+Every answer carries the model's :meth:`~designkit.models.ForwardModel.check`
+at the scene the answer names.
+
+Examples
+--------
+>>> a = exact_distinguishable(35000, 20000, contact_s=2.0, trials=30, repeats=1, jobs=1)
+>>> a.route, a.value, a.ideal_bound.method
+('exact', True, 'closed-form')
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+import numpy as np
+
+from .._validation import InputError, check_positive
+from ..objects import DEFAULT_CLASS_WIDTH, ObjectClass
+from .answer import Answer, IdealBound, number
+from .inputs import (
+    REFERENCE_RULE,
+    check_contact,
+    check_threshold,
+    pair_question,
+    reference_class,
+    scene_inputs,
+)
+
+__all__ = [
+    "RATIO_BRACKET",
+    "bisect",
+    "contact_search",
+    "exact_delta_e",
+    "exact_distinguishable",
+    "exact_max_noise",
+    "exact_min_contact",
+    "exact_min_delta_t",
+    "ratio_search",
+]
+
+#: sigma/dT searched by max-noise and min-delta-t: 10 uK per K up to noise as large as the contrast.
+RATIO_BRACKET = (1e-5, 1.0)
+
+
+# ============================================================ search routines
+def bisect(f_ok: Callable[[float], bool], lo: float, hi: float, tol: float, *, log: bool = False) -> float:
+    """Smallest x in (lo, hi] with ``f_ok(x)`` (monotone), to ``tol`` (relative if ``log``).
+
+    >>> round(bisect(lambda x: x >= 0.3, 0.0, 1.0, 1e-6), 5)
+    0.3
+    """
+    for _ in range(60):
+        if (math.log(hi / lo) if log else hi - lo) <= tol:
+            break
+        mid = math.sqrt(lo * hi) if log else 0.5 * (lo + hi)
+        if f_ok(mid):
+            hi = mid
+        else:
+            lo = mid
+    return hi
+
+
+def contact_search(svm_f1, phi: float, floor_s: float, max_contact_s: float, tolerance_s: float, z: float):
+    """Shortest contact time whose mean SVM F1 reaches ``phi``, by bisection, with its Monte Carlo interval.
+
+    ``svm_f1(contact_s)`` returns ``(mean F1, standard error)``. The interval runs
+    from the longest evaluated contact clearly below ``phi`` (mean + z SE < phi)
+    to the shortest clearly above (mean - z SE >= phi; None when none is).
+
+    Returns ``(value or None, (lo, hi), evaluations)``.
+    """
+    evaluated: dict[float, tuple[float, float]] = {}
+
+    def ok(c):
+        evaluated[c] = svm_f1(c)
+        return evaluated[c][0] >= phi
+
+    value = bisect(ok, floor_s, max_contact_s, tolerance_s) if ok(max_contact_s) else None
+    below = [c for c, (m, s) in evaluated.items() if m + z * s < phi]
+    above = [c for c, (m, s) in evaluated.items() if m - z * s >= phi]
+    interval = (max(below) if below else floor_s, min(above) if above else None)
+    evaluations = [{"contact_s": c, "svm_f1": m, "standard_error": s} for c, (m, s) in sorted(evaluated.items())]
+    return value, interval, evaluations
+
+
+def ratio_search(svm_f1, phi: float, lo_r: float, hi_r: float, z: float):
+    """Largest sigma/dT at which the mean SVM F1 still reaches ``phi``, by bisection in log sigma/dT.
+
+    ``svm_f1(ratio)`` returns ``(mean F1, standard error)``. The Monte Carlo interval
+    runs from the largest evaluated ratio clearly separable (mean - z SE >= phi) to the
+    smallest clearly not (mean + z SE < phi); None where no evaluation is clear.
+
+    Returns ``(ratio or None, (lo, hi), evaluations)``; ``hi_r`` itself when even it
+    separates, None when not even ``lo_r`` does.
+    """
+    evaluated: dict[float, tuple[float, float]] = {}
+
+    def ok(r):  # still separable at this noise ratio
+        evaluated[r] = svm_f1(r)
+        return evaluated[r][0] >= phi
+
+    if not ok(lo_r):
+        r = None
+    elif ok(hi_r):
+        r = hi_r
+    else:  # largest ratio that is ok == bisection on "not ok" from above
+        r = bisect(lambda x: not ok(x), lo_r, hi_r, 0.02, log=True)
+    ok_conf = [x for x, (m, s) in evaluated.items() if m - z * s >= phi]
+    bad_conf = [x for x, (m, s) in evaluated.items() if m + z * s < phi]
+    interval = (max(ok_conf) if ok_conf else None, min(bad_conf) if bad_conf else None)
+    evaluations = [{"noise_ratio": x, "svm_f1": m, "standard_error": s} for x, (m, s) in sorted(evaluated.items())]
+    return r, interval, evaluations
+
+
+# ============================================================ one question's computation
+@dataclass
+class _Run:
+    """The sensor, model and Monte Carlo settings of one exact question, and its ideal-observer log."""
+
+    sensor: Any
+    model: Any
+    phi: float
+    width: float
+    trials: int
+    folds: int
+    seed: int
+    repeats: int
+    z: float
+    jobs: int
+    n_mc: int
+    t0: float = field(default_factory=time.perf_counter)
+    ideal_calls: list = field(default_factory=list)
+
+    @classmethod
+    def make(cls, *, sensor, model, threshold, width, trials, folds, seed, repeats, z, jobs, n_mc) -> "_Run":
+        from ..models import get_model
+        from ..sensor import load_sensor
+
+        if int(folds) < 2:
+            raise InputError(f"folds must be >= 2, got {folds}")
+        if int(trials) < int(folds):
+            raise InputError(f"trials per class ({trials}) must be at least the number of folds ({folds})")
+        if int(repeats) < 1:
+            raise InputError(f"repeats must be >= 1, got {repeats}")
+        if int(n_mc) < 10:
+            raise InputError(f"the Monte Carlo ideal observer needs at least 10 touches per class, got {n_mc}")
+        return cls(load_sensor(sensor if sensor is not None else "paper"), get_model(model),
+                   check_threshold(threshold), check_positive("class width", width), int(trials), int(folds),
+                   int(seed), int(repeats), check_positive("z", z), int(jobs), int(n_mc))
+
+    # ---------------------------------------------------------------- the SVM
+    def svm(self, classes, scene) -> tuple[float, float]:
+        """Mean SVM F1 over ``repeats`` seeds and its standard error, for the pair's classes."""
+        from joblib import Parallel, delayed
+
+        from ..recognition.svm import pair_f1
+
+        a, b = classes
+        jobs = self.jobs if self.repeats > 1 else 1
+        results = Parallel(n_jobs=jobs, prefer="processes" if jobs != 1 else None)(
+            delayed(pair_f1)(a, b, self.sensor, scene, model=self.model, trials=self.trials, folds=self.folds,
+                             seed=[self.seed, r]) for r in range(self.repeats))
+        f1 = np.array([r.f1 for r in results])
+        se_fold = math.sqrt(float(np.mean([r.standard_error ** 2 for r in results])))
+        se_rep = float(np.std(f1, ddof=1)) if f1.size > 1 else 0.0
+        return float(f1.mean()), max(se_fold, se_rep) / math.sqrt(f1.size)
+
+    # ---------------------------------------------------------------- the ideal observer
+    def closed_form(self, *classes: ObjectClass) -> bool:
+        """Whether the vectorized closed form answers (shared shape, every class ``width`` wide)."""
+        return self.model.shared_shape and all(
+            math.isclose(c.e_range[1] - c.e_range[0], self.width, rel_tol=1e-9) for c in classes)
+
+    def ideal_f1(self, classes, scene) -> float:
+        """Ideal F1 of the pair (closed form or Monte Carlo, :func:`designkit.recognition.ideal.ideal_pair`)."""
+        from ..recognition.ideal import ideal_pair
+
+        r = ideal_pair(classes[0], classes[1], self.sensor, scene, model=self.model, n_mc=self.n_mc,
+                       seed=self.seed)
+        self.ideal_calls.append({"contact_s": scene.contact_s, "noise_ratio": scene.noise_ratio, "f1": r.f1,
+                                 "standard_error": r.standard_error, "method": r.method})
+        return r.f1
+
+    def ideal_method(self, closed: bool) -> str:
+        if closed:
+            return "closed-form"
+        methods = sorted({c["method"] for c in self.ideal_calls})
+        return "+".join(methods) if methods else "none"
+
+    # ---------------------------------------------------------------- the answer
+    def answer(self, question: str, *, value, interval, ideal, ideal_method: str, objects, limiting, rule: str,
+               scene: dict, details: dict, check_classes, check_at, notes=(), **computation) -> Answer:
+        check = None
+        if check_classes:
+            c, n, d = check_at
+            check = self.model.check(tuple(check_classes), self.sensor, contact_s=c, noise_c=n,
+                                     delta_t_c=d).to_dict()
+        comp = {"fidelity": "svm", "trials": self.trials, "folds": self.folds, "repeats": self.repeats,
+                "seed": self.seed, "z": self.z, "n_mc": self.n_mc, "width": self.width, **computation,
+                "ideal_evaluations": list(self.ideal_calls), "wall_s": time.perf_counter() - self.t0}
+        return Answer(
+            question=question, route="exact", value=value, interval=tuple(interval),
+            ideal_bound=IdealBound(ideal if isinstance(ideal, bool) else number(ideal),
+                                   ideal_method if ideal is not None else "none"),
+            objects=tuple(objects), limiting_pair=tuple(limiting), materials_rule=rule, scene=scene,
+            sensor=self.sensor.to_dict(), model=self.model.to_dict(), model_check=check, threshold=self.phi,
+            details=details, computation=comp, notes=tuple(n for n in notes if n))
+
+
+def _scene(contact_s=None, noise_c=None, delta_t_c=None) -> dict[str, Any]:
+    ratio = None if noise_c is None or delta_t_c is None else noise_c / abs(delta_t_c)
+    return {"contact_s": contact_s, "noise_c": noise_c, "delta_t_c": delta_t_c, "noise_ratio": ratio}
+
+
+def _make(kw: dict) -> _Run:
+    return _Run.make(**{k: kw[k] for k in ("sensor", "model", "threshold", "width", "trials", "folds", "seed",
+                                           "repeats", "z", "jobs", "n_mc")})
+
+
+def _no_pair(question, run: _Run, pq, scene, details) -> Answer:
+    return run.answer(question, value=None, interval=(None, None), ideal=None, ideal_method="none",
+                      objects=pq.objects_dicts(), limiting=(), rule=pq.rule, scene=scene, details=details,
+                      check_classes=(), check_at=None, notes=[pq.note])
+
+
+# ============================================================ min-contact
+def exact_min_contact(e1=None, e2=None, *, m1=None, m2=None, objects=None, noise_c: float = 0.05,
+                      delta_t_c: float = 10.0, threshold: float = 0.9, sensor=None, model=None,
+                      diffusivity_m2_s=None, width: float = DEFAULT_CLASS_WIDTH, trials: int = 100, folds: int = 3,
+                      seed: int = 0, repeats: int = 4, z: float = 2.0, jobs: int = -1, n_mc: int = 1000,
+                      max_contact_s: float = 10.0, tolerance_s: float = 0.05) -> Answer:
+    """Shortest contact time [s] computed for this pair: bisection on the SVM's mean F1.
+
+    Parameters
+    ----------
+    e1, e2, m1, m2, objects
+        The objects (:func:`designkit.query.inputs.pair_question`; materials by its rule).
+    noise_c, delta_t_c : float
+        Noise sigma [degC] and sensor minus object temperature [degC].
+    threshold : float
+        F1 threshold Phi.
+    sensor : name, path or Sensor, optional
+        Default the paper's.
+    model : ForwardModel, name or dict, optional
+        Forward model of the touches (default the paper's semi-infinite).
+    diffusivity_m2_s : float, optional
+        Diffusivity [m^2 s^-1] of objects given as numbers (models that need it).
+    width : float
+        Class width [J s^-1/2 K^-1 m^-2].
+    trials, folds, seed, repeats, z, jobs
+        Touches per class, cross-validation folds, seed, seeds per evaluation,
+        interval width in standard errors, worker processes (-1: all cores).
+    n_mc : int
+        Touches per class of the Monte Carlo ideal observer (models without a shared shape).
+    max_contact_s, tolerance_s : float
+        Longest contact examined and bisection tolerance [s].
+    """
+    from ..scene import Scene
+
+    kw = dict(locals())
+    noise, dt = scene_inputs(noise_c, delta_t_c)
+    run = _make(kw)
+    tmax = check_positive("maximum contact time [s]", max_contact_s)
+    pq = pair_question(e1, e2, m1, m2, objects=objects, width=run.width, diffusivity_m2_s=diffusivity_m2_s,
+                       model=run.model)
+    scene_d = _scene(None, noise, dt)
+    if pq.classes is None:
+        return _no_pair("min-contact", run, pq, scene_d, {})
+    cls = pq.classes
+
+    def scene(c):
+        return Scene.from_delta_t(contact_s=c, noise_c=noise, delta_t_c=dt)
+
+    floor = 1.0 / run.sensor.sample_rate_hz
+    value, interval, evaluations = contact_search(lambda c: run.svm(cls, scene(c)), run.phi, floor, tmax,
+                                                  tolerance_s, run.z)
+    closed = run.closed_form(*cls)
+    if closed:
+        from .ideal_bound import exact_ideal_min_contact
+
+        ideal = number(exact_ideal_min_contact(run.sensor, cls[0].e_range[0], cls[1].e_range[0],
+                                               noise / abs(dt), width=run.width, threshold=run.phi,
+                                               max_contact_s=tmax))
+    else:
+        ideal_ok = lambda c: run.ideal_f1(cls, scene(c)) >= run.phi  # noqa: E731
+        # the ideal observer needs no more contact than the SVM: bracket with the SVM's answer first (long
+        # contacts are the costly ones for the Monte Carlo likelihood), widen to tmax only if that fails
+        itol = min(0.01, tolerance_s)
+        if value is not None and ideal_ok(value):
+            ideal = bisect(ideal_ok, floor, value, itol)
+        elif ideal_ok(tmax):
+            ideal = bisect(ideal_ok, value if value is not None else floor, tmax, itol)
+        else:
+            ideal = None
+    needed = tmax if value is None else max(x for x in (value, ideal, interval[1]) if x is not None)
+    note = "" if value is not None else f"not separable by any contact time up to {tmax:g} s"
+    return run.answer("min-contact", value=value, interval=interval, ideal=ideal,
+                      ideal_method=run.ideal_method(closed), objects=pq.objects_dicts(),
+                      limiting=pq.limiting_dicts(), rule=pq.rule, scene=scene_d, details={}, check_classes=cls,
+                      check_at=(needed, noise, dt), notes=[note], evaluations=evaluations, max_contact_s=tmax)
+
+
+# ============================================================ max-noise / min-delta-t
+def _exact_ratio(question: str, kw: dict) -> Answer:
+    from ..scene import Scene
+
+    contact = check_contact(kw["contact_s"])
+    if question == "max-noise":
+        _, dt = scene_inputs(0.0, kw["delta_t_c"])
+        scene_d = _scene(contact, None, dt)
+    else:
+        noise, _ = scene_inputs(kw["noise_c"], 1.0)
+        if noise == 0:
+            raise InputError("noise sigma is 0: any temperature difference separates them (no smallest one)")
+        scene_d = _scene(contact, noise, None)
+    run = _make(kw)
+    pq = pair_question(kw["e1"], kw["e2"], kw["m1"], kw["m2"], objects=kw["objects"], width=run.width,
+                       diffusivity_m2_s=kw["diffusivity_m2_s"], model=run.model)
+    if pq.classes is None:
+        return _no_pair(question, run, pq, scene_d, {})
+    cls = pq.classes
+    lo_r, hi_r = RATIO_BRACKET
+
+    def scene(r):  # readings depend on sigma and dT only through r
+        return Scene.from_delta_t(contact_s=contact, noise_c=r, delta_t_c=1.0)
+
+    r, (r_lo, r_hi), evaluations = ratio_search(lambda x: run.svm(cls, scene(x)), run.phi, lo_r, hi_r, run.z)
+    closed = run.closed_form(*cls)
+    if closed:
+        from .ideal_bound import exact_ideal_max_ratio
+
+        ideal_r = number(exact_ideal_max_ratio(run.sensor, cls[0].e_range[0], cls[1].e_range[0], contact,
+                                               width=run.width, threshold=run.phi, bracket=RATIO_BRACKET))
+    else:
+        ideal_r = None
+        if run.ideal_f1(cls, scene(lo_r)) >= run.phi:
+            ideal_r = hi_r if run.ideal_f1(cls, scene(hi_r)) >= run.phi else \
+                bisect(lambda x: run.ideal_f1(cls, scene(x)) < run.phi, lo_r, hi_r, 2e-3, log=True)
+    if question == "max-noise":
+        conv = lambda x: None if x is None else x * abs(dt)  # noqa: E731
+        interval = (conv(r_lo), conv(r_hi))
+    else:
+        conv = lambda x: None if x is None else noise / x  # noqa: E731
+        interval = (conv(r_hi), conv(r_lo))
+    # the model check at the answer: the smaller sigma/dT of the SVM's and the ideal observer's is the stricter
+    r_check = min([x for x in (r, ideal_r) if x is not None], default=lo_r)
+    check_at = (contact, r_check * abs(dt), dt) if question == "max-noise" else (contact, noise, noise / r_check)
+    note = "" if r is not None else f"not separable even at sigma/dT = {lo_r:g}"
+    return run.answer(question, value=conv(r), interval=interval, ideal=conv(ideal_r),
+                      ideal_method=run.ideal_method(closed), objects=pq.objects_dicts(),
+                      limiting=pq.limiting_dicts(), rule=pq.rule, scene=scene_d, details={}, check_classes=cls,
+                      check_at=check_at, notes=[note], evaluations=evaluations)
+
+
+def exact_max_noise(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact_s: float, delta_t_c: float = 10.0,
+                    threshold: float = 0.9, sensor=None, model=None, diffusivity_m2_s=None,
+                    width: float = DEFAULT_CLASS_WIDTH, trials: int = 100, folds: int = 3, seed: int = 0,
+                    repeats: int = 4, z: float = 2.0, jobs: int = -1, n_mc: int = 1000) -> Answer:
+    """Largest noise sigma [degC] that still separates the pair (bisection in log sigma/dT).
+
+    Arguments as :func:`exact_min_contact`; ``contact_s`` [s] is the contact time.
+    """
+    return _exact_ratio("max-noise", dict(locals(), noise_c=None))
+
+
+def exact_min_delta_t(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact_s: float, noise_c: float = 0.05,
+                      threshold: float = 0.9, sensor=None, model=None, diffusivity_m2_s=None,
+                      width: float = DEFAULT_CLASS_WIDTH, trials: int = 100, folds: int = 3, seed: int = 0,
+                      repeats: int = 4, z: float = 2.0, jobs: int = -1, n_mc: int = 1000) -> Answer:
+    """Smallest sensor-object temperature difference [degC] that separates the pair.
+
+    Arguments as :func:`exact_min_contact`; ``contact_s`` [s] is the contact time.
+    """
+    return _exact_ratio("min-delta-t", dict(locals(), delta_t_c=None))
+
+
+# ============================================================ distinguishable
+def exact_distinguishable(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact_s: float,
+                          noise_c: float = 0.05, delta_t_c: float = 10.0, threshold: float = 0.9, sensor=None,
+                          model=None, diffusivity_m2_s=None, width: float = DEFAULT_CLASS_WIDTH, trials: int = 100,
+                          folds: int = 3, seed: int = 0, repeats: int = 4, z: float = 2.0, jobs: int = -1,
+                          n_mc: int = 1000) -> Answer:
+    """SVM F1 (mean of ``repeats`` seeds) and ideal F1 of the pair's classes at this scene.
+
+    ``value``: whether the mean SVM F1 reaches the threshold; ``details``: the
+    F1s, the SVM's standard error and whether the verdict is confident (the
+    mean at least ``z`` standard errors from the threshold).
+    """
+    from ..scene import Scene
+
+    kw = dict(locals())
+    noise, dt = scene_inputs(noise_c, delta_t_c)
+    contact = check_contact(contact_s)
+    run = _make(kw)
+    pq = pair_question(e1, e2, m1, m2, objects=objects, width=run.width, diffusivity_m2_s=diffusivity_m2_s,
+                       model=run.model)
+    scene_d = _scene(contact, noise, dt)
+    if pq.classes is None:
+        return _no_pair("distinguishable", run, pq, scene_d,
+                        {"distinguishable": None, "svm_f1": None, "svm_standard_error": None, "verdict": None,
+                         "ideal_f1": None, "ideal_distinguishable": None})
+    cls = pq.classes
+    scene = Scene.from_delta_t(contact_s=contact, noise_c=noise, delta_t_c=dt)
+    f1, se = run.svm(cls, scene)
+    ideal = run.ideal_f1(cls, scene)
+    yes = f1 >= run.phi
+    details = {"distinguishable": yes, "svm_f1": f1, "svm_standard_error": se,
+               "verdict": "confident" if abs(f1 - run.phi) >= run.z * se else "uncertain",
+               "ideal_f1": ideal, "ideal_distinguishable": ideal >= run.phi}
+    return run.answer("distinguishable", value=yes, interval=(f1 - run.z * se, f1 + run.z * se), ideal=ideal,
+                      ideal_method=run.ideal_method(False), objects=pq.objects_dicts(),
+                      limiting=pq.limiting_dicts(), rule=pq.rule, scene=scene_d, details=details,
+                      check_classes=cls, check_at=(contact, noise, dt))
+
+
+# ============================================================ delta-e
+def exact_delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, noise_c: float = 0.05,
+                  delta_t_c: float = 10.0, threshold: float = 0.9, sensor=None, model=None, diffusivity_m2_s=None,
+                  width: float = DEFAULT_CLASS_WIDTH, trials: int = 100, folds: int = 3, seed: int = 0,
+                  repeats: int = 4, z: float = 2.0, jobs: int = -1, n_mc: int = 1000,
+                  e_max: float = 40000.0) -> Answer:
+    """delta(e) computed for this reference: bisection on the partner's distance, both directions.
+
+    The reference is ``[e, e + width)`` (``m``: a material, at the middle of its
+    range with its diffusivity range; ``diffusivity_m2_s``: one value or a
+    ``(low, high)`` range for a reference given as a number); partners
+    ``[e +- d, e +- d + width)`` differ from it only in effusivity. ``e_max``:
+    the largest effusivity a partner may reach.
+    """
+    from ..scene import Scene
+
+    kw = dict(locals())
+    contact = check_contact(contact_s)
+    noise, dt = scene_inputs(noise_c, delta_t_c)
+    run = _make(kw)
+    ref = reference_class(e, m, width=run.width, diffusivity_m2_s=diffusivity_m2_s, model=run.model)
+    x, w = ref.e_range[0], run.width
+    scene = Scene.from_delta_t(contact_s=contact, noise_c=noise, delta_t_c=dt)
+    closed = run.closed_form(ref)
+    sides: dict[str, dict[str, Any]] = {}
+    checked = [ref]
+    for side, sign, limit in (("upper", +1, e_max - x - w), ("lower", -1, x - w)):
+        if limit < w:
+            sides[side] = {"value": None, "interval": [None, None], "ideal": None}
+            continue
+
+        def part(d, sign=sign):
+            lo = x + sign * d
+            return ObjectClass(f"{lo:g}", (lo, lo + w), ref.diffusivity_range_m2_s)
+
+        def ok(d, part=part):
+            return run.svm((ref, part(d)), scene)[0] >= run.phi
+
+        val = bisect(ok, 0.0, limit, w / 2) if ok(limit) else None
+        if closed:
+            from .ideal_bound import exact_ideal_delta
+
+            ideal = number(exact_ideal_delta(run.sensor, x, contact, noise / abs(dt), direction=sign, width=w,
+                                             threshold=run.phi, e_max=e_max))
+        else:
+            def iok(d, part=part):
+                return run.ideal_f1((ref, part(d)), scene) >= run.phi
+
+            ideal = bisect(iok, 0.0, limit, 1.0) if iok(limit) else None
+        sides[side] = {"value": val, "interval": [None, None], "ideal": ideal}
+        found = [v for v in (val, ideal) if v is not None]
+        if found:
+            checked.append(part(max(found)))
+    finite = [s["value"] for s in sides.values() if s["value"] is not None]
+    ifinite = [s["ideal"] for s in sides.values() if s["ideal"] is not None]
+    details = {"e": x, "lower": sides["lower"], "upper": sides["upper"]}
+    return run.answer("delta-e", value=min(finite) if finite else None, interval=(None, None),
+                      ideal=min(ifinite) if ifinite else None, ideal_method=run.ideal_method(closed),
+                      objects=(ref.to_dict(),), limiting=(ref.to_dict(),), rule=REFERENCE_RULE,
+                      scene=_scene(contact, noise, dt), details=details, check_classes=checked,
+                      check_at=(contact, noise, dt), e_max=e_max)

@@ -1,0 +1,170 @@
+"""The package's shape is a contract: layers that depend only downward, no import cycles, no
+private names imported from a peer module, every public module declaring ``__all__`` with names
+that exist, and every docstring example run (against the installed package)."""
+
+from __future__ import annotations
+
+import ast
+import doctest
+import importlib
+import importlib.util
+import pkgutil
+from pathlib import Path
+
+import pytest
+
+import designkit
+
+PKG = Path(designkit.__file__).resolve().parent
+
+# Layers, lowest first. A module may import from its own layer and the layers below, never above.
+LAYERS = [
+    {"designkit._validation", "designkit._io", "designkit._resources"},
+    {"designkit.properties", "designkit.sensor", "designkit.scene", "designkit.materials", "designkit.objects",
+     "designkit.figures"},
+    {"designkit.models"},
+    {"designkit.simulation"},
+    {"designkit.recognition"},
+    {"designkit.tables"},
+    {"designkit.sweep"},
+    {"designkit.query"},
+    {"designkit.export", "designkit.calibration"},
+    {"designkit.accuracy", "designkit.reproduce"},
+    {"designkit.cli", "designkit.__main__"},
+]
+
+
+def _modules() -> list[str]:
+    names = ["designkit"]
+    for info in pkgutil.walk_packages([str(PKG)], prefix="designkit."):
+        names.append(info.name)
+    return sorted(names)
+
+
+def _path(mod: str) -> Path:
+    rel = mod.split(".")[1:]
+    p = PKG.joinpath(*rel)
+    return p / "__init__.py" if p.is_dir() else p.with_suffix(".py")
+
+
+def _imports(mod: str) -> list[tuple[str, list[str], int]]:
+    """(imported module, names, line) for every designkit import in ``mod``, relative ones resolved."""
+    path = _path(mod)
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    pkg = mod if path.name == "__init__.py" else mod.rpartition(".")[0]
+    typing_only = {id(n) for block in ast.walk(tree) if isinstance(block, ast.If)
+                   and "TYPE_CHECKING" in ast.unparse(block.test) for n in ast.walk(block)}
+    out = []
+    for node in ast.walk(tree):
+        if id(node) in typing_only:  # annotations only: never imported at run time
+            continue
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = pkg.split(".")[: len(pkg.split(".")) - (node.level - 1)]
+                target = ".".join(base + ([node.module] if node.module else []))
+            else:
+                target = node.module or ""
+            if target.startswith("designkit"):
+                out.append((target, [a.name for a in node.names], node.lineno))
+        elif isinstance(node, ast.Import):
+            out.extend((a.name, [], node.lineno) for a in node.names if a.name.startswith("designkit"))
+    return out
+
+
+def _layer(mod: str) -> int:
+    if mod == "designkit":
+        return 0  # the top-level namespace loads its nouns lazily (PEP 562)
+    for i, layer in enumerate(LAYERS):
+        for prefix in layer:
+            if mod == prefix or mod.startswith(prefix + "."):
+                return i
+    raise AssertionError(f"{mod} is in no layer: add it to LAYERS in {__file__}")
+
+
+MODULES = _modules()
+
+
+def test_every_module_is_in_a_layer_and_imports_only_downward():
+    bad = []
+    for mod in MODULES:
+        for target, names, line in _imports(mod):
+            targets = [target] + [f"{target}.{n}" for n in names if importlib.util.find_spec(target) and
+                                  (PKG.joinpath(*target.split(".")[1:], n).is_dir() or
+                                   PKG.joinpath(*target.split(".")[1:], n + ".py").is_file())]
+            for t in targets:
+                if t == "designkit" and names == ["__version__"]:
+                    continue
+                if _layer(t) > _layer(mod):
+                    bad.append(f"{mod}:{line} imports {t} (a higher layer)")
+    assert not bad, "\n".join(bad)
+
+
+#: The designated homes of shared private helpers (pvlib's tools.py): importing from them is the point.
+SHARED = {"designkit._validation", "designkit._io", "designkit._resources", "designkit.cli._app",
+          "designkit.cli._options", "designkit.reproduce._report"}
+
+
+def test_no_module_imports_a_private_name_from_a_peer():
+    bad = []
+    for mod in MODULES:
+        for target, names, line in _imports(mod):
+            if target in SHARED:
+                continue
+            for n in names:
+                if f"{target}.{n}" in SHARED:
+                    continue  # the designated module itself, imported by name
+                if n.startswith("_") and not n.startswith("__"):
+                    bad.append(f"{mod}:{line} imports {n} from {target}")
+    assert not bad, "\n".join(bad)
+
+
+def test_no_import_cycles_between_modules():
+    graph: dict[str, set[str]] = {m: set() for m in MODULES}
+    for mod in MODULES:
+        for target, names, _ in _imports(mod):
+            for t in [target] + [f"{target}.{n}" for n in names]:
+                if t in graph and t != mod and not mod.startswith(t + "."):
+                    graph[mod].add(t)
+    # a package's __init__ importing its own submodules is not a cycle; drop the parent -> child edges
+    for mod in graph:
+        graph[mod] = {t for t in graph[mod] if not t.startswith(mod + ".")}
+    state: dict[str, int] = {}
+    stack: list[str] = []
+
+    def visit(m: str) -> None:
+        state[m] = 1
+        stack.append(m)
+        for n in sorted(graph[m]):
+            if state.get(n) == 1:
+                raise AssertionError("import cycle: " + " -> ".join(stack[stack.index(n):] + [n]))
+            if n not in state:
+                visit(n)
+        stack.pop()
+        state[m] = 2
+
+    for m in sorted(graph):
+        if m not in state:
+            visit(m)
+
+
+@pytest.mark.parametrize("mod", [m for m in MODULES if not m.rsplit(".", 1)[-1].startswith("_")
+                                 and not m.startswith("designkit.cli")])
+def test_public_modules_declare_all_with_names_that_exist(mod):
+    module = importlib.import_module(mod)
+    assert hasattr(module, "__all__"), f"{mod} declares no __all__"
+    missing = [n for n in module.__all__ if not hasattr(module, n)
+               and importlib.util.find_spec(f"{mod}.{n}") is None]  # a submodule may be listed
+    assert not missing, f"{mod}.__all__ names what it does not define: {missing}"
+
+
+@pytest.mark.parametrize("mod", [m for m in MODULES if m != "designkit.__main__"])  # importing it runs the CLI
+def test_docstring_examples_run(mod):
+    module = importlib.import_module(mod)
+    finder = doctest.DocTestFinder(exclude_empty=True)
+    runner = doctest.DocTestRunner(optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE)
+    tests = [t for t in finder.find(module, mod) if t.examples]
+    for t in tests:
+        runner.run(t, out=lambda s: None)
+    res = runner.summarize(verbose=False)
+    assert res.failed == 0, f"{res.failed} of {res.attempted} docstring examples of {mod} fail (run " \
+                            f"python -m pytest --doctest-modules on it to see them)"

@@ -33,7 +33,10 @@ def simulate(
     diffusivity: Diffusivity = None,
     json_: Json = False,
 ) -> None:
-    """Simulate touches of one object (paper eq. 4): sensor temperature against time, under any forward model."""
+    """Simulate touches of one object (paper eq. 4): sensor temperature against time, under any forward model.
+
+    Example: `designkit simulate --e 20000 --contact 2 --conductance 2000 --out curve.csv`
+    """
     from ..models.semi_infinite import contact_temperature
     from ..scene import Scene
     from ..sensor import load_sensor
@@ -148,7 +151,10 @@ def f1(
     json_: Json = False,
 ) -> None:
     """F1 of the paper's SVM and of the ideal observer for classes [e1, e1+width) and [e2, e2+width), under any
-    forward model."""
+    forward model.
+
+    Example: `designkit f1 --e1 35000 --e2 20000 --contact 2 --thickness 0.003 --diffusivity 1e-7`
+    """
     from .._validation import InputError, check_effusivity
     from ..objects import object_class
     from ..recognition.ideal import ideal_pair

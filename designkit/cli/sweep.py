@@ -68,6 +68,8 @@ def sweep(
     model); the model options, when given, replace it as a whole (`--thickness 0.002` is a 2 mm
     slab on the default backing, whatever the config said). A slab also needs `--diffusivity`
     (or `diffusivity_m2_s:` in the config): one object diffusivity for every interval.
+
+    Example: `designkit sweep --config tables/svm-paper.yaml --intervals 50 --contact 1,2 --conductance 2000`
     """
     import time
 

@@ -20,7 +20,10 @@ def tables_list(
     folder: Annotated[Optional[Path], typer.Option("--folder", help="List tables in this folder instead.")] = None,
     json_: Json = False,
 ) -> None:
-    """List the lookup tables (shipped, or in --folder)."""
+    """List the lookup tables (shipped, or in --folder).
+
+    Example: `designkit tables list --json`
+    """
     from ..tables.store import list_tables, load_table
 
     rows = []
@@ -53,7 +56,10 @@ def tables_show(
     name: Annotated[str, typer.Argument(help="Table name (see 'designkit tables list') or path.")],
     json_: Json = False,
 ) -> None:
-    """Describe one table: grid, units, sensor, fidelity, provenance, content hash."""
+    """Describe one table: grid, units, sensor, forward model, fidelity, provenance, content hash.
+
+    Example: `designkit tables show svm-paper`
+    """
     from ..tables.store import load_table
 
     from rich.markup import escape

@@ -414,7 +414,7 @@ def _as_batch(features, name):
 
 
 def batched_cv_f1(features_low, features_high, *, seeds, folds: int = 3, gram_dtype="float32",
-                  chunk_size: int = 32, xp=None) -> BatchedF1:
+                  chunk_size: int = 8, xp=None, timings: "dict | None" = None) -> BatchedF1:
     """Stratified k-fold F1 of the paper's SVM for a batch of pairs at once.
 
     Pair ``b`` gives the same folds, standardization, classifier and F1 as
@@ -439,6 +439,10 @@ def batched_cv_f1(features_low, features_high, *, seeds, folds: int = 3, gram_dt
         802 features at float32, plus the inputs.
     xp : array namespace, optional
         Array library for the heavy work (numpy by default).
+    timings : dict, optional
+        If given, CPU seconds of this process are added under ``"folds"``,
+        ``"standardize"``, ``"gram"``, ``"solve"`` and ``"predict"`` (for benchmarks;
+        on a GPU the stages overlap and these are not meaningful).
 
     Returns
     -------
@@ -470,6 +474,7 @@ def batched_cv_f1(features_low, features_high, *, seeds, folds: int = 3, gram_dt
         raise InputError(f"gram_dtype must be 'float32' or 'float64', got {gram_dtype!r}")
     chunk_size = max(1, int(chunk_size))
 
+    clock = _Clock(timings)
     n = n_lo + n_hi
     alloc = _allocation(n_lo, n_hi, folds)  # (folds, 2) test touches per class
     test_folds = np.stack([stratified_test_folds(n_lo, n_hi, s, folds) for s in seeds])  # (B, n)
@@ -480,6 +485,7 @@ def batched_cv_f1(features_low, features_high, *, seeds, folds: int = 3, gram_dt
     blk_hi = np.r_[0, np.cumsum(alloc[:, 1])]
     blk_size = alloc.sum(axis=1)
     blk_start = np.r_[0, np.cumsum(blk_size)]
+    clock.lap("folds")
 
     f1 = np.empty(B)
     fold_f1 = np.empty((B, folds))
@@ -495,7 +501,7 @@ def batched_cv_f1(features_low, features_high, *, seeds, folds: int = 3, gram_dt
     for c0 in range(0, B, chunk_size):
         c1 = min(B, c0 + chunk_size)
         out = _chunk(lo[c0:c1], hi[c0:c1], order_lo[c0:c1], order_hi[c0:c1], alloc, blk_lo, blk_hi,
-                     blk_start, folds, gram_dtype, _namespace(xp, lo))
+                     blk_start, folds, gram_dtype, _namespace(xp, lo), clock)
         dec_blocks, gaps, solv, its = out
         for f in range(folds):
             dec = dec_blocks[f]  # (b, blk_size[f]) libsvm convention, low rows then high rows
@@ -532,7 +538,22 @@ def _to_numpy(x):
     return np.asarray(x.get() if hasattr(x, "get") else (x.cpu() if hasattr(x, "cpu") else x))
 
 
-def _chunk(lo, hi, order_lo, order_hi, alloc, blk_lo, blk_hi, blk_start, folds, gram_dtype, xp):
+class _Clock:
+    def __init__(self, timings):
+        import time
+
+        self.timings = timings
+        self._now = time.process_time
+        self.t = self._now() if timings is not None else 0.0
+
+    def lap(self, name):
+        if self.timings is not None:
+            t = self._now()
+            self.timings[name] = self.timings.get(name, 0.0) + t - self.t
+            self.t = t
+
+
+def _chunk(lo, hi, order_lo, order_hi, alloc, blk_lo, blk_hi, blk_start, folds, gram_dtype, xp, clock):
     """Decision values of every test touch of one chunk of pairs; see batched_cv_f1."""
     b, n_lo, d = lo.shape
     n = n_lo + hi.shape[1]
@@ -562,6 +583,7 @@ def _chunk(lo, hi, order_lo, order_hi, alloc, blk_lo, blk_hi, blk_start, folds, 
     S1_all = xp.sum(S1, axis=1)
     S2_all = xp.sum(S2, axis=1)
     eps = float(np.finfo(np.float64).eps)
+    clock.lap("standardize")
 
     dec_blocks, gaps, solv, its = [], [], [], []
     for f in range(folds):
@@ -583,9 +605,12 @@ def _chunk(lo, hi, order_lo, order_hi, alloc, blk_lo, blk_hi, blk_start, folds, 
             Z[:, r:r + ge - gs, :] = xp.astype(Xp[:, gs:ge, :] * inv_scale[:, None, :], gdt)
             r += ge - gs
             y += [1.0] * int(alloc[g, 0]) + [-1.0] * int(alloc[g, 1])  # libsvm: lower class = +1
+        clock.lap("standardize")
         K = xp.astype(Z @ xp.permute_dims(Z, (0, 2, 1)), f64)
+        clock.lap("gram")
         yv = xp.asarray(y, dtype=f64)
         a, rho, info = solve_svc_duals(K, yv, xp=xp)
+        clock.lap("solve")
         beta = a * yv[None, :]
         # w (in centered, scaled coordinates) = Z^T beta ; decision of a test touch x: (x * s) . w - rho
         v = xp.zeros((b, d), dtype=f64)
@@ -600,4 +625,5 @@ def _chunk(lo, hi, order_lo, order_hi, alloc, blk_lo, blk_hi, blk_start, folds, 
         gaps.append(_to_numpy(info["kkt_gap"]))
         solv.append(_to_numpy(info["solver"]))
         its.append(_to_numpy(info["iterations"]))
+        clock.lap("predict")
     return dec_blocks, gaps, solv, its

@@ -150,7 +150,10 @@ def _bias_and_gap(K, y, a, C, xp):
     lb = xp.max(xp.where(to_lb, yG, -inf), axis=-1)
     n_free = xp.sum(xp.astype(free, yG.dtype), axis=-1)
     sum_free = xp.sum(xp.where(free, yG, 0.0), axis=-1)
-    rho = xp.where(n_free > 0, sum_free / xp.where(n_free > 0, n_free, 1.0), (ub + lb) / 2)
+    fin_ub, fin_lb = xp.isfinite(ub), xp.isfinite(lb)
+    ub0, lb0 = xp.where(fin_ub, ub, 0.0), xp.where(fin_lb, lb, 0.0)
+    mid = xp.where(fin_ub & fin_lb, (ub0 + lb0) / 2, ub0 + lb0)  # libsvm: (ub + lb) / 2 (one side empty: the other)
+    rho = xp.where(n_free > 0, sum_free / xp.where(n_free > 0, n_free, 1.0), mid)
     v = -yG
     i_up = ((y > 0) & (a < C)) | ((y < 0) & (a > 0))
     i_low = ((y > 0) & (a > 0)) | ((y < 0) & (a < C))
@@ -306,7 +309,7 @@ def solve_svc_duals(K, y, *, C: float = 1.0, xp=None, max_active_set_iter: int =
     >>> X = np.array([[0.0, 0.0], [0.0, 1.0], [2.0, 0.0], [2.0, 1.0]])
     >>> a, rho, info = solve_svc_duals((X @ X.T)[None], np.array([1.0, 1.0, -1.0, -1.0]))
     >>> np.round(a, 6).tolist(), round(float(rho[0]), 6)
-    ([[0.25, 0.25, 0.25, 0.25]], 1.0)
+    ([[0.25, 0.25, 0.25, 0.25]], -1.0)
     """
     xp = _namespace(xp, K)
     K = xp.asarray(K)
@@ -553,33 +556,53 @@ class _Clock:
             self.t = t
 
 
+def _gather_centered(x, order, center, xp):
+    """Rows of x (b, m, d) in the given order (b, m), minus center (b, d): a new (b, m, d) float64 array."""
+    b, m, d = x.shape
+    if xp is np:  # one gather into a contiguous buffer and an in-place subtraction, no temporaries
+        out = np.empty((b, m, d))
+        src = (order + (np.arange(b) * m)[:, None]).ravel()
+        np.take(x.reshape(b * m, d), src, axis=0, out=out.reshape(b * m, d), mode="clip")
+        np.subtract(out, center[:, None, :], out=out)
+        return out
+    return xp.take_along_axis(x, order[:, :, None], axis=1) - center[:, None, :]
+
+
+def _scaled(x, scale, dtype, out, xp):
+    """out[...] = x * scale cast to dtype (in place for numpy)."""
+    if xp is np:
+        np.multiply(x, scale, out=out, casting="same_kind")
+    else:
+        out[...] = xp.astype(x * scale, dtype)
+
+
 def _chunk(lo, hi, order_lo, order_hi, alloc, blk_lo, blk_hi, blk_start, folds, gram_dtype, xp, clock):
     """Decision values of every test touch of one chunk of pairs; see batched_cv_f1."""
     b, n_lo, d = lo.shape
-    n = n_lo + hi.shape[1]
+    n_hi = hi.shape[1]
+    n = n_lo + n_hi
     f64 = xp.float64
     gdt = xp.float32 if gram_dtype == "float32" else f64
     lo_x = xp.asarray(lo)
     hi_x = xp.asarray(hi)
-    o_lo = xp.asarray(order_lo)
-    o_hi = xp.asarray(order_hi)
     center = (xp.sum(lo_x, axis=1) + xp.sum(hi_x, axis=1)) / n  # (b, d): a shift common to all touches
-    # Xp: the pair's touches in fold-block order, centered.
-    Xp = xp.empty((b, n, d), dtype=f64)
-    for f in range(folds):
-        s = int(blk_start[f])
-        nl = int(alloc[f, 0])
-        il = o_lo[:, int(blk_lo[f]):int(blk_lo[f + 1])]
-        ih = o_hi[:, int(blk_hi[f]):int(blk_hi[f + 1])]
-        Xp[:, s:s + nl, :] = xp.take_along_axis(lo_x, il[:, :, None], axis=1) - center[:, None, :]
-        Xp[:, s + nl:int(blk_start[f + 1]), :] = xp.take_along_axis(hi_x, ih[:, :, None], axis=1) - center[:, None, :]
+    # Each class's touches in fold-block order (the test touches of fold 0 first, ...), centered.
+    D = (_gather_centered(lo_x, xp.asarray(order_lo), center, xp),
+         _gather_centered(hi_x, xp.asarray(order_hi), center, xp))
+    blk = (blk_lo, blk_hi)
+
+    def seg(c, g):  # class c's touches in block g
+        return D[c][:, int(blk[c][g]):int(blk[c][g + 1]), :]
+
     # Block sums of x and x^2 (relative to the common center) give every fold's training mean and variance.
-    E = np.zeros((folds, n))
-    for f in range(folds):
-        E[f, int(blk_start[f]):int(blk_start[f + 1])] = 1.0
-    E = xp.asarray(E, dtype=f64)
-    S1 = E @ Xp  # (b, folds, d)
-    S2 = E @ (Xp * Xp)
+    S1 = S2 = 0.0
+    for c in range(2):
+        E = np.zeros((folds, D[c].shape[1]))
+        for g in range(folds):
+            E[g, int(blk[c][g]):int(blk[c][g + 1])] = 1.0
+        E = xp.asarray(E, dtype=f64)
+        S1 = S1 + E @ D[c]  # (b, folds, d)
+        S2 = S2 + E @ (D[c] * D[c])
     S1_all = xp.sum(S1, axis=1)
     S2_all = xp.sum(S2, axis=1)
     eps = float(np.finfo(np.float64).eps)
@@ -587,26 +610,28 @@ def _chunk(lo, hi, order_lo, order_hi, alloc, blk_lo, blk_hi, blk_start, folds, 
 
     dec_blocks, gaps, solv, its = [], [], [], []
     for f in range(folds):
-        bs, be = int(blk_start[f]), int(blk_start[f + 1])
-        n_tr = n - (be - bs)
+        n_te = int(alloc[f, 0] + alloc[f, 1])
+        n_tr = n - n_te
         mean_c = (S1_all - S1[:, f, :]) / n_tr  # training mean relative to the center
         var = (S2_all - S2[:, f, :]) / n_tr - mean_c * mean_c
         var = xp.where(var > 0, var, 0.0)
         mean_raw = mean_c + center
         constant = var <= n_tr * eps * var + (n_tr * mean_raw * eps) ** 2  # StandardScaler's rule
         inv_scale = xp.where(constant, 1.0, 1.0 / xp.sqrt(xp.where(constant, 1.0, var)))  # (b, d)
-        # training touches of fold f: the other blocks, in block order
-        train_blocks = [g for g in range(folds) if g != f]
+        # training touches of fold f: the other blocks, each as [lower class, higher class]
+        parts = [(c, g) for g in range(folds) if g != f for c in range(2)]
         Z = xp.empty((b, n_tr, d), dtype=gdt)
         y = []
         r = 0
-        for g in train_blocks:
-            gs, ge = int(blk_start[g]), int(blk_start[g + 1])
-            Z[:, r:r + ge - gs, :] = xp.astype(Xp[:, gs:ge, :] * inv_scale[:, None, :], gdt)
-            r += ge - gs
-            y += [1.0] * int(alloc[g, 0]) + [-1.0] * int(alloc[g, 1])  # libsvm: lower class = +1
+        for c, g in parts:
+            x = seg(c, g)
+            m = x.shape[1]
+            _scaled(x, inv_scale[:, None, :], gdt, Z[:, r:r + m, :], xp)
+            r += m
+            y += [1.0 if c == 0 else -1.0] * m  # libsvm: the lower class (label 0) is +1
         clock.lap("standardize")
         K = xp.astype(Z @ xp.permute_dims(Z, (0, 2, 1)), f64)
+        del Z
         clock.lap("gram")
         yv = xp.asarray(y, dtype=f64)
         a, rho, info = solve_svc_duals(K, yv, xp=xp)
@@ -615,12 +640,13 @@ def _chunk(lo, hi, order_lo, order_hi, alloc, blk_lo, blk_hi, blk_start, folds, 
         # w (in centered, scaled coordinates) = Z^T beta ; decision of a test touch x: (x * s) . w - rho
         v = xp.zeros((b, d), dtype=f64)
         r = 0
-        for g in train_blocks:
-            gs, ge = int(blk_start[g]), int(blk_start[g + 1])
-            v = v + (xp.permute_dims(Xp[:, gs:ge, :], (0, 2, 1)) @ beta[:, r:r + ge - gs, None])[..., 0]
-            r += ge - gs
-        u = v * inv_scale * inv_scale
-        dec = (Xp[:, bs:be, :] @ u[:, :, None])[..., 0] - rho[:, None]
+        for c, g in parts:
+            x = seg(c, g)
+            m = x.shape[1]
+            v = v + (xp.permute_dims(x, (0, 2, 1)) @ beta[:, r:r + m, None])[..., 0]
+            r += m
+        u = (v * inv_scale * inv_scale)[:, :, None]
+        dec = xp.concat([(seg(0, f) @ u)[..., 0], (seg(1, f) @ u)[..., 0]], axis=1) - rho[:, None]
         dec_blocks.append(_to_numpy(dec))
         gaps.append(_to_numpy(info["kkt_gap"]))
         solv.append(_to_numpy(info["solver"]))

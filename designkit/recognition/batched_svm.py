@@ -200,7 +200,10 @@ def _active_set(K, y, C, ridge, free, up, max_iter, xp):
         M[:, n, :n] = fa
         M[:, n, n] = 1.0 - xp.astype(xp.any(free[idx], axis=-1), dt)  # no free variable: keep it solvable, flagged below
         rhs = xp.zeros((p, n + 1, 1), dtype=dt)
-        rhs[:, :n, 0] = fa * (ya - (Ka @ beta_u[..., None])[..., 0]) + (1.0 - fa) * beta_u
+        if bool(xp.any(up[idx])):
+            rhs[:, :n, 0] = fa * (ya - (Ka @ beta_u[..., None])[..., 0]) + (1.0 - fa) * beta_u
+        else:  # no variable at C (the usual case here): skip a batched mat-vec
+            rhs[:, :n, 0] = fa * ya
         rhs[:, n, 0] = -xp.sum(beta_u, axis=-1)
         z = _solve(M, rhs, xp)[..., 0]
         beta = z[:, :n]

@@ -94,3 +94,17 @@ def test_real_touches_layered_beats_semi_infinite_on_held_out_sets(robot_data_di
     assert s_lay["all"] < s_semi["all"] and s_lay["wood"] < s_semi["wood"]
     assert layered.consistent
     assert math.isfinite(layered.parameter("lag_s").value)
+
+
+def test_cli_fit_with_model_prints_the_held_out_comparison(robot_data_dir, cli):
+    index = robot_data_dir / "index.csv"
+    res = cli("calibrate", "fit", str(index), "--only", "metal,wood", "--range", "metal=aluminium",
+               "--object-temp", "metal=free", "--model", "semi-infinite", "--json")
+    assert res.exit_code == 0, res.output
+    import json
+
+    out = json.loads(res.output)
+    assert out["selected"] == "semi-infinite" and out["n_fit"] == 24 and out["n_held_out"] == 96
+    assert set(out["results"][0]["held_out_rms_c"]) == {"metal", "wood", "all"}
+    bad = cli("calibrate", "fit", str(index), "--model", "semi-infinite", "--out", "x.yaml")
+    assert bad.exit_code != 0 and "sensor files do not record a forward model" in bad.output

@@ -694,8 +694,11 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
         j = prob.n_model + 1 + k
         lr, s = x[j], sd[j]
         ident = j not in weak and not at_bound[j] and 2 * 1.96 * s < math.log(10.0)
+        why = ("at the search limit: the touches ask for the full temperature difference (e_o/e_s -> inf)"
+               if lr > 0 and at_bound[j] else "at the search limit (e_o/e_s -> 0)" if at_bound[j]
+               else "95 % interval wider than a factor of 10" if not ident else "")
         ratios[n] = IdentifiedParameter(f"e_o/e_s[{n}]", _exp(lr), (_exp(lr - 1.96 * s), _exp(lr + 1.96 * s)),
-                                        "", ident)
+                                        "", ident, why)
         if constrained[k]:
             e_lo, e_hi = rng[n]
             allowed[n] = (e_lo / _exp(lr + 1.96 * s), e_hi / _exp(lr - 1.96 * s))
@@ -747,7 +750,7 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
     for k, n in enumerate(names):
         rp = ratios[n]
         params.append(IdentifiedParameter(f"e_o[{n}]", rp.value * es, (rp.ci95[0] * es_ci[0], rp.ci95[1] * es_ci[1]),
-                                          "J s^-1/2 K^-1 m^-2", rp.identified))
+                                          "J s^-1/2 K^-1 m^-2", rp.identified, rp.note))
     # ------------------------------------------------ fit quality
     res_by: dict[str, list[np.ndarray]] = {n: [] for n in names}
     pos = 0

@@ -292,6 +292,89 @@ def _run_fit(index: Path, ranges: list[str], only: Optional[list[str]], object_t
     return result
 
 
+def _parse_sets(spec: str) -> list[int]:
+    from .._validation import InputError
+
+    out: list[int] = []
+    try:
+        for part in spec.split(","):
+            lo, sep, hi = part.strip().partition("-")
+            out += list(range(int(lo), int(hi) + 1)) if sep else [int(lo)]
+    except ValueError:
+        raise InputError(f"--fit-sets must look like 1-4 or 1,2,3, got {spec!r}") from None
+    if not out:
+        raise InputError(f"--fit-sets names no trial set: {spec!r}")
+    return out
+
+
+def _run_identify(index: Path, model: str, fit_sets: str, ranges: list[str], only: Optional[list[str]],
+                  object_temps: list[str], depth_um: float, out: Optional[Path], json_: bool) -> None:
+    """``calibrate fit --model``: identify one model or compare them all on held-out touches."""
+    from rich.markup import escape
+    from rich.table import Table
+
+    from .._validation import InputError
+    from ..calibration.fit import parse_object_temps, parse_ranges, resolve_ranges
+    from ..calibration.identify import CANDIDATES, candidate, compare_models, split_by_trial_set, trial_sets
+    from ..calibration.trials import load_index
+
+    if out is not None:
+        raise InputError("--out with --model: sensor files do not record a forward model yet; fit without "
+                         "--model to write one, or use --json to keep the identified model")
+    cands = list(CANDIDATES) if model.strip().lower() == "all" else [candidate(model)]
+    trials = load_index(index, only=only)
+    if not trials:
+        raise InputError(f"index {index} lists no trials")
+    names = sorted({tr.material for tr in trials})
+    rng = resolve_ranges(names, parse_ranges(ranges))
+    temps = parse_object_temps(object_temps)
+    kw = dict(ranges=rng, object_temps=temps, depth_m=depth_um * 1e-6)
+    if all(s is not None for s in trial_sets(trials, index)):
+        fit, held = split_by_trial_set(trials, _parse_sets(fit_sets), index)
+    else:
+        fit, held = trials, []
+    if held:
+        cmp = compare_models(fit, held, cands, **kw)
+        results, scores, selected = cmp.results, cmp.held_out_rms_c, cmp.selected
+    else:
+        from ..calibration.identify import identify
+
+        results = tuple(identify(fit, c, **kw) for c in cands)
+        scores = tuple({} for _ in results)
+        selected = min(results, key=lambda r: r.bic).candidate.label
+    if json_:
+        emit_json({"index": str(index), "n_fit": len(fit), "n_held_out": len(held), "selected": selected,
+                   "results": [dict(r.to_dict(), held_out_rms_c=dict(sc)) for r, sc in zip(results, scores)]})
+        return
+    con = console()
+    t = Table(title=f"Sensor models: fitted on {len(fit)} touches, scored on {len(held)} held-out touches",
+              title_justify="left")
+    for c in ("model", "fit RMS", *(f"held-out {n}" for n in names), "AIC", "BIC", "rank", "e_s [95 %]",
+              "fit time"):
+        t.add_column(escape(c), justify="left" if c == "model" else "right")
+    for r, sc in zip(results, scores):
+        es = "–" if r.effusivity is None else (f"{r.effusivity.value:.4g} [{r.effusivity.ci95[0]:.4g}, "
+                                               f"{r.effusivity.ci95[1]:.4g}]" if r.consistent else "conflict")
+        t.add_row(escape(r.candidate.label + (" *" if r.candidate.label == selected else "")), f"{r.rms_c:.4f} °C",
+                  *(f"{sc[n]:.4f} °C" if n in sc else "–" for n in names), f"{r.aic:.0f}", f"{r.bic:.0f}",
+                  f"{r.rank}/{r.n_nonlinear}", escape(es), f"{r.fit_time_s:.1f} s")
+    con.print(t)
+    best = next(r for r in results if r.candidate.label == selected)
+    p = Table(title=f"Selected: {selected} ({best.model().describe()})", title_justify="left")
+    for c in ("parameter", "value", "95 % interval", "unit", "identified"):
+        p.add_column(c, justify="left" if c in ("parameter", "unit", "identified") else "right")
+    for q in best.parameters:
+        p.add_row(escape(q.name), f"{q.value:.4g}", f"[{q.ci95[0]:.4g}, {q.ci95[1]:.4g}]", escape(q.unit),
+                  "yes" if q.identified else f"no: {escape(q.note or 'see notes')}")
+    con.print(p)
+    con.print(f"noise sigma before contact {best.noise_c:.4g} °C; object temperature: "
+              + ", ".join(f"{n} {m}" for n, m in best.object_modes.items()))
+    for n, (lo, hi) in best.es_allowed.items():
+        con.print(f"[dim]{escape(n)} allows e_s in [{lo:.4g}, {hi:.4g}][/]")
+    for note in best.notes:
+        con.print(f"[yellow]note:[/] {escape(note)}")
+
+
 # ------------------------------------------------------------------ record
 @calibrate_app.command()
 def record(
@@ -349,11 +432,21 @@ def fit(
     fit_to: Annotated[Optional[float], typer.Option(
         "--fit-to", help="Use samples up to this time after onset [s] (default: all, or to release).")] = None,
     plot: Annotated[Optional[Path], typer.Option("--plot", help="Write a PNG of the fit (needs matplotlib).")] = None,
+    model: Annotated[Optional[str], typer.Option(
+        "--model", help="Identify this sensor model instead of the paper's (semi-infinite, contact, "
+                        "contact+smoothing, layered, layered+lag, layered+lag+smoothing), or 'all' to compare "
+                        "them on held-out touches (default: the paper's semi-infinite fit).")] = None,
+    fit_sets: Annotated[str, typer.Option(
+        "--fit-sets", help="With --model: trial sets to fit (FIRST-LAST or a comma list); the others are held "
+                           "out and scored. Indexes without trial sets are fitted whole.")] = "1-4",
     json_: Json = False,
 ) -> None:
     """Identify e_s and alpha_s (and each e_o, the time offset) from recorded touches (paper appendix)."""
     settings = _fit_settings(depth_um, bootstrap, seed, baseline, offset_range, fit_to)
     only_list = [s.strip() for item in only for s in item.split(",") if s.strip()] if only else None
+    if model is not None:
+        _run_identify(index, model, fit_sets, range_ or [], only_list, object_temp or [], depth_um, out, json_)
+        return
     result = _run_fit(index, range_ or [], only_list, object_temp or [], settings, out, name, plot, quiet=json_)
     if json_:
         payload = result.to_dict()

@@ -12,6 +12,8 @@ name                model                                    shared shape
 ``slab``            an object of finite thickness on a       no
                     backing (image series / finite volumes)
 ``contact``         finite interface conductance h_c         no
+``layered``         heater film on a backing, h_c, the       no
+                    thermistor lag and the host smoothing
 ==================  =======================================  ==============
 
 Adding a model is one module defining a :class:`ForwardModel` subclass plus
@@ -43,6 +45,7 @@ MODELS: dict[str, tuple[str, str]] = {
     "semi-infinite": ("designkit.models.semi_infinite", "SemiInfinite"),
     "slab": ("designkit.models.slab", "Slab"),
     "contact": ("designkit.models.contact", "Contact"),
+    "layered": ("designkit.models.layered", "Layered"),
 }
 
 _CLASSES = {cls: name for name, (_, cls) in MODELS.items()}

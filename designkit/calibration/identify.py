@@ -1,0 +1,884 @@
+"""Identify any registered sensor model from recorded touches, and choose between models.
+
+:mod:`designkit.calibration.fit` identifies the paper's semi-infinite model
+(e_s and tau). On real touches that model's *shape* is wrong (issue 14): its
+residual is 30-40 times the noise and the materials ask for conflicting e_s.
+This module fits any forward model of :mod:`designkit.models` behind one
+least-squares problem and compares them on touches the fit has not seen.
+
+The problem
+-----------
+Trial ``i`` of material ``m`` on its own time grid (contact detected at 0,
+heat flowing from ``t_off``)::
+
+    T_i(t) = Ts0_i (1 - v_m(t)) + To_i v_m(t),    v_m = S[ u(t - t_off; e_o,m / e_s, theta) ]
+
+``u`` is the model's normalized reading (0 before contact), ``S`` the
+recordings' host smoothing (Savitzky-Golay over the whole trial, as the host
+did) when the candidate includes it, ``theta`` the model's sensor parameters.
+
+* Every model here is linear in the temperatures and changes nothing when all
+  effusivities (and h_c) are scaled together, so the fit runs with ``e_s = 1``:
+  it identifies ratios ``rho_m = e_o,m / e_s``, ``e_b / e_s`` and ``h_c / e_s``.
+  e_s itself comes from the materials' handbook ranges, as in the paper: each
+  material allows ``e_s`` in ``[e_min,m / rho_m, e_max,m / rho_m]``; one e_s
+  consistent with every range exists when these overlap (else: *conflict*).
+* Each touch's own initial temperatures: the sensor's ``Ts0_i`` is fitted
+  (closed form, variable projection; the pre-contact samples are in the fit),
+  the object's ``To_i`` is the passive thermistor before contact where it sits
+  still, ambient (a number) where there is none, or fitted per touch where the
+  object is not at room temperature (its passive channel moves in contact).
+* Nonlinear parameters (transformed: logs of positive quantities) by
+  :func:`scipy.optimize.least_squares` (trust-region reflective, bounded,
+  finite-difference Jacobian of the projected residual).
+
+Uncertainty and identifiability
+-------------------------------
+Residuals of a smoothed, imperfect model are correlated along a touch, so the
+covariance is the cluster-robust sandwich with touches as clusters (as in
+:mod:`~designkit.calibration.fit`). The Jacobian's singular values (columns
+scaled to unit norm) give its numerical rank; a parameter is reported *not
+identified* when the Jacobian is rank-deficient along it, its interval spans
+more than a factor of 10, or it sits on a search bound.
+
+Model selection
+---------------
+:func:`compare_models` fits each candidate on some touches (by default trial
+sets 1-4) and scores it on the others (residual RMS per material, each
+held-out touch with its own Ts0 and To), with AIC and BIC on the fitted
+touches for reference (their sample count overstates the information in
+correlated residuals: the held-out residual decides).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Mapping, Sequence
+
+import numpy as np
+
+from .._validation import InputError
+from .trials import Trial
+
+__all__ = [
+    "CANDIDATES",
+    "HOST_SMOOTHING",
+    "Candidate",
+    "Comparison",
+    "IdentifiedParameter",
+    "Identification",
+    "candidate",
+    "compare_models",
+    "identify",
+    "score",
+    "split_by_trial_set",
+    "trial_sets",
+]
+
+#: The recordings' host smoothing: Savitzky-Golay window 99, order 3 (at 200 Hz).
+HOST_SMOOTHING = (99, 3)
+_LOG_RATIO_LIMIT = 12.0
+
+
+# ------------------------------------------------------------ candidates
+@dataclass(frozen=True)
+class _Param:
+    """A nonlinear parameter: its name, unit, transform and search range (natural units)."""
+
+    name: str
+    unit: str
+    lo: float
+    hi: float
+    start: float
+    log: bool = True
+    scale_with_es: bool = False   # an effusivity or conductance: fitted as a ratio to e_s
+    description: str = ""
+
+    def to_x(self, v: float) -> float:
+        return math.log(v) if self.log else float(v)
+
+    def from_x(self, x: float) -> float:
+        return math.exp(min(max(float(x), -700.0), 700.0)) if self.log else float(x)
+
+
+_SENSOR_DIFF = _Param("diffusivity_m2_s", "m^2/s", 1e-11, 1e-5, 1.2e-9,
+                      description="sensor (film) diffusivity alpha_s at the fixed thermistor depth")
+_PARAMS: dict[str, _Param] = {p.name: p for p in (
+    _SENSOR_DIFF,
+    _Param("conductance_w_m2k", "W m^-2 K^-1", 1e-3, 1e4, 3.0, scale_with_es=True,
+           description="sensor-object interface conductance h_c"),
+    _Param("film_thickness_m", "m", 1e-6, 1e-2, 150e-6, description="heater film thickness L"),
+    _Param("backing_effusivity_ws05_m2k", "J s^-1/2 K^-1 m^-2", 1e-3, 1e3, 0.5, scale_with_es=True,
+           description="backing (finger) effusivity e_b"),
+    _Param("lag_s", "s", 1e-3, 20.0, 0.3, description="thermistor (and host filter) time constant"),
+    _Param("backing_thickness_m", "m", 1e-6, 1.0, 1e-3,
+           description="backing thickness L_b (its far face held at Ts0)"),
+    _Param("backing_diffusivity_m2_s", "m^2/s", 1e-10, 1e-4, 1e-7, description="backing diffusivity alpha_b"),
+)}
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """One model to identify: a registered forward model, which of its parameters are free, the chain.
+
+    Parameters
+    ----------
+    label : str
+        Name in reports (``"layered+lag+smoothing"``).
+    model : str
+        Registered model name (:data:`designkit.models.MODELS`).
+    free : tuple of str
+        Parameters fitted besides the time offset and the objects' ratios:
+        ``diffusivity_m2_s`` (the sensor's) and model fields among
+        ``conductance_w_m2k``, ``film_thickness_m``,
+        ``backing_effusivity_ws05_m2k``, ``lag_s``.
+    fixed : mapping
+        Model fields held at a value (effusivities and h_c as ratios to e_s).
+    smoothing : bool
+        Apply the host smoothing (:data:`HOST_SMOOTHING`) to the prediction.
+    """
+
+    label: str
+    model: str
+    free: tuple[str, ...] = ("diffusivity_m2_s",)
+    fixed: Mapping[str, Any] = field(default_factory=dict)
+    smoothing: bool = False
+
+    def __post_init__(self) -> None:
+        unknown = [p for p in self.free if p not in _PARAMS]
+        if unknown:
+            raise InputError(f"candidate {self.label}: no fittable parameter {', '.join(unknown)} "
+                             f"(fittable: {', '.join(_PARAMS)})")
+
+
+#: The candidates :func:`compare_models` tries by default, simplest first.
+CANDIDATES: tuple[Candidate, ...] = (
+    Candidate("semi-infinite", "semi-infinite"),
+    Candidate("contact", "contact", ("diffusivity_m2_s", "conductance_w_m2k")),
+    Candidate("contact+smoothing", "contact", ("diffusivity_m2_s", "conductance_w_m2k"), smoothing=True),
+    Candidate("layered", "layered", ("diffusivity_m2_s", "conductance_w_m2k", "film_thickness_m",
+                                     "backing_effusivity_ws05_m2k")),
+    Candidate("layered+lag", "layered", ("diffusivity_m2_s", "conductance_w_m2k", "film_thickness_m",
+                                         "backing_effusivity_ws05_m2k", "lag_s")),
+    Candidate("layered+lag+smoothing", "layered", ("diffusivity_m2_s", "conductance_w_m2k", "film_thickness_m",
+                                                   "backing_effusivity_ws05_m2k", "lag_s"), smoothing=True),
+)
+
+
+def candidate(name: str) -> Candidate:
+    """A default candidate by label, or the fullest one of a registered model name.
+
+    Examples
+    --------
+    >>> candidate("layered+lag+smoothing").smoothing
+    True
+    >>> candidate("contact").free
+    ('diffusivity_m2_s', 'conductance_w_m2k')
+    """
+    key = str(name).strip().lower()
+    for c in CANDIDATES:
+        if c.label == key:
+            return c
+    fullest = [c for c in CANDIDATES if c.model == key]
+    if fullest:
+        return fullest[-1]
+    from ..models import model_class
+
+    cls = model_class(key)  # unknown names: the registry's error
+    raise InputError(f"no identification set up for model {cls.name!r}; candidates: "
+                     f"{', '.join(c.label for c in CANDIDATES)}")
+
+
+# ------------------------------------------------------------ data
+@dataclass(frozen=True)
+class _Group:
+    """Trials of one material on one time grid: they share one predicted shape."""
+
+    material: int
+    time_s: np.ndarray     # (m,)
+    y: np.ndarray          # (n, m) sensor [degC]
+    to: np.ndarray         # (n,) object temperature [degC] (nan: fitted per touch)
+    free_to: bool
+    trials: tuple[int, ...]
+
+
+@dataclass(frozen=True)
+class _Data:
+    groups: tuple[_Group, ...]
+    names: tuple[str, ...]
+    modes: Mapping[str, "str | float"]
+    noise_c: float
+    sample_rate_hz: float
+    n_trials: int
+
+    @property
+    def n_samples(self) -> int:
+        return int(sum(g.y.size for g in self.groups))
+
+
+def trial_sets(trials: Sequence[Trial], index_csv: Path | str | None = None) -> list[int | None]:
+    """Trial set of each trial: the index's ``trial_set`` column, else from ``setNN_`` file names."""
+    import re
+
+    by_file: dict[str, int] = {}
+    if index_csv is not None:
+        from .trials import read_index_rows
+
+        for r in read_index_rows(Path(index_csv)):
+            v = (r.get("trial_set") or "").strip()
+            if r.get("file") and v.isdigit():
+                by_file[r["file"]] = int(v)
+    out: list[int | None] = []
+    for tr in trials:
+        name = Path(tr.source).name
+        if name in by_file:
+            out.append(by_file[name])
+            continue
+        m = re.match(r"set(\d+)_", name)
+        out.append(int(m.group(1)) if m else None)
+    return out
+
+
+def split_by_trial_set(trials: Sequence[Trial], fit_sets: Sequence[int],
+                       index_csv: Path | str | None = None) -> tuple[list[Trial], list[Trial]]:
+    """(trials of ``fit_sets``, the others); InputError when a trial has no set or a side is empty."""
+    sets = trial_sets(trials, index_csv)
+    if any(s is None for s in sets):
+        raise InputError("held-out scoring needs each trial's trial set (an index column trial_set, or file "
+                         "names setNN_...)")
+    keep = set(int(s) for s in fit_sets)
+    fit = [tr for tr, s in zip(trials, sets) if s in keep]
+    held = [tr for tr, s in zip(trials, sets) if s not in keep]
+    if not fit or not held:
+        raise InputError(f"trial sets {sorted(keep)} leave {len(fit)} touches to fit and {len(held)} to score")
+    return fit, held
+
+
+def _prepare(trials: Sequence[Trial], names: Sequence[str], object_temps: Mapping[str, Any],
+             moving_passive_c: float = 1.0) -> _Data:
+    """Group trials by material and time grid; decide each material's object temperature."""
+    if not trials:
+        raise InputError("no trials to fit")
+    idx = {n: k for k, n in enumerate(names)}
+    modes: dict[str, str] = {}
+    info = []
+    ssr, dof, rates = 0.0, 0, []
+    for tr in trials:
+        pre = tr.time_s < 0
+        if pre.sum() < 3:
+            raise InputError(f"trial {tr.source}: fewer than 3 samples before contact (time_s < 0)")
+        t, s = tr.time_s[pre], tr.sensor_c[pre]
+        early = t < t[0] + 0.5 * (t[-1] - t[0]) if t.size >= 20 else np.ones(t.size, bool)
+        coef = np.polyfit(t[early], s[early], 1)
+        ssr += float(np.sum((s[early] - np.polyval(coef, t[early])) ** 2))
+        dof += int(early.sum()) - 2
+        obj = tr.object_c[pre]
+        to = float(np.mean(obj[np.isfinite(obj)])) if np.isfinite(obj).any() else math.nan
+        post = tr.object_c[tr.time_s >= 0]
+        moved = float(np.nanmax(np.abs(post - to))) if math.isfinite(to) and np.isfinite(post).any() else math.nan
+        info.append((to, moved))
+        rates.append(1.0 / float(np.median(np.diff(tr.time_s))))
+    for n in names:
+        mode = object_temps.get(n)
+        if mode is None:
+            moves = [mv for tr, (_, mv) in zip(trials, info) if tr.material == n and math.isfinite(mv)]
+            if not moves:
+                raise InputError(f"trials of {n} have no passive (object) channel: give its object temperature "
+                                 f"({n}=DEGC, the ambient) or {n}=free")
+            mode = "free" if float(np.median(moves)) > moving_passive_c else "passive"
+        if isinstance(mode, str) and mode not in ("passive", "passive-end", "free"):
+            try:
+                mode = float(mode)
+            except ValueError:
+                raise InputError(f"object temperature of {n}: passive, passive-end, free or DEGC, got {mode!r}") \
+                    from None
+        modes[n] = mode if isinstance(mode, str) else float(mode)
+    groups: dict[tuple[int, bytes], list[int]] = {}
+    for i, tr in enumerate(trials):
+        if tr.material not in idx:
+            raise InputError(f"trial {tr.source}: material {tr.material!r} not among {', '.join(names)}")
+        ok = np.isfinite(tr.sensor_c)
+        if not ok.all():
+            raise InputError(f"trial {tr.source}: the sensor channel has missing values")
+        groups.setdefault((idx[tr.material], np.round(tr.time_s, 6).tobytes()), []).append(i)
+    out = []
+    for (k, _), members in groups.items():
+        n = names[k]
+        mode = modes[n]
+        tos = []
+        for i in members:
+            if mode == "passive-end":
+                tr = trials[i]
+                last = (tr.time_s >= tr.time_s[-1] - 1.0) & np.isfinite(tr.object_c)
+                if not last.any():
+                    raise InputError(f"trial {tr.source} has no passive reading at its end for {n}=passive-end")
+                tos.append(float(np.mean(tr.object_c[last])))
+            elif mode == "passive":
+                if not math.isfinite(info[i][0]):
+                    raise InputError(f"trial {trials[i].source} has no passive reading before contact: give "
+                                     f"{n}=DEGC")
+                tos.append(info[i][0])
+            elif mode == "free":
+                tos.append(math.nan)
+            else:
+                tos.append(float(mode))
+        out.append(_Group(k, trials[members[0]].time_s.copy(), np.array([trials[i].sensor_c for i in members]),
+                          np.array(tos), mode == "free", tuple(members)))
+    noise = math.sqrt(ssr / dof) if dof > 0 else math.nan
+    return _Data(tuple(out), tuple(names), modes, noise, float(np.median(rates)), len(trials))
+
+
+# ------------------------------------------------------------ the problem
+def _reading(model, t: np.ndarray, e_object: float, sensor, interp_points: int | None) -> np.ndarray:
+    """The model's unsmoothed normalized reading at times ``t > 0``.
+
+    Models solved numerically (with a ``conduction`` method) are evaluated at
+    ``interp_points`` log-spaced times and interpolated by a cubic spline in
+    ``log t`` (error below 1e-6 of the temperature difference for smooth
+    readings, tested), which makes a residual evaluation about 6x faster.
+    """
+    if not hasattr(model, "conduction"):
+        return model.response(t, [e_object], sensor)[0]
+    if not interp_points or t.size <= 2 * interp_points:
+        return model.conduction(t, [e_object], sensor, nodes=16)[0]
+    from scipy.interpolate import CubicSpline
+
+    lo, hi = float(t.min()), float(t.max())
+    grid = np.geomspace(lo, hi, interp_points)
+    u = model.conduction(grid, [e_object], sensor, nodes=16)[0]
+    return CubicSpline(np.log(grid), u)(np.log(t))
+
+
+class _Problem:
+    """Projected residuals of one candidate on prepared data; x = [model params, t_off, log rho_m]."""
+
+    def __init__(self, cand: Candidate, data: _Data, depth_m: float, offset_bounds_s: tuple[float, float],
+                 constrained: np.ndarray):
+        from ..models import get_model
+
+        self.cand = cand
+        self.data = data
+        self.depth_m = depth_m
+        self.params = [_PARAMS[p] for p in cand.free]
+        self.n_model = len(self.params)
+        self.n_mat = len(data.names)
+        self.constrained = constrained
+        self._get_model = get_model
+        self.interp_points: int | None = 160
+        lo = [p.to_x(p.lo) for p in self.params] + [offset_bounds_s[0]] + [-_LOG_RATIO_LIMIT] * self.n_mat
+        hi = [p.to_x(p.hi) for p in self.params] + [offset_bounds_s[1]] + [_LOG_RATIO_LIMIT] * self.n_mat
+        self.lo, self.hi = np.array(lo), np.array(hi)
+        # a material none of whose touches has a known object temperature: its ratio still shapes the
+        # curve (not for shared-shape models, where it is not identified at all)
+        self.names = [p.name for p in self.params] + ["time_offset_s"] + [f"log_ratio[{n}]" for n in data.names]
+
+    # -------------------------------------------------------- model
+    def model_and_sensor(self, x: np.ndarray):
+        from ..sensor import Sensor
+
+        vals = {p.name: p.from_x(v) for p, v in zip(self.params, x[:self.n_model])}
+        alpha = vals.pop("diffusivity_m2_s", _SENSOR_DIFF.start)
+        sensor = Sensor(effusivity=1.0, diffusivity_m2_s=alpha, depth_m=self.depth_m,
+                        sample_rate_hz=self.data.sample_rate_hz, name="identify")
+        kw = {k: v for k, v in self.cand.fixed.items()}
+        kw.update(vals)
+        model = self._get_model(self.cand.model, **kw)
+        return model, sensor
+
+    def shapes(self, x: np.ndarray) -> list[np.ndarray]:
+        """Predicted normalized reading v of each group on its grid (smoothed when the candidate says)."""
+        model, sensor = self.model_and_sensor(x)
+        off = x[self.n_model]
+        rho = np.exp(x[self.n_model + 1:])
+        out = []
+        cache: dict[tuple[int, bytes], np.ndarray] = {}
+        for g in self.data.groups:
+            key = (g.material, g.time_s.tobytes())
+            if key not in cache:
+                tt = g.time_s - off
+                u = np.zeros(tt.size)
+                pos = tt > 0
+                if pos.any():
+                    u[pos] = _reading(model, tt[pos], rho[g.material], sensor, self.interp_points)
+                if self.cand.smoothing:
+                    from ..models.layered import savgol_smooth
+
+                    u = savgol_smooth(u, *HOST_SMOOTHING)
+                cache[key] = u
+            out.append(cache[key])
+        return out
+
+    def project(self, x: np.ndarray):
+        """(residuals, per-group linear coefficients): Ts0 (and To where free) in closed form."""
+        res, coefs = [], []
+        for g, v in zip(self.data.groups, self.shapes(x)):
+            if g.free_to:
+                A = np.column_stack([1.0 - v, v])
+                coef = np.linalg.solve(A.T @ A, A.T @ g.y.T)            # (2, n): normal equations, well scaled
+                pred = (A @ coef).T
+            else:
+                a = 1.0 - v
+                den = float(a @ a)
+                b = g.y - g.to[:, None] * v[None, :]
+                ts0 = (b @ a) / den
+                pred = ts0[:, None] * a[None, :] + g.to[:, None] * v[None, :]
+                coef = np.vstack([ts0, g.to])
+            res.append((pred - g.y).ravel())
+            coefs.append(coef)
+        return np.concatenate(res), coefs
+
+    def residuals(self, x):
+        return self.project(x)[0]
+
+    def start(self) -> np.ndarray:
+        x = [p.to_x(p.start) for p in self.params] + [0.3]
+        return np.array(x + [0.0] * self.n_mat)
+
+    def rows_of(self, k: int) -> np.ndarray:
+        """Residual rows of material ``k``."""
+        mask = [np.full(g.y.size, g.material == k) for g in self.data.groups]
+        return np.concatenate(mask)
+
+    def n_linear(self) -> int:
+        return int(sum(len(g.trials) * (2 if g.free_to else 1) for g in self.data.groups))
+
+
+def _initial_ratios(prob: _Problem, x: np.ndarray) -> np.ndarray:
+    """Log ratios e_o/e_s from a coarse 1-D search per material (the other parameters at their start)."""
+    x = x.copy()
+    for k in range(prob.n_mat):
+        best = None
+        for lr in np.linspace(-6.0, 6.0, 25):
+            x[prob.n_model + 1 + k] = lr
+            r = prob.residuals(x)
+            sse = float(np.sum(r[prob.rows_of(k)] ** 2))
+            if best is None or sse < best[0]:
+                best = (sse, lr)
+        x[prob.n_model + 1 + k] = best[1]
+    return x
+
+
+# ------------------------------------------------------------ results
+@dataclass(frozen=True)
+class IdentifiedParameter:
+    """An identified quantity: value, 95 % interval, unit, and whether the data identify it.
+
+    ``identified`` is False when the Jacobian is rank-deficient along it, its
+    interval spans more than a factor of 10 (positive quantities) or it sits
+    on a search bound (``note`` says which).
+    """
+
+    name: str
+    value: float
+    ci95: tuple[float, float]
+    unit: str = ""
+    identified: bool = True
+    note: str = ""
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"name": self.name, "value": self.value, "ci95": list(self.ci95), "unit": self.unit,
+                "identified": self.identified, "note": self.note}
+
+
+@dataclass(frozen=True)
+class Identification:
+    """What :func:`identify` found for one candidate.
+
+    Attributes
+    ----------
+    candidate : Candidate
+    parameters : tuple of IdentifiedParameter
+        Sensor and model parameters in physical units (e_s from the ranges,
+        effusivities and h_c scaled by it), the time offset, and each
+        material's e_o.
+    ratios : dict
+        ``e_o / e_s`` per material (IdentifiedParameter).
+    effusivity : IdentifiedParameter or None
+        e_s; None where no material constrains it.
+    consistent : bool or None
+        One e_s keeps every constrained material within its handbook range
+        (None: no ranges given).
+    es_allowed : dict
+        Per material, the e_s interval its range allows (with the ratio's 95 % interval).
+    rms_c : float
+        Residual RMS on the fitted touches [degC].
+    rms_by_material_c : dict
+    n_samples, n_parameters : int
+        Samples fitted; parameters (nonlinear + each touch's linear ones).
+    aic, bic : float
+        Gaussian information criteria on the fitted samples.
+    rank, n_nonlinear : int
+        Numerical rank of the scaled Jacobian of the nonlinear parameters, and their number.
+    singular_values : ndarray
+    fit_time_s : float
+    x : ndarray
+        The transformed parameter vector (for :func:`score`).
+    notes : tuple of str
+    """
+
+    candidate: Candidate
+    parameters: tuple[IdentifiedParameter, ...]
+    ratios: Mapping[str, IdentifiedParameter]
+    effusivity: IdentifiedParameter | None
+    consistent: bool | None
+    es_allowed: Mapping[str, tuple[float, float]]
+    rms_c: float
+    rms_by_material_c: Mapping[str, float]
+    n_samples: int
+    n_parameters: int
+    aic: float
+    bic: float
+    rank: int
+    n_nonlinear: int
+    singular_values: np.ndarray
+    fit_time_s: float
+    noise_c: float
+    x: np.ndarray
+    names: tuple[str, ...]
+    depth_m: float
+    sample_rate_hz: float
+    object_modes: Mapping[str, "str | float"]
+    notes: tuple[str, ...] = ()
+
+    def parameter(self, name: str) -> IdentifiedParameter:
+        for p in self.parameters:
+            if p.name == name:
+                return p
+        raise KeyError(name)
+
+    def model(self):
+        """The identified forward model in physical units (e_s from the ranges; smoothing when fitted with it)."""
+        from ..models import get_model
+
+        es = self.effusivity.value if self.effusivity is not None else 1.0
+        kw = dict(self.candidate.fixed)
+        for p in self.parameters:
+            if p.name in _PARAMS and p.name != "diffusivity_m2_s":
+                kw[p.name] = p.value
+        for k, v in list(kw.items()):
+            if k in _PARAMS and _PARAMS[k].scale_with_es and k not in {p.name for p in self.parameters}:
+                kw[k] = v * es
+        if self.candidate.smoothing and self.candidate.model == "layered":
+            kw["smoothing_window"], kw["smoothing_order"] = HOST_SMOOTHING
+        return get_model(self.candidate.model, **kw)
+
+    def sensor(self, name: str = "identified"):
+        """The identified :class:`~designkit.sensor.Sensor` (e_s from the ranges, alpha_s at the fixed depth)."""
+        from ..sensor import Sensor
+
+        es = self.effusivity.value if self.effusivity is not None else 1.0
+        alpha = self.parameter("diffusivity_m2_s").value if "diffusivity_m2_s" in self.candidate.free \
+            else _SENSOR_DIFF.start
+        return Sensor(effusivity=es, diffusivity_m2_s=alpha, depth_m=self.depth_m,
+                      sample_rate_hz=self.sample_rate_hz, name=name, noise_c=self.noise_c,
+                      provenance={"method": f"designkit.calibration.identify ({self.candidate.label})",
+                                  "model": self.model().to_dict(), "rms_c": self.rms_c})
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "candidate": self.candidate.label, "model": self.model().to_dict(),
+            "parameters": [p.to_dict() for p in self.parameters],
+            "ratios": {k: v.to_dict() for k, v in self.ratios.items()},
+            "effusivity": None if self.effusivity is None else self.effusivity.to_dict(),
+            "consistent": self.consistent,
+            "es_allowed": {k: list(v) for k, v in self.es_allowed.items()},
+            "rms_c": self.rms_c, "rms_by_material_c": dict(self.rms_by_material_c),
+            "n_samples": self.n_samples, "n_parameters": self.n_parameters, "aic": self.aic, "bic": self.bic,
+            "rank": self.rank, "n_nonlinear": self.n_nonlinear,
+            "singular_values": [float(v) for v in self.singular_values], "fit_time_s": self.fit_time_s,
+            "noise_c": self.noise_c, "object_temperature": dict(self.object_modes), "notes": list(self.notes),
+        }
+
+
+def _exp(v: float) -> float:
+    """exp that saturates at the float range instead of raising."""
+    return math.exp(min(max(float(v), -700.0), 700.0)) if math.isfinite(v) else (math.inf if v > 0 else 0.0)
+
+
+def _sandwich(J: np.ndarray, r: np.ndarray, clusters: np.ndarray) -> np.ndarray:
+    """Cluster-robust covariance (touches as clusters)."""
+    bread = np.linalg.pinv(J.T @ J)
+    scores = np.zeros((int(clusters.max()) + 1, J.shape[1]))
+    np.add.at(scores, clusters, J * r[:, None])
+    return bread @ (scores.T @ scores) @ bread
+
+
+def _clusters(data: _Data) -> np.ndarray:
+    out = []
+    for g in data.groups:
+        m = g.y.shape[1]
+        out.append(np.repeat(np.asarray(g.trials), m))
+    return np.concatenate(out)
+
+
+def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+smoothing", *,
+             ranges: Mapping[str, Any] | None = None, object_temps: Mapping[str, Any] | None = None,
+             depth_m: float = 80e-6, offset_bounds_s: tuple[float, float] = (-1.5, 1.5),
+             start: Mapping[str, float] | None = None, x0: np.ndarray | None = None,
+             max_nfev: int = 100) -> Identification:
+    """Fit one candidate model to touches.
+
+    Parameters
+    ----------
+    trials : sequence of Trial
+        Touches (time 0 = detected contact onset, samples before it).
+    model : str or Candidate
+        A label of :data:`CANDIDATES` or a registered model name (its fullest candidate).
+    ranges : mapping material -> MaterialRange (or (e_min, e_max)), optional
+        Handbook effusivity ranges [J s^-1/2 K^-1 m^-2]; they set e_s's scale.
+    object_temps : mapping, optional
+        Per material ``"passive"``, ``"free"`` or a temperature [degC]; by
+        default the passive channel, or ``"free"`` when it moves in contact.
+    depth_m : float
+        Thermistor depth [m], fixed (only x^2/alpha_s is identifiable).
+    offset_bounds_s : (float, float)
+        Search range of the contact-time offset [s].
+    start : mapping, optional
+        Starting values of free parameters (physical units; effusivities and
+        h_c as ratios to e_s).
+    x0 : ndarray, optional
+        A transformed start vector (from another fit's ``x``).
+    max_nfev : int
+        Most residual evaluations of the optimizer.
+
+    Returns
+    -------
+    Identification
+    """
+    from scipy.optimize import least_squares
+
+    t0 = time.perf_counter()
+    cand = model if isinstance(model, Candidate) else candidate(model)
+    names = tuple(sorted({tr.material for tr in trials}))
+    data = _prepare(trials, names, dict(object_temps or {}))
+    rng = {n: _as_range(ranges[n]) for n in names if ranges and n in ranges}
+    constrained = np.array([n in rng and data.modes[n] != "free" for n in names])
+    prob = _Problem(cand, data, depth_m, offset_bounds_s, constrained)
+    if x0 is None:
+        x = prob.start()
+        for k, v in dict(start or {}).items():
+            if k == "time_offset_s":
+                x[prob.n_model] = float(v)
+            elif k in cand.free:
+                x[cand.free.index(k)] = _PARAMS[k].to_x(float(v))
+        x = _initial_ratios(prob, x)
+    else:
+        x = np.asarray(x0, dtype=np.float64).copy()
+    x = np.clip(x, prob.lo + 1e-9, prob.hi - 1e-9)
+    sol = least_squares(prob.residuals, x, bounds=(prob.lo, prob.hi), method="trf", x_scale="jac",
+                        diff_step=1e-6, xtol=1e-8, ftol=1e-8, gtol=1e-8, max_nfev=max_nfev)
+    x = sol.x
+    r = sol.fun
+    J = sol.jac
+    # ------------------------------------------------ identifiability
+    norms = np.linalg.norm(J, axis=0)
+    Js = J / np.where(norms > 0, norms, 1.0)
+    sv = np.linalg.svd(Js, compute_uv=False)
+    rank = int(np.sum(sv > sv[0] * 1e-6)) if sv.size else 0
+    _, _, vt = np.linalg.svd(Js, full_matrices=False)
+    weak = set()
+    for j in range(rank, len(sv)):
+        weak |= {int(i) for i in np.flatnonzero(np.abs(vt[j]) > 0.3)}
+    weak |= {int(i) for i in np.flatnonzero(norms == 0)}
+    cov = _sandwich(J, r, _clusters(data))
+    sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    at_bound = (np.abs(x - prob.lo) < 1e-6) | (np.abs(x - prob.hi) < 1e-6)
+    # ------------------------------------------------ e_s from the ranges
+    ratios: dict[str, IdentifiedParameter] = {}
+    allowed: dict[str, tuple[float, float]] = {}
+    point_lo, point_hi, wide_lo, wide_hi = [], [], [], []
+    for k, n in enumerate(names):
+        j = prob.n_model + 1 + k
+        lr, s = x[j], sd[j]
+        ident = j not in weak and not at_bound[j] and 2 * 1.96 * s < math.log(10.0)
+        why = ("at the search limit: the touches ask for the full temperature difference (e_o/e_s -> inf)"
+               if lr > 0 and at_bound[j] else "at the search limit (e_o/e_s -> 0)" if at_bound[j]
+               else "95 % interval wider than a factor of 10" if not ident else "")
+        ratios[n] = IdentifiedParameter(f"e_o/e_s[{n}]", _exp(lr), (_exp(lr - 1.96 * s), _exp(lr + 1.96 * s)),
+                                        "", ident, why)
+        if constrained[k]:
+            e_lo, e_hi = rng[n]
+            allowed[n] = (e_lo / _exp(lr + 1.96 * s), e_hi / _exp(lr - 1.96 * s))
+            point_lo.append(math.log(e_lo) - lr)
+            point_hi.append(math.log(e_hi) - lr)
+            wide_lo.append(math.log(min(max(allowed[n][0], 1e-300), 1e300)))
+            wide_hi.append(math.log(min(max(allowed[n][1], 1e-300), 1e300)))
+    notes: list[str] = []
+    es_p: IdentifiedParameter | None = None
+    consistent: bool | None = None
+    if point_lo:
+        a, b = max(point_lo), min(point_hi)
+        wa, wb = max(wide_lo), min(wide_hi)
+        consistent = bool(wa <= wb)
+        if a <= b:
+            les = 0.5 * (a + b)
+            note = "set-identified: every e_s in the interval keeps all materials in range"
+        elif consistent:
+            les = 0.5 * (wa + wb)
+            note = "the ranges touch only within the ratios' uncertainty"
+        else:
+            les = 0.5 * (a + b)
+            note = "conflict: no e_s keeps every material in its range"
+        ci = (_exp(wa), _exp(wb)) if consistent else (math.nan, math.nan)
+        es_p = IdentifiedParameter("effusivity", _exp(les), ci, "J s^-1/2 K^-1 m^-2", consistent, note)
+        if not consistent:
+            notes.append("the materials' ranges conflict under this model: " + "; ".join(
+                f"{n} allows e_s in [{lo:.4g}, {hi:.4g}]" for n, (lo, hi) in allowed.items()))
+    es = es_p.value if es_p is not None else 1.0
+    es_ci = es_p.ci95 if es_p is not None and consistent else (es, es)
+    # ------------------------------------------------ parameters in physical units
+    params: list[IdentifiedParameter] = []
+    for i, p in enumerate(prob.params):
+        v = p.from_x(x[i])
+        lo, hi = p.from_x(x[i] - 1.96 * sd[i]), p.from_x(x[i] + 1.96 * sd[i])
+        if p.scale_with_es:
+            v, lo, hi = v * es, lo * es_ci[0], hi * es_ci[1]
+        why = []
+        if i in weak:
+            why.append("Jacobian rank-deficient along it")
+        if at_bound[i]:
+            why.append("at a search bound")
+        if p.log and 2 * 1.96 * sd[i] > math.log(10.0):
+            why.append("95 % interval wider than a factor of 10")
+        params.append(IdentifiedParameter(p.name, v, (lo, hi), p.unit, not why, "; ".join(why)))
+    j = prob.n_model
+    params.append(IdentifiedParameter("time_offset_s", float(x[j]), (x[j] - 1.96 * sd[j], x[j] + 1.96 * sd[j]),
+                                      "s", j not in weak and not at_bound[j]))
+    for k, n in enumerate(names):
+        rp = ratios[n]
+        params.append(IdentifiedParameter(f"e_o[{n}]", rp.value * es, (rp.ci95[0] * es_ci[0], rp.ci95[1] * es_ci[1]),
+                                          "J s^-1/2 K^-1 m^-2", rp.identified, rp.note))
+    # ------------------------------------------------ fit quality
+    res_by: dict[str, list[np.ndarray]] = {n: [] for n in names}
+    pos = 0
+    for g in data.groups:
+        res_by[names[g.material]].append(r[pos:pos + g.y.size])
+        pos += g.y.size
+    rms_by = {n: float(np.sqrt(np.mean(np.concatenate(v) ** 2))) for n, v in res_by.items() if v}
+    n_s = r.size
+    k_par = x.size + prob.n_linear()
+    ssr = float(r @ r)
+    aic = n_s * math.log(ssr / n_s) + 2 * k_par
+    bic = n_s * math.log(ssr / n_s) + k_par * math.log(n_s)
+    if rank < x.size:
+        notes.append(f"the Jacobian has rank {rank} of {x.size}: "
+                     + ", ".join(prob.names[i] for i in sorted(weak)) + " not separately identified")
+    if "diffusivity_m2_s" in cand.free:
+        notes.append(f"alpha_s is identified at the fixed thermistor depth x = {depth_m * 1e6:g} um "
+                     "(only x^2/alpha_s matters)")
+    return Identification(cand, tuple(params), ratios, es_p, consistent, allowed, float(np.sqrt(np.mean(r ** 2))),
+                          rms_by, n_s, k_par, aic, bic, rank, x.size, sv, time.perf_counter() - t0,
+                          data.noise_c, x, names, depth_m, data.sample_rate_hz, dict(data.modes), tuple(notes))
+
+
+def _as_range(r) -> tuple[float, float]:
+    if hasattr(r, "e_min"):
+        return float(r.e_min), float(r.e_max)
+    lo, hi = r
+    return float(lo), float(hi)
+
+
+def score(result: Identification, trials: Sequence[Trial], *,
+          object_temps: Mapping[str, Any] | None = None) -> dict[str, float]:
+    """Residual RMS [degC] per material of an identified model on (held-out) touches.
+
+    Nothing of the fit is changed but each touch's own initial temperatures:
+    Ts0 fitted in closed form, To from its passive channel (or fitted where the
+    material's object temperature is free). Materials the fit did not see are
+    refused (their e_o is unknown).
+    """
+    names = result.names
+    unknown = sorted({tr.material for tr in trials} - set(names))
+    if unknown:
+        raise InputError(f"cannot score {', '.join(unknown)}: not among the fitted materials {', '.join(names)}")
+    modes = dict(result.object_modes)
+    modes.update(dict(object_temps or {}))
+    data = _prepare(trials, names, modes)
+    prob = _Problem(result.candidate, data, result.depth_m, (-math.inf, math.inf),
+                    np.zeros(len(names), dtype=bool))
+    r, _ = prob.project(result.x)
+    out: dict[str, list[np.ndarray]] = {}
+    pos = 0
+    for g in data.groups:
+        out.setdefault(names[g.material], []).append(r[pos:pos + g.y.size])
+        pos += g.y.size
+    per = {n: float(np.sqrt(np.mean(np.concatenate(v) ** 2))) for n, v in out.items()}
+    per["all"] = float(np.sqrt(np.mean(r ** 2)))
+    return per
+
+
+# ------------------------------------------------------------ comparison
+@dataclass(frozen=True)
+class Comparison:
+    """Candidates side by side: fit on some touches, scored on the others.
+
+    Attributes
+    ----------
+    results : tuple of Identification
+        One per candidate (fitted on the fit touches).
+    held_out_rms_c : tuple of dict
+        Per candidate, residual RMS per material (and ``"all"``) on the held-out touches.
+    selected : str
+        Label of the candidate with the smallest held-out RMS.
+    n_fit, n_held_out : int
+    total_time_s : float
+    """
+
+    results: tuple[Identification, ...]
+    held_out_rms_c: tuple[Mapping[str, float], ...]
+    selected: str
+    n_fit: int
+    n_held_out: int
+    total_time_s: float
+
+    def table(self) -> list[dict[str, Any]]:
+        """One row per candidate: label, fit and held-out RMS, AIC, BIC, rank, e_s and its consistency."""
+        rows = []
+        for res, held in zip(self.results, self.held_out_rms_c):
+            rows.append({"model": res.candidate.label, "fit_rms_c": res.rms_c,
+                         "held_out_rms_c": dict(held), "aic": res.aic, "bic": res.bic,
+                         "rank": f"{res.rank}/{res.n_nonlinear}", "consistent": res.consistent,
+                         "effusivity": None if res.effusivity is None else res.effusivity.to_dict(),
+                         "fit_time_s": res.fit_time_s})
+        return rows
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"selected": self.selected, "n_fit": self.n_fit, "n_held_out": self.n_held_out,
+                "total_time_s": self.total_time_s, "table": self.table(),
+                "results": [r.to_dict() for r in self.results]}
+
+
+def _warm_start(cand: Candidate, done: Sequence[Identification]) -> np.ndarray | None:
+    """Start a candidate from the last fitted one whose free parameters it contains (nested models)."""
+    for prev in reversed(done):
+        if prev.candidate.model != cand.model and not (prev.candidate.model in ("semi-infinite", "contact")
+                                                       and cand.model in ("contact", "layered")):
+            continue
+        if not set(prev.candidate.free) <= set(cand.free):
+            continue
+        n_prev = len(prev.candidate.free)
+        x = [prev.x[prev.candidate.free.index(p)] if p in prev.candidate.free else _PARAMS[p].to_x(_PARAMS[p].start)
+             for p in cand.free]
+        return np.concatenate([x, prev.x[n_prev:]])
+    return None
+
+
+def compare_models(fit_trials: Sequence[Trial], held_out: Sequence[Trial],
+                   candidates: Sequence["str | Candidate"] = CANDIDATES, **kwargs: Any) -> Comparison:
+    """Fit every candidate on ``fit_trials``, score each on ``held_out``; select by held-out RMS.
+
+    ``kwargs`` go to :func:`identify` (``ranges``, ``object_temps``, ``depth_m``, ...).
+    """
+    t0 = time.perf_counter()
+    results, held = [], []
+    for c in candidates:
+        c = c if isinstance(c, Candidate) else candidate(c)
+        res = identify(fit_trials, c, x0=_warm_start(c, results), **kwargs)
+        results.append(res)
+        held.append(score(res, held_out, object_temps=kwargs.get("object_temps")))
+    best = min(range(len(results)), key=lambda i: (held[i]["all"], results[i].bic))
+    return Comparison(tuple(results), tuple(held), results[best].candidate.label, len(fit_trials), len(held_out),
+                      time.perf_counter() - t0)

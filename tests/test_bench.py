@@ -52,7 +52,6 @@ def test_process_cost_reports_the_childs_own_peak_memory_and_exit_status():
     # the property that matters: the small child's peak is its own, not the big one's
     # carried over (as RUSAGE_CHILDREN would report), and the big one's is visibly larger.
     assert big.max_rss_mb - small.max_rss_mb > 100
-    assert small.max_rss_mb < 150
     assert big.wall_s > 0
     bad = bench.process_cost([sys.executable, "-c", "import sys; print('x'); sys.exit(3)"])
     assert bad.returncode == 3 and bad.stdout.strip() == "x"

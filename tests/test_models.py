@@ -24,6 +24,8 @@ def test_registry_names_every_model_and_round_trips_through_to_dict():
         m = get_model(name, **params)
         assert isinstance(m, ForwardModel) and m.name == name
         assert get_model(m.to_dict()) == m  # a table header's record gives the same model back
+    for m in (get_model("contact", conductance_w_m2k=math.inf), get_model("slab", thickness_m=math.inf)):
+        assert get_model(m.to_dict()) == m  # infinity is written as null (JSON) and read back
 
 
 @pytest.mark.parametrize("spec, params, words", [

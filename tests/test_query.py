@@ -359,3 +359,29 @@ def test_exact_routes_of_the_other_pair_questions_through_the_cli(cli):
     no = json.loads(cli("distinguishable", *pair, "--noise", str(4 * mn["value"]), *small).stdout)
     assert yes["value"] is True and no["value"] is False
     assert yes["details"]["svm_f1"] >= 0.9 > no["details"]["svm_f1"]
+
+
+def test_an_unreadable_ideal_table_is_an_error_not_a_silent_fallback():
+    from designkit.query import table as qt
+
+    with pytest.raises(InputError, match="nosuch"):
+        qt.min_contact(35000, 20000, ideal_table="nosuch")
+
+
+def test_without_an_ideal_source_the_bound_is_absent_not_the_svm_answer(tmp_path):
+    """An SVM table with no ideal arrays and no matching ideal table gives no bound (before, the
+    SVM table's own answer was printed as 'the bound no classifier beats')."""
+    from designkit.query import table as qt
+
+    t = load_table("svm-paper")
+    arrays = {k: v for k, v in t.arrays.items() if "ideal" not in k}
+    header = dict(t.header, name="svm-no-ideal",
+                  arrays={k: v for k, v in t.header["arrays"].items() if "ideal" not in k})
+    header.pop("content_hash", None)
+    path = write_table(tmp_path / "svm-no-ideal.npz", header, arrays)
+    other_sensor = load_table("ideal-paper")
+    assert other_sensor.model == t.model  # ideal-paper matches: bound from it
+    with_bound = qt.min_contact(35000, 20000, table=str(path))
+    assert with_bound.to_dict()["ideal"]["value"] is not None
+    alone = qt.min_contact(35000, 20000, table=str(path), ideal_table=None)
+    assert alone.value == with_bound.value and alone.to_dict()["ideal"]["value"] is None

@@ -49,8 +49,8 @@ class Contact(ForwardModel):
     Parameters
     ----------
     conductance_w_m2k : float
-        Interface conductance h_c [W m^-2 K^-1] (> 0; ``inf`` is perfect
-        contact, the paper's model). Typical: 10^3-10^4 for a light touch of
+        Interface conductance h_c [W m^-2 K^-1] (> 0; ``inf`` — or None, as
+        JSON records it — is perfect contact, the paper's model). Typical: 10^3-10^4 for a light touch of
         smooth solids, 10^2 through a thin air gap.
 
     Examples
@@ -73,6 +73,8 @@ class Contact(ForwardModel):
     units = {"conductance_w_m2k": "W m^-2 K^-1"}
 
     def __post_init__(self) -> None:
+        if self.conductance_w_m2k is None:  # what to_dict() writes for inf (JSON has no infinity)
+            object.__setattr__(self, "conductance_w_m2k", math.inf)
         object.__setattr__(self, "conductance_w_m2k",
                            check_positive("interface conductance h_c [W m^-2 K^-1]", self.conductance_w_m2k,
                                           allow_inf=True))

@@ -821,6 +821,8 @@ class Slab(ForwardModel):
     units = {"thickness_m": "m"}
 
     def __post_init__(self) -> None:
+        if self.thickness_m is None:  # what to_dict() writes for inf (JSON has no infinity)
+            object.__setattr__(self, "thickness_m", math.inf)
         object.__setattr__(self, "thickness_m",
                            check_positive("object thickness [m]", self.thickness_m, allow_inf=True))
         b = self.backing

@@ -177,18 +177,20 @@ class _Opened:
 
 
 def _ideal_view(svm: _View, ideal_table: "Table | str | None") -> tuple[_View, str, Table | None]:
-    """The view answering the ideal bound: a dedicated ideal table, else the SVM table's ideal arrays."""
+    """The view answering the ideal bound: a dedicated ideal table built for the same sensor, model and
+    threshold, else the SVM table's own ideal arrays, else none (``(None, "", None)``: no bound from
+    tables; never the SVM's own answer passed off as the bound). An ideal table that cannot be read is
+    an error, not a silent fallback."""
     if ideal_table is not None:
-        try:
-            t = _as_table(ideal_table)
-        except InputError:
-            t = None
-        if (t is not None and t.sensor == svm.t.sensor and t.fidelity == "ideal" and t.threshold == svm.t.threshold
+        t = _as_table(ideal_table)
+        if (t.sensor == svm.t.sensor and t.fidelity == "ideal" and t.threshold == svm.t.threshold
                 and t.model == svm.t.model):
             return _View(t), "svm", t
     if "delta_up_ideal" in svm.t.arrays:
         return svm, "ideal", svm.t
-    return svm, "svm", svm.t if svm.t.fidelity == "ideal" else None
+    if svm.t.fidelity == "ideal":
+        return svm, "svm", svm.t
+    return None, "", None
 
 
 def _open(table, ideal_table, *, threshold, sensor, model) -> _Opened:
@@ -354,7 +356,7 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
         wanted = {**_scene_wanted(view, noise, dt), "effusivity": (lo, hi)}
         return _answer("min-contact", op, value=None, interval=(None, None), ideal=None, in_grid=flags,
                        details={}, notes=_outside_notes(view, flags, wanted), **common)
-    icombos, iflags = op.iview.scene_weights(noise, dt)
+    icombos, iflags = op.iview.scene_weights(noise, dt) if op.iview is not None else ([], {"ideal": False})
 
     def contact_for(v: _View, kind: str, cmb) -> float | None:
         needs = [v.need(kind, cmb, k, lo, hi) for k in range(v.contacts.size)]
@@ -443,6 +445,9 @@ def _ratio_question(question: str, e1, e2, m1, m2, objects, contact_s, noise_c, 
         if op.tab.fidelity == "ideal" and kind in ("lo", "hi"):
             out[kind] = out["svm"]
             continue
+        if v is None:  # no ideal-observer source for this table: no bound rather than a wrong one
+            out[kind] = (None, "below")
+            continue
         out[kind] = _max_ratio(v, op.ikind if kind == "ideal" else kind, contact, lo, hi)
     r, where = out["svm"]
     note = ""
@@ -514,11 +519,11 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
         wanted = {**_scene_wanted(view, noise, dt), "contact_s": contact, "effusivity": (x,)}
         return _answer("delta-e", op, value=None, interval=(None, None), ideal=None, in_grid=flags,
                        details=_delta_details(x, {}), notes=_outside_notes(view, flags, wanted), **common)
-    icombos, _ = op.iview.scene_weights(noise, dt)
-    icw, _ = _contact_weights(op.iview, contact)
+    icombos, _ = op.iview.scene_weights(noise, dt) if op.iview is not None else ([], {})
+    icw, _ = _contact_weights(op.iview, contact) if op.iview is not None else ([], False)
 
     def at(v, cmb, cws, name):
-        if name not in v.t.arrays:
+        if v is None or name not in v.t.arrays:
             return None
         total = 0.0
         for k, w in cws:

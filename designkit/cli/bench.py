@@ -30,6 +30,8 @@ def bench_cmd(
     Prints one row per method and setting: error against the reference, time
     per answer, speed-up; then the sweep's cost curves with fitted exponents.
     `--quick` takes a few minutes on 2 cores; the full run about half an hour.
+
+    Example: `designkit bench --quick --out bench`
     """
     import time
 

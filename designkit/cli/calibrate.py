@@ -386,7 +386,10 @@ def record(
     timeout: TimeoutOpt = None,
     json_: Json = False,
 ) -> None:
-    """Record touches from a serial device: detect each contact, write each trial at once."""
+    """Record touches from a serial device: detect each contact, write each trial at once.
+
+    Example: `designkit calibrate record --port /dev/ttyACM0 --profile designkit --material wood --out trials/`
+    """
     from .._validation import InputError
     from ..calibration.profiles import load_profile
 
@@ -441,7 +444,10 @@ def fit(
                            "out and scored. Indexes without trial sets are fitted whole.")] = "1-4",
     json_: Json = False,
 ) -> None:
-    """Identify e_s and alpha_s (and each e_o, the time offset) from recorded touches (paper appendix)."""
+    """Identify e_s and alpha_s (and each e_o, the time offset) from recorded touches (paper appendix).
+
+    Example: `designkit calibrate fit trials/index.csv --range wood=331:506 --out my-sensor.yaml`
+    """
     settings = _fit_settings(depth_um, bootstrap, seed, baseline, offset_range, fit_to)
     only_list = [s.strip() for item in only for s in item.split(",") if s.strip()] if only else None
     if model is not None:
@@ -545,7 +551,10 @@ def emulate(
     seed: Seed = 0,
     json_: Json = False,
 ) -> None:
-    """Emulate a sensor rig on a pseudo-terminal: prints its path, streams the profile's wire format."""
+    """Emulate a sensor rig on a pseudo-terminal: prints its path, streams the profile's wire format.
+
+    Example: `designkit emulate --profile designkit --material wood=400 --material aluminium=20000 --speed 20`
+    """
     from .._validation import InputError
     from ..calibration.emulator import EmulatedMaterial, Emulator, Faults, TouchPlan
     from ..calibration.profiles import load_profile

@@ -35,7 +35,10 @@ def list_(
         "--sort", help="Order: 'file' (grouped by family), 'name' or 'effusivity' (by e_min).")] = "file",
     json_: Json = False,
 ) -> None:
-    """List materials with their effusivity and diffusivity ranges."""
+    """List materials with their effusivity and diffusivity ranges.
+
+    Example: `designkit materials list --family metals --sort effusivity`
+    """
     from .._validation import InputError
     from ..materials import FAMILY_LABELS, list_materials
 
@@ -85,7 +88,10 @@ def show(
         "--set", help="Look only in this set (default: database, then paper12).")] = None,
     json_: Json = False,
 ) -> None:
-    """Show one material: property ranges, effusivity, diffusivity and source."""
+    """Show one material: property ranges, effusivity, diffusivity and source.
+
+    Example: `designkit materials show "stainless steel"`
+    """
     from ..materials import get_material
 
     m = get_material(name, set=set_)

@@ -208,7 +208,10 @@ def min_contact_cmd(
     trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
     n_mc: NmcQ = 1000, max_contact: MaxContact = 10.0, json_: Json = False,
 ) -> None:
-    """Shortest contact time that separates two materials (e.g. --e1 35000 --e2 20000)."""
+    """Shortest contact time that separates two materials.
+
+    Example: `designkit min-contact --e1 35000 --e2 20000` or `designkit min-contact --m1 copper --m2 "stainless steel" --exact`
+    """
     ans = _ask("min-contact", exact=exact, table=table, ideal_table=ideal_table, threshold=threshold, sensor=sensor,
                model=model, conductance=conductance, thickness=thickness, backing=backing, diffusivity=diffusivity,
                width=width, trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc,
@@ -227,7 +230,10 @@ def max_noise_cmd(
     trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
     n_mc: NmcQ = 1000, json_: Json = False,
 ) -> None:
-    """Largest sensor noise at which a contact time still separates two materials."""
+    """Largest sensor noise at which a contact time still separates two materials.
+
+    Example: `designkit max-noise --e1 35000 --e2 20000 --contact 2`
+    """
     ans = _ask("max-noise", exact=exact, table=table, ideal_table=ideal_table, threshold=threshold, sensor=sensor,
                model=model, conductance=conductance, thickness=thickness, backing=backing, diffusivity=diffusivity,
                width=width, trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc,
@@ -245,7 +251,10 @@ def min_delta_t_cmd(
     trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
     n_mc: NmcQ = 1000, json_: Json = False,
 ) -> None:
-    """Smallest sensor-object temperature difference that separates two materials."""
+    """Smallest sensor-object temperature difference that separates two materials.
+
+    Example: `designkit min-delta-t --e1 35000 --e2 20000 --contact 2 --noise 0.05`
+    """
     ans = _ask("min-delta-t", exact=exact, table=table, ideal_table=ideal_table, threshold=threshold, sensor=sensor,
                model=model, conductance=conductance, thickness=thickness, backing=backing, diffusivity=diffusivity,
                width=width, trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc,
@@ -265,7 +274,10 @@ def delta_e_cmd(
     trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
     n_mc: NmcQ = 1000, json_: Json = False,
 ) -> None:
-    """Smallest distinguishable effusivity difference delta(e), towards lower and higher effusivity."""
+    """Smallest distinguishable effusivity difference delta(e), towards lower and higher effusivity.
+
+    Example: `designkit delta-e --e 20000 --contact 2`
+    """
     ans = _ask("delta-e", exact=exact, table=table, ideal_table=ideal_table, threshold=threshold, sensor=sensor,
                model=model, conductance=conductance, thickness=thickness, backing=backing, diffusivity=diffusivity,
                width=width, trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc,
@@ -284,7 +296,10 @@ def distinguishable_cmd(
     trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
     n_mc: NmcQ = 1000, json_: Json = False,
 ) -> None:
-    """Whether a scene separates two materials, with the SVM's and the ideal observer's F1."""
+    """Whether a scene separates two materials, with the SVM's and the ideal observer's F1.
+
+    Example: `designkit distinguishable --m1 wood --m2 glass --contact 2`
+    """
     ans = _ask("distinguishable", exact=exact, table=table, ideal_table=ideal_table, threshold=threshold,
                sensor=sensor, model=model, conductance=conductance, thickness=thickness, backing=backing,
                diffusivity=diffusivity, width=width, trials=trials, repeats=repeats, seed=seed, jobs=jobs,

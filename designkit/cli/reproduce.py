@@ -32,7 +32,10 @@ def reproduce(
     json_: Json = False,
 ) -> None:
     """Reproduce the paper's figures and tables (F1 matrices, δ(e) curves, node graphs, Table I, guideline,
-    real robot, sim-to-real, multi-class) into a markdown report with figures, beside the paper's numbers."""
+    real robot, sim-to-real, multi-class) into a markdown report with figures, beside the paper's numbers.
+
+    Example: `designkit reproduce --out report`
+    """
     from ..reproduce import ReproduceSettings, parse_only, reproduce as run
 
     names = parse_only(only)

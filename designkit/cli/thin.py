@@ -42,6 +42,8 @@ def validity(
     The reading of a slab differs from the semi-infinite one once heat reflected
     at its back face reaches the thermistor (image series, docs/thin_samples.md).
     Prints the first contact time at which that difference exceeds --tolerance.
+
+    Example: `designkit validity --m acrylic --thickness 0.003 --backing table`
     """
     import numpy as np
 

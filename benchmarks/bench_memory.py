@@ -101,7 +101,7 @@ def main(argv=None):
             print(f"| {r['intervals']} | {r['contact_s']:g} | {r['rss_mb']:.0f} | {r['fits']} | {r['wall_s']:.1f} |")
         at10 = [r for r in svm_rows if r["contact_s"] == contact]
         per_interval_theory = 100 * 2 * (int(contact * 200) + 1) * 8 / 2**20
-        from designkit.sweep.engine import FEATURE_CACHE_MB
+        from designkit.sweep.scorer import FEATURE_CACHE_MB
 
         cap = FEATURE_CACHE_MB / per_interval_theory  # intervals the chunk's feature cache holds at most
         uncapped = [r for r in at10 if r["intervals"] * 1.2 <= cap]

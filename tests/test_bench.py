@@ -232,7 +232,7 @@ def test_console_script_bench_prints_the_table(tmp_path):
 
 @pytest.mark.slow
 def test_svm_query_rows_against_exact_on_a_tiny_svm_table(tmp_path):
-    from designkit.sweep.engine import SweepConfig, run_sweep
+    from designkit.sweep import SweepConfig, run_sweep
     from designkit.tables.store import load_table
 
     cfg = SweepConfig(name="tiny-svm", fidelity="svm", intervals=5, e_max=40000.0, trials=12, max_repeats=1,

@@ -19,7 +19,7 @@ import pytest
 
 from designkit import InputError
 from designkit.query import table as q
-from designkit.sweep.engine import SweepConfig, run_sweep
+from designkit.sweep import SweepConfig, run_sweep
 from designkit.export import FORMATS, export_table, parse_contact, read_export, render, slice_table
 from designkit.export.formats.python import LOOKUP_BEGIN, LOOKUP_END, lookup_source
 from designkit.tables.store import Table, content_hash, load_table, table_header, write_table

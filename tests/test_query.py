@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 
 from designkit import InputError
 from designkit.query import table as q
-from designkit.sweep.engine import SweepConfig
+from designkit.sweep import SweepConfig
 from designkit.tables.store import load_table, table_header, write_table
 
 RATIOS = (0.001, 0.002, 0.005, 0.01, 0.02)

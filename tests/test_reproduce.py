@@ -138,7 +138,7 @@ def test_bayes_accuracy_limits(paper_sensor):
 @pytest.fixture(scope="session")
 def small_tables(tmp_path_factory) -> Path:
     """Tiny versions of the shipped tables the report reads (same names, real sweeps)."""
-    from designkit.sweep.engine import SweepConfig, run_sweep
+    from designkit.sweep import SweepConfig, run_sweep
 
     out = tmp_path_factory.mktemp("tables")
     common = dict(trials=6, folds=3, max_repeats=1, seed=0)

@@ -238,8 +238,8 @@ BAD_CALLS = {
                                                          table="ideal-paper"),
     "wrong threshold (query)": lambda: _q().min_contact(35000.0, 20000.0, threshold=0.8, table="ideal-paper"),
     "unknown table": lambda: _q().min_contact(35000.0, 20000.0, table="no-such-table"),
-    "one interval (sweep)": lambda: __import__("designkit.sweep.engine", fromlist=["x"]).SweepConfig(intervals=1),
-    "decreasing contacts (sweep)": lambda: __import__("designkit.sweep.engine", fromlist=["x"]).SweepConfig(
+    "one interval (sweep)": lambda: __import__("designkit.sweep", fromlist=["x"]).SweepConfig(intervals=1),
+    "decreasing contacts (sweep)": lambda: __import__("designkit.sweep", fromlist=["x"]).SweepConfig(
         contact_s=(2.0, 1.0)),
     "unseeded draw": lambda: __import__("designkit.simulation", fromlist=["x"]).simulate_trials(
         1000.0, PAPER, Scene(), seed=None),
@@ -287,7 +287,7 @@ def test_console_script_bad_input_has_no_traceback():
 @pytest.mark.parametrize("fs,contact", [(10.0, 0.05), (10.0, 60.0), (10_000.0, 1e-4), (10_000.0, 2.0)])
 @pytest.mark.parametrize("ratio", [0.0, 1e-4, 10.0])
 def test_ideal_sweep_chunk_is_sane_at_extremes(fs, contact, ratio):
-    from designkit.sweep.engine import SweepConfig, delta_from_staircase, run_chunk
+    from designkit.sweep import SweepConfig, delta_from_staircase, run_chunk
 
     n = 12
     cfg = SweepConfig(fidelity="ideal", intervals=n, e_min=0.0, e_max=1e6, noise_ratio=(ratio,),
@@ -414,7 +414,7 @@ def test_table_min_contact_is_monotone_in_noise(le1, gap, r1, r2):
 
 # ================================================================== tiny tables
 def _tiny_table(tmp_path, name, ratios, contacts, intervals=8, e_max=8000.0):
-    from designkit.sweep.engine import SweepConfig, run_sweep
+    from designkit.sweep import SweepConfig, run_sweep
     from designkit.tables.store import load_table
 
     cfg = SweepConfig(name=name, fidelity="ideal", intervals=intervals, e_max=e_max, noise_ratio=tuple(ratios),

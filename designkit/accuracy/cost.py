@@ -24,7 +24,7 @@ __all__ = ["cost_curve", "cost_curve_specs", "cost_curves"]
 
 def _config(variable: str, v: float, base: Mapping[str, Any]):
     """The sweep configuration of one point of a cost curve."""
-    from ..sweep.engine import SweepConfig
+    from ..sweep import SweepConfig
 
     kw = dict(base)
     if variable == "contact_s":
@@ -38,7 +38,7 @@ def _config(variable: str, v: float, base: Mapping[str, Any]):
 
 def _sweep_one_scene(cfg):
     """What a sweep does per scene point: run it, assemble the table arrays; the chunks."""
-    from ..sweep.engine import assemble, run_scene
+    from ..sweep import assemble, run_scene
 
     chunks = run_scene(cfg)
     assemble(cfg, chunks)
@@ -54,14 +54,14 @@ def cost_curve(name: str, variable: str, values: Sequence[float], base: Mapping[
     name : str
         The curve's label.
     variable : str
-        A :class:`~designkit.sweep.engine.SweepConfig` field (``intervals``,
+        A :class:`~designkit.sweep.SweepConfig` field (``intervals``,
         ``trials``), ``contact_s`` (one contact time of that length) or
         ``contacts`` (that many contact times from 0.5 s to 10 s, swept with
         warm starts).
     values : sequence of float
         The sizes, in increasing order.
     base : mapping
-        The other :class:`~designkit.sweep.engine.SweepConfig` fields.
+        The other :class:`~designkit.sweep.SweepConfig` fields.
     setting : str
         What is held fixed, for the report.
     relative_to_mb : float, optional
@@ -110,7 +110,7 @@ def _curve_in_fresh_process(name, variable, values, base, setting) -> CostCurve:
     """Body of :func:`cost_curves` in a child: warm up, take the baseline, run the curve."""
     import gc
 
-    from ..sweep.engine import SweepConfig
+    from ..sweep import SweepConfig
 
     _sweep_one_scene(SweepConfig(**{**base, "intervals": 4, "trials": 6, "contact_s": (0.5,)}))
     # imports, BLAS and libsvm are loaded before the baseline

@@ -41,7 +41,7 @@ def ideal_percent(depth_m: float, noise_ratio: float, contact_s: float = TABLE1_
                   intervals: int = 500, workdir: Path | None = None) -> float:
     """Ideal observer's % indistinguishable interval pairs on the paper's grid for the paper's
     sensor at thermistor depth ``depth_m`` (closed form, through the sweep engine)."""
-    from ..sweep.engine import SweepConfig, run_scene
+    from ..sweep import SweepConfig, run_scene
     from ..sensor import SENSORS
 
     sensor = SENSORS["paper"].replace(depth_m=float(depth_m), name=f"paper-depth-{depth_m * 1e6:g}um")

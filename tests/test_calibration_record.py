@@ -1,6 +1,6 @@
 """Recording over a real pseudo-terminal: the emulator speaks a profile's wire format, the
 recorder reads it with pyserial. No mocks of the serial layer. Recorded temperatures are
-checked against the physics model evaluated directly (designkit.physics), not against the
+checked against the physics model evaluated directly (designkit.models.semi_infinite), not against the
 emulator's own output."""
 
 from __future__ import annotations

@@ -114,7 +114,7 @@ def test_covering_intervals_cover_the_range_and_only_it(lo, span, width):
 
 
 def test_bayes_accuracy_two_classes_equals_the_ideal_observer(paper_sensor):
-    """Two ordered classes: the binned Bayes rule must reach the closed-form optimum of designkit.ideal."""
+    """Two ordered classes: the binned Bayes rule must reach the closed-form optimum of designkit.recognition.ideal."""
     from designkit import Scene
     from designkit.recognition.ideal import ideal_pair
 

@@ -257,3 +257,34 @@ def test_a_slab_sweep_takes_one_diffusivity_for_every_interval(cli, tmp_path):
     t = load_table(path)
     assert t.model.name == "slab" and t.header["model"]["thickness_m"] == 0.0005
     assert t.header["config"]["diffusivity_m2_s"] == 1e-7
+
+
+def test_the_contact_model_through_a_table_query_and_an_export(cli, tmp_path):
+    """The example model of the seam, used for real: a sweep makes its table, the table route answers
+    from it (and refuses it for another model), and its stdlib export answers the same."""
+    import importlib.util
+
+    r, path = _model_sweep(cli, tmp_path, "contact2k", "model: {name: contact, conductance_w_m2k: 2000}\n")
+    assert r.exit_code == 0, r.output
+    t = load_table(path)
+    e_lo, e_hi = float(t.axes["e_ref"][3]), float(t.axes["e_ref"][-4])
+    contact = float(t.axes["contact_s"][0])
+    noise = float(t.axes["noise_ratio"][0]) * 10.0
+    ask = ["distinguishable", "--e1", e_lo, "--e2", e_hi, "--contact", contact, "--noise", noise,
+           "--table", path, "--json"]
+    q = cli(*ask, "--model", "contact:conductance_w_m2k=2000")
+    assert q.exit_code == 0, q.output
+    answer = json.loads(q.stdout)
+    assert answer["route"] == "table" and answer["model"] == t.header["model"]
+    assert answer["table"]["content_hash"] == t.header["content_hash"]
+    wrong = cli(*ask)  # the same table asked for the paper's model: refused, both models named
+    assert wrong.exit_code == 2 and "contact" in wrong.stderr and "semi-infinite" in wrong.stderr
+    out = tmp_path / "contact_table.py"
+    ex = cli("export", "--table", path, "--format", "python", "--out", out)
+    assert ex.exit_code == 0, ex.output
+    spec = importlib.util.spec_from_file_location("contact_table", out)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    assert mod.MODEL["name"] == "contact"
+    got = mod.distinguishable(e_lo, e_hi, noise, 10.0, contact)
+    assert bool(got) == bool(answer["value"])

@@ -30,7 +30,8 @@ M1 = Annotated[Optional[str], typer.Option(
 M2 = Annotated[Optional[str], typer.Option("--m2", help="Second material by name (instead of --e2).")]
 ModelOpt = Annotated[Optional[str], typer.Option(
     "--model", help="Forward model: semi-infinite (the paper's, default), slab (a thin object: give --thickness) "
-                    "or contact (finite interface conductance: give --conductance); see docs/models.md.")]
+                    "or contact (finite interface conductance: give --conductance), or any registered model with "
+                    "its parameters as NAME:KEY=VALUE,... (e.g. contact:conductance_w_m2k=2000); see docs/models.md.")]
 Conductance = Annotated[Optional[float], typer.Option(
     "--conductance", help="Sensor-object interface conductance h_c \\[W m^-2 K^-1] (contact model; implies "
                           "--model contact).")]
@@ -54,12 +55,18 @@ def model_from_options(model: Optional[str], *, conductance: Optional[float] = N
     from .._validation import InputError
     from ..models import get_model
 
+    from ..models import parse_model_spec
+
+    if model is not None and ":" in model:  # NAME:KEY=VALUE,...: the parameters come with the name
+        if conductance is not None or thickness is not None or backing is not None:
+            raise InputError("give a model's parameters either in --model NAME:KEY=VALUE or as options, not both")
+        return get_model(model)
     implied = {"slab": thickness is not None or backing is not None, "contact": conductance is not None}
     wanted = [name for name, yes in implied.items() if yes]
     if len(wanted) > 1:
         raise InputError("--thickness/--backing (slab model) and --conductance (contact model) "
                          "describe different models: give one")
-    name = model or (wanted[0] if wanted else "semi-infinite")
+    name = parse_model_spec(model)[0] if model else (wanted[0] if wanted else "semi-infinite")
     if wanted and wanted[0] != get_model_name(name):
         flag = "--conductance" if wanted[0] == "contact" else "--thickness/--backing"
         raise InputError(f"{flag} belongs to the {wanted[0]} model, not --model {name}")

@@ -27,6 +27,8 @@ Examples
 'contact (conductance_w_m2k = 1500 W m^-2 K^-1)'
 >>> get_model().name
 'semi-infinite'
+>>> get_model("contact:conductance_w_m2k=800").conductance_w_m2k
+800.0
 """
 
 from __future__ import annotations
@@ -38,7 +40,7 @@ from typing import Any, Mapping
 from .._validation import InputError
 from .base import ForwardModel, ModelCheck
 
-__all__ = ["MODELS", "ForwardModel", "ModelCheck", "get_model", "model_names"]
+__all__ = ["MODELS", "ForwardModel", "ModelCheck", "get_model", "model_class", "model_names", "parse_model_spec"]
 
 #: name -> (module, class): the registry of forward models (pvlib-style catalogue).
 MODELS: dict[str, tuple[str, str]] = {
@@ -67,13 +69,34 @@ def model_class(name: str) -> type[ForwardModel]:
     return getattr(importlib.import_module(module), cls)
 
 
+def parse_model_spec(text: str) -> tuple[str, dict[str, Any]]:
+    """``"NAME"`` or ``"NAME:KEY=VALUE,KEY=VALUE"`` as (name, parameters); numbers become floats.
+
+    The one textual form of a model with its parameters, so that a command line
+    can name any registered model without options of its own, e.g.
+    ``--model contact:conductance_w_m2k=2000``.
+    """
+    name, _, rest = str(text).partition(":")
+    params: dict[str, Any] = {}
+    for item in filter(None, (p.strip() for p in rest.split(","))):
+        key, eq, value = item.partition("=")
+        if not eq or not key.strip():
+            raise InputError(f"model parameter {item!r} in {text!r} is not KEY=VALUE")
+        try:
+            params[key.strip()] = float(value)
+        except ValueError:
+            params[key.strip()] = value.strip()
+    return name.strip(), params
+
+
 def get_model(spec: "str | Mapping[str, Any] | ForwardModel | None" = None, **parameters: Any) -> ForwardModel:
     """A forward model from a name (and parameters), a dict like a table header's, or a model.
 
     Parameters
     ----------
     spec : str, dict, ForwardModel or None
-        ``None`` is the paper's semi-infinite model; a dict is
+        ``None`` is the paper's semi-infinite model; a string is a name, or
+        ``"NAME:KEY=VALUE,..."`` (:func:`parse_model_spec`); a dict is
         ``{"name": ..., **parameters}`` (what :meth:`ForwardModel.to_dict` writes).
     **parameters
         The model's parameters (with a name), e.g. ``conductance_w_m2k=2000``.
@@ -90,7 +113,12 @@ def get_model(spec: "str | Mapping[str, Any] | ForwardModel | None" = None, **pa
         if "name" not in spec:
             raise InputError(f"a model needs a name (one of {', '.join(MODELS)}), got keys {sorted(spec)}")
         return get_model(str(spec["name"]), **params, **parameters)
-    cls = model_class(str(spec))
+    name, inline = parse_model_spec(str(spec))
+    clash = sorted(set(inline) & set(parameters))
+    if clash:
+        raise InputError(f"model parameter {', '.join(clash)} given twice")
+    parameters = {**inline, **parameters}
+    cls = model_class(name)
     fields = {f for f in getattr(cls, "__dataclass_fields__", {})}
     unknown = sorted(set(parameters) - fields)
     if unknown:

@@ -1,6 +1,6 @@
 """1-D finite-volume heat conduction through a stack of layers (sensor, object, backing).
 
-The numerical reference and fallback of :mod:`designkit.slab`. A heated sensor
+The numerical reference and fallback of :mod:`designkit.models.slab`. A heated sensor
 (left of the contact plane ``z = 0``) touches a stack of layers (right of it);
 every layer is homogeneous and starts at a uniform temperature. The equation
 is ``rho c dT/dt = d/dz (k dT/dz)`` with continuity of temperature and heat
@@ -14,7 +14,7 @@ Units: ``z`` [m], ``t`` [s], effusivity ``e = k / sqrt(alpha)`` [J s^-1/2 K^-1
 m^-2], diffusivity ``alpha`` [m^2 s^-1]; from these, conductivity
 ``k = e sqrt(alpha)`` [W m^-1 K^-1] and volumetric heat capacity
 ``rho c = e / sqrt(alpha)`` [J m^-3 K^-1]. Temperatures are normalized (the
-sensor starts at 0 and the object at 1 in :mod:`designkit.slab`), the problem is
+sensor starts at 0 and the object at 1 in :mod:`designkit.models.slab`), the problem is
 linear, so any two temperatures follow by an affine map.
 
 Only what the contact time reaches is gridded: a semi-infinite layer (the

@@ -52,7 +52,7 @@ Which solver
   is below the tolerance (small Fourier number ``alpha_o t / L^2``);
 * ``"image-series"``: the series above, truncated where its tail bound is below
   the tolerance, when that takes a reasonable number of terms;
-* ``"finite-volume"``: the 1-D finite-volume solver of :mod:`designkit.fv`
+* ``"finite-volume"``: the 1-D finite-volume solver of :mod:`designkit.models.fv`
   (implicit, stiff-safe), when the series would need too many terms (strong
   reflections at a large Fourier number), or on request.
 

@@ -15,7 +15,7 @@ __all__ = ["exact_ideal_delta", "exact_ideal_max_ratio", "exact_ideal_min_contac
 
 
 def _projection_noises(sensor, contacts, ratios) -> np.ndarray:
-    """:func:`designkit.ideal.projection_noise` for arrays of contact times and sigma/dT (dT = 1)."""
+    """:func:`designkit.recognition.ideal.projection_noise` for arrays of contact times and sigma/dT (dT = 1)."""
     from ..recognition.ideal import projection_noise
     from ..scene import Scene
 

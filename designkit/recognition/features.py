@@ -83,7 +83,7 @@ def feature_matrix(temperature_c, sample_rate_hz: float,
     -------
     ndarray, shape (n, 2 m)
         Unscaled features; standardize them inside each training fold
-        (:func:`designkit.recognition.make_classifier` does).
+        (:func:`designkit.recognition.svm.make_classifier` does).
     """
     x = np.atleast_2d(np.asarray(temperature_c, dtype=np.float64))
     return np.hstack([x, local_slope(x, sample_rate_hz, window_s)])

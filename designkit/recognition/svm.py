@@ -1,6 +1,6 @@
 """Binary material recognition with the paper's pipeline (section III).
 
-Features: raw samples + local slope (:mod:`designkit.features`), standardized
+Features: raw samples + local slope (:mod:`designkit.recognition.features`), standardized
 inside each training fold; classifier: scikit-learn's binary SVM with a linear
 kernel; score: stratified k-fold cross-validated F1 (k = 3 in the paper).
 

@@ -8,9 +8,9 @@ stratified 3-fold cross-validation.
 
 The ideal observer's multi-class accuracy is exact here: with fixed initial
 conditions every class's touches reduce to one number ``v ~ w(e) + N(0, s^2)``
-(:mod:`designkit.ideal`), so the Bayes classifier picks the class of highest
+(:mod:`designkit.recognition.ideal`), so the Bayes classifier picks the class of highest
 density of ``v``. Its accuracy is computed from the classes' laws of ``v``
-(:func:`designkit.ideal.class_survival`, closed form) on bins of width
+(:func:`designkit.recognition.ideal.class_survival`, closed form) on bins of width
 ``s / 8`` (at most 100,000 bins: for nearly noise-free scenes the bins are
 wider and the result is a lower bound accurate to the bin width): the bin-wise
 Bayes rule, which converges to the Bayes accuracy from below as the bins

@@ -4,8 +4,8 @@ The shared recordings (``robot-thermal-recordings``: 60 touches each of an
 aluminium block, wood, and wood cooled below room temperature) stand in for
 the paper's 12-material robot study (section VI-VII); they are read where
 they live and never copied. Everything here uses the paper's features (raw
-samples + local slope, :mod:`designkit.features`) and classifier
-(:func:`designkit.recognition.make_classifier`) on the first 4 s after the
+samples + local slope, :mod:`designkit.recognition.features`) and classifier
+(:func:`designkit.recognition.svm.make_classifier`) on the first 4 s after the
 detected contact onset, as the paper's Table II.
 
 Sim-to-real follows section VII with the sensor identified by calibration

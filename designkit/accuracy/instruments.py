@@ -118,13 +118,35 @@ class ProcessCost:
     stderr: str
 
 
+#: Runs a command and reports its own peak resident set and wall time on a pipe. Linux carries a
+#: process's peak RSS across fork and exec (``signal->maxrss``), so a child forked straight from a
+#: large parent (a test runner, 300 MB) reports at least the parent's size; forked from this small
+#: launcher instead, the child starts from the launcher's ~10 MB. (-S: no site packages, stdlib only.)
+_LAUNCHER = """
+import os, sys, time
+fd = int(sys.argv[1])
+t0 = time.perf_counter()
+pid = os.fork()
+if pid == 0:
+    try:
+        os.execvp(sys.argv[2], sys.argv[2:])
+    finally:
+        os._exit(127)
+_, status, ru = os.wait4(pid, 0)
+os.write(fd, ("%d %r" % (ru.ru_maxrss, time.perf_counter() - t0)).encode())
+os._exit(os.waitstatus_to_exitcode(status) & 0xFF)
+"""
+
+
 def process_cost(cmd: Sequence[str], *, env: Mapping[str, str] | None = None, timeout: float = 600.0,
                  cwd: str | None = None) -> ProcessCost:
     """Run ``cmd`` as a child process: its wall time and peak resident set (``wait4`` rusage).
 
-    The peak is the child's own (``ru_maxrss`` of exactly that process, not of
-    every child this process ever had). A child still running after
-    ``timeout`` seconds is killed.
+    The peak is the child's own: the command is started by a small launcher
+    process (see ``_LAUNCHER``), so neither this process's size nor its other
+    children's peaks leak into it. The wall time is measured by the launcher
+    around the command alone. A child still running after ``timeout`` seconds
+    is killed.
 
     Examples
     --------
@@ -134,22 +156,32 @@ def process_cost(cmd: Sequence[str], *, env: Mapping[str, str] | None = None, ti
     (0, 'hi', True)
     """
     import subprocess
+    import sys
     import tempfile
-    import threading
 
     run_env = {**os.environ, **(env or {})}
-    with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
-        t0 = time.perf_counter()
-        proc = subprocess.Popen(list(cmd), stdout=out, stderr=err, env=run_env, cwd=cwd)
-        timer = threading.Timer(timeout, proc.kill)  # a hung child is killed, not waited for forever
-        timer.start()
-        try:
-            _, status, usage = os.wait4(proc.pid, 0)
-        finally:
-            timer.cancel()
-        wall = time.perf_counter() - t0
-        proc.returncode = os.waitstatus_to_exitcode(status)
-        out.seek(0)
-        err.seek(0)
-        return ProcessCost(wall, usage.ru_maxrss / 1024.0, proc.returncode, out.read().decode(errors="replace"),
-                           err.read().decode(errors="replace"))
+    read_fd, write_fd = os.pipe()
+    try:
+        with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
+            t0 = time.perf_counter()
+            proc = subprocess.Popen([sys.executable, "-S", "-c", _LAUNCHER, str(write_fd), *map(str, cmd)],
+                                    stdout=out, stderr=err, env=run_env, cwd=cwd, pass_fds=(write_fd,),
+                                    start_new_session=True)
+            os.close(write_fd)
+            write_fd = -1
+            try:
+                returncode = proc.wait(timeout=timeout)
+            except subprocess.TimeoutExpired:  # a hung child is killed with its launcher, not waited for forever
+                os.killpg(proc.pid, 9)
+                returncode = proc.wait()
+            report = os.read(read_fd, 256).decode().split()
+            wall = float(report[1]) if len(report) == 2 else time.perf_counter() - t0
+            max_rss_mb = int(report[0]) / 1024.0 if len(report) == 2 else float("nan")
+            out.seek(0)
+            err.seek(0)
+            return ProcessCost(wall, max_rss_mb, returncode, out.read().decode(errors="replace"),
+                               err.read().decode(errors="replace"))
+    finally:
+        os.close(read_fd)
+        if write_fd >= 0:
+            os.close(write_fd)

@@ -52,11 +52,13 @@ def test_min_contact_interpolates_exactly(linear_table, noise, gap, base):
         assert ans.value is None
     else:
         assert ans.value == pytest.approx(exact, rel=1e-9)
-        lo = (A - gap / (0.9 * scale)) / B
-        hi = (A - gap / (1.1 * scale)) / B
-        assert ans.interval[0] == pytest.approx(max(lo, CONTACTS[0]), rel=1e-9) or lo < CONTACTS[0]
-        if hi <= CONTACTS[-1]:
-            assert ans.interval[1] == pytest.approx(max(hi, CONTACTS[0]), rel=1e-9)
+        # the interval spans at least the grid cell of the crossing (interpolation error), never below the bound
+        prev = max([c for c in CONTACTS if c < ans.value - 1e-12], default=0.0)
+        nxt = min(c for c in CONTACTS if c >= ans.value - 1e-12)
+        assert ans.interval[1] >= nxt - 1e-9
+        bound = ans.ideal if ans.ideal is not None else -math.inf
+        assert ans.interval[0] <= prev + 1e-9 or ans.interval[0] == pytest.approx(bound)
+        assert ans.interval[0] >= bound - 1e-12
     assert ans.in_grid == {"noise_ratio": True, "effusivity": True}
 
 
@@ -243,7 +245,7 @@ def test_query_cli_json_is_the_answer_schema(cli, cmd, quantity):
     assert p["table"]["content_hash"].startswith("sha256:") and p["sensor"]["name"] == "paper"
     assert p["model"]["name"] == "semi-infinite" and p["threshold"] == 0.9 and all(p["in_grid"].values())
     assert set(p["scene"]) == {"contact_s", "noise_c", "delta_t_c", "noise_ratio"}
-    assert set(p["interval"]) == {"low", "high", "meaning"} and set(p["ideal"]) == {"value", "method"}
+    assert set(p["interval"]) == {"low", "high", "meaning", "coverage"} and set(p["ideal"]) == {"value", "method"}
     if cmd[0] == "delta-e":
         assert set(p["details"]) == {"e", "lower", "upper"}
     if cmd[0] == "distinguishable":
@@ -402,3 +404,21 @@ def test_the_table_routes_bound_is_never_above_the_exact_bound():
         exact = exact_ideal_min_contact(paper, *(edges if None not in edges else (lo, hi)), noise / 10.0)
         if a.ideal is not None:
             assert a.ideal <= float(exact) + 1e-12 and a.ideal_bound.method == "closed-form"
+
+
+def test_a_question_the_table_cannot_answer_exits_3_and_bad_coverage_exits_2(cli):
+    """Exit 3 (no answer here, with the quantity and its range) is distinct from bad input (2)."""
+    r = cli("min-contact", "--e1", "39990", "--e2", "39000", "--noise", "0.1")
+    assert r.exit_code == 3 and "contact time up to 10 s" in r.output
+    r = cli("min-contact", "--e1", "35000", "--e2", "20000", "--coverage", "1.5")
+    assert r.exit_code == 2 and "coverage must lie in (0, 1)" in r.output
+
+
+def test_exact_min_contact_is_an_estimate_with_a_stated_coverage():
+    from designkit.query import exact_min_contact
+
+    a = exact_min_contact(35000, 20000, trials=30, repeats=2, jobs=1, coverage=0.9)
+    d = a.to_dict()
+    assert d["interval"]["coverage"] == 0.9 and "confidence interval" in d["interval"]["meaning"]
+    assert d["ideal"] == {"value": 1.05, "method": "closed-form"}
+    assert 1.05 <= d["interval"]["low"] <= d["value"] <= d["interval"]["high"] < 3.0

@@ -276,7 +276,7 @@ def _scene_wanted(view: _View, noise, dt) -> dict[str, Any]:
 # ============================================================ one answer builder for the route
 def _answer(question: str, op: _Opened, *, objects, limiting, rule: str, scene: dict, value, interval,
             ideal, ideal_method: str = "table", in_grid: dict, details: dict, notes: Sequence[str] = (),
-            check_at: tuple[float, float, float] | None = None, classes=()) -> Answer:
+            check_at: tuple[float, float, float] | None = None, classes=(), interval_kind=None) -> Answer:
     check = None
     if check_at is not None and classes:
         c, n, d = check_at
@@ -291,7 +291,7 @@ def _answer(question: str, op: _Opened, *, objects, limiting, rule: str, scene: 
         table=op.tab.name, table_hash=op.tab.header.get("content_hash"), ideal_table=ideal_table,
         ideal_table_hash=op.ihash if ideal_table else None, in_grid=dict(in_grid), details=details,
         computation={"fidelity": op.tab.fidelity, "table_contacts_s": op.view.contacts.tolist()},
-        notes=tuple(n for n in notes if n))
+        notes=tuple(n for n in notes if n), interval_kind=interval_kind)
 
 
 def _scene(contact_s=None, noise_c=None, delta_t_c=None) -> dict[str, Any]:
@@ -404,9 +404,21 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
         prev = grid[grid.index(value) - 1]
         note = (f"{value:g} s is the table's next contact time after {prev:g} s, where they are not separable: "
                 f"the shortest time lies in ({prev:g}, {value:g}] s (the exact route resolves it)")
+    if value is not None:
+        # the interpolation error between grid points: the interval spans at least the grid cell the
+        # crossing lies in (a crossing on a grid point whose neighbour is not separable: the whole cell),
+        # never below the exact ideal bound
+        below = [g for g in grid if g < value - 1e-12]
+        prev = below[-1] if below else 0.0
+        nxt = min([g for g in grid if g >= value - 1e-12], default=value)
+        ends = [x for x in interval if x is not None]
+        low = min([prev] + ends)
+        low = max(low, ideal) if ideal is not None else low
+        interval = (low, max([nxt] + ends))
     needed = value if value is not None else float(view.contacts[-1])
     return _answer("min-contact", op, value=value, interval=interval, ideal=ideal, ideal_method=ideal_method,
-                   in_grid=flags, details={}, notes=[note], check_at=(needed, noise, dt), **common)
+                   in_grid=flags, details={}, notes=[note], check_at=(needed, noise, dt),
+                   interval_kind="table-cell" if value is not None else None, **common)
 
 
 # ============================================================ max-noise / min-delta-t

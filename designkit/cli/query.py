@@ -51,6 +51,13 @@ JobsQ = Annotated[int, typer.Option("--jobs", "-j", help="--exact: worker proces
 NmcQ = Annotated[int, typer.Option(
     "--n-mc", help="--exact: touches per class of the Monte Carlo ideal observer (models without a shared shape).")]
 MaxContact = Annotated[float, typer.Option("--max-contact", help="--exact: longest contact time to consider [s].")]
+CoverageOpt = Annotated[float, typer.Option(
+    "--coverage", help="--exact: coverage of the answer's confidence interval, in (0, 1).")]
+
+#: Exit status of a question the table cannot answer (outside its grid, or nothing tabulated
+#: separates the pair): distinct from bad input (2), so scripts can tell "no answer here" from
+#: an answer (0). The message names the quantity and its range in the user's units.
+EXIT_NO_ANSWER = 3
 
 #: Flag hints for library errors (the library speaks in its own terms).
 _HINTS = {
@@ -75,9 +82,16 @@ def _hints():
 
 def _ask(question: str, *, exact: bool, table: Optional[str], ideal_table: str, threshold: float, sensor: str,
          model, conductance, thickness, backing, diffusivity, width: float, trials: int, repeats: int, seed: int,
-         jobs: int, n_mc: int, objects: dict, scene: dict, exact_extra: Optional[dict] = None):
+         jobs: int, n_mc: int, objects: dict, scene: dict, exact_extra: Optional[dict] = None,
+         progress: bool = False):
     """The one library call of a command: the table route, or the exact one."""
     from .. import query
+
+    extra = dict(exact_extra or {})
+    if "coverage" in extra:
+        from ..query.crossing import check_coverage
+
+        check_coverage(extra["coverage"])  # bad input before any work, on either route
 
     with _hints():
         fm = model_from_options(model, conductance=conductance, thickness=thickness, backing=backing)
@@ -92,9 +106,21 @@ def _ask(question: str, *, exact: bool, table: Optional[str], ideal_table: str, 
             return query.ask(question, route="table", **objects, **scene, threshold=threshold,
                              table=table or "svm-paper", ideal_table=ideal_table,
                              sensor=None if sensor == "paper" else sensor, model=fm)
-        return query.ask(question, route="exact", **objects, **scene, threshold=threshold, sensor=sensor,
-                         model=fm, diffusivity_m2_s=diffusivity, width=width, trials=trials, repeats=repeats,
-                         seed=seed, jobs=jobs, n_mc=n_mc, **(exact_extra or {}))
+        kw = dict(threshold=threshold, sensor=sensor, model=fm, diffusivity_m2_s=diffusivity, width=width,
+                  trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc, **extra)
+        if not (progress and "coverage" in extra):
+            return query.ask(question, route="exact", **objects, **scene, **kw)
+        from rich.console import Console
+        from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+        with Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.completed}/{task.total}"),
+                      TimeElapsedColumn(), console=Console(stderr=True), transient=True) as bar:
+            task = bar.add_task("SVM evaluations", total=None)
+
+            def report(done, total, message):
+                bar.update(task, completed=done, total=total, description=f"SVM evaluations ({message})")
+
+            return query.ask(question, route="exact", **objects, **scene, progress=report, **kw)
 
 
 # ============================================================ rendering
@@ -106,7 +132,13 @@ def _render(ans, json_: bool) -> None:
     d = ans.to_dict()
     if json_:
         emit_json(d)
-        return
+    else:
+        _render_text(d)
+    if d["route"] == "table" and d["value"] is None and d["question"] != "delta-e" and d["limiting_pair"]:
+        raise typer.Exit(EXIT_NO_ANSWER)
+
+
+def _render_text(d) -> None:
     con = console()
     sc = d["scene"]
     scene = [f"{w} {sc[k]:g}{u}" for k, w, u in (("noise_c", "noise", " °C"), ("delta_t_c", "dT", " °C"),
@@ -131,7 +163,11 @@ def _model_words(d: dict) -> str:
 
 def _interval(d, unit):
     iv = d["interval"]
-    return f"(Monte Carlo interval {_fmt(iv['low'], unit)} to {_fmt(iv['high'], unit)})"
+    if iv["low"] is None and iv["high"] is None:
+        return "(no interval: the table cannot support one here)" if d["route"] == "table" else ""
+    if iv.get("coverage"):
+        return f"({iv['coverage']:.0%} confidence interval {_fmt(iv['low'], unit)} to {_fmt(iv['high'], unit)})"
+    return f"(interval {_fmt(iv['low'], unit)} to {_fmt(iv['high'], unit)}: the grid cell, coverage not stated)"
 
 
 def _scalar(words: str, unit: str):
@@ -206,7 +242,7 @@ def min_contact_cmd(
     backing: BackingOpt = None, diffusivity: Diffusivity = None,
     exact: Exact = False, table: TableOpt = None, ideal_table: IdealTableOpt = "ideal-paper",
     trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
-    n_mc: NmcQ = 1000, max_contact: MaxContact = 10.0, json_: Json = False,
+    n_mc: NmcQ = 1000, max_contact: MaxContact = 10.0, coverage: CoverageOpt = 0.9, json_: Json = False,
 ) -> None:
     """Shortest contact time that separates two materials.
 
@@ -216,7 +252,7 @@ def min_contact_cmd(
                model=model, conductance=conductance, thickness=thickness, backing=backing, diffusivity=diffusivity,
                width=width, trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc,
                objects=dict(e1=e1, e2=e2, m1=m1, m2=m2), scene=dict(noise_c=noise, delta_t_c=delta_t),
-               exact_extra=dict(max_contact_s=max_contact))
+               exact_extra=dict(max_contact_s=max_contact, coverage=coverage), progress=not json_)
     _render(ans, json_)
 
 

@@ -42,6 +42,12 @@ INTERVAL_MEANING = {
              "(optimistic, conservative); equal ends for an ideal-observer table",
     "exact": "the evaluated values whose mean SVM F1 is clearly (z standard errors) on either side of "
              "the threshold: the answer lies between them",
+    "exact-estimate": "confidence interval, at the stated coverage, of where the mean SVM F1 (infinitely many "
+                      "seeds) crosses the threshold: a logistic fit of F1 against log(quantity) near the crossing "
+                      "(delta method); never below the ideal-observer bound",
+    "table-cell": "the grid cell the crossing lies in: from the last tabulated value where the pair is not "
+                  "separable (or the ideal bound, if larger) to the first where it is; the table's Monte Carlo "
+                  "error of delta(e) is not included (coverage not stated)",
     "distinguishable": "the SVM F1 plus and minus z standard errors (exact route), or the verdict at the "
                        "ends of the table's Monte Carlo interval (table route, 1 = yes)",
 }
@@ -129,6 +135,10 @@ class Answer:
         What the route did (route-specific).
     notes : tuple of str
         Sentences for people.
+    interval_coverage : float or None
+        Nominal coverage of ``interval`` (None: not stated).
+    interval_kind : str or None
+        Key of :data:`INTERVAL_MEANING` for ``interval`` (None: by route).
     """
 
     question: str
@@ -152,6 +162,8 @@ class Answer:
     details: Mapping[str, Any] = field(default_factory=dict)
     computation: Mapping[str, Any] = field(default_factory=dict)
     notes: tuple[str, ...] = ()
+    interval_coverage: float | None = None
+    interval_kind: str | None = None
 
     # ------------------------------------------------------------ schema
     @property
@@ -175,7 +187,8 @@ class Answer:
 
     def to_dict(self) -> dict[str, Any]:
         """The ``--json`` schema: :data:`ANSWER_KEYS`, JSON-ready (no NaN, no infinities)."""
-        meaning = INTERVAL_MEANING["distinguishable" if self.question == "distinguishable" else self.route]
+        kind = self.interval_kind or ("distinguishable" if self.question == "distinguishable" else self.route)
+        meaning = INTERVAL_MEANING[kind]
         value = self.value if isinstance(self.value, bool) else number(self.value)
         return {
             "question": self.question,
@@ -183,7 +196,8 @@ class Answer:
             "quantity": self.quantity,
             "unit": self.unit,
             "value": value,
-            "interval": {"low": number(self.interval[0]), "high": number(self.interval[1]), "meaning": meaning},
+            "interval": {"low": number(self.interval[0]), "high": number(self.interval[1]), "meaning": meaning,
+                         "coverage": self.interval_coverage},
             "ideal": self.ideal_bound.to_dict(),
             "objects": [dict(o) for o in self.objects],
             "limiting_pair": [dict(o) for o in self.limiting_pair],

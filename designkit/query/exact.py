@@ -209,7 +209,8 @@ class _Run:
 
     # ---------------------------------------------------------------- the answer
     def answer(self, question: str, *, value, interval, ideal, ideal_method: str, objects, limiting, rule: str,
-               scene: dict, details: dict, check_classes, check_at, notes=(), **computation) -> Answer:
+               scene: dict, details: dict, check_classes, check_at, notes=(), interval_coverage=None,
+               interval_kind=None, **computation) -> Answer:
         check = None
         if check_classes:
             c, n, d = check_at
@@ -224,7 +225,8 @@ class _Run:
                                    ideal_method if ideal is not None else "none"),
             objects=tuple(objects), limiting_pair=tuple(limiting), materials_rule=rule, scene=scene,
             sensor=self.sensor.to_dict(), model=self.model.to_dict(), model_check=check, threshold=self.phi,
-            details=details, computation=comp, notes=tuple(n for n in notes if n))
+            details=details, computation=comp, notes=tuple(n for n in notes if n),
+            interval_coverage=interval_coverage, interval_kind=interval_kind)
 
 
 def _scene(contact_s=None, noise_c=None, delta_t_c=None) -> dict[str, Any]:
@@ -248,8 +250,14 @@ def exact_min_contact(e1=None, e2=None, *, m1=None, m2=None, objects=None, noise
                       delta_t_c: float = 10.0, threshold: float = 0.9, sensor=None, model=None,
                       diffusivity_m2_s=None, width: float = DEFAULT_CLASS_WIDTH, trials: int = 100, folds: int = 3,
                       seed: int = 0, repeats: int = 4, z: float = 2.0, jobs: int = -1, n_mc: int = 1000,
-                      max_contact_s: float = 10.0, tolerance_s: float = 0.05) -> Answer:
-    """Shortest contact time [s] computed for this pair: bisection on the SVM's mean F1.
+                      max_contact_s: float = 10.0, tolerance_s: float = 0.05, coverage: float = 0.9,
+                      progress=None) -> Answer:
+    """Shortest contact time [s] computed for this pair: an estimate of where the SVM's mean F1 crosses Phi.
+
+    The crossing of the noisy monotone F1 curve is estimated by a logistic fit in
+    log(contact) near it (:func:`designkit.query.crossing.estimate_crossing`),
+    with a confidence interval at ``coverage``, clipped below at the exact
+    ideal-observer bound (no classifier needs less contact).
 
     Parameters
     ----------
@@ -273,7 +281,11 @@ def exact_min_contact(e1=None, e2=None, *, m1=None, m2=None, objects=None, noise
     n_mc : int
         Touches per class of the Monte Carlo ideal observer (models without a shared shape).
     max_contact_s, tolerance_s : float
-        Longest contact examined and bisection tolerance [s].
+        Longest contact examined [s]; ``tolerance_s`` is kept for callers (the estimate replaces bisection).
+    coverage : float
+        Nominal coverage of the interval, in (0, 1).
+    progress : callable, optional
+        ``progress(done, total, message)`` after each SVM evaluation.
     """
     from ..scene import Scene
 
@@ -291,9 +303,10 @@ def exact_min_contact(e1=None, e2=None, *, m1=None, m2=None, objects=None, noise
     def scene(c):
         return Scene.from_delta_t(contact_s=c, noise_c=noise, delta_t_c=dt)
 
+    from .crossing import check_coverage, estimate_crossing
+
+    cov = check_coverage(coverage)
     floor = 1.0 / run.sensor.sample_rate_hz
-    value, interval, evaluations = contact_search(lambda c: run.svm(cls, scene(c)), run.phi, floor, tmax,
-                                                  tolerance_s, run.z)
     closed = run.closed_form(*cls)
     if closed:
         from .ideal_bound import exact_ideal_min_contact
@@ -303,21 +316,23 @@ def exact_min_contact(e1=None, e2=None, *, m1=None, m2=None, objects=None, noise
                                                max_contact_s=tmax))
     else:
         ideal_ok = lambda c: run.ideal_f1(cls, scene(c)) >= run.phi  # noqa: E731
-        # the ideal observer needs no more contact than the SVM: bracket with the SVM's answer first (long
-        # contacts are the costly ones for the Monte Carlo likelihood), widen to tmax only if that fails
         itol = min(0.01, tolerance_s)
-        if value is not None and ideal_ok(value):
-            ideal = bisect(ideal_ok, floor, value, itol)
-        elif ideal_ok(tmax):
-            ideal = bisect(ideal_ok, value if value is not None else floor, tmax, itol)
-        else:
-            ideal = None
+        ideal = bisect(ideal_ok, floor, tmax, itol) if ideal_ok(tmax) else None
+    # the SVM needs at least the ideal observer's contact: search from there
+    start = max(floor, ideal if ideal is not None else floor)
+    est = estimate_crossing(lambda c: run.svm(cls, scene(c)), start, tmax, run.phi, coverage=cov,
+                            progress=progress)
+    value = est.value if est.value is None or ideal is None else max(est.value, ideal)
+    interval = (est.low if est.low is None or ideal is None else max(est.low, ideal), est.high)
+    evaluations = [{"contact_s": e["x"], "svm_f1": e["svm_f1"], "standard_error": e["standard_error"]}
+                   for e in est.evaluations]
     needed = tmax if value is None else max(x for x in (value, ideal, interval[1]) if x is not None)
     note = "" if value is not None else f"not separable by any contact time up to {tmax:g} s"
     return run.answer("min-contact", value=value, interval=interval, ideal=ideal,
                       ideal_method=run.ideal_method(closed), objects=pq.objects_dicts(),
                       limiting=pq.limiting_dicts(), rule=pq.rule, scene=scene_d, details={}, check_classes=cls,
-                      check_at=(needed, noise, dt), notes=[note], evaluations=evaluations, max_contact_s=tmax)
+                      check_at=(needed, noise, dt), notes=[note], evaluations=evaluations, max_contact_s=tmax,
+                      estimate_method=est.method, interval_coverage=cov, interval_kind="exact-estimate")
 
 
 # ============================================================ max-noise / min-delta-t

@@ -58,6 +58,8 @@ from .inputs import (
 
 __all__ = [
     "DEFAULT_IDEAL_TABLE",
+    "CLOSED_FORM_MAX_CONTACT_S",
+    "CLOSED_FORM_RATIO_BRACKET",
     "DEFAULT_TABLE",
     "GRID_RTOL",
     "delta_e",
@@ -68,6 +70,10 @@ __all__ = [
 ]
 
 DEFAULT_TABLE = "svm-paper"
+#: Longest contact [s] the closed-form ideal bound examines (the exact route's default).
+CLOSED_FORM_MAX_CONTACT_S = 10.0
+#: sigma/dT the closed-form ideal bound searches (the exact route's bracket).
+CLOSED_FORM_RATIO_BRACKET = (1e-5, 1.0)
 DEFAULT_IDEAL_TABLE = "ideal-paper"
 
 
@@ -166,7 +172,7 @@ class _Opened:
     view: _View
     phi: float
     model: Any
-    iview: _View
+    iview: _View | None
     ikind: str
     iname: str | None
     ihash: str | None
@@ -174,6 +180,11 @@ class _Opened:
     @property
     def width(self) -> float:
         return float(self.tab.header["effusivity"]["width"])
+
+    @property
+    def closed(self) -> bool:
+        """The ideal bound is computed in closed form at query time (never read from a grid)."""
+        return _closed_form(self.tab, self.model)
 
 
 def _ideal_view(svm: _View, ideal_table: "Table | str | None") -> tuple[_View, str, Table | None]:
@@ -213,9 +224,18 @@ def _open(table, ideal_table, *, threshold, sensor, model) -> _Opened:
             raise TableMismatch(f"table {tab.name} was built for the {fm.describe()} model, "
                                 f"not the {asked.describe()} model")
     view = _View(tab)
+    if _closed_form(tab, fm):  # the bound is computed at query time: the default ideal table is not read
+        if ideal_table is not None and ideal_table != DEFAULT_IDEAL_TABLE:
+            _as_table(ideal_table)  # a table the caller named must exist: an error, not a silent fallback
+        return _Opened(tab, view, tab.threshold, fm, None, "", None, None)
     iview, ikind, it = _ideal_view(view, ideal_table)
     return _Opened(tab, view, tab.threshold, fm, iview, ikind, None if it is None else it.name,
                    None if it is None else it.header.get("content_hash"))
+
+
+def _closed_form(tab: Table, fm) -> bool:
+    """Whether the ideal bound is computed in closed form (shared-shape model, fixed initial conditions)."""
+    return bool(fm.shared_shape) and "noise_ratio" in tab.axes
 
 
 # ============================================================ in-grid flags, in the user's units
@@ -256,7 +276,7 @@ def _scene_wanted(view: _View, noise, dt) -> dict[str, Any]:
 # ============================================================ one answer builder for the route
 def _answer(question: str, op: _Opened, *, objects, limiting, rule: str, scene: dict, value, interval,
             ideal, ideal_method: str = "table", in_grid: dict, details: dict, notes: Sequence[str] = (),
-            check_at: tuple[float, float, float] | None = None, classes=()) -> Answer:
+            check_at: tuple[float, float, float] | None = None, classes=(), interval_kind=None) -> Answer:
     check = None
     if check_at is not None and classes:
         c, n, d = check_at
@@ -271,7 +291,7 @@ def _answer(question: str, op: _Opened, *, objects, limiting, rule: str, scene: 
         table=op.tab.name, table_hash=op.tab.header.get("content_hash"), ideal_table=ideal_table,
         ideal_table_hash=op.ihash if ideal_table else None, in_grid=dict(in_grid), details=details,
         computation={"fidelity": op.tab.fidelity, "table_contacts_s": op.view.contacts.tolist()},
-        notes=tuple(n for n in notes if n))
+        notes=tuple(n for n in notes if n), interval_kind=interval_kind)
 
 
 def _scene(contact_s=None, noise_c=None, delta_t_c=None) -> dict[str, Any]:
@@ -356,8 +376,6 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
         wanted = {**_scene_wanted(view, noise, dt), "effusivity": (lo, hi)}
         return _answer("min-contact", op, value=None, interval=(None, None), ideal=None, in_grid=flags,
                        details={}, notes=_outside_notes(view, flags, wanted), **common)
-    icombos, iflags = op.iview.scene_weights(noise, dt) if op.iview is not None else ([], {"ideal": False})
-
     def contact_for(v: _View, kind: str, cmb) -> float | None:
         needs = [v.need(kind, cmb, k, lo, hi) for k in range(v.contacts.size)]
         x, _ = _crossing(v.contacts, needs, hi - lo)
@@ -368,7 +386,16 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
         interval = (contact_for(view, "lo", combos), contact_for(view, "hi", combos))
     else:
         interval = (value, value)
-    ideal = contact_for(op.iview, op.ikind, icombos) if all(iflags.values()) else None
+    if op.closed:
+        from .ideal_bound import exact_ideal_min_contact
+
+        ideal = number(exact_ideal_min_contact(op.tab.sensor, lo, hi, noise / abs(dt), width=op.width,
+                                               threshold=op.phi, max_contact_s=CLOSED_FORM_MAX_CONTACT_S))
+        ideal_method = "closed-form"
+    else:
+        icombos, iflags = op.iview.scene_weights(noise, dt) if op.iview is not None else ([], {"ideal": False})
+        ideal = contact_for(op.iview, op.ikind, icombos) if all(iflags.values()) else None
+        ideal_method = "table"
     note = "" if value is not None else (
         f"no tabulated contact time up to {view.contacts[-1]:g} s separates them "
         "(the exact route examines longer contacts)")
@@ -377,9 +404,21 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
         prev = grid[grid.index(value) - 1]
         note = (f"{value:g} s is the table's next contact time after {prev:g} s, where they are not separable: "
                 f"the shortest time lies in ({prev:g}, {value:g}] s (the exact route resolves it)")
+    if value is not None:
+        # the interpolation error between grid points: the interval spans at least the grid cell the
+        # crossing lies in (a crossing on a grid point whose neighbour is not separable: the whole cell),
+        # never below the exact ideal bound
+        below = [g for g in grid if g < value - 1e-12]
+        prev = below[-1] if below else 0.0
+        nxt = min([g for g in grid if g >= value - 1e-12], default=value)
+        ends = [x for x in interval if x is not None]
+        low = min([prev] + ends)
+        low = max(low, ideal) if ideal is not None else low
+        interval = (low, max([nxt] + ends))
     needed = value if value is not None else float(view.contacts[-1])
-    return _answer("min-contact", op, value=value, interval=interval, ideal=ideal, in_grid=flags, details={},
-                   notes=[note], check_at=(needed, noise, dt), **common)
+    return _answer("min-contact", op, value=value, interval=interval, ideal=ideal, ideal_method=ideal_method,
+                   in_grid=flags, details={}, notes=[note], check_at=(needed, noise, dt),
+                   interval_kind="table-cell" if value is not None else None, **common)
 
 
 # ============================================================ max-noise / min-delta-t
@@ -442,6 +481,13 @@ def _ratio_question(question: str, e1, e2, m1, m2, objects, contact_s, noise_c, 
 
     out = {}
     for kind, v in (("svm", view), ("lo", view), ("hi", view), ("ideal", op.iview)):
+        if kind == "ideal" and op.closed:
+            from .ideal_bound import exact_ideal_max_ratio
+
+            ri = number(exact_ideal_max_ratio(op.tab.sensor, lo, hi, contact, width=op.width, threshold=op.phi,
+                                              bracket=CLOSED_FORM_RATIO_BRACKET))
+            out[kind] = (ri, "inside" if ri is not None else "below")
+            continue
         if op.tab.fidelity == "ideal" and kind in ("lo", "hi"):
             out[kind] = out["svm"]
             continue
@@ -466,7 +512,8 @@ def _ratio_question(question: str, e1, e2, m1, m2, objects, contact_s, noise_c, 
     ideal = to_answer(out["ideal"][0]) if out["ideal"][1] != "below" else None
     r_check = r if r is not None else float(ratios[0])
     check_at = (contact, r_check * abs(dt), dt) if question == "max-noise" else (contact, noise, noise / r_check)
-    return _answer(question, op, value=value, interval=interval, ideal=ideal, in_grid=flags, details={},
+    return _answer(question, op, value=value, interval=interval, ideal=ideal,
+                   ideal_method="closed-form" if op.closed else "table", in_grid=flags, details={},
                    notes=[note], check_at=check_at, **common)
 
 
@@ -521,6 +568,12 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
                        details=_delta_details(x, {}), notes=_outside_notes(view, flags, wanted), **common)
     icombos, _ = op.iview.scene_weights(noise, dt) if op.iview is not None else ([], {})
     icw, _ = _contact_weights(op.iview, contact) if op.iview is not None else ([], False)
+    if op.closed:
+        from .ideal_bound import exact_ideal_delta
+
+        ideal_closed = {side: number(exact_ideal_delta(op.tab.sensor, x, contact, noise / abs(dt), direction=sign,
+                                                       width=op.width, threshold=op.phi, e_max=view.e_hi))
+                        for side, sign in (("lower", -1), ("upper", +1))}
 
     def at(v, cmb, cws, name):
         if v is None or name not in v.t.arrays:
@@ -541,11 +594,13 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
         iv = ([at(view, combos, cw, f"delta_{direction}_lo"), at(view, combos, cw, f"delta_{direction}_hi")]
               if op.tab.fidelity == "svm" else [val, val])
         iname = f"delta_{direction}_ideal" if op.ikind == "ideal" else f"delta_{direction}"
-        sides[side] = {"value": val, "interval": iv, "ideal": at(op.iview, icombos, icw, iname)}
+        ideal_side = ideal_closed[side] if op.closed else at(op.iview, icombos, icw, iname)
+        sides[side] = {"value": val, "interval": iv, "ideal": ideal_side}
     finite = [s["value"] for s in sides.values() if s["value"] is not None]
     ifinite = [s["ideal"] for s in sides.values() if s["ideal"] is not None]
     return _answer("delta-e", op, value=min(finite) if finite else None, interval=(None, None),
-                   ideal=min(ifinite) if ifinite else None, in_grid=flags, details=_delta_details(x, sides),
+                   ideal=min(ifinite) if ifinite else None, ideal_method="closed-form" if op.closed else "table",
+                   in_grid=flags, details=_delta_details(x, sides),
                    check_at=(contact, noise, dt), **common)
 
 

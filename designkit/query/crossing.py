@@ -1,0 +1,199 @@
+"""Where a noisy monotone F1 curve crosses the threshold: an estimate with a stated-coverage interval.
+
+The SVM's F1 against the asked quantity ``x`` (contact time [s], sigma/dT [-]) is
+a noisy monotone curve: each evaluation is the mean over seeds with a standard
+error. Bisection points are not an estimate of the crossing; this module fits
+a model of the curve near the crossing and solves it:
+
+1. coarse bisection in ``log x`` brackets the crossing (``bracket_ratio``);
+2. a small design of points spread across the bracket (``design`` points)
+   is evaluated;
+3. ``logit((F1 - 0.5) / 0.5) = a + b log x`` is fitted by weighted least squares
+   (weights ``1 / SE^2`` on that scale, SE floored at ``se_floor``) to the evaluations whose mean is
+   informative (strictly between chance and 1), nearest the threshold first;
+4. the crossing ``x*`` where the fit reaches ``phi`` and its ``coverage`` confidence
+   interval by the delta method on ``(a, b)``, widened by the lack of fit
+   (residual variance above the stated SEs).
+
+The interval covers the crossing of the *mean* F1 curve (the answer with
+infinitely many seeds), at the stated coverage, to the extent the local
+linear model holds (the coverage benchmark, :mod:`designkit.accuracy.coverage`,
+measures it).
+
+Examples
+--------
+>>> import math
+>>> f = lambda x: (0.5 + 0.5 / (1.0 + x ** -2.0), 0.005)  # crosses 0.9 at x = 2
+>>> est = estimate_crossing(f, 0.1, 10.0, 0.9)
+>>> round(est.value, 6), est.low < 2.0 < est.high, est.method
+(2.0, True, 'wls-logit-log')
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from statistics import NormalDist
+from typing import Callable
+
+import numpy as np
+
+from .._validation import InputError
+
+__all__ = ["CrossingEstimate", "check_coverage", "estimate_crossing", "z_of_coverage"]
+
+
+def check_coverage(coverage: float) -> float:
+    """``coverage`` as a float in (0, 1), else :class:`~designkit._validation.InputError`.
+
+    >>> check_coverage(0.9)
+    0.9
+    """
+    c = float(coverage)
+    if not 0.0 < c < 1.0 or math.isnan(c):
+        raise InputError(f"coverage must lie in (0, 1), got {coverage:g}")
+    return c
+
+
+def z_of_coverage(coverage: float) -> float:
+    """Two-sided standard normal quantile for ``coverage`` (1.645 for 0.9).
+
+    >>> round(z_of_coverage(0.9), 3)
+    1.645
+    """
+    return NormalDist().inv_cdf(0.5 + 0.5 * check_coverage(coverage))
+
+
+@dataclass
+class CrossingEstimate:
+    """The crossing ``x*`` of the threshold by the mean F1 curve.
+
+    Attributes
+    ----------
+    value : float or None
+        Estimate of ``x*`` [unit of x]; None when the curve never crosses in the range.
+    low, high : float or None
+        Confidence interval of ``x*`` at ``coverage`` (None: unbounded that side).
+    coverage : float
+        Nominal coverage of ``(low, high)``.
+    method : str
+        ``"wls-logit-log"`` (the fit), ``"bracket"`` (too few informative
+        points: the interval is the bracket) or ``"none"``.
+    evaluations : list of dict
+        ``{"x", "svm_f1", "standard_error"}`` per evaluated point.
+    """
+
+    value: float | None
+    low: float | None
+    high: float | None
+    coverage: float
+    method: str
+    evaluations: list = field(default_factory=list)
+
+
+def _logit(m):
+    """The fitted scale: logit of F1 rescaled from (0.5, 1) to (0, 1), where the curve is near-linear in log x."""
+    p = np.clip((np.asarray(m, dtype=np.float64) - 0.5) / 0.5, 1e-6, 1 - 1e-6)
+    return np.log(p / (1.0 - p))
+
+
+def _logit_se(m, se):
+    p = np.clip((np.asarray(m, dtype=np.float64) - 0.5) / 0.5, 1e-6, 1 - 1e-6)
+    return se / (0.5 * p * (1.0 - p))
+
+
+def estimate_crossing(f: Callable[[float], tuple[float, float]], x_lo: float, x_hi: float, phi: float, *,
+                      increasing: bool = True, coverage: float = 0.9, bracket_ratio: float = 1.6,
+                      design: int = 4, se_floor: float = 0.004,
+                      progress: Callable[[int, int, str], None] | None = None) -> CrossingEstimate:
+    """Estimate where the mean of ``f`` crosses ``phi`` on ``[x_lo, x_hi]`` (``x > 0``), log scale.
+
+    Parameters
+    ----------
+    f : callable
+        ``f(x) -> (mean F1, standard error)``.
+    x_lo, x_hi : float
+        Range examined (> 0).
+    phi : float
+        Threshold.
+    increasing : bool
+        F1 rises with ``x`` (contact time) or falls (noise ratio).
+    coverage : float
+        Nominal coverage of the interval, in (0, 1).
+    bracket_ratio : float
+        Coarse bisection stops when the bracket spans at most this ratio.
+    design : int
+        Points evaluated inside the bracket after the bisection.
+    se_floor : float
+        Smallest standard error used as a weight (a mean of a few seeds can show SE 0).
+    progress : callable, optional
+        ``progress(done, total, message)`` after each evaluation (``total`` is an estimate).
+
+    Returns
+    -------
+    CrossingEstimate
+    """
+    z = z_of_coverage(coverage)
+    evals: dict[float, tuple[float, float]] = {}
+    n_bisect = max(1, math.ceil(math.log2(math.log(x_hi / x_lo) / math.log(bracket_ratio))))
+    total = 2 + n_bisect + design
+
+    def ev(x: float) -> tuple[float, float]:
+        if x not in evals:
+            evals[x] = f(x)
+            if progress is not None:
+                progress(len(evals), max(total, len(evals)), f"x = {x:.4g}: F1 {evals[x][0]:.3f}")
+        return evals[x]
+
+    def ok(x: float) -> bool:
+        return (ev(x)[0] >= phi) == increasing
+
+    def log_of(found):
+        return [{"x": x, "svm_f1": m, "standard_error": s} for x, (m, s) in sorted(found.items())]
+
+    # 1. bracket: a is "not ok", b is "ok" for increasing (reversed roles otherwise)
+    good_end, bad_end = (x_hi, x_lo) if increasing else (x_lo, x_hi)
+    if not ok(good_end):
+        return CrossingEstimate(None, None, None, coverage, "none", log_of(evals))
+    if ok(bad_end):
+        return CrossingEstimate(bad_end, None, bad_end, coverage, "none", log_of(evals))
+    a, b = x_lo, x_hi
+    while b / a > bracket_ratio:
+        mid = math.sqrt(a * b)
+        if ok(mid) == increasing:
+            b = mid
+        else:
+            a = mid
+    # 2. design points across the bracket, widened a little on both sides
+    la, lb = math.log(a), math.log(b)
+    pad = 0.25 * (lb - la)
+    for u in np.linspace(la - pad, lb + pad, design):
+        ev(float(min(max(math.exp(u), x_lo), x_hi)))
+    # 3. the fit on informative points (0.5 < F1 < 1), nearest the threshold first
+    xs = np.array(sorted(evals))
+    ms = np.array([evals[x][0] for x in xs])
+    ss = np.maximum(np.array([evals[x][1] for x in xs]), se_floor)
+    inform = (ms > 0.5) & (ms < 0.999)
+    near = np.argsort(np.abs(ms - phi) / ss)
+    use = [i for i in near if inform[i]][:max(design + 1, 4)]
+    if len(use) < 3:
+        return CrossingEstimate(math.sqrt(a * b), a, b, coverage, "bracket", log_of(evals))
+    u = np.log(xs[use])
+    y, w = _logit(ms[use]), 1.0 / _logit_se(ms[use], ss[use]) ** 2
+    X = np.column_stack([np.ones_like(u), u])
+    cov = np.linalg.inv(X.T @ (X * w[:, None]))
+    coef = cov @ (X.T @ (w * y))
+    resid = y - X @ coef
+    chi2 = float(np.sum(w * resid ** 2)) / max(len(use) - 2, 1)
+    cov = cov * max(1.0, chi2)  # lack of fit beyond the stated errors widens the interval
+    alpha, beta = float(coef[0]), float(coef[1])
+    if (beta <= 0) == increasing or beta == 0:
+        return CrossingEstimate(math.sqrt(a * b), a, b, coverage, "bracket", log_of(evals))
+    target = float(_logit(np.array(phi)))
+    u_star = (target - alpha) / beta
+    grad = np.array([-1.0 / beta, -(target - alpha) / beta ** 2])
+    sd = math.sqrt(max(float(grad @ cov @ grad), 0.0))
+    lo_u, hi_u = u_star - z * sd, u_star + z * sd
+    value = min(max(math.exp(u_star), x_lo), x_hi)
+    return CrossingEstimate(value, max(math.exp(lo_u), x_lo), min(math.exp(hi_u), x_hi), coverage,
+                            "wls-logit-log", log_of(evals))

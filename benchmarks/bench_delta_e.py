@@ -109,7 +109,10 @@ def main(argv=None):
         i_r = int(np.argmin(np.abs(np.log(ax["noise_ratio"]) - np.log(args.noise_ratio))))
         i_c = int(np.argmin(np.abs(ax["contact_s"] - args.contact)))
         fits = int(t.arrays["fits"][i_r, i_c])
-        wall = float(t.arrays["chunk_wall_s"][i_r, i_c])
+        run = t.header.get("stats", {}).get("run", {})
+        walls = np.asarray(t.arrays["chunk_wall_s"] if "chunk_wall_s" in t.arrays  # tables before the timings moved
+                           else run.get("chunk_wall_s", np.zeros(t.arrays["fits"].shape)))
+        wall = float(walls[i_r, i_c])
         out["svm_paper"] = {"noise_ratio": float(ax["noise_ratio"][i_r]), "contact_s": float(ax["contact_s"][i_c]),
                             "fits": fits, "compute_s": wall}
         print(f"\nThe shipped svm-paper build at sigma/dT {ax['noise_ratio'][i_r]:g}, contact "
@@ -117,7 +120,7 @@ def main(argv=None):
               f"interval staircases): {fits} SVM fits, {wall / 60:.1f} min of compute (header stats) against the "
               f"124,750-pair matrix: {124750 / max(fits, 1):.0f}x fewer fits.")
         per_scene = t.header.get("stats", {})
-        print(f"Whole table: {per_scene.get('svm_fits_total')} fits, {per_scene.get('compute_s_total', 0) / 3600:.2f} "
+        print(f"Whole table: {per_scene.get('svm_fits_total')} fits, {(per_scene.get('compute_s_total') or run.get('compute_s_total', 0)) / 3600:.2f} "
               f"h of compute over {t.arrays['fits'].size} (scene, contact) points.")
     except Exception as exc:  # the table is optional here
         print(f"\n(svm-paper table not available: {exc})")

@@ -33,7 +33,7 @@ contact_s: [1, 2, 4, 8]
 blocks: 1
 """
 N_CHUNKS = 8
-TIMING = {"chunk_wall_s"}  # the only arrays that may differ between two runs of one sweep
+TIMING: set[str] = set()  # no array may differ between two runs of one sweep (timings are in the header)
 
 
 def _sweep_cmd(cfg: Path, workdir: Path, out: Path, *extra: str) -> list[str]:
@@ -288,3 +288,20 @@ def test_the_contact_model_through_a_table_query_and_an_export(cli, tmp_path):
     assert mod.MODEL["name"] == "contact"
     got = mod.distinguishable(e_lo, e_hi, noise, 10.0, contact)
     assert bool(got) == bool(answer["value"])
+
+
+def test_an_unknown_solver_or_a_batch_that_cannot_fit_is_one_line_before_any_work(cli, tmp_path):
+    cases = [(("--solver", "libsvm"), "solver must be one of sklearn, batched"),
+             (("--solver", "batched", "--contact", "2000"), "does not fit in the batched solver")]
+    for k, (options, needle) in enumerate(cases):
+        bad, out = _model_sweep(cli, tmp_path, f"s{k}", "", *options)
+        err = bad.stderr.strip()
+        assert bad.exit_code == 2 and len(err.splitlines()) == 1 and needle in err, (options, err)
+        assert not (tmp_path / f"work-s{k}").exists() and not out.exists()
+
+
+def test_the_batched_solver_through_the_cli(cli, tmp_path):
+    r, out = _model_sweep(cli, tmp_path, "b", "", "--solver", "batched")
+    assert r.exit_code == 0, r.output
+    header = json.loads(out.with_suffix(".json").read_text())
+    assert header["config"]["solver"] == "batched" and header["stats"]["run"]["solver"] == "batched"

@@ -53,6 +53,7 @@ def sweep(
     thickness: Thickness = None,
     backing: BackingOpt = None,
     diffusivity: Diffusivity = None,
+    solver: Annotated[Optional[str], typer.Option("--solver", help="SVM solver: sklearn (the reference) or batched (many pairs at once, same classifier).")] = None,
     jobs: Annotated[int, typer.Option("--jobs", "-j", help="Local worker processes (-1: all cores).")] = -1,
     backend: Annotated[str, typer.Option("--backend", help="loky (local processes) or dask.")] = "loky",
     scheduler: Annotated[Optional[str], typer.Option("--scheduler", help="Dask scheduler address (with --backend dask).")] = None,
@@ -84,7 +85,7 @@ def sweep(
                      delta_t_c=_floats(delta_t, "--delta-t"), sensor_temp_spread_c=sensor_temp_spread,
                      ambient_temp_spread_c=ambient_temp_spread, contact_s=_floats(contact, "--contact"),
                      sample_rate_hz=sample_rate, blocks=blocks, full_matrix=full_matrix, model=fm,
-                     diffusivity_m2_s=diffusivity)
+                     diffusivity_m2_s=diffusivity, solver=solver)
     if overrides["noise_c"] is not None or overrides["delta_t_c"] is not None:
         overrides.setdefault("noise_ratio", None)
     if config is not None:

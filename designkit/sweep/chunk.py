@@ -4,8 +4,9 @@ A chunk is the unit of parallelism and of resumable state. It finds the
 ideal observer's staircase where the forward model allows a closed form (the
 floor of the SVM search), then walks three staircases on one cache of SVM
 scores: ``mean >= Phi`` gives delta, ``mean + z se >= Phi`` its lower end and
-``mean - z se >= Phi`` its upper end. The previous (shorter) contact time's
-staircase is the first guess for this one.
+``mean - z se >= Phi`` its upper end. A chunk depends on nothing but the
+config and its own coordinates (no hints from other chunks), so the table is
+the same however the sweep is split.
 """
 
 from __future__ import annotations
@@ -89,8 +90,7 @@ class ChunkResult:
                    wall_s=float(a["wall_s"]), f1_rows=a["f1_rows"] if "f1_rows" in a else None)
 
 
-def run_chunk(cfg: SweepConfig, point: tuple[int, ...], block: int, contact_index: int,
-              hint_J: np.ndarray | None = None, hint_J_hi: np.ndarray | None = None) -> ChunkResult:
+def run_chunk(cfg: SweepConfig, point: tuple[int, ...], block: int, contact_index: int) -> ChunkResult:
     """Compute one chunk (a picklable top-level function for joblib/dask workers).
 
     A chunk is the unit of parallelism: everything inside it runs sequentially in its
@@ -101,10 +101,10 @@ def run_chunk(cfg: SweepConfig, point: tuple[int, ...], block: int, contact_inde
     from joblib import parallel_config
 
     with parallel_config(backend="sequential"):
-        return _run_chunk(cfg, point, block, contact_index, hint_J, hint_J_hi)
+        return _run_chunk(cfg, point, block, contact_index)
 
 
-def _run_chunk(cfg: SweepConfig, point, block: int, contact_index: int, hint_J, hint_J_hi) -> ChunkResult:
+def _run_chunk(cfg: SweepConfig, point, block: int, contact_index: int) -> ChunkResult:
     t0 = time.perf_counter()
     sensor = cfg.resolved_sensor()
     scene = cfg.scene(point, cfg.contact_s[contact_index])
@@ -118,7 +118,7 @@ def _run_chunk(cfg: SweepConfig, point, block: int, contact_index: int, hint_J, 
         J_ideal = np.full(rows.size, IDEAL_UNKNOWN, dtype=np.int64)
 
     if cfg.fidelity == "ideal":
-        J = _ideal_mc_staircase(cfg, sensor, scene, rows, floor, hint_J) if cfg.varied else J_ideal
+        J = _ideal_mc_staircase(cfg, sensor, scene, rows, floor) if cfg.varied else J_ideal
         return ChunkResult(point, block, contact_index, rows, J, J.copy(), J.copy(), J_ideal, 0,
                            np.zeros((0, 5)), time.perf_counter() - t0)
 
@@ -127,23 +127,27 @@ def _run_chunk(cfg: SweepConfig, point, block: int, contact_index: int, hint_J, 
     if cfg.full_matrix:
         f1_rows, (J, J_lo, J_hi) = _full_matrix(cfg, scorer, rows)
     else:
-        J, J_lo, J_hi = _svm_staircases(cfg, scorer, rows, floor if cfg.ideal_bound else None, hint_J, hint_J_hi)
-    cells = np.array([(i, j, c.mean, c.stderr, c.reps) for (i, j), c in sorted(scorer.cells.items())],
+        J, J_lo, J_hi = _svm_staircases(cfg, scorer, rows, floor if cfg.ideal_bound else None)
+    cells = np.array([(i, j, c.mean, c.stderr, c.reps) for (i, j), c in sorted(scorer.scored.items())],
                      dtype=np.float64).reshape(-1, 5)
     return ChunkResult(point, block, contact_index, rows, J, J_lo, J_hi, J_ideal, scorer.fits,
                        cells, time.perf_counter() - t0, f1_rows)
 
 
-def _svm_staircases(cfg: SweepConfig, scorer: PairScorer, rows, floor, hint_J, hint_J_hi):
-    """``J``, ``J_lo``, ``J_hi`` of the SVM by staircase search on one cache of scores."""
+def _svm_staircases(cfg: SweepConfig, scorer: PairScorer, rows, floor):
+    """``J``, ``J_lo``, ``J_hi`` of the SVM by staircase search on one cache of scores.
+
+    Every search step's probes go to the scorer as one batch (the batched solver
+    scores them together; the reference solver one by one).
+    """
     n, phi, z = cfg.intervals, cfg.threshold, cfg.z
-    J = staircase_search(lambda i, j: scorer.cell(i, j).mean >= phi, rows, n, floor=floor,
-                         hint=_full(hint_J, rows, n))
-    J_full = _full(J, rows, n)
-    J_lo = staircase_search(lambda i, j: scorer.cell(i, j).mean + z * scorer.cell(i, j).stderr >= phi,
-                            rows, n, floor=floor, hint=J_full)
-    J_hi = staircase_search(lambda i, j: scorer.cell(i, j).mean - z * scorer.cell(i, j).stderr >= phi,
-                            rows, n, floor=J_full, hint=_full(hint_J_hi, rows, n))
+
+    def by(k: float):
+        return lambda pairs: [c.mean + k * c.stderr >= phi for c in scorer.cells(pairs)]
+
+    J = staircase_search(None, rows, n, floor=floor, decide_many=by(0.0))
+    J_lo = staircase_search(None, rows, n, floor=floor, decide_many=by(z))
+    J_hi = staircase_search(None, rows, n, floor=_full(J, rows, n), decide_many=by(-z))
     return J, J_lo, J_hi
 
 
@@ -172,13 +176,13 @@ def _first_crossing(scorer: PairScorer, rows, n, ok: Callable[[PairCell], bool])
     out = np.full(len(rows), n, dtype=np.int64)
     for r, i in enumerate(rows):
         for j in range(i + 1, n):
-            if ok(scorer.cells[(i, j)]):
+            if ok(scorer.scored[(i, j)]):
                 out[r] = j
                 break
     return out
 
 
-def _ideal_mc_staircase(cfg: SweepConfig, sensor: Sensor, scene: Scene, rows, floor, hint) -> np.ndarray:
+def _ideal_mc_staircase(cfg: SweepConfig, sensor: Sensor, scene: Scene, rows, floor) -> np.ndarray:
     """Ideal observer with varied initial conditions: Monte Carlo F1 per pair on the staircase."""
     from ..recognition.ideal import ideal_pair
 
@@ -192,18 +196,12 @@ def _ideal_mc_staircase(cfg: SweepConfig, sensor: Sensor, scene: Scene, rows, fl
             cache[(i, j)] = r.f1
         return cache[(i, j)] >= cfg.threshold
 
-    return staircase_search(decide, rows, cfg.intervals, floor=floor, hint=_full(hint, rows, cfg.intervals))
+    return staircase_search(decide, rows, cfg.intervals, floor=floor)
 
 
 def run_scene(cfg: SweepConfig, point: tuple[int, ...] = (0,), *,
               contact_indices: Sequence[int] | None = None) -> list[ChunkResult]:
     """All blocks and contact times of one scene point, in-process (library convenience)."""
-    out = []
-    prev: dict[int, ChunkResult] = {}
-    for k in (range(len(cfg.contact_s)) if contact_indices is None else contact_indices):
-        for b in range(len(cfg.blocks_of())):
-            p = prev.get(b)
-            res = run_chunk(cfg, tuple(point), b, k, None if p is None else p.J, None if p is None else p.J_hi)
-            prev[b] = res
-            out.append(res)
-    return out
+    return [run_chunk(cfg, tuple(point), b, k)
+            for k in (range(len(cfg.contact_s)) if contact_indices is None else contact_indices)
+            for b in range(len(cfg.blocks_of()))]

@@ -27,10 +27,13 @@ from ..recognition.features import DEFAULT_SLOPE_WINDOW_S
 from ..scene import Scene
 from ..sensor import Sensor, load_sensor
 
-__all__ = ["FIDELITIES", "SweepConfig"]
+__all__ = ["FIDELITIES", "SOLVERS", "SweepConfig"]
 
 #: What decides distinguishability: the paper's SVM, or the ideal observer (the bound).
 FIDELITIES = ("svm", "ideal")
+
+#: What fits the SVM: scikit-learn's pipeline (the reference) or the batched libsvm-equivalent solver.
+SOLVERS = ("sklearn", "batched")
 
 
 @dataclass(frozen=True)
@@ -88,6 +91,7 @@ class SweepConfig:
     ideal_bound: bool = True
     model: Any = None
     diffusivity_m2_s: float | None = None
+    solver: str = "sklearn"
 
     def __post_init__(self) -> None:
         for name in ("noise_ratio", "noise_c", "delta_t_c", "contact_s"):
@@ -98,6 +102,8 @@ class SweepConfig:
 
     def _check_grid(self) -> None:
         """The effusivity grid, the classifier protocol and the search settings."""
+        if self.solver not in SOLVERS:
+            raise InputError(f"solver must be one of {', '.join(SOLVERS)}, got {self.solver!r}")
         if self.fidelity not in FIDELITIES:
             raise InputError(f"fidelity must be one of {', '.join(FIDELITIES)}, got {self.fidelity!r}")
         if not (0 <= self.e_min < self.e_max < math.inf):
@@ -322,7 +328,8 @@ def _axis(name: str, values: Any) -> tuple[float, ...] | None:
 
 
 #: Config keys newer than the first tables, with the default that keeps an older digest.
-_DIGEST_DEFAULTS: dict[str, Any] = {"model": {"name": "semi-infinite"}, "diffusivity_m2_s": None}
+_DIGEST_DEFAULTS: dict[str, Any] = {"model": {"name": "semi-infinite"}, "diffusivity_m2_s": None,
+                                    "solver": "sklearn"}
 
 
 def _flatten(data: Mapping[str, Any], source: str) -> dict[str, Any]:

@@ -22,9 +22,9 @@ import numpy as np
 from .._validation import InputError
 from .chunk import ChunkResult, run_chunk
 from .config import SweepConfig
-from .search import assemble
+from .search import assemble, chunk_wall_s
 
-__all__ = ["BACKENDS", "SweepInterrupted", "iter_sweep", "prepare_workdir", "run_sweep"]
+__all__ = ["BACKENDS", "SweepInterrupted", "check_batches", "iter_sweep", "prepare_workdir", "run_sweep"]
 
 #: Where chunks run: local processes, this process, or a dask cluster.
 BACKENDS = ("loky", "sequential", "dask")
@@ -89,43 +89,34 @@ def prepare_workdir(cfg: SweepConfig, workdir: Path, *, resume: bool, fresh: boo
 
 def iter_sweep(cfg: SweepConfig, workdir: Path, *, jobs: int = 1, backend: str = "loky",
                scheduler: str | None = None) -> Iterator[tuple[ChunkResult, bool]]:
-    """Run the missing chunks, wave by wave (one wave per contact time).
+    """Run the missing chunks, all at once (no waves: chunks do not depend on each other).
 
     Yields ``(chunk, computed)`` for every chunk of the sweep, reading the
     finished ones from ``workdir`` and computing the rest in parallel; each
-    computed chunk is written atomically before it is yielded. A chunk's first
-    guess is the same (scene point, block)'s staircase at the previous contact.
+    computed chunk is written atomically before it is yielded. Longest contact
+    times are submitted first so that the slowest chunks do not start last.
     """
     from joblib import Parallel, delayed
 
     workdir = Path(workdir)
-    blocks = range(len(cfg.blocks_of()))
-    points = cfg.scene_points()
-    prev: dict[tuple, ChunkResult] = {}
+    todo = []
+    for k in range(len(cfg.contact_s)):
+        for p in cfg.scene_points():
+            for b in range(len(cfg.blocks_of())):
+                path = _chunk_path(workdir, p, b, k)
+                if path.exists():
+                    yield _load_chunk(path), False
+                else:
+                    todo.append((p, b, k))
+    if not todo:
+        return
+    todo.sort(key=lambda t: -t[2])
     with _executor(backend, jobs, scheduler) as (ctx, n_jobs):
-        for k in range(len(cfg.contact_s)):
-            todo = []
-            for p in points:
-                for b in blocks:
-                    path = _chunk_path(workdir, p, b, k)
-                    if path.exists():
-                        res = _load_chunk(path)
-                        prev[(p, b)] = res
-                        yield res, False
-                    else:
-                        todo.append((p, b))
-            if not todo:
-                continue
-            calls = []
-            for p, b in todo:
-                h = prev.get((p, b))
-                calls.append(delayed(run_chunk)(cfg, p, b, k, None if h is None else h.J,
-                                                None if h is None else h.J_hi))
-            with ctx():
-                for res in Parallel(n_jobs=n_jobs, return_as="generator_unordered")(calls):
-                    _save_chunk(_chunk_path(workdir, res.point, res.block, res.contact_index), res)
-                    prev[(res.point, res.block)] = res
-                    yield res, True
+        calls = [delayed(run_chunk)(cfg, p, b, k) for p, b, k in todo]
+        with ctx():
+            for res in Parallel(n_jobs=n_jobs, return_as="generator_unordered")(calls):
+                _save_chunk(_chunk_path(workdir, res.point, res.block, res.contact_index), res)
+                yield res, True
 
 
 @contextmanager
@@ -148,6 +139,25 @@ def _executor(backend: str, jobs: int, scheduler: str | None):
         yield (lambda: parallel_config(backend="dask")), -1
     finally:
         client.close()
+
+
+def check_batches(cfg: SweepConfig) -> None:
+    """Refuse, before any work, a batched-solver sweep of which not even one pair fits a batch.
+
+    Raises
+    ------
+    InputError
+        One pair's batch at the longest contact time exceeds :data:`~designkit.sweep.scorer.BATCH_MB`.
+    """
+    from .scorer import BATCH_MB, batch_pairs
+
+    if cfg.solver != "batched" or cfg.fidelity != "svm":
+        return
+    longest = max(cfg.contact_s)
+    n_samples = cfg.resolved_sensor().times_s(longest).size
+    if batch_pairs(cfg.trials, n_samples, cfg.folds) < 1:
+        raise InputError(f"one pair at {longest:g} s contact ({cfg.trials} trials x {n_samples} samples) does not "
+                         f"fit in the batched solver's {BATCH_MB} MiB batch; use --solver sklearn or fewer trials")
 
 
 def run_sweep(cfg: SweepConfig, workdir: str | Path, *, out: str | Path | None = None, jobs: int = 1,
@@ -177,6 +187,7 @@ def run_sweep(cfg: SweepConfig, workdir: str | Path, *, out: str | Path | None =
     from ..tables.store import table_header, write_table
 
     workdir = Path(workdir)
+    check_batches(cfg)
     prepare_workdir(cfg, workdir, resume=resume, fresh=fresh)
     total = len(cfg.scene_points()) * len(cfg.blocks_of()) * len(cfg.contact_s)
     chunks: list[ChunkResult] = []
@@ -192,7 +203,10 @@ def run_sweep(cfg: SweepConfig, workdir: str | Path, *, out: str | Path | None =
         raise SweepInterrupted(len(list((workdir / "chunks").glob("*.npz"))), total, workdir) from None
     arrays = assemble(cfg, chunks)
     elapsed = time.perf_counter() - t0
+    wall = chunk_wall_s(cfg, chunks)  # timings: in the header's run stats, never in the hashed arrays
     header = table_header(cfg, arrays, run={"elapsed_s": elapsed, "chunks_computed": computed,
-                                            "chunks_total": total, "jobs": jobs, "backend": backend})
+                                            "chunks_total": total, "jobs": jobs, "backend": backend,
+                                            "solver": cfg.solver, "compute_s_total": float(wall.sum()),
+                                            "chunk_wall_s": wall.tolist()})
     path = Path(out) if out is not None else workdir / f"{cfg.name}.npz"
     return write_table(path, header, arrays)

@@ -6,6 +6,13 @@ Pairs within ``z`` standard errors of the threshold are re-scored with fresh
 seeds (up to ``max_repeats``). Trials are rendered by the sweep's forward
 model; an interval's features are a deterministic function of (interval,
 repeat), so a bounded cache never changes a result.
+
+Two solvers score a fit (``SweepConfig.solver``): ``sklearn``, scikit-learn's
+pipeline one pair at a time (the reference), and ``batched``,
+:func:`~designkit.recognition.batched_svm.batched_cv_f1` on every pair a
+search step asks for at once (the same classifier; predictions can differ
+from the reference's only on near-ties). Batches are cut so that their
+inputs stay under :data:`BATCH_MB`.
 """
 
 from __future__ import annotations
@@ -16,13 +23,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._validation import InputError
 from ..recognition.features import feature_matrix
 from ..scene import Scene
 from ..sensor import Sensor
 from ..simulation import draw_trials, render_trials
 from .config import SweepConfig
 
-__all__ = ["CV_KEY", "FEATURE_CACHE_MB", "PairCell", "PairScorer"]
+__all__ = ["BATCH_MB", "CV_KEY", "FEATURE_CACHE_MB", "PairCell", "PairScorer", "batch_pairs"]
 
 #: Seed-key suffix of the fold-shuffle streams (distinguishes them from the trial streams).
 CV_KEY = 7919
@@ -55,6 +63,48 @@ class PairCell:
 #: 200 Hz and 100 trials an interval's features take 3 MiB, so 500 intervals would take 1.5 GiB).
 FEATURE_CACHE_MB = 512
 
+#: Working memory of one batched-solver call [MiB]: the stacked features of its pairs plus the
+#: solver's own arrays. Together with the feature cache it keeps a worker under 1 GB (measured
+#: at 256 MiB: 0.85 GB peak for 200 intervals at 10 s contact, the cache full; 128 leaves margin).
+BATCH_MB = 128
+
+#: Most pairs in one batched-solver call (beyond this a batch is no faster per pair).
+MAX_BATCH = 64
+
+
+def batch_pairs(trials: int, n_samples: int, folds: int = 3) -> int:
+    """Pairs per batched-solver call that fit in :data:`BATCH_MB` (0: not even one pair fits).
+
+    Per pair: the two classes' features stacked and centered (``2 x 2 trials x
+    2 n_samples`` float64 values), each fold's standardized training touches
+    (float32) and the Gram and KKT matrices of ``(n_train + 1)^2`` float64 values.
+
+    Parameters
+    ----------
+    trials : int
+        Touches per interval.
+    n_samples : int
+        Samples per touch (the feature count is twice this).
+    folds : int
+        Cross-validation folds.
+
+    Returns
+    -------
+    int
+        Pairs per call, at most :data:`MAX_BATCH`.
+
+    Examples
+    --------
+    >>> batch_pairs(100, 400)   # 2 s at 200 Hz
+    37
+    >>> batch_pairs(100, 100_000)  # 500 s at 200 Hz: one pair would need about 0.5 GiB
+    0
+    """
+    d = 2 * n_samples
+    n_train = 2 * trials - (2 * trials) // folds
+    per_pair = 2 * (2 * trials) * d * 8 + n_train * d * 4 + 4 * (n_train + 1) ** 2 * 8
+    return int(min(MAX_BATCH, BATCH_MB * 2**20 // per_pair))
+
 
 class PairScorer:
     """SVM F1 of interval pairs for one scene, with repeats and caches local to a chunk."""
@@ -70,7 +120,7 @@ class PairScorer:
         self._features: OrderedDict[tuple[int, int], np.ndarray] = OrderedDict()
         per_entry = cfg.trials * 2 * self.n_samples * 8  # raw samples + slope, float64
         self._max_features = max(8, int(FEATURE_CACHE_MB * 2**20 // max(per_entry, 1)))
-        self.cells: dict[tuple[int, int], PairCell] = {}
+        self.scored: dict[tuple[int, int], PairCell] = {}  # every pair scored so far
         self.fits = 0
 
     def features(self, k: int, rep: int) -> np.ndarray:
@@ -91,6 +141,47 @@ class PairScorer:
                 self._features.popitem(last=False)
         return feats
 
+    def score_many(self, keys: list[tuple[int, int, int]]) -> list[tuple[float, float]]:
+        """``(F1, standard error)`` of each ``(i, j, repeat)``, by the config's solver."""
+        if self.cfg.solver == "sklearn":
+            return [self.score(i, j, rep) for i, j, rep in keys]
+        from ..recognition.batched_svm import batched_cv_f1
+
+        size = batch_pairs(self.cfg.trials, self.n_samples, self.cfg.folds)
+        if size < 1:
+            raise InputError(f"one pair of {self.cfg.trials} trials x {self.n_samples} samples does not fit "
+                             f"in the batched solver's {BATCH_MB} MiB; use --solver sklearn")
+        out: list[tuple[float, float]] = []
+        for b0 in range(0, len(keys), size):
+            part = keys[b0:b0 + size]
+            r = batched_cv_f1([self.features(i, rep) for i, _, rep in part],
+                              [self.features(j, rep) for _, j, rep in part],
+                              seeds=[[self.cfg.seed, i, j, rep, CV_KEY] for i, j, rep in part],
+                              folds=self.cfg.folds)
+            self.fits += len(part)
+            out += [(float(f), float(e)) for f, e in zip(r.f1, r.standard_error)]
+        return out
+
+    def cells(self, pairs: list[tuple[int, int]]) -> list[PairCell]:
+        """:meth:`cell` of many pairs: each round of repeats scored as one batch."""
+        out = []
+        for i, j in pairs:
+            if (i, j) not in self.scored:
+                self.scored[(i, j)] = PairCell()
+            out.append(self.scored[(i, j)])
+        while True:
+            need = sorted({(i, j) for (i, j), c in zip(pairs, out) if self._unsettled(c)})
+            if not need:
+                return out
+            keys = [(i, j, self.scored[(i, j)].reps) for i, j in need]
+            for (i, j, _), (f, s) in zip(keys, self.score_many(keys)):
+                self.scored[(i, j)].f1.append(f)
+                self.scored[(i, j)].se.append(s)
+
+    def _unsettled(self, c: PairCell) -> bool:
+        cfg = self.cfg
+        return c.reps < cfg.max_repeats and (c.reps == 0 or abs(c.mean - cfg.threshold) < cfg.z * c.stderr)
+
     def score(self, i: int, j: int, rep: int) -> tuple[float, float]:
         from ..recognition.svm import f1_from_features
 
@@ -101,13 +192,5 @@ class PairScorer:
 
     def cell(self, i: int, j: int) -> PairCell:
         """Score (i, j), adding repeats while the verdict is within z standard errors of Phi."""
-        c = self.cells.get((i, j))
-        if c is None:
-            c = self.cells[(i, j)] = PairCell()
-        cfg = self.cfg
-        while c.reps < cfg.max_repeats and (c.reps == 0 or abs(c.mean - cfg.threshold) < cfg.z * c.stderr):
-            f, s = self.score(i, j, c.reps)
-            c.f1.append(f)
-            c.se.append(s)
-        return c
+        return self.cells([(i, j)])[0]
 

@@ -5,7 +5,8 @@ distinguishable so is ``(i - 1, j)`` and ``(i, j + 1)``. Hence ``J(i)``, the
 first distinguishable partner above ``i``, never decreases with ``i``, and
 ``J`` alone determines both directions of ``delta`` for every reference
 (:func:`delta_from_staircase`). :func:`staircase_search` finds ``J`` with a
-few decisions per reference; :func:`ideal_staircase` finds the ideal
+few decisions per reference, each row on its own (so the answer does not
+depend on how a sweep is split); :func:`ideal_staircase` finds the ideal
 observer's ``J`` in closed form, a floor no classifier goes below, where the
 forward model allows a closed form (:func:`closed_form_model`);
 :func:`assemble` turns the staircases of all chunks into a table's arrays.
@@ -27,6 +28,7 @@ from .config import SweepConfig
 __all__ = [
     "IDEAL_UNKNOWN",
     "assemble",
+    "chunk_wall_s",
     "closed_form_model",
     "delta_from_staircase",
     "ideal_bound_s",
@@ -38,18 +40,37 @@ __all__ = [
 IDEAL_UNKNOWN = -1
 
 
-def staircase_search(decide: Callable[[int, int], bool], rows: Sequence[int], n: int, *,
-                     floor: np.ndarray | None = None, hint: np.ndarray | None = None) -> np.ndarray:
-    """``J(i) = min{j > i : decide(i, j)}`` for the rows ``i`` (ascending), ``n`` if none.
+def staircase_search(decide: Callable[[int, int], bool] | None, rows: Sequence[int], n: int, *,
+                     floor: np.ndarray | None = None,
+                     decide_many: Callable[[list[tuple[int, int]]], Sequence[bool]] | None = None) -> np.ndarray:
+    """``J(i)``, the first distinguishable partner above ``i``, for each row (``n`` if none).
 
-    Assumes monotone decisions (true at (i, j) implies true at (i - 1, j) and
-    (i, j + 1)), so ``J`` never decreases with ``i`` and each row starts at
-    the previous row's answer. ``floor[i]`` is a known lower bound of ``J(i)``
-    (the ideal observer's staircase); ``hint[i]`` a likely upper bound (the
-    previous contact time's). The first guess extrapolates the previous row's
-    step (capped by the hint); from a true guess the search steps down, from a
-    false one it doubles its steps up, then bisects: two decisions per row
-    when the guess is right, ``O(log n)`` when it is not.
+    Each row is searched on its own, from its own floor only: ``f = max(i + 1,
+    floor[i])`` (``floor`` is a known lower bound, the ideal observer's
+    staircase), probing ``f, f + 2, f + 6, f + 14, ...`` (steps doubling) up to
+    the first true probe, then bisecting between it and the last false one.
+    The probes a row makes depend on nothing but that row's decisions, so the
+    answer of a row is the same whatever other rows are searched with it (the
+    blocks, jobs and contact times a sweep is split into): a table is a
+    function of its config alone. On exactly monotone decisions (true at
+    ``(i, j)`` implies true at ``(i, j + 1)``) this is ``min{j > i : decide(i,
+    j)}``; on noisy ones it is a crossing (false below, true at ``J``) found
+    by a fixed path. About ``2 log2(J - f + 1) + 1`` decisions per row.
+
+    Parameters
+    ----------
+    decide : callable ``(i, j) -> bool``, optional
+        One decision.
+    rows : sequence of int
+        Reference intervals.
+    n : int
+        Number of intervals.
+    floor : ndarray of int, optional
+        Lower bound of ``J`` per interval (indexed by ``i``).
+    decide_many : callable ``[(i, j), ...] -> [bool, ...]``, optional
+        Many decisions at once (a batched scorer); the rows then advance in
+        lockstep, all pending probes of a step in one call. Either this or
+        ``decide``; the answer is the same.
 
     Returns
     -------
@@ -62,47 +83,53 @@ def staircase_search(decide: Callable[[int, int], bool], rows: Sequence[int], n:
     >>> truth = np.array([2, 2, 4, 5, 6, 6])  # first distinguishable partner of each reference
     >>> staircase_search(lambda i, j: j >= truth[i], range(6), 6).tolist()
     [2, 2, 4, 5, 6, 6]
+    >>> staircase_search(None, range(6), 6, decide_many=lambda p: [j >= truth[i] for i, j in p]).tolist()
+    [2, 2, 4, 5, 6, 6]
     """
+    if decide_many is None:
+        if decide is None:
+            raise TypeError("staircase_search needs decide or decide_many")
+        decide_many = lambda pairs: [decide(i, j) for i, j in pairs]  # noqa: E731
+    rows = [int(i) for i in rows]
     out = np.full(len(rows), n, dtype=np.int64)
-    prev, step_prev = 0, 1
+    searches = {}
+    pending: dict[int, int] = {}
     for r, i in enumerate(rows):
-        bound = max(i + 1, prev, int(floor[i]) if floor is not None else 0)  # J(i) >= bound
-        if bound >= n:
-            break  # J = n here and for every later row
-        guess = prev + step_prev if r > 0 else bound
-        if hint is not None and hint[i] < n:
-            guess = min(guess, int(hint[i]))
-        guess = min(max(guess, bound), n - 1)
-        lo = bound - 1  # known (or assumed) false
-        if decide(i, guess):
-            hi, step = guess, 1
-            while hi - 1 > lo:  # step down until a false cell
-                probe = max(hi - step, lo + 1)
-                if decide(i, probe):
-                    hi, step = probe, step * 2
-                else:
-                    lo = probe
-                    break
-        else:
-            lo, step = guess, max(step_prev, 1)
-            hi = n
-            while lo < n - 1:  # step up until a true cell
-                probe = min(lo + step, n - 1)
-                if decide(i, probe):
-                    hi = probe
-                    break
-                lo, step = probe, step * 2
-            if hi >= n:
-                break
-        while hi - lo > 1:
-            mid = (lo + hi) // 2
-            if decide(i, mid):
-                hi = mid
-            else:
-                lo = mid
-        step_prev = max(hi - prev, 1) if r > 0 else 1
-        out[r] = prev = hi
+        f = max(i + 1, int(floor[i]) if floor is not None else 0)
+        if f < n:
+            g = _row_search(f, n)
+            pending[r] = next(g)
+            searches[r] = g
+    while pending:
+        order = sorted(pending)
+        answers = decide_many([(rows[r], pending[r]) for r in order])
+        for r, ok in zip(order, answers):
+            try:
+                pending[r] = searches[r].send(bool(ok))
+            except StopIteration as stop:
+                out[r] = stop.value
+                del pending[r], searches[r]
     return out
+
+
+def _row_search(f: int, n: int):
+    """One row's search from its floor ``f``: yields probes, is sent their decisions, returns ``J``."""
+    lo, step = f - 1, 1  # lo: known (or assumed) false
+    while True:  # gallop up to the first true probe
+        probe = min(lo + step, n - 1)
+        if (yield probe):
+            hi = probe
+            break
+        if probe >= n - 1:
+            return n
+        lo, step = probe, step * 2
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        if (yield mid):
+            hi = mid
+        else:
+            lo = mid
+    return hi
 
 
 def ideal_staircase(cfg: SweepConfig, sensor: Sensor, s: float, rows: np.ndarray) -> np.ndarray:
@@ -210,27 +237,26 @@ def assemble(cfg: SweepConfig, chunks: Sequence) -> dict[str, np.ndarray]:
 
     ``chunks`` are :class:`~designkit.sweep.chunk.ChunkResult` (anything with
     their ``point``, ``contact_index``, ``rows``, ``J``, ``J_lo``, ``J_hi``,
-    ``J_ideal``, ``fits``, ``wall_s`` and ``f1_rows``). The array names and
-    units are the table format's (:mod:`designkit.tables.store`): ``delta_*``
-    [J s^-1/2 K^-1 m^-2], ``fits``, ``chunk_wall_s`` [s], ``f1_matrix``.
+    ``J_ideal``, ``fits`` and ``f1_rows``). The array names and units are
+    the table format's (:mod:`designkit.tables.store`): ``delta_*``
+    [J s^-1/2 K^-1 m^-2], ``fits``, ``f1_matrix``. Nothing that depends on the
+    machine or the run goes in here (the arrays are the table's identity):
+    compute times are in the header's run stats (:func:`chunk_wall_s`).
     """
     n = cfg.intervals
     shape = cfg.scene_shape + (len(cfg.contact_s),)
     J = {name: np.full(shape + (n,), n, dtype=np.int64) for name in ("J", "J_lo", "J_hi", "J_ideal")}
     fits = np.zeros(shape, dtype=np.int64)
-    wall = np.zeros(shape, dtype=np.float64)
     f1 = np.full(shape + (n, n), np.nan, dtype=np.float32) if cfg.full_matrix else None
     for c in chunks:
         key = tuple(c.point) + (c.contact_index,)
         for name in J:
             J[name][key][c.rows] = getattr(c, name)
         fits[key] += c.fits
-        wall[key] += c.wall_s
         if f1 is not None and c.f1_rows is not None:
             f1[key][c.rows] = c.f1_rows
     out = _deltas(cfg, J, shape)
     out["fits"] = fits
-    out["chunk_wall_s"] = wall
     if f1 is not None:
         iu = np.triu_indices(n, 1)
         for key in np.ndindex(*shape):
@@ -238,6 +264,18 @@ def assemble(cfg: SweepConfig, chunks: Sequence) -> dict[str, np.ndarray]:
             m[(iu[1], iu[0])] = m[iu]
         out["f1_matrix"] = f1
     return out
+
+
+def chunk_wall_s(cfg: SweepConfig, chunks: Sequence) -> np.ndarray:
+    """Compute time [s] per scene point and contact time, summed over blocks (for the run stats).
+
+    Shaped like the table's ``fits`` array; timings are kept out of the
+    table's arrays so that two builds of one config are identical.
+    """
+    wall = np.zeros(cfg.scene_shape + (len(cfg.contact_s),), dtype=np.float64)
+    for c in chunks:
+        wall[tuple(c.point) + (c.contact_index,)] += c.wall_s
+    return wall
 
 
 def _deltas(cfg: SweepConfig, J: dict[str, np.ndarray], shape: tuple[int, ...]) -> dict[str, np.ndarray]:

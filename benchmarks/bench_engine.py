@@ -1,0 +1,144 @@
+"""delta(e) of one scene, three ways in one run: naive matrix loop, staircase + sklearn, staircase + batched.
+
+Run from the repository root::
+
+    python benchmarks/bench_engine.py                       # 100 intervals, 2 s, sigma/dT 0.005 (a few minutes)
+    python benchmarks/bench_engine.py --intervals 40 --repeat 3
+
+One scene (``--intervals`` intervals over (0, 40000], one contact time, one
+noise ratio, ``--trials`` touches per interval, the sweep's own seeds):
+
+* **naive**: the paper's loop, one scikit-learn fit of every pair of the
+  ``n (n - 1) / 2``; timed on ``--naive-pairs`` random pairs and extrapolated
+  (wall per fit times the number of pairs);
+* **staircase + sklearn**: ``run_chunk`` with ``solver: sklearn`` (the reference);
+* **staircase + batched**: ``run_chunk`` with ``solver: batched``.
+
+Printed for each: wall [s], SVM fits, fits per second and the ratios to the
+naive loop and to the sklearn staircase; the agreement of the two staircases
+(references whose ``J``, ``J_lo``, ``J_hi`` differ, and by how many intervals);
+and the parallel efficiency of the batched sweep (``run_sweep`` with 2 blocks)
+on ``--jobs 1`` and ``2`` local processes: ``T1 / (jobs x Tjobs)``. BLAS threads
+are limited to 1 per process. Wall times are medians of ``--repeat`` runs;
+the load average before and after is printed, because the machines are shared.
+No figure here is asserted anywhere.
+"""
+
+from __future__ import annotations
+
+import os
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("MKL_NUM_THREADS", "1")
+
+import argparse  # noqa: E402
+import statistics  # noqa: E402
+import sys  # noqa: E402
+import tempfile  # noqa: E402
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+from designkit.sweep import SweepConfig, run_chunk, run_sweep  # noqa: E402
+from designkit.sweep.scorer import CV_KEY, PairScorer  # noqa: E402
+
+
+def _median_run(fn, repeat):
+    walls, out = [], None
+    for _ in range(repeat):
+        t = time.perf_counter()
+        out = fn()
+        walls.append(time.perf_counter() - t)
+    return statistics.median(walls), out
+
+
+def naive(cfg: SweepConfig, pairs: int, seed: int = 0):
+    """Wall [s] per fit of the naive loop on ``pairs`` random pairs (features cached as the loop would)."""
+    from designkit.recognition.svm import f1_from_features
+
+    sensor = cfg.resolved_sensor()
+    scorer = PairScorer(cfg, sensor, cfg.scene((0,), cfg.contact_s[0]))
+    rng = np.random.default_rng(seed)
+    n = cfg.intervals
+    ij = set()
+    while len(ij) < min(pairs, n * (n - 1) // 2):
+        i, j = sorted(rng.choice(n, 2, replace=False).tolist())
+        ij.add((i, j))
+    ij = sorted(ij)
+    for i, j in ij:  # features first: the full loop draws each interval's touches once
+        scorer.features(i, 0), scorer.features(j, 0)
+    f1_from_features(scorer.features(ij[0][0], 0), scorer.features(ij[0][1], 0), folds=cfg.folds, seed=0)  # warm-up
+    t = time.perf_counter()
+    for i, j in ij:
+        f1_from_features(scorer.features(i, 0), scorer.features(j, 0), folds=cfg.folds, seed=[cfg.seed, i, j, 0, CV_KEY])
+    return (time.perf_counter() - t) / len(ij), len(ij)
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--intervals", type=int, default=100)
+    p.add_argument("--contact", type=float, default=2.0, help="contact time [s]")
+    p.add_argument("--noise-ratio", type=float, default=0.005, help="sigma/dT")
+    p.add_argument("--trials", type=int, default=100)
+    p.add_argument("--naive-pairs", type=int, default=30, help="pairs timed for the naive loop's extrapolation")
+    p.add_argument("--repeat", type=int, default=1, help="runs per wall figure (median)")
+    p.add_argument("--skip-parallel", action="store_true")
+    args = p.parse_args(argv)
+
+    base = dict(intervals=args.intervals, trials=args.trials, noise_ratio=(args.noise_ratio,),
+                contact_s=(args.contact,))
+    load0 = os.getloadavg()
+    print(f"scene: {args.intervals} intervals over (0, 40000], contact {args.contact:g} s, sigma/dT "
+          f"{args.noise_ratio:g}, {args.trials} trials per interval; {os.cpu_count()} cores, load average "
+          f"{load0[0]:.2f} {load0[1]:.2f} {load0[2]:.2f} at the start", flush=True)
+
+    per_fit, timed = naive(SweepConfig(**base), args.naive_pairs)
+    n_pairs = args.intervals * (args.intervals - 1) // 2
+    rows = {"naive (extrapolated)": (per_fit * n_pairs, n_pairs)}
+    print(f"  naive: {timed} pairs timed, {per_fit * 1e3:.1f} ms per fit", file=sys.stderr, flush=True)
+    res = {}
+    for solver in ("sklearn", "batched"):
+        wall, r = _median_run(lambda: run_chunk(SweepConfig(solver=solver, **base), (0,), 0, 0), args.repeat)
+        res[solver] = r
+        rows[f"staircase + {solver}"] = (wall, r.fits)
+        print(f"  staircase + {solver}: {wall:.1f} s, {r.fits} fits", file=sys.stderr, flush=True)
+
+    print("\n| route | wall [s] | SVM fits | fits/s | less wall than naive | less wall than staircase + sklearn |")
+    print("|---|---|---|---|---|---|")
+    ref_wall = rows["staircase + sklearn"][0]
+    for name, (wall, fits) in rows.items():
+        print(f"| {name} | {wall:.1f} | {fits} | {fits / wall:.1f} | {rows['naive (extrapolated)'][0] / wall:.1f}x "
+              f"| {ref_wall / wall:.2f}x |")
+
+    a, b = res["sklearn"], res["batched"]
+    print("\nAgreement of the two staircases (references differing, largest difference in intervals):")
+    for name in ("J", "J_lo", "J_hi"):
+        d = np.abs(getattr(a, name) - getattr(b, name))
+        print(f"  {name}: {int(np.sum(d > 0))} of {d.size}, max {int(d.max())}")
+    ca = {(int(c[0]), int(c[1])): c for c in a.cells}
+    cb = {(int(c[0]), int(c[1])): c for c in b.cells}
+    both = sorted(set(ca) & set(cb))
+    dF = np.array([abs(ca[k][2] - cb[k][2]) for k in both])
+    print(f"  cells scored by both: {len(both)}; mean F1 differs in {int(np.sum(dF > 0))} "
+          f"(max |dF1| {dF.max() if dF.size else 0:.4f})")
+
+    if not args.skip_parallel:
+        walls = {}
+        for jobs in (1, 2):
+            def go(jobs=jobs):
+                with tempfile.TemporaryDirectory() as tmp:
+                    cfg = SweepConfig(name="bench", solver="batched", blocks=2, **base)
+                    run_sweep(cfg, Path(tmp), jobs=jobs, backend="loky" if jobs > 1 else "sequential")
+            walls[jobs], _ = _median_run(go, args.repeat)
+        eff = walls[1] / (2 * walls[2])
+        print(f"\nParallel (batched solver, 2 blocks): --jobs 1 {walls[1]:.1f} s, --jobs 2 {walls[2]:.1f} s: "
+              f"speed-up {walls[1] / walls[2]:.2f}x, efficiency {eff:.0%} (process start-up included)")
+    load1 = os.getloadavg()
+    print(f"\nload average {load1[0]:.2f} {load1[1]:.2f} {load1[2]:.2f} at the end (2 cores shared with other users: "
+          "wall figures are upper bounds)")
+
+
+if __name__ == "__main__":
+    main()

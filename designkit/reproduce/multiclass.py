@@ -37,6 +37,9 @@ _MAX_BINS = 100_000
 def bayes_accuracy(ranges, sensor, scene) -> float:
     """Best multi-class accuracy of any classifier (equal priors), classes uniform over ``ranges``.
 
+    :func:`designkit.query.matrix.multiclass_ideal_accuracy` (the one implementation,
+    which ``designkit matrix`` uses too).
+
     Parameters
     ----------
     ranges : array_like, shape (K, 2)
@@ -45,23 +48,9 @@ def bayes_accuracy(ranges, sensor, scene) -> float:
     scene : Scene
         Fixed initial conditions.
     """
-    from ..recognition.ideal import class_survival, projection_noise
-    from ..models.semi_infinite import object_weight
+    from ..query.matrix import multiclass_ideal_accuracy
 
-    r = np.asarray(ranges, dtype=np.float64)
-    s = projection_noise(sensor, scene)
-    K = r.shape[0]
-    if not np.isfinite(s):
-        return 1.0 / K
-    w = object_weight(sensor.effusivity, r)
-    lo, hi = float(w.min()) - 9.0 * s, float(w.max()) + 9.0 * s
-    step = max(s / 8.0, (hi - lo) / _MAX_BINS)
-    edges = np.arange(lo, hi + step, step)
-    best = np.zeros(edges.size - 1)
-    for a, b in r:  # one class at a time: class_survival's quadrature allocates (bins x nodes)
-        surv = class_survival(edges, a, b, sensor.effusivity, s)
-        np.maximum(best, surv[:-1] - surv[1:], out=best)
-    return float(np.sum(best) / K)
+    return multiclass_ideal_accuracy(ranges, sensor, scene, max_bins=_MAX_BINS)
 
 
 def _simulate_classes(ranges, trials: int, sensor, scene, seed) -> tuple[np.ndarray, np.ndarray]:

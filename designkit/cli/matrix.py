@@ -26,6 +26,9 @@ def matrix(
         "--m", help="A material (repeat: --m copper --m glass ...); see 'designkit materials list'.")] = None,
     set_: Annotated[Optional[str], typer.Option(
         "--set", help="Every material of a named set: 'paper12' (the paper's robot materials) or 'database'.")] = None,
+    from_: Annotated[Optional[str], typer.Option(
+        "--from", help="Read materials from a file ('-': stdin): one name a line, or a CSV with a 'name' column "
+                       "(and 'set'), as 'designkit materials list --format csv' writes it.")] = None,
     question: Annotated[str, typer.Option("--question", "-q", help=f"What to ask of every pair: {_QUESTIONS}.")]
     = "min-contact",
     contact: Annotated[Optional[float], typer.Option(
@@ -56,9 +59,12 @@ def matrix(
     Example: `designkit matrix --set paper12`
 
     Example: `designkit matrix --m copper --m "stainless steel" --m glass --m granite -q max-noise --contact 2 --format csv`
+
+    Example: `designkit materials list --family metals --format csv | designkit matrix --from -`
     """
     from ..query.matrix import material_matrix
 
+    names = list(m or ()) + (read_material_names(from_) if from_ else [])
     fmt = "json" if json_ else check_format(format_)
     scene = {"contact_s": contact, "noise_c": noise, "delta_t_c": delta_t, "threshold": threshold}
     if question in ("max-noise", "min-delta-t", "distinguishable") and contact is None:
@@ -71,7 +77,7 @@ def matrix(
         raise InputError("min-contact asks for the contact time: drop --contact")
     progress = _progress(json_ or fmt == "json")
     try:
-        result = material_matrix(list(m or ()), question, set=set_, table=table, ideal_table=ideal_table,
+        result = material_matrix(names, question, set=set_, table=table, ideal_table=ideal_table,
                                  multiclass=multiclass, progress=progress.step if progress else None,
                                  **{k: v for k, v in scene.items() if v is not None})
     finally:
@@ -99,6 +105,27 @@ def matrix(
     emit_rows(rows, ["material", *names], fmt=fmt, out=out, payload=result.to_dict(), title=_title(result),
               notes=_notes(result), text=lambda _c, v: "·" if v is None else str(v),
               justify={"material": "left", **{n: "right" for n in names}})
+
+
+def read_material_names(path: str) -> list[str]:
+    """Material names from a file or stdin (``-``): one a line (``#`` comments and blank lines skipped), or a
+    CSV whose header has a ``name`` column (a ``set`` column qualifies each name: ``paper12:Glass``)."""
+    import csv
+    import io
+    import sys
+    from pathlib import Path
+
+    text = sys.stdin.read() if path == "-" else Path(path).read_text(encoding="utf-8")
+    lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
+    if not lines:
+        from .._validation import InputError
+
+        raise InputError(f"no material names in {'stdin' if path == '-' else path}")
+    header = next(csv.reader([lines[0]]))
+    if "name" in header and len(header) > 1:
+        rows = list(csv.DictReader(io.StringIO("\n".join(lines))))
+        return [f"{r['set']}:{r['name']}" if r.get("set") else r["name"] for r in rows if r.get("name")]
+    return [ln.strip() for ln in lines]
 
 
 def _cell(question: str, v: float, status: str, bound: str) -> str:

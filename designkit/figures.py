@@ -54,7 +54,7 @@ def save_figure(fig, path, *, dpi: int = 200) -> Path:
         raise InputError(f"figure file {path.name!r}: give a .png, .svg or .pdf name")
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=dpi if fmt == "png" else None, format=fmt, bbox_inches="tight",
-                metadata={"Date": None} if fmt == "pdf" else ({"Date": None} if fmt == "svg" else None))
+                metadata=None if fmt == "png" else {"Date": None})  # no date: the same figure, the same file
     pyplot().close(fig)
     return path
 

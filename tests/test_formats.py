@@ -81,3 +81,42 @@ def test_matrix_reads_one_name_a_line(cli, tmp_path):
     r = cli("matrix", "--from", str(p), "--format", "csv", "--no-multiclass")
     assert r.exit_code == 0, r.output
     assert r.stdout.splitlines()[0] == "material,Glass,Copper"
+
+
+# ---------------------------------------------------------------- figures: vector formats on request
+@pytest.mark.parametrize("fmt, magic", [("svg", b"<?xml"), ("pdf", b"%PDF"), ("png", b"\x89PNG")])
+def test_report_figures_in_the_format_asked(tmp_path, fmt, magic):
+    pytest.importorskip("matplotlib")
+    from designkit.figures import pyplot
+    from designkit.reproduce import ReproduceSettings
+    from designkit.reproduce._report import Context
+
+    ctx = Context(ReproduceSettings(figure_format=fmt), tmp_path)
+    fig, ax = pyplot().subplots()
+    ax.plot([0, 1], [0, 1])
+    rel = ctx.save_figure(fig, "line")
+    assert rel == f"figures/line.{fmt}"
+    assert (tmp_path / rel).read_bytes().startswith(magic)
+    assert not list((tmp_path / "figures").glob(".*"))  # no temporary file left
+
+
+def test_unknown_figure_format_is_refused():
+    from designkit._validation import InputError
+    from designkit.reproduce import ReproduceSettings
+
+    with pytest.raises(InputError, match="png, svg or pdf"):
+        ReproduceSettings(figure_format="jpg")
+
+
+def test_node_graph_layout_puts_every_node_somewhere_distinct():
+    nx = pytest.importorskip("networkx")
+    from designkit.reproduce.matrices import graph_layout
+
+    G = nx.Graph()
+    G.add_nodes_from(range(9))
+    G.add_edges_from([(0, 1), (1, 2), (2, 0), (3, 4)])
+    pos, angle = graph_layout(G, lambda v: v)
+    assert set(pos) == set(range(9)) == set(angle)
+    pts = {tuple(round(c, 9) for c in p) for p in pos.values()}
+    assert len(pts) == 9
+    assert all(angle[v] == -90.0 for v in (5, 6, 7, 8))  # lone nodes in a row, labels below

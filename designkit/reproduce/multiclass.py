@@ -139,6 +139,8 @@ def section_multiclass(ctx: Context) -> SectionResult:
     from ..figures import pyplot
 
     plt = pyplot()
+    from matplotlib.ticker import NullLocator
+
     fig, axes = plt.subplots(1, 3, figsize=(16, 4.8), constrained_layout=True,
                              gridspec_kw={"width_ratios": [1.0, 1.15, 1.15]})
     ks = [c["k"] for c in curve]
@@ -147,6 +149,8 @@ def section_multiclass(ctx: Context) -> SectionResult:
     axes[0].plot(ks, [c["bayes_accuracy"] for c in curve], "s--", label="ideal observer (Bayes)")
     axes[0].plot(ks, [c["chance"] for c in curve], ":", color="grey", label="chance")
     axes[0].set_xscale("log")
+    axes[0].set_xticks(ks, [str(k) for k in ks])  # the k computed, in plain numbers (no 2x10^0 minor labels)
+    axes[0].xaxis.set_minor_locator(NullLocator())
     axes[0].set_xlabel("materials recognised at once, k (random database subsets)")
     axes[0].set_ylabel("accuracy")
     axes[0].set_ylim(0, 1.02)

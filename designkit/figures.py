@@ -131,7 +131,7 @@ def plot_matrix(result, path) -> Path:
         ax2.set_ylabel(f"accuracy, all {n} at once")
         ax2.set_ylim(0, 1.02)
         ax2.grid(alpha=0.3)
-        ax2.legend(fontsize=8, loc="lower right")
+        ax2.legend(fontsize=8, loc="center right")
         sc = curve.scene
         ax2.set_title(f"σ {sc['noise_c']:g} °C, ΔT {sc['delta_t_c']:g} °C"
                       + ("" if curve.svm_accuracy is not None else " (SVM not computed)"), fontsize=9)

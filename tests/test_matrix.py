@@ -174,3 +174,24 @@ def test_cli_plot_writes_a_vector_figure(cli, tmp_path):
     r = cli("matrix", *sum((["--m", m] for m in THREE), []), "--plot", str(tmp_path / "m.svg"))
     assert r.exit_code == 0, r.output
     assert (tmp_path / "m.svg").read_text().lstrip().startswith("<?xml")
+
+
+def test_svm_multiclass_on_request_equals_the_reproduce_pipeline(paper_sensor):
+    pytest.importorskip("sklearn")
+    from designkit.reproduce.multiclass import svm_multiclass
+    from designkit.scene import Scene
+
+    r = material_matrix(THREE, svm_trials=6, seed=3)
+    mc = r.multiclass
+    assert mc.svm_accuracy is not None and mc.svm_accuracy.shape == mc.contact_s.shape
+    assert np.all((0 <= mc.svm_accuracy) & (mc.svm_accuracy <= 1)) and "SVM: the paper's pipeline" in mc.note
+    sc = Scene.from_delta_t(contact_s=float(mc.contact_s[2]), noise_c=0.05, delta_t_c=10.0)
+    want = svm_multiclass([m.effusivity_range for m in r.materials], 6, paper_sensor, sc, [3, 16, 2])["accuracy"]
+    assert mc.svm_accuracy[2] == want
+
+
+def test_progress_counts_pairs_then_svm_contacts():
+    pytest.importorskip("sklearn")
+    seen = []
+    material_matrix(THREE, svm_trials=3, progress=lambda d, t: seen.append((d, t)))
+    assert seen[0] == (1, 3 + 12) and seen[-1] == (15, 15) and [d for d, _ in seen] == list(range(1, 16))

@@ -46,6 +46,10 @@ def matrix(
     multiclass: Annotated[bool, typer.Option(
         "--multiclass/--no-multiclass", help="Add the accuracy of telling all N apart against contact time.")]
     = True,
+    svm_trials: Annotated[Optional[int], typer.Option(
+        "--svm-trials", help="Also the SVM's multi-class accuracy, on this many simulated touches per material "
+                             "(seconds; e.g. 60).")] = None,
+    seed: Annotated[int, typer.Option("--seed", help="Seed of the SVM's simulated touches.")] = 0,
     plot: Annotated[Optional[str], typer.Option(
         "--plot", help="Save a figure: heatmap + multi-class accuracy (.png, .svg or .pdf).")] = None,
     format_: FormatOpt = "table",
@@ -78,7 +82,8 @@ def matrix(
     progress = _progress(json_ or fmt == "json")
     try:
         result = material_matrix(names, question, set=set_, table=table, ideal_table=ideal_table,
-                                 multiclass=multiclass, progress=progress.step if progress else None,
+                                 multiclass=multiclass, svm_trials=svm_trials, seed=seed,
+                                 progress=progress.step if progress else None,
                                  **{k: v for k, v in scene.items() if v is not None})
     finally:
         if progress:
@@ -161,6 +166,10 @@ def _notes(r) -> list[str]:
                             if c in (0.5, 1.0, 2.0, 4.0, 10.0))
             notes.append(f"Telling all {len(r.materials)} apart at once (ideal observer, chance "
                          f"{mc.chance:.3f}): {pts}.")
+        if mc.svm_accuracy is not None:
+            pts = ", ".join(f"{c:g} s {a:.3f}" for c, a in zip(mc.contact_s, mc.svm_accuracy)
+                            if c in (0.5, 1.0, 2.0, 4.0, 10.0))
+            notes.append(f"Telling all {len(r.materials)} apart at once (SVM): {pts}.")
         notes.append(mc.note[0].upper() + mc.note[1:] + ".")
     return notes
 

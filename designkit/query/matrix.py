@@ -25,9 +25,8 @@ of highest density of ``v``; :func:`multiclass_ideal_accuracy` computes it on
 bins of ``v`` of width ``s / 8`` (the bin-wise Bayes rule, a lower bound that
 converges from below as the bins shrink). Overlapping materials cap it below 1
 at any contact time. The SVM's multi-class accuracy needs simulated touches
-and a classifier fit (seconds): it is not computed here (``svm_accuracy`` is
-None and the result says so); ``designkit reproduce --section multiclass``
-computes it.
+and a classifier fit (seconds): it is computed only when asked for
+(``svm_trials``; otherwise ``svm_accuracy`` is None and the result says so).
 
 Examples
 --------
@@ -61,6 +60,7 @@ __all__ = [
     "MulticlassCurve",
     "material_matrix",
     "multiclass_ideal_accuracy",
+    "multiclass_svm_accuracy",
     "resolve_materials",
 ]
 
@@ -368,25 +368,81 @@ def multiclass_ideal_accuracy(ranges, sensor, scene, *, max_bins: int = _MAX_BIN
     return float(np.sum(best) / K)
 
 
-def _multiclass(mats, tab, *, noise_c: float, delta_t_c: float) -> MulticlassCurve:
+def multiclass_svm_accuracy(ranges, trials: int, sensor, scene, seed) -> dict:
+    """Cross-validated (stratified 3-fold) accuracy and confusion of the paper's SVM on K classes at once.
+
+    Each class: ``trials`` simulated touches with effusivity uniform over its
+    range (:func:`designkit.simulation.simulate_interval`), the paper's
+    features and linear SVM, multi-class one-vs-one (scikit-learn's SVC).
+
+    Parameters
+    ----------
+    ranges : array_like, shape (K, 2)
+        Effusivity range of each class [J s^-1/2 K^-1 m^-2].
+    trials : int
+        Simulated touches per class.
+    sensor : Sensor
+    scene : Scene
+    seed : sequence of int
+        Seed of the touches and of the folds.
+
+    Returns
+    -------
+    dict
+        ``accuracy`` (float) and ``confusion`` (K x K counts, true x predicted).
+    """
+    import sklearn
+    from sklearn.metrics import confusion_matrix
+    from sklearn.model_selection import StratifiedKFold, cross_val_predict
+
+    from .._validation import as_generator
+    from ..recognition.features import feature_matrix
+    from ..recognition.svm import make_classifier
+    from ..simulation import simulate_interval
+
+    seed = list(seed)
+    X, y = [], []
+    for k, (lo, hi) in enumerate(np.asarray(ranges, dtype=np.float64)):
+        t = simulate_interval(lo, hi, trials, sensor, scene, seed=seed + [1, k])
+        X.append(feature_matrix(t.temperature_c, sensor.sample_rate_hz))
+        y.append(np.full(trials, k))
+    X, y = np.vstack(X), np.concatenate(y)
+    rs = int(as_generator(seed + [2]).integers(0, 2**31 - 1))
+    with sklearn.config_context(assume_finite=True, skip_parameter_validation=True):
+        pred = cross_val_predict(make_classifier(), X, y, cv=StratifiedKFold(3, shuffle=True, random_state=rs))
+    K = len(ranges)
+    return {"accuracy": float(np.mean(pred == y)), "confusion": confusion_matrix(y, pred, labels=list(range(K)))}
+
+
+def _multiclass(mats, tab, *, noise_c: float, delta_t_c: float, svm_trials: int | None, seed: int,
+                step: Callable[[], None]) -> MulticlassCurve:
     from ..scene import Scene
 
     contacts = np.asarray(tab.axes["contact_s"], dtype=np.float64)
     scene = {"noise_c": noise_c, "delta_t_c": delta_t_c}
-    svm_note = ("SVM accuracy not computed (it needs simulated touches and a classifier fit, seconds: "
-                "designkit reproduce --section multiclass)")
-    model = tab.model
-    if getattr(model, "name", "") != "semi-infinite" or not tab.fixed_initial_conditions:
-        return MulticlassCurve(contacts, None, None, 1.0 / len(mats), scene,
-                               f"ideal accuracy not computed: the closed form needs the semi-infinite model with "
-                               f"fixed initial conditions (table {tab.name}: {model.describe()}); " + svm_note)
     sensor = tab.sensor
     ranges = [m.effusivity_range for m in mats]
-    acc = np.array([multiclass_ideal_accuracy(ranges, sensor, Scene.from_delta_t(
-        contact_s=float(c), noise_c=noise_c, delta_t_c=delta_t_c)) for c in contacts])
+    scenes = [Scene.from_delta_t(contact_s=float(c), noise_c=noise_c, delta_t_c=delta_t_c) for c in contacts]
+    svm = None
+    if svm_trials:
+        svm = np.empty(contacts.size)
+        for k, sc in enumerate(scenes):
+            svm[k] = multiclass_svm_accuracy(ranges, svm_trials, sensor, sc, [seed, 16, k])["accuracy"]
+            step()
+        svm_note = (f"SVM: the paper's pipeline on {svm_trials} simulated touches per material, one-vs-one, "
+                    "stratified 3-fold cross-validated accuracy")
+    else:
+        svm_note = ("SVM accuracy not computed (it needs simulated touches and a classifier fit, seconds: "
+                    "ask for it with svm_trials, designkit matrix --svm-trials N)")
+    model = tab.model
+    if getattr(model, "name", "") != "semi-infinite" or not tab.fixed_initial_conditions:
+        return MulticlassCurve(contacts, None, svm, 1.0 / len(mats), scene,
+                               f"ideal accuracy not computed: the closed form needs the semi-infinite model with "
+                               f"fixed initial conditions (table {tab.name}: {model.describe()}); " + svm_note)
+    acc = np.array([multiclass_ideal_accuracy(ranges, sensor, sc) for sc in scenes])
     note = ("ideal observer: exact Bayes accuracy (equal priors), each material uniform over its whole effusivity "
             "range; " + svm_note)
-    return MulticlassCurve(contacts, acc, None, 1.0 / len(mats), scene, note)
+    return MulticlassCurve(contacts, acc, svm, 1.0 / len(mats), scene, note)
 
 
 # ============================================================ the matrix
@@ -440,8 +496,8 @@ def _limiting(question: str, cells: Sequence[MatrixCell], names: Sequence[str]) 
 
 def material_matrix(materials: Sequence[str | Material] = (), question: str = "min-contact", *,
                     set: str | None = None, table: Any = None, ideal_table: Any = "ideal-paper",  # noqa: A002
-                    multiclass: bool = True, progress: Callable[[int, int], None] | None = None,
-                    **scene: Any) -> MaterialMatrix:
+                    multiclass: bool = True, svm_trials: int | None = None, seed: int = 0,
+                    progress: Callable[[int, int], None] | None = None, **scene: Any) -> MaterialMatrix:
     """The pairwise matrix of ``question`` over N materials, its limiting pair and the multi-class view.
 
     Parameters
@@ -457,8 +513,14 @@ def material_matrix(materials: Sequence[str | Material] = (), question: str = "m
         table; each is loaded and verified once and passed to every query.
     multiclass : bool
         Compute the multi-class view.
+    svm_trials : int, optional
+        Also the SVM's multi-class accuracy at each contact time of the table,
+        on this many simulated touches per material (seconds; needs
+        scikit-learn). None: not computed (said so in the result).
+    seed : int
+        Seed of the SVM's simulated touches and folds.
     progress : callable(done, total), optional
-        Called after each pair (for a progress display).
+        Called after each pair and each SVM contact time (for a progress display).
     **scene
         The question's scene arguments and table-route options:
         ``contact_s`` [s], ``noise_c`` [degC], ``delta_t_c`` [degC],
@@ -488,7 +550,10 @@ def material_matrix(materials: Sequence[str | Material] = (), question: str = "m
     names = tuple(m.name for m in mats)
     cells = []
     n = len(mats)
-    total = n * (n - 1) // 2
+    n_svm = tab.axes["contact_s"].size if multiclass and svm_trials else 0
+    total = n * (n - 1) // 2 + n_svm
+    if svm_trials is not None and (int(svm_trials) != svm_trials or svm_trials < 3):
+        raise InputError(f"svm_trials must be an integer of at least 3 (3-fold cross-validation), got {svm_trials}")
     for i in range(n):
         for j in range(i + 1, n):
             a = ask(question, route="table", m1=mats[i].qualified_name, m2=mats[j].qualified_name, table=tab,
@@ -505,7 +570,14 @@ def material_matrix(materials: Sequence[str | Material] = (), question: str = "m
     if multiclass:
         noise = float(scene.get("noise_c") if scene.get("noise_c") is not None else 0.05)
         dt = float(scene.get("delta_t_c") if scene.get("delta_t_c") is not None else 10.0)
-        curve = _multiclass(mats, tab, noise_c=noise, delta_t_c=dt)
+        done = [len(cells)]
+
+        def step() -> None:
+            done[0] += 1
+            if progress is not None:
+                progress(done[0], total)
+
+        curve = _multiclass(mats, tab, noise_c=noise, delta_t_c=dt, svm_trials=svm_trials, seed=seed, step=step)
     first = cells[0].answer
     return MaterialMatrix(question, mats, tuple(cells), _limiting(question, cells, names), curve,
                           {k: first.scene.get(k) for k in ("contact_s", "noise_c", "delta_t_c", "noise_ratio")},

@@ -53,34 +53,14 @@ def bayes_accuracy(ranges, sensor, scene) -> float:
     return multiclass_ideal_accuracy(ranges, sensor, scene, max_bins=_MAX_BINS)
 
 
-def _simulate_classes(ranges, trials: int, sensor, scene, seed) -> tuple[np.ndarray, np.ndarray]:
-    from ..recognition.features import feature_matrix
-    from ..simulation import simulate_interval
-
-    X, y = [], []
-    for k, (lo, hi) in enumerate(np.asarray(ranges, dtype=np.float64)):
-        t = simulate_interval(lo, hi, trials, sensor, scene, seed=list(seed) + [k])
-        X.append(feature_matrix(t.temperature_c, sensor.sample_rate_hz))
-        y.append(np.full(trials, k))
-    return np.vstack(X), np.concatenate(y)
-
-
 def svm_multiclass(ranges, trials: int, sensor, scene, seed) -> dict:
-    """Cross-validated (3-fold) accuracy and confusion of the paper's SVM on K classes at once."""
-    import sklearn
-    from sklearn.metrics import confusion_matrix
-    from sklearn.model_selection import StratifiedKFold, cross_val_predict
+    """Cross-validated (3-fold) accuracy and confusion of the paper's SVM on K classes at once.
 
-    from .._validation import as_generator
-    from ..recognition.svm import make_classifier
+    :func:`designkit.query.matrix.multiclass_svm_accuracy` (the one implementation).
+    """
+    from ..query.matrix import multiclass_svm_accuracy
 
-    seed = list(seed)
-    X, y = _simulate_classes(ranges, trials, sensor, scene, seed + [1])
-    rs = int(as_generator(seed + [2]).integers(0, 2**31 - 1))
-    with sklearn.config_context(assume_finite=True, skip_parameter_validation=True):
-        pred = cross_val_predict(make_classifier(), X, y, cv=StratifiedKFold(3, shuffle=True, random_state=rs))
-    K = len(ranges)
-    return {"accuracy": float(np.mean(pred == y)), "confusion": confusion_matrix(y, pred, labels=list(range(K)))}
+    return multiclass_svm_accuracy(ranges, trials, sensor, scene, seed)
 
 
 def section_multiclass(ctx: Context) -> SectionResult:

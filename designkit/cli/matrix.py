@@ -34,9 +34,11 @@ def matrix(
     contact: Annotated[Optional[float], typer.Option(
         "--contact", help="Contact time [s] (max-noise, min-delta-t, distinguishable).")] = None,
     noise: Annotated[Optional[float], typer.Option(
-        "--noise", help="Noise sigma per sample [°C] (default 0.05; not for max-noise).")] = None,
+        "--noise", help="Noise sigma per sample [°C] (default 0.05; with max-noise only the multi-class curve "
+                        "uses it).")] = None,
     delta_t: Annotated[Optional[float], typer.Option(
-        "--delta-t", help="Sensor minus object temperature before contact [°C] (default 10; not for min-delta-t).")]
+        "--delta-t", help="Sensor minus object temperature before contact [°C] (default 10; with min-delta-t "
+                          "only the multi-class curve uses it).")]
     = None,
     threshold: Annotated[Optional[float], typer.Option(
         "--threshold", help="F1 threshold; must be the table's (0.9 for the shipped tables).")] = None,

@@ -117,8 +117,8 @@ class MatrixCell:
     def to_dict(self, names: Sequence[str]) -> dict[str, Any]:
         value = self.value if isinstance(self.value, bool) else number(self.value)
         return {"a": names[self.i], "b": names[self.j], "value": value, "ideal": number(self.ideal),
-                "status": self.status, "bound": self.bound or None, "interval": [number(x) if not isinstance(x, bool) else x
-                                                    for x in self.answer.interval],
+                "status": self.status, "bound": self.bound or None,
+                "interval": [x if isinstance(x, bool) else number(x) for x in self.answer.interval],
                 "limiting_classes": [dict(c) for c in self.answer.limiting_pair], "note": self.note}
 
 
@@ -290,7 +290,8 @@ class MaterialMatrix:
 
 
 # ============================================================ inputs
-def resolve_materials(materials: Sequence[str | Material] = (), *, set: str | None = None) -> tuple[Material, ...]:  # noqa: A002
+def resolve_materials(materials: Sequence[str | Material] = (), *,
+                      set: str | None = None) -> tuple[Material, ...]:  # noqa: A002 - the set's name
     """The materials of a matrix: names (or Material objects), and/or a whole named set.
 
     >>> [m.name for m in resolve_materials(["paper12:copper", "paper12:glass"])]

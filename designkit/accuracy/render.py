@@ -339,11 +339,69 @@ def _log_axes(ax) -> None:
 
 
 def _save(fig, path, plt) -> Path:
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    """Save by the suffix of ``path`` (png at 200 dpi, or vector svg / pdf) and close."""
+    from ..figures import save_figure
+
+    return save_figure(fig, path)
+
+
+def _declutter(ax, labels) -> None:
+    """Move point labels apart so that none overlaps another, and keep each inside its axes.
+
+    Call it on a figure already laid out and frozen (no layout engine), so that extents stay put.
+
+    A label that would run past the right edge is put on the left of its point; one that overlaps a
+    label already placed moves up or down by its own height (alternately, further each time) and is
+    tied to its point by a thin leader line.
+    """
+    from matplotlib.text import Text
+
+    def extent(ann):  # the text alone (not its leader line), where it is now
+        ann.update_positions(renderer)
+        return Text.get_window_extent(ann, renderer)
+
+    fig = ax.figure
+    renderer = fig.canvas.get_renderer()
+    box = ax.get_window_extent(renderer)
+    to_pt = 72.0 / fig.dpi
+    placed = []
+    for ann in sorted(labels, key=lambda a: (a.xy[0], a.xy[1])):
+        dx, dy = ann.xyann
+        bb = extent(ann)
+        if bb.x1 > box.x1:
+            ann.set_horizontalalignment("right")
+            dx = -abs(dx)
+            ann.xyann = (dx, dy)
+            bb = extent(ann)
+        if bb.x0 < box.x0:  # too long for either side: start it at the left edge
+            ann.set_horizontalalignment("left")
+            dx = abs(dx)
+            ann.xyann = (dx, dy)
+            bb = extent(ann)
+        if bb.y1 > box.y1:
+            dy -= (bb.y1 - box.y1) * to_pt + 1.0
+            ann.xyann = (dx, dy)
+            bb = extent(ann)
+        step = (bb.height + 1.0) * to_pt
+        base = dy
+        for k in range(1, 25):
+            if not any(bb.overlaps(p) for p in placed) and box.y0 <= bb.y0 and bb.y1 <= box.y1 + 0.5:
+                break
+            shift = ((k + 1) // 2) * step * (1 if k % 2 else -1)
+            ann.xyann = (dx, base + shift)
+            bb = extent(ann)
+        if ann.xyann[1] != base and ann.arrow_patch is not None:
+            ann.arrow_patch.set_visible(True)
+        placed.append(bb)
+
+
+def _label(ax, text: str, xy, **kw):
+    """A point label with a leader line that shows only once :func:`_declutter` moves the label."""
+    ann = ax.annotate(text, xy, xytext=kw.pop("xytext", (3, 2)), textcoords="offset points", fontsize=5.5,
+                      arrowprops={"arrowstyle": "-", "lw": 0.4, "color": "0.55", "shrinkA": 0, "shrinkB": 2}, **kw)
+    ann.arrow_patch.set_visible(False)
+    ann.set_in_layout(False)  # placed inside its axes by _declutter; the layout ignores it
+    return ann
 
 
 def plot_pareto(report: BenchReport, path) -> Path | None:
@@ -354,31 +412,38 @@ def plot_pareto(report: BenchReport, path) -> Path | None:
     return None if fig is None else _save(fig, path, pyplot())
 
 
-def _pareto_panel(ax, question: str, rows: Sequence[Row]) -> None:
-    """One question's methods (error against time) and its references (★ at the panel's floor)."""
+def _pareto_panel(ax, question: str, rows: Sequence[Row]) -> list:
+    """One question's methods (error against time) and its references (★ at the panel's floor);
+    returns the point labels (for :func:`_declutter`)."""
     floor = min([r.error for r in rows if r.error > 0] + [1.0]) / 10
+    labels = []
     for m_i, m in enumerate(sorted({r.method for r in rows})):
         sel = [r for r in rows if r.method == m]
         xs = [r.wall_s for r in sel]
         ys = [r.error if r.error > 0 else floor for r in sel]
-        ax.scatter(xs, ys, s=22, color=f"C{m_i}", label=m[:40], zorder=3,
+        ax.scatter(xs, ys, s=22, color=f"C{m_i}", label=m, zorder=3,
                    marker="o" if all(r.error > 0 for r in sel) else "v")
         for r, x, y in zip(sel, xs, ys):
-            ax.annotate(r.setting[:22], (x, y), fontsize=5.5, xytext=(3, 2), textcoords="offset points")
+            labels.append(_label(ax, r.setting, (x, y)))
     refs: dict[str, float] = {}
     for r in rows:
         if math.isfinite(r.reference_wall_s):
             refs.setdefault(r.reference, r.reference_wall_s)
     for ref_i, (name, t) in enumerate(refs.items()):
         ax.scatter([t], [floor], marker="*", s=70, color="k", zorder=4, label="reference" if ref_i == 0 else None)
-        ax.annotate(name[:26], (t, floor), fontsize=5.5, xytext=(3, 4), textcoords="offset points", color="0.3")
+        labels.append(_label(ax, name, (t, floor), xytext=(3, 4), color="0.3"))
     _log_axes(ax)
+    xs_all = [r.wall_s for r in rows] + list(refs.values())
+    lo_x, hi_x = min(xs_all), max(xs_all)
+    ax.set_xlim(lo_x / 2.5, hi_x * 2.5)  # room for the labels of the outermost points
     ax.set_title(question, fontsize=9)
     ax.set_xlabel("time per answer [s]", fontsize=7)
     ax.set_ylabel(rows[0].metric[:48], fontsize=7)
     ax.tick_params(labelsize=7)
     ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=5.5, loc="best")
+    # the legend below the panel, where it hides no point and no label
+    ax.legend(fontsize=6, loc="upper center", bbox_to_anchor=(0.5, -0.2), frameon=False, ncol=1)
+    return labels
 
 
 def pareto_figure(report: BenchReport) -> Any:
@@ -391,13 +456,18 @@ def pareto_figure(report: BenchReport) -> Any:
         return None
     ncol = 3
     nrow = math.ceil(len(groups) / ncol)
-    fig, axes = plt.subplots(nrow, ncol, figsize=(4.2 * ncol, 3.4 * nrow), constrained_layout=True, squeeze=False)
+    fig, axes = plt.subplots(nrow, ncol, figsize=(5.4 * ncol, 4.8 * nrow), constrained_layout=True, squeeze=False)
+    panels = []
     for ax, (question, rows) in zip(axes.ravel(), groups.items()):
-        _pareto_panel(ax, question, rows)
+        panels.append((ax, _pareto_panel(ax, question, rows)))
     for ax in axes.ravel()[len(groups):]:
         ax.set_visible(False)
     fig.suptitle("designkit: error against run time per answer (★ reference, drawn at the panel's floor; "
                  "▼ error 0)", fontsize=10)
+    fig.canvas.draw()  # lay the figure out once, then freeze it: labels are placed in that layout
+    fig.set_layout_engine("none")
+    for ax, labels in panels:
+        _declutter(ax, labels)
     return fig
 
 

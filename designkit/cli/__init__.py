@@ -6,6 +6,7 @@ from ._app import app, main
 # no scikit-learn) at module level.
 # Registration order is the order of ``designkit --help`` within each panel: questions first.
 from . import query  # noqa: E402,F401  min-contact, max-noise, min-delta-t, delta-e, distinguishable
+from . import matrix  # noqa: E402,F401  matrix (one question over N materials)
 from . import thin  # noqa: E402,F401  validity
 from . import materials  # noqa: E402,F401  materials list, materials show
 from . import tables  # noqa: E402,F401  tables list, tables show

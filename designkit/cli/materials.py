@@ -8,6 +8,7 @@ import typer
 
 from . import _app
 from ._app import console, emit_json, sub_app
+from ._format import FormatOpt, OutOpt, check_format, emit_rows
 from ._options import Json
 
 materials_app = sub_app(
@@ -33,15 +34,20 @@ def list_(
     set_: SetOpt = "database",
     sort: Annotated[str, typer.Option(
         "--sort", help="Order: 'file' (grouped by family), 'name' or 'effusivity' (by e_min).")] = "file",
+    format_: FormatOpt = "table",
+    out: OutOpt = None,
     json_: Json = False,
 ) -> None:
     """List materials with their effusivity and diffusivity ranges.
 
     Example: `designkit materials list --family metals --sort effusivity`
+
+    Example: `designkit materials list --set paper12 --format csv --out materials.csv`
     """
     from .._validation import InputError
     from ..materials import FAMILY_LABELS, list_materials
 
+    fmt = "json" if json_ else check_format(format_)
     if sort not in _SORTS:
         raise InputError(f"unknown sort {sort!r}; choose one of: {', '.join(_SORTS)}")
     mats = list_materials(family=family, set=set_)
@@ -49,35 +55,36 @@ def list_(
         mats = tuple(sorted(mats, key=lambda m: m.name.lower()))
     elif sort == "effusivity":
         mats = tuple(sorted(mats, key=lambda m: (m.e_min, m.e_max)))
-    if json_:
-        emit_json({"set": set_.strip().lower(), "family": family, "count": len(mats),
-                   "materials": [m.to_dict() for m in mats]})
-        return
-    from rich.table import Table
-
     paper = set_.strip().lower() == "paper12"
-    table = Table(title=f"{len(mats)} materials ({set_.strip().lower()} set)", title_justify="left")
-    table.add_column("name", min_width=15)
-    table.add_column("family", no_wrap=True)
-    if paper:
-        table.add_column("identified", justify="right", no_wrap=True)
-    table.add_column("e min–max", justify="right", no_wrap=True)
-    table.add_column("α min–max", justify="right", no_wrap=True)
+    payload = {"set": set_.strip().lower(), "family": family, "count": len(mats),
+               "materials": [m.to_dict() for m in mats]}
+    if fmt in ("csv", "json"):  # plain values, full precision; a name column that 'designkit matrix --from' reads
+        cols = ["name", "family", "set", *(["identified"] if paper else []), "e_min", "e_max",
+                "diffusivity_min_m2_s", "diffusivity_max_m2_s", "flags"]
+        rows = [{"name": m.name, "family": m.family, "set": m.set, "identified": m.identified, "e_min": m.e_min,
+                 "e_max": m.e_max, "diffusivity_min_m2_s": m.diffusivity_min_m2_s,
+                 "diffusivity_max_m2_s": m.diffusivity_max_m2_s, "flags": ";".join(m.flags)} for m in mats]
+        emit_rows(rows, cols, fmt=fmt, out=out, payload=payload)
+        return
+    e_fmt = ".2f" if paper else ".0f"
+    cols = ["name", "family", *(["identified"] if paper else []), "e min–max", "α min–max"]
+    rows = []
     for m in mats:
-        row = [m.name + (" [!]" if m.flags else ""), m.family]
+        row = {"name": m.name + (" [!]" if m.flags else ""), "family": m.family}
         if paper:
-            row.append("–" if m.identified is None else f"{m.identified:.2f}")
-        row.append(_range(m.e_min, m.e_max, ".2f" if paper else ".0f", "–"))
-        row.append(_range(m.diffusivity_min_m2_s * 1e6, m.diffusivity_max_m2_s * 1e6, ".3g", "–"))
-        table.add_row(*row)
-    con = console()
-    con.print(table)
+            row["identified"] = "–" if m.identified is None else f"{m.identified:.2f}"
+        row["e min–max"] = _range(m.e_min, m.e_max, e_fmt, "–")
+        row["α min–max"] = _range(m.diffusivity_min_m2_s * 1e6, m.diffusivity_max_m2_s * 1e6, ".3g", "–")
+        rows.append(row)
     counts = ", ".join(f"{f} {sum(m.family == f for m in mats)}" for f in FAMILY_LABELS
                        if any(m.family == f for m in mats))
     rule = ("as printed in the paper; α from the database family named by 'show'" if paper else
             "sqrt(k rho c) and k/(rho c) at the corners of the k, rho, c ranges")
     flagged = "; [!] = flagged, see 'show'" if any(m.flags for m in mats) else ""
-    con.print(f"[dim]{counts}. e in J s^-1/2 K^-1 m^-2, α in mm²/s: {rule}{flagged}.[/]")
+    emit_rows(rows, cols, fmt=fmt, out=out, title=f"{len(mats)} materials ({set_.strip().lower()} set)",
+              notes=[f"{counts}. e in J s^-1/2 K^-1 m^-2, α in mm²/s: {rule}{flagged}."],
+              justify={"name": "left", "family": "left", "identified": "right", "e min–max": "right",
+                       "α min–max": "right"})
 
 
 @materials_app.command("show")

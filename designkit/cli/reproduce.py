@@ -28,6 +28,8 @@ def reproduce(
     quick: Annotated[bool, typer.Option(
         "--quick", help="Fewer Monte Carlo repeats and trials in the parts computed now (a first look; tests).")] = False,
     jobs: Annotated[int, typer.Option("--jobs", "-j", help="Worker processes for the computed queries (-1: all cores).")] = 1,
+    figure_format: Annotated[str, typer.Option(
+        "--figure-format", help="Figures as png (200 dpi) or vector: svg, pdf.")] = "png",
     seed: Seed = 0,
     json_: Json = False,
 ) -> None:
@@ -35,11 +37,14 @@ def reproduce(
     real robot, sim-to-real, multi-class) into a markdown report with figures, beside the paper's numbers.
 
     Example: `designkit reproduce --out report`
+
+    Example: `designkit reproduce --out report --only multiclass,node-graphs --figure-format svg`
     """
     from ..reproduce import ReproduceSettings, parse_only, reproduce as run
 
     names = parse_only(only)
-    settings = ReproduceSettings(tables_dir=tables, robot_data=robot_data, quick=quick, seed=seed, jobs=jobs)
+    settings = ReproduceSettings(tables_dir=tables, robot_data=robot_data, quick=quick, seed=seed, jobs=jobs,
+                                 figure_format=figure_format)
     con = console(stderr=True)
     progress = None
     if con.is_terminal and not json_:

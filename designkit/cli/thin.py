@@ -34,7 +34,7 @@ def validity(
     sensor: SensorOpt = "paper",
     horizon: Annotated[float, typer.Option("--horizon", help="Longest contact time examined \\[s].")] = 3600.0,
     plot: Annotated[Optional[Path], typer.Option(
-        "--plot", help="Write a PNG of the deviation against contact time.")] = None,
+        "--plot", help="Write a figure of the deviation against contact time (.png, or vector .svg / .pdf).")] = None,
     json_: Json = False,
 ) -> None:
     """Contact time up to which the semi-infinite model (paper eq. 2) holds for a slab of this thickness.
@@ -133,19 +133,21 @@ def _plot(path: Path, v, L, back, sen, delta_t, tolerance, name) -> None:
     dev = -delta_t * semi_infinite_deviation(t, v.e_object, v.alpha_object_m2_s, L, back, sen)[0]
     fig, ax = plt.subplots(figsize=(6.4, 4.0), constrained_layout=True)
     floor = tolerance * 1e-4
-    ax.plot(t, np.maximum(np.abs(dev), floor), color="C0", lw=1.2, label="|slab - semi-infinite|")
+    # below the floor the difference is not drawn (a gap, not a flat line at the floor: it is no value)
+    shown = np.where(np.abs(dev) >= floor, np.abs(dev), np.nan)
+    ax.plot(t, shown, color="C0", lw=1.2, label=f"|slab - semi-infinite| (not drawn below {floor:g} °C)")
     ax.axhline(tolerance, color="grey", ls="--", lw=0.8, label=f"tolerance {tolerance:g} °C")
     if math.isfinite(v.time_s):
         ax.axvline(v.time_s, color="C3", lw=0.8, label=f"valid up to {v.time_s:.3g} s")
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_ylim(bottom=floor)
+    ax.set_xlim(t[0], t[-1])  # the whole time range examined, also where the difference is below the floor
     ax.set_xlabel("contact time [s]")
     ax.set_ylabel("reading difference [°C]")
     ax.set_title(f"{L * 1e3:g} mm {name or 'object'} on {back.name}, dT = {delta_t:g} °C", fontsize=9)
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=8)
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    from ..figures import save_figure
+
+    save_figure(fig, path)  # by suffix: png, or vector svg / pdf

@@ -61,6 +61,8 @@ class ReproduceSettings:
         Seed of every random draw made at run time.
     jobs : int
         Worker processes for the exact queries (1: in-process).
+    figure_format : {"png", "svg", "pdf"}
+        Format of the report's figures: png (200 dpi) or vector (svg, pdf).
     """
 
     tables_dir: Path | None = None
@@ -68,12 +70,17 @@ class ReproduceSettings:
     quick: bool = False
     seed: int = 0
     jobs: int = 1
+    figure_format: str = "png"
 
     def __post_init__(self) -> None:
         if int(self.seed) != self.seed or self.seed < 0:
             raise InputError(f"seed must be a non-negative integer, got {self.seed}")
         if int(self.jobs) != self.jobs or self.jobs == 0 or self.jobs < -1:
             raise InputError(f"jobs must be a positive integer or -1 (all cores), got {self.jobs}")
+        fmt = str(self.figure_format).strip().lower()
+        if fmt not in ("png", "svg", "pdf"):
+            raise InputError(f"figure format must be png, svg or pdf, got {self.figure_format!r}")
+        object.__setattr__(self, "figure_format", fmt)
         if self.tables_dir is not None:
             object.__setattr__(self, "tables_dir", Path(self.tables_dir))
         if self.robot_data is not None:
@@ -215,17 +222,17 @@ class Context:
 
     # ----------------------------------------------------------------- outputs
     def save_figure(self, fig, name: str) -> str:
-        """Save a matplotlib figure as ``figures/NAME.png``; returns the report-relative path."""
-        from ..figures import pyplot
+        """Save a matplotlib figure as ``figures/NAME.FMT`` (the settings' figure format: png at 200 dpi,
+        or vector svg / pdf); returns the report-relative path."""
+        from ..figures import save_figure
 
-        plt = pyplot()
+        fmt = self.settings.figure_format
         self.fig_dir.mkdir(parents=True, exist_ok=True)
-        path = self.fig_dir / f"{name}.png"
-        tmp = path.with_name(f".{path.name}.tmp.png")
-        fig.savefig(tmp, dpi=110)
-        plt.close(fig)
+        path = self.fig_dir / f"{name}.{fmt}"
+        tmp = path.with_name(f".{name}.tmp.{fmt}")
+        save_figure(fig, tmp)
         os.replace(tmp, path)
-        return f"figures/{name}.png"
+        return f"figures/{name}.{fmt}"
 
     def save_csv(self, name: str, header: Sequence[str], rows) -> str:
         """Write ``data/NAME.csv`` atomically; returns the report-relative path."""

@@ -44,6 +44,8 @@ __all__ = [
     "matrix_stats",
     "section_f1_matrices",
     "section_node_graphs",
+    "graph_layout",
+    "short_label",
     "staircase_percent",
 ]
 
@@ -454,18 +456,88 @@ def _graph_numbers(mf: MaterialF1, phi: float) -> dict:
     }
 
 
+def short_label(name: str) -> str:
+    """A node label: the acronym a material is known by, else its name without a lower-case aside.
+
+    >>> short_label("Polymethyl methacrylate (Acrylic, PMMA)"), short_label("Rigid polymer foam (HD)")
+    ('PMMA', 'rigid foam HD')
+    >>> short_label("CFRP, epoxy matrix (quasi-isotropic)"), short_label("Stainless steel")
+    ('CFRP, epoxy matrix', 'Stainless steel')
+    """
+    import re
+
+    base, _, aside = name.partition(" (")
+    aside = aside.rstrip(")")
+    if "foam" in base:
+        return f"{base.split()[0].lower()} foam {aside}".strip()
+    tokens = [t.strip() for t in aside.split(",")]
+    acronyms = [t for t in tokens if len(re.findall(r"[A-Z]", t)) >= 2 and " " not in t]
+    if acronyms:
+        return acronyms[-1]
+    return base if aside and aside == aside.lower() else name
+
+
+_RING_SPACING = 0.5  # distance between neighbouring nodes on a component's ring (axis units)
+_LABEL_ROOM = 5.0  # gap between rings, and margin around the drawing, for the labels (axis units)
+
+
+def graph_layout(G, order_key) -> tuple[dict, dict]:
+    """Positions and label angles for a readable node graph: each connected component on its own ring
+    (members in ``order_key`` order, so that similar materials sit side by side), rings left to right by
+    size, isolated nodes in a row beneath.
+
+    Returns ``(pos, angle)``: node -> (x, y), and node -> the label's direction in degrees (radially
+    outwards on a ring, -90 below a lone node).
+    """
+    import networkx as nx
+
+    comps = sorted((sorted(c, key=order_key) for c in nx.connected_components(G)), key=len, reverse=True)
+    rings = [c for c in comps if len(c) > 1]
+    singles = sorted((c[0] for c in comps if len(c) == 1), key=order_key)
+    pos, angle = {}, {}
+    x0, r_max = 0.0, 0.5
+    for c in rings:
+        r = max(0.45, len(c) * _RING_SPACING / (2 * math.pi))
+        for k, v in enumerate(c):
+            th = math.pi / 2 - 2 * math.pi * k / len(c)
+            pos[v] = (x0 + r + r * math.cos(th), r * math.sin(th))
+            angle[v] = math.degrees(th)
+        x0 += 2 * r + _LABEL_ROOM  # room for the labels between rings
+        r_max = max(r_max, r)
+    width = max(x0 - _LABEL_ROOM, 1.0)
+    if singles:
+        step = width / max(len(singles) - 1, 1) if len(singles) > 1 else 0.0
+        for k, v in enumerate(singles):
+            pos[v] = ((k * step) if len(singles) > 1 else width / 2, -r_max - 2.6)
+            angle[v] = -90.0
+    return pos, angle
+
+
 def _draw_graph(ax, mf: MaterialF1, G, edges, seed: int, title: str) -> None:
     import networkx as nx
 
-    pos = nx.spring_layout(G, seed=seed, k=1.6 / math.sqrt(max(G.number_of_nodes(), 1)))
     mid = mf.ranges.mean(axis=1)
-    radius = 3.0 + 22.0 * mid / mid.max()  # points; radius proportional to effusivity above a floor
+    pos, angle = graph_layout(G, lambda v: mid[v])
+    radius = 2.5 + 7.5 * mid / mid.max()  # points; radius grows with effusivity above a floor
     colours = [FAMILY_COLOURS.get(f, "grey") for f in mf.families]
-    widths = [1.2 * 0.9 / max(f1, 0.05) for _, _, f1 in edges]
-    nx.draw_networkx_edges(G, pos, edgelist=[(a, b) for a, b, _ in edges], width=widths, alpha=0.45, ax=ax)
+    widths = [0.9 * 0.9 / max(f1, 0.05) for _, _, f1 in edges]
+    nx.draw_networkx_edges(G, pos, edgelist=[(a, b) for a, b, _ in edges], width=widths, alpha=0.3, ax=ax)
     nx.draw_networkx_nodes(G, pos, node_size=radius ** 2, node_color=colours, edgecolors="black",
                            linewidths=0.4, ax=ax)
+    for v, (x, y) in pos.items():  # each label outside its node, along the ring's radius, never upside down
+        th = angle[v]
+        c, s = math.cos(math.radians(th)), math.sin(math.radians(th))
+        d = radius[v] + 2.0
+        left = c < -1e-9
+        rot = th + 180.0 if left else th
+        ax.annotate(short_label(mf.names[v]), (x, y), xytext=(d * c, d * s), textcoords="offset points",
+                    ha="right" if left else "left", va="center", rotation=rot, rotation_mode="anchor",
+                    fontsize=6.5)
     ax.set_title(title, fontsize=10)
+    xs, ys = [p[0] for p in pos.values()], [p[1] for p in pos.values()]
+    ax.set_xlim(min(xs) - _LABEL_ROOM * 0.8, max(xs) + _LABEL_ROOM * 0.8)
+    ax.set_ylim(min(ys) - _LABEL_ROOM, max(ys) + _LABEL_ROOM * 0.8)
+    ax.set_aspect("equal")
     ax.set_axis_off()
 
 
@@ -491,7 +563,7 @@ def section_node_graphs(ctx: Context) -> SectionResult:
     from ..materials import FAMILY_LABELS
 
     plt = pyplot()
-    fig, axes = plt.subplots(1, 2, figsize=(13, 6.6), constrained_layout=True)
+    fig, axes = plt.subplots(2, 1, figsize=(15, 13), constrained_layout=True)
     figs, csvs, numbers = [], [], {}
     for ax, ts0 in zip(axes, (30.0, 35.0)):
         mf, g = results[ts0]

@@ -37,6 +37,9 @@ _MAX_BINS = 100_000
 def bayes_accuracy(ranges, sensor, scene) -> float:
     """Best multi-class accuracy of any classifier (equal priors), classes uniform over ``ranges``.
 
+    :func:`designkit.query.matrix.multiclass_ideal_accuracy` (the one implementation,
+    which ``designkit matrix`` uses too).
+
     Parameters
     ----------
     ranges : array_like, shape (K, 2)
@@ -45,53 +48,19 @@ def bayes_accuracy(ranges, sensor, scene) -> float:
     scene : Scene
         Fixed initial conditions.
     """
-    from ..recognition.ideal import class_survival, projection_noise
-    from ..models.semi_infinite import object_weight
+    from ..query.matrix import multiclass_ideal_accuracy
 
-    r = np.asarray(ranges, dtype=np.float64)
-    s = projection_noise(sensor, scene)
-    K = r.shape[0]
-    if not np.isfinite(s):
-        return 1.0 / K
-    w = object_weight(sensor.effusivity, r)
-    lo, hi = float(w.min()) - 9.0 * s, float(w.max()) + 9.0 * s
-    step = max(s / 8.0, (hi - lo) / _MAX_BINS)
-    edges = np.arange(lo, hi + step, step)
-    best = np.zeros(edges.size - 1)
-    for a, b in r:  # one class at a time: class_survival's quadrature allocates (bins x nodes)
-        surv = class_survival(edges, a, b, sensor.effusivity, s)
-        np.maximum(best, surv[:-1] - surv[1:], out=best)
-    return float(np.sum(best) / K)
-
-
-def _simulate_classes(ranges, trials: int, sensor, scene, seed) -> tuple[np.ndarray, np.ndarray]:
-    from ..recognition.features import feature_matrix
-    from ..simulation import simulate_interval
-
-    X, y = [], []
-    for k, (lo, hi) in enumerate(np.asarray(ranges, dtype=np.float64)):
-        t = simulate_interval(lo, hi, trials, sensor, scene, seed=list(seed) + [k])
-        X.append(feature_matrix(t.temperature_c, sensor.sample_rate_hz))
-        y.append(np.full(trials, k))
-    return np.vstack(X), np.concatenate(y)
+    return multiclass_ideal_accuracy(ranges, sensor, scene, max_bins=_MAX_BINS)
 
 
 def svm_multiclass(ranges, trials: int, sensor, scene, seed) -> dict:
-    """Cross-validated (3-fold) accuracy and confusion of the paper's SVM on K classes at once."""
-    import sklearn
-    from sklearn.metrics import confusion_matrix
-    from sklearn.model_selection import StratifiedKFold, cross_val_predict
+    """Cross-validated (3-fold) accuracy and confusion of the paper's SVM on K classes at once.
 
-    from .._validation import as_generator
-    from ..recognition.svm import make_classifier
+    :func:`designkit.query.matrix.multiclass_svm_accuracy` (the one implementation).
+    """
+    from ..query.matrix import multiclass_svm_accuracy
 
-    seed = list(seed)
-    X, y = _simulate_classes(ranges, trials, sensor, scene, seed + [1])
-    rs = int(as_generator(seed + [2]).integers(0, 2**31 - 1))
-    with sklearn.config_context(assume_finite=True, skip_parameter_validation=True):
-        pred = cross_val_predict(make_classifier(), X, y, cv=StratifiedKFold(3, shuffle=True, random_state=rs))
-    K = len(ranges)
-    return {"accuracy": float(np.mean(pred == y)), "confusion": confusion_matrix(y, pred, labels=list(range(K)))}
+    return multiclass_svm_accuracy(ranges, trials, sensor, scene, seed)
 
 
 def section_multiclass(ctx: Context) -> SectionResult:
@@ -150,6 +119,8 @@ def section_multiclass(ctx: Context) -> SectionResult:
     from ..figures import pyplot
 
     plt = pyplot()
+    from matplotlib.ticker import NullLocator
+
     fig, axes = plt.subplots(1, 3, figsize=(16, 4.8), constrained_layout=True,
                              gridspec_kw={"width_ratios": [1.0, 1.15, 1.15]})
     ks = [c["k"] for c in curve]
@@ -158,6 +129,8 @@ def section_multiclass(ctx: Context) -> SectionResult:
     axes[0].plot(ks, [c["bayes_accuracy"] for c in curve], "s--", label="ideal observer (Bayes)")
     axes[0].plot(ks, [c["chance"] for c in curve], ":", color="grey", label="chance")
     axes[0].set_xscale("log")
+    axes[0].set_xticks(ks, [str(k) for k in ks])  # the k computed, in plain numbers (no 2x10^0 minor labels)
+    axes[0].xaxis.set_minor_locator(NullLocator())
     axes[0].set_xlabel("materials recognised at once, k (random database subsets)")
     axes[0].set_ylabel("accuracy")
     axes[0].set_ylim(0, 1.02)

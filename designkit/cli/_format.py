@@ -1,0 +1,182 @@
+"""The one row-output function of the CLI: ``--format table|json|csv|md`` and ``--out FILE|-``.
+
+sqlite-utils' convention: every command that prints rows takes the same
+output options and prints through one function, so a new user learns them
+once. A command that prints rows adopts it in three lines::
+
+    from ._format import FormatOpt, OutOpt, emit_rows
+
+    def cmd(..., format_: FormatOpt = "table", out: OutOpt = None, json_: Json = False):
+        rows = [...]                                   # list of dicts, plain values
+        emit_rows(rows, ["name", "e_min"], fmt="json" if json_ else format_, out=out,
+                  payload=library_result.to_dict())    # --format json prints the library's data
+
+========  ===================================================================
+format    what is printed
+========  ===================================================================
+table     a rich table for people: names and numbers never cut (on a
+          terminal a long cell folds onto a second line; piped, no wrapping)
+json      ``payload`` (the library's ``to_dict()``) if given, else the rows
+csv       a header line and one line per row: nothing else (no comments), so
+          ``pandas.read_csv`` reads it with its defaults; None is empty
+md        a GitHub Markdown table, then ``notes`` as paragraphs
+========  ===================================================================
+
+``--out -`` (or no ``--out``) is stdout; ``--out FILE`` writes the file.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import sys
+from pathlib import Path
+from typing import Annotated, Any, Callable, Mapping, Optional, Sequence
+
+import typer
+
+from .._validation import InputError
+
+FORMATS = ("table", "json", "csv", "md")
+
+FormatOpt = Annotated[str, typer.Option(
+    "--format", "-f", help="Output: table (for people), json (the library's data), csv (pandas-ready: header "
+                           "and rows only) or md (Markdown table).")]
+OutOpt = Annotated[Optional[str], typer.Option(
+    "--out", "-o", help="Write the output to this file ('-' or none: stdout).")]
+
+
+def check_format(fmt: str) -> str:
+    """``fmt`` lower-cased, or an error naming the formats."""
+    f = str(fmt).strip().lower()
+    if f not in FORMATS:
+        raise InputError(f"unknown format {fmt!r}; choose one of: {', '.join(FORMATS)}")
+    return f
+
+
+def cell_text(v: Any) -> str:
+    """A value as people read it in a table: floats to 4 significant digits, None as '–'."""
+    if v is None:
+        return "–"
+    if isinstance(v, bool):
+        return "yes" if v else "no"
+    if isinstance(v, float):
+        return "–" if not math.isfinite(v) else f"{v:.4g}"
+    return str(v)
+
+
+def _csv_text(v: Any) -> str:
+    if v is None:
+        return ""
+    if isinstance(v, float):
+        return "" if not math.isfinite(v) else repr(v)
+    if isinstance(v, (list, tuple, dict)):
+        return json.dumps(v)
+    return str(v)
+
+
+def _jsonable(obj: Any) -> Any:
+    if isinstance(obj, dict):
+        return {str(k): _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_jsonable(v) for v in obj]
+    if hasattr(obj, "tolist"):
+        return _jsonable(obj.tolist())
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    return obj
+
+
+def render_rows(rows: Sequence[Mapping[str, Any]], columns: Sequence[str] | None = None, *, fmt: str = "table",
+                title: str = "", notes: Sequence[str] = (), payload: Any = None,
+                text: Callable[[str, Any], str] | None = None, justify: Mapping[str, str] | None = None) -> str:
+    """The rows as text in format ``fmt`` (see the module docstring); what :func:`emit_rows` prints.
+
+    ``text(column, value)`` formats a cell for ``table`` and ``md`` (default
+    :func:`cell_text`); csv and json keep full precision. ``justify`` maps a
+    column to ``"left"`` or ``"right"`` (default: numbers right).
+    """
+    fmt = check_format(fmt)
+    cols = list(columns) if columns is not None else (list(rows[0]) if rows else [])
+    if fmt == "json":
+        data = payload if payload is not None else [dict(r) for r in rows]
+        return json.dumps(_jsonable(data), indent=2, allow_nan=False) + "\n"
+    if fmt == "csv":
+        buf = io.StringIO()
+        w = csv.writer(buf, lineterminator="\n")
+        w.writerow(cols)
+        for r in rows:
+            w.writerow([_csv_text(r.get(c)) for c in cols])
+        return buf.getvalue()
+    fmt_cell = text or (lambda _c, v: cell_text(v))
+    body = [[fmt_cell(c, r.get(c)) for c in cols] for r in rows]
+
+    def right(ci: int) -> bool:
+        c = cols[ci]
+        if justify and c in justify:
+            return justify[c] == "right"
+        return any(isinstance(r.get(c), (int, float)) and not isinstance(r.get(c), bool) for r in rows)
+
+    if fmt == "md":
+        def esc(s: str) -> str:
+            return s.replace("|", "\\|")
+
+        lines = ([f"**{esc(title)}**", ""] if title else [])
+        lines.append("| " + " | ".join(esc(c) for c in cols) + " |")
+        lines.append("|" + "|".join("---:" if right(i) else ":---" for i in range(len(cols))) + "|")
+        lines += ["| " + " | ".join(esc(s) for s in row) + " |" for row in body]
+        if notes:
+            lines.append("")
+            lines += [n for note in notes for n in (note, "")][:-1]
+        return "\n".join(lines) + "\n"
+    from rich.console import Console
+    from rich.table import Table
+    from rich.text import Text
+
+    # Text, not markup: units like [s] and flags like [!] are not style tags
+    table = Table(title=Text(title) if title else None, title_justify="left")
+    for i, c in enumerate(cols):
+        # never an ellipsis: a cell too wide for the terminal folds onto another line
+        widest_word = max([len(w) for s in [c] + [row[i] for row in body] for w in s.split()] or [1])
+        table.add_column(c, justify="right" if right(i) else "left", overflow="fold", min_width=min(widest_word, 30))
+    for row in body:
+        table.add_row(*(Text(x) for x in row))
+    buf = io.StringIO()
+    con = Console(file=buf, highlight=False, soft_wrap=True, width=_width(), force_terminal=False,
+                  color_system=None)
+    con.print(table)
+    for n in notes:
+        con.print(n, markup=False)
+    return buf.getvalue()
+
+
+def _width() -> int:
+    """The terminal's width on a terminal; unlimited when piped (a line is a line)."""
+    if hasattr(sys.stdout, "isatty") and sys.stdout.isatty():
+        import shutil
+
+        return shutil.get_terminal_size((100, 24)).columns
+    return 100_000
+
+
+def write_output(text: str, out: str | None) -> None:
+    """Write ``text`` to ``out`` (a path), or stdout for None and ``-``."""
+    if out is None or str(out) == "-":
+        sys.stdout.write(text)
+        sys.stdout.flush()
+        return
+    p = Path(out)
+    if p.parent and not p.parent.is_dir():
+        raise InputError(f"cannot write {p}: folder {p.parent} does not exist")
+    p.write_text(text, encoding="utf-8")
+
+
+def emit_rows(rows: Sequence[Mapping[str, Any]], columns: Sequence[str] | None = None, *, fmt: str = "table",
+              out: str | None = None, **kw: Any) -> None:
+    """Print (or write to ``out``) the rows in format ``fmt``: the one row output of the CLI.
+
+    Keyword arguments are :func:`render_rows`'s.
+    """
+    write_output(render_rows(rows, columns, fmt=fmt, **kw), out)

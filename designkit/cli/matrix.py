@@ -1,0 +1,212 @@
+"""``designkit matrix``: one question over every pair of N materials (designkit.query.matrix).
+
+One library call (:func:`designkit.query.matrix.material_matrix`), printed
+through the one row output (:mod:`designkit.cli._format`): the N x N matrix as
+rows (table, csv, md) or the library's ``to_dict()`` (json), and a figure on
+request (``--plot``).
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, List, Optional
+
+import typer
+
+from . import _app
+from ._app import app, console
+from ._format import FormatOpt, OutOpt, check_format, emit_rows
+from ._options import Json
+
+_QUESTIONS = "min-contact, max-noise, min-delta-t or distinguishable"
+
+
+@app.command("matrix", rich_help_panel=_app.ASK)
+def matrix(
+    m: Annotated[Optional[List[str]], typer.Option(
+        "--m", help="A material (repeat: --m copper --m glass ...); see 'designkit materials list'.")] = None,
+    set_: Annotated[Optional[str], typer.Option(
+        "--set", help="Every material of a named set: 'paper12' (the paper's robot materials) or 'database'.")] = None,
+    from_: Annotated[Optional[str], typer.Option(
+        "--from", help="Read materials from a file ('-': stdin): one name a line, or a CSV with a 'name' column "
+                       "(and 'set'), as 'designkit materials list --format csv' writes it.")] = None,
+    question: Annotated[str, typer.Option("--question", "-q", help=f"What to ask of every pair: {_QUESTIONS}.")]
+    = "min-contact",
+    contact: Annotated[Optional[float], typer.Option(
+        "--contact", help="Contact time [s] (max-noise, min-delta-t, distinguishable).")] = None,
+    noise: Annotated[Optional[float], typer.Option(
+        "--noise", help="Noise sigma per sample [°C] (default 0.05; with max-noise only the multi-class curve "
+                        "uses it).")] = None,
+    delta_t: Annotated[Optional[float], typer.Option(
+        "--delta-t", help="Sensor minus object temperature before contact [°C] (default 10; with min-delta-t "
+                          "only the multi-class curve uses it).")]
+    = None,
+    threshold: Annotated[Optional[float], typer.Option(
+        "--threshold", help="F1 threshold; must be the table's (0.9 for the shipped tables).")] = None,
+    table: Annotated[Optional[str], typer.Option("--table", help="Lookup table (default: svm-paper).")] = None,
+    ideal_table: Annotated[str, typer.Option("--ideal-table", help="Table for the ideal-observer bound.")]
+    = "ideal-paper",
+    multiclass: Annotated[bool, typer.Option(
+        "--multiclass/--no-multiclass", help="Add the accuracy of telling all N apart against contact time.")]
+    = True,
+    svm_trials: Annotated[Optional[int], typer.Option(
+        "--svm-trials", help="Also the SVM's multi-class accuracy, on this many simulated touches per material "
+                             "(seconds; e.g. 60).")] = None,
+    seed: Annotated[int, typer.Option("--seed", help="Seed of the SVM's simulated touches.")] = 0,
+    plot: Annotated[Optional[str], typer.Option(
+        "--plot", help="Save a figure: heatmap + multi-class accuracy (.png, .svg or .pdf).")] = None,
+    format_: FormatOpt = "table",
+    out: OutOpt = None,
+    json_: Json = False,
+) -> None:
+    """The pairwise matrix of one question over N materials, the pair that limits the design, and the
+    accuracy of telling all N apart at once; from the lookup tables (the materials rule: the hardest pair of
+    facing-edge classes).
+
+    Example: `designkit matrix --set paper12`
+
+    Example: `designkit matrix --m copper --m "stainless steel" --m glass --m granite -q max-noise --contact 2 --format csv`
+
+    Example: `designkit materials list --family metals --format csv | designkit matrix --from -`
+    """
+    from ..query.matrix import material_matrix
+
+    names = list(m or ()) + (read_material_names(from_) if from_ else [])
+    fmt = "json" if json_ else check_format(format_)
+    scene = {"contact_s": contact, "noise_c": noise, "delta_t_c": delta_t, "threshold": threshold}
+    if question in ("max-noise", "min-delta-t", "distinguishable") and contact is None:
+        from .._validation import InputError
+
+        raise InputError(f"{question} needs a contact time: give --contact SECONDS")
+    if question == "min-contact" and contact is not None:
+        from .._validation import InputError
+
+        raise InputError("min-contact asks for the contact time: drop --contact")
+    progress = _progress(json_ or fmt == "json")
+    try:
+        result = material_matrix(names, question, set=set_, table=table, ideal_table=ideal_table,
+                                 multiclass=multiclass, svm_trials=svm_trials, seed=seed,
+                                 progress=progress.step if progress else None,
+                                 **{k: v for k, v in scene.items() if v is not None})
+    finally:
+        if progress:
+            progress.stop()
+    if plot:
+        from ..figures import plot_matrix
+
+        path = plot_matrix(result, plot)
+        console(stderr=True).print(f"figure: {path}", markup=False)
+    names = result.names
+    rows = []
+    vals, ideal, status = result.values(), result.values(ideal=True), result.status()
+    bounds = {}
+    for c in result.cells:
+        bounds[c.i, c.j] = bounds[c.j, c.i] = c.bound
+    for i, a in enumerate(names):
+        row = {"material": a}
+        for j, b in enumerate(names):
+            row[b] = None if i == j else _cell(result.question, vals[i, j], status[i, j], bounds.get((i, j), ""))
+        rows.append(row)
+    if fmt == "csv":  # pandas-ready: plain values, the matrix with the materials as index
+        rows = [{"material": a, **{b: (None if i == j else (None if vals[i, j] != vals[i, j] else float(vals[i, j])))
+                                  for j, b in enumerate(names)}} for i, a in enumerate(names)]
+    emit_rows(rows, ["material", *names], fmt=fmt, out=out, payload=result.to_dict(), title=_title(result),
+              notes=_notes(result), text=lambda _c, v: "·" if v is None else str(v),
+              justify={"material": "left", **{n: "right" for n in names}})
+
+
+def read_material_names(path: str) -> list[str]:
+    """Material names from a file or stdin (``-``): one a line (``#`` comments and blank lines skipped), or a
+    CSV whose header has a ``name`` column (a ``set`` column qualifies each name: ``paper12:Glass``)."""
+    import csv
+    import io
+    import sys
+    from pathlib import Path
+
+    text = sys.stdin.read() if path == "-" else Path(path).read_text(encoding="utf-8")
+    lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
+    if not lines:
+        from .._validation import InputError
+
+        raise InputError(f"no material names in {'stdin' if path == '-' else path}")
+    header = next(csv.reader([lines[0]]))
+    if "name" in header and len(header) > 1:
+        rows = list(csv.DictReader(io.StringIO("\n".join(lines))))
+        return [f"{r['set']}:{r['name']}" if r.get("set") else r["name"] for r in rows if r.get("name")]
+    return [ln.strip() for ln in lines]
+
+
+def _cell(question: str, v: float, status: str, bound: str) -> str:
+    if status == "overlap":
+        return "overlap"
+    if v != v:  # NaN: no answer within the table
+        return "n/a"
+    if question == "distinguishable":
+        return "yes" if v else "no"
+    return {"at-most": "≤", "at-least": "≥"}.get(bound, "") + f"{v:.3g}"
+
+
+def _title(r) -> str:
+    unit = f" [{r.unit}]" if r.unit else ""
+    sc = ", ".join(f"{k} {v:g}" for k, v in r.scene.items() if v is not None and k != "noise_ratio")
+    return f"{r.question}{unit} for {len(r.materials)} materials ({sc}; table {r.table})"
+
+
+def _notes(r) -> list[str]:
+    notes = [f"Limiting pair: {r.limiting.why}."]
+    if r.question != "min-contact":
+        notes.append("≤ / ≥: the answer lies beyond the table's grid, at most / at least the value shown; overlap: "
+                     "the effusivity ranges overlap, no scene tells every object of one from every object of the "
+                     "other; n/a: no answer within the table.")
+    else:
+        notes.append("≤: separable already at the table's shortest contact time; overlap: the effusivity "
+                     "ranges overlap, no scene tells every object of one from every object of the other; n/a: no "
+                     "answer within the table.")
+    mc = r.multiclass
+    if mc is not None:
+        if mc.ideal_accuracy is not None:
+            pts = ", ".join(f"{c:g} s {a:.3f}" for c, a in zip(mc.contact_s, mc.ideal_accuracy)
+                            if c in (0.5, 1.0, 2.0, 4.0, 10.0))
+            notes.append(f"Telling all {len(r.materials)} apart at once (ideal observer, chance "
+                         f"{mc.chance:.3f}): {pts}.")
+        if mc.svm_accuracy is not None:
+            pts = ", ".join(f"{c:g} s {a:.3f}" for c, a in zip(mc.contact_s, mc.svm_accuracy)
+                            if c in (0.5, 1.0, 2.0, 4.0, 10.0))
+            notes.append(f"Telling all {len(r.materials)} apart at once (SVM): {pts}.")
+        notes.append(mc.note[0].upper() + mc.note[1:] + ".")
+    return notes
+
+
+class _Bar:
+    """A rich progress bar on stderr, shown only once the matrix has taken over a second."""
+
+    def __init__(self):
+        import time
+
+        self._t0 = time.perf_counter()
+        self._time = time.perf_counter
+        self._progress = None
+        self._task = None
+
+    def step(self, done: int, total: int) -> None:
+        if self._progress is None:
+            if self._time() - self._t0 < 1.0 or done >= total:
+                return
+            from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+
+            self._progress = Progress(TextColumn("[bold]matrix[/] pairs"), BarColumn(), MofNCompleteColumn(),
+                                      TimeRemainingColumn(), console=console(stderr=True), transient=True)
+            self._task = self._progress.add_task("pairs", total=total)
+            self._progress.start()
+        self._progress.update(self._task, completed=done)
+
+    def stop(self) -> None:
+        if self._progress is not None:
+            self._progress.stop()
+
+
+def _progress(quiet: bool) -> _Bar | None:
+    import sys
+
+    if quiet or not (hasattr(sys.stderr, "isatty") and sys.stderr.isatty()):
+        return None
+    return _Bar()

@@ -1,0 +1,122 @@
+"""The one row output (designkit.cli._format): ``--format table|json|csv|md`` and ``--out FILE|-`` agree
+across the commands that print rows (``materials list``, ``matrix``), and ``-`` reads stdin."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+
+import pytest
+
+from designkit.cli._format import FORMATS, render_rows
+
+ROWS = [{"name": "Stainless steel, 316 [!]", "e": 7800.123456, "ok": True, "none": None},
+        {"name": "Copper", "e": 36000.0, "ok": False, "none": None}]
+
+
+def test_csv_is_header_and_rows_at_full_precision():
+    text = render_rows(ROWS, fmt="csv")
+    rows = list(csv.reader(io.StringIO(text)))
+    assert rows[0] == ["name", "e", "ok", "none"]
+    assert rows[1] == ["Stainless steel, 316 [!]", "7800.123456", "True", ""]
+    assert len(rows) == 3
+
+
+def test_json_is_the_payload_or_the_rows():
+    assert json.loads(render_rows(ROWS, fmt="json"))[0]["e"] == 7800.123456
+    assert json.loads(render_rows(ROWS, fmt="json", payload={"x": float("nan")})) == {"x": None}
+
+
+def test_md_escapes_pipes_and_right_aligns_numbers():
+    text = render_rows([{"a": "x|y", "n": 1.5}], fmt="md", title="T", notes=["note one"])
+    assert "| x\\|y | 1.5 |" in text and "|:---|---:|" in text and text.rstrip().endswith("note one")
+
+
+def test_table_never_cuts_a_name_nor_eats_brackets():
+    text = render_rows(ROWS, fmt="table", title="e [J s^-1/2 K^-1 m^-2]")
+    assert "Stainless steel, 316 [!]" in text and "[J s^-1/2 K^-1 m^-2]" in text and "…" not in text
+
+
+def test_unknown_format_is_refused():
+    from designkit._validation import InputError
+
+    with pytest.raises(InputError, match="table, json, csv, md"):
+        render_rows(ROWS, fmt="xlsx")
+
+
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_materials_list_every_format_and_out_dash(cli, fmt):
+    r = cli("materials", "list", "--set", "paper12", "--format", fmt, "--out", "-")
+    assert r.exit_code == 0, r.output
+    assert "Stainless Steel" in r.stdout
+    assert not (r.stdout.startswith("-") and len(r.stdout) < 3)
+
+
+def test_materials_list_json_flag_equals_format_json(cli):
+    assert cli("materials", "list", "--json").stdout == cli("materials", "list", "--format", "json").stdout
+
+
+def test_materials_list_out_file(cli, tmp_path):
+    out = tmp_path / "m.csv"
+    r = cli("materials", "list", "--family", "metals", "--format", "csv", "--out", str(out))
+    assert r.exit_code == 0, r.output
+    rows = list(csv.DictReader(out.open()))
+    assert rows and {x["family"] for x in rows} == {"metals"} and float(rows[0]["e_min"]) > 0
+    assert r.stdout == ""
+
+
+def test_materials_csv_pipes_into_matrix_from_stdin(cli):
+    csv_text = cli("materials", "list", "--set", "paper12", "--format", "csv").stdout
+    r = cli("matrix", "--from", "-", "--json", "--no-multiclass", input=csv_text)
+    assert r.exit_code == 0, r.output
+    d = json.loads(r.stdout)
+    assert [m["qualified_name"] for m in d["materials"]][:2] == ["paper12:Cardboard", "paper12:Wood"]
+    assert len(d["cells"]) == 66
+
+
+def test_matrix_reads_one_name_a_line(cli, tmp_path):
+    p = tmp_path / "bin.txt"
+    p.write_text("# the bin\npaper12:glass\n\npaper12:copper\n")
+    r = cli("matrix", "--from", str(p), "--format", "csv", "--no-multiclass")
+    assert r.exit_code == 0, r.output
+    assert r.stdout.splitlines()[0] == "material,Glass,Copper"
+
+
+# ---------------------------------------------------------------- figures: vector formats on request
+@pytest.mark.parametrize("fmt, magic", [("svg", b"<?xml"), ("pdf", b"%PDF"), ("png", b"\x89PNG")])
+def test_report_figures_in_the_format_asked(tmp_path, fmt, magic):
+    pytest.importorskip("matplotlib")
+    from designkit.figures import pyplot
+    from designkit.reproduce import ReproduceSettings
+    from designkit.reproduce._report import Context
+
+    ctx = Context(ReproduceSettings(figure_format=fmt), tmp_path)
+    fig, ax = pyplot().subplots()
+    ax.plot([0, 1], [0, 1])
+    rel = ctx.save_figure(fig, "line")
+    assert rel == f"figures/line.{fmt}"
+    assert (tmp_path / rel).read_bytes().startswith(magic)
+    assert not list((tmp_path / "figures").glob(".*"))  # no temporary file left
+
+
+def test_unknown_figure_format_is_refused():
+    from designkit._validation import InputError
+    from designkit.reproduce import ReproduceSettings
+
+    with pytest.raises(InputError, match="png, svg or pdf"):
+        ReproduceSettings(figure_format="jpg")
+
+
+def test_node_graph_layout_puts_every_node_somewhere_distinct():
+    nx = pytest.importorskip("networkx")
+    from designkit.reproduce.matrices import graph_layout
+
+    G = nx.Graph()
+    G.add_nodes_from(range(9))
+    G.add_edges_from([(0, 1), (1, 2), (2, 0), (3, 4)])
+    pos, angle = graph_layout(G, lambda v: v)
+    assert set(pos) == set(range(9)) == set(angle)
+    pts = {tuple(round(c, 9) for c in p) for p in pos.values()}
+    assert len(pts) == 9
+    assert all(angle[v] == -90.0 for v in (5, 6, 7, 8))  # lone nodes in a row, labels below

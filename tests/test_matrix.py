@@ -1,0 +1,197 @@
+"""``designkit matrix`` and designkit.query.matrix: each cell is the public query's answer, the limiting
+pair is the hardest answered pair, the multi-class view agrees with the reproduce section, and the
+12-material matrix is fast."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import time
+
+import numpy as np
+import pytest
+
+from designkit import query
+from designkit.query.matrix import material_matrix, multiclass_ideal_accuracy, resolve_materials
+
+THREE = ["paper12:glass", "paper12:stainless steel", "paper12:copper"]
+
+
+@pytest.fixture(scope="module")
+def paper12():
+    return material_matrix(set="paper12")
+
+
+def test_each_cell_is_the_public_query_answer(paper12):
+    names = [m.qualified_name for m in paper12.materials]
+    vals = paper12.values()
+    for i, j in [(0, 2), (7, 9), (9, 10), (3, 6)]:
+        a = query.min_contact(m1=names[i], m2=names[j])
+        want = math.nan if a.value is None else a.value
+        assert vals[i, j] == pytest.approx(want, nan_ok=True)
+        assert vals[j, i] == vals[i, j] or (math.isnan(vals[j, i]) and math.isnan(vals[i, j]))
+
+
+def test_overlapping_materials_are_marked_and_never_limiting(paper12):
+    st = paper12.status()
+    by = dict(zip(paper12.names, range(len(paper12.names))))
+    assert st[by["Aluminum"], by["Copper"]] == "overlap"  # 12768-25972 vs 23049-36761
+    assert st[by["Glass"], by["Copper"]] == "answered"
+    lim = paper12.limiting
+    assert lim.status == "answered" and len(lim.names) == 2
+    i, j = by[lim.names[0]], by[lim.names[1]]
+    answered = paper12.values()[paper12.status() == "answered"]
+    assert paper12.values()[i, j] == pytest.approx(np.nanmax(answered))  # min-contact: the longest wins
+    assert "overlap" in lim.why
+
+
+def test_max_noise_limiting_pair_is_the_smallest_noise():
+    r = material_matrix(THREE, "max-noise", contact_s=1.0)
+    vals = r.values()
+    assert r.limiting.value == pytest.approx(np.nanmin(vals))
+    assert r.scene["contact_s"] == 1.0 and r.scene["noise_c"] is None
+
+
+def test_bounds_mark_answers_beyond_the_grid():
+    r = material_matrix(THREE, "min-contact")
+    glass_copper = next(c for c in r.cells if (c.i, c.j) == (0, 2))
+    assert glass_copper.bound == "at-most"  # separable at the table's shortest contact (0.5 s)
+    steel_copper = next(c for c in r.cells if (c.i, c.j) == (1, 2))
+    assert steel_copper.bound == ""
+
+
+def test_multiclass_ideal_equals_the_reproduce_section_formula(paper12):
+    from designkit.reproduce.multiclass import bayes_accuracy
+    from designkit.scene import Scene
+    from designkit.sensor import SENSORS
+
+    mc = paper12.multiclass
+    assert mc.svm_accuracy is None and "not computed" in mc.note
+    ranges = [m.effusivity_range for m in paper12.materials]
+    k = int(np.flatnonzero(mc.contact_s == 2.0)[0])
+    sc = Scene.from_delta_t(contact_s=2.0, noise_c=0.05, delta_t_c=10.0)
+    assert mc.ideal_accuracy[k] == pytest.approx(bayes_accuracy(ranges, SENSORS["paper"], sc), abs=1e-12)
+    assert np.all(np.diff(mc.ideal_accuracy) >= -1e-9)  # longer contact never hurts the ideal observer
+    assert mc.chance < mc.ideal_accuracy[0] < mc.ideal_accuracy[-1] < 1.0  # overlaps cap it below 1
+
+
+def test_separated_classes_are_told_apart_perfectly(paper_sensor):
+    from designkit.scene import Scene
+
+    assert multiclass_ideal_accuracy([(400, 500), (20000, 30000)], paper_sensor,
+                                     Scene.from_delta_t(contact_s=2.0)) == pytest.approx(1.0)
+    assert multiclass_ideal_accuracy([(400, 500), (400, 500)], paper_sensor,
+                                     Scene.from_delta_t(contact_s=2.0)) == pytest.approx(0.5, abs=1e-6)
+
+
+def test_to_dict_is_json_and_symmetric(paper12):
+    d = json.loads(json.dumps(paper12.to_dict(), allow_nan=False))
+    n = len(d["materials"])
+    assert n == 12 and len(d["cells"]) == 66 and d["computation"]["queries"] == 66
+    m = d["matrix"]["value"]
+    assert all(m[i][i] is None for i in range(n))
+    assert all(m[i][j] == m[j][i] for i in range(n) for j in range(n))
+
+
+def test_resolve_materials_needs_two_distinct():
+    from designkit._validation import InputError
+
+    with pytest.raises(InputError, match="two distinct"):
+        resolve_materials(["paper12:copper", "paper12:Copper"])
+    assert len(resolve_materials(["copper"], set="paper12")) == 13  # database copper alloys + the 12
+
+
+def test_a_question_without_a_matrix_is_refused():
+    from designkit._validation import InputError
+
+    with pytest.raises(InputError, match="a matrix asks one of"):
+        material_matrix(THREE, "delta-e")
+
+
+def test_twelve_materials_from_tables_in_well_under_a_second():
+    material_matrix(THREE)  # imports and first table load out of the way
+    t0 = time.process_time()
+    material_matrix(set="paper12")
+    assert time.process_time() - t0 < 1.0
+
+
+# ---------------------------------------------------------------- the command
+def test_cli_table_names_every_material_uncut(cli):
+    r = cli("matrix", "--set", "paper12")
+    assert r.exit_code == 0, r.output
+    for name in ("Stainless Steel", "Cardboard", "Porcelain"):
+        assert name in r.output
+    assert "…" not in r.output
+    assert "min-contact [s]" in r.output and "Limiting pair" in r.output and "overlap" in r.output
+
+
+def test_cli_csv_is_a_header_and_rows_only(cli):
+    r = cli("matrix", "--m", "copper", "--m", "stainless steel", "--m", "glass", "--format", "csv")
+    assert r.exit_code == 0, r.output
+    rows = list(csv.reader(io.StringIO(r.output)))
+    assert rows[0] == ["material", "Copper alloys", "Stainless steel", "Glass"]
+    assert len(rows) == 4 and rows[1][1] == "" and float(rows[1][2]) > 0
+    assert not any(line.startswith("#") for line in r.output.splitlines())
+
+
+def test_cli_csv_reads_with_pandas_defaults(cli):
+    pd = pytest.importorskip("pandas")
+    r = cli("matrix", "--m", "copper", "--m", "stainless steel", "--m", "glass", "--format", "csv")
+    assert r.exit_code == 0, r.output
+    df = pd.read_csv(io.StringIO(r.output), index_col=0)
+    assert list(df.index) == list(df.columns)
+    assert df.shape == (3, 3) and np.isnan(df.values[0, 0])
+
+
+def test_cli_json_is_the_library_dict(cli):
+    r = cli("matrix", *sum((["--m", m] for m in THREE), []), "--json")
+    assert r.exit_code == 0, r.output
+    d = json.loads(r.output)
+    lib = material_matrix(THREE).to_dict()
+    d["computation"].pop("wall_s"), lib["computation"].pop("wall_s")
+    assert d == json.loads(json.dumps(lib))
+
+
+def test_cli_md_and_out_file(cli, tmp_path):
+    out = tmp_path / "m.md"
+    r = cli("matrix", *sum((["--m", m] for m in THREE), []), "-q", "distinguishable", "--contact", "1",
+            "--format", "md", "--out", str(out))
+    assert r.exit_code == 0, r.output
+    text = out.read_text()
+    assert text.startswith("**distinguishable") and "| Glass | · | yes | yes |" in text
+
+
+def test_cli_needs_contact_for_max_noise(cli):
+    r = cli("matrix", "--set", "paper12", "-q", "max-noise", "--json")
+    assert r.exit_code == 2
+    assert "--contact" in json.loads(r.stdout)["error"]["message"]
+
+
+def test_cli_plot_writes_a_vector_figure(cli, tmp_path):
+    pytest.importorskip("matplotlib")
+    r = cli("matrix", *sum((["--m", m] for m in THREE), []), "--plot", str(tmp_path / "m.svg"))
+    assert r.exit_code == 0, r.output
+    assert (tmp_path / "m.svg").read_text().lstrip().startswith("<?xml")
+
+
+def test_svm_multiclass_on_request_equals_the_reproduce_pipeline(paper_sensor):
+    pytest.importorskip("sklearn")
+    from designkit.reproduce.multiclass import svm_multiclass
+    from designkit.scene import Scene
+
+    r = material_matrix(THREE, svm_trials=6, seed=3)
+    mc = r.multiclass
+    assert mc.svm_accuracy is not None and mc.svm_accuracy.shape == mc.contact_s.shape
+    assert np.all((0 <= mc.svm_accuracy) & (mc.svm_accuracy <= 1)) and "SVM: the paper's pipeline" in mc.note
+    sc = Scene.from_delta_t(contact_s=float(mc.contact_s[2]), noise_c=0.05, delta_t_c=10.0)
+    want = svm_multiclass([m.effusivity_range for m in r.materials], 6, paper_sensor, sc, [3, 16, 2])["accuracy"]
+    assert mc.svm_accuracy[2] == want
+
+
+def test_progress_counts_pairs_then_svm_contacts():
+    pytest.importorskip("sklearn")
+    seen = []
+    material_matrix(THREE, svm_trials=3, progress=lambda d, t: seen.append((d, t)))
+    assert seen[0] == (1, 3 + 12) and seen[-1] == (15, 15) and [d for d, _ in seen] == list(range(1, 16))

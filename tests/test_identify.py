@@ -108,3 +108,21 @@ def test_cli_fit_with_model_prints_the_held_out_comparison(robot_data_dir, cli):
     assert set(out["results"][0]["held_out_rms_c"]) == {"metal", "wood", "all"}
     bad = cli("calibrate", "fit", str(index), "--model", "semi-infinite", "--out", "x.yaml")
     assert bad.exit_code != 0 and "sensor files do not record a forward model" in bad.output
+
+
+def test_fit_on_a_decimated_grid_when_the_noise_is_smoothed_gives_the_full_grid_estimates():
+    """Host-smoothed noise (correlated over ~10 samples): "auto" fits every 10th-or-so sample, same answer."""
+    from scipy.signal import savgol_filter
+
+    rng = np.random.default_rng(3)
+    smooth = []
+    for tr in _touches(seed=5, n_per=3, noise_c=0.0):
+        noise = savgol_filter(rng.normal(0, 0.05, tr.time_s.size), 99, 3)
+        smooth.append(Trial(tr.time_s, tr.sensor_c + noise, tr.object_c, tr.force_n, tr.material, source=tr.source))
+    full = identify(smooth, CAND, ranges=RANGES, start={"lag_s": 0.2}, fit_rate_hz=None)
+    fast = identify(smooth, CAND, ranges=RANGES, start={"lag_s": 0.2})
+    for name in ("diffusivity_m2_s", "lag_s", "conductance_w_m2k"):
+        a, b = full.parameter(name), fast.parameter(name)
+        half_width = math.log(a.ci95[1] / a.ci95[0]) / 2
+        assert abs(math.log(b.value / a.value)) < 0.25 * half_width, name
+    assert fast.rms_c == pytest.approx(full.rms_c, rel=0.01)      # both on the full grid

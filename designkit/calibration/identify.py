@@ -81,6 +81,9 @@ __all__ = [
 #: The recordings' host smoothing: Savitzky-Golay window 99, order 3 (at 200 Hz).
 HOST_SMOOTHING = (99, 3)
 _LOG_RATIO_LIMIT = 12.0
+_AFFINE_OFFSET_C, _AFFINE_SLOPE = 5.0, 2.0   # search range of a passive channel's offset [degC] and slope
+#: Talbot nodes of the fitted readings (12: error < 1e-8 of the temperature difference).
+FIT_TALBOT_NODES = 12
 
 
 # ------------------------------------------------------------ candidates
@@ -203,6 +206,7 @@ class _Group:
     to: np.ndarray         # (n,) object temperature [degC] (nan: fitted per touch)
     free_to: bool
     trials: tuple[int, ...]
+    affine: bool = False   # To = passive + offset + slope (passive - reference): a rig calibration of the channel
 
 
 @dataclass(frozen=True)
@@ -213,6 +217,8 @@ class _Data:
     noise_c: float
     sample_rate_hz: float
     n_trials: int
+    refs: Mapping[str, float] = field(default_factory=dict)   # reference passive reading of affine materials
+    noise_lag: int = 1     # first lag [samples] at which the pre-contact noise's autocorrelation falls below 0.5
 
     @property
     def n_samples(self) -> int:
@@ -257,8 +263,11 @@ def split_by_trial_set(trials: Sequence[Trial], fit_sets: Sequence[int],
     return fit, held
 
 
+_OBJECT_MODES = ("passive", "passive-end", "free", "passive-affine", "passive-end-affine")
+
+
 def _prepare(trials: Sequence[Trial], names: Sequence[str], object_temps: Mapping[str, Any],
-             moving_passive_c: float = 1.0) -> _Data:
+             moving_passive_c: float = 1.0, refs: Mapping[str, float] | None = None) -> _Data:
     """Group trials by material and time grid; decide each material's object temperature."""
     if not trials:
         raise InputError("no trials to fit")
@@ -266,6 +275,7 @@ def _prepare(trials: Sequence[Trial], names: Sequence[str], object_temps: Mappin
     modes: dict[str, str] = {}
     info = []
     ssr, dof, rates = 0.0, 0, []
+    acf = np.zeros(41)
     for tr in trials:
         pre = tr.time_s < 0
         if pre.sum() < 3:
@@ -273,7 +283,10 @@ def _prepare(trials: Sequence[Trial], names: Sequence[str], object_temps: Mappin
         t, s = tr.time_s[pre], tr.sensor_c[pre]
         early = t < t[0] + 0.5 * (t[-1] - t[0]) if t.size >= 20 else np.ones(t.size, bool)
         coef = np.polyfit(t[early], s[early], 1)
-        ssr += float(np.sum((s[early] - np.polyval(coef, t[early])) ** 2))
+        e = s[early] - np.polyval(coef, t[early])
+        ssr += float(e @ e)
+        lags = min(acf.size, e.size)
+        acf[:lags] += [float(e[:e.size - k] @ e[k:]) for k in range(lags)]
         dof += int(early.sum()) - 2
         obj = tr.object_c[pre]
         to = float(np.mean(obj[np.isfinite(obj)])) if np.isfinite(obj).any() else math.nan
@@ -289,11 +302,11 @@ def _prepare(trials: Sequence[Trial], names: Sequence[str], object_temps: Mappin
                 raise InputError(f"trials of {n} have no passive (object) channel: give its object temperature "
                                  f"({n}=DEGC, the ambient) or {n}=free")
             mode = "free" if float(np.median(moves)) > moving_passive_c else "passive"
-        if isinstance(mode, str) and mode not in ("passive", "passive-end", "free"):
+        if isinstance(mode, str) and mode not in _OBJECT_MODES:
             try:
                 mode = float(mode)
             except ValueError:
-                raise InputError(f"object temperature of {n}: passive, passive-end, free or DEGC, got {mode!r}") \
+                raise InputError(f"object temperature of {n}: {', '.join(_OBJECT_MODES)} or DEGC, got {mode!r}") \
                     from None
         modes[n] = mode if isinstance(mode, str) else float(mode)
     groups: dict[tuple[int, bytes], list[int]] = {}
@@ -310,13 +323,13 @@ def _prepare(trials: Sequence[Trial], names: Sequence[str], object_temps: Mappin
         mode = modes[n]
         tos = []
         for i in members:
-            if mode == "passive-end":
+            if mode in ("passive-end", "passive-end-affine"):
                 tr = trials[i]
                 last = (tr.time_s >= tr.time_s[-1] - 1.0) & np.isfinite(tr.object_c)
                 if not last.any():
-                    raise InputError(f"trial {tr.source} has no passive reading at its end for {n}=passive-end")
+                    raise InputError(f"trial {tr.source} has no passive reading at its end for {n}={mode}")
                 tos.append(float(np.mean(tr.object_c[last])))
-            elif mode == "passive":
+            elif mode in ("passive", "passive-affine"):
                 if not math.isfinite(info[i][0]):
                     raise InputError(f"trial {trials[i].source} has no passive reading before contact: give "
                                      f"{n}=DEGC")
@@ -326,9 +339,16 @@ def _prepare(trials: Sequence[Trial], names: Sequence[str], object_temps: Mappin
             else:
                 tos.append(float(mode))
         out.append(_Group(k, trials[members[0]].time_s.copy(), np.array([trials[i].sensor_c for i in members]),
-                          np.array(tos), mode == "free", tuple(members)))
+                          np.array(tos), mode == "free", tuple(members),
+                          isinstance(mode, str) and mode.endswith("-affine")))
     noise = math.sqrt(ssr / dof) if dof > 0 else math.nan
-    return _Data(tuple(out), tuple(names), modes, noise, float(np.median(rates)), len(trials))
+    ref = dict(refs or {})
+    for n in names:  # the reference reading of an affine channel: the fitted touches' mean (kept for scoring)
+        if isinstance(modes[n], str) and modes[n].endswith("-affine") and n not in ref:
+            ref[n] = float(np.mean(np.concatenate([g.to for g in out if names[g.material] == n])))
+    below = np.flatnonzero(acf < 0.5 * acf[0]) if acf[0] > 0 else np.array([1])
+    lag = int(below[0]) if below.size else acf.size
+    return _Data(tuple(out), tuple(names), modes, noise, float(np.median(rates)), len(trials), ref, max(lag, 1))
 
 
 # ------------------------------------------------------------ the problem
@@ -339,25 +359,37 @@ def _reading(model, t: np.ndarray, e_object: float, sensor, interp_points: int |
     ``interp_points`` log-spaced times and interpolated by a cubic spline in
     ``log t`` (error below 1e-6 of the temperature difference for smooth
     readings, tested), which makes a residual evaluation about 6x faster.
+    The Talbot inversion uses :data:`FIT_TALBOT_NODES` nodes (error below
+    1e-8 of the temperature difference against 32 nodes over the fitted
+    parameter range, docs/sensor-models.md; the noise is about 1e-3 of it).
     """
     if not hasattr(model, "conduction"):
         return model.response(t, [e_object], sensor)[0]
     if not interp_points or t.size <= 2 * interp_points:
-        return model.conduction(t, [e_object], sensor, nodes=16)[0]
+        return model.conduction(t, [e_object], sensor, nodes=FIT_TALBOT_NODES)[0]
     from scipy.interpolate import CubicSpline
 
-    lo, hi = float(t.min()), float(t.max())
+    # the grid starts at half a sample, not at the smallest t: that moves by a whole sample when the
+    # contact offset crosses one, and would make the residual kink there (the optimizer then sticks)
+    lo = 0.5 / float(sensor.sample_rate_hz)
+    hi = max(float(t.max()), 2.0 * lo)
     grid = np.geomspace(lo, hi, interp_points)
-    u = model.conduction(grid, [e_object], sensor, nodes=16)[0]
-    return CubicSpline(np.log(grid), u)(np.log(t))
+    u = model.conduction(grid, [e_object], sensor, nodes=FIT_TALBOT_NODES)[0]
+    out = CubicSpline(np.log(grid), u)(np.log(np.maximum(t, lo)))
+    early = t < lo
+    if early.any():
+        out[early] = model.conduction(t[early], [e_object], sensor, nodes=FIT_TALBOT_NODES)[0]
+    return out
 
 
 class _Problem:
     """Projected residuals of one candidate on prepared data; x = [model params, t_off, log rho_m]."""
 
     def __init__(self, cand: Candidate, data: _Data, depth_m: float, offset_bounds_s: tuple[float, float],
-                 constrained: np.ndarray):
+                 constrained: np.ndarray, stride: int = 1):
         from ..models import get_model
+
+        self.stride = max(int(stride), 1)   # residual rows: every stride-th sample (shapes on the full grid)
 
         self.cand = cand
         self.data = data
@@ -367,13 +399,20 @@ class _Problem:
         self.n_mat = len(data.names)
         self.constrained = constrained
         self._get_model = get_model
-        self.interp_points: int | None = 160
+        self.interp_points: int | None = 80
+        #: materials whose To is the passive reading through a fitted offset and slope: x gets both
+        self.affine = [k for k, n in enumerate(data.names) if isinstance(data.modes[n], str)
+                       and data.modes[n].endswith("-affine")]
         lo = [p.to_x(p.lo) for p in self.params] + [offset_bounds_s[0]] + [-_LOG_RATIO_LIMIT] * self.n_mat
         hi = [p.to_x(p.hi) for p in self.params] + [offset_bounds_s[1]] + [_LOG_RATIO_LIMIT] * self.n_mat
+        lo += [-_AFFINE_OFFSET_C, -_AFFINE_SLOPE] * len(self.affine)
+        hi += [_AFFINE_OFFSET_C, _AFFINE_SLOPE] * len(self.affine)
         self.lo, self.hi = np.array(lo), np.array(hi)
         # a material none of whose touches has a known object temperature: its ratio still shapes the
         # curve (not for shared-shape models, where it is not identified at all)
         self.names = [p.name for p in self.params] + ["time_offset_s"] + [f"log_ratio[{n}]" for n in data.names]
+        for k in self.affine:
+            self.names += [f"passive_offset_c[{data.names[k]}]", f"passive_slope[{data.names[k]}]"]
 
     # -------------------------------------------------------- model
     def model_and_sensor(self, x: np.ndarray):
@@ -392,7 +431,7 @@ class _Problem:
         """Predicted normalized reading v of each group on its grid (smoothed when the candidate says)."""
         model, sensor = self.model_and_sensor(x)
         off = x[self.n_model]
-        rho = np.exp(x[self.n_model + 1:])
+        rho = np.exp(x[self.n_model + 1:self.n_model + 1 + self.n_mat])
         out = []
         cache: dict[tuple[int, bytes], np.ndarray] = {}
         for g in self.data.groups:
@@ -411,35 +450,50 @@ class _Problem:
             out.append(cache[key])
         return out
 
+    def fitted_y(self, g: _Group) -> np.ndarray:
+        """The samples of group ``g`` the residual uses (every ``stride``-th)."""
+        return g.y[:, ::self.stride] if self.stride > 1 else g.y
+
     def project(self, x: np.ndarray):
         """(residuals, per-group linear coefficients): Ts0 (and To where free) in closed form."""
         res, coefs = [], []
         for g, v in zip(self.data.groups, self.shapes(x)):
+            y = self.fitted_y(g)
+            v = v[::self.stride]
             if g.free_to:
                 A = np.column_stack([1.0 - v, v])
-                coef = np.linalg.solve(A.T @ A, A.T @ g.y.T)            # (2, n): normal equations, well scaled
+                coef = np.linalg.solve(A.T @ A, A.T @ y.T)              # (2, n): normal equations, well scaled
                 pred = (A @ coef).T
             else:
+                to = self.object_temps(g, x)
                 a = 1.0 - v
                 den = float(a @ a)
-                b = g.y - g.to[:, None] * v[None, :]
+                b = y - to[:, None] * v[None, :]
                 ts0 = (b @ a) / den
-                pred = ts0[:, None] * a[None, :] + g.to[:, None] * v[None, :]
-                coef = np.vstack([ts0, g.to])
-            res.append((pred - g.y).ravel())
+                pred = ts0[:, None] * a[None, :] + to[:, None] * v[None, :]
+                coef = np.vstack([ts0, to])
+            res.append((pred - y).ravel())
             coefs.append(coef)
         return np.concatenate(res), coefs
 
     def residuals(self, x):
         return self.project(x)[0]
 
+    def object_temps(self, g: _Group, x: np.ndarray) -> np.ndarray:
+        """Each touch's object temperature [degC]: the group's, through the fitted offset and slope if affine."""
+        if not g.affine:
+            return g.to
+        j = self.n_model + 1 + self.n_mat + 2 * self.affine.index(g.material)
+        ref = self.data.refs[self.data.names[g.material]]
+        return g.to + x[j] + x[j + 1] * (g.to - ref)
+
     def start(self) -> np.ndarray:
         x = [p.to_x(p.start) for p in self.params] + [0.3]
-        return np.array(x + [0.0] * self.n_mat)
+        return np.array(x + [0.0] * self.n_mat + [0.0, 0.0] * len(self.affine))
 
     def rows_of(self, k: int) -> np.ndarray:
         """Residual rows of material ``k``."""
-        mask = [np.full(g.y.size, g.material == k) for g in self.data.groups]
+        mask = [np.full(self.fitted_y(g).size, g.material == k) for g in self.data.groups]
         return np.concatenate(mask)
 
     def n_linear(self) -> int:
@@ -542,6 +596,7 @@ class Identification:
     sample_rate_hz: float
     object_modes: Mapping[str, "str | float"]
     notes: tuple[str, ...] = ()
+    object_refs: Mapping[str, float] = field(default_factory=dict)
 
     def parameter(self, name: str) -> IdentifiedParameter:
         for p in self.parameters:
@@ -589,7 +644,8 @@ class Identification:
             "n_samples": self.n_samples, "n_parameters": self.n_parameters, "aic": self.aic, "bic": self.bic,
             "rank": self.rank, "n_nonlinear": self.n_nonlinear,
             "singular_values": [float(v) for v in self.singular_values], "fit_time_s": self.fit_time_s,
-            "noise_c": self.noise_c, "object_temperature": dict(self.object_modes), "notes": list(self.notes),
+            "noise_c": self.noise_c, "object_temperature": dict(self.object_modes), "object_reference_c": dict(self.object_refs),
+            "notes": list(self.notes),
         }
 
 
@@ -606,10 +662,10 @@ def _sandwich(J: np.ndarray, r: np.ndarray, clusters: np.ndarray) -> np.ndarray:
     return bread @ (scores.T @ scores) @ bread
 
 
-def _clusters(data: _Data) -> np.ndarray:
+def _clusters(data: _Data, stride: int = 1) -> np.ndarray:
     out = []
     for g in data.groups:
-        m = g.y.shape[1]
+        m = g.y[:, ::stride].shape[1]
         out.append(np.repeat(np.asarray(g.trials), m))
     return np.concatenate(out)
 
@@ -618,7 +674,7 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
              ranges: Mapping[str, Any] | None = None, object_temps: Mapping[str, Any] | None = None,
              depth_m: float = 80e-6, offset_bounds_s: tuple[float, float] = (-1.5, 1.5),
              start: Mapping[str, float] | None = None, x0: np.ndarray | None = None,
-             max_nfev: int = 100) -> Identification:
+             max_nfev: int = 100, fit_rate_hz: "float | str | None" = "auto") -> Identification:
     """Fit one candidate model to touches.
 
     Parameters
@@ -643,6 +699,17 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
         A transformed start vector (from another fit's ``x``).
     max_nfev : int
         Most residual evaluations of the optimizer.
+    fit_rate_hz : float, "auto" or None
+        The least-squares fit uses every k-th sample, ``k = round(fs /
+        fit_rate_hz)`` (None: every sample; ``"auto"``: k = the lag at which
+        the pre-contact noise's autocorrelation falls below 0.5, so white
+        noise keeps every sample). The model's shapes (and the host
+        smoothing) are still computed on the full grid, and the reported
+        RMS, AIC and BIC are of the full grid. On the shared recordings
+        (smoothed by the host over 0.5 s) "auto" gives k = 10 (20 Hz): the
+        estimates move by a small fraction of their standard errors
+        (docs/sensor-models.md) and the fit runs several times faster. The
+        cluster-robust covariance does not depend on the stride.
 
     Returns
     -------
@@ -656,7 +723,11 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
     data = _prepare(trials, names, dict(object_temps or {}))
     rng = {n: _as_range(ranges[n]) for n in names if ranges and n in ranges}
     constrained = np.array([n in rng and data.modes[n] != "free" for n in names])
-    prob = _Problem(cand, data, depth_m, offset_bounds_s, constrained)
+    if fit_rate_hz == "auto":
+        stride = data.noise_lag
+    else:
+        stride = 1 if not fit_rate_hz else max(1, int(round(data.sample_rate_hz / float(fit_rate_hz))))
+    prob = _Problem(cand, data, depth_m, offset_bounds_s, constrained, stride=stride)
     if x0 is None:
         x = prob.start()
         for k, v in dict(start or {}).items():
@@ -668,8 +739,9 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
     else:
         x = np.asarray(x0, dtype=np.float64).copy()
     x = np.clip(x, prob.lo + 1e-9, prob.hi - 1e-9)
-    sol = least_squares(prob.residuals, x, bounds=(prob.lo, prob.hi), method="trf", x_scale="jac",
-                        diff_step=1e-6, xtol=1e-8, ftol=1e-8, gtol=1e-8, max_nfev=max_nfev)
+    with _one_blas_thread():  # tall, thin SVDs: threads only contend (4x slower on a loaded 2-core machine)
+        sol = least_squares(prob.residuals, x, bounds=(prob.lo, prob.hi), method="trf", x_scale="jac",
+                            diff_step=1e-6, xtol=1e-8, ftol=1e-8, gtol=1e-8, max_nfev=max_nfev)
     x = sol.x
     r = sol.fun
     J = sol.jac
@@ -683,7 +755,10 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
     for j in range(rank, len(sv)):
         weak |= {int(i) for i in np.flatnonzero(np.abs(vt[j]) > 0.3)}
     weak |= {int(i) for i in np.flatnonzero(norms == 0)}
-    cov = _sandwich(J, r, _clusters(data))
+    cov = _sandwich(J, r, _clusters(data, prob.stride))
+    if prob.stride > 1:  # fit quality on every sample
+        prob.stride = 1
+        r = prob.residuals(x)
     sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     at_bound = (np.abs(x - prob.lo) < 1e-6) | (np.abs(x - prob.hi) < 1e-6)
     # ------------------------------------------------ e_s from the ranges
@@ -751,6 +826,13 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
         rp = ratios[n]
         params.append(IdentifiedParameter(f"e_o[{n}]", rp.value * es, (rp.ci95[0] * es_ci[0], rp.ci95[1] * es_ci[1]),
                                           "J s^-1/2 K^-1 m^-2", rp.identified, rp.note))
+    for i, k in enumerate(prob.affine):
+        for j, name, unit in ((prob.n_model + 1 + prob.n_mat + 2 * i, "passive_offset_c", "degC"),
+                              (prob.n_model + 2 + prob.n_mat + 2 * i, "passive_slope", "")):
+            ok = j not in weak and not at_bound[j]
+            params.append(IdentifiedParameter(
+                f"{name}[{names[k]}]", float(x[j]), (x[j] - 1.96 * sd[j], x[j] + 1.96 * sd[j]), unit, ok,
+                "" if ok else "at a search bound or rank-deficient"))
     # ------------------------------------------------ fit quality
     res_by: dict[str, list[np.ndarray]] = {n: [] for n in names}
     pos = 0
@@ -771,7 +853,19 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
                      "(only x^2/alpha_s matters)")
     return Identification(cand, tuple(params), ratios, es_p, consistent, allowed, float(np.sqrt(np.mean(r ** 2))),
                           rms_by, n_s, k_par, aic, bic, rank, x.size, sv, time.perf_counter() - t0,
-                          data.noise_c, x, names, depth_m, data.sample_rate_hz, dict(data.modes), tuple(notes))
+                          data.noise_c, x, names, depth_m, data.sample_rate_hz, dict(data.modes), tuple(notes),
+                          dict(data.refs))
+
+
+def _one_blas_thread():
+    """A context limiting BLAS to one thread (a no-op without threadpoolctl)."""
+    try:
+        from threadpoolctl import threadpool_limits
+    except ImportError:  # pragma: no cover - scikit-learn depends on it
+        import contextlib
+
+        return contextlib.nullcontext()
+    return threadpool_limits(1)
 
 
 def _as_range(r) -> tuple[float, float]:
@@ -796,7 +890,7 @@ def score(result: Identification, trials: Sequence[Trial], *,
         raise InputError(f"cannot score {', '.join(unknown)}: not among the fitted materials {', '.join(names)}")
     modes = dict(result.object_modes)
     modes.update(dict(object_temps or {}))
-    data = _prepare(trials, names, modes)
+    data = _prepare(trials, names, modes, refs=result.object_refs)
     prob = _Problem(result.candidate, data, result.depth_m, (-math.inf, math.inf),
                     np.zeros(len(names), dtype=bool))
     r, _ = prob.project(result.x)
@@ -870,6 +964,9 @@ def compare_models(fit_trials: Sequence[Trial], held_out: Sequence[Trial],
                    candidates: Sequence["str | Candidate"] = CANDIDATES, **kwargs: Any) -> Comparison:
     """Fit every candidate on ``fit_trials``, score each on ``held_out``; select by held-out RMS.
 
+    Each candidate starts from the fitted parameters of the last one nested in it. With no
+    held-out touches the selection is by BIC (the scores are empty).
+
     ``kwargs`` go to :func:`identify` (``ranges``, ``object_temps``, ``depth_m``, ...).
     """
     t0 = time.perf_counter()
@@ -878,7 +975,7 @@ def compare_models(fit_trials: Sequence[Trial], held_out: Sequence[Trial],
         c = c if isinstance(c, Candidate) else candidate(c)
         res = identify(fit_trials, c, x0=_warm_start(c, results), **kwargs)
         results.append(res)
-        held.append(score(res, held_out, object_temps=kwargs.get("object_temps")))
-    best = min(range(len(results)), key=lambda i: (held[i]["all"], results[i].bic))
+        held.append(score(res, held_out, object_temps=kwargs.get("object_temps")) if held_out else {})
+    best = min(range(len(results)), key=lambda i: (held[i].get("all", 0.0), results[i].bic))
     return Comparison(tuple(results), tuple(held), results[best].candidate.label, len(fit_trials), len(held_out),
                       time.perf_counter() - t0)

@@ -333,15 +333,8 @@ def _run_identify(index: Path, model: str, fit_sets: str, ranges: list[str], onl
         fit, held = split_by_trial_set(trials, _parse_sets(fit_sets), index)
     else:
         fit, held = trials, []
-    if held:
-        cmp = compare_models(fit, held, cands, **kw)
-        results, scores, selected = cmp.results, cmp.held_out_rms_c, cmp.selected
-    else:
-        from ..calibration.identify import identify
-
-        results = tuple(identify(fit, c, **kw) for c in cands)
-        scores = tuple({} for _ in results)
-        selected = min(results, key=lambda r: r.bic).candidate.label
+    cmp = compare_models(fit, held, cands, **kw)   # no held-out touches: selected by BIC
+    results, scores, selected = cmp.results, cmp.held_out_rms_c, cmp.selected
     if json_:
         emit_json({"index": str(index), "n_fit": len(fit), "n_held_out": len(held), "selected": selected,
                    "results": [dict(r.to_dict(), held_out_rms_c=dict(sc)) for r, sc in zip(results, scores)]})

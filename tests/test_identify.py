@@ -126,3 +126,32 @@ def test_fit_on_a_decimated_grid_when_the_noise_is_smoothed_gives_the_full_grid_
         half_width = math.log(a.ci95[1] / a.ci95[0]) / 2
         assert abs(math.log(b.value / a.value)) < 0.25 * half_width, name
     assert fast.rms_c == pytest.approx(full.rms_c, rel=0.01)      # both on the full grid
+
+
+def test_per_touch_contact_conductance_explains_touches_that_differ_in_contact():
+    """Granite touches each with its own h_c: one shared h_c misfits, a per-touch h_c fits to the noise."""
+    rng = np.random.default_rng(21)
+    sensor = Sensor(TRUE_ES, TRUE["diffusivity_m2_s"], depth_m=80e-6)
+    t = np.arange(-200, 1401) / 200.0
+    trials = []
+    for i in range(8):
+        for name, eo in E_O.items():
+            hc = 2500.0 * (math.exp(rng.normal(0, 0.5)) if name == "granite" else 1.0)
+            u = np.zeros(t.size)
+            pos = t - OFFSET_S > 0
+            u[pos] = get_model("contact", conductance_w_m2k=hc).response(t[pos] - OFFSET_S, [eo], sensor)[0]
+            ts0, to = 29.5 + rng.normal(0, 0.2), 22.5 + rng.normal(0, 0.3)
+            y = ts0 + (to - ts0) * u + rng.normal(0, 0.01, t.size)
+            trials.append(Trial(t, y, np.full(t.size, to), np.full(t.size, 4.5), name,
+                                source=f"set{i + 1:02d}_{name}.csv"))
+    fit, held = split_by_trial_set(trials, [1, 2, 3, 4])
+    shared = identify(fit, "contact", ranges=RANGES)
+    own = identify(fit, "contact", ranges=RANGES, touch_conductance=("granite",))
+    assert own.rms_c < 0.0105 < shared.rms_c and own.bic < shared.bic
+    assert score(own, held)["granite"] < 0.0105 < score(shared, held)["granite"]
+    spread = own.parameter("conductance_spread[granite]")
+    assert 1.2 < spread.value < 2.5
+    with pytest.raises(InputError, match="not among the fitted materials"):
+        identify(fit, "contact", touch_conductance=("glass",))
+    with pytest.raises(InputError, match="fits h_c"):
+        identify(fit, "semi-infinite", touch_conductance=("granite",))

@@ -81,6 +81,7 @@ __all__ = [
 #: The recordings' host smoothing: Savitzky-Golay window 99, order 3 (at 200 Hz).
 HOST_SMOOTHING = (99, 3)
 _LOG_RATIO_LIMIT = 12.0
+_LOG_TOUCH_HC = 4.0   # search range of a touch's ln(h_c,i / h_c)
 _AFFINE_OFFSET_C, _AFFINE_SLOPE = 5.0, 2.0   # search range of a passive channel's offset [degC] and slope
 #: Talbot nodes of the fitted readings (12: error < 1e-8 of the temperature difference).
 FIT_TALBOT_NODES = 12
@@ -386,7 +387,7 @@ class _Problem:
     """Projected residuals of one candidate on prepared data; x = [model params, t_off, log rho_m]."""
 
     def __init__(self, cand: Candidate, data: _Data, depth_m: float, offset_bounds_s: tuple[float, float],
-                 constrained: np.ndarray, stride: int = 1):
+                 constrained: np.ndarray, stride: int = 1, touch_conductance: Sequence[str] = ()):
         from ..models import get_model
 
         self.stride = max(int(stride), 1)   # residual rows: every stride-th sample (shapes on the full grid)
@@ -413,6 +414,22 @@ class _Problem:
         self.names = [p.name for p in self.params] + ["time_offset_s"] + [f"log_ratio[{n}]" for n in data.names]
         for k in self.affine:
             self.names += [f"passive_offset_c[{data.names[k]}]", f"passive_slope[{data.names[k]}]"]
+        # each touch of these materials its own contact conductance: h_c,i = h_c exp(x_i), x_i last in x
+        unknown = sorted(set(touch_conductance) - set(data.names))
+        if unknown:
+            raise InputError(f"per-touch contact conductance for {', '.join(unknown)}: not among the fitted "
+                             f"materials {', '.join(data.names)}")
+        if touch_conductance and "conductance_w_m2k" not in cand.free:
+            raise InputError(f"per-touch contact conductance needs a candidate that fits h_c, not {cand.label}")
+        self.touch_cols: dict[int, int] = {}
+        self.n_global = len(self.names)
+        for gi, g in enumerate(data.groups):
+            if data.names[g.material] in touch_conductance:
+                self.touch_cols[gi] = len(self.names)
+                self.names += [f"log_hc_touch[{data.names[g.material]}#{t}]" for t in g.trials]
+        n_touch = len(self.names) - self.n_global
+        self.lo = np.concatenate([self.lo, np.full(n_touch, -_LOG_TOUCH_HC)])
+        self.hi = np.concatenate([self.hi, np.full(n_touch, _LOG_TOUCH_HC)])
 
     # -------------------------------------------------------- model
     def model_and_sensor(self, x: np.ndarray):
@@ -435,6 +452,11 @@ class _Problem:
         out = []
         cache: dict[tuple[int, bytes], np.ndarray] = {}
         for g in self.data.groups:
+            gi = len(out)
+            if gi in self.touch_cols:  # one shape per touch, each with its own h_c
+                out.append(self._touch_shapes(g, model, sensor, off, rho[g.material],
+                                              x[self.touch_cols[gi]:self.touch_cols[gi] + len(g.trials)]))
+                continue
             key = (g.material, g.time_s.tobytes())
             if key not in cache:
                 tt = g.time_s - off
@@ -450,30 +472,77 @@ class _Problem:
             out.append(cache[key])
         return out
 
+    def _touch_shapes(self, g: _Group, model, sensor, off: float, rho: float, log_dev: np.ndarray) -> np.ndarray:
+        import dataclasses
+
+        tt = g.time_s - off
+        pos = tt > 0
+        out = np.zeros((log_dev.size, tt.size))
+        for i, d in enumerate(log_dev):
+            m = dataclasses.replace(model, conductance_w_m2k=model.conductance_w_m2k * math.exp(float(d)))
+            if pos.any():
+                out[i, pos] = _reading(m, tt[pos], rho, sensor, self.interp_points)
+        if self.cand.smoothing:
+            from ..models.layered import savgol_smooth
+
+            out = savgol_smooth(out, *HOST_SMOOTHING)
+        return out
+
+    def jacobian(self, x: np.ndarray, touch_only: bool = False) -> np.ndarray:
+        """Forward differences (step 1e-6 max(1, |x|)); all per-touch columns from one evaluation.
+
+        A touch's residuals depend on its own h_c only (its Ts0 and To are its own), so perturbing
+        every touch's h_c at once gives each touch's column on its own rows.
+        """
+        r0 = self.residuals(x)
+        J = np.zeros((r0.size, x.size))
+        steps = 1e-6 * np.maximum(1.0, np.abs(x))
+        steps = np.where(x + steps > self.hi, -steps, steps)
+        for j in range(0 if touch_only else self.n_global):
+            xp = x.copy()
+            xp[j] += steps[j]
+            J[:, j] = (self.residuals(xp) - r0) / steps[j]
+        if self.touch_cols:
+            xp = x.copy()
+            xp[self.n_global:] += steps[self.n_global:]
+            d = self.residuals(xp) - r0
+            pos = 0
+            for gi, g in enumerate(self.data.groups):
+                m = self.fitted_y(g).shape[1]
+                if gi in self.touch_cols:
+                    for i in range(len(g.trials)):
+                        j = self.touch_cols[gi] + i
+                        J[pos + i * m:pos + (i + 1) * m, j] = d[pos + i * m:pos + (i + 1) * m] / steps[j]
+                pos += g.y.shape[0] * m
+        return J
+
     def fitted_y(self, g: _Group) -> np.ndarray:
         """The samples of group ``g`` the residual uses (every ``stride``-th)."""
         return g.y[:, ::self.stride] if self.stride > 1 else g.y
 
     def project(self, x: np.ndarray):
-        """(residuals, per-group linear coefficients): Ts0 (and To where free) in closed form."""
+        """(residuals, per-group linear coefficients): Ts0 (and To where free) in closed form.
+
+        A group's shape is one curve (m,) or one per touch (n, m); the sums run over the last axis.
+        """
         res, coefs = [], []
         for g, v in zip(self.data.groups, self.shapes(x)):
             y = self.fitted_y(g)
-            v = v[::self.stride]
-            if g.free_to:
-                A = np.column_stack([1.0 - v, v])
-                coef = np.linalg.solve(A.T @ A, A.T @ y.T)              # (2, n): normal equations, well scaled
-                pred = (A @ coef).T
+            v = v[..., ::self.stride]
+            a = 1.0 - v
+            saa = np.sum(a * a, axis=-1)
+            if g.free_to:  # per touch: [Ts0, To] from the 2x2 normal equations (well scaled)
+                sav, svv = np.sum(a * v, axis=-1), np.sum(v * v, axis=-1)
+                ya, yv = np.sum(y * a, axis=-1), np.sum(y * v, axis=-1)
+                det = saa * svv - sav * sav
+                ts0 = (svv * ya - sav * yv) / det
+                to = (saa * yv - sav * ya) / det
             else:
                 to = self.object_temps(g, x)
-                a = 1.0 - v
-                den = float(a @ a)
-                b = y - to[:, None] * v[None, :]
-                ts0 = (b @ a) / den
-                pred = ts0[:, None] * a[None, :] + to[:, None] * v[None, :]
-                coef = np.vstack([ts0, to])
+                ts0 = np.sum((y - to[:, None] * v) * a, axis=-1) / saa
+            pred = ts0[:, None] * a + to[:, None] * v
             res.append((pred - y).ravel())
-            coefs.append(coef)
+            coefs.append(np.vstack([ts0, to]))
         return np.concatenate(res), coefs
 
     def residuals(self, x):
@@ -489,7 +558,7 @@ class _Problem:
 
     def start(self) -> np.ndarray:
         x = [p.to_x(p.start) for p in self.params] + [0.3]
-        return np.array(x + [0.0] * self.n_mat + [0.0, 0.0] * len(self.affine))
+        return np.array(x + [0.0] * self.n_mat + [0.0, 0.0] * len(self.affine) + [0.0] * (self.lo.size - self.n_global))
 
     def rows_of(self, k: int) -> np.ndarray:
         """Residual rows of material ``k``."""
@@ -597,6 +666,7 @@ class Identification:
     object_modes: Mapping[str, "str | float"]
     notes: tuple[str, ...] = ()
     object_refs: Mapping[str, float] = field(default_factory=dict)
+    touch_conductance: tuple[str, ...] = ()
 
     def parameter(self, name: str) -> IdentifiedParameter:
         for p in self.parameters:
@@ -674,7 +744,8 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
              ranges: Mapping[str, Any] | None = None, object_temps: Mapping[str, Any] | None = None,
              depth_m: float = 80e-6, offset_bounds_s: tuple[float, float] = (-1.5, 1.5),
              start: Mapping[str, float] | None = None, x0: np.ndarray | None = None,
-             max_nfev: int = 100, fit_rate_hz: "float | str | None" = "auto") -> Identification:
+             max_nfev: int = 100, fit_rate_hz: "float | str | None" = "auto",
+             touch_conductance: Sequence[str] = ()) -> Identification:
     """Fit one candidate model to touches.
 
     Parameters
@@ -710,6 +781,11 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
         estimates move by a small fraction of their standard errors
         (docs/sensor-models.md) and the fit runs several times faster. The
         cluster-robust covariance does not depend on the stride.
+    touch_conductance : sequence of str
+        Materials whose touches each get their own contact conductance
+        ``h_c,i = h_c exp(d_i)`` (a per-touch nuisance: contact area and
+        pressure differ from touch to touch); needs a candidate fitting h_c.
+        Held-out touches of them get their own ``d_i`` fitted in :func:`score`.
 
     Returns
     -------
@@ -727,7 +803,8 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
         stride = data.noise_lag
     else:
         stride = 1 if not fit_rate_hz else max(1, int(round(data.sample_rate_hz / float(fit_rate_hz))))
-    prob = _Problem(cand, data, depth_m, offset_bounds_s, constrained, stride=stride)
+    prob = _Problem(cand, data, depth_m, offset_bounds_s, constrained, stride=stride,
+                    touch_conductance=tuple(touch_conductance))
     if x0 is None:
         x = prob.start()
         for k, v in dict(start or {}).items():
@@ -737,11 +814,13 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
                 x[cand.free.index(k)] = _PARAMS[k].to_x(float(v))
         x = _initial_ratios(prob, x)
     else:
-        x = np.asarray(x0, dtype=np.float64).copy()
+        x = np.asarray(x0, dtype=np.float64)[:prob.n_global].copy()
+    x = np.concatenate([x[:prob.n_global], np.zeros(prob.lo.size - prob.n_global)])
     x = np.clip(x, prob.lo + 1e-9, prob.hi - 1e-9)
     with _one_blas_thread():  # tall, thin SVDs: threads only contend (4x slower on a loaded 2-core machine)
+        jac = dict(jac=prob.jacobian) if prob.touch_cols else dict(diff_step=1e-6)
         sol = least_squares(prob.residuals, x, bounds=(prob.lo, prob.hi), method="trf", x_scale="jac",
-                            diff_step=1e-6, xtol=1e-8, ftol=1e-8, gtol=1e-8, max_nfev=max_nfev)
+                            xtol=1e-8, ftol=1e-8, gtol=1e-8, max_nfev=max_nfev, **jac)
     x = sol.x
     r = sol.fun
     J = sol.jac
@@ -826,6 +905,20 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
         rp = ratios[n]
         params.append(IdentifiedParameter(f"e_o[{n}]", rp.value * es, (rp.ci95[0] * es_ci[0], rp.ci95[1] * es_ci[1]),
                                           "J s^-1/2 K^-1 m^-2", rp.identified, rp.note))
+    for gi, j0 in prob.touch_cols.items():
+        g = data.groups[gi]
+        d = x[j0:j0 + len(g.trials)]
+        n = names[g.material]
+        sdl = float(np.std(d, ddof=1)) if d.size > 1 else math.nan
+        hc = _PARAMS["conductance_w_m2k"].from_x(x[prob.params.index(_PARAMS["conductance_w_m2k"])]) * es
+        inside = bool(np.all(~at_bound[j0:j0 + d.size]))
+        params.append(IdentifiedParameter(
+            f"conductance_w_m2k[{n} touches]", hc * _exp(float(np.mean(d))),
+            (hc * _exp(float(np.min(d))), hc * _exp(float(np.max(d)))), "W m^-2 K^-1", inside,
+            "geometric mean of the touches' own h_c,i; interval: their smallest and largest (not a CI)"))
+        params.append(IdentifiedParameter(
+            f"conductance_spread[{n}]", _exp(sdl) if math.isfinite(sdl) else math.nan,
+            (math.nan, math.nan), "factor", inside, "geometric standard deviation of the touches' h_c,i"))
     for i, k in enumerate(prob.affine):
         for j, name, unit in ((prob.n_model + 1 + prob.n_mat + 2 * i, "passive_offset_c", "degC"),
                               (prob.n_model + 2 + prob.n_mat + 2 * i, "passive_slope", "")):
@@ -854,7 +947,7 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
     return Identification(cand, tuple(params), ratios, es_p, consistent, allowed, float(np.sqrt(np.mean(r ** 2))),
                           rms_by, n_s, k_par, aic, bic, rank, x.size, sv, time.perf_counter() - t0,
                           data.noise_c, x, names, depth_m, data.sample_rate_hz, dict(data.modes), tuple(notes),
-                          dict(data.refs))
+                          dict(data.refs), tuple(touch_conductance))
 
 
 def _one_blas_thread():
@@ -892,8 +985,21 @@ def score(result: Identification, trials: Sequence[Trial], *,
     modes.update(dict(object_temps or {}))
     data = _prepare(trials, names, modes, refs=result.object_refs)
     prob = _Problem(result.candidate, data, result.depth_m, (-math.inf, math.inf),
-                    np.zeros(len(names), dtype=bool))
-    r, _ = prob.project(result.x)
+                    np.zeros(len(names), dtype=bool), stride=1, touch_conductance=result.touch_conductance)
+    x = np.concatenate([result.x[:prob.n_global], np.zeros(prob.lo.size - prob.n_global)])
+    if prob.touch_cols:  # each held-out touch's own h_c (the sensor's parameters stay as fitted)
+        from scipy.optimize import least_squares
+
+        glob = x[:prob.n_global]
+        free = slice(prob.n_global, None)
+        prob.stride = data.noise_lag
+        with _one_blas_thread():
+            sol = least_squares(lambda d: prob.residuals(np.concatenate([glob, d])), x[free],
+                                jac=lambda d: prob.jacobian(np.concatenate([glob, d]), touch_only=True)[:, free],
+                                bounds=(prob.lo[free], prob.hi[free]), method="trf", x_scale="jac", max_nfev=50)
+        x = np.concatenate([glob, sol.x])
+        prob.stride = 1
+    r, _ = prob.project(x)
     out: dict[str, list[np.ndarray]] = {}
     pos = 0
     for g in data.groups:

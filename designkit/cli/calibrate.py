@@ -308,7 +308,8 @@ def _parse_sets(spec: str) -> list[int]:
 
 
 def _run_identify(index: Path, model: str, fit_sets: str, ranges: list[str], only: Optional[list[str]],
-                  object_temps: list[str], depth_um: float, out: Optional[Path], json_: bool) -> None:
+                  object_temps: list[str], depth_um: float, out: Optional[Path], json_: bool,
+                  touch_conductance: Optional[str] = None) -> None:
     """``calibrate fit --model``: identify one model or compare them all on held-out touches."""
     from rich.markup import escape
     from rich.table import Table
@@ -327,9 +328,26 @@ def _run_identify(index: Path, model: str, fit_sets: str, ranges: list[str], onl
         raise InputError(f"index {index} lists no trials")
     names = sorted({tr.material for tr in trials})
     rng = resolve_ranges(names, parse_ranges(ranges))
-    temps = parse_object_temps(object_temps)
-    kw = dict(ranges=rng, object_temps=temps, depth_m=depth_um * 1e-6)
-    if all(s is not None for s in trial_sets(trials, index)):
+    affine = [spec for spec in object_temps if spec.strip().lower().endswith("-affine")]
+    temps = parse_object_temps([spec for spec in object_temps if spec not in affine])
+    for spec in affine:  # the passive reading through a fitted offset and slope (identification only)
+        mat, _, mode = spec.partition("=")
+        if mode.strip().lower() not in ("passive-affine", "passive-end-affine"):
+            raise InputError(f"--object-temp {spec!r}: the fitted-channel modes are passive-affine and "
+                             "passive-end-affine")
+        temps[mat.strip()] = mode.strip().lower()
+    per_touch = [n.strip() for n in (touch_conductance or "").split(",") if n.strip()]
+    unknown = sorted(set(per_touch) - set(names))
+    if unknown:
+        raise InputError(f"--touch-conductance names material(s) not being fitted: {', '.join(unknown)} "
+                         f"(fitted: {', '.join(names)})")
+    if per_touch:
+        cands = [c for c in cands if "conductance_w_m2k" in c.free]
+        if not cands:
+            raise InputError(f"--touch-conductance needs a model that fits the contact conductance "
+                             f"(contact, layered...), not {model}")
+    kw = dict(ranges=rng, object_temps=temps, depth_m=depth_um * 1e-6, touch_conductance=tuple(per_touch))
+    if fit_sets.strip().lower() != "all" and all(s is not None for s in trial_sets(trials, index)):
         fit, held = split_by_trial_set(trials, _parse_sets(fit_sets), index)
     else:
         fit, held = trials, []
@@ -434,7 +452,12 @@ def fit(
                         "them on held-out touches (default: the paper's semi-infinite fit).")] = None,
     fit_sets: Annotated[str, typer.Option(
         "--fit-sets", help="With --model: trial sets to fit (FIRST-LAST or a comma list); the others are held "
-                           "out and scored. Indexes without trial sets are fitted whole.")] = "1-4",
+                           "out and scored ('all': fit every touch, select by BIC). Indexes without trial "
+                           "sets are fitted whole.")] = "1-4",
+    touch_conductance: Annotated[Optional[str], typer.Option(
+        "--touch-conductance", help="With --model: give each touch of these materials (comma-separated) its own "
+                                    "contact conductance, e.g. metal (contact area differs between touches); "
+                                    "only models that fit h_c.")] = None,
     json_: Json = False,
 ) -> None:
     """Identify e_s and alpha_s (and each e_o, the time offset) from recorded touches (paper appendix).
@@ -444,7 +467,8 @@ def fit(
     settings = _fit_settings(depth_um, bootstrap, seed, baseline, offset_range, fit_to)
     only_list = [s.strip() for item in only for s in item.split(",") if s.strip()] if only else None
     if model is not None:
-        _run_identify(index, model, fit_sets, range_ or [], only_list, object_temp or [], depth_um, out, json_)
+        _run_identify(index, model, fit_sets, range_ or [], only_list, object_temp or [], depth_um, out, json_,
+                      touch_conductance)
         return
     result = _run_fit(index, range_ or [], only_list, object_temp or [], settings, out, name, plot, quiet=json_)
     if json_:

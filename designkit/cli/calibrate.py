@@ -259,7 +259,7 @@ def _print_fit(result, out: Optional[Path], plot: Optional[Path]) -> None:
 
 
 def _run_fit(index: Path, ranges: list[str], only: Optional[list[str]], object_temps: list[str], settings,
-             out: Optional[Path], name: Optional[str], plot: Optional[Path], quiet: bool):
+             out: Optional[Path], name: Optional[str], plot: Optional[Path], quiet: bool, force: bool = False):
     from ..calibration.fit import fit_sensor, parse_object_temps, parse_ranges, plot_fit, resolve_ranges
     from ..calibration.trials import load_index
 
@@ -273,8 +273,21 @@ def _run_fit(index: Path, ranges: list[str], only: Optional[list[str]], object_t
     unknown = sorted(set(temps) - set(names))
     if unknown:
         raise ValueError(f"--object-temp names material(s) not being fitted: {', '.join(unknown)}")
+    from rich.markup import escape
+
+    from ..calibration.fit import check_calibration
+
     total = settings.bootstrap + settings.profile_points
     con = console(stderr=True)
+    before = check_calibration(None, trials)  # the touches themselves: refuse before a fit that cannot help
+    if any(p.fatal for p in before) and not force:
+        from .._validation import InputError
+
+        for p in before:
+            con.print(f"[bold red]error:[/] {escape(p.text())}")
+        raise InputError(f"calibration unusable ({', '.join(sorted({p.kind for p in before}))}): "
+                         + (f"{out} not written; " if out is not None else "")
+                         + "see the messages above; --force fits and writes the sensor file anyway")
     if not quiet and con.is_terminal and total:
         from rich.progress import Progress
 
@@ -284,11 +297,27 @@ def _run_fit(index: Path, ranges: list[str], only: Optional[list[str]], object_t
                                 progress=lambda done, tot: progress.update(task, completed=done))
     else:
         result = fit_sensor(trials, rng, object_temps=temps, settings=settings)
-    if out is not None:
-        sensor = result.sensor(name=name or out.stem, provenance={"index": str(index), "materials_fitted": names})
-        sensor.to_yaml(out)
+    problems = check_calibration(result, trials)
+    fatal = [p for p in problems if p.fatal]
+    for p in problems:
+        con.print(f"[bold red]{'error' if p.fatal and not force else 'warning'}:[/] {escape(p.text())}")
     if plot is not None:
         plot_fit(result, plot)
+    if fatal and not force:
+        if not quiet:
+            _print_fit(result, None, None)
+        from .._validation import InputError
+
+        kinds = ", ".join(sorted({p.kind for p in fatal}))
+        raise InputError(f"calibration unusable ({kinds}): "
+                         + (f"{out} not written; " if out is not None else "")
+                         + "see the messages above; --force writes the sensor file anyway")
+    if out is not None:
+        prov = {"index": str(index), "materials_fitted": names}
+        if problems:
+            prov["problems"] = [p.text() for p in problems]
+        sensor = result.sensor(name=name or out.stem, provenance=prov)
+        sensor.to_yaml(out)
     return result
 
 
@@ -454,6 +483,9 @@ def fit(
         "--fit-sets", help="With --model: trial sets to fit (FIRST-LAST or a comma list); the others are held "
                            "out and scored ('all': fit every touch, select by BIC). Indexes without trial "
                            "sets are fitted whole.")] = "1-4",
+    force: Annotated[bool, typer.Option(
+        "--force", help="Write the sensor file even when the calibration is unusable (conflicting ranges, "
+                        "mislabelled touches, a sensor colder than the object).")] = False,
     touch_conductance: Annotated[Optional[str], typer.Option(
         "--touch-conductance", help="With --model: give each touch of these materials (comma-separated) its own "
                                     "contact conductance, e.g. metal (contact area differs between touches); "
@@ -470,7 +502,8 @@ def fit(
         _run_identify(index, model, fit_sets, range_ or [], only_list, object_temp or [], depth_um, out, json_,
                       touch_conductance)
         return
-    result = _run_fit(index, range_ or [], only_list, object_temp or [], settings, out, name, plot, quiet=json_)
+    result = _run_fit(index, range_ or [], only_list, object_temp or [], settings, out, name, plot, quiet=json_,
+                      force=force)
     if json_:
         payload = result.to_dict()
         payload.update({"out": str(out) if out else None, "plot": str(plot) if plot else None, "index": str(index)})
@@ -497,6 +530,8 @@ def guided(
     bootstrap: BootstrapOpt = 100,
     timeout: TimeoutOpt = None,
     yes: Annotated[bool, typer.Option("--yes", "-y", help="Do not wait for Enter before each material.")] = False,
+    force: Annotated[bool, typer.Option(
+        "--force", help="Write the sensor file even when the calibration is unusable.")] = False,
     json_: Json = False,
 ) -> None:
     """Guided calibration: record every material over serial, then fit and write the sensor file."""
@@ -531,7 +566,7 @@ def guided(
         raise typer.Exit(EXIT_INTERRUPTED)
     sensor_path = sensor_out or out / "sensor.yaml"
     result = _run_fit(out / "index.csv", range_ or [], materials, object_temp or [], settings, sensor_path, None,
-                      None, quiet=json_)
+                      None, quiet=json_, force=force)
     if json_:
         payload = {"record": _record_payload(rec, paths, out, False), "fit": result.to_dict(),
                    "sensor": str(sensor_path)}

@@ -155,3 +155,16 @@ def test_per_touch_contact_conductance_explains_touches_that_differ_in_contact()
         identify(fit, "contact", touch_conductance=("glass",))
     with pytest.raises(InputError, match="fits h_c"):
         identify(fit, "semi-infinite", touch_conductance=("granite",))
+
+
+def test_sim_to_real_with_the_identified_model_beats_the_paper(robot_data_dir):
+    """Simulator = the layered sensor identified on trial sets 1-4; tested on the real touches of sets 5-20."""
+    from designkit.reproduce.robot import CALIBRATION_SETS, calibrate_model, load_real, sim_to_real
+
+    touches = load_real(robot_data_dir)
+    test = touches.select(~np.isin(touches.trial_set, CALIBRATION_SETS))
+    setup = calibrate_model(touches, object_temp={"cold_wood": "passive-end-affine"})
+    assert setup.rms_c < 0.07                                   # chosen before testing: the fit's residual
+    r = sim_to_real(test, setup, setup.rms_c, per_trial=2, seed=0)
+    assert r["mean_f1"] >= 0.90 and r["multiclass"]["accuracy"] >= 0.80, r
+    assert r["pairs"]["wood vs cold wood"]["f1"] >= 0.95

@@ -690,6 +690,59 @@ class Identification:
             kw["smoothing_window"], kw["smoothing_order"] = HOST_SMOOTHING
         return get_model(self.candidate.model, **kw)
 
+    def reading(self, time_s, material: str, *, conductance_factor=None) -> np.ndarray:
+        """The identified normalized reading ``v`` of ``material`` at times after the detected onset.
+
+        ``T = Ts0 + (To - Ts0) v``: with the fitted time offset and, for a candidate with the host
+        smoothing, smoothed as the host smoothed a recording (1 s before contact to 7 s after, or
+        to the last time).
+
+        Parameters
+        ----------
+        time_s : array_like, shape (m,)
+            Times after the detected onset [s], uniformly sampled at the fit's rate.
+        material : str
+            A fitted material (its e_o / e_s).
+        conductance_factor : array_like of float, shape (k,), optional
+            Multiplies h_c (a touch's own contact, e.g. drawn from the fitted per-touch spread);
+            one reading per factor.
+
+        Returns
+        -------
+        ndarray, shape (m,) or (k, m)
+        """
+        import dataclasses
+
+        from ..models.layered import savgol_smooth
+
+        if material not in self.ratios:
+            raise InputError(f"no identified material {material!r} (fitted: {', '.join(self.ratios)})")
+        t = np.asarray(time_s, dtype=np.float64)
+        fs = self.sample_rate_hz
+        k0 = int(math.floor(min(-1.0, float(t.min())) * fs))
+        k1 = int(math.ceil(max(7.0, float(t.max())) * fs))
+        grid = np.arange(k0, k1 + 1) / fs
+        es = self.effusivity.value if self.effusivity is not None else 1.0
+        model = self.model()
+        if self.candidate.smoothing and hasattr(model, "smoothing_window"):
+            model = dataclasses.replace(model, smoothing_window=0)
+        sensor = self.sensor()
+        eo = self.ratios[material].value * es
+        off = self.parameter("time_offset_s").value
+        tt = grid - off
+        pos = tt > 0
+        factors = [None] if conductance_factor is None else list(np.atleast_1d(conductance_factor))
+        out = np.zeros((len(factors), grid.size))
+        for i, f in enumerate(factors):
+            m = model if f is None else dataclasses.replace(model, conductance_w_m2k=model.conductance_w_m2k * f)
+            if pos.any():
+                out[i, pos] = (m.conduction(tt[pos], [eo], sensor)[0] if hasattr(m, "conduction")
+                               else m.response(tt[pos], [eo], sensor)[0])
+        if self.candidate.smoothing:
+            out = savgol_smooth(out, *HOST_SMOOTHING)
+        res = np.array([np.interp(t, grid, row) for row in out])
+        return res[0] if conductance_factor is None else res
+
     def sensor(self, name: str = "identified"):
         """The identified :class:`~designkit.sensor.Sensor` (e_s from the ranges, alpha_s at the fixed depth)."""
         from ..sensor import Sensor

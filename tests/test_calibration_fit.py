@@ -297,3 +297,60 @@ def test_a_sensor_colder_than_the_object_is_a_wiring_error(cli, tmp_path):
     r = cli("calibrate", "fit", index, "--range", "metal=aluminium", "--out", tmp_path / "s.yaml", "--bootstrap", "0")
     assert r.exit_code == 2, r.output
     assert "reads colder than the object" in r.output and "side of its divider" in r.output
+
+
+def test_touches_below_the_contact_threshold_get_a_hint_with_their_peak_force(cli, tmp_path):
+    """The emulated rig presses with 4.2 N; the profile's threshold is 5 N: no touch would ever be recorded."""
+    from designkit import SENSORS
+    from designkit.calibration.emulator import EmulatedMaterial, Emulator, TouchPlan
+    from designkit.calibration.profiles import load_profile
+
+    prof = load_profile("designkit")
+    assert prof.contact.force_threshold_n == 5.0
+    import dataclasses
+
+    rig = dataclasses.replace(prof, contact=dataclasses.replace(prof.contact, force_threshold_n=3.0, release_n=1.5))
+    with Emulator(rig, SENSORS["paper"], [EmulatedMaterial("wood", 400.0)], noise_c=0.05, speed=20.0, seed=1,
+                  plan=TouchPlan(touch_every_s=13.0, press_force_n=4.2)) as emu:
+        r = cli("calibrate", "--port", emu.port, "--profile", "designkit", "--material", "wood", "--trials", "2",
+                "--range", "wood=380:420", "--out", tmp_path / "run", "--bootstrap", "0", "--yes", "--timeout", "30")
+    assert r.exit_code == 2, r.output
+    assert "touches were not recorded" in r.output and "threshold of 5 N" in r.output and "4.2 N" in r.output
+    assert "force_threshold_n" in r.output
+
+
+def test_data_lines_that_start_with_the_comment_prefix_are_named(cli, tmp_path):
+    """A rig writing '#T,...' data lines under a profile with comment '#': every sample would be a message."""
+    import os
+    import threading
+    import tty
+
+    master, slave = os.openpty()
+    tty.setraw(slave)
+    port = os.ttyname(slave)
+    stop = threading.Event()
+
+    def rig():
+        k = 0
+        while not stop.is_set():
+            lines = "".join(f"#T,{(k + i) / 200:.3f},35.00,25.00,0.0\n" for i in range(50))
+            try:
+                os.write(master, lines.encode())
+            except OSError:
+                return
+            k += 50
+            stop.wait(0.01)
+
+    th = threading.Thread(target=rig, daemon=True)
+    th.start()
+    try:
+        r = cli("calibrate", "--port", port, "--profile", "designkit", "--material", "wood", "--trials", "1",
+                "--range", "wood=380:420", "--out", tmp_path / "run", "--bootstrap", "0", "--yes", "--timeout", "20")
+    finally:
+        stop.set()
+        th.join(2)
+        os.close(master)
+        os.close(slave)
+    assert r.exit_code == 2, r.output
+    assert "start with the profile's comment prefix '#'" in r.output and "look like data lines" in r.output
+    assert "Set the profile's comment" in r.output

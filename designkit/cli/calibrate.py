@@ -146,6 +146,75 @@ class _Display:
             self.live.update(_status_table(st))
 
 
+class _ForceWatch:
+    """Touches the contact rule misses: force rises and falls again, peaking below the threshold.
+
+    Fed the recorder's live status (a few times a second); after ``MISSED`` such touches with no
+    trial recorded it raises an InputError naming the observed peaks and the threshold.
+    """
+
+    MISSED = 3
+
+    def __init__(self, profile) -> None:
+        rule = profile.contact
+        self.threshold = rule.force_threshold_n if rule.rule == "force" else None
+        self.peaks: list[float] = []
+        self.current: float | None = None
+
+    def __call__(self, st) -> None:
+        if self.threshold is None or st.trials > 0 or not math.isfinite(st.force_n):
+            self.current = None
+            return
+        lo = 0.2 * self.threshold
+        if st.force_n > lo:
+            self.current = max(self.current or 0.0, st.force_n)
+        elif self.current is not None:
+            if self.current < self.threshold:
+                self.peaks.append(self.current)
+            self.current = None
+        if len(self.peaks) >= self.MISSED:
+            from .._validation import InputError
+
+            raise InputError(
+                f"{len(self.peaks)} touches were not recorded: their force peaked at {min(self.peaks):.2g}-"
+                f"{max(self.peaks):.2g} N, below the profile's contact threshold of {self.threshold:g} N. Lower "
+                f"force_threshold_n in the profile (e.g. to {0.75 * min(self.peaks):.2g} N, with release_n below "
+                "it), or press harder")
+
+
+class _CommentWatch:
+    """A stream whose every line starts with the profile's comment prefix: samples taken for messages.
+
+    Fed the recorder's events; after ``LIMIT`` device messages and not one sample it raises an
+    InputError (a rig whose data lines start with, say, ``#T`` under ``comment: "#"``).
+    """
+
+    LIMIT = 200
+
+    def __init__(self, profile) -> None:
+        self.profile = profile
+        self.n = 0
+        self.example = ""
+
+    def __call__(self, event, lines_ok: int) -> None:
+        if event.kind != "device" or not self.profile.comment or lines_ok:
+            return
+        self.n += 1
+        self.example = event.message.removeprefix("device: ")
+        if self.n >= self.LIMIT:
+            from .._validation import InputError
+
+            rest = self.example[len(self.profile.comment):]
+            data_like = sum(c.isdigit() for c in rest) >= 3
+            raise InputError(
+                f"all {self.n} lines from the device start with the profile's comment prefix "
+                f"{self.profile.comment!r} (e.g. {self.example[:60]!r}), so each was taken as a device message "
+                "and not one sample was read"
+                + (": they look like data lines that begin with it" if data_like else "")
+                + ". Set the profile's comment to a prefix the data lines do not start with (or remove it), or "
+                  "make the rig send its messages with a different prefix")
+
+
 def _record_materials(port: str, profile, out: Path, materials: list[str], trials: int, timeout: Optional[float],
                       quiet: bool, prompt: bool):
     """Record each material in turn on one open connection; returns (recorder, paths, interrupted).
@@ -158,8 +227,21 @@ def _record_materials(port: str, profile, out: Path, materials: list[str], trial
     from ..calibration.trials import recorded_trials
 
     display = _Display(quiet)
-    rec = SerialRecorder(port, profile, out, no_data_timeout_s=timeout, on_event=display.event,
-                         on_status=display.status)
+    watch = _ForceWatch(profile)
+
+    def on_status(st) -> None:
+        display.status(st)
+        watch(st)
+
+    comments = _CommentWatch(profile)
+
+    def on_event(e) -> None:
+        if not (e.kind == "device" and comments.n >= 3 and rec.status.lines_ok == 0):
+            display.event(e)  # a stream of nothing but messages: show the first few, then the verdict
+        comments(e, rec.status.lines_ok)
+
+    rec = SerialRecorder(port, profile, out, no_data_timeout_s=timeout, on_event=on_event,
+                         on_status=on_status)
     before = set(recorded_trials(out))
     interrupted = False
     try:
@@ -174,6 +256,7 @@ def _record_materials(port: str, profile, out: Path, materials: list[str], trial
             elif i > 0:
                 rec.flush_input()
             with display:
+                watch.peaks.clear()
                 rec.record(material, trials)
     except KeyboardInterrupt:
         interrupted = True

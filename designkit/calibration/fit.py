@@ -1211,9 +1211,9 @@ def check_calibration(result: "CalibrationResult | None", trials: Sequence[Trial
     * **wiring**: the heated sensor reads colder than the object before contact in most touches (a
       thermistor on the wrong side of its divider reads a plausible temperature mirrored about the
       divider's midpoint);
-    * **mislabelled**: a touch whose normalized response at 2 s (``(Ts0 - T) / (Ts0 - To)``) is
-      nearer another material's median than its own's (touches recorded while another sample was
-      under the sensor);
+    * **mislabelled**: a touch whose normalized response at 2 s (``(Ts0 - T) / (Ts0 - To)``) lies
+      within 2 robust SDs of another material's median and beyond 5 of its own's (touches recorded
+      while another sample was under the sensor);
     * **conflict**: no e_s keeps every material inside its effusivity range (``result``).
 
     Examples
@@ -1244,6 +1244,9 @@ def check_calibration(result: "CalibrationResult | None", trials: Sequence[Trial
     drops = {n: [(i, _normalized_drop(tr)) for i, tr in enumerate(trials) if tr.material == n] for n in names}
     med = {n: float(np.nanmedian([d for _, d in v])) for n, v in drops.items()
            if sum(math.isfinite(d) for _, d in v) >= 2}
+    # robust spread of each material's responses (1.4826 MAD, at least 0.005): materials made to look
+    # alike (cold wood and metal) are not "mislabelled" just because their medians are close
+    spread = {n: max(0.005, 1.4826 * float(np.nanmedian([abs(d - med[n]) for _, d in drops[n]]))) for n in med}
     if len(med) >= 2:
         odd = []
         for n, v in drops.items():
@@ -1253,7 +1256,7 @@ def check_calibration(result: "CalibrationResult | None", trials: Sequence[Trial
                 if not math.isfinite(d):
                     continue
                 near = min(med, key=lambda m: abs(d - med[m]))
-                if near != n and abs(d - med[near]) < 0.5 * abs(d - med[n]):
+                if near != n and abs(d - med[near]) < 2.0 * spread[near] and abs(d - med[n]) > 5.0 * spread[n]:
                     odd.append(f"{Path(trials[i].source).name or f'touch {i + 1}'} ({n}, looks like {near}: "
                                f"response {d:.3g} against {med[n]:.3g} for {n} and {med[near]:.3g} for {near})")
         if odd:

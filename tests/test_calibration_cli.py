@@ -211,7 +211,7 @@ def test_fit_of_the_shared_robot_recordings(cli, robot_data_dir, tmp_path):
     order 0.1 degC. Metal and wood with the paper's aluminium and wood ranges."""
     r = cli("calibrate", "fit", robot_data_dir / "index.csv", "--only", "metal,wood",
             "--range", "metal=12767:25972", "--range", "wood=331:506", "--bootstrap", "10",
-            "--out", tmp_path / "robot.yaml", "--json")
+            "--out", tmp_path / "robot.yaml", "--json", "--force")  # a conflict is refused without it
     assert r.exit_code == 0, r.output
     d = json.loads(r.stdout)
     assert d["n_trials"] == 120
@@ -227,7 +227,7 @@ def test_fit_of_the_shared_robot_recordings(cli, robot_data_dir, tmp_path):
     # --only repeated means the same as comma-separated (users repeat options like --range)
     again = cli("calibrate", "fit", robot_data_dir / "index.csv", "--only", "metal", "--only", "wood",
                 "--range", "metal=12767:25972", "--range", "wood=331:506", "--bootstrap", "0",
-                "--out", tmp_path / "robot2.yaml", "--json")
+                "--out", tmp_path / "robot2.yaml", "--json", "--force")
     assert again.exit_code == 0, again.output
     d2 = json.loads(again.stdout)
     assert d2["n_trials"] == 120 and d2["effusivity"]["value"] == pytest.approx(d["effusivity"]["value"])

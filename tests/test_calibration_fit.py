@@ -218,3 +218,139 @@ def test_plot_is_written(tmp_path):
     res = fit_sensor(make_trials(sigma=0.05, n=3), ranges(), settings=FitSettings(bootstrap=0, profile_points=4))
     path = F.plot_fit(res, tmp_path / "fit.png")
     assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+# ------------------------------------------------------- failing loudly (issue 14)
+def test_guided_run_against_the_emulator_records_its_first_touch_and_labels_every_touch(cli, tmp_path):
+    """Over a real pty: the emulator touches wood 3x then metal 3x; the guided run must see touch 1."""
+    import json
+
+    from designkit import SENSORS
+    from designkit.calibration.emulator import EmulatedMaterial, Emulator, TouchPlan
+    from designkit.calibration.profiles import load_profile
+
+    paper = SENSORS["paper"]
+    mats = [EmulatedMaterial("wood", 400.0), EmulatedMaterial("metal", 17530.0)]
+    out = tmp_path / "run"
+    with Emulator(load_profile("designkit"), paper, mats, noise_c=0.05, speed=100.0, seed=4,
+                  plan=TouchPlan(touch_every_s=13.0, touches_per_material=3)) as emu:
+        r = cli("calibrate", "--port", emu.port, "--profile", "designkit", "--material", "wood", "--material",
+                "metal", "--trials", "3", "--range", "wood=380:420", "--range", "metal=16700:18400", "--out", out,
+                "--bootstrap", "0", "--yes", "--json")
+    assert r.exit_code == 0, r.output
+    onsets = {}
+    for side in sorted(out.glob("*.json")):
+        onsets[side.stem] = json.loads(side.read_text())["onset_device_time_s"]
+    first = min(onsets.values())
+    assert first < 13.0, onsets                       # touch 1 (heat from 2 s) is recorded
+    for name, t in onsets.items():                    # touches 1-3 are wood, 4-6 metal
+        touch = int(round((t - first) / 13.0))
+        assert name.startswith("wood" if touch < 3 else "metal"), onsets
+    fit = json.loads(r.stdout)["fit"]
+    assert fit["identification"] != "conflict"
+    assert fit["effusivity"]["ci95"][0] <= paper.effusivity <= fit["effusivity"]["ci95"][1]
+
+
+def _write(folder, trials):
+    from designkit.calibration.trials import write_trial
+
+    for tr in trials:
+        write_trial(folder, tr.material, tr.time_s, tr.sensor_c, tr.object_c, tr.force_n, {"profile": "test"})
+    return folder / "index.csv"
+
+
+def test_mislabelled_touches_stop_the_fit_from_writing_a_sensor_file(cli, tmp_path):
+    trials = make_trials(n=4, seed=3)
+    wood = [tr for tr in trials if tr.material == "wood"]
+    metal = [tr for tr in trials if tr.material == "metal"]
+    swapped = wood[:3] + metal[:1]                     # a metal touch recorded as wood, and vice versa
+    swapped = [Trial(tr.time_s, tr.sensor_c, tr.object_c, tr.force_n, "wood") for tr in swapped]
+    swapped += [Trial(tr.time_s, tr.sensor_c, tr.object_c, tr.force_n, "metal") for tr in metal[1:] + wood[3:]]
+    index = _write(tmp_path / "t", swapped)
+    out = tmp_path / "s.yaml"
+    r = cli("calibrate", "fit", index, "--range", "metal=aluminium", "--out", out, "--bootstrap", "0")
+    assert r.exit_code == 2 and not out.exists(), r.output
+    assert "look like another material" in r.output and "looks like metal" in r.output
+    assert "record those materials again" in r.output and "not written" in r.output
+    r = cli("calibrate", "fit", index, "--range", "metal=aluminium", "--out", out, "--bootstrap", "0", "--force")
+    assert r.exit_code == 0 and out.exists() and "warning:" in r.output
+
+
+def test_conflicting_ranges_stop_the_fit_unless_forced(cli, tmp_path):
+    index = _write(tmp_path / "t", make_trials(n=3, seed=5))
+    out = tmp_path / "s.yaml"
+    # wood's range put where no e_s agrees with metal's
+    args = ("calibrate", "fit", index, "--range", "wood=40:50", "--range", "metal=aluminium", "--out", out,
+            "--bootstrap", "0")
+    r = cli(*args)
+    assert r.exit_code == 2 and not out.exists(), r.output
+    assert "ranges conflict" in r.output and "--force" in r.output and "calibrate fit --model all" in r.output
+    r = cli(*args, "--force")
+    assert r.exit_code == 0 and out.exists()
+    assert "conflict" in " ".join(load_sensor(out).provenance["problems"])
+
+
+def test_a_sensor_colder_than_the_object_is_a_wiring_error(cli, tmp_path):
+    mirrored = [Trial(tr.time_s, 50.0 - tr.sensor_c, tr.object_c, tr.force_n, tr.material)
+                for tr in make_trials(n=3, seed=6)]     # 35 degC read as 15, as from the wrong side of a divider
+    index = _write(tmp_path / "t", mirrored)
+    r = cli("calibrate", "fit", index, "--range", "metal=aluminium", "--out", tmp_path / "s.yaml", "--bootstrap", "0")
+    assert r.exit_code == 2, r.output
+    assert "reads colder than the object" in r.output and "side of its divider" in r.output
+
+
+def test_touches_below_the_contact_threshold_get_a_hint_with_their_peak_force(cli, tmp_path):
+    """The emulated rig presses with 4.2 N; the profile's threshold is 5 N: no touch would ever be recorded."""
+    from designkit import SENSORS
+    from designkit.calibration.emulator import EmulatedMaterial, Emulator, TouchPlan
+    from designkit.calibration.profiles import load_profile
+
+    prof = load_profile("designkit")
+    assert prof.contact.force_threshold_n == 5.0
+    import dataclasses
+
+    rig = dataclasses.replace(prof, contact=dataclasses.replace(prof.contact, force_threshold_n=3.0, release_n=1.5))
+    with Emulator(rig, SENSORS["paper"], [EmulatedMaterial("wood", 400.0)], noise_c=0.05, speed=20.0, seed=1,
+                  plan=TouchPlan(touch_every_s=13.0, press_force_n=4.2)) as emu:
+        r = cli("calibrate", "--port", emu.port, "--profile", "designkit", "--material", "wood", "--trials", "2",
+                "--range", "wood=380:420", "--out", tmp_path / "run", "--bootstrap", "0", "--yes", "--timeout", "30")
+    assert r.exit_code == 2, r.output
+    assert "touches were not recorded" in r.output and "threshold of 5 N" in r.output and "4.2 N" in r.output
+    assert "force_threshold_n" in r.output
+
+
+def test_data_lines_that_start_with_the_comment_prefix_are_named(cli, tmp_path):
+    """A rig writing '#T,...' data lines under a profile with comment '#': every sample would be a message."""
+    import os
+    import threading
+    import tty
+
+    master, slave = os.openpty()
+    tty.setraw(slave)
+    port = os.ttyname(slave)
+    stop = threading.Event()
+
+    def rig():
+        k = 0
+        while not stop.is_set():
+            lines = "".join(f"#T,{(k + i) / 200:.3f},35.00,25.00,0.0\n" for i in range(50))
+            try:
+                os.write(master, lines.encode())
+            except OSError:
+                return
+            k += 50
+            stop.wait(0.01)
+
+    th = threading.Thread(target=rig, daemon=True)
+    th.start()
+    try:
+        r = cli("calibrate", "--port", port, "--profile", "designkit", "--material", "wood", "--trials", "1",
+                "--range", "wood=380:420", "--out", tmp_path / "run", "--bootstrap", "0", "--yes", "--timeout", "20")
+    finally:
+        stop.set()
+        th.join(2)
+        os.close(master)
+        os.close(slave)
+    assert r.exit_code == 2, r.output
+    assert "start with the profile's comment prefix '#'" in r.output and "look like data lines" in r.output
+    assert "Set the profile's comment" in r.output

@@ -50,6 +50,8 @@ from .profiles import DeviceProfile, Linear, Thermistor
 __all__ = ["EmulatedMaterial", "Emulator", "Faults", "TouchPlan", "TouchRecord"]
 
 _MAX_PENDING = 1 << 16
+#: Real seconds between a client opening the port and the first sample (a rig's reset on open).
+CLIENT_SETTLE_S = 0.05
 
 
 @dataclass(frozen=True)
@@ -423,8 +425,13 @@ class Emulator:
         tty.setraw(slave)  # no echo, no newline translation, whoever opens it
         flags = fcntl.fcntl(master, fcntl.F_GETFL)
         fcntl.fcntl(master, fcntl.F_SETFL, flags | os.O_NONBLOCK)
-        self._master, self._slave = master, slave
         self._port = os.ttyname(slave)
+        # Our own end stays closed until a client opens the port: the device clock starts then
+        # (_wait_for_client). Streaming into a pty nobody has opened put the first touch in the
+        # kernel's buffer, which pyserial flushes on open: a client never saw touch 1, so a
+        # guided run labelled every later touch with the wrong material.
+        os.close(slave)
+        self._master, self._slave = master, None
         self._thread = threading.Thread(target=self._run_safe, name="designkit-emulator", daemon=True)
         self._thread.start()
         return self._port
@@ -468,8 +475,31 @@ class Emulator:
             self.error = exc
             self._close()
 
+    def _wait_for_client(self) -> bool:
+        """Block until a client opens the port (POLLHUP on the master clears); False if stopped first.
+
+        Then keep a device end open ourselves (as before: a client may close and reopen the port),
+        and wait ``CLIENT_SETTLE_S`` more, like a rig that resets when its port opens: the client's
+        open (which flushes its input) is over before the first sample.
+        """
+        poller = select.poll()
+        poller.register(self._master, select.POLLHUP)
+        while not self._stop.is_set():
+            events = poller.poll(10)
+            if not any(ev & select.POLLHUP for _, ev in events):
+                break
+        else:
+            return False
+        try:
+            self._slave = os.open(self._port, os.O_RDWR | os.O_NOCTTY)
+        except OSError:
+            pass
+        return not self._stop.wait(CLIENT_SETTLE_S)
+
     def _run(self) -> None:
         fl = self.faults
+        if not self._wait_for_client():
+            return
         if fl.silent:
             self._stop.wait()
             return

@@ -56,10 +56,12 @@ from .._validation import InputError, as_generator, check_positive
 from .trials import Trial
 
 __all__ = [
+    "CalibrationProblem",
     "CalibrationResult",
     "FitSettings",
     "MaterialRange",
     "Parameter",
+    "check_calibration",
     "fit_sensor",
     "parse_object_temps",
     "parse_ranges",
@@ -1160,3 +1162,118 @@ def plot_fit(result: CalibrationResult, path: Path) -> Path:
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
+
+
+# --------------------------------------------------------------- checks
+@dataclass(frozen=True)
+class CalibrationProblem:
+    """Something about a calibration a user must hear before trusting (or writing) its sensor file.
+
+    Attributes
+    ----------
+    kind : str
+        ``"conflict"``, ``"mislabelled"``, ``"wiring"``.
+    message : str
+        What is wrong, with the numbers that show it.
+    suggestion : str
+        What to do about it.
+    fatal : bool
+        The result is unusable: no sensor file is written (unless forced) and the exit is non-zero.
+    """
+
+    kind: str
+    message: str
+    suggestion: str
+    fatal: bool = True
+
+    def text(self) -> str:
+        return f"{self.message}. {self.suggestion}"
+
+
+def _normalized_drop(tr: Trial, at_s: float = 2.0) -> float:
+    """(Ts0 - T(at_s)) / (Ts0 - To) of one touch (raw drop [degC] without a passive channel); NaN if too short."""
+    pre = tr.time_s < 0
+    late = np.abs(tr.time_s - at_s) <= 0.25
+    if pre.sum() < 3 or not late.any():
+        return math.nan
+    ts0 = float(np.mean(tr.sensor_c[pre]))
+    drop = ts0 - float(np.mean(tr.sensor_c[late]))
+    obj = tr.object_c[pre]
+    if np.isfinite(obj).any():
+        diff = ts0 - float(np.nanmean(obj))
+        return drop / diff if abs(diff) > 0.5 else math.nan
+    return drop
+
+
+def check_calibration(result: "CalibrationResult | None", trials: Sequence[Trial]) -> list[CalibrationProblem]:
+    """What makes a calibration unusable or suspect, each with a suggestion.
+
+    * **wiring**: the heated sensor reads colder than the object before contact in most touches (a
+      thermistor on the wrong side of its divider reads a plausible temperature mirrored about the
+      divider's midpoint);
+    * **mislabelled**: a touch whose normalized response at 2 s (``(Ts0 - T) / (Ts0 - To)``) lies
+      within 2 robust SDs of another material's median and beyond 5 of its own's (touches recorded
+      while another sample was under the sensor);
+    * **conflict**: no e_s keeps every material inside its effusivity range (``result``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(-200, 801) / 200.0
+    >>> cold = Trial(t, np.full(t.size, 20.0), np.full(t.size, 25.0), np.zeros(t.size), "wood")
+    >>> [p.kind for p in check_calibration(None, [cold, cold])]
+    ['wiring']
+    """
+    out: list[CalibrationProblem] = []
+    cold = []
+    for tr in trials:
+        pre = tr.time_s < 0
+        obj = tr.object_c[pre]
+        if pre.any() and np.isfinite(obj).any():
+            cold.append((float(np.mean(tr.sensor_c[pre])), float(np.nanmean(obj))))
+    below = [(s, o) for s, o in cold if s < o - 0.2]
+    if cold and len(below) > len(cold) / 2:
+        s, o = np.mean([b[0] for b in below]), np.mean([b[1] for b in below])
+        out.append(CalibrationProblem(
+            "wiring", f"the heated sensor reads colder than the object before contact in {len(below)} of "
+                      f"{len(cold)} touches (sensor {s:.2f} °C, object {o:.2f} °C on average)",
+            "A heated sensor should be the warmer one: check that each thermistor sits on the side of its "
+            "divider that the profile's channel says (wired the other way, a thermistor reads a plausible "
+            "but wrong temperature), and the heater's set point"))
+    names = sorted({tr.material for tr in trials})
+    drops = {n: [(i, _normalized_drop(tr)) for i, tr in enumerate(trials) if tr.material == n] for n in names}
+    med = {n: float(np.nanmedian([d for _, d in v])) for n, v in drops.items()
+           if sum(math.isfinite(d) for _, d in v) >= 2}
+    # robust spread of each material's responses (1.4826 MAD, at least 0.005): materials made to look
+    # alike (cold wood and metal) are not "mislabelled" just because their medians are close
+    spread = {n: max(0.005, 1.4826 * float(np.nanmedian([abs(d - med[n]) for _, d in drops[n]]))) for n in med}
+    if len(med) >= 2:
+        odd = []
+        for n, v in drops.items():
+            if n not in med:
+                continue
+            for i, d in v:
+                if not math.isfinite(d):
+                    continue
+                near = min(med, key=lambda m: abs(d - med[m]))
+                if near != n and abs(d - med[near]) < 2.0 * spread[near] and abs(d - med[n]) > 5.0 * spread[n]:
+                    odd.append(f"{Path(trials[i].source).name or f'touch {i + 1}'} ({n}, looks like {near}: "
+                               f"response {d:.3g} against {med[n]:.3g} for {n} and {med[near]:.3g} for {near})")
+        if odd:
+            out.append(CalibrationProblem(
+                "mislabelled", f"{len(odd)} touch(es) look like another material: " + "; ".join(odd[:6])
+                + (" ..." if len(odd) > 6 else ""),
+                "Touches recorded while another sample was under the sensor get the wrong label; record "
+                "those materials again (press Enter only once the sample is in place), or delete the odd "
+                "trials from the index and run 'calibrate fit' on it"))
+    if result is not None and result.identification == "conflict":
+        allowed = "; ".join(f"{m.name} allows e_s in [{m.es_interval[0]:.4g}, {m.es_interval[1]:.4g}]"
+                            for m in result.materials if m.es_interval is not None)
+        out.append(CalibrationProblem(
+            "conflict", f"the materials' effusivity ranges conflict under the paper's model ({allowed}): "
+                        f"e_s = {result.effusivity.value:.4g} is a compromise at the ranges' bounds, at "
+                        f"{result.rms_c / result.noise_c:.0f}x the pre-contact noise",
+            "Check each material's label, range (--range NAME=MIN:MAX) and object temperature "
+            "(--object-temp NAME=free for an object not at room temperature); compare sensor models "
+            "with 'calibrate fit --model all'; or write the file anyway with --force"))
+    return out

@@ -81,6 +81,10 @@ __all__ = [
 #: The recordings' host smoothing: Savitzky-Golay window 99, order 3 (at 200 Hz).
 HOST_SMOOTHING = (99, 3)
 _LOG_RATIO_LIMIT = 12.0
+_LOG_TOUCH_HC = 4.0   # search range of a touch's ln(h_c,i / h_c)
+_AFFINE_OFFSET_C, _AFFINE_SLOPE = 5.0, 2.0   # search range of a passive channel's offset [degC] and slope
+#: Talbot nodes of the fitted readings (12: error < 1e-8 of the temperature difference).
+FIT_TALBOT_NODES = 12
 
 
 # ------------------------------------------------------------ candidates
@@ -203,6 +207,7 @@ class _Group:
     to: np.ndarray         # (n,) object temperature [degC] (nan: fitted per touch)
     free_to: bool
     trials: tuple[int, ...]
+    affine: bool = False   # To = passive + offset + slope (passive - reference): a rig calibration of the channel
 
 
 @dataclass(frozen=True)
@@ -213,6 +218,8 @@ class _Data:
     noise_c: float
     sample_rate_hz: float
     n_trials: int
+    refs: Mapping[str, float] = field(default_factory=dict)   # reference passive reading of affine materials
+    noise_lag: int = 1     # first lag [samples] at which the pre-contact noise's autocorrelation falls below 0.5
 
     @property
     def n_samples(self) -> int:
@@ -257,8 +264,11 @@ def split_by_trial_set(trials: Sequence[Trial], fit_sets: Sequence[int],
     return fit, held
 
 
+_OBJECT_MODES = ("passive", "passive-end", "free", "passive-affine", "passive-end-affine")
+
+
 def _prepare(trials: Sequence[Trial], names: Sequence[str], object_temps: Mapping[str, Any],
-             moving_passive_c: float = 1.0) -> _Data:
+             moving_passive_c: float = 1.0, refs: Mapping[str, float] | None = None) -> _Data:
     """Group trials by material and time grid; decide each material's object temperature."""
     if not trials:
         raise InputError("no trials to fit")
@@ -266,6 +276,7 @@ def _prepare(trials: Sequence[Trial], names: Sequence[str], object_temps: Mappin
     modes: dict[str, str] = {}
     info = []
     ssr, dof, rates = 0.0, 0, []
+    acf = np.zeros(41)
     for tr in trials:
         pre = tr.time_s < 0
         if pre.sum() < 3:
@@ -273,7 +284,10 @@ def _prepare(trials: Sequence[Trial], names: Sequence[str], object_temps: Mappin
         t, s = tr.time_s[pre], tr.sensor_c[pre]
         early = t < t[0] + 0.5 * (t[-1] - t[0]) if t.size >= 20 else np.ones(t.size, bool)
         coef = np.polyfit(t[early], s[early], 1)
-        ssr += float(np.sum((s[early] - np.polyval(coef, t[early])) ** 2))
+        e = s[early] - np.polyval(coef, t[early])
+        ssr += float(e @ e)
+        lags = min(acf.size, e.size)
+        acf[:lags] += [float(e[:e.size - k] @ e[k:]) for k in range(lags)]
         dof += int(early.sum()) - 2
         obj = tr.object_c[pre]
         to = float(np.mean(obj[np.isfinite(obj)])) if np.isfinite(obj).any() else math.nan
@@ -289,11 +303,11 @@ def _prepare(trials: Sequence[Trial], names: Sequence[str], object_temps: Mappin
                 raise InputError(f"trials of {n} have no passive (object) channel: give its object temperature "
                                  f"({n}=DEGC, the ambient) or {n}=free")
             mode = "free" if float(np.median(moves)) > moving_passive_c else "passive"
-        if isinstance(mode, str) and mode not in ("passive", "passive-end", "free"):
+        if isinstance(mode, str) and mode not in _OBJECT_MODES:
             try:
                 mode = float(mode)
             except ValueError:
-                raise InputError(f"object temperature of {n}: passive, passive-end, free or DEGC, got {mode!r}") \
+                raise InputError(f"object temperature of {n}: {', '.join(_OBJECT_MODES)} or DEGC, got {mode!r}") \
                     from None
         modes[n] = mode if isinstance(mode, str) else float(mode)
     groups: dict[tuple[int, bytes], list[int]] = {}
@@ -310,13 +324,13 @@ def _prepare(trials: Sequence[Trial], names: Sequence[str], object_temps: Mappin
         mode = modes[n]
         tos = []
         for i in members:
-            if mode == "passive-end":
+            if mode in ("passive-end", "passive-end-affine"):
                 tr = trials[i]
                 last = (tr.time_s >= tr.time_s[-1] - 1.0) & np.isfinite(tr.object_c)
                 if not last.any():
-                    raise InputError(f"trial {tr.source} has no passive reading at its end for {n}=passive-end")
+                    raise InputError(f"trial {tr.source} has no passive reading at its end for {n}={mode}")
                 tos.append(float(np.mean(tr.object_c[last])))
-            elif mode == "passive":
+            elif mode in ("passive", "passive-affine"):
                 if not math.isfinite(info[i][0]):
                     raise InputError(f"trial {trials[i].source} has no passive reading before contact: give "
                                      f"{n}=DEGC")
@@ -326,9 +340,16 @@ def _prepare(trials: Sequence[Trial], names: Sequence[str], object_temps: Mappin
             else:
                 tos.append(float(mode))
         out.append(_Group(k, trials[members[0]].time_s.copy(), np.array([trials[i].sensor_c for i in members]),
-                          np.array(tos), mode == "free", tuple(members)))
+                          np.array(tos), mode == "free", tuple(members),
+                          isinstance(mode, str) and mode.endswith("-affine")))
     noise = math.sqrt(ssr / dof) if dof > 0 else math.nan
-    return _Data(tuple(out), tuple(names), modes, noise, float(np.median(rates)), len(trials))
+    ref = dict(refs or {})
+    for n in names:  # the reference reading of an affine channel: the fitted touches' mean (kept for scoring)
+        if isinstance(modes[n], str) and modes[n].endswith("-affine") and n not in ref:
+            ref[n] = float(np.mean(np.concatenate([g.to for g in out if names[g.material] == n])))
+    below = np.flatnonzero(acf < 0.5 * acf[0]) if acf[0] > 0 else np.array([1])
+    lag = int(below[0]) if below.size else acf.size
+    return _Data(tuple(out), tuple(names), modes, noise, float(np.median(rates)), len(trials), ref, max(lag, 1))
 
 
 # ------------------------------------------------------------ the problem
@@ -339,25 +360,37 @@ def _reading(model, t: np.ndarray, e_object: float, sensor, interp_points: int |
     ``interp_points`` log-spaced times and interpolated by a cubic spline in
     ``log t`` (error below 1e-6 of the temperature difference for smooth
     readings, tested), which makes a residual evaluation about 6x faster.
+    The Talbot inversion uses :data:`FIT_TALBOT_NODES` nodes (error below
+    1e-8 of the temperature difference against 32 nodes over the fitted
+    parameter range, docs/sensor-models.md; the noise is about 1e-3 of it).
     """
     if not hasattr(model, "conduction"):
         return model.response(t, [e_object], sensor)[0]
     if not interp_points or t.size <= 2 * interp_points:
-        return model.conduction(t, [e_object], sensor, nodes=16)[0]
+        return model.conduction(t, [e_object], sensor, nodes=FIT_TALBOT_NODES)[0]
     from scipy.interpolate import CubicSpline
 
-    lo, hi = float(t.min()), float(t.max())
+    # the grid starts at half a sample, not at the smallest t: that moves by a whole sample when the
+    # contact offset crosses one, and would make the residual kink there (the optimizer then sticks)
+    lo = 0.5 / float(sensor.sample_rate_hz)
+    hi = max(float(t.max()), 2.0 * lo)
     grid = np.geomspace(lo, hi, interp_points)
-    u = model.conduction(grid, [e_object], sensor, nodes=16)[0]
-    return CubicSpline(np.log(grid), u)(np.log(t))
+    u = model.conduction(grid, [e_object], sensor, nodes=FIT_TALBOT_NODES)[0]
+    out = CubicSpline(np.log(grid), u)(np.log(np.maximum(t, lo)))
+    early = t < lo
+    if early.any():
+        out[early] = model.conduction(t[early], [e_object], sensor, nodes=FIT_TALBOT_NODES)[0]
+    return out
 
 
 class _Problem:
     """Projected residuals of one candidate on prepared data; x = [model params, t_off, log rho_m]."""
 
     def __init__(self, cand: Candidate, data: _Data, depth_m: float, offset_bounds_s: tuple[float, float],
-                 constrained: np.ndarray):
+                 constrained: np.ndarray, stride: int = 1, touch_conductance: Sequence[str] = ()):
         from ..models import get_model
+
+        self.stride = max(int(stride), 1)   # residual rows: every stride-th sample (shapes on the full grid)
 
         self.cand = cand
         self.data = data
@@ -367,13 +400,36 @@ class _Problem:
         self.n_mat = len(data.names)
         self.constrained = constrained
         self._get_model = get_model
-        self.interp_points: int | None = 160
+        self.interp_points: int | None = 80
+        #: materials whose To is the passive reading through a fitted offset and slope: x gets both
+        self.affine = [k for k, n in enumerate(data.names) if isinstance(data.modes[n], str)
+                       and data.modes[n].endswith("-affine")]
         lo = [p.to_x(p.lo) for p in self.params] + [offset_bounds_s[0]] + [-_LOG_RATIO_LIMIT] * self.n_mat
         hi = [p.to_x(p.hi) for p in self.params] + [offset_bounds_s[1]] + [_LOG_RATIO_LIMIT] * self.n_mat
+        lo += [-_AFFINE_OFFSET_C, -_AFFINE_SLOPE] * len(self.affine)
+        hi += [_AFFINE_OFFSET_C, _AFFINE_SLOPE] * len(self.affine)
         self.lo, self.hi = np.array(lo), np.array(hi)
         # a material none of whose touches has a known object temperature: its ratio still shapes the
         # curve (not for shared-shape models, where it is not identified at all)
         self.names = [p.name for p in self.params] + ["time_offset_s"] + [f"log_ratio[{n}]" for n in data.names]
+        for k in self.affine:
+            self.names += [f"passive_offset_c[{data.names[k]}]", f"passive_slope[{data.names[k]}]"]
+        # each touch of these materials its own contact conductance: h_c,i = h_c exp(x_i), x_i last in x
+        unknown = sorted(set(touch_conductance) - set(data.names))
+        if unknown:
+            raise InputError(f"per-touch contact conductance for {', '.join(unknown)}: not among the fitted "
+                             f"materials {', '.join(data.names)}")
+        if touch_conductance and "conductance_w_m2k" not in cand.free:
+            raise InputError(f"per-touch contact conductance needs a candidate that fits h_c, not {cand.label}")
+        self.touch_cols: dict[int, int] = {}
+        self.n_global = len(self.names)
+        for gi, g in enumerate(data.groups):
+            if data.names[g.material] in touch_conductance:
+                self.touch_cols[gi] = len(self.names)
+                self.names += [f"log_hc_touch[{data.names[g.material]}#{t}]" for t in g.trials]
+        n_touch = len(self.names) - self.n_global
+        self.lo = np.concatenate([self.lo, np.full(n_touch, -_LOG_TOUCH_HC)])
+        self.hi = np.concatenate([self.hi, np.full(n_touch, _LOG_TOUCH_HC)])
 
     # -------------------------------------------------------- model
     def model_and_sensor(self, x: np.ndarray):
@@ -392,10 +448,15 @@ class _Problem:
         """Predicted normalized reading v of each group on its grid (smoothed when the candidate says)."""
         model, sensor = self.model_and_sensor(x)
         off = x[self.n_model]
-        rho = np.exp(x[self.n_model + 1:])
+        rho = np.exp(x[self.n_model + 1:self.n_model + 1 + self.n_mat])
         out = []
         cache: dict[tuple[int, bytes], np.ndarray] = {}
         for g in self.data.groups:
+            gi = len(out)
+            if gi in self.touch_cols:  # one shape per touch, each with its own h_c
+                out.append(self._touch_shapes(g, model, sensor, off, rho[g.material],
+                                              x[self.touch_cols[gi]:self.touch_cols[gi] + len(g.trials)]))
+                continue
             key = (g.material, g.time_s.tobytes())
             if key not in cache:
                 tt = g.time_s - off
@@ -411,35 +472,97 @@ class _Problem:
             out.append(cache[key])
         return out
 
+    def _touch_shapes(self, g: _Group, model, sensor, off: float, rho: float, log_dev: np.ndarray) -> np.ndarray:
+        import dataclasses
+
+        tt = g.time_s - off
+        pos = tt > 0
+        out = np.zeros((log_dev.size, tt.size))
+        for i, d in enumerate(log_dev):
+            m = dataclasses.replace(model, conductance_w_m2k=model.conductance_w_m2k * math.exp(float(d)))
+            if pos.any():
+                out[i, pos] = _reading(m, tt[pos], rho, sensor, self.interp_points)
+        if self.cand.smoothing:
+            from ..models.layered import savgol_smooth
+
+            out = savgol_smooth(out, *HOST_SMOOTHING)
+        return out
+
+    def jacobian(self, x: np.ndarray, touch_only: bool = False) -> np.ndarray:
+        """Forward differences (step 1e-6 max(1, |x|)); all per-touch columns from one evaluation.
+
+        A touch's residuals depend on its own h_c only (its Ts0 and To are its own), so perturbing
+        every touch's h_c at once gives each touch's column on its own rows.
+        """
+        r0 = self.residuals(x)
+        J = np.zeros((r0.size, x.size))
+        steps = 1e-6 * np.maximum(1.0, np.abs(x))
+        steps = np.where(x + steps > self.hi, -steps, steps)
+        for j in range(0 if touch_only else self.n_global):
+            xp = x.copy()
+            xp[j] += steps[j]
+            J[:, j] = (self.residuals(xp) - r0) / steps[j]
+        if self.touch_cols:
+            xp = x.copy()
+            xp[self.n_global:] += steps[self.n_global:]
+            d = self.residuals(xp) - r0
+            pos = 0
+            for gi, g in enumerate(self.data.groups):
+                m = self.fitted_y(g).shape[1]
+                if gi in self.touch_cols:
+                    for i in range(len(g.trials)):
+                        j = self.touch_cols[gi] + i
+                        J[pos + i * m:pos + (i + 1) * m, j] = d[pos + i * m:pos + (i + 1) * m] / steps[j]
+                pos += g.y.shape[0] * m
+        return J
+
+    def fitted_y(self, g: _Group) -> np.ndarray:
+        """The samples of group ``g`` the residual uses (every ``stride``-th)."""
+        return g.y[:, ::self.stride] if self.stride > 1 else g.y
+
     def project(self, x: np.ndarray):
-        """(residuals, per-group linear coefficients): Ts0 (and To where free) in closed form."""
+        """(residuals, per-group linear coefficients): Ts0 (and To where free) in closed form.
+
+        A group's shape is one curve (m,) or one per touch (n, m); the sums run over the last axis.
+        """
         res, coefs = [], []
         for g, v in zip(self.data.groups, self.shapes(x)):
-            if g.free_to:
-                A = np.column_stack([1.0 - v, v])
-                coef = np.linalg.solve(A.T @ A, A.T @ g.y.T)            # (2, n): normal equations, well scaled
-                pred = (A @ coef).T
+            y = self.fitted_y(g)
+            v = v[..., ::self.stride]
+            a = 1.0 - v
+            saa = np.sum(a * a, axis=-1)
+            if g.free_to:  # per touch: [Ts0, To] from the 2x2 normal equations (well scaled)
+                sav, svv = np.sum(a * v, axis=-1), np.sum(v * v, axis=-1)
+                ya, yv = np.sum(y * a, axis=-1), np.sum(y * v, axis=-1)
+                det = saa * svv - sav * sav
+                ts0 = (svv * ya - sav * yv) / det
+                to = (saa * yv - sav * ya) / det
             else:
-                a = 1.0 - v
-                den = float(a @ a)
-                b = g.y - g.to[:, None] * v[None, :]
-                ts0 = (b @ a) / den
-                pred = ts0[:, None] * a[None, :] + g.to[:, None] * v[None, :]
-                coef = np.vstack([ts0, g.to])
-            res.append((pred - g.y).ravel())
-            coefs.append(coef)
+                to = self.object_temps(g, x)
+                ts0 = np.sum((y - to[:, None] * v) * a, axis=-1) / saa
+            pred = ts0[:, None] * a + to[:, None] * v
+            res.append((pred - y).ravel())
+            coefs.append(np.vstack([ts0, to]))
         return np.concatenate(res), coefs
 
     def residuals(self, x):
         return self.project(x)[0]
 
+    def object_temps(self, g: _Group, x: np.ndarray) -> np.ndarray:
+        """Each touch's object temperature [degC]: the group's, through the fitted offset and slope if affine."""
+        if not g.affine:
+            return g.to
+        j = self.n_model + 1 + self.n_mat + 2 * self.affine.index(g.material)
+        ref = self.data.refs[self.data.names[g.material]]
+        return g.to + x[j] + x[j + 1] * (g.to - ref)
+
     def start(self) -> np.ndarray:
         x = [p.to_x(p.start) for p in self.params] + [0.3]
-        return np.array(x + [0.0] * self.n_mat)
+        return np.array(x + [0.0] * self.n_mat + [0.0, 0.0] * len(self.affine) + [0.0] * (self.lo.size - self.n_global))
 
     def rows_of(self, k: int) -> np.ndarray:
         """Residual rows of material ``k``."""
-        mask = [np.full(g.y.size, g.material == k) for g in self.data.groups]
+        mask = [np.full(self.fitted_y(g).size, g.material == k) for g in self.data.groups]
         return np.concatenate(mask)
 
     def n_linear(self) -> int:
@@ -542,6 +665,8 @@ class Identification:
     sample_rate_hz: float
     object_modes: Mapping[str, "str | float"]
     notes: tuple[str, ...] = ()
+    object_refs: Mapping[str, float] = field(default_factory=dict)
+    touch_conductance: tuple[str, ...] = ()
 
     def parameter(self, name: str) -> IdentifiedParameter:
         for p in self.parameters:
@@ -564,6 +689,59 @@ class Identification:
         if self.candidate.smoothing and self.candidate.model == "layered":
             kw["smoothing_window"], kw["smoothing_order"] = HOST_SMOOTHING
         return get_model(self.candidate.model, **kw)
+
+    def reading(self, time_s, material: str, *, conductance_factor=None) -> np.ndarray:
+        """The identified normalized reading ``v`` of ``material`` at times after the detected onset.
+
+        ``T = Ts0 + (To - Ts0) v``: with the fitted time offset and, for a candidate with the host
+        smoothing, smoothed as the host smoothed a recording (1 s before contact to 7 s after, or
+        to the last time).
+
+        Parameters
+        ----------
+        time_s : array_like, shape (m,)
+            Times after the detected onset [s], uniformly sampled at the fit's rate.
+        material : str
+            A fitted material (its e_o / e_s).
+        conductance_factor : array_like of float, shape (k,), optional
+            Multiplies h_c (a touch's own contact, e.g. drawn from the fitted per-touch spread);
+            one reading per factor.
+
+        Returns
+        -------
+        ndarray, shape (m,) or (k, m)
+        """
+        import dataclasses
+
+        from ..models.layered import savgol_smooth
+
+        if material not in self.ratios:
+            raise InputError(f"no identified material {material!r} (fitted: {', '.join(self.ratios)})")
+        t = np.asarray(time_s, dtype=np.float64)
+        fs = self.sample_rate_hz
+        k0 = int(math.floor(min(-1.0, float(t.min())) * fs))
+        k1 = int(math.ceil(max(7.0, float(t.max())) * fs))
+        grid = np.arange(k0, k1 + 1) / fs
+        es = self.effusivity.value if self.effusivity is not None else 1.0
+        model = self.model()
+        if self.candidate.smoothing and hasattr(model, "smoothing_window"):
+            model = dataclasses.replace(model, smoothing_window=0)
+        sensor = self.sensor()
+        eo = self.ratios[material].value * es
+        off = self.parameter("time_offset_s").value
+        tt = grid - off
+        pos = tt > 0
+        factors = [None] if conductance_factor is None else list(np.atleast_1d(conductance_factor))
+        out = np.zeros((len(factors), grid.size))
+        for i, f in enumerate(factors):
+            m = model if f is None else dataclasses.replace(model, conductance_w_m2k=model.conductance_w_m2k * f)
+            if pos.any():
+                out[i, pos] = (m.conduction(tt[pos], [eo], sensor)[0] if hasattr(m, "conduction")
+                               else m.response(tt[pos], [eo], sensor)[0])
+        if self.candidate.smoothing:
+            out = savgol_smooth(out, *HOST_SMOOTHING)
+        res = np.array([np.interp(t, grid, row) for row in out])
+        return res[0] if conductance_factor is None else res
 
     def sensor(self, name: str = "identified"):
         """The identified :class:`~designkit.sensor.Sensor` (e_s from the ranges, alpha_s at the fixed depth)."""
@@ -589,7 +767,8 @@ class Identification:
             "n_samples": self.n_samples, "n_parameters": self.n_parameters, "aic": self.aic, "bic": self.bic,
             "rank": self.rank, "n_nonlinear": self.n_nonlinear,
             "singular_values": [float(v) for v in self.singular_values], "fit_time_s": self.fit_time_s,
-            "noise_c": self.noise_c, "object_temperature": dict(self.object_modes), "notes": list(self.notes),
+            "noise_c": self.noise_c, "object_temperature": dict(self.object_modes), "object_reference_c": dict(self.object_refs),
+            "notes": list(self.notes),
         }
 
 
@@ -606,10 +785,10 @@ def _sandwich(J: np.ndarray, r: np.ndarray, clusters: np.ndarray) -> np.ndarray:
     return bread @ (scores.T @ scores) @ bread
 
 
-def _clusters(data: _Data) -> np.ndarray:
+def _clusters(data: _Data, stride: int = 1) -> np.ndarray:
     out = []
     for g in data.groups:
-        m = g.y.shape[1]
+        m = g.y[:, ::stride].shape[1]
         out.append(np.repeat(np.asarray(g.trials), m))
     return np.concatenate(out)
 
@@ -618,7 +797,8 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
              ranges: Mapping[str, Any] | None = None, object_temps: Mapping[str, Any] | None = None,
              depth_m: float = 80e-6, offset_bounds_s: tuple[float, float] = (-1.5, 1.5),
              start: Mapping[str, float] | None = None, x0: np.ndarray | None = None,
-             max_nfev: int = 100) -> Identification:
+             max_nfev: int = 100, fit_rate_hz: "float | str | None" = "auto",
+             touch_conductance: Sequence[str] = ()) -> Identification:
     """Fit one candidate model to touches.
 
     Parameters
@@ -643,6 +823,22 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
         A transformed start vector (from another fit's ``x``).
     max_nfev : int
         Most residual evaluations of the optimizer.
+    fit_rate_hz : float, "auto" or None
+        The least-squares fit uses every k-th sample, ``k = round(fs /
+        fit_rate_hz)`` (None: every sample; ``"auto"``: k = the lag at which
+        the pre-contact noise's autocorrelation falls below 0.5, so white
+        noise keeps every sample). The model's shapes (and the host
+        smoothing) are still computed on the full grid, and the reported
+        RMS, AIC and BIC are of the full grid. On the shared recordings
+        (smoothed by the host over 0.5 s) "auto" gives k = 10 (20 Hz): the
+        estimates move by a small fraction of their standard errors
+        (docs/sensor-models.md) and the fit runs several times faster. The
+        cluster-robust covariance does not depend on the stride.
+    touch_conductance : sequence of str
+        Materials whose touches each get their own contact conductance
+        ``h_c,i = h_c exp(d_i)`` (a per-touch nuisance: contact area and
+        pressure differ from touch to touch); needs a candidate fitting h_c.
+        Held-out touches of them get their own ``d_i`` fitted in :func:`score`.
 
     Returns
     -------
@@ -656,7 +852,12 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
     data = _prepare(trials, names, dict(object_temps or {}))
     rng = {n: _as_range(ranges[n]) for n in names if ranges and n in ranges}
     constrained = np.array([n in rng and data.modes[n] != "free" for n in names])
-    prob = _Problem(cand, data, depth_m, offset_bounds_s, constrained)
+    if fit_rate_hz == "auto":
+        stride = data.noise_lag
+    else:
+        stride = 1 if not fit_rate_hz else max(1, int(round(data.sample_rate_hz / float(fit_rate_hz))))
+    prob = _Problem(cand, data, depth_m, offset_bounds_s, constrained, stride=stride,
+                    touch_conductance=tuple(touch_conductance))
     if x0 is None:
         x = prob.start()
         for k, v in dict(start or {}).items():
@@ -666,10 +867,13 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
                 x[cand.free.index(k)] = _PARAMS[k].to_x(float(v))
         x = _initial_ratios(prob, x)
     else:
-        x = np.asarray(x0, dtype=np.float64).copy()
+        x = np.asarray(x0, dtype=np.float64)[:prob.n_global].copy()
+    x = np.concatenate([x[:prob.n_global], np.zeros(prob.lo.size - prob.n_global)])
     x = np.clip(x, prob.lo + 1e-9, prob.hi - 1e-9)
-    sol = least_squares(prob.residuals, x, bounds=(prob.lo, prob.hi), method="trf", x_scale="jac",
-                        diff_step=1e-6, xtol=1e-8, ftol=1e-8, gtol=1e-8, max_nfev=max_nfev)
+    with _one_blas_thread():  # tall, thin SVDs: threads only contend (4x slower on a loaded 2-core machine)
+        jac = dict(jac=prob.jacobian) if prob.touch_cols else dict(diff_step=1e-6)
+        sol = least_squares(prob.residuals, x, bounds=(prob.lo, prob.hi), method="trf", x_scale="jac",
+                            xtol=1e-8, ftol=1e-8, gtol=1e-8, max_nfev=max_nfev, **jac)
     x = sol.x
     r = sol.fun
     J = sol.jac
@@ -683,7 +887,10 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
     for j in range(rank, len(sv)):
         weak |= {int(i) for i in np.flatnonzero(np.abs(vt[j]) > 0.3)}
     weak |= {int(i) for i in np.flatnonzero(norms == 0)}
-    cov = _sandwich(J, r, _clusters(data))
+    cov = _sandwich(J, r, _clusters(data, prob.stride))
+    if prob.stride > 1:  # fit quality on every sample
+        prob.stride = 1
+        r = prob.residuals(x)
     sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     at_bound = (np.abs(x - prob.lo) < 1e-6) | (np.abs(x - prob.hi) < 1e-6)
     # ------------------------------------------------ e_s from the ranges
@@ -751,6 +958,27 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
         rp = ratios[n]
         params.append(IdentifiedParameter(f"e_o[{n}]", rp.value * es, (rp.ci95[0] * es_ci[0], rp.ci95[1] * es_ci[1]),
                                           "J s^-1/2 K^-1 m^-2", rp.identified, rp.note))
+    for gi, j0 in prob.touch_cols.items():
+        g = data.groups[gi]
+        d = x[j0:j0 + len(g.trials)]
+        n = names[g.material]
+        sdl = float(np.std(d, ddof=1)) if d.size > 1 else math.nan
+        hc = _PARAMS["conductance_w_m2k"].from_x(x[prob.params.index(_PARAMS["conductance_w_m2k"])]) * es
+        inside = bool(np.all(~at_bound[j0:j0 + d.size]))
+        params.append(IdentifiedParameter(
+            f"conductance_w_m2k[{n} touches]", hc * _exp(float(np.mean(d))),
+            (hc * _exp(float(np.min(d))), hc * _exp(float(np.max(d)))), "W m^-2 K^-1", inside,
+            "geometric mean of the touches' own h_c,i; interval: their smallest and largest (not a CI)"))
+        params.append(IdentifiedParameter(
+            f"conductance_spread[{n}]", _exp(sdl) if math.isfinite(sdl) else math.nan,
+            (math.nan, math.nan), "factor", inside, "geometric standard deviation of the touches' h_c,i"))
+    for i, k in enumerate(prob.affine):
+        for j, name, unit in ((prob.n_model + 1 + prob.n_mat + 2 * i, "passive_offset_c", "degC"),
+                              (prob.n_model + 2 + prob.n_mat + 2 * i, "passive_slope", "")):
+            ok = j not in weak and not at_bound[j]
+            params.append(IdentifiedParameter(
+                f"{name}[{names[k]}]", float(x[j]), (x[j] - 1.96 * sd[j], x[j] + 1.96 * sd[j]), unit, ok,
+                "" if ok else "at a search bound or rank-deficient"))
     # ------------------------------------------------ fit quality
     res_by: dict[str, list[np.ndarray]] = {n: [] for n in names}
     pos = 0
@@ -771,7 +999,19 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
                      "(only x^2/alpha_s matters)")
     return Identification(cand, tuple(params), ratios, es_p, consistent, allowed, float(np.sqrt(np.mean(r ** 2))),
                           rms_by, n_s, k_par, aic, bic, rank, x.size, sv, time.perf_counter() - t0,
-                          data.noise_c, x, names, depth_m, data.sample_rate_hz, dict(data.modes), tuple(notes))
+                          data.noise_c, x, names, depth_m, data.sample_rate_hz, dict(data.modes), tuple(notes),
+                          dict(data.refs), tuple(touch_conductance))
+
+
+def _one_blas_thread():
+    """A context limiting BLAS to one thread (a no-op without threadpoolctl)."""
+    try:
+        from threadpoolctl import threadpool_limits
+    except ImportError:  # pragma: no cover - scikit-learn depends on it
+        import contextlib
+
+        return contextlib.nullcontext()
+    return threadpool_limits(1)
 
 
 def _as_range(r) -> tuple[float, float]:
@@ -796,10 +1036,23 @@ def score(result: Identification, trials: Sequence[Trial], *,
         raise InputError(f"cannot score {', '.join(unknown)}: not among the fitted materials {', '.join(names)}")
     modes = dict(result.object_modes)
     modes.update(dict(object_temps or {}))
-    data = _prepare(trials, names, modes)
+    data = _prepare(trials, names, modes, refs=result.object_refs)
     prob = _Problem(result.candidate, data, result.depth_m, (-math.inf, math.inf),
-                    np.zeros(len(names), dtype=bool))
-    r, _ = prob.project(result.x)
+                    np.zeros(len(names), dtype=bool), stride=1, touch_conductance=result.touch_conductance)
+    x = np.concatenate([result.x[:prob.n_global], np.zeros(prob.lo.size - prob.n_global)])
+    if prob.touch_cols:  # each held-out touch's own h_c (the sensor's parameters stay as fitted)
+        from scipy.optimize import least_squares
+
+        glob = x[:prob.n_global]
+        free = slice(prob.n_global, None)
+        prob.stride = data.noise_lag
+        with _one_blas_thread():
+            sol = least_squares(lambda d: prob.residuals(np.concatenate([glob, d])), x[free],
+                                jac=lambda d: prob.jacobian(np.concatenate([glob, d]), touch_only=True)[:, free],
+                                bounds=(prob.lo[free], prob.hi[free]), method="trf", x_scale="jac", max_nfev=50)
+        x = np.concatenate([glob, sol.x])
+        prob.stride = 1
+    r, _ = prob.project(x)
     out: dict[str, list[np.ndarray]] = {}
     pos = 0
     for g in data.groups:
@@ -870,6 +1123,9 @@ def compare_models(fit_trials: Sequence[Trial], held_out: Sequence[Trial],
                    candidates: Sequence["str | Candidate"] = CANDIDATES, **kwargs: Any) -> Comparison:
     """Fit every candidate on ``fit_trials``, score each on ``held_out``; select by held-out RMS.
 
+    Each candidate starts from the fitted parameters of the last one nested in it. With no
+    held-out touches the selection is by BIC (the scores are empty).
+
     ``kwargs`` go to :func:`identify` (``ranges``, ``object_temps``, ``depth_m``, ...).
     """
     t0 = time.perf_counter()
@@ -878,7 +1134,7 @@ def compare_models(fit_trials: Sequence[Trial], held_out: Sequence[Trial],
         c = c if isinstance(c, Candidate) else candidate(c)
         res = identify(fit_trials, c, x0=_warm_start(c, results), **kwargs)
         results.append(res)
-        held.append(score(res, held_out, object_temps=kwargs.get("object_temps")))
-    best = min(range(len(results)), key=lambda i: (held[i]["all"], results[i].bic))
+        held.append(score(res, held_out, object_temps=kwargs.get("object_temps")) if held_out else {})
+    best = min(range(len(results)), key=lambda i: (held[i].get("all", 0.0), results[i].bic))
     return Comparison(tuple(results), tuple(held), results[best].candidate.label, len(fit_trials), len(held_out),
                       time.perf_counter() - t0)

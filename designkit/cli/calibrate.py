@@ -146,6 +146,75 @@ class _Display:
             self.live.update(_status_table(st))
 
 
+class _ForceWatch:
+    """Touches the contact rule misses: force rises and falls again, peaking below the threshold.
+
+    Fed the recorder's live status (a few times a second); after ``MISSED`` such touches with no
+    trial recorded it raises an InputError naming the observed peaks and the threshold.
+    """
+
+    MISSED = 3
+
+    def __init__(self, profile) -> None:
+        rule = profile.contact
+        self.threshold = rule.force_threshold_n if rule.rule == "force" else None
+        self.peaks: list[float] = []
+        self.current: float | None = None
+
+    def __call__(self, st) -> None:
+        if self.threshold is None or st.trials > 0 or not math.isfinite(st.force_n):
+            self.current = None
+            return
+        lo = 0.2 * self.threshold
+        if st.force_n > lo:
+            self.current = max(self.current or 0.0, st.force_n)
+        elif self.current is not None:
+            if self.current < self.threshold:
+                self.peaks.append(self.current)
+            self.current = None
+        if len(self.peaks) >= self.MISSED:
+            from .._validation import InputError
+
+            raise InputError(
+                f"{len(self.peaks)} touches were not recorded: their force peaked at {min(self.peaks):.2g}-"
+                f"{max(self.peaks):.2g} N, below the profile's contact threshold of {self.threshold:g} N. Lower "
+                f"force_threshold_n in the profile (e.g. to {0.75 * min(self.peaks):.2g} N, with release_n below "
+                "it), or press harder")
+
+
+class _CommentWatch:
+    """A stream whose every line starts with the profile's comment prefix: samples taken for messages.
+
+    Fed the recorder's events; after ``LIMIT`` device messages and not one sample it raises an
+    InputError (a rig whose data lines start with, say, ``#T`` under ``comment: "#"``).
+    """
+
+    LIMIT = 200
+
+    def __init__(self, profile) -> None:
+        self.profile = profile
+        self.n = 0
+        self.example = ""
+
+    def __call__(self, event, lines_ok: int) -> None:
+        if event.kind != "device" or not self.profile.comment or lines_ok:
+            return
+        self.n += 1
+        self.example = event.message.removeprefix("device: ")
+        if self.n >= self.LIMIT:
+            from .._validation import InputError
+
+            rest = self.example[len(self.profile.comment):]
+            data_like = sum(c.isdigit() for c in rest) >= 3
+            raise InputError(
+                f"all {self.n} lines from the device start with the profile's comment prefix "
+                f"{self.profile.comment!r} (e.g. {self.example[:60]!r}), so each was taken as a device message "
+                "and not one sample was read"
+                + (": they look like data lines that begin with it" if data_like else "")
+                + ". Set the profile's comment to a prefix the data lines do not start with (or remove it), or "
+                  "make the rig send its messages with a different prefix")
+
+
 def _record_materials(port: str, profile, out: Path, materials: list[str], trials: int, timeout: Optional[float],
                       quiet: bool, prompt: bool):
     """Record each material in turn on one open connection; returns (recorder, paths, interrupted).
@@ -158,8 +227,21 @@ def _record_materials(port: str, profile, out: Path, materials: list[str], trial
     from ..calibration.trials import recorded_trials
 
     display = _Display(quiet)
-    rec = SerialRecorder(port, profile, out, no_data_timeout_s=timeout, on_event=display.event,
-                         on_status=display.status)
+    watch = _ForceWatch(profile)
+
+    def on_status(st) -> None:
+        display.status(st)
+        watch(st)
+
+    comments = _CommentWatch(profile)
+
+    def on_event(e) -> None:
+        if not (e.kind == "device" and comments.n >= 3 and rec.status.lines_ok == 0):
+            display.event(e)  # a stream of nothing but messages: show the first few, then the verdict
+        comments(e, rec.status.lines_ok)
+
+    rec = SerialRecorder(port, profile, out, no_data_timeout_s=timeout, on_event=on_event,
+                         on_status=on_status)
     before = set(recorded_trials(out))
     interrupted = False
     try:
@@ -174,6 +256,7 @@ def _record_materials(port: str, profile, out: Path, materials: list[str], trial
             elif i > 0:
                 rec.flush_input()
             with display:
+                watch.peaks.clear()
                 rec.record(material, trials)
     except KeyboardInterrupt:
         interrupted = True
@@ -259,7 +342,7 @@ def _print_fit(result, out: Optional[Path], plot: Optional[Path]) -> None:
 
 
 def _run_fit(index: Path, ranges: list[str], only: Optional[list[str]], object_temps: list[str], settings,
-             out: Optional[Path], name: Optional[str], plot: Optional[Path], quiet: bool):
+             out: Optional[Path], name: Optional[str], plot: Optional[Path], quiet: bool, force: bool = False):
     from ..calibration.fit import fit_sensor, parse_object_temps, parse_ranges, plot_fit, resolve_ranges
     from ..calibration.trials import load_index
 
@@ -273,8 +356,21 @@ def _run_fit(index: Path, ranges: list[str], only: Optional[list[str]], object_t
     unknown = sorted(set(temps) - set(names))
     if unknown:
         raise ValueError(f"--object-temp names material(s) not being fitted: {', '.join(unknown)}")
+    from rich.markup import escape
+
+    from ..calibration.fit import check_calibration
+
     total = settings.bootstrap + settings.profile_points
     con = console(stderr=True)
+    before = check_calibration(None, trials)  # the touches themselves: refuse before a fit that cannot help
+    if any(p.fatal for p in before) and not force:
+        from .._validation import InputError
+
+        for p in before:
+            con.print(f"[bold red]error:[/] {escape(p.text())}")
+        raise InputError(f"calibration unusable ({', '.join(sorted({p.kind for p in before}))}): "
+                         + (f"{out} not written; " if out is not None else "")
+                         + "see the messages above; --force fits and writes the sensor file anyway")
     if not quiet and con.is_terminal and total:
         from rich.progress import Progress
 
@@ -284,11 +380,27 @@ def _run_fit(index: Path, ranges: list[str], only: Optional[list[str]], object_t
                                 progress=lambda done, tot: progress.update(task, completed=done))
     else:
         result = fit_sensor(trials, rng, object_temps=temps, settings=settings)
-    if out is not None:
-        sensor = result.sensor(name=name or out.stem, provenance={"index": str(index), "materials_fitted": names})
-        sensor.to_yaml(out)
+    problems = check_calibration(result, trials)
+    fatal = [p for p in problems if p.fatal]
+    for p in problems:
+        con.print(f"[bold red]{'error' if p.fatal and not force else 'warning'}:[/] {escape(p.text())}")
     if plot is not None:
         plot_fit(result, plot)
+    if fatal and not force:
+        if not quiet:
+            _print_fit(result, None, None)
+        from .._validation import InputError
+
+        kinds = ", ".join(sorted({p.kind for p in fatal}))
+        raise InputError(f"calibration unusable ({kinds}): "
+                         + (f"{out} not written; " if out is not None else "")
+                         + "see the messages above; --force writes the sensor file anyway")
+    if out is not None:
+        prov = {"index": str(index), "materials_fitted": names}
+        if problems:
+            prov["problems"] = [p.text() for p in problems]
+        sensor = result.sensor(name=name or out.stem, provenance=prov)
+        sensor.to_yaml(out)
     return result
 
 
@@ -308,7 +420,8 @@ def _parse_sets(spec: str) -> list[int]:
 
 
 def _run_identify(index: Path, model: str, fit_sets: str, ranges: list[str], only: Optional[list[str]],
-                  object_temps: list[str], depth_um: float, out: Optional[Path], json_: bool) -> None:
+                  object_temps: list[str], depth_um: float, out: Optional[Path], json_: bool,
+                  touch_conductance: Optional[str] = None) -> None:
     """``calibrate fit --model``: identify one model or compare them all on held-out touches."""
     from rich.markup import escape
     from rich.table import Table
@@ -327,21 +440,31 @@ def _run_identify(index: Path, model: str, fit_sets: str, ranges: list[str], onl
         raise InputError(f"index {index} lists no trials")
     names = sorted({tr.material for tr in trials})
     rng = resolve_ranges(names, parse_ranges(ranges))
-    temps = parse_object_temps(object_temps)
-    kw = dict(ranges=rng, object_temps=temps, depth_m=depth_um * 1e-6)
-    if all(s is not None for s in trial_sets(trials, index)):
+    affine = [spec for spec in object_temps if spec.strip().lower().endswith("-affine")]
+    temps = parse_object_temps([spec for spec in object_temps if spec not in affine])
+    for spec in affine:  # the passive reading through a fitted offset and slope (identification only)
+        mat, _, mode = spec.partition("=")
+        if mode.strip().lower() not in ("passive-affine", "passive-end-affine"):
+            raise InputError(f"--object-temp {spec!r}: the fitted-channel modes are passive-affine and "
+                             "passive-end-affine")
+        temps[mat.strip()] = mode.strip().lower()
+    per_touch = [n.strip() for n in (touch_conductance or "").split(",") if n.strip()]
+    unknown = sorted(set(per_touch) - set(names))
+    if unknown:
+        raise InputError(f"--touch-conductance names material(s) not being fitted: {', '.join(unknown)} "
+                         f"(fitted: {', '.join(names)})")
+    if per_touch:
+        cands = [c for c in cands if "conductance_w_m2k" in c.free]
+        if not cands:
+            raise InputError(f"--touch-conductance needs a model that fits the contact conductance "
+                             f"(contact, layered...), not {model}")
+    kw = dict(ranges=rng, object_temps=temps, depth_m=depth_um * 1e-6, touch_conductance=tuple(per_touch))
+    if fit_sets.strip().lower() != "all" and all(s is not None for s in trial_sets(trials, index)):
         fit, held = split_by_trial_set(trials, _parse_sets(fit_sets), index)
     else:
         fit, held = trials, []
-    if held:
-        cmp = compare_models(fit, held, cands, **kw)
-        results, scores, selected = cmp.results, cmp.held_out_rms_c, cmp.selected
-    else:
-        from ..calibration.identify import identify
-
-        results = tuple(identify(fit, c, **kw) for c in cands)
-        scores = tuple({} for _ in results)
-        selected = min(results, key=lambda r: r.bic).candidate.label
+    cmp = compare_models(fit, held, cands, **kw)   # no held-out touches: selected by BIC
+    results, scores, selected = cmp.results, cmp.held_out_rms_c, cmp.selected
     if json_:
         emit_json({"index": str(index), "n_fit": len(fit), "n_held_out": len(held), "selected": selected,
                    "results": [dict(r.to_dict(), held_out_rms_c=dict(sc)) for r, sc in zip(results, scores)]})
@@ -441,7 +564,15 @@ def fit(
                         "them on held-out touches (default: the paper's semi-infinite fit).")] = None,
     fit_sets: Annotated[str, typer.Option(
         "--fit-sets", help="With --model: trial sets to fit (FIRST-LAST or a comma list); the others are held "
-                           "out and scored. Indexes without trial sets are fitted whole.")] = "1-4",
+                           "out and scored ('all': fit every touch, select by BIC). Indexes without trial "
+                           "sets are fitted whole.")] = "1-4",
+    force: Annotated[bool, typer.Option(
+        "--force", help="Write the sensor file even when the calibration is unusable (conflicting ranges, "
+                        "mislabelled touches, a sensor colder than the object).")] = False,
+    touch_conductance: Annotated[Optional[str], typer.Option(
+        "--touch-conductance", help="With --model: give each touch of these materials (comma-separated) its own "
+                                    "contact conductance, e.g. metal (contact area differs between touches); "
+                                    "only models that fit h_c.")] = None,
     json_: Json = False,
 ) -> None:
     """Identify e_s and alpha_s (and each e_o, the time offset) from recorded touches (paper appendix).
@@ -451,9 +582,11 @@ def fit(
     settings = _fit_settings(depth_um, bootstrap, seed, baseline, offset_range, fit_to)
     only_list = [s.strip() for item in only for s in item.split(",") if s.strip()] if only else None
     if model is not None:
-        _run_identify(index, model, fit_sets, range_ or [], only_list, object_temp or [], depth_um, out, json_)
+        _run_identify(index, model, fit_sets, range_ or [], only_list, object_temp or [], depth_um, out, json_,
+                      touch_conductance)
         return
-    result = _run_fit(index, range_ or [], only_list, object_temp or [], settings, out, name, plot, quiet=json_)
+    result = _run_fit(index, range_ or [], only_list, object_temp or [], settings, out, name, plot, quiet=json_,
+                      force=force)
     if json_:
         payload = result.to_dict()
         payload.update({"out": str(out) if out else None, "plot": str(plot) if plot else None, "index": str(index)})
@@ -480,6 +613,8 @@ def guided(
     bootstrap: BootstrapOpt = 100,
     timeout: TimeoutOpt = None,
     yes: Annotated[bool, typer.Option("--yes", "-y", help="Do not wait for Enter before each material.")] = False,
+    force: Annotated[bool, typer.Option(
+        "--force", help="Write the sensor file even when the calibration is unusable.")] = False,
     json_: Json = False,
 ) -> None:
     """Guided calibration: record every material over serial, then fit and write the sensor file."""
@@ -514,7 +649,7 @@ def guided(
         raise typer.Exit(EXIT_INTERRUPTED)
     sensor_path = sensor_out or out / "sensor.yaml"
     result = _run_fit(out / "index.csv", range_ or [], materials, object_temp or [], settings, sensor_path, None,
-                      None, quiet=json_)
+                      None, quiet=json_, force=force)
     if json_:
         payload = {"record": _record_payload(rec, paths, out, False), "fit": result.to_dict(),
                    "sensor": str(sensor_path)}

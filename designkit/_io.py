@@ -15,8 +15,27 @@ def atomic_write_bytes(path: Path, data: bytes) -> Path:
 
     A crash or kill at any moment leaves either the old file or the new one,
     never a truncated mix. The data are flushed to disk before the rename.
+
+    A destination that exists and is not a regular file (``/dev/null``, a
+    terminal, a FIFO) is written to as it is: renaming over it would replace
+    the device with a file (as root, ``--out /dev/null`` did exactly that).
+    A folder is refused.
     """
+    import stat
+
     path = Path(path)
+    try:
+        mode = os.stat(path).st_mode
+    except FileNotFoundError:
+        mode = None
+    except OSError as exc:
+        raise OSError(exc.errno, f"cannot write {path}: {exc.strerror}", str(path)) from None
+    if mode is not None and stat.S_ISDIR(mode):
+        raise IsADirectoryError(21, f"cannot write {path}: it is a folder", str(path))
+    if mode is not None and not stat.S_ISREG(mode):
+        with open(path, "wb") as fh:
+            fh.write(data)
+        return path
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:

@@ -18,8 +18,11 @@ __all__ = [
     "check_effusivity",
     "check_effusivity_range",
     "check_finite",
+    "check_memory",
     "check_nonnegative",
     "check_positive",
+    "check_probability",
+    "memory_limit_bytes",
 ]
 
 
@@ -54,6 +57,49 @@ def check_positive(name: str, value: float, *, allow_inf: bool = False) -> float
         what = "positive" if allow_inf else "positive and finite"
         raise InputError(f"{name} must be {what}, got {_fmt(v)}")
     return v
+
+
+def check_probability(name: str, value: float, *, low: float = 0.0, high: float = 1.0) -> float:
+    """Return ``value`` as float, or raise unless ``low < value < high`` (an F1 threshold: (2/3, 1))."""
+    v = check_finite(name, value)
+    if not low < v < high:
+        raise InputError(f"{name} must be in ({low:g}, {high:g}), got {_fmt(v)}")
+    return v
+
+
+def memory_limit_bytes() -> int:
+    """What one request may allocate: ``DESIGNKIT_MEMORY_LIMIT_GB`` or half of this machine's memory."""
+    import os
+
+    env = os.environ.get("DESIGNKIT_MEMORY_LIMIT_GB")
+    if env:
+        try:
+            gb = float(env)
+        except ValueError:
+            raise InputError(f"DESIGNKIT_MEMORY_LIMIT_GB must be a number of GB, got {env!r}") from None
+        if math.isfinite(gb) and gb > 0:
+            return int(gb * 1024 ** 3)
+    try:
+        total = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (ValueError, OSError, AttributeError):  # pragma: no cover - not POSIX
+        total = 8 * 1024 ** 3
+    return int(total // 2)
+
+
+def _bytes(n: float) -> str:
+    for unit in ("B", "KiB", "MiB", "GiB", "TiB", "PiB"):
+        if n < 1024 or unit == "PiB":
+            return f"{n:.3g} {unit}"
+        n /= 1024
+    return f"{n:.3g} PiB"  # pragma: no cover
+
+
+def check_memory(what: str, nbytes: float) -> None:
+    """Refuse a request whose estimated memory ``nbytes`` exceeds :func:`memory_limit_bytes`, in one line."""
+    limit = memory_limit_bytes()
+    if not nbytes <= limit:
+        raise InputError(f"{what} needs about {_bytes(float(nbytes))} of memory; the limit is {_bytes(limit)} "
+                         f"(half this machine's memory; set DESIGNKIT_MEMORY_LIMIT_GB to change it)")
 
 
 def check_nonnegative(name: str, value: float) -> float:

@@ -29,6 +29,13 @@ from ..sensor import Sensor, load_sensor
 
 __all__ = ["FIDELITIES", "SweepConfig"]
 
+#: Limits checked before any work: more intervals than this cannot be swept (the full F1 matrix of
+#: 100 000 intervals is 80 GB per scene point and contact), nor axes longer than this.
+MAX_INTERVALS = 100_000
+MAX_AXIS_POINTS = 10_000
+#: Trials per interval: 1 000 000 touches of one interval is already ~6 GB of curves at 800 samples.
+MAX_TRIALS = 1_000_000
+
 #: What decides distinguishability: the paper's SVM, or the ideal observer (the bound).
 FIDELITIES = ("svm", "ideal")
 
@@ -95,6 +102,16 @@ class SweepConfig:
         self._check_grid()
         self._check_axes()
         self._check_model()
+        self._check_size()
+
+    def _check_size(self) -> None:
+        """The table's arrays must fit: scene points x contacts x intervals (x intervals for F1 matrices)."""
+        from .._validation import check_memory
+
+        cells = math.prod(self.scene_shape) * len(self.contact_s) * self.intervals
+        per_cell = 8 * 12 + (8 * self.intervals if self.full_matrix else 0)
+        check_memory(f"a table of {cells:g} cells ({self.intervals} intervals"
+                     + (", full F1 matrices" if self.full_matrix else "") + ")", cells * per_cell)
 
     def _check_grid(self) -> None:
         """The effusivity grid, the classifier protocol and the search settings."""
@@ -102,8 +119,30 @@ class SweepConfig:
             raise InputError(f"fidelity must be one of {', '.join(FIDELITIES)}, got {self.fidelity!r}")
         if not (0 <= self.e_min < self.e_max < math.inf):
             raise InputError(f"effusivity range must satisfy 0 <= min < max < inf, got ({self.e_min:g}, {self.e_max:g}]")
+        for key in ("intervals", "folds", "trials", "max_repeats", "blocks", "seed"):
+            value = getattr(self, key)
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+                    or not math.isfinite(value):
+                raise InputError(f"{key}: expected an integer, got {value!r}")
+        for key in ("e_min", "e_max", "threshold", "z", "ambient_temp_c", "sensor_temp_spread_c",
+                    "ambient_temp_spread_c", "slope_window_s"):
+            value = getattr(self, key)
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+                    or not math.isfinite(value):
+                raise InputError(f"{key}: expected a finite number, got {value!r}")
+        for key in ("full_matrix", "ideal_bound"):
+            if not isinstance(getattr(self, key), (bool, np.bool_)):
+                raise InputError(f"{key}: expected true or false, got {getattr(self, key)!r}")
+        if not isinstance(self.name, str) or not isinstance(self.sensor, str):
+            bad = "name" if not isinstance(self.name, str) else "sensor"
+            raise InputError(f"{bad}: expected text, got {getattr(self, bad)!r}")
         if int(self.intervals) != self.intervals or self.intervals < 2:
             raise InputError(f"intervals must be an integer >= 2, got {self.intervals}")
+        if self.intervals > MAX_INTERVALS:
+            raise InputError(f"intervals = {self.intervals:g} is more than this designkit sweeps "
+                             f"(limit {MAX_INTERVALS}: the grid, its staircases and F1 matrices must fit in memory)")
+        if self.trials > MAX_TRIALS:
+            raise InputError(f"trials = {self.trials:g} per interval is more than the limit {MAX_TRIALS}")
         if int(self.folds) != self.folds or self.folds < 2:
             raise InputError(f"folds must be >= 2, got {self.folds}")
         if int(self.trials) != self.trials or self.trials < self.folds:
@@ -273,7 +312,12 @@ class SweepConfig:
     def from_mapping(cls, data: Mapping[str, Any], *, source: str = "config") -> "SweepConfig":
         if not isinstance(data, Mapping):
             raise InputError(f"{source}: a sweep config must be a mapping of keys")
+        from .._schemas import schemas, validate
+
         known = {f.name for f in dataclasses.fields(cls)}
+        # strict types first, naming the key: "intervals: expected an integer, got 'ten'"
+        checked = validate(schemas()["sweep"], dict(data), source)
+        data = {k: _plain(getattr(checked, k)) for k in data}
         flat = _flatten(data, source)
         unknown = sorted(set(flat) - known)
         if unknown:
@@ -288,19 +332,18 @@ class SweepConfig:
     @classmethod
     def from_yaml(cls, path: str | Path, **overrides: Any) -> "SweepConfig":
         """Read a YAML config; non-None ``overrides`` (CLI options) win over the file."""
-        import yaml
+        from .._schemas import load_yaml
 
         p = Path(path)
-        try:
-            text = p.read_text()
-        except OSError as exc:
-            raise InputError(f"cannot read sweep config {p}: {exc.strerror or exc}") from None
-        try:
-            data = yaml.safe_load(text) or {}
-        except yaml.YAMLError:
-            raise InputError(f"sweep config {p} is not valid YAML") from None
+        # An empty config is refused: its defaults are the paper's 500-interval sweep (hours of work)
+        data = load_yaml(p, "sweep config")
         if not isinstance(data, Mapping):
-            raise InputError(f"sweep config {p} must be a mapping of keys")
+            raise InputError(f"sweep config {p} must be a mapping of keys, got {type(data).__name__}")
+        if not data:
+            raise InputError(f"sweep config {p} is empty (a sweep needs at least its grid and axes)")
+        from .._schemas import schemas, validate
+
+        validate(schemas()["sweep"], dict(data), f"sweep config {p}")  # before flattening: keys as written
         data = _flatten(data, f"sweep config {p}")
         if isinstance(data.get("sensor"), str) and not Path(data["sensor"]).is_absolute() \
                 and data["sensor"].endswith((".yaml", ".yml")):
@@ -309,13 +352,27 @@ class SweepConfig:
         return cls.from_mapping(data, source=f"sweep config {p}")
 
 
+def _plain(value: Any) -> Any:
+    """A validated schema value back as plain data (nested models as dicts)."""
+    if hasattr(value, "model_dump"):
+        return {k: v for k, v in value.model_dump().items() if v is not None}
+    return value
+
+
 def _axis(name: str, values: Any) -> tuple[float, ...] | None:
     """A sweep axis as a tuple of floats (a single number is a one-point axis; None stays None)."""
     if values is None:
         return None
-    if isinstance(values, (int, float)):
+    if isinstance(values, (int, float)) and not isinstance(values, bool):
         values = (values,)
-    vals = tuple(float(x) for x in values)
+    if isinstance(values, (str, bytes, bool)) or not hasattr(values, "__iter__"):
+        raise InputError(f"{name}: expected a number or a list of numbers, got {values!r}")
+    try:
+        vals = tuple(float(x) for x in values)
+    except (TypeError, ValueError):
+        raise InputError(f"{name}: expected a number or a list of numbers, got {list(values)!r}") from None
+    if len(vals) > MAX_AXIS_POINTS:
+        raise InputError(f"sweep axis {name} has {len(vals)} points; the limit is {MAX_AXIS_POINTS}")
     if not vals:
         raise InputError(f"sweep axis {name} is empty")
     return vals

@@ -30,7 +30,7 @@ def test_round_trip_and_header(tmp_path):
     assert h["schema_version"] == SCHEMA_VERSION and h["format"] == "designkit-table"
     assert [a["name"] for a in h["axes"]] == ["noise_ratio", "contact_s", "e_ref"]
     assert h["axes"][1]["units"] == "s" and "J s^-1/2" in h["axes"][2]["units"]
-    assert h["content_hash"] == content_hash(arrays)
+    assert h["content_hash"] == content_hash(arrays, h) != content_hash(arrays)  # header and arrays
     assert h["sensor"]["effusivity"] == 892.0 and h["designkit_version"]
     assert t.sensor.name == "paper"
     # loaded without pickle: the npz holds plain numeric arrays only

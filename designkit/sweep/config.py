@@ -27,7 +27,7 @@ from ..recognition.features import DEFAULT_SLOPE_WINDOW_S
 from ..scene import Scene
 from ..sensor import Sensor, load_sensor
 
-__all__ = ["FIDELITIES", "SweepConfig"]
+__all__ = ["FIDELITIES", "SweepConfig", "check_chunk", "chunk_identity", "stamp_chunk"]
 
 #: Limits checked before any work: more intervals than this cannot be swept (the full F1 matrix of
 #: 100 000 intervals is 80 GB per scene point and contact), nor axes longer than this.
@@ -399,3 +399,45 @@ def _flatten(data: Mapping[str, Any], source: str) -> dict[str, Any]:
                 flat[k_out] = eff[k_in]
     return flat
 
+
+
+# ------------------------------------------------------------------ chunk identity
+def chunk_identity(cfg: SweepConfig, point: Sequence[int], block: int, contact_index: int) -> str:
+    """The identity of one chunk slot: the sweep's :meth:`~SweepConfig.digest` and the slot's indices.
+
+    A chunk file carries it (:func:`stamp_chunk`) and :func:`check_chunk` compares it on resume, so a
+    chunk copied into another slot, or from another sweep's folder, is refused rather than trusted.
+    """
+    key = f"{cfg.digest()}|point={','.join(str(int(x)) for x in point)}|block={int(block)}|contact={int(contact_index)}"
+    return "sha256:" + hashlib.sha256(key.encode()).hexdigest()
+
+
+def stamp_chunk(arrays: Mapping[str, np.ndarray], cfg: SweepConfig, point: Sequence[int], block: int,
+                contact_index: int) -> dict[str, np.ndarray]:
+    """``arrays`` plus ``identity`` (a string array, readable with ``allow_pickle=False``) for the chunk file."""
+    return {**arrays, "identity": np.asarray(chunk_identity(cfg, point, block, contact_index))}
+
+
+def check_chunk(arrays: Mapping[str, np.ndarray], cfg: SweepConfig, point: Sequence[int], block: int,
+                contact_index: int, path: str | Path = "chunk") -> None:
+    """Refuse (InputError) a chunk file that is not the one of this slot of this sweep.
+
+    The chunk's own ``point``, ``block`` and ``contact_index`` must be the slot's, and its
+    ``identity`` (see :func:`stamp_chunk`) the slot's :func:`chunk_identity`. A chunk written
+    before chunks carried an identity is checked on its indices only.
+    """
+    name = Path(path).name
+    try:
+        own = (tuple(int(x) for x in np.atleast_1d(arrays["point"])), int(arrays["block"]),
+               int(arrays["contact_index"]))
+    except (KeyError, TypeError, ValueError):
+        raise InputError(f"chunk {name} lacks its point, block or contact index: delete it and resume") from None
+    slot = (tuple(int(x) for x in point), int(block), int(contact_index))
+    if own != slot:
+        raise InputError(f"chunk {name} holds point {own[0]}, block {own[1]}, contact {own[2]} but sits in the slot of "
+                         f"point {slot[0]}, block {slot[1]}, contact {slot[2]} (copied or renamed?): delete it and resume")
+    if "identity" in arrays:
+        ident = str(np.asarray(arrays["identity"]).reshape(()).item()) if np.asarray(arrays["identity"]).size == 1 else ""
+        if ident != chunk_identity(cfg, point, block, contact_index):
+            raise InputError(f"chunk {name} belongs to another sweep (its identity is not this sweep's slot): "
+                             "delete it and resume")

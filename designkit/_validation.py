@@ -63,7 +63,8 @@ def check_probability(name: str, value: float, *, low: float = 0.0, high: float 
     """Return ``value`` as float, or raise unless ``low < value < high`` (an F1 threshold: (2/3, 1))."""
     v = check_finite(name, value)
     if not low < v < high:
-        raise InputError(f"{name} must be in ({low:g}, {high:g}), got {_fmt(v)}")
+        lo = "2/3" if abs(low - 2 / 3) < 1e-12 else f"{low:g}"
+        raise InputError(f"{name} must be in ({lo}, {high:g}), got {_fmt(v)}")
     return v
 
 

@@ -198,18 +198,21 @@ def _copy(base: Path, folder: Path) -> Path:
 @pytest.fixture(scope="module")
 def cli():
     """The CLI in-process, its click command built once (typer rebuilds it per invoke: ~0.1 s)."""
-    import click.testing
-    import typer.main
+    import typer.testing
 
     from designkit.cli import app
 
-    command = typer.main.get_command(app)
-    runner = click.testing.CliRunner()
+    # typer's runner rebuilds the click command on every invoke (~0.1 s): build it once
+    build = typer.testing._get_command
+    command = build(app)
+    typer.testing._get_command = lambda a: command if a is app else build(a)
+    runner = typer.testing.CliRunner()
 
     def invoke(*args: str):
-        return runner.invoke(command, [str(a) for a in args])
+        return runner.invoke(app, [str(a) for a in args])
 
-    return invoke
+    yield invoke
+    typer.testing._get_command = build
 
 
 def test_the_base_table_answers_every_command(base, cli, tmp_path):

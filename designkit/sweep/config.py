@@ -33,6 +33,8 @@ __all__ = ["FIDELITIES", "SweepConfig", "check_chunk", "chunk_identity", "stamp_
 #: 100 000 intervals is 80 GB per scene point and contact), nor axes longer than this.
 MAX_INTERVALS = 100_000
 MAX_AXIS_POINTS = 10_000
+#: Effusivity grids end below this [J s^-1/2 K^-1 m^-2] (diamond ~1e5); 1e308 overflowed the grid.
+MAX_EFFUSIVITY = 1e7
 #: Trials per interval: 1 000 000 touches of one interval is already ~6 GB of curves at 800 samples.
 MAX_TRIALS = 1_000_000
 
@@ -117,6 +119,9 @@ class SweepConfig:
         """The effusivity grid, the classifier protocol and the search settings."""
         if self.fidelity not in FIDELITIES:
             raise InputError(f"fidelity must be one of {', '.join(FIDELITIES)}, got {self.fidelity!r}")
+        if self.e_max > MAX_EFFUSIVITY:
+            raise InputError(f"effusivity range max = {self.e_max:g} is above {MAX_EFFUSIVITY:g} J s^-1/2 K^-1 m^-2 "
+                             "(no material comes near: diamond is about 1e5)")
         if not (0 <= self.e_min < self.e_max < math.inf):
             raise InputError(f"effusivity range must satisfy 0 <= min < max < inf, got ({self.e_min:g}, {self.e_max:g}]")
         for key in ("intervals", "folds", "trials", "max_repeats", "blocks", "seed"):

@@ -188,6 +188,11 @@ def write_table(path: str | Path, header: dict, arrays: Mapping[str, np.ndarray]
     path = Path(path)
     if path.suffix != ".npz":
         path = path.with_suffix(".npz")
+    for parent in (path.parent, *path.parent.parents):
+        if parent.exists():
+            if not parent.is_dir():
+                raise InputError(f"cannot write table {path}: {parent} is not a folder")
+            break
     arrays = {k: np.ascontiguousarray(v) for k, v in arrays.items()}
     for name, a in arrays.items():
         if a.dtype == object:

@@ -185,6 +185,19 @@ def _strict_integer(value: Any) -> int:
     return int(value)
 
 
+def _json_number(value: Any) -> Any:
+    """JSON has real numbers: a string is never one (no YAML 1.1 quirk to forgive)."""
+    if isinstance(value, str):
+        raise ValueError("a number")
+    return _strict_number(value)
+
+
+def _json_integer(value: Any) -> int:
+    if isinstance(value, str) or isinstance(value, float):
+        raise ValueError("an integer")
+    return _strict_integer(value)
+
+
 def _strict_axis(value: Any) -> Any:
     """A number or a non-empty list of numbers."""
     if isinstance(value, (list, tuple)):
@@ -260,6 +273,10 @@ def schemas() -> dict[str, type]:
         ideal_bound: Optional[StrictBool] = None
         model: Any = None  # a name, a mapping or a ForwardModel: checked by designkit.models
         diffusivity_m2_s: Optional[Number] = None
+
+    # JSON formats (table header, trial sidecar): numbers are numbers, never strings
+    Number = Annotated[Any, PlainValidator(_json_number)]
+    Integer = Annotated[Any, PlainValidator(_json_integer)]
 
     class TableAxis(_Strict):
         name: Literal["noise_ratio", "noise_c", "delta_t_c", "contact_s", "e_ref"]

@@ -19,11 +19,16 @@ __all__ = [
     "check_effusivity_range",
     "check_finite",
     "check_memory",
+    "check_temperature",
     "check_nonnegative",
     "check_positive",
     "check_probability",
     "memory_limit_bytes",
 ]
+
+
+#: The smallest normal float: a positive value below it is subnormal, never a physical quantity.
+_TINY = 2.2250738585072014e-308
 
 
 class InputError(ValueError):
@@ -56,6 +61,8 @@ def check_positive(name: str, value: float, *, allow_inf: bool = False) -> float
     if math.isnan(v) or v <= 0 or (math.isinf(v) and not allow_inf):
         what = "positive" if allow_inf else "positive and finite"
         raise InputError(f"{name} must be {what}, got {_fmt(v)}")
+    if v < _TINY:  # subnormal: never a physical quantity; 1 / v overflows or divides by zero downstream
+        raise InputError(f"{name} must be at least {_TINY:.3g} (a normal float), got {_fmt(v)}")
     return v
 
 
@@ -101,6 +108,19 @@ def check_memory(what: str, nbytes: float) -> None:
     if not nbytes <= limit:
         raise InputError(f"{what} needs about {_bytes(float(nbytes))} of memory; the limit is {_bytes(limit)} "
                          f"(half this machine's memory; set DESIGNKIT_MEMORY_LIMIT_GB to change it)")
+
+
+#: Temperatures and temperature noise beyond this many degC are refused: no sensor survives them, and
+#: 1e308 overflowed the simulation (inf readings, or an overflow error).
+MAX_ABS_TEMPERATURE_C = 1e4
+
+
+def check_temperature(name: str, value: float, *, nonnegative: bool = False) -> float:
+    """A finite temperature (or noise, or difference) [degC] of magnitude at most 1e4."""
+    v = check_nonnegative(name, value) if nonnegative else check_finite(name, value)
+    if abs(v) > MAX_ABS_TEMPERATURE_C:
+        raise InputError(f"{name} must be at most {MAX_ABS_TEMPERATURE_C:g} degC in magnitude, got {_fmt(v)}")
+    return v
 
 
 def check_nonnegative(name: str, value: float) -> float:

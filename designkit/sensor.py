@@ -51,11 +51,11 @@ def sample_times_s(contact_s: float, sample_rate_hz: float) -> np.ndarray:
     contact_s = check_positive("contact time [s]", contact_s)
     fs = check_positive("sample rate [Hz]", sample_rate_hz)
     # A tolerance of 1e-9 samples keeps 2.0 s * 200 Hz = 400 from rounding down.
-    n_float = math.floor(contact_s * fs + 1e-9)
+    n_float = contact_s * fs + 1e-9  # may be inf (1e308 s): compared before math.floor sees it
     if not n_float < MAX_SAMPLES_PER_TOUCH:
         raise InputError(f"a touch of {contact_s:g} s at {fs:g} Hz has {n_float + 1:.4g} samples; the limit is "
                          f"{MAX_SAMPLES_PER_TOUCH:.0e} per touch (shorten the contact or lower the sample rate)")
-    n = int(n_float)
+    n = int(math.floor(n_float))
     return np.arange(n + 1, dtype=np.float64) / fs
 
 
@@ -157,7 +157,7 @@ class Sensor:
             sensor = cls(**kwargs)
         except InputError as exc:
             raise InputError(f"{source}: {exc}") from None
-        if "tau_s" in data:
+        if data.get("tau_s") is not None:
             tau = float(data["tau_s"])
             if not math.isclose(tau, sensor.tau_s, rel_tol=1e-6):
                 raise InputError(

@@ -143,7 +143,8 @@ class _Reader:
         return lo, hi
 
     def done(self) -> None:
-        unknown = sorted(str(k) for k in self.data if k not in self.used)
+        # repr() for keys with newlines or control characters: the message stays one line
+        unknown = sorted(str(k) if str(k).isprintable() else repr(str(k)) for k in self.data if k not in self.used)
         if unknown:
             where = f" in {self.path}" if self.path else ""
             raise InputError(f"{self.source}: unknown key(s) {', '.join(unknown)}{where}")

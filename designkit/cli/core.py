@@ -41,12 +41,13 @@ def simulate(
     from ..scene import Scene
     from ..sensor import load_sensor
 
-    from .._validation import check_finite
+    from .._validation import check_temperature
 
     if trials < 1:
         raise ValueError(f"trials must be >= 1, got {trials}")
-    check_finite("--sensor-temp [°C]", sensor_temp)
-    check_finite("--ambient [°C]", ambient)
+    check_temperature("--sensor-temp [°C]", sensor_temp)
+    check_temperature("--ambient [°C]", ambient)
+    check_temperature("--noise [°C]", noise, nonnegative=True)
     fm = model_from_options(model, conductance=conductance, thickness=thickness, backing=backing)
     sen = load_sensor(sensor)
     scene = Scene(contact_s=contact, noise_c=noise, sensor_temp_c=sensor_temp, ambient_temp_c=ambient)
@@ -172,7 +173,7 @@ def f1(
 
     Example: `designkit f1 --e1 35000 --e2 20000 --contact 2 --thickness 0.003 --diffusivity 1e-7`
     """
-    from .._validation import InputError, check_effusivity, check_probability
+    from .._validation import InputError, check_effusivity, check_positive, check_probability, check_temperature
     from ..objects import object_class
     from ..recognition.ideal import ideal_pair
     from ..recognition.svm import pair_f1
@@ -186,6 +187,16 @@ def f1(
     if e1 == e2:
         raise InputError(f"e1 and e2 are equal ({e1:g}): nothing to separate")
     check_probability("--threshold (F1)", threshold, low=2 / 3, high=1.0)  # a blind guess scores 2/3
+    check_temperature("--noise [°C]", noise, nonnegative=True)
+    check_temperature("--delta-t [°C]", delta_t)
+    from ..sweep.config import MAX_EFFUSIVITY
+
+    check_positive("--width", width)
+    for label, value in (("--width", width), ("--e1", e1 + width), ("--e2", e2 + width)):
+        if value > MAX_EFFUSIVITY:  # 1e308 overflowed the class edges
+            raise InputError(f"{label}: classes must end below {MAX_EFFUSIVITY:g} J s^-1/2 K^-1 m^-2, got one "
+                             f"ending at {value:g} (no material comes near: diamond is about 1e5)")
+    check_temperature("--ambient [°C]", ambient)
     if folds < 2:
         raise InputError(f"folds must be >= 2, got {folds}")
     if trials < folds:

@@ -110,6 +110,13 @@ class SweepConfig:
         """The table's arrays must fit: scene points x contacts x intervals (x intervals for F1 matrices)."""
         from .._validation import check_memory
 
+        from ..sensor import MAX_SAMPLES_PER_TOUCH
+
+        fs = self.sample_rate_hz if self.sample_rate_hz is not None else load_sensor(self.sensor).sample_rate_hz
+        longest = max(self.contact_s)
+        if not longest * fs < MAX_SAMPLES_PER_TOUCH:
+            raise InputError(f"contact_s: a touch of {longest:g} s at {fs:g} Hz has {longest * fs:.4g} samples; the limit "
+                             f"is {MAX_SAMPLES_PER_TOUCH:.0e} per touch")
         cells = math.prod(self.scene_shape) * len(self.contact_s) * self.intervals
         per_cell = 8 * 12 + (8 * self.intervals if self.full_matrix else 0)
         check_memory(f"a table of {cells:g} cells ({self.intervals} intervals"
@@ -185,6 +192,14 @@ class SweepConfig:
                 raise InputError(f"{name} values must be finite and >= 0, got {list(vals)}")
         if self.delta_t_c is not None and any(not (v != 0 and math.isfinite(v)) for v in self.delta_t_c):
             raise InputError(f"delta_t_c values must be finite and non-zero, got {list(self.delta_t_c)}")
+        from .._validation import check_temperature
+
+        for name in ("noise_ratio", "noise_c", "delta_t_c"):  # 1e308 overflowed the simulation
+            for v in getattr(self, name) or ():
+                check_temperature(f"{name} value", v)
+        check_temperature("ambient_temp_c", self.ambient_temp_c)
+        check_temperature("sensor_temp_spread_c", self.sensor_temp_spread_c)
+        check_temperature("ambient_temp_spread_c", self.ambient_temp_spread_c)
         if self.sample_rate_hz is not None:
             object.__setattr__(self, "sample_rate_hz", check_positive("sample rate [Hz]", self.sample_rate_hz))
         for name in ("sensor_temp_spread_c", "ambient_temp_spread_c"):

@@ -127,7 +127,8 @@ def _short(value: Any) -> str:
 
 
 def _message(source: str, err: dict) -> str:
-    loc = ".".join(str(x) for x in err.get("loc", ()) if not (isinstance(x, str) and x.startswith("function-")))
+    parts = [str(x) for x in err.get("loc", ()) if not (isinstance(x, str) and x.startswith("function-"))]
+    loc = ".".join(p if p.isprintable() else repr(p) for p in parts)  # a key with a newline stays one line
     kind = err.get("type", "")
     if kind == "missing":
         return f"{source}: {loc}: missing key"

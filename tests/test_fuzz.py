@@ -269,7 +269,7 @@ ISSUE_CASES = [
     (["f1", "--e1", "35000", "--e2", "20000", "--trials", "100000000"], "memory"),
     (["f1", "--e1", "35000", "--e2", "20000", "--threshold", "2"], "threshold"),
     (["simulate", "--e", "100", "--sensor-temp", "nan"], "sensor-temp"),
-    (["tables", "list", "--folder", "@MISSING"], "does not exist"),
+    (["tables", "list", "--folder", "@NOWHERE"], "does not exist"),
     (["tables", "list", "--folder", "/dev/null"], "not a folder"),
     (["tables", "show", ""], "empty"),
     (["tables", "show", "@fifo"], "table"),
@@ -292,7 +292,8 @@ LEAD = [
     reason="fix in a file owned elsewhere (issue 15 report)", strict=False)) for c in LEAD],
     ids=lambda v: " ".join(v)[:60] if isinstance(v, list) else None)
 def test_every_case_of_issue_15_is_refused_in_one_line(argv, needle, env, run):
-    files = {**env["files"], **{f"@{k}": v for k, v in _files(env["root"]).items()}}
+    files = {**env["files"], **{f"@{k}": v for k, v in _files(env["root"]).items()},
+             "@NOWHERE": str(env["root"] / "no-such-folder" / "x")}
     argv = [files.get(a, a) for a in argv]
     r = run(argv)
     check(r, argv)

@@ -18,9 +18,17 @@ __all__ = [
     "check_effusivity",
     "check_effusivity_range",
     "check_finite",
+    "check_memory",
+    "check_temperature",
     "check_nonnegative",
     "check_positive",
+    "check_probability",
+    "memory_limit_bytes",
 ]
+
+
+#: The smallest normal float: a positive value below it is subnormal, never a physical quantity.
+_TINY = 2.2250738585072014e-308
 
 
 class InputError(ValueError):
@@ -53,6 +61,65 @@ def check_positive(name: str, value: float, *, allow_inf: bool = False) -> float
     if math.isnan(v) or v <= 0 or (math.isinf(v) and not allow_inf):
         what = "positive" if allow_inf else "positive and finite"
         raise InputError(f"{name} must be {what}, got {_fmt(v)}")
+    if v < _TINY:  # subnormal: never a physical quantity; 1 / v overflows or divides by zero downstream
+        raise InputError(f"{name} must be at least {_TINY:.3g} (a normal float), got {_fmt(v)}")
+    return v
+
+
+def check_probability(name: str, value: float, *, low: float = 0.0, high: float = 1.0) -> float:
+    """Return ``value`` as float, or raise unless ``low < value < high`` (an F1 threshold: (2/3, 1))."""
+    v = check_finite(name, value)
+    if not low < v < high:
+        lo = "2/3" if abs(low - 2 / 3) < 1e-12 else f"{low:g}"
+        raise InputError(f"{name} must be in ({lo}, {high:g}), got {_fmt(v)}")
+    return v
+
+
+def memory_limit_bytes() -> int:
+    """What one request may allocate: ``DESIGNKIT_MEMORY_LIMIT_GB`` or half of this machine's memory."""
+    import os
+
+    env = os.environ.get("DESIGNKIT_MEMORY_LIMIT_GB")
+    if env:
+        try:
+            gb = float(env)
+        except ValueError:
+            raise InputError(f"DESIGNKIT_MEMORY_LIMIT_GB must be a number of GB, got {env!r}") from None
+        if math.isfinite(gb) and gb > 0:
+            return int(gb * 1024 ** 3)
+    try:
+        total = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (ValueError, OSError, AttributeError):  # pragma: no cover - not POSIX
+        total = 8 * 1024 ** 3
+    return int(total // 2)
+
+
+def _bytes(n: float) -> str:
+    for unit in ("B", "KiB", "MiB", "GiB", "TiB", "PiB"):
+        if n < 1024 or unit == "PiB":
+            return f"{n:.3g} {unit}"
+        n /= 1024
+    return f"{n:.3g} PiB"  # pragma: no cover
+
+
+def check_memory(what: str, nbytes: float) -> None:
+    """Refuse a request whose estimated memory ``nbytes`` exceeds :func:`memory_limit_bytes`, in one line."""
+    limit = memory_limit_bytes()
+    if not nbytes <= limit:
+        raise InputError(f"{what} needs about {_bytes(float(nbytes))} of memory; the limit is {_bytes(limit)} "
+                         f"(half this machine's memory; set DESIGNKIT_MEMORY_LIMIT_GB to change it)")
+
+
+#: Temperatures and temperature noise beyond this many degC are refused: no sensor survives them, and
+#: 1e308 overflowed the simulation (inf readings, or an overflow error).
+MAX_ABS_TEMPERATURE_C = 1e4
+
+
+def check_temperature(name: str, value: float, *, nonnegative: bool = False) -> float:
+    """A finite temperature (or noise, or difference) [degC] of magnitude at most 1e4."""
+    v = check_nonnegative(name, value) if nonnegative else check_finite(name, value)
+    if abs(v) > MAX_ABS_TEMPERATURE_C:
+        raise InputError(f"{name} must be at most {MAX_ABS_TEMPERATURE_C:g} degC in magnitude, got {_fmt(v)}")
     return v
 
 

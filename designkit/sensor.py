@@ -20,9 +20,13 @@ import numpy as np
 from ._validation import InputError, check_nonnegative, check_positive
 from .properties import time_constant
 
-__all__ = ["SENSORS", "Sensor", "load_sensor", "sample_times_s"]
+__all__ = ["MAX_SAMPLES_PER_TOUCH", "SENSORS", "Sensor", "load_sensor", "sample_times_s"]
 
 SENSOR_FILE_VERSION = 1
+
+#: The most samples one touch may have (10 000 s at 100 Hz, 1 s at 1 MHz): 8 MB per touch curve.
+#: A longer touch or a faster sensor is refused before anything is allocated.
+MAX_SAMPLES_PER_TOUCH = 1_000_000
 
 
 def sample_times_s(contact_s: float, sample_rate_hz: float) -> np.ndarray:
@@ -47,7 +51,11 @@ def sample_times_s(contact_s: float, sample_rate_hz: float) -> np.ndarray:
     contact_s = check_positive("contact time [s]", contact_s)
     fs = check_positive("sample rate [Hz]", sample_rate_hz)
     # A tolerance of 1e-9 samples keeps 2.0 s * 200 Hz = 400 from rounding down.
-    n = int(math.floor(contact_s * fs + 1e-9))
+    n_float = contact_s * fs + 1e-9  # may be inf (1e308 s): compared before math.floor sees it
+    if not n_float < MAX_SAMPLES_PER_TOUCH:
+        raise InputError(f"a touch of {contact_s:g} s at {fs:g} Hz has {n_float + 1:.4g} samples; the limit is "
+                         f"{MAX_SAMPLES_PER_TOUCH:.0e} per touch (shorten the contact or lower the sample rate)")
+    n = int(math.floor(n_float))
     return np.arange(n + 1, dtype=np.float64) / fs
 
 
@@ -127,6 +135,8 @@ class Sensor:
     @classmethod
     def from_dict(cls, data: Mapping[str, Any], *, source: str = "sensor") -> "Sensor":
         """Build from :meth:`to_dict` output, with one-line errors naming ``source``."""
+        from ._schemas import schemas, validate
+
         if not isinstance(data, Mapping):
             raise InputError(f"{source}: a sensor must be a mapping of fields, got {type(data).__name__}")
         version = data.get("designkit_sensor", SENSOR_FILE_VERSION)
@@ -140,12 +150,14 @@ class Sensor:
         unknown = sorted(set(data) - known)
         if unknown:
             raise InputError(f"{source}: unknown sensor field(s) {', '.join(unknown)}")
+        checked = validate(schemas()["sensor"], dict(data), source)  # types, strictly: no [1, 2] for a number
+        data = {k: getattr(checked, k) for k in data}
         kwargs = {k: data[k] for k in data if k not in ("designkit_sensor", "tau_s")}
         try:
             sensor = cls(**kwargs)
         except InputError as exc:
             raise InputError(f"{source}: {exc}") from None
-        if "tau_s" in data:
+        if data.get("tau_s") is not None:
             tau = float(data["tau_s"])
             if not math.isclose(tau, sensor.tau_s, rel_tol=1e-6):
                 raise InputError(
@@ -167,19 +179,10 @@ class Sensor:
     @classmethod
     def from_yaml(cls, path: str | Path) -> "Sensor":
         """Read a sensor YAML file written by :meth:`to_yaml` or by calibration."""
-        import yaml
+        from ._schemas import load_yaml
 
         p = Path(path)
-        try:
-            text = p.read_text()
-        except OSError as exc:
-            raise InputError(f"cannot read sensor file {p}: {exc.strerror or exc}") from None
-        try:
-            data = yaml.safe_load(text)
-        except yaml.YAMLError as exc:
-            line = getattr(getattr(exc, "problem_mark", None), "line", None)
-            where = f" (line {line + 1})" if line is not None else ""
-            raise InputError(f"sensor file {p} is not valid YAML{where}") from None
+        data = load_yaml(p, "sensor file")  # a regular UTF-8 file (a FIFO is refused, not waited on)
         return cls.from_dict(data, source=f"sensor file {p}")
 
 

@@ -30,7 +30,7 @@ def test_round_trip_and_header(tmp_path):
     assert h["schema_version"] == SCHEMA_VERSION and h["format"] == "designkit-table"
     assert [a["name"] for a in h["axes"]] == ["noise_ratio", "contact_s", "e_ref"]
     assert h["axes"][1]["units"] == "s" and "J s^-1/2" in h["axes"][2]["units"]
-    assert h["content_hash"] == content_hash(arrays)
+    assert h["content_hash"] == content_hash(arrays, h) != content_hash(arrays)  # header and arrays
     assert h["sensor"]["effusivity"] == 892.0 and h["designkit_version"]
     assert t.sensor.name == "paper"
     # loaded without pickle: the npz holds plain numeric arrays only
@@ -157,3 +157,42 @@ def test_tables_from_before_the_seam_are_semi_infinite(cli):
     assert t.model.name == "semi-infinite" and SweepConfig.from_mapping(t.header["config"]).model.name == "semi-infinite"
     r = cli("tables", "show", "svm-paper")
     assert r.exit_code == 0 and "model semi-infinite" in r.stdout
+
+
+def test_every_shipped_table_loads_under_the_header_and_arrays_hash():
+    for name in list_tables():
+        t = load_table(name)
+        assert t.header["schema_version"] == SCHEMA_VERSION == 2
+        assert t.header["content_hash"] == content_hash(t.arrays, t.header) != content_hash(t.arrays)
+
+
+def test_a_version_1_table_is_refused_with_the_remedy(tmp_path):
+    path, arrays = _small(tmp_path)
+    header = json.loads(path.with_suffix(".json").read_text())
+    header["schema_version"] = 1
+    header["content_hash"] = content_hash(arrays)  # the old, arrays-only hash
+    path.with_suffix(".json").write_text(json.dumps(header))
+    with pytest.raises(InputError, match="schema version 1.*rehash_tables.py"):
+        load_table(path)
+
+
+def test_table_listing_and_names_refuse_what_is_not_there(cli, tmp_path):
+    for args, needle in ((["tables", "list", "--folder", str(tmp_path / "none")], "does not exist"),
+                         (["tables", "list", "--folder", __file__], "not a folder"),
+                         (["tables", "show", ""], "empty"), (["tables", "show", " "], "empty")):
+        r = cli(*args)
+        assert r.exit_code == 2 and needle in r.stderr and len(r.stderr.strip().splitlines()) == 1, r.output
+
+
+def test_a_chunk_is_checked_against_its_slot_and_sweep():
+    from designkit.sweep.config import check_chunk, stamp_chunk
+
+    cfg = SweepConfig(name="c", intervals=4, contact_s=(1.0, 2.0), fidelity="ideal")
+    own = {"point": np.array([0]), "block": np.array(0), "contact_index": np.array(1)}
+    stamped = stamp_chunk(own, cfg, (0,), 0, 1)
+    check_chunk(stamped, cfg, (0,), 0, 1)
+    check_chunk(own, cfg, (0,), 0, 1)  # written before chunks carried an identity: its indices decide
+    with pytest.raises(InputError, match="sits in the slot"):
+        check_chunk(stamped, cfg, (0,), 0, 0, "p000-b000-c000.npz")  # copied into another slot
+    with pytest.raises(InputError, match="another sweep"):
+        check_chunk(stamped, SweepConfig(name="c", intervals=5, contact_s=(1.0, 2.0), fidelity="ideal"), (0,), 0, 1)

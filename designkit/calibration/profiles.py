@@ -143,7 +143,8 @@ class _Reader:
         return lo, hi
 
     def done(self) -> None:
-        unknown = sorted(str(k) for k in self.data if k not in self.used)
+        # repr() for keys with newlines or control characters: the message stays one line
+        unknown = sorted(str(k) if str(k).isprintable() else repr(str(k)) for k in self.data if k not in self.used)
         if unknown:
             where = f" in {self.path}" if self.path else ""
             raise InputError(f"{self.source}: unknown key(s) {', '.join(unknown)}{where}")
@@ -810,15 +811,9 @@ def load_profile(name_or_path: "str | Path | DeviceProfile") -> DeviceProfile:
             names = ", ".join(shipped) or "none found"
             raise InputError(f"unknown device profile {key!r}: use a shipped name ({names}) or a profile YAML file")
     source = f"profile {path}"
-    try:
-        data = path.read_bytes()
-    except OSError as exc:
-        raise InputError(f"cannot read {source}: {exc.strerror or exc}") from None
-    try:
-        text = data.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        line = data[:exc.start].count(b"\n") + 1
-        raise InputError(f"{source} is not UTF-8 text (byte 0x{data[exc.start]:02x} on line {line})") from None
+    from .._schemas import read_text
+
+    text = read_text(path, "profile")  # a regular UTF-8 file: a FIFO or a folder is refused before reading
     try:
         data = yaml.safe_load(text)
     except yaml.YAMLError as exc:

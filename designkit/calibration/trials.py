@@ -230,12 +230,18 @@ def check_trial_folder(folder: Path | str) -> None:
 def _sidecar_rows(folder: Path) -> list[tuple[str, str, Any]]:
     """(file, material, trial_index) of every trial in ``folder`` with a sidecar and its CSV, sorted."""
     rows = []
+    from .._schemas import load_json, schemas, validate
+
     for side in sorted(folder.glob("*.json")):
         try:
-            meta = json.loads(side.read_text(encoding="utf-8"))
-        except (OSError, ValueError):
+            meta = load_json(side, "trial sidecar")
+        except ValueError:
             continue
         if not isinstance(meta, dict) or "designkit_trial" not in meta:
+            continue
+        try:  # a sidecar whose fields have the wrong types, or that names a file elsewhere, lists nothing
+            validate(schemas()["sidecar"], meta, f"trial sidecar {side}")
+        except ValueError:
             continue
         csv_path = folder / str(meta.get("file", side.with_suffix(".csv").name))
         if csv_path.is_file():
@@ -246,15 +252,9 @@ def _sidecar_rows(folder: Path) -> list[tuple[str, str, Any]]:
 
 def _read_text(path: Path, what: str) -> str:
     """The text of a UTF-8 file (a byte-order mark is allowed); InputError naming ``path`` otherwise."""
-    try:
-        data = path.read_bytes()
-    except OSError as exc:
-        raise InputError(f"cannot read {what} {path}: {exc.strerror or exc}") from None
-    try:
-        return data.decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        line = data[:exc.start].count(b"\n") + 1
-        raise InputError(f"{what} {path} is not UTF-8 text (byte 0x{data[exc.start]:02x} on line {line})") from None
+    from .._schemas import read_text
+
+    return read_text(path, what)  # also refuses a FIFO, a device or a folder before reading
 
 
 def read_trial_csv(path: Path, material: str = "") -> Trial:
@@ -292,6 +292,11 @@ def read_trial_csv(path: Path, material: str = "") -> Trial:
             meta = json.loads(side_text)
         except ValueError:
             raise InputError(f"trial sidecar {side} is not valid JSON") from None
+        from .._schemas import schemas, validate
+
+        if not isinstance(meta, dict):
+            raise InputError(f"trial sidecar {side}: expected a mapping of keys, got {type(meta).__name__}")
+        validate(schemas()["sidecar"], {"designkit_trial": 1, **meta}, f"trial sidecar {side}")
     return Trial(time_s=t, sensor_c=col("active_temp_c")[keep], object_c=col("passive_temp_c")[keep],
                  force_n=col("force_n")[keep], material=material or str(meta.get("material", "")),
                  source=str(path), meta=meta)

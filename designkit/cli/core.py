@@ -41,11 +41,17 @@ def simulate(
     from ..scene import Scene
     from ..sensor import load_sensor
 
+    from .._validation import check_temperature
+
     if trials < 1:
         raise ValueError(f"trials must be >= 1, got {trials}")
+    check_temperature("--sensor-temp [°C]", sensor_temp)
+    check_temperature("--ambient [°C]", ambient)
+    check_temperature("--noise [°C]", noise, nonnegative=True)
     fm = model_from_options(model, conductance=conductance, thickness=thickness, backing=backing)
     sen = load_sensor(sensor)
     scene = Scene(contact_s=contact, noise_c=noise, sensor_temp_c=sensor_temp, ambient_temp_c=ambient)
+    _check_touch_memory("simulate", trials, sen, contact, copies=6)
     result = _touches(e, sen, scene, trials, seed, fm, diffusivity)
     # the paper's contact temperature (eq. 1): where the surface jumps at once under a shared-shape
     # model; other models reach it later (a contact's lag) or never (a slab on its backing)
@@ -88,6 +94,18 @@ def simulate(
         con.print(f"  wrote {out}")
     if plot is not None:
         con.print(f"  wrote {plot}")
+
+
+def _check_touch_memory(what: str, touches: int, sensor, contact_s: float, *, copies: int) -> None:
+    """Refuse, before any allocation, ``touches`` curves of ``contact_s`` that cannot fit in memory.
+
+    The samples per touch are bounded by the sensor (:data:`designkit.sensor.MAX_SAMPLES_PER_TOUCH`);
+    ``copies`` counts the float64 arrays of that size the computation holds at once.
+    """
+    from .._validation import check_memory
+
+    samples = sensor.times_s(contact_s).size
+    check_memory(f"{what}: {touches:g} touches x {samples} samples", float(touches) * samples * 8 * copies)
 
 
 def _touches(e: float, sensor, scene, trials: int, seed: int, model, diffusivity_m2_s: Optional[float]):
@@ -155,7 +173,7 @@ def f1(
 
     Example: `designkit f1 --e1 35000 --e2 20000 --contact 2 --thickness 0.003 --diffusivity 1e-7`
     """
-    from .._validation import InputError, check_effusivity
+    from .._validation import InputError, check_effusivity, check_positive, check_probability, check_temperature
     from ..objects import object_class
     from ..recognition.ideal import ideal_pair
     from ..recognition.svm import pair_f1
@@ -168,6 +186,17 @@ def f1(
     e2 = check_effusivity("e2", e2)
     if e1 == e2:
         raise InputError(f"e1 and e2 are equal ({e1:g}): nothing to separate")
+    check_probability("--threshold (F1)", threshold, low=2 / 3, high=1.0)  # a blind guess scores 2/3
+    check_temperature("--noise [°C]", noise, nonnegative=True)
+    check_temperature("--delta-t [°C]", delta_t)
+    from ..sweep.config import MAX_EFFUSIVITY
+
+    check_positive("--width", width)
+    for label, value in (("--width", width), ("--e1", e1 + width), ("--e2", e2 + width)):
+        if value > MAX_EFFUSIVITY:  # 1e308 overflowed the class edges
+            raise InputError(f"{label}: classes must end below {MAX_EFFUSIVITY:g} J s^-1/2 K^-1 m^-2, got one "
+                             f"ending at {value:g} (no material comes near: diamond is about 1e5)")
+    check_temperature("--ambient [°C]", ambient)
     if folds < 2:
         raise InputError(f"folds must be >= 2, got {folds}")
     if trials < folds:
@@ -179,6 +208,7 @@ def f1(
         raise InputError(f"the {fm.name} model needs the objects' --diffusivity [m^2/s]")
     sen = load_sensor(sensor)
     scene = Scene.from_delta_t(contact_s=contact, noise_c=noise, delta_t_c=delta_t, ambient_temp_c=ambient)
+    _check_touch_memory("f1", 2 * trials, sen, contact, copies=8)  # two classes; raw, slope, scaled, folds
     obj1 = object_class(e1, width=width, diffusivity_m2_s=diffusivity)
     obj2 = object_class(e2, width=width, diffusivity_m2_s=diffusivity)
     ra, rb = obj1.e_range, obj2.e_range

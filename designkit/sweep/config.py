@@ -27,7 +27,16 @@ from ..recognition.features import DEFAULT_SLOPE_WINDOW_S
 from ..scene import Scene
 from ..sensor import Sensor, load_sensor
 
-__all__ = ["FIDELITIES", "SOLVERS", "SweepConfig"]
+__all__ = ["FIDELITIES", "SOLVERS", "SweepConfig", "check_chunk", "chunk_identity", "stamp_chunk"]
+
+#: Limits checked before any work: more intervals than this cannot be swept (the full F1 matrix of
+#: 100 000 intervals is 80 GB per scene point and contact), nor axes longer than this.
+MAX_INTERVALS = 100_000
+MAX_AXIS_POINTS = 10_000
+#: Effusivity grids end below this [J s^-1/2 K^-1 m^-2] (diamond ~1e5); 1e308 overflowed the grid.
+MAX_EFFUSIVITY = 1e7
+#: Trials per interval: 1 000 000 touches of one interval is already ~6 GB of curves at 800 samples.
+MAX_TRIALS = 1_000_000
 
 #: What decides distinguishability: the paper's SVM, or the ideal observer (the bound).
 FIDELITIES = ("svm", "ideal")
@@ -99,6 +108,23 @@ class SweepConfig:
         self._check_grid()
         self._check_axes()
         self._check_model()
+        self._check_size()
+
+    def _check_size(self) -> None:
+        """The table's arrays must fit: scene points x contacts x intervals (x intervals for F1 matrices)."""
+        from .._validation import check_memory
+
+        from ..sensor import MAX_SAMPLES_PER_TOUCH
+
+        fs = self.sample_rate_hz if self.sample_rate_hz is not None else load_sensor(self.sensor).sample_rate_hz
+        longest = max(self.contact_s)
+        if not longest * fs < MAX_SAMPLES_PER_TOUCH:
+            raise InputError(f"contact_s: a touch of {longest:g} s at {fs:g} Hz has {longest * fs:.4g} samples; the limit "
+                             f"is {MAX_SAMPLES_PER_TOUCH:.0e} per touch")
+        cells = math.prod(self.scene_shape) * len(self.contact_s) * self.intervals
+        per_cell = 8 * 12 + (8 * self.intervals if self.full_matrix else 0)
+        check_memory(f"a table of {cells:g} cells ({self.intervals} intervals"
+                     + (", full F1 matrices" if self.full_matrix else "") + ")", cells * per_cell)
 
     def _check_grid(self) -> None:
         """The effusivity grid, the classifier protocol and the search settings."""
@@ -106,10 +132,35 @@ class SweepConfig:
             raise InputError(f"solver must be one of {', '.join(SOLVERS)}, got {self.solver!r}")
         if self.fidelity not in FIDELITIES:
             raise InputError(f"fidelity must be one of {', '.join(FIDELITIES)}, got {self.fidelity!r}")
+        if self.e_max > MAX_EFFUSIVITY:
+            raise InputError(f"effusivity range max = {self.e_max:g} is above {MAX_EFFUSIVITY:g} J s^-1/2 K^-1 m^-2 "
+                             "(no material comes near: diamond is about 1e5)")
         if not (0 <= self.e_min < self.e_max < math.inf):
             raise InputError(f"effusivity range must satisfy 0 <= min < max < inf, got ({self.e_min:g}, {self.e_max:g}]")
+        for key in ("intervals", "folds", "trials", "max_repeats", "blocks", "seed"):
+            value = getattr(self, key)
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+                    or not math.isfinite(value):
+                raise InputError(f"{key}: expected an integer, got {value!r}")
+        for key in ("e_min", "e_max", "threshold", "z", "ambient_temp_c", "sensor_temp_spread_c",
+                    "ambient_temp_spread_c", "slope_window_s"):
+            value = getattr(self, key)
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
+                    or not math.isfinite(value):
+                raise InputError(f"{key}: expected a finite number, got {value!r}")
+        for key in ("full_matrix", "ideal_bound"):
+            if not isinstance(getattr(self, key), (bool, np.bool_)):
+                raise InputError(f"{key}: expected true or false, got {getattr(self, key)!r}")
+        if not isinstance(self.name, str) or not isinstance(self.sensor, str):
+            bad = "name" if not isinstance(self.name, str) else "sensor"
+            raise InputError(f"{bad}: expected text, got {getattr(self, bad)!r}")
         if int(self.intervals) != self.intervals or self.intervals < 2:
             raise InputError(f"intervals must be an integer >= 2, got {self.intervals}")
+        if self.intervals > MAX_INTERVALS:
+            raise InputError(f"intervals = {self.intervals:g} is more than this designkit sweeps "
+                             f"(limit {MAX_INTERVALS}: the grid, its staircases and F1 matrices must fit in memory)")
+        if self.trials > MAX_TRIALS:
+            raise InputError(f"trials = {self.trials:g} per interval is more than the limit {MAX_TRIALS}")
         if int(self.folds) != self.folds or self.folds < 2:
             raise InputError(f"folds must be >= 2, got {self.folds}")
         if int(self.trials) != self.trials or self.trials < self.folds:
@@ -147,6 +198,14 @@ class SweepConfig:
                 raise InputError(f"{name} values must be finite and >= 0, got {list(vals)}")
         if self.delta_t_c is not None and any(not (v != 0 and math.isfinite(v)) for v in self.delta_t_c):
             raise InputError(f"delta_t_c values must be finite and non-zero, got {list(self.delta_t_c)}")
+        from .._validation import check_temperature
+
+        for name in ("noise_ratio", "noise_c", "delta_t_c"):  # 1e308 overflowed the simulation
+            for v in getattr(self, name) or ():
+                check_temperature(f"{name} value", v)
+        check_temperature("ambient_temp_c", self.ambient_temp_c)
+        check_temperature("sensor_temp_spread_c", self.sensor_temp_spread_c)
+        check_temperature("ambient_temp_spread_c", self.ambient_temp_spread_c)
         if self.sample_rate_hz is not None:
             object.__setattr__(self, "sample_rate_hz", check_positive("sample rate [Hz]", self.sample_rate_hz))
         for name in ("sensor_temp_spread_c", "ambient_temp_spread_c"):
@@ -279,7 +338,12 @@ class SweepConfig:
     def from_mapping(cls, data: Mapping[str, Any], *, source: str = "config") -> "SweepConfig":
         if not isinstance(data, Mapping):
             raise InputError(f"{source}: a sweep config must be a mapping of keys")
+        from .._schemas import schemas, validate
+
         known = {f.name for f in dataclasses.fields(cls)}
+        # strict types first, naming the key: "intervals: expected an integer, got 'ten'"
+        checked = validate(schemas()["sweep"], dict(data), source)
+        data = {k: _plain(getattr(checked, k)) for k in data}
         flat = _flatten(data, source)
         unknown = sorted(set(flat) - known)
         if unknown:
@@ -294,19 +358,18 @@ class SweepConfig:
     @classmethod
     def from_yaml(cls, path: str | Path, **overrides: Any) -> "SweepConfig":
         """Read a YAML config; non-None ``overrides`` (CLI options) win over the file."""
-        import yaml
+        from .._schemas import load_yaml
 
         p = Path(path)
-        try:
-            text = p.read_text()
-        except OSError as exc:
-            raise InputError(f"cannot read sweep config {p}: {exc.strerror or exc}") from None
-        try:
-            data = yaml.safe_load(text) or {}
-        except yaml.YAMLError:
-            raise InputError(f"sweep config {p} is not valid YAML") from None
+        # An empty config is refused: its defaults are the paper's 500-interval sweep (hours of work)
+        data = load_yaml(p, "sweep config")
         if not isinstance(data, Mapping):
-            raise InputError(f"sweep config {p} must be a mapping of keys")
+            raise InputError(f"sweep config {p} must be a mapping of keys, got {type(data).__name__}")
+        if not data:
+            raise InputError(f"sweep config {p} is empty (a sweep needs at least its grid and axes)")
+        from .._schemas import schemas, validate
+
+        validate(schemas()["sweep"], dict(data), f"sweep config {p}")  # before flattening: keys as written
         data = _flatten(data, f"sweep config {p}")
         if isinstance(data.get("sensor"), str) and not Path(data["sensor"]).is_absolute() \
                 and data["sensor"].endswith((".yaml", ".yml")):
@@ -315,13 +378,27 @@ class SweepConfig:
         return cls.from_mapping(data, source=f"sweep config {p}")
 
 
+def _plain(value: Any) -> Any:
+    """A validated schema value back as plain data (nested models as dicts)."""
+    if hasattr(value, "model_dump"):
+        return {k: v for k, v in value.model_dump().items() if v is not None}
+    return value
+
+
 def _axis(name: str, values: Any) -> tuple[float, ...] | None:
     """A sweep axis as a tuple of floats (a single number is a one-point axis; None stays None)."""
     if values is None:
         return None
-    if isinstance(values, (int, float)):
+    if isinstance(values, (int, float)) and not isinstance(values, bool):
         values = (values,)
-    vals = tuple(float(x) for x in values)
+    if isinstance(values, (str, bytes, bool)) or not hasattr(values, "__iter__"):
+        raise InputError(f"{name}: expected a number or a list of numbers, got {values!r}")
+    try:
+        vals = tuple(float(x) for x in values)
+    except (TypeError, ValueError):
+        raise InputError(f"{name}: expected a number or a list of numbers, got {list(values)!r}") from None
+    if len(vals) > MAX_AXIS_POINTS:
+        raise InputError(f"sweep axis {name} has {len(vals)} points; the limit is {MAX_AXIS_POINTS}")
     if not vals:
         raise InputError(f"sweep axis {name} is empty")
     return vals
@@ -349,3 +426,45 @@ def _flatten(data: Mapping[str, Any], source: str) -> dict[str, Any]:
                 flat[k_out] = eff[k_in]
     return flat
 
+
+
+# ------------------------------------------------------------------ chunk identity
+def chunk_identity(cfg: SweepConfig, point: Sequence[int], block: int, contact_index: int) -> str:
+    """The identity of one chunk slot: the sweep's :meth:`~SweepConfig.digest` and the slot's indices.
+
+    A chunk file carries it (:func:`stamp_chunk`) and :func:`check_chunk` compares it on resume, so a
+    chunk copied into another slot, or from another sweep's folder, is refused rather than trusted.
+    """
+    key = f"{cfg.digest()}|point={','.join(str(int(x)) for x in point)}|block={int(block)}|contact={int(contact_index)}"
+    return "sha256:" + hashlib.sha256(key.encode()).hexdigest()
+
+
+def stamp_chunk(arrays: Mapping[str, np.ndarray], cfg: SweepConfig, point: Sequence[int], block: int,
+                contact_index: int) -> dict[str, np.ndarray]:
+    """``arrays`` plus ``identity`` (a string array, readable with ``allow_pickle=False``) for the chunk file."""
+    return {**arrays, "identity": np.asarray(chunk_identity(cfg, point, block, contact_index))}
+
+
+def check_chunk(arrays: Mapping[str, np.ndarray], cfg: SweepConfig, point: Sequence[int], block: int,
+                contact_index: int, path: str | Path = "chunk") -> None:
+    """Refuse (InputError) a chunk file that is not the one of this slot of this sweep.
+
+    The chunk's own ``point``, ``block`` and ``contact_index`` must be the slot's, and its
+    ``identity`` (see :func:`stamp_chunk`) the slot's :func:`chunk_identity`. A chunk written
+    before chunks carried an identity is checked on its indices only.
+    """
+    name = Path(path).name
+    try:
+        own = (tuple(int(x) for x in np.atleast_1d(arrays["point"])), int(arrays["block"]),
+               int(arrays["contact_index"]))
+    except (KeyError, TypeError, ValueError):
+        raise InputError(f"chunk {name} lacks its point, block or contact index: delete it and resume") from None
+    slot = (tuple(int(x) for x in point), int(block), int(contact_index))
+    if own != slot:
+        raise InputError(f"chunk {name} holds point {own[0]}, block {own[1]}, contact {own[2]} but sits in the slot of "
+                         f"point {slot[0]}, block {slot[1]}, contact {slot[2]} (copied or renamed?): delete it and resume")
+    if "identity" in arrays:
+        ident = str(np.asarray(arrays["identity"]).reshape(()).item()) if np.asarray(arrays["identity"]).size == 1 else ""
+        if ident != chunk_identity(cfg, point, block, contact_index):
+            raise InputError(f"chunk {name} belongs to another sweep (its identity is not this sweep's slot): "
+                             "delete it and resume")

@@ -12,9 +12,17 @@ A table ``NAME`` is two files side by side:
     array: shape, dtype, units, meaning), ``threshold``, ``trials``, ``folds``,
     ``seed``, ``max_repeats``, ``z``, ``designkit_version``, ``created``,
     ``config`` (the full sweep config, to rebuild it), ``stats`` (SVM fits and
-    compute time per scene), and ``content_hash``: SHA-256 over every array's
-    name, dtype, shape and bytes in name order. The hash is verified on load;
-    a corrupted or truncated table is refused.
+    compute time per scene), and ``content_hash``: SHA-256 over the header
+    (canonical JSON, without the hash itself and the fields that change no
+    answer: ``created`` and ``stats``) and every array's name, dtype, shape
+    and bytes in name order. The hash is verified on load, and the header is
+    checked against its schema and the arrays (axis lengths, units, fidelity,
+    sensor, model): a corrupted, truncated or edited table is refused.
+
+Schema version 2 (this one) hashes the header with the arrays; version 1 hashed
+the arrays only, so its header could be edited unnoticed. A version-1 table is
+refused with the remedy: ``python benchmarks/rehash_tables.py TABLE.json``
+re-hashes it (arrays untouched) after you have checked its header, or rebuild it.
 
 Arrays (shape ``[scene axes..., contact, effusivity]``; effusivity units
 J s^-1/2 K^-1 m^-2; NaN where no distinguishable partner lies inside the grid):
@@ -39,6 +47,7 @@ import io
 import json
 import math
 import zipfile
+import zlib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Mapping
@@ -54,11 +63,15 @@ __all__ = [
     "list_tables",
     "load_table",
     "resolve_table",
+    "UNHASHED_FIELDS",
+    "check_table",
     "table_header",
     "write_table",
 ]
 
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
+#: Header fields outside the content hash: they change no answer (when it was built, how long it took).
+UNHASHED_FIELDS = ("content_hash", "created", "stats")
 FORMAT = "designkit-table"
 E_UNITS = "J s^-1/2 K^-1 m^-2"
 
@@ -85,9 +98,19 @@ _AXIS_DOCS = {
 }
 
 
-def content_hash(arrays: Mapping[str, np.ndarray]) -> str:
-    """SHA-256 over every array's name, dtype, shape and C-order bytes, in name order."""
+def content_hash(arrays: Mapping[str, np.ndarray], header: Mapping[str, Any] | None = None) -> str:
+    """SHA-256 over a table's identity: ``header`` (if given; canonical JSON without
+    :data:`UNHASHED_FIELDS`), then every array's name, dtype, shape and C-order bytes, in name order."""
     h = hashlib.sha256()
+    if header is not None:
+        ident = {k: v for k, v in header.items() if k not in UNHASHED_FIELDS}
+        try:
+            text = json.dumps(ident, sort_keys=True, separators=(",", ":"), allow_nan=False)
+        except (TypeError, ValueError) as exc:
+            raise InputError(f"table header cannot be hashed: {exc}") from None
+        h.update(b"designkit-table-header\0")
+        h.update(text.encode("utf-8"))
+        h.update(b"\0arrays\0")
     for name in sorted(arrays):
         a = np.ascontiguousarray(arrays[name])
         h.update(name.encode())
@@ -165,12 +188,18 @@ def write_table(path: str | Path, header: dict, arrays: Mapping[str, np.ndarray]
     path = Path(path)
     if path.suffix != ".npz":
         path = path.with_suffix(".npz")
+    for parent in (path.parent, *path.parent.parents):
+        if parent.exists():
+            if not parent.is_dir():
+                raise InputError(f"cannot write table {path}: {parent} is not a folder")
+            break
     arrays = {k: np.ascontiguousarray(v) for k, v in arrays.items()}
     for name, a in arrays.items():
         if a.dtype == object:
             raise InputError(f"table array {name} has dtype object; tables hold numbers only")
-    header = dict(header)
-    header["content_hash"] = content_hash(arrays)
+    header = json.loads(json.dumps(dict(header), allow_nan=False))  # the JSON the reader will hash
+    header["schema_version"] = SCHEMA_VERSION
+    header["content_hash"] = content_hash(arrays, header)
     buf = io.BytesIO()
     np.savez_compressed(buf, **arrays)
     atomic_write_bytes(path, buf.getvalue())
@@ -248,9 +277,16 @@ class Table:
 
 
 def list_tables(folder: Path | None = None) -> list[str]:
-    """Names of the tables in ``folder`` (default: the shipped tables)."""
+    """Names of the tables in ``folder`` (default: the shipped tables); a missing folder is an error."""
     from .._resources import shipped_tables_dir
 
+    if folder is not None:
+        if str(folder) == "":
+            raise InputError("table folder: the path is empty")
+        if not Path(folder).exists():
+            raise InputError(f"table folder {folder} does not exist")
+        if not Path(folder).is_dir():
+            raise InputError(f"table folder {folder} is not a folder")
     folder = shipped_tables_dir() if folder is None else Path(folder)
     return sorted(p.stem for p in folder.glob("*.json")
                   if p.with_suffix(".npz").is_file() and _looks_like_table(p))
@@ -269,6 +305,10 @@ def resolve_table(name_or_path: str | Path) -> Path:
     from .._resources import shipped_tables_dir
 
     s = str(name_or_path)
+    if not s.strip():
+        raise InputError("table name is empty (see 'designkit tables list' for the shipped tables)")
+    if "\0" in s:
+        raise InputError(f"table name {s!r} holds a NUL character")
     p = Path(s)
     candidates = [p, p.with_suffix(".npz")] if p.suffix in ("", ".json", ".npz") else [p]
     if p.suffix == "" and "/" not in s:
@@ -282,41 +322,120 @@ def resolve_table(name_or_path: str | Path) -> Path:
 
 
 def _read_header(path: Path) -> dict:
+    from .._schemas import load_json, schemas, validate
+
     jpath = path.with_suffix(".json")
-    try:
-        header = json.loads(jpath.read_text())
-    except OSError as exc:
-        raise InputError(f"cannot read table header {jpath}: {exc.strerror or exc}") from None
-    except ValueError:
-        raise InputError(f"table header {jpath} is not valid JSON (corrupted or truncated)") from None
+    header = load_json(jpath, "table header")
     if not isinstance(header, dict) or header.get("format") != FORMAT:
         raise InputError(f"{jpath} is not a designkit table header")
     version = header.get("schema_version")
+    if version == 1:
+        raise InputError(f"table {path.stem} has schema version 1, whose hash covers the arrays only (its header "
+                         f"could be edited unnoticed): check its header, then re-hash it with 'python "
+                         f"benchmarks/rehash_tables.py {jpath}', or rebuild it with designkit sweep")
     if version != SCHEMA_VERSION:
-        raise InputError(f"table {path.stem} has schema version {version}; this designkit reads "
+        raise InputError(f"table {path.stem} has schema version {version!r}; this designkit reads "
                          f"version {SCHEMA_VERSION} (rebuild it with designkit sweep)")
+    validate(schemas()["table"], header, f"table header {jpath}")
     return header
 
 
 def load_table(name_or_path: str | Path, *, verify: bool = True) -> Table:
-    """Load and verify a table (shipped name or path)."""
+    """Load and verify a table (shipped name or path): its content hash (header and arrays) and its
+    header's schema and consistency with the arrays."""
     path = resolve_table(name_or_path)
     header = _read_header(path)
+    from .._schemas import check_regular_file
+
+    check_regular_file(path, "table")
     try:
         with np.load(path, allow_pickle=False) as z:
             arrays = {k: z[k] for k in z.files}
-    except (zipfile.BadZipFile, ValueError, OSError, EOFError, KeyError) as exc:
+    except (zipfile.BadZipFile, ValueError, OSError, EOFError, KeyError, zlib.error) as exc:
         raise InputError(f"table {path.name} is corrupted or truncated ({type(exc).__name__}); "
                          f"rebuild it with designkit sweep") from None
     if verify:
-        got = content_hash(arrays)
+        got = content_hash(arrays, header)
         if got != header.get("content_hash"):
-            raise InputError(f"table {path.name} failed its content check (hash mismatch): corrupted or edited; "
-                             f"rebuild it with designkit sweep")
-    for name, spec in header.get("arrays", {}).items():
-        if name not in arrays or list(arrays[name].shape) != spec["shape"]:
-            raise InputError(f"table {path.name}: array {name} missing or of the wrong shape")
-    return Table(name=header.get("name", path.stem), path=path, header=header, arrays=arrays)
+            raise InputError(f"table {path.name} failed its content check (hash of header and arrays mismatch): "
+                             f"corrupted or edited; rebuild it with designkit sweep")
+    check_table(header, arrays, path.name)
+    return Table(name=header["name"], path=path, header=header, arrays=arrays)
+
+
+def check_table(header: Mapping[str, Any], arrays: Mapping[str, np.ndarray], what: str) -> None:
+    """The header's consistency with itself and the arrays: one-line InputError naming ``what`` otherwise.
+
+    Axis names, order, units and values; the effusivity grid and its reference centres; every
+    array listed with its shape and dtype (and none unlisted); the arrays a fidelity needs; the
+    classifier protocol; the sensor and the forward model.
+    """
+    def bad(msg: str) -> InputError:
+        return InputError(f"table {what}: {msg}")
+
+    axes = header["axes"]
+    names = [a["name"] for a in axes]
+    if names[-2:] != ["contact_s", "e_ref"] or names[:-2] not in (["noise_ratio"], ["noise_c", "delta_t_c"]):
+        raise bad(f"axes must be noise_ratio (or noise_c, delta_t_c), contact_s, e_ref; got {', '.join(names)}")
+    for a in axes:
+        units, scale, _ = _AXIS_DOCS[a["name"]]
+        if a["units"] != units:
+            raise bad(f"axis {a['name']}: expected units {units!r}, got {a['units']!r}")
+        v = np.asarray(a["values"], dtype=np.float64)
+        if not np.all(np.isfinite(v)) or np.any(np.diff(v) <= 0):
+            raise bad(f"axis {a['name']}: values must be finite and increasing")
+        if a["name"] in ("noise_ratio", "noise_c") and np.any(v < 0) or a["name"] == "contact_s" and np.any(v <= 0):
+            raise bad(f"axis {a['name']}: values out of range ({v.min():g} .. {v.max():g})")
+    fixed = names[0] == "noise_ratio"
+    if header.get("fixed_initial_conditions", True) != fixed:
+        raise bad(f"fixed_initial_conditions is {header.get('fixed_initial_conditions')} but the axes are {names[0]}")
+    eff = header["effusivity"]
+    lo, hi, n, width = eff["min"], eff["max"], eff["intervals"], eff["width"]
+    if not (0 <= lo < hi < math.inf) or n < 2:
+        raise bad(f"effusivity grid must satisfy 0 <= min < max < inf with >= 2 intervals, got ({lo:g}, {hi:g}], {n}")
+    if not math.isclose(width, (hi - lo) / n, rel_tol=1e-9):
+        raise bad(f"effusivity width {width:g} is not (max - min) / intervals = {(hi - lo) / n:g}")
+    e_ref = np.asarray(axes[-1]["values"], dtype=np.float64)
+    centres = lo + width * (np.arange(n) + 0.5)
+    if e_ref.shape != centres.shape or not np.allclose(e_ref, centres, rtol=1e-9, atol=1e-9 * hi):
+        raise bad(f"axis e_ref ({e_ref.size} values) is not the centres of the {n} effusivity intervals")
+    shape = [len(a["values"]) for a in axes]
+    listed = header["arrays"]
+    if set(listed) != set(arrays):
+        extra = sorted(set(arrays) - set(listed))
+        missing = sorted(set(listed) - set(arrays))
+        raise bad(f"arrays in the file and in the header differ (missing {missing or 'none'}, unlisted {extra or 'none'})")
+    need = {"delta_up", "delta_down"}
+    if not need <= set(arrays):
+        raise bad(f"a {header['fidelity']} table needs arrays {', '.join(sorted(need - set(arrays)))}")
+    if header["fidelity"] == "ideal" and {"delta_up_lo", "delta_up_hi"} & set(arrays):
+        raise bad("an ideal table is exact: it has no Monte Carlo interval arrays (is it an svm table?)")
+    for name, a in arrays.items():
+        spec = listed[name]
+        if list(a.shape) != list(spec["shape"]) or str(a.dtype) != spec["dtype"]:
+            raise bad(f"array {name} is {a.dtype}{list(a.shape)}, the header says {spec['dtype']}{spec['shape']}")
+        if a.dtype.kind not in "fiub":
+            raise bad(f"array {name} has dtype {a.dtype}; tables hold numbers only")
+        expect = {"fits": shape[:-1], "chunk_wall_s": shape[:-1], "f1_matrix": shape + [n]}.get(name, shape)
+        if list(a.shape) != expect:
+            raise bad(f"array {name} has shape {list(a.shape)}; the axes give {expect}")
+    threshold, trials, folds = header["threshold"], header["trials"], header["folds"]
+    if not 2 / 3 < threshold < 1 or folds < 2 or trials < folds:
+        raise bad(f"classifier protocol out of range (threshold {threshold:g}, {trials} trials, {folds} folds)")
+    cfg = header["config"]
+    for key, value in (("e_min", lo), ("e_max", hi), ("intervals", n), ("threshold", threshold),
+                       ("trials", trials), ("folds", folds), ("seed", header["seed"]),
+                       ("fidelity", header["fidelity"])):
+        if key in cfg and cfg[key] != value:
+            raise bad(f"config.{key} = {cfg[key]!r} disagrees with the header's {value!r}")
+    from ..models import get_model
+    from ..sensor import Sensor
+
+    Sensor.from_dict(header["sensor"], source=f"table {what}: sensor")
+    try:
+        get_model(header.get("model"))
+    except InputError as exc:
+        raise bad(f"model: {exc}") from None
 
 
 def finite_or_none(x: float) -> float | None:

@@ -274,6 +274,7 @@ def schemas() -> dict[str, type]:
         ideal_bound: Optional[StrictBool] = None
         model: Any = None  # a name, a mapping or a ForwardModel: checked by designkit.models
         diffusivity_m2_s: Optional[Number] = None
+        solver: Optional[StrictStr] = None
 
     # JSON formats (table header, trial sidecar): numbers are numbers, never strings
     Number = Annotated[Any, PlainValidator(_json_number)]

@@ -40,6 +40,15 @@ def _wants_json(args: Any) -> bool:
     return any(a == "--json" for a in (args or ()))
 
 
+def _command_line(ctx: Any, sub_args: list) -> list:
+    """The user's command line after ``designkit`` (the real argv when run as the console script)."""
+    prog = sys.argv[0] if sys.argv else ""
+    if prog.endswith(("designkit", "__main__.py")) and len(sys.argv) > 1:
+        return [a for a in sys.argv[1:] if a != "--debug"]
+    name = getattr(ctx, "invoked_subcommand", None)
+    return ([name] if name and name not in sub_args else []) + list(sub_args)
+
+
 def _report_error(kind: str, message: str, status: int, as_json: bool) -> None:
     """Print one error: a line on stderr, and under --json also ``{"error": ...}`` on stdout."""
     typer.echo(f"Error: {message}", err=True)
@@ -97,7 +106,7 @@ class _Group(TyperGroup):
             where = f"{type(exc).__name__}: {str(exc).strip().splitlines()[0] if str(exc).strip() else ''}"
             message = (f"internal error in designkit {__version__} ({where.rstrip(': ')}); this is a bug: "
                        f"please report it at {ISSUES_URL} with the output of 'designkit --debug "
-                       f"{' '.join(str(a) for a in sub_args)}'")
+                       f"{' '.join(str(a) for a in _command_line(ctx, sub_args))}'")
             _report_error("internal", message, EXIT_BUG, _wants_json(sub_args))
             raise typer.Exit(EXIT_BUG) from None
 

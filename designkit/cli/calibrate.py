@@ -694,6 +694,10 @@ def emulate(
     from ..calibration.emulator import EmulatedMaterial, Emulator, Faults, TouchPlan
     from ..calibration.profiles import load_profile
     from ..sensor import load_sensor
+    from .._validation import check_temperature
+
+    sensor_temp = check_temperature("--sensor-temp [degC]", sensor_temp)
+    ambient = check_temperature("--ambient [degC]", ambient)
 
     mats = []
     for spec in material or []:

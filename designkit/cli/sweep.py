@@ -74,8 +74,16 @@ def sweep(
     """
     import time
 
+    from .._validation import InputError
     from ..sweep import SweepConfig, SweepInterrupted, run_sweep
 
+    if resume and fresh:
+        raise InputError("--resume and --fresh contradict each other: give one")
+    if config is None and (intervals is None or contact is None):
+        raise InputError("sweep needs --config FILE, or at least --intervals and --contact (without them it "
+                         "would start the paper's 500-interval sweep: hours of work)")
+    if out is not None and out.suffix and out.parent.exists() and not out.parent.is_dir():
+        raise InputError(f"--out {out}: {out.parent} is not a folder")
     fm = None
     if any(v is not None for v in (model, conductance, thickness, backing)):
         fm = model_from_options(model, conductance=conductance, thickness=thickness, backing=backing)

@@ -52,6 +52,8 @@ def validity(
     from ..models.slab import material_validity, resolve_backing, semi_infinite_deviation, semi_infinite_validity
 
     L = check_positive("thickness [m]", thickness)
+    if delta_t == 0:
+        raise InputError("--delta-t must be non-zero: an unheated sensor sees no difference to hold a tolerance to")
     sen = load_sensor(sensor)
     back = resolve_backing("table" if backing is None else backing)  # the queries' default: on a table
     kw = dict(delta_t_c=delta_t, tolerance_c=tolerance, horizon_s=horizon)

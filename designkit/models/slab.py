@@ -717,6 +717,10 @@ def semi_infinite_validity(e_object, alpha_object_m2_s, thickness_m, backing="in
     dt = abs(check_finite("temperature difference [degC]", delta_t_c))
     tol = check_positive("tolerance [degC]", tolerance_c)
     horizon = check_positive("horizon [s]", horizon_s)
+    if horizon > 1e9:  # about 30 years of contact; beyond it the root finder cannot converge (1e300 did not)
+        raise InputError(f"horizon must be at most 1e9 s, got {horizon:g}")
+    if math.isfinite(L) and L > 1e6:  # 1e308 overflowed; a slab this thick is semi-infinite for any contact
+        raise InputError(f"object thickness must be at most 1e6 m (or inf), got {L:g} m")
     back = resolve_backing(backing)
     sen = SENSORS["paper"] if sensor is None else sensor
     e = np.atleast_1d(np.asarray(e_object, dtype=np.float64)).ravel()

@@ -30,7 +30,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from .._validation import InputError, check_effusivity, check_finite, check_nonnegative, check_positive
+from .._validation import (InputError, check_effusivity, check_finite, check_positive,
+                          check_temperature)
 from ..objects import DEFAULT_CLASS_WIDTH, ObjectClass, object_class, ordered_pair
 
 __all__ = [
@@ -70,8 +71,8 @@ class TableMismatch(InputError):
 
 def scene_inputs(noise_c: float, delta_t_c: float) -> tuple[float, float]:
     """Checked noise sigma [degC] (>= 0) and sensor-object temperature difference [degC] (!= 0)."""
-    noise = check_nonnegative("noise sigma [degC]", noise_c)
-    dt = check_finite("temperature difference [degC]", delta_t_c)
+    noise = check_temperature("noise sigma [degC]", noise_c, nonnegative=True)
+    dt = check_temperature("temperature difference [degC]", delta_t_c)
     if dt == 0:
         raise InputError("temperature difference is 0: an unheated sensor sees no contrast between materials")
     return noise, dt

@@ -44,21 +44,31 @@ def _chunk_path(workdir: Path, point, block, k) -> Path:
     return workdir / "chunks" / f"p{p}-b{block:03d}-c{k:03d}.npz"
 
 
-def _save_chunk(path: Path, res: ChunkResult) -> None:
+def _save_chunk(path: Path, res: ChunkResult, cfg: SweepConfig) -> None:
+    """Write a chunk atomically, stamped with the identity of its slot in this sweep."""
     import io
 
     from .._io import atomic_write_bytes
+    from .config import stamp_chunk
 
     buf = io.BytesIO()
-    np.savez(buf, **res.to_arrays())
+    np.savez(buf, **stamp_chunk(res.to_arrays(), cfg, res.point, res.block, res.contact_index))
     atomic_write_bytes(path, buf.getvalue())
 
 
-def _load_chunk(path: Path) -> ChunkResult:
+def _load_chunk(path: Path, cfg: SweepConfig, point, block: int, contact_index: int) -> ChunkResult:
+    """A finished chunk, refused unless it is this slot's (a chunk copied into another slot changed tables)."""
+    from .config import check_chunk
+
     try:
         with np.load(path, allow_pickle=False) as z:
-            return ChunkResult.from_arrays({k: z[k] for k in z.files})
+            arrays = {k: z[k] for k in z.files}
     except Exception as exc:  # a damaged chunk is recomputed, never trusted
+        raise InputError(f"chunk {path.name} is unreadable ({exc}); delete it and resume") from None
+    check_chunk(arrays, cfg, point, block, contact_index, path)
+    try:
+        return ChunkResult.from_arrays(arrays)
+    except (KeyError, ValueError, TypeError) as exc:
         raise InputError(f"chunk {path.name} is unreadable ({exc}); delete it and resume") from None
 
 
@@ -105,7 +115,7 @@ def iter_sweep(cfg: SweepConfig, workdir: Path, *, jobs: int = 1, backend: str =
             for b in range(len(cfg.blocks_of())):
                 path = _chunk_path(workdir, p, b, k)
                 if path.exists():
-                    yield _load_chunk(path), False
+                    yield _load_chunk(path, cfg, p, b, k), False
                 else:
                     todo.append((p, b, k))
     if not todo:
@@ -115,7 +125,7 @@ def iter_sweep(cfg: SweepConfig, workdir: Path, *, jobs: int = 1, backend: str =
         calls = [delayed(run_chunk)(cfg, p, b, k) for p, b, k in todo]
         with ctx():
             for res in Parallel(n_jobs=n_jobs, return_as="generator_unordered")(calls):
-                _save_chunk(_chunk_path(workdir, res.point, res.block, res.contact_index), res)
+                _save_chunk(_chunk_path(workdir, res.point, res.block, res.contact_index), res, cfg)
                 yield res, True
 
 

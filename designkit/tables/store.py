@@ -134,7 +134,10 @@ def table_header(cfg, arrays: Mapping[str, np.ndarray], *, run: Mapping[str, Any
     axes.append({"name": "e_ref", "units": units, "scale": scale, "meaning": meaning,
                  "values": [float(v) for v in cfg.centres]})
     fits = np.asarray(arrays.get("fits", 0))
-    wall = np.asarray(arrays.get("chunk_wall_s", 0.0))
+    # compute seconds: the run's statistics (sweeps since the engine kept timings out of the hashed
+    # arrays), else a chunk_wall_s array (tables built before)
+    run_wall = (run or {}).get("chunk_wall_s")
+    wall = np.asarray(run_wall if run_wall is not None else arrays.get("chunk_wall_s", 0.0), dtype=np.float64)
     return {
         "format": FORMAT,
         "schema_version": SCHEMA_VERSION,

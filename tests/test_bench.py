@@ -238,7 +238,7 @@ def test_svm_query_rows_against_exact_on_a_tiny_svm_table(tmp_path):
     from designkit.sweep import SweepConfig, run_sweep
     from designkit.tables.store import load_table
 
-    cfg = SweepConfig(name="tiny-svm", fidelity="svm", intervals=5, e_max=40000.0, trials=12, max_repeats=1,
+    cfg = SweepConfig(name="tiny-svm", fidelity="svm", intervals=8, e_max=40000.0, trials=24, max_repeats=1,
                       noise_ratio=(0.002, 0.005), contact_s=(0.5, 1.0, 2.0))
     tab = load_table(run_sweep(cfg, tmp_path / "w", out=tmp_path / "tiny-svm.npz", backend="sequential"))
     rows, facts = bench.svm_query_rows(tab, quick=True, n=1, repeats=1)

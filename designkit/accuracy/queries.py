@@ -411,7 +411,12 @@ def _svm_pairs(svm_table, n: int, rng) -> list[tuple[float, float, float, float]
     ratios = svm_table.axes["noise_ratio"]
     c_lo, c_hi, _ = _contact_window(svm_table)
     pairs: list[tuple[float, float, float, float]] = []
+    tries = 0
     while len(pairs) < n:
+        tries += 1
+        if tries > 200 * n:  # a table whose deltas leave no room in its grid: say so instead of looping
+            raise InputError(f"table {svm_table.name}: no pair with a distinguishable partner inside its "
+                             f"effusivity grid in {tries - 1} random draws")
         e1 = float(rng.uniform(width, e_hi / 2))
         r = float(np.exp(rng.uniform(math.log(ratios[0]), math.log(ratios[-1]))))
         c = float(rng.uniform(c_lo, c_hi))

@@ -8,9 +8,10 @@ and exits with status 2; library users catch ``ValueError``.
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import numpy as np
+if TYPE_CHECKING:  # numpy loads where a seed is used, not with every input check (``--version``, ``--help``)
+    import numpy as np
 
 __all__ = [
     "InputError",
@@ -170,6 +171,8 @@ def as_generator(seed: "int | np.random.Generator | np.random.SeedSequence | lis
     :class:`numpy.random.SeedSequence`, which gives independent streams for
     different keys and the same stream for the same key on every machine.
     """
+    import numpy as np
+
     if seed is None:
         raise InputError("a seed or numpy Generator is required (designkit never draws unseeded)")
     if isinstance(seed, np.random.Generator):

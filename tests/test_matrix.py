@@ -8,7 +8,6 @@ import csv
 import io
 import json
 import math
-import time
 
 import numpy as np
 import pytest
@@ -110,11 +109,33 @@ def test_a_question_without_a_matrix_is_refused():
         material_matrix(THREE, "delta-e")
 
 
-def test_twelve_materials_from_tables_in_well_under_a_second():
-    material_matrix(THREE)  # imports and first table load out of the way
-    t0 = time.process_time()
-    material_matrix(set="paper12")
-    assert time.process_time() - t0 < 1.0
+def test_twelve_materials_load_each_table_once():
+    """The speed of a 12-material plan is measured in benchmarks/bench_library.py (no timed assertion
+    here); what makes it fast is checked: each table is loaded once for all 66 pairs."""
+    import designkit.query.matrix as qm
+    from designkit.query import table as qt
+    from designkit.tables import store
+
+    calls = []
+    real = store.load_table
+
+    def counting(*a, **k):
+        calls.append(str(a[0]) if a else str(k))
+        return real(*a, **k)
+
+    patched = [(mod, "load_table") for mod in (store, qt, qm) if hasattr(mod, "load_table")]
+    saved = [getattr(mod, name) for mod, name in patched]
+    for mod, name in patched:
+        setattr(mod, name, counting)
+    try:
+        qt.clear_table_cache()
+        m = material_matrix(set="paper12")
+    finally:
+        for (mod, name), old in zip(patched, saved):
+            setattr(mod, name, old)
+        qt.clear_table_cache()
+    assert len(m.to_dict()["materials"]) == 12
+    assert 1 <= len(calls) <= 2, calls  # the SVM table (and at most the ideal one), not 66 of each
 
 
 # ---------------------------------------------------------------- the command

@@ -303,7 +303,8 @@ def _scene_wanted(view: _View, noise, dt) -> dict[str, Any]:
 # ============================================================ one answer builder for the route
 def _answer(question: str, op: _Opened, *, objects, limiting, rule: str, scene: dict, value, interval,
             ideal, ideal_method: str = "table", in_grid: dict, details: dict, notes: Sequence[str] = (),
-            check_at: tuple[float, float, float] | None = None, classes=(), interval_kind=None) -> Answer:
+            check_at: tuple[float, float, float] | None = None, classes=(), interval_kind=None,
+            computation: dict | None = None) -> Answer:
     check = None
     if check_at is not None and classes:
         c, n, d = check_at
@@ -317,7 +318,8 @@ def _answer(question: str, op: _Opened, *, objects, limiting, rule: str, scene: 
         sensor=op.tab.sensor.to_dict(), model=op.model.to_dict(), model_check=check, threshold=op.phi,
         table=op.tab.name, table_hash=op.tab.header.get("content_hash"), ideal_table=ideal_table,
         ideal_table_hash=op.ihash if ideal_table else None, in_grid=dict(in_grid), details=details,
-        computation={"fidelity": op.tab.fidelity, "table_contacts_s": op.view.contacts.tolist()},
+        computation={"fidelity": op.tab.fidelity, "table_contacts_s": op.view.contacts.tolist(),
+                     **(computation or {})},
         notes=tuple(n for n in notes if n), interval_kind=interval_kind)
 
 
@@ -413,6 +415,9 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
         interval = (contact_for(view, "lo", combos), contact_for(view, "hi", combos))
     else:
         interval = (value, value)
+    monte_carlo = {"monte_carlo_interval": list(interval)}  # the table's delta_lo / delta_hi answers alone
+    if "delta_up_ideal" in view.t.arrays:  # the grid's own bound, beside the exact one (its interpolation error)
+        monte_carlo["table_ideal_s"] = contact_for(view, "ideal", combos)
     if op.closed:
         from .ideal_bound import exact_ideal_min_contact
 
@@ -445,7 +450,7 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
     needed = value if value is not None else float(view.contacts[-1])
     return _answer("min-contact", op, value=value, interval=interval, ideal=ideal, ideal_method=ideal_method,
                    in_grid=flags, details={}, notes=[note], check_at=(needed, noise, dt),
-                   interval_kind="table-cell" if value is not None else None, **common)
+                   interval_kind="table-cell" if value is not None else None, computation=monte_carlo, **common)
 
 
 # ============================================================ max-noise / min-delta-t
@@ -595,8 +600,7 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
                        details=_delta_details(x, {}), notes=_outside_notes(view, flags, wanted), **common)
     # delta(e)'s bound is read from the ideal grid even where a closed form exists: its bisection over
     # effusivity costs ~0.3 s a call, too slow for a table question (the exact route computes it)
-    iview, ikind, _ = (op.iview, op.ikind, None) if not op.closed else _ideal_view(view, ideal_table or
-                                                                                   DEFAULT_IDEAL_TABLE)
+    iview, ikind, _ = (op.iview, op.ikind, None) if not op.closed else _ideal_view(view, ideal_table)
     icombos, _ = iview.scene_weights(noise, dt) if iview is not None else ([], {})
     icw, _ = _contact_weights(iview, contact) if iview is not None else ([], False)
 

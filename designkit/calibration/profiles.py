@@ -799,8 +799,6 @@ def load_profile(name_or_path: "str | Path | DeviceProfile") -> DeviceProfile:
     """A device profile from a shipped name (``designkit``, ``adc12-thermistor``) or a YAML path."""
     if isinstance(name_or_path, DeviceProfile):
         return name_or_path
-    import yaml
-
     key = str(name_or_path)
     shipped = list_profiles()
     if key in shipped:
@@ -810,17 +808,11 @@ def load_profile(name_or_path: "str | Path | DeviceProfile") -> DeviceProfile:
         if not path.exists():
             names = ", ".join(shipped) or "none found"
             raise InputError(f"unknown device profile {key!r}: use a shipped name ({names}) or a profile YAML file")
-    source = f"profile {path}"
-    from .._schemas import read_text
+    from .._schemas import load_yaml
 
-    text = read_text(path, "profile")  # a regular UTF-8 file: a FIFO or a folder is refused before reading
-    try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f" (line {mark.line + 1})" if mark is not None else ""
-        raise InputError(f"{source} is not valid YAML{where}") from None
-    return _parse_profile(data, source)
+    # a regular UTF-8 file (a FIFO or a folder is refused before reading), parsed by the one YAML reader
+    data = load_yaml(path, "profile", empty_ok=True)
+    return _parse_profile(data, f"profile {path}")
 
 
 def profile_from_dict(data: Mapping[str, Any], source: str = "profile") -> DeviceProfile:

@@ -352,7 +352,9 @@ def test_exact_routes_of_the_other_pair_questions_through_the_cli(cli):
     small = ("--exact", "--trials", "30", "--repeats", "1", "--jobs", "1", "--json")
     pair = ("--e1", "35000", "--e2", "20000", "--contact", "1.5")
     mn = json.loads(cli("max-noise", *pair, "--delta-t", "10", *small).stdout)
-    lib = q.exact_max_noise(35000, 20000, contact_s=1.5, delta_t_c=10, trials=30, repeats=1, jobs=1)
+    from designkit.query import exact_max_noise
+
+    lib = exact_max_noise(35000, 20000, contact_s=1.5, delta_t_c=10, trials=30, repeats=1, jobs=1)
     assert mn["route"] == "exact" and mn["value"] == pytest.approx(lib.value)
     assert mn["ideal"]["value"] >= mn["value"]  # no classifier beats the ideal observer
     dt = json.loads(cli("min-delta-t", *pair, "--noise", str(mn["value"]), *small).stdout)

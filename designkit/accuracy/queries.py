@@ -5,8 +5,8 @@ across each shipped table's grid. For ``ideal-paper`` the exact answer is the
 ideal observer's closed form with bisection, vectorized
 (:mod:`designkit.query.ideal_bound`, the answers behind ``--exact`` for the
 ideal bound); for ``svm-paper`` it is
-:func:`designkit.query.table.exact_min_contact` /
-:func:`~designkit.query.table.exact_distinguishable` (Monte Carlo, a modest
+:func:`designkit.query.exact_min_contact` /
+:func:`~designkit.query.exact_distinguishable` (Monte Carlo, a modest
 number of pairs). The same ideal table cut down to sparser grids shows what
 table density buys.
 
@@ -434,7 +434,7 @@ def _exact_kw(svm_table, trials, repeats, jobs) -> dict[str, Any]:
 
 def _svm_min_contact_cases(svm_table, pairs, seed, exact_kw, progress) -> list[dict[str, Any]]:
     """Table and ``--exact`` min-contact, their intervals and times, per pair."""
-    from ..query import table as query
+    from .. import query
 
     res = []
     for k, (e1, e2, r, c) in enumerate(pairs):
@@ -476,7 +476,7 @@ def _svm_min_contact_row(svm_table, res, trials, repeats) -> tuple[Row, dict[str
 
 def _svm_distinguishable(svm_table, pairs, rng, seed, exact_kw, progress) -> tuple[Row, dict[str, Any]]:
     """Table verdicts against one ``--exact`` evaluation each: the pairs, then the pairs at other contacts."""
-    from ..query import table as query
+    from .. import query
 
     c_lo, c_hi, _ = _contact_window(svm_table)
     m = 2 * len(pairs)

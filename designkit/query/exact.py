@@ -49,7 +49,6 @@ from .inputs import (
 __all__ = [
     "RATIO_BRACKET",
     "bisect",
-    "contact_search",
     "exact_delta_e",
     "exact_distinguishable",
     "exact_max_noise",
@@ -78,29 +77,6 @@ def bisect(f_ok: Callable[[float], bool], lo: float, hi: float, tol: float, *, l
         else:
             lo = mid
     return hi
-
-
-def contact_search(svm_f1, phi: float, floor_s: float, max_contact_s: float, tolerance_s: float, z: float):
-    """Shortest contact time whose mean SVM F1 reaches ``phi``, by bisection, with its Monte Carlo interval.
-
-    ``svm_f1(contact_s)`` returns ``(mean F1, standard error)``. The interval runs
-    from the longest evaluated contact clearly below ``phi`` (mean + z SE < phi)
-    to the shortest clearly above (mean - z SE >= phi; None when none is).
-
-    Returns ``(value or None, (lo, hi), evaluations)``.
-    """
-    evaluated: dict[float, tuple[float, float]] = {}
-
-    def ok(c):
-        evaluated[c] = svm_f1(c)
-        return evaluated[c][0] >= phi
-
-    value = bisect(ok, floor_s, max_contact_s, tolerance_s) if ok(max_contact_s) else None
-    below = [c for c, (m, s) in evaluated.items() if m + z * s < phi]
-    above = [c for c, (m, s) in evaluated.items() if m - z * s >= phi]
-    interval = (max(below) if below else floor_s, min(above) if above else None)
-    evaluations = [{"contact_s": c, "svm_f1": m, "standard_error": s} for c, (m, s) in sorted(evaluated.items())]
-    return value, interval, evaluations
 
 
 def ratio_search(svm_f1, phi: float, lo_r: float, hi_r: float, z: float):

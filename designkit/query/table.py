@@ -39,13 +39,6 @@ from ..tables import lookup
 from ..tables.lookup import GRID_RTOL
 from ..tables.store import Table, load_table, resolve_table
 from .answer import Answer, IdealBound, number
-from .exact import (  # noqa: F401  importable from here for callers written before the route split
-    exact_delta_e,
-    exact_distinguishable,
-    exact_max_noise,
-    exact_min_contact,
-    exact_min_delta_t,
-)
 from .inputs import (
     REFERENCE_RULE,
     PairQuestion,

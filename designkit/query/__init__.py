@@ -8,7 +8,8 @@ module                 what it holds
 ``inputs``             objects, the materials rule, scene inputs (shared by both routes)
 ``table``              the table route (milliseconds, no scikit-learn)
 ``exact``              the exact route (simulation + SVM, any forward model)
-``ideal_bound``        the ideal observer's closed-form answers, vectorized
+``ideal_bound``        the ideal observer's closed-form answers, vectorized, cached per process
+``vectorized``         every question over numpy arrays (:class:`ArrayAnswer`)
 =====================  ===========================================================
 
 Examples
@@ -22,6 +23,7 @@ Examples
 from .answer import ANSWER_KEYS, Answer, IdealBound
 from .exact import exact_delta_e, exact_distinguishable, exact_max_noise, exact_min_contact, exact_min_delta_t
 from .inputs import MATERIALS_RULE, NeedsInput, PairQuestion, TableMismatch, pair_question, reference_class
+from .vectorized import ArrayAnswer
 from .questions import QUESTIONS, Question, ask, delta_e, distinguishable, max_noise, min_contact, min_delta_t
 
 __all__ = [
@@ -29,6 +31,7 @@ __all__ = [
     "MATERIALS_RULE",
     "QUESTIONS",
     "Answer",
+    "ArrayAnswer",
     "IdealBound",
     "NeedsInput",
     "PairQuestion",

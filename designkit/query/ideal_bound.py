@@ -25,10 +25,15 @@ from __future__ import annotations
 
 import functools
 import math
+from collections import OrderedDict
 
 import numpy as np
 
 __all__ = [
+    "BOUND_CACHE_SIZE",
+    "cached_ideal_max_ratio",
+    "cached_ideal_min_contact",
+    "clear_bound_cache",
     "exact_ideal_delta",
     "exact_ideal_max_ratio",
     "exact_ideal_min_contact",
@@ -259,10 +264,10 @@ def exact_ideal_max_ratio(sensor, lo, hi, contact_s, *, width: float = 80.0, thr
     la = np.full(lo.shape, math.log(bracket[0]))
     lb = np.full(lo.shape, math.log(bracket[1]))
     ok_lo, ok_hi = ok(la), ok(lb)
-    while np.any(lb - la > rel_tol):
-        mid = 0.5 * (la + lb)
+    while np.any(active := lb - la > rel_tol):  # an element stops when it converges: its answer does not
+        mid = 0.5 * (la + lb)                    # depend on the other elements of the call (nor on a cache)
         good = ok(mid)
-        la, lb = np.where(good, mid, la), np.where(good, lb, mid)
+        la, lb = np.where(active & good, mid, la), np.where(active & ~good, mid, lb)
     out = np.where(ok_hi, bracket[1], np.exp(la))
     return np.where(ok_lo, out, np.nan)
 
@@ -289,8 +294,68 @@ def exact_ideal_delta(sensor, e, contact_s, ratio, *, direction: int = +1, width
     lim = np.where(valid, limit, width)
     top = ok(lim) & valid
     a, b = np.zeros(e.shape), lim.copy()
-    while np.any(b - a > tol):
+    while np.any(active := b - a > tol):
         mid = 0.5 * (a + b)
         good = ok(mid)
-        b, a = np.where(good, mid, b), np.where(good, a, mid)
+        b, a = np.where(active & good, mid, b), np.where(active & ~good, mid, a)
     return np.where(top, b, np.nan)
+
+
+# ============================================================ per-process cache of the closed-form bounds
+#: Closed-form bounds kept per process (least recently used out): a table question asked again (a loop,
+#: a matrix over scenes) costs a dict look-up instead of ~30 ms of quadrature. Entries are pure
+#: functions of their key (sensor, class width, threshold, the pair and the scene), so a hit returns
+#: exactly what a computation would (each element's bisection is independent of the others).
+BOUND_CACHE_SIZE = 65536
+_BOUNDS: "OrderedDict[tuple, float]" = OrderedDict()
+
+
+def clear_bound_cache() -> None:
+    """Forget the closed-form bounds this process has computed."""
+    _BOUNDS.clear()
+
+
+def _cached(kind: str, sensor, lo, hi, x, params: tuple, compute) -> np.ndarray:
+    """``compute(lo, hi, x)`` elementwise through the cache: the distinct misses in one vectorized call."""
+    lo, hi, x = (np.asarray(v, dtype=np.float64) for v in np.broadcast_arrays(lo, hi, x))
+    head = (kind, float(sensor.effusivity), float(sensor.tau_s), float(sensor.sample_rate_hz)) + params
+    keys = [head + k for k in zip(lo.ravel().tolist(), hi.ravel().tolist(), x.ravel().tolist())]
+    missing = list(dict.fromkeys(k for k in keys if k not in _BOUNDS))
+    if missing:
+        m = np.array([k[-3:] for k in missing], dtype=np.float64)
+        for k, v in zip(missing, compute(m[:, 0], m[:, 1], m[:, 2]).tolist()):
+            _BOUNDS[k] = v
+    out = np.empty(len(keys))
+    for i, k in enumerate(keys):
+        out[i] = _BOUNDS[k]
+        _BOUNDS.move_to_end(k)
+    while len(_BOUNDS) > BOUND_CACHE_SIZE:
+        _BOUNDS.popitem(last=False)
+    return out.reshape(lo.shape)
+
+
+def cached_ideal_min_contact(sensor, lo, hi, ratio, *, width: float = 80.0, threshold: float = 0.9,
+                             max_contact_s: float = 10.0) -> np.ndarray:
+    """:func:`exact_ideal_min_contact` through the per-process cache (same answers, same arguments).
+
+    >>> from designkit.sensor import load_sensor
+    >>> s = load_sensor("paper")
+    >>> float(cached_ideal_min_contact(s, 20000.0, 35000.0, 0.005)) == float(exact_ideal_min_contact(
+    ...     s, 20000.0, 35000.0, 0.005))
+    True
+    """
+    def compute(a, b, r):
+        return exact_ideal_min_contact(sensor, a, b, r, width=width, threshold=threshold,
+                                       max_contact_s=max_contact_s)
+    return _cached("min-contact", sensor, lo, hi, ratio, (float(width), float(threshold), float(max_contact_s)),
+                   compute)
+
+
+def cached_ideal_max_ratio(sensor, lo, hi, contact_s, *, width: float = 80.0, threshold: float = 0.9,
+                           bracket=(1e-6, 1.0), rel_tol: float = 1e-5) -> np.ndarray:
+    """:func:`exact_ideal_max_ratio` through the per-process cache (same answers, same arguments)."""
+    def compute(a, b, c):
+        return exact_ideal_max_ratio(sensor, a, b, c, width=width, threshold=threshold, bracket=bracket,
+                                     rel_tol=rel_tol)
+    return _cached("max-ratio", sensor, lo, hi, contact_s,
+                   (float(width), float(threshold), float(bracket[0]), float(bracket[1]), float(rel_tol)), compute)

@@ -27,12 +27,15 @@ Examples
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any, Callable, overload
+
+from numpy.typing import ArrayLike
 
 from .._validation import InputError
 from . import exact as _exact_route
 from . import table as _table_route
 from .answer import QUANTITIES, Answer
+from .vectorized import ArrayAnswer, answer_arrays, is_array_call
 
 __all__ = ["QUESTIONS", "ROUTES", "Question", "ask", "delta_e", "distinguishable", "max_noise", "min_contact",
            "min_delta_t"]
@@ -93,15 +96,24 @@ QUESTIONS: dict[str, Question] = {q.name: q for q in (
 )}
 
 
-def ask(question: str, *, route: str = "table", **arguments: Any) -> Answer:
+def ask(question: str, *, route: str = "table", ideal_bound: bool = True,
+        **arguments: Any) -> "Answer | ArrayAnswer":
     """Answer ``question`` by ``route`` (``"table"`` or ``"exact"``).
 
     ``arguments`` are the route function's (objects, scene, and the route's
     options: ``table=`` ... for the table route, ``trials=`` ... for the exact one).
+    Numeric inputs given as arrays (or lists) broadcast like numpy and give an
+    :class:`~designkit.query.vectorized.ArrayAnswer` (:mod:`designkit.query.vectorized`);
+    ``ideal_bound=False`` there skips the closed-form ideal bound (the slow part of a first call).
     """
     if question not in QUESTIONS:
         raise InputError(f"unknown question {question!r}; known: {', '.join(QUESTIONS)}")
-    return QUESTIONS[question].route(route)(**arguments)
+    fn = QUESTIONS[question].route(route)
+    if is_array_call(question, arguments):
+        return answer_arrays(question, fn, route, arguments, ideal_bound=ideal_bound)
+    if not ideal_bound:
+        raise InputError("ideal_bound=False is for array inputs (a single answer always carries its bound)")
+    return fn(**arguments)
 
 
 def _route(exact: bool, route: str | None) -> str:
@@ -110,30 +122,68 @@ def _route(exact: bool, route: str | None) -> str:
     return route or ("exact" if exact else "table")
 
 
-def min_contact(e1=None, e2=None, *, exact: bool = False, route: str | None = None, **kw: Any) -> Answer:
+# Each question answers one Answer for numbers and one ArrayAnswer when a numeric input is an array
+# (the overloads tell editors and type checkers which).
+@overload
+def min_contact(e1: float | None = None, e2: float | None = None, *, noise_c: float = 0.05,
+                delta_t_c: float = 10.0, exact: bool = False, route: str | None = None, **kw: Any) -> Answer: ...
+@overload
+def min_contact(e1: ArrayLike | None = None, e2: ArrayLike | None = None, *, noise_c: ArrayLike = 0.05,
+                delta_t_c: ArrayLike = 10.0, exact: bool = False, route: str | None = None,
+                ideal_bound: bool = True, **kw: Any) -> ArrayAnswer: ...
+def min_contact(e1=None, e2=None, *, exact: bool = False, route: str | None = None, **kw: Any):
     """Shortest contact time [s] that separates two objects (table route unless ``exact``).
 
     See :func:`designkit.query.table.min_contact` and
-    :func:`designkit.query.exact.exact_min_contact` for the arguments.
+    :func:`designkit.query.exact.exact_min_contact` for the arguments; arrays:
+    :mod:`designkit.query.vectorized`.
     """
     return ask("min-contact", route=_route(exact, route), e1=e1, e2=e2, **kw)
 
 
-def max_noise(e1=None, e2=None, *, exact: bool = False, route: str | None = None, **kw: Any) -> Answer:
-    """Largest noise sigma [degC] at which ``contact_s`` still separates two objects."""
+@overload
+def max_noise(e1: float | None = None, e2: float | None = None, *, contact_s: float, delta_t_c: float = 10.0,
+              exact: bool = False, route: str | None = None, **kw: Any) -> Answer: ...
+@overload
+def max_noise(e1: ArrayLike | None = None, e2: ArrayLike | None = None, *, contact_s: ArrayLike,
+              delta_t_c: ArrayLike = 10.0, exact: bool = False, route: str | None = None,
+              ideal_bound: bool = True, **kw: Any) -> ArrayAnswer: ...
+def max_noise(e1=None, e2=None, *, exact: bool = False, route: str | None = None, **kw: Any):
+    """Largest noise sigma [degC] at which ``contact_s`` still separates two objects (arrays: as min_contact)."""
     return ask("max-noise", route=_route(exact, route), e1=e1, e2=e2, **kw)
 
 
-def min_delta_t(e1=None, e2=None, *, exact: bool = False, route: str | None = None, **kw: Any) -> Answer:
-    """Smallest sensor-object temperature difference [degC] that separates two objects."""
+@overload
+def min_delta_t(e1: float | None = None, e2: float | None = None, *, contact_s: float, noise_c: float = 0.05,
+                exact: bool = False, route: str | None = None, **kw: Any) -> Answer: ...
+@overload
+def min_delta_t(e1: ArrayLike | None = None, e2: ArrayLike | None = None, *, contact_s: ArrayLike,
+                noise_c: ArrayLike = 0.05, exact: bool = False, route: str | None = None,
+                ideal_bound: bool = True, **kw: Any) -> ArrayAnswer: ...
+def min_delta_t(e1=None, e2=None, *, exact: bool = False, route: str | None = None, **kw: Any):
+    """Smallest sensor-object temperature difference [degC] that separates two objects (arrays: as min_contact)."""
     return ask("min-delta-t", route=_route(exact, route), e1=e1, e2=e2, **kw)
 
 
-def delta_e(e=None, *, exact: bool = False, route: str | None = None, **kw: Any) -> Answer:
-    """delta(e) [J s^-1/2 K^-1 m^-2] towards lower and higher effusivity."""
+@overload
+def delta_e(e: float | None = None, *, contact_s: float, noise_c: float = 0.05, delta_t_c: float = 10.0,
+            exact: bool = False, route: str | None = None, **kw: Any) -> Answer: ...
+@overload
+def delta_e(e: ArrayLike | None = None, *, contact_s: ArrayLike, noise_c: ArrayLike = 0.05,
+            delta_t_c: ArrayLike = 10.0, exact: bool = False, route: str | None = None,
+            ideal_bound: bool = True, **kw: Any) -> ArrayAnswer: ...
+def delta_e(e=None, *, exact: bool = False, route: str | None = None, **kw: Any):
+    """delta(e) [J s^-1/2 K^-1 m^-2] towards lower and higher effusivity (arrays: as min_contact)."""
     return ask("delta-e", route=_route(exact, route), e=e, **kw)
 
 
-def distinguishable(e1=None, e2=None, *, exact: bool = False, route: str | None = None, **kw: Any) -> Answer:
-    """Whether a scene separates two objects, with the SVM's and the ideal observer's F1."""
+@overload
+def distinguishable(e1: float | None = None, e2: float | None = None, *, contact_s: float, noise_c: float = 0.05,
+                    delta_t_c: float = 10.0, exact: bool = False, route: str | None = None, **kw: Any) -> Answer: ...
+@overload
+def distinguishable(e1: ArrayLike | None = None, e2: ArrayLike | None = None, *, contact_s: ArrayLike,
+                    noise_c: ArrayLike = 0.05, delta_t_c: ArrayLike = 10.0, exact: bool = False,
+                    route: str | None = None, ideal_bound: bool = True, **kw: Any) -> ArrayAnswer: ...
+def distinguishable(e1=None, e2=None, *, exact: bool = False, route: str | None = None, **kw: Any):
+    """Whether a scene separates two objects, with the SVM's and the ideal observer's F1 (arrays: 1.0 / 0.0 / NaN)."""
     return ask("distinguishable", route=_route(exact, route), e1=e1, e2=e2, **kw)

@@ -58,10 +58,12 @@ __all__ = [
     "GRID_RTOL",
     "clear_table_cache",
     "delta_e",
+    "delta_e_ideal_view",
     "distinguishable",
     "max_noise",
     "min_contact",
     "min_delta_t",
+    "open_table",
 ]
 
 DEFAULT_TABLE = "svm-paper"
@@ -399,7 +401,7 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
         return _answer("min-contact", op, value=None, interval=(None, None), ideal=None, in_grid=flags,
                        details={}, notes=_outside_notes(view, flags, wanted), **common)
     def contact_for(v: _View, kind: str, cmb) -> float | None:
-        needs = [v.need(kind, cmb, k, lo, hi) for k in range(v.contacts.size)]
+        needs = (v.need(kind, cmb, k, lo, hi) for k in range(v.contacts.size))  # read up to the crossing
         x, _ = _crossing(v.contacts, needs, hi - lo)
         return x
 
@@ -412,9 +414,9 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
     if "delta_up_ideal" in view.t.arrays:  # the grid's own bound, beside the exact one (its interpolation error)
         monte_carlo["table_ideal_s"] = contact_for(view, "ideal", combos)
     if op.closed:
-        from .ideal_bound import exact_ideal_min_contact
+        from .ideal_bound import cached_ideal_min_contact
 
-        ideal = number(exact_ideal_min_contact(op.tab.sensor, lo, hi, noise / abs(dt), width=op.width,
+        ideal = number(cached_ideal_min_contact(op.tab.sensor, lo, hi, noise / abs(dt), width=op.width,
                                                threshold=op.phi, max_contact_s=CLOSED_FORM_MAX_CONTACT_S))
         ideal_method = "closed-form"
     else:
@@ -507,9 +509,9 @@ def _ratio_question(question: str, e1, e2, m1, m2, objects, contact_s, noise_c, 
     out = {}
     for kind, v in (("svm", view), ("lo", view), ("hi", view), ("ideal", op.iview)):
         if kind == "ideal" and op.closed:
-            from .ideal_bound import exact_ideal_max_ratio
+            from .ideal_bound import cached_ideal_max_ratio
 
-            ri = number(exact_ideal_max_ratio(op.tab.sensor, lo, hi, contact, width=op.width, threshold=op.phi,
+            ri = number(cached_ideal_max_ratio(op.tab.sensor, lo, hi, contact, width=op.width, threshold=op.phi,
                                               bracket=CLOSED_FORM_RATIO_BRACKET))
             out[kind] = (ri, "inside" if ri is not None else "below")
             continue
@@ -677,3 +679,24 @@ def distinguishable(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact
                "ideal_f1": ideal_f1, "ideal_distinguishable": ideal_f1 >= op.phi}
     return _answer("distinguishable", op, value=yes, interval=interval, ideal=ideal_f1, ideal_method=res.method,
                    in_grid=flags, details=details, check_at=(contact, noise, dt), **common)
+
+
+# ============================================================ for the array route (designkit.query.vectorized)
+def open_table(table: "Table | str" = DEFAULT_TABLE, ideal_table: "Table | str | None" = DEFAULT_IDEAL_TABLE, *,
+               threshold=None, sensor=None, model=None):
+    """The table checked against the question, as this route opens it (for the array route).
+
+    Returns an object with ``tab`` (the :class:`~designkit.tables.store.Table`), ``view`` (its
+    interpolation view: ``scene_weights``, ``delta_at``, ``need``, ``contacts``, ``centres``, ``e_lo``,
+    ``e_hi``), ``phi``, ``model``, ``width``, ``closed`` (the ideal bound is computed in closed form),
+    ``iview`` / ``ikind`` (the ideal bound's view and array kind when read from a grid).
+    """
+    return _open(table, ideal_table, threshold=threshold, sensor=sensor, model=model)
+
+
+def delta_e_ideal_view(opened, ideal_table: "Table | str | None" = DEFAULT_IDEAL_TABLE):
+    """The view and kind delta-e reads its ideal bound from (a grid even where a closed form exists)."""
+    if not opened.closed:
+        return opened.iview, opened.ikind
+    iview, ikind, _ = _ideal_view(opened.view, ideal_table)
+    return iview, ikind

@@ -42,6 +42,7 @@ J s^-1/2 K^-1 m^-2; NaN where no distinguishable partner lies inside the grid):
 from __future__ import annotations
 
 import datetime as _dt
+import functools
 import hashlib
 import io
 import json
@@ -227,15 +228,20 @@ class Table:
     def threshold(self) -> float:
         return float(self.header["threshold"])
 
-    @property
+    # axes, sensor and model are parsed once per loaded table (a table query reads them several times:
+    # parsing the sensor through its schema on every read cost a fifth of a query); read-only arrays
+    @functools.cached_property
     def axes(self) -> dict[str, np.ndarray]:
-        return {a["name"]: np.asarray(a["values"], dtype=np.float64) for a in self.header["axes"]}
+        out = {a["name"]: np.asarray(a["values"], dtype=np.float64) for a in self.header["axes"]}
+        for v in out.values():
+            v.flags.writeable = False
+        return out
 
     @property
     def axis_names(self) -> list[str]:
         return [a["name"] for a in self.header["axes"]]
 
-    @property
+    @functools.cached_property
     def sensor(self):
         from ..sensor import Sensor
 
@@ -245,7 +251,7 @@ class Table:
     def fixed_initial_conditions(self) -> bool:
         return bool(self.header.get("fixed_initial_conditions", True))
 
-    @property
+    @functools.cached_property
     def model(self):
         """The forward model the table was built with (tables from before the header recorded it:
         the paper's semi-infinite model, the only one there was)."""

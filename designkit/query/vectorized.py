@@ -1,0 +1,568 @@
+"""The design questions over numpy arrays: inputs broadcast like numpy, answers come as arrays.
+
+Every numeric input of a question (``e1``, ``e2``, ``e``, ``contact_s``,
+``noise_c``, ``delta_t_c``) may be a number or an array of any shape; they
+broadcast together as numpy does, and the answer is one :class:`ArrayAnswer`
+whose arrays have the broadcast shape, element ``i`` being what the scalar call
+with the ``i``-th inputs answers (``None`` there is NaN here; ``distinguishable``
+answers 1.0 / 0.0 / NaN). The question functions of :mod:`designkit.query`
+send a call here when any numeric input is an array or a list.
+
+Routes
+------
+* **table** with effusivities given as numbers: vectorized. The table's
+  interpolation (:mod:`designkit.tables.lookup`'s rule, the same as the scalar
+  route) runs over all effusivities at once, once per distinct scene (the
+  scene values, or only the contact time for max-noise / min-delta-t, are
+  grouped); the closed-form ideal bound is computed for the distinct
+  elements in one vectorized call and kept in the per-process cache of
+  :mod:`designkit.query.ideal_bound` (~7 ms per distinct pair and scene the
+  first time, a dictionary look-up after). ``ideal_bound=False`` skips it
+  (``ideal`` is then NaN).
+* **exact**, and objects given as material names: one scalar call per
+  element (seconds each on the exact route), assembled into the same arrays.
+
+Bad input names the offending element: ``effusivity e1[2] must be positive, got -5``.
+
+Examples
+--------
+>>> import numpy as np
+>>> from designkit.query import min_contact
+>>> a = min_contact(35000, np.array([20000.0, 25000.0, 30000.0]), table="ideal-paper")
+>>> a.shape, a.unit
+((3,), 's')
+>>> bool(np.all(a.value[:-1] < a.value[1:]))   # closer pairs need longer contact
+True
+>>> float(a.value[0]) == min_contact(35000, 20000, table="ideal-paper").value
+True
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Callable, Mapping
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from .._validation import InputError, check_effusivity, check_positive, check_temperature
+from . import table as _table_route
+from .answer import QUANTITIES, Answer
+
+__all__ = ["ARRAY_INPUTS", "ArrayAnswer", "answer_arrays", "is_array_call"]
+
+#: The numeric inputs of each question that may be arrays (they broadcast together).
+ARRAY_INPUTS: dict[str, tuple[str, ...]] = {
+    "min-contact": ("e1", "e2", "noise_c", "delta_t_c"),
+    "max-noise": ("e1", "e2", "contact_s", "delta_t_c"),
+    "min-delta-t": ("e1", "e2", "contact_s", "noise_c"),
+    "delta-e": ("e", "contact_s", "noise_c", "delta_t_c"),
+    "distinguishable": ("e1", "e2", "contact_s", "noise_c", "delta_t_c"),
+}
+_DEFAULTS = {"noise_c": 0.05, "delta_t_c": 10.0}
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class ArrayAnswer:
+    """Answers to one design question over arrays of inputs (all arrays share :attr:`shape`).
+
+    Attributes
+    ----------
+    question : str
+        As :attr:`designkit.query.Answer.question`.
+    route : str
+        ``"table"`` or ``"exact"``.
+    quantity, unit : str
+        What ``value`` measures and its unit (``contact_s`` / ``s`` ...).
+    value : ndarray of float
+        The SVM's answer per element; NaN where the scalar call answers None
+        (``distinguishable``: 1.0 yes, 0.0 no, NaN no answer).
+    low, high : ndarray of float
+        The answer's interval per element (``Answer.interval``; NaN: None).
+    ideal : ndarray of float
+        The ideal observer's answer per element (``Answer.ideal_bound.value``;
+        ``distinguishable``: the ideal F1); NaN: none, or not computed.
+    in_grid : ndarray of bool
+        Whether every table axis held the element's question (always True on the exact route).
+    table : str or None
+        Table read (None on the exact route).
+    details : mapping of str to ndarray
+        Question-specific arrays: delta-e's ``lower`` / ``upper`` (each
+        direction's value) and ``lower_ideal`` / ``upper_ideal``.
+    """
+
+    question: str
+    route: str
+    value: FloatArray
+    low: FloatArray
+    high: FloatArray
+    ideal: FloatArray
+    in_grid: NDArray[np.bool_]
+    table: str | None = None
+    details: Mapping[str, FloatArray] = field(default_factory=dict)
+
+    @property
+    def quantity(self) -> str:
+        return QUANTITIES[self.question][0]
+
+    @property
+    def unit(self) -> str:
+        return QUANTITIES[self.question][1]
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        return self.value.shape
+
+    @property
+    def size(self) -> int:
+        return int(self.value.size)
+
+    def __len__(self) -> int:
+        return len(self.value)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready: nested lists (None for NaN), the shape, and what the arrays measure."""
+        def lst(a):
+            a = np.asarray(a, dtype=np.float64)
+            return np.where(np.isfinite(a), a, None).tolist() if a.ndim else (float(a) if np.isfinite(a) else None)
+        return {"question": self.question, "route": self.route, "quantity": self.quantity, "unit": self.unit,
+                "shape": list(self.shape), "value": lst(self.value), "interval_low": lst(self.low),
+                "interval_high": lst(self.high), "ideal": lst(self.ideal), "in_grid": self.in_grid.tolist(),
+                "table": self.table, "details": {k: lst(v) for k, v in self.details.items()}}
+
+
+def is_array_call(question: str, arguments: Mapping[str, Any]) -> bool:
+    """Whether any numeric input of ``question`` is an array (ndim >= 1) or a list/tuple."""
+    for name in ARRAY_INPUTS.get(question, ()):
+        x = arguments.get(name)
+        if x is not None and not isinstance(x, (str, bytes)) and np.ndim(x) >= 1:
+            return True
+    return False
+
+
+# ============================================================ input checks, naming the element
+def _as_array(name: str, x: Any) -> np.ndarray:
+    try:
+        return np.asarray(x, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be numbers (an array of floats), got {x!r:.60}") from None
+
+
+def _first_bad(name: str, a: np.ndarray, fine: np.ndarray, check: Callable[[str, float], Any]) -> None:
+    """Run the scalar check on every element outside ``fine`` (a conservative mask): the first bad raises."""
+    for idx in zip(*np.nonzero(~fine)):
+        where = ", ".join(str(int(i)) for i in idx)
+        check(f"{name}[{where}]", float(a[idx]))
+
+
+def _checked(question: str, inputs: dict[str, Any]) -> dict[str, np.ndarray]:
+    """The numeric inputs as float64 arrays of one broadcast shape, each element checked as the scalar route does."""
+    arrays = {n: _as_array(n, v) for n, v in inputs.items()}
+    try:
+        shape = np.broadcast_shapes(*(a.shape for a in arrays.values()))
+    except ValueError:
+        shapes = ", ".join(f"{n} {a.shape}" for n, a in arrays.items())
+        raise InputError(f"the array inputs do not broadcast together: {shapes}") from None
+    out = {n: np.broadcast_to(a, shape) for n, a in arrays.items()}
+    for n, a in out.items():
+        if n in ("e1", "e2", "e"):
+            _first_bad(n, a, np.isfinite(a) & (a > 0), lambda k, v: check_effusivity(k, v))
+        elif n == "contact_s":
+            _first_bad(n, a, np.isfinite(a) & (a >= 1e-300),
+                       lambda k, v: check_positive(f"contact time [s] {k}", v))
+        elif n == "noise_c":
+            _first_bad(n, a, np.isfinite(a) & (a >= 0) & (a <= 1e4),
+                       lambda k, v: check_temperature(f"noise sigma [degC] {k}", v, nonnegative=True))
+            if question == "min-delta-t":
+                _first_bad(n, a, a != 0, lambda k, v: _raise(
+                    f"{k}: noise sigma is 0: any temperature difference separates them (no smallest one)"))
+        elif n == "delta_t_c":
+            def dt_check(k, v):
+                check_temperature(f"temperature difference [degC] {k}", v)
+                if v == 0:
+                    _raise(f"temperature difference {k} is 0: an unheated sensor sees no contrast between materials")
+            _first_bad(n, a, np.isfinite(a) & (a != 0) & (np.abs(a) <= 1e4), dt_check)
+    if "e1" in out and "e2" in out:
+        _first_bad("e1", out["e1"], out["e1"] != out["e2"], lambda k, v: _raise(
+            f"e1 and e2 are equal at {k.replace('e1', 'index ')} ({v:g}): nothing to separate"))
+    return out
+
+
+def _raise(message: str):
+    raise InputError(message)
+
+
+# ============================================================ vectorized interpolation (lookup's rule)
+def _interp_rows(rows: np.ndarray, centres: np.ndarray, e: np.ndarray) -> np.ndarray:
+    """:func:`designkit.tables.lookup.interp_e` for every row of ``rows`` [contact, centre] at every ``e``:
+    shape [contact, len(e)]."""
+    n = centres.size
+    j = np.clip(np.searchsorted(centres, e, side="right") - 1, 0, n - 2)
+    a, b = rows[:, j], rows[:, j + 1]
+    w = (e - centres[j]) / (centres[j + 1] - centres[j])
+    with np.errstate(invalid="ignore"):
+        out = np.where(w == 0.0, a, np.where(np.isnan(a) | np.isnan(b), np.nan, a + w * (b - a)))
+    out = np.where(e >= centres[-1], rows[:, -1:], out)
+    return np.where(e <= centres[0], rows[:, :1], out)
+
+
+def _delta(view, name: str, combos, e: np.ndarray) -> np.ndarray:
+    """``view.delta_at`` at every contact of the table and every ``e``: [contact, len(e)]."""
+    arr = view.t.arrays[name]
+    total = np.zeros((view.contacts.size, e.size))
+    bad = np.zeros(total.shape, dtype=bool)
+    for idx, w in combos:
+        if w == 0:
+            continue
+        v = _interp_rows(arr[idx], view.centres, e)
+        bad |= np.isnan(v)
+        total = total + w * v
+    return np.where(bad, np.nan, total)
+
+
+def _need(view, kind: str, combos, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """``view.need`` at every contact and pair: [contact, n] (NaN: not within the grid)."""
+    suffix = {"svm": "", "lo": "_lo", "hi": "_hi", "ideal": "_ideal"}[kind]
+    up_name, down_name = f"delta_up{suffix}", f"delta_down{suffix}"
+    if up_name not in view.t.arrays:
+        up_name, down_name = "delta_up", "delta_down"
+    up, down = _delta(view, up_name, combos, lo), _delta(view, down_name, combos, hi)
+    return np.where(np.isnan(up) | np.isnan(down), np.nan, np.maximum(up, down))
+
+
+def _crossing(xs: np.ndarray, need: np.ndarray, gap: np.ndarray) -> np.ndarray:
+    """:func:`designkit.tables.lookup.crossing` per column of ``need`` [contact, n]; NaN: none."""
+    with np.errstate(invalid="ignore"):
+        ok = ~np.isnan(need) & (need <= gap)
+    found = ok.any(axis=0)
+    k = np.argmax(ok, axis=0)
+    cols = np.arange(need.shape[1])
+    cur = need[k, cols]
+    prev = np.where(k > 0, need[np.maximum(k - 1, 0), cols], np.nan)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        w = np.where(prev != cur, (prev - gap) / (prev - cur), 1.0)
+    x0 = xs[np.maximum(k - 1, 0)]
+    x = np.where((k == 0) | np.isnan(prev), xs[k], x0 + w * (xs[k] - x0))
+    return np.where(found, x, np.nan)
+
+
+def _at_contact(cw, per_contact: np.ndarray) -> np.ndarray:
+    """Contact-weighted sum of ``per_contact`` [contact, n] (NaN if a weighted term is NaN)."""
+    total = np.zeros(per_contact.shape[1])
+    bad = np.zeros(total.shape, dtype=bool)
+    for k, w in cw:
+        if w == 0:
+            continue
+        bad |= np.isnan(per_contact[k])
+        total = total + w * per_contact[k]
+    return np.where(bad, np.nan, total)
+
+
+def _axis_weights(vals: np.ndarray, x: float, *, log: bool = False):
+    """Weights and in-grid flag of one axis value (the scalar route's rule)."""
+    from ..tables import lookup
+
+    pts = lookup.axis_weights(vals, x, log=log, grid=np.log(vals) if log and vals[0] > 0 else vals)
+    if pts is not None:
+        return pts, True
+    return [(0 if (x < vals[0] or (log and x <= 0)) else vals.size - 1, 1.0)], False
+
+
+def _groups(*columns: np.ndarray):
+    """Indices of the elements sharing each distinct combination of ``columns`` (1-D, equal length)."""
+    stacked = np.stack(columns, axis=1)
+    uniq, inverse = np.unique(stacked, axis=0, return_inverse=True)
+    inverse = inverse.ravel()
+    order = np.argsort(inverse, kind="stable")
+    bounds = np.searchsorted(inverse[order], np.arange(len(uniq) + 1))
+    for g, row in enumerate(uniq):
+        yield tuple(float(v) for v in row), order[bounds[g]:bounds[g + 1]]
+
+
+def _nan(n: int) -> np.ndarray:
+    return np.full(n, np.nan)
+
+
+# ============================================================ the table route, vectorized
+def _table_pair(question: str, x: dict[str, np.ndarray], op, ideal_bound: bool) -> dict[str, np.ndarray]:
+    e1, e2 = x["e1"], x["e2"]
+    lo, hi = np.minimum(e1, e2), np.maximum(e1, e2)
+    n = lo.size
+    view = op.view
+    res = {k: _nan(n) for k in ("value", "low", "high", "ideal")}
+    res["in_grid"] = np.zeros(n, dtype=bool)
+    e_in = (view.e_lo < lo) & (lo <= view.e_hi) & (view.e_lo < hi) & (hi <= view.e_hi)
+    if question == "min-contact":
+        _min_contact(x, op, lo, hi, e_in, res, ideal_bound)
+    elif question in ("max-noise", "min-delta-t"):
+        _ratio(question, x, op, lo, hi, e_in, res, ideal_bound)
+    else:
+        _distinguishable(x, op, lo, hi, e_in, res, ideal_bound)
+    return res
+
+
+def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool) -> None:
+    view = op.view
+    grid = view.contacts
+    svm = op.tab.fidelity == "svm"
+    todo = np.zeros(lo.size, dtype=bool)
+    for (noise, dt), idx in _groups(x["noise_c"], x["delta_t_c"]):
+        combos, flags = view.scene_weights(noise, dt)
+        if not all(flags.values()):
+            continue
+        idx = idx[e_in[idx]]
+        if not idx.size:
+            continue
+        l, h = lo[idx], hi[idx]
+        gap = h - l
+        value = _crossing(grid, _need(view, "svm", combos, l, h), gap)
+        ilo = _crossing(grid, _need(view, "lo", combos, l, h), gap) if svm else value
+        ihi = _crossing(grid, _need(view, "hi", combos, l, h), gap) if svm else value
+        if not op.closed:
+            if op.iview is not None:
+                icombos, iflags = op.iview.scene_weights(noise, dt)
+                if all(iflags.values()):
+                    res["ideal"][idx] = _crossing(op.iview.contacts, _need(op.iview, op.ikind, icombos, l, h), gap)
+        res["value"][idx], res["low"][idx], res["high"][idx] = value, ilo, ihi
+        res["in_grid"][idx] = True
+        todo[idx] = True
+    if op.closed and ideal_bound and todo.any():
+        from .ideal_bound import cached_ideal_min_contact
+
+        ratio = x["noise_c"] / np.abs(x["delta_t_c"])
+        res["ideal"][todo] = cached_ideal_min_contact(
+            op.tab.sensor, lo[todo], hi[todo], ratio[todo], width=op.width, threshold=op.phi,
+            max_contact_s=_table_route.CLOSED_FORM_MAX_CONTACT_S)
+    # the grid cell around a crossing, never below the ideal bound (as the scalar route)
+    v = res["value"]
+    has = ~np.isnan(v)
+    count = np.searchsorted(grid, np.where(has, v, 0.0) - 1e-12, side="left")
+    prev = np.where(count > 0, grid[np.maximum(count - 1, 0)], 0.0)
+    nxt = np.where(count < grid.size, grid[np.minimum(count, grid.size - 1)], v)
+    low = np.fmin(prev, np.fmin(res["low"], res["high"]))
+    low = np.where(np.isnan(res["ideal"]), low, np.maximum(low, res["ideal"]))
+    high = np.fmax(nxt, np.fmax(res["low"], res["high"]))
+    res["low"], res["high"] = np.where(has, low, res["low"]), np.where(has, high, res["high"])
+
+
+def _max_ratio(view, kind: str, cw, lo, hi) -> tuple[np.ndarray, np.ndarray]:
+    """Per pair: largest sigma/dT that separates it, and where: 0 below, 1 inside, 2 above the grid."""
+    ratios = view.t.axes["noise_ratio"]
+    logs = np.array([math.log(r) for r in ratios.tolist()])  # math.log, as the scalar route
+    gap = hi - lo
+    margins = []
+    for i in range(ratios.size):
+        nd = _at_contact(cw, _need(view, kind, [((i,), 1.0)], lo, hi))
+        margins.append(np.where(np.isnan(nd), -np.inf, gap - nd))
+    m = np.array(margins)  # [ratio, n]
+    ok = m >= 0
+    r_n = ratios.size
+    last = r_n - 1 - np.argmax(ok[::-1], axis=0)
+    cols = np.arange(lo.size)
+    m0 = m[last, cols]
+    m1 = m[np.minimum(last + 1, r_n - 1), cols]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        w = np.where(m0 != m1, m0 / (m0 - m1), 0.0)
+    nxt = np.minimum(last + 1, r_n - 1)
+    inside = np.where(np.isfinite(m1), np.exp(logs[last] + w * (logs[nxt] - logs[last])), ratios[last])
+    where = np.where(~ok[0], 0, np.where(last == r_n - 1, 2, 1))
+    r = np.where(where == 0, np.nan, np.where(where == 2, ratios[-1], inside))
+    return r, where
+
+
+def _ratio(question, x, op, lo, hi, e_in, res, ideal_bound: bool) -> None:
+    view = op.view
+    if "noise_ratio" not in op.tab.axes:
+        from .inputs import TableMismatch
+
+        raise TableMismatch(f"table {op.tab.name} has separate noise and temperature axes (varied initial "
+                            f"conditions): it cannot answer {question}; the exact route can")
+
+    def to_answer(r, idx):
+        return r * np.abs(x["delta_t_c"][idx]) if question == "max-noise" else x["noise_c"][idx] / r
+
+    for (contact,), idx in _groups(x["contact_s"]):
+        cw, c_ok = _axis_weights(view.contacts, contact)
+        if not c_ok:
+            continue
+        idx = idx[e_in[idx]]
+        if not idx.size:
+            continue
+        l, h = lo[idx], hi[idx]
+        out = {"svm": _max_ratio(view, "svm", cw, l, h)}
+        for kind in ("lo", "hi"):
+            out[kind] = out["svm"] if op.tab.fidelity == "ideal" else _max_ratio(view, kind, cw, l, h)
+        if op.closed:
+            out["ideal"] = (_nan(idx.size), np.zeros(idx.size, dtype=int))  # filled below
+        elif op.iview is not None:
+            icw, _ = _axis_weights(op.iview.contacts, contact)
+            out["ideal"] = _max_ratio(op.iview, op.ikind, icw, l, h)
+        else:
+            out["ideal"] = (_nan(idx.size), np.zeros(idx.size, dtype=int))
+        r, where = out["svm"]
+        res["value"][idx] = np.where(where == 0, np.nan, to_answer(r, idx))
+        res["in_grid"][idx] = where != 2
+        ends = [np.where(out[k][1] == 0, np.nan, to_answer(out[k][0], idx)) for k in ("hi", "lo")]
+        both = ~np.isnan(ends[0]) & ~np.isnan(ends[1])
+        res["low"][idx] = np.where(both, np.fmin(*ends), ends[0])
+        res["high"][idx] = np.where(both, np.fmax(*ends), ends[1])
+        if not op.closed:
+            res["ideal"][idx] = np.where(out["ideal"][1] == 0, np.nan, to_answer(out["ideal"][0], idx))
+        else:
+            res["ideal"][idx] = -np.inf  # marks the elements whose closed-form bound is wanted
+    todo = res["ideal"] == -np.inf
+    res["ideal"][todo] = np.nan
+    if op.closed and ideal_bound and todo.any():
+        from .ideal_bound import cached_ideal_max_ratio
+
+        ri = cached_ideal_max_ratio(op.tab.sensor, lo[todo], hi[todo], x["contact_s"][todo], width=op.width,
+                                    threshold=op.phi, bracket=_table_route.CLOSED_FORM_RATIO_BRACKET)
+        res["ideal"][todo] = to_answer(ri, np.nonzero(todo)[0])
+
+
+def _distinguishable(x, op, lo, hi, e_in, res, ideal_bound: bool) -> None:
+    view = op.view
+    svm = op.tab.fidelity == "svm"
+    todo = np.zeros(lo.size, dtype=bool)
+    for (contact, noise, dt), idx in _groups(x["contact_s"], x["noise_c"], x["delta_t_c"]):
+        combos, flags = view.scene_weights(noise, dt)
+        cw, c_ok = _axis_weights(view.contacts, contact)
+        if not (all(flags.values()) and c_ok):
+            continue
+        idx = idx[e_in[idx]]
+        if not idx.size:
+            continue
+        l, h = lo[idx], hi[idx]
+
+        def verdict(kind):
+            nd = _at_contact(cw, _need(view, kind, combos, l, h))
+            return (~np.isnan(nd) & (nd <= h - l)).astype(np.float64)
+
+        yes = verdict("svm")
+        res["value"][idx] = yes
+        res["low"][idx], res["high"][idx] = (verdict("hi"), verdict("lo")) if svm else (yes, yes)
+        res["in_grid"][idx] = True
+        todo[idx] = True
+    if not (ideal_bound and todo.any()):
+        return
+    if op.closed:
+        from .ideal_bound import ideal_f1, shape_norm
+
+        norm = shape_norm(op.tab.sensor, x["contact_s"][todo])
+        with np.errstate(divide="ignore"):
+            s = np.where(norm > 0, (x["noise_c"][todo] / np.abs(x["delta_t_c"][todo])) / norm, np.inf)
+        res["ideal"][todo] = ideal_f1(lo[todo], hi[todo], op.width, op.tab.sensor.effusivity, s)
+    else:  # Monte Carlo ideal observer (varied initial conditions, per-object shapes): one call per element
+        from ..recognition.ideal import ideal_pair
+        from ..scene import Scene
+
+        for i in np.nonzero(todo)[0]:
+            scene = Scene.from_delta_t(contact_s=float(x["contact_s"][i]), noise_c=float(x["noise_c"][i]),
+                                       delta_t_c=float(x["delta_t_c"][i]))
+            res["ideal"][i] = ideal_pair((lo[i], lo[i] + op.width), (hi[i], hi[i] + op.width), op.tab.sensor, scene,
+                                         model=op.model).f1
+
+
+def _table_delta_e(x: dict[str, np.ndarray], op, ideal_table) -> dict[str, np.ndarray]:
+    e = x["e"]
+    n = e.size
+    view = op.view
+    res = {k: _nan(n) for k in ("value", "low", "high", "ideal", "lower", "upper", "lower_ideal", "upper_ideal")}
+    res["in_grid"] = np.zeros(n, dtype=bool)
+    e_in = (view.e_lo < e) & (e <= view.e_hi)
+    iview, ikind = _table_route.delta_e_ideal_view(op, ideal_table)
+    for (contact, noise, dt), idx in _groups(x["contact_s"], x["noise_c"], x["delta_t_c"]):
+        combos, flags = view.scene_weights(noise, dt)
+        cw, c_ok = _axis_weights(view.contacts, contact)
+        if not (all(flags.values()) and c_ok):
+            continue
+        idx = idx[e_in[idx]]
+        if not idx.size:
+            continue
+        xe = e[idx]
+
+        def at(v, cmb, cws, name):
+            if v is None or name not in v.t.arrays:
+                return _nan(xe.size)
+            return _at_contact(cws, _delta(v, name, cmb, xe))
+
+        icombos = iview.scene_weights(noise, dt)[0] if iview is not None else []
+        icw = _axis_weights(iview.contacts, contact)[0] if iview is not None else []
+        for direction, side in (("down", "lower"), ("up", "upper")):
+            res[side][idx] = at(view, combos, cw, f"delta_{direction}")
+            iname = f"delta_{direction}_ideal" if ikind == "ideal" else f"delta_{direction}"
+            res[f"{side}_ideal"][idx] = at(iview, icombos, icw, iname)
+        res["in_grid"][idx] = True
+    res["value"] = np.fmin(res["lower"], res["upper"])
+    res["ideal"] = np.fmin(res["lower_ideal"], res["upper_ideal"])
+    return res
+
+
+# ============================================================ any route: one scalar call per element
+def _from_answers(answers: list[Answer], shape: tuple[int, ...], question: str) -> dict[str, np.ndarray]:
+    def num(v):
+        return np.nan if v is None else float(v)
+
+    res = {
+        "value": np.array([num(a.value) for a in answers]),
+        "low": np.array([num(a.interval[0]) for a in answers]),
+        "high": np.array([num(a.interval[1]) for a in answers]),
+        "ideal": np.array([num(a.ideal_bound.value) for a in answers]),
+        "in_grid": np.array([all(a.in_grid.values()) for a in answers], dtype=bool),
+    }
+    if question == "delta-e":
+        for side in ("lower", "upper"):
+            res[side] = np.array([num(a.details[side]["value"]) for a in answers])
+            res[f"{side}_ideal"] = np.array([num(a.details[side]["ideal"]) for a in answers])
+    return {k: v.reshape(shape) for k, v in res.items()}
+
+
+def answer_arrays(question: str, scalar: Callable[..., Answer], route: str, arguments: dict[str, Any], *,
+                  ideal_bound: bool = True) -> ArrayAnswer:
+    """Answer ``question`` over array inputs (see the module docstring).
+
+    Parameters
+    ----------
+    question : str
+        A name of :data:`designkit.query.QUESTIONS`.
+    scalar : callable
+        The route's scalar function (used element by element where the route is not vectorized).
+    route : str
+        ``"table"`` or ``"exact"``.
+    arguments : dict
+        The call's keyword arguments (numeric inputs may be arrays or lists).
+    ideal_bound : bool
+        Compute the closed-form ideal bound on the table route (False: ``ideal`` is NaN, faster).
+    """
+    names = ARRAY_INPUTS[question]
+    numeric = {n: arguments.get(n, _DEFAULTS.get(n)) for n in names}
+    present = {n: v for n, v in numeric.items() if v is not None}
+    x = _checked(question, present)
+    shape = next(iter(x.values())).shape if x else ()
+    flat = {n: np.ascontiguousarray(a).ravel() for n, a in x.items()}
+    others = {k: v for k, v in arguments.items() if k not in names}
+    by_name = any(others.get(k) is not None for k in ("m", "m1", "m2", "objects"))
+    pair = question != "delta-e"
+    if route == "table" and not by_name and all(n in flat for n in names):
+        op = _table_route.open_table(others.get("table", _table_route.DEFAULT_TABLE),
+                                     others.get("ideal_table", _table_route.DEFAULT_IDEAL_TABLE),
+                                     threshold=others.get("threshold"), sensor=others.get("sensor"),
+                                     model=others.get("model"))
+        unknown = set(others) - {"table", "ideal_table", "threshold", "sensor", "model"}
+        if unknown:
+            raise InputError(f"{question} from a table takes no {', '.join(sorted(unknown))}")
+        res = (_table_pair(question, flat, op, ideal_bound) if pair
+               else _table_delta_e(flat, op, others.get("ideal_table", _table_route.DEFAULT_IDEAL_TABLE)))
+        res = {k: v.reshape(shape) for k, v in res.items()}
+        table = op.tab.name
+    else:
+        n = int(np.prod(shape)) if shape else 1
+        answers = [scalar(**others, **{k: float(v[i]) for k, v in flat.items()}) for i in range(n)]
+        res = _from_answers(answers, shape, question)
+        table = answers[0].table if answers else None
+    details = {k: res.pop(k) for k in ("lower", "upper", "lower_ideal", "upper_ideal") if k in res}
+    in_grid = res.pop("in_grid")
+    return ArrayAnswer(question=question, route=route, table=table, in_grid=in_grid, details=details, **res)

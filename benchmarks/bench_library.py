@@ -2,37 +2,31 @@
 
 Run from the repository root::
 
-    /work/main/.venv/bin/python benchmarks/bench_library.py                 # all parts, 10,000 scalar calls
+    /work/main/.venv/bin/python benchmarks/bench_library.py                 # all parts, 10,000 queries
     /work/main/.venv/bin/python benchmarks/bench_library.py --n 2000 --json out.json
 
 Measured in one process, on whatever machine runs it (CPU time per call as well
 as wall time: on a shared machine wall time measures the neighbours):
 
 1. ``designkit.query.min_contact(35000, 20000)`` in a loop, **tables named by
-   string** (as the README shows): every call resolves, reads and hashes both
-   table files (``svm-paper`` and the ideal bound ``ideal-paper``).
+   string** (as the README shows): the tables are loaded once per process, the
+   closed-form ideal bound computed once per scene (then a cache hit).
    Target: at most 0.5 ms per call.
-2. The same with **loaded Table objects** (``load_table`` once, the objects
-   passed to every call).
-3. The same with a **per-process cache of verified tables** keyed by (path,
-   mtime, size), as proposed for :mod:`designkit.query.table` (issue 16):
-   emulated here outside the library (``_cached``: resolve the name, ``stat``
-   both files, a dict hit), so the figure is what the change would give.
-4. **10,000 queries as scalar calls** (loaded tables, different pairs): the
-   total; the library has no array call yet.
-5. The same 10,000 queries through a **prototype array call** written here in
-   numpy (min-contact's value for effusivities given as numbers, one scene;
-   the table route's rule, :mod:`designkit.tables.lookup`): checked equal to
-   the scalar calls, and timed, as evidence for the proposed array-valued
-   question calls. Target: at least 50x faster than 4.
+2. The same with **loaded Table objects** passed to every call.
+3. ``min_contact`` on **a new pair every call** (the bound computed each time,
+   the cost a first question pays).
+4. **N queries, different pairs**: one **array call** with the bounds not yet
+   computed (cold: the closed form, vectorized, for every distinct element),
+   then **N scalar calls** and **the same array call** again with the bounds
+   cached (warm), and the array call with ``ideal_bound=False``; the array
+   answers are checked equal to the scalar calls. Target: the array call at
+   least 50x faster than the N scalar calls.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
-import math
-import os
 import statistics
 import time
 from pathlib import Path
@@ -40,7 +34,8 @@ from pathlib import Path
 import numpy as np
 
 from designkit.query import min_contact
-from designkit.tables.store import Table, load_table, resolve_table
+from designkit.query.ideal_bound import clear_bound_cache
+from designkit.tables.store import load_table
 
 PAIR = (35000.0, 20000.0)
 
@@ -58,75 +53,19 @@ def _timed(fn, n: int) -> dict:
             "cpu_ms_median": 1e3 * statistics.median(cpus), "wall_ms_best": 1e3 * min(walls)}
 
 
-_CACHE: dict[tuple, Table] = {}
-
-
-def _cached(name: str) -> Table:
-    """The proposed per-process cache, emulated: one verified load per (path, mtime, size) of both files."""
-    npz = resolve_table(name)
-    key = tuple((str(p), st.st_mtime_ns, st.st_size) for p in (npz, npz.with_suffix(".json"))
-                for st in (os.stat(p),))
-    hit = _CACHE.get(key)
-    if hit is None:
-        hit = _CACHE[key] = load_table(npz)
-    return hit
-
-
-def min_contact_array(e1, e2, table: Table, *, noise_c: float = 0.05, delta_t_c: float = 10.0) -> np.ndarray:
-    """Prototype array call: min-contact's SVM value [s] for effusivities given as numbers (NaN: none).
-
-    ``e1`` and ``e2`` broadcast like numpy; one scene (``noise_c``, ``delta_t_c``)
-    on a table with a ``noise_ratio`` axis. Outside the effusivity grid or the
-    scene grid: NaN (the scalar call answers None there).
-    """
-    from designkit.tables.lookup import axis_weights
-
-    e1, e2 = np.broadcast_arrays(np.asarray(e1, dtype=np.float64), np.asarray(e2, dtype=np.float64))
-    lo, hi = np.minimum(e1, e2), np.maximum(e1, e2)
-    gap = hi - lo
-    ax = table.axes
-    centres, contacts, ratios = ax["e_ref"], ax["contact_s"], ax["noise_ratio"]
-    pts = axis_weights(ratios, noise_c / abs(delta_t_c), log=True, grid=np.log(ratios))
-    if pts is None:
-        return np.full(lo.shape, np.nan)
-
-    def interp(arr_name: str, e: np.ndarray) -> np.ndarray:  # [contact, ...e.shape]
-        rows = sum(w * table.arrays[arr_name][r] for r, w in pts if w)  # [contact, centre]
-        j = np.clip(np.searchsorted(centres, e, side="right") - 1, 0, centres.size - 2)
-        w = np.clip((e - centres[j]) / (centres[j + 1] - centres[j]), 0.0, 1.0)
-        a, b = rows[:, j], rows[:, j + 1]
-        out = np.where(w == 0.0, a, a + w * (b - a))
-        return np.where(e >= centres[-1], rows[:, -1:].reshape((-1,) + (1,) * e.ndim), out)
-
-    up, down = interp("delta_up", lo), interp("delta_down", hi)
-    need = np.where(np.isnan(up) | np.isnan(down), np.nan, np.maximum(up, down))  # NaN: beyond the grid
-    ok = ~np.isnan(need) & (need <= gap)
-    k = np.argmax(ok, axis=0)
-    found = ok.any(axis=0)
-    prev = np.where(k > 0, need[np.maximum(k - 1, 0), *np.indices(k.shape)], np.nan)
-    cur = need[k, *np.indices(k.shape)]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        w = np.where(prev != cur, (prev - gap) / (prev - cur), 1.0)
-    x = np.where((k == 0) | np.isnan(prev), contacts[k], contacts[np.maximum(k - 1, 0)] + w * (
-        contacts[k] - contacts[np.maximum(k - 1, 0)]))
-    e_lo, e_hi = float(table.header["effusivity"]["min"]), float(table.header["effusivity"]["max"])
-    inside = (lo > e_lo) & (hi <= e_hi)
-    return np.where(found & inside, x, np.nan)
-
-
 def main(argv=None) -> dict:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--n", type=int, default=10_000, help="queries in parts 4 and 5 (default 10,000)")
-    ap.add_argument("--loop", type=int, default=50, help="calls timed in parts 1-3")
+    ap.add_argument("--n", type=int, default=10_000, help="queries in part 4 (default 10,000)")
+    ap.add_argument("--loop", type=int, default=200, help="calls timed in parts 1-2")
     ap.add_argument("--json", type=Path, help="also write the figures here")
     args = ap.parse_args(argv)
 
     svm, ideal = load_table("svm-paper"), load_table("ideal-paper")
     out: dict = {"n": args.n}
     out["by_name"] = _timed(lambda: min_contact(*PAIR, table="svm-paper", ideal_table="ideal-paper"), args.loop)
-    out["loaded_tables"] = _timed(lambda: min_contact(*PAIR, table=svm, ideal_table=ideal), args.loop * 4)
-    out["cached_by_name"] = _timed(lambda: min_contact(*PAIR, table=_cached("svm-paper"),
-                                                       ideal_table=_cached("ideal-paper")), args.loop * 4)
+    out["loaded_tables"] = _timed(lambda: min_contact(*PAIR, table=svm, ideal_table=ideal), args.loop)
+    fresh = iter(np.linspace(21000.0, 39000.0, 1000).tolist())
+    out["new_pair_each_call"] = _timed(lambda: min_contact(next(fresh), 20000.0, table=svm), 20)
 
     rng = np.random.default_rng(16)
     e_min, e_max = float(svm.header["effusivity"]["min"]), float(svm.header["effusivity"]["max"])
@@ -135,33 +74,51 @@ def main(argv=None) -> dict:
     e2 = np.clip(e2, e_min + 100, e_max - 100)
     e2 = np.where(np.abs(e2 - e1) < 100, e1 + 150, e2)
 
+    clear_bound_cache()
     w0, c0 = time.perf_counter(), time.process_time()
-    scalar = np.array([np.nan if (v := min_contact(a, b, table=svm, ideal_table=ideal).value) is None else v
-                       for a, b in zip(e1.tolist(), e2.tolist())])
+    cold = min_contact(e1, e2, table=svm)
+    out["array_cold"] = {"wall_s": time.perf_counter() - w0, "cpu_s": time.process_time() - c0}
+
+    w0, c0 = time.perf_counter(), time.process_time()
+    scalar = [min_contact(a, b, table=svm) for a, b in zip(e1.tolist(), e2.tolist())]
     out["scalar_calls"] = {"wall_s": time.perf_counter() - w0, "cpu_s": time.process_time() - c0}
 
-    min_contact_array(e1[:10], e2[:10], svm)  # warm-up
-    reps = 20
-    w0, c0 = time.perf_counter(), time.process_time()
-    for _ in range(reps):
-        arr = min_contact_array(e1, e2, svm)
-    out["array_prototype"] = {"wall_s": (time.perf_counter() - w0) / reps, "cpu_s": (time.process_time() - c0) / reps}
-    agree = np.allclose(arr, scalar, rtol=1e-12, atol=0.0, equal_nan=True)
-    out["array_prototype"]["equals_scalar_calls"] = bool(agree)
-    out["array_prototype"]["answered"] = int(np.isfinite(scalar).sum())
-    out["speedup_cpu"] = out["scalar_calls"]["cpu_s"] / out["array_prototype"]["cpu_s"]
+    def num(v):
+        return np.nan if v is None else v
 
-    print(f"min_contact(35000, 20000), median per call (wall / CPU):")
-    for key, label in (("by_name", "tables named by string"), ("loaded_tables", "loaded Table objects"),
-                       ("cached_by_name", "by name, proposed (path, mtime, size) cache")):
+    reps = 5
+    for key, kw in (("array_warm", {}), ("array_no_bound", {"ideal_bound": False})):
+        w0, c0 = time.perf_counter(), time.process_time()
+        for _ in range(reps):
+            arr = min_contact(e1, e2, table=svm, **kw)
+        out[key] = {"wall_s": (time.perf_counter() - w0) / reps, "cpu_s": (time.process_time() - c0) / reps}
+        fields = [("value", [num(a.value) for a in scalar])]
+        if not kw:  # without the bound only the value is the scalar call's (the interval stops at the bound)
+            fields += [("low", [num(a.interval[0]) for a in scalar]), ("high", [num(a.interval[1]) for a in scalar]),
+                       ("ideal", [num(a.ideal_bound.value) for a in scalar])]
+        out[key]["equals_scalar_calls"] = all(np.allclose(getattr(arr, f), np.array(v, dtype=float), rtol=1e-12,
+                                                          atol=0.0, equal_nan=True) for f, v in fields)
+    out["answered"] = int(np.isfinite(arr.value).sum())
+    out["speedup_cpu"] = out["scalar_calls"]["cpu_s"] / out["array_warm"]["cpu_s"]
+    out["speedup_cpu_no_bound"] = out["scalar_calls"]["cpu_s"] / out["array_no_bound"]["cpu_s"]
+
+    print("min_contact(35000, 20000), median per call (wall / CPU):")
+    for key, label in (("by_name", "tables named by string (target <= 0.5 ms)"),
+                       ("loaded_tables", "loaded Table objects"),
+                       ("new_pair_each_call", "a new pair each call (bound computed)")):
         r = out[key]
         print(f"  {label:<46} {r['wall_ms_median']:8.3f} ms / {r['cpu_ms_median']:.3f} ms  ({r['calls']} calls)")
-    s, a = out["scalar_calls"], out["array_prototype"]
-    print(f"{args.n:,} different pairs, loaded tables:")
-    print(f"  scalar calls                                  {s['wall_s']:8.3f} s wall / {s['cpu_s']:.3f} s CPU")
-    print(f"  prototype array call (numpy, this file)       {a['wall_s'] * 1e3:8.3f} ms wall / "
-          f"{a['cpu_s'] * 1e3:.3f} ms CPU; equal to the scalar calls: {agree} ({a['answered']} answered)")
-    print(f"  speed-up (CPU)                                {out['speedup_cpu']:8.0f}x")
+    c, s_, a, nb = out["array_cold"], out["scalar_calls"], out["array_warm"], out["array_no_bound"]
+    print(f"{args.n:,} different pairs, loaded tables ({out['answered']:,} answered):")
+    print(f"  array call, bounds cold (closed form, vectorized) {c['wall_s']:8.3f} s wall / {c['cpu_s']:.3f} s CPU"
+          f"  ({1e3 * c['cpu_s'] / args.n:.2f} ms CPU per query)")
+    print(f"  scalar calls, bounds cached                  {s_['wall_s']:8.3f} s wall / {s_['cpu_s']:.3f} s CPU")
+    print(f"  array call, bounds cached                    {a['wall_s'] * 1e3:8.1f} ms wall / {a['cpu_s'] * 1e3:.1f} ms CPU"
+          f"; equal to the scalar calls: {a['equals_scalar_calls']}")
+    print(f"  array call, ideal_bound=False                {nb['wall_s'] * 1e3:8.1f} ms wall / {nb['cpu_s'] * 1e3:.1f} ms CPU"
+          f"; equal to the scalar calls: {nb['equals_scalar_calls']}")
+    print(f"  speed-up of the array call (CPU, target >= 50x)  {out['speedup_cpu']:8.0f}x"
+          f"  ({out['speedup_cpu_no_bound']:.0f}x without the bound)")
     if args.json:
         args.json.write_text(json.dumps(out, indent=2))
     return out

@@ -116,3 +116,31 @@ def test_changelog_names_the_current_version():
     headings = re.findall(r"^## \[(\d+\.\d+\.\d+)\] - \d{4}-\d{2}-\d{2}$", text, flags=re.M)
     assert designkit.__version__ in headings, f"CHANGELOG.md has no entry for {designkit.__version__}"
     assert f"[{designkit.__version__}]: http" in text
+
+
+# ----------------------------------------------------------------- shell completion
+def _run_module(args, env_extra=None):
+    import os
+
+    env = {**os.environ, **(env_extra or {})}
+    env["PYTHONPATH"] = str(REPO) + os.pathsep + env.get("PYTHONPATH", "")
+    return subprocess.run([sys.executable, "-m", "designkit", *args], capture_output=True, text=True, env=env,
+                          timeout=120)
+
+
+def test_show_completion_prints_a_bash_script_for_the_designkit_command():
+    r = _run_module(["--show-completion", "bash"])
+    assert r.returncode == 0, r.stderr
+    assert "_DESIGNKIT_COMPLETE=complete_bash" in r.stdout
+    assert "complete -o default -F _designkit_completion designkit" in r.stdout
+
+
+@pytest.mark.parametrize("words, cword, expected", [
+    ("designkit min-co", 1, {"min-contact"}),
+    ("designkit min-contact --e", 2, {"--e1", "--e2", "--exact"}),
+    ("designkit tables ", 2, {"list", "show"}),
+])
+def test_completion_protocol_completes_commands_and_options(words, cword, expected):
+    r = _run_module([], {"_DESIGNKIT_COMPLETE": "complete_bash", "COMP_WORDS": words, "COMP_CWORD": str(cword)})
+    assert r.returncode == 0, r.stderr
+    assert expected <= set(r.stdout.split()), r.stdout

@@ -1,5 +1,6 @@
 """The one row output (designkit.cli._format): ``--format table|json|csv|md`` and ``--out FILE|-`` agree
-across the commands that print rows (``materials list``, ``matrix``), and ``-`` reads stdin."""
+across the commands that print rows (``materials list|show``, ``tables list|show``, ``delta-e``, ``matrix``),
+and ``-`` reads stdin."""
 
 from __future__ import annotations
 
@@ -36,6 +37,8 @@ def test_md_escapes_pipes_and_right_aligns_numbers():
 def test_table_never_cuts_a_name_nor_eats_brackets():
     text = render_rows(ROWS, fmt="table", title="e [J s^-1/2 K^-1 m^-2]")
     assert "Stainless steel, 316 [!]" in text and "[J s^-1/2 K^-1 m^-2]" in text and "…" not in text
+    # a column name with a unit in brackets is text, not a style tag
+    assert "contact [s]" in render_rows([{"contact [s]": 1.0}], fmt="table")
 
 
 def test_unknown_format_is_refused():
@@ -120,3 +123,34 @@ def test_node_graph_layout_puts_every_node_somewhere_distinct():
     pts = {tuple(round(c, 9) for c in p) for p in pos.values()}
     assert len(pts) == 9
     assert all(angle[v] == -90.0 for v in (5, 6, 7, 8))  # lone nodes in a row, labels below
+
+
+# ----------------------------------------------------------------- the other commands that print rows
+ROW_COMMANDS = {
+    "tables list": (("tables", "list"), "name", "svm-paper"),
+    "tables show": (("tables", "show", "svm-paper"), "axis", "contact_s"),
+    "materials show": (("materials", "show", "copper"), "property", "effusivity"),
+    "delta-e": (("delta-e", "--e", "20000", "--contact", "2"), "direction", "upper"),
+}
+
+
+@pytest.mark.parametrize("command", sorted(ROW_COMMANDS))
+def test_row_commands_print_csv_with_a_header_and_rows_only_and_json_that_parses(cli, command):
+    args, key, expected = ROW_COMMANDS[command]
+    r = cli(*args, "--format", "csv")
+    assert r.exit_code == 0, r.output
+    rows = list(csv.DictReader(io.StringIO(r.stdout)))  # a header, rows, nothing else (no comment lines)
+    assert expected in [row[key] for row in rows] and len(rows) >= 2
+    assert all(len(row) == len(rows[0]) and None not in row for row in rows)
+    j = cli(*args, "--format", "json")
+    assert j.exit_code == 0, j.output
+    data = json.loads(j.stdout)
+    items = data if isinstance(data, list) else [data]
+    assert any(expected in json.dumps(item) for item in items)
+    for fmt in ("table", "md"):
+        t = cli(*args, "--format", fmt)
+        assert t.exit_code == 0 and expected in t.stdout, t.output
+
+
+def test_tables_list_json_flag_equals_format_json(cli):
+    assert cli("tables", "list", "--json").stdout == cli("tables", "list", "--format", "json").stdout

@@ -117,7 +117,7 @@ app = typer.Typer(
     help="Design guidelines for active thermal tactile sensors: which contact time, noise and "
          "temperature difference separate two materials (semi-infinite model + SVM, Bai et al.).",
     no_args_is_help=True,
-    add_completion=False,
+    add_completion=True,  # --install-completion / --show-completion (typer; no import cost until used)
     pretty_exceptions_enable=False,
     # markdown, not rich markup: unit brackets like [s] or [J s^-1/2 K^-1 m^-2] in help
     # texts are not style tags
@@ -197,7 +197,9 @@ def console(stderr: bool = False):
 def main() -> None:
     """Console-script entry point."""
     try:
-        app()
+        # one program name however it is started (console script or ``python -m designkit``): the usage
+        # lines and the shell-completion script (``_DESIGNKIT_COMPLETE``) name the ``designkit`` command
+        app(prog_name="designkit")
     except KeyboardInterrupt:
         typer.echo("Interrupted.", err=True)
         sys.exit(EXIT_INTERRUPTED)

@@ -140,7 +140,8 @@ def render_rows(rows: Sequence[Mapping[str, Any]], columns: Sequence[str] | None
     for i, c in enumerate(cols):
         # never an ellipsis: a cell too wide for the terminal folds onto another line
         widest_word = max([len(w) for s in [c] + [row[i] for row in body] for w in s.split()] or [1])
-        table.add_column(c, justify="right" if right(i) else "left", overflow="fold", min_width=min(widest_word, 30))
+        table.add_column(Text(c), justify="right" if right(i) else "left", overflow="fold",
+                         min_width=min(widest_word, 30))
     for row in body:
         table.add_row(*(Text(x) for x in row))
     buf = io.StringIO()

@@ -93,17 +93,37 @@ def show(
                                              "prefix 'paper12:' for the paper's set.")],
     set_: Annotated[Optional[str], typer.Option(
         "--set", help="Look only in this set (default: database, then paper12).")] = None,
+    format_: Annotated[Optional[str], typer.Option(
+        "--format", "-f", help="Print the properties as rows (property, min, max, unit): table, json, csv or md "
+                               "(default: the description for people; --json: the whole material).")] = None,
+    out: OutOpt = None,
     json_: Json = False,
 ) -> None:
     """Show one material: property ranges, effusivity, diffusivity and source.
 
-    Example: `designkit materials show "stainless steel"`
+    Example: `designkit materials show "stainless steel"` (`--format csv` for one row per property)
     """
     from ..materials import get_material
 
     m = get_material(name, set=set_)
     if json_:
         emit_json(m.to_dict())
+        return
+    if format_ is not None:
+        fmt = check_format(format_)
+        props = [("conductivity", m.conductivity_min_w_mk, m.conductivity_max_w_mk, "W m^-1 K^-1"),
+                 ("density", m.density_min_kg_m3, m.density_max_kg_m3, "kg m^-3"),
+                 ("specific_heat", m.specific_heat_min_j_kgk, m.specific_heat_max_j_kgk, "J kg^-1 K^-1"),
+                 ("effusivity", m.e_min, m.e_max, "J s^-1/2 K^-1 m^-2"),
+                 ("diffusivity", m.diffusivity_min_m2_s, m.diffusivity_max_m2_s, "m^2 s^-1")]
+        rows = [{"material": m.name, "property": p, "min": lo, "max": hi, "unit": u}
+                for p, lo, hi, u in props if lo is not None or hi is not None]
+        if m.identified is not None:
+            rows.append({"material": m.name, "property": "identified_effusivity", "min": m.identified,
+                         "max": m.identified, "unit": "J s^-1/2 K^-1 m^-2"})
+        emit_rows(rows, ["material", "property", "min", "max", "unit"], fmt=fmt, out=out,
+                  title=f"{m.name} ({m.family_label}; {m.set} set)", notes=[f"source: {m.source}"],
+                  payload=rows if fmt == "json" else None)
         return
     con = console()
     con.print(f"[bold]{m.name}[/]  ({m.family_label}; {m.set} set)")

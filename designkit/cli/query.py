@@ -18,6 +18,7 @@ import typer
 
 from . import _app
 from ._app import app, console, emit_json
+from ._format import OutOpt, check_format, emit_rows
 from ._options import (
     E1,
     E2,
@@ -308,16 +309,32 @@ def delta_e_cmd(
     backing: BackingOpt = None, diffusivity: Diffusivity = None,
     exact: Exact = False, table: TableOpt = None, ideal_table: IdealTableOpt = "ideal-paper",
     trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
-    n_mc: NmcQ = 1000, json_: Json = False,
+    n_mc: NmcQ = 1000,
+    format_: Annotated[Optional[str], typer.Option(
+        "--format", "-f", help="Print the two directions as rows: table, json, csv or md (default: the answer "
+                               "for people; --json: the whole answer).")] = None,
+    out: OutOpt = None, json_: Json = False,
 ) -> None:
     """Smallest distinguishable effusivity difference delta(e), towards lower and higher effusivity.
 
-    Example: `designkit delta-e --e 20000 --contact 2`
+    Example: `designkit delta-e --e 20000 --contact 2` (`--format csv` for one row per direction)
     """
+    fmt = None if json_ or format_ is None else check_format(format_)
     ans = _ask("delta-e", exact=exact, table=table, ideal_table=ideal_table, threshold=threshold, sensor=sensor,
                model=model, conductance=conductance, thickness=thickness, backing=backing, diffusivity=diffusivity,
                width=width, trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc,
                objects=dict(e=e, m=m), scene=dict(contact_s=contact, noise_c=noise, delta_t_c=delta_t))
+    if fmt is not None:
+        d = ans.to_dict()
+        rows = [{"direction": side, "e": d["details"]["e"], "delta": d["details"][side]["value"],
+                 "interval_low": (d["details"][side]["interval"] or [None, None])[0],
+                 "interval_high": (d["details"][side]["interval"] or [None, None])[1],
+                 "ideal": d["details"][side]["ideal"], "unit": d["unit"], "route": d["route"],
+                 "table": d["table"]["name"] if isinstance(d["table"], dict) else d["table"]}
+                for side in ("lower", "upper")]
+        emit_rows(rows, list(rows[0]), fmt=fmt, out=out, title=f"delta(e) at {d['details']['e']:g}",
+                  payload=rows if fmt == "json" else None)
+        return
     _render(ans, json_)
 
 

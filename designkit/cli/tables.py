@@ -9,6 +9,7 @@ import typer
 
 from . import _app
 from ._app import console, emit_json, sub_app
+from ._format import FormatOpt, OutOpt, check_format, emit_rows
 from ._options import Json
 
 tables_app = sub_app("tables", "Shipped lookup tables: list them, or show one's grid and provenance.",
@@ -18,14 +19,17 @@ tables_app = sub_app("tables", "Shipped lookup tables: list them, or show one's 
 @tables_app.command("list")
 def tables_list(
     folder: Annotated[Optional[Path], typer.Option("--folder", help="List tables in this folder instead.")] = None,
+    format_: FormatOpt = "table",
+    out: OutOpt = None,
     json_: Json = False,
 ) -> None:
     """List the lookup tables (shipped, or in --folder).
 
-    Example: `designkit tables list --json`
+    Example: `designkit tables list --format csv`
     """
     from ..tables.store import list_tables, load_table
 
+    fmt = "json" if json_ else check_format(format_)
     rows = []
     for name in list_tables(folder):
         t = load_table(name if folder is None else folder / f"{name}.npz")
@@ -33,32 +37,43 @@ def tables_list(
         rows.append({"name": name, "fidelity": s["fidelity"], "sensor": s["sensor"]["name"], "model": s["model"],
                      "axes": {a["name"]: [a["min"], a["max"], a["points"]] for a in s["axes"]},
                      "size_bytes": s["size_bytes"], "path": s["path"]})
-    if json_:
-        emit_json(rows)
+    if fmt == "json":
+        emit_rows(rows, fmt="json", out=out, payload=rows)
         return
-    from rich.table import Table as RichTable
-
-    tab = RichTable(title="designkit lookup tables")
-    for col in ("name", "fidelity", "sensor", "model", "sigma/dT", "contact [s]", "intervals", "size"):
-        tab.add_column(col)
-    for r in rows:
+    flat = []
+    for r in rows:  # one plain value per column (csv: full precision; table/md: ranges for people)
         ax = r["axes"]
-        noise = ax.get("noise_ratio") or ax.get("noise_c")
-        tab.add_row(r["name"], r["fidelity"], r["sensor"], r["model"]["name"],
-                    f"{noise[0]:g}–{noise[1]:g} ({noise[2]})",
-                    f"{ax['contact_s'][0]:g}–{ax['contact_s'][1]:g} ({ax['contact_s'][2]})",
-                    str(ax["e_ref"][2]), f"{r['size_bytes'] / 1024:.0f} KiB")
-    console().print(tab)
+        noise_axis = "noise_ratio" if "noise_ratio" in ax else "noise_c"
+        noise, contact = ax[noise_axis], ax["contact_s"]
+        flat.append({"name": r["name"], "fidelity": r["fidelity"], "sensor": r["sensor"], "model": r["model"]["name"],
+                     "noise_axis": noise_axis, "noise_min": noise[0], "noise_max": noise[1], "noise_points": noise[2],
+                     "contact_min_s": contact[0], "contact_max_s": contact[1], "contact_points": contact[2],
+                     "intervals": ax["e_ref"][2], "size_bytes": r["size_bytes"], "path": r["path"]})
+    if fmt == "csv":
+        emit_rows(flat, fmt="csv", out=out)
+        return
+    people = [{"name": f["name"], "fidelity": f["fidelity"], "sensor": f["sensor"], "model": f["model"],
+               "sigma/dT" if f["noise_axis"] == "noise_ratio" else "noise [degC]":
+                   f"{f['noise_min']:g}–{f['noise_max']:g} ({f['noise_points']})",
+               "contact [s]": f"{f['contact_min_s']:g}–{f['contact_max_s']:g} ({f['contact_points']})",
+               "intervals": f["intervals"], "size": f"{f['size_bytes'] / 1024:.0f} KiB"} for f in flat]
+    cols = list(dict.fromkeys(k for p in people for k in p))
+    emit_rows(people, cols, fmt=fmt, out=out, title="designkit lookup tables",
+              justify={c: ("right" if c in ("intervals", "size") else "left") for c in cols})
 
 
 @tables_app.command("show")
 def tables_show(
     name: Annotated[str, typer.Argument(help="Table name (see 'designkit tables list') or path.")],
+    format_: Annotated[Optional[str], typer.Option(
+        "--format", "-f", help="Print the table's axes as rows: table, json, csv or md (default: the description "
+                               "for people; --json: the whole summary).")] = None,
+    out: OutOpt = None,
     json_: Json = False,
 ) -> None:
     """Describe one table: grid, units, sensor, forward model, fidelity, provenance, content hash.
 
-    Example: `designkit tables show svm-paper`
+    Example: `designkit tables show svm-paper` (or `--format csv` for its axes, one row each)
     """
     from ..tables.store import load_table
 
@@ -68,6 +83,14 @@ def tables_show(
     s = table.summary()
     if json_:
         emit_json(s)
+        return
+    if format_ is not None:
+        fmt = check_format(format_)
+        rows = [{"axis": a["name"], "units": a.get("units"), "scale": a.get("scale"), "points": a.get("points"),
+                 "min": a.get("min"), "max": a.get("max"),
+                 "values": " ".join(f"{v:g}" for v in a.get("values", []))} for a in s["axes"]]
+        emit_rows(rows, ["axis", "units", "scale", "points", "min", "max", "values"], fmt=fmt, out=out,
+                  title=f"{s['name']}: axes", payload=s["axes"] if fmt == "json" else None)
         return
     con = console()
     con.print(f"[bold]{s['name']}[/]  ({s['fidelity']} fidelity, {s['path']})")

@@ -1,0 +1,74 @@
+"""Fresh-process start-up of the CLI against ``python -c "import numpy"``, measured in the same run (issue 16).
+
+Run from the repository root::
+
+    /work/main/.venv/bin/python benchmarks/bench_startup.py            # 15 runs each
+    /work/main/.venv/bin/python benchmarks/bench_startup.py --runs 30 --json out.json
+
+Like hyperfine: each command runs ``--runs`` times as a new process, round robin
+(so a neighbour's load spreads over all of them), after one warm-up run each;
+the figure is the median wall time. The CLI runs as ``python -m designkit`` with
+this interpreter (the tree on ``PYTHONPATH`` if set), which costs the same as
+the console script plus runpy's few milliseconds.
+
+Targets: ``designkit min-contact --e1 35000 --e2 20000`` at most 2x ``import
+numpy``; ``designkit --version`` at most 1.5x.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+PY = sys.executable
+COMMANDS = {
+    "python -c pass": [PY, "-c", "pass"],
+    "import numpy": [PY, "-c", "import numpy"],
+    "designkit --version": [PY, "-m", "designkit", "--version"],
+    "designkit min-contact": [PY, "-m", "designkit", "min-contact", "--e1", "35000", "--e2", "20000"],
+    "designkit min-contact --json": [PY, "-m", "designkit", "min-contact", "--e1", "35000", "--e2", "20000",
+                                     "--json"],
+}
+TARGETS = {"designkit --version": 1.5, "designkit min-contact": 2.0}
+
+
+def _run(cmd: list[str]) -> float:
+    t0 = time.perf_counter()
+    subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, check=True, env=os.environ.copy())
+    return time.perf_counter() - t0
+
+
+def main(argv=None) -> dict:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--runs", type=int, default=15)
+    ap.add_argument("--json", type=Path)
+    args = ap.parse_args(argv)
+    for cmd in COMMANDS.values():  # warm-up: page cache, .pyc files
+        _run(cmd)
+    times: dict[str, list[float]] = {k: [] for k in COMMANDS}
+    for _ in range(args.runs):
+        for name, cmd in COMMANDS.items():
+            times[name].append(_run(cmd))
+    base = statistics.median(times["import numpy"])
+    out = {"runs": args.runs, "load_average": os.getloadavg(), "median_s": {}, "ratio_to_import_numpy": {}}
+    print(f"median wall time over {args.runs} runs (load average {os.getloadavg()[0]:.2f}):")
+    for name, ts in times.items():
+        med = statistics.median(ts)
+        out["median_s"][name] = med
+        out["ratio_to_import_numpy"][name] = med / base
+        target = f"   target <= {TARGETS[name]:g}x" if name in TARGETS else ""
+        print(f"  {name:<30} {med * 1e3:7.1f} ms  {med / base:5.2f}x import numpy  "
+              f"(min {min(ts) * 1e3:.1f} ms){target}")
+    if args.json:
+        args.json.write_text(json.dumps(out, indent=2))
+    return out
+
+
+if __name__ == "__main__":
+    main()

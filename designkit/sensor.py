@@ -133,8 +133,12 @@ class Sensor:
         return out
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any], *, source: str = "sensor") -> "Sensor":
-        """Build from :meth:`to_dict` output, with one-line errors naming ``source``."""
+    def from_dict(cls, data: Mapping[str, Any], *, source: str = "sensor", schema: bool = True) -> "Sensor":
+        """Build from :meth:`to_dict` output, with one-line errors naming ``source``.
+
+        ``schema=False`` skips the schema's type check, for data that passed it already (a shipped
+        table's header, known by its content hash); the field checks below still run.
+        """
         from ._schemas import schemas, validate
 
         if not isinstance(data, Mapping):
@@ -150,8 +154,9 @@ class Sensor:
         unknown = sorted(set(data) - known)
         if unknown:
             raise InputError(f"{source}: unknown sensor field(s) {', '.join(unknown)}")
-        checked = validate(schemas()["sensor"], dict(data), source)  # types, strictly: no [1, 2] for a number
-        data = {k: getattr(checked, k) for k in data}
+        if schema:
+            checked = validate(schemas()["sensor"], dict(data), source)  # types, strictly: no [1, 2] for a number
+            data = {k: getattr(checked, k) for k in data}
         kwargs = {k: data[k] for k in data if k not in ("designkit_sensor", "tau_s")}
         try:
             sensor = cls(**kwargs)

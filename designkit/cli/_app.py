@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import sys
 from typing import Any
 
@@ -57,8 +58,95 @@ def _report_error(kind: str, message: str, status: int, as_json: bool) -> None:
         sys.stdout.flush()
 
 
+_FLOAT_TEXT = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
+_INT_TEXT = re.compile(r"[+-]?\d+")
+_MISSING = object()
+
+
+class _PlainCoercion:
+    """Typer's coercion of one option, with a fast path for plain numbers and text.
+
+    Typer (0.29) converts every option through a pydantic ``TypeAdapter`` built on first use:
+    importing pydantic and building the adapters of a query's 25 options cost more start-up
+    time than the query itself (``benchmarks/bench_startup.py``). A float, int or str option
+    whose value is already of its type, or is plain decimal text, is converted here to the
+    value pydantic gives; anything else (other types, ranges, lists, odd text, bad input) goes
+    to typer's own coercion, so its conversions and its error messages stay typer's.
+    """
+
+    def __init__(self, kind: type):
+        self.kind = kind
+        self._typer: Any = None
+
+    def _fast(self, value: Any) -> Any:
+        kind = self.kind
+        if type(value) is kind:
+            return value
+        if kind is float:
+            if type(value) is int:
+                return float(value)
+            if isinstance(value, str) and _FLOAT_TEXT.fullmatch(value):
+                return float(value)
+        elif kind is int and isinstance(value, str) and _INT_TEXT.fullmatch(value):
+            return int(value)
+        return _MISSING
+
+    def coerce(self, value: Any, param: Any, ctx: Any) -> Any:
+        if value is None:
+            return None
+        fast = self._fast(value)
+        if fast is not _MISSING:
+            return fast
+        if self._typer is None:
+            from typer._coercion import build_runtime_param
+
+            self._typer = build_runtime_param(param.type_descriptor)
+        return self._typer.coerce(value, param=param, ctx=ctx)
+
+
+def _plain_kind(param: Any) -> type | None:
+    """float, int, str or bool when the option is a single plain value of that type (or None of it)."""
+    desc = getattr(param, "type_descriptor", None)
+    if desc is None or not hasattr(param, "_runtime_param") or param._runtime_param is not None:
+        return None
+    if getattr(param, "multiple", False) or getattr(param, "nargs", 1) != 1:
+        return None
+    info = desc.parameter_info
+    if any(getattr(info, k, None) is not None for k in ("min", "max", "click_type", "parser")):
+        return None
+    ann = desc.annotation
+    args = [a for a in getattr(ann, "__args__", ()) if a is not type(None)]
+    if getattr(ann, "__origin__", None) is not None or args:  # Optional[X] (typing.Union[X, None])
+        ann = args[0] if len(args) == 1 and len(getattr(ann, "__args__", ())) == 2 else None
+    return ann if ann in (float, int, str, bool) else None
+
+
+def _fast_coercion(command: Any, ctx: Any) -> None:
+    """Give ``command``'s plain options the fast coercion (once; typer versions without it: untouched)."""
+    try:
+        params = command.get_params(ctx)  # with the help option click adds
+    except Exception:  # pragma: no cover - another click/typer: leave typer's coercion alone
+        return
+    for param in params:
+        kind = _plain_kind(param)
+        if kind is not None and param.name in ("install_completion", "show_completion"):
+            kind = type(None)  # absent: None, fast; given: typer's own coercion (it reads the shell from it)
+        if kind is not None:
+            param._runtime_param = _PlainCoercion(kind)
+
+
 class _Group(TyperGroup):
     """Typer group that turns bad input into a one-line error and exit status 2."""
+
+    def parse_args(self, ctx: Any, args: Any) -> Any:
+        _fast_coercion(self, ctx)  # the group's own options (--version, --help, completion)
+        return super().parse_args(ctx, args)
+
+    def resolve_command(self, ctx: Any, args: Any) -> Any:
+        name, cmd, rest = super().resolve_command(ctx, args)
+        if cmd is not None:
+            _fast_coercion(cmd, ctx)
+        return name, cmd, rest
 
     def main(self, *args: Any, standalone_mode: bool = True, **kwargs: Any) -> Any:
         if not standalone_mode:
@@ -194,12 +282,46 @@ def console(stderr: bool = False):
     return Console(stderr=stderr, highlight=False, soft_wrap=True, width=100_000)
 
 
+def _app_for(argv: list[str]) -> typer.Typer:
+    """The app with only the command ``argv`` names, when it names one first (else the whole app).
+
+    Typer turns every registered command into a click command (reading each function's signature
+    and type hints) before it runs any: a fifth of a fresh query's start-up for commands it does not
+    run. The lean copy holds the one command (or command group) asked for, with the same callback,
+    so parsing, help, errors and output are that command's; anything else (no command, an unknown
+    one, completion, options before the command) gets the whole app.
+    """
+    import os
+
+    if any(k.endswith("_COMPLETE") for k in os.environ):
+        return app
+    if argv and argv[0] in ("--version", "-V"):  # answered while parsing the top-level options
+        import copy
+
+        lean = copy.copy(app)
+        lean.registered_commands, lean.registered_groups = [], []
+        return lean
+    if not argv or argv[0].startswith("-"):
+        return app
+    name = argv[0]
+    cmds = [c for c in app.registered_commands
+            if (c.name or (c.callback.__name__.replace("_", "-") if c.callback else None)) == name]
+    groups = [g for g in app.registered_groups if g.name == name]
+    if len(cmds) + len(groups) != 1:
+        return app
+    import copy
+
+    lean = copy.copy(app)
+    lean.registered_commands, lean.registered_groups = cmds, groups
+    return lean
+
+
 def main() -> None:
     """Console-script entry point."""
     try:
         # one program name however it is started (console script or ``python -m designkit``): the usage
         # lines and the shell-completion script (``_DESIGNKIT_COMPLETE``) name the ``designkit`` command
-        app(prog_name="designkit")
+        _app_for(sys.argv[1:])(prog_name="designkit")
     except KeyboardInterrupt:
         typer.echo("Interrupted.", err=True)
         sys.exit(EXIT_INTERRUPTED)

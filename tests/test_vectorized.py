@@ -130,3 +130,33 @@ def test_to_dict_is_json_ready():
     a = min_contact(np.array([35000.0, 45000.0]), 20000)
     d = json.loads(json.dumps(a.to_dict()))
     assert d["shape"] == [2] and d["value"][1] is None and d["unit"] == "s"
+
+
+def test_scipy_free_class_survival_and_projection_noise_agree_with_the_recognition_layer():
+    from designkit.query.ideal_bound import class_survival, projection_noise
+    from designkit.recognition.ideal import class_survival as reference_survival
+    from designkit.recognition.ideal import projection_noise as reference_noise
+    from designkit.scene import Scene
+
+    s = load_sensor("paper")
+    t = np.linspace(0.3, 1.0, 501)
+    for contact, (a, b) in ((0.3, (20000.0, 35000.0)), (1.0, (500.0, 900.0)), (4.0, (9000.0, 9080.0))):
+        scene = Scene.from_delta_t(contact_s=contact, noise_c=0.05, delta_t_c=10.0)
+        noise = projection_noise(s, contact, scene.noise_ratio)
+        assert math.isclose(noise, reference_noise(s, scene), rel_tol=1e-12)
+        np.testing.assert_allclose(class_survival(t, a, b, s.effusivity, noise),
+                                   reference_survival(t, a, b, s.effusivity, noise), rtol=0, atol=1e-12)
+
+
+def test_matrix_prefilled_bounds_equal_the_per_pair_bounds():
+    from designkit.query.ideal_bound import clear_bound_cache
+    from designkit.query.matrix import material_matrix
+
+    clear_bound_cache()
+    m = material_matrix(["copper", "glass", "wood", "granite"], multiclass=False)
+    clear_bound_cache()
+    for c in m.cells:
+        if c.answer.limiting_pair:
+            one = min_contact(m1=m.materials[c.i].qualified_name, m2=m.materials[c.j].qualified_name)
+            clear_bound_cache()
+            assert _same(_num(c.ideal), _num(one.ideal_bound.value), 0.0)

@@ -31,6 +31,8 @@ import numpy as np
 
 __all__ = [
     "BOUND_CACHE_SIZE",
+    "class_survival",
+    "projection_noise",
     "cached_ideal_max_ratio",
     "cached_ideal_min_contact",
     "clear_bound_cache",
@@ -129,6 +131,27 @@ def _survival(t, a, b, wa, wb, e_s, s):
     z[np.isnan(z)] = 0.0
     middle = half * (_ndtr(z) @ _GL_W)
     return np.minimum(np.maximum(((b - e_hi) + middle) / (b - a), 0.0), 1.0)
+
+
+def class_survival(t, e_low: float, e_high: float, e_sensor: float, s: float) -> np.ndarray:
+    """``P(w(e) + s N(0,1) > t)`` for ``e ~ U[e_low, e_high)``, at every threshold ``t`` (scipy-free).
+
+    The same closed form as :func:`designkit.recognition.ideal.class_survival` (agrees to 1e-12,
+    tested), without importing scipy (the query layer's multi-class view uses it).
+
+    >>> float(class_survival([0.0], 20000.0, 20080.0, 892.0, 0.01)[0])
+    1.0
+    """
+    t = np.asarray(t, dtype=np.float64)
+    return _survival(t, float(e_low), float(e_high), _weight(e_sensor, float(e_low)), _weight(e_sensor, float(e_high)),
+                     e_sensor, np.full(t.shape, float(s)))
+
+
+def projection_noise(sensor, contact_s: float, ratio: float) -> float:
+    """Projection noise ``s = (sigma/dT) / |g|`` (inf: no sample after contact), as
+    :func:`designkit.recognition.ideal.projection_noise` for fixed initial conditions."""
+    norm = float(shape_norm(sensor, contact_s))
+    return math.inf if norm == 0.0 or math.isinf(ratio) else ratio / norm
 
 
 def ideal_f1(lo, hi, width, e_sensor: float, s, *, points: int = 17, passes: int = 7) -> np.ndarray:

@@ -345,10 +345,10 @@ def multiclass_ideal_accuracy(ranges, sensor, scene, *, max_bins: int = _MAX_BIN
     1.0
     """
     from ..models.semi_infinite import object_weight
-    from ..recognition.ideal import class_survival, projection_noise
+    from .ideal_bound import class_survival, projection_noise  # scipy-free: importing scipy cost more than this
 
     r = np.asarray(ranges, dtype=np.float64)
-    s = projection_noise(sensor, scene)
+    s = projection_noise(sensor, scene.contact_s, scene.noise_ratio)
     K = r.shape[0]
     if not np.isfinite(s):
         return 1.0 / K
@@ -447,6 +447,43 @@ def _multiclass(mats, tab, *, noise_c: float, delta_t_c: float, svm_trials: int 
 
 
 # ============================================================ the matrix
+def _prefill_bounds(question: str, mats, tab, itab, given: dict) -> None:
+    """The closed-form ideal bounds of all pairs in one vectorized call, kept in the cache of
+    :mod:`designkit.query.ideal_bound` where the per-pair table questions find them: one bisection per
+    pair (numpy's per-call overhead, ~16 ms each) was most of a 12-material matrix. Anything odd is left
+    to the per-pair questions, which say what is wrong."""
+    if question not in ("min-contact", "max-noise", "min-delta-t"):
+        return
+    from . import table as table_route
+    from .ideal_bound import cached_ideal_max_ratio, cached_ideal_min_contact
+    from .inputs import check_contact, pair_question, scene_inputs
+
+    try:
+        op = table_route.open_table(tab, itab, threshold=given.get("threshold"), sensor=given.get("sensor"),
+                                    model=given.get("model"))
+        if not op.closed:
+            return
+        los, his = [], []
+        for i in range(len(mats)):
+            for j in range(i + 1, len(mats)):
+                pq = pair_question(m1=mats[i].qualified_name, m2=mats[j].qualified_name, width=op.width,
+                                   model=op.model)
+                if pq.classes is not None and op.view.e_in_grid(*pq.points):
+                    los.append(pq.points[0])
+                    his.append(pq.points[1])
+        if not los:
+            return
+        if question == "min-contact":
+            noise, dt = scene_inputs(given.get("noise_c", 0.05), given.get("delta_t_c", 10.0))
+            cached_ideal_min_contact(op.tab.sensor, los, his, noise / abs(dt), width=op.width, threshold=op.phi,
+                                     max_contact_s=table_route.CLOSED_FORM_MAX_CONTACT_S)
+        else:
+            cached_ideal_max_ratio(op.tab.sensor, los, his, check_contact(given["contact_s"]), width=op.width,
+                                   threshold=op.phi, bracket=table_route.CLOSED_FORM_RATIO_BRACKET)
+    except (InputError, KeyError):
+        return
+
+
 def _bound(question: str, a: Answer) -> str:
     """Whether the value is a grid end beyond which the true answer lies (see :class:`MatrixCell`)."""
     if a.value is None or isinstance(a.value, bool):
@@ -555,6 +592,7 @@ def material_matrix(materials: Sequence[str | Material] = (), question: str = "m
     total = n * (n - 1) // 2 + n_svm
     if svm_trials is not None and (int(svm_trials) != svm_trials or svm_trials < 3):
         raise InputError(f"svm_trials must be an integer of at least 3 (3-fold cross-validation), got {svm_trials}")
+    _prefill_bounds(question, mats, tab, itab, given)
     for i in range(n):
         for j in range(i + 1, n):
             a = ask(question, route="table", m1=mats[i].qualified_name, m2=mats[j].qualified_name, table=tab,

@@ -316,6 +316,36 @@ def _app_for(argv: list[str]) -> typer.Typer:
     return lean
 
 
+class busy:
+    """A spinner with the elapsed time on stderr while a long library call runs (a terminal only).
+
+    For work whose library call reports no progress (an exact question without a coverage target,
+    ``f1``, a model identification): the user sees that something runs and for how long. Piped,
+    logged or under ``--json`` nothing is drawn; the line disappears when the work ends.
+
+    >>> with busy("nothing to see", quiet=True):
+    ...     pass
+    """
+
+    def __init__(self, message: str, *, quiet: bool = False):
+        self.message, self.quiet, self._progress = message, quiet, None
+
+    def __enter__(self) -> "busy":
+        if not self.quiet and hasattr(sys.stderr, "isatty") and sys.stderr.isatty():
+            from rich.console import Console
+            from rich.progress import Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
+
+            self._progress = Progress(SpinnerColumn(), TextColumn("{task.description}"), TimeElapsedColumn(),
+                                      console=Console(stderr=True), transient=True)
+            self._progress.add_task(self.message, total=None)
+            self._progress.start()
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        if self._progress is not None:
+            self._progress.stop()
+
+
 def main() -> None:
     """Console-script entry point."""
     try:

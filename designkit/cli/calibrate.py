@@ -463,7 +463,8 @@ def _run_identify(index: Path, model: str, fit_sets: str, ranges: list[str], onl
         fit, held = split_by_trial_set(trials, _parse_sets(fit_sets), index)
     else:
         fit, held = trials, []
-    cmp = compare_models(fit, held, cands, **kw)   # no held-out touches: selected by BIC
+    with _app.busy(f"identifying {len(cands)} model(s) on {len(fit)} touches", quiet=json_):
+        cmp = compare_models(fit, held, cands, **kw)   # no held-out touches: selected by BIC
     results, scores, selected = cmp.results, cmp.held_out_rms_c, cmp.selected
     if json_:
         emit_json({"index": str(index), "n_fit": len(fit), "n_held_out": len(held), "selected": selected,

@@ -213,9 +213,10 @@ def f1(
     obj2 = object_class(e2, width=width, diffusivity_m2_s=diffusivity)
     ra, rb = obj1.e_range, obj2.e_range
     t0 = time.perf_counter()
-    svm = pair_f1(obj1, obj2, sen, scene, model=fm, trials=trials, folds=folds, seed=seed)
-    t1 = time.perf_counter()
-    ideal = ideal_pair(obj1, obj2, sen, scene, seed=seed, model=fm)
+    with _app.busy("f1: simulating touches, fitting the SVM, the ideal observer", quiet=json_):
+        svm = pair_f1(obj1, obj2, sen, scene, model=fm, trials=trials, folds=folds, seed=seed)
+        t1 = time.perf_counter()
+        ideal = ideal_pair(obj1, obj2, sen, scene, seed=seed, model=fm)
     t2 = time.perf_counter()
     payload = {
         "svm_f1": svm.f1,

@@ -109,7 +109,10 @@ def _ask(question: str, *, exact: bool, table: Optional[str], ideal_table: str, 
                              sensor=None if sensor == "paper" else sensor, model=fm)
         kw = dict(threshold=threshold, sensor=sensor, model=fm, diffusivity_m2_s=diffusivity, width=width,
                   trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc, **extra)
-        if not (progress and "coverage" in extra):
+        if "coverage" not in extra:  # no progress reported by this question's exact route: a spinner
+            with _app.busy(f"{question}: simulating touches and fitting SVMs (exact route)", quiet=not progress):
+                return query.ask(question, route="exact", **objects, **scene, **kw)
+        if not progress:
             return query.ask(question, route="exact", **objects, **scene, **kw)
         from rich.console import Console
         from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
@@ -274,7 +277,8 @@ def max_noise_cmd(
     ans = _ask("max-noise", exact=exact, table=table, ideal_table=ideal_table, threshold=threshold, sensor=sensor,
                model=model, conductance=conductance, thickness=thickness, backing=backing, diffusivity=diffusivity,
                width=width, trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc,
-               objects=dict(e1=e1, e2=e2, m1=m1, m2=m2), scene=dict(contact_s=contact, delta_t_c=delta_t))
+               objects=dict(e1=e1, e2=e2, m1=m1, m2=m2), scene=dict(contact_s=contact, delta_t_c=delta_t),
+               progress=not json_)
     _render(ans, json_)
 
 
@@ -295,7 +299,8 @@ def min_delta_t_cmd(
     ans = _ask("min-delta-t", exact=exact, table=table, ideal_table=ideal_table, threshold=threshold, sensor=sensor,
                model=model, conductance=conductance, thickness=thickness, backing=backing, diffusivity=diffusivity,
                width=width, trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc,
-               objects=dict(e1=e1, e2=e2, m1=m1, m2=m2), scene=dict(contact_s=contact, noise_c=noise))
+               objects=dict(e1=e1, e2=e2, m1=m1, m2=m2), scene=dict(contact_s=contact, noise_c=noise),
+               progress=not json_)
     _render(ans, json_)
 
 
@@ -323,7 +328,8 @@ def delta_e_cmd(
     ans = _ask("delta-e", exact=exact, table=table, ideal_table=ideal_table, threshold=threshold, sensor=sensor,
                model=model, conductance=conductance, thickness=thickness, backing=backing, diffusivity=diffusivity,
                width=width, trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc,
-               objects=dict(e=e, m=m), scene=dict(contact_s=contact, noise_c=noise, delta_t_c=delta_t))
+               objects=dict(e=e, m=m), scene=dict(contact_s=contact, noise_c=noise, delta_t_c=delta_t),
+               progress=not json_)
     if fmt is not None:
         d = ans.to_dict()
         rows = [{"direction": side, "e": d["details"]["e"], "delta": d["details"][side]["value"],
@@ -357,5 +363,5 @@ def distinguishable_cmd(
                sensor=sensor, model=model, conductance=conductance, thickness=thickness, backing=backing,
                diffusivity=diffusivity, width=width, trials=trials, repeats=repeats, seed=seed, jobs=jobs,
                n_mc=n_mc, objects=dict(e1=e1, e2=e2, m1=m1, m2=m2),
-               scene=dict(contact_s=contact, noise_c=noise, delta_t_c=delta_t))
+               scene=dict(contact_s=contact, noise_c=noise, delta_t_c=delta_t), progress=not json_)
     _render(ans, json_)

@@ -154,7 +154,8 @@ def projection_noise(sensor, contact_s: float, ratio: float) -> float:
     return math.inf if norm == 0.0 or math.isinf(ratio) else ratio / norm
 
 
-def ideal_f1(lo, hi, width, e_sensor: float, s, *, points: int = 17, passes: int = 7) -> np.ndarray:
+def ideal_f1(lo, hi, width, e_sensor: float, s, *, points: int = 17, passes: int = 7,
+             stop_at: float | None = None) -> np.ndarray:
     """Best F1 of the ideal observer for classes ``[lo, lo+width)`` and ``[hi, hi+width)``, vectorized.
 
     Parameters
@@ -170,6 +171,10 @@ def ideal_f1(lo, hi, width, e_sensor: float, s, *, points: int = 17, passes: int
     points, passes : int
         Thresholds per pass and passes (each zooms onto the best cell: the
         threshold is located to ``(2 / (points - 1)) ** passes`` of its bracket).
+    stop_at : float, optional
+        Stop zooming once every element's F1 reaches this (a decision ``F1 >= stop_at``
+        needs no more: F1 only grows with the passes). The values returned are then
+        lower bounds, exact as decisions.
 
     Returns
     -------
@@ -209,6 +214,8 @@ def ideal_f1(lo, hi, width, e_sensor: float, s, *, points: int = 17, passes: int
         f = f1(t)
         k = np.argmax(f, axis=1)
         best = np.maximum(best, f[np.arange(k.size), k])
+        if stop_at is not None and np.all(best >= stop_at):
+            break
         step = (b - a) / (points - 1)
         centre = t[np.arange(k.size), k]
         a, b = centre - step, centre + step
@@ -217,7 +224,7 @@ def ideal_f1(lo, hi, width, e_sensor: float, s, *, points: int = 17, passes: int
 
 
 def _ok(sensor, lo, hi, width, s, threshold) -> np.ndarray:
-    return ideal_f1(lo, hi, width, sensor.effusivity, s) >= threshold
+    return ideal_f1(lo, hi, width, sensor.effusivity, s, stop_at=threshold) >= threshold
 
 
 def exact_ideal_min_contact(sensor, lo, hi, ratio, *, width: float = 80.0, threshold: float = 0.9,

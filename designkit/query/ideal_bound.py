@@ -198,9 +198,10 @@ def ideal_f1(lo, hi, width, e_sensor: float, s, *, points: int = 17, passes: int
     cols = [x[:, None] for x in (ha, hb, _weight(e_sensor, ha), _weight(e_sensor, hb),
                                  la, lb, _weight(e_sensor, la), _weight(e_sensor, lb), s)]
 
-    def f1(t):  # t: (n, k) thresholds per pair
-        tpr = _survival(t, *cols[0:4], e_sensor, cols[8])
-        fpr = _survival(t, *cols[4:8], e_sensor, cols[8])
+    def f1(t, rows):  # t: (len(rows), k) thresholds per pair of ``rows``
+        c = cols if rows is None else [x[rows] for x in cols]
+        tpr = _survival(t, *c[0:4], e_sensor, c[8])
+        fpr = _survival(t, *c[4:8], e_sensor, c[8])
         return 2.0 * tpr / (1.0 + tpr + fpr)
 
     # F1 is quasi-concave in the threshold: a grid, then zooms onto the best cell (one vectorized
@@ -209,16 +210,25 @@ def ideal_f1(lo, hi, width, e_sensor: float, s, *, points: int = 17, passes: int
     b = _weight(e_sensor, np.maximum(lb, hb)) + (_CUT + 1) * s
     best = np.full(la.shape, -np.inf)
     u = np.linspace(0.0, 1.0, points)
+    rows = None  # the elements still zooming (None: all); with stop_at, those below it
     for _ in range(passes):
-        t = a[:, None] + (b - a)[:, None] * u
-        f = f1(t)
+        ra, rb = (a, b) if rows is None else (a[rows], b[rows])
+        t = ra[:, None] + (rb - ra)[:, None] * u
+        f = f1(t, rows)
         k = np.argmax(f, axis=1)
-        best = np.maximum(best, f[np.arange(k.size), k])
-        if stop_at is not None and np.all(best >= stop_at):
-            break
-        step = (b - a) / (points - 1)
+        top = f[np.arange(k.size), k]
+        step = (rb - ra) / (points - 1)
         centre = t[np.arange(k.size), k]
-        a, b = centre - step, centre + step
+        if rows is None:
+            best = np.maximum(best, top)
+            a, b = centre - step, centre + step
+        else:
+            best[rows] = np.maximum(best[rows], top)
+            a[rows], b[rows] = centre - step, centre + step
+        if stop_at is not None:
+            rows = np.nonzero(best < stop_at)[0]
+            if rows.size == 0:
+                break
     out[ok] = np.maximum(best, _TRIVIAL_F1)
     return out.reshape(shape)
 

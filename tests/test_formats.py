@@ -154,3 +154,25 @@ def test_row_commands_print_csv_with_a_header_and_rows_only_and_json_that_parses
 
 def test_tables_list_json_flag_equals_format_json(cli):
     assert cli("tables", "list", "--json").stdout == cli("tables", "list", "--format", "json").stdout
+
+
+def test_out_to_a_fifo_nothing_reads_is_refused_not_waited_on(cli, tmp_path):
+    import os
+    import threading
+
+    fifo = tmp_path / "pipe"
+    os.mkfifo(fifo)
+    r = cli("tables", "list", "--format", "csv", "--out", str(fifo))
+    assert r.exit_code == 2 and "nothing reads" in r.output
+    got = []
+    reader = threading.Thread(target=lambda: got.append(fifo.read_text()))
+    reader.start()
+    import time
+
+    for _ in range(200):  # the reader opens the FIFO: now it is written to
+        r = cli("tables", "list", "--format", "csv", "--out", str(fifo))
+        if r.exit_code == 0:
+            break
+        time.sleep(0.01)
+    reader.join(timeout=30)
+    assert r.exit_code == 0 and got and got[0].startswith("name,")

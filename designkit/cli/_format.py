@@ -168,9 +168,25 @@ def write_output(text: str, out: str | None) -> None:
         sys.stdout.write(text)
         sys.stdout.flush()
         return
+    import os
+    import stat
+
     p = Path(out)
     if p.parent and not p.parent.is_dir():
         raise InputError(f"cannot write {p}: folder {p.parent} does not exist")
+    try:
+        fifo = stat.S_ISFIFO(os.stat(p).st_mode)
+    except OSError:
+        fifo = False
+    if fifo:  # a named pipe: written to when something reads it, refused (not waited on) when nothing does
+        try:
+            fd = os.open(p, os.O_WRONLY | os.O_NONBLOCK)
+        except OSError:
+            raise InputError(f"cannot write {p}: a FIFO (named pipe) that nothing reads") from None
+        os.set_blocking(fd, True)
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+        return
     p.write_text(text, encoding="utf-8")
 
 

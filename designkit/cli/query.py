@@ -143,7 +143,7 @@ def _render(ans, json_: bool) -> None:
 
 
 def _render_text(d) -> None:
-    con = console()
+    con = _app.text_console()
     sc = d["scene"]
     scene = [f"{w} {sc[k]:g}{u}" for k, w, u in (("noise_c", "noise", " °C"), ("delta_t_c", "dT", " °C"),
                                                   ("contact_s", "contact", " s")) if sc.get(k) is not None]

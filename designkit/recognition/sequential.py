@@ -598,6 +598,11 @@ class SequentialTest:
         return DecisionPlan(cands, thr, self.max_contact_s, False, None, bad, reason)
 
     @property
+    def n_samples(self) -> int:
+        """Samples fed since the touch began."""
+        return self._n
+
+    @property
     def shape_table(self) -> np.ndarray:
         """The response shape ``g_k = g(k / fs)`` up to the longest contact (a copy)."""
         return self._g.copy()

@@ -51,7 +51,7 @@ int main(int argc, char **argv) {
         clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &a);
         for (i = 0; i < n_touch; i++) {
             seq_state st;
-            seq_init(&st);
+            seq_init(&st, SEQ_DEFAULT_TS0_C, SEQ_DEFAULT_TA_C);
             for (k = 0; k < m; k++) {
                 int r = seq_update(&st, (double)k / SEQ_SAMPLE_RATE_HZ, y[i * m + k]);
                 calls++;

@@ -14,6 +14,11 @@ Protocol, fixed before looking at test touches:
 - candidates: metal [12767, 25972] and wood [331, 506] J s^-1/2 K^-1 m^-2 (the
   calibration ranges); each touch's Ts0 is the heated sensor's mean before
   contact and Ta the passive thermistor's (what a robot measures);
+- a second run assumes sigma = RMS x sqrt(99): the recordings were smoothed by the host
+  with a Savitzky-Golay window of 99 samples (the recordings' README), so the misfit is
+  correlated over about 99 samples and a white-noise likelihood counts each piece of
+  evidence about 99 times; sqrt(99) is the matching inflation (chosen from the README,
+  not tuned on the test touches);
 - the test touches (sets 5-20) are replayed sample by sample through
   :meth:`SequentialTest.update` from the calibrated onset, up to 4 s;
 - baseline: the paper's SVM trained and tested on real touches (3-fold x 10
@@ -46,7 +51,7 @@ def data_dir() -> Path | None:
     return None
 
 
-def main(eps_list=(0.05, 0.01, 0.001)) -> int:
+def main(eps_list=(0.01, 0.001)) -> int:
     d = data_dir()
     if d is None:
         print("robot recordings not found (set DESIGNKIT_ROBOT_DATA): nothing to measure")
@@ -56,46 +61,48 @@ def main(eps_list=(0.05, 0.01, 0.001)) -> int:
     touches = load_real(d, contact_s=6.0)
     setup = calibrate(touches, seed=0)
     print(f"calibration ({time.perf_counter() - t0:.1f} s): {setup.source}")
-    sensor, offset, sigma = setup.sensor, setup.time_offset_s, setup.rms_c
+    sensor, offset, rms = setup.sensor, setup.time_offset_s, setup.rms_c
     print(f"  e_s {sensor.effusivity:.0f}, tau {sensor.tau_s:.3f} s, time offset {offset:+.3f} s, "
-          f"residual RMS {sigma:.3f} degC (the sigma assumed)")
+          f"residual RMS {rms:.3f} degC")
     test_sets = touches.trial_set >= 5
     fs = sensor.sample_rate_hz
     k0 = int(round(max(offset, 0.0) * fs))  # first sample after the heat starts to flow
     cands = [("metal", (12767.0, 25972.0)), ("wood", (331.0, 506.0))]
     print(f"test touches: trial sets 5-20, {int(test_sets.sum())} touches; replay from {k0 / fs:.3f} s after the "
           f"detected onset, at most 4 s of contact")
-    for eps in eps_list:
-        rows = {}
-        for mat in ("metal", "wood", "cold_wood"):
-            idx = np.flatnonzero(test_sets & (touches.material == mat))
-            out = []
-            for i in idx:
-                test = SequentialTest(cands, sensor, noise_c=sigma, sensor_temp_c=touches.sensor_temp_c[i],
-                                      ambient_temp_c=touches.object_temp_c[i], error_rate=eps, max_contact_s=4.0)
-                dec = None
-                for k in range(k0, touches.time_s.size):
-                    t_rel = (k - k0) / fs
-                    if t_rel > 4.0 + 1e-9:
-                        break
-                    dec = test.update(t_rel, touches.sensor_c[i, k])
-                    if dec.final:
-                        break
-                out.append((dec.state, dec.material, dec.time_s))
-            rows[mat] = out
-        mw = rows["metal"] + rows["wood"]
-        truth = ["metal"] * len(rows["metal"]) + ["wood"] * len(rows["wood"])
-        decided = [o for o in mw if o[0] == "decided"]
-        correct = sum(o[0] == "decided" and o[1] == t for o, t in zip(mw, truth))
-        times = np.array([o[2] for o in mw])
-        print(f"  eps {eps:g}: metal vs wood: {correct}/{len(mw)} correct ({correct / len(mw):.3f}), "
-              f"{len(mw) - len(decided)} undecided by 4 s; time to decision mean {times.mean():.3f} s, "
-              f"median {np.median(times):.3f}, max {times.max():.3f} "
-              f"(metal {np.mean([o[2] for o in rows['metal']]):.3f}, wood {np.mean([o[2] for o in rows['wood']]):.3f})")
-        cw = rows["cold_wood"]
-        says = {m: sum(o[0] == "decided" and o[1] == m for o in cw) for m in ("metal", "wood")}
-        print(f"          cold wood ({len(cw)} touches): said metal {says['metal']}, wood {says['wood']}, "
-              f"undecided {len(cw) - sum(says.values())}; mean time {np.mean([o[2] for o in cw]):.3f} s")
+    for sigma, why in ((rms, "residual RMS"), (rms * np.sqrt(99.0), "residual RMS x sqrt(99), the smoothing window")):
+        print(f" sigma {sigma:.3f} degC ({why}):")
+        for eps in eps_list:
+            rows = {}
+            for mat in ("metal", "wood", "cold_wood"):
+                idx = np.flatnonzero(test_sets & (touches.material == mat))
+                out = []
+                for i in idx:
+                    test = SequentialTest(cands, sensor, noise_c=sigma, sensor_temp_c=touches.sensor_temp_c[i],
+                                          ambient_temp_c=touches.object_temp_c[i], error_rate=eps, max_contact_s=4.0)
+                    dec = None
+                    for k in range(k0, touches.time_s.size):
+                        t_rel = (k - k0) / fs
+                        if t_rel > 4.0 + 1e-9:
+                            break
+                        dec = test.update(t_rel, touches.sensor_c[i, k])
+                        if dec.final:
+                            break
+                    out.append((dec.state, dec.material, dec.time_s))
+                rows[mat] = out
+            mw = rows["metal"] + rows["wood"]
+            truth = ["metal"] * len(rows["metal"]) + ["wood"] * len(rows["wood"])
+            decided = [o for o in mw if o[0] == "decided"]
+            correct = sum(o[0] == "decided" and o[1] == t for o, t in zip(mw, truth))
+            times = np.array([o[2] for o in mw])
+            print(f"  eps {eps:g}: metal vs wood: {correct}/{len(mw)} correct ({correct / len(mw):.3f}), "
+                  f"{len(mw) - len(decided)} undecided by 4 s; time to decision mean {times.mean():.3f} s, "
+                  f"median {np.median(times):.3f}, max {times.max():.3f} "
+                  f"(metal {np.mean([o[2] for o in rows['metal']]):.3f}, wood {np.mean([o[2] for o in rows['wood']]):.3f})")
+            cw = rows["cold_wood"]
+            says = {m: sum(o[0] == "decided" and o[1] == m for o in cw) for m in ("metal", "wood")}
+            print(f"          cold wood ({len(cw)} touches): said metal {says['metal']}, wood {says['wood']}, "
+                  f"undecided {len(cw) - sum(says.values())}; mean time {np.mean([o[2] for o in cw]):.3f} s")
     real4 = load_real(d, contact_s=4.0)
     for pair in (("wood", "metal"), ("cold_wood", "metal")):
         r = real_pair_f1(real4, pair, repeats=10, seed=0)

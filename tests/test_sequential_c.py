@@ -28,18 +28,20 @@ MAIN = r"""
 #include <stdio.h>
 #include <stdlib.h>
 #include "seq.h"
-/* stdin: lines "t y"; a line "R" starts a new touch. stdout: per touch "answer n time_s" at the first
-   final answer (or the last sample), and every BAD_RATE / INVALID answer as "E code". */
+/* stdin: a line "R ts0 ta" starts a touch, then lines "t y". stdout: per touch "answer n time_s" at the
+   first final answer (or after its last sample), and every BAD_RATE / INVALID answer as "E code". */
 int main(void) {
     char line[256];
     seq_state st;
-    int done = 0, last = SEQ_KEEP_TOUCHING;
-    seq_init(&st);
+    int done = 1, last = SEQ_KEEP_TOUCHING;
+    seq_init(&st, SEQ_DEFAULT_TS0_C, SEQ_DEFAULT_TA_C);
     while (fgets(line, sizeof line, stdin)) {
         double t, y;
         if (line[0] == 'R') {
             if (!done) printf("%d %ld %.17g\n", last, st.n, st.time_s);
-            seq_init(&st); done = 0; last = SEQ_KEEP_TOUCHING;
+            if (sscanf(line + 1, "%lf %lf", &t, &y) != 2) return 3;
+            if (seq_init(&st, t, y) != 0) { printf("E init\n"); return 0; }
+            done = 0; last = SEQ_KEEP_TOUCHING;
             continue;
         }
         if (sscanf(line, "%lf %lf", &t, &y) != 2) return 3;
@@ -52,7 +54,6 @@ int main(void) {
 }
 """
 
-
 def _build(tmp_path: Path, test: SequentialTest, flags=("-O2",)) -> Path:
     (tmp_path / "seq.h").write_bytes(write_sequential_c(test, "seq"))
     (tmp_path / "main.c").write_text(MAIN)
@@ -62,10 +63,10 @@ def _build(tmp_path: Path, test: SequentialTest, flags=("-O2",)) -> Path:
     return exe
 
 
-def _python(test: SequentialTest, times, temps):
+def _python(make, temps0, times, temps):
     out = []
-    for row in temps:
-        test.reset()
+    for (ts0, ta), row in zip(temps0, temps):
+        test = make(ts0, ta)
         for t, y in zip(times, row):
             d = test.update(t, y)
             if d.final:
@@ -77,11 +78,10 @@ def _python(test: SequentialTest, times, temps):
     return out
 
 
-def _c(exe: Path, times, temps):
+def _c(exe: Path, temps0, times, temps):
     lines = []
-    for i, row in enumerate(temps):
-        if i:
-            lines.append("R")
+    for (ts0, ta), row in zip(temps0, temps):
+        lines.append(f"R {float(ts0)!r} {float(ta)!r}")
         lines.extend(f"{float(t)!r} {float(y)!r}" for t, y in zip(times, row))
     r = subprocess.run([str(exe)], input="\n".join(lines) + "\n", capture_output=True, text=True, check=True)
     out = []
@@ -98,13 +98,22 @@ def _c(exe: Path, times, temps):
      [(331.0, 506.46), (550.0, 650.0), (12767.0, 25972.0)], 0.3),
 ])
 def test_c_decisions_equal_python(tmp_path, cands, e_true, noise):
-    test = SequentialTest(list(cands), PAPER, noise_c=0.05 if len(cands) == 2 else 0.2, sensor_temp_c=35.0,
-                          ambient_temp_c=25.0, error_rate=0.01, max_contact_s=3.0)
-    exe = _build(tmp_path, test)
+    sigma = 0.05 if len(cands) == 2 else 0.2
+
+    def make(ts0, ta):
+        return SequentialTest(list(cands), PAPER, noise_c=sigma, sensor_temp_c=ts0, ambient_temp_c=ta,
+                              error_rate=0.01, max_contact_s=3.0)
+    exe = _build(tmp_path, make(35.0, 25.0))
     temps = np.vstack([simulate_class(ObjectClass("x", r), 30, PAPER, Scene(contact_s=3.0, noise_c=noise),
                                       seed=[4, i]).temperature_c for i, r in enumerate(e_true)])
+    # each touch its own initial temperatures (as a robot measures them), shifted readings to match
+    rng = np.random.default_rng(7)
+    shift = rng.uniform(-3.0, 3.0, temps.shape[0])
+    ta = 25.0 + rng.uniform(-2.0, 2.0, temps.shape[0])
+    temps = temps + shift[:, None]  # the same touches, seen from other set points (Ta differs too: both sides get it)
+    temps0 = list(zip(35.0 + shift, ta))
     times = np.arange(temps.shape[1]) / PAPER.sample_rate_hz
-    py, c = _python(test, times, temps), _c(exe, times, temps)
+    py, c = _python(make, temps0, times, temps), _c(exe, temps0, times, temps)
     assert len(c) == len(py)
     assert c == py
     codes = {a for a, _, _ in py}
@@ -115,13 +124,16 @@ def test_c_refuses_off_grid_samples_and_hopeless_pairs(tmp_path):
     test = SequentialTest([("a", 20000.0), ("b", 35000.0)], PAPER, noise_c=0.05, sensor_temp_c=35,
                           ambient_temp_c=25, error_rate=0.05, max_contact_s=2.0)
     exe = _build(tmp_path, test)
-    r = subprocess.run([str(exe)], input="0 35\n0.001 35\n0.005 35\nnan 35\n", capture_output=True, text=True,
-                       check=True)
+    r = subprocess.run([str(exe)], input="R 35 25\n0 35\n0.001 35\n0.005 35\nnan 35\n", capture_output=True,
+                       text=True, check=True)
     assert r.stdout.split("\n")[:2] == ["E -4", "E -5"]
+    r = subprocess.run([str(exe)], input="R 35 35\n", capture_output=True, text=True, check=True)
+    assert r.stdout == "E init\n"
     hopeless = SequentialTest([("a", 20000.0), ("b", 20050.0)], PAPER, noise_c=0.05, sensor_temp_c=35,
                               ambient_temp_c=25, error_rate=0.01, max_contact_s=2.0)
     exe = _build(tmp_path, hopeless)
-    assert subprocess.run([str(exe)], input="0 35\n", capture_output=True, text=True).stdout.startswith("-3 ")
+    assert subprocess.run([str(exe)], input="R 35 25\n0 35\n", capture_output=True,
+                          text=True).stdout.startswith("-3 ")
 
 
 def test_c_header_escapes_names_and_validates_the_prefix(tmp_path):

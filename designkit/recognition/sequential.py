@@ -77,7 +77,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import special
+from scipy import optimize, special
 
 from .._validation import InputError, check_positive
 from ..models import get_model
@@ -411,15 +411,14 @@ def fixed_time_errors(range_low, range_high, error_low: float, error_high: float
     for i, s_i in enumerate(s):
         if not np.isfinite(s_i):
             continue
-        # threshold where the low class's false-positive rate equals error_low (bisection on w)
-        lo_w, hi_w = -1.0, 2.0
-        for _ in range(80):
-            mid = 0.5 * (lo_w + hi_w)
-            if _survival(mid, range_low, es, s_i) > error_low:
-                lo_w = mid
-            else:
-                hi_w = mid
-        miss = 1.0 - _survival(hi_w, range_high, es, s_i)
+        # threshold where the low class's false-positive rate equals error_low (Brent's method on w;
+        # P(v > t | low) falls from 1 to 0 over [-1, 2] for any s that matters here)
+        def excess(t, s_i=s_i):
+            return _survival(t, range_low, es, s_i) - error_low
+        lo_w, hi_w = -1.0 - 10.0 * s_i, 2.0 + 10.0 * s_i
+        thr = optimize.brentq(excess, lo_w, hi_w, xtol=1e-14, rtol=4 * np.finfo(float).eps) \
+            if excess(lo_w) > 0 > excess(hi_w) else hi_w
+        miss = 1.0 - _survival(thr, range_high, es, s_i)
         ok[i] = miss <= error_high
     return ok
 

@@ -72,3 +72,24 @@ def test_classify_bad_input_is_one_line(cli, args, msg):
     r = cli("classify", "--port", "/dev/null", *args)
     assert r.exit_code == 2, r.output
     assert msg in r.output and len(r.output.strip().splitlines()) == 1
+
+
+def test_classify_export_c_writes_a_header_that_compiles(cli, tmp_path):
+    import shutil
+    import subprocess
+
+    out = tmp_path / "robot_seq.h"
+    r = cli("classify", "--m", "wood", "--m", "metal=12767:25972", "--export-c", str(out), "--prefix", "robot",
+            "--json")
+    assert r.exit_code == 0, r.output
+    text = out.read_text()
+    assert json.loads(r.stdout)["bytes"] == len(text.encode()) and "robot_update" in text
+    cc = shutil.which("cc") or shutil.which("gcc")
+    if cc:
+        (tmp_path / "m.c").write_text('#include "robot_seq.h"\nint main(void) { robot_state s; '
+                                      'robot_init(&s, 35.0, 25.0); return robot_update(&s, 0.0, 35.0) != -1; }\n')
+        subprocess.run([cc, "-std=c99", "-Wall", "-Werror", "-o", str(tmp_path / "m"), str(tmp_path / "m.c"), "-lm"],
+                       check=True)
+        assert subprocess.run([str(tmp_path / "m")]).returncode == 0
+    r = cli("classify", "--m", "a=1", "--m", "b=2", "--export-c", str(out), "--prefix", "9bad")
+    assert r.exit_code == 2 and "prefix" in r.output

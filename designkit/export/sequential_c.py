@@ -66,7 +66,7 @@ def write_sequential_c(test: "seq.SequentialTest", prefix: str = "designkit_seq"
     lines = [" *   " + c_comment(f"{i}: {c.name}, e [{c.e_range[0]:g}, {c.e_range[1]:g}), error rate {c.error_rate:g}, "
                                   f"{len(c.log_mass)} piece(s)") for i, c in enumerate(cands)]
     s = test.sensor
-    nbytes = 8 * (g.size + 3 * len(lm) + k * k + 2) + 8 * k
+    nbytes = 8 * (g.size + 4 * len(lm) + k * k + 2) + 8 * k
     thr = [[float(x) for x in row] for row in plan.thresholds]
     text = fill_template(read_template(TEMPLATE), {
         "P": P, "p": prefix,
@@ -83,11 +83,13 @@ def write_sequential_c(test: "seq.SequentialTest", prefix: str = "designkit_seq"
         "SEPARABLE": "1" if plan.separable else "0", "BYTES": str(nbytes),
         "FS": c_double(s.sample_rate_hz), "TS0": c_double(test.sensor_temp_c), "TA": c_double(test.ambient_temp_c),
         "SIGMA": c_double(test.noise_c), "LOG_SQRT_2PI": c_double(seq.LOG_SQRT_2PI), "FAR": c_double(seq.FAR_PIECES),
+        "CENTRAL": c_double(seq.CENTRAL),
         "NAMES": ", ".join(c_string(c.name) for c in cands),
         "THRESHOLDS": ", ".join("{" + ", ".join(c_double(x) for x in row) + "}" for row in thr),
         "FIRST": ", ".join(map(str, first)), "COUNT": ", ".join(map(str, count)),
         "W0": ", ".join(c_double(x) for x in w0), "W1": ", ".join(c_double(x) for x in w1),
         "LM": ", ".join(c_double(x) for x in lm),
+        "LW": ", ".join(c_double(math.log(b - a) if b > a else 0.0) for a, b in zip(w0, w1)),
         "G": _doubles(g),
     })
     if not all(math.isfinite(x) for row in thr for x in row):

@@ -28,7 +28,7 @@ LAYERS = [
     {"designkit.tables"},
     {"designkit.sweep"},
     {"designkit.query"},
-    {"designkit.export", "designkit.calibration"},
+    {"designkit.export", "designkit.calibration", "designkit.design"},
     {"designkit.accuracy", "designkit.reproduce"},
     {"designkit.cli", "designkit.__main__"},
 ]

@@ -338,14 +338,15 @@ class SerialRecorder:
         ``no_data_timeout_s``.
     """
 
-    def __init__(self, port: str, profile: DeviceProfile, out_dir: Path, *,
+    def __init__(self, port: str, profile: DeviceProfile, out_dir: Path | None, *,
                  no_data_timeout_s: float | None = None,
                  on_event: Callable[[RecordEvent], None] | None = None,
                  on_status: Callable[[RecorderStatus], None] | None = None) -> None:
         self.port = str(port)
         self.profile = profile
-        self.out_dir = Path(out_dir)
-        check_trial_folder(self.out_dir)
+        self.out_dir = Path(out_dir) if out_dir is not None else None  # None: a subclass writes no trials
+        if self.out_dir is not None:
+            check_trial_folder(self.out_dir)
         if no_data_timeout_s is None:
             no_data_timeout_s = profile.serial.no_data_timeout_s
         self.no_data_timeout_s = check_positive("no_data_timeout_s [s]", no_data_timeout_s)
@@ -446,13 +447,7 @@ class SerialRecorder:
             raise InputError("the material label must not be empty (it names the trials in the index)")
         if self._ser is None:
             self.open()
-        try:  # now, not when the first touch is complete
-            self.out_dir.mkdir(parents=True, exist_ok=True)
-        except OSError as exc:
-            raise InputError(f"cannot create the trial folder {self.out_dir}: {exc.strerror or exc}") from None
-        cutter = TrialCutter(self.profile, self.out_dir, material,
-                             meta={"profile": self.profile.name, "port": self.port,
-                                   "timestamps": "device" if self.profile.has_timestamp else "line count"})
+        cutter = self._new_cutter(material)
         self._cutter = cutter
         st = self.status
         st.material, st.target, st.trials, st.state = material, trials, 0, cutter.state
@@ -493,6 +488,21 @@ class SerialRecorder:
                 last_status = now
         self._publish(cutter)
         return self.written[start_written:]
+
+    def _new_cutter(self, material: str) -> TrialCutter:
+        """What the samples are fed to: a :class:`TrialCutter` writing into ``out_dir``.
+
+        A subclass may return another object with the cutter's interface
+        (``feed``, ``discontinuity``, ``state``, ``in_trial``, ``written``):
+        :class:`designkit.calibration.live.LiveClassifier` decides each touch live.
+        """
+        try:  # now, not when the first touch is complete
+            self.out_dir.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise InputError(f"cannot create the trial folder {self.out_dir}: {exc.strerror or exc}") from None
+        return TrialCutter(self.profile, self.out_dir, material,
+                           meta={"profile": self.profile.name, "port": self.port,
+                                 "timestamps": "device" if self.profile.has_timestamp else "line count"})
 
     def _sync(self, cutter: TrialCutter) -> None:
         for p in cutter.written:

@@ -12,6 +12,8 @@ from . import materials  # noqa: E402,F401  materials list, materials show
 from . import tables  # noqa: E402,F401  tables list, tables show
 from . import export  # noqa: E402,F401  export
 from . import calibrate  # noqa: E402,F401  calibrate (record, fit, guided run), emulate
+from . import classify  # noqa: E402,F401  classify (live decisions over serial)
+from . import design  # noqa: E402,F401  design (recommend a sensor)
 from . import core  # noqa: E402,F401  simulate, f1
 from . import sweep  # noqa: E402,F401  sweep
 from . import reproduce  # noqa: E402,F401  reproduce

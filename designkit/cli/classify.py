@@ -1,0 +1,204 @@
+"""``designkit classify``: decide each touch live over serial (a sequential test on the streaming samples).
+
+Exit status: 0 when every touch was answered, 2 for bad input (a stream whose
+sample rate differs from the sensor file's, unknown materials, ...), 3 when no
+contact time up to ``--max-contact`` can separate the materials at the requested
+error rates (said before the first touch), 130 on Ctrl-C (decisions so far are
+printed).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+from . import _app
+from ._app import EXIT_INTERRUPTED, app, console, emit_json
+from ._options import Json, SensorOpt
+
+#: Exit status when no decision is possible (as questions with no answer).
+EXIT_NO_DECISION = 3
+
+MOpt = Annotated[Optional[list[str]], typer.Option(
+    "--m", help="A candidate material (repeatable, two or more): a materials database name, NAME=MIN:MAX or "
+                "NAME=E [J s^-1/2 K^-1 m^-2].")]
+
+
+def parse_candidates(specs: list[str]) -> list:
+    """``--m`` values as SequentialTest candidates (database names, NAME=MIN:MAX, NAME=E)."""
+    from .._validation import InputError
+
+    out = []
+    for spec in specs:
+        name, sep, value = spec.partition("=")
+        if not sep:
+            out.append(spec.strip())
+            continue
+        lo, colon, hi = value.partition(":")
+        try:
+            rng = (float(lo), float(hi)) if colon else (float(lo), float(lo))
+        except ValueError:
+            raise InputError(f"--m {spec!r}: give NAME=MIN:MAX or NAME=E with effusivities in "
+                             "J s^-1/2 K^-1 m^-2, or a database name") from None
+        if not name.strip():
+            raise InputError(f"--m {spec!r}: the material needs a name before '='")
+        if not all(math.isfinite(x) and x > 0 for x in rng) or rng[1] < rng[0]:
+            raise InputError(f"--m {spec!r}: effusivities must be positive and finite, MIN <= MAX")
+        out.append((name.strip(), rng))
+    return out
+
+
+def _table(decisions, live, candidates) -> object:
+    from rich.table import Table
+
+    t = Table(title="live decisions", title_justify="left")
+    for col in ("touch", "decision", "time to decision [s]", "samples", "Ts0 [°C]", "Ta [°C]"):
+        t.add_column(col)
+    for d in decisions[-12:]:
+        t.add_row(str(d.index + 1), d.material if d.state == "decided" else d.state,
+                  f"{d.time_to_decision_s:.3f}", str(d.n_samples), f"{d.sensor_temp_c:.2f}", f"{d.ambient_temp_c:.2f}")
+    if live:
+        ll = live.get("log_likelihoods") or ()
+        lead = ", ".join(f"{c.name} {x - max(ll):.1f}" for c, x in zip(candidates, ll)) if ll else ""
+        t.caption = f"now: t = {live['t']:.3f} s, {live['temp_c']:.3f} °C; log-likelihood vs best: {lead}"
+    return t
+
+
+@app.command(rich_help_panel=_app.SENSOR)
+def classify(
+    port: Annotated[Optional[str], typer.Option(
+        "--port", help="Serial port of the rig (/dev/ttyACM0, COM3, or the pty 'designkit emulate' prints).")] = None,
+    profile: Annotated[str, typer.Option(
+        "--profile", help="Device profile: a shipped name ('designkit', 'adc12-thermistor') or a YAML file.")] = "designkit",
+    m: MOpt = None,
+    sensor: SensorOpt = "paper",
+    noise: Annotated[Optional[float], typer.Option(
+        "--noise", help="White-noise sigma per sample [°C] (default: the sensor file's, else 0.05).")] = None,
+    error_rate: Annotated[float, typer.Option(
+        "--error-rate", help="Requested probability of a wrong decision on a touch of each material.")] = 0.01,
+    max_contact: Annotated[float, typer.Option(
+        "--max-contact", help="Longest contact [s]: no decision by then is said so.")] = 5.0,
+    delta_t: Annotated[float, typer.Option(
+        "--delta-t", help="Expected sensor minus object temperature [°C], for the check before the first touch "
+                          "(each touch uses its own, measured before contact).")] = 10.0,
+    object_temp: Annotated[Optional[float], typer.Option(
+        "--object-temp", help="Object temperature [°C] (default: the profile's object thermistor before contact).")] = None,
+    time_offset: Annotated[float, typer.Option(
+        "--time-offset", help="Heat-flow start minus detected onset [s] (calibration's time offset; the "
+                              "emulator's is -0.25 s).")] = 0.0,
+    touches: Annotated[int, typer.Option("--touches", help="Touches to decide, then stop (1 to 1000).")] = 1,
+    timeout: Annotated[Optional[float], typer.Option(
+        "--timeout", help="Give up when the device sends nothing for this long [s] (default: the profile's).")] = None,
+    export_c: Annotated[Optional[Path], typer.Option(
+        "--export-c", help="Write the test as a C99 header (fixed memory, no allocation, one update call per "
+                           "sample) to this file instead of reading a port.")] = None,
+    prefix: Annotated[str, typer.Option("--prefix", help="Prefix of the C header's names (with --export-c).")] = "designkit_seq",
+    json_: Json = False,
+) -> None:
+    """Decide each touch while it lasts: material, or keep touching, or no contact time will do.
+
+    A sequential probability ratio test on the streaming samples (designkit.recognition.sequential), with
+    the error rate you ask for; prints each touch's decision and its time to decision. Exit 3 when no
+    contact up to --max-contact can separate the materials at that error rate.
+
+    Example: `designkit classify --port /dev/pts/3 --profile designkit --m wood --m "aluminium alloys" --touches 5`
+
+    Example: `designkit classify --m wood --m "aluminium alloys" --error-rate 0.001 --export-c robot_seq.h`
+    """
+    from .._validation import InputError
+    from ..calibration.live import LiveClassifier
+    from ..calibration.profiles import load_profile
+    from ..recognition.sequential import SequentialTest
+    from ..sensor import load_sensor
+
+    if port is None and export_c is None:
+        raise InputError("give --port (the serial device of the rig), or --export-c FILE for a C header")
+    if not m or len(m) < 2:
+        raise InputError("give two or more candidate materials with --m")
+    if not 1 <= touches <= 1000:
+        raise InputError(f"--touches must be 1 to 1000, got {touches}")
+    if timeout is not None and not (math.isfinite(timeout) and timeout > 0):
+        raise InputError(f"--timeout must be a positive, finite number of seconds, got {timeout:g}")
+    if not (math.isfinite(delta_t) and delta_t != 0):
+        raise InputError(f"--delta-t must be a non-zero temperature difference [°C], got {delta_t:g}")
+    if not math.isfinite(time_offset) or abs(time_offset) > 5:
+        raise InputError(f"--time-offset must be within ±5 s, got {time_offset:g}")
+    sens = load_sensor(sensor)
+    sigma = noise if noise is not None else (sens.noise_c if sens.noise_c else 0.05)
+    prof = load_profile(profile)
+    cands = parse_candidates(m)
+
+    def make_test(ts0: float, ta: float) -> SequentialTest:
+        return SequentialTest(cands, sens, noise_c=sigma, sensor_temp_c=ts0, ambient_temp_c=ta,
+                              error_rate=error_rate, max_contact_s=max_contact)
+
+    check = make_test(35.0, 35.0 - delta_t)
+    if export_c is not None:
+        from .._io import atomic_write_bytes
+        from ..export.sequential_c import write_sequential_c
+
+        data = write_sequential_c(check, prefix)
+        atomic_write_bytes(Path(export_c), data)
+        info = {"out": str(export_c), "bytes": len(data), "plan": check.plan.to_dict()}
+        if json_:
+            emit_json(info)
+        else:
+            console().print(f"wrote {export_c} ({len(data):,} bytes): {check.plan.reason}", highlight=False)
+        raise typer.Exit(0 if check.plan.separable else EXIT_NO_DECISION)
+    payload = {"port": port, "profile": prof.name, "sensor": sens.name, "noise_c": sigma, "error_rate": error_rate,
+               "plan": check.plan.to_dict(), "decisions": [], "interrupted": False}
+    if not check.plan.separable:
+        if json_:
+            emit_json(payload)
+        else:
+            console().print(f"No decision possible: {check.plan.reason}.")
+        raise typer.Exit(EXIT_NO_DECISION)
+    con = console(stderr=True)
+    live_view = None
+    clf = None
+
+    def refresh(_status=None) -> None:
+        if live_view is not None and clf is not None:
+            live_view.update(_table(clf.decider.written, clf.decider.live, check.candidates))
+
+    def on_event(e) -> None:
+        if not json_ and live_view is None and e.kind in ("decision", "skipped", "gap", "bad_line"):
+            con.print(e.message, highlight=False)
+        refresh()
+
+    clf = LiveClassifier(port, prof, make_test, sample_rate_hz=sens.sample_rate_hz, time_offset_s=time_offset,
+                         ambient_temp_c=object_temp, no_data_timeout_s=timeout, on_event=on_event,
+                         on_status=refresh)
+    interrupted = False
+    try:
+        clf.open()
+        if not json_ and con.is_terminal:
+            from rich.live import Live
+
+            live_view = Live(console=con, refresh_per_second=8)
+            live_view.__enter__()
+        clf.classify(touches)
+    except KeyboardInterrupt:
+        interrupted = True
+    finally:
+        if live_view is not None:
+            live_view.__exit__(None, None, None)
+        clf.close()
+    decisions = clf.decider.written
+    payload["decisions"] = [d.to_dict() for d in decisions]
+    payload["interrupted"] = interrupted
+    if json_:
+        emit_json(payload)
+    else:
+        out = console(stderr=interrupted)
+        out.print(f"{check.plan.reason}.", highlight=False)
+        for d in decisions:
+            what = d.material if d.state == "decided" else d.state
+            out.print(f"touch {d.index + 1}: {what} after {d.time_to_decision_s:.3f} s of contact "
+                      f"({d.n_samples} samples; Ts0 {d.sensor_temp_c:.2f} °C, Ta {d.ambient_temp_c:.2f} °C)",
+                      highlight=False)
+    if interrupted:
+        raise typer.Exit(EXIT_INTERRUPTED)

@@ -1,0 +1,95 @@
+"""``designkit classify`` over a real pseudo-terminal: the emulator streams touches of known
+materials in the profile's wire format; every touch is decided live, correctly, before the
+fixed contact the ideal observer needs. Bad input is one line and exit 2; a hopeless pair exits 3."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from designkit import SENSORS
+from designkit.calibration.emulator import EmulatedMaterial, Emulator, TouchPlan
+from designkit.calibration.profiles import load_profile
+
+PAPER = SENSORS["paper"]
+
+
+def _emulator(materials, *, speed=25.0, seed=0, noise=0.05):
+    plan = TouchPlan(touch_every_s=10.0, contact_s=4.0, touches_per_material=1)
+    return Emulator(load_profile("designkit"), PAPER, materials, noise_c=noise, sensor_temp_c=35.0, ambient_c=25.0,
+                    plan=plan, speed=speed, seed=seed)
+
+
+def test_classify_decides_each_touch_over_a_pty(cli):
+    mats = [EmulatedMaterial("metal", 20000.0), EmulatedMaterial("wood", 420.0)]
+    with _emulator(mats) as emu:
+        r = cli("classify", "--port", emu.port, "--profile", "designkit", "--m", "metal=12767:25972",
+                "--m", "wood=331:506.46", "--touches", "4", "--time-offset", str(emu.expected_time_offset_s),
+                "--error-rate", "0.001", "--json")
+    assert r.exit_code == 0, r.output
+    out = json.loads(r.stdout)
+    got = [(d["state"], d["material"]) for d in out["decisions"]]
+    assert got == [("decided", "metal"), ("decided", "wood")] * 2
+    fixed = out["plan"]["fixed_contact_s"]
+    assert all(d["time_to_decision_s"] <= fixed + 0.2 for d in out["decisions"])  # a touch each: not a mean
+    assert all(abs(d["sensor_temp_c"] - 35.0) < 0.05 and abs(d["ambient_temp_c"] - 25.0) < 0.05
+               for d in out["decisions"])
+
+
+def test_classify_text_output_names_decision_and_time(cli):
+    with _emulator([EmulatedMaterial("a", 35000.0)], seed=2) as emu:
+        r = cli("classify", "--port", emu.port, "--m", "a=35000:35080", "--m", "b=20000:20080",
+                "--time-offset", str(emu.expected_time_offset_s), "--error-rate", "0.05")
+    assert r.exit_code == 0, r.output
+    assert "touch 1: a after" in r.output and "s of contact" in r.output
+
+
+def test_classify_sample_rate_mismatch_is_one_line_exit_2(cli, tmp_path):
+    sensor = tmp_path / "s.yaml"
+    PAPER.replace(sample_rate_hz=100.0, name="slow").to_yaml(sensor)
+    with _emulator([EmulatedMaterial("a", 35000.0)]) as emu:
+        r = cli("classify", "--port", emu.port, "--sensor", str(sensor), "--m", "a=35000", "--m", "b=20000")
+    assert r.exit_code == 2
+    line = r.output.strip().splitlines()
+    assert len(line) == 1 and "sample rate (200 Hz" in line[0] and "100 Hz" in line[0]
+
+
+def test_classify_hopeless_exits_3_before_touching(cli):
+    r = cli("classify", "--port", "/dev/null", "--m", "a=20000:20080", "--m", "b=20100:20180",
+            "--max-contact", "2", "--json")
+    assert r.exit_code == 3
+    assert json.loads(r.stdout)["plan"]["separable"] is False
+
+
+@pytest.mark.parametrize("args,msg", [
+    (["--m", "a=1:2"], "two or more"),
+    (["--m", "a=x", "--m", "b=3"], "NAME=MIN:MAX"),
+    (["--m", "wood", "--m", "nosuchmaterial"], "nosuchmaterial"),
+    (["--m", "a=1", "--m", "b=2", "--error-rate", "0.9"], "error rate"),
+])
+def test_classify_bad_input_is_one_line(cli, args, msg):
+    r = cli("classify", "--port", "/dev/null", *args)
+    assert r.exit_code == 2, r.output
+    assert msg in r.output and len(r.output.strip().splitlines()) == 1
+
+
+def test_classify_export_c_writes_a_header_that_compiles(cli, tmp_path):
+    import shutil
+    import subprocess
+
+    out = tmp_path / "robot_seq.h"
+    r = cli("classify", "--m", "wood", "--m", "metal=12767:25972", "--export-c", str(out), "--prefix", "robot",
+            "--json")
+    assert r.exit_code == 0, r.output
+    text = out.read_text()
+    assert json.loads(r.stdout)["bytes"] == len(text.encode()) and "robot_update" in text
+    cc = shutil.which("cc") or shutil.which("gcc")
+    if cc:
+        (tmp_path / "m.c").write_text('#include "robot_seq.h"\nint main(void) { robot_state s; '
+                                      'robot_init(&s, 35.0, 25.0); return robot_update(&s, 0.0, 35.0) != -1; }\n')
+        subprocess.run([cc, "-std=c99", "-Wall", "-Werror", "-o", str(tmp_path / "m"), str(tmp_path / "m.c"), "-lm"],
+                       check=True)
+        assert subprocess.run([str(tmp_path / "m")]).returncode == 0
+    r = cli("classify", "--m", "a=1", "--m", "b=2", "--export-c", str(out), "--prefix", "9bad")
+    assert r.exit_code == 2 and "prefix" in r.output

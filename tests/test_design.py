@@ -1,0 +1,72 @@
+"""``designkit design``: the recommendation is the grid's best by the ideal observer, checked against the
+independent closed form of designkit.recognition.ideal; no design is exit 3, contradictions exit 2."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from designkit.design.search import Constraints, recommend, targets_from
+from designkit.recognition.ideal import ideal_pair
+from designkit.scene import Scene
+
+PEEK = "Polyetheretherketone (PEEK)"
+
+
+def test_recommendation_is_the_grid_minimum_and_matches_the_ideal_observer():
+    targets = targets_from(["low=20000", "high=35000"])
+    cons = Constraints(max_contact_s=4.0, noise_c=0.05, max_delta_t_c=10.0, max_rate_hz=200.0,
+                       depth_um=(200.0, 2000.0))
+    r = recommend(targets, cons, skins=(PEEK, "Silicone elastomers"), n_depth=4)
+    assert r.best.min_contact_s > 0.1  # several samples: the check one sample earlier means something
+    best = r.best
+    assert best.min_contact_s == min(d.min_contact_s for d in r.designs)
+    # independent check (scipy closed form): F1 >= 0.9 at the answer, below it one sample earlier
+    sensor, fs = best.sensor(), best.sample_rate_hz
+    at = ideal_pair((20000, 20080), (35000, 35080), sensor, Scene(contact_s=best.min_contact_s, noise_c=0.05))
+    before = ideal_pair((20000, 20080), (35000, 35080), sensor,
+                        Scene(contact_s=best.min_contact_s - 1 / fs, noise_c=0.05))
+    assert at.f1 >= 0.9 > before.f1
+    # deeper thermistors are slower for one skin (a physical sanity check of the search)
+    peek = sorted((d for d in r.designs if d.skin == PEEK), key=lambda d: d.depth_um)
+    assert all(a.min_contact_s <= b.min_contact_s for a, b in zip(peek, peek[1:]))
+    # noise over dT is the only scene variable: the trade-off curve rises with it
+    t = [x for _, x in r.pareto]
+    assert all(a <= b for a, b in zip(t, t[1:]))
+
+
+def test_paper12_at_identified_effusivities_and_overlapping_ranges():
+    r = recommend(targets_from(set_name="paper12"), Constraints(), skins=(PEEK,), n_depth=2)
+    assert r.best is not None and len(r.pairs) == 66
+    names = {t.name for t in targets_from(set_name="paper12")}
+    assert set(r.best.limiting_pair) <= names
+    # the paper's database ranges overlap (wood and acrylic): no design separates them
+    r = recommend(targets_from(["wood", "Polymethyl methacrylate (Acrylic, PMMA)"]), Constraints(), skins=(PEEK,))
+    assert r.best is None and "overlap" in r.reason
+
+
+def test_cli_json_with_svm_confirmation(cli, tmp_path):
+    r = cli("design", "--m", "a=20000", "--m", "b=35000", "--skin", PEEK, "--depth-um", "400:400", "--json",
+            "--plot", str(tmp_path / "d.png"))
+    assert r.exit_code == 0, r.output
+    out = json.loads(r.stdout)
+    assert out["best"]["skin"] == PEEK and out["svm"]["svm_min_contact_s"] is not None
+    assert out["svm"]["svm_min_contact_s"] >= out["best"]["min_contact_s"]  # no classifier beats the bound
+    assert (tmp_path / "d.png").stat().st_size > 10_000
+
+
+@pytest.mark.parametrize("args,code,msg", [
+    (["--m", "wood", "--m", "Polymethyl methacrylate (Acrylic, PMMA)"], 3, "overlap"),
+    (["--m", "a=20000", "--m", "b=20100", "--max-contact", "0.5", "--skin", PEEK, "--depth-um", "400:400"], 3,
+     "no allowed design"),
+    (["--m", "a=1000", "--m", "b=2000", "--depth-um", "500:20"], 2, "contradict"),
+    (["--m", "a=1000", "--m", "b=2000", "--max-rate", "10", "--max-contact", "0.05"], 2, "contradict"),
+    (["--m", "a=1000"], 2, "at least two"),
+    (["--m", "a=1000", "--m", "b=2000", "--noise", "-1"], 2, "noise floor"),
+])
+def test_cli_no_design_and_bad_input(cli, args, code, msg):
+    r = cli("design", "--no-svm", *args)
+    assert r.exit_code == code, r.output
+    assert msg in r.output and len(r.output.strip().splitlines()) == 1

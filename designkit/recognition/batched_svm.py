@@ -175,6 +175,84 @@ def _solve(M, rhs, xp):
         return out
 
 
+def _kkt_bordered(Ka, ya, fr, uu, C, ridge, eye, xp):
+    """Equality-constrained KKT step of the active set (fr free, uu at C) as one bordered solve.
+
+    Returns z, shape (p, n + 1): ``beta = y a`` of every variable, then the multiplier
+    of ``y^T a = 0`` (libsvm's ``-rho``).
+    """
+    p, n = ya.shape
+    dt = Ka.dtype
+    fa = xp.astype(fr, dt)
+    ua = xp.astype(uu, dt)
+    beta_u = C * ya * ua
+    M = xp.zeros((p, n + 1, n + 1), dtype=dt)
+    M[:, :n, :n] = Ka * (fa[:, :, None] * fa[:, None, :]) + eye * ((1.0 - fa) + ridge[:, None] * fa)[:, None, :]
+    M[:, :n, n] = fa
+    M[:, n, :n] = fa
+    M[:, n, n] = 1.0 - xp.astype(xp.any(fr, axis=-1), dt)  # no free variable: keep it solvable, flagged below
+    rhs = xp.zeros((p, n + 1, 1), dtype=dt)
+    if bool(xp.any(uu)):
+        rhs[:, :n, 0] = fa * (ya - (Ka @ beta_u[..., None])[..., 0]) + (1.0 - fa) * beta_u
+    else:  # no variable at C (the usual case here): skip a batched mat-vec
+        rhs[:, :n, 0] = fa * ya
+    rhs[:, n, 0] = -xp.sum(beta_u, axis=-1)
+    return _solve(M, rhs, xp)[..., 0]
+
+
+def _kkt_step(Ka, ya, fr, uu, C, ridge, eye, xp):
+    """:func:`_kkt_bordered`'s answer; with numpy, by a Cholesky solve of the free block alone.
+
+    The free block ``K_FF + ridge I`` is symmetric positive definite wherever the
+    bordered system is well posed, so block elimination of the equality constraint
+    (``K_FF [u v] = [r 1]``, ``b = (1.u - c) / 1.v``, ``beta_F = u - b v``) gives the
+    same solution with one LAPACK ``dposv`` on ``|F|`` variables instead of an LU of
+    ``n + 1`` (measured: 3-4x less solver time at n = 133, |F| ~ 114; numpy has no
+    batched Cholesky solve, hence the loop over problems). A block that Cholesky
+    refuses (numerically indefinite: rank-deficient Gram matrices, float32 rounding)
+    is solved by the bordered LU as before.
+    """
+    if xp is not np:
+        return _kkt_bordered(Ka, ya, fr, uu, C, ridge, eye, xp)
+    from scipy.linalg.lapack import dposv
+
+    p, n = ya.shape
+    z = np.zeros((p, n + 1))
+    retry = []
+    any_up = uu.any(axis=1)
+    for k in range(p):
+        F = np.flatnonzero(fr[k])
+        if F.size == 0:
+            z[k] = np.nan
+            continue
+        yk = ya[k]
+        rhs = np.empty((F.size, 2), order="F")
+        rhs[:, 1] = 1.0
+        c = 0.0
+        if any_up[k]:
+            U = np.flatnonzero(uu[k])
+            bu = C * yk[U]
+            rhs[:, 0] = yk[F] - Ka[k][np.ix_(F, U)] @ bu
+            c = -float(bu.sum())
+            z[k, U] = bu
+        else:
+            rhs[:, 0] = yk[F]
+        A = Ka[k].take(F, axis=0).take(F, axis=1)  # symmetric: its transpose is the Fortran-order view LAPACK wants
+        A.flat[:: F.size + 1] += ridge[k]
+        _, x, info = dposv(A.T, rhs, overwrite_a=1, overwrite_b=1)
+        if info != 0:
+            retry.append(k)
+            continue
+        u, v = x[:, 0], x[:, 1]
+        b = (u.sum() - c) / v.sum()
+        z[k, F] = u - b * v
+        z[k, n] = b
+    if retry:
+        r = np.asarray(retry)
+        z[r] = _kkt_bordered(Ka[r], ya[r], fr[r], uu[r], C, ridge[r], eye, xp)
+    return z
+
+
 def _active_set(K, y, C, ridge, free, up, max_iter, xp):
     """Batched primal-dual active-set method; returns (a, converged, iterations)."""
     P, n = y.shape
@@ -190,22 +268,7 @@ def _active_set(K, y, C, ridge, free, up, max_iter, xp):
         if idx.shape[0] == 0:
             break
         Ka, ya = K[idx], y[idx]
-        fa = xp.astype(free[idx], dt)
-        ua = xp.astype(up[idx], dt)
-        p = idx.shape[0]
-        beta_u = C * ya * ua
-        M = xp.zeros((p, n + 1, n + 1), dtype=dt)
-        M[:, :n, :n] = Ka * (fa[:, :, None] * fa[:, None, :]) + eye * ((1.0 - fa) + ridge[idx][:, None] * fa)[:, None, :]
-        M[:, :n, n] = fa
-        M[:, n, :n] = fa
-        M[:, n, n] = 1.0 - xp.astype(xp.any(free[idx], axis=-1), dt)  # no free variable: keep it solvable, flagged below
-        rhs = xp.zeros((p, n + 1, 1), dtype=dt)
-        if bool(xp.any(up[idx])):
-            rhs[:, :n, 0] = fa * (ya - (Ka @ beta_u[..., None])[..., 0]) + (1.0 - fa) * beta_u
-        else:  # no variable at C (the usual case here): skip a batched mat-vec
-            rhs[:, :n, 0] = fa * ya
-        rhs[:, n, 0] = -xp.sum(beta_u, axis=-1)
-        z = _solve(M, rhs, xp)[..., 0]
+        z = _kkt_step(Ka, ya, free[idx], up[idx], C, ridge[idx], eye, xp)
         beta = z[:, :n]
         a = ya * beta
         g = ya * ((Ka @ beta[..., None])[..., 0] + z[:, n:]) - 1.0
@@ -277,7 +340,7 @@ def _smo(K, y, C, eps, max_iter, xp):
 
 
 def solve_svc_duals(K, y, *, C: float = 1.0, xp=None, max_active_set_iter: int = 25,
-                    smo_max_iter: int = 200_000):
+                    smo_max_iter: int = 200_000, start=None):
     """Solve a batch of libsvm C-SVC duals with a precomputed kernel.
 
     Parameters
@@ -294,6 +357,12 @@ def solve_svc_duals(K, y, *, C: float = 1.0, xp=None, max_active_set_iter: int =
         Active-set solves per problem before it is handed to the next stage.
     smo_max_iter : int
         Iteration cap of the SMO fallback.
+    start : tuple of two bool arrays, shape (P, n), optional
+        A guess of the active set: which ``a_i`` are free and which are at ``C``
+        (the rest at 0). Only the path changes: the active-set method stops only
+        where the KKT conditions hold, and the (ridged) dual has one optimum, so a
+        good guess saves linear solves and a bad one costs a few. Problems whose
+        guessed start does not converge are restarted from all-free.
 
     Returns
     -------
@@ -327,11 +396,25 @@ def solve_svc_duals(K, y, *, C: float = 1.0, xp=None, max_active_set_iter: int =
     solver = xp.zeros(P, dtype=xp.int64)
     iters = xp.zeros(P, dtype=xp.int64)
 
-    free = xp.ones((P, n), dtype=xp.bool)
-    up = xp.zeros((P, n), dtype=xp.bool)
+    if start is None:
+        free = xp.ones((P, n), dtype=xp.bool)
+        up = xp.zeros((P, n), dtype=xp.bool)
+    else:
+        free = xp.asarray(start[0], dtype=xp.bool, copy=True)
+        up = xp.asarray(start[1], dtype=xp.bool, copy=True) & ~free
     a0, ok, it0 = _active_set(K, y, C, _RIDGE * scale, free, up, max_active_set_iter, xp)
     a = xp.where(ok[:, None], a0, a)
     iters = iters + it0
+    if start is not None and not bool(xp.all(ok)):  # the guess led nowhere: from all-free, as without one
+        redo = xp.nonzero(~ok)[0]
+        free_r = xp.ones((redo.shape[0], n), dtype=xp.bool)
+        up_r = xp.zeros((redo.shape[0], n), dtype=xp.bool)
+        a_r, ok_r, it_r = _active_set(K[redo], y[redo], C, _RIDGE * scale[redo], free_r, up_r,
+                                      max_active_set_iter, xp)
+        a[redo] = xp.where(ok_r[:, None], a_r, a[redo])
+        iters[redo] += it_r
+        ok = xp.asarray(ok, copy=True)
+        ok[redo] = ok_r
     todo = xp.nonzero(~ok)[0]
     if todo.shape[0]:
         Kt, yt = K[todo], y[todo]
@@ -605,7 +688,14 @@ def _chunk(lo, hi, order_lo, order_hi, alloc, blk_lo, blk_hi, blk_start, folds, 
             E[g, int(blk[c][g]):int(blk[c][g + 1])] = 1.0
         E = xp.asarray(E, dtype=f64)
         S1 = S1 + E @ D[c]  # (b, folds, d)
-        S2 = S2 + E @ (D[c] * D[c])
+        if xp is np:  # sums of squares per block without an (m, d) temporary: half the memory traffic
+            S2 = S2 + np.stack([np.einsum("bmd,bmd->bd", seg(c, g), seg(c, g)) for g in range(folds)], axis=1)
+        else:
+            S2 = S2 + E @ (D[c] * D[c])
+    # The Gram products read the centered touches in the Gram's precision: one cast here instead of a
+    # float64 -> float32 cast in every fold's scaling (3.2x faster scaling, measured; the scaled values
+    # then carry two float32 roundings instead of one, relative 1e-7, far below what moves a prediction).
+    D_g = D if gdt == f64 else tuple(xp.astype(x, gdt) for x in D)
     S1_all = xp.sum(S1, axis=1)
     S2_all = xp.sum(S2, axis=1)
     eps = float(np.finfo(np.float64).eps)
@@ -621,15 +711,16 @@ def _chunk(lo, hi, order_lo, order_hi, alloc, blk_lo, blk_hi, blk_start, folds, 
         mean_raw = mean_c + center
         constant = var <= n_tr * eps * var + (n_tr * mean_raw * eps) ** 2  # StandardScaler's rule
         inv_scale = xp.where(constant, 1.0, 1.0 / xp.sqrt(xp.where(constant, 1.0, var)))  # (b, d)
+        inv_scale_g = xp.astype(inv_scale, gdt)[:, None, :]
         # training touches of fold f: the other blocks, each as [lower class, higher class]
         parts = [(c, g) for g in range(folds) if g != f for c in range(2)]
         Z = xp.empty((b, n_tr, d), dtype=gdt)
         y = []
         r = 0
         for c, g in parts:
-            x = seg(c, g)
+            x = D_g[c][:, int(blk[c][g]):int(blk[c][g + 1]), :]
             m = x.shape[1]
-            _scaled(x, inv_scale[:, None, :], gdt, Z[:, r:r + m, :], xp)
+            _scaled(x, inv_scale_g, gdt, Z[:, r:r + m, :], xp)
             r += m
             y += [1.0 if c == 0 else -1.0] * m  # libsvm: the lower class (label 0) is +1
         clock.lap("standardize")

@@ -491,15 +491,32 @@ class BatchedF1:
         return [self.result(i) for i in range(len(self))]
 
 
-def _as_batch(features, name):
-    if isinstance(features, (list, tuple)):
-        features = np.stack([np.asarray(f, dtype=np.float64) for f in features])
-    x = np.asarray(features, dtype=np.float64)
-    if x.ndim == 2:
-        x = x[None]
-    if x.ndim != 3:
-        raise InputError(f"{name} must be shaped (B, n, d) or a list of (n, d) arrays, got shape {x.shape}")
-    return x
+class _Batch:
+    """A batch of feature matrices, stacked one chunk at a time (a list is never stacked whole)."""
+
+    def __init__(self, features, name):
+        if isinstance(features, (list, tuple)):
+            self.items = [np.asarray(f, dtype=np.float64) for f in features]
+            shapes = {f.shape for f in self.items}
+            if len(shapes) > 1:
+                raise InputError(f"{name}: every feature matrix must have the same shape, got {sorted(shapes)}")
+            if not self.items or self.items[0].ndim != 2:
+                raise InputError(f"{name} must be shaped (B, n, d) or a non-empty list of (n, d) arrays")
+            self.shape = (len(self.items),) + self.items[0].shape
+            self.array = None
+        else:
+            x = np.asarray(features, dtype=np.float64)
+            if x.ndim == 2:
+                x = x[None]
+            if x.ndim != 3:
+                raise InputError(f"{name} must be shaped (B, n, d) or a list of (n, d) arrays, got shape {x.shape}")
+            self.array, self.shape = x, x.shape
+
+    def get(self, c0: int, c1: int) -> np.ndarray:
+        x = self.array[c0:c1] if self.array is not None else np.stack(self.items[c0:c1])
+        if not np.isfinite(x).all():
+            raise InputError("features contain NaN or infinite values")
+        return x
 
 
 def batched_cv_f1(features_low, features_high, *, seeds, folds: int = 3, gram_dtype="float32",
@@ -525,7 +542,9 @@ def batched_cv_f1(features_low, features_high, *, seeds, folds: int = 3, gram_dt
         Precision of the Gram products (the solver is float64 either way).
     chunk_size : int
         Pairs processed together; memory is about 3.5 MB per pair of 200 touches x
-        802 features at float32, plus the inputs.
+        802 features at float32, plus the inputs. Lists of feature matrices are
+        stacked one chunk at a time, so a call may carry any number of pairs: its
+        working memory is that of one chunk.
     xp : array namespace, optional
         Array library for the heavy work (numpy by default).
     timings : dict, optional
@@ -546,8 +565,8 @@ def batched_cv_f1(features_low, features_high, *, seeds, folds: int = 3, gram_dt
     >>> r.f1.shape, r.predictions.shape, bool(np.all(r.kkt_gap < 1e-3))
     ((2,), (2, 60), True)
     """
-    lo = _as_batch(features_low, "features_low")
-    hi = _as_batch(features_high, "features_high")
+    lo = _Batch(features_low, "features_low")
+    hi = _Batch(features_high, "features_high")
     if lo.shape[0] != hi.shape[0] or lo.shape[2] != hi.shape[2]:
         raise InputError(f"features_low {lo.shape} and features_high {hi.shape} must have the same batch "
                          "size and feature count")
@@ -557,8 +576,6 @@ def batched_cv_f1(features_low, features_high, *, seeds, folds: int = 3, gram_dt
     if len(seeds) != B:
         raise InputError(f"need one seed per pair: {B} pairs, {len(seeds)} seeds")
     folds = _check_folds(folds, min(n_lo, n_hi))
-    if not (np.isfinite(lo).all() and np.isfinite(hi).all()):
-        raise InputError("features contain NaN or infinite values")
     if gram_dtype not in ("float32", "float64"):
         raise InputError(f"gram_dtype must be 'float32' or 'float64', got {gram_dtype!r}")
     chunk_size = max(1, int(chunk_size))
@@ -589,8 +606,10 @@ def batched_cv_f1(features_low, features_high, *, seeds, folds: int = 3, gram_dt
 
     for c0 in range(0, B, chunk_size):
         c1 = min(B, c0 + chunk_size)
-        out = _chunk(lo[c0:c1], hi[c0:c1], order_lo[c0:c1], order_hi[c0:c1], alloc, blk_lo, blk_hi,
-                     blk_start, folds, gram_dtype, _namespace(xp, lo), clock)
+        lo_c, hi_c = lo.get(c0, c1), hi.get(c0, c1)
+        out = _chunk(lo_c, hi_c, order_lo[c0:c1], order_hi[c0:c1], alloc, blk_lo, blk_hi,
+                     blk_start, folds, gram_dtype, _namespace(xp, lo_c), clock)
+        del lo_c, hi_c
         dec_blocks, gaps, solv, its = out
         for f in range(folds):
             dec = dec_blocks[f]  # (b, blk_size[f]) libsvm convention, low rows then high rows

@@ -53,8 +53,10 @@ from .._validation import InputError, as_generator
 from .svm import F1Result, f1_standard_error
 
 __all__ = [
+    "ARRAY_LIBRARIES",
     "BatchedF1",
     "LIBSVM_EPS",
+    "array_library",
     "batched_cv_f1",
     "solve_svc_duals",
     "stratified_test_folds",
@@ -71,11 +73,46 @@ _SOLVER_NAMES = ("active-set", "active-set continuation", "smo")
 def _namespace(xp, *arrays):
     if xp is not None:
         return xp
+    if all(isinstance(a, np.ndarray) for a in arrays):
+        return np  # numpy's own namespace: the fast paths below test for it
     try:
         from array_api_compat import array_namespace
     except ImportError:
         return np
     return array_namespace(*arrays)
+
+
+#: Array libraries the batched solver runs on by name (``array_library``); numpy is the default.
+ARRAY_LIBRARIES = ("numpy", "cupy")
+
+
+def array_library(name: str):
+    """The array namespace of a library by name, or one clear error if it is not installed.
+
+    ``"numpy"`` is numpy itself; ``"cupy"`` is CuPy through ``array_api_compat``
+    (``pip install 'designkit[gpu]'``): the same solver code then runs on the GPU.
+
+    Raises
+    ------
+    InputError
+        Unknown name, or the library (or ``array_api_compat``) is not installed.
+
+    Examples
+    --------
+    >>> array_library("numpy").__name__
+    'numpy'
+    """
+    if name not in ARRAY_LIBRARIES:
+        raise InputError(f"array library must be one of {', '.join(ARRAY_LIBRARIES)}, got {name!r}")
+    if name == "numpy":
+        return np
+    try:
+        import cupy  # noqa: F401
+        from array_api_compat import cupy as xp
+    except ImportError as exc:
+        raise InputError(f"the {name} array library is not usable here ({exc}); "
+                         "install it with pip install 'designkit[gpu]' on a machine with a GPU") from None
+    return xp
 
 
 def _check_folds(folds: int, n_min: int) -> int:

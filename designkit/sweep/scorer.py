@@ -8,7 +8,8 @@ model; an interval's features are a deterministic function of (interval,
 repeat), so a bounded cache never changes a result.
 
 Two solvers score a fit (``SweepConfig.solver``): ``sklearn``, scikit-learn's
-pipeline one pair at a time (the reference), and ``batched``,
+pipeline one pair at a time (the reference), and ``batched`` (the default; ``batched-cupy``
+is the same code on CuPy arrays),
 :func:`~designkit.recognition.batched_svm.batched_cv_f1` on every pair a
 search step asks for at once (the same classifier; predictions can differ
 from the reference's only on near-ties). Batches are cut so that their
@@ -30,7 +31,8 @@ from ..sensor import Sensor
 from ..simulation import draw_trials, render_trials
 from .config import SweepConfig
 
-__all__ = ["BATCH_MB", "CHUNK_PAIRS", "CV_KEY", "FEATURE_CACHE_MB", "PairCell", "PairScorer", "batch_pairs"]
+__all__ = ["BATCH_MB", "CHUNK_PAIRS", "CV_KEY", "FEATURE_CACHE_MB", "PairCell", "PairScorer", "array_namespace",
+           "batch_pairs"]
 
 #: Seed-key suffix of the fold-shuffle streams (distinguishes them from the trial streams).
 CV_KEY = 7919
@@ -74,6 +76,21 @@ MAX_BATCH = 64
 #: Pairs the batched solver stacks and solves together inside a call (its ``chunk_size``); a
 #: call itself carries every pair of a search step (bounded by the feature cache, not by this).
 CHUNK_PAIRS = 8
+
+
+def array_namespace(solver: str):
+    """Array namespace of a batched solver's name (``batched``: numpy; ``batched-cupy``: CuPy).
+
+    Raises :class:`~designkit.InputError` (one line) where the library is not installed.
+
+    Examples
+    --------
+    >>> array_namespace("batched").__name__
+    'numpy'
+    """
+    from ..recognition.batched_svm import array_library
+
+    return array_library(solver.partition("-")[2] or "numpy")
 
 
 def batch_pairs(trials: int, n_samples: int, folds: int = 3) -> int:
@@ -156,6 +173,7 @@ class PairScorer:
         if size < 1:
             raise InputError(f"one pair of {self.cfg.trials} trials x {self.n_samples} samples does not fit "
                              f"in the batched solver's {BATCH_MB} MiB; use --solver sklearn")
+        xp = array_namespace(self.cfg.solver)
         out: list[tuple[float, float]] = []
         for part in self._calls(keys):
             # the solver stacks the features one chunk of `size` pairs at a time: a call of any length
@@ -163,7 +181,7 @@ class PairScorer:
             r = batched_cv_f1([self.features(i, rep) for i, _, rep in part],
                               [self.features(j, rep) for _, j, rep in part],
                               seeds=[[self.cfg.seed, i, j, rep, CV_KEY] for i, j, rep in part],
-                              folds=self.cfg.folds, chunk_size=min(size, CHUNK_PAIRS))
+                              folds=self.cfg.folds, chunk_size=min(size, CHUNK_PAIRS), xp=xp)
             self.fits += len(part)
             self.calls += 1
             out += [(float(f), float(e)) for f, e in zip(r.f1, r.standard_error)]

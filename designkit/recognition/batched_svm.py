@@ -549,11 +549,12 @@ class _Batch:
                 raise InputError(f"{name} must be shaped (B, n, d) or a list of (n, d) arrays, got shape {x.shape}")
             self.array, self.shape = x, x.shape
 
-    def get(self, c0: int, c1: int) -> np.ndarray:
-        x = self.array[c0:c1] if self.array is not None else np.stack(self.items[c0:c1])
-        if not np.isfinite(x).all():
-            raise InputError("features contain NaN or infinite values")
-        return x
+    def get(self, c0: int, c1: int, stack: bool = True):
+        """Pairs c0:c1 as one (b, n, d) array, or (``stack=False``) a list as given: the numpy
+        path gathers each pair's rows straight from it (a whole pass over the features saved)."""
+        if self.array is not None:
+            return self.array[c0:c1]
+        return np.stack(self.items[c0:c1]) if stack else self.items[c0:c1]
 
 
 def batched_cv_f1(features_low, features_high, *, seeds, folds: int = 3, gram_dtype="float32",
@@ -643,9 +644,10 @@ def batched_cv_f1(features_low, features_high, *, seeds, folds: int = 3, gram_dt
 
     for c0 in range(0, B, chunk_size):
         c1 = min(B, c0 + chunk_size)
-        lo_c, hi_c = lo.get(c0, c1), hi.get(c0, c1)
+        ns = _namespace(xp, np.empty(0)) if xp is None or xp is np else xp
+        lo_c, hi_c = lo.get(c0, c1, stack=ns is not np), hi.get(c0, c1, stack=ns is not np)
         out = _chunk(lo_c, hi_c, order_lo[c0:c1], order_hi[c0:c1], alloc, blk_lo, blk_hi,
-                     blk_start, folds, gram_dtype, _namespace(xp, lo_c), clock)
+                     blk_start, folds, gram_dtype, ns, clock)
         del lo_c, hi_c
         dec_blocks, gaps, solv, its = out
         for f in range(folds):
@@ -699,12 +701,15 @@ class _Clock:
 
 
 def _gather_centered(x, order, center, xp):
-    """Rows of x (b, m, d) in the given order (b, m), minus center (b, d): a new (b, m, d) float64 array."""
-    b, m, d = x.shape
-    if xp is np:  # one gather into a contiguous buffer and an in-place subtraction, no temporaries
+    """Rows of x (b, m, d) in the given order (b, m), minus center (b, d): a new (b, m, d) float64 array.
+
+    With numpy, ``x`` may be a list of b (m, d) arrays (never stacked: one pass fewer).
+    """
+    if xp is np:  # one gather per pair into a contiguous buffer and an in-place subtraction
+        b, (m, d) = len(x), x[0].shape
         out = np.empty((b, m, d))
-        src = (order + (np.arange(b) * m)[:, None]).ravel()
-        np.take(x.reshape(b * m, d), src, axis=0, out=out.reshape(b * m, d), mode="clip")
+        for k in range(b):
+            np.take(x[k], order[k], axis=0, out=out[k], mode="clip")
         np.subtract(out, center[:, None, :], out=out)
         return out
     return xp.take_along_axis(x, order[:, :, None], axis=1) - center[:, None, :]
@@ -720,17 +725,20 @@ def _scaled(x, scale, dtype, out, xp):
 
 def _chunk(lo, hi, order_lo, order_hi, alloc, blk_lo, blk_hi, blk_start, folds, gram_dtype, xp, clock):
     """Decision values of every test touch of one chunk of pairs; see batched_cv_f1."""
-    b, n_lo, d = lo.shape
-    n_hi = hi.shape[1]
+    b, (n_lo, d), n_hi = len(lo), lo[0].shape, hi[0].shape[0]
     n = n_lo + n_hi
     f64 = xp.float64
     gdt = xp.float32 if gram_dtype == "float32" else f64
-    lo_x = xp.asarray(lo)
-    hi_x = xp.asarray(hi)
-    center = (xp.sum(lo_x, axis=1) + xp.sum(hi_x, axis=1)) / n  # (b, d): a shift common to all touches
-    # Each class's touches in fold-block order (the test touches of fold 0 first, ...), centered.
-    D = (_gather_centered(lo_x, xp.asarray(order_lo), center, xp),
-         _gather_centered(hi_x, xp.asarray(order_hi), center, xp))
+    if xp is np:  # lo, hi: (b, m, d) arrays or lists of b (m, d) arrays, gathered pair by pair
+        center = (np.stack([x.sum(axis=0) for x in lo]) + np.stack([x.sum(axis=0) for x in hi])) / n
+        D = (_gather_centered(lo, order_lo, center, xp), _gather_centered(hi, order_hi, center, xp))
+    else:
+        lo_x = xp.asarray(lo)
+        hi_x = xp.asarray(hi)
+        center = (xp.sum(lo_x, axis=1) + xp.sum(hi_x, axis=1)) / n  # (b, d): a shift common to all touches
+        # Each class's touches in fold-block order (the test touches of fold 0 first, ...), centered.
+        D = (_gather_centered(lo_x, xp.asarray(order_lo), center, xp),
+             _gather_centered(hi_x, xp.asarray(order_hi), center, xp))
     blk = (blk_lo, blk_hi)
 
     def seg(c, g):  # class c's touches in block g
@@ -754,6 +762,10 @@ def _chunk(lo, hi, order_lo, order_hi, alloc, blk_lo, blk_hi, blk_start, folds, 
     D_g = D if gdt == f64 else tuple(xp.astype(x, gdt) for x in D)
     S1_all = xp.sum(S1, axis=1)
     S2_all = xp.sum(S2, axis=1)
+    # a NaN or infinity anywhere in a pair's features reaches its sums (inf - inf is NaN): checked
+    # here on (b, d) values instead of a pass over every feature
+    if not bool(xp.all(xp.isfinite(S2_all)) and xp.all(xp.isfinite(center))):
+        raise InputError("features contain NaN or infinite values")
     eps = float(np.finfo(np.float64).eps)
     clock.lap("standardize")
 

@@ -18,7 +18,10 @@ Printed for each: wall [s], SVM fits, fits per second and the ratios to the
 naive loop and to the sklearn staircase; the agreement of the two staircases
 (references whose ``J``, ``J_lo``, ``J_hi`` differ, and by how many intervals);
 and the parallel efficiency of the batched sweep (``run_sweep`` with 2 blocks)
-on ``--jobs 1`` and ``2`` local processes: ``T1 / (jobs x Tjobs)``. BLAS threads
+on ``--jobs 1`` and ``2`` local processes: ``T1 / (jobs x Tjobs)``. CPU seconds
+are this process's (the in-process routes; the naive loop's extrapolated like its
+wall). The staircases' agreement is also stated against each other's Monte Carlo
+interval ``[J_lo, J_hi]``. BLAS threads
 are limited to 1 per process. Wall times are medians of ``--repeat`` runs;
 the load average before and after is printed, because the machines are shared.
 No figure here is asserted anywhere.
@@ -45,12 +48,15 @@ from designkit.sweep import SweepConfig, run_chunk, run_sweep  # noqa: E402
 from designkit.sweep.scorer import CV_KEY, PairScorer  # noqa: E402
 
 
-def _median_run(fn, repeat):
-    walls, out = [], None
+def _median_run(fn, repeat, cpu=None):
+    walls, cpus, out = [], [], None
     for _ in range(repeat):
-        t = time.perf_counter()
+        t, c = time.perf_counter(), time.process_time()
         out = fn()
         walls.append(time.perf_counter() - t)
+        cpus.append(time.process_time() - c)
+    if cpu is not None:
+        cpu.append(statistics.median(cpus))
     return statistics.median(walls), out
 
 
@@ -70,10 +76,10 @@ def naive(cfg: SweepConfig, pairs: int, seed: int = 0):
     for i, j in ij:  # features first: the full loop draws each interval's touches once
         scorer.features(i, 0), scorer.features(j, 0)
     f1_from_features(scorer.features(ij[0][0], 0), scorer.features(ij[0][1], 0), folds=cfg.folds, seed=0)  # warm-up
-    t = time.perf_counter()
+    t, c = time.perf_counter(), time.process_time()
     for i, j in ij:
         f1_from_features(scorer.features(i, 0), scorer.features(j, 0), folds=cfg.folds, seed=[cfg.seed, i, j, 0, CV_KEY])
-    return (time.perf_counter() - t) / len(ij), len(ij)
+    return (time.perf_counter() - t) / len(ij), len(ij), (time.process_time() - c) / len(ij)
 
 
 def main(argv=None):
@@ -94,29 +100,37 @@ def main(argv=None):
           f"{args.noise_ratio:g}, {args.trials} trials per interval; {os.cpu_count()} cores, load average "
           f"{load0[0]:.2f} {load0[1]:.2f} {load0[2]:.2f} at the start", flush=True)
 
-    per_fit, timed = naive(SweepConfig(**base), args.naive_pairs)
+    per_fit, timed, cpu_fit = naive(SweepConfig(**base), args.naive_pairs)
     n_pairs = args.intervals * (args.intervals - 1) // 2
-    rows = {"naive (extrapolated)": (per_fit * n_pairs, n_pairs)}
-    print(f"  naive: {timed} pairs timed, {per_fit * 1e3:.1f} ms per fit", file=sys.stderr, flush=True)
+    rows = {"naive (extrapolated)": (per_fit * n_pairs, n_pairs, cpu_fit * n_pairs)}
+    print(f"  naive: {timed} pairs timed, {per_fit * 1e3:.1f} ms per fit ({cpu_fit * 1e3:.1f} ms CPU)",
+          file=sys.stderr, flush=True)
     res = {}
     for solver in ("sklearn", "batched"):
-        wall, r = _median_run(lambda: run_chunk(SweepConfig(solver=solver, **base), (0,), 0, 0), args.repeat)
+        cpu: list = []
+        wall, r = _median_run(lambda: run_chunk(SweepConfig(solver=solver, **base), (0,), 0, 0), args.repeat, cpu)
         res[solver] = r
-        rows[f"staircase + {solver}"] = (wall, r.fits)
+        rows[f"staircase + {solver}"] = (wall, r.fits, cpu[0])
         print(f"  staircase + {solver}: {wall:.1f} s, {r.fits} fits", file=sys.stderr, flush=True)
 
-    print("\n| route | wall [s] | SVM fits | fits/s | less wall than naive | less wall than staircase + sklearn |")
-    print("|---|---|---|---|---|---|")
+    print("\n| route | wall [s] | CPU [s] | SVM fits | fits/s | less wall than naive | less CPU than naive "
+          "| less wall than staircase + sklearn |")
+    print("|---|---|---|---|---|---|---|---|")
     ref_wall = rows["staircase + sklearn"][0]
-    for name, (wall, fits) in rows.items():
-        print(f"| {name} | {wall:.1f} | {fits} | {fits / wall:.1f} | {rows['naive (extrapolated)'][0] / wall:.1f}x "
-              f"| {ref_wall / wall:.2f}x |")
+    naive_wall, _, naive_cpu = rows["naive (extrapolated)"]
+    for name, (wall, fits, cpu_s) in rows.items():
+        print(f"| {name} | {wall:.1f} | {cpu_s:.1f} | {fits} | {fits / wall:.1f} | {naive_wall / wall:.1f}x "
+              f"| {naive_cpu / cpu_s:.1f}x | {ref_wall / wall:.2f}x |")
 
     a, b = res["sklearn"], res["batched"]
     print("\nAgreement of the two staircases (references differing, largest difference in intervals):")
     for name in ("J", "J_lo", "J_hi"):
         d = np.abs(getattr(a, name) - getattr(b, name))
         print(f"  {name}: {int(np.sum(d > 0))} of {d.size}, max {int(d.max())}")
+    for x, y, label in ((b, a, "batched J inside the sklearn staircase's Monte Carlo interval"),
+                        (a, b, "sklearn J inside the batched staircase's Monte Carlo interval")):
+        inside = (x.J >= y.J_lo) & (x.J <= y.J_hi)
+        print(f"  {label}: {int(inside.sum())} of {inside.size}")
     ca = {(int(c[0]), int(c[1])): c for c in a.cells}
     cb = {(int(c[0]), int(c[1])): c for c in b.cells}
     both = sorted(set(ca) & set(cb))

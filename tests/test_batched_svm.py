@@ -154,3 +154,29 @@ def test_bad_input_is_refused():
         batched_cv_f1(lo, lo + 1, seeds=[0, 1], gram_dtype="float16")
     with pytest.raises(InputError, match="shaped"):
         batched_cv_f1(np.zeros(5), np.zeros(5), seeds=[0])
+
+
+@pytest.mark.parametrize("case", ["separable", "overlapping", "rank-deficient"])
+def test_the_array_api_path_is_the_same_solver(case, paper_sensor):
+    """The code a GPU library runs (every ``xp is not np`` branch: bordered LU steps, no LAPACK
+    loop) on numpy arrays through array_api_compat's wrapper namespace: the same duals and the
+    same F1 as numpy's own fast path."""
+    xnp = pytest.importorskip("array_api_compat.numpy", reason="array-api-compat is in the test and gpu extras")
+    rng = np.random.default_rng(40)
+    n, d = 40, {"separable": 60, "overlapping": 3, "rank-deficient": 10}[case]
+    y_lib = np.r_[np.ones(n // 2), -np.ones(n // 2)]
+    X = rng.normal(size=(n, d)) + 0.4 * (y_lib < 0)[:, None]
+    K = np.stack([X @ X.T, (2 * X) @ (2 * X).T])
+    a_np, rho_np, info_np = solve_svc_duals(K, y_lib)
+    a_xp, rho_xp, info_xp = solve_svc_duals(xnp.asarray(K), xnp.asarray(y_lib), xp=xnp)
+    assert np.all(np.asarray(info_xp["kkt_gap"]) < LIBSVM_EPS)
+    np.testing.assert_array_equal(np.asarray(info_xp["solver"]), info_np["solver"])
+    scale = max(1.0, float(np.abs(rho_np).max()))
+    np.testing.assert_allclose(np.asarray(a_xp), a_np, atol=1e-6)
+    np.testing.assert_allclose(np.asarray(rho_xp), rho_np, atol=1e-6 * scale)
+    if case == "separable":  # and the whole cross-validation on simulated touches
+        feats = [_pair(paper_sensor, 20000.0, 20000.0 + g, 1.0, 0.01, k, trials=30) for k, g in enumerate([160, 4000])]
+        lo, hi = [f[0] for f in feats], [f[1] for f in feats]
+        ours, generic = batched_cv_f1(lo, hi, seeds=[0, 1]), batched_cv_f1(lo, hi, seeds=[0, 1], xp=xnp)
+        np.testing.assert_array_equal(generic.f1, ours.f1)
+        np.testing.assert_allclose(generic.decision, ours.decision, atol=1e-9)

@@ -165,7 +165,7 @@ def test_the_batched_solver_decides_as_the_reference_except_near_ties():
 
 
 def test_an_unknown_solver_is_refused():
-    with pytest.raises(InputError, match="solver must be one of sklearn, batched"):
+    with pytest.raises(InputError, match="solver must be one of batched, sklearn, batched-cupy"):
         SweepConfig(solver="libsvm")
 
 

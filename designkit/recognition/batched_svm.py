@@ -53,8 +53,10 @@ from .._validation import InputError, as_generator
 from .svm import F1Result, f1_standard_error
 
 __all__ = [
+    "ARRAY_LIBRARIES",
     "BatchedF1",
     "LIBSVM_EPS",
+    "array_library",
     "batched_cv_f1",
     "solve_svc_duals",
     "stratified_test_folds",
@@ -71,11 +73,46 @@ _SOLVER_NAMES = ("active-set", "active-set continuation", "smo")
 def _namespace(xp, *arrays):
     if xp is not None:
         return xp
+    if all(isinstance(a, np.ndarray) for a in arrays):
+        return np  # numpy's own namespace: the fast paths below test for it
     try:
         from array_api_compat import array_namespace
     except ImportError:
         return np
     return array_namespace(*arrays)
+
+
+#: Array libraries the batched solver runs on by name (``array_library``); numpy is the default.
+ARRAY_LIBRARIES = ("numpy", "cupy")
+
+
+def array_library(name: str):
+    """The array namespace of a library by name, or one clear error if it is not installed.
+
+    ``"numpy"`` is numpy itself; ``"cupy"`` is CuPy through ``array_api_compat``
+    (``pip install 'designkit[gpu]'``): the same solver code then runs on the GPU.
+
+    Raises
+    ------
+    InputError
+        Unknown name, or the library (or ``array_api_compat``) is not installed.
+
+    Examples
+    --------
+    >>> array_library("numpy").__name__
+    'numpy'
+    """
+    if name not in ARRAY_LIBRARIES:
+        raise InputError(f"array library must be one of {', '.join(ARRAY_LIBRARIES)}, got {name!r}")
+    if name == "numpy":
+        return np
+    try:
+        import cupy  # noqa: F401
+        from array_api_compat import cupy as xp
+    except ImportError as exc:
+        raise InputError(f"the {name} array library is not usable here ({exc}); "
+                         "install it with pip install 'designkit[gpu]' on a machine with a GPU") from None
+    return xp
 
 
 def _check_folds(folds: int, n_min: int) -> int:
@@ -175,6 +212,84 @@ def _solve(M, rhs, xp):
         return out
 
 
+def _kkt_bordered(Ka, ya, fr, uu, C, ridge, eye, xp):
+    """Equality-constrained KKT step of the active set (fr free, uu at C) as one bordered solve.
+
+    Returns z, shape (p, n + 1): ``beta = y a`` of every variable, then the multiplier
+    of ``y^T a = 0`` (libsvm's ``-rho``).
+    """
+    p, n = ya.shape
+    dt = Ka.dtype
+    fa = xp.astype(fr, dt)
+    ua = xp.astype(uu, dt)
+    beta_u = C * ya * ua
+    M = xp.zeros((p, n + 1, n + 1), dtype=dt)
+    M[:, :n, :n] = Ka * (fa[:, :, None] * fa[:, None, :]) + eye * ((1.0 - fa) + ridge[:, None] * fa)[:, None, :]
+    M[:, :n, n] = fa
+    M[:, n, :n] = fa
+    M[:, n, n] = 1.0 - xp.astype(xp.any(fr, axis=-1), dt)  # no free variable: keep it solvable, flagged below
+    rhs = xp.zeros((p, n + 1, 1), dtype=dt)
+    if bool(xp.any(uu)):
+        rhs[:, :n, 0] = fa * (ya - (Ka @ beta_u[..., None])[..., 0]) + (1.0 - fa) * beta_u
+    else:  # no variable at C (the usual case here): skip a batched mat-vec
+        rhs[:, :n, 0] = fa * ya
+    rhs[:, n, 0] = -xp.sum(beta_u, axis=-1)
+    return _solve(M, rhs, xp)[..., 0]
+
+
+def _kkt_step(Ka, ya, fr, uu, C, ridge, eye, xp):
+    """:func:`_kkt_bordered`'s answer; with numpy, by a Cholesky solve of the free block alone.
+
+    The free block ``K_FF + ridge I`` is symmetric positive definite wherever the
+    bordered system is well posed, so block elimination of the equality constraint
+    (``K_FF [u v] = [r 1]``, ``b = (1.u - c) / 1.v``, ``beta_F = u - b v``) gives the
+    same solution with one LAPACK ``dposv`` on ``|F|`` variables instead of an LU of
+    ``n + 1`` (measured: 3-4x less solver time at n = 133, |F| ~ 114; numpy has no
+    batched Cholesky solve, hence the loop over problems). A block that Cholesky
+    refuses (numerically indefinite: rank-deficient Gram matrices, float32 rounding)
+    is solved by the bordered LU as before.
+    """
+    if xp is not np:
+        return _kkt_bordered(Ka, ya, fr, uu, C, ridge, eye, xp)
+    from scipy.linalg.lapack import dposv
+
+    p, n = ya.shape
+    z = np.zeros((p, n + 1))
+    retry = []
+    any_up = uu.any(axis=1)
+    for k in range(p):
+        F = np.flatnonzero(fr[k])
+        if F.size == 0:
+            z[k] = np.nan
+            continue
+        yk = ya[k]
+        rhs = np.empty((F.size, 2), order="F")
+        rhs[:, 1] = 1.0
+        c = 0.0
+        if any_up[k]:
+            U = np.flatnonzero(uu[k])
+            bu = C * yk[U]
+            rhs[:, 0] = yk[F] - Ka[k][np.ix_(F, U)] @ bu
+            c = -float(bu.sum())
+            z[k, U] = bu
+        else:
+            rhs[:, 0] = yk[F]
+        A = Ka[k].take(F, axis=0).take(F, axis=1)  # symmetric: its transpose is the Fortran-order view LAPACK wants
+        A.flat[:: F.size + 1] += ridge[k]
+        _, x, info = dposv(A.T, rhs, overwrite_a=1, overwrite_b=1)
+        if info != 0:
+            retry.append(k)
+            continue
+        u, v = x[:, 0], x[:, 1]
+        b = (u.sum() - c) / v.sum()
+        z[k, F] = u - b * v
+        z[k, n] = b
+    if retry:
+        r = np.asarray(retry)
+        z[r] = _kkt_bordered(Ka[r], ya[r], fr[r], uu[r], C, ridge[r], eye, xp)
+    return z
+
+
 def _active_set(K, y, C, ridge, free, up, max_iter, xp):
     """Batched primal-dual active-set method; returns (a, converged, iterations)."""
     P, n = y.shape
@@ -190,22 +305,7 @@ def _active_set(K, y, C, ridge, free, up, max_iter, xp):
         if idx.shape[0] == 0:
             break
         Ka, ya = K[idx], y[idx]
-        fa = xp.astype(free[idx], dt)
-        ua = xp.astype(up[idx], dt)
-        p = idx.shape[0]
-        beta_u = C * ya * ua
-        M = xp.zeros((p, n + 1, n + 1), dtype=dt)
-        M[:, :n, :n] = Ka * (fa[:, :, None] * fa[:, None, :]) + eye * ((1.0 - fa) + ridge[idx][:, None] * fa)[:, None, :]
-        M[:, :n, n] = fa
-        M[:, n, :n] = fa
-        M[:, n, n] = 1.0 - xp.astype(xp.any(free[idx], axis=-1), dt)  # no free variable: keep it solvable, flagged below
-        rhs = xp.zeros((p, n + 1, 1), dtype=dt)
-        if bool(xp.any(up[idx])):
-            rhs[:, :n, 0] = fa * (ya - (Ka @ beta_u[..., None])[..., 0]) + (1.0 - fa) * beta_u
-        else:  # no variable at C (the usual case here): skip a batched mat-vec
-            rhs[:, :n, 0] = fa * ya
-        rhs[:, n, 0] = -xp.sum(beta_u, axis=-1)
-        z = _solve(M, rhs, xp)[..., 0]
+        z = _kkt_step(Ka, ya, free[idx], up[idx], C, ridge[idx], eye, xp)
         beta = z[:, :n]
         a = ya * beta
         g = ya * ((Ka @ beta[..., None])[..., 0] + z[:, n:]) - 1.0
@@ -277,7 +377,7 @@ def _smo(K, y, C, eps, max_iter, xp):
 
 
 def solve_svc_duals(K, y, *, C: float = 1.0, xp=None, max_active_set_iter: int = 25,
-                    smo_max_iter: int = 200_000):
+                    smo_max_iter: int = 200_000, start=None):
     """Solve a batch of libsvm C-SVC duals with a precomputed kernel.
 
     Parameters
@@ -294,6 +394,12 @@ def solve_svc_duals(K, y, *, C: float = 1.0, xp=None, max_active_set_iter: int =
         Active-set solves per problem before it is handed to the next stage.
     smo_max_iter : int
         Iteration cap of the SMO fallback.
+    start : tuple of two bool arrays, shape (P, n), optional
+        A guess of the active set: which ``a_i`` are free and which are at ``C``
+        (the rest at 0). Only the path changes: the active-set method stops only
+        where the KKT conditions hold, and the (ridged) dual has one optimum, so a
+        good guess saves linear solves and a bad one costs a few. Problems whose
+        guessed start does not converge are restarted from all-free.
 
     Returns
     -------
@@ -327,11 +433,25 @@ def solve_svc_duals(K, y, *, C: float = 1.0, xp=None, max_active_set_iter: int =
     solver = xp.zeros(P, dtype=xp.int64)
     iters = xp.zeros(P, dtype=xp.int64)
 
-    free = xp.ones((P, n), dtype=xp.bool)
-    up = xp.zeros((P, n), dtype=xp.bool)
+    if start is None:
+        free = xp.ones((P, n), dtype=xp.bool)
+        up = xp.zeros((P, n), dtype=xp.bool)
+    else:
+        free = xp.asarray(start[0], dtype=xp.bool, copy=True)
+        up = xp.asarray(start[1], dtype=xp.bool, copy=True) & ~free
     a0, ok, it0 = _active_set(K, y, C, _RIDGE * scale, free, up, max_active_set_iter, xp)
     a = xp.where(ok[:, None], a0, a)
     iters = iters + it0
+    if start is not None and not bool(xp.all(ok)):  # the guess led nowhere: from all-free, as without one
+        redo = xp.nonzero(~ok)[0]
+        free_r = xp.ones((redo.shape[0], n), dtype=xp.bool)
+        up_r = xp.zeros((redo.shape[0], n), dtype=xp.bool)
+        a_r, ok_r, it_r = _active_set(K[redo], y[redo], C, _RIDGE * scale[redo], free_r, up_r,
+                                      max_active_set_iter, xp)
+        a[redo] = xp.where(ok_r[:, None], a_r, a[redo])
+        iters[redo] += it_r
+        ok = xp.asarray(ok, copy=True)
+        ok[redo] = ok_r
     todo = xp.nonzero(~ok)[0]
     if todo.shape[0]:
         Kt, yt = K[todo], y[todo]
@@ -408,15 +528,33 @@ class BatchedF1:
         return [self.result(i) for i in range(len(self))]
 
 
-def _as_batch(features, name):
-    if isinstance(features, (list, tuple)):
-        features = np.stack([np.asarray(f, dtype=np.float64) for f in features])
-    x = np.asarray(features, dtype=np.float64)
-    if x.ndim == 2:
-        x = x[None]
-    if x.ndim != 3:
-        raise InputError(f"{name} must be shaped (B, n, d) or a list of (n, d) arrays, got shape {x.shape}")
-    return x
+class _Batch:
+    """A batch of feature matrices, stacked one chunk at a time (a list is never stacked whole)."""
+
+    def __init__(self, features, name):
+        if isinstance(features, (list, tuple)):
+            self.items = [np.asarray(f, dtype=np.float64) for f in features]
+            shapes = {f.shape for f in self.items}
+            if len(shapes) > 1:
+                raise InputError(f"{name}: every feature matrix must have the same shape, got {sorted(shapes)}")
+            if not self.items or self.items[0].ndim != 2:
+                raise InputError(f"{name} must be shaped (B, n, d) or a non-empty list of (n, d) arrays")
+            self.shape = (len(self.items),) + self.items[0].shape
+            self.array = None
+        else:
+            x = np.asarray(features, dtype=np.float64)
+            if x.ndim == 2:
+                x = x[None]
+            if x.ndim != 3:
+                raise InputError(f"{name} must be shaped (B, n, d) or a list of (n, d) arrays, got shape {x.shape}")
+            self.array, self.shape = x, x.shape
+
+    def get(self, c0: int, c1: int, stack: bool = True):
+        """Pairs c0:c1 as one (b, n, d) array, or (``stack=False``) a list as given: the numpy
+        path gathers each pair's rows straight from it (a whole pass over the features saved)."""
+        if self.array is not None:
+            return self.array[c0:c1]
+        return np.stack(self.items[c0:c1]) if stack else self.items[c0:c1]
 
 
 def batched_cv_f1(features_low, features_high, *, seeds, folds: int = 3, gram_dtype="float32",
@@ -442,7 +580,9 @@ def batched_cv_f1(features_low, features_high, *, seeds, folds: int = 3, gram_dt
         Precision of the Gram products (the solver is float64 either way).
     chunk_size : int
         Pairs processed together; memory is about 3.5 MB per pair of 200 touches x
-        802 features at float32, plus the inputs.
+        802 features at float32, plus the inputs. Lists of feature matrices are
+        stacked one chunk at a time, so a call may carry any number of pairs: its
+        working memory is that of one chunk.
     xp : array namespace, optional
         Array library for the heavy work (numpy by default).
     timings : dict, optional
@@ -463,8 +603,8 @@ def batched_cv_f1(features_low, features_high, *, seeds, folds: int = 3, gram_dt
     >>> r.f1.shape, r.predictions.shape, bool(np.all(r.kkt_gap < 1e-3))
     ((2,), (2, 60), True)
     """
-    lo = _as_batch(features_low, "features_low")
-    hi = _as_batch(features_high, "features_high")
+    lo = _Batch(features_low, "features_low")
+    hi = _Batch(features_high, "features_high")
     if lo.shape[0] != hi.shape[0] or lo.shape[2] != hi.shape[2]:
         raise InputError(f"features_low {lo.shape} and features_high {hi.shape} must have the same batch "
                          "size and feature count")
@@ -474,8 +614,6 @@ def batched_cv_f1(features_low, features_high, *, seeds, folds: int = 3, gram_dt
     if len(seeds) != B:
         raise InputError(f"need one seed per pair: {B} pairs, {len(seeds)} seeds")
     folds = _check_folds(folds, min(n_lo, n_hi))
-    if not (np.isfinite(lo).all() and np.isfinite(hi).all()):
-        raise InputError("features contain NaN or infinite values")
     if gram_dtype not in ("float32", "float64"):
         raise InputError(f"gram_dtype must be 'float32' or 'float64', got {gram_dtype!r}")
     chunk_size = max(1, int(chunk_size))
@@ -506,8 +644,11 @@ def batched_cv_f1(features_low, features_high, *, seeds, folds: int = 3, gram_dt
 
     for c0 in range(0, B, chunk_size):
         c1 = min(B, c0 + chunk_size)
-        out = _chunk(lo[c0:c1], hi[c0:c1], order_lo[c0:c1], order_hi[c0:c1], alloc, blk_lo, blk_hi,
-                     blk_start, folds, gram_dtype, _namespace(xp, lo), clock)
+        ns = _namespace(xp, np.empty(0)) if xp is None or xp is np else xp
+        lo_c, hi_c = lo.get(c0, c1, stack=ns is not np), hi.get(c0, c1, stack=ns is not np)
+        out = _chunk(lo_c, hi_c, order_lo[c0:c1], order_hi[c0:c1], alloc, blk_lo, blk_hi,
+                     blk_start, folds, gram_dtype, ns, clock)
+        del lo_c, hi_c
         dec_blocks, gaps, solv, its = out
         for f in range(folds):
             dec = dec_blocks[f]  # (b, blk_size[f]) libsvm convention, low rows then high rows
@@ -560,12 +701,15 @@ class _Clock:
 
 
 def _gather_centered(x, order, center, xp):
-    """Rows of x (b, m, d) in the given order (b, m), minus center (b, d): a new (b, m, d) float64 array."""
-    b, m, d = x.shape
-    if xp is np:  # one gather into a contiguous buffer and an in-place subtraction, no temporaries
+    """Rows of x (b, m, d) in the given order (b, m), minus center (b, d): a new (b, m, d) float64 array.
+
+    With numpy, ``x`` may be a list of b (m, d) arrays (never stacked: one pass fewer).
+    """
+    if xp is np:  # one gather per pair into a contiguous buffer and an in-place subtraction
+        b, (m, d) = len(x), x[0].shape
         out = np.empty((b, m, d))
-        src = (order + (np.arange(b) * m)[:, None]).ravel()
-        np.take(x.reshape(b * m, d), src, axis=0, out=out.reshape(b * m, d), mode="clip")
+        for k in range(b):
+            np.take(x[k], order[k], axis=0, out=out[k], mode="clip")
         np.subtract(out, center[:, None, :], out=out)
         return out
     return xp.take_along_axis(x, order[:, :, None], axis=1) - center[:, None, :]
@@ -581,17 +725,20 @@ def _scaled(x, scale, dtype, out, xp):
 
 def _chunk(lo, hi, order_lo, order_hi, alloc, blk_lo, blk_hi, blk_start, folds, gram_dtype, xp, clock):
     """Decision values of every test touch of one chunk of pairs; see batched_cv_f1."""
-    b, n_lo, d = lo.shape
-    n_hi = hi.shape[1]
+    b, (n_lo, d), n_hi = len(lo), lo[0].shape, hi[0].shape[0]
     n = n_lo + n_hi
     f64 = xp.float64
     gdt = xp.float32 if gram_dtype == "float32" else f64
-    lo_x = xp.asarray(lo)
-    hi_x = xp.asarray(hi)
-    center = (xp.sum(lo_x, axis=1) + xp.sum(hi_x, axis=1)) / n  # (b, d): a shift common to all touches
-    # Each class's touches in fold-block order (the test touches of fold 0 first, ...), centered.
-    D = (_gather_centered(lo_x, xp.asarray(order_lo), center, xp),
-         _gather_centered(hi_x, xp.asarray(order_hi), center, xp))
+    if xp is np:  # lo, hi: (b, m, d) arrays or lists of b (m, d) arrays, gathered pair by pair
+        center = (np.stack([x.sum(axis=0) for x in lo]) + np.stack([x.sum(axis=0) for x in hi])) / n
+        D = (_gather_centered(lo, order_lo, center, xp), _gather_centered(hi, order_hi, center, xp))
+    else:
+        lo_x = xp.asarray(lo)
+        hi_x = xp.asarray(hi)
+        center = (xp.sum(lo_x, axis=1) + xp.sum(hi_x, axis=1)) / n  # (b, d): a shift common to all touches
+        # Each class's touches in fold-block order (the test touches of fold 0 first, ...), centered.
+        D = (_gather_centered(lo_x, xp.asarray(order_lo), center, xp),
+             _gather_centered(hi_x, xp.asarray(order_hi), center, xp))
     blk = (blk_lo, blk_hi)
 
     def seg(c, g):  # class c's touches in block g
@@ -605,9 +752,20 @@ def _chunk(lo, hi, order_lo, order_hi, alloc, blk_lo, blk_hi, blk_start, folds, 
             E[g, int(blk[c][g]):int(blk[c][g + 1])] = 1.0
         E = xp.asarray(E, dtype=f64)
         S1 = S1 + E @ D[c]  # (b, folds, d)
-        S2 = S2 + E @ (D[c] * D[c])
+        if xp is np:  # sums of squares per block without an (m, d) temporary: half the memory traffic
+            S2 = S2 + np.stack([np.einsum("bmd,bmd->bd", seg(c, g), seg(c, g)) for g in range(folds)], axis=1)
+        else:
+            S2 = S2 + E @ (D[c] * D[c])
+    # The Gram products read the centered touches in the Gram's precision: one cast here instead of a
+    # float64 -> float32 cast in every fold's scaling (3.2x faster scaling, measured; the scaled values
+    # then carry two float32 roundings instead of one, relative 1e-7, far below what moves a prediction).
+    D_g = D if gdt == f64 else tuple(xp.astype(x, gdt) for x in D)
     S1_all = xp.sum(S1, axis=1)
     S2_all = xp.sum(S2, axis=1)
+    # a NaN or infinity anywhere in a pair's features reaches its sums (inf - inf is NaN): checked
+    # here on (b, d) values instead of a pass over every feature
+    if not bool(xp.all(xp.isfinite(S2_all)) and xp.all(xp.isfinite(center))):
+        raise InputError("features contain NaN or infinite values")
     eps = float(np.finfo(np.float64).eps)
     clock.lap("standardize")
 
@@ -621,15 +779,16 @@ def _chunk(lo, hi, order_lo, order_hi, alloc, blk_lo, blk_hi, blk_start, folds, 
         mean_raw = mean_c + center
         constant = var <= n_tr * eps * var + (n_tr * mean_raw * eps) ** 2  # StandardScaler's rule
         inv_scale = xp.where(constant, 1.0, 1.0 / xp.sqrt(xp.where(constant, 1.0, var)))  # (b, d)
+        inv_scale_g = xp.astype(inv_scale, gdt)[:, None, :]
         # training touches of fold f: the other blocks, each as [lower class, higher class]
         parts = [(c, g) for g in range(folds) if g != f for c in range(2)]
         Z = xp.empty((b, n_tr, d), dtype=gdt)
         y = []
         r = 0
         for c, g in parts:
-            x = seg(c, g)
+            x = D_g[c][:, int(blk[c][g]):int(blk[c][g + 1]), :]
             m = x.shape[1]
-            _scaled(x, inv_scale[:, None, :], gdt, Z[:, r:r + m, :], xp)
+            _scaled(x, inv_scale_g, gdt, Z[:, r:r + m, :], xp)
             r += m
             y += [1.0 if c == 0 else -1.0] * m  # libsvm: the lower class (label 0) is +1
         clock.lap("standardize")

@@ -63,7 +63,8 @@ from __future__ import annotations
 from .chunk import ChunkResult, run_chunk, run_scene
 from .config import FIDELITIES, SOLVERS, SweepConfig
 from .run import SweepInterrupted, iter_sweep, prepare_workdir, run_sweep
-from .search import assemble, closed_form_model, delta_from_staircase, ideal_staircase, staircase_search
+from .search import (assemble, closed_form_model, delta_from_staircase, ideal_staircase, staircase_search,
+                     staircase_searches)
 
 __all__ = [
     "FIDELITIES",
@@ -81,4 +82,5 @@ __all__ = [
     "run_scene",
     "run_sweep",
     "staircase_search",
+    "staircase_searches",
 ]

@@ -21,7 +21,8 @@ from ..scene import Scene
 from ..sensor import Sensor
 from .config import SweepConfig
 from .scorer import PairCell, PairScorer
-from .search import IDEAL_UNKNOWN, closed_form_model, ideal_bound_s, ideal_staircase, staircase_search
+from .search import (IDEAL_UNKNOWN, closed_form_model, ideal_bound_s, ideal_staircase, staircase_search,
+                     staircase_searches)
 
 __all__ = ["ChunkResult", "run_chunk", "run_scene"]
 
@@ -96,11 +97,17 @@ def run_chunk(cfg: SweepConfig, point: tuple[int, ...], block: int, contact_inde
     A chunk is the unit of parallelism: everything inside it runs sequentially in its
     worker. (On a dask worker joblib's active backend is dask, and scikit-learn's own
     joblib calls, such as the folds of cross-validation, would otherwise be sent back to
-    the cluster one by one: measured 5x slower per chunk.)
+    the cluster one by one: measured 5x slower per chunk.) BLAS and LAPACK run on one
+    thread for the same reason: the batched solver's small factorizations (133 x 133)
+    spent most of their time in idle threads of a multithreaded BLAS on a loaded machine
+    (measured: one 60-interval chunk at 4 s, 43 s of CPU with the default threads, 3.7 s
+    with one), and one thread everywhere makes the floating-point order the same
+    whatever machine or worker count.
     """
     from joblib import parallel_config
+    from threadpoolctl import threadpool_limits
 
-    with parallel_config(backend="sequential"):
+    with parallel_config(backend="sequential"), threadpool_limits(limits=1):
         return _run_chunk(cfg, point, block, contact_index)
 
 
@@ -142,12 +149,15 @@ def _svm_staircases(cfg: SweepConfig, scorer: PairScorer, rows, floor):
     """
     n, phi, z = cfg.intervals, cfg.threshold, cfg.z
 
-    def by(k: float):
-        return lambda pairs: [c.mean + k * c.stderr >= phi for c in scorer.cells(pairs)]
+    def by(*ks: float):
+        def decide(probes):
+            cells = scorer.cells([(i, j) for _, i, j in probes])
+            return [c.mean + ks[s] * c.stderr >= phi for (s, _, _), c in zip(probes, cells)]
+        return decide
 
-    J = staircase_search(None, rows, n, floor=floor, decide_many=by(0.0))
-    J_lo = staircase_search(None, rows, n, floor=floor, decide_many=by(z))
-    J_hi = staircase_search(None, rows, n, floor=_full(J, rows, n), decide_many=by(-z))
+    # J and J_lo in lockstep (one scorer call per step for both); J_hi starts from J, so after it
+    J, J_lo = staircase_searches([(rows, floor), (rows, floor)], n, by(0.0, z))
+    (J_hi,) = staircase_searches([(rows, _full(J, rows, n))], n, by(-z))
     return J, J_lo, J_hi
 
 

@@ -152,17 +152,20 @@ def _executor(backend: str, jobs: int, scheduler: str | None):
 
 
 def check_batches(cfg: SweepConfig) -> None:
-    """Refuse, before any work, a batched-solver sweep of which not even one pair fits a batch.
+    """Refuse, before any work, a batched-solver sweep that cannot run here.
 
     Raises
     ------
     InputError
-        One pair's batch at the longest contact time exceeds :data:`~designkit.sweep.scorer.BATCH_MB`.
+        The solver's array library is not installed (``batched-cupy`` without CuPy),
+        or one pair's batch at the longest contact time exceeds
+        :data:`~designkit.sweep.scorer.BATCH_MB`.
     """
-    from .scorer import BATCH_MB, batch_pairs
+    from .scorer import BATCH_MB, array_namespace, batch_pairs
 
-    if cfg.solver != "batched" or cfg.fidelity != "svm":
+    if cfg.solver == "sklearn" or cfg.fidelity != "svm":
         return
+    array_namespace(cfg.solver)
     longest = max(cfg.contact_s)
     n_samples = cfg.resolved_sensor().times_s(longest).size
     if batch_pairs(cfg.trials, n_samples, cfg.folds) < 1:

@@ -8,7 +8,8 @@ model; an interval's features are a deterministic function of (interval,
 repeat), so a bounded cache never changes a result.
 
 Two solvers score a fit (``SweepConfig.solver``): ``sklearn``, scikit-learn's
-pipeline one pair at a time (the reference), and ``batched``,
+pipeline one pair at a time (the reference), and ``batched`` (the default; ``batched-cupy``
+is the same code on CuPy arrays),
 :func:`~designkit.recognition.batched_svm.batched_cv_f1` on every pair a
 search step asks for at once (the same classifier; predictions can differ
 from the reference's only on near-ties). Batches are cut so that their
@@ -30,7 +31,8 @@ from ..sensor import Sensor
 from ..simulation import draw_trials, render_trials
 from .config import SweepConfig
 
-__all__ = ["BATCH_MB", "CV_KEY", "FEATURE_CACHE_MB", "PairCell", "PairScorer", "batch_pairs"]
+__all__ = ["BATCH_MB", "CHUNK_PAIRS", "CV_KEY", "FEATURE_CACHE_MB", "PairCell", "PairScorer", "array_namespace",
+           "batch_pairs"]
 
 #: Seed-key suffix of the fold-shuffle streams (distinguishes them from the trial streams).
 CV_KEY = 7919
@@ -63,7 +65,7 @@ class PairCell:
 #: 200 Hz and 100 trials an interval's features take 3 MiB, so 500 intervals would take 1.5 GiB).
 FEATURE_CACHE_MB = 512
 
-#: Working memory of one batched-solver call [MiB]: the stacked features of its pairs plus the
+#: Working memory of one batched-solver chunk [MiB]: the stacked features of its pairs plus the
 #: solver's own arrays. Together with the feature cache it keeps a worker under 1 GB (measured
 #: at 256 MiB: 0.85 GB peak for 200 intervals at 10 s contact, the cache full; 128 leaves margin).
 BATCH_MB = 128
@@ -71,9 +73,28 @@ BATCH_MB = 128
 #: Most pairs in one batched-solver call (beyond this a batch is no faster per pair).
 MAX_BATCH = 64
 
+#: Pairs the batched solver stacks and solves together inside a call (its ``chunk_size``); a
+#: call itself carries every pair of a search step (bounded by the feature cache, not by this).
+CHUNK_PAIRS = 8
+
+
+def array_namespace(solver: str):
+    """Array namespace of a batched solver's name (``batched``: numpy; ``batched-cupy``: CuPy).
+
+    Raises :class:`~designkit.InputError` (one line) where the library is not installed.
+
+    Examples
+    --------
+    >>> array_namespace("batched").__name__
+    'numpy'
+    """
+    from ..recognition.batched_svm import array_library
+
+    return array_library(solver.partition("-")[2] or "numpy")
+
 
 def batch_pairs(trials: int, n_samples: int, folds: int = 3) -> int:
-    """Pairs per batched-solver call that fit in :data:`BATCH_MB` (0: not even one pair fits).
+    """Pairs the batched solver may stack at once within :data:`BATCH_MB` (0: not even one pair fits).
 
     Per pair: the two classes' features stacked and centered (``2 x 2 trials x
     2 n_samples`` float64 values), each fold's standardized training touches
@@ -91,7 +112,7 @@ def batch_pairs(trials: int, n_samples: int, folds: int = 3) -> int:
     Returns
     -------
     int
-        Pairs per call, at most :data:`MAX_BATCH`.
+        Pairs per solver chunk, at most :data:`MAX_BATCH`.
 
     Examples
     --------
@@ -122,6 +143,7 @@ class PairScorer:
         self._max_features = max(8, int(FEATURE_CACHE_MB * 2**20 // max(per_entry, 1)))
         self.scored: dict[tuple[int, int], PairCell] = {}  # every pair scored so far
         self.fits = 0
+        self.calls = 0  # batched-solver calls (fits / calls: pairs per call)
 
     def features(self, k: int, rep: int) -> np.ndarray:
         key = (k, rep)
@@ -151,16 +173,40 @@ class PairScorer:
         if size < 1:
             raise InputError(f"one pair of {self.cfg.trials} trials x {self.n_samples} samples does not fit "
                              f"in the batched solver's {BATCH_MB} MiB; use --solver sklearn")
+        xp = array_namespace(self.cfg.solver)
         out: list[tuple[float, float]] = []
-        for b0 in range(0, len(keys), size):
-            part = keys[b0:b0 + size]
+        for part in self._calls(keys):
+            # the solver stacks the features one chunk of `size` pairs at a time: a call of any length
+            # needs one chunk's working memory, plus the features it references (bounded in _calls)
             r = batched_cv_f1([self.features(i, rep) for i, _, rep in part],
                               [self.features(j, rep) for _, j, rep in part],
                               seeds=[[self.cfg.seed, i, j, rep, CV_KEY] for i, j, rep in part],
-                              folds=self.cfg.folds)
+                              folds=self.cfg.folds, chunk_size=min(size, CHUNK_PAIRS), xp=xp)
             self.fits += len(part)
+            self.calls += 1
             out += [(float(f), float(e)) for f, e in zip(r.f1, r.standard_error)]
         return out
+
+    def _calls(self, keys: list[tuple[int, int, int]]):
+        """Consecutive runs of ``keys`` whose distinct feature matrices fit a quarter of the feature cache.
+
+        A call holds every feature matrix it references until it returns, cached or not, so
+        this bounds a call's features to a quarter of the cache's budget (:data:`FEATURE_CACHE_MB`)
+        on top of the cache itself; at 2 s of contact a whole search step fits one call.
+        """
+        cap = max(2, self._max_features // 4)
+        part: list[tuple[int, int, int]] = []
+        seen: set[tuple[int, int]] = set()
+        for i, j, rep in keys:
+            new = {(i, rep), (j, rep)} - seen
+            if part and len(seen) + len(new) > cap:
+                yield part
+                part, seen = [], set()
+                new = {(i, rep), (j, rep)}
+            part.append((i, j, rep))
+            seen |= new
+        if part:
+            yield part
 
     def cells(self, pairs: list[tuple[int, int]]) -> list[PairCell]:
         """:meth:`cell` of many pairs: each round of repeats scored as one batch."""

@@ -34,6 +34,7 @@ __all__ = [
     "ideal_bound_s",
     "ideal_staircase",
     "staircase_search",
+    "staircase_searches",
 ]
 
 #: ``J_ideal`` of a reference whose ideal observer has no closed form (model and scene).
@@ -90,26 +91,48 @@ def staircase_search(decide: Callable[[int, int], bool] | None, rows: Sequence[i
         if decide is None:
             raise TypeError("staircase_search needs decide or decide_many")
         decide_many = lambda pairs: [decide(i, j) for i, j in pairs]  # noqa: E731
-    rows = [int(i) for i in rows]
-    out = np.full(len(rows), n, dtype=np.int64)
-    searches = {}
-    pending: dict[int, int] = {}
-    for r, i in enumerate(rows):
-        f = max(i + 1, int(floor[i]) if floor is not None else 0)
-        if f < n:
-            g = _row_search(f, n)
-            pending[r] = next(g)
-            searches[r] = g
+    return staircase_searches([(rows, floor)], n, lambda probes: decide_many([(i, j) for _, i, j in probes]))[0]
+
+
+def staircase_searches(searches: Sequence[tuple[Sequence[int], np.ndarray | None]], n: int,
+                       decide_many: Callable[[list[tuple[int, int, int]]], Sequence[bool]]) -> list[np.ndarray]:
+    """Several :func:`staircase_search` runs in lockstep: every step's probes of all of them in one call.
+
+    Each search ``s`` is ``(rows, floor)`` and decides by its own rule; ``decide_many``
+    receives ``(s, i, j)`` probes and returns one decision each. Each row's path depends
+    only on its own decisions, so the answers are those of separate runs; only the calls
+    are fewer and larger (what a batched scorer needs).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> truth = np.array([2, 2, 4, 5, 6, 6])
+    >>> J, J_late = staircase_searches([(range(6), None), (range(6), None)], 6,
+    ...                                lambda p: [j >= truth[i] + s for s, i, j in p])
+    >>> J.tolist(), J_late.tolist()
+    ([2, 2, 4, 5, 6, 6], [3, 3, 5, 6, 6, 6])
+    """
+    outs, gens, pending, rows_of = [], {}, {}, []
+    for s, (rows, floor) in enumerate(searches):
+        rows = [int(i) for i in rows]
+        rows_of.append(rows)
+        outs.append(np.full(len(rows), n, dtype=np.int64))
+        for r, i in enumerate(rows):
+            f = max(i + 1, int(floor[i]) if floor is not None else 0)
+            if f < n:
+                g = _row_search(f, n)
+                pending[(s, r)] = next(g)
+                gens[(s, r)] = g
     while pending:
         order = sorted(pending)
-        answers = decide_many([(rows[r], pending[r]) for r in order])
-        for r, ok in zip(order, answers):
+        answers = decide_many([(s, rows_of[s][r], pending[(s, r)]) for s, r in order])
+        for key, ok in zip(order, answers):
             try:
-                pending[r] = searches[r].send(bool(ok))
+                pending[key] = gens[key].send(bool(ok))
             except StopIteration as stop:
-                out[r] = stop.value
-                del pending[r], searches[r]
-    return out
+                outs[key[0]][key[1]] = stop.value
+                del pending[key], gens[key]
+    return outs
 
 
 def _row_search(f: int, n: int):

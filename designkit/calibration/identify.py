@@ -753,7 +753,30 @@ class Identification:
         return Sensor(effusivity=es, diffusivity_m2_s=alpha, depth_m=self.depth_m,
                       sample_rate_hz=self.sample_rate_hz, name=name, noise_c=self.noise_c,
                       provenance={"method": f"designkit.calibration.identify ({self.candidate.label})",
-                                  "model": self.model().to_dict(), "rms_c": self.rms_c})
+                                  "rms_c": self.rms_c, "consistent": self.consistent,
+                                  "parameters": [p.to_dict() for p in self.parameters],
+                                  "notes": list(self.notes)},
+                      model=self.model_record())
+
+    def model_record(self) -> dict[str, Any]:
+        """What a sensor file records of the identified model (:data:`designkit.sensor.MODEL_KEYS`).
+
+        ``params``: the model's fields in physical units (effusivities and h_c
+        scaled by the identified e_s; the host smoothing when fitted with it);
+        ``contact_spread``: per material fitted with per-touch conductances, the
+        geometric standard deviation of the touches' h_c,i; ``object_temperature``:
+        how each material's temperature was taken (passive, free, a number).
+        """
+        spread = {}
+        for p in self.parameters:
+            if p.name.startswith("conductance_spread[") and math.isfinite(p.value):
+                spread[p.name[len("conductance_spread["):-1]] = float(p.value)
+        return {"name": self.candidate.model, "params": self.model().parameters(),
+                "time_offset_s": float(self.parameter("time_offset_s").value),
+                "contact_spread": spread or None,
+                "object_temperature": {k: (v if isinstance(v, str) else float(v))
+                                       for k, v in self.object_modes.items()},
+                "candidate": self.candidate.label}
 
     def to_dict(self) -> dict[str, Any]:
         return {

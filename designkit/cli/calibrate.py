@@ -419,9 +419,38 @@ def _parse_sets(spec: str) -> list[int]:
     return out
 
 
+def _write_identified(best, trials, out: Path, name: Optional[str], index: Path, force: bool, names) -> list[str]:
+    """Write the selected model's sensor file, or refuse (exit 2) when its fit is unusable and not forced.
+
+    Returns the problems written into the file's provenance (so that ``--sensor`` can warn).
+    """
+    from rich.markup import escape
+
+    from .._validation import InputError
+    from ..calibration.fit import check_calibration
+
+    problems = [p.text() for p in check_calibration(None, trials) if p.fatal]
+    if best.consistent is False:
+        problems += [n for n in best.notes if "conflict" in n] or ["the materials' ranges conflict under this model"]
+    con = console(stderr=True)
+    for text in problems:
+        con.print(f"[bold red]{'warning' if force else 'error'}:[/] {escape(text)}")
+    if problems and not force:
+        raise InputError(f"calibration unusable ({len(problems)} problem(s) above): {out} not written; "
+                         "--force writes the sensor file anyway")
+    prov = {"index": str(index), "materials_fitted": list(names)}
+    if problems:
+        prov["problems"] = problems
+    sensor = best.sensor(name=name or out.stem)
+    sensor = sensor.replace(provenance={**sensor.provenance, **prov})
+    sensor.to_yaml(out)
+    return problems
+
+
 def _run_identify(index: Path, model: str, fit_sets: str, ranges: list[str], only: Optional[list[str]],
                   object_temps: list[str], depth_um: float, out: Optional[Path], json_: bool,
-                  touch_conductance: Optional[str] = None) -> None:
+                  touch_conductance: Optional[str] = None, name: Optional[str] = None,
+                  force: bool = False) -> None:
     """``calibrate fit --model``: identify one model or compare them all on held-out touches."""
     from rich.markup import escape
     from rich.table import Table
@@ -431,9 +460,6 @@ def _run_identify(index: Path, model: str, fit_sets: str, ranges: list[str], onl
     from ..calibration.identify import CANDIDATES, candidate, compare_models, split_by_trial_set, trial_sets
     from ..calibration.trials import load_index
 
-    if out is not None:
-        raise InputError("--out with --model: sensor files do not record a forward model yet; fit without "
-                         "--model to write one, or use --json to keep the identified model")
     cands = list(CANDIDATES) if model.strip().lower() == "all" else [candidate(model)]
     trials = load_index(index, only=only)
     if not trials:
@@ -465,8 +491,12 @@ def _run_identify(index: Path, model: str, fit_sets: str, ranges: list[str], onl
         fit, held = trials, []
     cmp = compare_models(fit, held, cands, **kw)   # no held-out touches: selected by BIC
     results, scores, selected = cmp.results, cmp.held_out_rms_c, cmp.selected
+    best = next(r for r in results if r.candidate.label == selected)
+    if out is not None:
+        _write_identified(best, trials, out, name, index, force, names)
     if json_:
         emit_json({"index": str(index), "n_fit": len(fit), "n_held_out": len(held), "selected": selected,
+                   "out": str(out) if out is not None else None,
                    "results": [dict(r.to_dict(), held_out_rms_c=dict(sc)) for r, sc in zip(results, scores)]})
         return
     con = console()
@@ -482,7 +512,6 @@ def _run_identify(index: Path, model: str, fit_sets: str, ranges: list[str], onl
                   *(f"{sc[n]:.4f} °C" if n in sc else "–" for n in names), f"{r.aic:.0f}", f"{r.bic:.0f}",
                   f"{r.rank}/{r.n_nonlinear}", escape(es), f"{r.fit_time_s:.1f} s")
     con.print(t)
-    best = next(r for r in results if r.candidate.label == selected)
     p = Table(title=f"Selected: {selected} ({best.model().describe()})", title_justify="left")
     for c in ("parameter", "value", "95 % interval", "unit", "identified"):
         p.add_column(c, justify="left" if c in ("parameter", "unit", "identified") else "right")
@@ -496,6 +525,8 @@ def _run_identify(index: Path, model: str, fit_sets: str, ranges: list[str], onl
         con.print(f"[dim]{escape(n)} allows e_s in [{lo:.4g}, {hi:.4g}][/]")
     for note in best.notes:
         con.print(f"[yellow]note:[/] {escape(note)}")
+    if out is not None:
+        con.print(f"wrote {out} with the {selected} model  (use it with --sensor {out})")
 
 
 # ------------------------------------------------------------------ record
@@ -583,7 +614,7 @@ def fit(
     only_list = [s.strip() for item in only for s in item.split(",") if s.strip()] if only else None
     if model is not None:
         _run_identify(index, model, fit_sets, range_ or [], only_list, object_temp or [], depth_um, out, json_,
-                      touch_conductance)
+                      touch_conductance, name=name, force=force)
         return
     result = _run_fit(index, range_ or [], only_list, object_temp or [], settings, out, name, plot, quiet=json_,
                       force=force)
@@ -615,9 +646,15 @@ def guided(
     yes: Annotated[bool, typer.Option("--yes", "-y", help="Do not wait for Enter before each material.")] = False,
     force: Annotated[bool, typer.Option(
         "--force", help="Write the sensor file even when the calibration is unusable.")] = False,
+    model: Annotated[Optional[str], typer.Option(
+        "--model", help="Identify this sensor model (as 'calibrate fit --model'; 'all': the best by BIC) and "
+                        "record it in the sensor file (default: the paper's semi-infinite fit).")] = None,
     json_: Json = False,
 ) -> None:
-    """Guided calibration: record every material over serial, then fit and write the sensor file."""
+    """Guided calibration: record every material over serial, then fit and write the sensor file.
+
+    Example: `designkit calibrate --port /dev/pts/5 --material wood --material metal --out trials/ --yes`
+    """
     from .._validation import InputError
 
     if ctx.invoked_subcommand is not None:
@@ -648,6 +685,12 @@ def guided(
                                    f"'designkit calibrate fit {out / 'index.csv'}'")
         raise typer.Exit(EXIT_INTERRUPTED)
     sensor_path = sensor_out or out / "sensor.yaml"
+    if model is not None:
+        if not json_:
+            console().print(f"Recorded {len(paths)} trial(s) in {out}")
+        _run_identify(out / "index.csv", model, "all", range_ or [], materials, object_temp or [], depth_um,
+                      sensor_path, json_, name=None, force=force)
+        return
     result = _run_fit(out / "index.csv", range_ or [], materials, object_temp or [], settings, sensor_path, None,
                       None, quiet=json_, force=force)
     if json_:

@@ -11,7 +11,8 @@ import typer
 from ._app import app, console, emit_json
 from . import _app
 from ._options import (E1, E2, Ambient, BackingOpt, Conductance, Contact, DeltaT, Diffusivity, Folds, Json,
-                       ModelOpt, Noise, Seed, SensorOpt, Thickness, Threshold, Trials, Width, model_from_options)
+                       ModelOpt, Noise, Seed, SensorOpt, Thickness, Threshold, Trials, Width, model_words,
+                       sensor_and_model)
 
 
 @app.command(rich_help_panel=_app.MODEL)
@@ -39,8 +40,6 @@ def simulate(
     """
     from ..models.semi_infinite import contact_temperature
     from ..scene import Scene
-    from ..sensor import load_sensor
-
     from .._validation import check_temperature
 
     if trials < 1:
@@ -48,8 +47,8 @@ def simulate(
     check_temperature("--sensor-temp [°C]", sensor_temp)
     check_temperature("--ambient [°C]", ambient)
     check_temperature("--noise [°C]", noise, nonnegative=True)
-    fm = model_from_options(model, conductance=conductance, thickness=thickness, backing=backing)
-    sen = load_sensor(sensor)
+    sen, fm, source = sensor_and_model(sensor, model, conductance=conductance, thickness=thickness,
+                                       backing=backing)
     scene = Scene(contact_s=contact, noise_c=noise, sensor_temp_c=sensor_temp, ambient_temp_c=ambient)
     _check_touch_memory("simulate", trials, sen, contact, copies=6)
     result = _touches(e, sen, scene, trials, seed, fm, diffusivity)
@@ -72,6 +71,7 @@ def simulate(
             "scene": scene.to_dict(),
             "sensor": sen.to_dict(),
             "model": fm.to_dict(),
+            "model_source": source,
             "diffusivity_m2_s": diffusivity,
             "seed": seed,
             "out": str(out) if out else None,
@@ -84,7 +84,7 @@ def simulate(
     final = result.temperature_c[:, -1]
     con.print(f"[bold]{trials} touch(es)[/] of e = {e:g} J s^-1/2 K^-1 m^-2 for {contact:g} s "
               f"({result.time_s.size} samples at {sen.sample_rate_hz:g} Hz, {sen.name} sensor, tau = {sen.tau_s:.3f} s)")
-    con.print(escape(f"  model {fm.describe()}"
+    con.print(escape("  " + model_words(sen, fm, source)
                      + (f", object diffusivity {diffusivity:g} m^2/s" if diffusivity is not None else "")))
     con.print(f"  sensor {sensor_temp:g} °C, object {ambient:g} °C"
               + (f", contact surface Tc = {tc:.4f} °C" if tc is not None else ""))
@@ -178,7 +178,6 @@ def f1(
     from ..recognition.ideal import ideal_pair
     from ..recognition.svm import pair_f1
     from ..scene import Scene
-    from ..sensor import load_sensor
 
     if e1 is None or e2 is None:
         raise InputError("give both --e1 and --e2")
@@ -201,12 +200,12 @@ def f1(
         raise InputError(f"folds must be >= 2, got {folds}")
     if trials < folds:
         raise InputError(f"trials per class ({trials}) must be at least the number of folds ({folds})")
-    fm = model_from_options(model, conductance=conductance, thickness=thickness, backing=backing)
+    sen, fm, source = sensor_and_model(sensor, model, conductance=conductance, thickness=thickness,
+                                       backing=backing)
     if diffusivity is not None and "diffusivity_m2_s" not in fm.object_properties:
         raise InputError(f"--diffusivity is for models that need it (slab), not the {fm.name} model")
     if diffusivity is None and "diffusivity_m2_s" in fm.object_properties:
         raise InputError(f"the {fm.name} model needs the objects' --diffusivity [m^2/s]")
-    sen = load_sensor(sensor)
     scene = Scene.from_delta_t(contact_s=contact, noise_c=noise, delta_t_c=delta_t, ambient_temp_c=ambient)
     _check_touch_memory("f1", 2 * trials, sen, contact, copies=8)  # two classes; raw, slope, scaled, folds
     obj1 = object_class(e1, width=width, diffusivity_m2_s=diffusivity)
@@ -237,6 +236,7 @@ def f1(
         "scene": scene.to_dict(),
         "sensor": sen.to_dict(),
         "model": fm.to_dict(),
+        "model_source": source,
         "diffusivity_m2_s": diffusivity,
         "svm_time_s": t1 - t0,
         "ideal_time_s": t2 - t1,
@@ -249,7 +249,7 @@ def f1(
     con = console()
     con.print(f"[bold]{e1:g}[/] vs [bold]{e2:g}[/] J s^-1/2 K^-1 m^-2 (classes {width:g} wide), contact {contact:g} s, "
               f"noise {noise:g} °C, dT {delta_t:g} °C, {sen.name} sensor")
-    con.print(escape(f"  model {fm.describe()}"
+    con.print(escape("  " + model_words(sen, fm, source)
                      + (f", object diffusivity {diffusivity:g} m^2/s" if diffusivity is not None else "")))
     verdict = "[green]distinguishable[/]" if svm.f1 >= threshold else "[red]not distinguishable[/]"
     folds_txt = ", ".join(f"{f:.3f}" for f in svm.fold_f1)

@@ -18,7 +18,7 @@ import typer
 
 from ._app import EXIT_INTERRUPTED, app, console, emit_json, sub_app
 from . import _app
-from ._options import Json, Noise, Seed, SensorOpt
+from ._options import Json, Noise, Seed, SensorOpt, sensor_and_model
 
 calibrate_app = sub_app(
     "calibrate",
@@ -736,7 +736,6 @@ def emulate(
     from .._validation import InputError
     from ..calibration.emulator import EmulatedMaterial, Emulator, Faults, TouchPlan
     from ..calibration.profiles import load_profile
-    from ..sensor import load_sensor
     from .._validation import check_temperature
 
     sensor_temp = check_temperature("--sensor-temp [degC]", sensor_temp)
@@ -763,13 +762,15 @@ def emulate(
     if duration is not None and not duration > 0:
         raise InputError(f"--duration must be positive, got {duration:g}")
     prof = load_profile(profile)
-    emu = Emulator(prof, load_sensor(sensor), mats, noise_c=noise, sensor_temp_c=sensor_temp, ambient_c=ambient,
+    sen, fm, _ = sensor_and_model(sensor)   # a sensor file's recorded model is what the rig plays
+    emu = Emulator(prof, sen, mats, noise_c=noise, sensor_temp_c=sensor_temp, ambient_c=ambient,
                    plan=TouchPlan(touch_every_s=touch_every, touches_per_material=touches_per_material),
-                   speed=speed, faults=Faults.parse(fault or []), seed=seed)
+                   speed=speed, faults=Faults.parse(fault or []), seed=seed, model=fm)
     port = emu.start()
     info = {"port": port, "profile": prof.name, "speed": speed, "touch_every_s": touch_every,
             "materials": [{"label": m.label, "effusivity": m.effusivity} for m in mats],
-            "noise_c": noise, "sensor": emu.sensor.to_dict(), "time_offset_s": emu.expected_time_offset_s,
+            "noise_c": noise, "sensor": emu.sensor.to_dict(), "model": fm.to_dict(),
+            "time_offset_s": emu.expected_time_offset_s,
             "faults": [str(f) for f in fault or []]}
     if json_:
         emit_json(info)
@@ -779,6 +780,11 @@ def emulate(
         con.print("  touching " + ", ".join(f"{m.label} (e = {m.effusivity:g})" for m in mats)
                   + f" every {touch_every:g} s; noise {noise:g} °C; sensor e_s = {emu.sensor.effusivity:g}, "
                     f"tau = {emu.sensor.tau_s:.3f} s")
+        if fm.name != "semi-infinite":
+            from rich.markup import escape
+
+            con.print(escape(f"  model {fm.describe()} (recorded in sensor file {emu.sensor.name}; the wire "
+                             "carries the raw reading: any host smoothing is the host's)"))
         con.print(f"  try: designkit calibrate record --port {port} --profile {profile} "
                   f"--material {mats[0].label} --out trials/")
         sys.stdout.flush()

@@ -44,7 +44,7 @@ def test_the_emulator_streams_any_forward_model_reading():
 
 @pytest.mark.parametrize("case", list(CASES))
 def test_round_trip_over_a_pty_recovers_every_identifiable_parameter(case, tmp_path):
-    r = round_trip(case, seed=0, folder=tmp_path)
+    r = round_trip(case, seed=0, folder=tmp_path, touches=6)
     assert r.n_trials == 12 and (tmp_path / "index.csv").is_file()   # recorded from the pty, 6 + 6 touches
     for name in r.rows:
         assert r.covered(name), (name, r.rows[name])
@@ -52,7 +52,7 @@ def test_round_trip_over_a_pty_recovers_every_identifiable_parameter(case, tmp_p
     truth, lo, hi = r.es
     assert lo <= truth <= hi
     t_off, est, lo, hi = r.offset
-    assert lo <= t_off <= hi and abs(est - t_off) < 0.01
+    assert abs(est - t_off) <= 0.005   # the detected onset defines the truth to one sample (5 ms)
     summ = summarize([r])
     assert set(summ) == set(r.rows) | {"e_s", "time_offset_s"} and summ["e_s"]["coverage"] == 1.0
 

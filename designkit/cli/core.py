@@ -166,12 +166,22 @@ def f1(
     thickness: Thickness = None,
     backing: BackingOpt = None,
     diffusivity: Diffusivity = None,
+    two_sensor: Annotated[bool, typer.Option(
+        "--two-sensor", help="Also read each touch with a passive thermistor resting at --ambient (room) "
+                             "temperature beside the heated sensor, and say whether it resolves the pair.")] = False,
+    object_temp1: Annotated[Optional[float], typer.Option(
+        "--object-temp1", help="With --two-sensor: temperature of the first object [°C] (default: --ambient).")] = None,
+    object_temp2: Annotated[Optional[float], typer.Option(
+        "--object-temp2", help="With --two-sensor: temperature of the second object [°C] (default: --ambient).")]
+    = None,
     json_: Json = False,
 ) -> None:
     """F1 of the paper's SVM and of the ideal observer for classes [e1, e1+width) and [e2, e2+width), under any
     forward model.
 
     Example: `designkit f1 --e1 35000 --e2 20000 --contact 2 --thickness 0.003 --diffusivity 1e-7`
+
+    Example (a cold block of wood against room-temperature metal, one sensor and two): `designkit f1 --e1 17530 --e2 400 --width 10 --delta-t 7 --ambient 22.5 --object-temp2 8 --two-sensor`
     """
     from .._validation import InputError, check_effusivity, check_positive, check_probability, check_temperature
     from ..objects import object_class
@@ -207,9 +217,16 @@ def f1(
     if diffusivity is None and "diffusivity_m2_s" in fm.object_properties:
         raise InputError(f"the {fm.name} model needs the objects' --diffusivity [m^2/s]")
     scene = Scene.from_delta_t(contact_s=contact, noise_c=noise, delta_t_c=delta_t, ambient_temp_c=ambient)
-    _check_touch_memory("f1", 2 * trials, sen, contact, copies=8)  # two classes; raw, slope, scaled, folds
+    _check_touch_memory("f1", 2 * trials, sen, contact, copies=16 if two_sensor else 8)  # raw, slope, folds
     obj1 = object_class(e1, width=width, diffusivity_m2_s=diffusivity)
     obj2 = object_class(e2, width=width, diffusivity_m2_s=diffusivity)
+    if two_sensor or object_temp1 is not None or object_temp2 is not None:
+        if not two_sensor:
+            raise InputError("--object-temp1/--object-temp2 go with --two-sensor (one sensor's scene has one "
+                             "object temperature: --ambient, with --delta-t)")
+        _f1_two_sensor(obj1, obj2, object_temp1, object_temp2, sen, fm, source, scene, trials, folds, seed,
+                       threshold, json_)
+        return
     ra, rb = obj1.e_range, obj2.e_range
     t0 = time.perf_counter()
     svm = pair_f1(obj1, obj2, sen, scene, model=fm, trials=trials, folds=folds, seed=seed)
@@ -257,3 +274,45 @@ def f1(
               f"  -> {verdict} at F1 >= {threshold:g}")
     con.print(f"  ideal F1  {ideal.f1:.3f}, accuracy {ideal.accuracy:.3f}  ({ideal.method}; no classifier does better)")
     con.print(f"  [dim]{(t1 - t0) * 1e3:.0f} ms SVM, {(t2 - t1) * 1e3:.0f} ms ideal[/]")
+
+
+def _f1_two_sensor(obj1, obj2, temp1, temp2, sen, fm, source, scene, trials, folds, seed, threshold, json_) -> None:
+    """``f1 --two-sensor``: the heated sensor alone, then with the passive thermistor at room temperature."""
+    from .._validation import check_temperature
+    from ..recognition.two_sensor import TouchClass, two_sensor_pair_f1
+
+    temps = [None if t is None else check_temperature(f"--object-temp{i} [°C]", t)
+             for i, t in ((1, temp1), (2, temp2))]
+    a, b = (TouchClass(o, t, f"{o.label} at {scene.ambient_temp_c if t is None else t:g} °C")
+            for o, t in zip((obj1, obj2), temps))
+    t0 = time.perf_counter()
+    r = two_sensor_pair_f1(a, b, sen, scene, model=fm, trials=trials, folds=folds, seed=seed, threshold=threshold)
+    wall = time.perf_counter() - t0
+    payload = dict(r.to_dict(), scene=scene.to_dict(), sensor=sen.to_dict(), model=fm.to_dict(),
+                   model_source=source, passive_sensor={"initial_temp_c": scene.ambient_temp_c,
+                                                      "like": "the heated sensor, unheated"},
+                   trials=trials, folds=folds, seed=seed, wall_s=wall)
+    if json_:
+        emit_json(payload)
+        return
+    from rich.markup import escape
+
+    con = console()
+    con.print(f"[bold]{escape(a.label)}[/] vs [bold]{escape(b.label)}[/] (classes {obj1.e_range[1] - obj1.e_range[0]:g} "
+              f"wide), contact {scene.contact_s:g} s, noise {scene.noise_c:g} °C, heated sensor at "
+              f"{scene.sensor_temp_c:g} °C, room {scene.ambient_temp_c:g} °C, {escape(sen.name)} sensor")
+    con.print(escape("  " + model_words(sen, fm, source)))
+
+    def line(words, res):
+        ok = "[green]distinguishable[/]" if res.f1 >= threshold else "[red]not distinguishable[/]"
+        return f"  {words} F1 {res.f1:.3f} ± {res.standard_error:.3f}  -> {ok}"
+
+    con.print(line("heated sensor alone:        ", r.one_sensor))
+    con.print(line("with the passive thermistor:", r.two_sensors))
+    if r.resolves:
+        con.print("  [bold]the second sensor resolves this pair[/]: one heated sensor cannot tell them apart")
+    elif r.one_sensor.f1 >= threshold:
+        con.print("  [dim]one sensor already suffices[/]")
+    else:
+        con.print("  [yellow]not even two sensors separate them here[/]")
+    con.print(f"  [dim]{trials} trials/class, {folds} folds, {wall:.1f} s[/]")

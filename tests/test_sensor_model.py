@@ -151,7 +151,7 @@ def test_a_forced_sensor_file_is_named_each_time_it_is_used(cli, tmp_path):
                              ).to_yaml(path)
     res = cli("simulate", "--e", "400", "--contact", "1", "--sensor", path, "--json")
     assert res.exit_code == 0
-    assert "sensor forced was written with --force despite: conflict" in res.stderr
+    assert "sensor forced: its calibration reported: conflict" in res.stderr
     json.loads(res.stdout)  # the warning stays off stdout
 
 

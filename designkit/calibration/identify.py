@@ -946,15 +946,17 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
     for k, n in enumerate(names):
         j = prob.n_model + 1 + k
         lr, s = x[j], sd[j]
-        ident = j not in weak and not at_bound[j] and 2 * q * s < math.log(10.0)
+        # a material's e_o/e_s is informed by its own touches only: t with (its touches - 1) degrees of freedom
+        qm = _critical(sum(len(g.trials) for g in data.groups if g.material == k))
+        ident = j not in weak and not at_bound[j] and 2 * qm * s < math.log(10.0)
         why = ("at the search limit: the touches ask for the full temperature difference (e_o/e_s -> inf)"
                if lr > 0 and at_bound[j] else "at the search limit (e_o/e_s -> 0)" if at_bound[j]
                else "95 % interval wider than a factor of 10" if not ident else "")
-        ratios[n] = IdentifiedParameter(f"e_o/e_s[{n}]", _exp(lr), (_exp(lr - q * s), _exp(lr + q * s)),
+        ratios[n] = IdentifiedParameter(f"e_o/e_s[{n}]", _exp(lr), (_exp(lr - qm * s), _exp(lr + qm * s)),
                                         "", ident, why)
         if constrained[k]:
             e_lo, e_hi = rng[n]
-            allowed[n] = (e_lo / _exp(lr + q * s), e_hi / _exp(lr - q * s))
+            allowed[n] = (e_lo / _exp(lr + qm * s), e_hi / _exp(lr - qm * s))
             point_lo.append(math.log(e_lo) - lr)
             point_hi.append(math.log(e_hi) - lr)
             wide_lo.append(math.log(min(max(allowed[n][0], 1e-300), 1e300)))

@@ -116,7 +116,7 @@ def sensor_and_model(sensor, model: Optional[str] = None, *, conductance: Option
 
         con = console(stderr=True)
         for text in sen.problems:
-            con.print(f"[bold yellow]warning:[/] sensor {escape(sen.name)} was written with --force despite: "
+            con.print(f"[bold yellow]warning:[/] sensor {escape(sen.name)}: its calibration reported: "
                       f"{escape(text)}")
     return sen, fm, source
 

@@ -230,6 +230,14 @@ def schemas() -> dict[str, type]:
     class _Strict(BaseModel):
         model_config = ConfigDict(extra="forbid", strict=True, frozen=True)
 
+    class SensorModel(_Strict):
+        name: StrictStr
+        params: dict[str, Any] = {}   # the model's own fields: checked by designkit.models.get_model
+        time_offset_s: Optional[Number] = None
+        contact_spread: Optional[dict[str, Optional[Number]]] = None
+        object_temperature: Optional[dict[str, Union[StrictStr, Number]]] = None
+        candidate: Optional[StrictStr] = None
+
     class SensorFile(_Strict):
         designkit_sensor: Integer = 1
         name: StrictStr = "custom"
@@ -240,6 +248,7 @@ def schemas() -> dict[str, type]:
         sample_rate_hz: Number = 200.0
         noise_c: Optional[Number] = None
         provenance: dict[str, Any] = {}
+        model: Optional[SensorModel] = None
 
     class EffusivityGrid(_Strict):
         min: Optional[Number] = None

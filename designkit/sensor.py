@@ -20,7 +20,7 @@ import numpy as np
 from ._validation import InputError, check_nonnegative, check_positive
 from .properties import time_constant
 
-__all__ = ["MAX_SAMPLES_PER_TOUCH", "SENSORS", "Sensor", "load_sensor", "sample_times_s"]
+__all__ = ["MAX_SAMPLES_PER_TOUCH", "MODEL_KEYS", "SENSORS", "Sensor", "load_sensor", "sample_times_s"]
 
 SENSOR_FILE_VERSION = 1
 
@@ -81,6 +81,18 @@ class Sensor:
         estimates it from pre-contact samples). Scenes set their own noise.
     provenance : mapping
         Free-form record of where the numbers came from (not compared).
+    model : mapping or None
+        The forward model the sensor was identified with, as calibration
+        records it (:data:`MODEL_KEYS`): ``{"name", "params", "time_offset_s",
+        "contact_spread", "object_temperature", "candidate"}``. None (old files,
+        presets): the paper's semi-infinite model. Plain data here;
+        :func:`designkit.models.sensor_model` turns it into a forward model.
+
+    Examples
+    --------
+    >>> s = Sensor(1982.0, 1.1e-9, model={"name": "contact", "params": {"conductance_w_m2k": 3000.0}})
+    >>> s.model["name"], Sensor.from_dict(s.to_dict()) == s
+    ('contact', True)
     """
 
     effusivity: float
@@ -90,6 +102,7 @@ class Sensor:
     name: str = "custom"
     noise_c: float | None = None
     provenance: Mapping[str, Any] = field(default_factory=dict, compare=False, hash=False)
+    model: Mapping[str, Any] | None = field(default=None, hash=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "effusivity", check_positive("sensor effusivity e_s", self.effusivity))
@@ -100,6 +113,8 @@ class Sensor:
         if self.noise_c is not None:
             object.__setattr__(self, "noise_c", check_nonnegative("sensor noise [degC]", self.noise_c))
         object.__setattr__(self, "provenance", dict(self.provenance))
+        if self.model is not None:
+            object.__setattr__(self, "model", _model_block(self.model, "sensor model"))
 
     @property
     def tau_s(self) -> float:
@@ -129,8 +144,20 @@ class Sensor:
         if self.noise_c is not None:
             out["noise_c"] = self.noise_c
         if self.provenance:
-            out["provenance"] = dict(self.provenance)
+            out["provenance"] = _plain(self.provenance)
+        if self.model is not None:
+            out["model"] = _plain(self.model)
         return out
+
+    @property
+    def model_name(self) -> str:
+        """Name of the forward model the sensor was identified with (``semi-infinite`` when none is recorded)."""
+        return "semi-infinite" if self.model is None else str(self.model["name"])
+
+    @property
+    def problems(self) -> list[str]:
+        """What calibration found wrong but wrote anyway (``--force``): one line each, empty when none."""
+        return [str(p) for p in self.provenance.get("problems", []) or []]
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any], *, source: str = "sensor", schema: bool = True) -> "Sensor":
@@ -157,6 +184,8 @@ class Sensor:
         if schema:
             checked = validate(schemas()["sensor"], dict(data), source)  # types, strictly: no [1, 2] for a number
             data = {k: getattr(checked, k) for k in data}
+            if data.get("model") is not None:
+                data["model"] = checked.model.model_dump(exclude_none=False)
         kwargs = {k: data[k] for k in data if k not in ("designkit_sensor", "tau_s")}
         try:
             sensor = cls(**kwargs)
@@ -178,6 +207,10 @@ class Sensor:
 
         text = "# designkit sensor file: effusivity [J s^-1/2 K^-1 m^-2], diffusivity [m^2/s],\n" \
                "# depth [m], tau = depth^2 / (4 diffusivity) [s], sample rate [Hz], noise [degC]\n"
+        if self.model is not None:
+            text += ("# model: the forward model identified with it (name, its parameters in SI units with e_s\n"
+                     "# above; null = infinite), the fitted contact-time offset [s], the per-touch spread of the\n"
+                     "# contact conductance (geometric SD), how each material's temperature was taken\n")
         text += yaml.safe_dump(self.to_dict(), sort_keys=False)
         return atomic_write_text(Path(path), text)
 
@@ -189,6 +222,41 @@ class Sensor:
         p = Path(path)
         data = load_yaml(p, "sensor file")  # a regular UTF-8 file (a FIFO is refused, not waited on)
         return cls.from_dict(data, source=f"sensor file {p}")
+
+
+#: The keys of a sensor's ``model`` record (what calibration writes beside the sensor fields).
+MODEL_KEYS = ("name", "params", "time_offset_s", "contact_spread", "object_temperature", "candidate")
+
+
+def _plain(value: Any) -> Any:
+    """JSON/YAML-ready copy: mappings to dicts, tuples to lists, numpy scalars to Python numbers."""
+    if isinstance(value, Mapping):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, float) and math.isinf(value):
+        return None  # what a model's to_dict writes for an infinite parameter
+    return value
+
+
+def _model_block(model: Any, source: str) -> dict[str, Any]:
+    """A checked ``model`` record: a mapping with a name, its other keys among :data:`MODEL_KEYS`."""
+    if not isinstance(model, Mapping):
+        raise InputError(f"{source}: expected a mapping with a name and params, got {type(model).__name__}")
+    unknown = sorted(set(model) - set(MODEL_KEYS))
+    if unknown:
+        raise InputError(f"{source}: unknown key(s) {', '.join(unknown)} (known: {', '.join(MODEL_KEYS)})")
+    if not isinstance(model.get("name"), str) or not model["name"].strip():
+        raise InputError(f"{source}: the model needs a name (e.g. layered)")
+    params = model.get("params") or {}
+    if not isinstance(params, Mapping):
+        raise InputError(f"{source}: params must be a mapping of the model's parameters")
+    out = {k: None for k in MODEL_KEYS}
+    out.update(_plain(model))
+    out["params"] = _plain(params)
+    return out
 
 
 #: Named sensor presets. ``paper``: the values identified in the paper's

@@ -126,6 +126,23 @@ def test_guided_run_records_then_fits(cli, tmp_path):
     assert lo <= PAPER.effusivity <= hi and sen.tau_s == pytest.approx(PAPER.tau_s, rel=0.05)
 
 
+def test_guided_run_with_a_model_records_it_in_the_sensor_file(cli, tmp_path):
+    """calibrate --model NAME: the identified model goes into sensor.yaml, and --sensor answers with it."""
+    out = tmp_path / "run"
+    with _emulator(WOOD, "wood", seed=3) as emu:
+        r = cli("calibrate", "--port", emu.port, "--profile", "designkit", "--material", "wood", "--trials", "3",
+                "--range", f"wood={WOOD * 0.95}:{WOOD * 1.05}", "--out", out, "--model", "semi-infinite", "--yes",
+                "--json")
+    assert r.exit_code == 0, r.output
+    d = json.loads(r.stdout)
+    assert d["selected"] == "semi-infinite" and d["out"] == str(out / "sensor.yaml")
+    from designkit.models import load_sensor_model
+
+    sen, fm = load_sensor_model(out / "sensor.yaml")
+    assert fm.name == "semi-infinite" and sen.model["candidate"] == "semi-infinite"
+    assert sen.tau_s == pytest.approx(PAPER.tau_s, rel=0.05)
+
+
 def test_guided_run_stops_before_recording_when_a_range_is_missing(cli, tmp_path):
     r = cli("calibrate", "--port", "/dev/whatever", "--material", "unobtainium", "--out", tmp_path, "--yes")
     assert r.exit_code == 2 and "no effusivity range for unobtainium" in r.stderr

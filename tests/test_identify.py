@@ -96,7 +96,7 @@ def test_real_touches_layered_beats_semi_infinite_on_held_out_sets(robot_data_di
     assert math.isfinite(layered.parameter("lag_s").value)
 
 
-def test_cli_fit_with_model_prints_the_held_out_comparison(robot_data_dir, cli):
+def test_cli_fit_with_model_prints_the_held_out_comparison(robot_data_dir, cli, tmp_path):
     index = robot_data_dir / "index.csv"
     res = cli("calibrate", "fit", str(index), "--only", "metal,wood", "--range", "metal=aluminium",
                "--object-temp", "metal=free", "--model", "semi-infinite", "--json")
@@ -106,8 +106,18 @@ def test_cli_fit_with_model_prints_the_held_out_comparison(robot_data_dir, cli):
     out = json.loads(res.output)
     assert out["selected"] == "semi-infinite" and out["n_fit"] == 24 and out["n_held_out"] == 96
     assert set(out["results"][0]["held_out_rms_c"]) == {"metal", "wood", "all"}
-    bad = cli("calibrate", "fit", str(index), "--model", "semi-infinite", "--out", "x.yaml")
-    assert bad.exit_code != 0 and "sensor files do not record a forward model" in bad.output
+    # --out writes the selected model into the sensor file, and --sensor answers with it
+    path = tmp_path / "rig.yaml"
+    res = cli("calibrate", "fit", str(index), "--only", "metal,wood", "--range", "metal=aluminium",
+              "--object-temp", "metal=free", "--model", "contact", "--out", str(path))
+    assert res.exit_code == 0, res.output
+    assert f"wrote {path} with the contact model" in res.stdout
+    from designkit.models import load_sensor_model
+
+    sen, fm = load_sensor_model(path)
+    assert fm.name == "contact" and sen.model["candidate"] == "contact"
+    assert sen.model["object_temperature"] == {"metal": "free", "wood": "passive"}
+    assert sen.provenance["materials_fitted"] == ["metal", "wood"] and sen.name == "rig"
 
 
 def test_fit_on_a_decimated_grid_when_the_noise_is_smoothed_gives_the_full_grid_estimates():
@@ -168,3 +178,18 @@ def test_sim_to_real_with_the_identified_model_beats_the_paper(robot_data_dir):
     r = sim_to_real(test, setup, setup.rms_c, per_trial=2, seed=0)
     assert r["mean_f1"] >= 0.90 and r["multiclass"]["accuracy"] >= 0.80, r
     assert r["pairs"]["wood vs cold wood"]["f1"] >= 0.95
+
+
+def test_cli_fit_with_model_refuses_to_write_a_conflicting_sensor_unless_forced(robot_data_dir, cli, tmp_path):
+    """Wood given a range its touches cannot have (1-5): metal and wood ask for different e_s (issue 14)."""
+    index = robot_data_dir / "index.csv"
+    path = tmp_path / "conflict.yaml"
+    args = ("calibrate", "fit", str(index), "--only", "metal,wood", "--range", "metal=12767:25972",
+            "--range", "wood=1:5", "--model", "semi-infinite", "--out", str(path))
+    res = cli(*args)
+    assert res.exit_code == 2 and "not written" in res.output and "conflict" in res.output
+    assert not path.exists()
+    forced = cli(*args, "--force")
+    assert forced.exit_code == 0, forced.output
+    used = cli("simulate", "--e", "400", "--contact", "1", "--sensor", str(path))
+    assert used.exit_code == 0 and "its calibration reported: " in used.stderr and "conflict" in used.stderr

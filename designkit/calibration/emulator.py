@@ -207,6 +207,11 @@ class Emulator:
         Noise and fault draws.
     force_noise_n : float
         Force noise sigma [N].
+    model : ForwardModel, optional
+        The forward model of the touches (default, None: the paper's
+        semi-infinite model). The wire carries the raw reading: a layered
+        model's host smoothing (``smoothing_window``) is left to the host,
+        as on a real rig, and only its conduction and lag are streamed.
 
     Examples
     --------
@@ -219,11 +224,22 @@ class Emulator:
     def __init__(self, profile: DeviceProfile, sensor: Sensor,
                  materials: Sequence[EmulatedMaterial], *, noise_c: float = 0.05,
                  sensor_temp_c: float = 35.0, ambient_c: float = 25.0, plan: TouchPlan = TouchPlan(),
-                 speed: float = 1.0, faults: Faults = Faults(), seed=0, force_noise_n: float = 0.02) -> None:
+                 speed: float = 1.0, faults: Faults = Faults(), seed=0, force_noise_n: float = 0.02,
+                 model=None) -> None:
         if not materials:
             raise InputError("the emulator needs at least one material to touch")
         self.profile = profile
         self.sensor = sensor
+        if model is not None:
+            from ..models import get_model
+
+            model = get_model(model)
+            if "diffusivity_m2_s" in model.object_properties:
+                raise InputError(f"the emulator touches objects by effusivity alone; the {model.name} model needs "
+                                 "their diffusivity")
+            if model.name == "semi-infinite":
+                model = None  # the closed form below, bit for bit what it always streamed
+        self.model = model
         self.materials = tuple(materials)
         self.noise_c = check_nonnegative("noise sigma [degC]", noise_c)
         self.sensor_temp_c = float(sensor_temp_c)
@@ -308,16 +324,20 @@ class Emulator:
         e_o = np.array([mats[x - base].effusivity for x in j]) if n else np.zeros(0)
         t_obj = np.array([self.ambient_c if mats[x - base].object_temp_c is None else mats[x - base].object_temp_c
                           for x in j]) if n else np.zeros(0)
-        w = object_weight(self.sensor.effusivity, e_o)
-        tau = self.sensor.tau_s
         c = p.contact_s
+        if self.model is None:
+            w = object_weight(self.sensor.effusivity, e_o)
+            tau = self.sensor.tau_s
+            u_now = w * response_shape(np.clip(rel, 0.0, c), tau)
+            u_end = w * response_shape(c, tau)
+        else:
+            u_now, u_end = self._model_reading(np.clip(rel, 0.0, c), e_o, c)
 
         def curve(start_c):
             in_contact = (rel >= 0) & (rel < c)
             after = rel >= c
-            g = response_shape(np.clip(rel, 0.0, c), tau)
-            during = start_c + (t_obj - start_c) * w * g
-            released = start_c + (t_obj - start_c) * w * response_shape(c, tau)
+            during = start_c + (t_obj - start_c) * u_now
+            released = start_c + (t_obj - start_c) * u_end
             decay = np.exp(-np.clip(rel - c, 0.0, None) / p.recover_s)
             out = np.full(n, start_c, dtype=np.float64)
             out = np.where(in_contact, during, out)
@@ -335,6 +355,19 @@ class Emulator:
         if self.force_noise_n > 0:
             force = np.maximum(force + self.force_noise_n * z[2], 0.0)
         return {"sensor": sensor, "object": passive, "force": force, "timestamp": t}
+
+    def _model_reading(self, rel_s: np.ndarray, e_o: np.ndarray, contact_s: float):
+        """Normalized reading of :attr:`model` at times ``rel_s`` after heat starts, and at release."""
+        m = self.model
+        fn = m.conduction if hasattr(m, "conduction") else (
+            lambda t, e, sensor: m.response(t, e, sensor))   # conduction: the raw reading, before host smoothing
+        now = np.zeros(rel_s.size)
+        end = np.zeros(rel_s.size)
+        for e in np.unique(e_o):
+            sel = e_o == e
+            now[sel] = fn(rel_s[sel], [float(e)], self.sensor)[0]
+            end[sel] = fn(np.array([contact_s]), [float(e)], self.sensor)[0, 0]
+        return now, end
 
     _BLOCK = 8192
 

@@ -641,9 +641,13 @@ class CalibrationResult:
             "notes": list(self.notes),
         }
         prov.update(dict(provenance or {}))
+        record = {"name": "semi-infinite", "params": {}, "time_offset_s": float(self.time_offset_s.value),
+                  "contact_spread": None,
+                  "object_temperature": {m.name: str(m.object_temp) for m in self.materials},
+                  "candidate": "semi-infinite (paper appendix fit)"}
         return Sensor(effusivity=self.effusivity.value, diffusivity_m2_s=self.diffusivity_m2_s.value,
                       depth_m=self.depth_m, sample_rate_hz=self.sample_rate_hz, name=name,
-                      noise_c=self.noise_c, provenance=_plain(prov))
+                      noise_c=self.noise_c, provenance=_plain(prov), model=record)
 
     def to_dict(self) -> dict[str, Any]:
         return {

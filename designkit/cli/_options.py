@@ -8,7 +8,8 @@ import typer
 
 Json = Annotated[bool, typer.Option("--json", help="Print the result as JSON on stdout.")]
 SensorOpt = Annotated[str, typer.Option(
-    "--sensor", help="Sensor preset name ('paper') or a sensor YAML file written by calibration.")]
+    "--sensor", help="Sensor preset name ('paper') or a sensor YAML file written by calibration; a file's "
+                     "recorded model answers unless --model (or --thickness, --conductance) is given.")]
 Noise = Annotated[float, typer.Option("--noise", help="Noise sigma per sample [°C].")]
 DeltaT = Annotated[float, typer.Option(
     "--delta-t", help="Sensor minus object temperature before contact [°C].")]
@@ -82,6 +83,51 @@ def model_from_options(model: Optional[str], *, conductance: Optional[float] = N
     if get_model_name(name) == "contact" and conductance is None:
         raise InputError("the contact model needs the interface --conductance [W m^-2 K^-1]")
     return get_model(name, **params)
+
+
+def sensor_and_model(sensor, model: Optional[str] = None, *, conductance: Optional[float] = None,
+                     thickness: Optional[float] = None, backing: Optional[str] = None, warn: bool = True):
+    """The sensor (preset or file) and the forward model that answers for it, and where the model came from.
+
+    Model options given on the command line (``--model``, ``--thickness``, ``--conductance``) override the
+    model a sensor file records; without them the file's model answers (semi-infinite for presets and old
+    files). A sensor file that calibration wrote despite problems (``--force``) is named on stderr each time
+    it is used (``warn``).
+
+    Returns
+    -------
+    (Sensor, ForwardModel, str)
+        The last item says where the model came from: ``"sensor file"``, ``"options"`` or ``"default"``.
+    """
+    from ..models import sensor_model
+    from ..sensor import load_sensor
+
+    sen = load_sensor(sensor if sensor is not None else "paper")
+    given = any(x is not None for x in (model, conductance, thickness, backing))
+    if given:
+        fm, source = model_from_options(model, conductance=conductance, thickness=thickness, backing=backing), \
+            "options"
+    else:
+        fm, source = sensor_model(sen), ("sensor file" if sen.model is not None else "default")
+    if warn and sen.problems:
+        from rich.markup import escape
+
+        from ._app import console
+
+        con = console(stderr=True)
+        for text in sen.problems:
+            con.print(f"[bold yellow]warning:[/] sensor {escape(sen.name)}: its calibration reported: "
+                      f"{escape(text)}")
+    return sen, fm, source
+
+
+def model_words(sen, fm, source: str) -> str:
+    """One line saying which model answers, and why (for text output)."""
+    if source == "sensor file":
+        return f"model {fm.describe()} (recorded in sensor file {sen.name})"
+    if source == "options" and sen.model is not None and sen.model_name != fm.name:
+        return f"model {fm.describe()} (from the options; sensor {sen.name} was identified with {sen.model_name})"
+    return f"model {fm.describe()}"
 
 
 def get_model_name(name: str) -> str:

@@ -18,7 +18,7 @@ import typer
 
 from ._app import EXIT_INTERRUPTED, app, console, emit_json, sub_app
 from . import _app
-from ._options import Json, Noise, Seed, SensorOpt
+from ._options import Json, Noise, Seed, SensorOpt, sensor_and_model
 
 calibrate_app = sub_app(
     "calibrate",
@@ -419,9 +419,38 @@ def _parse_sets(spec: str) -> list[int]:
     return out
 
 
+def _write_identified(best, trials, out: Path, name: Optional[str], index: Path, force: bool, names) -> list[str]:
+    """Write the selected model's sensor file, or refuse (exit 2) when its fit is unusable and not forced.
+
+    Returns the problems written into the file's provenance (so that ``--sensor`` can warn).
+    """
+    from rich.markup import escape
+
+    from .._validation import InputError
+    from ..calibration.fit import check_calibration
+
+    problems = [p.text() for p in check_calibration(None, trials) if p.fatal]
+    if best.consistent is False:
+        problems += [n for n in best.notes if "conflict" in n] or ["the materials' ranges conflict under this model"]
+    con = console(stderr=True)
+    for text in problems:
+        con.print(f"[bold red]{'warning' if force else 'error'}:[/] {escape(text)}")
+    if problems and not force:
+        raise InputError(f"calibration unusable ({len(problems)} problem(s) above): {out} not written; "
+                         "--force writes the sensor file anyway")
+    prov = {"index": str(index), "materials_fitted": list(names)}
+    if problems:
+        prov["problems"] = problems
+    sensor = best.sensor(name=name or out.stem)
+    sensor = sensor.replace(provenance={**sensor.provenance, **prov})
+    sensor.to_yaml(out)
+    return problems
+
+
 def _run_identify(index: Path, model: str, fit_sets: str, ranges: list[str], only: Optional[list[str]],
                   object_temps: list[str], depth_um: float, out: Optional[Path], json_: bool,
-                  touch_conductance: Optional[str] = None) -> None:
+                  touch_conductance: Optional[str] = None, name: Optional[str] = None,
+                  force: bool = False) -> None:
     """``calibrate fit --model``: identify one model or compare them all on held-out touches."""
     from rich.markup import escape
     from rich.table import Table
@@ -431,9 +460,6 @@ def _run_identify(index: Path, model: str, fit_sets: str, ranges: list[str], onl
     from ..calibration.identify import CANDIDATES, candidate, compare_models, split_by_trial_set, trial_sets
     from ..calibration.trials import load_index
 
-    if out is not None:
-        raise InputError("--out with --model: sensor files do not record a forward model yet; fit without "
-                         "--model to write one, or use --json to keep the identified model")
     cands = list(CANDIDATES) if model.strip().lower() == "all" else [candidate(model)]
     trials = load_index(index, only=only)
     if not trials:
@@ -466,8 +492,12 @@ def _run_identify(index: Path, model: str, fit_sets: str, ranges: list[str], onl
     with _app.busy(f"identifying {len(cands)} model(s) on {len(fit)} touches", quiet=json_):
         cmp = compare_models(fit, held, cands, **kw)   # no held-out touches: selected by BIC
     results, scores, selected = cmp.results, cmp.held_out_rms_c, cmp.selected
+    best = next(r for r in results if r.candidate.label == selected)
+    if out is not None:
+        _write_identified(best, trials, out, name, index, force, names)
     if json_:
         emit_json({"index": str(index), "n_fit": len(fit), "n_held_out": len(held), "selected": selected,
+                   "out": str(out) if out is not None else None,
                    "results": [dict(r.to_dict(), held_out_rms_c=dict(sc)) for r, sc in zip(results, scores)]})
         return
     con = console()
@@ -483,7 +513,6 @@ def _run_identify(index: Path, model: str, fit_sets: str, ranges: list[str], onl
                   *(f"{sc[n]:.4f} °C" if n in sc else "–" for n in names), f"{r.aic:.0f}", f"{r.bic:.0f}",
                   f"{r.rank}/{r.n_nonlinear}", escape(es), f"{r.fit_time_s:.1f} s")
     con.print(t)
-    best = next(r for r in results if r.candidate.label == selected)
     p = Table(title=f"Selected: {selected} ({best.model().describe()})", title_justify="left")
     for c in ("parameter", "value", "95 % interval", "unit", "identified"):
         p.add_column(c, justify="left" if c in ("parameter", "unit", "identified") else "right")
@@ -497,6 +526,8 @@ def _run_identify(index: Path, model: str, fit_sets: str, ranges: list[str], onl
         con.print(f"[dim]{escape(n)} allows e_s in [{lo:.4g}, {hi:.4g}][/]")
     for note in best.notes:
         con.print(f"[yellow]note:[/] {escape(note)}")
+    if out is not None:
+        con.print(f"wrote {out} with the {selected} model  (use it with --sensor {out})")
 
 
 # ------------------------------------------------------------------ record
@@ -584,7 +615,7 @@ def fit(
     only_list = [s.strip() for item in only for s in item.split(",") if s.strip()] if only else None
     if model is not None:
         _run_identify(index, model, fit_sets, range_ or [], only_list, object_temp or [], depth_um, out, json_,
-                      touch_conductance)
+                      touch_conductance, name=name, force=force)
         return
     result = _run_fit(index, range_ or [], only_list, object_temp or [], settings, out, name, plot, quiet=json_,
                       force=force)
@@ -616,9 +647,15 @@ def guided(
     yes: Annotated[bool, typer.Option("--yes", "-y", help="Do not wait for Enter before each material.")] = False,
     force: Annotated[bool, typer.Option(
         "--force", help="Write the sensor file even when the calibration is unusable.")] = False,
+    model: Annotated[Optional[str], typer.Option(
+        "--model", help="Identify this sensor model (as 'calibrate fit --model'; 'all': the best by BIC) and "
+                        "record it in the sensor file (default: the paper's semi-infinite fit).")] = None,
     json_: Json = False,
 ) -> None:
-    """Guided calibration: record every material over serial, then fit and write the sensor file."""
+    """Guided calibration: record every material over serial, then fit and write the sensor file.
+
+    Example: `designkit calibrate --port /dev/pts/5 --material wood --material metal --out trials/ --yes`
+    """
     from .._validation import InputError
 
     if ctx.invoked_subcommand is not None:
@@ -649,6 +686,12 @@ def guided(
                                    f"'designkit calibrate fit {out / 'index.csv'}'")
         raise typer.Exit(EXIT_INTERRUPTED)
     sensor_path = sensor_out or out / "sensor.yaml"
+    if model is not None:
+        if not json_:
+            console().print(f"Recorded {len(paths)} trial(s) in {out}")
+        _run_identify(out / "index.csv", model, "all", range_ or [], materials, object_temp or [], depth_um,
+                      sensor_path, json_, name=None, force=force)
+        return
     result = _run_fit(out / "index.csv", range_ or [], materials, object_temp or [], settings, sensor_path, None,
                       None, quiet=json_, force=force)
     if json_:
@@ -694,7 +737,6 @@ def emulate(
     from .._validation import InputError
     from ..calibration.emulator import EmulatedMaterial, Emulator, Faults, TouchPlan
     from ..calibration.profiles import load_profile
-    from ..sensor import load_sensor
     from .._validation import check_temperature
 
     sensor_temp = check_temperature("--sensor-temp [degC]", sensor_temp)
@@ -721,13 +763,15 @@ def emulate(
     if duration is not None and not duration > 0:
         raise InputError(f"--duration must be positive, got {duration:g}")
     prof = load_profile(profile)
-    emu = Emulator(prof, load_sensor(sensor), mats, noise_c=noise, sensor_temp_c=sensor_temp, ambient_c=ambient,
+    sen, fm, _ = sensor_and_model(sensor)   # a sensor file's recorded model is what the rig plays
+    emu = Emulator(prof, sen, mats, noise_c=noise, sensor_temp_c=sensor_temp, ambient_c=ambient,
                    plan=TouchPlan(touch_every_s=touch_every, touches_per_material=touches_per_material),
-                   speed=speed, faults=Faults.parse(fault or []), seed=seed)
+                   speed=speed, faults=Faults.parse(fault or []), seed=seed, model=fm)
     port = emu.start()
     info = {"port": port, "profile": prof.name, "speed": speed, "touch_every_s": touch_every,
             "materials": [{"label": m.label, "effusivity": m.effusivity} for m in mats],
-            "noise_c": noise, "sensor": emu.sensor.to_dict(), "time_offset_s": emu.expected_time_offset_s,
+            "noise_c": noise, "sensor": emu.sensor.to_dict(), "model": fm.to_dict(),
+            "time_offset_s": emu.expected_time_offset_s,
             "faults": [str(f) for f in fault or []]}
     if json_:
         emit_json(info)
@@ -737,6 +781,11 @@ def emulate(
         con.print("  touching " + ", ".join(f"{m.label} (e = {m.effusivity:g})" for m in mats)
                   + f" every {touch_every:g} s; noise {noise:g} °C; sensor e_s = {emu.sensor.effusivity:g}, "
                     f"tau = {emu.sensor.tau_s:.3f} s")
+        if fm.name != "semi-infinite":
+            from rich.markup import escape
+
+            con.print(escape(f"  model {fm.describe()} (recorded in sensor file {emu.sensor.name}; the wire "
+                             "carries the raw reading: any host smoothing is the host's)"))
         con.print(f"  try: designkit calibrate record --port {port} --profile {profile} "
                   f"--material {mats[0].label} --out trials/")
         sys.stdout.flush()

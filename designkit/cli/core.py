@@ -11,7 +11,8 @@ import typer
 from ._app import app, console, emit_json
 from . import _app
 from ._options import (E1, E2, Ambient, BackingOpt, Conductance, Contact, DeltaT, Diffusivity, Folds, Json,
-                       ModelOpt, Noise, Seed, SensorOpt, Thickness, Threshold, Trials, Width, model_from_options)
+                       ModelOpt, Noise, Seed, SensorOpt, Thickness, Threshold, Trials, Width, model_words,
+                       sensor_and_model)
 
 
 @app.command(rich_help_panel=_app.MODEL)
@@ -39,8 +40,6 @@ def simulate(
     """
     from ..models.semi_infinite import contact_temperature
     from ..scene import Scene
-    from ..sensor import load_sensor
-
     from .._validation import check_temperature
 
     if trials < 1:
@@ -48,8 +47,8 @@ def simulate(
     check_temperature("--sensor-temp [°C]", sensor_temp)
     check_temperature("--ambient [°C]", ambient)
     check_temperature("--noise [°C]", noise, nonnegative=True)
-    fm = model_from_options(model, conductance=conductance, thickness=thickness, backing=backing)
-    sen = load_sensor(sensor)
+    sen, fm, source = sensor_and_model(sensor, model, conductance=conductance, thickness=thickness,
+                                       backing=backing)
     scene = Scene(contact_s=contact, noise_c=noise, sensor_temp_c=sensor_temp, ambient_temp_c=ambient)
     _check_touch_memory("simulate", trials, sen, contact, copies=6)
     result = _touches(e, sen, scene, trials, seed, fm, diffusivity)
@@ -72,6 +71,7 @@ def simulate(
             "scene": scene.to_dict(),
             "sensor": sen.to_dict(),
             "model": fm.to_dict(),
+            "model_source": source,
             "diffusivity_m2_s": diffusivity,
             "seed": seed,
             "out": str(out) if out else None,
@@ -84,7 +84,7 @@ def simulate(
     final = result.temperature_c[:, -1]
     con.print(f"[bold]{trials} touch(es)[/] of e = {e:g} J s^-1/2 K^-1 m^-2 for {contact:g} s "
               f"({result.time_s.size} samples at {sen.sample_rate_hz:g} Hz, {sen.name} sensor, tau = {sen.tau_s:.3f} s)")
-    con.print(escape(f"  model {fm.describe()}"
+    con.print(escape("  " + model_words(sen, fm, source)
                      + (f", object diffusivity {diffusivity:g} m^2/s" if diffusivity is not None else "")))
     con.print(f"  sensor {sensor_temp:g} °C, object {ambient:g} °C"
               + (f", contact surface Tc = {tc:.4f} °C" if tc is not None else ""))
@@ -166,19 +166,28 @@ def f1(
     thickness: Thickness = None,
     backing: BackingOpt = None,
     diffusivity: Diffusivity = None,
+    two_sensor: Annotated[bool, typer.Option(
+        "--two-sensor", help="Also read each touch with a passive thermistor resting at --ambient (room) "
+                             "temperature beside the heated sensor, and say whether it resolves the pair.")] = False,
+    object_temp1: Annotated[Optional[float], typer.Option(
+        "--object-temp1", help="With --two-sensor: temperature of the first object [°C] (default: --ambient).")] = None,
+    object_temp2: Annotated[Optional[float], typer.Option(
+        "--object-temp2", help="With --two-sensor: temperature of the second object [°C] (default: --ambient).")]
+    = None,
     json_: Json = False,
 ) -> None:
     """F1 of the paper's SVM and of the ideal observer for classes [e1, e1+width) and [e2, e2+width), under any
     forward model.
 
     Example: `designkit f1 --e1 35000 --e2 20000 --contact 2 --thickness 0.003 --diffusivity 1e-7`
+
+    Example (a cold block of wood against room-temperature metal, one sensor and two): `designkit f1 --e1 17530 --e2 400 --width 10 --delta-t 7 --ambient 22.5 --object-temp2 8 --two-sensor`
     """
     from .._validation import InputError, check_effusivity, check_positive, check_probability, check_temperature
     from ..objects import object_class
     from ..recognition.ideal import ideal_pair
     from ..recognition.svm import pair_f1
     from ..scene import Scene
-    from ..sensor import load_sensor
 
     if e1 is None or e2 is None:
         raise InputError("give both --e1 and --e2")
@@ -201,16 +210,23 @@ def f1(
         raise InputError(f"folds must be >= 2, got {folds}")
     if trials < folds:
         raise InputError(f"trials per class ({trials}) must be at least the number of folds ({folds})")
-    fm = model_from_options(model, conductance=conductance, thickness=thickness, backing=backing)
+    sen, fm, source = sensor_and_model(sensor, model, conductance=conductance, thickness=thickness,
+                                       backing=backing)
     if diffusivity is not None and "diffusivity_m2_s" not in fm.object_properties:
         raise InputError(f"--diffusivity is for models that need it (slab), not the {fm.name} model")
     if diffusivity is None and "diffusivity_m2_s" in fm.object_properties:
         raise InputError(f"the {fm.name} model needs the objects' --diffusivity [m^2/s]")
-    sen = load_sensor(sensor)
     scene = Scene.from_delta_t(contact_s=contact, noise_c=noise, delta_t_c=delta_t, ambient_temp_c=ambient)
-    _check_touch_memory("f1", 2 * trials, sen, contact, copies=8)  # two classes; raw, slope, scaled, folds
+    _check_touch_memory("f1", 2 * trials, sen, contact, copies=16 if two_sensor else 8)  # raw, slope, folds
     obj1 = object_class(e1, width=width, diffusivity_m2_s=diffusivity)
     obj2 = object_class(e2, width=width, diffusivity_m2_s=diffusivity)
+    if two_sensor or object_temp1 is not None or object_temp2 is not None:
+        if not two_sensor:
+            raise InputError("--object-temp1/--object-temp2 go with --two-sensor (one sensor's scene has one "
+                             "object temperature: --ambient, with --delta-t)")
+        _f1_two_sensor(obj1, obj2, object_temp1, object_temp2, sen, fm, source, scene, trials, folds, seed,
+                       threshold, json_)
+        return
     ra, rb = obj1.e_range, obj2.e_range
     t0 = time.perf_counter()
     with _app.busy("f1: simulating touches, fitting the SVM, the ideal observer", quiet=json_):
@@ -238,6 +254,7 @@ def f1(
         "scene": scene.to_dict(),
         "sensor": sen.to_dict(),
         "model": fm.to_dict(),
+        "model_source": source,
         "diffusivity_m2_s": diffusivity,
         "svm_time_s": t1 - t0,
         "ideal_time_s": t2 - t1,
@@ -250,7 +267,7 @@ def f1(
     con = console()
     con.print(f"[bold]{e1:g}[/] vs [bold]{e2:g}[/] J s^-1/2 K^-1 m^-2 (classes {width:g} wide), contact {contact:g} s, "
               f"noise {noise:g} °C, dT {delta_t:g} °C, {sen.name} sensor")
-    con.print(escape(f"  model {fm.describe()}"
+    con.print(escape("  " + model_words(sen, fm, source)
                      + (f", object diffusivity {diffusivity:g} m^2/s" if diffusivity is not None else "")))
     verdict = "[green]distinguishable[/]" if svm.f1 >= threshold else "[red]not distinguishable[/]"
     folds_txt = ", ".join(f"{f:.3f}" for f in svm.fold_f1)
@@ -258,3 +275,45 @@ def f1(
               f"  -> {verdict} at F1 >= {threshold:g}")
     con.print(f"  ideal F1  {ideal.f1:.3f}, accuracy {ideal.accuracy:.3f}  ({ideal.method}; no classifier does better)")
     con.print(f"  [dim]{(t1 - t0) * 1e3:.0f} ms SVM, {(t2 - t1) * 1e3:.0f} ms ideal[/]")
+
+
+def _f1_two_sensor(obj1, obj2, temp1, temp2, sen, fm, source, scene, trials, folds, seed, threshold, json_) -> None:
+    """``f1 --two-sensor``: the heated sensor alone, then with the passive thermistor at room temperature."""
+    from .._validation import check_temperature
+    from ..recognition.two_sensor import TouchClass, two_sensor_pair_f1
+
+    temps = [None if t is None else check_temperature(f"--object-temp{i} [°C]", t)
+             for i, t in ((1, temp1), (2, temp2))]
+    a, b = (TouchClass(o, t, f"{o.label} at {scene.ambient_temp_c if t is None else t:g} °C")
+            for o, t in zip((obj1, obj2), temps))
+    t0 = time.perf_counter()
+    r = two_sensor_pair_f1(a, b, sen, scene, model=fm, trials=trials, folds=folds, seed=seed, threshold=threshold)
+    wall = time.perf_counter() - t0
+    payload = dict(r.to_dict(), scene=scene.to_dict(), sensor=sen.to_dict(), model=fm.to_dict(),
+                   model_source=source, passive_sensor={"initial_temp_c": scene.ambient_temp_c,
+                                                      "like": "the heated sensor, unheated"},
+                   trials=trials, folds=folds, seed=seed, wall_s=wall)
+    if json_:
+        emit_json(payload)
+        return
+    from rich.markup import escape
+
+    con = console()
+    con.print(f"[bold]{escape(a.label)}[/] vs [bold]{escape(b.label)}[/] (classes {obj1.e_range[1] - obj1.e_range[0]:g} "
+              f"wide), contact {scene.contact_s:g} s, noise {scene.noise_c:g} °C, heated sensor at "
+              f"{scene.sensor_temp_c:g} °C, room {scene.ambient_temp_c:g} °C, {escape(sen.name)} sensor")
+    con.print(escape("  " + model_words(sen, fm, source)))
+
+    def line(words, res):
+        ok = "[green]distinguishable[/]" if res.f1 >= threshold else "[red]not distinguishable[/]"
+        return f"  {words} F1 {res.f1:.3f} ± {res.standard_error:.3f}  -> {ok}"
+
+    con.print(line("heated sensor alone:        ", r.one_sensor))
+    con.print(line("with the passive thermistor:", r.two_sensors))
+    if r.resolves:
+        con.print("  [bold]the second sensor resolves this pair[/]: one heated sensor cannot tell them apart")
+    elif r.one_sensor.f1 >= threshold:
+        con.print("  [dim]one sensor already suffices[/]")
+    else:
+        con.print("  [yellow]not even two sensors separate them here[/]")
+    con.print(f"  [dim]{trials} trials/class, {folds} folds, {wall:.1f} s[/]")

@@ -40,6 +40,7 @@ def export_cmd(
     e_max: Annotated[Optional[float], typer.Option("--e-max", help="Keep effusivities up to this value (plus one interval of margin).")] = None,
     prefix: Annotated[str, typer.Option("--prefix", help="C: prefix of every function, constant and macro.")] = "designkit",
     kind: Annotated[str, typer.Option("--kind", help="Which delta: svm (the table's classifier), lo / hi (ends of its Monte Carlo interval; hi is the conservative one) or ideal.")] = "svm",
+    sensor: Annotated[Optional[str], typer.Option("--sensor", help="Check that the table was built for this sensor (preset or sensor YAML) and the model its file records; refused otherwise.")] = None,
     json_: Json = False,
 ) -> None:
     """Export a table, or only the slice a deployment needs, for software where designkit does not run.
@@ -50,6 +51,8 @@ def export_cmd(
     """
     from ..export import export_bytes, export_table
 
+    if sensor is not None:
+        _check_sensor(table, sensor)
     slice_opts = dict(prefix=prefix, noise_c=noise, delta_t_c=delta_t, contact=contact, e_min=e_min, e_max=e_max,
                       kind=kind)
     if out == "-":
@@ -78,6 +81,22 @@ def export_cmd(
     elif res.format == "python":
         con.print("  [dim]import it; call min_contact_s, delta_e, distinguishable (None: none suffices; "
                   "OutsideTable / ValueError otherwise)[/]")
+
+
+def _check_sensor(table: str, sensor: str) -> None:
+    """Refuse (one line, exit 2) a table built for another sensor or forward model than ``--sensor``'s."""
+    from .._validation import InputError
+    from ..query.inputs import table_reroute
+    from ..tables.store import load_table
+    from ._options import sensor_and_model
+
+    sen, fm, source = sensor_and_model(sensor)
+    tab = load_table(table)
+    why = table_reroute(sen, fm, table_sensor=tab.sensor, table_model=tab.model)
+    if why:
+        raise InputError(f"table {tab.name} was built for sensor {tab.sensor.name!r} and the {tab.model.name} model, "
+                         f"not sensor {sen.name!r} with the {fm.name} model ({source}): its answers would be "
+                         f"another sensor's; build one with 'designkit sweep --sensor {sensor} ...'")
 
 
 def _to_stdout(export_bytes, table: str, fmt: str | None, json_: bool, slice_opts: dict) -> None:

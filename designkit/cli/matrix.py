@@ -15,7 +15,7 @@ import typer
 from . import _app
 from ._app import app, console
 from ._format import FormatOpt, OutOpt, check_format, emit_rows
-from ._options import Json
+from ._options import Json, SensorOpt, sensor_and_model
 
 _QUESTIONS = "min-contact, max-noise, min-delta-t or distinguishable"
 
@@ -56,6 +56,7 @@ def matrix(
         "--plot", help="Save a figure: heatmap + multi-class accuracy (.png, .svg or .pdf).")] = None,
     format_: FormatOpt = "table",
     out: OutOpt = None,
+    sensor: SensorOpt = "paper",
     json_: Json = False,
 ) -> None:
     """The pairwise matrix of one question over N materials, the pair that limits the design, and the
@@ -68,6 +69,7 @@ def matrix(
 
     Example: `designkit materials list --family metals --format csv | designkit matrix --from -`
     """
+    from ..query.inputs import TableMismatch
     from ..query.matrix import material_matrix
 
     names = list(m or ()) + (read_material_names(from_) if from_ else [])
@@ -81,12 +83,19 @@ def matrix(
         from .._validation import InputError
 
         raise InputError("min-contact asks for the contact time: drop --contact")
+    if sensor != "paper":  # a sensor file: its model too; a table built for another sensor is refused
+        sen, fm, _ = sensor_and_model(sensor)
+        scene.update(sensor=sen, model=fm)
     progress = _progress(json_ or fmt == "json")
     try:
         result = material_matrix(names, question, set=set_, table=table, ideal_table=ideal_table,
                                  multiclass=multiclass, svm_trials=svm_trials, seed=seed,
                                  progress=progress.step if progress else None,
                                  **{k: v for k, v in scene.items() if v is not None})
+    except TableMismatch as exc:
+        raise TableMismatch(f"{exc}: matrix reads tables only; build one for this sensor with 'designkit sweep "
+                            f"--sensor {sensor} ...' and name it with --table, or ask one pair with --exact "
+                            "(designkit distinguishable --sensor ...)") from None
     finally:
         if progress:
             progress.stop()

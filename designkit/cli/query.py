@@ -34,7 +34,7 @@ from ._options import (
     SensorOpt,
     Thickness,
     Threshold,
-    model_from_options,
+    sensor_and_model,
 )
 
 Contact = Annotated[float, typer.Option("--contact", help="Contact time [s].")]
@@ -95,9 +95,14 @@ def _ask(question: str, *, exact: bool, table: Optional[str], ideal_table: str, 
         check_coverage(extra["coverage"])  # bad input before any work, on either route
 
     with _hints():
-        fm = model_from_options(model, conductance=conductance, thickness=thickness, backing=backing)
-        # the shipped tables are for the semi-infinite model: another model is computed unless a table is named
-        route = "exact" if exact or (table is None and fm.name != "semi-infinite") else "table"
+        from ..query.inputs import table_reroute
+
+        sen, fm, source = sensor_and_model(sensor, model, conductance=conductance, thickness=thickness,
+                                           backing=backing)
+        # the shipped tables are for the paper sensor and the semi-infinite model: another sensor or model is
+        # computed unless a table is named (a named table built for another one is refused, never used)
+        reroute = None if exact or table is not None else table_reroute(sen, fm)
+        route = "exact" if exact or reroute else "table"
         if route == "table":
             if diffusivity is not None:
                 from ..query.inputs import NeedsInput
@@ -106,14 +111,15 @@ def _ask(question: str, *, exact: bool, table: Optional[str], ideal_table: str, 
                                  "diffusivity-unused")
             return query.ask(question, route="table", **objects, **scene, threshold=threshold,
                              table=table or "svm-paper", ideal_table=ideal_table,
-                             sensor=None if sensor == "paper" else sensor, model=fm)
-        kw = dict(threshold=threshold, sensor=sensor, model=fm, diffusivity_m2_s=diffusivity, width=width,
+                             sensor=None if sensor == "paper" else sen, model=fm)
+        kw = dict(threshold=threshold, sensor=sen, model=fm, diffusivity_m2_s=diffusivity, width=width,
                   trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc, **extra)
         if "coverage" not in extra:  # no progress reported by this question's exact route: a spinner
             with _app.busy(f"{question}: simulating touches and fitting SVMs (exact route)", quiet=not progress):
-                return query.ask(question, route="exact", **objects, **scene, **kw)
+                return _noted(query.ask(question, route="exact", **objects, **scene, **kw), reroute, sen, fm,
+                              source)
         if not progress:
-            return query.ask(question, route="exact", **objects, **scene, **kw)
+            return _noted(query.ask(question, route="exact", **objects, **scene, **kw), reroute, sen, fm, source)
         from rich.console import Console
         from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
@@ -124,7 +130,20 @@ def _ask(question: str, *, exact: bool, table: Optional[str], ideal_table: str, 
             def report(done, total, message):
                 bar.update(task, completed=done, total=total, description=f"SVM evaluations ({message})")
 
-            return query.ask(question, route="exact", **objects, **scene, progress=report, **kw)
+            return _noted(query.ask(question, route="exact", **objects, **scene, progress=report, **kw), reroute,
+                          sen, fm, source)
+
+
+def _noted(ans, reroute: Optional[str], sen, fm, source: str):
+    """The answer with a note saying why it was computed rather than read, and where its model came from."""
+    import dataclasses
+
+    notes = list(ans.notes)
+    if reroute:
+        notes.append(reroute)
+    if source == "sensor file" and fm.name != "semi-infinite":
+        notes.append(f"model {fm.name}: recorded in sensor file {sen.name}")
+    return dataclasses.replace(ans, notes=tuple(notes)) if notes != list(ans.notes) else ans
 
 
 # ============================================================ rendering

@@ -10,7 +10,8 @@ import typer
 
 from ._app import EXIT_INTERRUPTED, app, console, emit_json
 from . import _app
-from ._options import BackingOpt, Conductance, Diffusivity, Json, ModelOpt, Thickness, model_from_options
+from ._options import (BackingOpt, Conductance, Diffusivity, Json, ModelOpt, Thickness, model_from_options,
+                       sensor_and_model)
 
 
 def _floats(text: Optional[str], name: str) -> Optional[tuple[float, ...]]:
@@ -87,6 +88,8 @@ def sweep(
     fm = None
     if any(v is not None for v in (model, conductance, thickness, backing)):
         fm = model_from_options(model, conductance=conductance, thickness=thickness, backing=backing)
+    if sensor is not None:  # a forced sensor file is named; its recorded model answers unless options say otherwise
+        sensor_and_model(sensor, model, conductance=conductance, thickness=thickness, backing=backing)
     overrides = dict(name=name, sensor=sensor, fidelity=fidelity, e_min=e_min, e_max=e_max, intervals=intervals,
                      trials=trials, folds=folds, threshold=threshold, seed=seed, max_repeats=max_repeats,
                      noise_ratio=_floats(noise_ratio, "--noise-ratio"), noise_c=_floats(noise, "--noise"),
@@ -160,5 +163,7 @@ def sweep(
     out_con = console()
     out_con.print(f"[bold green]Wrote[/] {path} (+ .json): {total} chunks "
                   f"({stats['computed']} computed now), {stats['fits']} SVM fits, {elapsed:.1f} s; "
-                  f"model {escape(cfg.model.describe())}")
+                  f"model {escape(cfg.model.describe())}"
+                  + (f" (recorded in sensor file {escape(cfg.sensor)})" if fm is None and cfg.model.name !=
+                     "semi-infinite" else ""))
     sys.stdout.flush()

@@ -40,7 +40,8 @@ from typing import Any, Mapping
 from .._validation import InputError
 from .base import ForwardModel, ModelCheck
 
-__all__ = ["MODELS", "ForwardModel", "ModelCheck", "get_model", "model_class", "model_names", "parse_model_spec"]
+__all__ = ["MODELS", "ForwardModel", "ModelCheck", "get_model", "load_sensor_model", "model_class", "model_names",
+           "parse_model_spec", "sensor_model"]
 
 #: name -> (module, class): the registry of forward models (pvlib-style catalogue).
 MODELS: dict[str, tuple[str, str]] = {
@@ -128,6 +129,55 @@ def get_model(spec: "str | Mapping[str, Any] | ForwardModel | None" = None, **pa
         return cls(**parameters)
     except TypeError as exc:  # pragma: no cover - a missing required parameter
         raise InputError(f"model {cls.name!r}: {exc}") from None
+
+
+def sensor_model(sensor) -> ForwardModel:
+    """The forward model a sensor was identified with (its file's ``model:``; none: the semi-infinite model).
+
+    Parameters
+    ----------
+    sensor : designkit.Sensor
+        A sensor whose ``model`` record is None or ``{"name": ..., "params": {...}, ...}``.
+
+    Examples
+    --------
+    >>> from designkit import SENSORS
+    >>> sensor_model(SENSORS["paper"]).name
+    'semi-infinite'
+    >>> s = SENSORS["paper"].replace(model={"name": "contact", "params": {"conductance_w_m2k": 2500.0}})
+    >>> sensor_model(s).describe()
+    'contact (conductance_w_m2k = 2500 W m^-2 K^-1)'
+    """
+    record = getattr(sensor, "model", None)
+    if record is None:
+        return get_model("semi-infinite")
+    try:
+        return get_model(str(record["name"]), **dict(record.get("params") or {}))
+    except InputError as exc:
+        raise InputError(f"sensor {sensor.name!r}: its recorded model: {exc}") from None
+
+
+def load_sensor_model(spec="paper", model: "str | Mapping[str, Any] | ForwardModel | None" = None):
+    """A sensor (preset name, YAML path or Sensor) and the forward model that answers for it.
+
+    ``model`` None takes the model the sensor file records (the semi-infinite
+    model for presets and files without ``model:``); a model given explicitly
+    overrides it.
+
+    Returns
+    -------
+    (Sensor, ForwardModel)
+
+    Examples
+    --------
+    >>> s, m = load_sensor_model("paper")
+    >>> s.name, m.name
+    ('paper', 'semi-infinite')
+    """
+    from ..sensor import load_sensor
+
+    sensor = load_sensor(spec if spec is not None else "paper")
+    return sensor, (sensor_model(sensor) if model is None else get_model(model))
 
 
 def __getattr__(name: str):

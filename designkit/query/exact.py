@@ -140,7 +140,10 @@ class _Run:
             raise InputError(f"repeats must be >= 1, got {repeats}")
         if int(n_mc) < 10:
             raise InputError(f"the Monte Carlo ideal observer needs at least 10 touches per class, got {n_mc}")
-        return cls(load_sensor(sensor if sensor is not None else "paper"), get_model(model),
+        from ..models import sensor_model
+
+        sen = load_sensor(sensor if sensor is not None else "paper")
+        return cls(sen, sensor_model(sen) if model is None else get_model(model),  # a sensor file's own model
                    check_threshold(threshold), check_positive("class width", width), int(trials), int(folds),
                    int(seed), int(repeats), check_positive("z", z), int(jobs), int(n_mc))
 

@@ -46,6 +46,7 @@ __all__ = [
     "pair_question",
     "reference_class",
     "scene_inputs",
+    "table_reroute",
 ]
 
 MATERIALS_RULE = ("materials: the hardest pair, the two classes one class width wide at the facing edges of "
@@ -255,3 +256,39 @@ def reference_class(e: float | None = None, m: str | None = None, *, width: floa
         ref = ObjectClass(f"{v:g}", (v, v + w), d)
     _require((ref,), fm.object_properties, fm.name, m is None and diffusivity_m2_s is not None)
     return ref
+
+
+def table_reroute(sensor, model, table_sensor=None, table_model=None) -> str | None:
+    """Why a question about ``sensor`` under ``model`` cannot be read from a table built for another one.
+
+    The shipped tables (``svm-paper``, ``ideal-paper``) are for the paper's
+    sensor and the semi-infinite model; by default ``table_sensor`` /
+    ``table_model`` are those. Returns None when the table answers for this
+    sensor and model, else one sentence for the answer's notes (the caller
+    computes the answer instead: a table never answers silently for another
+    sensor).
+
+    Examples
+    --------
+    >>> from designkit import SENSORS
+    >>> table_reroute(SENSORS["paper"], None) is None
+    True
+    >>> table_reroute(SENSORS["paper"].replace(effusivity=1982.0, name="mine"), None)[:53]
+    'the shipped tables are for the paper sensor, not mine'
+    """
+    from ..models import get_model
+    from ..sensor import SENSORS, load_sensor
+
+    sen = load_sensor(sensor)
+    fm = get_model(model) if model is not None else None
+    ts = table_sensor if table_sensor is not None else SENSORS["paper"]
+    tm = get_model(table_model)
+    why = []
+    if sen != ts:
+        why.append(f"the {ts.name} sensor, not {sen.name}")
+    if fm is not None and fm != tm:
+        why.append(f"the {tm.name} model, not {fm.name}")
+    if not why:
+        return None
+    return ("the shipped tables are for " + " and ".join(why)
+            + ": computed for this sensor and model instead (--table names a table built for them)")

@@ -239,6 +239,10 @@ def _open(table, ideal_table, *, threshold, sensor, model) -> _Opened:
         s = load_sensor(sensor)
         if s != tab.sensor:
             raise TableMismatch(f"table {tab.name} was built for sensor {tab.sensor.name!r}, not {s.name!r}")
+        if model is None and s.model is not None:  # a sensor file's own model must be the table's too
+            from ..models import sensor_model
+
+            model = sensor_model(s)
     fm = tab.model
     if model is not None:
         asked = get_model(model)

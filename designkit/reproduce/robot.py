@@ -83,6 +83,9 @@ class RealTouches:
         an upper bound of its surface temperature).
     trials : tuple
         The :class:`designkit.calibration.trials.Trial` objects (for calibration).
+    object_c : ndarray, shape (n, m), or None
+        The passive thermistor's readings [degC] on ``time_s`` (the second sensor of
+        two-sensor recognition).
     """
 
     material: np.ndarray
@@ -94,12 +97,14 @@ class RealTouches:
     object_temp_c: np.ndarray
     object_end_c: np.ndarray
     trials: tuple
+    object_c: np.ndarray | None = None
 
     def select(self, mask) -> "RealTouches":
         m = np.asarray(mask, dtype=bool)
         return RealTouches(self.material[m], self.trial_set[m], tuple(f for f, k in zip(self.files, m) if k),
                            self.time_s, self.sensor_c[m], self.sensor_temp_c[m], self.object_temp_c[m],
-                           self.object_end_c[m], tuple(t for t, k in zip(self.trials, m) if k))
+                           self.object_end_c[m], tuple(t for t, k in zip(self.trials, m) if k),
+                           None if self.object_c is None else self.object_c[m])
 
     def of(self, material: str) -> np.ndarray:
         return self.sensor_c[self.material == material]
@@ -112,13 +117,14 @@ def load_real(data_dir: Path, contact_s: float = CONTACT_S, sample_rate_hz: floa
     index = Path(data_dir) / "index.csv"
     rows = read_index_rows(index)
     grid = np.arange(int(round(contact_s * sample_rate_hz)) + 1) / sample_rate_hz
-    mats, sets, files, curves, ts0, ta, tend, trials = [], [], [], [], [], [], [], []
+    mats, sets, files, curves, ts0, ta, tend, trials, passive = [], [], [], [], [], [], [], [], []
     for r in rows:
         tr = read_trial_csv(index.parent / r["file"], r["material"])
         if tr.time_s[0] >= 0 or tr.time_s[-1] < contact_s:
             raise InputError(f"trial {r['file']} does not cover 1 sample before contact to {contact_s:g} s after it")
         pre = tr.time_s < 0
         curves.append(np.interp(grid, tr.time_s, tr.sensor_c))
+        passive.append(np.interp(grid, tr.time_s, tr.object_c))  # NaN where the rig has no passive channel
         ts0.append(float(np.mean(tr.sensor_c[pre])))
         ta.append(float(np.nanmean(tr.object_c[pre])) if np.isfinite(tr.object_c[pre]).any() else math.nan)
         end = (tr.time_s > contact_s - 0.1) & (tr.time_s <= contact_s)
@@ -128,7 +134,7 @@ def load_real(data_dir: Path, contact_s: float = CONTACT_S, sample_rate_hz: floa
         files.append(r["file"])
         trials.append(tr)
     return RealTouches(np.array(mats), np.array(sets), tuple(files), grid, np.vstack(curves), np.array(ts0),
-                       np.array(ta), np.array(tend), tuple(trials))
+                       np.array(ta), np.array(tend), tuple(trials), np.vstack(passive))
 
 
 # ============================================================ train real, test real
@@ -283,8 +289,13 @@ def calibrate_model(touches: RealTouches, *, candidate: str = SIM_MODEL,
 
 
 def _simulate_model(test: RealTouches, setup: SimToRealSetup, noise_c: float, per_trial: int,
-                    seed: int) -> tuple[np.ndarray, np.ndarray]:
-    """Simulated touches from an identified model: each test touch's own Ts0 and To, host-smoothed noise."""
+                    seed: int, passive: bool = False):
+    """Simulated touches from an identified model: each test touch's own Ts0 and To, host-smoothed noise.
+
+    Returns (readings, labels), and with ``passive`` also the passive thermistor's simulated readings:
+    the same touch read from the passive channel's own pre-contact temperature Tp0 (room, or the air
+    above a cooled block) towards the same To, with the identified reading shape and its own noise.
+    """
     from .._validation import as_generator
     from ..models.layered import savgol_smooth
 
@@ -292,7 +303,7 @@ def _simulate_model(test: RealTouches, setup: SimToRealSetup, noise_c: float, pe
     ident = setup.identification
     temps = setup.object_temp or {}
     contact = setup.contact or {}
-    out, labels = [], []
+    out, labels, pout = [], [], []
     for cls in CLASSES:
         idx = np.flatnonzero(test.material == cls)
         if idx.size == 0:
@@ -313,14 +324,23 @@ def _simulate_model(test: RealTouches, setup: SimToRealSetup, noise_c: float, pe
             to = to + off + slope * (to - ref)
         ts0 = test.sensor_temp_c[reps][:, None]
         out.append(ts0 + (to[reps][:, None] - ts0) * v)
+        tp0 = test.object_temp_c[reps][:, None]
+        pout.append(tp0 + (to[reps][:, None] - tp0) * v)
         labels.append(np.full(reps.size, cls))
     sim = np.vstack(out)
     # the host smoothed every recording: the simulated noise is smoothed white noise with RMS noise_c
     pad = 200
-    raw = rng.standard_normal((sim.shape[0], sim.shape[1] + 2 * pad))
-    sm = savgol_smooth(raw, 99, 3)[:, pad:pad + sim.shape[1]]
-    sim = sim + noise_c * sm / np.sqrt(np.mean(sm ** 2))
-    return sim, np.concatenate(labels)
+
+    def noise(shape):
+        raw = rng.standard_normal((shape[0], shape[1] + 2 * pad))
+        sm = savgol_smooth(raw, 99, 3)[:, pad:pad + shape[1]]
+        return noise_c * sm / np.sqrt(np.mean(sm ** 2))
+
+    sim = sim + noise(sim.shape)
+    if not passive:
+        return sim, np.concatenate(labels)
+    psim = np.vstack(pout)
+    return sim, np.concatenate(labels), psim + noise(psim.shape)
 
 
 # ============================================================ sim to real
@@ -343,21 +363,36 @@ def _simulate_like(test: RealTouches, setup: SimToRealSetup, noise_c: float, per
 
 
 def sim_to_real(test: RealTouches, setup: SimToRealSetup, noise_c: float, *, per_trial: int, seed: int,
-                object_temp: str = "passive") -> dict:
-    """Train on simulated touches, test on the real ones: binary F1 per pair and the 3-class confusion."""
+                object_temp: str = "passive", two_sensor: bool = False) -> dict:
+    """Train on simulated touches, test on the real ones: binary F1 per pair and the 3-class confusion.
+
+    ``two_sensor``: the passive thermistor is a second sensor (its simulated and real readings join
+    the heated sensor's, :func:`designkit.recognition.two_sensor.two_sensor_features`); needs an
+    identified model (:func:`calibrate_model`) and recordings with a passive channel.
+    """
     import sklearn
 
     from ..recognition.features import feature_matrix
     from ..recognition.svm import binary_f1, make_classifier
 
     fs = 1.0 / (test.time_s[1] - test.time_s[0])
-    if setup.identification is not None:
-        sim, labels = _simulate_model(test, setup, noise_c, per_trial, seed)
+    if two_sensor:
+        from ..recognition.two_sensor import two_sensor_features
+
+        if setup.identification is None or test.object_c is None or not np.isfinite(test.object_c).all():
+            raise InputError("two-sensor sim-to-real needs an identified model and a passive channel in every "
+                             "recording")
+        sim, labels, psim = _simulate_model(test, setup, noise_c, per_trial, seed, passive=True)
+        Xs = two_sensor_features(sim, psim, fs)
+        Xr = two_sensor_features(test.sensor_c, test.object_c, fs)
     else:
-        sim, labels = _simulate_like(test, setup, noise_c, per_trial, seed, object_temp)
-    Xs = feature_matrix(sim, fs)
-    Xr = feature_matrix(test.sensor_c, fs)
-    out = {"noise_c": noise_c, "object_temp": object_temp, "pairs": {}}
+        if setup.identification is not None:
+            sim, labels = _simulate_model(test, setup, noise_c, per_trial, seed)
+        else:
+            sim, labels = _simulate_like(test, setup, noise_c, per_trial, seed, object_temp)
+        Xs = feature_matrix(sim, fs)
+        Xr = feature_matrix(test.sensor_c, fs)
+    out = {"noise_c": noise_c, "object_temp": object_temp, "two_sensor": two_sensor, "pairs": {}}
     with sklearn.config_context(assume_finite=True):
         for neg, pos in PAIRS:
             tr = np.isin(labels, (neg, pos))
@@ -556,6 +591,11 @@ def section_sim_to_real(ctx: Context) -> SectionResult:
             continue
         identified.append((label, sim_to_real(test, msetup, msetup.rms_c, per_trial=per_trial, seed=seed),
                            msetup))
+        if cold == "passive-end" and test.object_c is not None and np.isfinite(test.object_c).all():
+            identified.append((f"identified {SIM_MODEL}, **two sensors**: the passive thermistor's readings join "
+                               "the heated sensor's (recognition.two_sensor)",
+                               sim_to_real(test, msetup, msetup.rms_c, per_trial=per_trial, seed=seed,
+                                           two_sensor=True), msetup))
     fig = _confusion_figure(ctx, [(f"sim-to-real, σ = {rms:.3f} °C", main["multiclass"]["confusion"]),
                                   ("sim-to-real, cold wood at its passive end reading", end["multiclass"]["confusion"])],
                             CLASSES, "sim_to_real_confusion")

@@ -216,7 +216,12 @@ class SweepConfig:
     def _check_model(self) -> None:
         """Resolve ``model`` to a ForwardModel and check what it needs from the config."""
         try:
-            model = get_model(self.model)
+            if self.model is None:  # the model a sensor file records (semi-infinite for presets)
+                from ..models import sensor_model
+
+                model = sensor_model(load_sensor(self.sensor))
+            else:
+                model = get_model(self.model)
         except InputError as exc:
             raise InputError(f"model: {exc}") from None
         object.__setattr__(self, "model", model)

@@ -1,0 +1,62 @@
+"""Round trips over a real pty for every identifiable sensor model: a few seeds here, 50 in benchmarks/."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from designkit import InputError
+from designkit.calibration.emulator import EmulatedMaterial, Emulator, TouchPlan
+from designkit.calibration.profiles import load_profile
+from designkit.calibration.roundtrip import CASES, round_trip, summarize
+from designkit.models import get_model
+from designkit.sensor import Sensor
+
+SENSOR = Sensor(1000.0, 1.5e-9, depth_m=80e-6)
+
+
+def _emulator(model=None, noise=0.0):
+    return Emulator(load_profile("designkit"), SENSOR, [EmulatedMaterial("wood", 400.0)], noise_c=noise,
+                    sensor_temp_c=29.5, ambient_c=22.5, plan=TouchPlan(touch_every_s=13.0), model=model,
+                    force_noise_n=0.0)
+
+
+def test_the_emulator_streams_any_forward_model_reading():
+    layered = get_model("layered", film_thickness_m=150e-6, backing_effusivity_ws05_m2k=300.0,
+                        conductance_w_m2k=2500.0, lag_s=0.4, smoothing_window=99)
+    emu = _emulator(layered)
+    fs = emu.profile.sample_rate_hz
+    start = emu.touch(0).start_s
+    k0 = int(round(start * fs))
+    v = emu.values(k0 - 10, k0 + 600)["sensor"]
+    rel = (np.arange(k0 - 10, k0 + 600) / fs) - start
+    pos = rel >= 0
+    # the raw conduction (the wire carries no host smoothing), independently computed
+    u = layered.conduction(rel[pos], [400.0], SENSOR)[0]
+    assert np.allclose(v[pos], 29.5 + (22.5 - 29.5) * u, rtol=0, atol=1e-12)
+    assert np.all(v[~pos] == 29.5)
+    # the semi-infinite model named explicitly streams exactly what the default always did
+    a, b = _emulator(None, 0.05), _emulator("semi-infinite", 0.05)
+    assert np.array_equal(a.values(0, 5000)["sensor"], b.values(0, 5000)["sensor"])
+    with pytest.raises(InputError, match="needs their diffusivity"):
+        _emulator(get_model("slab", thickness_m=0.003))
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_round_trip_over_a_pty_recovers_every_identifiable_parameter(case, tmp_path):
+    r = round_trip(case, seed=0, folder=tmp_path, touches=6)
+    assert r.n_trials == 12 and (tmp_path / "index.csv").is_file()   # recorded from the pty, 6 + 6 touches
+    for name in r.rows:
+        assert r.covered(name), (name, r.rows[name])
+        assert r.rel_error(name) <= 0.02, (name, r.rows[name])
+    truth, lo, hi = r.es
+    assert lo <= truth <= hi
+    t_off, est, lo, hi = r.offset
+    assert abs(est - t_off) <= 0.005   # the detected onset defines the truth to one sample (5 ms)
+    summ = summarize([r])
+    assert set(summ) == set(r.rows) | {"e_s", "time_offset_s"} and summ["e_s"]["coverage"] == 1.0
+
+
+def test_unknown_case_is_named():
+    with pytest.raises(InputError, match="unknown round-trip case 'slab'"):
+        round_trip("slab", 0)

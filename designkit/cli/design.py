@@ -96,7 +96,8 @@ def design(
     targets = targets_from(m or (), set_)
     skins = tuple(get_material(s).name for s in skin) if skin else SKIN_SET
     t0, c0 = time.perf_counter(), time.process_time()
-    result = recommend(targets, cons, skins=skins)
+    with _app.busy(f"design: searching skins x depths with the ideal observer ({len(skins)} skins)", quiet=json_):
+        result = recommend(targets, cons, skins=skins)
     search = {"wall_s": round(time.perf_counter() - t0, 3), "cpu_s": round(time.process_time() - c0, 3),
               "designs": len(result.designs)}
     payload = {**result.to_dict(), "search": search, "svm": None}
@@ -107,7 +108,8 @@ def design(
             console().print(f"No design possible: {result.reason}.", highlight=False)
         raise typer.Exit(EXIT_NO_DESIGN)
     if svm:
-        payload["svm"] = confirm_with_svm(result, targets)
+        with _app.busy("design: confirming the limiting pair with the paper's SVM", quiet=json_):
+            payload["svm"] = confirm_with_svm(result, targets)
     if plot is not None:
         payload["figure"] = str(_plot(result, plot))
     if json_:

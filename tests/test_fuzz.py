@@ -199,6 +199,8 @@ BASE = {
     "calibrate record": ["--port", "@PORT", "--material", "wood", "--trials", "1", "--timeout", "0.5"],
     "calibrate fit": ["@MISSING"],
     "calibrate": ["--port", "@PORT", "--material", "wood", "--yes", "--timeout", "0.5"],
+    "classify": ["--port", "@PORT", "--m", "wood", "--m", "copper", "--touches", "1", "--timeout", "0.5"],
+    "design": ["--m", "copper", "--m", "wood", "--no-svm", "--skin", "alumina"],
 }
 SKIP = {"--exact", "--jobs", "--backend", "--scheduler", "--help", "--only", "--section", "--duration",
         "--quick", "--resume", "--fresh", "--workdir"}

@@ -52,3 +52,26 @@ def test_every_named_package_data_file_exists():
         for name in patterns:
             if not any(c in name for c in "*?["):
                 assert (folder / name).is_file(), f"package-data {pkg}: {name} does not exist in {folder}"
+
+
+def test_every_data_file_in_a_package_folder_is_installed():
+    """A template or data file added beside the code but not matched by package-data works in an
+    editable checkout and is missing from the wheel (the sequential C template once was)."""
+    import fnmatch
+
+    pyproject = REPO / "pyproject.toml"
+    if not pyproject.is_file():
+        pytest.skip("not running from a source checkout")
+    cfg = tomllib.loads(pyproject.read_text())["tool"]["setuptools"]
+    folders = cfg.get("package-dir", {})
+    data = cfg["package-data"]
+    owners = {pkg: REPO / pkg.replace(".", "/") for pkg in cfg["packages"] if pkg not in folders}
+    missing = []
+    for p in (REPO / "designkit").rglob("*"):
+        if not p.is_file() or "__pycache__" in p.parts or p.suffix in (".py", ".pyc") or p.name.startswith("."):
+            continue
+        pkg, folder = max(((k, f) for k, f in owners.items() if f in p.parents), key=lambda kf: len(kf[1].parts))
+        rel = p.relative_to(folder).as_posix()
+        if not any(fnmatch.fnmatch(rel, pat) for pat in data.get(pkg, [])):
+            missing.append(f"{pkg}: {rel}")
+    assert not missing, f"not in [tool.setuptools.package-data]: {missing}"

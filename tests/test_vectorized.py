@@ -160,3 +160,17 @@ def test_matrix_prefilled_bounds_equal_the_per_pair_bounds():
             one = min_contact(m1=m.materials[c.i].qualified_name, m2=m.materials[c.j].qualified_name)
             clear_bound_cache()
             assert _same(_num(c.ideal), _num(one.ideal_bound.value), 0.0)
+
+
+def test_normal_cdf_of_the_closed_form_bounds_against_mpmath():
+    """The scipy-free normal CDF behind every closed-form bound (Hermite pieces in Horner form)."""
+    import mpmath
+
+    from designkit.query.ideal_bound import _ndtr
+
+    rng = np.random.default_rng(7)
+    z = np.concatenate([rng.normal(0.0, 3.0, 4000), [-9.0, 9.0, -9.5, 12.0, 0.0, -1e-300, 8.999999]])
+    got = _ndtr(z.reshape(-1, 1)).ravel()
+    ref = np.array([float(mpmath.ncdf(mpmath.mpf(float(v)))) for v in z])
+    assert np.max(np.abs(got - ref)) < 1e-13
+    assert np.all(np.diff(_ndtr(np.linspace(-9.0, 9.0, 20001))) >= -2.3e-16)  # monotone to an ulp of 1

@@ -59,21 +59,39 @@ def _phi_table() -> tuple[np.ndarray, np.ndarray]:
     return cdf, np.exp(-0.5 * z * z) / math.sqrt(2.0 * math.pi)
 
 
+@functools.lru_cache(maxsize=1)
+def _phi_horner() -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Coefficients ``c0..c3`` of the cubic Hermite piece on each interval of :func:`_phi_table`, in
+    ``x = (z + 9) * 512 - k`` on [0, 1]: ``Phi = ((c3 x + c2) x + c1) x + c0``."""
+    cdf, pdf = _phi_table()
+    p0, p1, m0, m1 = cdf[:-1], cdf[1:], _PHI_H * pdf[:-1], _PHI_H * pdf[1:]
+    return p0, m0, -3.0 * p0 - 2.0 * m0 + 3.0 * p1 - m1, 2.0 * p0 + m0 - 2.0 * p1 + m1
+
+
 def _ndtr(z: np.ndarray) -> np.ndarray:
     """Standard normal CDF, elementwise: cubic Hermite interpolation of :func:`_phi_table`.
 
     Interpolation error at most h^4 max|d4 Phi| / 384 = 5e-14 (h = 1/512), tested against
     :func:`math.erfc`; a Python call of math.erfc per element costs 5x more, scipy's import 0.35 s.
+    Evaluated in Horner form from per-interval coefficients, in place, with 1-D ``take`` gathers:
+    8x faster than the textbook basis form on (3000, 40) arrays (9.1 -> 1.1 ms, same values to
+    7e-16), which was a fifth of a 12-material ``designkit matrix``.
     """
-    cdf, pdf = _phi_table()
-    u = (np.clip(z, -_PHI_Z, _PHI_Z) + _PHI_Z) * (1.0 / _PHI_H)
-    k = np.minimum(u.astype(np.int64), cdf.size - 2)
-    x = u - k
-    x2 = x * x
-    x3 = x2 * x
-    h = _PHI_H
-    return ((2 * x3 - 3 * x2 + 1) * cdf[k] + (x3 - 2 * x2 + x) * (h * pdf[k])
-            + (3 * x2 - 2 * x3) * cdf[k + 1] + (x3 - x2) * (h * pdf[k + 1]))
+    c0, c1, c2, c3 = _phi_horner()
+    u = np.clip(z, -_PHI_Z, _PHI_Z)
+    u += _PHI_Z
+    u *= 1.0 / _PHI_H
+    k = u.astype(np.int64)
+    np.minimum(k, c0.size - 1, out=k)
+    u -= k
+    r = c3.take(k)
+    r *= u
+    r += c2.take(k)
+    r *= u
+    r += c1.take(k)
+    r *= u
+    r += c0.take(k)
+    return r
 
 
 @functools.lru_cache(maxsize=16)

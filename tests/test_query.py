@@ -52,13 +52,13 @@ def test_min_contact_interpolates_exactly(linear_table, noise, gap, base):
         assert ans.value is None
     else:
         assert ans.value == pytest.approx(exact, rel=1e-9)
-        # the interval spans at least the grid cell of the crossing (interpolation error), never below the bound
-        prev = max([c for c in CONTACTS if c < ans.value - 1e-12], default=0.0)
-        nxt = min(c for c in CONTACTS if c >= ans.value - 1e-12)
-        assert ans.interval[1] >= nxt - 1e-9
+        # interpolated between two tabulated contacts: an interval at the stated coverage around the answer
+        # (Monte Carlo ends and interpolation error), never below the bound
         bound = ans.ideal if ans.ideal is not None else -math.inf
-        assert ans.interval[0] <= prev + 1e-9 or ans.interval[0] == pytest.approx(bound)
-        assert ans.interval[0] >= bound - 1e-12
+        d = ans.to_dict()["interval"]
+        assert d["method"] == "table-estimate" and d["coverage"] == 0.9
+        assert d["low"] <= ans.value <= d["high"] and d["low"] < d["high"]
+        assert d["low"] >= min(bound, ans.value) - 1e-12  # (this synthetic table's answers may lie below it)
     assert ans.in_grid == {"noise_ratio": True, "effusivity": True}
 
 
@@ -245,7 +245,8 @@ def test_query_cli_json_is_the_answer_schema(cli, cmd, quantity):
     assert p["table"]["content_hash"].startswith("sha256:") and p["sensor"]["name"] == "paper"
     assert p["model"]["name"] == "semi-infinite" and p["threshold"] == 0.9 and all(p["in_grid"].values())
     assert set(p["scene"]) == {"contact_s", "noise_c", "delta_t_c", "noise_ratio"}
-    assert set(p["interval"]) == {"low", "high", "meaning", "coverage"} and set(p["ideal"]) == {"value", "method"}
+    assert set(p["interval"]) == {"low", "high", "meaning", "coverage", "method"}
+    assert set(p["ideal"]) == {"value", "method"}
     if cmd[0] == "delta-e":
         assert set(p["details"]) == {"e", "lower", "upper"}
     if cmd[0] == "distinguishable":
@@ -414,6 +415,16 @@ def test_a_question_the_table_cannot_answer_exits_3_and_bad_coverage_exits_2(cli
     assert r.exit_code == 3 and "contact time up to 10 s" in r.output
     r = cli("min-contact", "--e1", "35000", "--e2", "20000", "--coverage", "1.5")
     assert r.exit_code == 2 and "coverage must lie in (0, 1)" in r.output
+    # outside the table's axes: every question exits 3 and names the axis and its range in user units
+    for cmd in (("min-contact", "--e1", "35000", "--e2", "20000", "--noise", "0.5"),
+                ("max-noise", "--e1", "35000", "--e2", "20000", "--contact", "20"),
+                ("min-delta-t", "--e1", "35000", "--e2", "20000", "--contact", "0.2"),
+                ("delta-e", "--e", "20000", "--noise", "0.5"),
+                ("distinguishable", "--e1", "35000", "--e2", "20000", "--contact", "20")):
+        r = cli(*cmd)
+        assert r.exit_code == 3, (cmd, r.output)
+        assert ("noise 0.005 to 0.2 degC" in r.output or "contact time" in r.output), r.output
+        assert cli(*cmd, "--coverage", "0").exit_code == 2
 
 
 def test_exact_min_contact_is_an_estimate_with_a_stated_coverage():

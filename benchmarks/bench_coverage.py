@@ -59,11 +59,16 @@ def figure(results: list[dict], out: Path) -> Path:
                     hi = r[route]["high"] if r[route]["high"] is not None else 1e300
                     hit = lo <= r["reference"]["value"] <= hi
                 marker = "o" if hit else ("x" if hit is False else "s")
-                ax.scatter(e, max(rel, 1e-4), c=colors.get(r["noise_c"], "k"), marker=marker, s=18,
-                           facecolors="none" if marker == "o" else None, linewidths=1)
+                col = colors.get(r["noise_c"], "k")
+                if marker == "o":
+                    ax.scatter(e, max(rel, 1e-4), marker=marker, s=22, facecolors="none", edgecolors=col,
+                               linewidths=1)
+                else:
+                    ax.scatter(e, max(rel, 1e-4), marker=marker, s=22, color=col, linewidths=1)
             ax.set_xscale("log")
             ax.set_yscale("log")
             ax.set_ylim(1e-4, 3)
+            ax.set_xlim(80, 40000)
             ax.axhline(0.05, color="grey", lw=0.7, ls="--")
             ax.set_title(f"{q}, {route}", fontsize=10)
             ax.set_xlabel("lower effusivity of the pair / reference [J s^-1/2 K^-1 m^-2]", fontsize=8)
@@ -106,7 +111,8 @@ def report(results: list[dict], synthetic: dict, meta: dict, out: Path) -> dict:
     for s in rows:
         print(f"{s['question']:16s} {s['route']:6s} {s['n']:4d} {s['n_stated']:6d} {fmt(s['coverage'], '{:.1%}'):>6s} "
               f"{s['n_unstated']:6d} {s['n_no_answer']:5d} {fmt(s['median_abs']):>9s} {fmt(s['p95_abs']):>9s} "
-              f"{fmt(s['median_rel']):>8s} {fmt(s['p95_rel']):>8s} {s['violations']:4d}")
+              f"{fmt(s['median_rel']):>8s} {fmt(s['p95_rel']):>8s} {s['violations']:4d} "
+              f"(at bound {s.get('reference_at_bound', 0)})")
         if "far" in s:
             f, n = s["far"], s["near"]
             print(f"{'':23s}pairs >= 5 intervals apart: n {f['n_compared']}, p95 rel {fmt(f['p95_rel'])}, "

@@ -100,3 +100,12 @@ def test_stated_interval_schema_and_refusals():
 def test_diluted_coverage():
     assert diluted_coverage(0.9, 0.0) == pytest.approx(0.9)
     assert diluted_coverage(0.9, 0.5) < 0.9
+
+
+def test_normal_quantile_of_the_query_path_against_the_standard_library():
+    from statistics import NormalDist
+
+    from designkit.query.crossing import z_of_coverage
+
+    for c in (0.5, 0.8, 0.9, 0.95, 0.99, 0.999):
+        assert z_of_coverage(c) == pytest.approx(NormalDist().inv_cdf(0.5 + 0.5 * c), rel=1e-12)

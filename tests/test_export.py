@@ -137,7 +137,8 @@ def reference(tab, kind: str, op: str, args):
     if op == "min_contact":
         comp = a.to_dict()["computation"]  # the arrays' own answers (value/interval/ideal are refined)
         mc = comp.get("monte_carlo_interval", [None, None])
-        return {"svm": a.value, "lo": mc[0], "hi": mc[1], "ideal": comp.get("table_ideal_s", a.ideal)}[kind]
+        svm = comp.get("table_crossing_s", a.value)  # the grid's raw crossing (the answer is bias-corrected)
+        return {"svm": svm, "lo": mc[0], "hi": mc[1], "ideal": comp.get("table_ideal_s", a.ideal)}[kind]
     if op == "distinguishable":
         assert kind != "ideal", "the table route answers the ideal observer's F1 in closed form, not by delta"
         mv = a.computation["monte_carlo_verdicts"]  # the arrays' own verdicts (the interval is the F1's)

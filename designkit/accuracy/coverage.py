@@ -188,14 +188,14 @@ def _violation(question: str, ref, coverage: float) -> bool | None:
     if question == "delta-e":
         evals = [(e["delta_e"], e["svm_f1"], e["standard_error"]) for s in ("lower", "upper")
                  for e in ref.details[s].get("evaluations") or [] if ref.details[s].get("ideal") is not None
-                 and e["delta_e"] < ref.details[s]["ideal"] * (1 - 1e-9)]
+                 and e["delta_e"] <= ref.details[s]["ideal"] * (1 + 1e-9)]
         return any(m - z * s >= ref.threshold for _, m, s in evals)
     evals = ref.computation.get("evaluations") or []
-    if question == "min-contact":
-        bad = [e for e in evals if e["contact_s"] < ideal * (1 - 1e-9)]
-    else:  # the noise ratio beyond the ideal observer's
+    if question == "min-contact":  # the search starts at the bound: its first evaluation is there
+        bad = [e for e in evals if e["contact_s"] <= ideal * (1 + 1e-9)]
+    else:  # the noise ratio at or beyond the ideal observer's
         r_ideal = ideal / ref.scene["delta_t_c"] if question == "max-noise" else ref.scene["noise_c"] / ideal
-        bad = [e for e in evals if e["noise_ratio"] > r_ideal * (1 + 1e-9)]
+        bad = [e for e in evals if e["noise_ratio"] >= r_ideal * (1 - 1e-9)]
     return any(e["svm_f1"] - z * e["standard_error"] >= ref.threshold for e in bad)
 
 
@@ -244,6 +244,11 @@ def summarize(results: Iterable[Mapping[str, Any]], question: str, route: str, *
                                              and r[route]["low"] is not None and r[route]["value"]]))
         if stated else None,
         "violations": sum(1 for r in rows if r.get("violation")),
+        # the reference's crossing at the bound itself: its F1 reached Phi at the ideal observer's answer
+        "reference_at_bound": sum(1 for r in rows if r["reference"].get("value") is not None
+                                  and not isinstance(r["reference"]["value"], bool)
+                                  and r["reference"].get("ideal") is not None
+                                  and math.isclose(r["reference"]["value"], r["reference"]["ideal"], rel_tol=1e-9)),
     }
 
 

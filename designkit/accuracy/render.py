@@ -588,7 +588,7 @@ def coverage_markdown(doc: Mapping[str, Any], figure: str | None = None) -> list
         out.append(f"| `{r['question']}` | {r['route']} | {r['n']} | {r['n_compared']} | {r['n_stated']} | "
                    f"{pct(r['coverage'])} | {r['n_unstated']} | {r['n_no_answer']} | {format_value(r['median_abs'], 3)} | "
                    f"{format_value(r['p95_abs'], 3)} | {pct(r['median_rel'])} | {pct(r['p95_rel'])} | "
-                   f"{r['violations']} |")
+                   f"{r['violations']}{_at_bound(r)} |")
     out += ["", "Units of the absolute errors: s (min-contact), degC (max-noise, min-delta-t), "
             "J s^-1/2 K^-1 m^-2 (delta-e), F1 (distinguishable; its relative error is of the F1).", ""]
     far = next((r for r in doc["rows"] if "far" in r), None)
@@ -606,6 +606,11 @@ def coverage_markdown(doc: Mapping[str, Any], figure: str | None = None) -> list
     if figure:
         out += ["", f"![answer error against the reference by effusivity and noise]({figure})"]
     return out + [""]
+
+
+def _at_bound(r: Mapping[str, Any]) -> str:
+    n = r.get("reference_at_bound")
+    return f" ({n} references reach Phi at the bound itself)" if n else ""
 
 
 def insert_coverage(page: str, section: Sequence[str]) -> str:

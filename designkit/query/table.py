@@ -475,14 +475,43 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
             # z-SE ends, rescaled to the coverage) and the interpolation error, estimated as the distance to
             # the crossing of a log-log interpolation (the need falls roughly as a power of the contact time)
             xs, ns = grid[k_cross - 1:k_cross + 1], needs[k_cross - 1:k_cross + 1]
-            loglog, _ = _crossing([math.log(x) for x in xs], [math.log(n) for n in ns], math.log(hi - lo))
-            interp = abs(math.log(value) - loglog) if loglog is not None else 0.0
+            raw = value
+            if op.tab.fidelity == "svm":
+                # a tabulated delta is the first grid distance whose F1 reaches Phi: the crossing of the mean
+                # F1 lies up to one width w below it, on average w/2 (uniform: SD w/sqrt(12)). Subtracting
+                # w/2 from the need and interpolating log-log (the need falls roughly as a power of the
+                # contact time) removes the bias of the raw linear crossing (always late: the need is
+                # convex in contact time); the interpolation error is the distance between the two
+                # interpolants, and the rounding's SD enters through the local log-log slope
+                w = op.width
+                ns_c = [n - 0.5 * w for n in ns]
+                lx, ln = [math.log(x) for x in xs], [math.log(n) for n in ns_c]
+                lg = math.log(hi - lo)
+                loglog, _ = _crossing(lx, ln, lg)
+                linear, _ = _crossing(xs, ns_c, hi - lo)
+                if loglog is not None and linear is not None and xs[0] < math.exp(loglog) <= xs[1]:
+                    value = math.exp(loglog)
+                    interp = abs(loglog - math.log(linear))
+                    slope = abs((lx[1] - lx[0]) / (ln[1] - ln[0])) if ln[1] != ln[0] else 0.0
+                    rounding = slope * (w / math.sqrt(12.0)) / (hi - lo)
+                else:  # the corrected need no longer crosses inside this cell: keep the raw crossing
+                    loglog, _ = _crossing(lx, [math.log(n) for n in ns], lg)
+                    interp = abs(math.log(value) - loglog) if loglog is not None else 0.0
+                    rounding = 0.0
+            else:
+                loglog, _ = _crossing([math.log(x) for x in xs], [math.log(n) for n in ns], math.log(hi - lo))
+                interp = abs(math.log(value) - loglog) if loglog is not None else 0.0
+                rounding = 0.0
             zc = z_of_coverage(coverage)
-            low, high = _stated(value, mc_interval[0], mc_interval[1], interp, _table_z(op.tab), zc, log=True)
+            z_t = _table_z(op.tab)
+            # the Monte Carlo ends, measured from the raw crossing, carried over to the corrected one
+            ends = [None if m is None else math.exp(math.log(value) + math.log(m) - math.log(raw))
+                    for m in mc_interval]
+            low, high = _stated(value, ends[0], ends[1], math.hypot(interp, rounding), z_t, zc, log=True)
             if low is not None and ideal is not None:  # never below the bound (unless the table's answer is)
                 low = min(max(low, ideal), value)
             interval, kind, cov = (low, high), "table-estimate", coverage
-            monte_carlo["interpolation_error_log"] = interp
+            monte_carlo.update(interpolation_error_log=interp, rounding_error_log=rounding, table_crossing_s=raw)
         else:
             prev = grid[k_cross - 1] if k_cross > 0 else 0.0
             low = max(prev, ideal) if ideal is not None else prev

@@ -293,7 +293,8 @@ def test_table_route_refuses_another_model_and_says_where_a_question_is_outside(
     with pytest.raises(TableMismatch, match="built for the semi-infinite model, not the contact"):
         q.min_contact(1000, 5000, table=linear_table, model="contact")
     far = q.min_contact(1000, 9000, noise_c=1.0, delta_t_c=10.0, table=linear_table, ideal_table=None)
-    assert "sigma/dT 0.1 outside table linear's [0.001, 0.02]" in far.note
+    assert "noise 1 degC at dT 10 degC (sigma/dT 0.1) outside table linear's sigma/dT [0.001, 0.02]" in far.note
+    assert "it answers for noise 0.01 to 0.2 degC" in far.note  # the range in the user's units
     late = q.delta_e(2000, contact_s=20.0, table=linear_table, ideal_table=None)
     assert "contact time 20 s outside table linear's [0.5, 4] s" in late.note
 

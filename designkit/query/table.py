@@ -485,9 +485,10 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
                 # interpolants, and the rounding's SD enters through the local log-log slope
                 w = op.width
                 ns_c = [n - 0.5 * w for n in ns]
-                lx, ln = [math.log(x) for x in xs], [math.log(n) for n in ns_c]
-                lg = math.log(hi - lo)
-                loglog, _ = _crossing(lx, ln, lg)
+                lx, lg = [math.log(x) for x in xs], math.log(hi - lo)
+                ok_c = min(ns_c) > 0  # a grid coarser than the needs themselves: no correction
+                ln = [math.log(n) for n in ns_c] if ok_c else ns_c
+                loglog, _ = _crossing(lx, ln, lg) if ok_c else (None, None)
                 linear, _ = _crossing(xs, ns_c, hi - lo)
                 if loglog is not None and linear is not None and xs[0] < math.exp(loglog) <= xs[1]:
                     value = math.exp(loglog)
@@ -760,7 +761,9 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
         if val is not None and op.tab.fidelity == "svm":
             geo = at(view, combos, gcw, f"delta_{direction}", geometric=True)
             interp = abs(math.log(val) - math.log(geo)) if geo is not None else 0.0
-            low, high = _stated(val, iv[0], iv[1], interp, z_t, zc, log=True)
+            # plus the grid's rounding: the first grid distance reaching Phi, the crossing up to one width below
+            rounding = (op.width / math.sqrt(12.0)) / val
+            low, high = _stated(val, iv[0], iv[1], math.hypot(interp, rounding), z_t, zc, log=True)
             if low is not None and ideal_side is not None:
                 low = min(max(low, ideal_side), val)
             stated, cov_side, method = [low, high], coverage, "table-estimate"

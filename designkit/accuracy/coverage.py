@@ -219,8 +219,11 @@ def summarize(results: Iterable[Mapping[str, Any]], question: str, route: str, *
     (1.0, 0.1)
     """
     rows = [r for r in results if r["question"] == question and (min_gap is None or r.get("gap", 1e9) >= min_gap)]
+    # an answer at the edge of a table's axis ("separable even at the largest noise ratio: at least this")
+    # is a one-sided bound, not an estimate: counted apart, not as an error
+    edge = [r for r in rows if r[route]["value"] is not None and r[route].get("in_grid") is False]
     both = [r for r in rows if r[route]["value"] is not None and r["reference"]["value"] is not None
-            and not isinstance(r["reference"]["value"], bool)]
+            and not isinstance(r["reference"]["value"], bool) and r[route].get("in_grid") is not False]
     err = np.array([abs(r[route]["value"] - r["reference"]["value"]) for r in both], dtype=np.float64)
     rel = np.array([abs(r[route]["value"] - r["reference"]["value"]) / abs(r["reference"]["value"])
                     for r in both if r["reference"]["value"] != 0], dtype=np.float64)
@@ -235,6 +238,9 @@ def summarize(results: Iterable[Mapping[str, Any]], question: str, route: str, *
         "unstated_contains": float(np.mean([_covered(r[route], r["reference"]["value"]) for r in unstated]))
         if unstated else None,
         "n_no_answer": sum(1 for r in rows if r[route]["value"] is None),
+        "n_edge_bound": len(edge),
+        "edge_bound_holds": sum(1 for r in edge if r["reference"]["value"] is not None and _covered(
+            r[route], r["reference"]["value"])),
         "median_abs": float(np.median(err)) if err.size else None,
         "p95_abs": float(np.percentile(err, 95)) if err.size else None,
         "median_rel": float(np.median(rel)) if rel.size else None,

@@ -599,6 +599,11 @@ def coverage_markdown(doc: Mapping[str, Any], figure: str | None = None) -> list
                 f"(median {pct(f['median_rel'])}, {f['n_compared']} pairs; target 5 %); closer pairs: p95 "
                 f"{pct(n['p95_rel'])} ({n['n_compared']} pairs).", ""]
     for r in doc["rows"]:
+        if r.get("n_edge_bound"):
+            out += [f"`{r['question']}` {r['route']}: {r['n_edge_bound']} answers at the edge of the table's axis "
+                    f"(\"at least\" / \"at most\" the axis' end) are one-sided bounds, not counted as errors; "
+                    f"{r['edge_bound_holds']} of them hold for the reference.", ""]
+    for r in doc["rows"]:
         if r.get("verdicts"):
             v = r["verdicts"]
             out += [f"`distinguishable` {r['route']} verdicts agreeing with the reference's (mean F1 >= 0.9): "

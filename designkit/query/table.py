@@ -521,7 +521,7 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
                    f"the table's next contact time after {prev:g} s, where they are not separable within its "
                    "effusivity range")
             note = (f"{value:g} s is {why}: the shortest time lies in ({low:g}, {value:g}] s and the grid cannot "
-                    "support an interval of stated coverage there (--exact estimates it)")
+                    "support an interval of stated coverage there (the exact route estimates it)")
     needed = value if value is not None else float(view.contacts[-1])
     return _answer("min-contact", op, value=value, interval=interval, ideal=ideal, ideal_method=ideal_method,
                    in_grid=flags, details={}, notes=[note], check_at=(needed, noise, dt),
@@ -530,11 +530,11 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
 
 # ============================================================ max-noise / min-delta-t
 def _max_ratio(view: _View, kind: str, contact_s: float, lo: float, hi: float, *,
-               geometric: bool = False) -> tuple[float | None, str]:
+               geometric: bool = False, shift: float = 0.0) -> tuple[float | None, str]:
     """Largest sigma/dT (fixed-condition table) at which the pair separates, and where it lies.
 
-    ``geometric``: the alternative interpolant of the interval's interpolation error (log need,
-    log-log in contact time) instead of the linear one of the answer.
+    ``geometric``: the alternative interpolant (log need, log-log in contact time) instead of
+    the linear one. ``shift``: subtracted from every tabulated need (the grid's rounding of delta).
     """
     ratios = view.t.axes["noise_ratio"]
     cw, _ = _contact_weights(view, contact_s)
@@ -543,10 +543,12 @@ def _max_ratio(view: _View, kind: str, contact_s: float, lo: float, hi: float, *
 
     def margin(r_idx):
         if geometric:
-            logs = [w * math.log(view.need(kind, [((r_idx,), 1.0)], k, lo, hi)) if w else 0.0 for k, w in cw]
-            nd = math.exp(sum(logs)) if all(math.isfinite(v) for v in logs) else math.nan
-            return -math.inf if math.isnan(nd) else math.log(hi - lo) - math.log(nd)
-        nd = _need_at_contact(view, kind, [((r_idx,), 1.0)], cw, lo, hi)
+            nds = [view.need(kind, [((r_idx,), 1.0)], k, lo, hi) - shift if w else 1.0 for k, w in cw]
+            if any(math.isnan(n) or n <= 0 for n in nds):
+                return -math.inf
+            nd = math.exp(sum(w * math.log(n) for (_, w), n in zip(cw, nds)))
+            return math.log(hi - lo) - math.log(nd)
+        nd = _need_at_contact(view, kind, [((r_idx,), 1.0)], cw, lo, hi) - shift
         return -math.inf if math.isnan(nd) else (hi - lo) - nd
 
     ok_rows = [margin(i) >= 0 for i in range(ratios.size)]
@@ -633,19 +635,35 @@ def _ratio_question(question: str, e1, e2, m1, m2, objects, contact_s, noise_c, 
     kind, cov = "none", None
     computation = {"monte_carlo_interval": list(mc)}
     if where == "inside" and op.tab.fidelity == "svm":
-        r_geo, w_geo = _max_ratio(view, "svm", contact, lo, hi, geometric=True)
-        interp = abs(math.log(r) - math.log(r_geo)) if r_geo is not None and w_geo == "inside" else 0.0
-        r_lo_end = out["hi"][0] if out["hi"][1] != "below" else None  # conservative: smaller ratio
-        r_hi_end = out["lo"][0] if out["lo"][1] != "below" else None
-        r_low, r_high = _stated(r, r_lo_end, r_hi_end if out["lo"][1] != "above" else None, interp,
-                                _table_z(op.tab), z_of_coverage(coverage), log=True)
+        # as min-contact: the tabulated deltas are rounded up to the grid (on average half a width late),
+        # so the raw crossing tolerates too little noise; the answer subtracts w/2 from the need and
+        # interpolates log-log, the interval carries the interpolants' difference and the rounding's SD
+        w = op.width
+        raw = r
+        r_c, w_c = _max_ratio(view, "svm", contact, lo, hi, geometric=True, shift=0.5 * w)
+        r_lin, w_lin = _max_ratio(view, "svm", contact, lo, hi, shift=0.5 * w)
+        r_rnd, w_rnd = _max_ratio(view, "svm", contact, lo, hi, geometric=True, shift=0.5 * w + w / math.sqrt(12))
+        if r_c is not None and w_c == "inside" and r_lin is not None and w_lin == "inside":
+            r = r_c
+            interp = abs(math.log(r_c) - math.log(r_lin))
+            rounding = abs(math.log(r_rnd) - math.log(r_c)) if r_rnd is not None and w_rnd == "inside" else 0.0
+        else:
+            r_geo, w_geo = _max_ratio(view, "svm", contact, lo, hi, geometric=True)
+            interp = abs(math.log(r) - math.log(r_geo)) if r_geo is not None and w_geo == "inside" else 0.0
+            rounding = 0.0
+        value = to_answer(r)
+        ends = [None if out[k][1] == "below" or (k == "lo" and out[k][1] == "above") else
+                math.exp(math.log(r) + math.log(out[k][0]) - math.log(raw)) for k in ("hi", "lo")]
+        r_low, r_high = _stated(r, ends[0], ends[1], math.hypot(interp, rounding), _table_z(op.tab),
+                                z_of_coverage(coverage), log=True)
+        computation["table_crossing_noise_ratio"] = raw
         ri = out["ideal"][0] if out["ideal"][1] != "below" else None
         if ri is not None and r_high is not None:  # never beyond the bound (unless the table's answer is)
             r_high = max(min(r_high, ri), r)
         iv = [to_answer(r_low), to_answer(r_high)]
         interval = tuple(iv) if question == "max-noise" else (iv[1], iv[0])
         kind, cov = "table-estimate", coverage
-        computation["interpolation_error_log"] = interp
+        computation.update(interpolation_error_log=interp, rounding_error_log=rounding)
     elif where == "cell":  # a neighbour beyond the grid: the crossing lies in the cell, no stated coverage
         k = int(np.searchsorted(ratios, r))
         nxt = float(ratios[min(k + 1, ratios.size - 1)])
@@ -655,11 +673,13 @@ def _ratio_question(question: str, e1, e2, m1, m2, objects, contact_s, noise_c, 
         interval, kind = (tuple(iv) if question == "max-noise" else (iv[1], iv[0])), "table-cell"
         note = (f"sigma/dT {r:g} is the table's last noise ratio where they separate; at the next, {nxt:g}, the "
                 "pair lies beyond its effusivity range: the answer lies between them and the grid cannot support "
-                "an interval of stated coverage there (--exact estimates it)")
+                "an interval of stated coverage there (the exact route estimates it)")
     elif where == "inside":  # an ideal-observer table: no Monte Carlo ends
         interval, kind = mc, "table"
-    elif value is not None:
+    elif value is not None:  # separable beyond the table's largest ratio: the answer is a one-sided bound
         note += " (the grid cannot support an interval of stated coverage there)"
+        interval = (value, None) if question == "max-noise" else (None, value)
+        kind = "table-cell"
     r_check = r if r is not None else float(ratios[0])
     check_at = (contact, r_check * abs(dt), dt) if question == "max-noise" else (contact, noise, noise / r_check)
     return _answer(question, op, value=value, interval=interval, ideal=ideal,
@@ -843,7 +863,7 @@ def distinguishable(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact
         sure = "uncertain" if lo_c <= contact <= (hi_c if hi_c is not None else math.inf) else "confident"
     details = {"distinguishable": yes, "svm_f1": None, "svm_standard_error": None, "verdict": sure,
                "ideal_f1": ideal_f1, "ideal_distinguishable": ideal_f1 >= op.phi}
-    note = "no interval: a table holds delta(e), not this pair's F1 (--exact states the F1's interval)"
+    note = "no interval: a table holds delta(e), not this pair's F1 (the exact route states the F1's interval)"
     if sure is not None:
         note += (f"; verdict {sure}: {contact:g} s lies {'inside' if sure == 'uncertain' else 'outside'} the "
                  f"{coverage:.0%} interval of the shortest separating contact, {mc.interval[0]:.3g} to "

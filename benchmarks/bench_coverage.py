@@ -148,12 +148,13 @@ def main(argv=None) -> int:
                          "milliseconds; the exact answers and references are kept)")
     ap.add_argument("--run-wall-s", type=float, default=None,
                     help="--render-only: wall time of the run(s) that produced the cases [s], for the record")
+    ap.add_argument("--note", action="append", default=[], help="a sentence for the record and the page")
     ap.add_argument("--resume", action="store_true")
     ap.add_argument("--render-only", action="store_true")
     a = ap.parse_args(argv)
     a.out.mkdir(parents=True, exist_ok=True)
     cases_path = a.out / "cases.jsonl"
-    meta = {"exact_solver": a.exact_solver, "pairs": a.pairs, "seed": a.seed, "repeats": a.repeats, "ref_repeats": a.ref_repeats, "jobs": a.jobs,
+    meta = {"notes": a.note, "exact_solver": a.exact_solver, "pairs": a.pairs, "seed": a.seed, "repeats": a.repeats, "ref_repeats": a.ref_repeats, "jobs": a.jobs,
             "load_start": os.getloadavg()[0], "cpus": os.cpu_count()}
     t0 = time.perf_counter()
     synthetic = synthetic_coverage(300, seed=a.seed)

@@ -614,6 +614,8 @@ def coverage_markdown(doc: Mapping[str, Any], figure: str | None = None) -> list
             w = "; ".join(f"noise {d['noise_c']:g} degC, e {d['e_band'][0]}-{d['e_band'][1]}: "
                           f"{100 * d['median_rel']:.1f} % (n {d['n']})" for d in r["worst"])
             out.append(f"- `{r['question']}` {r['route']}: {w}")
+    if m.get("notes"):
+        out += ["", *[f"- {n}" for n in m["notes"]]]
     if figure:
         out += ["", f"![answer error against the reference by effusivity and noise]({figure})"]
     return out + [""]

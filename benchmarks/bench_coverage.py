@@ -148,6 +148,8 @@ def main(argv=None) -> int:
                          "milliseconds; the exact answers and references are kept)")
     ap.add_argument("--run-wall-s", type=float, default=None,
                     help="--render-only: wall time of the run(s) that produced the cases [s], for the record")
+    ap.add_argument("--run-load", type=float, default=None,
+                    help="--render-only: load average at the start of the run(s) that produced the cases")
     ap.add_argument("--note", action="append", default=[], help="a sentence for the record and the page")
     ap.add_argument("--resume", action="store_true")
     ap.add_argument("--render-only", action="store_true")
@@ -176,6 +178,8 @@ def main(argv=None) -> int:
                 run_cases(q, a.pairs, seed=a.seed, jobs=a.jobs, done=done, repeats=a.repeats,
                           ref_repeats=a.ref_repeats, exact_solver=a.exact_solver)
     meta["wall_s"] = a.run_wall_s if a.render_only and a.run_wall_s else time.perf_counter() - t0
+    if a.render_only and a.run_load is not None:
+        meta["load_start"] = a.run_load
     meta["load_end"] = os.getloadavg()[0]
     results = _load(cases_path)
     if a.rescore_table:

@@ -156,7 +156,8 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     a.out.mkdir(parents=True, exist_ok=True)
     cases_path = a.out / "cases.jsonl"
-    meta = {"notes": a.note, "exact_solver": a.exact_solver, "pairs": a.pairs, "seed": a.seed, "repeats": a.repeats, "ref_repeats": a.ref_repeats, "jobs": a.jobs,
+    meta = {"notes": a.note, "exact_solver": a.exact_solver, "pairs": a.pairs, "seed": a.seed,
+            "repeats": a.repeats, "ref_repeats": a.ref_repeats, "jobs": a.jobs,
             "load_start": os.getloadavg()[0], "cpus": os.cpu_count()}
     t0 = time.perf_counter()
     synthetic = synthetic_coverage(300, seed=a.seed)
@@ -184,15 +185,15 @@ def main(argv=None) -> int:
     results = _load(cases_path)
     if a.rescore_table:
         from designkit import query
-        from designkit.accuracy.coverage import _args, _reading
+        from designkit.accuracy.coverage import answer_reading, case_arguments
 
         for r in results:
             try:
                 ans = query.ask(r["question"], route="table", table="svm-paper", coverage=0.9,
-                                **_args(r["question"], r))
-                r["table"] = _reading(r["question"], ans)
+                                **case_arguments(r["question"], r))
+                r["table"] = answer_reading(r["question"], ans)
             except Exception as exc:  # noqa: BLE001 - recorded as the benchmark does
-                r["table"] = {**_reading(r["question"], None), "error": str(exc)}
+                r["table"] = {**answer_reading(r["question"], None), "error": str(exc)}
         meta["table_rescored"] = True
     doc = report(results, synthetic, meta, a.out)
     fig = figure(results, a.out)

@@ -45,6 +45,8 @@ from .._validation import as_generator
 
 __all__ = [
     "COVERAGE_QUESTIONS",
+    "answer_reading",
+    "case_arguments",
     "coverage_case",
     "diluted_coverage",
     "draw_case",
@@ -105,7 +107,8 @@ def draw_case(question: str, rng: np.random.Generator) -> dict[str, Any]:
     return case
 
 
-def _args(question: str, case: Mapping[str, Any]) -> dict[str, Any]:
+def case_arguments(question: str, case: Mapping[str, Any]) -> dict[str, Any]:
+    """The question function's keyword arguments for one case (objects and scene)."""
     if question == "delta-e":
         return {"e": case["e"], "contact_s": case["contact_s"], "noise_c": case["noise_c"],
                 "delta_t_c": case["delta_t_c"]}
@@ -119,7 +122,7 @@ def _args(question: str, case: Mapping[str, Any]) -> dict[str, Any]:
     return {**out, "contact_s": case["contact_s"], "noise_c": case["noise_c"], "delta_t_c": case["delta_t_c"]}
 
 
-def _reading(question: str, ans) -> dict[str, Any]:
+def answer_reading(question: str, ans) -> dict[str, Any]:
     """What the benchmark compares: value, interval, coverage, ideal (F1 for distinguishable)."""
     if ans is None:
         return {"value": None, "low": None, "high": None, "coverage": None, "ideal": None, "method": "error"}
@@ -147,14 +150,14 @@ def coverage_case(question: str, case: Mapping[str, Any], index: int, *, repeats
     from .. import query
     from ..query import exact as ex
 
-    args = _args(question, case)
+    args = case_arguments(question, case)
     out: dict[str, Any] = {"question": question, "index": index, **case}
     t0 = time.perf_counter()
     try:
-        out["table"] = _reading(question, query.ask(question, route="table", table=table, coverage=coverage,
+        out["table"] = answer_reading(question, query.ask(question, route="table", table=table, coverage=coverage,
                                                     **args))
     except Exception as exc:  # noqa: BLE001 - recorded, the benchmark goes on
-        out["table"] = {**_reading(question, None), "error": str(exc)}
+        out["table"] = {**answer_reading(question, None), "error": str(exc)}
     t1 = time.perf_counter()
     fn = {"min-contact": ex.exact_min_contact, "max-noise": ex.exact_max_noise,
           "min-delta-t": ex.exact_min_delta_t, "delta-e": ex.exact_delta_e,
@@ -164,8 +167,8 @@ def coverage_case(question: str, case: Mapping[str, Any], index: int, *, repeats
     t2 = time.perf_counter()
     ref = fn(seed=500000 + index, repeats=ref_repeats, solver="batched", **common)
     t3 = time.perf_counter()
-    out["exact"] = _reading(question, ans)
-    out["reference"] = _reading(question, ref)
+    out["exact"] = answer_reading(question, ans)
+    out["reference"] = answer_reading(question, ref)
     out["wall_s"] = {"table": t1 - t0, "exact": t2 - t1, "reference": t3 - t2}
     out["violation"] = _violation(question, ref, coverage)
     if question == "delta-e":  # both directions, each an answer of its own

@@ -587,7 +587,8 @@ def coverage_markdown(doc: Mapping[str, Any], figure: str | None = None) -> list
            "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in doc["rows"]:
         out.append(f"| `{r['question']}` | {r['route']} | {r['n']} | {r['n_compared']} | {r['n_stated']} | "
-                   f"{pct(r['coverage'])} | {r['n_unstated']} | {r['n_no_answer']} | {format_value(r['median_abs'], 3)} | "
+                   f"{pct(r['coverage'])} | {r['n_unstated']} | {r['n_no_answer']} | "
+                   f"{format_value(r['median_abs'], 3)} | "
                    f"{format_value(r['p95_abs'], 3)} | {pct(r['median_rel'])} | {pct(r['p95_rel'])} | "
                    f"{r['violations']}{_at_bound(r)} |")
     out += ["", "Units of the absolute errors: s (min-contact), degC (max-noise, min-delta-t), "

@@ -151,6 +151,8 @@ def main(argv=None) -> int:
     ap.add_argument("--run-load", type=float, default=None,
                     help="--render-only: load average at the start of the run(s) that produced the cases")
     ap.add_argument("--note", action="append", default=[], help="a sentence for the record and the page")
+    ap.add_argument("--start", type=int, default=0, help="skip the first START cases of each question "
+                    "(the draws are seeded: a later run extends an earlier one)")
     ap.add_argument("--resume", action="store_true")
     ap.add_argument("--render-only", action="store_true")
     a = ap.parse_args(argv)
@@ -168,7 +170,7 @@ def main(argv=None) -> int:
         qs = [q for q in a.questions.split(",") if q]
         with Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn()) as bar:
             for q in qs:
-                task = bar.add_task(q, total=a.pairs)
+                task = bar.add_task(q, total=a.pairs - a.start)
 
                 def done(r, task=task):
                     if (r["question"], r["index"]) not in have:
@@ -177,7 +179,7 @@ def main(argv=None) -> int:
                     bar.advance(task)
 
                 run_cases(q, a.pairs, seed=a.seed, jobs=a.jobs, done=done, repeats=a.repeats,
-                          ref_repeats=a.ref_repeats, exact_solver=a.exact_solver)
+                          ref_repeats=a.ref_repeats, exact_solver=a.exact_solver, start=a.start)
     meta["wall_s"] = a.run_wall_s if a.render_only and a.run_wall_s else time.perf_counter() - t0
     if a.render_only and a.run_load is not None:
         meta["load_start"] = a.run_load

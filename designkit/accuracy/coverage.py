@@ -328,16 +328,17 @@ def worst_regions(results: Sequence[Mapping[str, Any]], question: str, route: st
 
 
 def run_cases(question: str, n: int, *, seed: int, jobs: int = 1, done: Callable[[dict], None] | None = None,
-              **options: Any) -> list[dict[str, Any]]:
-    """``n`` random cases of ``question`` (:func:`draw_case`, seeded), each through :func:`coverage_case`,
-    over ``jobs`` processes; ``done(result)`` is called as each finishes (for progress and saving)."""
+              start: int = 0, **options: Any) -> list[dict[str, Any]]:
+    """Random cases ``start .. n-1`` of ``question`` (:func:`draw_case`, seeded: case ``i`` is the same
+    whatever ``start``), each through :func:`coverage_case`, over ``jobs`` processes; ``done(result)`` is
+    called as each finishes (for progress and saving)."""
     from joblib import Parallel, delayed
 
     rng = as_generator([int(seed), COVERAGE_QUESTIONS.index(question)])
     cases = [draw_case(question, rng) for _ in range(int(n))]
     results = []
     gen = Parallel(n_jobs=jobs, return_as="generator_unordered")(
-        delayed(coverage_case)(question, c, i, **options) for i, c in enumerate(cases))
+        delayed(coverage_case)(question, c, i, **options) for i, c in enumerate(cases) if i >= start)
     for r in gen:
         results.append(r)
         if done is not None:

@@ -254,7 +254,8 @@ def summarize(results: Iterable[Mapping[str, Any]], question: str, route: str, *
         if stated else None,
         "violations": sum(1 for r in rows if r.get("violation")),
         # the reference's crossing at the bound itself: its F1 reached Phi at the ideal observer's answer
-        "reference_at_bound": sum(1 for r in rows if r["reference"].get("value") is not None
+        "reference_at_bound": 0 if question == "distinguishable" else sum(  # (an F1 of 1 is no violation)
+            1 for r in rows if r["reference"].get("value") is not None
                                   and not isinstance(r["reference"]["value"], bool)
                                   and r["reference"].get("ideal") is not None
                                   and math.isclose(r["reference"]["value"], r["reference"]["ideal"], rel_tol=1e-9)),

@@ -58,13 +58,18 @@ __all__ = [
     "DEFAULT_TABLE",
     "GRID_RTOL",
     "clear_table_cache",
+    "contact_estimate",
+    "cross2",
     "delta_e",
     "delta_e_ideal_view",
+    "delta_estimate",
     "distinguishable",
     "max_noise",
     "min_contact",
     "min_delta_t",
     "open_table",
+    "ratio_estimate",
+    "stated_log",
 ]
 
 DEFAULT_TABLE = "svm-paper"
@@ -191,22 +196,164 @@ def _table_z(tab: Table) -> float:
     return float(tab.header.get("z") or 2.0)
 
 
-def _stated(value: float, lo_end, hi_end, interp: float, z_table: float, zc: float, *, log: bool = False):
-    """``value``'s interval at the coverage of ``zc``: the table's Monte Carlo ends (``lo_end``, ``hi_end``,
-    each ``z_table`` standard errors from the value) rescaled to ``zc``, combined in quadrature with the
-    interpolation error ``interp`` (one standard error) on each side; in log space if ``log``.
-    A missing end (None: not reached within the grid) leaves that side open (None)."""
-    f = math.log if log else (lambda v: v)
-    g = math.exp if log else (lambda v: v)
-    v = f(value)
+# ============================================================ estimates shared with the array route
+# The rounding correction and the stated intervals are written once, over numpy arrays (NaN for "none"):
+# the scalar questions below call them with one element, designkit.query.vectorized with many.
+def _arr(x) -> np.ndarray:
+    return np.asarray(np.nan if x is None else x, dtype=np.float64)
+
+
+def _opt(x) -> float | None:
+    """One element back to the scalar route's convention (None for NaN)."""
+    v = float(x)
+    return None if math.isnan(v) else v
+
+
+def cross2(x0, x1, n0, n1, gap) -> np.ndarray:
+    """:func:`designkit.tables.lookup.crossing` on two grid points, elementwise over arrays (NaN: none).
+
+    >>> float(cross2(1.0, 2.0, 300.0, 50.0, 100.0))
+    1.8
+    """
+    x0, x1, n0, n1, gap = np.broadcast_arrays(*(np.asarray(a, dtype=np.float64) for a in (x0, x1, n0, n1, gap)))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ok0 = ~np.isnan(n0) & (n0 <= gap)
+        ok1 = ~np.isnan(n1) & (n1 <= gap)
+        w = np.where(n0 != n1, (n0 - gap) / (n0 - n1), 1.0)
+        inside = np.where(np.isnan(n0), x1, x0 + w * (x1 - x0))
+    return np.where(ok0, x0, np.where(ok1, inside, np.nan))
+
+
+def stated_log(value, lo_end, hi_end, interp, z_table: float, zc: float) -> tuple[np.ndarray, np.ndarray]:
+    """``value``'s interval at the coverage of ``zc``, in log space, elementwise: the table's Monte Carlo ends
+    (``lo_end``, ``hi_end``, each ``z_table`` standard errors from the value) rescaled to ``zc``, combined in
+    quadrature with the interpolation error ``interp`` (one standard error, log) on each side. A missing end
+    (NaN, or not positive) leaves that side open (NaN).
+
+    >>> [round(float(v), 4) for v in stated_log(2.0, 1.0, 4.0, 0.0, 2.0, 2.0)]
+    [1.0, 4.0]
+    """
+    v = np.log(np.asarray(value, dtype=np.float64))
     out = []
     for end, sign in ((lo_end, -1.0), (hi_end, +1.0)):
-        if end is None or (isinstance(end, float) and math.isnan(end)) or (log and end <= 0):
-            out.append(None)
-            continue
-        mc = abs(f(end) - v) / z_table
-        out.append(g(v + sign * zc * math.hypot(mc, interp)))
+        end = np.asarray(end, dtype=np.float64)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            mc = np.abs(np.log(end) - v) / z_table
+            x = np.exp(v + sign * zc * np.hypot(mc, interp))
+        out.append(np.where(np.isnan(end) | (end <= 0), np.nan, x))
     return out[0], out[1]
+
+
+def contact_estimate(x0, x1, n0, n1, gap, raw, mc_lo, mc_hi, ideal, *, width: float, svm: bool,
+                     z_table: float, zc: float) -> dict[str, np.ndarray]:
+    """min-contact's estimate where the crossing ``raw`` [s] is interpolated between tabulated contact times
+    ``x0 < x1`` [s] with needs ``n0 > gap >= n1`` [J s^-1/2 K^-1 m^-2], elementwise over arrays.
+
+    A tabulated delta is the first grid distance whose F1 reaches Phi: the crossing of the mean F1 lies up
+    to one width ``width`` below it, on average w/2 (uniform: SD w/sqrt(12)). On an SVM table (``svm``) the
+    estimate subtracts w/2 from the needs and interpolates log-log (the need falls roughly as a power of the
+    contact time), which removes the raw linear crossing's bias (always late: the need is convex in contact
+    time); the interpolation error is the distance between the two interpolants (log), the rounding's SD
+    enters through the local log-log slope. Where the corrected need no longer crosses inside the cell (or
+    the grid is coarser than the needs), the raw crossing stays, with the log-log interpolant's distance as
+    its error. The Monte Carlo ends ``mc_lo`` / ``mc_hi`` (the table's delta_lo / delta_hi crossings, NaN:
+    none) are carried from the raw crossing to the estimate; the interval (:func:`stated_log`) never reaches
+    below the ideal bound ``ideal`` (NaN: none) unless the estimate does.
+
+    Returns
+    -------
+    dict of ndarray
+        ``value``, ``low``, ``high`` [s], ``interp`` and ``rounding`` (log errors).
+
+    >>> r = contact_estimate(1.0, 1.5, 6000.0, 2000.0, 3000.0, 1.375, 1.2, 1.6, 1.05, width=80.0, svm=True,
+    ...                      z_table=2.0, zc=1.645)
+    >>> 1.0 < float(r["value"]) < 1.375 and float(r["low"]) < float(r["value"]) < float(r["high"])
+    True
+    """
+    x0, x1, n0, n1, gap, raw = np.broadcast_arrays(
+        *(np.asarray(a, dtype=np.float64) for a in (x0, x1, n0, n1, gap, raw)))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        lx0, lx1, lg = np.log(x0), np.log(x1), np.log(gap)
+        raw_loglog = cross2(lx0, lx1, np.log(n0), np.log(n1), lg)
+        raw_interp = np.where(np.isnan(raw_loglog), 0.0, np.abs(np.log(raw) - raw_loglog))
+        if svm:
+            c0, c1 = n0 - 0.5 * width, n1 - 0.5 * width
+            ok_c = np.minimum(c0, c1) > 0  # a grid coarser than the needs themselves: no correction
+            l0, l1 = np.log(c0), np.log(c1)
+            loglog = np.where(ok_c, cross2(lx0, lx1, l0, l1, lg), np.nan)
+            linear = cross2(x0, x1, c0, c1, gap)
+            est = np.exp(loglog)
+            use = ~np.isnan(loglog) & ~np.isnan(linear) & (x0 < est) & (est <= x1)
+            slope = np.where(l1 != l0, np.abs((lx1 - lx0) / (l1 - l0)), 0.0)
+            value = np.where(use, est, raw)
+            interp = np.where(use, np.abs(loglog - np.log(linear)), raw_interp)
+            rounding = np.where(use, slope * (width / math.sqrt(12.0)) / gap, 0.0)
+        else:
+            value, interp, rounding = raw, raw_interp, np.zeros_like(raw)
+        shift = np.log(value) - np.log(raw)
+        ends = [np.exp(np.log(np.asarray(m, dtype=np.float64)) + shift) for m in (mc_lo, mc_hi)]
+    low, high = stated_log(value, ends[0], ends[1], np.hypot(interp, rounding), z_table, zc)
+    ideal = np.asarray(ideal, dtype=np.float64)
+    low = np.where(np.isnan(low) | np.isnan(ideal), low, np.minimum(np.maximum(low, ideal), value))
+    return {"value": value, "low": low, "high": high, "interp": interp, "rounding": rounding}
+
+
+def ratio_estimate(raw, r_c, r_lin, r_rnd, r_geo, end_lo, end_hi, ideal, *, z_table: float,
+                   zc: float) -> dict[str, np.ndarray]:
+    """max-noise / min-delta-t's estimate of the largest separating sigma/dT where the raw crossing ``raw``
+    lies inside the table's noise ratios, elementwise over arrays (NaN: none).
+
+    As :func:`contact_estimate`: the tabulated deltas are rounded up to the grid (on average half a width
+    late), so the raw crossing tolerates too little noise. ``r_c`` is the crossing with w/2 subtracted from
+    every need and log interpolation (log need, log contact time), ``r_lin`` the same shift interpolated
+    linearly, ``r_rnd`` the log one shifted by a further w/sqrt(12) (the rounding's SD), ``r_geo`` the log one
+    without shift; each NaN where it does not cross inside the grid. Where ``r_c`` and ``r_lin`` both exist the
+    estimate is ``r_c``, its interpolation error their log distance and its rounding error ``r_rnd``'s;
+    otherwise the raw crossing with ``r_geo``'s distance. ``end_lo`` / ``end_hi`` are the table's Monte Carlo
+    ends (sigma/dT, carried from the raw crossing to the estimate); ``high`` never exceeds the ideal
+    bound ``ideal`` (sigma/dT, NaN: none) unless the estimate does.
+
+    >>> r = ratio_estimate(0.010, 0.011, 0.0112, 0.0105, 0.0101, 0.008, 0.012, 0.02, z_table=2.0, zc=1.645)
+    >>> float(r["value"]), float(r["low"]) < 0.011 < float(r["high"])
+    (0.011, True)
+    """
+    raw, r_c, r_lin, r_rnd, r_geo = np.broadcast_arrays(
+        *(np.asarray(a, dtype=np.float64) for a in (raw, r_c, r_lin, r_rnd, r_geo)))
+    use = ~np.isnan(r_c) & ~np.isnan(r_lin)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        r = np.where(use, r_c, raw)
+        interp = np.where(use, np.abs(np.log(r_c) - np.log(r_lin)),
+                          np.where(np.isnan(r_geo), 0.0, np.abs(np.log(raw) - np.log(r_geo))))
+        rounding = np.where(use & ~np.isnan(r_rnd), np.abs(np.log(r_rnd) - np.log(r_c)), 0.0)
+        shift = np.log(r) - np.log(raw)
+        ends = [np.exp(np.log(np.asarray(m, dtype=np.float64)) + shift) for m in (end_lo, end_hi)]
+    low, high = stated_log(r, ends[0], ends[1], np.hypot(interp, rounding), z_table, zc)
+    ideal = np.asarray(ideal, dtype=np.float64)
+    high = np.where(np.isnan(high) | np.isnan(ideal), high, np.maximum(np.minimum(high, ideal), r))
+    return {"value": r, "low": low, "high": high, "interp": interp, "rounding": rounding}
+
+
+def delta_estimate(value, mc_lo, mc_hi, geometric, ideal, *, width: float, z_table: float,
+                   zc: float) -> tuple[np.ndarray, np.ndarray]:
+    """delta-e's interval of one direction's delta(e) ``value`` [J s^-1/2 K^-1 m^-2] at the coverage of ``zc``,
+    elementwise over arrays (NaN: none): the table's Monte Carlo ends ``mc_lo`` / ``mc_hi`` rescaled, in
+    quadrature with the interpolation error (``value`` against ``geometric``, the log-space interpolant; NaN:
+    none) and the grid's rounding (the first grid distance reaching Phi: the crossing lies up to one width
+    ``width`` below it, SD w/sqrt(12)); the low end never below the ideal bound ``ideal`` unless the value is.
+
+    >>> low, high = delta_estimate(3000.0, 2800.0, 3300.0, 3050.0, 2000.0, width=80.0, z_table=2.0, zc=1.645)
+    >>> 2000.0 < float(low) < 3000.0 < float(high)
+    True
+    """
+    value = np.asarray(value, dtype=np.float64)
+    geometric = np.asarray(geometric, dtype=np.float64)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        interp = np.where(np.isnan(geometric), 0.0, np.abs(np.log(value) - np.log(geometric)))
+        rounding = (width / math.sqrt(12.0)) / value
+    low, high = stated_log(value, mc_lo, mc_hi, np.hypot(interp, rounding), z_table, zc)
+    ideal = np.asarray(ideal, dtype=np.float64)
+    low = np.where(np.isnan(low) | np.isnan(ideal), low, np.minimum(np.maximum(low, ideal), value))
+    return low, high
 
 
 # ============================================================ opening a table for a question
@@ -487,43 +634,13 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
             # interpolated between two tabulated needs: the Monte Carlo interval of the table (its deltas'
             # z-SE ends, rescaled to the coverage) and the interpolation error, estimated as the distance to
             # the crossing of a log-log interpolation (the need falls roughly as a power of the contact time)
-            xs, ns = grid[k_cross - 1:k_cross + 1], needs[k_cross - 1:k_cross + 1]
             raw = value
-            if op.tab.fidelity == "svm":
-                # a tabulated delta is the first grid distance whose F1 reaches Phi: the crossing of the mean
-                # F1 lies up to one width w below it, on average w/2 (uniform: SD w/sqrt(12)). Subtracting
-                # w/2 from the need and interpolating log-log (the need falls roughly as a power of the
-                # contact time) removes the bias of the raw linear crossing (always late: the need is
-                # convex in contact time); the interpolation error is the distance between the two
-                # interpolants, and the rounding's SD enters through the local log-log slope
-                w = op.width
-                ns_c = [n - 0.5 * w for n in ns]
-                lx, lg = [math.log(x) for x in xs], math.log(hi - lo)
-                ok_c = min(ns_c) > 0  # a grid coarser than the needs themselves: no correction
-                ln = [math.log(n) for n in ns_c] if ok_c else ns_c
-                loglog, _ = _crossing(lx, ln, lg) if ok_c else (None, None)
-                linear, _ = _crossing(xs, ns_c, hi - lo)
-                if loglog is not None and linear is not None and xs[0] < math.exp(loglog) <= xs[1]:
-                    value = math.exp(loglog)
-                    interp = abs(loglog - math.log(linear))
-                    slope = abs((lx[1] - lx[0]) / (ln[1] - ln[0])) if ln[1] != ln[0] else 0.0
-                    rounding = slope * (w / math.sqrt(12.0)) / (hi - lo)
-                else:  # the corrected need no longer crosses inside this cell: keep the raw crossing
-                    loglog, _ = _crossing(lx, [math.log(n) for n in ns], lg)
-                    interp = abs(math.log(value) - loglog) if loglog is not None else 0.0
-                    rounding = 0.0
-            else:
-                loglog, _ = _crossing([math.log(x) for x in xs], [math.log(n) for n in ns], math.log(hi - lo))
-                interp = abs(math.log(value) - loglog) if loglog is not None else 0.0
-                rounding = 0.0
-            zc = z_of_coverage(coverage)
-            z_t = _table_z(op.tab)
-            # the Monte Carlo ends, measured from the raw crossing, carried over to the corrected one
-            ends = [None if m is None else math.exp(math.log(value) + math.log(m) - math.log(raw))
-                    for m in mc_interval]
-            low, high = _stated(value, ends[0], ends[1], math.hypot(interp, rounding), z_t, zc, log=True)
-            if low is not None and ideal is not None:  # never below the bound (unless the table's answer is)
-                low = min(max(low, ideal), value)
+            est = contact_estimate(grid[k_cross - 1], grid[k_cross], needs[k_cross - 1], needs[k_cross], hi - lo,
+                                   raw, _arr(mc_interval[0]), _arr(mc_interval[1]), _arr(ideal), width=op.width,
+                                   svm=op.tab.fidelity == "svm", z_table=_table_z(op.tab),
+                                   zc=z_of_coverage(coverage))
+            value, low, high = float(est["value"]), _opt(est["low"]), _opt(est["high"])
+            interp, rounding = float(est["interp"]), float(est["rounding"])
             interval, kind, cov = (low, high), "table-estimate", coverage
             monte_carlo.update(interpolation_error_log=interp, rounding_error_log=rounding, table_crossing_s=raw)
         else:
@@ -653,26 +770,25 @@ def _ratio_question(question: str, e1, e2, m1, m2, objects, contact_s, noise_c, 
         # interpolates log-log, the interval carries the interpolants' difference and the rounding's SD
         w = op.width
         raw = r
-        r_c, w_c = _max_ratio(view, "svm", contact, lo, hi, geometric=True, shift=0.5 * w)
-        r_lin, w_lin = _max_ratio(view, "svm", contact, lo, hi, shift=0.5 * w)
-        r_rnd, w_rnd = _max_ratio(view, "svm", contact, lo, hi, geometric=True, shift=0.5 * w + w / math.sqrt(12))
-        if r_c is not None and w_c == "inside" and r_lin is not None and w_lin == "inside":
-            r = r_c
-            interp = abs(math.log(r_c) - math.log(r_lin))
-            rounding = abs(math.log(r_rnd) - math.log(r_c)) if r_rnd is not None and w_rnd == "inside" else 0.0
-        else:
-            r_geo, w_geo = _max_ratio(view, "svm", contact, lo, hi, geometric=True)
-            interp = abs(math.log(r) - math.log(r_geo)) if r_geo is not None and w_geo == "inside" else 0.0
-            rounding = 0.0
-        value = to_answer(r)
-        ends = [None if out[k][1] == "below" or (k == "lo" and out[k][1] == "above") else
-                math.exp(math.log(r) + math.log(out[k][0]) - math.log(raw)) for k in ("hi", "lo")]
-        r_low, r_high = _stated(r, ends[0], ends[1], math.hypot(interp, rounding), _table_z(op.tab),
-                                z_of_coverage(coverage), log=True)
-        computation["table_crossing_noise_ratio"] = raw
+
+        def inside(v):
+            return v[0] if v[1] == "inside" else math.nan
+
+        r_c = inside(_max_ratio(view, "svm", contact, lo, hi, geometric=True, shift=0.5 * w))
+        r_lin = inside(_max_ratio(view, "svm", contact, lo, hi, shift=0.5 * w))
+        both = not (math.isnan(r_c) or math.isnan(r_lin))
+        r_rnd = inside(_max_ratio(view, "svm", contact, lo, hi, geometric=True,
+                                  shift=0.5 * w + w / math.sqrt(12))) if both else math.nan
+        r_geo = math.nan if both else inside(_max_ratio(view, "svm", contact, lo, hi, geometric=True))
+        ends = [math.nan if out[k][1] == "below" or (k == "lo" and out[k][1] == "above") else out[k][0]
+                for k in ("hi", "lo")]
         ri = out["ideal"][0] if out["ideal"][1] != "below" else None
-        if ri is not None and r_high is not None:  # never beyond the bound (unless the table's answer is)
-            r_high = max(min(r_high, ri), r)
+        est = ratio_estimate(raw, r_c, r_lin, r_rnd, r_geo, ends[0], ends[1], _arr(ri), z_table=_table_z(op.tab),
+                             zc=z_of_coverage(coverage))
+        r, r_low, r_high = float(est["value"]), _opt(est["low"]), _opt(est["high"])
+        interp, rounding = float(est["interp"]), float(est["rounding"])
+        value = to_answer(r)
+        computation["table_crossing_noise_ratio"] = raw
         iv = [to_answer(r_low), to_answer(r_high)]
         interval = tuple(iv) if question == "max-noise" else (iv[1], iv[0])
         kind, cov = "table-estimate", coverage
@@ -793,12 +909,8 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
         stated, cov_side, method = [None, None], None, "none"
         if val is not None and op.tab.fidelity == "svm":
             geo = at(view, combos, gcw, f"delta_{direction}", geometric=True)
-            interp = abs(math.log(val) - math.log(geo)) if geo is not None else 0.0
-            # plus the grid's rounding: the first grid distance reaching Phi, the crossing up to one width below
-            rounding = (op.width / math.sqrt(12.0)) / val
-            low, high = _stated(val, iv[0], iv[1], math.hypot(interp, rounding), z_t, zc, log=True)
-            if low is not None and ideal_side is not None:
-                low = min(max(low, ideal_side), val)
+            low, high = (_opt(v) for v in delta_estimate(val, _arr(iv[0]), _arr(iv[1]), _arr(geo), _arr(ideal_side),
+                                                         width=op.width, z_table=z_t, zc=zc))
             stated, cov_side, method = [low, high], coverage, "table-estimate"
         sides[side] = {"value": val, "interval": stated, "ideal": ideal_side, "coverage": cov_side,
                        "estimate_method": method, "monte_carlo_interval": iv}

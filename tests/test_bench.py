@@ -297,6 +297,11 @@ def test_the_shipped_page_renders_from_its_own_json():
     """docs/accuracy.md is exactly what the renderer makes of docs/accuracy.json (same rows, same markdown)."""
     report = _report_from_json(REPO / "docs" / "accuracy.json")
     md = bench.render_markdown(report, {"pareto": "accuracy_pareto.png", "cost": "accuracy_cost.png"})
+    cov = REPO / "docs" / "accuracy_coverage.json"
+    if cov.is_file():  # the coverage benchmark's section (benchmarks/bench_coverage.py --docs) from its record
+        from designkit.accuracy.render import coverage_markdown, insert_coverage
+
+        md = insert_coverage(md, coverage_markdown(json.loads(cov.read_text()), "accuracy_coverage.png"))
     assert md == (REPO / "docs" / "accuracy.md").read_text()
 
 

@@ -137,10 +137,12 @@ def reference(tab, kind: str, op: str, args):
     if op == "min_contact":
         comp = a.to_dict()["computation"]  # the arrays' own answers (value/interval/ideal are refined)
         mc = comp.get("monte_carlo_interval", [None, None])
-        return {"svm": a.value, "lo": mc[0], "hi": mc[1], "ideal": comp.get("table_ideal_s", a.ideal)}[kind]
+        svm = comp.get("table_crossing_s", a.value)  # the grid's raw crossing (the answer is bias-corrected)
+        return {"svm": svm, "lo": mc[0], "hi": mc[1], "ideal": comp.get("table_ideal_s", a.ideal)}[kind]
     if op == "distinguishable":
         assert kind != "ideal", "the table route answers the ideal observer's F1 in closed form, not by delta"
-        return bool({"svm": a.value, "hi": a.interval[0], "lo": a.interval[1]}[kind])
+        mv = a.computation["monte_carlo_verdicts"]  # the arrays' own verdicts (the interval is the F1's)
+        return bool({"svm": a.value, "hi": mv[0], "lo": mv[1]}[kind])
     x = a.extra
     if kind == "svm":
         lower, upper = x["delta_e_lower"], x["delta_e_upper"]
@@ -148,7 +150,8 @@ def reference(tab, kind: str, op: str, args):
         lower, upper = x["delta_e_lower_ideal"], x["delta_e_upper_ideal"]
     else:
         i = 0 if kind == "lo" else 1
-        lower, upper = x["delta_e_lower_interval"][i], x["delta_e_upper_interval"][i]
+        d = a.details  # the arrays' own Monte Carlo ends (the stated interval is refined)
+        lower, upper = d["lower"]["monte_carlo_interval"][i], d["upper"]["monte_carlo_interval"][i]
     if op == "delta_e_lower":
         return lower
     if op == "delta_e_upper":

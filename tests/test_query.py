@@ -51,14 +51,17 @@ def test_min_contact_interpolates_exactly(linear_table, noise, gap, base):
     elif exact > CONTACTS[-1]:
         assert ans.value is None
     else:
-        assert ans.value == pytest.approx(exact, rel=1e-9)
-        # the interval spans at least the grid cell of the crossing (interpolation error), never below the bound
-        prev = max([c for c in CONTACTS if c < ans.value - 1e-12], default=0.0)
-        nxt = min(c for c in CONTACTS if c >= ans.value - 1e-12)
-        assert ans.interval[1] >= nxt - 1e-9
+        # the grid's raw linear crossing is exact on this table; the answer corrects it for the grid's
+        # rounding of delta (half a width) and interpolates log-log
+        raw = ans.computation.get("table_crossing_s", ans.value)
+        assert raw == pytest.approx(exact, rel=1e-9)
+        # interpolated between two tabulated contacts: an interval at the stated coverage around the answer
+        # (Monte Carlo ends and interpolation error), never below the bound
         bound = ans.ideal if ans.ideal is not None else -math.inf
-        assert ans.interval[0] <= prev + 1e-9 or ans.interval[0] == pytest.approx(bound)
-        assert ans.interval[0] >= bound - 1e-12
+        d = ans.to_dict()["interval"]
+        assert d["method"] == "table-estimate" and d["coverage"] == 0.9
+        assert d["low"] <= ans.value <= d["high"] and d["low"] < d["high"]
+        assert d["low"] >= min(bound, ans.value) - 1e-12  # (this synthetic table's answers may lie below it)
     assert ans.in_grid == {"noise_ratio": True, "effusivity": True}
 
 
@@ -67,9 +70,11 @@ def test_max_noise_and_min_delta_t_interpolate_exactly(linear_table):
     # delta(t, r) = gap  =>  ln(r/0.001) = (gap / (A - B t) - 1) / K
     r_star = 0.001 * math.exp((gap / (A - B * t) - 1) / K)
     mn = q.max_noise(1000, 1000 + gap, contact_s=t, delta_t_c=10.0, table=linear_table, ideal_table=None)
-    assert mn.value == pytest.approx(r_star * 10.0, rel=1e-9)
+    # the grid's raw crossing is exact on this table (the answer corrects it for the grid's rounding)
+    assert mn.computation["table_crossing_noise_ratio"] == pytest.approx(r_star, rel=1e-9)
     md = q.min_delta_t(1000, 1000 + gap, contact_s=t, noise_c=0.05, table=linear_table, ideal_table=None)
-    assert md.value == pytest.approx(0.05 / r_star, rel=1e-9)
+    assert md.computation["table_crossing_noise_ratio"] == pytest.approx(r_star, rel=1e-9)
+    assert mn.value == pytest.approx(0.05 * 10.0 / md.value, rel=1e-9)  # one crossing answers both
     de = q.delta_e(20000, contact_s=3.0, noise_c=0.05, delta_t_c=10.0, table=linear_table, ideal_table=None)
     assert de.extra["delta_e_lower"] == pytest.approx(_delta(3.0, 0.005), rel=1e-12)
 
@@ -245,7 +250,8 @@ def test_query_cli_json_is_the_answer_schema(cli, cmd, quantity):
     assert p["table"]["content_hash"].startswith("sha256:") and p["sensor"]["name"] == "paper"
     assert p["model"]["name"] == "semi-infinite" and p["threshold"] == 0.9 and all(p["in_grid"].values())
     assert set(p["scene"]) == {"contact_s", "noise_c", "delta_t_c", "noise_ratio"}
-    assert set(p["interval"]) == {"low", "high", "meaning", "coverage"} and set(p["ideal"]) == {"value", "method"}
+    assert set(p["interval"]) == {"low", "high", "meaning", "coverage", "method"}
+    assert set(p["ideal"]) == {"value", "method"}
     if cmd[0] == "delta-e":
         assert set(p["details"]) == {"e", "lower", "upper"}
     if cmd[0] == "distinguishable":
@@ -289,7 +295,8 @@ def test_table_route_refuses_another_model_and_says_where_a_question_is_outside(
     with pytest.raises(TableMismatch, match="built for the semi-infinite model, not the contact"):
         q.min_contact(1000, 5000, table=linear_table, model="contact")
     far = q.min_contact(1000, 9000, noise_c=1.0, delta_t_c=10.0, table=linear_table, ideal_table=None)
-    assert "sigma/dT 0.1 outside table linear's [0.001, 0.02]" in far.note
+    assert "noise 1 degC at dT 10 degC (sigma/dT 0.1) outside table linear's sigma/dT [0.001, 0.02]" in far.note
+    assert "it answers for noise 0.01 to 0.2 degC" in far.note  # the range in the user's units
     late = q.delta_e(2000, contact_s=20.0, table=linear_table, ideal_table=None)
     assert "contact time 20 s outside table linear's [0.5, 4] s" in late.note
 
@@ -414,6 +421,16 @@ def test_a_question_the_table_cannot_answer_exits_3_and_bad_coverage_exits_2(cli
     assert r.exit_code == 3 and "contact time up to 10 s" in r.output
     r = cli("min-contact", "--e1", "35000", "--e2", "20000", "--coverage", "1.5")
     assert r.exit_code == 2 and "coverage must lie in (0, 1)" in r.output
+    # outside the table's axes: every question exits 3 and names the axis and its range in user units
+    for cmd in (("min-contact", "--e1", "35000", "--e2", "20000", "--noise", "0.5"),
+                ("max-noise", "--e1", "35000", "--e2", "20000", "--contact", "20"),
+                ("min-delta-t", "--e1", "35000", "--e2", "20000", "--contact", "0.2"),
+                ("delta-e", "--e", "20000", "--noise", "0.5"),
+                ("distinguishable", "--e1", "35000", "--e2", "20000", "--contact", "20")):
+        r = cli(*cmd)
+        assert r.exit_code == 3, (cmd, r.output)
+        assert ("noise 0.005 to 0.2 degC" in r.output or "contact time" in r.output), r.output
+        assert cli(*cmd, "--coverage", "0").exit_code == 2
 
 
 def test_exact_min_contact_is_an_estimate_with_a_stated_coverage():

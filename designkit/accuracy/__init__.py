@@ -18,6 +18,8 @@ module          what it holds
 ``queries``     table answers (the question layer users call) against
                 exact answers
 ``cost``        the sweep engine's wall time, fits and memory as work grows
+``coverage``    do stated intervals cover a 4x-more-seeds reference? (the
+                coverage benchmark, benchmarks/bench_coverage.py)
 ``instruments`` timing, peak memory, a child process's cost, power-law fits
 ``results``     :class:`Row`, :class:`CostCurve` and the shared summaries
 ``render``      the page, its figures and the JSON record
@@ -28,20 +30,26 @@ module          what it holds
 from __future__ import annotations
 
 from .cost import cost_curve, cost_curve_specs, cost_curves
+from .coverage import (COVERAGE_QUESTIONS, answer_reading, case_arguments, coverage_case, diluted_coverage, draw_case,
+                       run_cases, summarize, synthetic_coverage, worst_regions)
 from .delta import delta_rows, grid_rows, staircase_vs_full
 from .instruments import ProcessCost, fit_exponent, measure, process_cost, reset_peak_memory, resident_mb, timed
 from .physics import physics_rows, slab_rows
 from .queries import GAP_BINS, QUESTIONS, density_rows, query_rows, subsample_table, svm_query_rows
 from .recognition import RECOGNITION_PAIRS, ideal_mc_rows, recognition_rows
-from .render import (FIGURES_HINT, curves_markdown, format_time, format_value, markdown_cell, pareto_figure,
-                     plot_costs, plot_pareto, render_markdown, require_figures, rows_markdown, write_report)
+from .render import (COVERAGE_FILES, FIGURES_HINT, coverage_markdown, curves_markdown, format_time, format_value,
+                     insert_coverage, markdown_cell, pareto_figure, plot_costs, plot_pareto, render_markdown,
+                     require_figures, rows_markdown, write_coverage, write_report)
 from .results import PAPER_RATIO, CostCurve, Row, p95, paper_sensor, worst
 from .run import SECTIONS, BenchReport, check_sections, environment, run_bench
 
 __all__ = [
-    "FIGURES_HINT", "GAP_BINS", "PAPER_RATIO", "QUESTIONS", "RECOGNITION_PAIRS", "SECTIONS",
+    "COVERAGE_FILES", "COVERAGE_QUESTIONS", "FIGURES_HINT", "GAP_BINS", "PAPER_RATIO", "QUESTIONS",
+    "RECOGNITION_PAIRS", "SECTIONS",
     "BenchReport", "CostCurve", "ProcessCost", "Row",
-    "check_sections", "cost_curve", "cost_curve_specs", "cost_curves", "curves_markdown", "delta_rows",
+    "answer_reading", "case_arguments", "check_sections", "coverage_case", "coverage_markdown", "diluted_coverage",
+    "draw_case", "insert_coverage", "run_cases", "summarize", "synthetic_coverage", "worst_regions", "write_coverage",
+    "cost_curve", "cost_curve_specs", "cost_curves", "curves_markdown", "delta_rows",
     "density_rows", "environment", "fit_exponent", "format_time", "format_value", "grid_rows", "ideal_mc_rows",
     "markdown_cell", "measure", "p95", "paper_sensor", "pareto_figure", "physics_rows", "plot_costs",
     "plot_pareto", "process_cost", "query_rows", "recognition_rows", "render_markdown", "require_figures",

@@ -371,7 +371,7 @@ def _app_for(argv: list[str]) -> typer.Typer:
 class busy:
     """A spinner with the elapsed time on stderr while a long library call runs (a terminal only).
 
-    For work whose library call reports no progress (an exact question without a coverage target,
+    For work whose library call reports no progress step by step (exact `distinguishable`,
     ``f1``, a model identification): the user sees that something runs and for how long. Piped,
     logged or under ``--json`` nothing is drawn; the line disappears when the work ends.
 

@@ -52,13 +52,22 @@ JobsQ = Annotated[int, typer.Option("--jobs", "-j", help="--exact: worker proces
 NmcQ = Annotated[int, typer.Option(
     "--n-mc", help="--exact: touches per class of the Monte Carlo ideal observer (models without a shared shape).")]
 MaxContact = Annotated[float, typer.Option("--max-contact", help="--exact: longest contact time to consider [s].")]
+SpreadOpt = Annotated[float, typer.Option(
+    "--sensor-temp-spread", help="Varied initial conditions: each touch's sensor temperature uniform within "
+    "+-this [°C] of ambient + dT (the paper's robot: --delta-t 7.5 --sensor-temp-spread 2.5); computed like "
+    "--exact (the shipped tables are for fixed conditions). Must stay below |dT|.")]
 CoverageOpt = Annotated[float, typer.Option(
-    "--coverage", help="--exact: coverage of the answer's confidence interval, in (0, 1).")]
+    "--coverage", help="Coverage of the answer's interval, in (0, 1) (table and --exact).")]
 
-#: Exit status of a question the table cannot answer (outside its grid, or nothing tabulated
-#: separates the pair): distinct from bad input (2), so scripts can tell "no answer here" from
-#: an answer (0). The message names the quantity and its range in the user's units.
+#: Exit status of a question the table cannot answer (outside its grid along an axis, or nothing
+#: tabulated separates the pair), for every question: distinct from bad input (2), so scripts can
+#: tell "no answer here" from an answer (0). The message names the axis and its range in the
+#: user's units.
 EXIT_NO_ANSWER = 3
+
+#: Questions whose exact route reports its progress evaluation by evaluation (a progress bar); the
+#: others get a spinner with the elapsed time.
+_STEPWISE = frozenset({"min-contact", "max-noise", "min-delta-t", "delta-e"})
 
 #: Flag hints for library errors (the library speaks in its own terms).
 _HINTS = {
@@ -84,25 +93,30 @@ def _hints():
 def _ask(question: str, *, exact: bool, table: Optional[str], ideal_table: str, threshold: float, sensor: str,
          model, conductance, thickness, backing, diffusivity, width: float, trials: int, repeats: int, seed: int,
          jobs: int, n_mc: int, objects: dict, scene: dict, exact_extra: Optional[dict] = None,
-         progress: bool = False):
+         progress: bool = False, coverage: float = 0.9, spread: float = 0.0):
     """The one library call of a command: the table route, or the exact one."""
     from .. import query
+    from ..query.crossing import check_coverage
 
     extra = dict(exact_extra or {})
-    if "coverage" in extra:
-        from ..query.crossing import check_coverage
-
-        check_coverage(extra["coverage"])  # bad input before any work, on either route
+    extra["coverage"] = check_coverage(coverage)  # bad input before any work, on either route
 
     with _hints():
         from ..query.inputs import table_reroute
 
+        if spread < 0 or spread != spread:
+            from .._validation import InputError
+
+            raise InputError(f"sensor temperature spread must be >= 0 degC, got {spread:g}")
         sen, fm, source = sensor_and_model(sensor, model, conductance=conductance, thickness=thickness,
                                            backing=backing)
         # the shipped tables are for the paper sensor and the semi-infinite model: another sensor or model is
-        # computed unless a table is named (a named table built for another one is refused, never used)
-        reroute = None if exact or table is not None else table_reroute(sen, fm)
-        route = "exact" if exact or reroute else "table"
+        # computed unless a table is named (a named table built for another one is refused, never used);
+        # varied initial conditions: no shipped table holds them, computed for the pair
+        reroute = None if exact or spread > 0 or table is not None else table_reroute(sen, fm)
+        route = "exact" if exact or spread > 0 or reroute else "table"
+        if spread > 0:
+            extra["sensor_temp_spread_c"] = spread
         if route == "table":
             if diffusivity is not None:
                 from ..query.inputs import NeedsInput
@@ -111,10 +125,10 @@ def _ask(question: str, *, exact: bool, table: Optional[str], ideal_table: str, 
                                  "diffusivity-unused")
             return query.ask(question, route="table", **objects, **scene, threshold=threshold,
                              table=table or "svm-paper", ideal_table=ideal_table,
-                             sensor=None if sensor == "paper" else sen, model=fm)
+                             sensor=None if sensor == "paper" else sen, model=fm, coverage=extra["coverage"])
         kw = dict(threshold=threshold, sensor=sen, model=fm, diffusivity_m2_s=diffusivity, width=width,
                   trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc, **extra)
-        if "coverage" not in extra:  # no progress reported by this question's exact route: a spinner
+        if question not in _STEPWISE:  # no step-by-step progress from this question's exact route: a spinner
             with _app.busy(f"{question}: simulating touches and fitting SVMs (exact route)", quiet=not progress):
                 return _noted(query.ask(question, route="exact", **objects, **scene, **kw), reroute, sen, fm,
                               source)
@@ -157,7 +171,8 @@ def _render(ans, json_: bool) -> None:
         emit_json(d)
     else:
         _render_text(d)
-    if d["route"] == "table" and d["value"] is None and d["question"] != "delta-e" and d["limiting_pair"]:
+    if d["route"] == "table" and d["value"] is None and d["limiting_pair"] and (
+            d["question"] != "delta-e" or not all(d["in_grid"].values())):
         raise typer.Exit(EXIT_NO_ANSWER)
 
 
@@ -187,10 +202,12 @@ def _model_words(d: dict) -> str:
 def _interval(d, unit):
     iv = d["interval"]
     if iv["low"] is None and iv["high"] is None:
-        return "(no interval: the table cannot support one here)" if d["route"] == "table" else ""
+        return "(no interval: see below)"
+    ends = f"{_fmt(iv['low'], unit)} to {_fmt(iv['high'], unit)}"
     if iv.get("coverage"):
-        return f"({iv['coverage']:.0%} confidence interval {_fmt(iv['low'], unit)} to {_fmt(iv['high'], unit)})"
-    return f"(interval {_fmt(iv['low'], unit)} to {_fmt(iv['high'], unit)}: the grid cell, coverage not stated)"
+        return f"({iv['coverage']:.0%} interval {ends})"
+    why = {"table-cell": "the grid cell, coverage not stated", "exact": "the search bracket, coverage not stated"}
+    return f"(interval {ends}: {why.get(iv.get('method'), 'coverage not stated')})"
 
 
 def _scalar(words: str, unit: str):
@@ -211,8 +228,9 @@ def _delta_lines(con, d):
     for words, side in (("towards lower e ", "lower"), ("towards higher e", "upper")):
         s = x[side]
         iv = s["interval"]
-        con.print(f"  {words}: SVM [bold green]{_fmt(s['value'], '', 4)}[/] (interval {_fmt(iv[0], '', 4)} to "
-                  f"{_fmt(iv[1], '', 4)}), ideal {_fmt(s['ideal'], '', 4)}")
+        cov = f"{s['coverage']:.0%} interval" if s.get("coverage") else "interval, coverage not stated"
+        ivs = f"({cov} {_fmt(iv[0], '', 4)} to {_fmt(iv[1], '', 4)})" if s["value"] is not None else ""
+        con.print(f"  {words}: SVM [bold green]{_fmt(s['value'], '', 4)}[/] {ivs}, ideal {_fmt(s['ideal'], '', 4)}")
     con.print("  [dim]— : no distinguishable effusivity in that direction within the range examined[/]")
 
 
@@ -222,7 +240,9 @@ def _distinguishable_lines(con, d):
         con.print("  [yellow]no answer[/]")
         return
     yes = "[bold green]yes[/]" if x["distinguishable"] else "[bold red]no[/]"
-    f1 = f", F1 {x['svm_f1']:.3f} ± {x['svm_standard_error']:.3f}" if x["svm_f1"] is not None else ""
+    iv = d["interval"]
+    f1 = (f", F1 {x['svm_f1']:.3f} ({iv['coverage']:.0%} interval {iv['low']:.3f} to {iv['high']:.3f}; "
+          f"{x['verdict']})" if x["svm_f1"] is not None else "")
     con.print(f"  SVM (the paper's classifier): {yes}{f1}")
     con.print(f"  ideal observer: F1 {x['ideal_f1']:.3f} ({d['ideal']['method']})"
               + (" (distinguishable)" if x["ideal_distinguishable"] else " (not even in principle)"))
@@ -239,14 +259,18 @@ _VALUE_LINES = {
 
 def _source_lines(con, d):
     if d["route"] == "table":
-        bad = [k for k, ok in d["in_grid"].items() if not ok]
+        words = {"noise_ratio": "sigma/dT", "contact_s": "contact time", "noise_c": "noise",
+                 "delta_t_c": "temperature difference"}
+        bad = [words.get(k, k) for k, ok in d["in_grid"].items() if not ok]
         where = "inside its grid" if not bad else "OUTSIDE its grid along " + ", ".join(bad)
         con.print(f"  [dim]from table {d['table']['name']} ({where}), interpolated; --exact computes it for this "
                   f"pair[/]")
     else:
         c = d["computation"]
-        con.print(f"  [dim]computed for this pair ({c['repeats']} seeds x {c['trials']} trials per class, "
-                  f"{c['wall_s']:.1f} s)[/]")
+        varied = (f", sensor temperature varied per touch by ±{c['sensor_temp_spread_c']:g} °C"
+                  if c.get("sensor_temp_spread_c") else "")
+        con.print(f"  [dim]computed for this pair ({c['repeats']} seeds x {c['trials']} trials per class"
+                  f"{varied}, {c['wall_s']:.1f} s)[/]")
     for n in d["notes"]:
         con.print(f"  [yellow]{n}[/]")
     chk = d["model_check"]
@@ -265,7 +289,8 @@ def min_contact_cmd(
     backing: BackingOpt = None, diffusivity: Diffusivity = None,
     exact: Exact = False, table: TableOpt = None, ideal_table: IdealTableOpt = "ideal-paper",
     trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
-    n_mc: NmcQ = 1000, max_contact: MaxContact = 10.0, coverage: CoverageOpt = 0.9, json_: Json = False,
+    n_mc: NmcQ = 1000, max_contact: MaxContact = 10.0, coverage: CoverageOpt = 0.9,
+    sensor_temp_spread: SpreadOpt = 0.0, json_: Json = False,
 ) -> None:
     """Shortest contact time that separates two materials.
 
@@ -275,7 +300,8 @@ def min_contact_cmd(
                model=model, conductance=conductance, thickness=thickness, backing=backing, diffusivity=diffusivity,
                width=width, trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc,
                objects=dict(e1=e1, e2=e2, m1=m1, m2=m2), scene=dict(noise_c=noise, delta_t_c=delta_t),
-               exact_extra=dict(max_contact_s=max_contact, coverage=coverage), progress=not json_)
+               exact_extra=dict(max_contact_s=max_contact), coverage=coverage, progress=not json_,
+               spread=sensor_temp_spread)
     _render(ans, json_)
 
 
@@ -287,7 +313,7 @@ def max_noise_cmd(
     backing: BackingOpt = None, diffusivity: Diffusivity = None,
     exact: Exact = False, table: TableOpt = None, ideal_table: IdealTableOpt = "ideal-paper",
     trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
-    n_mc: NmcQ = 1000, json_: Json = False,
+    n_mc: NmcQ = 1000, coverage: CoverageOpt = 0.9, sensor_temp_spread: SpreadOpt = 0.0, json_: Json = False,
 ) -> None:
     """Largest sensor noise at which a contact time still separates two materials.
 
@@ -296,8 +322,9 @@ def max_noise_cmd(
     ans = _ask("max-noise", exact=exact, table=table, ideal_table=ideal_table, threshold=threshold, sensor=sensor,
                model=model, conductance=conductance, thickness=thickness, backing=backing, diffusivity=diffusivity,
                width=width, trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc,
-               objects=dict(e1=e1, e2=e2, m1=m1, m2=m2), scene=dict(contact_s=contact, delta_t_c=delta_t),
-               progress=not json_)
+               objects=dict(e1=e1, e2=e2, m1=m1, m2=m2),
+               scene=dict(contact_s=contact, delta_t_c=delta_t), coverage=coverage, progress=not json_,
+               spread=sensor_temp_spread)
     _render(ans, json_)
 
 
@@ -309,7 +336,7 @@ def min_delta_t_cmd(
     backing: BackingOpt = None, diffusivity: Diffusivity = None,
     exact: Exact = False, table: TableOpt = None, ideal_table: IdealTableOpt = "ideal-paper",
     trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
-    n_mc: NmcQ = 1000, json_: Json = False,
+    n_mc: NmcQ = 1000, coverage: CoverageOpt = 0.9, sensor_temp_spread: SpreadOpt = 0.0, json_: Json = False,
 ) -> None:
     """Smallest sensor-object temperature difference that separates two materials.
 
@@ -318,8 +345,9 @@ def min_delta_t_cmd(
     ans = _ask("min-delta-t", exact=exact, table=table, ideal_table=ideal_table, threshold=threshold, sensor=sensor,
                model=model, conductance=conductance, thickness=thickness, backing=backing, diffusivity=diffusivity,
                width=width, trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc,
-               objects=dict(e1=e1, e2=e2, m1=m1, m2=m2), scene=dict(contact_s=contact, noise_c=noise),
-               progress=not json_)
+               objects=dict(e1=e1, e2=e2, m1=m1, m2=m2),
+               scene=dict(contact_s=contact, noise_c=noise), coverage=coverage, progress=not json_,
+               spread=sensor_temp_spread)
     _render(ans, json_)
 
 
@@ -333,7 +361,7 @@ def delta_e_cmd(
     backing: BackingOpt = None, diffusivity: Diffusivity = None,
     exact: Exact = False, table: TableOpt = None, ideal_table: IdealTableOpt = "ideal-paper",
     trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
-    n_mc: NmcQ = 1000,
+    n_mc: NmcQ = 1000, coverage: CoverageOpt = 0.9, sensor_temp_spread: SpreadOpt = 0.0,
     format_: Annotated[Optional[str], typer.Option(
         "--format", "-f", help="Print the two directions as rows: table, json, csv or md (default: the answer "
                                "for people; --json: the whole answer).")] = None,
@@ -348,7 +376,7 @@ def delta_e_cmd(
                model=model, conductance=conductance, thickness=thickness, backing=backing, diffusivity=diffusivity,
                width=width, trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc,
                objects=dict(e=e, m=m), scene=dict(contact_s=contact, noise_c=noise, delta_t_c=delta_t),
-               progress=not json_)
+               coverage=coverage, progress=not json_, spread=sensor_temp_spread)
     if fmt is not None:
         d = ans.to_dict()
         rows = [{"direction": side, "e": d["details"]["e"], "delta": d["details"][side]["value"],
@@ -372,7 +400,7 @@ def distinguishable_cmd(
     backing: BackingOpt = None, diffusivity: Diffusivity = None,
     exact: Exact = False, table: TableOpt = None, ideal_table: IdealTableOpt = "ideal-paper",
     trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
-    n_mc: NmcQ = 1000, json_: Json = False,
+    n_mc: NmcQ = 1000, coverage: CoverageOpt = 0.9, sensor_temp_spread: SpreadOpt = 0.0, json_: Json = False,
 ) -> None:
     """Whether a scene separates two materials, with the SVM's and the ideal observer's F1.
 
@@ -382,5 +410,6 @@ def distinguishable_cmd(
                sensor=sensor, model=model, conductance=conductance, thickness=thickness, backing=backing,
                diffusivity=diffusivity, width=width, trials=trials, repeats=repeats, seed=seed, jobs=jobs,
                n_mc=n_mc, objects=dict(e1=e1, e2=e2, m1=m1, m2=m2),
-               scene=dict(contact_s=contact, noise_c=noise, delta_t_c=delta_t), progress=not json_)
+               scene=dict(contact_s=contact, noise_c=noise, delta_t_c=delta_t), coverage=coverage,
+               progress=not json_, spread=sensor_temp_spread)
     _render(ans, json_)

@@ -36,20 +36,27 @@ QUANTITIES: dict[str, tuple[str, str]] = {
     "distinguishable": ("distinguishable", ""),
 }
 
-#: What ``interval`` means, per route.
+#: What ``interval`` means, per kind (``interval.method`` in the ``--json`` schema).
 INTERVAL_MEANING = {
     "table": "the answer at the two ends of the table's Monte Carlo interval of delta(e) "
-             "(optimistic, conservative); equal ends for an ideal-observer table",
-    "exact": "the evaluated values whose mean SVM F1 is clearly (z standard errors) on either side of "
-             "the threshold: the answer lies between them",
+             "(optimistic, conservative); equal ends for an ideal-observer table (coverage not stated)",
+    "exact": "the search bracket the crossing lies in: too few informative evaluations for a fit "
+             "(coverage not stated)",
     "exact-estimate": "confidence interval, at the stated coverage, of where the mean SVM F1 (infinitely many "
                       "seeds) crosses the threshold: a logistic fit of F1 against log(quantity) near the crossing "
-                      "(delta method); never below the ideal-observer bound",
-    "table-cell": "the grid cell the crossing lies in: from the last tabulated value where the pair is not "
-                  "separable (or the ideal bound, if larger) to the first where it is; the table's Monte Carlo "
-                  "error of delta(e) is not included (coverage not stated)",
-    "distinguishable": "the SVM F1 plus and minus z standard errors (exact route), or the verdict at the "
-                       "ends of the table's Monte Carlo interval (table route, 1 = yes)",
+                      "(delta method); never beyond the ideal-observer bound",
+    "exact-f1": "confidence interval, at the stated coverage, of the mean SVM F1 of the pair (normal, the "
+                "larger of the fold-level and seed-to-seed standard errors)",
+    "table-estimate": "interval at the stated coverage from the table: its Monte Carlo interval of delta(e) "
+                      "(rescaled from the table's z to the coverage) combined with the interpolation error "
+                      "between grid points (the difference between linear and log-log interpolation); "
+                      "never beyond the ideal-observer bound",
+    "table-cell": "the grid cell the crossing lies in, from the last tabulated value where the pair is not "
+                  "separable to the first where it is: the grid cannot support an interval of stated "
+                  "coverage here (a neighbour is beyond the grid)",
+    "none": "no interval: see the answer's notes for why",
+    "distinguishable": "the verdict at the ends of the table's Monte Carlo interval (1 = yes; coverage not "
+                       "stated)",
 }
 
 #: The keys of every answer's dictionary (the ``--json`` schema), whatever the question and route.
@@ -108,7 +115,8 @@ class Answer:
         The SVM's answer in :data:`QUANTITIES` ``[question]`` (None: no answer,
         see ``notes``); a bool for ``distinguishable``.
     interval : (low, high)
-        Monte Carlo interval of ``value`` (see :data:`INTERVAL_MEANING`).
+        Interval of ``value`` (see :data:`INTERVAL_MEANING`); its coverage is
+        ``interval_coverage`` where stated.
     ideal_bound : IdealBound
         The ideal observer's answer.
     objects : tuple of dict
@@ -188,6 +196,8 @@ class Answer:
     def to_dict(self) -> dict[str, Any]:
         """The ``--json`` schema: :data:`ANSWER_KEYS`, JSON-ready (no NaN, no infinities)."""
         kind = self.interval_kind or ("distinguishable" if self.question == "distinguishable" else self.route)
+        if self.interval[0] is None and self.interval[1] is None and self.interval_kind is None:
+            kind = "none"
         meaning = INTERVAL_MEANING[kind]
         value = self.value if isinstance(self.value, bool) else number(self.value)
         return {
@@ -196,8 +206,8 @@ class Answer:
             "quantity": self.quantity,
             "unit": self.unit,
             "value": value,
-            "interval": {"low": number(self.interval[0]), "high": number(self.interval[1]), "meaning": meaning,
-                         "coverage": self.interval_coverage},
+            "interval": {"low": number(self.interval[0]), "high": number(self.interval[1]),
+                         "coverage": self.interval_coverage, "method": kind, "meaning": meaning},
             "ideal": self.ideal_bound.to_dict(),
             "objects": [dict(o) for o in self.objects],
             "limiting_pair": [dict(o) for o in self.limiting_pair],

@@ -1,9 +1,11 @@
 """The exact route: a design question computed for one pair and scene, under any forward model.
 
 The SVM's answer comes from simulated touches (:func:`designkit.recognition.svm.pair_f1`,
-``repeats`` seeds per evaluation, the model through the seam) and a bisection
-on the asked quantity; its interval collects the evaluations whose mean F1 is
-clearly (``z`` standard errors) on either side of the threshold.
+``repeats`` seeds per evaluation, the model through the seam). min-contact,
+max-noise, min-delta-t and each direction of delta-e are estimates of where the
+noisy monotone mean F1 crosses the threshold, with a confidence interval at the
+asked ``coverage`` (:mod:`designkit.query.crossing`); distinguishable states the
+mean F1 with its ``coverage`` interval.
 
 The ideal observer's bound: for a shared-shape model (the paper's) the
 vectorized closed-form answers of :mod:`designkit.query.ideal_bound`; for
@@ -48,14 +50,18 @@ from .inputs import (
 
 __all__ = [
     "RATIO_BRACKET",
+    "SOLVERS",
     "bisect",
     "exact_delta_e",
     "exact_distinguishable",
     "exact_max_noise",
     "exact_min_contact",
     "exact_min_delta_t",
-    "ratio_search",
 ]
+
+#: SVM solvers of the exact route: scikit-learn one seed at a time (the reference), or every seed's
+#: cross-validation at once (:mod:`designkit.recognition.batched_svm`, ~3x faster, same classifier).
+SOLVERS = ("sklearn", "batched")
 
 #: sigma/dT searched by max-noise and min-delta-t: 10 uK per K up to noise as large as the contrast.
 RATIO_BRACKET = (1e-5, 1.0)
@@ -79,35 +85,6 @@ def bisect(f_ok: Callable[[float], bool], lo: float, hi: float, tol: float, *, l
     return hi
 
 
-def ratio_search(svm_f1, phi: float, lo_r: float, hi_r: float, z: float):
-    """Largest sigma/dT at which the mean SVM F1 still reaches ``phi``, by bisection in log sigma/dT.
-
-    ``svm_f1(ratio)`` returns ``(mean F1, standard error)``. The Monte Carlo interval
-    runs from the largest evaluated ratio clearly separable (mean - z SE >= phi) to the
-    smallest clearly not (mean + z SE < phi); None where no evaluation is clear.
-
-    Returns ``(ratio or None, (lo, hi), evaluations)``; ``hi_r`` itself when even it
-    separates, None when not even ``lo_r`` does.
-    """
-    evaluated: dict[float, tuple[float, float]] = {}
-
-    def ok(r):  # still separable at this noise ratio
-        evaluated[r] = svm_f1(r)
-        return evaluated[r][0] >= phi
-
-    if not ok(lo_r):
-        r = None
-    elif ok(hi_r):
-        r = hi_r
-    else:  # largest ratio that is ok == bisection on "not ok" from above
-        r = bisect(lambda x: not ok(x), lo_r, hi_r, 0.02, log=True)
-    ok_conf = [x for x, (m, s) in evaluated.items() if m - z * s >= phi]
-    bad_conf = [x for x, (m, s) in evaluated.items() if m + z * s < phi]
-    interval = (max(ok_conf) if ok_conf else None, min(bad_conf) if bad_conf else None)
-    evaluations = [{"noise_ratio": x, "svm_f1": m, "standard_error": s} for x, (m, s) in sorted(evaluated.items())]
-    return r, interval, evaluations
-
-
 # ============================================================ one question's computation
 @dataclass
 class _Run:
@@ -124,11 +101,14 @@ class _Run:
     z: float
     jobs: int
     n_mc: int
+    solver: str = "sklearn"
+    spread: float = 0.0
     t0: float = field(default_factory=time.perf_counter)
     ideal_calls: list = field(default_factory=list)
 
     @classmethod
-    def make(cls, *, sensor, model, threshold, width, trials, folds, seed, repeats, z, jobs, n_mc) -> "_Run":
+    def make(cls, *, sensor, model, threshold, width, trials, folds, seed, repeats, z, jobs, n_mc,
+             solver="sklearn", sensor_temp_spread_c=0.0) -> "_Run":
         from ..models import get_model
         from ..sensor import load_sensor
 
@@ -140,12 +120,16 @@ class _Run:
             raise InputError(f"repeats must be >= 1, got {repeats}")
         if int(n_mc) < 10:
             raise InputError(f"the Monte Carlo ideal observer needs at least 10 touches per class, got {n_mc}")
+        if solver not in SOLVERS:
+            raise InputError(f"unknown solver {solver!r}; known: {', '.join(SOLVERS)}")
+        from .._validation import check_nonnegative
         from ..models import sensor_model
 
+        spread = check_nonnegative("sensor temperature spread [degC]", sensor_temp_spread_c)
         sen = load_sensor(sensor if sensor is not None else "paper")
         return cls(sen, sensor_model(sen) if model is None else get_model(model),  # a sensor file's own model
                    check_threshold(threshold), check_positive("class width", width), int(trials), int(folds),
-                   int(seed), int(repeats), check_positive("z", z), int(jobs), int(n_mc))
+                   int(seed), int(repeats), check_positive("z", z), int(jobs), int(n_mc), solver, spread)
 
     # ---------------------------------------------------------------- the SVM
     def svm(self, classes, scene) -> tuple[float, float]:
@@ -155,6 +139,8 @@ class _Run:
         from ..recognition.svm import pair_f1
 
         a, b = classes
+        if self.solver == "batched":
+            return self._svm_batched(a, b, scene)
         jobs = self.jobs if self.repeats > 1 else 1
         results = Parallel(n_jobs=jobs, prefer="processes" if jobs != 1 else None)(
             delayed(pair_f1)(a, b, self.sensor, scene, model=self.model, trials=self.trials, folds=self.folds,
@@ -164,10 +150,46 @@ class _Run:
         se_rep = float(np.std(f1, ddof=1)) if f1.size > 1 else 0.0
         return float(f1.mean()), max(se_fold, se_rep) / math.sqrt(f1.size)
 
+    def _svm_batched(self, a, b, scene) -> tuple[float, float]:
+        """:meth:`svm` with every seed's cross-validation solved at once (same touches, folds and
+        classifier as :func:`~designkit.recognition.svm.pair_f1`; predictions can differ only at
+        near-ties, :mod:`designkit.recognition.batched_svm`)."""
+        from ..objects import ordered_pair
+        from ..recognition.batched_svm import batched_cv_f1
+        from ..recognition.features import feature_matrix
+        from ..simulation import simulate_class
+
+        low, high = ordered_pair(a, b)
+        fs = self.sensor.sample_rate_hz
+        lo, hi, seeds = [], [], []
+        for r in range(self.repeats):
+            base = [self.seed, r]
+            lo.append(feature_matrix(simulate_class(low, self.trials, self.sensor, scene, base + [0],
+                                                    self.model).temperature_c, fs))
+            hi.append(feature_matrix(simulate_class(high, self.trials, self.sensor, scene, base + [1],
+                                                    self.model).temperature_c, fs))
+            seeds.append(base + [2])
+        res = batched_cv_f1(lo, hi, seeds=seeds, folds=self.folds)
+        f1 = np.asarray(res.f1, dtype=np.float64)
+        se_fold = math.sqrt(float(np.mean(np.asarray(res.standard_error) ** 2)))
+        se_rep = float(np.std(f1, ddof=1)) if f1.size > 1 else 0.0
+        return float(f1.mean()), max(se_fold, se_rep) / math.sqrt(f1.size)
+
     # ---------------------------------------------------------------- the ideal observer
+    def scene(self, contact_s: float, noise_c: float, delta_t_c: float):
+        """The scene of one evaluation: Ts0 = Ta + dT (Ta 25 degC), drawn per touch uniformly within
+        +-``spread`` degC of it when the question has a sensor temperature spread (varied initial conditions)."""
+        from ..scene import Scene
+
+        if self.spread == 0:
+            return Scene.from_delta_t(contact_s=contact_s, noise_c=noise_c, delta_t_c=delta_t_c)
+        return Scene(contact_s=contact_s, noise_c=noise_c, sensor_temp_c=25.0 + delta_t_c, ambient_temp_c=25.0,
+                     sensor_temp_spread_c=self.spread)
+
     def closed_form(self, *classes: ObjectClass) -> bool:
-        """Whether the vectorized closed form answers (shared shape, every class ``width`` wide)."""
-        return self.model.shared_shape and all(
+        """Whether the vectorized closed form answers (shared shape, fixed initial conditions, every class
+        ``width`` wide); varied initial conditions take the Monte Carlo ideal observer."""
+        return self.spread == 0 and self.model.shared_shape and all(
             math.isclose(c.e_range[1] - c.e_range[0], self.width, rel_tol=1e-9) for c in classes)
 
     def ideal_f1(self, classes, scene) -> float:
@@ -196,7 +218,8 @@ class _Run:
             check = self.model.check(tuple(check_classes), self.sensor, contact_s=c, noise_c=n,
                                      delta_t_c=d).to_dict()
         comp = {"fidelity": "svm", "trials": self.trials, "folds": self.folds, "repeats": self.repeats,
-                "seed": self.seed, "z": self.z, "n_mc": self.n_mc, "width": self.width, **computation,
+                "seed": self.seed, "z": self.z, "n_mc": self.n_mc, "width": self.width,
+                "sensor_temp_spread_c": self.spread, "solver": self.solver, **computation,
                 "ideal_evaluations": list(self.ideal_calls), "wall_s": time.perf_counter() - self.t0}
         return Answer(
             question=question, route="exact", value=value, interval=tuple(interval),
@@ -215,7 +238,15 @@ def _scene(contact_s=None, noise_c=None, delta_t_c=None) -> dict[str, Any]:
 
 def _make(kw: dict) -> _Run:
     return _Run.make(**{k: kw[k] for k in ("sensor", "model", "threshold", "width", "trials", "folds", "seed",
-                                           "repeats", "z", "jobs", "n_mc")})
+                                           "repeats", "z", "jobs", "n_mc")}, solver=kw.get("solver", "sklearn"),
+                     sensor_temp_spread_c=kw.get("sensor_temp_spread_c", 0.0))
+
+
+def _check_spread(spread: float, dt: float) -> None:
+    """A sensor temperature spread must leave dT on one side of zero in every touch."""
+    if spread and spread >= abs(dt):
+        raise InputError(f"a sensor temperature spread of {spread:g} degC around dT {dt:g} degC makes the "
+                         "sensor-object temperature difference cross zero; give a spread below |dT|")
 
 
 def _no_pair(question, run: _Run, pq, scene, details) -> Answer:
@@ -230,7 +261,8 @@ def exact_min_contact(e1=None, e2=None, *, m1=None, m2=None, objects=None, noise
                       diffusivity_m2_s=None, width: float = DEFAULT_CLASS_WIDTH, trials: int = 100, folds: int = 3,
                       seed: int = 0, repeats: int = 4, z: float = 2.0, jobs: int = -1, n_mc: int = 1000,
                       max_contact_s: float = 10.0, tolerance_s: float = 0.05, coverage: float = 0.9,
-                      progress=None) -> Answer:
+                      progress=None, solver: str = "sklearn",
+                      sensor_temp_spread_c: float = 0.0) -> Answer:
     """Shortest contact time [s] computed for this pair: an estimate of where the SVM's mean F1 crosses Phi.
 
     The crossing of the noisy monotone F1 curve is estimated by a logistic fit in
@@ -265,8 +297,14 @@ def exact_min_contact(e1=None, e2=None, *, m1=None, m2=None, objects=None, noise
         Nominal coverage of the interval, in (0, 1).
     progress : callable, optional
         ``progress(done, total, message)`` after each SVM evaluation.
+    solver : {"sklearn", "batched"}
+        :data:`SOLVERS`: scikit-learn seed by seed, or all seeds at once (faster, same classifier).
+    sensor_temp_spread_c : float
+        Varied initial conditions: each touch's sensor temperature is drawn uniformly within
+        +-this [degC] of Ta + dT (the paper's robot: dT 7.5, spread 2.5, i.e. Ts0 in 30-35 degC
+        with Ta 25 degC); 0 is fixed. Must stay below |dT|. The ideal bound is then Monte Carlo
+        (``n_mc`` touches per class) with its standard error under ``computation``.
     """
-    from ..scene import Scene
 
     kw = dict(locals())
     noise, dt = scene_inputs(noise_c, delta_t_c)
@@ -279,8 +317,10 @@ def exact_min_contact(e1=None, e2=None, *, m1=None, m2=None, objects=None, noise
         return _no_pair("min-contact", run, pq, scene_d, {})
     cls = pq.classes
 
+    _check_spread(run.spread, dt)
+
     def scene(c):
-        return Scene.from_delta_t(contact_s=c, noise_c=noise, delta_t_c=dt)
+        return run.scene(c, noise, dt)
 
     from .crossing import check_coverage, estimate_crossing
 
@@ -311,12 +351,15 @@ def exact_min_contact(e1=None, e2=None, *, m1=None, m2=None, objects=None, noise
                       ideal_method=run.ideal_method(closed), objects=pq.objects_dicts(),
                       limiting=pq.limiting_dicts(), rule=pq.rule, scene=scene_d, details={}, check_classes=cls,
                       check_at=(needed, noise, dt), notes=[note], evaluations=evaluations, max_contact_s=tmax,
-                      estimate_method=est.method, interval_coverage=cov, interval_kind="exact-estimate")
+                      estimate_method=est.method,
+                      interval_coverage=cov if est.method == "wls-logit-log" else None,
+                      interval_kind="exact-estimate" if est.method == "wls-logit-log" else "exact")
 
 
 # ============================================================ max-noise / min-delta-t
 def _exact_ratio(question: str, kw: dict) -> Answer:
     from ..scene import Scene
+    from .crossing import check_coverage, estimate_crossing
 
     contact = check_contact(kw["contact_s"])
     if question == "max-noise":
@@ -327,6 +370,7 @@ def _exact_ratio(question: str, kw: dict) -> Answer:
         if noise == 0:
             raise InputError("noise sigma is 0: any temperature difference separates them (no smallest one)")
         scene_d = _scene(contact, noise, None)
+    cov = check_coverage(kw["coverage"])
     run = _make(kw)
     pq = pair_question(kw["e1"], kw["e2"], kw["m1"], kw["m2"], objects=kw["objects"], width=run.width,
                        diffusivity_m2_s=kw["diffusivity_m2_s"], model=run.model)
@@ -334,11 +378,20 @@ def _exact_ratio(question: str, kw: dict) -> Answer:
         return _no_pair(question, run, pq, scene_d, {})
     cls = pq.classes
     lo_r, hi_r = RATIO_BRACKET
+    if run.spread == 0:
+        def scene(r):  # readings depend on sigma and dT only through r
+            return Scene.from_delta_t(contact_s=contact, noise_c=r, delta_t_c=1.0)
+    elif question == "max-noise":  # varied Ts0: the ratio invariance is gone, sigma moves at the asked dT
+        _check_spread(run.spread, dt)
 
-    def scene(r):  # readings depend on sigma and dT only through r
-        return Scene.from_delta_t(contact_s=contact, noise_c=r, delta_t_c=1.0)
+        def scene(r):
+            return run.scene(contact, r * abs(dt), dt)
+    else:  # min-delta-t with varied Ts0: dT = sigma / r, which must stay above the spread
+        hi_r = min(hi_r, noise / run.spread * (1 - 1e-9))
 
-    r, (r_lo, r_hi), evaluations = ratio_search(lambda x: run.svm(cls, scene(x)), run.phi, lo_r, hi_r, run.z)
+        def scene(r):
+            return run.scene(contact, noise, noise / r)
+
     closed = run.closed_form(*cls)
     if closed:
         from .ideal_bound import exact_ideal_max_ratio
@@ -350,12 +403,22 @@ def _exact_ratio(question: str, kw: dict) -> Answer:
         if run.ideal_f1(cls, scene(lo_r)) >= run.phi:
             ideal_r = hi_r if run.ideal_f1(cls, scene(hi_r)) >= run.phi else \
                 bisect(lambda x: run.ideal_f1(cls, scene(x)) < run.phi, lo_r, hi_r, 2e-3, log=True)
+    # no classifier tolerates more noise than the ideal observer: search below its ratio. The mean SVM F1
+    # falls with sigma/dT; one crossing in log(sigma/dT) answers both max-noise and min-delta-t
+    top = hi_r if ideal_r is None else min(hi_r, ideal_r)
+    est = estimate_crossing(lambda x: run.svm(cls, scene(x)), lo_r, max(top, lo_r * 1.0001), run.phi,
+                            increasing=False, coverage=cov, progress=kw.get("progress"))
+    r, r_lo, r_hi = est.value, est.low, est.high
+    if ideal_r is not None:
+        r, r_hi = (None if r is None else min(r, ideal_r)), (None if r_hi is None else min(r_hi, ideal_r))
     if question == "max-noise":
         conv = lambda x: None if x is None else x * abs(dt)  # noqa: E731
         interval = (conv(r_lo), conv(r_hi))
     else:
         conv = lambda x: None if x is None else noise / x  # noqa: E731
         interval = (conv(r_hi), conv(r_lo))
+    evaluations = [{"noise_ratio": e["x"], "svm_f1": e["svm_f1"], "standard_error": e["standard_error"]}
+                   for e in est.evaluations]
     # the model check at the answer: the smaller sigma/dT of the SVM's and the ideal observer's is the stricter
     r_check = min([x for x in (r, ideal_r) if x is not None], default=lo_r)
     check_at = (contact, r_check * abs(dt), dt) if question == "max-noise" else (contact, noise, noise / r_check)
@@ -363,16 +426,26 @@ def _exact_ratio(question: str, kw: dict) -> Answer:
     return run.answer(question, value=conv(r), interval=interval, ideal=conv(ideal_r),
                       ideal_method=run.ideal_method(closed), objects=pq.objects_dicts(),
                       limiting=pq.limiting_dicts(), rule=pq.rule, scene=scene_d, details={}, check_classes=cls,
-                      check_at=check_at, notes=[note], evaluations=evaluations)
+                      check_at=check_at, notes=[note], evaluations=evaluations, estimate_method=est.method,
+                      noise_ratio_estimate={"value": r, "low": r_lo, "high": r_hi},
+                      interval_coverage=cov if est.method == "wls-logit-log" else None,
+                      interval_kind="exact-estimate" if est.method == "wls-logit-log" else "exact")
 
 
 def exact_max_noise(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact_s: float, delta_t_c: float = 10.0,
                     threshold: float = 0.9, sensor=None, model=None, diffusivity_m2_s=None,
                     width: float = DEFAULT_CLASS_WIDTH, trials: int = 100, folds: int = 3, seed: int = 0,
-                    repeats: int = 4, z: float = 2.0, jobs: int = -1, n_mc: int = 1000) -> Answer:
-    """Largest noise sigma [degC] that still separates the pair (bisection in log sigma/dT).
+                    repeats: int = 4, z: float = 2.0, jobs: int = -1, n_mc: int = 1000, coverage: float = 0.9,
+                    progress=None, solver: str = "sklearn",
+                      sensor_temp_spread_c: float = 0.0) -> Answer:
+    """Largest noise sigma [degC] that still separates the pair: an estimate with a ``coverage`` interval.
 
-    Arguments as :func:`exact_min_contact`; ``contact_s`` [s] is the contact time.
+    The mean SVM F1 depends on sigma and dT only through sigma/dT (fixed initial
+    conditions, standardized features, a model linear in the temperatures), so the
+    answer is where the F1 against log(sigma/dT) crosses Phi
+    (:func:`designkit.query.crossing.estimate_crossing`, searched below the exact
+    ideal-observer ratio), times |dT|. Arguments as :func:`exact_min_contact`;
+    ``contact_s`` [s] is the contact time.
     """
     return _exact_ratio("max-noise", dict(locals(), noise_c=None))
 
@@ -380,10 +453,14 @@ def exact_max_noise(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact
 def exact_min_delta_t(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact_s: float, noise_c: float = 0.05,
                       threshold: float = 0.9, sensor=None, model=None, diffusivity_m2_s=None,
                       width: float = DEFAULT_CLASS_WIDTH, trials: int = 100, folds: int = 3, seed: int = 0,
-                      repeats: int = 4, z: float = 2.0, jobs: int = -1, n_mc: int = 1000) -> Answer:
-    """Smallest sensor-object temperature difference [degC] that separates the pair.
+                      repeats: int = 4, z: float = 2.0, jobs: int = -1, n_mc: int = 1000, coverage: float = 0.9,
+                      progress=None, solver: str = "sklearn",
+                      sensor_temp_spread_c: float = 0.0) -> Answer:
+    """Smallest sensor-object temperature difference [degC] that separates the pair (estimate, interval).
 
-    Arguments as :func:`exact_min_contact`; ``contact_s`` [s] is the contact time.
+    sigma divided by the crossing of :func:`exact_max_noise` (the same estimate
+    in log(sigma/dT)). Arguments as :func:`exact_min_contact`; ``contact_s`` [s] is
+    the contact time.
     """
     return _exact_ratio("min-delta-t", dict(locals(), delta_t_c=None))
 
@@ -393,16 +470,21 @@ def exact_distinguishable(e1=None, e2=None, *, m1=None, m2=None, objects=None, c
                           noise_c: float = 0.05, delta_t_c: float = 10.0, threshold: float = 0.9, sensor=None,
                           model=None, diffusivity_m2_s=None, width: float = DEFAULT_CLASS_WIDTH, trials: int = 100,
                           folds: int = 3, seed: int = 0, repeats: int = 4, z: float = 2.0, jobs: int = -1,
-                          n_mc: int = 1000) -> Answer:
+                          n_mc: int = 1000, coverage: float = 0.9, progress=None,
+                          solver: str = "sklearn",
+                      sensor_temp_spread_c: float = 0.0) -> Answer:
     """SVM F1 (mean of ``repeats`` seeds) and ideal F1 of the pair's classes at this scene.
 
-    ``value``: whether the mean SVM F1 reaches the threshold; ``details``: the
-    F1s, the SVM's standard error and whether the verdict is confident (the
-    mean at least ``z`` standard errors from the threshold).
+    ``value``: whether the mean SVM F1 reaches the threshold; ``interval``: the
+    ``coverage`` confidence interval of the mean SVM F1 (normal, the larger of the
+    fold-level and seed-to-seed standard errors); ``details``: the F1s, the SVM's
+    standard error and whether the verdict is confident (the threshold outside
+    that interval).
     """
-    from ..scene import Scene
+    from .crossing import check_coverage, z_of_coverage
 
     kw = dict(locals())
+    zc = z_of_coverage(check_coverage(coverage))
     noise, dt = scene_inputs(noise_c, delta_t_c)
     contact = check_contact(contact_s)
     run = _make(kw)
@@ -414,17 +496,22 @@ def exact_distinguishable(e1=None, e2=None, *, m1=None, m2=None, objects=None, c
                         {"distinguishable": None, "svm_f1": None, "svm_standard_error": None, "verdict": None,
                          "ideal_f1": None, "ideal_distinguishable": None})
     cls = pq.classes
-    scene = Scene.from_delta_t(contact_s=contact, noise_c=noise, delta_t_c=dt)
+    _check_spread(run.spread, dt)
+    scene = run.scene(contact, noise, dt)
     f1, se = run.svm(cls, scene)
+    if progress is not None:
+        progress(1, 1, f"F1 {f1:.3f}")
     ideal = run.ideal_f1(cls, scene)
     yes = f1 >= run.phi
+    low, high = max(0.0, f1 - zc * se), min(1.0, f1 + zc * se)
     details = {"distinguishable": yes, "svm_f1": f1, "svm_standard_error": se,
-               "verdict": "confident" if abs(f1 - run.phi) >= run.z * se else "uncertain",
+               "verdict": "confident" if not low <= run.phi <= high else "uncertain",
                "ideal_f1": ideal, "ideal_distinguishable": ideal >= run.phi}
-    return run.answer("distinguishable", value=yes, interval=(f1 - run.z * se, f1 + run.z * se), ideal=ideal,
+    return run.answer("distinguishable", value=yes, interval=(low, high), ideal=ideal,
                       ideal_method=run.ideal_method(False), objects=pq.objects_dicts(),
                       limiting=pq.limiting_dicts(), rule=pq.rule, scene=scene_d, details=details,
-                      check_classes=cls, check_at=(contact, noise, dt))
+                      check_classes=cls, check_at=(contact, noise, dt), interval_coverage=kw["coverage"],
+                      interval_kind="exact-f1")
 
 
 # ============================================================ delta-e
@@ -432,8 +519,16 @@ def exact_delta_e(e: float | None = None, *, m: str | None = None, contact_s: fl
                   delta_t_c: float = 10.0, threshold: float = 0.9, sensor=None, model=None, diffusivity_m2_s=None,
                   width: float = DEFAULT_CLASS_WIDTH, trials: int = 100, folds: int = 3, seed: int = 0,
                   repeats: int = 4, z: float = 2.0, jobs: int = -1, n_mc: int = 1000,
-                  e_max: float = 40000.0) -> Answer:
-    """delta(e) computed for this reference: bisection on the partner's distance, both directions.
+                  e_max: float = 40000.0, coverage: float = 0.9, progress=None,
+                  solver: str = "sklearn",
+                      sensor_temp_spread_c: float = 0.0) -> Answer:
+    """delta(e) computed for this reference, both directions: estimates with ``coverage`` intervals.
+
+    Per direction, the mean SVM F1 of the reference against a partner ``d`` away
+    rises with ``d``; its crossing of Phi is estimated like min-contact's
+    (:func:`designkit.query.crossing.estimate_crossing`, logistic fit in log d,
+    searched from the exact ideal-observer delta up). ``interval`` is the
+    interval of the direction giving ``value``; each direction's is in ``details``.
 
     The reference is ``[e, e + width)`` (``m``: a material, at the middle of its
     range with its diffusivity range; ``diffusivity_m2_s``: one value or a
@@ -441,31 +536,30 @@ def exact_delta_e(e: float | None = None, *, m: str | None = None, contact_s: fl
     ``[e +- d, e +- d + width)`` differ from it only in effusivity. ``e_max``:
     the largest effusivity a partner may reach.
     """
-    from ..scene import Scene
+    from .crossing import check_coverage, estimate_crossing
 
     kw = dict(locals())
     contact = check_contact(contact_s)
     noise, dt = scene_inputs(noise_c, delta_t_c)
+    cov = check_coverage(coverage)
     run = _make(kw)
     ref = reference_class(e, m, width=run.width, diffusivity_m2_s=diffusivity_m2_s, model=run.model)
     x, w = ref.e_range[0], run.width
-    scene = Scene.from_delta_t(contact_s=contact, noise_c=noise, delta_t_c=dt)
+    _check_spread(run.spread, dt)
+    scene = run.scene(contact, noise, dt)
     closed = run.closed_form(ref)
     sides: dict[str, dict[str, Any]] = {}
     checked = [ref]
     for side, sign, limit in (("upper", +1, e_max - x - w), ("lower", -1, x - w)):
         if limit < w:
-            sides[side] = {"value": None, "interval": [None, None], "ideal": None}
+            sides[side] = {"value": None, "interval": [None, None], "ideal": None, "coverage": None,
+                           "estimate_method": "none", "evaluations": []}
             continue
 
         def part(d, sign=sign):
             lo = x + sign * d
             return ObjectClass(f"{lo:g}", (lo, lo + w), ref.diffusivity_range_m2_s)
 
-        def ok(d, part=part):
-            return run.svm((ref, part(d)), scene)[0] >= run.phi
-
-        val = bisect(ok, 0.0, limit, w / 2) if ok(limit) else None
         if closed:
             from .ideal_bound import exact_ideal_delta
 
@@ -476,14 +570,34 @@ def exact_delta_e(e: float | None = None, *, m: str | None = None, contact_s: fl
                 return run.ideal_f1((ref, part(d)), scene) >= run.phi
 
             ideal = bisect(iok, 0.0, limit, 1.0) if iok(limit) else None
-        sides[side] = {"value": val, "interval": [None, None], "ideal": ideal}
+        if ideal is None:  # not even the ideal observer separates a partner within the range: nor does the SVM
+            sides[side] = {"value": None, "interval": [None, None], "ideal": None, "coverage": None,
+                           "estimate_method": "none", "evaluations": []}
+            continue
+        # no classifier separates a nearer partner than the ideal observer: search from its delta up
+        start = min(max(w / 2.0, ideal), limit / 1.0001)
+        est = estimate_crossing(lambda d, part=part: run.svm((ref, part(d)), scene), start, limit, run.phi,
+                                coverage=cov, progress=progress)
+        val, lo_d, hi_d = est.value, est.low, est.high
+        if ideal is not None and val is not None:
+            val, lo_d = max(val, ideal), (None if lo_d is None else max(lo_d, ideal))
+        stated = est.method == "wls-logit-log"
+        sides[side] = {"value": val, "interval": [lo_d, hi_d], "ideal": ideal,
+                       "coverage": cov if stated else None, "estimate_method": est.method,
+                       "evaluations": [{"delta_e": e["x"], "svm_f1": e["svm_f1"],
+                                        "standard_error": e["standard_error"]} for e in est.evaluations]}
         found = [v for v in (val, ideal) if v is not None]
         if found:
             checked.append(part(max(found)))
     finite = [s["value"] for s in sides.values() if s["value"] is not None]
     ifinite = [s["ideal"] for s in sides.values() if s["ideal"] is not None]
     details = {"e": x, "lower": sides["lower"], "upper": sides["upper"]}
-    return run.answer("delta-e", value=min(finite) if finite else None, interval=(None, None),
+    best = min((s for s in sides.values() if s["value"] is not None), key=lambda s: s["value"], default=None)
+    interval = tuple(best["interval"]) if best is not None else (None, None)
+    stated = best is not None and best.get("coverage") is not None
+    return run.answer("delta-e", value=min(finite) if finite else None, interval=interval,
+                      interval_coverage=cov if stated else None,
+                      interval_kind="exact-estimate" if stated else "exact",
                       ideal=min(ifinite) if ifinite else None, ideal_method=run.ideal_method(closed),
                       objects=(ref.to_dict(),), limiting=(ref.to_dict(),), rule=REFERENCE_RULE,
                       scene=_scene(contact, noise, dt), details=details, check_classes=checked,

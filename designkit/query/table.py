@@ -39,6 +39,7 @@ from ..tables import lookup
 from ..tables.lookup import GRID_RTOL
 from ..tables.store import Table, load_table, resolve_table
 from .answer import Answer, IdealBound, number
+from .crossing import check_coverage, z_of_coverage
 from .inputs import (
     REFERENCE_RULE,
     PairQuestion,
@@ -57,13 +58,18 @@ __all__ = [
     "DEFAULT_TABLE",
     "GRID_RTOL",
     "clear_table_cache",
+    "contact_estimate",
+    "cross2",
     "delta_e",
     "delta_e_ideal_view",
+    "delta_estimate",
     "distinguishable",
     "max_noise",
     "min_contact",
     "min_delta_t",
     "open_table",
+    "ratio_estimate",
+    "stated_log",
 ]
 
 DEFAULT_TABLE = "svm-paper"
@@ -185,6 +191,171 @@ def _crossing(xs: Sequence[float], needs: Sequence[float], gap: float) -> tuple[
     return lookup.crossing(xs, needs, gap)
 
 
+def _table_z(tab: Table) -> float:
+    """The z (standard errors) of the table's Monte Carlo interval of delta(e) (its header; 2 if absent)."""
+    return float(tab.header.get("z") or 2.0)
+
+
+# ============================================================ estimates shared with the array route
+# The rounding correction and the stated intervals are written once, over numpy arrays (NaN for "none"):
+# the scalar questions below call them with one element, designkit.query.vectorized with many.
+def _arr(x) -> np.ndarray:
+    return np.asarray(np.nan if x is None else x, dtype=np.float64)
+
+
+def _opt(x) -> float | None:
+    """One element back to the scalar route's convention (None for NaN)."""
+    v = float(x)
+    return None if math.isnan(v) else v
+
+
+def cross2(x0, x1, n0, n1, gap) -> np.ndarray:
+    """:func:`designkit.tables.lookup.crossing` on two grid points, elementwise over arrays (NaN: none).
+
+    >>> float(cross2(1.0, 2.0, 300.0, 50.0, 100.0))
+    1.8
+    """
+    x0, x1, n0, n1, gap = np.broadcast_arrays(*(np.asarray(a, dtype=np.float64) for a in (x0, x1, n0, n1, gap)))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ok0 = ~np.isnan(n0) & (n0 <= gap)
+        ok1 = ~np.isnan(n1) & (n1 <= gap)
+        w = np.where(n0 != n1, (n0 - gap) / (n0 - n1), 1.0)
+        inside = np.where(np.isnan(n0), x1, x0 + w * (x1 - x0))
+    return np.where(ok0, x0, np.where(ok1, inside, np.nan))
+
+
+def stated_log(value, lo_end, hi_end, interp, z_table: float, zc: float) -> tuple[np.ndarray, np.ndarray]:
+    """``value``'s interval at the coverage of ``zc``, in log space, elementwise: the table's Monte Carlo ends
+    (``lo_end``, ``hi_end``, each ``z_table`` standard errors from the value) rescaled to ``zc``, combined in
+    quadrature with the interpolation error ``interp`` (one standard error, log) on each side. A missing end
+    (NaN, or not positive) leaves that side open (NaN).
+
+    >>> [round(float(v), 4) for v in stated_log(2.0, 1.0, 4.0, 0.0, 2.0, 2.0)]
+    [1.0, 4.0]
+    """
+    v = np.log(np.asarray(value, dtype=np.float64))
+    out = []
+    for end, sign in ((lo_end, -1.0), (hi_end, +1.0)):
+        end = np.asarray(end, dtype=np.float64)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            mc = np.abs(np.log(end) - v) / z_table
+            x = np.exp(v + sign * zc * np.hypot(mc, interp))
+        out.append(np.where(np.isnan(end) | (end <= 0), np.nan, x))
+    return out[0], out[1]
+
+
+def contact_estimate(x0, x1, n0, n1, gap, raw, mc_lo, mc_hi, ideal, *, width: float, svm: bool,
+                     z_table: float, zc: float) -> dict[str, np.ndarray]:
+    """min-contact's estimate where the crossing ``raw`` [s] is interpolated between tabulated contact times
+    ``x0 < x1`` [s] with needs ``n0 > gap >= n1`` [J s^-1/2 K^-1 m^-2], elementwise over arrays.
+
+    A tabulated delta is the first grid distance whose F1 reaches Phi: the crossing of the mean F1 lies up
+    to one width ``width`` below it, on average w/2 (uniform: SD w/sqrt(12)). On an SVM table (``svm``) the
+    estimate subtracts w/2 from the needs and interpolates log-log (the need falls roughly as a power of the
+    contact time), which removes the raw linear crossing's bias (always late: the need is convex in contact
+    time); the interpolation error is the distance between the two interpolants (log), the rounding's SD
+    enters through the local log-log slope. Where the corrected need no longer crosses inside the cell (or
+    the grid is coarser than the needs), the raw crossing stays, with the log-log interpolant's distance as
+    its error. The Monte Carlo ends ``mc_lo`` / ``mc_hi`` (the table's delta_lo / delta_hi crossings, NaN:
+    none) are carried from the raw crossing to the estimate; the interval (:func:`stated_log`) never reaches
+    below the ideal bound ``ideal`` (NaN: none) unless the estimate does.
+
+    Returns
+    -------
+    dict of ndarray
+        ``value``, ``low``, ``high`` [s], ``interp`` and ``rounding`` (log errors).
+
+    >>> r = contact_estimate(1.0, 1.5, 6000.0, 2000.0, 3000.0, 1.375, 1.2, 1.6, 1.05, width=80.0, svm=True,
+    ...                      z_table=2.0, zc=1.645)
+    >>> 1.0 < float(r["value"]) < 1.375 and float(r["low"]) < float(r["value"]) < float(r["high"])
+    True
+    """
+    x0, x1, n0, n1, gap, raw = np.broadcast_arrays(
+        *(np.asarray(a, dtype=np.float64) for a in (x0, x1, n0, n1, gap, raw)))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        lx0, lx1, lg = np.log(x0), np.log(x1), np.log(gap)
+        raw_loglog = cross2(lx0, lx1, np.log(n0), np.log(n1), lg)
+        raw_interp = np.where(np.isnan(raw_loglog), 0.0, np.abs(np.log(raw) - raw_loglog))
+        if svm:
+            c0, c1 = n0 - 0.5 * width, n1 - 0.5 * width
+            ok_c = np.minimum(c0, c1) > 0  # a grid coarser than the needs themselves: no correction
+            l0, l1 = np.log(c0), np.log(c1)
+            loglog = np.where(ok_c, cross2(lx0, lx1, l0, l1, lg), np.nan)
+            linear = cross2(x0, x1, c0, c1, gap)
+            est = np.exp(loglog)
+            use = ~np.isnan(loglog) & ~np.isnan(linear) & (x0 < est) & (est <= x1)
+            slope = np.where(l1 != l0, np.abs((lx1 - lx0) / (l1 - l0)), 0.0)
+            value = np.where(use, est, raw)
+            interp = np.where(use, np.abs(loglog - np.log(linear)), raw_interp)
+            rounding = np.where(use, slope * (width / math.sqrt(12.0)) / gap, 0.0)
+        else:
+            value, interp, rounding = raw, raw_interp, np.zeros_like(raw)
+        shift = np.log(value) - np.log(raw)
+        ends = [np.exp(np.log(np.asarray(m, dtype=np.float64)) + shift) for m in (mc_lo, mc_hi)]
+    low, high = stated_log(value, ends[0], ends[1], np.hypot(interp, rounding), z_table, zc)
+    ideal = np.asarray(ideal, dtype=np.float64)
+    low = np.where(np.isnan(low) | np.isnan(ideal), low, np.minimum(np.maximum(low, ideal), value))
+    return {"value": value, "low": low, "high": high, "interp": interp, "rounding": rounding}
+
+
+def ratio_estimate(raw, r_c, r_lin, r_rnd, r_geo, end_lo, end_hi, ideal, *, z_table: float,
+                   zc: float) -> dict[str, np.ndarray]:
+    """max-noise / min-delta-t's estimate of the largest separating sigma/dT where the raw crossing ``raw``
+    lies inside the table's noise ratios, elementwise over arrays (NaN: none).
+
+    As :func:`contact_estimate`: the tabulated deltas are rounded up to the grid (on average half a width
+    late), so the raw crossing tolerates too little noise. ``r_c`` is the crossing with w/2 subtracted from
+    every need and log interpolation (log need, log contact time), ``r_lin`` the same shift interpolated
+    linearly, ``r_rnd`` the log one shifted by a further w/sqrt(12) (the rounding's SD), ``r_geo`` the log one
+    without shift; each NaN where it does not cross inside the grid. Where ``r_c`` and ``r_lin`` both exist the
+    estimate is ``r_c``, its interpolation error their log distance and its rounding error ``r_rnd``'s;
+    otherwise the raw crossing with ``r_geo``'s distance. ``end_lo`` / ``end_hi`` are the table's Monte Carlo
+    ends (sigma/dT, carried from the raw crossing to the estimate); ``high`` never exceeds the ideal
+    bound ``ideal`` (sigma/dT, NaN: none) unless the estimate does.
+
+    >>> r = ratio_estimate(0.010, 0.011, 0.0112, 0.0105, 0.0101, 0.008, 0.012, 0.02, z_table=2.0, zc=1.645)
+    >>> float(r["value"]), float(r["low"]) < 0.011 < float(r["high"])
+    (0.011, True)
+    """
+    raw, r_c, r_lin, r_rnd, r_geo = np.broadcast_arrays(
+        *(np.asarray(a, dtype=np.float64) for a in (raw, r_c, r_lin, r_rnd, r_geo)))
+    use = ~np.isnan(r_c) & ~np.isnan(r_lin)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        r = np.where(use, r_c, raw)
+        interp = np.where(use, np.abs(np.log(r_c) - np.log(r_lin)),
+                          np.where(np.isnan(r_geo), 0.0, np.abs(np.log(raw) - np.log(r_geo))))
+        rounding = np.where(use & ~np.isnan(r_rnd), np.abs(np.log(r_rnd) - np.log(r_c)), 0.0)
+        shift = np.log(r) - np.log(raw)
+        ends = [np.exp(np.log(np.asarray(m, dtype=np.float64)) + shift) for m in (end_lo, end_hi)]
+    low, high = stated_log(r, ends[0], ends[1], np.hypot(interp, rounding), z_table, zc)
+    ideal = np.asarray(ideal, dtype=np.float64)
+    high = np.where(np.isnan(high) | np.isnan(ideal), high, np.maximum(np.minimum(high, ideal), r))
+    return {"value": r, "low": low, "high": high, "interp": interp, "rounding": rounding}
+
+
+def delta_estimate(value, mc_lo, mc_hi, geometric, ideal, *, width: float, z_table: float,
+                   zc: float) -> tuple[np.ndarray, np.ndarray]:
+    """delta-e's interval of one direction's delta(e) ``value`` [J s^-1/2 K^-1 m^-2] at the coverage of ``zc``,
+    elementwise over arrays (NaN: none): the table's Monte Carlo ends ``mc_lo`` / ``mc_hi`` rescaled, in
+    quadrature with the interpolation error (``value`` against ``geometric``, the log-space interpolant; NaN:
+    none) and the grid's rounding (the first grid distance reaching Phi: the crossing lies up to one width
+    ``width`` below it, SD w/sqrt(12)); the low end never below the ideal bound ``ideal`` unless the value is.
+
+    >>> low, high = delta_estimate(3000.0, 2800.0, 3300.0, 3050.0, 2000.0, width=80.0, z_table=2.0, zc=1.645)
+    >>> 2000.0 < float(low) < 3000.0 < float(high)
+    True
+    """
+    value = np.asarray(value, dtype=np.float64)
+    geometric = np.asarray(geometric, dtype=np.float64)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        interp = np.where(np.isnan(geometric), 0.0, np.abs(np.log(value) - np.log(geometric)))
+        rounding = (width / math.sqrt(12.0)) / value
+    low, high = stated_log(value, mc_lo, mc_hi, np.hypot(interp, rounding), z_table, zc)
+    ideal = np.asarray(ideal, dtype=np.float64)
+    low = np.where(np.isnan(low) | np.isnan(ideal), low, np.minimum(np.maximum(low, ideal), value))
+    return low, high
+
+
 # ============================================================ opening a table for a question
 @dataclass(frozen=True)
 class _Opened:
@@ -284,6 +455,12 @@ def _outside_notes(view: _View, flags: dict[str, bool], wanted: dict[str, Any]) 
             es = ", ".join(f"{e:g}" for e in wanted.get("effusivity", ()))
             notes.append(f"effusivity {es} outside table {view.t.name}'s ({view.e_lo:g}, {view.e_hi:g}] "
                          "J s^-1/2 K^-1 m^-2 (no extrapolation)")
+        elif name == "noise_ratio" and wanted.get("noise_c") is not None and wanted.get("delta_t_c") is not None:
+            lo, hi = _axis_range(view, name)
+            n, d = wanted["noise_c"], abs(wanted["delta_t_c"])
+            notes.append(f"noise {n:g} degC at dT {d:g} degC (sigma/dT {n / d:g}) outside table {view.t.name}'s "
+                         f"sigma/dT [{lo:g}, {hi:g}]: at dT {d:g} degC it answers for noise {lo * d:g} to "
+                         f"{hi * d:g} degC (no extrapolation)")
         else:
             word, unit = _AXIS_WORDS.get(name, (name, ""))
             lo, hi = _axis_range(view, name)
@@ -295,7 +472,8 @@ def _outside_notes(view: _View, flags: dict[str, bool], wanted: dict[str, Any]) 
 
 def _scene_wanted(view: _View, noise, dt) -> dict[str, Any]:
     if view.scene_axes == ["noise_ratio"]:
-        return {"noise_ratio": None if noise is None or dt is None else noise / abs(dt)}
+        return {"noise_ratio": None if noise is None or dt is None else noise / abs(dt), "noise_c": noise,
+                "delta_t_c": dt}
     return {"noise_c": noise, "delta_t_c": dt}
 
 
@@ -303,7 +481,7 @@ def _scene_wanted(view: _View, noise, dt) -> dict[str, Any]:
 def _answer(question: str, op: _Opened, *, objects, limiting, rule: str, scene: dict, value, interval,
             ideal, ideal_method: str = "table", in_grid: dict, details: dict, notes: Sequence[str] = (),
             check_at: tuple[float, float, float] | None = None, classes=(), interval_kind=None,
-            computation: dict | None = None) -> Answer:
+            interval_coverage=None, computation: dict | None = None) -> Answer:
     check = None
     if check_at is not None and classes:
         c, n, d = check_at
@@ -319,7 +497,7 @@ def _answer(question: str, op: _Opened, *, objects, limiting, rule: str, scene: 
         ideal_table_hash=op.ihash if ideal_table else None, in_grid=dict(in_grid), details=details,
         computation={"fidelity": op.tab.fidelity, "table_contacts_s": op.view.contacts.tolist(),
                      **(computation or {})},
-        notes=tuple(n for n in notes if n), interval_kind=interval_kind)
+        notes=tuple(n for n in notes if n), interval_kind=interval_kind, interval_coverage=interval_coverage)
 
 
 def _scene(contact_s=None, noise_c=None, delta_t_c=None) -> dict[str, Any]:
@@ -353,7 +531,8 @@ def _need_at_contact(view: _View, kind: str, combos, cw, lo: float, hi: float) -
 def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | None = None,
                 m2: str | None = None, objects=None, noise_c: float = 0.05, delta_t_c: float = 10.0,
                 threshold: float | None = None, table: "Table | str" = DEFAULT_TABLE,
-                ideal_table: "Table | str | None" = DEFAULT_IDEAL_TABLE, sensor=None, model=None) -> Answer:
+                ideal_table: "Table | str | None" = DEFAULT_IDEAL_TABLE, sensor=None, model=None,
+                coverage: float = 0.9) -> Answer:
     """Shortest contact time [s] that separates two objects, from a table.
 
     Parameters
@@ -376,12 +555,17 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
         Must be the table's.
     model : ForwardModel or name, optional
         Must be the table's (default: whatever the table was built with).
+    coverage : float
+        Nominal coverage of the interval, in (0, 1).
 
     Returns
     -------
     Answer
         ``value``: contact time [s], None when no tabulated contact time up to
-        the table's longest suffices.
+        the table's longest suffices. ``interval``: at ``coverage`` where the
+        crossing is interpolated between two tabulated contact times (the
+        table's Monte Carlo error and the interpolation error); the grid cell,
+        coverage not stated, where a neighbour lies beyond the grid.
 
     Examples
     --------
@@ -389,6 +573,7 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
     'contact_s'
     """
     noise, dt = scene_inputs(noise_c, delta_t_c)
+    coverage = check_coverage(coverage)
     op = _open(table, ideal_table, threshold=threshold, sensor=sensor, model=model)
     pq = pair_question(e1, e2, m1, m2, objects=objects, width=op.width, model=op.model)
     scene = _scene(None, noise, dt)
@@ -404,17 +589,27 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
         wanted = {**_scene_wanted(view, noise, dt), "effusivity": (lo, hi)}
         return _answer("min-contact", op, value=None, interval=(None, None), ideal=None, in_grid=flags,
                        details={}, notes=_outside_notes(view, flags, wanted), **common)
+    def needs_read(v: _View, kind: str, cmb) -> tuple[list[float], Any]:
+        """The needs read lazily up to the crossing (a generator), and the list of those read so far."""
+        read: list[float] = []
+
+        def gen():
+            for k in range(v.contacts.size):
+                read.append(v.need(kind, cmb, k, lo, hi))
+                yield read[-1]
+        return read, gen()
+
     def contact_for(v: _View, kind: str, cmb) -> float | None:
-        needs = (v.need(kind, cmb, k, lo, hi) for k in range(v.contacts.size))  # read up to the crossing
-        x, _ = _crossing(v.contacts, needs, hi - lo)
+        x, _ = _crossing(v.contacts, needs_read(v, kind, cmb)[1], hi - lo)  # read up to the crossing
         return x
 
-    value = contact_for(view, "svm", combos)
+    needs, lazy = needs_read(view, "svm", combos)
+    value, k_cross = _crossing(view.contacts, lazy, hi - lo)  # needs[:k_cross + 1] read
     if op.tab.fidelity == "svm":
-        interval = (contact_for(view, "lo", combos), contact_for(view, "hi", combos))
+        mc_interval = (contact_for(view, "lo", combos), contact_for(view, "hi", combos))
     else:
-        interval = (value, value)
-    monte_carlo = {"monte_carlo_interval": list(interval)}  # the table's delta_lo / delta_hi answers alone
+        mc_interval = (value, value)
+    monte_carlo = {"monte_carlo_interval": list(mc_interval)}  # the table's delta_lo / delta_hi answers alone
     if "delta_up_ideal" in view.t.arrays:  # the grid's own bound, beside the exact one (its interpolation error)
         monte_carlo["table_ideal_s"] = contact_for(view, "ideal", combos)
     if op.closed:
@@ -431,35 +626,59 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
         f"no tabulated contact time up to {view.contacts[-1]:g} s separates them "
         "(the exact route examines longer contacts)")
     grid = [float(c) for c in view.contacts]
-    if value is not None and value in grid and grid.index(value) > 0:
-        prev = grid[grid.index(value) - 1]
-        note = (f"{value:g} s is the table's next contact time after {prev:g} s, where they are not separable: "
-                f"the shortest time lies in ({prev:g}, {value:g}] s (the exact route resolves it)")
+    interval: tuple = (None, None)
+    kind, cov = "none", None
     if value is not None:
-        # the interpolation error between grid points: the interval spans at least the grid cell the
-        # crossing lies in (a crossing on a grid point whose neighbour is not separable: the whole cell),
-        # never below the exact ideal bound
-        below = [g for g in grid if g < value - 1e-12]
-        prev = below[-1] if below else 0.0
-        nxt = min([g for g in grid if g >= value - 1e-12], default=value)
-        ends = [x for x in interval if x is not None]
-        low = min([prev] + ends)
-        low = max(low, ideal) if ideal is not None else low
-        interval = (low, max([nxt] + ends))
+        prev_need = needs[k_cross - 1] if k_cross > 0 else math.nan
+        if k_cross > 0 and not math.isnan(prev_need):
+            # interpolated between two tabulated needs: the Monte Carlo interval of the table (its deltas'
+            # z-SE ends, rescaled to the coverage) and the interpolation error, estimated as the distance to
+            # the crossing of a log-log interpolation (the need falls roughly as a power of the contact time)
+            raw = value
+            est = contact_estimate(grid[k_cross - 1], grid[k_cross], needs[k_cross - 1], needs[k_cross], hi - lo,
+                                   raw, _arr(mc_interval[0]), _arr(mc_interval[1]), _arr(ideal), width=op.width,
+                                   svm=op.tab.fidelity == "svm", z_table=_table_z(op.tab),
+                                   zc=z_of_coverage(coverage))
+            value, low, high = float(est["value"]), _opt(est["low"]), _opt(est["high"])
+            interp, rounding = float(est["interp"]), float(est["rounding"])
+            interval, kind, cov = (low, high), "table-estimate", coverage
+            monte_carlo.update(interpolation_error_log=interp, rounding_error_log=rounding, table_crossing_s=raw)
+        else:
+            prev = grid[k_cross - 1] if k_cross > 0 else 0.0
+            low = max(prev, ideal) if ideal is not None else prev
+            interval, kind = (low, value), "table-cell"
+            why = ("the table's first contact time" if k_cross == 0 else
+                   f"the table's next contact time after {prev:g} s, where they are not separable within its "
+                   "effusivity range")
+            note = (f"{value:g} s is {why}: the shortest time lies in ({low:g}, {value:g}] s and the grid cannot "
+                    "support an interval of stated coverage there (the exact route estimates it)")
     needed = value if value is not None else float(view.contacts[-1])
     return _answer("min-contact", op, value=value, interval=interval, ideal=ideal, ideal_method=ideal_method,
                    in_grid=flags, details={}, notes=[note], check_at=(needed, noise, dt),
-                   interval_kind="table-cell" if value is not None else None, computation=monte_carlo, **common)
+                   interval_kind=kind, interval_coverage=cov, computation=monte_carlo, **common)
 
 
 # ============================================================ max-noise / min-delta-t
-def _max_ratio(view: _View, kind: str, contact_s: float, lo: float, hi: float) -> tuple[float | None, str]:
-    """Largest sigma/dT (fixed-condition table) at which the pair separates, and where it lies."""
+def _max_ratio(view: _View, kind: str, contact_s: float, lo: float, hi: float, *,
+               geometric: bool = False, shift: float = 0.0) -> tuple[float | None, str]:
+    """Largest sigma/dT (fixed-condition table) at which the pair separates, and where it lies.
+
+    ``geometric``: the alternative interpolant (log need, log-log in contact time) instead of
+    the linear one. ``shift``: subtracted from every tabulated need (the grid's rounding of delta).
+    """
     ratios = view.t.axes["noise_ratio"]
     cw, _ = _contact_weights(view, contact_s)
+    if geometric:
+        cw = _axis_weights(view.contacts, contact_s, log=True)[0]
 
     def margin(r_idx):
-        nd = _need_at_contact(view, kind, [((r_idx,), 1.0)], cw, lo, hi)
+        if geometric:
+            nds = [view.need(kind, [((r_idx,), 1.0)], k, lo, hi) - shift if w else 1.0 for k, w in cw]
+            if any(math.isnan(n) or n <= 0 for n in nds):
+                return -math.inf
+            nd = math.exp(sum(w * math.log(n) for (_, w), n in zip(cw, nds)))
+            return math.log(hi - lo) - math.log(nd)
+        nd = _need_at_contact(view, kind, [((r_idx,), 1.0)], cw, lo, hi) - shift
         return -math.inf if math.isnan(nd) else (hi - lo) - nd
 
     ok_rows = [margin(i) >= 0 for i in range(ratios.size)]
@@ -469,16 +688,17 @@ def _max_ratio(view: _View, kind: str, contact_s: float, lo: float, hi: float) -
     if last == ratios.size - 1:
         return float(ratios[-1]), "above"
     m0, m1 = margin(last), margin(last + 1)  # interpolate the crossing in log(ratio)
-    if not math.isfinite(m1):
-        return float(ratios[last]), "inside"
+    if not math.isfinite(m1):  # the next row's delta lies beyond the grid: the crossing is in the cell
+        return float(ratios[last]), "cell"
     w = m0 / (m0 - m1) if m0 != m1 else 0.0
     lr = math.log(ratios[last]) + w * (math.log(ratios[last + 1]) - math.log(ratios[last]))
     return math.exp(lr), "inside"
 
 
 def _ratio_question(question: str, e1, e2, m1, m2, objects, contact_s, noise_c, delta_t_c, threshold, table,
-                    ideal_table, sensor, model) -> Answer:
+                    ideal_table, sensor, model, coverage: float = 0.9) -> Answer:
     contact = check_contact(contact_s)
+    coverage = check_coverage(coverage)
     if question == "max-noise":
         _, dt = scene_inputs(0.0, delta_t_c)
         scene = _scene(contact, None, dt)
@@ -537,51 +757,104 @@ def _ratio_question(question: str, e1, e2, m1, m2, objects, contact_s, noise_c, 
         note = (f"separable even at the table's largest noise ratio sigma/dT = {ratios[-1]:g}: "
                 "the answer is at least this (the exact route looks further)")
         flags["noise_ratio"] = False
-    # with more noise allowed at the optimistic end: 'lo' (possibly) ratio >= 'svm' ratio
+    # the Monte Carlo ends: more noise allowed at the optimistic end ('lo': ratio >= the answer's)
     ends = [to_answer(out[k][0]) if out[k][1] != "below" else None for k in ("hi", "lo")]
-    interval = tuple(sorted(ends, key=lambda x: (x is None, x))) if all(e is not None for e in ends) else tuple(ends)
+    mc = tuple(sorted(ends, key=lambda x: (x is None, x))) if all(e is not None for e in ends) else tuple(ends)
     ideal = to_answer(out["ideal"][0]) if out["ideal"][1] != "below" else None
+    interval: tuple = (None, None)
+    kind, cov = "none", None
+    computation = {"monte_carlo_interval": list(mc)}
+    if where == "inside" and op.tab.fidelity == "svm":
+        # as min-contact: the tabulated deltas are rounded up to the grid (on average half a width late),
+        # so the raw crossing tolerates too little noise; the answer subtracts w/2 from the need and
+        # interpolates log-log, the interval carries the interpolants' difference and the rounding's SD
+        w = op.width
+        raw = r
+
+        def inside(v):
+            return v[0] if v[1] == "inside" else math.nan
+
+        r_c = inside(_max_ratio(view, "svm", contact, lo, hi, geometric=True, shift=0.5 * w))
+        r_lin = inside(_max_ratio(view, "svm", contact, lo, hi, shift=0.5 * w))
+        both = not (math.isnan(r_c) or math.isnan(r_lin))
+        r_rnd = inside(_max_ratio(view, "svm", contact, lo, hi, geometric=True,
+                                  shift=0.5 * w + w / math.sqrt(12))) if both else math.nan
+        r_geo = math.nan if both else inside(_max_ratio(view, "svm", contact, lo, hi, geometric=True))
+        ends = [math.nan if out[k][1] == "below" or (k == "lo" and out[k][1] == "above") else out[k][0]
+                for k in ("hi", "lo")]
+        ri = out["ideal"][0] if out["ideal"][1] != "below" else None
+        est = ratio_estimate(raw, r_c, r_lin, r_rnd, r_geo, ends[0], ends[1], _arr(ri), z_table=_table_z(op.tab),
+                             zc=z_of_coverage(coverage))
+        r, r_low, r_high = float(est["value"]), _opt(est["low"]), _opt(est["high"])
+        interp, rounding = float(est["interp"]), float(est["rounding"])
+        value = to_answer(r)
+        computation["table_crossing_noise_ratio"] = raw
+        iv = [to_answer(r_low), to_answer(r_high)]
+        interval = tuple(iv) if question == "max-noise" else (iv[1], iv[0])
+        kind, cov = "table-estimate", coverage
+        computation.update(interpolation_error_log=interp, rounding_error_log=rounding)
+    elif where == "cell":  # a neighbour beyond the grid: the crossing lies in the cell, no stated coverage
+        k = int(np.searchsorted(ratios, r))
+        nxt = float(ratios[min(k + 1, ratios.size - 1)])
+        ri = out["ideal"][0] if out["ideal"][1] != "below" else None
+        nxt = min(nxt, ri) if ri is not None else nxt
+        iv = [to_answer(r), to_answer(nxt)]
+        interval, kind = (tuple(iv) if question == "max-noise" else (iv[1], iv[0])), "table-cell"
+        note = (f"sigma/dT {r:g} is the table's last noise ratio where they separate; at the next, {nxt:g}, the "
+                "pair lies beyond its effusivity range: the answer lies between them and the grid cannot support "
+                "an interval of stated coverage there (the exact route estimates it)")
+    elif where == "inside":  # an ideal-observer table: no Monte Carlo ends
+        interval, kind = mc, "table"
+    elif value is not None:  # separable beyond the table's largest ratio: the answer is a one-sided bound
+        note += " (the grid cannot support an interval of stated coverage there)"
+        interval = (value, None) if question == "max-noise" else (None, value)
+        kind = "table-cell"
     r_check = r if r is not None else float(ratios[0])
     check_at = (contact, r_check * abs(dt), dt) if question == "max-noise" else (contact, noise, noise / r_check)
     return _answer(question, op, value=value, interval=interval, ideal=ideal,
                    ideal_method="closed-form" if op.closed else "table", in_grid=flags, details={},
-                   notes=[note], check_at=check_at, **common)
+                   notes=[note], check_at=check_at, interval_kind=kind, interval_coverage=cov,
+                   computation=computation, **common)
 
 
 def max_noise(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact_s: float, delta_t_c: float = 10.0,
               threshold=None, table=DEFAULT_TABLE, ideal_table=DEFAULT_IDEAL_TABLE, sensor=None,
-              model=None) -> Answer:
+              model=None, coverage: float = 0.9) -> Answer:
     """Largest noise sigma [degC] at which ``contact_s`` still separates the objects (table).
 
     Arguments as :func:`min_contact`; ``contact_s`` [s] is the contact time.
     """
     return _ratio_question("max-noise", e1, e2, m1, m2, objects, contact_s, None, delta_t_c, threshold, table,
-                           ideal_table, sensor, model)
+                           ideal_table, sensor, model, coverage)
 
 
 def min_delta_t(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact_s: float, noise_c: float = 0.05,
                 threshold=None, table=DEFAULT_TABLE, ideal_table=DEFAULT_IDEAL_TABLE, sensor=None,
-                model=None) -> Answer:
+                model=None, coverage: float = 0.9) -> Answer:
     """Smallest sensor-object temperature difference [degC] that separates the objects (table).
 
     Arguments as :func:`min_contact`; ``contact_s`` [s] is the contact time.
     """
     return _ratio_question("min-delta-t", e1, e2, m1, m2, objects, contact_s, noise_c, None, threshold, table,
-                           ideal_table, sensor, model)
+                           ideal_table, sensor, model, coverage)
 
 
 # ============================================================ delta-e
 def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, noise_c: float = 0.05,
             delta_t_c: float = 10.0, threshold=None, table=DEFAULT_TABLE, ideal_table=DEFAULT_IDEAL_TABLE,
-            sensor=None, model=None) -> Answer:
+            sensor=None, model=None, coverage: float = 0.9) -> Answer:
     """delta(e) towards lower and higher effusivity [J s^-1/2 K^-1 m^-2] (table).
 
     ``value`` is the smaller of the two; ``details["lower"]`` and
-    ``details["upper"]`` hold each direction's value, interval and ideal
-    bound (None: nothing distinguishable within the grid that way). ``m``: a
+    ``details["upper"]`` hold each direction's value, interval at ``coverage``
+    (the table's Monte Carlo interval rescaled, combined with the interpolation
+    error: linear against log-space interpolation over contact time and sigma/dT)
+    and ideal bound (None: nothing distinguishable within the grid that way).
+    ``interval`` is the interval of the direction giving ``value``. ``m``: a
     material, its range's middle as the reference.
     """
     contact = check_contact(contact_s)
+    coverage = check_coverage(coverage)
     noise, dt = scene_inputs(noise_c, delta_t_c)
     op = _open(table, ideal_table, threshold=threshold, sensor=sensor, model=model)
     ref = reference_class(e, m, width=op.width, model=op.model)
@@ -603,18 +876,28 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
     icombos, _ = iview.scene_weights(noise, dt) if iview is not None else ([], {})
     icw, _ = _contact_weights(iview, contact) if iview is not None else ([], False)
 
-    def at(v, cmb, cws, name):
+    def at(v, cmb, cws, name, geometric=False):
         if v is None or name not in v.t.arrays:
             return None
         total = 0.0
         for k, w in cws:
             if w == 0:
                 continue
+            if geometric:  # log delta interpolated (weights in log contact, log sigma/dT)
+                for idx, wi in cmb:
+                    y = _interp_e(v.t.arrays[name][idx + (k,)], v.centres, x) if wi else 1.0
+                    if math.isnan(y) or y <= 0:
+                        return None
+                    total += w * wi * math.log(y)
+                continue
             y = v.delta_at(name, cmb, k, x)
             if math.isnan(y):
                 return None
             total += w * y
-        return total
+        return math.exp(total) if geometric else total
+
+    zc, z_t = z_of_coverage(coverage), _table_z(op.tab)
+    gcw = _axis_weights(view.contacts, contact, log=True)[0]
 
     sides = {}
     for direction, side in (("down", "lower"), ("up", "upper")):
@@ -623,29 +906,46 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
               if op.tab.fidelity == "svm" else [val, val])
         iname = f"delta_{direction}_ideal" if ikind == "ideal" else f"delta_{direction}"
         ideal_side = at(iview, icombos, icw, iname)
-        sides[side] = {"value": val, "interval": iv, "ideal": ideal_side}
+        stated, cov_side, method = [None, None], None, "none"
+        if val is not None and op.tab.fidelity == "svm":
+            geo = at(view, combos, gcw, f"delta_{direction}", geometric=True)
+            low, high = (_opt(v) for v in delta_estimate(val, _arr(iv[0]), _arr(iv[1]), _arr(geo), _arr(ideal_side),
+                                                         width=op.width, z_table=z_t, zc=zc))
+            stated, cov_side, method = [low, high], coverage, "table-estimate"
+        sides[side] = {"value": val, "interval": stated, "ideal": ideal_side, "coverage": cov_side,
+                       "estimate_method": method, "monte_carlo_interval": iv}
     finite = [s["value"] for s in sides.values() if s["value"] is not None]
     ifinite = [s["ideal"] for s in sides.values() if s["ideal"] is not None]
-    return _answer("delta-e", op, value=min(finite) if finite else None, interval=(None, None),
+    best = min((s for s in sides.values() if s["value"] is not None), key=lambda s: s["value"], default=None)
+    stated = best is not None and best["coverage"] is not None
+    return _answer("delta-e", op, value=min(finite) if finite else None,
+                   interval=tuple(best["interval"]) if stated else (None, None),
+                   interval_kind="table-estimate" if stated else "none",
+                   interval_coverage=coverage if stated else None,
                    ideal=min(ifinite) if ifinite else None, ideal_method="table",
                    in_grid=flags, details=_delta_details(x, sides),
                    check_at=(contact, noise, dt), **common)
 
 
 def _delta_details(e: float, sides: dict) -> dict[str, Any]:
-    empty = {"value": None, "interval": [None, None], "ideal": None}
+    empty = {"value": None, "interval": [None, None], "ideal": None, "coverage": None, "estimate_method": "none"}
     return {"e": e, "lower": sides.get("lower", empty), "upper": sides.get("upper", empty)}
 
 
 # ============================================================ distinguishable
 def distinguishable(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact_s: float, noise_c: float = 0.05,
                     delta_t_c: float = 10.0, threshold=None, table=DEFAULT_TABLE, ideal_table=DEFAULT_IDEAL_TABLE,
-                    sensor=None, model=None) -> Answer:
+                    sensor=None, model=None, coverage: float = 0.9) -> Answer:
     """Whether ``contact_s`` separates the objects (table), with the ideal observer's F1 (closed form).
 
     ``value`` is True or False; the SVM's F1 of the pair itself is not in a
-    table (``details["svm_f1"]`` None; the exact route computes it).
+    table (``details["svm_f1"]`` None; the exact route computes it), so there is
+    no interval of the F1: the answer says so. ``details["verdict"]`` is
+    ``"confident"`` when ``contact_s`` lies outside the table's ``coverage``
+    interval of the shortest separating contact (:func:`min_contact`),
+    ``"uncertain"`` inside it, None where that interval is not stated.
     """
+    coverage = check_coverage(coverage)
     from ..recognition.ideal import ideal_pair
     from ..scene import Scene
 
@@ -675,14 +975,33 @@ def distinguishable(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact
         return not math.isnan(nd) and nd <= hi - lo
 
     yes = verdict("svm")
-    interval = (float(verdict("hi")), float(verdict("lo"))) if op.tab.fidelity == "svm" else (float(yes),) * 2
+    verdicts = (verdict("hi"), verdict("lo")) if op.tab.fidelity == "svm" else (yes, yes)
     res = ideal_pair(*pq.classes, op.tab.sensor, Scene.from_delta_t(contact_s=contact, noise_c=noise,
                                                                      delta_t_c=dt), model=op.model)
     ideal_f1 = res.f1
-    details = {"distinguishable": yes, "svm_f1": None, "svm_standard_error": None, "verdict": None,
+    # how sure the verdict is: the contact against the table's interval of the shortest separating contact
+    mc = min_contact(objects=pq.classes, noise_c=noise, delta_t_c=dt, table=op.tab, ideal_table=None,
+                     coverage=coverage) if op.tab.fidelity == "svm" else None
+    sure = None
+    if mc is not None and mc.interval_coverage is not None and mc.interval[0] is not None:
+        lo_c, hi_c = mc.interval
+        sure = "uncertain" if lo_c <= contact <= (hi_c if hi_c is not None else math.inf) else "confident"
+    details = {"distinguishable": yes, "svm_f1": None, "svm_standard_error": None, "verdict": sure,
                "ideal_f1": ideal_f1, "ideal_distinguishable": ideal_f1 >= op.phi}
-    return _answer("distinguishable", op, value=yes, interval=interval, ideal=ideal_f1, ideal_method=res.method,
-                   in_grid=flags, details=details, check_at=(contact, noise, dt), **common)
+    note = "no interval: a table holds delta(e), not this pair's F1 (the exact route states the F1's interval)"
+    if sure is not None:
+        note += (f"; verdict {sure}: {contact:g} s lies {'inside' if sure == 'uncertain' else 'outside'} the "
+                 f"{coverage:.0%} interval of the shortest separating contact, {mc.interval[0]:.3g} to "
+                 f"{_fmt_or_open(mc.interval[1])} s")
+    return _answer("distinguishable", op, value=yes, interval=(None, None), ideal=ideal_f1,
+                   ideal_method=res.method, in_grid=flags, details=details, check_at=(contact, noise, dt),
+                   notes=[note], interval_kind="none",
+                   computation={"monte_carlo_verdicts": list(verdicts),
+                                "min_contact_interval_s": None if mc is None else list(mc.interval)}, **common)
+
+
+def _fmt_or_open(x) -> str:
+    return "(open)" if x is None else f"{x:.3g}"
 
 
 # ============================================================ for the array route (designkit.query.vectorized)

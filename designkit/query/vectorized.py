@@ -18,7 +18,11 @@ Routes
   elements in one vectorized call and kept in the per-process cache of
   :mod:`designkit.query.ideal_bound` (~7 ms per distinct pair and scene the
   first time, a dictionary look-up after). ``ideal_bound=False`` skips it
-  (``ideal`` is then NaN).
+  (``ideal`` is then NaN, and the intervals are not held to it). The
+  rounding-corrected estimates and their intervals at ``coverage`` are the
+  table route's own functions over arrays (:func:`~designkit.query.table.contact_estimate`,
+  :func:`~designkit.query.table.ratio_estimate`, :func:`~designkit.query.table.delta_estimate`),
+  so element ``i`` equals the scalar call.
 * **exact**, and objects given as material names: one scalar call per
   element (seconds each on the exact route), assembled into the same arrays.
 
@@ -49,6 +53,7 @@ from numpy.typing import ArrayLike, NDArray
 from .._validation import InputError, check_effusivity, check_positive, check_temperature
 from . import table as _table_route
 from .answer import QUANTITIES, Answer
+from .crossing import check_coverage, z_of_coverage
 
 __all__ = ["ARRAY_INPUTS", "ArrayAnswer", "answer_arrays", "is_array_call"]
 
@@ -81,7 +86,9 @@ class ArrayAnswer:
         The SVM's answer per element; NaN where the scalar call answers None
         (``distinguishable``: 1.0 yes, 0.0 no, NaN no answer).
     low, high : ndarray of float
-        The answer's interval per element (``Answer.interval``; NaN: None).
+        The answer's interval per element (``Answer.interval``; NaN: None): at the
+        call's ``coverage`` where the scalar answer states one, else the grid cell or
+        a one-sided bound, as the scalar answer (``distinguishable``: NaN, no interval).
     ideal : ndarray of float
         The ideal observer's answer per element (``Answer.ideal_bound.value``;
         ``distinguishable``: the ideal F1); NaN: none, or not computed.
@@ -233,8 +240,9 @@ def _need(view, kind: str, combos, lo: np.ndarray, hi: np.ndarray) -> np.ndarray
     return np.where(np.isnan(up) | np.isnan(down), np.nan, np.maximum(up, down))
 
 
-def _crossing(xs: np.ndarray, need: np.ndarray, gap: np.ndarray) -> np.ndarray:
-    """:func:`designkit.tables.lookup.crossing` per column of ``need`` [contact, n]; NaN: none."""
+def _crossing(xs: np.ndarray, need: np.ndarray, gap: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`designkit.tables.lookup.crossing` per column of ``need`` [contact, n]: the crossing (NaN: none)
+    and the index of the first contact that suffices (-1: none)."""
     with np.errstate(invalid="ignore"):
         ok = ~np.isnan(need) & (need <= gap)
     found = ok.any(axis=0)
@@ -246,7 +254,7 @@ def _crossing(xs: np.ndarray, need: np.ndarray, gap: np.ndarray) -> np.ndarray:
         w = np.where(prev != cur, (prev - gap) / (prev - cur), 1.0)
     x0 = xs[np.maximum(k - 1, 0)]
     x = np.where((k == 0) | np.isnan(prev), xs[k], x0 + w * (xs[k] - x0))
-    return np.where(found, x, np.nan)
+    return np.where(found, x, np.nan), np.where(found, k, -1)
 
 
 def _at_contact(cw, per_contact: np.ndarray) -> np.ndarray:
@@ -287,7 +295,13 @@ def _nan(n: int) -> np.ndarray:
 
 
 # ============================================================ the table route, vectorized
-def _table_pair(question: str, x: dict[str, np.ndarray], op, ideal_bound: bool) -> dict[str, np.ndarray]:
+def _table_z(op) -> float:
+    """The z (standard errors) of the table's Monte Carlo interval of delta(e) (its header; 2 if absent)."""
+    return float(op.tab.header.get("z") or 2.0)
+
+
+def _table_pair(question: str, x: dict[str, np.ndarray], op, ideal_bound: bool,
+                zc: float) -> dict[str, np.ndarray]:
     e1, e2 = x["e1"], x["e2"]
     lo, hi = np.minimum(e1, e2), np.maximum(e1, e2)
     n = lo.size
@@ -296,19 +310,21 @@ def _table_pair(question: str, x: dict[str, np.ndarray], op, ideal_bound: bool) 
     res["in_grid"] = np.zeros(n, dtype=bool)
     e_in = (view.e_lo < lo) & (lo <= view.e_hi) & (view.e_lo < hi) & (hi <= view.e_hi)
     if question == "min-contact":
-        _min_contact(x, op, lo, hi, e_in, res, ideal_bound)
+        _min_contact(x, op, lo, hi, e_in, res, ideal_bound, zc)
     elif question in ("max-noise", "min-delta-t"):
-        _ratio(question, x, op, lo, hi, e_in, res, ideal_bound)
+        _ratio(question, x, op, lo, hi, e_in, res, ideal_bound, zc)
     else:
         _distinguishable(x, op, lo, hi, e_in, res, ideal_bound)
     return res
 
 
-def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool) -> None:
+def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> None:
     view = op.view
     grid = view.contacts
     svm = op.tab.fidelity == "svm"
     todo = np.zeros(lo.size, dtype=bool)
+    k_cross = np.full(lo.size, -1)
+    n_prev, n_at = _nan(lo.size), _nan(lo.size)  # the svm need at the contact before the crossing, and at it
     for (noise, dt), idx in _groups(x["noise_c"], x["delta_t_c"]):
         combos, flags = view.scene_weights(noise, dt)
         if not all(flags.values()):
@@ -318,14 +334,20 @@ def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool) -> None:
             continue
         l, h = lo[idx], hi[idx]
         gap = h - l
-        value = _crossing(grid, _need(view, "svm", combos, l, h), gap)
-        ilo = _crossing(grid, _need(view, "lo", combos, l, h), gap) if svm else value
-        ihi = _crossing(grid, _need(view, "hi", combos, l, h), gap) if svm else value
+        need = _need(view, "svm", combos, l, h)
+        value, k = _crossing(grid, need, gap)
+        cols = np.arange(idx.size)
+        k_cross[idx] = k
+        n_prev[idx] = np.where(k > 0, need[np.maximum(k - 1, 0), cols], np.nan)
+        n_at[idx] = need[np.maximum(k, 0), cols]
+        ilo = _crossing(grid, _need(view, "lo", combos, l, h), gap)[0] if svm else value
+        ihi = _crossing(grid, _need(view, "hi", combos, l, h), gap)[0] if svm else value
         if not op.closed:
             if op.iview is not None:
                 icombos, iflags = op.iview.scene_weights(noise, dt)
                 if all(iflags.values()):
-                    res["ideal"][idx] = _crossing(op.iview.contacts, _need(op.iview, op.ikind, icombos, l, h), gap)
+                    res["ideal"][idx] = _crossing(op.iview.contacts, _need(op.iview, op.ikind, icombos, l, h),
+                                                  gap)[0]
         res["value"][idx], res["low"][idx], res["high"][idx] = value, ilo, ihi
         res["in_grid"][idx] = True
         todo[idx] = True
@@ -336,54 +358,82 @@ def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool) -> None:
         res["ideal"][todo] = cached_ideal_min_contact(
             op.tab.sensor, lo[todo], hi[todo], ratio[todo], width=op.width, threshold=op.phi,
             max_contact_s=_table_route.CLOSED_FORM_MAX_CONTACT_S)
-    # the grid cell around a crossing, never below the ideal bound (as the scalar route)
-    v = res["value"]
-    has = ~np.isnan(v)
-    count = np.searchsorted(grid, np.where(has, v, 0.0) - 1e-12, side="left")
-    prev = np.where(count > 0, grid[np.maximum(count - 1, 0)], 0.0)
-    nxt = np.where(count < grid.size, grid[np.minimum(count, grid.size - 1)], v)
-    low = np.fmin(prev, np.fmin(res["low"], res["high"]))
-    low = np.where(np.isnan(res["ideal"]), low, np.maximum(low, res["ideal"]))
-    high = np.fmax(nxt, np.fmax(res["low"], res["high"]))
-    res["low"], res["high"] = np.where(has, low, res["low"]), np.where(has, high, res["high"])
+    # the scalar route's interval: an estimate where the crossing is interpolated between two tabulated needs
+    # (table.contact_estimate, the same function), else the grid cell, never below the ideal bound
+    raw, ideal = res["value"], res["ideal"]
+    est = (k_cross > 0) & ~np.isnan(n_prev) & ~np.isnan(raw)
+    cell = ~np.isnan(raw) & ~est
+    low, high = _nan(lo.size), _nan(lo.size)
+    value = raw.copy()
+    if est.any():
+        i = np.nonzero(est)[0]
+        r = _table_route.contact_estimate(
+            grid[k_cross[i] - 1], grid[k_cross[i]], n_prev[i], n_at[i], hi[i] - lo[i], raw[i], res["low"][i],
+            res["high"][i], ideal[i], width=op.width, svm=svm, z_table=_table_z(op), zc=zc)
+        value[i], low[i], high[i] = r["value"], r["low"], r["high"]
+    prev = np.where(k_cross > 0, grid[np.maximum(k_cross - 1, 0)], 0.0)
+    low = np.where(cell, np.where(np.isnan(ideal), prev, np.maximum(prev, ideal)), low)
+    high = np.where(cell, raw, high)
+    res["value"], res["low"], res["high"] = value, low, high
 
 
-def _max_ratio(view, kind: str, cw, lo, hi) -> tuple[np.ndarray, np.ndarray]:
-    """Per pair: largest sigma/dT that separates it, and where: 0 below, 1 inside, 2 above the grid."""
+_BELOW, _INSIDE, _ABOVE, _CELL = 0, 1, 2, 3  # where a largest separating ratio lies (the scalar route's words)
+
+
+def _max_ratio(view, kind: str, cw, lo, hi, *, gcw=None, shift: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """Per pair: largest sigma/dT that separates it, and where (``_BELOW`` ... ``_CELL``), as the scalar
+    route's ``_max_ratio``: ``gcw`` (log contact weights) for its geometric interpolant, ``shift``
+    subtracted from every tabulated need."""
     ratios = view.t.axes["noise_ratio"]
     logs = np.array([math.log(r) for r in ratios.tolist()])  # math.log, as the scalar route
     gap = hi - lo
     margins = []
-    for i in range(ratios.size):
-        nd = _at_contact(cw, _need(view, kind, [((i,), 1.0)], lo, hi))
-        margins.append(np.where(np.isnan(nd), -np.inf, gap - nd))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        for i in range(ratios.size):
+            per = _need(view, kind, [((i,), 1.0)], lo, hi)
+            if gcw is None:
+                nd = _at_contact(cw, per) - shift
+                margins.append(np.where(np.isnan(nd), -np.inf, gap - nd))
+                continue
+            total = np.zeros(lo.size)
+            bad = np.zeros(lo.size, dtype=bool)
+            for k, w in gcw:
+                if not w:
+                    continue
+                n = per[k] - shift
+                bad |= np.isnan(n) | (n <= 0)
+                total = total + w * np.log(n)
+            margins.append(np.where(bad, -np.inf, np.log(gap) - np.log(np.exp(total))))
     m = np.array(margins)  # [ratio, n]
     ok = m >= 0
     r_n = ratios.size
     last = r_n - 1 - np.argmax(ok[::-1], axis=0)
     cols = np.arange(lo.size)
-    m0 = m[last, cols]
-    m1 = m[np.minimum(last + 1, r_n - 1), cols]
+    nxt = np.minimum(last + 1, r_n - 1)
+    m0, m1 = m[last, cols], m[nxt, cols]
     with np.errstate(invalid="ignore", divide="ignore"):
         w = np.where(m0 != m1, m0 / (m0 - m1), 0.0)
-    nxt = np.minimum(last + 1, r_n - 1)
-    inside = np.where(np.isfinite(m1), np.exp(logs[last] + w * (logs[nxt] - logs[last])), ratios[last])
-    where = np.where(~ok[0], 0, np.where(last == r_n - 1, 2, 1))
-    r = np.where(where == 0, np.nan, np.where(where == 2, ratios[-1], inside))
+        inside = np.exp(logs[last] + w * (logs[nxt] - logs[last]))
+    where = np.where(~ok[0], _BELOW, np.where(last == r_n - 1, _ABOVE,
+                                              np.where(np.isfinite(m1), _INSIDE, _CELL)))
+    r = np.where(where == _BELOW, np.nan, np.where(where == _INSIDE, inside, ratios[last]))
     return r, where
 
 
-def _ratio(question, x, op, lo, hi, e_in, res, ideal_bound: bool) -> None:
+def _ratio(question, x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> None:
     view = op.view
-    if "noise_ratio" not in op.tab.axes:
+    ratios = view.t.axes["noise_ratio"] if "noise_ratio" in op.tab.axes else None
+    if ratios is None:
         from .inputs import TableMismatch
 
         raise TableMismatch(f"table {op.tab.name} has separate noise and temperature axes (varied initial "
                             f"conditions): it cannot answer {question}; the exact route can")
-
-    def to_answer(r, idx):
-        return r * np.abs(x["delta_t_c"][idx]) if question == "max-noise" else x["noise_c"][idx] / r
-
+    n = lo.size
+    svm = op.tab.fidelity == "svm"
+    r_all, where_all = _nan(n), np.full(n, -1)
+    ends = {"hi": _nan(n), "lo": _nan(n)}       # the Monte Carlo ends (sigma/dT), NaN: none
+    alt = {k: _nan(n) for k in ("c", "lin", "rnd", "geo")}  # the estimate's interpolants (NaN: not inside)
+    ri = _nan(n)
     for (contact,), idx in _groups(x["contact_s"]):
         cw, c_ok = _axis_weights(view.contacts, contact)
         if not c_ok:
@@ -394,38 +444,76 @@ def _ratio(question, x, op, lo, hi, e_in, res, ideal_bound: bool) -> None:
         l, h = lo[idx], hi[idx]
         out = {"svm": _max_ratio(view, "svm", cw, l, h)}
         for kind in ("lo", "hi"):
-            out[kind] = out["svm"] if op.tab.fidelity == "ideal" else _max_ratio(view, kind, cw, l, h)
-        if op.closed:
-            out["ideal"] = (_nan(idx.size), np.zeros(idx.size, dtype=int))  # filled below
-        elif op.iview is not None:
+            out[kind] = out["svm"] if not svm else _max_ratio(view, kind, cw, l, h)
+        if not op.closed and op.iview is not None:
             icw, _ = _axis_weights(op.iview.contacts, contact)
-            out["ideal"] = _max_ratio(op.iview, op.ikind, icw, l, h)
-        else:
-            out["ideal"] = (_nan(idx.size), np.zeros(idx.size, dtype=int))
+            r_i, w_i = _max_ratio(op.iview, op.ikind, icw, l, h)
+            ri[idx] = np.where(w_i == _BELOW, np.nan, r_i)
         r, where = out["svm"]
-        res["value"][idx] = np.where(where == 0, np.nan, to_answer(r, idx))
-        res["in_grid"][idx] = where != 2
-        ends = [np.where(out[k][1] == 0, np.nan, to_answer(out[k][0], idx)) for k in ("hi", "lo")]
-        both = ~np.isnan(ends[0]) & ~np.isnan(ends[1])
-        res["low"][idx] = np.where(both, np.fmin(*ends), ends[0])
-        res["high"][idx] = np.where(both, np.fmax(*ends), ends[1])
-        if not op.closed:
-            res["ideal"][idx] = np.where(out["ideal"][1] == 0, np.nan, to_answer(out["ideal"][0], idx))
-        else:
-            res["ideal"][idx] = -np.inf  # marks the elements whose closed-form bound is wanted
-    todo = res["ideal"] == -np.inf
-    res["ideal"][todo] = np.nan
-    if op.closed and ideal_bound and todo.any():
-        from .ideal_bound import cached_ideal_max_ratio
+        r_all[idx], where_all[idx] = r, where
+        ends["hi"][idx] = np.where(out["hi"][1] == _BELOW, np.nan, out["hi"][0])
+        # the optimistic end is open where it is separable beyond the grid (the scalar route's rule)
+        ends["lo"][idx] = np.where((out["lo"][1] == _BELOW) | (out["lo"][1] == _ABOVE), np.nan, out["lo"][0])
+        res["in_grid"][idx] = where != _ABOVE
+        est = where == _INSIDE
+        if svm and est.any():
+            w = op.width
+            gcw = _axis_weights(view.contacts, contact, log=True)[0]
+            j, le, he = idx[est], l[est], h[est]
+            for key, kw in (("c", dict(gcw=gcw, shift=0.5 * w)), ("lin", dict(shift=0.5 * w)),
+                            ("rnd", dict(gcw=gcw, shift=0.5 * w + w / math.sqrt(12))), ("geo", dict(gcw=gcw))):
+                a_r, a_w = _max_ratio(view, "svm", cw, le, he, **kw)
+                alt[key][j] = np.where(a_w == _INSIDE, a_r, np.nan)
+    if op.closed:
+        todo = where_all >= 0
+        if ideal_bound and todo.any():
+            from .ideal_bound import cached_ideal_max_ratio
 
-        ri = cached_ideal_max_ratio(op.tab.sensor, lo[todo], hi[todo], x["contact_s"][todo], width=op.width,
-                                    threshold=op.phi, bracket=_table_route.CLOSED_FORM_RATIO_BRACKET)
-        res["ideal"][todo] = to_answer(ri, np.nonzero(todo)[0])
+            ri[todo] = cached_ideal_max_ratio(op.tab.sensor, lo[todo], hi[todo], x["contact_s"][todo],
+                                              width=op.width, threshold=op.phi,
+                                              bracket=_table_route.CLOSED_FORM_RATIO_BRACKET)
+
+    def to_answer(r):
+        return r * np.abs(x["delta_t_c"]) if question == "max-noise" else x["noise_c"] / r
+
+    def ordered(r_low, r_high):  # the interval in the answer's units, low <= high
+        a, b = to_answer(r_low), to_answer(r_high)
+        return (a, b) if question == "max-noise" else (b, a)
+
+    low, high = _nan(n), _nan(n)
+    inside = where_all == _INSIDE
+    if svm and inside.any():  # the scalar route's estimate (table.ratio_estimate, the same function)
+        est = _table_route.ratio_estimate(r_all, alt["c"], alt["lin"], alt["rnd"], alt["geo"], ends["hi"], ends["lo"], ri,
+                                          z_table=_table_z(op), zc=zc)
+        a, b = ordered(est["low"], est["high"])
+        low, high = np.where(inside, a, low), np.where(inside, b, high)
+        r_all = np.where(inside, est["value"], r_all)
+    elif inside.any():  # an ideal-observer table: the Monte Carlo ends (both the answer)
+        mc = [to_answer(ends[k]) for k in ("hi", "lo")]
+        both = ~np.isnan(mc[0]) & ~np.isnan(mc[1])
+        low = np.where(inside, np.where(both, np.fmin(*mc), mc[0]), low)
+        high = np.where(inside, np.where(both, np.fmax(*mc), mc[1]), high)
+    cell = where_all == _CELL
+    if cell.any():  # a neighbour beyond the grid: the grid cell, up to the next ratio (or the bound)
+        k = np.searchsorted(ratios, np.where(cell, r_all, ratios[0]))
+        nxt = ratios[np.minimum(k + 1, ratios.size - 1)]
+        nxt = np.where(np.isnan(ri), nxt, np.minimum(nxt, ri))
+        a, b = ordered(r_all, nxt)
+        low, high = np.where(cell, a, low), np.where(cell, b, high)
+    above = where_all == _ABOVE  # separable beyond the largest ratio: a one-sided bound
+    v = to_answer(r_all)
+    if question == "max-noise":
+        low = np.where(above, v, low)
+    else:
+        high = np.where(above, v, high)
+    answered = where_all >= 0
+    res["value"] = np.where(answered & (where_all != _BELOW), v, np.nan)
+    res["low"], res["high"] = np.where(answered, low, np.nan), np.where(answered, high, np.nan)
+    res["ideal"] = np.where(answered, to_answer(ri), np.nan)
 
 
 def _distinguishable(x, op, lo, hi, e_in, res, ideal_bound: bool) -> None:
     view = op.view
-    svm = op.tab.fidelity == "svm"
     todo = np.zeros(lo.size, dtype=bool)
     for (contact, noise, dt), idx in _groups(x["contact_s"], x["noise_c"], x["delta_t_c"]):
         combos, flags = view.scene_weights(noise, dt)
@@ -441,9 +529,7 @@ def _distinguishable(x, op, lo, hi, e_in, res, ideal_bound: bool) -> None:
             nd = _at_contact(cw, _need(view, kind, combos, l, h))
             return (~np.isnan(nd) & (nd <= h - l)).astype(np.float64)
 
-        yes = verdict("svm")
-        res["value"][idx] = yes
-        res["low"][idx], res["high"][idx] = (verdict("hi"), verdict("lo")) if svm else (yes, yes)
+        res["value"][idx] = verdict("svm")  # no interval: a table holds delta(e), not the pair's F1 (NaN)
         res["in_grid"][idx] = True
         todo[idx] = True
     if not (ideal_bound and todo.any()):
@@ -466,11 +552,13 @@ def _distinguishable(x, op, lo, hi, e_in, res, ideal_bound: bool) -> None:
                                          model=op.model).f1
 
 
-def _table_delta_e(x: dict[str, np.ndarray], op, ideal_table) -> dict[str, np.ndarray]:
+def _table_delta_e(x: dict[str, np.ndarray], op, ideal_table, zc: float) -> dict[str, np.ndarray]:
     e = x["e"]
     n = e.size
     view = op.view
-    res = {k: _nan(n) for k in ("value", "low", "high", "ideal", "lower", "upper", "lower_ideal", "upper_ideal")}
+    svm = op.tab.fidelity == "svm"
+    res = {k: _nan(n) for k in ("value", "low", "high", "ideal", "lower", "upper", "lower_ideal", "upper_ideal",
+                                "lower_low", "lower_high", "upper_low", "upper_high")}
     res["in_grid"] = np.zeros(n, dtype=bool)
     e_in = (view.e_lo < e) & (e <= view.e_hi)
     iview, ikind = _table_route.delta_e_ideal_view(op, ideal_table)
@@ -489,15 +577,43 @@ def _table_delta_e(x: dict[str, np.ndarray], op, ideal_table) -> dict[str, np.nd
                 return _nan(xe.size)
             return _at_contact(cws, _delta(v, name, cmb, xe))
 
+        def at_geometric(v, cmb, cws, name):  # log delta interpolated (the scalar route's alternative)
+            total = np.zeros(xe.size)
+            bad = np.zeros(xe.size, dtype=bool)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                for k, w in cws:
+                    if w == 0:
+                        continue
+                    for i, wi in cmb:
+                        if not wi:
+                            continue
+                        y = _interp_rows(v.t.arrays[name][i][k:k + 1], v.centres, xe)[0]
+                        bad |= np.isnan(y) | (y <= 0)
+                        total = total + w * wi * np.log(y)
+                return np.where(bad, np.nan, np.exp(total))
+
         icombos = iview.scene_weights(noise, dt)[0] if iview is not None else []
         icw = _axis_weights(iview.contacts, contact)[0] if iview is not None else []
+        gcw = _axis_weights(view.contacts, contact, log=True)[0]
         for direction, side in (("down", "lower"), ("up", "upper")):
-            res[side][idx] = at(view, combos, cw, f"delta_{direction}")
+            val = at(view, combos, cw, f"delta_{direction}")
             iname = f"delta_{direction}_ideal" if ikind == "ideal" else f"delta_{direction}"
-            res[f"{side}_ideal"][idx] = at(iview, icombos, icw, iname)
+            ideal = at(iview, icombos, icw, iname)
+            res[side][idx], res[f"{side}_ideal"][idx] = val, ideal
+            if svm:  # the scalar route's interval (table.delta_estimate, the same function)
+                low, high = _table_route.delta_estimate(
+                    val, at(view, combos, cw, f"delta_{direction}_lo"), at(view, combos, cw, f"delta_{direction}_hi"),
+                    at_geometric(view, combos, gcw, f"delta_{direction}"), ideal, width=op.width,
+                    z_table=_table_z(op), zc=zc)
+                res[f"{side}_low"][idx] = np.where(np.isnan(val), np.nan, low)
+                res[f"{side}_high"][idx] = np.where(np.isnan(val), np.nan, high)
         res["in_grid"][idx] = True
     res["value"] = np.fmin(res["lower"], res["upper"])
     res["ideal"] = np.fmin(res["lower_ideal"], res["upper_ideal"])
+    # the interval of the direction giving the value (the lower one on a tie, as the scalar route)
+    lower = ~np.isnan(res["lower"]) & (np.isnan(res["upper"]) | (res["lower"] <= res["upper"]))
+    for end in ("low", "high"):
+        res[end] = np.where(lower, res.pop(f"lower_{end}"), res.pop(f"upper_{end}"))
     return res
 
 
@@ -551,11 +667,12 @@ def answer_arrays(question: str, scalar: Callable[..., Answer], route: str, argu
                                      others.get("ideal_table", _table_route.DEFAULT_IDEAL_TABLE),
                                      threshold=others.get("threshold"), sensor=others.get("sensor"),
                                      model=others.get("model"))
-        unknown = set(others) - {"table", "ideal_table", "threshold", "sensor", "model"}
+        unknown = set(others) - {"table", "ideal_table", "threshold", "sensor", "model", "coverage"}
         if unknown:
             raise InputError(f"{question} from a table takes no {', '.join(sorted(unknown))}")
-        res = (_table_pair(question, flat, op, ideal_bound) if pair
-               else _table_delta_e(flat, op, others.get("ideal_table", _table_route.DEFAULT_IDEAL_TABLE)))
+        zc = z_of_coverage(check_coverage(others.get("coverage", 0.9)))
+        res = (_table_pair(question, flat, op, ideal_bound, zc) if pair
+               else _table_delta_e(flat, op, others.get("ideal_table", _table_route.DEFAULT_IDEAL_TABLE), zc))
         res = {k: v.reshape(shape) for k, v in res.items()}
         table = op.tab.name
     else:

@@ -48,7 +48,7 @@ from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
 from .._validation import InputError, check_effusivity, check_positive, check_temperature
 from . import table as _table_route
@@ -277,6 +277,19 @@ def _axis_weights(vals: np.ndarray, x: float, *, log: bool = False):
     if pts is not None:
         return pts, True
     return [(0 if (x < vals[0] or (log and x <= 0)) else vals.size - 1, 1.0)], False
+
+
+def _scenes_in_grid(x: dict[str, np.ndarray], view, e_in: np.ndarray):
+    """Per distinct scene (contact, noise, dT) inside the table's grid: the scene, its weights on the scene
+    axes and on the contact axis, and the indices of its elements whose effusivities are inside the grid."""
+    for (contact, noise, dt), idx in _groups(x["contact_s"], x["noise_c"], x["delta_t_c"]):
+        combos, flags = view.scene_weights(noise, dt)
+        cw, c_ok = _axis_weights(view.contacts, contact)
+        if not (all(flags.values()) and c_ok):
+            continue
+        idx = idx[e_in[idx]]
+        if idx.size:
+            yield (contact, noise, dt), combos, cw, idx
 
 
 def _groups(*columns: np.ndarray):
@@ -515,14 +528,7 @@ def _ratio(question, x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> 
 def _distinguishable(x, op, lo, hi, e_in, res, ideal_bound: bool) -> None:
     view = op.view
     todo = np.zeros(lo.size, dtype=bool)
-    for (contact, noise, dt), idx in _groups(x["contact_s"], x["noise_c"], x["delta_t_c"]):
-        combos, flags = view.scene_weights(noise, dt)
-        cw, c_ok = _axis_weights(view.contacts, contact)
-        if not (all(flags.values()) and c_ok):
-            continue
-        idx = idx[e_in[idx]]
-        if not idx.size:
-            continue
+    for _, combos, cw, idx in _scenes_in_grid(x, view, e_in):
         l, h = lo[idx], hi[idx]
 
         def verdict(kind):
@@ -562,14 +568,7 @@ def _table_delta_e(x: dict[str, np.ndarray], op, ideal_table, zc: float) -> dict
     res["in_grid"] = np.zeros(n, dtype=bool)
     e_in = (view.e_lo < e) & (e <= view.e_hi)
     iview, ikind = _table_route.delta_e_ideal_view(op, ideal_table)
-    for (contact, noise, dt), idx in _groups(x["contact_s"], x["noise_c"], x["delta_t_c"]):
-        combos, flags = view.scene_weights(noise, dt)
-        cw, c_ok = _axis_weights(view.contacts, contact)
-        if not (all(flags.values()) and c_ok):
-            continue
-        idx = idx[e_in[idx]]
-        if not idx.size:
-            continue
+    for (contact, noise, dt), combos, cw, idx in _scenes_in_grid(x, view, e_in):
         xe = e[idx]
 
         def at(v, cmb, cws, name):

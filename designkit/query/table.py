@@ -121,6 +121,7 @@ class _View:
         self.scene_axes = [n for n in table.axis_names if n not in ("contact_s", "e_ref")]
         self.e_lo = float(table.header["effusivity"]["min"])
         self.e_hi = float(table.header["effusivity"]["max"])
+        self._needs: dict[tuple, float] = {}  # need() is a function of its arguments: asked again, not recomputed
 
     # ---- scene axes -> weights
     def scene_weights(self, noise_c: float, delta_t_c: float) -> tuple[list[tuple[tuple[int, ...], float]], dict[str, bool]]:
@@ -158,6 +159,16 @@ class _View:
 
     def need(self, kind: str, combos, k: int, lo: float, hi: float) -> float:
         """Distance needed to separate lo < hi at contact index k (NaN: not within the grid)."""
+        key = (kind, tuple(combos), k, lo, hi)
+        hit = self._needs.get(key)
+        if hit is not None:
+            return hit
+        if len(self._needs) >= 65536:
+            self._needs.clear()
+        self._needs[key] = value = self._need(kind, combos, k, lo, hi)
+        return value
+
+    def _need(self, kind: str, combos, k: int, lo: float, hi: float) -> float:
         suffix = {"svm": "", "lo": "_lo", "hi": "_hi", "ideal": "_ideal"}[kind]
         up_name, down_name = f"delta_up{suffix}", f"delta_down{suffix}"
         if up_name not in self.t.arrays:  # ideal tables carry only delta_up / delta_down

@@ -70,22 +70,30 @@ def compare(new, old) -> dict:
             v_old = _upper(old.arrays[f"delta_{d}"][a_old, b_old])
             n_lo = _upper(new.arrays[f"delta_{d}_lo"][a, b])
             n_hi = _upper(new.arrays[f"delta_{d}_hi"][a, b])
-            inside = (v >= lo) & (v <= hi)
-            overlap = (n_lo <= hi) & (lo <= n_hi)
-            counts["compared"] += v.size
-            counts["equal"] += int(np.sum(v == v_old))
-            counts["inside"] += int(inside.sum())
-            counts["explained"] += int(np.sum(~inside & overlap))
-            bad = np.flatnonzero(~inside & ~overlap)
-            counts["unexplained"] += bad.size
-            finite = np.isfinite(v) & np.isfinite(v_old)
-            if finite.any():
-                worst = max(worst, float(np.max(np.abs(v[finite] - v_old[finite]))) / width)
+            bad, w = _tally(counts, v, v_old, lo, hi, n_lo, n_hi, width)
+            worst = max(worst, w)
             for i in bad[:20]:
                 listed.append((noise_new[a], c_new[b], d, int(i), float(v[i]), float(lo[i]), float(hi[i]),
                                float(n_lo[i]), float(n_hi[i])))
     return {"points": len(points), "counts": counts, "worst_intervals": worst, "unexplained": listed,
             "fits_new": fits_new, "fits_old": fits_old}
+
+
+def _tally(counts: dict, v, v_old, lo, hi, n_lo, n_hi, width: float):
+    """Add one block of deltas to ``counts``: inside the old MC interval [lo, hi], outside but with the
+    new interval [n_lo, n_hi] overlapping it (explained), or neither. Returns the unexplained indices and
+    the largest finite difference from the old delta, in intervals."""
+    inside = (v >= lo) & (v <= hi)
+    overlap = (n_lo <= hi) & (lo <= n_hi)
+    counts["compared"] += v.size
+    counts["equal"] += int(np.sum(v == v_old))
+    counts["inside"] += int(inside.sum())
+    counts["explained"] += int(np.sum(~inside & overlap))
+    bad = np.flatnonzero(~inside & ~overlap)
+    counts["unexplained"] += bad.size
+    finite = np.isfinite(v) & np.isfinite(v_old)
+    worst = float(np.max(np.abs(v[finite] - v_old[finite]))) / width if finite.any() else 0.0
+    return bad, worst
 
 
 def compare_chunks(workdir: Path, old) -> dict:
@@ -118,18 +126,9 @@ def compare_chunks(workdir: Path, old) -> dict:
         v_old = _upper(old.arrays["delta_up"][a, b][rows])
         lo = _upper(old.arrays["delta_up_lo"][a, b][rows])
         hi = _upper(old.arrays["delta_up_hi"][a, b][rows])
-        inside = (v >= lo) & (v <= hi)
-        overlap = (np.minimum(n_lo, v) <= hi) & (lo <= np.maximum(n_hi, v))
         fits_new += ch.fits
-        counts["compared"] += v.size
-        counts["equal"] += int(np.sum(v == v_old))
-        counts["inside"] += int(inside.sum())
-        counts["explained"] += int(np.sum(~inside & overlap))
-        bad = np.flatnonzero(~inside & ~overlap)
-        counts["unexplained"] += bad.size
-        finite = np.isfinite(v) & np.isfinite(v_old)
-        if finite.any():
-            worst = max(worst, float(np.max(np.abs(v[finite] - v_old[finite]))) / width)
+        bad, w = _tally(counts, v, v_old, lo, hi, np.minimum(n_lo, v), np.maximum(n_hi, v), width)
+        worst = max(worst, w)
         for i in bad[:20]:
             listed.append((noise, contact, "up", int(rows[i]), float(v[i]), float(lo[i]), float(hi[i]),
                            float(n_lo[i]), float(n_hi[i])))

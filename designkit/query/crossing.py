@@ -31,6 +31,7 @@ Examples
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 from typing import Callable
@@ -54,6 +55,7 @@ def check_coverage(coverage: float) -> float:
     return c
 
 
+@functools.lru_cache(maxsize=64)  # asked on every answer, nearly always for the same coverage
 def z_of_coverage(coverage: float) -> float:
     """Two-sided standard normal quantile for ``coverage`` (1.645 for 0.9).
 

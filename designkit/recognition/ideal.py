@@ -64,6 +64,7 @@ __all__ = [
     "class_survival",
     "ideal_pair",
     "ideal_scores",
+    "log_ndtr_diff",
     "projection_noise",
     "score_llr",
 ]
@@ -228,8 +229,12 @@ def _log1mexp(x):
         return np.where(x > -math.log(2.0), np.log(-np.expm1(x)), np.log1p(-np.exp(x)))
 
 
-def _log_ndtr_diff(lo, hi):
-    """log(Phi(hi) - Phi(lo)) for lo <= hi, stable in both tails."""
+def log_ndtr_diff(lo, hi):
+    """log(Phi(hi) - Phi(lo)) for lo <= hi, stable in both tails (Phi: the standard normal CDF).
+
+    >>> round(float(log_ndtr_diff(40.0, 41.0)), 3)  # Phi(-40) - Phi(-41), far below double precision
+    -804.608
+    """
     lo, hi = np.broadcast_arrays(lo, hi)
     upper = lo > 0  # both in the upper tail: use Phi(-lo) - Phi(-hi)
     a = np.where(upper, -hi, lo)
@@ -255,7 +260,7 @@ def _loglik_sensor_integrated(Y0, Y1, YY, w, ta, m, S1, S2, mu_s, h_s, sigma):
     x_hat = u_dot_y / u_dot_u
     resid = r_dot_r - u_dot_y * x_hat
     scale = np.sqrt(u_dot_u) / sigma
-    log_mass = _log_ndtr_diff((mu_s - h_s - x_hat) * scale, (mu_s + h_s - x_hat) * scale)
+    log_mass = log_ndtr_diff((mu_s - h_s - x_hat) * scale, (mu_s + h_s - x_hat) * scale)
     return -resid / (2.0 * var) + 0.5 * np.log(2.0 * math.pi * var / u_dot_u) + log_mass - math.log(2.0 * h_s)
 
 

@@ -83,7 +83,7 @@ from .._validation import InputError, check_positive
 from ..models import get_model
 from ..objects import ObjectClass
 from ..sensor import Sensor
-from .ideal import class_survival
+from .ideal import class_survival, log_ndtr_diff
 
 __all__ = [
     "KEEP_TOUCHING",
@@ -255,17 +255,6 @@ def candidate_pieces(e_low: float, e_high: float, e_sensor: float) -> tuple[np.n
     return w_edges, np.log(np.diff(e_edges) / (hi - lo))
 
 
-def _log_phi_diff(hi, lo):
-    """log(Phi(hi) - Phi(lo)) for lo <= hi, stable in both tails."""
-    upper = lo > 0.0  # both in the upper tail: Phi(-lo) - Phi(-hi)
-    a = np.where(upper, -hi, lo)
-    b = np.where(upper, -lo, hi)
-    lb = special.log_ndtr(b)
-    d = special.log_ndtr(a) - lb  # <= 0
-    with np.errstate(divide="ignore"):
-        return lb + np.where(d > -math.log(2.0), np.log(-np.expm1(d)), np.log1p(-np.exp(d)))
-
-
 def log_marginals(v, s, candidates) -> np.ndarray:
     """Log marginal density ``l_j = log p(v | candidate j)`` of the projection, vectorized.
 
@@ -301,7 +290,7 @@ def log_marginals(v, s, candidates) -> np.ndarray:
             point = -0.5 * ((v - 0.5 * (w0 + w1)) / s) ** 2 - np.log(s) - LOG_SQRT_2PI
             if width > 0:
                 with np.errstate(divide="ignore", invalid="ignore"):
-                    spread = _log_phi_diff((w1 - v) / s, (w0 - v) / s) - math.log(width)
+                    spread = log_ndtr_diff((w0 - v) / s, (w1 - v) / s) - math.log(width)
                 term = np.where(width < POINT_PIECE * s, point, spread)
             else:
                 term = point

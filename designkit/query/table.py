@@ -52,6 +52,8 @@ from .inputs import (
 )
 
 __all__ = [
+    "axis_weights_flagged",
+    "table_z",
     "DEFAULT_IDEAL_TABLE",
     "CLOSED_FORM_MAX_CONTACT_S",
     "CLOSED_FORM_RATIO_BRACKET",
@@ -136,7 +138,7 @@ class _View:
         for name in self.scene_axes:
             vals = ax[name]
             scale = next(a["scale"] for a in self.t.header["axes"] if a["name"] == name)
-            pts, ok = _axis_weights(vals, wanted[name], log=scale == "log")
+            pts, ok = axis_weights_flagged(vals, wanted[name], log=scale == "log")
             coords.append(pts)
             flags[name] = ok
         combos = [((), 1.0)]
@@ -183,7 +185,8 @@ class _View:
         return all(self.e_lo < e <= self.e_hi for e in es)
 
 
-def _axis_weights(vals: np.ndarray, x: float, *, log: bool) -> tuple[list[tuple[int, float]], bool]:
+def axis_weights_flagged(vals: np.ndarray, x: float, *,
+                         log: bool = False) -> tuple[list[tuple[int, float]], bool]:
     """Weights of ``x`` on one axis (:func:`designkit.tables.lookup.axis_weights`, the one lookup),
     plus an in-grid flag; outside the grid the nearest end, flagged (nothing is extrapolated)."""
     pts = lookup.axis_weights(vals, x, log=log, grid=np.log(vals) if log and vals[0] > 0 else vals)
@@ -202,7 +205,7 @@ def _crossing(xs: Sequence[float], needs: Sequence[float], gap: float) -> tuple[
     return lookup.crossing(xs, needs, gap)
 
 
-def _table_z(tab: Table) -> float:
+def table_z(tab: Table) -> float:
     """The z (standard errors) of the table's Monte Carlo interval of delta(e) (its header; 2 if absent)."""
     return float(tab.header.get("z") or 2.0)
 
@@ -523,7 +526,7 @@ def _no_pair(question: str, op: _Opened, pq: PairQuestion, scene: dict, details:
 
 
 def _contact_weights(view: _View, contact_s: float) -> tuple[list[tuple[int, float]], bool]:
-    return _axis_weights(view.contacts, contact_s, log=False)
+    return axis_weights_flagged(view.contacts, contact_s, log=False)
 
 
 def _need_at_contact(view: _View, kind: str, combos, cw, lo: float, hi: float) -> float:
@@ -648,7 +651,7 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
             raw = value
             est = contact_estimate(grid[k_cross - 1], grid[k_cross], needs[k_cross - 1], needs[k_cross], hi - lo,
                                    raw, _arr(mc_interval[0]), _arr(mc_interval[1]), _arr(ideal), width=op.width,
-                                   svm=op.tab.fidelity == "svm", z_table=_table_z(op.tab),
+                                   svm=op.tab.fidelity == "svm", z_table=table_z(op.tab),
                                    zc=z_of_coverage(coverage))
             value, low, high = float(est["value"]), _opt(est["low"]), _opt(est["high"])
             interp, rounding = float(est["interp"]), float(est["rounding"])
@@ -680,7 +683,7 @@ def _max_ratio(view: _View, kind: str, contact_s: float, lo: float, hi: float, *
     ratios = view.t.axes["noise_ratio"]
     cw, _ = _contact_weights(view, contact_s)
     if geometric:
-        cw = _axis_weights(view.contacts, contact_s, log=True)[0]
+        cw = axis_weights_flagged(view.contacts, contact_s, log=True)[0]
 
     def margin(r_idx):
         if geometric:
@@ -794,7 +797,7 @@ def _ratio_question(question: str, e1, e2, m1, m2, objects, contact_s, noise_c, 
         ends = [math.nan if out[k][1] == "below" or (k == "lo" and out[k][1] == "above") else out[k][0]
                 for k in ("hi", "lo")]
         ri = out["ideal"][0] if out["ideal"][1] != "below" else None
-        est = ratio_estimate(raw, r_c, r_lin, r_rnd, r_geo, ends[0], ends[1], _arr(ri), z_table=_table_z(op.tab),
+        est = ratio_estimate(raw, r_c, r_lin, r_rnd, r_geo, ends[0], ends[1], _arr(ri), z_table=table_z(op.tab),
                              zc=z_of_coverage(coverage))
         r, r_low, r_high = float(est["value"]), _opt(est["low"]), _opt(est["high"])
         interp, rounding = float(est["interp"]), float(est["rounding"])
@@ -907,8 +910,8 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
             total += w * y
         return math.exp(total) if geometric else total
 
-    zc, z_t = z_of_coverage(coverage), _table_z(op.tab)
-    gcw = _axis_weights(view.contacts, contact, log=True)[0]
+    zc, z_t = z_of_coverage(coverage), table_z(op.tab)
+    gcw = axis_weights_flagged(view.contacts, contact, log=True)[0]
 
     sides = {}
     for direction, side in (("down", "lower"), ("up", "upper")):

@@ -269,22 +269,12 @@ def _at_contact(cw, per_contact: np.ndarray) -> np.ndarray:
     return np.where(bad, np.nan, total)
 
 
-def _axis_weights(vals: np.ndarray, x: float, *, log: bool = False):
-    """Weights and in-grid flag of one axis value (the scalar route's rule)."""
-    from ..tables import lookup
-
-    pts = lookup.axis_weights(vals, x, log=log, grid=np.log(vals) if log and vals[0] > 0 else vals)
-    if pts is not None:
-        return pts, True
-    return [(0 if (x < vals[0] or (log and x <= 0)) else vals.size - 1, 1.0)], False
-
-
 def _scenes_in_grid(x: dict[str, np.ndarray], view, e_in: np.ndarray):
     """Per distinct scene (contact, noise, dT) inside the table's grid: the scene, its weights on the scene
     axes and on the contact axis, and the indices of its elements whose effusivities are inside the grid."""
     for (contact, noise, dt), idx in _groups(x["contact_s"], x["noise_c"], x["delta_t_c"]):
         combos, flags = view.scene_weights(noise, dt)
-        cw, c_ok = _axis_weights(view.contacts, contact)
+        cw, c_ok = _table_route.axis_weights_flagged(view.contacts, contact)
         if not (all(flags.values()) and c_ok):
             continue
         idx = idx[e_in[idx]]
@@ -308,11 +298,6 @@ def _nan(n: int) -> np.ndarray:
 
 
 # ============================================================ the table route, vectorized
-def _table_z(op) -> float:
-    """The z (standard errors) of the table's Monte Carlo interval of delta(e) (its header; 2 if absent)."""
-    return float(op.tab.header.get("z") or 2.0)
-
-
 def _table_pair(question: str, x: dict[str, np.ndarray], op, ideal_bound: bool,
                 zc: float) -> dict[str, np.ndarray]:
     e1, e2 = x["e1"], x["e2"]
@@ -382,7 +367,7 @@ def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> None
         i = np.nonzero(est)[0]
         r = _table_route.contact_estimate(
             grid[k_cross[i] - 1], grid[k_cross[i]], n_prev[i], n_at[i], hi[i] - lo[i], raw[i], res["low"][i],
-            res["high"][i], ideal[i], width=op.width, svm=svm, z_table=_table_z(op), zc=zc)
+            res["high"][i], ideal[i], width=op.width, svm=svm, z_table=_table_route.table_z(op.tab), zc=zc)
         value[i], low[i], high[i] = r["value"], r["low"], r["high"]
     prev = np.where(k_cross > 0, grid[np.maximum(k_cross - 1, 0)], 0.0)
     low = np.where(cell, np.where(np.isnan(ideal), prev, np.maximum(prev, ideal)), low)
@@ -448,7 +433,7 @@ def _ratio(question, x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> 
     alt = {k: _nan(n) for k in ("c", "lin", "rnd", "geo")}  # the estimate's interpolants (NaN: not inside)
     ri = _nan(n)
     for (contact,), idx in _groups(x["contact_s"]):
-        cw, c_ok = _axis_weights(view.contacts, contact)
+        cw, c_ok = _table_route.axis_weights_flagged(view.contacts, contact)
         if not c_ok:
             continue
         idx = idx[e_in[idx]]
@@ -459,7 +444,7 @@ def _ratio(question, x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> 
         for kind in ("lo", "hi"):
             out[kind] = out["svm"] if not svm else _max_ratio(view, kind, cw, l, h)
         if not op.closed and op.iview is not None:
-            icw, _ = _axis_weights(op.iview.contacts, contact)
+            icw, _ = _table_route.axis_weights_flagged(op.iview.contacts, contact)
             r_i, w_i = _max_ratio(op.iview, op.ikind, icw, l, h)
             ri[idx] = np.where(w_i == _BELOW, np.nan, r_i)
         r, where = out["svm"]
@@ -471,7 +456,7 @@ def _ratio(question, x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> 
         est = where == _INSIDE
         if svm and est.any():
             w = op.width
-            gcw = _axis_weights(view.contacts, contact, log=True)[0]
+            gcw = _table_route.axis_weights_flagged(view.contacts, contact, log=True)[0]
             j, le, he = idx[est], l[est], h[est]
             for key, kw in (("c", dict(gcw=gcw, shift=0.5 * w)), ("lin", dict(shift=0.5 * w)),
                             ("rnd", dict(gcw=gcw, shift=0.5 * w + w / math.sqrt(12))), ("geo", dict(gcw=gcw))):
@@ -497,7 +482,7 @@ def _ratio(question, x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> 
     inside = where_all == _INSIDE
     if svm and inside.any():  # the scalar route's estimate (table.ratio_estimate, the same function)
         est = _table_route.ratio_estimate(r_all, alt["c"], alt["lin"], alt["rnd"], alt["geo"], ends["hi"], ends["lo"], ri,
-                                          z_table=_table_z(op), zc=zc)
+                                          z_table=_table_route.table_z(op.tab), zc=zc)
         a, b = ordered(est["low"], est["high"])
         low, high = np.where(inside, a, low), np.where(inside, b, high)
         r_all = np.where(inside, est["value"], r_all)
@@ -592,8 +577,8 @@ def _table_delta_e(x: dict[str, np.ndarray], op, ideal_table, zc: float) -> dict
                 return np.where(bad, np.nan, np.exp(total))
 
         icombos = iview.scene_weights(noise, dt)[0] if iview is not None else []
-        icw = _axis_weights(iview.contacts, contact)[0] if iview is not None else []
-        gcw = _axis_weights(view.contacts, contact, log=True)[0]
+        icw = _table_route.axis_weights_flagged(iview.contacts, contact)[0] if iview is not None else []
+        gcw = _table_route.axis_weights_flagged(view.contacts, contact, log=True)[0]
         for direction, side in (("down", "lower"), ("up", "upper")):
             val = at(view, combos, cw, f"delta_{direction}")
             iname = f"delta_{direction}_ideal" if ikind == "ideal" else f"delta_{direction}"
@@ -603,7 +588,7 @@ def _table_delta_e(x: dict[str, np.ndarray], op, ideal_table, zc: float) -> dict
                 low, high = _table_route.delta_estimate(
                     val, at(view, combos, cw, f"delta_{direction}_lo"), at(view, combos, cw, f"delta_{direction}_hi"),
                     at_geometric(view, combos, gcw, f"delta_{direction}"), ideal, width=op.width,
-                    z_table=_table_z(op), zc=zc)
+                    z_table=_table_route.table_z(op.tab), zc=zc)
                 res[f"{side}_low"][idx] = np.where(np.isnan(val), np.nan, low)
                 res[f"{side}_high"][idx] = np.where(np.isnan(val), np.nan, high)
         res["in_grid"][idx] = True

@@ -250,17 +250,12 @@ def _sidecar_rows(folder: Path) -> list[tuple[str, str, Any]]:
     return rows
 
 
-def _read_text(path: Path, what: str) -> str:
-    """The text of a UTF-8 file (a byte-order mark is allowed); InputError naming ``path`` otherwise."""
-    from .._schemas import read_text
-
-    return read_text(path, what)  # also refuses a FIFO, a device or a folder before reading
-
-
 def read_trial_csv(path: Path, material: str = "") -> Trial:
     """Read a trial CSV (the shared recordings' columns; passive and force optional)."""
+    from .._schemas import load_json, read_text, schemas, validate
+
     path = Path(path)
-    text = _read_text(path, "trial")
+    text = read_text(path, "trial")  # also refuses a FIFO, a device or a folder before reading
     header = next(csv.reader(io.StringIO(text, newline="")), None)
     if not header:
         raise InputError(f"trial {path} is empty")
@@ -287,13 +282,7 @@ def read_trial_csv(path: Path, material: str = "") -> Trial:
     meta: dict[str, Any] = {}
     side = path.with_suffix(".json")
     if side.is_file():
-        side_text = _read_text(side, "trial sidecar")
-        try:
-            meta = json.loads(side_text)
-        except ValueError:
-            raise InputError(f"trial sidecar {side} is not valid JSON") from None
-        from .._schemas import schemas, validate
-
+        meta = load_json(side, "trial sidecar")
         if not isinstance(meta, dict):
             raise InputError(f"trial sidecar {side}: expected a mapping of keys, got {type(meta).__name__}")
         validate(schemas()["sidecar"], {"designkit_trial": 1, **meta}, f"trial sidecar {side}")
@@ -307,8 +296,10 @@ def read_index_rows(index_csv: Path | str) -> list[dict[str, str]]:
 
     Raises InputError, with the path, when it cannot be read, is not UTF-8 or lacks those columns.
     """
+    from .._schemas import read_text
+
     index_csv = Path(index_csv)
-    reader = csv.DictReader(io.StringIO(_read_text(index_csv, "index"), newline=""))
+    reader = csv.DictReader(io.StringIO(read_text(index_csv, "index"), newline=""))
     rows = list(reader)
     if not {"file", "material"} <= set(reader.fieldnames or ()):
         raise InputError(f"index {index_csv} needs columns file and material")

@@ -150,7 +150,7 @@ def targets_from(names=(), set_name: str | None = None) -> list[Target]:
     out = []
     mats = list(list_materials(set=set_name)) if set_name else []
     for m in mats:
-        e = m.identified if m.identified is not None else None
+        e = m.identified
         out.append(Target(m.name, float(e), (float(m.e_min), float(m.e_max)), POINT_WIDTH)
                    if e else _range_target(m.name, (float(m.e_min), float(m.e_max))))
     for spec in names:

@@ -29,6 +29,8 @@ from collections import OrderedDict
 
 import numpy as np
 
+from ..sensor import last_sample_index
+
 __all__ = [
     "BOUND_CACHE_SIZE",
     "class_survival",
@@ -104,11 +106,6 @@ def _cumulative_g2(tau_s: float, rate_hz: float, n_max: int) -> np.ndarray:
     return np.cumsum(g * g)
 
 
-def _samples(contact_s, rate_hz: float) -> np.ndarray:
-    """Index of a touch's last sample (:func:`designkit.sensor.sample_times_s`'s rounding)."""
-    return np.floor(np.asarray(contact_s, dtype=np.float64) * rate_hz + 1e-9).astype(np.int64)
-
-
 def shape_norm(sensor, contact_s) -> np.ndarray:
     """``|g|``, the norm of the response shape over a touch's samples, vectorized over ``contact_s`` [s].
 
@@ -118,7 +115,7 @@ def shape_norm(sensor, contact_s) -> np.ndarray:
     >>> round(float(shape_norm(load_sensor("paper"), 2.0)), 4)
     2.6732
     """
-    n = _samples(contact_s, sensor.sample_rate_hz)
+    n = last_sample_index(contact_s, sensor.sample_rate_hz)
     cum = _cumulative_g2(float(sensor.tau_s), float(sensor.sample_rate_hz), int(max(np.max(n), 1)))
     return np.sqrt(cum[n])
 
@@ -286,7 +283,7 @@ def exact_ideal_min_contact(sensor, lo, hi, ratio, *, width: float = 80.0, thres
     """
     lo, hi, ratio = (np.asarray(x, dtype=np.float64) for x in np.broadcast_arrays(lo, hi, ratio))
     fs = float(sensor.sample_rate_hz)
-    n_max = int(_samples(max_contact_s, fs))
+    n_max = int(last_sample_index(max_contact_s, fs))
     cum = _cumulative_g2(float(sensor.tau_s), fs, max(n_max, 1))
 
     def ok(n):

@@ -37,10 +37,12 @@ __all__ = [
     "projection_noise",
     "cached_ideal_max_ratio",
     "cached_ideal_min_contact",
+    "cached_efficiency_min_contact",
     "clear_bound_cache",
     "exact_ideal_delta",
     "exact_ideal_max_ratio",
     "exact_ideal_min_contact",
+    "efficiency_min_contact",
     "ideal_f1",
     "shape_norm",
 ]
@@ -301,6 +303,87 @@ def exact_ideal_min_contact(sensor, lo, hi, ratio, *, width: float = 80.0, thres
     return np.where(top, b / fs, np.nan)
 
 
+def efficiency_min_contact(sensor, lo, hi, ratio, t0, t1, eff0, eff1, upper_s, *, width: float = 80.0,
+                           threshold: float = 0.9) -> np.ndarray:
+    """Shortest contact [s] for a classifier that needs ``eff(t)`` times the ideal observer's separation.
+
+    A classifier's *efficiency* ``eff(t) = delta_classifier(t) / delta_ideal(t)`` (>= 1) is the ratio of
+    the effusivity difference it needs to the ideal observer's at the same contact time. Given it at two
+    contact times (log-linear in log t between them, constant beyond; ``eff1`` alone where ``eff0`` is NaN;
+    never below 1: the ideal observer is a bound), the
+    classifier separates classes ``[lo, lo+w)`` and ``[hi, hi+w)`` once the ideal observer separates each
+    of them from a partner ``(hi - lo) / eff(t)`` away (upwards from ``lo`` and downwards from ``hi``,
+    the two directions a table's delta(e) has). This is the first sample time up to ``upper_s`` where
+    that holds (bisection on the sample count; ``upper_s`` where it never does), vectorized.
+
+    Parameters
+    ----------
+    sensor : Sensor
+    lo, hi : array_like
+        Lower edges of the two classes [J s^-1/2 K^-1 m^-2].
+    ratio : array_like
+        sigma/dT [-].
+    t0, t1 : array_like
+        Contact times [s] where the efficiency is known (``t0 < t1``).
+    eff0, eff1 : array_like
+        Efficiency there [-] (``eff0`` NaN: constant ``eff1``).
+    upper_s : array_like
+        Longest contact examined [s] (for example the table's crossing).
+    width, threshold : float
+        Class width [J s^-1/2 K^-1 m^-2] and F1 threshold.
+
+    Returns
+    -------
+    ndarray
+        Contact time [s].
+
+    Examples
+    --------
+    >>> from designkit.sensor import load_sensor
+    >>> s = load_sensor("paper")
+    >>> ideal = float(exact_ideal_min_contact(s, 20000.0, 35000.0, 0.005))
+    >>> float(efficiency_min_contact(s, 20000.0, 35000.0, 0.005, 1.0, 2.0, 1.0, 1.0, 4.0)) == ideal
+    True
+    >>> 1.2 < float(efficiency_min_contact(s, 20000.0, 35000.0, 0.005, 1.0, 2.0, float("nan"), 1.5, 4.0))
+    True
+    """
+    lo, hi, ratio, t0, t1, eff0, eff1, upper = (np.asarray(x, dtype=np.float64) for x in np.broadcast_arrays(
+        lo, hi, ratio, t0, t1, eff0, eff1, upper_s))
+    fs = float(sensor.sample_rate_hz)
+    b = last_sample_index(upper, fs)
+    a = np.zeros(b.shape, dtype=np.int64)  # n = 0: one sample at contact, no information
+    cum = _cumulative_g2(float(sensor.tau_s), fs, int(max(np.max(b), 1)))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        slope = np.where(np.isnan(eff0), 0.0, np.log(eff1 / eff0) / np.log(t1 / t0))
+
+    t_min, t_max = np.fmin(t0, t1), np.fmax(t0, t1)
+
+    def ok(n):
+        t = np.minimum(np.maximum(n / fs, t_min), t_max)  # constant beyond the two known points
+        with np.errstate(divide="ignore", invalid="ignore"):
+            g = (hi - lo) / np.maximum(eff1 * np.exp(slope * np.log(t / t1)), 1.0)  # no classifier beats the ideal
+            s = ratio / np.sqrt(cum[n])
+        up = _ok(sensor, lo, lo + g, width, s, threshold)
+        down = _ok(sensor, np.maximum(hi - g, 0.0), hi, width, s, threshold)
+        return up & down & (g > 0)
+
+    while np.any(b - a > 1):
+        mid = (a + b) // 2
+        good = ok(mid)
+        b, a = np.where(good, mid, b), np.where(good, a, mid)
+    return b / fs
+
+
+def cached_efficiency_min_contact(sensor, lo, hi, ratio, t0, t1, eff0, eff1, upper_s, *,
+                                  width: float = 80.0, threshold: float = 0.9) -> np.ndarray:
+    """:func:`efficiency_min_contact` through the per-process cache (same answers, same arguments)."""
+    def compute(*cols):
+        return efficiency_min_contact(sensor, *cols, width=width, threshold=threshold)
+    eff0 = np.where(np.isnan(eff0), eff1, eff0)  # the same answer (constant eff1), and a key NaN cannot spoil
+    return _cached("efficiency-min-contact", sensor, (lo, hi, ratio, t0, t1, eff0, eff1, upper_s),
+                   (float(width), float(threshold)), compute)
+
+
 def exact_ideal_max_ratio(sensor, lo, hi, contact_s, *, width: float = 80.0, threshold: float = 0.9,
                           bracket=(1e-6, 1.0), rel_tol: float = 1e-5) -> np.ndarray:
     """Ideal observer's largest sigma/dT [-] that still separates the classes, vectorized (log bisection).
@@ -370,15 +453,16 @@ def clear_bound_cache() -> None:
     _BOUNDS.clear()
 
 
-def _cached(kind: str, sensor, lo, hi, x, params: tuple, compute) -> np.ndarray:
-    """``compute(lo, hi, x)`` elementwise through the cache: the distinct misses in one vectorized call."""
-    lo, hi, x = (np.asarray(v, dtype=np.float64) for v in np.broadcast_arrays(lo, hi, x))
+def _cached(kind: str, sensor, columns: tuple, params: tuple, compute) -> np.ndarray:
+    """``compute(*columns)`` elementwise through the cache: the distinct misses in one vectorized call."""
+    cols = [np.asarray(v, dtype=np.float64) for v in np.broadcast_arrays(*columns)]
     head = (kind, float(sensor.effusivity), float(sensor.tau_s), float(sensor.sample_rate_hz)) + params
-    keys = [head + k for k in zip(lo.ravel().tolist(), hi.ravel().tolist(), x.ravel().tolist())]
+    width = len(cols)
+    keys = [head + k for k in zip(*(c.ravel().tolist() for c in cols))]
     missing = list(dict.fromkeys(k for k in keys if k not in _BOUNDS))
     if missing:
-        m = np.array([k[-3:] for k in missing], dtype=np.float64)
-        for k, v in zip(missing, compute(m[:, 0], m[:, 1], m[:, 2]).tolist()):
+        m = np.array([k[-width:] for k in missing], dtype=np.float64).reshape(len(missing), width)
+        for k, v in zip(missing, np.asarray(compute(*m.T)).tolist()):
             _BOUNDS[k] = v
     out = np.empty(len(keys))
     for i, k in enumerate(keys):
@@ -386,7 +470,7 @@ def _cached(kind: str, sensor, lo, hi, x, params: tuple, compute) -> np.ndarray:
         _BOUNDS.move_to_end(k)
     while len(_BOUNDS) > BOUND_CACHE_SIZE:
         _BOUNDS.popitem(last=False)
-    return out.reshape(lo.shape)
+    return out.reshape(cols[0].shape)
 
 
 def cached_ideal_min_contact(sensor, lo, hi, ratio, *, width: float = 80.0, threshold: float = 0.9,
@@ -402,7 +486,7 @@ def cached_ideal_min_contact(sensor, lo, hi, ratio, *, width: float = 80.0, thre
     def compute(a, b, r):
         return exact_ideal_min_contact(sensor, a, b, r, width=width, threshold=threshold,
                                        max_contact_s=max_contact_s)
-    return _cached("min-contact", sensor, lo, hi, ratio, (float(width), float(threshold), float(max_contact_s)),
+    return _cached("min-contact", sensor, (lo, hi, ratio), (float(width), float(threshold), float(max_contact_s)),
                    compute)
 
 
@@ -412,5 +496,5 @@ def cached_ideal_max_ratio(sensor, lo, hi, contact_s, *, width: float = 80.0, th
     def compute(a, b, c):
         return exact_ideal_max_ratio(sensor, a, b, c, width=width, threshold=threshold, bracket=bracket,
                                      rel_tol=rel_tol)
-    return _cached("max-ratio", sensor, lo, hi, contact_s,
+    return _cached("max-ratio", sensor, (lo, hi, contact_s),
                    (float(width), float(threshold), float(bracket[0]), float(bracket[1]), float(rel_tol)), compute)

@@ -77,6 +77,7 @@ __all__ = [
     "contact_area",
     "identify",
     "relative_force",
+    "residual_series",
     "score",
     "split_by_trial_set",
     "trial_sets",
@@ -1288,6 +1289,41 @@ def score(result: Identification, trials: Sequence[Trial], *,
     material's object temperature is free). Materials the fit did not see are
     refused (their e_o is unknown).
     """
+    data, r = _held_out(result, trials, object_temps)
+    names = result.names
+    out: dict[str, list[np.ndarray]] = {}
+    pos = 0
+    for g in data.groups:
+        out.setdefault(names[g.material], []).append(r[pos:pos + g.y.size])
+        pos += g.y.size
+    per = {n: float(np.sqrt(np.mean(np.concatenate(v) ** 2))) for n, v in out.items()}
+    per["all"] = float(np.sqrt(np.mean(r ** 2)))
+    return per
+
+
+def residual_series(result: Identification, trials: Sequence[Trial], *,
+                    object_temps: Mapping[str, Any] | None = None) -> list[tuple[str, np.ndarray, np.ndarray]]:
+    """Each touch's residual (prediction - reading) [degC] on its own grid, as :func:`score` computes it.
+
+    Returns
+    -------
+    list of (material, time_s, residual), in the order of ``trials``.
+    """
+    data, r = _held_out(result, trials, object_temps)
+    rows: dict[int, tuple[str, np.ndarray, np.ndarray]] = {}
+    pos = 0
+    for g in data.groups:
+        n, m = g.y.shape
+        block = r[pos:pos + n * m].reshape(n, m)
+        pos += n * m
+        for i, k in enumerate(g.trials):
+            rows[k] = (result.names[g.material], g.time_s, block[i])
+    return [rows[k] for k in range(len(trials))]
+
+
+def _held_out(result: Identification, trials: Sequence[Trial],
+              object_temps: Mapping[str, Any] | None) -> tuple[_Data, np.ndarray]:
+    """(prepared data, residuals) of an identified model on touches, each with its own nuisances."""
     names = result.names
     unknown = sorted({tr.material for tr in trials} - set(names))
     if unknown:
@@ -1311,14 +1347,7 @@ def score(result: Identification, trials: Sequence[Trial], *,
         x = np.concatenate([glob, sol.x])
         prob.stride = 1
     r, _ = prob.project(x)
-    out: dict[str, list[np.ndarray]] = {}
-    pos = 0
-    for g in data.groups:
-        out.setdefault(names[g.material], []).append(r[pos:pos + g.y.size])
-        pos += g.y.size
-    per = {n: float(np.sqrt(np.mean(np.concatenate(v) ** 2))) for n, v in out.items()}
-    per["all"] = float(np.sqrt(np.mean(r ** 2)))
-    return per
+    return data, r
 
 
 # ------------------------------------------------------------ comparison

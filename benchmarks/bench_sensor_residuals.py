@@ -90,7 +90,8 @@ def main() -> None:
         print(f"\nwrote {args.figure}")
     if args.json:
         args.json.write_text(json.dumps({"selected": cmp.selected, "table": rows, "windows_s": WINDOWS_S,
-                                         "window_rms_c": windows, "total_s": wall}, indent=1))
+                                         "window_rms_c": windows, "total_s": wall}, indent=1,
+                                        default=lambda o: o.item() if hasattr(o, "item") else str(o)))
 
 
 def _figure(series, shown, path: Path) -> None:

@@ -175,7 +175,8 @@ def test_sim_to_real_with_the_identified_model_beats_the_paper(robot_data_dir):
     test = touches.select(~np.isin(touches.trial_set, CALIBRATION_SETS))
     setup = calibrate_model(touches)       # cold wood: wood at the temperature its passive thermistor reads
     assert setup.rms_c < 0.05                                   # chosen before testing: the fit's residual
-    r = sim_to_real(test, setup, setup.rms_c, per_trial=2, seed=0)
+    pool = touches.select(np.isin(touches.trial_set, CALIBRATION_SETS))   # forces of the calibration touches
+    r = sim_to_real(test, setup, setup.rms_c, per_trial=2, seed=0, force_pool=pool)
     assert r["mean_f1"] >= 0.90 and r["multiclass"]["accuracy"] >= 0.80, r
     assert r["pairs"]["wood vs cold wood"]["f1"] >= 0.95
     # the cooled block's temperature read from the passive channel alone is far below its end reading

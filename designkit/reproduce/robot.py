@@ -270,12 +270,20 @@ def _baseline(trial) -> tuple[float, float]:
     return float(ts0), float(slope)
 
 
-def _touch_curves(ident, material: str, trial, time_s: np.ndarray):
-    """(v, b) of ``material`` for one touch on ``time_s``: its own force where the model uses it."""
+def _touch_curves(ident, material: str, trial, time_s: np.ndarray, pressed=None):
+    """(v, b) of ``material`` for one touch on ``time_s``: its own force where the model uses it.
+
+    ``pressed``: touches (Trial) whose forces to use instead, one reading each.
+    """
     from ..calibration.identify import relative_force
 
-    force = relative_force(trial) if ident.candidate.force_area else None
-    return ident.reading(time_s, material, force=force, force_time_s=trial.time_s, drift=True)
+    if not ident.candidate.force_area:
+        return ident.reading(time_s, material, drift=True)
+    if pressed is None:
+        return ident.reading(time_s, material, force=relative_force(trial), force_time_s=trial.time_s, drift=True)
+    grid = pressed[0].time_s
+    force = np.array([np.interp(grid, p.time_s, relative_force(p)) for p in pressed])
+    return ident.reading(time_s, material, force=force, force_time_s=grid, drift=True)
 
 
 def _passive_response(ident, cal: RealTouches, material: str, like: str) -> np.ndarray:
@@ -359,7 +367,7 @@ def calibrate_model(touches: RealTouches, *, candidate: str = SIM_MODEL,
 
 
 def _simulate_model(test: RealTouches, setup: SimToRealSetup, noise_c: float, per_trial: int,
-                    seed: int, passive: bool = False):
+                    seed: int, passive: bool = False, force_pool: RealTouches | None = None):
     """Simulated touches from an identified model: each test touch's own initial state, host-smoothed noise.
 
     A test touch's own state: Ts0 and the sensor's drift (a line through its pre-contact samples), To
@@ -402,6 +410,9 @@ def _simulate_model(test: RealTouches, setup: SimToRealSetup, noise_c: float, pe
                 v, b = ident.reading(test.time_s, mat, conductance_factor=np.exp(rng.normal(mu, sd, per_trial)),
                                      force=relative_force(tr) if ident.candidate.force_area else None,
                                      force_time_s=tr.time_s, drift=True)
+            elif force_pool is not None and ident.candidate.force_area:
+                pressed = [force_pool.trials[j] for j in rng.integers(0, force_pool.material.size, per_trial)]
+                v, b = _touch_curves(ident, mat, tr, test.time_s, pressed)
             else:
                 v, b = _touch_curves(ident, mat, tr, test.time_s)
                 v, b = np.broadcast_to(v, (per_trial, v.size)), np.broadcast_to(b, (per_trial, b.size))
@@ -451,8 +462,11 @@ def _simulate_like(test: RealTouches, setup: SimToRealSetup, noise_c: float, per
 
 
 def sim_to_real(test: RealTouches, setup: SimToRealSetup, noise_c: float, *, per_trial: int, seed: int,
-                object_temp: str = "passive", two_sensor: bool = False) -> dict:
+                object_temp: str = "passive", two_sensor: bool = False, force_pool: RealTouches | None = None) -> dict:
     """Train on simulated touches, test on the real ones: binary F1 per pair and the 3-class confusion.
+
+    ``force_pool``: for a model whose contact area follows the force, each simulated touch presses with
+    the force of a touch drawn from these (e.g. the calibration touches) instead of its test touch's own.
 
     ``two_sensor``: the passive thermistor is a second sensor (its simulated and real readings join
     the heated sensor's, :func:`designkit.recognition.two_sensor.two_sensor_features`); needs an
@@ -470,12 +484,13 @@ def sim_to_real(test: RealTouches, setup: SimToRealSetup, noise_c: float, *, per
         if setup.identification is None or test.object_c is None or not np.isfinite(test.object_c).all():
             raise InputError("two-sensor sim-to-real needs an identified model and a passive channel in every "
                              "recording")
-        sim, labels, psim = _simulate_model(test, setup, noise_c, per_trial, seed, passive=True)
+        sim, labels, psim = _simulate_model(test, setup, noise_c, per_trial, seed, passive=True,
+                                            force_pool=force_pool)
         Xs = two_sensor_features(sim, psim, fs)
         Xr = two_sensor_features(test.sensor_c, test.object_c, fs)
     else:
         if setup.identification is not None:
-            sim, labels = _simulate_model(test, setup, noise_c, per_trial, seed)
+            sim, labels = _simulate_model(test, setup, noise_c, per_trial, seed, force_pool=force_pool)
         else:
             sim, labels = _simulate_like(test, setup, noise_c, per_trial, seed, object_temp)
         Xs = feature_matrix(sim, fs)
@@ -528,7 +543,7 @@ def _cold_wood_text(test: RealTouches, main: dict, end: dict, rms: float) -> str
         f"({w_cold_e} of {n_w} wood touches misread as cold wood) but is still far warmer than the real one "
         f"({cw_metal_e} of {n_cw} cold-wood touches classified as metal). The passive thermistor approaches the "
         f"block's surface temperature slowly: read through its own response, calibrated on the cold-wood touches "
-        f"of the calibration sets (the identified model's rows below), it gives the object temperature the "
+        f"of the calibration sets (the identified model's rows of the table above), it gives the object temperature the "
         f"simulator needs.")
 
 
@@ -670,6 +685,7 @@ def section_sim_to_real(ctx: Context) -> SectionResult:
     end = sim_to_real(test, setup, rms, per_trial=per_trial, seed=seed, object_temp="passive-end")
     ctx.step(4, 4)
     identified = []  # the identified sensor model (docs/sensor-models.md), noise = its residual on calibration
+    pool = touches.select(np.isin(touches.trial_set, CALIBRATION_SETS))   # simulated touches press as these did
     for label, cold in ((f"identified {SIM_MODEL}; cold wood = wood at the temperature its passive thermistor "
                          f"reads through that thermistor's calibrated response", "passive-response"),
                         (f"identified {SIM_MODEL}; cold wood calibrated as its own class (its passive end "
@@ -679,13 +695,13 @@ def section_sim_to_real(ctx: Context) -> SectionResult:
         except InputError as exc:  # pragma: no cover - reported, not fatal
             identified.append((label, None, str(exc)))
             continue
-        identified.append((label, sim_to_real(test, msetup, msetup.rms_c, per_trial=per_trial, seed=seed),
-                           msetup))
+        identified.append((label, sim_to_real(test, msetup, msetup.rms_c, per_trial=per_trial, seed=seed,
+                                              force_pool=pool), msetup))
         if cold == "passive-response" and test.object_c is not None and np.isfinite(test.object_c).all():
             identified.append((f"identified {SIM_MODEL}, **two sensors**: the passive thermistor's readings join "
                                "the heated sensor's (recognition.two_sensor)",
                                sim_to_real(test, msetup, msetup.rms_c, per_trial=per_trial, seed=seed,
-                                           two_sensor=True), msetup))
+                                           two_sensor=True, force_pool=pool), msetup))
     fig = _confusion_figure(ctx, [(f"sim-to-real, σ = {rms:.3f} °C", main["multiclass"]["confusion"]),
                                   ("sim-to-real, cold wood at its passive end reading", end["multiclass"]["confusion"])],
                             CLASSES, "sim_to_real_confusion")
@@ -714,14 +730,23 @@ def section_sim_to_real(ctx: Context) -> SectionResult:
         f"Training: {per_trial} simulated touches per real test touch ({test.material.size} touches of trial sets "
         f"5-20, never used by calibration), each with that touch's own Ts0 (sensor before contact) and Ta "
         f"(passive channel before contact), white noise σ. Test: the real touches. Features and SVM as the paper; "
-        f"F1 with the higher-effusivity (or the cold) class positive.",
+        f"F1 with the higher-effusivity (or the cold) class positive. The identified model's rows: each simulated "
+        f"touch takes its test touch's Ts0 and drift (a line through its samples from 1 s to 0.25 s before "
+        f"contact) and its object temperature from the passive channel (metal and wood: before contact; cold "
+        f"wood: its curve over {PASSIVE_WINDOW_S[0]:g}-{PASSIVE_WINDOW_S[1]:g} s through the passive thermistor's "
+        f"response calibrated on the cold-wood touches of the calibration sets), presses with the force of a "
+        f"calibration touch drawn at random (the contact area follows it), and gets host-smoothed noise.",
         "",
         md_table(["training noise"] + pair_names + ["mean F1", "3-class accuracy"], rows, align="l" + "r" * 5),
         "",
         f"Headline: mean F1 **{main['mean_f1']:.3f}** over the three pairs ({main['percent_indistinguishable']:.0f} % "
         f"of pairs below 0.9); the paper: {REAL_ROBOT['sim_to_real_f1']:g} over its 66 pairs "
         f"({REAL_ROBOT['sim_to_real_indistinguishable_percent']:g} % indistinguishable) with σ chosen as the best "
-        f"of the same grid on the test data.",
+        f"of the same grid on the test data."
+        + "".join(f" With the identified {SIM_MODEL} sensor ({'two sensors' if r['two_sensor'] else 'one sensor'}): "
+                  f"mean F1 **{r['mean_f1']:.3f}**, 3-class accuracy **{r['multiclass']['accuracy']:.3f}**, wood vs "
+                  f"cold wood {r['pairs']['wood vs cold wood']['f1']:.3f}."
+                  for label, r, _ in identified[:2] if r is not None),
         "",
         f"![sim-to-real confusion]({fig})",
         "",

@@ -76,7 +76,7 @@ def main() -> None:
     shown = [lab for lab in SHOWN if lab != cmp.selected] + [cmp.selected]
     series = {lab: residual_series(next(r for r in cmp.results if r.candidate.label == lab), held) for lab in shown}
     windows = {}
-    print(f"\nheld-out RMS [degC] by window of the touch (s after the detected onset)")
+    print("\nheld-out RMS [degC] by window of the touch (s after the detected onset)")
     print(f"{'model':34s} {'material':9s} " + " ".join(f"{f'{a:g}..{b:g}':>8s}" for a, b in WINDOWS_S))
     for lab in shown:
         for mat in ("metal", "wood"):

@@ -543,8 +543,8 @@ def _cold_wood_text(test: RealTouches, main: dict, end: dict, rms: float) -> str
         f"({w_cold_e} of {n_w} wood touches misread as cold wood) but is still far warmer than the real one "
         f"({cw_metal_e} of {n_cw} cold-wood touches classified as metal). The passive thermistor approaches the "
         f"block's surface temperature slowly: read through its own response, calibrated on the cold-wood touches "
-        f"of the calibration sets (the identified model's rows of the table above), it gives the object temperature the "
-        f"simulator needs.")
+        f"of the calibration sets (the identified model's rows of the table above), it gives the object "
+        f"temperature the simulator needs.")
 
 
 def _calibration_text(setup: "SimToRealSetup") -> str:

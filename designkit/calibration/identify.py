@@ -158,8 +158,10 @@ class Candidate:
         the drift goes on on the sensor's side of the contact: the baseline
         ``Ts0`` becomes ``Ts0 + s_i t`` in ``T = (Ts0 + s_i t)(1 - u) + To u``
         (smoothed as a whole when ``smoothing``), ``s_i`` [degC/s] one more
-        per-touch linear coefficient beside ``Ts0_i`` (closed form; an initial
-        condition of the touch like ``Ts0_i``, fitted on held-out touches too).
+        per-touch linear coefficient beside ``Ts0_i`` (closed form, fitted to the
+        whole touch like ``Ts0_i``, on held-out touches too; on the shared
+        recordings it is a slow trend of the touch, not the rate measured
+        before contact: docs/sensor-models.md).
     force_area : bool
         The contact area grows with the touch's own force while the finger
         presses in: the reading is the area-weighted sum of step responses

@@ -287,3 +287,20 @@ def test_real_touches_drift_and_force_area_reach_the_held_out_target(robot_data_
     assert held_rms["metal"] <= 0.05 and held_rms["wood"] <= 0.05, held_rms
     assert res.consistent and res.effusivity.ci95[0] < res.effusivity.value < res.effusivity.ci95[1]
     assert not res.ratios["metal"].note.startswith("at the search limit")   # metal informs e_s again
+
+
+def test_passive_object_temp_reads_the_object_through_the_passive_response():
+    """A passive channel approaching To along a known response gives To back, from that channel alone."""
+    from designkit.reproduce.robot import RealTouches, passive_object_temp
+
+    t = np.arange(801) / 200.0
+    w = 1.0 - np.exp(-t / 9.0)                      # a slow thermistor: 36 % of the way at 4 s
+    tp0 = np.array([21.7, 22.4, 22.6])
+    to = np.array([8.0, 22.4, 30.0])
+    passive = tp0[:, None] + (to - tp0)[:, None] * w
+    n = to.size
+    touches = RealTouches(np.array(["cold_wood", "wood", "warm"]), np.ones(n, int), ("a", "b", "c"), t,
+                          np.zeros((n, t.size)), np.full(n, 29.5), tp0, passive[:, -1], (None,) * n, passive)
+    got = passive_object_temp(touches, w)
+    assert got == pytest.approx(to, abs=1e-9)
+    assert passive[0, -1] - got[0] > 8.0 and got[2] - passive[2, -1] > 4.0   # the end reading is far off

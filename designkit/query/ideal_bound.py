@@ -347,8 +347,10 @@ def efficiency_min_contact(sensor, lo, hi, ratio, t0, t1, eff0, eff1, upper_s, *
     >>> 1.2 < float(efficiency_min_contact(s, 20000.0, 35000.0, 0.005, 1.0, 2.0, float("nan"), 1.5, 4.0))
     True
     """
-    lo, hi, ratio, t0, t1, eff0, eff1, upper = (np.asarray(x, dtype=np.float64) for x in np.broadcast_arrays(
-        lo, hi, ratio, t0, t1, eff0, eff1, upper_s))
+    cols = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64) for x in (lo, hi, ratio, t0, t1, eff0, eff1,
+                                                                            upper_s)))
+    shape = cols[0].shape
+    lo, hi, ratio, t0, t1, eff0, eff1, upper = (c.ravel() for c in cols)
     fs = float(sensor.sample_rate_hz)
     b = last_sample_index(upper, fs)
     a = np.zeros(b.shape, dtype=np.int64)  # n = 0: one sample at contact, no information
@@ -363,15 +365,16 @@ def efficiency_min_contact(sensor, lo, hi, ratio, t0, t1, eff0, eff1, upper_s, *
         with np.errstate(divide="ignore", invalid="ignore"):
             g = (hi - lo) / np.maximum(eff1 * np.exp(slope * np.log(t / t1)), 1.0)  # no classifier beats the ideal
             s = ratio / np.sqrt(cum[n])
-        up = _ok(sensor, lo, lo + g, width, s, threshold)
-        down = _ok(sensor, np.maximum(hi - g, 0.0), hi, width, s, threshold)
-        return up & down & (g > 0)
+        # both directions in one vectorized call (each element's decision is independent of the others)
+        both = _ok(sensor, np.concatenate([lo, np.maximum(hi - g, 0.0)]), np.concatenate([lo + g, hi]), width,
+                   np.concatenate([s, s]), threshold)
+        return both[:lo.size] & both[lo.size:] & (g > 0)
 
     while np.any(b - a > 1):
         mid = (a + b) // 2
         good = ok(mid)
         b, a = np.where(good, mid, b), np.where(good, a, mid)
-    return b / fs
+    return (b / fs).reshape(shape)
 
 
 def cached_efficiency_min_contact(sensor, lo, hi, ratio, t0, t1, eff0, eff1, upper_s, *,

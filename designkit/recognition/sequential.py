@@ -340,7 +340,9 @@ def _log_marginals_1(v: float, s: float, candidates) -> list[float]:
 
     Pieces more than :data:`FAR_PIECES` projection noises beyond the nearest piece are skipped
     (the C export skips the same ones), which makes a wide material cost a few pieces per sample
-    once the evidence is sharp.
+    once the evidence is sharp. Central pieces (both ends within :data:`CENTRAL` noises) are summed
+    in linear space, density times probability, and enter the log-sum-exp as one term: one special
+    function per piece instead of three (the C update's cost per sample for wide materials).
     """
     out = []
     for c in candidates:
@@ -348,6 +350,7 @@ def _log_marginals_1(v: float, s: float, candidates) -> list[float]:
         edges = c.w_edges
         near = _near_pieces(v, s, edges)
         cached_k, cached_phi = -1, 0.0  # Phi at the last edge used: shared by neighbouring pieces
+        central = 0.0  # the central pieces' sum, in linear space (no log and exp per piece)
         for m, lm in enumerate(c.log_mass):
             w0, w1 = edges[m], edges[m + 1]
             if w0 - v > near or v - w1 > near:
@@ -364,7 +367,8 @@ def _log_marginals_1(v: float, s: float, candidates) -> list[float]:
                 p_lo = cached_phi if cached_k == m else 0.5 * math.erfc(-lo / _SQRT2)
                 p_hi = 0.5 * math.erfc(-hi / _SQRT2)
                 cached_k, cached_phi = m + 1, p_hi
-                term = math.log(p_hi - p_lo) - math.log(width)
+                central += math.exp(lm - math.log(width)) * (p_hi - p_lo)  # the piece's density x probability
+                continue
             else:
                 a, b = (-hi, -lo) if lo > 0.0 else (lo, hi)
                 lb = _log_ndtr_1(b)
@@ -375,6 +379,8 @@ def _log_marginals_1(v: float, s: float, candidates) -> list[float]:
                     term = lb + (math.log(-math.expm1(d)) if d > -_LOG2 else math.log1p(-math.exp(d))) \
                         - math.log(width)
             terms.append(lm + term)
+        if central > 0.0:
+            terms.append(math.log(central))
         if len(terms) == 1:
             out.append(terms[0])
         else:

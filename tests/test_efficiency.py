@@ -91,3 +91,34 @@ def test_entry_noise_is_measured_on_the_table_and_positive():
     sd = view.entry_noise(combos)
     assert 0.005 < sd < 0.5  # a few per cent of scatter between neighbouring tabulated needs
     assert view.entry_noise(combos) == sd  # cached, a pure function of the slice
+
+
+@pytest.mark.parametrize("e,contact", [(20000.0, 1.25), (5000.0, 2.5), (30000.0, 0.75)])
+def test_delta_e_of_a_classifier_as_good_as_the_ideal_observer_is_the_exact_ideal_delta(ideal_as_svm, e, contact):
+    from designkit.query import delta_e
+    from designkit.query.ideal_bound import exact_ideal_delta
+
+    width = float(ideal_as_svm.header["effusivity"]["width"])
+    ans = delta_e(e, contact_s=contact, noise_c=0.05, delta_t_c=10.0, table=ideal_as_svm, ideal_table=None)
+    assert ans.to_dict()["interval"]["method"] == "table-efficiency"
+    for side, sign in (("lower", -1), ("upper", +1)):
+        s = ans.details[side]
+        if s["value"] is None:
+            continue
+        exact = float(exact_ideal_delta(PAPER, ans.details["e"], contact, 0.005, direction=sign, width=width))
+        assert s["efficiency"] == pytest.approx(1.0)
+        assert s["value"] == pytest.approx(exact, rel=1e-12) and s["ideal"] == pytest.approx(exact, rel=1e-12)
+        assert s["interval"][0] <= s["value"] <= s["interval"][1]
+    assert ans.ideal_bound.method == "closed-form"
+
+
+def test_delta_e_from_the_shipped_table_states_an_exact_bound_below_it():
+    from designkit.query import delta_e
+
+    ans = delta_e(20000.0, contact_s=1.75, noise_c=0.05)
+    assert ans.to_dict()["interval"]["method"] == "table-efficiency" and ans.ideal_bound.method == "closed-form"
+    for side in ("lower", "upper"):
+        s = ans.details[side]
+        assert s["ideal"] <= s["interval"][0] <= s["value"] <= s["interval"][1]
+        # the arrays' own (interpolated, grid-rounded) value is kept beside the estimate
+        assert s["table_value"] > 0 and s["efficiency"] > 1.0

@@ -38,6 +38,7 @@ __all__ = [
     "cached_ideal_max_ratio",
     "cached_ideal_min_contact",
     "cached_efficiency_min_contact",
+    "cached_ideal_delta",
     "clear_bound_cache",
     "exact_ideal_delta",
     "exact_ideal_max_ratio",
@@ -491,6 +492,21 @@ def cached_ideal_min_contact(sensor, lo, hi, ratio, *, width: float = 80.0, thre
                                        max_contact_s=max_contact_s)
     return _cached("min-contact", sensor, (lo, hi, ratio), (float(width), float(threshold), float(max_contact_s)),
                    compute)
+
+
+def cached_ideal_delta(sensor, e, contact_s, ratio, direction, *, width: float = 80.0, threshold: float = 0.9,
+                       e_max: float = 40000.0, tol: float = 0.5) -> np.ndarray:
+    """:func:`exact_ideal_delta` through the per-process cache, ``direction`` (+1 / -1) elementwise."""
+    def compute(a, c, r, d):
+        out = np.full(a.shape, np.nan)
+        for sign in (+1, -1):
+            m = d == sign
+            if m.any():
+                out[m] = exact_ideal_delta(sensor, a[m], c[m], r[m], direction=sign, width=width,
+                                           threshold=threshold, e_max=e_max, tol=tol)
+        return out
+    return _cached("delta", sensor, (e, contact_s, ratio, direction),
+                   (float(width), float(threshold), float(e_max), float(tol)), compute)
 
 
 def cached_ideal_max_ratio(sensor, lo, hi, contact_s, *, width: float = 80.0, threshold: float = 0.9,

@@ -68,6 +68,7 @@ __all__ = [
     "CLOSED_FORM_MAX_CONTACT_S",
     "CLOSED_FORM_RATIO_BRACKET",
     "efficiency_estimate",
+    "delta_efficiency_estimate",
     "DEFAULT_TABLE",
     "GRID_RTOL",
     "clear_table_cache",
@@ -517,6 +518,91 @@ def delta_estimate(value, mc_lo, mc_hi, geometric, ideal, *, width: float, z_tab
     ideal = np.asarray(ideal, dtype=np.float64)
     low = np.where(np.isnan(low) | np.isnan(ideal), low, np.minimum(np.maximum(low, ideal), value))
     return low, high
+
+
+def delta_efficiency_estimate(sensor, e, contact_s, ratio, direction, t_a, t_b, svm_a, svm_b, ideal_a, ideal_b,
+                              mc_lo, mc_hi, *, width: float, threshold: float, e_max: float, z_table: float,
+                              zc: float, entry_sd=0.0) -> dict[str, np.ndarray]:
+    """delta-e's estimate of one direction from the SVM's efficiency against the exact ideal observer.
+
+    As :func:`efficiency_estimate` for min-contact: the SVM's efficiency ``eff = (svm need - w/2) / (ideal
+    need - w/2)`` at the tabulated contact times ``t_a``, ``t_b`` around ``contact_s`` (log-linear in log t;
+    the known one where the other is NaN) times the ideal observer's delta(e) computed exactly at
+    ``contact_s`` (:func:`designkit.query.ideal_bound.exact_ideal_delta`): no interpolation of the steep need
+    itself, and an ideal bound computed, not read from a grid. Standard error in log: the larger of the
+    table's Monte Carlo error at the asked contact (``mc_lo``/``mc_hi``, ``z_table`` SEs from the value each)
+    and ``entry_sd`` (averaged over the two entries' weights), the rounding of both needs and the
+    interpolation error, ``2 w (1 - w)`` times the efficiency's change across the cell (half of it mid-cell).
+
+    Parameters
+    ----------
+    e : array_like
+        Reference class's lower edge [J s^-1/2 K^-1 m^-2].
+    contact_s, ratio : array_like
+        Contact time [s] and sigma/dT [-].
+    direction : array_like
+        +1 (towards higher effusivity) or -1.
+    t_a, t_b, svm_a, svm_b, ideal_a, ideal_b : array_like
+        Tabulated contact times [s] and the SVM and ideal deltas there.
+    mc_lo, mc_hi : array_like
+        The table's Monte Carlo ends of the SVM delta at the asked contact.
+    width, threshold, e_max, z_table, zc : float
+        Grid width, F1 threshold, upper end of the effusivity range, the table's z and the asked coverage's.
+    entry_sd : float or array_like
+        Scatter of one tabulated efficiency about its trend, log (``_View.entry_noise``).
+
+    Returns
+    -------
+    dict of ndarray
+        ``value``, ``low``, ``high``, ``ideal`` [J s^-1/2 K^-1 m^-2], ``efficiency``, ``se_log`` (NaN where
+        it does not apply).
+
+    Examples
+    --------
+    >>> from designkit.sensor import load_sensor
+    >>> r = delta_efficiency_estimate(load_sensor("paper"), 20000.0, 1.75, 0.005, +1, 1.5, 2.0, 8760.0, 5000.0,
+    ...                               4920.0, 2680.0, 6200.0, 7300.0, width=80.0, threshold=0.9, e_max=40000.0,
+    ...                               z_table=2.0, zc=1.645, entry_sd=0.04)
+    >>> float(r["ideal"]) < float(r["low"]) < float(r["value"]) < float(r["high"])
+    True
+    """
+    arrs = np.broadcast_arrays(*(np.asarray(a, dtype=np.float64) for a in (
+        e, contact_s, ratio, direction, t_a, t_b, svm_a, svm_b, ideal_a, ideal_b, mc_lo, mc_hi, entry_sd)))
+    e, contact, ratio, direction, t_a, t_b, svm_a, svm_b, ideal_a, ideal_b, mc_lo, mc_hi, entry_sd = arrs
+    h = 0.5 * width
+    with np.errstate(invalid="ignore", divide="ignore"):
+        eff_a = np.where((svm_a > h) & (ideal_a > h), (svm_a - h) / (ideal_a - h), np.nan)
+        eff_b = np.where((svm_b > h) & (ideal_b > h), (svm_b - h) / (ideal_b - h), np.nan)
+        both = ~np.isnan(eff_a) & ~np.isnan(eff_b) & (t_a != t_b)
+        w = np.where(both, np.log(contact / t_a) / np.log(t_b / t_a), 0.0)
+        log_eff = np.where(both, (1.0 - w) * np.log(eff_a) + w * np.log(eff_b),
+                           np.where(np.isnan(eff_a), np.log(eff_b), np.log(eff_a)))
+        eff = np.maximum(np.exp(log_eff), 1.0)  # no classifier beats the ideal observer
+        sd = width / math.sqrt(12.0)
+        near_svm, near_ideal = np.where(np.isnan(eff_b), svm_a, svm_b), np.where(np.isnan(eff_b), ideal_a, ideal_b)
+        rounding = np.hypot(sd / (near_svm - h), sd / (near_ideal - h))
+        # linear interpolation's error vanishes at the grid points and peaks mid-cell (shape w (1 - w));
+        # at mid-cell it is taken as half the change across the cell, as min-contact's
+        interp = np.where(both, 2.0 * w * (1.0 - w) * np.abs(np.log(eff_b / eff_a)), 0.0)
+        mc = np.abs(np.log((mc_hi - h) / (mc_lo - h))) / (2.0 * z_table)
+        mc = np.where(np.isfinite(mc), mc, 0.0)
+        # two tabulated entries' scatter, weighted (1 - w) and w, averages down
+        entry = entry_sd * np.where(both, np.sqrt((1.0 - w) ** 2 + w ** 2), 1.0)
+        se = np.hypot(np.maximum(mc, entry), np.hypot(rounding, interp))
+    ok = np.isfinite(log_eff) & np.isfinite(se)
+    ideal = np.full(e.shape, np.nan)
+    if ok.any():
+        from .ideal_bound import cached_ideal_delta
+
+        ideal[ok] = cached_ideal_delta(sensor, e[ok], contact[ok], ratio[ok], direction[ok], width=width,
+                                       threshold=threshold, e_max=e_max)
+    ok &= ~np.isnan(ideal)
+    with np.errstate(invalid="ignore"):
+        value = np.where(ok, eff * ideal, np.nan)
+        low = np.where(ok, np.maximum(value * np.exp(-zc * se), ideal), np.nan)
+        high = np.where(ok, value * np.exp(zc * se), np.nan)
+    return {"value": value, "low": low, "high": high, "ideal": ideal, "efficiency": np.where(ok, eff, np.nan),
+            "se_log": np.where(ok, se, np.nan)}
 
 
 # ============================================================ opening a table for a question
@@ -1103,6 +1189,8 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
     zc, z_t = z_of_coverage(coverage), table_z(op.tab)
     gcw = axis_weights_flagged(view.contacts, contact, log=True)[0]
 
+    efficiency = op.tab.fidelity == "svm" and op.closed and "delta_up_ideal" in view.t.arrays
+    ends = (cw[0][0], cw[-1][0])  # the tabulated contacts around the asked one (the same where it is on one)
     sides = {}
     for direction, side in (("down", "lower"), ("up", "upper")):
         val = at(view, combos, cw, f"delta_{direction}")
@@ -1111,6 +1199,23 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
         iname = f"delta_{direction}_ideal" if ikind == "ideal" else f"delta_{direction}"
         ideal_side = at(iview, icombos, icw, iname)
         stated, cov_side, method = [None, None], None, "none"
+        eff = None
+        if val is not None and efficiency:
+            r = delta_efficiency_estimate(
+                op.tab.sensor, x, contact, noise / abs(dt), -1.0 if direction == "down" else 1.0,
+                *(view.contacts[k] for k in ends),
+                *(view.delta_at(f"delta_{direction}", combos, k, x) for k in ends),
+                *(view.delta_at(f"delta_{direction}_ideal", combos, k, x) for k in ends),
+                math.nan if iv[0] is None else iv[0], math.nan if iv[1] is None else iv[1], width=op.width,
+                threshold=op.phi, e_max=view.e_hi, z_table=table_z(op.tab), zc=z_of_coverage(coverage),
+                entry_sd=view.entry_noise(combos))
+            if not math.isnan(float(r["value"])):
+                eff = {k: float(v) for k, v in r.items()}
+        if eff is not None:  # the SVM's efficiency against the exact ideal observer (delta_efficiency_estimate)
+            sides[side] = {"value": eff["value"], "interval": [eff["low"], eff["high"]], "ideal": eff["ideal"],
+                           "coverage": coverage, "estimate_method": "table-efficiency", "monte_carlo_interval": iv,
+                           "table_value": val, "table_ideal": ideal_side, "efficiency": eff["efficiency"]}
+            continue
         if val is not None and op.tab.fidelity == "svm":
             geo = at(view, combos, gcw, f"delta_{direction}", geometric=True)
             low, high = (_opt(v) for v in delta_estimate(val, _arr(iv[0]), _arr(iv[1]), _arr(geo), _arr(ideal_side),
@@ -1122,11 +1227,12 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
     ifinite = [s["ideal"] for s in sides.values() if s["ideal"] is not None]
     best = min((s for s in sides.values() if s["value"] is not None), key=lambda s: s["value"], default=None)
     stated = best is not None and best["coverage"] is not None
+    closed = best is not None and best["estimate_method"] == "table-efficiency"
     return _answer("delta-e", op, value=min(finite) if finite else None,
                    interval=tuple(best["interval"]) if stated else (None, None),
-                   interval_kind="table-estimate" if stated else "none",
+                   interval_kind=best["estimate_method"] if stated else "none",
                    interval_coverage=coverage if stated else None,
-                   ideal=min(ifinite) if ifinite else None, ideal_method="table",
+                   ideal=min(ifinite) if ifinite else None, ideal_method="closed-form" if closed else "table",
                    in_grid=flags, details=_delta_details(x, sides),
                    check_at=(contact, noise, dt), **common)
 

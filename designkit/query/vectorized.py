@@ -614,16 +614,33 @@ def _table_delta_e(x: dict[str, np.ndarray], op, ideal_table, zc: float) -> dict
         icombos = iview.scene_weights(noise, dt)[0] if iview is not None else []
         icw = _table_route.axis_weights_flagged(iview.contacts, contact)[0] if iview is not None else []
         gcw = _table_route.axis_weights_flagged(view.contacts, contact, log=True)[0]
+        efficiency = svm and op.closed and "delta_up_ideal" in view.t.arrays
+        ends = (cw[0][0], cw[-1][0])
         for direction, side in (("down", "lower"), ("up", "upper")):
             val = at(view, combos, cw, f"delta_{direction}")
             iname = f"delta_{direction}_ideal" if ikind == "ideal" else f"delta_{direction}"
             ideal = at(iview, icombos, icw, iname)
+            mc_lo = at(view, combos, cw, f"delta_{direction}_lo") if svm else None
+            mc_hi = at(view, combos, cw, f"delta_{direction}_hi") if svm else None
+            by_eff = np.zeros(xe.size, dtype=bool)
+            if efficiency:  # the scalar route's delta_efficiency_estimate where the tabulated value exists
+                sv = _delta(view, f"delta_{direction}", combos, xe)
+                iv_ = _delta(view, f"delta_{direction}_ideal", combos, xe)
+                r = _table_route.delta_efficiency_estimate(
+                    op.tab.sensor, xe, contact, noise / abs(dt), -1.0 if direction == "down" else 1.0,
+                    view.contacts[ends[0]], view.contacts[ends[1]], sv[ends[0]], sv[ends[1]], iv_[ends[0]],
+                    iv_[ends[1]], mc_lo, mc_hi, width=op.width, threshold=op.phi, e_max=view.e_hi,
+                    z_table=_table_route.table_z(op.tab), zc=zc, entry_sd=view.entry_noise(combos))
+                by_eff = ~np.isnan(val) & ~np.isnan(r["value"])
+                val = np.where(by_eff, r["value"], val)
+                ideal = np.where(by_eff, r["ideal"], ideal)
             res[side][idx], res[f"{side}_ideal"][idx] = val, ideal
             if svm:  # the scalar route's interval (table.delta_estimate, the same function)
                 low, high = _table_route.delta_estimate(
-                    val, at(view, combos, cw, f"delta_{direction}_lo"), at(view, combos, cw, f"delta_{direction}_hi"),
-                    at_geometric(view, combos, gcw, f"delta_{direction}"), ideal, width=op.width,
+                    val, mc_lo, mc_hi, at_geometric(view, combos, gcw, f"delta_{direction}"), ideal, width=op.width,
                     z_table=_table_route.table_z(op.tab), zc=zc)
+                if efficiency:
+                    low, high = np.where(by_eff, r["low"], low), np.where(by_eff, r["high"], high)
                 res[f"{side}_low"][idx] = np.where(np.isnan(val), np.nan, low)
                 res[f"{side}_high"][idx] = np.where(np.isnan(val), np.nan, high)
         res["in_grid"][idx] = True

@@ -75,7 +75,7 @@ import numpy as np
 from .._validation import InputError, check_nonnegative, check_positive
 from .base import ForwardModel
 
-__all__ = ["Layered", "laplace_reading", "savgol_smooth", "talbot_invert"]
+__all__ = ["Layered", "laplace_reading", "savgol_smooth", "smoothed_reading", "talbot_invert"]
 
 #: Fixed-Talbot nodes: 24 gives about 1e-11 absolute error in double precision.
 TALBOT_NODES = 24
@@ -376,20 +376,53 @@ class Layered(ForwardModel):
         t = np.atleast_1d(np.asarray(time_s, dtype=np.float64))
         if self.smoothing_window <= 1:
             return self.conduction(t, e_object, sensor)
-        if t.size > 1:
-            dt = np.diff(t)
-            if np.any(np.abs(dt - dt[0]) > 1e-6 * dt[0]) or dt[0] <= 0:
-                raise InputError("the smoothed layered model needs uniformly sampled times")
-            step = float(dt[0])
-        else:
-            step = 1.0 / float(sensor.sample_rate_hz)
-        half = self.smoothing_window // 2
-        before = t[0] - step * np.arange(half, 0, -1)
-        u = self.conduction(np.concatenate([before, t]), e_object, sensor)
-        if u.shape[1] < self.smoothing_window:  # short series: extend past the end, smooth, cut
-            extra = self.smoothing_window - u.shape[1]
-            after = t[-1] + step * np.arange(1, extra + 1)
-            u = self.conduction(np.concatenate([before, t, after]), e_object, sensor)
-            return np.clip(savgol_smooth(u, self.smoothing_window, self.smoothing_order)[:, half:half + t.size],
-                           0.0, 1.0)
-        return np.clip(savgol_smooth(u, self.smoothing_window, self.smoothing_order)[:, half:], 0.0, 1.0)
+        return smoothed_reading(lambda tt: self.conduction(tt, e_object, sensor), t, sensor.sample_rate_hz,
+                                self.smoothing_window, self.smoothing_order, what="the smoothed layered model")
+
+
+def smoothed_reading(reading, time_s, sample_rate_hz: float, window: int, order: int, *,
+                     what: str = "a smoothed model") -> np.ndarray:
+    """A reading smoothed as the host smoothed a recording (Savitzky-Golay, ``mode="interp"``).
+
+    ``reading(t)`` gives the unsmoothed reading (K, len(t)), 0 before contact.
+    It is evaluated from ``window // 2`` samples before the first time (zeros
+    before contact, as the host saw them) to the last (extended past the end
+    when the series is shorter than the window), smoothed, and cut back to
+    ``time_s``; the last ``window // 2`` samples use the filter's polynomial
+    fit at the end. The result is clipped to [0, 1].
+
+    Parameters
+    ----------
+    reading : callable
+        ``t -> ndarray (K, len(t))``.
+    time_s : array_like, shape (m,)
+        Uniformly spaced times [s] (one time: the sample period ``1/fs``).
+    sample_rate_hz : float
+        Used for the spacing when ``time_s`` has one time.
+    window, order : int
+        Savitzky-Golay window (odd, samples) and order.
+
+    Examples
+    --------
+    >>> t = np.arange(300) / 200.0
+    >>> u = smoothed_reading(lambda tt: np.clip(tt, 0.0, None)[None, :] * 0.1, t, 200.0, 99, 3)
+    >>> bool(np.allclose(u[0, 60:240], 0.1 * t[60:240]))   # a line away from the kink at 0 passes unchanged
+    True
+    """
+    t = np.atleast_1d(np.asarray(time_s, dtype=np.float64))
+    if t.size > 1:
+        dt = np.diff(t)
+        if np.any(np.abs(dt - dt[0]) > 1e-6 * dt[0]) or dt[0] <= 0:
+            raise InputError(f"{what} needs uniformly sampled times")
+        step = float(dt[0])
+    else:
+        step = 1.0 / float(sample_rate_hz)
+    half = window // 2
+    before = t[0] - step * np.arange(half, 0, -1)
+    u = reading(np.concatenate([before, t]))
+    if u.shape[1] < window:  # short series: extend past the end, smooth, cut
+        extra = window - u.shape[1]
+        after = t[-1] + step * np.arange(1, extra + 1)
+        u = reading(np.concatenate([before, t, after]))
+        return np.clip(savgol_smooth(u, window, order)[:, half:half + t.size], 0.0, 1.0)
+    return np.clip(savgol_smooth(u, window, order)[:, half:], 0.0, 1.0)

@@ -75,8 +75,9 @@ class ForceRamp(ForwardModel):
 
     Parameters
     ----------
-    base : ForwardModel or mapping
-        The full-contact model (a mapping as :meth:`ForwardModel.to_dict` writes it).
+    base : ForwardModel or mapping or None
+        The full-contact model (a mapping as :meth:`ForwardModel.to_dict` writes
+        it; None: the semi-infinite model).
     ramp_time_s : tuple of float
         Times [s] after the first contact, increasing, the first 0.
     ramp_area : tuple of float
@@ -112,6 +113,10 @@ class ForceRamp(ForwardModel):
 
     def __post_init__(self) -> None:
         base = self.base
+        if base is None:   # the defaults: the paper's model, the whole area at once
+            from .semi_infinite import SemiInfinite
+
+            base = SemiInfinite()
         if isinstance(base, Mapping):
             from . import get_model
 

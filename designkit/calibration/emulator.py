@@ -229,7 +229,10 @@ class Emulator:
         The forward model of the touches (default, None: the paper's
         semi-infinite model). The wire carries the raw reading: a layered
         model's host smoothing (``smoothing_window``) is left to the host,
-        as on a real rig, and only its conduction and lag are streamed.
+        as on a real rig, and only its conduction and lag are streamed. A
+        :class:`~designkit.models.ramp.ForceRamp` (a sensor file calibrated
+        with the force-driven area) plays its base model with the area
+        following the plan's own force ramp at its threshold c.
 
     Examples
     --------
@@ -255,6 +258,12 @@ class Emulator:
             if "diffusivity_m2_s" in model.object_properties:
                 raise InputError(f"the emulator touches objects by effusivity alone; the {model.name} model needs "
                                  "their diffusivity")
+            if model.name == "force-ramp":
+                # a sensor file's model with its force-driven contact area: the rig presses along its own
+                # (linear) force ramp, the area following it with the file's threshold c
+                if plan.contact_force_fraction is None:
+                    plan = replace(plan, contact_force_fraction=model.force_fraction)
+                model = model.base
             if model.name == "semi-infinite":
                 model = None  # the closed form below, bit for bit what it always streamed
         self.model = model

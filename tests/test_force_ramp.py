@@ -200,3 +200,14 @@ def test_the_real_sensor_file_answers_questions_with_its_model(cli, robot_data_d
     assert ans["model"]["name"] == "force-ramp" and ans["model"]["base"]["name"] == "layered"
     assert any("recorded in sensor file real (calibrated as layered+lag+smoothing+drift+area)" in n
                for n in ans["notes"])
+
+
+def test_a_sweep_config_takes_the_ramp_and_its_record_survives_json(synthetic_fit, tmp_path):
+    from designkit.sweep.config import SweepConfig
+
+    _, res = synthetic_fit
+    path = tmp_path / "chain.yaml"
+    res.sensor(name="chain").to_yaml(path)
+    cfg = SweepConfig(sensor=str(path), intervals=4, contact_s=(1.0,))
+    assert cfg.model == sensor_model(load_sensor_model(path)[0]) and cfg.model.name == "force-ramp"
+    assert get_model(json.loads(json.dumps(cfg.model.to_dict()))) == cfg.model   # what a table header keeps

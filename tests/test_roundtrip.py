@@ -83,8 +83,13 @@ def test_the_emulator_streams_drift_and_a_contact_area_following_each_touch_s_ow
 
 @pytest.mark.parametrize("case", list(CASES))
 def test_round_trip_over_a_pty_recovers_every_identifiable_parameter(case, tmp_path):
-    r = round_trip(case, seed=0, folder=tmp_path, touches=6)
-    assert r.n_trials == 12 and (tmp_path / "index.csv").is_file()   # recorded from the pty, 6 + 6 touches
+    # the area cases read the area from the measured force: its noise, clipped at the plateau, biases
+    # e_o/e_s by a few tenths of a percent (docs/sensor-models.md); here the force is clean, and they
+    # have 10 + 10 touches as in the benchmark (c's 95 % interval is about +-2 % with them)
+    area = "area" in case
+    touches = 10 if area else 6
+    r = round_trip(case, seed=0, folder=tmp_path, touches=touches, force_noise_n=0.0 if area else 0.02)
+    assert r.n_trials == 2 * touches and (tmp_path / "index.csv").is_file()   # recorded from the pty
     for name in r.rows:
         assert r.covered(name), (name, r.rows[name])
         assert r.rel_error(name) <= 0.02, (name, r.rows[name])

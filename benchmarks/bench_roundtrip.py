@@ -34,6 +34,7 @@ def main() -> None:
     ap.add_argument("--case", action="append", choices=list(CASES), help="models to run (default: all)")
     ap.add_argument("--noise", type=float, default=0.01, help="thermistor noise sigma [degC]")
     ap.add_argument("--touches", type=int, default=10, help="touches per material")
+    ap.add_argument("--force-noise", type=float, default=0.02, help="force sensor noise sigma [N] (10 N press)")
     ap.add_argument("--speed", type=float, default=200.0, help="device seconds per real second")
     ap.add_argument("--json", type=Path, default=None, help="write every run and the summary here")
     args = ap.parse_args()
@@ -45,12 +46,14 @@ def main() -> None:
         runs = []
         t0 = time.perf_counter()
         for seed in range(args.seeds):
-            runs.append(round_trip(name, seed, noise_c=args.noise, touches=args.touches, speed=args.speed))
+            runs.append(round_trip(name, seed, noise_c=args.noise, touches=args.touches, speed=args.speed,
+                                   force_noise_n=args.force_noise))
         wall = time.perf_counter() - t0
         summ = summarize(runs)
         rec = sum(r.record_s for r in runs) / len(runs)
         fit = sum(r.fit_s for r in runs) / len(runs)
-        print(f"\n{name}: {len(runs)} runs, {runs[0].n_trials} touches each, noise {args.noise:g} degC; "
+        print(f"\n{name}: {len(runs)} runs, {runs[0].n_trials} touches each, noise {args.noise:g} degC, "
+              f"force noise {args.force_noise:g} N; "
               f"{wall:.0f} s ({rec:.1f} s recording + {fit:.1f} s fitting a run), "
               f"load {os.getloadavg()[0]:.2f}")
         print(f"  {'quantity':22s} {'in 95 % CI':>10s} {'within 2 %':>10s} {'median err':>10s} {'worst err':>10s}")

@@ -237,6 +237,8 @@ def schemas() -> dict[str, type]:
         contact_spread: Optional[dict[str, Optional[Number]]] = None
         object_temperature: Optional[dict[str, Union[StrictStr, Number]]] = None
         candidate: Optional[StrictStr] = None
+        contact_area: Optional[dict[str, Any]] = None   # checked by designkit.models.sensor_model
+        drift: Optional[StrictStr] = None
 
     class SensorFile(_Strict):
         designkit_sensor: Integer = 1

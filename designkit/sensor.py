@@ -116,8 +116,15 @@ class Sensor:
     model : mapping or None
         The forward model the sensor was identified with, as calibration
         records it (:data:`MODEL_KEYS`): ``{"name", "params", "time_offset_s",
-        "contact_spread", "object_temperature", "candidate"}``. None (old files,
-        presets): the paper's semi-infinite model. Plain data here;
+        "contact_spread", "object_temperature", "candidate", "contact_area",
+        "drift"}``. ``contact_area`` (calibrated with a force-driven contact
+        area): the threshold ``force_fraction`` c (with ``force_fraction_ci95``),
+        the calibration touches' median force over its plateau (``time_s``
+        after the detected onset, ``force_share``) and ``n_touches``;
+        ``drift``: how the heater's drift was treated (``"per-touch"``: a
+        nuisance fitted per touch like its initial temperature, not a
+        property of the sensor). None (old files, presets): the paper's
+        semi-infinite model. Plain data here;
         :func:`designkit.models.sensor_model` turns it into a forward model.
 
     Examples
@@ -242,7 +249,11 @@ class Sensor:
         if self.model is not None:
             text += ("# model: the forward model identified with it (name, its parameters in SI units with e_s\n"
                      "# above; null = infinite), the fitted contact-time offset [s], the per-touch spread of the\n"
-                     "# contact conductance (geometric SD), how each material's temperature was taken\n")
+                     "# contact conductance (geometric SD), how each material's temperature was taken;\n"
+                     "# contact_area: the area grows with the force as clip((F/F_p - c)/(1 - c), 0, 1), c =\n"
+                     "# force_fraction; a question plays the calibration touches' median F/F_p (force_share at\n"
+                     "# time_s after the onset); drift: per-touch = each touch's heater drift was fitted like its\n"
+                     "# initial temperature: not a sensor property, a question's touch has none\n")
         text += yaml.safe_dump(self.to_dict(), sort_keys=False)
         return atomic_write_text(Path(path), text)
 
@@ -257,7 +268,8 @@ class Sensor:
 
 
 #: The keys of a sensor's ``model`` record (what calibration writes beside the sensor fields).
-MODEL_KEYS = ("name", "params", "time_offset_s", "contact_spread", "object_temperature", "candidate")
+MODEL_KEYS = ("name", "params", "time_offset_s", "contact_spread", "object_temperature", "candidate", "contact_area",
+              "drift")
 
 
 def _plain(value: Any) -> Any:

@@ -119,3 +119,18 @@ def test_talbot_and_smoothing_helpers():
     out = savgol_smooth(step, 99, 3)
     assert out.shape == step.shape and out.min() < 0  # the filter's overshoot before a step, as in the recordings
     assert np.allclose(savgol_smooth(step, 0, 3), step)
+
+
+@pytest.mark.parametrize("shape, window, order", [((120, 1601), 99, 3), ((401,), 99, 3), ((3, 2, 99), 99, 3),
+                                                  ((5, 100), 5, 2), ((1, 250), 21, 4), ((2, 30), 11, 0)])
+def test_the_fast_smoothing_is_scipy_s_savgol_filter(shape, window, order):
+    """savgol_smooth (FFT inside, end projections) against scipy.signal.savgol_filter(mode="interp")."""
+    from scipy.signal import savgol_filter
+
+    x = np.cumsum(np.random.default_rng(window + order).normal(size=shape), axis=-1)
+    ref = savgol_filter(x, window, order, axis=-1, mode="interp")
+    assert np.allclose(savgol_smooth(x, window, order), ref, rtol=0, atol=1e-12 * np.abs(ref).max())
+    padded = savgol_filter(np.concatenate([np.zeros(shape[:-1] + (7,)), x], axis=-1), window, order, axis=-1,
+                           mode="interp")[..., 7:]
+    assert np.allclose(savgol_smooth(x, window, order, pad_before=7), padded, rtol=0,
+                       atol=1e-12 * np.abs(padded).max())

@@ -162,6 +162,19 @@ class TouchPlan:
 
     ``contact_s`` defaults to the profile's trial window plus half a second,
     ``press_force_n`` to twice the contact threshold.
+
+    What real touches do beyond the paper's model (all off by default):
+
+    ``ramp_spread``: touch ``j``'s force ramp lasts ``ramp_s (1 + ramp_spread
+    v_j)``, ``v_j`` uniform in [-1, 1] (the pace differs from touch to touch).
+    ``contact_force_fraction`` (c): the contact area grows with the force,
+    ``A = clip((F / F_p - c) / (1 - c), 0, 1)``, each share starting its heat
+    flow as it comes into contact (:class:`~designkit.models.ramp.ForceRamp`);
+    None: the whole area at once when the force leaves zero.
+    ``drift_c_per_s`` and ``drift_sd_c_per_s``: the heater still warms at a
+    rate ``s_j`` (normal, per touch) from ``drift_lead_s`` before contact until
+    release, on the sensor's side of the contact: ``T = (Ts + s_j t)(1 - u) +
+    To u``; after release it settles back to its set point.
     """
 
     touch_every_s: float = 20.0
@@ -171,6 +184,11 @@ class TouchPlan:
     ramp_s: float = 0.5
     recover_s: float = 0.4
     touches_per_material: int = 1
+    ramp_spread: float = 0.0
+    contact_force_fraction: float | None = None
+    drift_c_per_s: float = 0.0
+    drift_sd_c_per_s: float = 0.0
+    drift_lead_s: float = 1.5
 
 
 @dataclass(frozen=True)
@@ -211,7 +229,10 @@ class Emulator:
         The forward model of the touches (default, None: the paper's
         semi-infinite model). The wire carries the raw reading: a layered
         model's host smoothing (``smoothing_window``) is left to the host,
-        as on a real rig, and only its conduction and lag are streamed.
+        as on a real rig, and only its conduction and lag are streamed. A
+        :class:`~designkit.models.ramp.ForceRamp` (a sensor file calibrated
+        with the force-driven area) plays its base model with the area
+        following the plan's own force ramp at its threshold c.
 
     Examples
     --------
@@ -237,6 +258,12 @@ class Emulator:
             if "diffusivity_m2_s" in model.object_properties:
                 raise InputError(f"the emulator touches objects by effusivity alone; the {model.name} model needs "
                                  "their diffusivity")
+            if model.name == "force-ramp":
+                # a sensor file's model with its force-driven contact area: the rig presses along its own
+                # (linear) force ramp, the area following it with the file's threshold c
+                if plan.contact_force_fraction is None:
+                    plan = replace(plan, contact_force_fraction=model.force_fraction)
+                model = model.base
             if model.name == "semi-infinite":
                 model = None  # the closed form below, bit for bit what it always streamed
         self.model = model
@@ -252,6 +279,7 @@ class Emulator:
             raise InputError(f"seed must be a non-negative integer, got {seed}")
         self._rng = as_generator([int(self._seed), 1 << 30])  # fault draws
         self._blocks: dict[int, np.ndarray] = {}
+        self._curves: dict[tuple[int, float], tuple[np.ndarray, np.ndarray]] = {}
         fs = profile.sample_rate_hz
         threshold = profile.contact.force_threshold_n if profile.contact.rule == "force" else 5.0
         contact = plan.contact_s if plan.contact_s is not None else profile.trial.post_s + 0.5
@@ -264,12 +292,21 @@ class Emulator:
         check_positive("heater recovery time constant [s]", plan.recover_s)
         if plan.touches_per_material < 1:
             raise InputError(f"touches per material must be >= 1, got {plan.touches_per_material}")
-        if 2 * plan.ramp_s >= plan.contact_s:
+        if not 0.0 <= plan.ramp_spread < 1.0:
+            raise InputError(f"ramp spread must be in [0, 1), got {plan.ramp_spread:g}")
+        if plan.contact_force_fraction is not None and not 0.0 <= plan.contact_force_fraction < 1.0:
+            raise InputError(f"contact force fraction must be in [0, 1), got {plan.contact_force_fraction:g}")
+        check_nonnegative("drift spread [degC/s]", plan.drift_sd_c_per_s)
+        drifts = bool(plan.drift_c_per_s or plan.drift_sd_c_per_s)
+        if drifts and plan.drift_lead_s < profile.trial.pre_s:
+            raise InputError(f"the drift must start before the recorded window ({profile.trial.pre_s:g} s before "
+                             f"the onset), got drift_lead_s {plan.drift_lead_s:g}")
+        if 2 * plan.ramp_s * (1.0 + plan.ramp_spread) >= plan.contact_s:
             raise InputError(f"contact ({plan.contact_s:g} s) must outlast the force ramps (2 x {plan.ramp_s:g} s)")
         if plan.press_force_n <= threshold and profile.contact.rule == "force":
             raise InputError(f"press force {plan.press_force_n:g} N never reaches the profile's contact "
                              f"threshold {threshold:g} N")
-        needed = plan.contact_s + 10 * plan.recover_s + profile.trial.pre_s
+        needed = plan.contact_s + 10 * plan.recover_s + max(profile.trial.pre_s, plan.drift_lead_s if drifts else 0.0)
         if plan.touch_every_s < needed:
             raise InputError(f"touch interval {plan.touch_every_s:g} s is too short: contact {plan.contact_s:g} s, "
                              f"heater recovery and {profile.trial.pre_s:g} s before the next touch need "
@@ -290,6 +327,33 @@ class Emulator:
         self.vanished = False
 
     # ----------------------------------------------------------------- truth
+    def _touch_draws(self, j: int) -> tuple[float, float]:
+        """Touch ``j``'s force ramp [s] and heater drift [degC/s] (seeded per touch, chunking-independent)."""
+        p = self.plan
+        if not (p.ramp_spread or p.drift_sd_c_per_s):
+            return p.ramp_s, p.drift_c_per_s
+        v = as_generator([int(self._seed), 1 << 29, int(j)]).standard_normal(2)
+        from scipy.special import ndtr
+
+        ramp = p.ramp_s * (1.0 + p.ramp_spread * (2.0 * float(ndtr(v[0])) - 1.0))
+        return ramp, p.drift_c_per_s + p.drift_sd_c_per_s * float(v[1])
+
+    @staticmethod
+    def _per_touch(fn, touches: np.ndarray) -> np.ndarray:
+        """``fn(j)`` for each sample's touch index, evaluated once per distinct touch."""
+        if touches.size == 0:
+            return np.zeros(0)
+        uniq, inverse = np.unique(touches, return_inverse=True)
+        return np.array([fn(int(x)) for x in uniq])[inverse.ravel()]
+
+    def touch_ramp_s(self, j: int) -> float:
+        """Seconds touch ``j``'s force takes from zero to its plateau."""
+        return self._touch_draws(j)[0]
+
+    def touch_drift_c_per_s(self, j: int) -> float:
+        """Touch ``j``'s heater drift [degC/s]."""
+        return self._touch_draws(j)[1]
+
     def material_of_touch(self, j: int) -> EmulatedMaterial:
         return self.materials[(j // self.plan.touches_per_material) % len(self.materials)]
 
@@ -298,14 +362,20 @@ class Emulator:
         p = self.plan
         fs = self.profile.sample_rate_hz
         start = p.first_touch_s + j * p.touch_every_s
-        delay = p.ramp_s * self._threshold / p.press_force_n
+        delay = self.touch_ramp_s(j) * self._threshold / p.press_force_n
         onset = math.ceil((start + delay) * fs - 1e-9) / fs
         m = self.material_of_touch(j)
         return TouchRecord(j, m.label, m.effusivity, start, onset)
 
     @property
     def expected_time_offset_s(self) -> float:
-        """Heat-flow start minus detected onset for a noise-free force signal [s] (negative)."""
+        """Heat-flow start minus detected onset for a noise-free force signal [s] (negative).
+
+        With a force-driven contact area (``contact_force_fraction``) each share of the area starts its
+        heat flow when the force puts it down, so relative to the measured force the offset is 0.
+        """
+        if self.plan.contact_force_fraction is not None:
+            return 0.0
         t = self.touch(0)
         return t.start_s - t.expected_onset_s
 
@@ -325,7 +395,10 @@ class Emulator:
         t_obj = np.array([self.ambient_c if mats[x - base].object_temp_c is None else mats[x - base].object_temp_c
                           for x in j]) if n else np.zeros(0)
         c = p.contact_s
-        if self.model is None:
+        ramps = self._per_touch(self.touch_ramp_s, j)
+        if p.contact_force_fraction is not None:
+            u_now, u_end = self._area_reading(np.clip(rel, 0.0, c), e_o, c, j)
+        elif self.model is None:
             w = object_weight(self.sensor.effusivity, e_o)
             tau = self.sensor.tau_s
             u_now = w * response_shape(np.clip(rel, 0.0, c), tau)
@@ -333,21 +406,31 @@ class Emulator:
         else:
             u_now, u_end = self._model_reading(np.clip(rel, 0.0, c), e_o, c)
 
-        def curve(start_c):
+        def curve(start_c, drift=0.0, drift_end=0.0):
             in_contact = (rel >= 0) & (rel < c)
             after = rel >= c
-            during = start_c + (t_obj - start_c) * u_now
-            released = start_c + (t_obj - start_c) * u_end
+            during = start_c + drift + (t_obj - start_c - drift) * u_now
+            released = start_c + drift_end + (t_obj - start_c - drift_end) * u_end
             decay = np.exp(-np.clip(rel - c, 0.0, None) / p.recover_s)
             out = np.full(n, start_c, dtype=np.float64)
             out = np.where(in_contact, during, out)
-            return np.where(after, start_c + (released - start_c) * decay, out)
+            return np.where(after, start_c + (released - start_c) * decay, out) + np.where(in_contact, 0.0, drift)
 
-        sensor = curve(self.sensor_temp_c)
+        if p.drift_c_per_s or p.drift_sd_c_per_s:
+            # the touch whose drift window [start - lead, start + contact) holds each sample
+            lead = p.drift_lead_s
+            jn = np.floor((t - p.first_touch_s + lead) / p.touch_every_s)
+            rel_d = t - (p.first_touch_s + jn * p.touch_every_s)
+            rate = self._per_touch(self.touch_drift_c_per_s, np.maximum(jn, 0).astype(np.int64))
+            drift = np.where((jn >= 0) & (rel_d < c), rate * (rel_d + lead), 0.0)
+            rate_j = self._per_touch(self.touch_drift_c_per_s, j)
+            sensor = curve(self.sensor_temp_c, drift, rate_j * (c + lead))
+        else:
+            sensor = curve(self.sensor_temp_c)
         passive = curve(self.ambient_c)
         f = p.press_force_n
         force = np.where((rel >= 0) & (rel < c),
-                         f * np.clip(np.minimum(rel, c - rel) / p.ramp_s, 0.0, 1.0), 0.0)
+                         f * np.clip(np.minimum(rel, c - rel) / np.maximum(ramps, 1e-12), 0.0, 1.0), 0.0)
         z = self._noise(k0, k1)
         if self.noise_c > 0:
             sensor = sensor + self.noise_c * z[0]
@@ -368,6 +451,61 @@ class Emulator:
             now[sel] = fn(rel_s[sel], [float(e)], self.sensor)[0]
             end[sel] = fn(np.array([contact_s]), [float(e)], self.sensor)[0, 0]
         return now, end
+
+    def _area_reading(self, rel_s: np.ndarray, e_o: np.ndarray, contact_s: float, touch: np.ndarray):
+        """Normalized raw reading with the contact area following each touch's force ramp, and at release.
+
+        The area share ``A(F / F_p)`` (:func:`~designkit.models.ramp.area_share`) of touch ``j``'s linear
+        ramp over ``ramp_j``: the first share touches when the force reaches ``c F_p`` (``c ramp_j`` after
+        the force leaves zero), and the area is whole at ``ramp_j``; the reading is the area-weighted sum
+        of the model's raw step responses (Duhamel), on a 1 ms grid.
+        """
+        import dataclasses
+
+        from ..models import get_model
+        from ..models.ramp import ForceRamp
+
+        now = np.zeros(rel_s.size)
+        end = np.zeros(rel_s.size)
+        for jj in np.unique(touch):
+            for e in np.unique(e_o[touch == jj]):
+                sel = (touch == jj) & (e_o == e)
+                grid, u = self._area_curve(int(jj), float(e), contact_s)
+                now[sel] = np.interp(rel_s[sel], grid, u)
+                end[sel] = u[-1]
+        return now, end
+
+    def _area_curve(self, j: int, e: float, contact_s: float) -> tuple[np.ndarray, np.ndarray]:
+        """Touch ``j``'s raw reading on its own sample grid from the force leaving zero to release (cached)."""
+        import dataclasses
+
+        from scipy.signal import fftconvolve
+
+        from ..models import get_model
+        from ..models.ramp import area_share
+
+        key = (j, e)
+        if key in self._curves:
+            return self._curves[key]
+        base = self.model if self.model is not None else get_model("semi-infinite")
+        if getattr(base, "smoothing_window", 0) > 1:
+            base = dataclasses.replace(base, smoothing_window=0)   # the wire carries the raw reading
+        ramp_s = self.touch_ramp_s(j)
+        # Duhamel's sum on a 1 ms grid: the share put down at t_j conducts from t_j on
+        dt = 1e-3
+        fine = np.arange(int(math.ceil(contact_s / dt)) + 1) * dt
+        d_area = np.diff(area_share(np.minimum(fine / ramp_s, 1.0), float(self.plan.contact_force_fraction)),
+                         prepend=0.0)
+        step = np.zeros(fine.size)
+        step[1:] = base.response(fine[1:], [e], self.sensor)[0]
+        u_fine = fftconvolve(d_area, step)[:fine.size]
+        fs = self.profile.sample_rate_hz
+        grid = np.append(np.arange(0.0, contact_s, 1.0 / fs), contact_s)
+        u = np.interp(grid, fine, u_fine)
+        if len(self._curves) > 8:
+            self._curves.pop(next(iter(self._curves)))
+        self._curves[key] = (grid, u)
+        return grid, u
 
     _BLOCK = 8192
 

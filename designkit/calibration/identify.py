@@ -76,6 +76,7 @@ __all__ = [
     "compare_models",
     "contact_area",
     "identify",
+    "nominal_force_profile",
     "relative_force",
     "residual_series",
     "score",
@@ -352,8 +353,9 @@ def contact_area(force_rel, fraction: float = 0.0) -> np.ndarray:
     >>> contact_area([0.1, 0.3, 0.65, 1.0, 1.2], 0.3).round(3).tolist()
     [0.0, 0.0, 0.5, 1.0, 1.0]
     """
-    c = float(fraction)
-    return np.clip((np.asarray(force_rel, dtype=np.float64) - c) / (1.0 - c), 0.0, 1.0)
+    from ..models.ramp import area_share
+
+    return area_share(force_rel, fraction)
 
 
 def _prepare(trials: Sequence[Trial], names: Sequence[str], object_temps: Mapping[str, Any],
@@ -495,13 +497,27 @@ def _area_weighted(step, time_s: np.ndarray, area: np.ndarray, offset_s: float) 
 
     m = time_s.size
     dt = float(time_s[1] - time_s[0])
+    # out[k] = sum_j dA_j u(k dt - j dt - offset): only lags k - j in [-(m-1), m-1] with a positive argument
+    # matter, so the kernel starts at the first positive one (index i0 on that lag grid) and the convolution
+    # is of length about 2m rather than 3m (a third of a fit's time went to this FFT)
     lags = np.arange(-(m - 1), m) * dt - offset_s
-    u1 = np.zeros(lags.size)
-    pos = lags > 0
-    if pos.any():
-        u1[pos] = step(lags[pos])
+    pos = np.flatnonzero(lags > 0)
+    if pos.size == 0:
+        return np.zeros(area.shape)
+    i0 = int(pos[0])
+    u1 = step(lags[i0:])
     d_area = np.diff(area, axis=-1, prepend=0.0)
-    return fftconvolve(d_area, u1[None, :], axes=-1)[:, m - 1:2 * m - 1]
+    shift = i0 - (m - 1)                      # out[k] = full[k - shift] of the convolution with u1
+    if shift >= m:
+        return np.zeros(area.shape)
+    u1 = u1[:m - shift]                        # kernel entries needed: k - j - shift <= m - 1 - shift
+    full = fftconvolve(d_area, u1[None, :], axes=-1)
+    out = np.zeros(area.shape)
+    k = np.arange(m)
+    src = k - shift
+    ok = (src >= 0) & (src < full.shape[-1])
+    out[:, ok] = full[:, src[ok]]
+    return out
 
 
 class _Problem:
@@ -847,6 +863,7 @@ class Identification:
     notes: tuple[str, ...] = ()
     object_refs: Mapping[str, float] = field(default_factory=dict)
     touch_conductance: tuple[str, ...] = ()
+    force_profile: Mapping[str, Any] | None = None
 
     def parameter(self, name: str) -> IdentifiedParameter:
         for p in self.parameters:
@@ -980,7 +997,12 @@ class Identification:
         scaled by the identified e_s; the host smoothing when fitted with it);
         ``contact_spread``: per material fitted with per-touch conductances, the
         geometric standard deviation of the touches' h_c,i; ``object_temperature``:
-        how each material's temperature was taken (passive, free, a number).
+        how each material's temperature was taken (passive, free, a number);
+        ``contact_area`` (a ``force_area`` candidate): the threshold c
+        (``force_fraction``, its 95 % interval) and the fitted touches' median
+        force over its plateau (:func:`nominal_force_profile`), which questions
+        play as the nominal ramp; ``drift`` (a ``drift`` candidate):
+        ``"per-touch"``, a nuisance fitted for each touch, not a sensor property.
         """
         spread = {}
         for p in self.parameters:
@@ -991,7 +1013,19 @@ class Identification:
                 "contact_spread": spread or None,
                 "object_temperature": {k: (v if isinstance(v, str) else float(v))
                                        for k, v in self.object_modes.items()},
-                "candidate": self.candidate.label}
+                "candidate": self.candidate.label,
+                "contact_area": self._contact_area_record(),
+                "drift": "per-touch" if self.candidate.drift else None}
+
+    def _contact_area_record(self) -> dict[str, Any] | None:
+        if not self.candidate.force_area or self.force_profile is None:
+            return None
+        if "contact_force_fraction" in self.candidate.free:
+            p = self.parameter("contact_force_fraction")
+            c, ci = float(p.value), [float(v) for v in p.ci95]
+        else:
+            c, ci = 0.0, None
+        return {"force_fraction": c, "force_fraction_ci95": ci, **dict(self.force_profile)}
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -1006,7 +1040,7 @@ class Identification:
             "rank": self.rank, "n_nonlinear": self.n_nonlinear,
             "singular_values": [float(v) for v in self.singular_values], "fit_time_s": self.fit_time_s,
             "noise_c": self.noise_c, "object_temperature": dict(self.object_modes), "object_reference_c": dict(self.object_refs),
-            "notes": list(self.notes),
+            "notes": list(self.notes), "force_profile": None if self.force_profile is None else dict(self.force_profile),
         }
 
 
@@ -1261,7 +1295,42 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
     return Identification(cand, tuple(params), ratios, es_p, consistent, allowed, float(np.sqrt(np.mean(r ** 2))),
                           rms_by, n_s, k_par, aic, bic, rank, x.size, sv, time.perf_counter() - t0,
                           data.noise_c, x, names, depth_m, data.sample_rate_hz, dict(data.modes), tuple(notes),
-                          dict(data.refs), tuple(touch_conductance))
+                          dict(data.refs), tuple(touch_conductance),
+                          nominal_force_profile(data) if cand.force_area else None)
+
+
+#: The nominal force ramp a sensor file records: F / F_p from 1 s before the onset to 1.5 s after, every 20 ms.
+FORCE_PROFILE_S = (-1.0, 1.5, 0.02)
+
+
+def nominal_force_profile(data: "_Data | Sequence[Trial]") -> dict[str, Any]:
+    """The median over touches of the force over its plateau (:func:`relative_force`), after the onset.
+
+    What a question plays for a ``force_area`` model (it has no force trace of its
+    own): ``{"time_s": [...], "force_share": [...], "n_touches": n}`` on
+    :data:`FORCE_PROFILE_S`. The median of the area shares is the area share of
+    the median force (the share is a non-decreasing function of the force).
+
+    Examples
+    --------
+    >>> t = np.arange(-200, 1000) / 200.0
+    >>> trs = [Trial(t, np.zeros(t.size), np.zeros(t.size), np.clip(t / r, 0.0, 1.0) * 4.0, "wood")
+    ...        for r in (0.4, 0.5, 0.6)]
+    >>> p = nominal_force_profile(trs)
+    >>> p["n_touches"], p["time_s"][50:53], p["force_share"][50:53]
+    (3, [0.0, 0.02, 0.04], [0.0, 0.04, 0.08])
+    """
+    lo, hi, step = FORCE_PROFILE_S
+    grid = np.round(np.arange(round((hi - lo) / step) + 1) * step + lo, 9)
+    if isinstance(data, _Data):
+        rows = [np.interp(grid, g.time_s, f) for g in data.groups if g.force is not None for f in g.force]
+    else:
+        rows = [np.interp(grid, tr.time_s, relative_force(tr)) for tr in data]
+    if not rows:
+        raise InputError("a nominal force profile needs touches with a force channel")
+    med = np.median(np.array(rows), axis=0)
+    return {"time_s": [float(v) for v in grid], "force_share": [round(float(v), 4) for v in med],
+            "n_touches": len(rows)}
 
 
 def _one_blas_thread():
@@ -1394,18 +1463,33 @@ class Comparison:
 
 
 def _warm_start(cand: Candidate, done: Sequence[Identification]) -> np.ndarray | None:
-    """Start a candidate from the last fitted one whose free parameters it contains (nested models)."""
-    for prev in reversed(done):
-        if prev.candidate.model != cand.model and not (prev.candidate.model in ("semi-infinite", "contact")
-                                                       and cand.model in ("contact", "layered")):
-            continue
-        if not set(prev.candidate.free) <= set(cand.free):
-            continue
-        n_prev = len(prev.candidate.free)
-        x = [prev.x[prev.candidate.free.index(p)] if p in prev.candidate.free else _PARAMS[p].to_x(_PARAMS[p].start)
-             for p in cand.free]
-        return np.concatenate([x, prev.x[n_prev:]])
-    return None
+    """Start a candidate from fitted ones nested in it.
+
+    The base is the fitted candidate nested in ``cand`` that shares the most free parameters with it
+    (the latest on a tie); a free parameter it lacks, and the time offset, come from the latest nested
+    candidate with the same contact-area option where one has them (an area model's offset counts
+    from the first share's contact, not from full contact), else the parameter's default start.
+    Starting the layered area candidate from the layered drift fit (5 of its 6 parameters) rather than
+    from the contact area fit (3 of 6) takes its fit on the 120 shared touches from 423 to fewer
+    residual evaluations (docs/sensor-models.md, "Fit time").
+    """
+    nested = [prev for prev in done
+              if (prev.candidate.model == cand.model or (prev.candidate.model in ("semi-infinite", "contact")
+                                                         and cand.model in ("contact", "layered")))
+              and set(prev.candidate.free) <= set(cand.free)]
+    if not nested:
+        return None
+    base = max(reversed(nested), key=lambda r: len(set(r.candidate.free) & set(cand.free)))
+    alike = [r for r in nested if r.candidate.force_area == cand.force_area]
+    x = []
+    for p in cand.free:
+        src = base if p in base.candidate.free else next(
+            (r for r in reversed(alike) if p in r.candidate.free), None)
+        x.append(src.x[src.candidate.free.index(p)] if src is not None else _PARAMS[p].to_x(_PARAMS[p].start))
+    rest = np.array(base.x[len(base.candidate.free):], dtype=np.float64)
+    if alike and base.candidate.force_area != cand.force_area:
+        rest[0] = alike[-1].x[len(alike[-1].candidate.free)]     # the time offset
+    return np.concatenate([x, rest])
 
 
 def compare_models(fit_trials: Sequence[Trial], held_out: Sequence[Trial],

@@ -14,6 +14,11 @@ What a round trip can recover is what the data identify (module docstring of
 and the contact-time offset; e_s itself only as the interval the materials'
 handbook ranges allow (the truth must lie in it).
 
+The ``+drift+area`` cases emulate touches whose heater still warms at contact
+and whose contact area follows a force ramp of its own pace (:data:`CHAIN_PLAN`),
+and identify them with the drift and force-area options; c is compared with the
+truth like the other parameters.
+
 The ``+smoothing`` case smooths each recorded trial as the shared recordings'
 host did (Savitzky-Golay, window 99, order 3, over the whole trial) before the
 fit: the wire carries the raw reading, the smoothing is the host's.
@@ -61,6 +66,12 @@ class RoundTripCase:
         rig's known construction would.
     smoothing : bool
         The host smooths each recorded trial; the candidate models it.
+    drift : bool
+        The emulated heater still warms at contact, at a rate that differs from touch to touch
+        (:data:`CHAIN_PLAN`); the candidate fits a drift per touch.
+    force_area : bool
+        The emulated contact area follows each touch's force ramp, whose pace differs from touch to
+        touch (:data:`CHAIN_PLAN`, threshold c = ``contact_force_fraction``); the candidate fits c.
     """
 
     label: str
@@ -68,11 +79,28 @@ class RoundTripCase:
     free: tuple[str, ...]
     fixed: Mapping[str, Any] = field(default_factory=dict)
     smoothing: bool = False
+    drift: bool = False
+    force_area: bool = False
 
     def candidate(self):
         from .identify import Candidate
 
-        return Candidate(self.label, str(self.model["name"]), self.free, dict(self.fixed), self.smoothing)
+        free = self.free + (("contact_force_fraction",) if self.force_area else ())
+        return Candidate(self.label, str(self.model["name"]), free, dict(self.fixed), self.smoothing,
+                         drift=self.drift, force_area=self.force_area)
+
+    def plan(self, touches: int) -> dict[str, Any]:
+        """The emulator's :class:`~designkit.calibration.emulator.TouchPlan` settings for this case."""
+        out: dict[str, Any] = {"touch_every_s": 13.0, "touches_per_material": touches}
+        if self.drift:
+            out.update(drift_c_per_s=CHAIN_PLAN["drift_c_per_s"], drift_sd_c_per_s=CHAIN_PLAN["drift_sd_c_per_s"])
+        if self.force_area:
+            # the release ramp stays after the recorded window (7 s after the onset): the fit's area follows
+            # the measured force down again, the emulator's does not (unloading is not loading reversed)
+            out.update(ramp_s=CHAIN_PLAN["ramp_s"], ramp_spread=CHAIN_PLAN["ramp_spread"],
+                       contact_force_fraction=CHAIN_PLAN["contact_force_fraction"], contact_s=9.0,
+                       touch_every_s=15.0)
+        return out
 
     def truth(self) -> dict[str, float]:
         """The identifiable quantities' true values (ratios to e_s where only a ratio is identified)."""
@@ -82,8 +110,16 @@ class RoundTripCase:
             out["h_c/e_s"] = float(self.model["conductance_w_m2k"]) / TRUE_ES
         if "lag_s" in self.free:
             out["lag_s"] = float(self.model["lag_s"])
+        if self.force_area:
+            out["contact_force_fraction"] = CHAIN_PLAN["contact_force_fraction"]
         return out
 
+
+#: What the drift and force-area cases' emulated touches do (about as on the shared recordings): the heater
+#: warms at 0.1 +- 0.03 degC/s at contact; the force ramps to its plateau over 0.3-0.9 s (0.6 s +- 50 %); the
+#: contact area starts to grow at c = 0.3 of the plateau force.
+CHAIN_PLAN = {"drift_c_per_s": 0.1, "drift_sd_c_per_s": 0.03, "ramp_s": 0.6, "ramp_spread": 0.5,
+              "contact_force_fraction": 0.3}
 
 _LAYERED_FIXED = {"film_thickness_m": _LAYERED["film_thickness_m"],
                   "backing_effusivity_ws05_m2k": _LAYERED["backing_effusivity_ws05_m2k"] / TRUE_ES}
@@ -97,6 +133,11 @@ CASES: dict[str, RoundTripCase] = {c.label: c for c in (
                   _LAYERED_FIXED),
     RoundTripCase("layered+lag+smoothing", {"name": "layered", **_LAYERED},
                   ("diffusivity_m2_s", "conductance_w_m2k", "lag_s"), _LAYERED_FIXED, smoothing=True),
+    RoundTripCase("contact+drift+area", {"name": "contact", "conductance_w_m2k": 2500.0},
+                  ("diffusivity_m2_s", "conductance_w_m2k"), drift=True, force_area=True),
+    RoundTripCase("layered+lag+smoothing+drift+area", {"name": "layered", **_LAYERED},
+                  ("diffusivity_m2_s", "conductance_w_m2k", "lag_s"), _LAYERED_FIXED, smoothing=True, drift=True,
+                  force_area=True),
 )}
 
 
@@ -134,7 +175,8 @@ class RoundTripResult:
                 "record_s": self.record_s, "fit_s": self.fit_s}
 
 
-def _record(case: RoundTripCase, seed: int, noise_c: float, touches: int, speed: float, folder: Path):
+def _record(case: RoundTripCase, seed: int, noise_c: float, touches: int, speed: float, folder: Path,
+            force_noise_n: float = 0.02):
     """Emulate and record every material over its own pty; returns the emulated time offset [s]."""
     from ..models import get_model
     from ..sensor import Sensor
@@ -148,8 +190,8 @@ def _record(case: RoundTripCase, seed: int, noise_c: float, touches: int, speed:
     offset = math.nan
     for k, (label, e) in enumerate(OBJECTS.items()):
         emu = Emulator(prof, sensor, [EmulatedMaterial(label, e)], noise_c=noise_c, sensor_temp_c=29.5,
-                       ambient_c=22.5, speed=speed, plan=TouchPlan(touch_every_s=13.0, touches_per_material=touches),
-                       seed=1000 * int(seed) + k, model=model)
+                       ambient_c=22.5, speed=speed, plan=TouchPlan(**case.plan(touches)),
+                       seed=1000 * int(seed) + k, model=model, force_noise_n=force_noise_n)
         with emu, SerialRecorder(emu.port, prof, folder, no_data_timeout_s=30.0) as rec:
             rec.record(label, touches)
         offset = emu.expected_time_offset_s
@@ -166,7 +208,8 @@ def _host_smoothed(trials):
 
 
 def round_trip(case: "str | RoundTripCase", seed: int, *, noise_c: float = 0.01, touches: int = 10,
-               speed: float = 200.0, folder: "str | Path | None" = None) -> RoundTripResult:
+               speed: float = 200.0, folder: "str | Path | None" = None,
+               force_noise_n: float = 0.02) -> RoundTripResult:
     """Emulate, record over a real pty, fit; compare with the truth.
 
     Parameters
@@ -183,6 +226,10 @@ def round_trip(case: "str | RoundTripCase", seed: int, *, noise_c: float = 0.01,
         Device seconds per real second of the emulated rig.
     folder : path, optional
         Where the trials are written (default: a temporary folder, removed after).
+    force_noise_n : float
+        Noise sigma of the force sensor [N] (the emulator's default, 0.02 N on a 10 N press). The
+        force-area cases read the area from the measured force: its noise, clipped at the plateau,
+        biases the area low there (errors in variables; docs/sensor-models.md).
     """
     from .identify import identify
     from .trials import load_index
@@ -193,7 +240,7 @@ def round_trip(case: "str | RoundTripCase", seed: int, *, noise_c: float = 0.01,
     with tempfile.TemporaryDirectory(prefix="designkit-roundtrip-") as tmp:
         where = Path(folder) if folder is not None else Path(tmp)
         t0 = time.perf_counter()
-        offset = _record(c, seed, noise_c, touches, speed, where)
+        offset = _record(c, seed, noise_c, touches, speed, where, force_noise_n)
         t1 = time.perf_counter()
         trials = load_index(where / "index.csv")
         if c.smoothing:

@@ -124,7 +124,10 @@ def sensor_and_model(sensor, model: Optional[str] = None, *, conductance: Option
 def model_words(sen, fm, source: str) -> str:
     """One line saying which model answers, and why (for text output)."""
     if source == "sensor file":
-        return f"model {fm.describe()} (recorded in sensor file {sen.name})"
+        from ..models import sensor_model_notes
+
+        extra = sensor_model_notes(sen, fm)[1:]   # the contact area and drift lines (the first names the model)
+        return f"model {fm.describe()} (recorded in sensor file {sen.name})" + "".join(f"; {x}" for x in extra)
     if source == "options" and sen.model is not None and sen.model_name != fm.name:
         return f"model {fm.describe()} (from the options; sensor {sen.name} was identified with {sen.model_name})"
     return f"model {fm.describe()}"

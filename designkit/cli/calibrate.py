@@ -787,7 +787,10 @@ def emulate(
         if fm.name != "semi-infinite":
             from rich.markup import escape
 
-            con.print(escape(f"  model {fm.describe()} (recorded in sensor file {emu.sensor.name}; the wire "
+            played = fm.describe() if fm.name != "force-ramp" else (
+                f"{fm.base.describe()} with the contact area following the emulator's force ramp "
+                f"({emu.plan.ramp_s:g} s) at c = {emu.plan.contact_force_fraction:.3g}")
+            con.print(escape(f"  model {played} (recorded in sensor file {emu.sensor.name}; the wire "
                              "carries the raw reading: any host smoothing is the host's)"))
         con.print(f"  try: designkit calibrate record --port {port} --profile {profile} "
                   f"--material {mats[0].label} --out trials/")

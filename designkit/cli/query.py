@@ -155,8 +155,10 @@ def _noted(ans, reroute: Optional[str], sen, fm, source: str):
     notes = list(ans.notes)
     if reroute:
         notes.append(reroute)
-    if source == "sensor file" and fm.name != "semi-infinite":
-        notes.append(f"model {fm.name}: recorded in sensor file {sen.name}")
+    if source == "sensor file":
+        from ..models import sensor_model_notes
+
+        notes.extend(sensor_model_notes(sen, fm))
     return dataclasses.replace(ans, notes=tuple(notes)) if notes != list(ans.notes) else ans
 
 

@@ -14,6 +14,8 @@ name                model                                    shared shape
 ``contact``         finite interface conductance h_c         no
 ``layered``         heater film on a backing, h_c, the       no
                     thermistor lag and the host smoothing
+``force-ramp``      any of these with a contact area that    no
+                    grows while the finger presses in
 ==================  =======================================  ==============
 
 Adding a model is one module defining a :class:`ForwardModel` subclass plus
@@ -41,7 +43,7 @@ from .._validation import InputError
 from .base import ForwardModel, ModelCheck
 
 __all__ = ["MODELS", "ForwardModel", "ModelCheck", "get_model", "load_sensor_model", "model_class", "model_names",
-           "parse_model_spec", "sensor_model"]
+           "parse_model_spec", "sensor_model", "sensor_model_notes"]
 
 #: name -> (module, class): the registry of forward models (pvlib-style catalogue).
 MODELS: dict[str, tuple[str, str]] = {
@@ -49,6 +51,7 @@ MODELS: dict[str, tuple[str, str]] = {
     "slab": ("designkit.models.slab", "Slab"),
     "contact": ("designkit.models.contact", "Contact"),
     "layered": ("designkit.models.layered", "Layered"),
+    "force-ramp": ("designkit.models.ramp", "ForceRamp"),
 }
 
 _CLASSES = {cls: name for name, (_, cls) in MODELS.items()}
@@ -134,6 +137,12 @@ def get_model(spec: "str | Mapping[str, Any] | ForwardModel | None" = None, **pa
 def sensor_model(sensor) -> ForwardModel:
     """The forward model a sensor was identified with (its file's ``model:``; none: the semi-infinite model).
 
+    A record with a ``contact_area`` (calibrated with the force-driven contact area) gives the model
+    with the nominal force ramp it records (:class:`~designkit.models.ramp.ForceRamp`: the calibration
+    touches' median force over its plateau, through the fitted threshold ``c``): a question has no
+    force trace of its own. A record's ``drift`` is a per-touch nuisance (each touch's heater still
+    warming) and plays no part: a new touch has no drift.
+
     Parameters
     ----------
     sensor : designkit.Sensor
@@ -152,9 +161,69 @@ def sensor_model(sensor) -> ForwardModel:
     if record is None:
         return get_model("semi-infinite")
     try:
-        return get_model(str(record["name"]), **dict(record.get("params") or {}))
+        base = get_model(str(record["name"]), **dict(record.get("params") or {}))
+        area = record.get("contact_area")
+        if not area:
+            return base
+        from .ramp import ForceRamp
+
+        missing = [k for k in ("force_fraction", "time_s", "force_share") if area.get(k) is None]
+        if missing:
+            raise InputError(f"contact_area needs {', '.join(missing)}")
+        return ForceRamp.from_force_profile(
+            base, area["time_s"], area["force_share"], float(area["force_fraction"]),
+            source=f"the median force ramp of {area.get('n_touches', 'the')} calibration touches")
     except InputError as exc:
         raise InputError(f"sensor {sensor.name!r}: its recorded model: {exc}") from None
+
+
+def sensor_model_notes(sensor, model: "ForwardModel | None" = None) -> list[str]:
+    """What an answer says about the model a sensor file recorded: which, and what it plays for a touch.
+
+    One line naming the model (and the calibration candidate), one on the
+    contact area when the model has a force ramp (a question has no force
+    trace: the calibration touches' median ramp), one on the heater drift when
+    calibration fitted one per touch (a nuisance, not a property of the
+    sensor: a question's touch has none). Empty for the semi-infinite model
+    without extras.
+
+    Parameters
+    ----------
+    sensor : designkit.Sensor
+    model : ForwardModel, optional
+        The model that answered (default: :func:`sensor_model` of ``sensor``).
+
+    Examples
+    --------
+    >>> from designkit import SENSORS
+    >>> s = SENSORS["paper"].replace(name="rig", model={"name": "contact", "params": {"conductance_w_m2k": 2500.0},
+    ...                                                 "drift": "per-touch"})
+    >>> for line in sensor_model_notes(s):
+    ...     print(line[:60])
+    model contact: recorded in sensor file rig
+    heater drift: fitted per touch in calibration (a nuisance li
+    """
+    record = getattr(sensor, "model", None)
+    if record is None:
+        return []
+    fm = sensor_model(sensor) if model is None else model
+    ramp = getattr(fm, "name", "") == "force-ramp"
+    name = fm.base.name if ramp else fm.name
+    cand = record.get("candidate")
+    out = []
+    if name != "semi-infinite" or ramp or record.get("drift"):
+        out.append(f"model {name}{' with a force-driven contact area' if ramp else ''}: recorded in sensor file "
+                   f"{sensor.name}" + (f" (calibrated as {cand})" if cand and cand != name else ""))
+    if ramp:
+        n = (record.get("contact_area") or {}).get("n_touches", "?")
+        out.append(f"contact area: the median force ramp of the {n} calibration touches (a question has no force "
+                   f"trace), area share clip((F/F_p - c)/(1 - c), 0, 1) with c = {fm.force_fraction:.3g}; "
+                   f"the whole area is in contact {fm.ramp_duration_s:.2f} s after the first contact, from which "
+                   "the contact time counts")
+    if record.get("drift"):
+        out.append("heater drift: fitted per touch in calibration (a nuisance like the touch's initial "
+                   "temperature, not a property of the sensor); not played here: a new touch has none")
+    return out
 
 
 def load_sensor_model(spec="paper", model: "str | Mapping[str, Any] | ForwardModel | None" = None):

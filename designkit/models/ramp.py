@@ -1,0 +1,245 @@
+"""A contact area that grows while the finger presses in: any model's reading, summed over the area's shares.
+
+A real touch does not put the whole contact area down at once: the force
+rises over 0.5-1 s, and each share of the final area starts its own heat flow
+when it comes into contact. With the shares as parallel columns (lateral
+conduction neglected) and every model here linear in the temperatures, the
+reading is the area-weighted sum of step responses (Duhamel's principle),
+
+.. math::
+
+    u(t) = \\sum_j \\Delta A_j \\, u_{\\mathrm{step}}(t - t_j),
+
+with ``A(t)`` the share of the final area in contact (0 before contact, 1 from
+the end of the ramp on) and ``u_step`` the full-contact reading of the
+``base`` model. Calibration (:mod:`designkit.calibration.identify`, option
+``force_area``) fits the area from each touch's measured force,
+``A = clip((F / F_p - c) / (1 - c), 0, 1)`` (:func:`area_share`); a sensor file
+records the threshold ``c`` and the calibration touches' median force ramp, and
+:func:`designkit.models.sensor_model` plays that nominal ramp for touches that
+have no force trace (questions, sweeps, simulations).
+
+Time ``t = 0`` is the first instant any share of the area is in contact (the
+heat flow's start, as for every other model), so a contact time counts from
+there.
+
+Examples
+--------
+>>> from designkit import SENSORS
+>>> from designkit.models.semi_infinite import SemiInfinite
+>>> instant = ForceRamp(SemiInfinite(), ramp_time_s=(0.0,), ramp_area=(1.0,))
+>>> t = [0.5, 2.0]
+>>> bool(np.allclose(instant.response(t, [400.0], SENSORS["paper"]), SemiInfinite().response(t, [400.0],
+...      SENSORS["paper"])))
+True
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from typing import Any, Mapping
+
+import numpy as np
+
+from .._validation import InputError
+from .base import ForwardModel
+
+__all__ = ["ForceRamp", "area_share"]
+
+
+def area_share(force_rel, fraction: float = 0.0) -> np.ndarray:
+    """Share of the final contact area in contact: ``clip((F / F_p - c) / (1 - c), 0, 1)``.
+
+    Parameters
+    ----------
+    force_rel : array_like
+        Force divided by its plateau ``F / F_p``.
+    fraction : float
+        ``c``, the force share at which the area starts to grow, in [0, 1).
+
+    Examples
+    --------
+    >>> area_share([0.1, 0.3, 0.65, 1.0, 1.2], 0.3).round(3).tolist()
+    [0.0, 0.0, 0.5, 1.0, 1.0]
+    """
+    c = float(fraction)
+    if not 0.0 <= c < 1.0:
+        raise InputError(f"contact force fraction c must be in [0, 1), got {c:g}")
+    return np.clip((np.asarray(force_rel, dtype=np.float64) - c) / (1.0 - c), 0.0, 1.0)
+
+
+@dataclass(frozen=True)
+class ForceRamp(ForwardModel):
+    """The ``base`` model's reading with a contact area that grows along a given ramp.
+
+    Parameters
+    ----------
+    base : ForwardModel or mapping or None
+        The full-contact model (a mapping as :meth:`ForwardModel.to_dict` writes
+        it; None: the semi-infinite model).
+    ramp_time_s : tuple of float
+        Times [s] after the first contact, increasing, the first 0.
+    ramp_area : tuple of float
+        Share of the final contact area in contact at those times: in (0, 1],
+        non-decreasing, the last 1 (held at 1 afterwards).
+    force_fraction : float
+        The threshold ``c`` the ramp was made with (recorded, for people; the
+        ramp already contains it).
+    source : str
+        Where the ramp came from (for people).
+
+    Examples
+    --------
+    >>> from designkit import SENSORS
+    >>> from designkit.models.contact import Contact
+    >>> base = Contact(conductance_w_m2k=2500.0)
+    >>> slow = ForceRamp(base, ramp_time_s=(0.0, 0.25, 0.5), ramp_area=(0.2, 0.6, 1.0))
+    >>> u, full = slow.response([0.1, 0.4, 3.0], [400.0], SENSORS["paper"]), base.response([0.1, 0.4, 3.0], [400.0],
+    ...                                                                             SENSORS["paper"])
+    >>> bool(np.all(u < full)), bool(np.isclose(u[0, 0], 0.2 * full[0, 0]))
+    (True, True)
+    """
+
+    base: Any = None
+    ramp_time_s: tuple[float, ...] = (0.0,)
+    ramp_area: tuple[float, ...] = (1.0,)
+    force_fraction: float = 0.0
+    source: str = ""
+
+    name = "force-ramp"
+    shared_shape = False
+    units = {"ramp_time_s": "s", "ramp_area": "share of the final contact area", "force_fraction": "of F_p"}
+
+    def __post_init__(self) -> None:
+        base = self.base
+        if base is None:   # the defaults: the paper's model, the whole area at once
+            from .semi_infinite import SemiInfinite
+
+            base = SemiInfinite()
+        if isinstance(base, Mapping):
+            from . import get_model
+
+            base = get_model(dict(base))
+        if not isinstance(base, ForwardModel) or isinstance(base, ForceRamp):
+            raise InputError("a force ramp needs a base model (a full-contact forward model, not another ramp)")
+        object.__setattr__(self, "base", base)
+        t = np.asarray(self.ramp_time_s, dtype=np.float64).ravel()
+        a = np.asarray(self.ramp_area, dtype=np.float64).ravel()
+        if t.size == 0 or t.size != a.size:
+            raise InputError(f"a force ramp needs as many area shares as times, got {a.size} and {t.size}")
+        if not (np.all(np.isfinite(t)) and np.all(np.isfinite(a))):
+            raise InputError("a force ramp's times and area shares must be finite numbers")
+        if t[0] != 0.0 or np.any(np.diff(t) <= 0):
+            raise InputError("a force ramp's times must start at 0 (the first contact) and increase")
+        if a[0] <= 0.0 or np.any(np.diff(a) < 0) or abs(a[-1] - 1.0) > 1e-9:
+            raise InputError("a force ramp's area shares must be above 0, non-decreasing, and end at 1")
+        object.__setattr__(self, "ramp_time_s", tuple(float(v) for v in t))
+        object.__setattr__(self, "ramp_area", tuple(float(v) for v in a))
+        object.__setattr__(self, "force_fraction", float(self.force_fraction))
+        object.__setattr__(self, "source", str(self.source))
+        object.__setattr__(self, "object_properties", base.object_properties)
+
+    @classmethod
+    def from_force_profile(cls, base, time_s, force_rel, fraction: float, *, source: str = "") -> "ForceRamp":
+        """The ramp of a nominal force profile ``F / F_p`` at ``time_s`` after the detected onset.
+
+        The area ``A = clip((F/F_p - c) / (1 - c), 0, 1)`` (made non-decreasing:
+        an area in contact stays in contact, a force overshoot does not add
+        area) starts its heat flow when it comes into contact; ``t = 0`` of the
+        result is the first share's contact (a calibrated time offset of the
+        heat flow relative to the detected onset moves every share alike, so it
+        does not enter). After the profile's last time the whole area is in
+        contact.
+
+        Examples
+        --------
+        >>> from designkit.models.semi_infinite import SemiInfinite
+        >>> r = ForceRamp.from_force_profile(SemiInfinite(), [0.0, 0.1, 0.2, 0.3], [0.1, 0.5, 0.9, 1.0], 0.3)
+        >>> r.ramp_time_s, [round(a, 3) for a in r.ramp_area]
+        ((0.0, 0.1, 0.2), [0.286, 0.857, 1.0])
+        """
+        t = np.asarray(time_s, dtype=np.float64).ravel()
+        area = np.maximum.accumulate(area_share(force_rel, fraction))
+        if t.size != area.size or t.size == 0:
+            raise InputError(f"a force profile needs as many forces as times, got {area.size} and {t.size}")
+        on = np.flatnonzero(area > 0)
+        if on.size == 0:
+            raise InputError(f"the force profile never exceeds the contact threshold c = {fraction:g} of its "
+                             "plateau: no contact area")
+        first = int(on[0])
+        full = np.flatnonzero(area >= 1.0)
+        last = int(full[0]) if full.size else area.size - 1
+        times = np.round(t[first:last + 1] - t[first], 9)
+        shares = area[first:last + 1].copy()
+        if shares[-1] < 1.0:  # the plateau from the next sample on
+            step = float(t[1] - t[0]) if t.size > 1 else 0.0
+            times = np.append(times, times[-1] + step)
+            shares = np.append(shares, 1.0)
+        return cls(base, tuple(times), tuple(shares), float(fraction), source)
+
+    # ------------------------------------------------------------ the physics
+    def _step_model(self):
+        """The base model without the host smoothing (applied once, to the summed reading)."""
+        if getattr(self.base, "smoothing_window", 0) > 1:
+            return dataclasses.replace(self.base, smoothing_window=0)
+        return self.base
+
+    def _unsmoothed(self, t: np.ndarray, e_object, sensor, diffusivity_m2_s, tolerance: float) -> np.ndarray:
+        step = self._step_model()
+        tj = np.asarray(self.ramp_time_s)
+        da = np.diff(np.asarray(self.ramp_area), prepend=0.0)
+        keep = da > 0
+        tj, da = tj[keep], da[keep]
+        lags = t[None, :] - tj[:, None]                                 # (J, m)
+        pos = lags > 0
+        k = np.atleast_1d(np.asarray(e_object)).size
+        out = np.zeros((k, t.size))
+        if not pos.any():
+            return out
+        # one evaluation of the step response at the distinct lags (on a uniform grid with the ramp on
+        # the same grid: about m + J of them, not m J)
+        key = np.round(lags[pos] * 1e9).astype(np.int64)
+        uniq, first, inverse = np.unique(key, return_index=True, return_inverse=True)
+        u = step.response(lags[pos][first], e_object, sensor, diffusivity_m2_s=diffusivity_m2_s,
+                          tolerance=tolerance)                           # (K, U)
+        full = np.zeros((k,) + lags.shape)
+        full[:, pos] = u[:, inverse.ravel()]
+        return np.einsum("j,kjm->km", da, full)
+
+    def response(self, time_s, e_object, sensor, *, diffusivity_m2_s=None, tolerance: float = 1e-9) -> np.ndarray:
+        """Normalized reading (K, m): the area-weighted sum of the base model's step responses.
+
+        With a base model that smooths (the host's Savitzky-Golay filter), the
+        sum is smoothed once, as the host smoothed the recorded touch; then the
+        times must be uniform.
+        """
+        t = np.atleast_1d(np.asarray(time_s, dtype=np.float64))
+        window = int(getattr(self.base, "smoothing_window", 0) or 0)
+        if window <= 1:
+            return self._unsmoothed(t, e_object, sensor, diffusivity_m2_s, tolerance)
+        from .layered import smoothed_reading
+
+        return smoothed_reading(lambda tt: self._unsmoothed(tt, e_object, sensor, diffusivity_m2_s, tolerance),
+                                t, sensor.sample_rate_hz, window, int(self.base.smoothing_order),
+                                what="a smoothed model with a force ramp")
+
+    def check(self, objects, sensor, *, contact_s: float, noise_c: float, delta_t_c: float):
+        """The base model's check (the ramp adds no validity limit of its own)."""
+        return self.base.check(objects, sensor, contact_s=contact_s, noise_c=noise_c, delta_t_c=delta_t_c)
+
+    # ------------------------------------------------------------ the catalogue entry
+    @property
+    def ramp_duration_s(self) -> float:
+        """Time [s] from the first contact until the whole area is in contact."""
+        return float(self.ramp_time_s[-1])
+
+    def parameters(self) -> dict[str, Any]:
+        return {"base": self.base.to_dict(), "ramp_time_s": list(self.ramp_time_s),
+                "ramp_area": list(self.ramp_area), "force_fraction": self.force_fraction, "source": self.source}
+
+    def describe(self) -> str:
+        """The base model, and the ramp in one phrase."""
+        how = f", {self.source}" if self.source else ""
+        return (f"{self.base.describe()} with a contact area growing over {self.ramp_duration_s:.2f} s "
+                f"(c = {self.force_fraction:.3g}{how})")

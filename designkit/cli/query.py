@@ -191,7 +191,7 @@ def _render_text(d) -> None:
                   + " vs ".join(o["label"] for o in d["limiting_pair"]) + "[/]")
     _VALUE_LINES[d["question"]](con, d)
     if d["question"] == "min-contact":
-        from ..reproduce.paper import guideline_remark
+        from ..query.guideline import guideline_remark
 
         remark = guideline_remark(d)
         if remark:

@@ -9,10 +9,10 @@ use sigma = 0.05).
 
 from __future__ import annotations
 
-import math
 import types
 from dataclasses import dataclass
-from typing import Any, Mapping
+
+from ..query import guideline as _guideline
 
 __all__ = [
     "GUIDELINE",
@@ -22,7 +22,6 @@ __all__ = [
     "Table1Row",
     "TABLE1_F1_TOLERANCE",
     "TABLE1_PERCENT_TOLERANCE",
-    "guideline_remark",
 ]
 
 #: Differences from the paper larger than these are explained in the report (issue 5).
@@ -67,52 +66,10 @@ TABLE1: tuple[Table1Row, ...] = (
     Table1Row(0.01, 10.0, 13.04, 0.945, 11.28, 0.960),
 )
 
-#: The design guideline (section VIII-B): 35k vs 20k, sigma 0.05, dT 10, contact grid 1-4 s, F1 >= 0.9.
-GUIDELINE = types.MappingProxyType({
-    "e1": 35000.0, "e2": 20000.0, "noise_c": 0.05, "delta_t_c": 10.0,
-    "contact_grid_s": (1.0, 2.0, 3.0, 4.0), "min_contact_s": 2.0, "threshold": 0.9,
-})
+#: The design guideline (section VIII-B) lives with the questions (:mod:`designkit.query.guideline`): the
+#: main job prints it beside its answer, and importing this package would cost a fresh shell ~10-30 ms.
+GUIDELINE = _guideline.GUIDELINE
 
-
-def guideline_remark(answer: Mapping[str, Any]) -> str | None:
-    """The paper's own figure beside a ``min-contact`` answer (its dict) asked in the guideline's scene.
-
-    The scene is the paper's (:data:`GUIDELINE`: the two effusivities as numbers, sigma, dT and
-    Phi, its sensor, the semi-infinite model, fixed initial conditions); otherwise None.
-    The answer's contact is placed on the paper's 1-s grid (the first grid time at or above it).
-
-    >>> d = {"question": "min-contact", "value": 1.5, "threshold": 0.9, "sensor": {"name": "paper"},
-    ...      "model": {"name": "semi-infinite"}, "scene": {"noise_c": 0.05, "delta_t_c": 10.0},
-    ...      "objects": [{"material": None, "e_range": [35000.0, 35080.0]},
-    ...                  {"material": None, "e_range": [20000.0, 20080.0]}], "computation": {}}
-    >>> print(guideline_remark(d))
-    the paper (section VIII-B): at least 2 s on its 1-s grid (1, 2, 3, 4 s); 1.5 s rounds up to 2 s there
-    >>> guideline_remark({**d, "scene": {"noise_c": 0.1, "delta_t_c": 10.0}}) is None
-    True
-    """
-    g = GUIDELINE
-    try:
-        same = (answer["question"] == "min-contact" and answer["sensor"]["name"] == "paper"
-                and answer["model"]["name"] == "semi-infinite"
-                and not (answer.get("computation") or {}).get("sensor_temp_spread_c")
-                and all(o.get("material") is None for o in answer["objects"])
-                and sorted(o["e_range"][0] for o in answer["objects"]) == sorted((g["e1"], g["e2"]))
-                and math.isclose(answer["scene"]["noise_c"], g["noise_c"])
-                and math.isclose(answer["scene"]["delta_t_c"], g["delta_t_c"])
-                and math.isclose(answer["threshold"], g["threshold"]))
-    except (KeyError, TypeError, IndexError):
-        return None
-    if not same:
-        return None
-    grid = g["contact_grid_s"]
-    words = (f"the paper (section VIII-B): at least {g['min_contact_s']:g} s on its 1-s grid "
-             f"({', '.join(f'{c:g}' for c in grid)} s)")
-    value = answer.get("value")
-    if value is None:
-        return words
-    on_grid = next((c for c in grid if c >= value - 1e-9), None)
-    where = f"rounds up to {on_grid:g} s there" if on_grid is not None else f"lies beyond that grid's {grid[-1]:g} s"
-    return f"{words}; {value:.3g} s {where}"
 
 #: Real robot (Table II, contact 4 s, 12 materials, 66 pairs) and sim-to-real (section VII).
 REAL_ROBOT = types.MappingProxyType({

@@ -46,6 +46,7 @@ from .._validation import as_generator
 __all__ = [
     "COVERAGE_QUESTIONS",
     "answer_reading",
+    "calibration_z",
     "case_arguments",
     "coverage_case",
     "diluted_coverage",
@@ -203,6 +204,44 @@ def _violation(question: str, ref, coverage: float) -> bool | None:
 
 
 # ============================================================ the summary
+def _stated_sd(r: Mapping[str, Any], log: bool) -> float | None:
+    """The standard deviation a stated two-sided interval implies (half-width / z), on log scale for crossings."""
+    lo, hi, cov = r.get("low"), r.get("high"), r.get("coverage")
+    if lo is None or hi is None or not cov or hi <= lo or (log and lo <= 0):
+        return None
+    width = math.log(hi) - math.log(lo) if log else hi - lo
+    return width / (2.0 * NormalDist().inv_cdf(0.5 + 0.5 * cov))
+
+
+def calibration_z(results: Iterable[Mapping[str, Any]], question: str, route: str = "exact") -> np.ndarray:
+    """``(answer - reference) / sqrt(sd_answer^2 + sd_reference^2)`` per case where both state an interval.
+
+    The sd are the ones the stated intervals imply (log scale for the crossings, F1 scale for
+    ``distinguishable``). Both sides' Monte Carlo errors are in the denominator, so the spread of
+    these is 1 for calibrated intervals whatever the reference's own error (coverage against the
+    reference is diluted by it, :func:`diluted_coverage`); above 1: intervals too narrow.
+
+    >>> r = [{"question": "q", "exact": {"value": 1.1, "low": 1.0, "high": 1.2, "coverage": 0.9},
+    ...       "reference": {"value": 1.0, "low": 0.95, "high": 1.05, "coverage": 0.9}}]
+    >>> round(float(calibration_z(r, "q", "exact")[0]), 2)
+    1.51
+    """
+    log = question != "distinguishable"
+    out = []
+    for r in results:
+        if r["question"] != question or route not in r:
+            continue
+        a, ref = r[route], r["reference"]
+        if a.get("value") is None or isinstance(ref.get("value"), bool) or ref.get("value") is None:
+            continue
+        sa, sr = _stated_sd(a, log), _stated_sd(ref, log)
+        if sa is None or sr is None or (log and (a["value"] <= 0 or ref["value"] <= 0)):
+            continue
+        d = math.log(a["value"]) - math.log(ref["value"]) if log else a["value"] - ref["value"]
+        out.append(d / math.hypot(sa, sr))
+    return np.asarray(out, dtype=np.float64)
+
+
 def _covered(r: Mapping[str, Any], truth: float) -> bool:
     lo = r["low"] if r["low"] is not None else -math.inf
     hi = r["high"] if r["high"] is not None else math.inf
@@ -254,12 +293,21 @@ def summarize(results: Iterable[Mapping[str, Any]], question: str, route: str, *
         if stated else None,
         "violations": sum(1 for r in rows if r.get("violation")),
         # the reference's crossing at the bound itself: its F1 reached Phi at the ideal observer's answer
+        **_z_summary(calibration_z(rows, question, route)),
         "reference_at_bound": 0 if question == "distinguishable" else sum(  # (an F1 of 1 is no violation)
             1 for r in rows if r["reference"].get("value") is not None
                                   and not isinstance(r["reference"]["value"], bool)
                                   and r["reference"].get("ideal") is not None
                                   and math.isclose(r["reference"]["value"], r["reference"]["ideal"], rel_tol=1e-9)),
     }
+
+
+def _z_summary(z: np.ndarray) -> dict[str, Any]:
+    """Spread of :func:`calibration_z` (robust: 1.4826 x the median absolute value, so that a few
+    clipped intervals do not dominate) and the share inside the nominal 90 % band."""
+    if z.size == 0:
+        return {"n_z": 0, "z_sd": None, "z_robust_sd": None}
+    return {"n_z": int(z.size), "z_sd": float(np.std(z)), "z_robust_sd": float(1.4826 * np.median(np.abs(z)))}
 
 
 # ============================================================ the machinery on a known truth

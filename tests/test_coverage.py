@@ -128,6 +128,29 @@ def test_stated_interval_schema_and_refusals():
             query.ask("min-contact", route="table", e1=3000, e2=1500, coverage=bad)
 
 
+def test_calibration_z_is_one_for_calibrated_intervals_whatever_the_reference_error():
+    # records drawn with known errors: answers' log-sd 0.05, references' 0.025 (a 4x-seeds reference);
+    # coverage against the reference is diluted (~86 %), the z spread is not
+    from designkit.accuracy.coverage import calibration_z
+
+    rng = np.random.default_rng(8)
+    z90 = 1.6448536269514722
+
+    def reading(truth, sd, s_true):
+        v = truth * math.exp(s_true * rng.standard_normal())
+        return {"value": v, "low": v * math.exp(-z90 * sd), "high": v * math.exp(z90 * sd), "coverage": 0.9}
+
+    def records(s_answer):
+        return [{"question": "max-noise", "exact": reading(t, 0.05, s_answer), "reference": reading(t, 0.025, 0.025)}
+                for t in np.exp(rng.uniform(-5, 0, 3000))]
+
+    ok = records(0.05)
+    assert np.std(calibration_z(ok, "max-noise")) == pytest.approx(1.0, abs=0.05)
+    assert summarize(ok, "max-noise", "exact")["coverage"] == pytest.approx(diluted_coverage(0.9, 0.5), abs=0.02)
+    narrow = records(0.1)  # the answer's real spread twice what its interval states
+    assert np.std(calibration_z(narrow, "max-noise")) > 1.6
+
+
 def test_diluted_coverage():
     assert diluted_coverage(0.9, 0.0) == pytest.approx(0.9)
     assert diluted_coverage(0.9, 0.5) < 0.9

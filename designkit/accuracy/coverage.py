@@ -219,7 +219,8 @@ def calibration_z(results: Iterable[Mapping[str, Any]], question: str, route: st
     The sd are the ones the stated intervals imply (log scale for the crossings, F1 scale for
     ``distinguishable``). Both sides' Monte Carlo errors are in the denominator, so the spread of
     these is 1 for calibrated intervals whatever the reference's own error (coverage against the
-    reference is diluted by it, :func:`diluted_coverage`); above 1: intervals too narrow.
+    reference is diluted by it, :func:`diluted_coverage`); above 1: intervals too narrow. An F1 of 1
+    on either side (no spread: the interval is clipped there) leaves the case out.
 
     >>> r = [{"question": "q", "exact": {"value": 1.1, "low": 1.0, "high": 1.2, "coverage": 0.9},
     ...       "reference": {"value": 1.0, "low": 0.95, "high": 1.05, "coverage": 0.9}}]
@@ -233,6 +234,8 @@ def calibration_z(results: Iterable[Mapping[str, Any]], question: str, route: st
             continue
         a, ref = r[route], r["reference"]
         if a.get("value") is None or isinstance(ref.get("value"), bool) or ref.get("value") is None:
+            continue
+        if not log and max(a["value"], ref["value"]) >= 1.0 - 1e-12:  # an F1 of 1 has no spread to calibrate
             continue
         sa, sr = _stated_sd(a, log), _stated_sd(ref, log)
         if sa is None or sr is None or (log and (a["value"] <= 0 or ref["value"] <= 0)):

@@ -582,9 +582,9 @@ def coverage_markdown(doc: Mapping[str, Any], figure: str | None = None) -> list
            f"crossings (median relative error {doc['synthetic']['median_rel']:.3g}, p95 "
            f"{doc['synthetic']['p95_rel']:.3g}). Against a reference with its own Monte Carlo error an exactly "
            f"calibrated 90 % interval covers about {pct(doc['diluted_nominal'])} (the target band is 85-97 %).", "",
-           *([" ".join(["Variants of the same check:", *(
-               f"{v['label']}: {pct(v['coverage'])} covered, stated widths {1 / v['z_sd']:.2f}x the real "
-               f"spread;" for v in doc["synthetic"]["variants"])]), ""] if doc["synthetic"].get("variants") else []),
+           *(["Variants of the same check: " + "; ".join(
+               f"{v['label']}: {pct(v['coverage'])} covered, stated widths {1 / v['z_sd']:.2f}x the real spread"
+               for v in doc["synthetic"]["variants"]) + ".", ""] if doc["synthetic"].get("variants") else []),
            "| question | route | cases | compared | stated | coverage of 90 % | no stated coverage | no answer "
            "| median abs err | p95 abs err | median rel err | p95 rel err | ideal-bound violations |",
            "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]

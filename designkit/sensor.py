@@ -20,13 +20,46 @@ import numpy as np
 from ._validation import InputError, check_nonnegative, check_positive
 from .properties import time_constant
 
-__all__ = ["MAX_SAMPLES_PER_TOUCH", "MODEL_KEYS", "SENSORS", "Sensor", "load_sensor", "sample_times_s"]
+__all__ = ["MAX_SAMPLES_PER_TOUCH", "MODEL_KEYS", "SENSORS", "Sensor", "last_sample_index", "load_sensor",
+           "sample_times_s"]
 
 SENSOR_FILE_VERSION = 1
 
 #: The most samples one touch may have (10 000 s at 100 Hz, 1 s at 1 MHz): 8 MB per touch curve.
 #: A longer touch or a faster sensor is refused before anything is allocated.
 MAX_SAMPLES_PER_TOUCH = 1_000_000
+
+
+#: Samples of tolerance when a contact time is turned into a sample count: keeps 2.0 s * 200 Hz = 400
+#: (399.99999999999994 in floating point) from rounding down.
+_SAMPLE_TOLERANCE = 1e-9
+
+
+def last_sample_index(contact_s, sample_rate_hz: float) -> np.ndarray:
+    """Index ``k`` of the last sample a contact of ``contact_s`` takes: ``floor(contact_s * fs)``, vectorized.
+
+    The rule of :func:`sample_times_s` (samples ``0 .. k``, the first at contact)
+    for arrays of contact times, without its checks: callers validate first.
+
+    Parameters
+    ----------
+    contact_s : array_like
+        Contact durations [s], >= 0 and finite.
+    sample_rate_hz : float
+        Sampling rate [Hz].
+
+    Returns
+    -------
+    ndarray of int64
+        Same shape as ``contact_s`` (0-d for a number).
+
+    Examples
+    --------
+    >>> int(last_sample_index(2.0, 200.0)), last_sample_index([0.0, 0.004, 0.005], 200.0).tolist()
+    (400, [0, 0, 1])
+    """
+    return np.floor(np.asarray(contact_s, dtype=np.float64) * float(sample_rate_hz)
+                    + _SAMPLE_TOLERANCE).astype(np.int64)
 
 
 def sample_times_s(contact_s: float, sample_rate_hz: float) -> np.ndarray:
@@ -50,8 +83,7 @@ def sample_times_s(contact_s: float, sample_rate_hz: float) -> np.ndarray:
     """
     contact_s = check_positive("contact time [s]", contact_s)
     fs = check_positive("sample rate [Hz]", sample_rate_hz)
-    # A tolerance of 1e-9 samples keeps 2.0 s * 200 Hz = 400 from rounding down.
-    n_float = contact_s * fs + 1e-9  # may be inf (1e308 s): compared before math.floor sees it
+    n_float = contact_s * fs + _SAMPLE_TOLERANCE  # may be inf (1e308 s): compared before math.floor sees it
     if not n_float < MAX_SAMPLES_PER_TOUCH:
         raise InputError(f"a touch of {contact_s:g} s at {fs:g} Hz has {n_float + 1:.4g} samples; the limit is "
                          f"{MAX_SAMPLES_PER_TOUCH:.0e} per touch (shorten the contact or lower the sample rate)")

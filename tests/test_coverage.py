@@ -115,14 +115,19 @@ def test_stated_interval_schema_and_refusals():
     a = query.ask("min-contact", route="table", e1=3000, e2=1500)
     iv = a.to_dict()["interval"]
     assert set(iv) >= {"low", "high", "coverage", "method"}
-    assert iv["method"] == "table-estimate" and iv["coverage"] == 0.9
+    assert iv["method"] == "table-efficiency" and iv["coverage"] == 0.9
     assert iv["low"] < a.value < iv["high"] and iv["low"] >= a.ideal
     # wider for a higher coverage
     wide = query.ask("min-contact", route="table", e1=3000, e2=1500, coverage=0.99).interval
     assert wide[0] < iv["low"] and wide[1] > iv["high"]
-    # the guideline pair's crossing follows a 'beyond the grid' neighbour: the cell, coverage not stated
-    g = query.ask("min-contact", route="table", e1=35000, e2=20000).to_dict()["interval"]
-    assert g["method"] == "table-cell" and g["coverage"] is None and g["low"] < g["high"]
+    # the guideline pair's crossing follows a 'beyond the grid' neighbour: interpolation cannot state a
+    # coverage there (the cell), the efficiency against the exact ideal observer can
+    g = query.ask("min-contact", route="table", e1=35000, e2=20000)
+    assert g.interval_kind == "table-efficiency" and g.interval_coverage == 0.9
+    assert g.ideal <= g.interval[0] < g.value < g.interval[1] < g.computation["table_crossing_s"]
+    # an ideal-observer table has no efficiency: the cell, coverage not stated
+    c = query.ask("min-contact", route="table", e1=35000, e2=20000, table="ideal-paper").to_dict()["interval"]
+    assert c["method"] in ("table-cell", "table-estimate") and (c["coverage"] is None) == (c["method"] == "table-cell")
     for bad in (0.0, 1.0, -0.1, 1.5, math.nan):
         with pytest.raises(InputError, match="coverage"):
             query.ask("min-contact", route="table", e1=3000, e2=1500, coverage=bad)

@@ -144,10 +144,11 @@ def reference(tab, kind: str, op: str, args):
         mv = a.computation["monte_carlo_verdicts"]  # the arrays' own verdicts (the interval is the F1's)
         return bool({"svm": a.value, "hi": mv[0], "lo": mv[1]}[kind])
     x = a.extra
+    d = a.details  # where the answer is the efficiency estimate, the arrays' own values are kept beside it
     if kind == "svm":
-        lower, upper = x["delta_e_lower"], x["delta_e_upper"]
+        lower, upper = (d[s].get("table_value", x[f"delta_e_{s}"]) for s in ("lower", "upper"))
     elif kind == "ideal":
-        lower, upper = x["delta_e_lower_ideal"], x["delta_e_upper_ideal"]
+        lower, upper = (d[s].get("table_ideal", x[f"delta_e_{s}_ideal"]) for s in ("lower", "upper"))
     else:
         i = 0 if kind == "lo" else 1
         d = a.details  # the arrays' own Monte Carlo ends (the stated interval is refined)

@@ -29,10 +29,13 @@ def _delta(t, r):
 
 @pytest.fixture(scope="module")
 def linear_table(tmp_path_factory):
-    """A table whose delta is linear in contact time and in log(sigma/dT): interpolation is exact."""
+    """A table whose delta is linear in contact time and in log(sigma/dT): interpolation is exact.
+
+    It has no ideal arrays: min-contact's efficiency route (which needs the table's ideal arrays to be the
+    closed-form ideal observer's) does not apply, and the interpolation route is what is tested here."""
     cfg = SweepConfig(name="linear", intervals=40, noise_ratio=RATIOS, contact_s=CONTACTS)
     d = np.array([[[_delta(t, r)] * 40 for t in CONTACTS] for r in RATIOS])
-    arrays = {name: d.copy() for name in ("delta_up", "delta_down", "delta_up_ideal", "delta_down_ideal")}
+    arrays = {name: d.copy() for name in ("delta_up", "delta_down")}
     arrays.update(delta_up_lo=d * 0.9, delta_down_lo=d * 0.9, delta_up_hi=d * 1.1, delta_down_hi=d * 1.1,
                   fits=np.zeros((5, 4), dtype=np.int64), chunk_wall_s=np.zeros((5, 4)))
     path = write_table(tmp_path_factory.mktemp("t") / "linear.npz", table_header(cfg, arrays), arrays)
@@ -205,7 +208,9 @@ def test_materials_edge_pair_against_the_old_nine_by_nine_worst_case():
     table's shortest contact), within 0.07 s wherever the materials are more than 1000 apart, and up to 1.2 s
     less for the closest pairs (porcelain vs glass, 99 apart: 1.21 s instead of 2.38 s), where one class
     width is most of the gap; three pairs closer than one width (cardboard-ABS, wood-ABS, rubber-MDF) had no
-    grid answer and now have one."""
+    grid answer and now have one. (Since min-contact reads the SVM's efficiency against the exact ideal
+    observer, far-apart pairs no longer share the table's shortest contact, so equality is rare; the edge
+    answer is still never the more demanding.)"""
     from designkit.materials import get_material
 
     tab = load_table("svm-paper")
@@ -229,7 +234,7 @@ def test_materials_edge_pair_against_the_old_nine_by_nine_worst_case():
             same += edge == worst
             if b0 - a1 > 1000.0:
                 assert worst - edge < 0.07, (a, b, edge, worst)
-    assert compared == 55 and same >= 30
+    assert compared == 55 and same >= 1
 
 
 @pytest.mark.parametrize("cmd,quantity", [

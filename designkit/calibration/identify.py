@@ -74,7 +74,10 @@ __all__ = [
     "Identification",
     "candidate",
     "compare_models",
+    "contact_area",
     "identify",
+    "relative_force",
+    "residual_series",
     "score",
     "split_by_trial_set",
     "trial_sets",
@@ -123,7 +126,11 @@ _PARAMS: dict[str, _Param] = {p.name: p for p in (
     _Param("backing_thickness_m", "m", 1e-6, 1.0, 1e-3,
            description="backing thickness L_b (its far face held at Ts0)"),
     _Param("backing_diffusivity_m2_s", "m^2/s", 1e-10, 1e-4, 1e-7, description="backing diffusivity alpha_b"),
+    _Param("contact_force_fraction", "", 0.0, 0.9, 0.3, log=False,
+           description="force (share of the touch's plateau) at which the contact area starts to grow"),
 )}
+#: Fittable parameters that belong to the measurement chain, not to the forward model's fields.
+_CHAIN_PARAMS = ("contact_force_fraction",)
 
 
 @dataclass(frozen=True)
@@ -145,6 +152,27 @@ class Candidate:
         Model fields held at a value (effusivities and h_c as ratios to e_s).
     smoothing : bool
         Apply the host smoothing (:data:`HOST_SMOOTHING`) to the prediction.
+    drift : bool
+        Each touch's sensor drifts before contact (the heater still warming
+        towards its set point, about 0.1 degC/s on the shared recordings) and
+        the drift goes on on the sensor's side of the contact: the baseline
+        ``Ts0`` becomes ``Ts0 + s_i t`` in ``T = (Ts0 + s_i t)(1 - u) + To u``
+        (smoothed as a whole when ``smoothing``), ``s_i`` [degC/s] one more
+        per-touch linear coefficient beside ``Ts0_i`` (closed form, fitted to the
+        whole touch like ``Ts0_i``, on held-out touches too; on the shared
+        recordings it is a slow trend of the touch, not the rate measured
+        before contact: docs/sensor-models.md).
+    force_area : bool
+        The contact area grows with the touch's own force while the finger
+        presses in: the reading is the area-weighted sum of step responses
+        started as each share of the area comes into contact (parallel
+        columns, lateral conduction neglected),
+        ``u_i(t) = sum_j dA_i(t_j) u(t - t_j - t_off)``, with the area share
+        ``A_i = clip((F_i - c F_p,i) / ((1 - c) F_p,i), 0, 1)`` from the
+        measured force ``F_i`` and its plateau ``F_p,i`` (median from 1 s after
+        the onset); ``c`` (``contact_force_fraction``, the force share at which
+        the area starts to grow) is fitted when free, else 0. Needs a force
+        channel on a uniform grid.
     """
 
     label: str
@@ -152,6 +180,8 @@ class Candidate:
     free: tuple[str, ...] = ("diffusivity_m2_s",)
     fixed: Mapping[str, Any] = field(default_factory=dict)
     smoothing: bool = False
+    drift: bool = False
+    force_area: bool = False
 
     def __post_init__(self) -> None:
         unknown = [p for p in self.free if p not in _PARAMS]
@@ -171,11 +201,24 @@ CANDIDATES: tuple[Candidate, ...] = (
                                          "backing_effusivity_ws05_m2k", "lag_s")),
     Candidate("layered+lag+smoothing", "layered", ("diffusivity_m2_s", "conductance_w_m2k", "film_thickness_m",
                                                    "backing_effusivity_ws05_m2k", "lag_s"), smoothing=True),
+    Candidate("layered+lag+smoothing+drift", "layered", ("diffusivity_m2_s", "conductance_w_m2k",
+                                                         "film_thickness_m", "backing_effusivity_ws05_m2k", "lag_s"),
+              smoothing=True, drift=True),
+    Candidate("contact+smoothing+drift+area", "contact", ("diffusivity_m2_s", "conductance_w_m2k",
+                                                          "contact_force_fraction"),
+              smoothing=True, drift=True, force_area=True),
+    Candidate("layered+lag+smoothing+drift+area", "layered",
+              ("diffusivity_m2_s", "conductance_w_m2k", "film_thickness_m", "backing_effusivity_ws05_m2k", "lag_s",
+               "contact_force_fraction"), smoothing=True, drift=True, force_area=True),
 )
 
 
 def candidate(name: str) -> Candidate:
     """A default candidate by label, or the fullest one of a registered model name.
+
+    The fullest one of a model name is the last of :data:`CANDIDATES` for it without the chain
+    options ``drift`` and ``force_area`` (those need to be asked for by label: ``force_area`` needs
+    a force channel).
 
     Examples
     --------
@@ -188,7 +231,7 @@ def candidate(name: str) -> Candidate:
     for c in CANDIDATES:
         if c.label == key:
             return c
-    fullest = [c for c in CANDIDATES if c.model == key]
+    fullest = [c for c in CANDIDATES if c.model == key and not (c.drift or c.force_area)]
     if fullest:
         return fullest[-1]
     from ..models import model_class
@@ -210,6 +253,7 @@ class _Group:
     free_to: bool
     trials: tuple[int, ...]
     affine: bool = False   # To = passive + offset + slope (passive - reference): a rig calibration of the channel
+    force: np.ndarray | None = None       # (n, m) force / its plateau, each touch (force-area candidates)
 
 
 @dataclass(frozen=True)
@@ -269,8 +313,52 @@ def split_by_trial_set(trials: Sequence[Trial], fit_sets: Sequence[int],
 _OBJECT_MODES = ("passive", "passive-end", "free", "passive-affine", "passive-end-affine")
 
 
+def relative_force(trial: Trial) -> np.ndarray:
+    """The touch's force divided by its plateau (median from 1 s after the onset), on its grid.
+
+    Examples
+    --------
+    >>> t = np.arange(-200, 1000) / 200.0
+    >>> tr = Trial(t, np.zeros(t.size), np.zeros(t.size), np.clip(t, 0.0, 1.0) * 4.0, "wood")
+    >>> relative_force(tr)[[0, 300, 400]].tolist()
+    [0.0, 0.5, 1.0]
+    """
+    t, f = np.asarray(trial.time_s), np.asarray(trial.force_n, dtype=np.float64)
+    late = (t >= 1.0) & np.isfinite(f)
+    if not late.any() or not np.isfinite(f).all():
+        raise InputError(f"trial {trial.source}: a force-driven contact area needs the force channel on every "
+                         "sample, to 1 s after the onset or later")
+    dt = np.diff(t)
+    if not np.allclose(dt, dt[0], rtol=1e-6, atol=1e-9):
+        raise InputError(f"trial {trial.source}: a force-driven contact area needs a uniform time grid")
+    plateau = float(np.median(f[late]))
+    if plateau <= 0:
+        raise InputError(f"trial {trial.source}: the force's plateau is {plateau:.3g} N (no contact?)")
+    return f / plateau
+
+
+def contact_area(force_rel, fraction: float = 0.0) -> np.ndarray:
+    """Share of the final contact area in contact: ``clip((F / F_p - c) / (1 - c), 0, 1)``.
+
+    Parameters
+    ----------
+    force_rel : array_like
+        Force divided by its plateau (:func:`relative_force`).
+    fraction : float
+        ``c``, the force share at which the area starts to grow, in [0, 1).
+
+    Examples
+    --------
+    >>> contact_area([0.1, 0.3, 0.65, 1.0, 1.2], 0.3).round(3).tolist()
+    [0.0, 0.0, 0.5, 1.0, 1.0]
+    """
+    c = float(fraction)
+    return np.clip((np.asarray(force_rel, dtype=np.float64) - c) / (1.0 - c), 0.0, 1.0)
+
+
 def _prepare(trials: Sequence[Trial], names: Sequence[str], object_temps: Mapping[str, Any],
-             moving_passive_c: float = 1.0, refs: Mapping[str, float] | None = None) -> _Data:
+             moving_passive_c: float = 1.0, refs: Mapping[str, float] | None = None,
+             force_area: bool = False) -> _Data:
     """Group trials by material and time grid; decide each material's object temperature."""
     if not trials:
         raise InputError("no trials to fit")
@@ -343,7 +431,8 @@ def _prepare(trials: Sequence[Trial], names: Sequence[str], object_temps: Mappin
                 tos.append(float(mode))
         out.append(_Group(k, trials[members[0]].time_s.copy(), np.array([trials[i].sensor_c for i in members]),
                           np.array(tos), mode == "free", tuple(members),
-                          isinstance(mode, str) and mode.endswith("-affine")))
+                          isinstance(mode, str) and mode.endswith("-affine"),
+                          np.array([relative_force(trials[i]) for i in members]) if force_area else None))
     noise = math.sqrt(ssr / dof) if dof > 0 else math.nan
     ref = dict(refs or {})
     for n in names:  # the reference reading of an affine channel: the fitted touches' mean (kept for scoring)
@@ -383,6 +472,36 @@ def _reading(model, t: np.ndarray, e_object: float, sensor, interp_points: int |
     if early.any():
         out[early] = model.conduction(t[early], [e_object], sensor, nodes=FIT_TALBOT_NODES)[0]
     return out
+
+
+def _area_weighted(step, time_s: np.ndarray, area: np.ndarray, offset_s: float) -> np.ndarray:
+    """Readings of touches whose contact area grows: ``u_i(t_k) = sum_j dA_ij u(t_k - t_j - offset)``.
+
+    ``step(t)`` is the full-contact reading at times ``t > 0``; ``area`` (n, m)
+    the share of the final area in contact at each sample of the uniform grid
+    ``time_s`` (what is in contact at the first sample counts from there). A
+    discrete convolution (:func:`scipy.signal.fftconvolve`) of the area's
+    increments with the step response on the lags of the grid.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> t = np.arange(-5, 20) * 0.1
+    >>> full = _area_weighted(lambda tt: 1.0 - np.exp(-tt), t, np.ones((1, t.size)) * (t >= 0), 0.0)
+    >>> bool(np.allclose(full[0], np.where(t > 0, 1.0 - np.exp(-np.maximum(t, 0.0)), 0.0)))
+    True
+    """
+    from scipy.signal import fftconvolve
+
+    m = time_s.size
+    dt = float(time_s[1] - time_s[0])
+    lags = np.arange(-(m - 1), m) * dt - offset_s
+    u1 = np.zeros(lags.size)
+    pos = lags > 0
+    if pos.any():
+        u1[pos] = step(lags[pos])
+    d_area = np.diff(area, axis=-1, prepend=0.0)
+    return fftconvolve(d_area, u1[None, :], axes=-1)[:, m - 1:2 * m - 1]
 
 
 class _Problem:
@@ -438,6 +557,8 @@ class _Problem:
         from ..sensor import Sensor
 
         vals = {p.name: p.from_x(v) for p, v in zip(self.params, x[:self.n_model])}
+        for k in _CHAIN_PARAMS:
+            vals.pop(k, None)
         alpha = vals.pop("diffusivity_m2_s", _SENSOR_DIFF.start)
         sensor = Sensor(effusivity=1.0, diffusivity_m2_s=alpha, depth_m=self.depth_m,
                         sample_rate_hz=self.data.sample_rate_hz, name="identify")
@@ -448,16 +569,31 @@ class _Problem:
 
     def shapes(self, x: np.ndarray) -> list[np.ndarray]:
         """Predicted normalized reading v of each group on its grid (smoothed when the candidate says)."""
+        return [v for v, _ in self.shapes_and_drift(x)]
+
+    def shapes_and_drift(self, x: np.ndarray) -> list[tuple[np.ndarray, np.ndarray | None]]:
+        """Per group (v, b): the normalized reading and, with ``drift``, the drift's basis ``t (1 - u)``.
+
+        Both smoothed by the host's filter when the candidate says (the filter is linear: the
+        prediction ``Ts0 (1 - v) + s b + To v`` is the smoothed ``(Ts0 + s t)(1 - u) + To u``).
+        """
         model, sensor = self.model_and_sensor(x)
         off = x[self.n_model]
         rho = np.exp(x[self.n_model + 1:self.n_model + 1 + self.n_mat])
         out = []
-        cache: dict[tuple[int, bytes], np.ndarray] = {}
+        cache: dict[tuple[int, bytes], tuple[np.ndarray, np.ndarray | None]] = {}
         for g in self.data.groups:
             gi = len(out)
             if gi in self.touch_cols:  # one shape per touch, each with its own h_c
-                out.append(self._touch_shapes(g, model, sensor, off, rho[g.material],
-                                              x[self.touch_cols[gi]:self.touch_cols[gi] + len(g.trials)]))
+                u = self._touch_shapes(g, model, sensor, off, rho[g.material],
+                                       x[self.touch_cols[gi]:self.touch_cols[gi] + len(g.trials)], x)
+                out.append(self._chain(g.time_s, u))
+                continue
+            if g.force is not None:  # one shape per touch: its contact area grows with its own force
+                area = self.contact_area(g, x)
+                out.append(self._chain(g.time_s, _area_weighted(
+                    lambda tt: _reading(model, tt, rho[g.material], sensor, self.interp_points),
+                    g.time_s, area, off)))
                 continue
             key = (g.material, g.time_s.tobytes())
             if key not in cache:
@@ -466,28 +602,50 @@ class _Problem:
                 pos = tt > 0
                 if pos.any():
                     u[pos] = _reading(model, tt[pos], rho[g.material], sensor, self.interp_points)
-                if self.cand.smoothing:
-                    from ..models.layered import savgol_smooth
-
-                    u = savgol_smooth(u, *HOST_SMOOTHING)
-                cache[key] = u
+                cache[key] = self._chain(g.time_s, u)
             out.append(cache[key])
         return out
 
-    def _touch_shapes(self, g: _Group, model, sensor, off: float, rho: float, log_dev: np.ndarray) -> np.ndarray:
+    def contact_area(self, g: _Group, x: np.ndarray) -> np.ndarray | None:
+        """Share of the final contact area (n, m) of a force-area group's touches (None: full contact)."""
+        if g.force is None:
+            return None
+        return contact_area(g.force, self.params_value(x, "contact_force_fraction", 0.0))
+
+    def params_value(self, x: np.ndarray, name: str, default: float) -> float:
+        """A free parameter's natural value in ``x`` (``default`` when the candidate does not fit it)."""
+        for i, p in enumerate(self.params):
+            if p.name == name:
+                return p.from_x(x[i])
+        return default
+
+    def _chain(self, time_s: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+        """The measurement chain on unsmoothed readings ``u``: (v, drift basis or None)."""
+        b = time_s * (1.0 - u) if self.cand.drift else None
+        if self.cand.smoothing:
+            from ..models.layered import savgol_smooth
+
+            u = savgol_smooth(u, *HOST_SMOOTHING)
+            if b is not None:
+                b = savgol_smooth(b, *HOST_SMOOTHING)
+        return u, b
+
+    def _touch_shapes(self, g: _Group, model, sensor, off: float, rho: float, log_dev: np.ndarray,
+                      x: np.ndarray) -> np.ndarray:
+        """Unsmoothed readings (n, m) of a group whose touches each have their own h_c."""
         import dataclasses
 
         tt = g.time_s - off
         pos = tt > 0
-        out = np.zeros((log_dev.size, tt.size))
+        out = np.zeros((log_dev.size, g.time_s.size))
+        area = self.contact_area(g, x)
         for i, d in enumerate(log_dev):
             m = dataclasses.replace(model, conductance_w_m2k=model.conductance_w_m2k * math.exp(float(d)))
-            if pos.any():
+            if area is not None:
+                out[i] = _area_weighted(lambda t: _reading(m, t, rho, sensor, self.interp_points), g.time_s,
+                                        area[i:i + 1], off)[0]
+            elif pos.any():
                 out[i, pos] = _reading(m, tt[pos], rho, sensor, self.interp_points)
-        if self.cand.smoothing:
-            from ..models.layered import savgol_smooth
-
-            out = savgol_smooth(out, *HOST_SMOOTHING)
         return out
 
     def jacobian(self, x: np.ndarray, touch_only: bool = False) -> np.ndarray:
@@ -528,10 +686,29 @@ class _Problem:
         A group's shape is one curve (m,) or one per touch (n, m); the sums run over the last axis.
         """
         res, coefs = [], []
-        for g, v in zip(self.data.groups, self.shapes(x)):
+        for g, (v, b) in zip(self.data.groups, self.shapes_and_drift(x)):
             y = self.fitted_y(g)
             v = v[..., ::self.stride]
             a = 1.0 - v
+            if b is not None:  # per touch: [Ts0, s] (and To where free) by least squares on its own basis
+                b = b[..., ::self.stride]
+                n = y.shape[0]
+                cols = [np.broadcast_to(a, y.shape), np.broadcast_to(b, y.shape)]
+                target = y
+                if g.free_to:
+                    cols.append(np.broadcast_to(v, y.shape))
+                else:
+                    to = self.object_temps(g, x)
+                    target = y - to[:, None] * v
+                B = np.stack(cols, axis=1)                       # (n, k, m)
+                G = np.einsum("nkm,nlm->nkl", B, B)
+                c = np.linalg.solve(G, np.einsum("nkm,nm->nk", B, target)[..., None])[..., 0]
+                if g.free_to:
+                    to = c[:, 2]
+                pred = np.einsum("nk,nkm->nm", c, B) + (0.0 if g.free_to else to[:, None] * v)
+                res.append((pred - y).ravel())
+                coefs.append(np.vstack([c[:, 0], np.broadcast_to(to, (n,)), c[:, 1]]))
+                continue
             saa = np.sum(a * a, axis=-1)
             if g.free_to:  # per touch: [Ts0, To] from the 2x2 normal equations (well scaled)
                 sav, svv = np.sum(a * v, axis=-1), np.sum(v * v, axis=-1)
@@ -568,7 +745,8 @@ class _Problem:
         return np.concatenate(mask)
 
     def n_linear(self) -> int:
-        return int(sum(len(g.trials) * (2 if g.free_to else 1) for g in self.data.groups))
+        per = (2 if self.cand.drift else 1)
+        return int(sum(len(g.trials) * (per + (1 if g.free_to else 0)) for g in self.data.groups))
 
 
 def _initial_ratios(prob: _Problem, x: np.ndarray) -> np.ndarray:
@@ -683,7 +861,7 @@ class Identification:
         es = self.effusivity.value if self.effusivity is not None else 1.0
         kw = dict(self.candidate.fixed)
         for p in self.parameters:
-            if p.name in _PARAMS and p.name != "diffusivity_m2_s":
+            if p.name in _PARAMS and p.name != "diffusivity_m2_s" and p.name not in _CHAIN_PARAMS:
                 kw[p.name] = p.value
         for k, v in list(kw.items()):
             if k in _PARAMS and _PARAMS[k].scale_with_es and k not in {p.name for p in self.parameters}:
@@ -692,12 +870,13 @@ class Identification:
             kw["smoothing_window"], kw["smoothing_order"] = HOST_SMOOTHING
         return get_model(self.candidate.model, **kw)
 
-    def reading(self, time_s, material: str, *, conductance_factor=None) -> np.ndarray:
+    def reading(self, time_s, material: str, *, conductance_factor=None, force=None, force_time_s=None,
+                drift: bool = False):
         """The identified normalized reading ``v`` of ``material`` at times after the detected onset.
 
-        ``T = Ts0 + (To - Ts0) v``: with the fitted time offset and, for a candidate with the host
-        smoothing, smoothed as the host smoothed a recording (1 s before contact to 7 s after, or
-        to the last time).
+        ``T = Ts0 + (To - Ts0) v`` (``+ s b`` for a candidate with ``drift``): with the fitted time
+        offset and, for a candidate with the host smoothing, smoothed as the host smoothed a
+        recording (1 s before contact to 7 s after, or to the last time).
 
         Parameters
         ----------
@@ -708,10 +887,19 @@ class Identification:
         conductance_factor : array_like of float, shape (k,), optional
             Multiplies h_c (a touch's own contact, e.g. drawn from the fitted per-touch spread);
             one reading per factor.
+        force : array_like, shape (k, p), optional
+            For a ``force_area`` candidate: each simulated touch's force divided by its plateau
+            (:func:`relative_force`) on ``force_time_s`` (held at its end values outside it); one
+            reading per row. Without it a ``force_area`` candidate reads as full contact from the
+            offset on.
+        force_time_s : array_like, shape (p,), optional
+            Times of ``force`` after the detected onset [s].
+        drift : bool
+            Also return the drift basis ``b`` (smoothed ``t (1 - u)``, see :class:`Candidate`).
 
         Returns
         -------
-        ndarray, shape (m,) or (k, m)
+        ndarray, shape (m,) or (k, m); with ``drift`` a pair (v, b) of them.
         """
         import dataclasses
 
@@ -734,16 +922,41 @@ class Identification:
         tt = grid - off
         pos = tt > 0
         factors = [None] if conductance_factor is None else list(np.atleast_1d(conductance_factor))
-        out = np.zeros((len(factors), grid.size))
-        for i, f in enumerate(factors):
+        areas = [None]
+        if force is not None and self.candidate.force_area:
+            if force_time_s is None:
+                raise InputError("reading: force needs force_time_s")
+            ft = np.asarray(force_time_s, dtype=np.float64)
+            c = self.parameter("contact_force_fraction").value if "contact_force_fraction" in self.candidate.free \
+                else 0.0
+            areas = [contact_area(np.interp(grid, ft, row), c) for row in np.atleast_2d(force)]
+        n = max(len(factors), len(areas))
+        if len(factors) not in (1, n) or len(areas) not in (1, n):
+            raise InputError(f"reading: {len(factors)} conductance factors and {len(areas)} force rows")
+        out = np.zeros((n, grid.size))
+        for i in range(n):
+            f, area = factors[i % len(factors)], areas[i % len(areas)]
             m = model if f is None else dataclasses.replace(model, conductance_w_m2k=model.conductance_w_m2k * f)
-            if pos.any():
-                out[i, pos] = (m.conduction(tt[pos], [eo], sensor)[0] if hasattr(m, "conduction")
-                               else m.response(tt[pos], [eo], sensor)[0])
+
+            def step(tp, m=m):
+                return (m.conduction(tp, [eo], sensor)[0] if hasattr(m, "conduction")
+                        else m.response(tp, [eo], sensor)[0])
+
+            if area is not None:
+                out[i] = _area_weighted(step, grid, area[None, :], off)[0]
+            elif pos.any():
+                out[i, pos] = step(tt[pos])
+        b = grid * (1.0 - out)
         if self.candidate.smoothing:
             out = savgol_smooth(out, *HOST_SMOOTHING)
+            b = savgol_smooth(b, *HOST_SMOOTHING)
+        single = conductance_factor is None and (force is None or np.ndim(force) == 1)
         res = np.array([np.interp(t, grid, row) for row in out])
-        return res[0] if conductance_factor is None else res
+        res = res[0] if single else res
+        if not drift:
+            return res
+        bres = np.array([np.interp(t, grid, row) for row in b])
+        return res, (bres[0] if single else bres)
 
     def sensor(self, name: str = "identified"):
         """The identified :class:`~designkit.sensor.Sensor` (e_s from the ranges, alpha_s at the fixed depth)."""
@@ -893,7 +1106,7 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
     t0 = time.perf_counter()
     cand = model if isinstance(model, Candidate) else candidate(model)
     names = tuple(sorted({tr.material for tr in trials}))
-    data = _prepare(trials, names, dict(object_temps or {}))
+    data = _prepare(trials, names, dict(object_temps or {}), force_area=cand.force_area)
     rng = {n: _as_range(ranges[n]) for n in names if ranges and n in ranges}
     constrained = np.array([n in rng and data.modes[n] != "free" for n in names])
     if fit_rate_hz == "auto":
@@ -1078,13 +1291,48 @@ def score(result: Identification, trials: Sequence[Trial], *,
     material's object temperature is free). Materials the fit did not see are
     refused (their e_o is unknown).
     """
+    data, r = _held_out(result, trials, object_temps)
+    names = result.names
+    out: dict[str, list[np.ndarray]] = {}
+    pos = 0
+    for g in data.groups:
+        out.setdefault(names[g.material], []).append(r[pos:pos + g.y.size])
+        pos += g.y.size
+    per = {n: float(np.sqrt(np.mean(np.concatenate(v) ** 2))) for n, v in out.items()}
+    per["all"] = float(np.sqrt(np.mean(r ** 2)))
+    return per
+
+
+def residual_series(result: Identification, trials: Sequence[Trial], *,
+                    object_temps: Mapping[str, Any] | None = None) -> list[tuple[str, np.ndarray, np.ndarray]]:
+    """Each touch's residual (prediction - reading) [degC] on its own grid, as :func:`score` computes it.
+
+    Returns
+    -------
+    list of (material, time_s, residual), in the order of ``trials``.
+    """
+    data, r = _held_out(result, trials, object_temps)
+    rows: dict[int, tuple[str, np.ndarray, np.ndarray]] = {}
+    pos = 0
+    for g in data.groups:
+        n, m = g.y.shape
+        block = r[pos:pos + n * m].reshape(n, m)
+        pos += n * m
+        for i, k in enumerate(g.trials):
+            rows[k] = (result.names[g.material], g.time_s, block[i])
+    return [rows[k] for k in range(len(trials))]
+
+
+def _held_out(result: Identification, trials: Sequence[Trial],
+              object_temps: Mapping[str, Any] | None) -> tuple[_Data, np.ndarray]:
+    """(prepared data, residuals) of an identified model on touches, each with its own nuisances."""
     names = result.names
     unknown = sorted({tr.material for tr in trials} - set(names))
     if unknown:
         raise InputError(f"cannot score {', '.join(unknown)}: not among the fitted materials {', '.join(names)}")
     modes = dict(result.object_modes)
     modes.update(dict(object_temps or {}))
-    data = _prepare(trials, names, modes, refs=result.object_refs)
+    data = _prepare(trials, names, modes, refs=result.object_refs, force_area=result.candidate.force_area)
     prob = _Problem(result.candidate, data, result.depth_m, (-math.inf, math.inf),
                     np.zeros(len(names), dtype=bool), stride=1, touch_conductance=result.touch_conductance)
     x = np.concatenate([result.x[:prob.n_global], np.zeros(prob.lo.size - prob.n_global)])
@@ -1101,14 +1349,7 @@ def score(result: Identification, trials: Sequence[Trial], *,
         x = np.concatenate([glob, sol.x])
         prob.stride = 1
     r, _ = prob.project(x)
-    out: dict[str, list[np.ndarray]] = {}
-    pos = 0
-    for g in data.groups:
-        out.setdefault(names[g.material], []).append(r[pos:pos + g.y.size])
-        pos += g.y.size
-    per = {n: float(np.sqrt(np.mean(np.concatenate(v) ** 2))) for n, v in out.items()}
-    per["all"] = float(np.sqrt(np.mean(r ** 2)))
-    return per
+    return data, r
 
 
 # ------------------------------------------------------------ comparison
@@ -1172,14 +1413,18 @@ def compare_models(fit_trials: Sequence[Trial], held_out: Sequence[Trial],
     """Fit every candidate on ``fit_trials``, score each on ``held_out``; select by held-out RMS.
 
     Each candidate starts from the fitted parameters of the last one nested in it. With no
-    held-out touches the selection is by BIC (the scores are empty).
+    held-out touches the selection is by BIC (the scores are empty). Candidates with
+    ``force_area`` are left out of a comparison of several when a touch has no force channel.
 
     ``kwargs`` go to :func:`identify` (``ranges``, ``object_temps``, ``depth_m``, ...).
     """
     t0 = time.perf_counter()
     results, held = [], []
+    forced = all(np.isfinite(tr.force_n).all() for tr in list(fit_trials) + list(held_out))
     for c in candidates:
         c = c if isinstance(c, Candidate) else candidate(c)
+        if c.force_area and not forced and len(candidates) > 1:
+            continue   # a force-driven contact area needs the force channel of every touch
         res = identify(fit_trials, c, x0=_warm_start(c, results), **kwargs)
         results.append(res)
         held.append(score(res, held_out, object_temps=kwargs.get("object_temps")) if held_out else {})

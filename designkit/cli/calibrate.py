@@ -592,7 +592,10 @@ def fit(
     plot: Annotated[Optional[Path], typer.Option("--plot", help="Write a PNG of the fit (needs matplotlib).")] = None,
     model: Annotated[Optional[str], typer.Option(
         "--model", help="Identify this sensor model instead of the paper's (semi-infinite, contact, "
-                        "contact+smoothing, layered, layered+lag, layered+lag+smoothing), or 'all' to compare "
+                        "contact+smoothing, layered, layered+lag, layered+lag+smoothing, "
+                        "layered+lag+smoothing+drift, contact+smoothing+drift+area, "
+                        "layered+lag+smoothing+drift+area: +drift for a heater still warming at contact, "
+                        "+area for a contact area growing with the measured force), or 'all' to compare "
                         "them on held-out touches (default: the paper's semi-infinite fit).")] = None,
     fit_sets: Annotated[str, typer.Option(
         "--fit-sets", help="With --model: trial sets to fit (FIRST-LAST or a comma list); the others are held "

@@ -269,8 +269,9 @@ def _source_lines(con, d):
                  "delta_t_c": "temperature difference"}
         bad = [words.get(k, k) for k, ok in d["in_grid"].items() if not ok]
         where = "inside its grid" if not bad else "OUTSIDE its grid along " + ", ".join(bad)
-        con.print(f"  [dim]from table {d['table']['name']} ({where}), interpolated; --exact computes it for this "
-                  f"pair[/]")
+        how = ("the SVM's tabulated efficiency applied to the exact ideal observer between grid points"
+               if d["interval"].get("method") == "table-efficiency" else "interpolated")
+        con.print(f"  [dim]from table {d['table']['name']} ({where}), {how}; --exact computes it for this pair[/]")
     else:
         c = d["computation"]
         varied = (f", sensor temperature varied per touch by ±{c['sensor_temp_spread_c']:g} °C"

@@ -240,13 +240,15 @@ def recommend(targets: list[Target], constraints: Constraints, *, skins=SKIN_SET
                             f"no allowed design separates {hard[0]} from {hard[1]} within {c.max_contact_s:g} s "
                             f"(noise {c.noise_c:g} degC, dT {c.max_delta_t_c:g} degC, {c.max_rate_hz:g} Hz)")
     sensor = best.sensor()
-    all_pairs = []
-    for i in range(len(targets)):
-        for j in range(i + 1, len(targets)):
-            e = _pair_classes(targets[i], targets[j])
-            t = float(exact_ideal_min_contact(sensor, e[0], e[1], ratio, width=e[2], threshold=c.threshold,
-                                              max_contact_s=c.max_contact_s)) if e else math.nan
-            all_pairs.append((targets[i].name, targets[j].name, t))
+    # every pair of targets, one vectorized call for the separable ones (overlapping ones have no answer)
+    ij = [(i, j) for i in range(len(targets)) for j in range(i + 1, len(targets))]
+    cls = [_pair_classes(targets[i], targets[j]) for i, j in ij]
+    sep = [e for e in cls if e is not None]
+    t_sep = iter(exact_ideal_min_contact(sensor, *(np.array([e[k] for e in sep]) for k in (0, 1)), ratio,
+                                         width=np.array([e[2] for e in sep]), threshold=c.threshold,
+                                         max_contact_s=c.max_contact_s).tolist() if sep else [])
+    all_pairs = [(targets[i].name, targets[j].name, next(t_sep) if e is not None else math.nan)
+                 for (i, j), e in zip(ij, cls)]
     # trade-off: the best design's limiting contact against sigma/dT (noise floor and dT enter only so)
     ratios = ratio * np.geomspace(0.125, 8.0, 13)
     t = exact_ideal_min_contact(sensor, lo[None, :], hi[None, :], ratios[:, None], width=wd[None, :],

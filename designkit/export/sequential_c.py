@@ -90,6 +90,8 @@ def write_sequential_c(test: "seq.SequentialTest", prefix: str = "designkit_seq"
         "W0": ", ".join(c_double(x) for x in w0), "W1": ", ".join(c_double(x) for x in w1),
         "LM": ", ".join(c_double(x) for x in lm),
         "LW": ", ".join(c_double(math.log(b - a) if b > a else 0.0) for a, b in zip(w0, w1)),
+        # the Python object's expression, so that the constants are its values to the bit
+        "DENS": ", ".join(c_double(math.exp(m - math.log(b - a)) if b > a else 0.0) for a, b, m in zip(w0, w1, lm)),
         "G": _doubles(g),
     })
     if not all(math.isfinite(x) for row in thr for x in row):

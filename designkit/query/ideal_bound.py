@@ -29,16 +29,21 @@ from collections import OrderedDict
 
 import numpy as np
 
+from ..sensor import last_sample_index
+
 __all__ = [
     "BOUND_CACHE_SIZE",
     "class_survival",
     "projection_noise",
     "cached_ideal_max_ratio",
     "cached_ideal_min_contact",
+    "cached_efficiency_min_contact",
+    "cached_ideal_delta",
     "clear_bound_cache",
     "exact_ideal_delta",
     "exact_ideal_max_ratio",
     "exact_ideal_min_contact",
+    "efficiency_min_contact",
     "ideal_f1",
     "shape_norm",
 ]
@@ -104,11 +109,6 @@ def _cumulative_g2(tau_s: float, rate_hz: float, n_max: int) -> np.ndarray:
     return np.cumsum(g * g)
 
 
-def _samples(contact_s, rate_hz: float) -> np.ndarray:
-    """Index of a touch's last sample (:func:`designkit.sensor.sample_times_s`'s rounding)."""
-    return np.floor(np.asarray(contact_s, dtype=np.float64) * rate_hz + 1e-9).astype(np.int64)
-
-
 def shape_norm(sensor, contact_s) -> np.ndarray:
     """``|g|``, the norm of the response shape over a touch's samples, vectorized over ``contact_s`` [s].
 
@@ -118,7 +118,7 @@ def shape_norm(sensor, contact_s) -> np.ndarray:
     >>> round(float(shape_norm(load_sensor("paper"), 2.0)), 4)
     2.6732
     """
-    n = _samples(contact_s, sensor.sample_rate_hz)
+    n = last_sample_index(contact_s, sensor.sample_rate_hz)
     cum = _cumulative_g2(float(sensor.tau_s), float(sensor.sample_rate_hz), int(max(np.max(n), 1)))
     return np.sqrt(cum[n])
 
@@ -286,7 +286,7 @@ def exact_ideal_min_contact(sensor, lo, hi, ratio, *, width: float = 80.0, thres
     """
     lo, hi, ratio = (np.asarray(x, dtype=np.float64) for x in np.broadcast_arrays(lo, hi, ratio))
     fs = float(sensor.sample_rate_hz)
-    n_max = int(_samples(max_contact_s, fs))
+    n_max = int(last_sample_index(max_contact_s, fs))
     cum = _cumulative_g2(float(sensor.tau_s), fs, max(n_max, 1))
 
     def ok(n):
@@ -302,6 +302,90 @@ def exact_ideal_min_contact(sensor, lo, hi, ratio, *, width: float = 80.0, thres
         good = ok(mid)
         b, a = np.where(good, mid, b), np.where(good, a, mid)
     return np.where(top, b / fs, np.nan)
+
+
+def efficiency_min_contact(sensor, lo, hi, ratio, t0, t1, eff0, eff1, upper_s, *, width: float = 80.0,
+                           threshold: float = 0.9) -> np.ndarray:
+    """Shortest contact [s] for a classifier that needs ``eff(t)`` times the ideal observer's separation.
+
+    A classifier's *efficiency* ``eff(t) = delta_classifier(t) / delta_ideal(t)`` (>= 1) is the ratio of
+    the effusivity difference it needs to the ideal observer's at the same contact time. Given it at two
+    contact times (log-linear in log t between them, constant beyond; ``eff1`` alone where ``eff0`` is NaN;
+    never below 1: the ideal observer is a bound), the
+    classifier separates classes ``[lo, lo+w)`` and ``[hi, hi+w)`` once the ideal observer separates each
+    of them from a partner ``(hi - lo) / eff(t)`` away (upwards from ``lo`` and downwards from ``hi``,
+    the two directions a table's delta(e) has). This is the first sample time up to ``upper_s`` where
+    that holds (bisection on the sample count; ``upper_s`` where it never does), vectorized.
+
+    Parameters
+    ----------
+    sensor : Sensor
+    lo, hi : array_like
+        Lower edges of the two classes [J s^-1/2 K^-1 m^-2].
+    ratio : array_like
+        sigma/dT [-].
+    t0, t1 : array_like
+        Contact times [s] where the efficiency is known (``t0 < t1``).
+    eff0, eff1 : array_like
+        Efficiency there [-] (``eff0`` NaN: constant ``eff1``).
+    upper_s : array_like
+        Longest contact examined [s] (for example the table's crossing).
+    width, threshold : float
+        Class width [J s^-1/2 K^-1 m^-2] and F1 threshold.
+
+    Returns
+    -------
+    ndarray
+        Contact time [s].
+
+    Examples
+    --------
+    >>> from designkit.sensor import load_sensor
+    >>> s = load_sensor("paper")
+    >>> ideal = float(exact_ideal_min_contact(s, 20000.0, 35000.0, 0.005))
+    >>> float(efficiency_min_contact(s, 20000.0, 35000.0, 0.005, 1.0, 2.0, 1.0, 1.0, 4.0)) == ideal
+    True
+    >>> 1.2 < float(efficiency_min_contact(s, 20000.0, 35000.0, 0.005, 1.0, 2.0, float("nan"), 1.5, 4.0))
+    True
+    """
+    cols = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64) for x in (lo, hi, ratio, t0, t1, eff0, eff1,
+                                                                            upper_s)))
+    shape = cols[0].shape
+    lo, hi, ratio, t0, t1, eff0, eff1, upper = (c.ravel() for c in cols)
+    fs = float(sensor.sample_rate_hz)
+    b = last_sample_index(upper, fs)
+    a = np.zeros(b.shape, dtype=np.int64)  # n = 0: one sample at contact, no information
+    cum = _cumulative_g2(float(sensor.tau_s), fs, int(max(np.max(b), 1)))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        slope = np.where(np.isnan(eff0), 0.0, np.log(eff1 / eff0) / np.log(t1 / t0))
+
+    t_min, t_max = np.fmin(t0, t1), np.fmax(t0, t1)
+
+    def ok(n):
+        t = np.minimum(np.maximum(n / fs, t_min), t_max)  # constant beyond the two known points
+        with np.errstate(divide="ignore", invalid="ignore"):
+            g = (hi - lo) / np.maximum(eff1 * np.exp(slope * np.log(t / t1)), 1.0)  # no classifier beats the ideal
+            s = ratio / np.sqrt(cum[n])
+        # both directions in one vectorized call (each element's decision is independent of the others)
+        both = _ok(sensor, np.concatenate([lo, np.maximum(hi - g, 0.0)]), np.concatenate([lo + g, hi]), width,
+                   np.concatenate([s, s]), threshold)
+        return both[:lo.size] & both[lo.size:] & (g > 0)
+
+    while np.any(b - a > 1):
+        mid = (a + b) // 2
+        good = ok(mid)
+        b, a = np.where(good, mid, b), np.where(good, a, mid)
+    return (b / fs).reshape(shape)
+
+
+def cached_efficiency_min_contact(sensor, lo, hi, ratio, t0, t1, eff0, eff1, upper_s, *,
+                                  width: float = 80.0, threshold: float = 0.9) -> np.ndarray:
+    """:func:`efficiency_min_contact` through the per-process cache (same answers, same arguments)."""
+    def compute(*cols):
+        return efficiency_min_contact(sensor, *cols, width=width, threshold=threshold)
+    eff0 = np.where(np.isnan(eff0), eff1, eff0)  # the same answer (constant eff1), and a key NaN cannot spoil
+    return _cached("efficiency-min-contact", sensor, (lo, hi, ratio, t0, t1, eff0, eff1, upper_s),
+                   (float(width), float(threshold)), compute)
 
 
 def exact_ideal_max_ratio(sensor, lo, hi, contact_s, *, width: float = 80.0, threshold: float = 0.9,
@@ -373,15 +457,16 @@ def clear_bound_cache() -> None:
     _BOUNDS.clear()
 
 
-def _cached(kind: str, sensor, lo, hi, x, params: tuple, compute) -> np.ndarray:
-    """``compute(lo, hi, x)`` elementwise through the cache: the distinct misses in one vectorized call."""
-    lo, hi, x = (np.asarray(v, dtype=np.float64) for v in np.broadcast_arrays(lo, hi, x))
+def _cached(kind: str, sensor, columns: tuple, params: tuple, compute) -> np.ndarray:
+    """``compute(*columns)`` elementwise through the cache: the distinct misses in one vectorized call."""
+    cols = [np.asarray(v, dtype=np.float64) for v in np.broadcast_arrays(*columns)]
     head = (kind, float(sensor.effusivity), float(sensor.tau_s), float(sensor.sample_rate_hz)) + params
-    keys = [head + k for k in zip(lo.ravel().tolist(), hi.ravel().tolist(), x.ravel().tolist())]
+    width = len(cols)
+    keys = [head + k for k in zip(*(c.ravel().tolist() for c in cols))]
     missing = list(dict.fromkeys(k for k in keys if k not in _BOUNDS))
     if missing:
-        m = np.array([k[-3:] for k in missing], dtype=np.float64)
-        for k, v in zip(missing, compute(m[:, 0], m[:, 1], m[:, 2]).tolist()):
+        m = np.array([k[-width:] for k in missing], dtype=np.float64).reshape(len(missing), width)
+        for k, v in zip(missing, np.asarray(compute(*m.T)).tolist()):
             _BOUNDS[k] = v
     out = np.empty(len(keys))
     for i, k in enumerate(keys):
@@ -389,7 +474,7 @@ def _cached(kind: str, sensor, lo, hi, x, params: tuple, compute) -> np.ndarray:
         _BOUNDS.move_to_end(k)
     while len(_BOUNDS) > BOUND_CACHE_SIZE:
         _BOUNDS.popitem(last=False)
-    return out.reshape(lo.shape)
+    return out.reshape(cols[0].shape)
 
 
 def cached_ideal_min_contact(sensor, lo, hi, ratio, *, width: float = 80.0, threshold: float = 0.9,
@@ -405,8 +490,23 @@ def cached_ideal_min_contact(sensor, lo, hi, ratio, *, width: float = 80.0, thre
     def compute(a, b, r):
         return exact_ideal_min_contact(sensor, a, b, r, width=width, threshold=threshold,
                                        max_contact_s=max_contact_s)
-    return _cached("min-contact", sensor, lo, hi, ratio, (float(width), float(threshold), float(max_contact_s)),
+    return _cached("min-contact", sensor, (lo, hi, ratio), (float(width), float(threshold), float(max_contact_s)),
                    compute)
+
+
+def cached_ideal_delta(sensor, e, contact_s, ratio, direction, *, width: float = 80.0, threshold: float = 0.9,
+                       e_max: float = 40000.0, tol: float = 0.5) -> np.ndarray:
+    """:func:`exact_ideal_delta` through the per-process cache, ``direction`` (+1 / -1) elementwise."""
+    def compute(a, c, r, d):
+        out = np.full(a.shape, np.nan)
+        for sign in (+1, -1):
+            m = d == sign
+            if m.any():
+                out[m] = exact_ideal_delta(sensor, a[m], c[m], r[m], direction=sign, width=width,
+                                           threshold=threshold, e_max=e_max, tol=tol)
+        return out
+    return _cached("delta", sensor, (e, contact_s, ratio, direction),
+                   (float(width), float(threshold), float(e_max), float(tol)), compute)
 
 
 def cached_ideal_max_ratio(sensor, lo, hi, contact_s, *, width: float = 80.0, threshold: float = 0.9,
@@ -415,5 +515,5 @@ def cached_ideal_max_ratio(sensor, lo, hi, contact_s, *, width: float = 80.0, th
     def compute(a, b, c):
         return exact_ideal_max_ratio(sensor, a, b, c, width=width, threshold=threshold, bracket=bracket,
                                      rel_tol=rel_tol)
-    return _cached("max-ratio", sensor, lo, hi, contact_s,
+    return _cached("max-ratio", sensor, (lo, hi, contact_s),
                    (float(width), float(threshold), float(bracket[0]), float(bracket[1]), float(rel_tol)), compute)

@@ -323,6 +323,8 @@ def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> None
     todo = np.zeros(lo.size, dtype=bool)
     k_cross = np.full(lo.size, -1)
     n_prev, n_at = _nan(lo.size), _nan(lo.size)  # the svm need at the contact before the crossing, and at it
+    efficiency = svm and op.closed and "delta_up_ideal" in view.t.arrays  # the scalar route's _efficiency_at, per element
+    eff_in = {k: _nan(lo.size) for k in ("t_a", "svm_a", "ideal_a", "ideal_b", "mc_lo", "mc_hi", "entry_sd")}
     for (noise, dt), idx in _groups(x["noise_c"], x["delta_t_c"]):
         combos, flags = view.scene_weights(noise, dt)
         if not all(flags.values()):
@@ -346,6 +348,26 @@ def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> None
                 if all(iflags.values()):
                     res["ideal"][idx] = _crossing(op.iview.contacts, _need(op.iview, op.ikind, icombos, l, h),
                                                   gap)[0]
+        if efficiency:
+            ideal_need = _need(view, "ideal", combos, l, h)
+            kk = np.maximum(k, 0)
+            # table._second_contact per element: before with both needs, after with both, before / after with
+            # an ideal need (slope only)
+            a = np.full(k.shape, -1)
+            for j, both in ((k - 1, True), (k + 1, True), (k - 1, False), (k + 1, False)):
+                inside = (k >= 0) & (j >= 0) & (j < grid.size)
+                jc = np.clip(j, 0, grid.size - 1)
+                known = ~np.isnan(ideal_need[jc, cols]) & (~np.isnan(need[jc, cols]) if both else True)
+                a = np.where((a < 0) & inside & known, j, a)
+            has_a = a >= 0
+            ac = np.maximum(a, 0)
+            eff_in["t_a"][idx] = np.where(has_a, grid[ac], np.nan)
+            eff_in["svm_a"][idx] = np.where(has_a, need[ac, cols], np.nan)
+            eff_in["ideal_a"][idx] = np.where(has_a, ideal_need[ac, cols], np.nan)
+            eff_in["ideal_b"][idx] = ideal_need[kk, cols]
+            eff_in["mc_lo"][idx] = _need(view, "lo", combos, l, h)[kk, cols]
+            eff_in["mc_hi"][idx] = _need(view, "hi", combos, l, h)[kk, cols]
+            eff_in["entry_sd"][idx] = view.entry_noise(combos)
         res["value"][idx], res["low"][idx], res["high"][idx] = value, ilo, ihi
         res["in_grid"][idx] = True
         todo[idx] = True
@@ -359,10 +381,23 @@ def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> None
     # the scalar route's interval: an estimate where the crossing is interpolated between two tabulated needs
     # (table.contact_estimate, the same function), else the grid cell, never below the ideal bound
     raw, ideal = res["value"], res["ideal"]
-    est = (k_cross > 0) & ~np.isnan(n_prev) & ~np.isnan(raw)
-    cell = ~np.isnan(raw) & ~est
     low, high = _nan(lo.size), _nan(lo.size)
     value = raw.copy()
+    by_eff = np.zeros(lo.size, dtype=bool)
+    if efficiency and (cand := ~np.isnan(raw) & ~np.isnan(eff_in["t_a"])).any():
+        i = np.nonzero(cand)[0]
+        ratio = x["noise_c"] / np.abs(x["delta_t_c"])
+        r = _table_route.efficiency_estimate(
+            op.tab.sensor, lo[i], hi[i], ratio[i], eff_in["t_a"][i], grid[k_cross[i]], eff_in["svm_a"][i], n_at[i],
+            eff_in["ideal_a"][i], eff_in["ideal_b"][i], eff_in["mc_lo"][i], eff_in["mc_hi"][i], ideal[i],
+            width=op.width, threshold=op.phi, z_table=_table_route.table_z(op.tab), zc=zc,
+            entry_sd=eff_in["entry_sd"][i])
+        got = ~np.isnan(r["value"])
+        j = i[got]
+        value[j], low[j], high[j] = r["value"][got], r["low"][got], r["high"][got]
+        by_eff[j] = True
+    est = (k_cross > 0) & ~np.isnan(n_prev) & ~np.isnan(raw) & ~by_eff
+    cell = ~np.isnan(raw) & ~est & ~by_eff
     if est.any():
         i = np.nonzero(est)[0]
         r = _table_route.contact_estimate(
@@ -579,16 +614,33 @@ def _table_delta_e(x: dict[str, np.ndarray], op, ideal_table, zc: float) -> dict
         icombos = iview.scene_weights(noise, dt)[0] if iview is not None else []
         icw = _table_route.axis_weights_flagged(iview.contacts, contact)[0] if iview is not None else []
         gcw = _table_route.axis_weights_flagged(view.contacts, contact, log=True)[0]
+        efficiency = svm and op.closed and "delta_up_ideal" in view.t.arrays
+        ends = (cw[0][0], cw[-1][0])
         for direction, side in (("down", "lower"), ("up", "upper")):
             val = at(view, combos, cw, f"delta_{direction}")
             iname = f"delta_{direction}_ideal" if ikind == "ideal" else f"delta_{direction}"
             ideal = at(iview, icombos, icw, iname)
+            mc_lo = at(view, combos, cw, f"delta_{direction}_lo") if svm else None
+            mc_hi = at(view, combos, cw, f"delta_{direction}_hi") if svm else None
+            by_eff = np.zeros(xe.size, dtype=bool)
+            if efficiency:  # the scalar route's delta_efficiency_estimate where the tabulated value exists
+                sv = _delta(view, f"delta_{direction}", combos, xe)
+                iv_ = _delta(view, f"delta_{direction}_ideal", combos, xe)
+                r = _table_route.delta_efficiency_estimate(
+                    op.tab.sensor, xe, contact, noise / abs(dt), -1.0 if direction == "down" else 1.0,
+                    view.contacts[ends[0]], view.contacts[ends[1]], sv[ends[0]], sv[ends[1]], iv_[ends[0]],
+                    iv_[ends[1]], mc_lo, mc_hi, width=op.width, threshold=op.phi, e_max=view.e_hi,
+                    z_table=_table_route.table_z(op.tab), zc=zc, entry_sd=view.entry_noise(combos))
+                by_eff = ~np.isnan(val) & ~np.isnan(r["value"])
+                val = np.where(by_eff, r["value"], val)
+                ideal = np.where(by_eff, r["ideal"], ideal)
             res[side][idx], res[f"{side}_ideal"][idx] = val, ideal
             if svm:  # the scalar route's interval (table.delta_estimate, the same function)
                 low, high = _table_route.delta_estimate(
-                    val, at(view, combos, cw, f"delta_{direction}_lo"), at(view, combos, cw, f"delta_{direction}_hi"),
-                    at_geometric(view, combos, gcw, f"delta_{direction}"), ideal, width=op.width,
+                    val, mc_lo, mc_hi, at_geometric(view, combos, gcw, f"delta_{direction}"), ideal, width=op.width,
                     z_table=_table_route.table_z(op.tab), zc=zc)
+                if efficiency:
+                    low, high = np.where(by_eff, r["low"], low), np.where(by_eff, r["high"], high)
                 res[f"{side}_low"][idx] = np.where(np.isnan(val), np.nan, low)
                 res[f"{side}_high"][idx] = np.where(np.isnan(val), np.nan, high)
         res["in_grid"][idx] = True

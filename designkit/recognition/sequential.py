@@ -82,7 +82,7 @@ from scipy import optimize, special
 from .._validation import InputError, check_positive
 from ..models import get_model
 from ..objects import ObjectClass
-from ..sensor import Sensor
+from ..sensor import Sensor, last_sample_index
 from .ideal import class_survival, log_ndtr_diff
 
 __all__ = [
@@ -98,7 +98,6 @@ __all__ = [
     "CENTRAL",
     "FAR_PIECES",
     "candidate_pieces",
-    "decide",
     "fixed_time_errors",
     "log_marginals",
     "min_fixed_contact_s",
@@ -341,7 +340,9 @@ def _log_marginals_1(v: float, s: float, candidates) -> list[float]:
 
     Pieces more than :data:`FAR_PIECES` projection noises beyond the nearest piece are skipped
     (the C export skips the same ones), which makes a wide material cost a few pieces per sample
-    once the evidence is sharp.
+    once the evidence is sharp. Central pieces (both ends within :data:`CENTRAL` noises) are summed
+    in linear space, density times probability, and enter the log-sum-exp as one term: one special
+    function per piece instead of three (the C update's cost per sample for wide materials).
     """
     out = []
     for c in candidates:
@@ -349,6 +350,7 @@ def _log_marginals_1(v: float, s: float, candidates) -> list[float]:
         edges = c.w_edges
         near = _near_pieces(v, s, edges)
         cached_k, cached_phi = -1, 0.0  # Phi at the last edge used: shared by neighbouring pieces
+        central = 0.0  # the central pieces' sum, in linear space (no log and exp per piece)
         for m, lm in enumerate(c.log_mass):
             w0, w1 = edges[m], edges[m + 1]
             if w0 - v > near or v - w1 > near:
@@ -365,7 +367,8 @@ def _log_marginals_1(v: float, s: float, candidates) -> list[float]:
                 p_lo = cached_phi if cached_k == m else 0.5 * math.erfc(-lo / _SQRT2)
                 p_hi = 0.5 * math.erfc(-hi / _SQRT2)
                 cached_k, cached_phi = m + 1, p_hi
-                term = math.log(p_hi - p_lo) - math.log(width)
+                central += math.exp(lm - math.log(width)) * (p_hi - p_lo)  # the piece's density x probability
+                continue
             else:
                 a, b = (-hi, -lo) if lo > 0.0 else (lo, hi)
                 lb = _log_ndtr_1(b)
@@ -376,6 +379,8 @@ def _log_marginals_1(v: float, s: float, candidates) -> list[float]:
                     term = lb + (math.log(-math.expm1(d)) if d > -_LOG2 else math.log1p(-math.exp(d))) \
                         - math.log(width)
             terms.append(lm + term)
+        if central > 0.0:
+            terms.append(math.log(central))
         if len(terms) == 1:
             out.append(terms[0])
         else:
@@ -431,26 +436,26 @@ def fixed_time_errors(range_low, range_high, error_low: float, error_high: float
     """
     fm = get_model(model)
     t = np.atleast_1d(np.asarray(contact_s, dtype=np.float64))
-    n_max = int(math.floor(float(t.max()) * sensor.sample_rate_hz + 1e-9)) + 1
-    g2 = np.cumsum(_shape(sensor, fm, n_max) ** 2)
-    idx = np.floor(t * sensor.sample_rate_hz + 1e-9).astype(int)
+    idx = last_sample_index(t, sensor.sample_rate_hz)
+    g2 = np.cumsum(_shape(sensor, fm, int(idx.max()) + 1) ** 2)
     with np.errstate(divide="ignore"):
         s = noise_ratio / np.sqrt(g2[idx])
-    ok = np.zeros(t.shape, dtype=bool)
-    es = sensor.effusivity
-    for i, s_i in enumerate(s):
-        if not np.isfinite(s_i):
-            continue
-        # threshold where the low class's false-positive rate equals error_low (Brent's method on w;
-        # P(v > t | low) falls from 1 to 0 over [-1, 2] for any s that matters here)
-        def excess(t, s_i=s_i):
-            return _survival(t, range_low, es, s_i) - error_low
-        lo_w, hi_w = -1.0 - 10.0 * s_i, 2.0 + 10.0 * s_i
-        thr = optimize.brentq(excess, lo_w, hi_w, xtol=1e-14, rtol=4 * np.finfo(float).eps) \
-            if excess(lo_w) > 0 > excess(hi_w) else hi_w
-        miss = 1.0 - _survival(thr, range_high, es, s_i)
-        ok[i] = miss <= error_high
-    return ok
+    return np.array([_fixed_ok(range_low, range_high, error_low, error_high, sensor.effusivity, s_i) for s_i in s],
+                    dtype=bool)
+
+
+def _fixed_ok(range_low, range_high, error_low: float, error_high: float, e_sensor: float, s: float) -> bool:
+    """Whether the best fixed test with projection noise ``s`` reaches both error rates (see fixed_time_errors)."""
+    if not np.isfinite(s):
+        return False
+    # threshold where the low class's false-positive rate equals error_low (Brent's method on w;
+    # P(v > t | low) falls from 1 to 0 over [-1, 2] for any s that matters here)
+    def excess(t):
+        return _survival(t, range_low, e_sensor, s) - error_low
+    lo_w, hi_w = -1.0 - 10.0 * s, 2.0 + 10.0 * s
+    thr = optimize.brentq(excess, lo_w, hi_w, xtol=1e-14, rtol=4 * np.finfo(float).eps) \
+        if excess(lo_w) > 0 > excess(hi_w) else hi_w
+    return bool(1.0 - _survival(thr, range_high, e_sensor, s) <= error_high)
 
 
 def min_fixed_contact_s(range_low, range_high, error_low: float, error_high: float, sensor: Sensor,
@@ -468,11 +473,20 @@ def min_fixed_contact_s(range_low, range_high, error_low: float, error_high: flo
     True
     """
     fs = sensor.sample_rate_hz
-    n_hi = int(math.floor(max_contact_s * fs + 1e-9))
+    n_hi = int(last_sample_index(max_contact_s, fs))
+    return _min_fixed_n(range_low, range_high, error_low, error_high, sensor.effusivity, noise_ratio,
+                        _shape(sensor, get_model(model), n_hi + 1), fs)
+
+
+def _min_fixed_n(range_low, range_high, error_low: float, error_high: float, e_sensor: float, noise_ratio: float,
+                 g: np.ndarray, fs: float) -> float | None:
+    """:func:`min_fixed_contact_s` on a shape table ``g`` (samples 0 .. the longest contact's last)."""
+    with np.errstate(divide="ignore"):
+        s_of_n = noise_ratio / np.sqrt(np.cumsum(g * g))
 
     def ok(n):
-        return bool(fixed_time_errors(range_low, range_high, error_low, error_high, sensor, noise_ratio,
-                                      [n / fs], model=model)[0])
+        return _fixed_ok(range_low, range_high, error_low, error_high, e_sensor, float(s_of_n[n]))
+    n_hi = g.size - 1
     if n_hi < 1 or not ok(n_hi):
         return None
     lo = 0
@@ -589,9 +603,8 @@ class SequentialTest:
             raise InputError(f"candidate names must differ, got {names}")
         if rates is not None and set(rates) - set(names):
             raise InputError(f"error rates given for unknown candidates: {sorted(set(rates) - set(names))}")
+        self._g = _shape(sensor, fm, int(last_sample_index(self.max_contact_s, sensor.sample_rate_hz)) + 1)
         self.plan = self._plan(tuple(cands))
-        n_max = int(math.floor(self.max_contact_s * sensor.sample_rate_hz + 1e-9)) + 1
-        self._g = _shape(sensor, fm, n_max)
         self._thr = self.plan.thresholds.tolist()
         self._fs = float(sensor.sample_rate_hz)
         self.reset()
@@ -609,8 +622,8 @@ class SequentialTest:
                 if a.e_range[1] > b.e_range[0]:
                     separable, bad = False, (a.name, b.name)
                     break
-                t = min_fixed_contact_s(a.e_range, b.e_range, a.error_rate, b.error_rate, self.sensor, ratio,
-                                        self.max_contact_s, model=self.model)
+                t = _min_fixed_n(a.e_range, b.e_range, a.error_rate, b.error_rate, self.sensor.effusivity, ratio,
+                                 self._g, float(self.sensor.sample_rate_hz))
                 if t is None:
                     separable, bad = False, (a.name, b.name)
                     break
@@ -710,14 +723,6 @@ def _decide_1(ll, thr) -> tuple[str, int]:
         if all(j == i or ll[i] - ll[j] >= thr[i][j] for j in range(k)):
             return "decided", i
     return KEEP_TOUCHING, -1
-
-
-def decide(ll, thresholds) -> tuple[str, int]:
-    """``("decided", i)`` when ``l_i - l_j >= A_ij`` for every ``j != i``, else ``("keep touching", -1)``."""
-    diff = ll[:, None] - ll[None, :]
-    ok = (diff >= thresholds) | np.eye(len(ll), dtype=bool)
-    won = np.flatnonzero(ok.all(axis=1))
-    return ("decided", int(won[0])) if won.size else (KEEP_TOUCHING, -1)
 
 
 # ----------------------------------------------------------------- many touches at once

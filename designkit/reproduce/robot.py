@@ -38,6 +38,7 @@ __all__ = [
     "calibrate",
     "calibrate_model",
     "load_real",
+    "passive_object_temp",
     "real_pair_f1",
     "section_real_robot",
     "section_sim_to_real",
@@ -199,8 +200,12 @@ class SimToRealSetup:
     identification: object = None
     #: per class, (mean, sd) of ln(h_c,i / h_c) of its touches' own contact (drawn per simulated touch)
     contact: dict | None = None
-    #: per class, where a simulated touch's object temperature comes from ("passive" / "passive-end")
+    #: per class, where a simulated touch's object temperature comes from ("passive" / "passive-end" /
+    #: "passive-response")
     object_temp: dict | None = None
+    #: the passive thermistor's normalized response (P - Tp0) / (To - Tp0) on the touches' window,
+    #: calibrated on the cold-wood calibration touches (for "passive-response")
+    passive_response: np.ndarray | None = None
 
 
 def _paper_setup(why: str) -> SimToRealSetup:
@@ -251,50 +256,126 @@ def calibrate(touches: RealTouches, *, seed: int) -> SimToRealSetup:
 
 
 #: The sensor model sim-to-real uses when identified (docs/sensor-models.md): the layered sensor with
-#: the thermistor lag and the host smoothing, each metal touch its own contact conductance.
-SIM_MODEL = "layered+lag+smoothing"
+#: the thermistor lag, the host smoothing, the heater's drift and the contact area growing with the force.
+SIM_MODEL = "layered+lag+smoothing+drift+area"
+#: Where the passive channel's curve is read to estimate an object's temperature (s after the onset).
+PASSIVE_WINDOW_S = (0.25, CONTACT_S)
+
+
+def _baseline(trial) -> tuple[float, float]:
+    """(Ts0 at the onset, drift [degC/s]): a line through the sensor's samples from 1 s to 0.25 s before
+    contact (the last 0.25 s carry the host smoothing's view of the onset)."""
+    pre = (trial.time_s < -0.25) & np.isfinite(trial.sensor_c)
+    slope, ts0 = np.polyfit(trial.time_s[pre], trial.sensor_c[pre], 1)
+    return float(ts0), float(slope)
+
+
+def _touch_curves(ident, material: str, trial, time_s: np.ndarray, pressed=None):
+    """(v, b) of ``material`` for one touch on ``time_s``: its own force where the model uses it.
+
+    ``pressed``: touches (Trial) whose forces to use instead, one reading each.
+    """
+    from ..calibration.identify import relative_force
+
+    if not ident.candidate.force_area:
+        return ident.reading(time_s, material, drift=True)
+    if pressed is None:
+        return ident.reading(time_s, material, force=relative_force(trial), force_time_s=trial.time_s, drift=True)
+    grid = pressed[0].time_s
+    force = np.array([np.interp(grid, p.time_s, relative_force(p)) for p in pressed])
+    return ident.reading(time_s, material, force=force, force_time_s=grid, drift=True)
+
+
+def _passive_response(ident, cal: RealTouches, material: str, like: str) -> np.ndarray:
+    """The passive thermistor's normalized response on the window, calibrated on ``material``'s touches.
+
+    Each calibration touch's object temperature comes from its *heated* channel (``like``'s identified
+    shape, Ts0, drift and To fitted to the touch: the object is ``like`` at another temperature); the
+    passive channel's reading from its own pre-contact temperature Tp0 towards it, (P - Tp0) / (To - Tp0),
+    averaged over the touches, is its response. Only calibration touches enter.
+    """
+    rows = []
+    for k in np.flatnonzero(cal.material == material):
+        tr = cal.trials[k]
+        v, b = _touch_curves(ident, like, tr, tr.time_s)
+        A = np.stack([1.0 - v, b, v], axis=1)
+        to = float(np.linalg.lstsq(A, tr.sensor_c, rcond=None)[0][2])
+        tp0 = cal.object_temp_c[k]
+        if abs(to - tp0) > 1.0:
+            rows.append((cal.object_c[k] - tp0) / (to - tp0))
+    if not rows:
+        raise InputError(f"no {material} calibration touch has an object temperature 1 degC or more away from "
+                         "its passive channel's: the passive response cannot be calibrated")
+    return np.mean(rows, axis=0)
+
+
+def passive_object_temp(touches: RealTouches, response: np.ndarray) -> np.ndarray:
+    """Each touch's object temperature from its passive channel through the calibrated response [degC].
+
+    ``To = Tp0 + sum (P - Tp0) w / sum w^2`` over :data:`PASSIVE_WINDOW_S` (least squares of the
+    passive curve on the response ``w``); uses the passive channel only.
+    """
+    win = (touches.time_s >= PASSIVE_WINDOW_S[0]) & (touches.time_s <= PASSIVE_WINDOW_S[1])
+    w = response[win]
+    dp = touches.object_c[:, win] - touches.object_temp_c[:, None]
+    return touches.object_temp_c + dp @ w / float(w @ w)
 
 
 def calibrate_model(touches: RealTouches, *, candidate: str = SIM_MODEL,
-                    object_temp: dict | None = None) -> SimToRealSetup:
+                    object_temp: dict | None = None, touch_conductance: tuple[str, ...] = ()) -> SimToRealSetup:
     """Identify ``candidate`` on the calibration subset (trial sets 1-4, metal and wood).
 
-    Metal's object temperature is the passive reading before contact and each metal touch gets its
-    own contact conductance (:func:`designkit.calibration.identify.identify`, ``touch_conductance``);
-    the simulator draws a simulated metal touch's conductance from the fitted spread. Cold wood is
-    the same wood; by default its object temperature is the passive reading at the end of the window
-    (before contact the passive thermistor reads the air above the cooled block).
+    Metal's and wood's object temperature is the passive reading before contact (both at room
+    temperature). Cold wood is the same wood: by default (``"passive-response"``) its temperature is
+    read from the passive thermistor through that thermistor's response, calibrated on the cold-wood
+    touches of the calibration sets (:func:`passive_object_temp`); ``"passive-end"`` takes the passive
+    reading at the end of the window, ``"passive-end-affine"`` calibrates cold wood as its own class.
+    ``touch_conductance``: materials whose touches each get their own contact conductance (the
+    simulator draws a simulated touch's conductance from the fitted spread).
     """
     from ..calibration.identify import identify
 
-    temps = {"metal": "passive", "wood": "passive", "cold_wood": "passive-end"}
+    temps = {"metal": "passive", "wood": "passive", "cold_wood": "passive-response"}
     temps.update(object_temp or {})
     mats = CALIBRATED + (("cold_wood",) if temps["cold_wood"].endswith("-affine") else ())
-    sub = touches.select(np.isin(touches.trial_set, CALIBRATION_SETS) & np.isin(touches.material, mats))
+    cal_sets = np.isin(touches.trial_set, CALIBRATION_SETS)
+    sub = touches.select(cal_sets & np.isin(touches.material, mats))
     ranges = {k: tuple(float(v) for v in CALIBRATION_RANGES[k].split(":")) for k in mats}
-    res = identify(list(sub.trials), candidate, ranges=ranges, object_temps={k: temps[k] for k in mats},
-                   touch_conductance=("metal",))
-    hc = res.parameter("conductance_w_m2k").value
-    mean = res.parameter("conductance_w_m2k[metal touches]").value
-    spread = res.parameter("conductance_spread[metal]").value
-    contact = {"metal": (math.log(mean / hc), math.log(spread))}
+    fit_temps = {k: ("passive" if temps[k] == "passive-response" else temps[k]) for k in mats}
+    res = identify(list(sub.trials), candidate, ranges=ranges, object_temps=fit_temps,
+                   touch_conductance=tuple(touch_conductance))
+    contact = {}
+    for m in touch_conductance:
+        hc = res.parameter("conductance_w_m2k").value
+        mean = res.parameter(f"conductance_w_m2k[{m} touches]").value
+        spread = res.parameter(f"conductance_spread[{m}]").value
+        contact[m] = (math.log(mean / hc), math.log(spread))
+    response = None
+    if "passive-response" in temps.values():
+        cal = touches.select(cal_sets)
+        response = _passive_response(res, cal, "cold_wood", "wood")
     es = res.effusivity.value if res.effusivity is not None else math.nan
     eff = {k: v.value * es for k, v in res.ratios.items()}
     eff.setdefault("cold_wood", eff["wood"])
     return SimToRealSetup(res.sensor(name=f"identified {candidate} (shared recordings, sets 1-4)"),
                           float(res.parameter("time_offset_s").value), eff,
-                          f"designkit.calibration.identify ({candidate}, metal's contact per touch) on trial sets "
-                          f"{CALIBRATION_SETS[0]}-{CALIBRATION_SETS[-1]} ({sub.material.size} touches of metal "
-                          f"and wood)", float(res.rms_c), float(res.noise_c), res.to_dict(), res, contact, temps)
+                          f"designkit.calibration.identify ({candidate}"
+                          + (f", {' and '.join(touch_conductance)}'s contact per touch" if touch_conductance else "")
+                          + f") on trial sets {CALIBRATION_SETS[0]}-{CALIBRATION_SETS[-1]} ({sub.material.size} "
+                          f"touches of metal and wood)", float(res.rms_c), float(res.noise_c), res.to_dict(), res,
+                          contact or None, temps, response)
 
 
 def _simulate_model(test: RealTouches, setup: SimToRealSetup, noise_c: float, per_trial: int,
-                    seed: int, passive: bool = False):
-    """Simulated touches from an identified model: each test touch's own Ts0 and To, host-smoothed noise.
+                    seed: int, passive: bool = False, force_pool: RealTouches | None = None):
+    """Simulated touches from an identified model: each test touch's own initial state, host-smoothed noise.
 
-    Returns (readings, labels), and with ``passive`` also the passive thermistor's simulated readings:
-    the same touch read from the passive channel's own pre-contact temperature Tp0 (room, or the air
-    above a cooled block) towards the same To, with the identified reading shape and its own noise.
+    A test touch's own state: Ts0 and the sensor's drift (a line through its pre-contact samples), To
+    from its passive channel (per class, :class:`SimToRealSetup` ``object_temp``) and, for a model with
+    a force-driven contact area, its own force. Returns (readings, labels), and with ``passive`` also
+    the passive thermistor's simulated readings: the same touch read from the passive channel's own
+    pre-contact temperature Tp0 towards the same To, with the calibrated passive response where there
+    is one (else the identified reading shape), and its own noise.
     """
     from .._validation import as_generator
     from ..models.layered import savgol_smooth
@@ -303,30 +384,48 @@ def _simulate_model(test: RealTouches, setup: SimToRealSetup, noise_c: float, pe
     ident = setup.identification
     temps = setup.object_temp or {}
     contact = setup.contact or {}
+    drift = bool(getattr(ident.candidate, "drift", False))
     out, labels, pout = [], [], []
     for cls in CLASSES:
         idx = np.flatnonzero(test.material == cls)
         if idx.size == 0:
             continue
-        reps = np.repeat(idx, per_trial)
         mat = cls if cls in ident.ratios else "wood"
-        if cls in contact:
-            mu, sd = contact[cls]
-            v = ident.reading(test.time_s, mat, conductance_factor=np.exp(rng.normal(mu, sd, reps.size)))
-        else:
-            v = np.broadcast_to(ident.reading(test.time_s, mat), (reps.size, test.time_s.size))
         mode = temps.get(cls, "passive")
-        to = test.object_end_c if mode.startswith("passive-end") else test.object_temp_c
+        if mode == "passive-response":
+            to_all = passive_object_temp(test, setup.passive_response)
+        else:
+            to_all = test.object_end_c if mode.startswith("passive-end") else test.object_temp_c
         if mode.endswith("-affine"):  # the passive channel through the offset and slope fitted on calibration
             ref = ident.object_refs[cls]
             off = ident.parameter(f"passive_offset_c[{cls}]").value
             slope = ident.parameter(f"passive_slope[{cls}]").value
-            to = to + off + slope * (to - ref)
-        ts0 = test.sensor_temp_c[reps][:, None]
-        out.append(ts0 + (to[reps][:, None] - ts0) * v)
-        tp0 = test.object_temp_c[reps][:, None]
-        pout.append(tp0 + (to[reps][:, None] - tp0) * v)
-        labels.append(np.full(reps.size, cls))
+            to_all = to_all + off + slope * (to_all - ref)
+        for k in idx:
+            tr = test.trials[k]
+            if cls in contact:
+                from ..calibration.identify import relative_force
+
+                mu, sd = contact[cls]
+                v, b = ident.reading(test.time_s, mat, conductance_factor=np.exp(rng.normal(mu, sd, per_trial)),
+                                     force=relative_force(tr) if ident.candidate.force_area else None,
+                                     force_time_s=tr.time_s, drift=True)
+            elif force_pool is not None and ident.candidate.force_area:
+                pressed = [force_pool.trials[j] for j in rng.integers(0, force_pool.material.size, per_trial)]
+                v, b = _touch_curves(ident, mat, tr, test.time_s, pressed)
+            else:
+                v, b = _touch_curves(ident, mat, tr, test.time_s)
+                v, b = np.broadcast_to(v, (per_trial, v.size)), np.broadcast_to(b, (per_trial, b.size))
+            if drift:
+                ts0, slope_c = _baseline(tr)
+            else:
+                ts0, slope_c = test.sensor_temp_c[k], 0.0
+            to = to_all[k]
+            out.append(ts0 * (1.0 - v) + slope_c * b + to * v)
+            tp0 = test.object_temp_c[k]
+            w = setup.passive_response if setup.passive_response is not None else v
+            pout.append(np.broadcast_to(tp0 + (to - tp0) * w, v.shape))
+            labels.append(np.full(per_trial, cls))
     sim = np.vstack(out)
     # the host smoothed every recording: the simulated noise is smoothed white noise with RMS noise_c
     pad = 200
@@ -363,8 +462,11 @@ def _simulate_like(test: RealTouches, setup: SimToRealSetup, noise_c: float, per
 
 
 def sim_to_real(test: RealTouches, setup: SimToRealSetup, noise_c: float, *, per_trial: int, seed: int,
-                object_temp: str = "passive", two_sensor: bool = False) -> dict:
+                object_temp: str = "passive", two_sensor: bool = False, force_pool: RealTouches | None = None) -> dict:
     """Train on simulated touches, test on the real ones: binary F1 per pair and the 3-class confusion.
+
+    ``force_pool``: for a model whose contact area follows the force, each simulated touch presses with
+    the force of a touch drawn from these (e.g. the calibration touches) instead of its test touch's own.
 
     ``two_sensor``: the passive thermistor is a second sensor (its simulated and real readings join
     the heated sensor's, :func:`designkit.recognition.two_sensor.two_sensor_features`); needs an
@@ -382,12 +484,13 @@ def sim_to_real(test: RealTouches, setup: SimToRealSetup, noise_c: float, *, per
         if setup.identification is None or test.object_c is None or not np.isfinite(test.object_c).all():
             raise InputError("two-sensor sim-to-real needs an identified model and a passive channel in every "
                              "recording")
-        sim, labels, psim = _simulate_model(test, setup, noise_c, per_trial, seed, passive=True)
+        sim, labels, psim = _simulate_model(test, setup, noise_c, per_trial, seed, passive=True,
+                                            force_pool=force_pool)
         Xs = two_sensor_features(sim, psim, fs)
         Xr = two_sensor_features(test.sensor_c, test.object_c, fs)
     else:
         if setup.identification is not None:
-            sim, labels = _simulate_model(test, setup, noise_c, per_trial, seed)
+            sim, labels = _simulate_model(test, setup, noise_c, per_trial, seed, force_pool=force_pool)
         else:
             sim, labels = _simulate_like(test, setup, noise_c, per_trial, seed, object_temp)
         Xs = feature_matrix(sim, fs)
@@ -438,8 +541,10 @@ def _cold_wood_text(test: RealTouches, main: dict, end: dict, rms: float) -> str
         f"woods is a fraction of a degree). Told instead the passive reading at the end of the window (still "
         f"only an upper bound of the block's surface temperature), the simulated cold wood separates from wood "
         f"({w_cold_e} of {n_w} wood touches misread as cold wood) but is still far warmer than the real one "
-        f"({cw_metal_e} of {n_cw} cold-wood touches classified as metal). The surface temperature of an object "
-        f"away from room temperature is an input the model needs and this rig does not measure.")
+        f"({cw_metal_e} of {n_cw} cold-wood touches classified as metal). The passive thermistor approaches the "
+        f"block's surface temperature slowly: read through its own response, calibrated on the cold-wood touches "
+        f"of the calibration sets (the identified model's rows of the table above), it gives the object "
+        f"temperature the simulator needs.")
 
 
 def _calibration_text(setup: "SimToRealSetup") -> str:
@@ -580,8 +685,9 @@ def section_sim_to_real(ctx: Context) -> SectionResult:
     end = sim_to_real(test, setup, rms, per_trial=per_trial, seed=seed, object_temp="passive-end")
     ctx.step(4, 4)
     identified = []  # the identified sensor model (docs/sensor-models.md), noise = its residual on calibration
-    for label, cold in ((f"identified {SIM_MODEL}; cold wood = wood at its passive reading at {CONTACT_S:g} s",
-                         "passive-end"),
+    pool = touches.select(np.isin(touches.trial_set, CALIBRATION_SETS))   # simulated touches press as these did
+    for label, cold in ((f"identified {SIM_MODEL}; cold wood = wood at the temperature its passive thermistor "
+                         f"reads through that thermistor's calibrated response", "passive-response"),
                         (f"identified {SIM_MODEL}; cold wood calibrated as its own class (its passive end "
                          f"reading through a fitted offset and slope)", "passive-end-affine")):
         try:
@@ -589,13 +695,13 @@ def section_sim_to_real(ctx: Context) -> SectionResult:
         except InputError as exc:  # pragma: no cover - reported, not fatal
             identified.append((label, None, str(exc)))
             continue
-        identified.append((label, sim_to_real(test, msetup, msetup.rms_c, per_trial=per_trial, seed=seed),
-                           msetup))
-        if cold == "passive-end" and test.object_c is not None and np.isfinite(test.object_c).all():
+        identified.append((label, sim_to_real(test, msetup, msetup.rms_c, per_trial=per_trial, seed=seed,
+                                              force_pool=pool), msetup))
+        if cold == "passive-response" and test.object_c is not None and np.isfinite(test.object_c).all():
             identified.append((f"identified {SIM_MODEL}, **two sensors**: the passive thermistor's readings join "
                                "the heated sensor's (recognition.two_sensor)",
                                sim_to_real(test, msetup, msetup.rms_c, per_trial=per_trial, seed=seed,
-                                           two_sensor=True), msetup))
+                                           two_sensor=True, force_pool=pool), msetup))
     fig = _confusion_figure(ctx, [(f"sim-to-real, σ = {rms:.3f} °C", main["multiclass"]["confusion"]),
                                   ("sim-to-real, cold wood at its passive end reading", end["multiclass"]["confusion"])],
                             CLASSES, "sim_to_real_confusion")
@@ -624,14 +730,23 @@ def section_sim_to_real(ctx: Context) -> SectionResult:
         f"Training: {per_trial} simulated touches per real test touch ({test.material.size} touches of trial sets "
         f"5-20, never used by calibration), each with that touch's own Ts0 (sensor before contact) and Ta "
         f"(passive channel before contact), white noise σ. Test: the real touches. Features and SVM as the paper; "
-        f"F1 with the higher-effusivity (or the cold) class positive.",
+        f"F1 with the higher-effusivity (or the cold) class positive. The identified model's rows: each simulated "
+        f"touch takes its test touch's Ts0 and drift (a line through its samples from 1 s to 0.25 s before "
+        f"contact) and its object temperature from the passive channel (metal and wood: before contact; cold "
+        f"wood: its curve over {PASSIVE_WINDOW_S[0]:g}-{PASSIVE_WINDOW_S[1]:g} s through the passive thermistor's "
+        f"response calibrated on the cold-wood touches of the calibration sets), presses with the force of a "
+        f"calibration touch drawn at random (the contact area follows it), and gets host-smoothed noise.",
         "",
         md_table(["training noise"] + pair_names + ["mean F1", "3-class accuracy"], rows, align="l" + "r" * 5),
         "",
         f"Headline: mean F1 **{main['mean_f1']:.3f}** over the three pairs ({main['percent_indistinguishable']:.0f} % "
         f"of pairs below 0.9); the paper: {REAL_ROBOT['sim_to_real_f1']:g} over its 66 pairs "
         f"({REAL_ROBOT['sim_to_real_indistinguishable_percent']:g} % indistinguishable) with σ chosen as the best "
-        f"of the same grid on the test data.",
+        f"of the same grid on the test data."
+        + "".join(f" With the identified {SIM_MODEL} sensor ({'two sensors' if r['two_sensor'] else 'one sensor'}): "
+                  f"mean F1 **{r['mean_f1']:.3f}**, 3-class accuracy **{r['multiclass']['accuracy']:.3f}**, wood vs "
+                  f"cold wood {r['pairs']['wood vs cold wood']['f1']:.3f}."
+                  for label, r, _ in identified[:2] if r is not None),
         "",
         f"![sim-to-real confusion]({fig})",
         "",

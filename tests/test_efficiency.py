@@ -1,0 +1,124 @@
+"""min-contact's efficiency route: the SVM's tabulated need over the ideal observer's, applied to the exact
+ideal observer between a table's contact times (designkit.query.table.efficiency_estimate)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from designkit.query import min_contact
+from designkit.query import table as q
+from designkit.query.ideal_bound import efficiency_min_contact, exact_ideal_min_contact
+from designkit.sensor import load_sensor
+from designkit.sweep import SweepConfig
+from designkit.sweep.run import run_sweep
+from designkit.tables.store import load_table, table_header, write_table
+
+PAPER = load_sensor("paper")
+CONTACTS = (0.5, 1.0, 1.5, 2.0, 3.0)
+
+
+@pytest.fixture(scope="module")
+def ideal_as_svm(tmp_path_factory):
+    """An "SVM" table whose classifier is exactly as good as the ideal observer: its needs are the
+    closed-form ideal observer's, tabulated by the sweep (efficiency 1 everywhere)."""
+    folder = tmp_path_factory.mktemp("eff")
+    cfg = SweepConfig(name="ideal-src", fidelity="ideal", intervals=100, noise_ratio=(0.002, 0.005),
+                      contact_s=CONTACTS)
+    ideal = load_table(run_sweep(cfg, folder / "w", out=folder / "ideal-src.npz", backend="sequential"))
+    up, down = ideal.arrays["delta_up"], ideal.arrays["delta_down"]
+    arrays = {"delta_up": up, "delta_down": down, "delta_up_ideal": up, "delta_down_ideal": down,
+              "delta_up_lo": up, "delta_down_lo": down, "delta_up_hi": up, "delta_down_hi": down,
+              "fits": np.zeros((2, len(CONTACTS)), dtype=np.int64), "chunk_wall_s": np.zeros((2, len(CONTACTS)))}
+    svm_cfg = SweepConfig(name="ideal-as-svm", intervals=100, noise_ratio=(0.002, 0.005), contact_s=CONTACTS)
+    return load_table(write_table(folder / "ideal-as-svm.npz", table_header(svm_cfg, arrays), arrays))
+
+
+@pytest.mark.parametrize("noise", [0.02, 0.05])
+@pytest.mark.parametrize("pair", [(20000.0, 35000.0), (5000.0, 9000.0), (30000.0, 38000.0), (1000.0, 1500.0)])
+def test_a_classifier_as_good_as_the_ideal_observer_gets_the_exact_bound(ideal_as_svm, pair, noise):
+    ans = min_contact(*pair, noise_c=noise, delta_t_c=10.0, table=ideal_as_svm, ideal_table=None)
+    width = float(ideal_as_svm.header["effusivity"]["width"])  # the table's classes (400 wide here)
+    exact = float(exact_ideal_min_contact(PAPER, pair[0], pair[1], noise / 10.0, width=width))
+    if ans.value is None:  # not separable within the grid's contact times
+        assert exact > CONTACTS[-1]
+        return
+    assert ans.to_dict()["interval"]["method"] == "table-efficiency"
+    assert ans.computation["efficiency"] == pytest.approx(1.0)
+    assert ans.value == pytest.approx(exact, abs=1e-12)  # to the sample: the same first separating sample
+    assert ans.ideal == exact
+    assert ans.interval[0] <= ans.value <= ans.interval[1]
+
+
+def test_efficiency_moves_the_answer_the_right_way():
+    # a classifier needing 1.5x the ideal observer's separation needs a longer contact; 1.0x gives the bound
+    s = PAPER
+    bound = float(exact_ideal_min_contact(s, 20000.0, 35000.0, 0.005))
+    one = float(efficiency_min_contact(s, 20000.0, 35000.0, 0.005, 1.0, 2.0, 1.0, 1.0, 4.0))
+    worse = float(efficiency_min_contact(s, 20000.0, 35000.0, 0.005, 1.0, 2.0, 1.5, 1.5, 4.0))
+    even_worse = float(efficiency_min_contact(s, 20000.0, 35000.0, 0.005, 1.0, 2.0, 2.0, 2.0, 4.0))
+    assert one == bound < worse < even_worse <= 4.0
+    # below 1 is read as 1 (no classifier beats the ideal observer)
+    assert float(efficiency_min_contact(s, 20000.0, 35000.0, 0.005, 1.0, 2.0, 0.5, 0.5, 4.0)) == bound
+    # never beyond the search's end
+    assert float(efficiency_min_contact(s, 20000.0, 35000.0, 0.005, 1.0, 2.0, 50.0, 50.0, 1.5)) == 1.5
+
+
+def test_shipped_table_answers_lie_between_the_bound_and_the_grid_crossing():
+    rng = np.random.default_rng(7)
+    n = 0
+    for _ in range(60):
+        e1 = float(rng.uniform(300, 39000))
+        e2 = float(np.clip(e1 + rng.choice([-1, 1]) * rng.uniform(400, 9000), 200, 39800))
+        noise = float(rng.choice([0.01, 0.05, 0.1]))
+        ans = min_contact(e1, e2, noise_c=noise)
+        if ans.to_dict()["interval"]["method"] != "table-efficiency":
+            continue
+        n += 1
+        raw = ans.computation["table_crossing_s"]  # the grid's interpolated crossing
+        first_enough = min(c for c in ans.computation["table_contacts_s"] if c >= raw - 1e-12)
+        assert ans.ideal - 1e-12 <= ans.value <= first_enough + 1e-12
+        low, high = ans.interval
+        assert low <= ans.value <= high and low >= ans.ideal - 1e-12
+        assert 0 < ans.computation["efficiency_se_log"] < 1
+    assert n >= 30  # the route answers most pairs inside the shipped grid
+
+
+def test_entry_noise_is_measured_on_the_table_and_positive():
+    op = q.open_table("svm-paper")
+    view = op.view
+    combos, _ = view.scene_weights(0.05, 10.0)
+    sd = view.entry_noise(combos)
+    assert 0.005 < sd < 0.5  # a few per cent of scatter between neighbouring tabulated needs
+    assert view.entry_noise(combos) == sd  # cached, a pure function of the slice
+
+
+@pytest.mark.parametrize("e,contact", [(20000.0, 1.25), (5000.0, 2.5), (30000.0, 0.75)])
+def test_delta_e_of_a_classifier_as_good_as_the_ideal_observer_is_the_exact_ideal_delta(ideal_as_svm, e, contact):
+    from designkit.query import delta_e
+    from designkit.query.ideal_bound import exact_ideal_delta
+
+    width = float(ideal_as_svm.header["effusivity"]["width"])
+    ans = delta_e(e, contact_s=contact, noise_c=0.05, delta_t_c=10.0, table=ideal_as_svm, ideal_table=None)
+    assert ans.to_dict()["interval"]["method"] == "table-efficiency"
+    for side, sign in (("lower", -1), ("upper", +1)):
+        s = ans.details[side]
+        if s["value"] is None:
+            continue
+        exact = float(exact_ideal_delta(PAPER, ans.details["e"], contact, 0.005, direction=sign, width=width))
+        assert s["efficiency"] == pytest.approx(1.0)
+        assert s["value"] == pytest.approx(exact, rel=1e-12) and s["ideal"] == pytest.approx(exact, rel=1e-12)
+        assert s["interval"][0] <= s["value"] <= s["interval"][1]
+    assert ans.ideal_bound.method == "closed-form"
+
+
+def test_delta_e_from_the_shipped_table_states_an_exact_bound_below_it():
+    from designkit.query import delta_e
+
+    ans = delta_e(20000.0, contact_s=1.75, noise_c=0.05)
+    assert ans.to_dict()["interval"]["method"] == "table-efficiency" and ans.ideal_bound.method == "closed-form"
+    for side in ("lower", "upper"):
+        s = ans.details[side]
+        assert s["ideal"] <= s["interval"][0] <= s["value"] <= s["interval"][1]
+        # the arrays' own (interpolated, grid-rounded) value is kept beside the estimate
+        assert s["table_value"] > 0 and s["efficiency"] > 1.0

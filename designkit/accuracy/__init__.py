@@ -30,8 +30,8 @@ module          what it holds
 from __future__ import annotations
 
 from .cost import cost_curve, cost_curve_specs, cost_curves
-from .coverage import (COVERAGE_QUESTIONS, answer_reading, case_arguments, coverage_case, diluted_coverage, draw_case,
-                       run_cases, summarize, synthetic_coverage, worst_regions)
+from .coverage import (COVERAGE_QUESTIONS, answer_reading, calibration_z, case_arguments, coverage_case,
+                       diluted_coverage, draw_case, run_cases, summarize, synthetic_coverage, worst_regions)
 from .delta import delta_rows, grid_rows, staircase_vs_full
 from .instruments import ProcessCost, fit_exponent, measure, process_cost, reset_peak_memory, resident_mb, timed
 from .physics import physics_rows, slab_rows
@@ -47,7 +47,7 @@ __all__ = [
     "COVERAGE_FILES", "COVERAGE_QUESTIONS", "FIGURES_HINT", "GAP_BINS", "PAPER_RATIO", "QUESTIONS",
     "RECOGNITION_PAIRS", "SECTIONS",
     "BenchReport", "CostCurve", "ProcessCost", "Row",
-    "answer_reading", "case_arguments", "check_sections", "coverage_case", "coverage_markdown", "diluted_coverage",
+    "answer_reading", "calibration_z", "case_arguments", "check_sections", "coverage_case", "coverage_markdown", "diluted_coverage",
     "draw_case", "insert_coverage", "run_cases", "summarize", "synthetic_coverage", "worst_regions", "write_coverage",
     "cost_curve", "cost_curve_specs", "cost_curves", "curves_markdown", "delta_rows",
     "density_rows", "environment", "fit_exponent", "format_time", "format_value", "grid_rows", "ideal_mc_rows",

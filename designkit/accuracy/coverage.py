@@ -46,6 +46,7 @@ from .._validation import as_generator
 __all__ = [
     "COVERAGE_QUESTIONS",
     "answer_reading",
+    "calibration_z",
     "case_arguments",
     "coverage_case",
     "diluted_coverage",
@@ -203,6 +204,47 @@ def _violation(question: str, ref, coverage: float) -> bool | None:
 
 
 # ============================================================ the summary
+def _stated_sd(r: Mapping[str, Any], log: bool) -> float | None:
+    """The standard deviation a stated two-sided interval implies (half-width / z), on log scale for crossings."""
+    lo, hi, cov = r.get("low"), r.get("high"), r.get("coverage")
+    if lo is None or hi is None or not cov or hi <= lo or (log and lo <= 0):
+        return None
+    width = math.log(hi) - math.log(lo) if log else hi - lo
+    return width / (2.0 * NormalDist().inv_cdf(0.5 + 0.5 * cov))
+
+
+def calibration_z(results: Iterable[Mapping[str, Any]], question: str, route: str = "exact") -> np.ndarray:
+    """``(answer - reference) / sqrt(sd_answer^2 + sd_reference^2)`` per case where both state an interval.
+
+    The sd are the ones the stated intervals imply (log scale for the crossings, F1 scale for
+    ``distinguishable``). Both sides' Monte Carlo errors are in the denominator, so the spread of
+    these is 1 for calibrated intervals whatever the reference's own error (coverage against the
+    reference is diluted by it, :func:`diluted_coverage`); above 1: intervals too narrow. An F1 of 1
+    on either side (no spread: the interval is clipped there) leaves the case out.
+
+    >>> r = [{"question": "q", "exact": {"value": 1.1, "low": 1.0, "high": 1.2, "coverage": 0.9},
+    ...       "reference": {"value": 1.0, "low": 0.95, "high": 1.05, "coverage": 0.9}}]
+    >>> round(float(calibration_z(r, "q", "exact")[0]), 2)
+    1.51
+    """
+    log = question != "distinguishable"
+    out = []
+    for r in results:
+        if r["question"] != question or route not in r:
+            continue
+        a, ref = r[route], r["reference"]
+        if a.get("value") is None or isinstance(ref.get("value"), bool) or ref.get("value") is None:
+            continue
+        if not log and max(a["value"], ref["value"]) >= 1.0 - 1e-12:  # an F1 of 1 has no spread to calibrate
+            continue
+        sa, sr = _stated_sd(a, log), _stated_sd(ref, log)
+        if sa is None or sr is None or (log and (a["value"] <= 0 or ref["value"] <= 0)):
+            continue
+        d = math.log(a["value"]) - math.log(ref["value"]) if log else a["value"] - ref["value"]
+        out.append(d / math.hypot(sa, sr))
+    return np.asarray(out, dtype=np.float64)
+
+
 def _covered(r: Mapping[str, Any], truth: float) -> bool:
     lo = r["low"] if r["low"] is not None else -math.inf
     hi = r["high"] if r["high"] is not None else math.inf
@@ -254,6 +296,7 @@ def summarize(results: Iterable[Mapping[str, Any]], question: str, route: str, *
         if stated else None,
         "violations": sum(1 for r in rows if r.get("violation")),
         # the reference's crossing at the bound itself: its F1 reached Phi at the ideal observer's answer
+        **_z_summary(calibration_z(rows, question, route)),
         "reference_at_bound": 0 if question == "distinguishable" else sum(  # (an F1 of 1 is no violation)
             1 for r in rows if r["reference"].get("value") is not None
                                   and not isinstance(r["reference"]["value"], bool)
@@ -262,39 +305,59 @@ def summarize(results: Iterable[Mapping[str, Any]], question: str, route: str, *
     }
 
 
+def _z_summary(z: np.ndarray) -> dict[str, Any]:
+    """Spread of :func:`calibration_z` (robust: 1.4826 x the median absolute value, so that a few
+    clipped intervals do not dominate) and the share inside the nominal 90 % band."""
+    if z.size == 0:
+        return {"n_z": 0, "z_sd": None, "z_robust_sd": None}
+    return {"n_z": int(z.size), "z_sd": float(np.std(z)), "z_robust_sd": float(1.4826 * np.median(np.abs(z)))}
+
+
 # ============================================================ the machinery on a known truth
-def synthetic_coverage(n: int, *, seed: int, coverage: float = 0.9, repeats: int = 4,
-                       trials: int = 100) -> dict[str, Any]:
+def synthetic_coverage(n: int, *, seed: int, coverage: float = 0.9, repeats: int = 4, trials: int = 100,
+                       increasing: bool = True, correlation: float = 0.0) -> dict[str, Any]:
     """Coverage of :func:`designkit.query.crossing.estimate_crossing` on synthetic F1 curves.
 
     Each curve is ``F1(x) = 0.5 + 0.5 / (1 + (x / x50)^-k)`` (a logistic in log x, slope
-    ``k`` uniform in [2, 8], crossing 0.9 at a random ``x*`` in [0.5, 5]); an
-    evaluation is the mean of ``repeats`` draws, each the curve plus normal noise with
+    ``k`` uniform in [2, 8], crossing 0.9 at a random ``x*`` in [0.5, 5]; with
+    ``increasing=False`` the mirror image ``(x50 / x)``, falling like F1 against sigma/dT);
+    an evaluation is the mean of ``repeats`` draws, each the curve plus normal noise with
     the SVM's standard error at that F1 (:func:`designkit.recognition.svm.f1_standard_error`
     with ``trials`` touches per class). The truth is ``x*`` exactly.
 
-    Returns ``{"n", "coverage", "median_rel", "p95_rel", "none"}``.
+    ``correlation`` models common random numbers: seed ``r``'s noise is
+    ``sqrt(rho) c_r + sqrt(1 - rho) e_{r,x}``, with ``c_r`` shared by every point of the
+    curve (the exact route once reused its seeds at every point: measured 0.7-0.9 between
+    neighbouring points on the sigma/dT and delta-e axes, 0.2-0.65 on contact time). The
+    estimator assumes independent points (``correlation=0``, what the exact route now draws).
+
+    Returns ``{"n", "coverage", "median_rel", "p95_rel", "none", "z_sd"}``; ``z_sd`` is the
+    spread of ``(log x_est - log x*) / sd`` with ``sd`` the interval's stated standard deviation
+    in log x (1 when the stated width is right; the coverage follows from it).
     """
-    from ..query.crossing import estimate_crossing
+    from ..query.crossing import estimate_crossing, z_of_coverage
     from ..recognition.svm import f1_standard_error
 
     rng = as_generator(seed)
-    hits, rel, none = [], [], 0
+    rho = float(correlation)
+    z = z_of_coverage(coverage)
+    hits, rel, zs, none = [], [], [], 0
     for _ in range(int(n)):
         k = rng.uniform(2.0, 8.0)
         x_star = float(np.exp(rng.uniform(math.log(0.5), math.log(5.0))))
-        # 0.5 + 0.5 p = 0.9 -> p = 0.8 -> (x*/x50)^k = 4
-        x50 = x_star / 4.0 ** (1.0 / k)
+        # 0.5 + 0.5 p = 0.9 -> p = 0.8 -> (x*/x50)^k = 4 rising, (x50/x*)^k = 4 falling
+        x50 = x_star / 4.0 ** (1.0 / k) if increasing else x_star * 4.0 ** (1.0 / k)
+        common = rng.standard_normal(repeats)
 
-        def f(x, k=k, x50=x50):
-            p = 1.0 / (1.0 + (x / x50) ** -k)
+        def f(x, k=k, x50=x50, common=common):
+            p = 1.0 / (1.0 + ((x / x50) if increasing else (x50 / x)) ** -k)
             m = 0.5 + 0.5 * p
-            tpr = min(1.0, m)
-            se1 = f1_standard_error(tpr, max(0.0, 1.0 - m), trials)
-            draws = np.clip(m + se1 * rng.standard_normal(repeats), 0.0, 1.0)
+            se1 = f1_standard_error(min(1.0, m), max(0.0, 1.0 - m), trials)
+            noise = math.sqrt(rho) * common + math.sqrt(1.0 - rho) * rng.standard_normal(repeats)
+            draws = np.clip(m + se1 * noise, 0.0, 1.0)
             return float(draws.mean()), max(se1, float(np.std(draws, ddof=1))) / math.sqrt(repeats)
 
-        est = estimate_crossing(f, 0.05, 10.0, 0.9, coverage=coverage)
+        est = estimate_crossing(f, 0.05, 10.0, 0.9, coverage=coverage, increasing=increasing)
         if est.value is None:
             none += 1
             continue
@@ -302,10 +365,13 @@ def synthetic_coverage(n: int, *, seed: int, coverage: float = 0.9, repeats: int
         hi = est.high if est.high is not None else math.inf
         hits.append(lo <= x_star <= hi)
         rel.append(abs(est.value - x_star) / x_star)
+        if est.method == "wls-logit-log" and est.low is not None and est.high is not None and est.high > est.low:
+            zs.append((math.log(est.value) - math.log(x_star)) / ((math.log(est.high) - math.log(est.low)) / (2 * z)))
     rel_a = np.array(rel)
     return {"n": int(n), "coverage": float(np.mean(hits)) if hits else None,
             "median_rel": float(np.median(rel_a)) if rel else None,
-            "p95_rel": float(np.percentile(rel_a, 95)) if rel else None, "none": none}
+            "p95_rel": float(np.percentile(rel_a, 95)) if rel else None, "none": none,
+            "z_sd": float(np.std(zs)) if zs else None}
 
 
 def worst_regions(results: Sequence[Mapping[str, Any]], question: str, route: str) -> list[dict[str, Any]]:

@@ -582,6 +582,9 @@ def coverage_markdown(doc: Mapping[str, Any], figure: str | None = None) -> list
            f"crossings (median relative error {doc['synthetic']['median_rel']:.3g}, p95 "
            f"{doc['synthetic']['p95_rel']:.3g}). Against a reference with its own Monte Carlo error an exactly "
            f"calibrated 90 % interval covers about {pct(doc['diluted_nominal'])} (the target band is 85-97 %).", "",
+           *(["Variants of the same check: " + "; ".join(
+               f"{v['label']}: {pct(v['coverage'])} covered, stated widths {1 / v['z_sd']:.2f}x the real spread"
+               for v in doc["synthetic"]["variants"]) + ".", ""] if doc["synthetic"].get("variants") else []),
            "| question | route | cases | compared | stated | coverage of 90 % | no stated coverage | no answer "
            "| median abs err | p95 abs err | median rel err | p95 rel err | ideal-bound violations |",
            "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
@@ -593,6 +596,14 @@ def coverage_markdown(doc: Mapping[str, Any], figure: str | None = None) -> list
                    f"{r['violations']}{_at_bound(r)} |")
     out += ["", "Units of the absolute errors: s (min-contact), degC (max-noise, min-delta-t), "
             "J s^-1/2 K^-1 m^-2 (delta-e), F1 (distinguishable; its relative error is of the F1).", ""]
+    zs = [r for r in doc["rows"] if r.get("n_z")]
+    if zs:
+        out += ["Calibration free of the reference's own error: the spread of (answer - reference) / "
+                "sqrt(sd_answer^2 + sd_reference^2), the sd each stated interval implies (log scale for the "
+                "crossings), is 1 for calibrated intervals, above 1 for too narrow ones (robust spread, "
+                "1.4826 x median |z|; cases): "
+                + "; ".join(f"`{r['question']}` {r['route']} {r['z_robust_sd']:.2f} (n {r['n_z']})" for r in zs)
+                + ".", ""]
     far = next((r for r in doc["rows"] if "far" in r), None)
     if far is not None:
         f, n = far["far"], far["near"]

@@ -192,6 +192,12 @@ def _render_text(d) -> None:
         con.print("  [dim]answered for the hardest pair: "
                   + " vs ".join(o["label"] for o in d["limiting_pair"]) + "[/]")
     _VALUE_LINES[d["question"]](con, d)
+    if d["question"] == "min-contact":
+        from ..query.guideline import guideline_remark
+
+        remark = guideline_remark(d)
+        if remark:
+            con.print(f"  {remark}")
     _source_lines(con, d)
 
 

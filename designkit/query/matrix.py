@@ -448,15 +448,15 @@ def _multiclass(mats, tab, *, noise_c: float, delta_t_c: float, svm_trials: int 
 
 # ============================================================ the matrix
 def _prefill_bounds(question: str, mats, tab, itab, given: dict) -> None:
-    """The closed-form ideal bounds of all pairs in one vectorized call, kept in the cache of
-    :mod:`designkit.query.ideal_bound` where the per-pair table questions find them: one bisection per
-    pair (numpy's per-call overhead, ~16 ms each) was most of a 12-material matrix. Anything odd is left
-    to the per-pair questions, which say what is wrong."""
+    """The closed-form ideal bounds (and min-contact's efficiency estimates) of all pairs in one vectorized
+    call, kept in the cache of :mod:`designkit.query.ideal_bound` where the per-pair table questions find
+    them: one bisection per pair (numpy's per-call overhead, ~16 ms each) was most of a 12-material matrix.
+    Anything odd is left to the per-pair questions, which say what is wrong."""
     if question not in ("min-contact", "max-noise", "min-delta-t"):
         return
     from . import table as table_route
-    from .ideal_bound import cached_ideal_max_ratio, cached_ideal_min_contact
-    from .inputs import check_contact, pair_question, scene_inputs
+    from .ideal_bound import cached_ideal_max_ratio
+    from .inputs import check_contact, pair_question
 
     try:
         op = table_route.open_table(tab, itab, threshold=given.get("threshold"), sensor=given.get("sensor"),
@@ -474,9 +474,10 @@ def _prefill_bounds(question: str, mats, tab, itab, given: dict) -> None:
         if not los:
             return
         if question == "min-contact":
-            noise, dt = scene_inputs(given.get("noise_c", 0.05), given.get("delta_t_c", 10.0))
-            cached_ideal_min_contact(op.tab.sensor, los, his, noise / abs(dt), width=op.width, threshold=op.phi,
-                                     max_contact_s=table_route.CLOSED_FORM_MAX_CONTACT_S)
+            # the array route: its closed-form bounds and efficiency estimates land in the same cache, under
+            # the same keys, as the per-pair questions' (the one vectorized computation for every pair)
+            ask("min-contact", route="table", e1=np.array(los), e2=np.array(his), table=tab, ideal_table=itab,
+                **given)
         else:
             cached_ideal_max_ratio(op.tab.sensor, los, his, check_contact(given["contact_s"]), width=op.width,
                                    threshold=op.phi, bracket=table_route.CLOSED_FORM_RATIO_BRACKET)

@@ -141,6 +141,7 @@ class PairScorer:
         self._features: OrderedDict[tuple[int, int], np.ndarray] = OrderedDict()
         per_entry = cfg.trials * 2 * self.n_samples * 8  # raw samples + slope, float64
         self.max_features = max(8, int(FEATURE_CACHE_MB * 2**20 // max(per_entry, 1)))  # cache entries
+        self._prepare = cfg.solver == "batched"  # numpy's batched path: cache PreparedFeatures
         self.scored: dict[tuple[int, int], PairCell] = {}  # every pair scored so far
         self.fits = 0
         self.calls = 0  # batched-solver calls (fits / calls: pairs per call)
@@ -158,6 +159,10 @@ class PairScorer:
                                 vary_ambient=cfg.ambient_temp_spread_c > 0)
             temps = render_trials(draws, self.sensor, self.scene, cfg.model, cfg.trial_diffusivity()).temperature_c
             feats = feature_matrix(temps, self.sensor.sample_rate_hz, cfg.slope_window_s)
+            if self._prepare:  # the batched solver's numpy path reads these (as many bytes as the float64 matrix)
+                from ..recognition.batched_svm import prepare_features
+
+                feats = prepare_features(feats)
             self._features[key] = feats
             while len(self._features) > self.max_features:
                 self._features.popitem(last=False)

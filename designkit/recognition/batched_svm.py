@@ -36,7 +36,13 @@ default they are formed in float32 from features centered in float64 (relative e
 of ``K`` about 1e-6, far below what moves a prediction); the solver runs in float64.
 Standardization is folded into the products: features are centered once per pair
 (the SVM is invariant to a common shift of all touches, training and test alike), then
-scaled by each fold's inverse standard deviation.
+scaled by each fold's inverse standard deviation. On numpy (float32 Gram) each feature
+matrix is first prepared once (:func:`prepare_features`: float32 deviations from its
+own mean and their squares; a sweep caches these per interval), so that a pair's fold
+statistics are block sums, the class offsets from the pair's center enter the Gram
+matrix as exact float64 rank-two corrections, and the only ``n x d`` array written per
+fold is the scaled training set (measured at 10 s of contact, 4,000 features: the
+standardize stage 6.8 -> 5.3 ms per pair inside a sweep, with the preparation).
 
 The code is written against the array API (``xp``: numpy by default, or the namespace
 ``array_api_compat`` finds for the inputs where it is installed); the fold assignment
@@ -952,20 +958,25 @@ def _chunk_prepared(lo, hi, test_folds, order_lo, order_hi, alloc, blk_lo, blk_h
         parts = [(c, g) for g in range(folds) if g != f for c in range(2)]
         Z = np.empty((b, n_tr, d), dtype=gdt)
         cls_of = np.empty(n_tr, dtype=np.intp)
+        segs = []  # (start, stop, class) of the training rows
         r = 0
         for c, g in parts:
             x = G[c][:, int(blk[c][g]):int(blk[c][g + 1]), :]
             m = x.shape[1]
             np.multiply(x, s_g, out=Z[:, r:r + m, :])
             cls_of[r:r + m] = c
+            segs.append((r, r + m, c))
             r += m
         clock.lap("standardize")
         V = offs * inv_scale[:, None, :]  # (b, 2, d) offsets in scaled coordinates, float64
         K = (Z @ np.swapaxes(Z, 1, 2)).astype(np.float64)
         H = (Z @ np.swapaxes(V.astype(gdt), 1, 2)).astype(np.float64)  # (b, n_tr, 2): dev_a s . o_l s
         VV = V @ np.swapaxes(V, 1, 2)  # (b, 2, 2)
-        Hc = H[:, :, cls_of]  # (b, n_tr, n_tr): dev_a s . o_{k(b)} s
-        K += Hc + np.swapaxes(Hc, 1, 2) + VV[:, cls_of][:, :, cls_of]
+        # K_ab += H[a, k(b)] + H[b, k(a)] + VV[k(a), k(b)], segment by segment (each segment is one class)
+        for P0, P1, cP in segs:
+            for Q0, Q1, cQ in segs:
+                K[:, P0:P1, Q0:Q1] += ((H[:, P0:P1, cQ][:, :, None] + H[:, Q0:Q1, cP][:, None, :])
+                                       + VV[:, cP, cQ][:, None, None])
         clock.lap("gram")
         yv = np.where(cls_of == 0, 1.0, -1.0)  # libsvm: the lower class (label 0) is +1
         a, rho, info = solve_svc_duals(K, yv, xp=np)

@@ -146,7 +146,10 @@ class PairScorer:
         self.fits = 0
         self.calls = 0  # batched-solver calls (fits / calls: pairs per call)
 
-    def features(self, k: int, rep: int) -> np.ndarray:
+    def features(self, k: int, rep: int):
+        """Features of interval ``k`` with seed ``rep``: the ``(trials, 2 n_samples)`` matrix, or with the
+        ``batched`` solver its :class:`~designkit.recognition.batched_svm.PreparedFeatures` (what that
+        solver reads; as many bytes as the float64 matrix, prepared once per cache entry)."""
         key = (k, rep)
         feats = self._features.get(key)
         if feats is not None:

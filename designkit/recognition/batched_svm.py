@@ -312,7 +312,8 @@ def _active_set(K, y, C, ridge, free, up, max_iter, xp):
     for _ in range(max_iter):
         if idx.shape[0] == 0:
             break
-        Ka, ya = K[idx], y[idx]
+        # every problem still open (always the first step): the arrays themselves, not gathered copies
+        Ka, ya = (K, y) if idx.shape[0] == P else (K[idx], y[idx])
         z = _kkt_step(Ka, ya, free[idx], up[idx], C, ridge[idx], eye, xp)
         beta = z[:, :n]
         a = ya * beta

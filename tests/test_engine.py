@@ -72,6 +72,20 @@ def test_a_row_answer_does_not_depend_on_the_other_rows_searched(n, seed, parts,
         assert J == i + 1 or J == n or not noisy[i, J - 1]
 
 
+def test_guided_rows_ask_fewer_questions_where_the_staircase_is_smooth():
+    """Rows starting from their anchors' interpolated answers need a few probes each, not a gallop
+    from the floor; the answers are the same (exactly monotone decisions)."""
+    n = 300
+    J_true = np.minimum(np.arange(n) + 25 + np.arange(n) // 7, n)
+    asked = {}
+    for every in (None, 8):
+        calls = []
+        got = staircase_search(lambda i, j: calls.append((i, j)) or j >= J_true[i], range(n), n, anchor_every=every)
+        np.testing.assert_array_equal(got, J_true)
+        asked[every] = len(calls)
+    assert asked[8] < 0.6 * asked[None], asked
+
+
 def test_delta_from_staircase_matches_the_decision_matrix():
     rng = np.random.default_rng(0)
     n, width = 30, 80.0

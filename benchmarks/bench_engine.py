@@ -36,6 +36,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 os.environ.setdefault("MKL_NUM_THREADS", "1")
 
 import argparse  # noqa: E402
+import dataclasses  # noqa: E402
 import statistics  # noqa: E402
 import sys  # noqa: E402
 import tempfile  # noqa: E402
@@ -65,7 +66,8 @@ def naive(cfg: SweepConfig, pairs: int, seed: int = 0):
     from designkit.recognition.svm import f1_from_features
 
     sensor = cfg.resolved_sensor()
-    scorer = PairScorer(cfg, sensor, cfg.scene((0,), cfg.contact_s[0]))
+    # the reference solver's scorer caches raw feature matrices (the batched one caches prepared ones)
+    scorer = PairScorer(dataclasses.replace(cfg, solver="sklearn"), sensor, cfg.scene((0,), cfg.contact_s[0]))
     rng = np.random.default_rng(seed)
     n = cfg.intervals
     ij = set()

@@ -179,4 +179,6 @@ def test_the_array_api_path_is_the_same_solver(case, paper_sensor):
         lo, hi = [f[0] for f in feats], [f[1] for f in feats]
         ours, generic = batched_cv_f1(lo, hi, seeds=[0, 1]), batched_cv_f1(lo, hi, seeds=[0, 1], xp=xnp)
         np.testing.assert_array_equal(generic.f1, ours.f1)
-        np.testing.assert_allclose(generic.decision, ours.decision, atol=1e-9)
+        # numpy's own path reads float32 deviations from prepared features (decisions to about 1e-6 of
+        # the functional margin; libsvm itself stops at a KKT gap of 1e-3), the generic one float64
+        np.testing.assert_allclose(generic.decision, ours.decision, atol=1e-5)

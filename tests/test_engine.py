@@ -44,7 +44,7 @@ def test_staircase_finds_every_monotone_boundary(case, seed):
 
     # floors at or below the truth must not change the answer, nor asking in batches
     floor = np.maximum(J_true - rng.integers(0, 4, n), 0)
-    for kw in ({}, {"floor": floor}):
+    for kw in ({}, {"floor": floor}, {"anchor_every": 3}, {"floor": floor, "anchor_every": 8}):
         calls.clear()
         got = staircase_search(decide, range(n), n, **kw)
         np.testing.assert_array_equal(got, J_true)
@@ -56,20 +56,34 @@ def test_staircase_finds_every_monotone_boundary(case, seed):
 
 
 @settings(max_examples=100, deadline=None)
-@given(st.integers(2, 40), st.integers(0, 2**16), st.integers(1, 6))
-def test_a_row_answer_does_not_depend_on_the_other_rows_searched(n, seed, parts):
+@given(st.integers(2, 40), st.integers(0, 2**16), st.integers(1, 6), st.sampled_from([None, 2, 3, 8]))
+def test_a_row_answer_does_not_depend_on_the_other_rows_searched(n, seed, parts, anchor_every):
     """Noisy (not monotone) decisions: any split of the rows gives the same J (a table is a function
-    of its config, whatever --blocks)."""
+    of its config, whatever --blocks), also when rows start from guesses of their anchors' answers."""
     noisy = np.random.default_rng(seed).random((n, n)) < 0.5
     rows = np.arange(n)
-    whole = staircase_search(lambda i, j: bool(noisy[i, j]), rows, n)
-    split = np.concatenate([staircase_search(lambda i, j: bool(noisy[i, j]), part, n)
+    whole = staircase_search(lambda i, j: bool(noisy[i, j]), rows, n, anchor_every=anchor_every)
+    split = np.concatenate([staircase_search(lambda i, j: bool(noisy[i, j]), part, n, anchor_every=anchor_every)
                             for part in np.array_split(rows, parts) if part.size])
     np.testing.assert_array_equal(split, whole)
     # a crossing: false below J (or J at its floor), true at J
     for i, J in enumerate(whole):
         assert J == n or noisy[i, J]
         assert J == i + 1 or J == n or not noisy[i, J - 1]
+
+
+def test_guided_rows_ask_fewer_questions_where_the_staircase_is_smooth():
+    """Rows starting from their anchors' interpolated answers need a few probes each, not a gallop
+    from the floor; the answers are the same (exactly monotone decisions)."""
+    n = 300
+    J_true = np.minimum(np.arange(n) + 25 + np.arange(n) // 7, n)
+    asked = {}
+    for every in (None, 8):
+        calls = []
+        got = staircase_search(lambda i, j: calls.append((i, j)) or j >= J_true[i], range(n), n, anchor_every=every)
+        np.testing.assert_array_equal(got, J_true)
+        asked[every] = len(calls)
+    assert asked[8] < 0.6 * asked[None], asked
 
 
 def test_delta_from_staircase_matches_the_decision_matrix():

@@ -36,7 +36,13 @@ default they are formed in float32 from features centered in float64 (relative e
 of ``K`` about 1e-6, far below what moves a prediction); the solver runs in float64.
 Standardization is folded into the products: features are centered once per pair
 (the SVM is invariant to a common shift of all touches, training and test alike), then
-scaled by each fold's inverse standard deviation.
+scaled by each fold's inverse standard deviation. On numpy (float32 Gram) each feature
+matrix is first prepared once (:func:`prepare_features`: float32 deviations from its
+own mean and their squares; a sweep caches these per interval), so that a pair's fold
+statistics are block sums, the class offsets from the pair's center enter the Gram
+matrix as exact float64 rank-two corrections, and the only ``n x d`` array written per
+fold is the scaled training set (measured at 10 s of contact, 4,000 features: the
+standardize stage 6.8 -> 5.3 ms per pair inside a sweep, with the preparation).
 
 The code is written against the array API (``xp``: numpy by default, or the namespace
 ``array_api_compat`` finds for the inputs where it is installed); the fold assignment
@@ -56,8 +62,10 @@ __all__ = [
     "ARRAY_LIBRARIES",
     "BatchedF1",
     "LIBSVM_EPS",
+    "PreparedFeatures",
     "array_library",
     "batched_cv_f1",
+    "prepare_features",
     "solve_svc_duals",
     "stratified_test_folds",
 ]
@@ -304,7 +312,8 @@ def _active_set(K, y, C, ridge, free, up, max_iter, xp):
     for _ in range(max_iter):
         if idx.shape[0] == 0:
             break
-        Ka, ya = K[idx], y[idx]
+        # every problem still open (always the first step): the arrays themselves, not gathered copies
+        Ka, ya = (K, y) if idx.shape[0] == P else (K[idx], y[idx])
         z = _kkt_step(Ka, ya, free[idx], up[idx], C, ridge[idx], eye, xp)
         beta = z[:, :n]
         a = ya * beta
@@ -528,16 +537,71 @@ class BatchedF1:
         return [self.result(i) for i in range(len(self))]
 
 
+@dataclass(frozen=True)
+class PreparedFeatures:
+    """One class's feature matrix as the numpy path of :func:`batched_cv_f1` reads it.
+
+    Attributes
+    ----------
+    dev : ndarray of float32, shape (n, d)
+        Features minus their own mean (computed in float64, then rounded once).
+    dev_sq : ndarray of float32, shape (n, d)
+        ``dev ** 2`` (squared in float64): the fold statistics are block sums of these.
+    mean : ndarray of float64, shape (d,)
+        The feature means.
+
+    A pair's common center and each class's offset from it are then exact float64
+    vectors, and every per-fold statistic, Gram product and decision value is a small
+    product of these arrays: nothing of size ``n x d`` is rebuilt per pair but one
+    scaled copy of each fold's training touches. Built once per feature matrix (a
+    sweep caches them per interval) by :func:`prepare_features`.
+    """
+
+    dev: np.ndarray
+    dev_sq: np.ndarray
+    mean: np.ndarray
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return self.dev.shape
+
+
+def prepare_features(features) -> PreparedFeatures:
+    """:class:`PreparedFeatures` of one ``(n, d)`` feature matrix (float64 in, one pass).
+
+    Raises :class:`~designkit.InputError` if a value is NaN or infinite.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> p = prepare_features(np.array([[1.0, 10.0], [3.0, 10.0]]))
+    >>> p.mean.tolist(), p.dev.tolist(), p.dev.dtype.name
+    ([2.0, 10.0], [[-1.0, 0.0], [1.0, 0.0]], 'float32')
+    """
+    if isinstance(features, PreparedFeatures):
+        return features
+    x = np.asarray(features, dtype=np.float64)
+    if x.ndim != 2:
+        raise InputError(f"a feature matrix must be 2-D (touches x features), got shape {x.shape}")
+    mean = x.mean(axis=0)
+    dev = x - mean
+    sq = dev * dev
+    if not (np.all(np.isfinite(mean)) and np.all(np.isfinite(sq.sum(axis=0)))):
+        raise InputError("features contain NaN or infinite values")
+    return PreparedFeatures(dev=dev.astype(np.float32), dev_sq=sq.astype(np.float32), mean=mean)
+
+
 class _Batch:
     """A batch of feature matrices, stacked one chunk at a time (a list is never stacked whole)."""
 
     def __init__(self, features, name):
         if isinstance(features, (list, tuple)):
-            self.items = [np.asarray(f, dtype=np.float64) for f in features]
+            self.items = [f if isinstance(f, PreparedFeatures) else np.asarray(f, dtype=np.float64)
+                          for f in features]
             shapes = {f.shape for f in self.items}
             if len(shapes) > 1:
                 raise InputError(f"{name}: every feature matrix must have the same shape, got {sorted(shapes)}")
-            if not self.items or self.items[0].ndim != 2:
+            if not self.items or len(self.items[0].shape) != 2:
                 raise InputError(f"{name} must be shaped (B, n, d) or a non-empty list of (n, d) arrays")
             self.shape = (len(self.items),) + self.items[0].shape
             self.array = None
@@ -553,8 +617,11 @@ class _Batch:
         """Pairs c0:c1 as one (b, n, d) array, or (``stack=False``) a list as given: the numpy
         path gathers each pair's rows straight from it (a whole pass over the features saved)."""
         if self.array is not None:
-            return self.array[c0:c1]
-        return np.stack(self.items[c0:c1]) if stack else self.items[c0:c1]
+            return self.array[c0:c1] if stack else list(self.array[c0:c1])
+        if stack:
+            return np.stack([f.dev.astype(np.float64) + f.mean if isinstance(f, PreparedFeatures) else f
+                             for f in self.items[c0:c1]])
+        return self.items[c0:c1]
 
 
 def batched_cv_f1(features_low, features_high, *, seeds, folds: int = 3, gram_dtype="float32",
@@ -645,9 +712,15 @@ def batched_cv_f1(features_low, features_high, *, seeds, folds: int = 3, gram_dt
     for c0 in range(0, B, chunk_size):
         c1 = min(B, c0 + chunk_size)
         ns = _namespace(xp, np.empty(0)) if xp is None or xp is np else xp
-        lo_c, hi_c = lo.get(c0, c1, stack=ns is not np), hi.get(c0, c1, stack=ns is not np)
-        out = _chunk(lo_c, hi_c, order_lo[c0:c1], order_hi[c0:c1], alloc, blk_lo, blk_hi,
-                     blk_start, folds, gram_dtype, ns, clock)
+        fast = ns is np and gram_dtype == "float32"  # prepared features hold float32 deviations
+        lo_c, hi_c = lo.get(c0, c1, stack=not fast), hi.get(c0, c1, stack=not fast)
+        if fast:
+            out = _chunk_prepared([prepare_features(x) for x in lo_c], [prepare_features(x) for x in hi_c],
+                                  test_folds[c0:c1], order_lo[c0:c1], order_hi[c0:c1], alloc, blk_lo, blk_hi,
+                                  folds, gram_dtype, clock)
+        else:
+            out = _chunk(lo_c, hi_c, order_lo[c0:c1], order_hi[c0:c1], alloc, blk_lo, blk_hi,
+                         blk_start, folds, gram_dtype, ns, clock)
         del lo_c, hi_c
         dec_blocks, gaps, solv, its = out
         for f in range(folds):
@@ -813,5 +886,115 @@ def _chunk(lo, hi, order_lo, order_hi, alloc, blk_lo, blk_hi, blk_start, folds, 
         gaps.append(_to_numpy(info["kkt_gap"]))
         solv.append(_to_numpy(info["solver"]))
         its.append(_to_numpy(info["iterations"]))
+        clock.lap("predict")
+    return dec_blocks, gaps, solv, its
+
+
+def _chunk_prepared(lo, hi, test_folds, order_lo, order_hi, alloc, blk_lo, blk_hi, folds, gram_dtype, clock):
+    """:func:`_chunk` on numpy from :class:`PreparedFeatures`: the same decisions, a fraction of the passes.
+
+    A touch ``x`` of class ``k`` relative to the pair's center ``c`` is ``dev + o_k``
+    (``o_k = mean_k - c``, exact float64). Hence, per fold, with ``s`` the training
+    fold's inverse standard deviations:
+
+    - block sums of ``dev`` and ``dev^2`` (one product with the fold indicator, in the
+      touches' own order: no gathered copy) give every fold's training mean and
+      variance: ``sum (x - c)^2 = sum dev^2 + 2 o_k sum dev + m o_k^2``;
+    - ``K_ab = (dev_a s).(dev_b s) + (dev_a s).(o_l s) + (o_k s).(dev_b s) + (o_k s).(o_l s)``:
+      one Gram product of the scaled training ``dev`` (float32, the only ``n x d``
+      array written per fold) plus rank-two corrections in float64;
+    - the decision of a test touch is ``(dev s + o_k s) . t - rho`` with
+      ``t = sum_a beta_a (dev_a s + o_k(a) s)``.
+
+    Measured against :func:`_chunk` (which centers, gathers, casts and scales a float64 copy
+    of every pair's touches): about 8 passes over the pair's ``n x d`` float64 values
+    become 2-3 over float32 ones.
+    """
+    b = len(lo)
+    n_lo, d = lo[0].shape
+    n_hi = hi[0].shape[0]
+    n = n_lo + n_hi
+    gdt = np.float32 if gram_dtype == "float32" else np.float64
+    eps = float(np.finfo(np.float64).eps)
+    # per pair: offsets of the classes from the common center, fold-block sums of dev and dev^2
+    offs = np.empty((b, 2, d))
+    S1 = np.zeros((b, folds, d))
+    S2 = np.zeros((b, folds, d))
+    center = np.empty((b, d))
+    for p in range(b):
+        c = (n_lo * lo[p].mean + n_hi * hi[p].mean) / n
+        center[p] = c
+        for k, (cls, tf) in enumerate(((lo[p], test_folds[p, :n_lo]), (hi[p], test_folds[p, n_lo:]))):
+            o = cls.mean - c
+            offs[p, k] = o
+            E = (tf[None, :] == np.arange(folds)[:, None]).astype(np.float32)  # (folds, m) indicator
+            s1 = (E @ cls.dev).astype(np.float64)
+            s2 = (E @ cls.dev_sq).astype(np.float64)
+            cnt = alloc[:, k].astype(np.float64)[:, None]
+            S1[p] += s1 + cnt * o
+            S2[p] += s2 + 2.0 * o * s1 + cnt * o * o
+    S1_all = S1.sum(axis=1)
+    S2_all = S2.sum(axis=1)
+    clock.lap("standardize")
+
+    # each class's dev rows in fold-block order, so a fold's training rows are contiguous ranges
+    G = [np.empty((b, n_lo, d), dtype=gdt), np.empty((b, n_hi, d), dtype=gdt)]
+    for p in range(b):
+        np.take(lo[p].dev, order_lo[p], axis=0, out=G[0][p], mode="clip")
+        np.take(hi[p].dev, order_hi[p], axis=0, out=G[1][p], mode="clip")
+    blk = (blk_lo, blk_hi)
+    clock.lap("standardize")
+
+    dec_blocks, gaps, solv, its = [], [], [], []
+    for f in range(folds):
+        n_te = int(alloc[f, 0] + alloc[f, 1])
+        n_tr = n - n_te
+        mean_c = (S1_all - S1[:, f, :]) / n_tr
+        var = (S2_all - S2[:, f, :]) / n_tr - mean_c * mean_c
+        var = np.where(var > 0, var, 0.0)
+        mean_raw = mean_c + center
+        constant = var <= n_tr * eps * var + (n_tr * mean_raw * eps) ** 2  # StandardScaler's rule
+        inv_scale = np.where(constant, 1.0, 1.0 / np.sqrt(np.where(constant, 1.0, var)))  # (b, d)
+        s_g = inv_scale.astype(gdt)[:, None, :]
+        parts = [(c, g) for g in range(folds) if g != f for c in range(2)]
+        Z = np.empty((b, n_tr, d), dtype=gdt)
+        cls_of = np.empty(n_tr, dtype=np.intp)
+        segs = []  # (start, stop, class) of the training rows
+        r = 0
+        for c, g in parts:
+            x = G[c][:, int(blk[c][g]):int(blk[c][g + 1]), :]
+            m = x.shape[1]
+            np.multiply(x, s_g, out=Z[:, r:r + m, :])
+            cls_of[r:r + m] = c
+            segs.append((r, r + m, c))
+            r += m
+        clock.lap("standardize")
+        V = offs * inv_scale[:, None, :]  # (b, 2, d) offsets in scaled coordinates, float64
+        K = (Z @ np.swapaxes(Z, 1, 2)).astype(np.float64)
+        H = (Z @ np.swapaxes(V.astype(gdt), 1, 2)).astype(np.float64)  # (b, n_tr, 2): dev_a s . o_l s
+        VV = V @ np.swapaxes(V, 1, 2)  # (b, 2, 2)
+        # K_ab += H[a, k(b)] + H[b, k(a)] + VV[k(a), k(b)], segment by segment (each segment is one class)
+        for P0, P1, cP in segs:
+            for Q0, Q1, cQ in segs:
+                K[:, P0:P1, Q0:Q1] += ((H[:, P0:P1, cQ][:, :, None] + H[:, Q0:Q1, cP][:, None, :])
+                                       + VV[:, cP, cQ][:, None, None])
+        clock.lap("gram")
+        yv = np.where(cls_of == 0, 1.0, -1.0)  # libsvm: the lower class (label 0) is +1
+        a, rho, info = solve_svc_duals(K, yv, xp=np)
+        clock.lap("solve")
+        beta = a * yv[None, :]
+        # t = sum_a beta_a (dev_a s + o_k(a) s): in scaled coordinates
+        t = (np.swapaxes(Z, 1, 2) @ beta.astype(gdt)[:, :, None])[..., 0].astype(np.float64)
+        Bk = np.stack([beta[:, cls_of == 0].sum(axis=1), beta[:, cls_of == 1].sum(axis=1)], axis=1)  # (b, 2)
+        t += (Bk[:, :, None] * V).sum(axis=1)
+        u = (t * inv_scale).astype(gdt)[:, :, None]  # a test touch's dev is unscaled: dev . (s t)
+        dec = []
+        for c in range(2):
+            x = G[c][:, int(blk[c][f]):int(blk[c][f + 1]), :]
+            dec.append((x @ u)[..., 0].astype(np.float64) + (V[:, c, :] * t).sum(axis=1)[:, None])
+        dec_blocks.append(np.concatenate(dec, axis=1) - rho[:, None])
+        gaps.append(info["kkt_gap"])
+        solv.append(info["solver"])
+        its.append(info["iterations"])
         clock.lap("predict")
     return dec_blocks, gaps, solv, its

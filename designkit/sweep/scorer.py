@@ -140,12 +140,16 @@ class PairScorer:
         # of their key, so evicting one only costs its regeneration, never changes a result
         self._features: OrderedDict[tuple[int, int], np.ndarray] = OrderedDict()
         per_entry = cfg.trials * 2 * self.n_samples * 8  # raw samples + slope, float64
-        self._max_features = max(8, int(FEATURE_CACHE_MB * 2**20 // max(per_entry, 1)))
+        self.max_features = max(8, int(FEATURE_CACHE_MB * 2**20 // max(per_entry, 1)))  # cache entries
+        self._prepare = cfg.solver == "batched"  # numpy's batched path: cache PreparedFeatures
         self.scored: dict[tuple[int, int], PairCell] = {}  # every pair scored so far
         self.fits = 0
         self.calls = 0  # batched-solver calls (fits / calls: pairs per call)
 
-    def features(self, k: int, rep: int) -> np.ndarray:
+    def features(self, k: int, rep: int):
+        """Features of interval ``k`` with seed ``rep``: the ``(trials, 2 n_samples)`` matrix, or with the
+        ``batched`` solver its :class:`~designkit.recognition.batched_svm.PreparedFeatures` (what that
+        solver reads; as many bytes as the float64 matrix, prepared once per cache entry)."""
         key = (k, rep)
         feats = self._features.get(key)
         if feats is not None:
@@ -158,8 +162,12 @@ class PairScorer:
                                 vary_ambient=cfg.ambient_temp_spread_c > 0)
             temps = render_trials(draws, self.sensor, self.scene, cfg.model, cfg.trial_diffusivity()).temperature_c
             feats = feature_matrix(temps, self.sensor.sample_rate_hz, cfg.slope_window_s)
+            if self._prepare:  # the batched solver's numpy path reads these (as many bytes as the float64 matrix)
+                from ..recognition.batched_svm import prepare_features
+
+                feats = prepare_features(feats)
             self._features[key] = feats
-            while len(self._features) > self._max_features:
+            while len(self._features) > self.max_features:
                 self._features.popitem(last=False)
         return feats
 
@@ -194,7 +202,7 @@ class PairScorer:
         this bounds a call's features to a quarter of the cache's budget (:data:`FEATURE_CACHE_MB`)
         on top of the cache itself; at 2 s of contact a whole search step fits one call.
         """
-        cap = max(2, self._max_features // 4)
+        cap = max(2, self.max_features // 4)
         part: list[tuple[int, int, int]] = []
         seen: set[tuple[int, int]] = set()
         for i, j, rep in keys:

@@ -152,10 +152,10 @@ def test_the_header_records_the_model_and_tables_show_prints_it(tmp_path, cli):
 
 
 def test_tables_from_before_the_seam_are_semi_infinite(cli):
-    t = load_table("svm-paper")
+    t = load_table("ideal-paper")
     assert "model" not in t.header["config"]  # built before the header recorded a model
     assert t.model.name == "semi-infinite" and SweepConfig.from_mapping(t.header["config"]).model.name == "semi-infinite"
-    r = cli("tables", "show", "svm-paper")
+    r = cli("tables", "show", "ideal-paper")
     assert r.exit_code == 0 and "model semi-infinite" in r.stdout
 
 

@@ -344,7 +344,7 @@ SHIPPED_CONTENT_HASHES = frozenset({
     "sha256:f4ecf487aec590490a63ec41215c6511218f038794ad33b52d5077bc1e5cf7ca",  # f1-matrix-fine-low
     "sha256:6290aff2cd7e4de3f9d1dc5ef445e66fdbb24a7cadd8e448a8733f373d111a60",  # f1-matrix-paper
     "sha256:1820bf01e2ffe9e79d35e4c0b9f8b310b10bbe7c8d481db47c9c09aa57564bae",  # ideal-paper
-    "sha256:faf7c7aea01cc5b673f522017c6e20b982d952e62fad87d3ddef3a40e870ddcd",  # svm-paper
+    "sha256:fb51017379fcac6a31e872004c42d77bb2f0cd72bbdf4b10d3c8874e288d783e",  # svm-paper
 })
 
 

@@ -83,6 +83,31 @@ def test_fit_human_output_and_plot(cli, tmp_path):
     assert plot.read_bytes()[:4] == b"\x89PNG"
 
 
+def test_fit_parameters_as_csv_read_by_the_csv_module_and_equal_to_the_json(cli, tmp_path):
+    import csv
+    import io
+
+    index = _synthetic_index(tmp_path / "trials", n=3)
+    args = [index, *sum((["--range", x] for x in METER_RANGES), []), "--bootstrap", "0"]
+    r = cli("calibrate", "fit", *args, "--format", "csv")
+    assert r.exit_code == 0, r.output
+    rows = list(csv.DictReader(io.StringIO(r.stdout)))
+    assert list(rows[0]) == ["parameter", "material", "value", "std_error", "low_95", "high_95", "unit"]
+    d = json.loads(cli("calibrate", "fit", *args, "--format", "json").stdout)
+    es = next(x for x in rows if x["parameter"] == "e_s")
+    assert float(es["value"]) == pytest.approx(d["effusivity"]["value"], rel=1e-12)
+    assert {x["material"] for x in rows if x["parameter"] == "residual_rms"} == {"metal", "wood"}
+    md = cli("calibrate", "fit", *args, "--format", "md")
+    assert md.exit_code == 0 and md.stdout.startswith("| parameter | material |")
+    bad = cli("calibrate", "fit", *args, "--format", "xml")
+    assert bad.exit_code == 2 and "unknown format 'xml'" in bad.output
+    # with --model: the selected model's parameters, e_s first
+    m = cli("calibrate", "fit", *args[:-2], "--model", "semi-infinite", "--format", "csv")
+    assert m.exit_code == 0, m.output
+    mrows = list(csv.DictReader(io.StringIO(m.stdout)))
+    assert mrows[0]["parameter"] == "e_s" and float(mrows[0]["low_95"]) <= float(mrows[0]["value"])
+
+
 @pytest.mark.parametrize("args, message", [
     ([], "no effusivity range for metal"),
     (["--range", "metal=1:2", "--range", "wood=3"], "wood=3"),

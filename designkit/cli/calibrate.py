@@ -447,10 +447,33 @@ def _write_identified(best, trials, out: Path, name: Optional[str], index: Path,
     return problems
 
 
+#: The columns of ``calibrate fit --format csv|md``: one row per identified quantity.
+PARAMETER_COLUMNS = ("parameter", "material", "value", "std_error", "low_95", "high_95", "unit")
+
+
+def _fit_rows(result) -> list[dict[str, Any]]:
+    """The semi-infinite fit's quantities as rows (:data:`PARAMETER_COLUMNS`)."""
+    def row(name, p, unit, material=None):
+        lo, hi = p.ci95
+        return {"parameter": name, "material": material, "value": p.value, "std_error": p.std_error,
+                "low_95": lo if math.isfinite(lo) else None, "high_95": hi if math.isfinite(hi) else None,
+                "unit": unit}
+    rows = [row("e_s", result.effusivity, "J s^-1/2 K^-1 m^-2"), row("alpha_s", result.diffusivity_m2_s, "m^2/s"),
+            row("tau", result.tau_s, "s"), row("time_offset", result.time_offset_s, "s")]
+    for mf in result.materials:
+        if mf.effusivity is not None:
+            rows.append(row("e_o", mf.effusivity, "J s^-1/2 K^-1 m^-2", mf.name))
+        if mf.ratio is not None:
+            rows.append(row("e_o/e_s", mf.ratio, "1", mf.name))
+        rows.append({"parameter": "residual_rms", "material": mf.name, "value": mf.rms_c, "std_error": None,
+                     "low_95": None, "high_95": None, "unit": "degC"})
+    return rows
+
+
 def _run_identify(index: Path, model: str, fit_sets: str, ranges: list[str], only: Optional[list[str]],
                   object_temps: list[str], depth_um: float, out: Optional[Path], json_: bool,
                   touch_conductance: Optional[str] = None, name: Optional[str] = None,
-                  force: bool = False) -> None:
+                  force: bool = False, rows_fmt: Optional[str] = None) -> None:
     """``calibrate fit --model``: identify one model or compare them all on held-out touches."""
     from rich.markup import escape
     from rich.table import Table
@@ -489,12 +512,24 @@ def _run_identify(index: Path, model: str, fit_sets: str, ranges: list[str], onl
         fit, held = split_by_trial_set(trials, _parse_sets(fit_sets), index)
     else:
         fit, held = trials, []
-    with _app.busy(f"identifying {len(cands)} model(s) on {len(fit)} touches", quiet=json_):
+    with _app.busy(f"identifying {len(cands)} model(s) on {len(fit)} touches", quiet=json_ or rows_fmt is not None):
         cmp = compare_models(fit, held, cands, **kw)   # no held-out touches: selected by BIC
     results, scores, selected = cmp.results, cmp.held_out_rms_c, cmp.selected
     best = next(r for r in results if r.candidate.label == selected)
     if out is not None:
         _write_identified(best, trials, out, name, index, force, names)
+    if rows_fmt is not None:  # the selected model's parameters (the comparison stays in the report and --json)
+        from ._format import emit_rows
+
+        es = best.effusivity
+        head = [] if es is None or not best.consistent else [
+            {"parameter": "e_s", "material": None, "value": es.value, "std_error": None, "low_95": es.ci95[0],
+             "high_95": es.ci95[1], "unit": "J s^-1/2 K^-1 m^-2"}]
+        emit_rows(head + [{"parameter": q.name, "material": None, "value": q.value, "std_error": None,
+                           "low_95": q.ci95[0], "high_95": q.ci95[1], "unit": q.unit} for q in best.parameters],
+                  PARAMETER_COLUMNS, fmt=rows_fmt,
+                  notes=[f"model {selected}, fitted on {len(fit)} touches, {len(held)} held out"])
+        return
     if json_:
         emit_json({"index": str(index), "n_fit": len(fit), "n_held_out": len(held), "selected": selected,
                    "out": str(out) if out is not None else None,
@@ -608,21 +643,34 @@ def fit(
         "--touch-conductance", help="With --model: give each touch of these materials (comma-separated) its own "
                                     "contact conductance, e.g. metal (contact area differs between touches); "
                                     "only models that fit h_c.")] = None,
+    format_: Annotated[str, typer.Option(
+        "--format", "-f", help="table (the report, default), json (as --json), or csv / md: the identified "
+                               "sensor's parameters as rows (parameter, material, value, std_error, low_95, "
+                               "high_95, unit), pandas-ready.")] = "table",
     json_: Json = False,
 ) -> None:
     """Identify e_s and alpha_s (and each e_o, the time offset) from recorded touches (paper appendix).
 
     Example: `designkit calibrate fit trials/index.csv --range wood=331:506 --out my-sensor.yaml`
+
+    Example (the parameters as CSV): `designkit calibrate fit trials/index.csv --model all --format csv`
     """
+    from ._format import check_format, emit_rows
+
+    fmt = "json" if json_ else check_format(format_)
+    rows_only = fmt in ("csv", "md")
     settings = _fit_settings(depth_um, bootstrap, seed, baseline, offset_range, fit_to)
     only_list = [s.strip() for item in only for s in item.split(",") if s.strip()] if only else None
     if model is not None:
-        _run_identify(index, model, fit_sets, range_ or [], only_list, object_temp or [], depth_um, out, json_,
-                      touch_conductance, name=name, force=force)
+        _run_identify(index, model, fit_sets, range_ or [], only_list, object_temp or [], depth_um, out,
+                      fmt == "json", touch_conductance, name=name, force=force, rows_fmt=fmt if rows_only else None)
         return
-    result = _run_fit(index, range_ or [], only_list, object_temp or [], settings, out, name, plot, quiet=json_,
-                      force=force)
-    if json_:
+    result = _run_fit(index, range_ or [], only_list, object_temp or [], settings, out, name, plot,
+                      quiet=fmt != "table", force=force)
+    if rows_only:
+        emit_rows(_fit_rows(result), PARAMETER_COLUMNS, fmt=fmt)
+        return
+    if fmt == "json":
         payload = result.to_dict()
         payload.update({"out": str(out) if out else None, "plot": str(plot) if plot else None, "index": str(index)})
         emit_json(payload)

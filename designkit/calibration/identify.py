@@ -63,6 +63,7 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from .._validation import InputError
+from ..models.ramp import area_share
 from .trials import Trial
 
 __all__ = [
@@ -338,24 +339,9 @@ def relative_force(trial: Trial) -> np.ndarray:
     return f / plateau
 
 
-def contact_area(force_rel, fraction: float = 0.0) -> np.ndarray:
-    """Share of the final contact area in contact: ``clip((F / F_p - c) / (1 - c), 0, 1)``.
-
-    Parameters
-    ----------
-    force_rel : array_like
-        Force divided by its plateau (:func:`relative_force`).
-    fraction : float
-        ``c``, the force share at which the area starts to grow, in [0, 1).
-
-    Examples
-    --------
-    >>> contact_area([0.1, 0.3, 0.65, 1.0, 1.2], 0.3).round(3).tolist()
-    [0.0, 0.0, 0.5, 1.0, 1.0]
-    """
-    from ..models.ramp import area_share
-
-    return area_share(force_rel, fraction)
+#: Share of the final contact area in contact, ``clip((F / F_p - c) / (1 - c), 0, 1)``: the forward model's
+#: rule (:func:`designkit.models.ramp.area_share`), the one the identification fits ``c`` of.
+contact_area = area_share
 
 
 def _prepare(trials: Sequence[Trial], names: Sequence[str], object_temps: Mapping[str, Any],

@@ -25,7 +25,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Any, Mapping
 
-__all__ = ["ANSWER_KEYS", "INTERVAL_MEANING", "QUANTITIES", "Answer", "IdealBound", "number"]
+__all__ = ["ANSWER_KEYS", "INTERVAL_MEANING", "QUANTITIES", "Answer", "IdealBound", "QuestionQuantity", "number"]
 
 #: question -> (quantity name of ``value``, its unit).
 QUANTITIES: dict[str, tuple[str, str]] = {
@@ -35,6 +35,23 @@ QUANTITIES: dict[str, tuple[str, str]] = {
     "delta-e": ("delta_e", "J s^-1/2 K^-1 m^-2"),
     "distinguishable": ("distinguishable", ""),
 }
+
+class QuestionQuantity:
+    """``quantity`` and ``unit`` of a result of one question (its ``question`` attribute, :data:`QUANTITIES`):
+    shared by :class:`Answer`, the array route's answers and the material matrix."""
+
+    __slots__ = ()
+
+    @property
+    def quantity(self) -> str:
+        """Name of the quantity ``value`` is in (``contact_s``, ``noise_c`` ...)."""
+        return QUANTITIES[self.question][0]
+
+    @property
+    def unit(self) -> str:
+        """Its unit."""
+        return QUANTITIES[self.question][1]
+
 
 #: What ``interval`` means, per kind (``interval.method`` in the ``--json`` schema).
 INTERVAL_MEANING = {
@@ -107,7 +124,7 @@ class IdealBound:
 
 
 @dataclass(frozen=True)
-class Answer:
+class Answer(QuestionQuantity):
     """One answer to a design question.
 
     Attributes
@@ -179,15 +196,6 @@ class Answer:
     interval_kind: str | None = None
 
     # ------------------------------------------------------------ schema
-    @property
-    def quantity(self) -> str:
-        """Name of the quantity ``value`` is in (``contact_s``, ``noise_c`` ...)."""
-        return QUANTITIES[self.question][0]
-
-    @property
-    def unit(self) -> str:
-        return QUANTITIES[self.question][1]
-
     @property
     def ideal(self) -> float | None:
         """The ideal observer's value (``ideal_bound.value``)."""

@@ -50,7 +50,7 @@ import numpy as np
 
 from .._validation import InputError
 from ..materials import Material, get_material, list_materials
-from .answer import QUANTITIES, Answer, number
+from .answer import QUANTITIES, Answer, QuestionQuantity, number
 from .questions import QUESTIONS, ask
 
 __all__ = [
@@ -178,7 +178,7 @@ class MulticlassCurve:
 
 
 @dataclass(frozen=True)
-class MaterialMatrix:
+class MaterialMatrix(QuestionQuantity):
     """The pairwise matrix of one question over N materials, its limiting pair and the multi-class view.
 
     :meth:`to_dict` is the ``designkit matrix --format json`` output.
@@ -220,14 +220,6 @@ class MaterialMatrix:
     def names(self) -> tuple[str, ...]:
         """Display names of the materials."""
         return tuple(m.name for m in self.materials)
-
-    @property
-    def quantity(self) -> str:
-        return QUANTITIES[self.question][0]
-
-    @property
-    def unit(self) -> str:
-        return QUANTITIES[self.question][1]
 
     def values(self, ideal: bool = False) -> np.ndarray:
         """The symmetric N x N matrix of values (float; NaN: no answer or the diagonal; bools as 0/1).

@@ -370,6 +370,25 @@ def contact_estimate(x0, x1, n0, n1, gap, raw, mc_lo, mc_hi, ideal, *, width: fl
     return {"value": value, "low": low, "high": high, "interp": interp, "rounding": rounding}
 
 
+def _efficiency(svm, ideal, width: float) -> np.ndarray:
+    """``(svm need - w/2) / (ideal need - w/2)`` (both tabulated deltas are rounded up to the grid's width
+    ``w``: on average w/2); NaN unless both needs exceed w/2."""
+    h = 0.5 * width
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where((svm > h) & (ideal > h), (svm - h) / (ideal - h), np.nan)
+
+
+def _table_se_log(svm, ideal, mc_lo, mc_hi, *, width: float, z_table: float) -> tuple[np.ndarray, np.ndarray]:
+    """Standard errors in log of an efficiency read from the table: the rounding of its two needs (SD
+    ``w/sqrt(12)`` each) and the table's Monte Carlo interval of the SVM need (``mc_lo``/``mc_hi``, each
+    ``z_table`` standard errors from the value; 0 where an end is missing)."""
+    h, sd = 0.5 * width, width / math.sqrt(12.0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        rounding = np.hypot(sd / (svm - h), sd / (ideal - h))
+        mc = np.abs(np.log((mc_hi - h) / (mc_lo - h))) / (2.0 * z_table)
+    return rounding, np.where(np.isfinite(mc), mc, 0.0)
+
+
 def efficiency_estimate(sensor, lo, hi, ratio, t_a, t_b, svm_a, svm_b, ideal_a, ideal_b, mc_lo, mc_hi, ideal, *,
                         width: float, threshold: float, z_table: float, zc: float,
                         entry_sd: float = 0.0) -> dict[str, np.ndarray]:
@@ -432,16 +451,11 @@ def efficiency_estimate(sensor, lo, hi, ratio, t_a, t_b, svm_a, svm_b, ideal_a, 
         lo, hi, ratio, t_a, t_b, svm_a, svm_b, ideal_a, ideal_b, mc_lo, mc_hi, ideal)))
     lo, hi, ratio, t_a, t_b, svm_a, svm_b, ideal_a, ideal_b, mc_lo, mc_hi, ideal = arrs
     h = 0.5 * width
+    eff_a, eff_b = _efficiency(svm_a, ideal_a, width), _efficiency(svm_b, ideal_b, width)
+    rounding, mc = _table_se_log(svm_b, ideal_b, mc_lo, mc_hi, width=width, z_table=z_table)
     with np.errstate(invalid="ignore", divide="ignore"):
-        eff_b = (svm_b - h) / (ideal_b - h)
-        eff_a = (svm_a - h) / (ideal_a - h)
-        eff_a = np.where((svm_a > h) & (ideal_a > h) & (eff_a > 0), eff_a, np.nan)
         beta = np.abs(np.log((ideal_a - h) / (ideal_b - h)) / np.log(t_a / t_b))
-        ok = (svm_b > h) & (ideal_b > h) & (eff_b > 0) & np.isfinite(beta) & (beta > 0)
-        sd = width / math.sqrt(12.0)
-        rounding = np.hypot(sd / (svm_b - h), sd / (ideal_b - h))
-        mc = np.abs(np.log((mc_hi - h) / (mc_lo - h))) / (2.0 * z_table)
-        mc = np.where(np.isfinite(mc), mc, 0.0)
+        ok = ~np.isnan(eff_b) & np.isfinite(beta) & (beta > 0)
         interp = np.where(np.isnan(eff_a), 0.0, 0.5 * np.abs(np.log(eff_b / eff_a)))
         trend = np.where(np.isnan(eff_a), 0.0, np.abs(np.log(eff_b / eff_a) / np.log(t_b / t_a)))
     value = np.full(lo.shape, np.nan)
@@ -569,23 +583,18 @@ def delta_efficiency_estimate(sensor, e, contact_s, ratio, direction, t_a, t_b, 
     arrs = np.broadcast_arrays(*(np.asarray(a, dtype=np.float64) for a in (
         e, contact_s, ratio, direction, t_a, t_b, svm_a, svm_b, ideal_a, ideal_b, mc_lo, mc_hi, entry_sd)))
     e, contact, ratio, direction, t_a, t_b, svm_a, svm_b, ideal_a, ideal_b, mc_lo, mc_hi, entry_sd = arrs
-    h = 0.5 * width
+    eff_a, eff_b = _efficiency(svm_a, ideal_a, width), _efficiency(svm_b, ideal_b, width)
+    near_svm, near_ideal = np.where(np.isnan(eff_b), svm_a, svm_b), np.where(np.isnan(eff_b), ideal_a, ideal_b)
+    rounding, mc = _table_se_log(near_svm, near_ideal, mc_lo, mc_hi, width=width, z_table=z_table)
     with np.errstate(invalid="ignore", divide="ignore"):
-        eff_a = np.where((svm_a > h) & (ideal_a > h), (svm_a - h) / (ideal_a - h), np.nan)
-        eff_b = np.where((svm_b > h) & (ideal_b > h), (svm_b - h) / (ideal_b - h), np.nan)
         both = ~np.isnan(eff_a) & ~np.isnan(eff_b) & (t_a != t_b)
         w = np.where(both, np.log(contact / t_a) / np.log(t_b / t_a), 0.0)
         log_eff = np.where(both, (1.0 - w) * np.log(eff_a) + w * np.log(eff_b),
                            np.where(np.isnan(eff_a), np.log(eff_b), np.log(eff_a)))
         eff = np.maximum(np.exp(log_eff), 1.0)  # no classifier beats the ideal observer
-        sd = width / math.sqrt(12.0)
-        near_svm, near_ideal = np.where(np.isnan(eff_b), svm_a, svm_b), np.where(np.isnan(eff_b), ideal_a, ideal_b)
-        rounding = np.hypot(sd / (near_svm - h), sd / (near_ideal - h))
         # linear interpolation's error vanishes at the grid points and peaks mid-cell (shape w (1 - w));
         # at mid-cell it is taken as half the change across the cell, as min-contact's
         interp = np.where(both, 2.0 * w * (1.0 - w) * np.abs(np.log(eff_b / eff_a)), 0.0)
-        mc = np.abs(np.log((mc_hi - h) / (mc_lo - h))) / (2.0 * z_table)
-        mc = np.where(np.isfinite(mc), mc, 0.0)
         # two tabulated entries' scatter, weighted (1 - w) and w, averages down
         entry = entry_sd * np.where(both, np.sqrt((1.0 - w) ** 2 + w ** 2), 1.0)
         se = np.hypot(np.maximum(mc, entry), np.hypot(rounding, interp))

@@ -52,7 +52,7 @@ from numpy.typing import NDArray
 
 from .._validation import InputError, check_effusivity, check_positive, check_temperature
 from . import table as _table_route
-from .answer import QUANTITIES, Answer
+from .answer import Answer, QuestionQuantity
 from .crossing import check_coverage, z_of_coverage
 
 __all__ = ["ARRAY_INPUTS", "ArrayAnswer", "answer_arrays", "is_array_call"]
@@ -71,7 +71,7 @@ FloatArray = NDArray[np.float64]
 
 
 @dataclass(frozen=True)
-class ArrayAnswer:
+class ArrayAnswer(QuestionQuantity):
     """Answers to one design question over arrays of inputs (all arrays share :attr:`shape`).
 
     Attributes
@@ -110,14 +110,6 @@ class ArrayAnswer:
     in_grid: NDArray[np.bool_]
     table: str | None = None
     details: Mapping[str, FloatArray] = field(default_factory=dict)
-
-    @property
-    def quantity(self) -> str:
-        return QUANTITIES[self.question][0]
-
-    @property
-    def unit(self) -> str:
-        return QUANTITIES[self.question][1]
 
     @property
     def shape(self) -> tuple[int, ...]:
@@ -323,7 +315,8 @@ def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> None
     todo = np.zeros(lo.size, dtype=bool)
     k_cross = np.full(lo.size, -1)
     n_prev, n_at = _nan(lo.size), _nan(lo.size)  # the svm need at the contact before the crossing, and at it
-    efficiency = svm and op.closed and "delta_up_ideal" in view.t.arrays  # the scalar route's _efficiency_at, per element
+    # the scalar route's _efficiency_at, per element
+    efficiency = svm and op.closed and "delta_up_ideal" in view.t.arrays
     eff_in = {k: _nan(lo.size) for k in ("t_a", "svm_a", "ideal_a", "ideal_b", "mc_lo", "mc_hi", "entry_sd")}
     for (noise, dt), idx in _groups(x["noise_c"], x["delta_t_c"]):
         combos, flags = view.scene_weights(noise, dt)

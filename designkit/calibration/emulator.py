@@ -460,11 +460,6 @@ class Emulator:
         the force leaves zero), and the area is whole at ``ramp_j``; the reading is the area-weighted sum
         of the model's raw step responses (Duhamel), on a 1 ms grid.
         """
-        import dataclasses
-
-        from ..models import get_model
-        from ..models.ramp import ForceRamp
-
         now = np.zeros(rel_s.size)
         end = np.zeros(rel_s.size)
         for jj in np.unique(touch):

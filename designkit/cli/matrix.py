@@ -106,7 +106,7 @@ def matrix(
         console(stderr=True).print(f"figure: {path}", markup=False)
     names = result.names
     rows = []
-    vals, ideal, status = result.values(), result.values(ideal=True), result.status()
+    vals, status = result.values(), result.status()
     bounds = {}
     for c in result.cells:
         bounds[c.i, c.j] = bounds[c.j, c.i] = c.bound

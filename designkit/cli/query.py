@@ -17,7 +17,7 @@ from typing import Annotated, Optional
 import typer
 
 from . import _app
-from ._app import app, console, emit_json
+from ._app import app, emit_json
 from ._format import OutOpt, check_format, emit_rows
 from ._options import (
     E1,

@@ -38,7 +38,6 @@ JSON (no NaN). Anything else is refused in one line.
 from __future__ import annotations
 
 import json
-import math
 from dataclasses import dataclass
 from typing import Any, Sequence
 

@@ -255,6 +255,16 @@ def _ok(sensor, lo, hi, width, s, threshold) -> np.ndarray:
     return ideal_f1(lo, hi, width, sensor.effusivity, s, stop_at=threshold) >= threshold
 
 
+def _first_good_sample(ok, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Bisection on the sample count, elementwise: the first ``n`` in ``(a, b]`` where ``ok(n)`` holds, for a
+    decision false at ``a`` and true from some ``n`` on (``b`` where it never turns true below ``b``)."""
+    while np.any(b - a > 1):
+        mid = (a + b) // 2
+        good = ok(mid)
+        b, a = np.where(good, mid, b), np.where(good, a, mid)
+    return b
+
+
 def exact_ideal_min_contact(sensor, lo, hi, ratio, *, width: float = 80.0, threshold: float = 0.9,
                             max_contact_s: float = 10.0) -> np.ndarray:
     """Ideal observer's shortest contact [s] for classes ``[lo, lo+w)``, ``[hi, hi+w)``, vectorized.
@@ -297,11 +307,7 @@ def exact_ideal_min_contact(sensor, lo, hi, ratio, *, width: float = 80.0, thres
     a = np.zeros(lo.shape, dtype=np.int64)  # n = 0: one sample at contact, no information
     b = np.full(lo.shape, n_max, dtype=np.int64)
     top = ok(b)
-    while np.any(b - a > 1):
-        mid = (a + b) // 2
-        good = ok(mid)
-        b, a = np.where(good, mid, b), np.where(good, a, mid)
-    return np.where(top, b / fs, np.nan)
+    return np.where(top, _first_good_sample(ok, a, b) / fs, np.nan)
 
 
 def efficiency_min_contact(sensor, lo, hi, ratio, t0, t1, eff0, eff1, upper_s, *, width: float = 80.0,
@@ -371,11 +377,7 @@ def efficiency_min_contact(sensor, lo, hi, ratio, t0, t1, eff0, eff1, upper_s, *
                    np.concatenate([s, s]), threshold)
         return both[:lo.size] & both[lo.size:] & (g > 0)
 
-    while np.any(b - a > 1):
-        mid = (a + b) // 2
-        good = ok(mid)
-        b, a = np.where(good, mid, b), np.where(good, a, mid)
-    return (b / fs).reshape(shape)
+    return (_first_good_sample(ok, a, b) / fs).reshape(shape)
 
 
 def cached_efficiency_min_contact(sensor, lo, hi, ratio, t0, t1, eff0, eff1, upper_s, *,

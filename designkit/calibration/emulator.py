@@ -442,8 +442,7 @@ class Emulator:
     def _model_reading(self, rel_s: np.ndarray, e_o: np.ndarray, contact_s: float):
         """Normalized reading of :attr:`model` at times ``rel_s`` after heat starts, and at release."""
         m = self.model
-        fn = m.conduction if hasattr(m, "conduction") else (
-            lambda t, e, sensor: m.response(t, e, sensor))   # conduction: the raw reading, before host smoothing
+        fn = m.conduction  # the raw reading, before the host's smoothing
         now = np.zeros(rel_s.size)
         end = np.zeros(rel_s.size)
         for e in np.unique(e_o):

@@ -435,7 +435,7 @@ def _prepare(trials: Sequence[Trial], names: Sequence[str], object_temps: Mappin
 def _reading(model, t: np.ndarray, e_object: float, sensor, interp_points: int | None) -> np.ndarray:
     """The model's unsmoothed normalized reading at times ``t > 0``.
 
-    Models solved numerically (with a ``conduction`` method) are evaluated at
+    Models solved numerically (``solved_numerically``) are evaluated at
     ``interp_points`` log-spaced times and interpolated by a cubic spline in
     ``log t`` (error below 1e-6 of the temperature difference for smooth
     readings, tested), which makes a residual evaluation about 6x faster.
@@ -443,8 +443,8 @@ def _reading(model, t: np.ndarray, e_object: float, sensor, interp_points: int |
     1e-8 of the temperature difference against 32 nodes over the fitted
     parameter range, docs/sensor-models.md; the noise is about 1e-3 of it).
     """
-    if not hasattr(model, "conduction"):
-        return model.response(t, [e_object], sensor)[0]
+    if not model.solved_numerically:
+        return model.conduction(t, [e_object], sensor)[0]
     if not interp_points or t.size <= 2 * interp_points:
         return model.conduction(t, [e_object], sensor, nodes=FIT_TALBOT_NODES)[0]
     from scipy.interpolate import CubicSpline
@@ -942,8 +942,7 @@ class Identification:
             m = model if f is None else dataclasses.replace(model, conductance_w_m2k=model.conductance_w_m2k * f)
 
             def step(tp, m=m):
-                return (m.conduction(tp, [eo], sensor)[0] if hasattr(m, "conduction")
-                        else m.response(tp, [eo], sensor)[0])
+                return m.conduction(tp, [eo], sensor)[0]
 
             if area is not None:
                 out[i] = _area_weighted(step, grid, area[None, :], off)[0]

@@ -89,6 +89,9 @@ class ForwardModel:
     shared_shape: ClassVar[bool] = False
     object_properties: ClassVar[tuple[str, ...]] = ("effusivity",)
     units: ClassVar[dict[str, str]] = {}
+    #: Solved numerically (an inverse Laplace transform, say): a caller evaluating it at many times may
+    #: interpolate it between fewer (the identification does).
+    solved_numerically: ClassVar[bool] = False
 
     # ------------------------------------------------------------ the physics
     def response(self, time_s, e_object, sensor, *, diffusivity_m2_s=None, tolerance: float = 1e-9) -> np.ndarray:
@@ -114,6 +117,12 @@ class ForwardModel:
             w = np.atleast_1d(self.weight(e_object, sensor))
             return w[:, None] * self.shape(t, sensor)[None, :]
         raise NotImplementedError(f"model {self.name!r} defines no response")
+
+    def conduction(self, time_s, e_object, sensor, *, nodes: int | None = None) -> np.ndarray:
+        """The reading before any smoothing by the measurement chain, shape ``(K, m)``: what an emulated
+        rig streams raw and what a calibration fit smooths itself. This default is :meth:`response` (a
+        model without a smoothing stage); ``nodes`` is for numerically inverted models (ignored here)."""
+        return self.response(time_s, e_object, sensor)
 
     def shape(self, time_s, sensor) -> np.ndarray:
         """Shared shape ``g(t)`` (shared-shape models only)."""

@@ -314,6 +314,7 @@ class Layered(ForwardModel):
 
     name = "layered"
     shared_shape = False
+    solved_numerically = True
     units = {"film_thickness_m": "m", "backing_effusivity_ws05_m2k": "J s^-1/2 K^-1 m^-2",
              "backing_diffusivity_m2_s": "m^2 s^-1", "conductance_w_m2k": "W m^-2 K^-1", "lag_s": "s", "backing_thickness_m": "m",
              "smoothing_window": "samples", "smoothing_order": ""}

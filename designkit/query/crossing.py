@@ -101,6 +101,11 @@ class CrossingEstimate:
     method: str
     evaluations: list = field(default_factory=list)
 
+    @property
+    def stated(self) -> bool:
+        """Whether ``(low, high)`` has the stated coverage (the fit); a bracket has none."""
+        return self.method == "wls-logit-log"
+
 
 def _logit(m):
     """The fitted scale: logit of F1 rescaled from (0.5, 1) to (0, 1), where the curve is near-linear in log x."""

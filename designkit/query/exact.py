@@ -370,8 +370,8 @@ def exact_min_contact(e1=None, e2=None, *, m1=None, m2=None, objects=None, noise
                       limiting=pq.limiting_dicts(), rule=pq.rule, scene=scene_d, details={}, check_classes=cls,
                       check_at=(needed, noise, dt), notes=[note], evaluations=evaluations, max_contact_s=tmax,
                       estimate_method=est.method,
-                      interval_coverage=cov if est.method == "wls-logit-log" else None,
-                      interval_kind="exact-estimate" if est.method == "wls-logit-log" else "exact")
+                      interval_coverage=cov if est.stated else None,
+                      interval_kind="exact-estimate" if est.stated else "exact")
 
 
 # ============================================================ max-noise / min-delta-t
@@ -446,8 +446,8 @@ def _exact_ratio(question: str, kw: dict) -> Answer:
                       limiting=pq.limiting_dicts(), rule=pq.rule, scene=scene_d, details={}, check_classes=cls,
                       check_at=check_at, notes=[note], evaluations=evaluations, estimate_method=est.method,
                       noise_ratio_estimate={"value": r, "low": r_lo, "high": r_hi},
-                      interval_coverage=cov if est.method == "wls-logit-log" else None,
-                      interval_kind="exact-estimate" if est.method == "wls-logit-log" else "exact")
+                      interval_coverage=cov if est.stated else None,
+                      interval_kind="exact-estimate" if est.stated else "exact")
 
 
 def exact_max_noise(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact_s: float, delta_t_c: float = 10.0,
@@ -599,9 +599,8 @@ def exact_delta_e(e: float | None = None, *, m: str | None = None, contact_s: fl
         val, lo_d, hi_d = est.value, est.low, est.high
         if ideal is not None and val is not None:
             val, lo_d = max(val, ideal), (None if lo_d is None else max(lo_d, ideal))
-        stated = est.method == "wls-logit-log"
         sides[side] = {"value": val, "interval": [lo_d, hi_d], "ideal": ideal,
-                       "coverage": cov if stated else None, "estimate_method": est.method,
+                       "coverage": cov if est.stated else None, "estimate_method": est.method,
                        "evaluations": [{"delta_e": e["x"], "svm_f1": e["svm_f1"],
                                         "standard_error": e["standard_error"]} for e in est.evaluations]}
         found = [v for v in (val, ideal) if v is not None]

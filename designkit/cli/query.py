@@ -128,24 +128,34 @@ def _ask(question: str, *, exact: bool, table: Optional[str], ideal_table: str, 
                              sensor=None if sensor == "paper" else sen, model=fm, coverage=extra["coverage"])
         kw = dict(threshold=threshold, sensor=sen, model=fm, diffusivity_m2_s=diffusivity, width=width,
                   trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc, **extra)
-        if question not in _STEPWISE:  # no step-by-step progress from this question's exact route: a spinner
-            with _app.busy(f"{question}: simulating touches and fitting SVMs (exact route)", quiet=not progress):
-                return _noted(query.ask(question, route="exact", **objects, **scene, **kw), reroute, sen, fm,
-                              source)
-        if not progress:
+        with _exact_display(question, progress) as report:
+            if report is not None:
+                kw["progress"] = report
             return _noted(query.ask(question, route="exact", **objects, **scene, **kw), reroute, sen, fm, source)
-        from rich.console import Console
-        from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
-        with Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.completed}/{task.total}"),
-                      TimeElapsedColumn(), console=Console(stderr=True), transient=True) as bar:
-            task = bar.add_task("SVM evaluations", total=None)
 
-            def report(done, total, message):
-                bar.update(task, completed=done, total=total, description=f"SVM evaluations ({message})")
+@contextmanager
+def _exact_display(question: str, progress: bool):
+    """What the exact route shows while it runs: a bar of SVM evaluations for a question that reports its
+    steps (yields the callback to pass as ``progress``), a spinner for one that does not, nothing when quiet."""
+    if not progress:
+        yield None
+        return
+    if question not in _STEPWISE:  # no step-by-step progress from this question's exact route: a spinner
+        with _app.busy(f"{question}: simulating touches and fitting SVMs (exact route)"):
+            yield None
+        return
+    from rich.console import Console
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
-            return _noted(query.ask(question, route="exact", **objects, **scene, progress=report, **kw), reroute,
-                          sen, fm, source)
+    with Progress(TextColumn("{task.description}"), BarColumn(), TextColumn("{task.completed}/{task.total}"),
+                  TimeElapsedColumn(), console=Console(stderr=True), transient=True) as bar:
+        task = bar.add_task("SVM evaluations", total=None)
+
+        def report(done, total, message):
+            bar.update(task, completed=done, total=total, description=f"SVM evaluations ({message})")
+
+        yield report
 
 
 def _noted(ans, reroute: Optional[str], sen, fm, source: str):

@@ -251,17 +251,66 @@ def ideal_f1(lo, hi, width, e_sensor: float, s, *, points: int = 17, passes: int
     return out.reshape(shape)
 
 
+def _gaussian_sample_guess(sensor, lo, hi, width, ratio, threshold, cum: np.ndarray) -> np.ndarray:
+    """A guess of the first sample count where the ideal observer separates ``[lo, lo+w)`` from ``[hi, hi+w)``.
+
+    Each class's weight ``w(e)`` is taken as Gaussian with its uniform spread (variance ``(w(b) - w(a))^2 / 12``)
+    added to the projection noise; for two equal Gaussians the best F1 is about ``Phi(d/2)`` with
+    ``d = (w_hi - w_lo) / s_total``, so the largest projection noise that still reaches ``threshold`` is
+    ``s* = sqrt((dw / (2 z))^2 - spread^2)`` with ``z = Phi^-1(threshold)``, and the count is the first
+    ``n`` with ``ratio / sqrt(cum[n]) <= s*``. Only a starting bracket for the exact bisection (which
+    decides every answer): NaN where the approximation says no noise is small enough.
+    """
+    cdf, _ = _phi_table()
+    z = float(np.interp(threshold, cdf, np.arange(-_PHI_Z, _PHI_Z + _PHI_H / 2, _PHI_H)))
+    e_s = sensor.effusivity
+    wl = _weight(e_s, np.stack([lo, lo + width]))
+    wh = _weight(e_s, np.stack([hi, hi + width]))
+    spread2 = ((wl[1] - wl[0]) ** 2 + (wh[1] - wh[0]) ** 2) / 24.0
+    dw = np.abs(0.5 * (wh[0] + wh[1] - wl[0] - wl[1]))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        s2 = (dw / (2.0 * z)) ** 2 - spread2
+        need = np.where(s2 > 0, ratio * ratio / s2, np.nan)
+    n = np.searchsorted(cum, np.nan_to_num(need, nan=np.inf)).astype(np.float64)
+    return np.where(np.isfinite(need) & (n < cum.size), n, np.nan)
+
+
 def _ok(sensor, lo, hi, width, s, threshold) -> np.ndarray:
     return ideal_f1(lo, hi, width, sensor.effusivity, s, stop_at=threshold) >= threshold
 
 
-def _first_good_sample(ok, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Bisection on the sample count, elementwise: the first ``n`` in ``(a, b]`` where ``ok(n)`` holds, for a
-    decision false at ``a`` and true from some ``n`` on (``b`` where it never turns true below ``b``)."""
-    while np.any(b - a > 1):
-        mid = (a + b) // 2
-        good = ok(mid)
-        b, a = np.where(good, mid, b), np.where(good, a, mid)
+#: Half-width of the bracket put around a guessed sample count, relative to the guess: the Gaussian
+#: guess was within 1.9 % of the exact count on 2,748 random pairs and scenes (all it answered).
+_GUESS_SPAN = 0.025
+
+
+def _first_good_sample(ok, a: np.ndarray, b: np.ndarray, guess: np.ndarray | None = None) -> np.ndarray:
+    """Bisection on the sample count, elementwise: the first ``n`` in ``(a, b]`` where ``ok(n, rows)`` holds,
+    for a decision false at ``a`` and true from some ``n`` on (``b`` where it never turns true below ``b``).
+
+    ``ok(n, rows)`` decides the elements ``rows`` (an index array) at counts ``n`` shaped ``(len(rows),)``
+    or ``(2, len(rows))`` (two counts per element); each step decides only the elements still bracketed
+    wider than one sample. With a ``guess`` (a float sample count per element, NaN: none), the counts
+    ``guess * (1 -+ 2.5 %)`` are decided first in one call and the bisection goes on in whichever of the
+    three pieces of ``(a, b]`` holds the switch: the same answer (the decision is monotone in ``n``) in
+    about half the calls where the guess is good, one call more where it is not.
+    """
+    a, b = a.copy(), b.copy()
+    if guess is not None:
+        rows = np.nonzero(np.isfinite(guess) & (b - a > 1))[0]
+        if rows.size:
+            g, ar, br = guess[rows], a[rows], b[rows]
+            lo = np.clip(np.floor(g * (1.0 - _GUESS_SPAN)), ar, br).astype(np.int64)
+            hi = np.clip(np.maximum(np.ceil(g * (1.0 + _GUESS_SPAN)), lo + 1), ar, br).astype(np.int64)
+            ok_lo, ok_hi = ok(np.stack([lo, hi]), rows)
+            ok_lo &= lo > ar  # n = a is false by the contract (a guess clipped onto it decides nothing)
+            a[rows] = np.where(ok_lo, ar, np.where(ok_hi, lo, hi))
+            b[rows] = np.where(ok_lo, lo, np.where(ok_hi, hi, br))
+    while (rows := np.nonzero(b - a > 1)[0]).size:
+        mid = (a[rows] + b[rows]) // 2
+        good = ok(mid, rows)
+        b[rows] = np.where(good, mid, b[rows])
+        a[rows] = np.where(good, a[rows], mid)
     return b
 
 
@@ -299,15 +348,19 @@ def exact_ideal_min_contact(sensor, lo, hi, ratio, *, width: float = 80.0, thres
     n_max = int(last_sample_index(max_contact_s, fs))
     cum = _cumulative_g2(float(sensor.tau_s), fs, max(n_max, 1))
 
-    def ok(n):
+    shape = lo.shape
+    lo, hi, ratio = lo.ravel(), hi.ravel(), ratio.ravel()
+
+    def ok(n, rows):
         with np.errstate(divide="ignore"):
-            s = ratio / np.sqrt(cum[n])
-        return _ok(sensor, lo, hi, width, s, threshold)
+            s = ratio[rows] / np.sqrt(cum[n])
+        return _ok(sensor, lo[rows], hi[rows], width, s, threshold)
 
     a = np.zeros(lo.shape, dtype=np.int64)  # n = 0: one sample at contact, no information
     b = np.full(lo.shape, n_max, dtype=np.int64)
-    top = ok(b)
-    return np.where(top, _first_good_sample(ok, a, b) / fs, np.nan)
+    top = ok(b, np.arange(lo.size))
+    guess = _gaussian_sample_guess(sensor, lo, hi, width, ratio, threshold, cum)
+    return np.where(top, _first_good_sample(ok, a, b, guess) / fs, np.nan).reshape(shape)
 
 
 def efficiency_min_contact(sensor, lo, hi, ratio, t0, t1, eff0, eff1, upper_s, *, width: float = 80.0,
@@ -367,17 +420,35 @@ def efficiency_min_contact(sensor, lo, hi, ratio, t0, t1, eff0, eff1, upper_s, *
 
     t_min, t_max = np.fmin(t0, t1), np.fmax(t0, t1)
 
-    def ok(n):
-        t = np.minimum(np.maximum(n / fs, t_min), t_max)  # constant beyond the two known points
+    def partner(n, rows):  # the separation the classifier needs at sample count n [J s^-1/2 K^-1 m^-2]
+        t = np.minimum(np.maximum(n / fs, t_min[rows]), t_max[rows])  # constant beyond the two known points
         with np.errstate(divide="ignore", invalid="ignore"):
-            g = (hi - lo) / np.maximum(eff1 * np.exp(slope * np.log(t / t1)), 1.0)  # no classifier beats the ideal
-            s = ratio / np.sqrt(cum[n])
-        # both directions in one vectorized call (each element's decision is independent of the others)
-        both = _ok(sensor, np.concatenate([lo, np.maximum(hi - g, 0.0)]), np.concatenate([lo + g, hi]), width,
-                   np.concatenate([s, s]), threshold)
-        return both[:lo.size] & both[lo.size:] & (g > 0)
+            return (hi[rows] - lo[rows]) / np.maximum(eff1[rows] * np.exp(slope[rows] * np.log(t / t1[rows])), 1.0)
 
-    return (_first_good_sample(ok, a, b) / fs).reshape(shape)
+    def ok(n, rows):
+        lo_, hi_ = np.broadcast_to(lo[rows], n.shape), np.broadcast_to(hi[rows], n.shape)
+        g = partner(n, rows)
+        with np.errstate(divide="ignore"):
+            s = ratio[rows] / np.sqrt(cum[n])
+        # both directions in one vectorized call (each element's decision is independent of the others)
+        both = _ok(sensor, np.stack([lo_, np.maximum(hi_ - g, 0.0)]), np.stack([lo_ + g, hi_]), width,
+                   np.stack([s, s]), threshold)
+        return both[0] & both[1] & (g > 0)
+
+    # the starting guess: the Gaussian count for the partner the efficiency asks at the guessed count, a few
+    # fixed-point steps from the efficiency at t1 (the bisection decides; the guess only brackets it). Only
+    # where the efficiency does not grow with time up to ``upper_s``: then the decision is monotone in n, and
+    # the bracket finds
+    # the same first sample as the plain bisection; where it grows, a later sample can fail again (the
+    # partner shrinks faster than the noise), and the plain bisection keeps its answer unchanged.
+    every = np.arange(lo.size)
+    guess = np.full(lo.shape, cum.size - 1.0)
+    for _ in range(3):
+        g = partner(np.nan_to_num(guess, nan=cum.size - 1.0), every)
+        guess = np.fmax(_gaussian_sample_guess(sensor, lo, lo + g, width, ratio, threshold, cum),
+                        _gaussian_sample_guess(sensor, np.maximum(hi - g, 0.0), hi, width, ratio, threshold, cum))
+    guess[(slope > 0) & (b / fs > t_min)] = np.nan  # constant efficiency up to the upper end: monotone too
+    return (_first_good_sample(ok, a, b, guess) / fs).reshape(shape)
 
 
 def cached_efficiency_min_contact(sensor, lo, hi, ratio, t0, t1, eff0, eff1, upper_s, *,

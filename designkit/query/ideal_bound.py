@@ -343,18 +343,18 @@ def exact_ideal_min_contact(sensor, lo, hi, ratio, *, width: float = 80.0, thres
     ndarray
         Contact time [s] (NaN: none up to ``max_contact_s``).
     """
-    lo, hi, ratio = (np.asarray(x, dtype=np.float64) for x in np.broadcast_arrays(lo, hi, ratio))
+    lo, hi, ratio, width = (np.asarray(x, dtype=np.float64) for x in np.broadcast_arrays(lo, hi, ratio, width))
     fs = float(sensor.sample_rate_hz)
     n_max = int(last_sample_index(max_contact_s, fs))
     cum = _cumulative_g2(float(sensor.tau_s), fs, max(n_max, 1))
 
     shape = lo.shape
-    lo, hi, ratio = lo.ravel(), hi.ravel(), ratio.ravel()
+    lo, hi, ratio, width = lo.ravel(), hi.ravel(), ratio.ravel(), width.ravel()
 
     def ok(n, rows):
         with np.errstate(divide="ignore"):
             s = ratio[rows] / np.sqrt(cum[n])
-        return _ok(sensor, lo[rows], hi[rows], width, s, threshold)
+        return _ok(sensor, lo[rows], hi[rows], width[rows], s, threshold)
 
     a = np.zeros(lo.shape, dtype=np.int64)  # n = 0: one sample at contact, no information
     b = np.full(lo.shape, n_max, dtype=np.int64)

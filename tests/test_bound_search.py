@@ -86,3 +86,13 @@ def test_efficiency_min_contact_is_the_first_sample_where_both_partners_separate
 
     assert holds(n) and not holds(n - 1)
     assert t > float(ib.exact_ideal_min_contact(PAPER, lo, hi, ratio))
+
+
+@pytest.mark.parametrize("n", [5, 20, 40, 64])
+def test_the_quadrature_rule_is_numpys_gauss_legendre(n):
+    x, w = np.polynomial.legendre.leggauss(n)
+    gx, gw = ib._gauss_legendre(n)
+    assert np.max(np.abs(gx - x)) < 1e-15
+    assert np.max(np.abs(gw - w)) < 1e-14
+    # and it integrates polynomials up to degree 2n - 1 exactly
+    assert abs(np.sum(gw * gx ** (2 * n - 2)) - 2.0 / (2 * n - 1)) < 1e-13

@@ -105,6 +105,7 @@ __all__ = [
     "optimal_stopping",
     "optimal_test",
     "run_batch",
+    "run_boundaries",
 ]
 
 KEEP_TOUCHING = "keep touching"
@@ -895,16 +896,18 @@ class _Stopping:
         lw = self.log_weights(x, n)
         return self._lse(lw[self.cls]) - self._lse(lw[~self.cls])
 
-    def _expect(self, tables, n1, post, out_err):
-        """E[f(x')] for f in ``tables`` (T, E), x' = x + the increment of sample n1, under the predictive."""
+    def _expect(self, tables, n1, post, out_err, band: slice):
+        """E[f(x')] for f in ``tables`` (T, E), x' = x + the increment of sample n1, under the predictive,
+        for the grid points ``x[band]``."""
         io = self.iota[n1]
         if io <= 0.0:
-            return tables.copy()
+            return tables[:, band].copy()
         x0, dx, m = self.x[0], self.dx, self.x.size
-        acc = np.zeros_like(tables)
+        xs = self.x[band]
+        acc = np.zeros((2, xs.size))
         sd = math.sqrt(io)
         for i, ri in enumerate(self.r):
-            xx = self.x[:, None] + (ri * io + sd * self.z)[None, :]
+            xx = xs[:, None] + (ri * io + sd * self.z)[None, :]
             f = (xx - x0) / dx
             j = np.floor(f).astype(np.int64)
             inside = (j >= 0) & (j < m - 1)
@@ -915,7 +918,7 @@ class _Stopping:
                 # beyond the grid the rule stops at once: no more time, the stopping error there
                 vals[0] = np.where(inside, vals[0], 0.0)
                 vals[1][~inside] = out_err(xx[~inside], n1)
-            acc += post[i] * (vals @ self.wz)
+            acc += post[i, band] * (vals @ self.wz)
         return acc
 
     def stop_error(self, x, n):
@@ -937,13 +940,22 @@ class _Stopping:
             post = np.exp(lw - self._lse(lw))
             lo = self._lse(lw[self.cls]) - self._lse(lw[~self.cls])
             serr = special.expit(-np.abs(lo))
-            cont = self._expect(tab, n + 1, post, self.stop_error)
-            cont[0] += dt
-            if threshold is None:
-                stop = cost * serr <= cont[0] + cost * cont[1]
-            else:
-                stop = np.abs(lo) >= threshold
-            tab = np.where(stop, np.stack([np.zeros_like(x), serr]), cont)
+            # only where continuing can pay (the optimal rule stops once cost * P(error) <= dt, the least a
+            # further sample costs; the SPRT beyond its threshold) is the expectation computed
+            maybe = cost * serr > dt if threshold is None else np.abs(lo) < threshold
+            stop = np.ones(x.size, dtype=bool)
+            new = np.stack([np.zeros_like(x), serr])
+            if maybe.any():
+                idx = np.flatnonzero(maybe)  # an interval: the log-odds increase with x
+                band = slice(int(idx[0]), int(idx[-1]) + 1)
+                cont = self._expect(tab, n + 1, post, self.stop_error, band)
+                cont[0] += dt
+                if threshold is None:
+                    stop[band] = cost * serr[band] <= cont[0] + cost * cont[1]
+                else:
+                    stop[band] = False
+                new[:, band] = np.where(stop[band], new[:, band], cont)
+            tab = new
             up, dn = stop & (lo > 0), stop & (lo <= 0)
             upper[n] = lo[up].min() if up.any() else np.inf
             lower[n] = lo[dn].max() if dn.any() else -np.inf
@@ -1099,3 +1111,50 @@ def optimal_test(test: SequentialTest, error_rate: float | None = None, *, point
     thr = float(test.plan.thresholds[0, 1]) if cands[0].error_rate == cands[1].error_rate else None
     return optimal_stopping(iota, offsets, lp, cls, 1.0 / test.sensor.sample_rate_hz, eps, sprt_threshold=thr,
                             step=step, nodes=nodes, iterations=iterations)
+
+
+def run_boundaries(test: SequentialTest, temps_c: np.ndarray, upper, lower) -> BatchResult:
+    """A two-candidate rule with time-varying boundaries (the optimal test's) on many touches.
+
+    Candidate 1 is decided at the first sample ``k`` with ``l_1 - l_0 >= upper[k]``, candidate 0 at
+    the first with ``l_1 - l_0 <= lower[k]``, the statistic as in :func:`run_batch`; at the last
+    boundary sample the likelier is decided. The touches are cut to ``len(upper)`` samples.
+
+    Examples
+    --------
+    >>> from designkit import SENSORS
+    >>> from designkit.simulation import simulate_trials
+    >>> from designkit.scene import Scene
+    >>> test = SequentialTest([("20000", (20000, 20080)), ("35000", (35000, 35080))], SENSORS["paper"],
+    ...                       noise_c=0.05, sensor_temp_c=35.0, ambient_temp_c=25.0, error_rate=0.01)
+    >>> y = simulate_trials(35040, SENSORS["paper"], Scene(contact_s=5), 20, seed=1).temperature_c
+    >>> thr = test.plan.thresholds[1, 0]  # constant boundaries: the SPRT, as run_batch runs it
+    >>> r, b = run_boundaries(test, y, np.full(1001, thr), np.full(1001, -thr)), run_batch(test, y)
+    >>> bool(np.all(r.decided == b.decided) and np.all(r.time_s == b.time_s))
+    True
+    """
+    if len(test.plan.candidates) != 2:
+        raise InputError(f"boundaries on l_1 - l_0 need two candidates, got {len(test.plan.candidates)}")
+    upper = np.asarray(upper, dtype=np.float64)
+    lower = np.asarray(lower, dtype=np.float64)
+    y = np.asarray(temps_c, dtype=np.float64)
+    if y.ndim != 2 or upper.shape != lower.shape or upper.ndim != 1:
+        raise InputError(f"touches must be (touch, sample) and the boundaries two 1-D arrays of one length; got "
+                         f"{y.shape}, {upper.shape}, {lower.shape}")
+    m = min(upper.size, y.shape[1], test._g.size)
+    g = test._g[:m]
+    s_gg = np.cumsum(g * g)
+    first = int(np.argmax(s_gg > 0))
+    a = test.amplitude_c
+    v = np.cumsum((y[:, :m] - test.sensor_temp_c) * g, axis=1)[:, first:] / (a * s_gg[first:])
+    s = np.broadcast_to(test.noise_c / (abs(a) * np.sqrt(s_gg[first:])), v.shape)
+    ll = log_marginals(v, s, test.plan.candidates)
+    d = ll[..., 1] - ll[..., 0]
+    up, dn = d >= upper[first:m], d <= lower[first:m]
+    stop = up | dn
+    hit = stop.any(axis=1)
+    at = np.where(hit, np.argmax(stop, axis=1), d.shape[1] - 1)
+    rows = np.arange(d.shape[0])
+    decided = np.where(hit, np.where(up[rows, at], 1, 0), -1)
+    best = np.where(hit, decided, (d[:, -1] > 0).astype(int))
+    return BatchResult(decided, (at + first) / test.sensor.sample_rate_hz, best)

@@ -2,8 +2,8 @@
 
 Run from the repository root::
 
-    python benchmarks/bench_sequential.py                     # 10,000 touches per class, ~1-2 min
-    python benchmarks/bench_sequential.py --touches 2000 --no-svm --figure docs/decisions_times.png
+    python benchmarks/bench_sequential.py --figure docs/decisions_times.png  # 10,000 touches per class, ~15 min
+    python benchmarks/bench_sequential.py --touches 2000 --no-svm --no-optimal   # ~1 min
 
 The paper's guideline pair (35,000 vs 20,000 J s^-1/2 K^-1 m^-2, classes 80 wide,
 noise 0.05 degC, dT 10 degC, the paper's sensor at 200 Hz, fixed initial

@@ -34,6 +34,7 @@ from ..sensor import last_sample_index
 __all__ = [
     "BOUND_CACHE_SIZE",
     "class_survival",
+    "critical_noise",
     "projection_noise",
     "cached_ideal_max_ratio",
     "cached_ideal_min_contact",
@@ -45,6 +46,7 @@ __all__ = [
     "exact_ideal_min_contact",
     "efficiency_min_contact",
     "ideal_f1",
+    "noise_k_contact",
     "shape_norm",
 ]
 
@@ -519,3 +521,66 @@ def cached_ideal_max_ratio(sensor, lo, hi, contact_s, *, width: float = 80.0, th
                                      rel_tol=rel_tol)
     return _cached("max-ratio", sensor, (lo, hi, contact_s),
                    (float(width), float(threshold), float(bracket[0]), float(bracket[1]), float(rel_tol)), compute)
+
+
+# ============================================================ the noise at which the ideal observer just separates
+def critical_noise(sensor, lo, hi, s_lo, s_hi, *, width: float = 80.0, threshold: float = 0.9,
+                   rel_tol: float = 1e-3) -> np.ndarray:
+    """Projection noise ``s*`` [-] at which the ideal observer's F1 of ``[lo, lo+w)``, ``[hi, hi+w)`` is
+    ``threshold``, vectorized (bisection in log s; the F1 falls as the noise grows).
+
+    A classifier that needs the pair's separation at noise ``s`` behaves like an ideal observer at the
+    larger noise ``k s``: ``k`` (>= 1) is its *noise efficiency*, ``s*(its need) / s``
+    (:func:`designkit.query.table.noise_k_min_contact`). ``s_lo < s_hi`` bracket ``s*`` per element; the
+    result is clipped to that bracket. Located to ``rel_tol`` in log.
+
+    >>> from designkit.sensor import load_sensor
+    >>> s = load_sensor("paper")
+    >>> star = float(critical_noise(s, 20000.0, 35000.0, 1e-6, 1.0))
+    >>> bool(ideal_f1(20000.0, 35000.0, 80.0, s.effusivity, 0.99 * star) >= 0.9 > ideal_f1(
+    ...     20000.0, 35000.0, 80.0, s.effusivity, 1.01 * star))
+    True
+    """
+    cols = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64) for x in (lo, hi, s_lo, s_hi)))
+    shape = cols[0].shape
+    lo, hi, s_lo, s_hi = (c.ravel() for c in cols)
+    la, lb = np.log(s_lo), np.log(s_hi)
+    steps = int(math.ceil(math.log2(max(float(np.max(lb - la, initial=0.0)), rel_tol) / rel_tol)))
+    for _ in range(steps):
+        mid = 0.5 * (la + lb)
+        ok = _ok(sensor, lo, hi, width, np.exp(mid), threshold)
+        la, lb = np.where(ok, mid, la), np.where(ok, lb, mid)
+    return np.exp(0.5 * (la + lb)).reshape(shape)
+
+
+def noise_k_contact(sensor, ratio, s_star, t_a, t_b, log_k_a, log_k_b, max_contact_s: float) -> np.ndarray:
+    """First sample time [s] at which a classifier of noise efficiency ``k(t)`` separates a pair whose ideal
+    observer needs projection noise at most ``s_star``: ``k(t) (sigma/dT) / |g(t)| <= s_star``, ``log k``
+    linear in ``log t`` through ``(t_a, log_k_a)``, ``(t_b, log_k_b)`` (extrapolated beyond them, never
+    below 0: no classifier beats the ideal observer), vectorized; NaN where no contact up to
+    ``max_contact_s`` suffices. Pure numpy over the sample counts (no quadrature).
+
+    >>> from designkit.sensor import load_sensor
+    >>> s = load_sensor("paper")
+    >>> star = critical_noise(s, 20000.0, 35000.0, 1e-6, 1.0)
+    >>> t1 = float(noise_k_contact(s, 0.005, star, 1.0, 2.0, 0.0, 0.0, 10.0))
+    >>> abs(t1 - float(exact_ideal_min_contact(s, 20000.0, 35000.0, 0.005))) <= 0.005
+    True
+    >>> float(noise_k_contact(s, 0.005, star, 1.0, 2.0, 0.4, 0.5, 10.0)) > t1
+    True
+    """
+    cols = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64) for x in (
+        ratio, s_star, t_a, t_b, log_k_a, log_k_b)))
+    shape = cols[0].shape
+    ratio, s_star, t_a, t_b, ka, kb = (c.ravel() for c in cols)
+    fs = float(sensor.sample_rate_hz)
+    n_max = int(last_sample_index(max_contact_s, fs))
+    cum = _cumulative_g2(float(sensor.tau_s), fs, max(n_max, 1))
+    n = np.arange(1, n_max + 1)
+    lt = np.log(n / fs)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        slope = np.where(t_a != t_b, (kb - ka) / np.log(t_b / t_a), 0.0)
+        log_k = np.maximum(ka[:, None] + slope[:, None] * (lt[None, :] - np.log(t_a)[:, None]), 0.0)
+        ok = log_k + np.log(ratio)[:, None] - 0.5 * np.log(cum[n])[None, :] <= np.log(s_star)[:, None]
+    first = np.argmax(ok, axis=1)
+    return np.where(ok.any(axis=1), n[first] / fs, np.nan).reshape(shape)

@@ -81,6 +81,7 @@ __all__ = [
     "max_noise",
     "min_contact",
     "min_delta_t",
+    "noise_k_min_contact",
     "open_table",
     "ratio_estimate",
     "stated_log",
@@ -474,6 +475,163 @@ def efficiency_estimate(sensor, lo, hi, ratio, t_a, t_b, svm_a, svm_b, ideal_a, 
     nan = ~ok
     return {"value": value, "low": np.where(nan, np.nan, low), "high": np.where(nan, np.nan, high),
             "efficiency": np.where(nan, np.nan, eff_b), "se_log": np.where(nan, np.nan, se)}
+
+
+# ============================================================ the noise efficiency (min-contact)
+def _interp_at(arr2d: np.ndarray, centres: np.ndarray, j: np.ndarray, e: np.ndarray) -> np.ndarray:
+    """:func:`designkit.tables.lookup.interp_e` of row ``j[p]`` of ``arr2d`` [contact, centre] at ``e[p]``, per p."""
+    n = centres.size
+    c = np.clip(np.searchsorted(centres, e, side="right") - 1, 0, n - 2)
+    a, b = arr2d[j, c], arr2d[j, c + 1]
+    w = (e - centres[c]) / (centres[c + 1] - centres[c])
+    with np.errstate(invalid="ignore"):
+        out = np.where(w == 0.0, a, np.where(np.isnan(a) | np.isnan(b), np.nan, a + w * (b - a)))
+    out = np.where(e >= centres[-1], arr2d[j, n - 1], out)
+    return np.where(e <= centres[0], arr2d[j, 0], out)
+
+
+def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
+                        max_contact_s: float = CLOSED_FORM_MAX_CONTACT_S) -> dict[str, np.ndarray]:
+    """min-contact from the SVM's *noise efficiency* against the exact ideal observer, for pairs of one scene.
+
+    The SVM separates a pair when the ideal observer would at a larger noise: ``k(t)`` times the projection
+    noise ``s(t) = (sigma/dT) / |g(t)|`` (:mod:`designkit.query.ideal_bound`). Every tabulated need gives
+    one reading of ``k``: the noise at which the ideal observer needs exactly that separation (less the
+    grid's rounding, w/2: :func:`~designkit.query.ideal_bound.critical_noise`) over ``s(t)`` of its slice.
+    ``k`` is a property of the classifier and the contact time (on svm-paper it is the same for every
+    sigma/dT, direction and effusivity to about 1 %, docs/accuracy.md), unlike the ratio of the needs in
+    effusivity, which changes with the pair's width because the signal ``w(e) = e / (e_s + e)`` is concave
+    (that ratio, read at pairs narrower and wider than the asked one, put the answers late). ``k`` is read at
+    the crossing's tabulated contact ``t_b`` (index ``k_cross``) and the one before, ``t_a`` (after, where
+    ``t_b`` is the first), from the pair's own entries (upwards at ``lo``, downwards at ``hi``) in every
+    scene slice the question interpolates between; ``log k`` is linear in ``log t`` through them. The
+    answer is the first sample time where ``k(t) s(t)`` reaches the pair's own critical noise
+    (:func:`~designkit.query.ideal_bound.noise_k_contact`).
+
+    Standard error of ``log k`` at a contact: the entries' inverse-variance mean, each entry's in log k
+    the local slope ``gamma = dlog s*/dlog need`` (a second critical noise, one width further) times its
+    need's relative error: the grid's rounding (w/sqrt(12)) and the table's Monte Carlo interval
+    (``delta_lo`` / ``delta_hi``, ``z`` standard errors each). Between the two contacts: ``(1-u)`` and ``u``
+    weights, plus ``u (1-u)`` times half the change of ``log k`` across the cell (interpolation; the
+    measured curvature of log k in log t on the table is below this). In log t it is that over
+    ``beta_g - beta_k``, the local log-log slopes of ``|g|`` and ``k``.
+
+    Parameters
+    ----------
+    op : the opened table (:func:`open_table`)
+    combos : scene weights (``view.scene_weights``)
+    k_cross : array_like of int
+        Index of the first tabulated contact whose need suffices, per pair (>= 0).
+    lo, hi, ratio : array_like
+        Pairs [J s^-1/2 K^-1 m^-2] and the asked sigma/dT.
+    zc : float
+        z of the asked coverage.
+
+    Returns
+    -------
+    dict of ndarray
+        ``value``, ``low``, ``high`` [s], ``k_a``, ``k_b`` (NaN: no reading there), ``t_a``, ``t_b``,
+        ``se_log`` (of the answer, log); ``value`` NaN where the route does not apply.
+    """
+    from .ideal_bound import critical_noise, shape_norm, noise_k_contact
+
+    view, tab = op.view, op.tab
+    sensor, width, phi = tab.sensor, op.width, op.phi
+    z_table = table_z(tab)
+    lo, hi, ratio = (np.atleast_1d(np.asarray(x, dtype=np.float64)) for x in (lo, hi, ratio))
+    kb = np.atleast_1d(np.asarray(k_cross, dtype=np.int64))
+    nc, n = view.contacts.size, lo.size
+    ka = np.where(kb > 0, kb - 1, kb + 1)
+    ka_ok = ka < nc
+    ka = np.minimum(ka, nc - 1)
+    h, rnd_sd = 0.5 * width, width / math.sqrt(12.0)
+    ratios = view.t.axes["noise_ratio"]
+    # every entry: (pair p, which contact c in {0: a, 1: b}, slice weight, its need and Monte Carlo ends)
+    P, Cc, W, D, DL, DH, SIGN, RS, T = ([] for _ in range(9))
+    for c, j in ((0, ka), (1, kb)):
+        t = view.contacts[j]
+        for idx, ws in combos:
+            if ws == 0:
+                continue
+            for sign, e, name in ((+1, lo, "delta_up"), (-1, hi, "delta_down")):
+                d = _interp_at(view.t.arrays[name][idx], view.centres, j, e)
+                dl = _interp_at(view.t.arrays[f"{name}_lo"][idx], view.centres, j, e)
+                dh = _interp_at(view.t.arrays[f"{name}_hi"][idx], view.centres, j, e)
+                ok = np.isfinite(d) & (d > width) & ((c == 1) | ka_ok)
+                if sign < 0:
+                    ok &= e - (d - h) > 0
+                p = np.nonzero(ok)[0]
+                P.append(p), Cc.append(np.full(p.size, c)), W.append(np.full(p.size, ws)), D.append(d[p])
+                DL.append(dl[p]), DH.append(dh[p]), SIGN.append(np.full(p.size, sign))
+                RS.append(np.full(p.size, float(ratios[idx[0]]))), T.append(t[p])
+    P, Cc, W, D, DL, DH, SIGN, RS, T = (np.concatenate(x) if x else np.zeros(0) for x in (P, Cc, W, D, DL, DH, SIGN,
+                                                                                        RS, T))
+    P, Cc = P.astype(np.int64), Cc.astype(np.int64)
+    e_ref = np.where(SIGN > 0, lo[P], hi[P])
+    s_t = RS / shape_norm(sensor, T) if T.size else np.zeros(0)
+
+    def pair_of(d):  # the entry's pair of lower edges at distance d from its reference
+        return np.where(SIGN > 0, e_ref, e_ref - d), np.where(SIGN > 0, e_ref + d, e_ref)
+
+    a1, b1 = pair_of(D - h)
+    a2, b2 = pair_of(D - h + width)
+    a2 = np.maximum(a2, 0.0)
+    m = P.size
+    # one bisection: every entry at its need and one width further, and each pair's own critical noise
+    star = critical_noise(sensor, np.concatenate([a1, a2, lo]), np.concatenate([b1, b2, hi]),
+                          np.concatenate([0.25 * s_t, 0.25 * s_t, np.full(n, 1e-7)]),
+                          np.concatenate([12.0 * s_t, 12.0 * s_t, np.full(n, 10.0)]), width=width, threshold=phi)
+    s1, s2, s_pair = star[:m], star[m:2 * m], star[2 * m:]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        log_k = np.log(s1 / s_t)
+        gamma = np.log(s2 / s1) / np.log((D - h + width) / (D - h))
+        mc = np.where(np.isfinite(DH) & np.isfinite(DL) & (DL > h), np.log((DH - h) / (DL - h)) / (2.0 * z_table),
+                      np.where(np.isfinite(DL) & (DL > h), np.log((D - h) / (DL - h)) / z_table, 0.0))
+        sd = np.maximum(np.abs(gamma) * np.hypot(rnd_sd / (D - h), mc), 1e-3)
+    good = np.isfinite(log_k) & np.isfinite(sd)
+    om = np.where(good, W / sd ** 2, 0.0)
+    lk, se = np.full((2, n), np.nan), np.full((2, n), np.nan)
+    for c in (0, 1):
+        sel = Cc == c
+        num = np.bincount(P[sel], om[sel] * np.where(good[sel], log_k[sel], 0.0), minlength=n)
+        den = np.bincount(P[sel], om[sel], minlength=n)
+        var = np.bincount(P[sel], om[sel] ** 2 * np.where(good[sel], sd[sel] ** 2, 0.0), minlength=n)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            lk[c] = np.where(den > 0, num / den, np.nan)
+            se[c] = np.where(den > 0, np.sqrt(var) / den, np.nan)
+    t_a, t_b = view.contacts[ka], view.contacts[kb]
+    have_a, have_b = np.isfinite(lk[0]), np.isfinite(lk[1])
+    # one contact without a reading: k held at the other's (its trend is then part of the error below)
+    la_, lb_ = np.where(have_a, lk[0], lk[1]), np.where(have_b, lk[1], lk[0])
+    # k never falls with contact time (more samples only add features to fit): on svm-paper the slice
+    # medians of k rise at every step in every slice, so two readings that fall are noise: pooled, flat
+    with np.errstate(invalid="ignore", divide="ignore"):
+        wa, wb = np.where(have_a, 1.0 / se[0] ** 2, 0.0), np.where(have_b, 1.0 / se[1] ** 2, 0.0)
+        falls = have_a & have_b & ((lb_ - la_) * np.sign(np.log(t_b / t_a)) < 0)
+        pooled = (np.nan_to_num(la_) * wa + np.nan_to_num(lb_) * wb) / (wa + wb)
+        disagree = np.where(falls, np.abs(lb_ - la_), 0.0)
+    la_, lb_ = np.where(falls, pooled, la_), np.where(falls, pooled, lb_)
+    ok = have_a | have_b
+    value = np.full(n, np.nan)
+    if ok.any():
+        value[ok] = noise_k_contact(sensor, ratio[ok], s_pair[ok], t_a[ok], t_b[ok], la_[ok], lb_[ok], max_contact_s)
+    ok &= np.isfinite(value)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        u = np.log(value / t_a) / np.log(t_b / t_a)
+        dk = np.abs(lb_ - la_)
+        var_k = np.where(have_a & have_b, ((1 - u) * se[0]) ** 2 + (u * se[1]) ** 2 + (u * (1 - u) * dk / 2) ** 2,
+                         np.where(have_a, se[0], se[1]) ** 2 + (0.5 * np.log(value / np.where(have_a, t_a, t_b))) ** 2)
+        var_k = np.where(falls, 1.0 / (wa + wb) + (disagree / 2) ** 2, var_k)
+        slope_k = np.where(have_a & have_b, (lb_ - la_) / np.log(t_b / t_a), 0.0)
+        beta_g = np.log(shape_norm(sensor, value * 1.05) / shape_norm(sensor, value / 1.05)) / (2 * math.log(1.05))
+        se_t = np.sqrt(var_k) / np.maximum(beta_g - slope_k, 0.05)
+        low, high = value * np.exp(-zc * se_t), value * np.exp(zc * se_t)
+    nan = ~ok
+    return {"value": np.where(nan, np.nan, value), "low": np.where(nan, np.nan, low),
+            "high": np.where(nan, np.nan, high), "k_a": np.where(have_a & ok, np.exp(lk[0]), np.nan),
+            "k_b": np.where(have_b & ok, np.exp(lk[1]), np.nan), "t_a": t_a, "t_b": t_b,
+            "k": np.where(nan, np.nan, np.exp(np.maximum(la_ + slope_k * np.log(value / t_a), 0.0))),
+            "se_log": np.where(nan, np.nan, se_t)}
 
 
 def ratio_estimate(raw, r_c, r_lin, r_rnd, r_geo, end_lo, end_hi, ideal, *, z_table: float,
@@ -887,15 +1045,18 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
     interval: tuple = (None, None)
     kind, cov = "none", None
     eff = None
-    if value is not None and op.tab.fidelity == "svm" and op.closed and "delta_up_ideal" in view.t.arrays:
-        eff = _efficiency_at(view, combos, k_cross, lo, hi, needs[k_cross], noise / abs(dt), ideal, op,
-                             z_of_coverage(coverage))
+    if value is not None and op.tab.fidelity == "svm" and op.closed and "delta_up_lo" in view.t.arrays:
+        r = noise_k_min_contact(op, combos, [k_cross], [lo], [hi], [noise / abs(dt)], zc=z_of_coverage(coverage))
+        if not math.isnan(float(r["value"][0])):
+            eff = {key: float(v[0]) for key, v in r.items()}
     if eff is not None:
-        # the SVM's efficiency against the exact ideal observer (efficiency_estimate): no interpolation of
-        # the steep need between grid points
+        # the SVM's noise efficiency against the exact ideal observer (noise_k_min_contact): no interpolation
+        # of the steep need between grid points
         raw = value
-        value, interval, kind, cov = eff["value"], (eff["low"], eff["high"]), "table-efficiency", coverage
-        monte_carlo.update(efficiency=eff["efficiency"], efficiency_se_log=eff["se_log"], table_crossing_s=raw)
+        low = eff["low"] if ideal is None else min(max(eff["low"], ideal), eff["value"])
+        value, interval, kind, cov = eff["value"], (low, eff["high"]), "table-efficiency", coverage
+        monte_carlo.update(efficiency=eff["k"], efficiency_se_log=eff["se_log"], table_crossing_s=raw,
+                           noise_efficiency_at_s={f"{eff['t_a']:g}": eff["k_a"], f"{eff['t_b']:g}": eff["k_b"]})
     elif value is not None:
         prev_need = needs[k_cross - 1] if k_cross > 0 else math.nan
         if k_cross > 0 and not math.isnan(prev_need):

@@ -35,6 +35,7 @@ __all__ = [
     "BOUND_CACHE_SIZE",
     "class_survival",
     "critical_noise",
+    "cached_critical_noise",
     "projection_noise",
     "cached_ideal_max_ratio",
     "cached_ideal_min_contact",
@@ -545,12 +546,23 @@ def critical_noise(sensor, lo, hi, s_lo, s_hi, *, width: float = 80.0, threshold
     shape = cols[0].shape
     lo, hi, s_lo, s_hi = (c.ravel() for c in cols)
     la, lb = np.log(s_lo), np.log(s_hi)
-    steps = int(math.ceil(math.log2(max(float(np.max(lb - la, initial=0.0)), rel_tol) / rel_tol)))
-    for _ in range(steps):
-        mid = 0.5 * (la + lb)
-        ok = _ok(sensor, lo, hi, width, np.exp(mid), threshold)
-        la, lb = np.where(ok, mid, la), np.where(ok, lb, mid)
+    # each element's own number of halvings (its answer does not depend on the others in the call: cacheable)
+    steps = np.ceil(np.log2(np.maximum(lb - la, rel_tol) / rel_tol)).astype(np.int64)
+    for i in range(int(steps.max(initial=0))):
+        live = np.nonzero(steps > i)[0]
+        mid = 0.5 * (la[live] + lb[live])
+        ok = _ok(sensor, lo[live], hi[live], width, np.exp(mid), threshold)
+        la[live], lb[live] = np.where(ok, mid, la[live]), np.where(ok, lb[live], mid)
     return np.exp(0.5 * (la + lb)).reshape(shape)
+
+
+def cached_critical_noise(sensor, lo, hi, s_lo, s_hi, *, width: float = 80.0, threshold: float = 0.9,
+                          rel_tol: float = 1e-3) -> np.ndarray:
+    """:func:`critical_noise` through the per-process cache (same answers, same arguments)."""
+    def compute(a, b, c, d):
+        return critical_noise(sensor, a, b, c, d, width=width, threshold=threshold, rel_tol=rel_tol)
+    return _cached("critical-noise", sensor, (lo, hi, s_lo, s_hi), (float(width), float(threshold), float(rel_tol)),
+                   compute)
 
 
 def noise_k_contact(sensor, ratio, s_star, t_a, t_b, log_k_a, log_k_b, max_contact_s: float) -> np.ndarray:

@@ -81,6 +81,7 @@ __all__ = [
     "max_noise",
     "min_contact",
     "min_delta_t",
+    "noise_k_max_ratio",
     "noise_k_min_contact",
     "open_table",
     "ratio_estimate",
@@ -478,16 +479,119 @@ def efficiency_estimate(sensor, lo, hi, ratio, t_a, t_b, svm_a, svm_b, ideal_a, 
 
 
 # ============================================================ the noise efficiency (min-contact)
-def _interp_at(arr2d: np.ndarray, centres: np.ndarray, j: np.ndarray, e: np.ndarray) -> np.ndarray:
-    """:func:`designkit.tables.lookup.interp_e` of row ``j[p]`` of ``arr2d`` [contact, centre] at ``e[p]``, per p."""
+def _interp_at(arr3d: np.ndarray, centres: np.ndarray, si: np.ndarray, j: np.ndarray, e: np.ndarray) -> np.ndarray:
+    """:func:`designkit.tables.lookup.interp_e` of ``arr3d[si[p], j[p]]`` (a [slice, contact, centre] array) at
+    ``e[p]``, per p."""
     n = centres.size
     c = np.clip(np.searchsorted(centres, e, side="right") - 1, 0, n - 2)
-    a, b = arr2d[j, c], arr2d[j, c + 1]
+    a, b = arr3d[si, j, c], arr3d[si, j, c + 1]
     w = (e - centres[c]) / (centres[c + 1] - centres[c])
     with np.errstate(invalid="ignore"):
         out = np.where(w == 0.0, a, np.where(np.isnan(a) | np.isnan(b), np.nan, a + w * (b - a)))
-    out = np.where(e >= centres[-1], arr2d[j, n - 1], out)
-    return np.where(e <= centres[0], arr2d[j, 0], out)
+    out = np.where(e >= centres[-1], arr3d[si, j, n - 1], out)
+    return np.where(e <= centres[0], arr3d[si, j, 0], out)
+
+
+def _k_readings(op, slices, sw, ka, kb, lo, hi, extra=None):
+    """The noise efficiency ``log k`` and its standard error at the tabulated contacts ``ka`` and ``kb`` (rows
+    0 and 1 of the (2, n) arrays; NaN: no usable entry), per pair, from the pair's own entries (upwards at
+    ``lo``, downwards at ``hi``) in the noise-ratio slices ``slices`` (n, m) weighted ``sw`` (n, m); see
+    :func:`noise_k_min_contact`. ``extra``: (lo, hi, s_lo, s_hi) of further critical noises computed in the
+    same bisection, returned third (or None)."""
+    from .ideal_bound import cached_critical_noise, shape_norm
+
+    view, tab = op.view, op.tab
+    sensor, width = tab.sensor, op.width
+    z_table = table_z(tab)
+    n = lo.size
+    h, rnd_sd = 0.5 * width, width / math.sqrt(12.0)
+    ratios = view.t.axes["noise_ratio"]
+    P, Cc, W, D, DL, DH, SIGN, RS, T = ([] for _ in range(9))
+    for c, j in ((0, ka), (1, kb)):
+        ok_j = (j >= 0) & (j < view.contacts.size)
+        jj = np.clip(j, 0, view.contacts.size - 1)
+        t = view.contacts[jj]
+        for col in range(slices.shape[1]):
+            si, ws = slices[:, col], sw[:, col]
+            for sign, e, name in ((+1, lo, "delta_up"), (-1, hi, "delta_down")):
+                d = _interp_at(view.t.arrays[name], view.centres, si, jj, e)
+                dl = _interp_at(view.t.arrays[f"{name}_lo"], view.centres, si, jj, e)
+                dh = _interp_at(view.t.arrays[f"{name}_hi"], view.centres, si, jj, e)
+                ok = np.isfinite(d) & (d > width) & ok_j & (ws > 0)
+                if sign < 0:
+                    ok &= e - (d - h) > 0
+                p = np.nonzero(ok)[0]
+                P.append(p), Cc.append(np.full(p.size, c)), W.append(ws[p]), D.append(d[p])
+                DL.append(dl[p]), DH.append(dh[p]), SIGN.append(np.full(p.size, sign))
+                RS.append(ratios[si[p]]), T.append(t[p])
+    P, Cc, W, D, DL, DH, SIGN, RS, T = (np.concatenate(x) for x in (P, Cc, W, D, DL, DH, SIGN, RS, T))
+    P, Cc = P.astype(np.int64), Cc.astype(np.int64)
+    e_ref = np.where(SIGN > 0, lo[P], hi[P])
+    s_t = RS / shape_norm(sensor, T) if T.size else np.zeros(0)
+
+    def pair_of(d):  # the entry's pair of lower edges at distance d from its reference
+        return np.where(SIGN > 0, e_ref, e_ref - d), np.where(SIGN > 0, e_ref + d, e_ref)
+
+    a1, b1 = pair_of(D - h)
+    a2, b2 = pair_of(D - h + width)
+    a2 = np.maximum(a2, 0.0)
+    m = P.size
+    xa, xb, xl, xh = extra if extra is not None else (np.zeros(0),) * 4
+    # one bisection: every entry at its need and one width further (and the extra pairs)
+    star = cached_critical_noise(sensor, np.concatenate([a1, a2, xa]), np.concatenate([b1, b2, xb]),
+                                 np.concatenate([0.25 * s_t, 0.25 * s_t, xl]),
+                                 np.concatenate([12.0 * s_t, 12.0 * s_t, xh]), width=width, threshold=op.phi)
+    s1, s2 = star[:m], star[m:2 * m]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        log_k = np.log(s1 / s_t)
+        gamma = np.log(s2 / s1) / np.log((D - h + width) / (D - h))
+        mc = np.where(np.isfinite(DH) & np.isfinite(DL) & (DL > h), np.log((DH - h) / (DL - h)) / (2.0 * z_table),
+                      np.where(np.isfinite(DL) & (DL > h), np.log((D - h) / (DL - h)) / z_table, 0.0))
+        sd = np.maximum(np.abs(gamma) * np.hypot(rnd_sd / (D - h), mc), 1e-3)
+    good = np.isfinite(log_k) & np.isfinite(sd)
+    om = np.where(good, W / sd ** 2, 0.0)
+    lk, se = np.full((2, n), np.nan), np.full((2, n), np.nan)
+    for c in (0, 1):
+        sel = Cc == c
+        num = np.bincount(P[sel], om[sel] * np.where(good[sel], log_k[sel], 0.0), minlength=n)
+        den = np.bincount(P[sel], om[sel], minlength=n)
+        var = np.bincount(P[sel], om[sel] ** 2 * np.where(good[sel], sd[sel] ** 2, 0.0), minlength=n)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            lk[c] = np.where(den > 0, num / den, np.nan)
+            se[c] = np.where(den > 0, np.sqrt(var) / den, np.nan)
+    return lk, se, (star[2 * m:] if extra is not None else None)
+
+
+def _k_line(lk, se, t_a, t_b):
+    """``log k`` at ``t_a`` and ``t_b`` (one held at the other's where it has no reading; two that fall pooled:
+    k never falls with contact time, on svm-paper the slice medians rise at every step in every slice), the
+    weights and the readings' disagreement where they fell."""
+    have_a, have_b = np.isfinite(lk[0]), np.isfinite(lk[1])
+    la_, lb_ = np.where(have_a, lk[0], lk[1]), np.where(have_b, lk[1], lk[0])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        wa, wb = np.where(have_a, 1.0 / se[0] ** 2, 0.0), np.where(have_b, 1.0 / se[1] ** 2, 0.0)
+        falls = have_a & have_b & ((lb_ - la_) * np.sign(np.log(t_b / t_a)) < 0)
+        pooled = (np.nan_to_num(la_) * wa + np.nan_to_num(lb_) * wb) / (wa + wb)
+        disagree = np.where(falls, np.abs(lb_ - la_), 0.0)
+    la_, lb_ = np.where(falls, pooled, la_), np.where(falls, pooled, lb_)
+    return la_, lb_, have_a, have_b, falls, wa, wb, disagree
+
+
+def _k_var(u, se, la_, lb_, have_a, have_b, falls, wa, wb, disagree, far):
+    """Variance of ``log k`` at fraction ``u`` of the way from ``t_a`` to ``t_b`` (``far``: log distance to
+    the one reading where only one exists)."""
+    dk = np.abs(lb_ - la_)
+    v = np.where(have_a & have_b, ((1 - u) * se[0]) ** 2 + (u * se[1]) ** 2 + (u * (1 - u) * dk / 2) ** 2,
+                 np.where(have_a, se[0], se[1]) ** 2 + (0.5 * far) ** 2)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(falls, 1.0 / (wa + wb) + (disagree / 2) ** 2, v)
+
+
+def _slices(combos, n):
+    """Shared scene weights as per-pair slice arrays (n, m)."""
+    live = [(idx[0], w) for idx, w in combos if w]
+    return (np.tile(np.array([i for i, _ in live], dtype=np.int64), (n, 1)),
+            np.tile(np.array([w for _, w in live], dtype=np.float64), (n, 1)))
 
 
 def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
@@ -533,84 +637,20 @@ def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
         ``value``, ``low``, ``high`` [s], ``k_a``, ``k_b`` (NaN: no reading there), ``t_a``, ``t_b``,
         ``se_log`` (of the answer, log); ``value`` NaN where the route does not apply.
     """
-    from .ideal_bound import critical_noise, shape_norm, noise_k_contact
+    from .ideal_bound import noise_k_contact, shape_norm
 
-    view, tab = op.view, op.tab
-    sensor, width, phi = tab.sensor, op.width, op.phi
-    z_table = table_z(tab)
-    lo, hi, ratio = (np.atleast_1d(np.asarray(x, dtype=np.float64)) for x in (lo, hi, ratio))
-    kb = np.atleast_1d(np.asarray(k_cross, dtype=np.int64))
+    view, sensor = op.view, op.tab.sensor
+    lo, hi, ratio, kb = (np.atleast_1d(a) for a in np.broadcast_arrays(
+        np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64), np.asarray(ratio, dtype=np.float64),
+        np.asarray(k_cross, dtype=np.int64)))
     nc, n = view.contacts.size, lo.size
     ka = np.where(kb > 0, kb - 1, kb + 1)
-    ka_ok = ka < nc
-    ka = np.minimum(ka, nc - 1)
-    h, rnd_sd = 0.5 * width, width / math.sqrt(12.0)
-    ratios = view.t.axes["noise_ratio"]
-    # every entry: (pair p, which contact c in {0: a, 1: b}, slice weight, its need and Monte Carlo ends)
-    P, Cc, W, D, DL, DH, SIGN, RS, T = ([] for _ in range(9))
-    for c, j in ((0, ka), (1, kb)):
-        t = view.contacts[j]
-        for idx, ws in combos:
-            if ws == 0:
-                continue
-            for sign, e, name in ((+1, lo, "delta_up"), (-1, hi, "delta_down")):
-                d = _interp_at(view.t.arrays[name][idx], view.centres, j, e)
-                dl = _interp_at(view.t.arrays[f"{name}_lo"][idx], view.centres, j, e)
-                dh = _interp_at(view.t.arrays[f"{name}_hi"][idx], view.centres, j, e)
-                ok = np.isfinite(d) & (d > width) & ((c == 1) | ka_ok)
-                if sign < 0:
-                    ok &= e - (d - h) > 0
-                p = np.nonzero(ok)[0]
-                P.append(p), Cc.append(np.full(p.size, c)), W.append(np.full(p.size, ws)), D.append(d[p])
-                DL.append(dl[p]), DH.append(dh[p]), SIGN.append(np.full(p.size, sign))
-                RS.append(np.full(p.size, float(ratios[idx[0]]))), T.append(t[p])
-    P, Cc, W, D, DL, DH, SIGN, RS, T = (np.concatenate(x) if x else np.zeros(0) for x in (P, Cc, W, D, DL, DH, SIGN,
-                                                                                        RS, T))
-    P, Cc = P.astype(np.int64), Cc.astype(np.int64)
-    e_ref = np.where(SIGN > 0, lo[P], hi[P])
-    s_t = RS / shape_norm(sensor, T) if T.size else np.zeros(0)
-
-    def pair_of(d):  # the entry's pair of lower edges at distance d from its reference
-        return np.where(SIGN > 0, e_ref, e_ref - d), np.where(SIGN > 0, e_ref + d, e_ref)
-
-    a1, b1 = pair_of(D - h)
-    a2, b2 = pair_of(D - h + width)
-    a2 = np.maximum(a2, 0.0)
-    m = P.size
-    # one bisection: every entry at its need and one width further, and each pair's own critical noise
-    star = critical_noise(sensor, np.concatenate([a1, a2, lo]), np.concatenate([b1, b2, hi]),
-                          np.concatenate([0.25 * s_t, 0.25 * s_t, np.full(n, 1e-7)]),
-                          np.concatenate([12.0 * s_t, 12.0 * s_t, np.full(n, 10.0)]), width=width, threshold=phi)
-    s1, s2, s_pair = star[:m], star[m:2 * m], star[2 * m:]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        log_k = np.log(s1 / s_t)
-        gamma = np.log(s2 / s1) / np.log((D - h + width) / (D - h))
-        mc = np.where(np.isfinite(DH) & np.isfinite(DL) & (DL > h), np.log((DH - h) / (DL - h)) / (2.0 * z_table),
-                      np.where(np.isfinite(DL) & (DL > h), np.log((D - h) / (DL - h)) / z_table, 0.0))
-        sd = np.maximum(np.abs(gamma) * np.hypot(rnd_sd / (D - h), mc), 1e-3)
-    good = np.isfinite(log_k) & np.isfinite(sd)
-    om = np.where(good, W / sd ** 2, 0.0)
-    lk, se = np.full((2, n), np.nan), np.full((2, n), np.nan)
-    for c in (0, 1):
-        sel = Cc == c
-        num = np.bincount(P[sel], om[sel] * np.where(good[sel], log_k[sel], 0.0), minlength=n)
-        den = np.bincount(P[sel], om[sel], minlength=n)
-        var = np.bincount(P[sel], om[sel] ** 2 * np.where(good[sel], sd[sel] ** 2, 0.0), minlength=n)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            lk[c] = np.where(den > 0, num / den, np.nan)
-            se[c] = np.where(den > 0, np.sqrt(var) / den, np.nan)
-    t_a, t_b = view.contacts[ka], view.contacts[kb]
-    have_a, have_b = np.isfinite(lk[0]), np.isfinite(lk[1])
-    # one contact without a reading: k held at the other's (its trend is then part of the error below)
-    la_, lb_ = np.where(have_a, lk[0], lk[1]), np.where(have_b, lk[1], lk[0])
-    # k never falls with contact time (more samples only add features to fit): on svm-paper the slice
-    # medians of k rise at every step in every slice, so two readings that fall are noise: pooled, flat
-    with np.errstate(invalid="ignore", divide="ignore"):
-        wa, wb = np.where(have_a, 1.0 / se[0] ** 2, 0.0), np.where(have_b, 1.0 / se[1] ** 2, 0.0)
-        falls = have_a & have_b & ((lb_ - la_) * np.sign(np.log(t_b / t_a)) < 0)
-        pooled = (np.nan_to_num(la_) * wa + np.nan_to_num(lb_) * wb) / (wa + wb)
-        disagree = np.where(falls, np.abs(lb_ - la_), 0.0)
-    la_, lb_ = np.where(falls, pooled, la_), np.where(falls, pooled, lb_)
+    ka = np.where(ka < nc, ka, -1)
+    slices, sw = _slices(combos, n)
+    lk, se, s_pair = _k_readings(op, slices, sw, ka, kb, lo, hi,
+                                 extra=(lo, hi, np.full(n, 1e-7), np.full(n, 10.0)))
+    t_a, t_b = view.contacts[np.where(ka >= 0, ka, kb)], view.contacts[kb]
+    la_, lb_, have_a, have_b, falls, wa, wb, disagree = _k_line(lk, se, t_a, t_b)
     ok = have_a | have_b
     value = np.full(n, np.nan)
     if ok.any():
@@ -618,20 +658,56 @@ def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
     ok &= np.isfinite(value)
     with np.errstate(divide="ignore", invalid="ignore"):
         u = np.log(value / t_a) / np.log(t_b / t_a)
-        dk = np.abs(lb_ - la_)
-        var_k = np.where(have_a & have_b, ((1 - u) * se[0]) ** 2 + (u * se[1]) ** 2 + (u * (1 - u) * dk / 2) ** 2,
-                         np.where(have_a, se[0], se[1]) ** 2 + (0.5 * np.log(value / np.where(have_a, t_a, t_b))) ** 2)
-        var_k = np.where(falls, 1.0 / (wa + wb) + (disagree / 2) ** 2, var_k)
-        slope_k = np.where(have_a & have_b, (lb_ - la_) / np.log(t_b / t_a), 0.0)
+        var_k = _k_var(u, se, la_, lb_, have_a, have_b, falls, wa, wb, disagree,
+                       np.log(value / np.where(have_a, t_a, t_b)))
+        slope_k = np.where(have_a & have_b & (t_a != t_b), (lb_ - la_) / np.log(t_b / t_a), 0.0)
         beta_g = np.log(shape_norm(sensor, value * 1.05) / shape_norm(sensor, value / 1.05)) / (2 * math.log(1.05))
         se_t = np.sqrt(var_k) / np.maximum(beta_g - slope_k, 0.05)
         low, high = value * np.exp(-zc * se_t), value * np.exp(zc * se_t)
+        k_at = np.exp(np.maximum(la_ + slope_k * np.log(value / t_a), 0.0))
     nan = ~ok
     return {"value": np.where(nan, np.nan, value), "low": np.where(nan, np.nan, low),
             "high": np.where(nan, np.nan, high), "k_a": np.where(have_a & ok, np.exp(lk[0]), np.nan),
             "k_b": np.where(have_b & ok, np.exp(lk[1]), np.nan), "t_a": t_a, "t_b": t_b,
-            "k": np.where(nan, np.nan, np.exp(np.maximum(la_ + slope_k * np.log(value / t_a), 0.0))),
-            "se_log": np.where(nan, np.nan, se_t)}
+            "k": np.where(nan, np.nan, k_at), "se_log": np.where(nan, np.nan, se_t)}
+
+
+def noise_k_max_ratio(op, contact_s, r_table, r_ideal, lo, hi, *, zc: float) -> dict[str, np.ndarray]:
+    """max-noise / min-delta-t from the SVM's noise efficiency (:func:`noise_k_min_contact`): the SVM separates
+    the pair up to ``sigma/dT = r_ideal / k(contact)``, ``r_ideal`` the ideal observer's exact largest
+    sigma/dT, ``k`` read at the two tabulated contacts around ``contact_s`` (log-linear in log t) in the two
+    noise-ratio slices around ``r_table`` (the table's own crossing), elementwise. Standard error in log:
+    that of ``log k`` there (as min-contact's), no slope to divide by.
+
+    Returns
+    -------
+    dict of ndarray
+        ``value``, ``low``, ``high`` (sigma/dT), ``k``, ``se_log``; NaN where it does not apply.
+    """
+    view = op.view
+    contact, r_table, r_ideal, lo, hi = (np.atleast_1d(a) for a in np.broadcast_arrays(*(
+        np.asarray(x, dtype=np.float64) for x in (contact_s, r_table, r_ideal, lo, hi))))
+    n, C = lo.size, view.contacts
+    kb = np.clip(np.searchsorted(C, contact, side="left"), 0, C.size - 1)  # the first contact >= the asked one
+    ka = np.where(C[kb] == contact, kb, np.maximum(kb - 1, 0))
+    lr, lrt = np.log(view.t.axes["noise_ratio"]), np.log(r_table)
+    i0 = np.clip(np.searchsorted(lr, lrt, side="right") - 1, 0, lr.size - 2)
+    w1 = np.clip((lrt - lr[i0]) / (lr[i0 + 1] - lr[i0]), 0.0, 1.0)
+    slices, sw = np.stack([i0, i0 + 1], axis=1), np.stack([1.0 - w1, w1], axis=1)
+    lk, se, _ = _k_readings(op, slices, sw, ka, kb, lo, hi)
+    t_a, t_b = C[ka], C[kb]
+    la_, lb_, have_a, have_b, falls, wa, wb, disagree = _k_line(lk, se, t_a, t_b)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        u = np.where(t_a != t_b, np.log(contact / t_a) / np.log(t_b / t_a), 1.0)
+        log_k = np.maximum((1 - u) * la_ + u * lb_, 0.0)
+        var_k = _k_var(u, se, la_, lb_, have_a, have_b, falls, wa, wb, disagree,
+                       np.log(contact / np.where(have_a, t_a, t_b)))
+        sd = np.sqrt(var_k)
+    ok = (have_a | have_b) & np.isfinite(r_ideal) & np.isfinite(sd)
+    value = r_ideal * np.exp(-log_k)
+    return {"value": np.where(ok, value, np.nan), "low": np.where(ok, value * np.exp(-zc * sd), np.nan),
+            "high": np.where(ok, value * np.exp(zc * sd), np.nan), "k": np.where(ok, np.exp(log_k), np.nan),
+            "se_log": np.where(ok, sd, np.nan)}
 
 
 def ratio_estimate(raw, r_c, r_lin, r_rnd, r_geo, end_lo, end_hi, ideal, *, z_table: float,
@@ -1224,7 +1300,20 @@ def _ratio_question(question: str, e1, e2, m1, m2, objects, contact_s, noise_c, 
     interval: tuple = (None, None)
     kind, cov = "none", None
     computation = {"monte_carlo_interval": list(mc)}
-    if where == "inside" and op.tab.fidelity == "svm":
+    kr = None
+    if where in ("inside", "cell") and op.tab.fidelity == "svm" and op.closed and out["ideal"][1] != "below":
+        kr = noise_k_max_ratio(op, contact, r, out["ideal"][0], lo, hi, zc=z_of_coverage(coverage))
+        kr = None if math.isnan(float(kr["value"][0])) else {key: float(v[0]) for key, v in kr.items()}
+    if kr is not None:
+        # the SVM's noise efficiency against the exact ideal observer (noise_k_max_ratio)
+        raw = r
+        r = min(kr["value"], out["ideal"][0])
+        value = to_answer(r)
+        iv = [to_answer(kr["low"]), to_answer(min(kr["high"], out["ideal"][0]))]
+        interval = tuple(iv) if question == "max-noise" else (iv[1], iv[0])
+        kind, cov = "table-efficiency", coverage
+        computation.update(table_crossing_noise_ratio=raw, efficiency=kr["k"], efficiency_se_log=kr["se_log"])
+    elif where == "inside" and op.tab.fidelity == "svm":
         # as min-contact: the tabulated deltas are rounded up to the grid (on average half a width late),
         # so the raw crossing tolerates too little noise; the answer subtracts w/2 from the need and
         # interpolates log-log, the interval carries the interpolants' difference and the rounding's SD

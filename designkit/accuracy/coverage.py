@@ -255,11 +255,11 @@ def summarize(results: Iterable[Mapping[str, Any]], question: str, route: str, *
               min_gap: float | None = None) -> dict[str, Any]:
     """Coverage and error of one (question, route) over benchmark results.
 
-    Only cases with both an answer and a reference value count for the error; only those
-    with a stated coverage for ``coverage``. ``min_gap``: only pairs at least this far apart.
+    Only cases with both an answer and a reference estimate (a reference with a stated coverage, not
+    a search bracket) count for the error; only those with a stated coverage for ``coverage``. ``min_gap``: only pairs at least this far apart.
 
-    >>> r = [{"question": "q", "reference": {"value": 1.0}, "table": {"value": 1.1, "low": 0.9, "high": 1.2,
-    ...       "coverage": 0.9}}]
+    >>> r = [{"question": "q", "reference": {"value": 1.0, "coverage": 0.9}, "table": {"value": 1.1, "low": 0.9,
+    ...       "high": 1.2, "coverage": 0.9}}]
     >>> s = summarize(r, "q", "table"); s["coverage"], round(s["median_rel"], 3)
     (1.0, 0.1)
     """

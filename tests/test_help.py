@@ -37,3 +37,34 @@ def test_every_command_has_help_with_an_example(cli, path):
     assert r.exit_code == 0, r.output
     assert "Example" in r.output and "designkit " + path[0] in r.output.split("Example", 1)[1], \
         f"'designkit {' '.join(path)} --help' shows no example invocation"
+
+
+def test_the_console_script_knows_which_module_registers_each_command():
+    """``designkit NAME`` imports only NAME's module: the map must name every top-level command, and right."""
+    import designkit.cli as cli_pkg
+
+    app = cli_pkg.app
+    registered = {}
+    for c in app.registered_commands:
+        registered[c.name or c.callback.__name__.replace("_", "-")] = c.callback.__module__
+    for g in app.registered_groups:
+        registered[g.name] = g.typer_instance.registered_commands[0].callback.__module__
+    assert set(cli_pkg.COMMAND_MODULE) == set(registered)
+    for name, module in registered.items():
+        assert module == f"designkit.cli.{cli_pkg.COMMAND_MODULE[name]}", name
+    assert set(cli_pkg.COMMAND_MODULE.values()) == set(cli_pkg.COMMAND_MODULES)
+
+
+def test_a_command_runs_with_only_its_own_module_imported():
+    import subprocess
+    import sys
+
+    code = ("import sys; sys.argv = ['designkit', 'materials', 'list', '--format', 'csv']\n"
+            "from designkit.cli import main\n"
+            "try:\n    main()\nexcept SystemExit as e:\n    assert e.code in (0, None), e.code\n"
+            "print('LOADED', sorted(m.rsplit('.', 1)[1] for m in sys.modules if m.startswith('designkit.cli.')"
+            " and not m.split('.')[-1].startswith('_')), file=sys.stderr)\n")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.startswith("name,family")
+    assert "LOADED ['materials']" in r.stderr

@@ -13,23 +13,67 @@ BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THR
 if not any(v in os.environ for v in BLAS_THREAD_VARIABLES):
     os.environ["OPENBLAS_NUM_THREADS"] = "1"
 
-from ._app import app, main  # noqa: E402
+import importlib  # noqa: E402
+import sys  # noqa: E402
 
-# Each module registers its commands on ``app``; keep imports cheap (no numpy work,
-# no scikit-learn) at module level.
-# Registration order is the order of ``designkit --help`` within each panel: questions first.
-from . import query  # noqa: E402,F401  min-contact, max-noise, min-delta-t, delta-e, distinguishable
-from . import matrix  # noqa: E402,F401  matrix (one question over N materials)
-from . import thin  # noqa: E402,F401  validity
-from . import materials  # noqa: E402,F401  materials list, materials show
-from . import tables  # noqa: E402,F401  tables list, tables show
-from . import export  # noqa: E402,F401  export
-from . import calibrate  # noqa: E402,F401  calibrate (record, fit, guided run), emulate
-from . import classify  # noqa: E402,F401  classify (live decisions over serial)
-from . import design  # noqa: E402,F401  design (recommend a sensor)
-from . import core  # noqa: E402,F401  simulate, f1
-from . import sweep  # noqa: E402,F401  sweep
-from . import reproduce  # noqa: E402,F401  reproduce
-from . import bench  # noqa: E402,F401  bench
+from . import _app  # noqa: E402
 
-__all__ = ["app", "main"]
+#: The modules that register commands on ``app``, in the order of ``designkit --help`` within each panel
+#: (questions first). Each keeps its imports cheap (no numpy work, no scikit-learn) at module level.
+COMMAND_MODULES = ("query", "matrix", "thin", "materials", "tables", "export", "calibrate", "classify", "design",
+                   "core", "sweep", "reproduce", "bench")
+
+#: Which module registers each top-level command or command group. The console script imports only the
+#: module of the command it runs (importing the other twelve cost a fresh query a few milliseconds of the
+#: start-up that issue 16 counts); anything else (help, an unknown name, shell completion) imports them all.
+#: tests/test_help.py checks that this map names every registered command and nothing else.
+COMMAND_MODULE = {
+    "min-contact": "query", "max-noise": "query", "min-delta-t": "query", "delta-e": "query",
+    "distinguishable": "query", "matrix": "matrix", "validity": "thin", "materials": "materials",
+    "tables": "tables", "export": "export", "calibrate": "calibrate", "emulate": "calibrate",
+    "classify": "classify", "design": "design", "simulate": "core", "f1": "core", "sweep": "sweep",
+    "reproduce": "reproduce", "bench": "bench",
+}
+
+
+def _register(modules) -> None:
+    for name in modules:
+        importlib.import_module(f"{__name__}.{name}")
+
+
+def _register_all() -> "_app.typer.Typer":
+    """Every command on ``app``, in help order whatever was imported first."""
+    _register(COMMAND_MODULES)
+    rank = {f"{__name__}.{m}": i for i, m in enumerate(COMMAND_MODULES)}
+
+    def module_rank(callback) -> int:
+        return rank.get(getattr(callback, "__module__", ""), len(rank))
+
+    app = _app.app
+    app.registered_commands.sort(key=lambda c: module_rank(c.callback))
+    app.registered_groups.sort(key=lambda g: min((module_rank(c.callback) for c in g.typer_instance.registered_commands),
+                                                 default=len(rank)))
+    return app
+
+
+def main() -> None:
+    """Console-script entry point: registers the command asked for (or all), then runs it."""
+    argv = sys.argv[1:]
+    module = COMMAND_MODULE.get(argv[0]) if argv else None
+    if any(k.endswith("_COMPLETE") for k in os.environ):
+        _register_all()
+    elif module is not None:
+        _register((module,))
+    elif not (argv and argv[0] in ("--version", "-V")):  # answered while parsing the top-level options
+        _register_all()
+    _app.main()
+
+
+def __getattr__(name: str):
+    # ``designkit.cli.app``: the application with every command registered (tests, docs, typer's tools)
+    if name == "app":
+        return _register_all()
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+__all__ = ["BLAS_THREAD_VARIABLES", "COMMAND_MODULE", "COMMAND_MODULES", "app", "main"]

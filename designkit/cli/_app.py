@@ -173,8 +173,8 @@ class _Group(TyperGroup):
         sub_args = list(getattr(ctx, "protected_args", []) or []) + list(ctx.args or [])
         try:
             return super().invoke(ctx)
-        except (typer.Exit, typer.Abort, _ClickException, KeyboardInterrupt, SystemExit):
-            raise
+        except (typer.Exit, typer.Abort, _ClickException, KeyboardInterrupt, SystemExit, BrokenPipeError):
+            raise  # a closed pipe is not bad input: main() stops quietly
         except (ValueError, OSError) as exc:
             message = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
             if isinstance(exc, OSError) and exc.filename and str(exc.filename) not in message:
@@ -398,12 +398,28 @@ class busy:
             self._progress.stop()
 
 
+#: Exit status when the reader of stdout went away (``designkit ... | head -1``): click's (it stops a command
+#: that writes into a closed pipe with status 1 and no message); the same when the pipe closes at the last flush.
+EXIT_BROKEN_PIPE = 1
+
+
 def main() -> None:
     """Console-script entry point."""
     try:
-        # one program name however it is started (console script or ``python -m designkit``): the usage
-        # lines and the shell-completion script (``_DESIGNKIT_COMPLETE``) name the ``designkit`` command
-        _app_for(sys.argv[1:])(prog_name="designkit")
+        try:
+            # one program name however it is started (console script or ``python -m designkit``): the usage
+            # lines and the shell-completion script (``_DESIGNKIT_COMPLETE``) name the ``designkit`` command
+            _app_for(sys.argv[1:])(prog_name="designkit")
+        finally:
+            sys.stdout.flush()  # a closed pipe shows here, inside the handler, not at interpreter exit
     except KeyboardInterrupt:
         typer.echo("Interrupted.", err=True)
         sys.exit(EXIT_INTERRUPTED)
+    except BrokenPipeError:
+        # the reader closed the pipe before the last flush: stop quietly (no "Error:", no "Exception ignored"
+        # at interpreter exit), as click does when a command's write meets the closed pipe
+        import os
+
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        sys.exit(EXIT_BROKEN_PIPE)

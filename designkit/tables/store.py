@@ -118,7 +118,7 @@ def content_hash(arrays: Mapping[str, np.ndarray], header: Mapping[str, Any] | N
         h.update(name.encode())
         h.update(a.dtype.str.encode())
         h.update(repr(tuple(a.shape)).encode())
-        h.update(a.tobytes())
+        h.update(a if a.size else b"")  # the array's buffer itself: the bytes of tobytes() without copying them
     return "sha256:" + h.hexdigest()
 
 

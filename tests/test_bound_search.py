@@ -1,0 +1,98 @@
+"""The closed-form bounds' search over the sample count: a guessed bracket never changes an answer.
+
+The ideal observer's min-contact (and the efficiency route's) is the first sample count at which a
+monotone decision holds. The search starts from a Gaussian guess of that count and bisects inside a
+bracket around it; these tests check the answers against the definition (the decision fails one sample
+earlier and holds at the answer) and against the plain bisection with guesses that are wrong on purpose.
+"""
+
+import numpy as np
+import pytest
+
+from designkit.query import ideal_bound as ib
+from designkit.sensor import load_sensor
+
+PAPER = load_sensor("paper")
+
+
+def _decides(lo, hi, ratio, n):
+    cum = ib._cumulative_g2(float(PAPER.tau_s), float(PAPER.sample_rate_hz), 2000)
+    with np.errstate(divide="ignore"):
+        s = ratio / np.sqrt(cum[n])
+    return bool(ib._ok(PAPER, np.array([lo]), np.array([hi]), 80.0, np.array([s]), 0.9)[0])
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_ideal_min_contact_is_the_first_sample_where_the_ideal_observer_separates(seed):
+    rng = np.random.default_rng(seed)
+    lo = rng.uniform(100.0, 39000.0, 12)
+    hi = lo + rng.uniform(100.0, 15000.0, 12)
+    ratio = 10.0 ** rng.uniform(-3.5, -1.5, 12)
+    t = ib.exact_ideal_min_contact(PAPER, lo, hi, ratio)
+    fs = float(PAPER.sample_rate_hz)
+    checked = 0
+    for i in np.nonzero(np.isfinite(t))[0]:
+        n = int(round(t[i] * fs))
+        assert _decides(lo[i], hi[i], ratio[i], n), (lo[i], hi[i], ratio[i], n)
+        assert not _decides(lo[i], hi[i], ratio[i], n - 1), (lo[i], hi[i], ratio[i], n)
+        checked += 1
+    assert checked >= 6
+
+
+def test_a_wrong_guess_gives_the_plain_bisection_answer():
+    rng = np.random.default_rng(3)
+    switch = rng.integers(1, 2000, 400)  # the first count where each element's decision holds
+
+    def ok(n, rows):
+        return n >= switch[rows]
+
+    a = np.zeros(400, dtype=np.int64)
+    b = np.full(400, 2000, dtype=np.int64)
+    plain = ib._first_good_sample(ok, a, b)
+    assert np.array_equal(plain, switch)
+    for guess in (switch * 1.0, switch * 0.5, switch * 2.0, switch + 0.3, np.full(400, np.nan),
+                  np.zeros(400), rng.uniform(0, 3000, 400)):
+        assert np.array_equal(ib._first_good_sample(ok, a, b, guess), plain)
+    # a decision that never holds below b answers b, guessed or not
+    never = np.full(400, 5000)
+    assert np.array_equal(ib._first_good_sample(lambda n, rows: n >= never[rows], a, b, switch * 1.0), b)
+
+
+def test_the_gaussian_guess_lands_near_the_exact_count():
+    rng = np.random.default_rng(4)
+    lo = rng.uniform(100.0, 39000.0, 200)
+    hi = lo + rng.uniform(100.0, 15000.0, 200)
+    ratio = 10.0 ** rng.uniform(-3.5, -1.5, 200)
+    fs = float(PAPER.sample_rate_hz)
+    cum = ib._cumulative_g2(float(PAPER.tau_s), fs, 2000)
+    exact = ib.exact_ideal_min_contact(PAPER, lo, hi, ratio) * fs
+    guess = ib._gaussian_sample_guess(PAPER, lo, hi, 80.0, ratio, 0.9, cum)
+    both = np.isfinite(exact) & np.isfinite(guess)
+    assert both.sum() >= 100
+    # within the second probe (else the search costs a few calls more, never a different answer)
+    assert np.max(np.abs(guess[both] / exact[both] - 1.0)) < ib._GUESS_SPAN
+
+
+def test_efficiency_min_contact_is_the_first_sample_where_both_partners_separate():
+    # constant efficiency 1.3 over the range: the decision is monotone and the guessed bracket is used
+    lo, hi, ratio = 20000.0, 35000.0, 0.005
+    t = float(ib.efficiency_min_contact(PAPER, lo, hi, ratio, 1.0, 2.0, 1.3, 1.3, 4.0))
+    fs = float(PAPER.sample_rate_hz)
+    n = int(round(t * fs))
+    g = (hi - lo) / 1.3
+
+    def holds(k):
+        return _decides(lo, lo + g, ratio, k) and _decides(hi - g, hi, ratio, k)
+
+    assert holds(n) and not holds(n - 1)
+    assert t > float(ib.exact_ideal_min_contact(PAPER, lo, hi, ratio))
+
+
+@pytest.mark.parametrize("n", [5, 20, 40, 64])
+def test_the_quadrature_rule_is_numpys_gauss_legendre(n):
+    x, w = np.polynomial.legendre.leggauss(n)
+    gx, gw = ib._gauss_legendre(n)
+    assert np.max(np.abs(gx - x)) < 1e-15
+    assert np.max(np.abs(gw - w)) < 1e-14
+    # and it integrates polynomials up to degree 2n - 1 exactly
+    assert abs(np.sum(gw * gx ** (2 * n - 2)) - 2.0 / (2 * n - 1)) < 1e-13

@@ -1,0 +1,32 @@
+"""A reader that closes the pipe early (``designkit ... | head -1``) stops designkit quietly.
+
+Before, the command's write into the closed pipe was caught as an ``OSError`` and reported as bad input
+("Error: [Errno 32] Broken pipe", exit 2). Real pipes, real processes: the read end is closed before the
+command writes anything.
+"""
+
+import subprocess
+import sys
+
+import pytest
+
+
+@pytest.mark.parametrize("args", [
+    ["materials", "list"],
+    ["min-contact", "--e1", "35000", "--e2", "20000"],
+    ["min-contact", "--e1", "35000", "--e2", "20000", "--json"],
+    ["tables", "list", "--format", "csv"],
+])
+def test_a_closed_pipe_stops_the_command_without_an_error(args):
+    p = subprocess.Popen([sys.executable, "-m", "designkit", *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    p.stdout.close()  # the reader is gone before designkit prints
+    err = p.stderr.read().decode()
+    p.stderr.close()
+    assert p.wait(timeout=120) == 1  # click's status for a closed pipe
+    assert err == ""
+
+
+def test_the_same_commands_print_when_the_reader_stays():
+    out = subprocess.run([sys.executable, "-m", "designkit", "tables", "list", "--format", "csv"],
+                         capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0 and out.stdout.startswith("name") and out.stderr == ""

@@ -18,15 +18,14 @@ The ideal bound comes from an ideal-observer table (``ideal_table``) or the
 SVM table's own ideal arrays, interpolated the same way; ``distinguishable``
 computes the ideal F1 in closed form.
 
-``min-contact`` on an SVM table with ideal arrays (the closed-form ideal
-observer's, as ``designkit sweep`` writes them), where the model has a
-closed-form ideal observer, does not interpolate the SVM's need between
-tabulated contact times (it falls steeply there: interpolation missed the
-crossing by up to 40 %): it reads the SVM's *efficiency* (its need over the
-ideal observer's) at the tabulated contact times around the crossing and
-applies it to the exact ideal observer in between
-(:func:`efficiency_estimate`; on the coverage benchmark's pairs the 95th
-percentile error fell from 31 % to 12 %, docs/accuracy.md).
+``min-contact``, ``max-noise`` and ``min-delta-t`` on an SVM table, where the model
+has a closed-form ideal observer, do not interpolate the SVM's need between
+tabulated points (it falls steeply there): they read the SVM's *noise
+efficiency* k at the tabulated contact times around the answer (the noise at
+which the ideal observer needs the tabulated separation, over the table's) and
+apply it to the exact ideal observer (:func:`noise_k_min_contact`,
+:func:`noise_k_max_ratio`; docs/accuracy.md has their coverage). ``delta-e``
+reads the ratio of the needs (:func:`delta_efficiency_estimate`).
 
 Examples
 --------
@@ -67,7 +66,6 @@ __all__ = [
     "DEFAULT_IDEAL_TABLE",
     "CLOSED_FORM_MAX_CONTACT_S",
     "CLOSED_FORM_RATIO_BRACKET",
-    "efficiency_estimate",
     "delta_efficiency_estimate",
     "DEFAULT_TABLE",
     "GRID_RTOL",
@@ -391,93 +389,6 @@ def _table_se_log(svm, ideal, mc_lo, mc_hi, *, width: float, z_table: float) -> 
     return rounding, np.where(np.isfinite(mc), mc, 0.0)
 
 
-def efficiency_estimate(sensor, lo, hi, ratio, t_a, t_b, svm_a, svm_b, ideal_a, ideal_b, mc_lo, mc_hi, ideal, *,
-                        width: float, threshold: float, z_table: float, zc: float,
-                        entry_sd: float = 0.0) -> dict[str, np.ndarray]:
-    """min-contact's estimate from the SVM's *efficiency* against the exact ideal observer, elementwise.
-
-    Between tabulated contact times the SVM's need falls steeply, and interpolating it (linear or log-log)
-    misses the crossing by up to 40 % (docs/accuracy.md). The ideal observer's need has the same shape and is
-    exact at any contact time; what the table adds is how much more the SVM needs, its efficiency
-    ``eff = (svm need - w/2) / (ideal need - w/2)`` (both tabulated deltas are rounded up to the grid's width
-    ``w``: on average w/2). That ratio changes slowly, so it is read at the crossing's tabulated contact
-    ``t_b`` and the one before, ``t_a`` (log-linear in log t; constant where ``t_a``'s is unknown), and the
-    crossing is the first sample time where the ideal observer separates the pair with the gap divided by it
-    (:func:`designkit.query.ideal_bound.efficiency_min_contact`), searched up to ``t_b``. ``t_a`` may also be
-    the tabulated contact after ``t_b`` (where the one before has no need within the grid).
-
-    Its standard error in log t is that of log(eff) over the ideal need's local log-log slope ``beta``
-    (``t ~ (gap / eff)^(-1/beta)``): in quadrature, the Monte Carlo error of a tabulated need (the larger of
-    the table's own interval, its ``delta_lo``/``delta_hi`` needs ``mc_lo``/``mc_hi`` at ``t_b`` each ``z_table``
-    standard errors from the value, and ``entry_sd``, the scatter of the table's entries about their smooth
-    trend measured on the table itself: ``_View.entry_noise``), the rounding of both needs (SD ``w/sqrt(12)``
-    each), half the efficiency's change across the cell (the interpolation), and where the estimate lies
-    outside the two contact times (below the table's first), the change the efficiency's trend would make
-    over that distance (it is held constant there).
-
-    Parameters
-    ----------
-    sensor : Sensor
-    lo, hi, ratio : array_like
-        Pair [J s^-1/2 K^-1 m^-2] and sigma/dT [-].
-    t_a, t_b : array_like
-        Tabulated contact times around the crossing [s] (``t_b``: the first that suffices).
-    svm_a, svm_b, ideal_a, ideal_b : array_like
-        The SVM and the (tabulated) ideal needs there [J s^-1/2 K^-1 m^-2] (NaN: not within the grid).
-    mc_lo, mc_hi : array_like
-        The table's Monte Carlo ends of the SVM need at ``t_b``.
-    ideal : array_like
-        The exact ideal bound [s] (NaN: not computed); the interval never reaches below it unless the
-        estimate does.
-    width, threshold, z_table, zc : float
-        Grid width, F1 threshold, the table's z and the asked coverage's.
-
-    Returns
-    -------
-    dict of ndarray
-        ``value``, ``low``, ``high`` [s], ``efficiency`` (at ``t_b``) and ``se_log`` (NaN where it does
-        not apply: unknown needs or slope; the caller falls back to interpolation).
-
-    Examples
-    --------
-    The guideline pair on the shipped table's needs at 1.5 and 2 s (sigma/dT 0.005):
-
-    >>> from designkit.sensor import load_sensor
-    >>> r = efficiency_estimate(load_sensor("paper"), 20000.0, 35000.0, 0.005, 2.0, 1.5, 9040.0, 12240.0,
-    ...                         5840.0, 8880.0, 11200.0, 12240.0, 1.05, width=80.0, threshold=0.9,
-    ...                         z_table=2.0, zc=1.645, entry_sd=0.04)
-    >>> round(float(r["efficiency"]), 2), 1.05 < float(r["low"]) < float(r["value"]) < float(r["high"]) < 1.5
-    (1.38, True)
-    """
-    arrs = np.broadcast_arrays(*(np.asarray(a, dtype=np.float64) for a in (
-        lo, hi, ratio, t_a, t_b, svm_a, svm_b, ideal_a, ideal_b, mc_lo, mc_hi, ideal)))
-    lo, hi, ratio, t_a, t_b, svm_a, svm_b, ideal_a, ideal_b, mc_lo, mc_hi, ideal = arrs
-    h = 0.5 * width
-    eff_a, eff_b = _efficiency(svm_a, ideal_a, width), _efficiency(svm_b, ideal_b, width)
-    rounding, mc = _table_se_log(svm_b, ideal_b, mc_lo, mc_hi, width=width, z_table=z_table)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        beta = np.abs(np.log((ideal_a - h) / (ideal_b - h)) / np.log(t_a / t_b))
-        ok = ~np.isnan(eff_b) & np.isfinite(beta) & (beta > 0)
-        interp = np.where(np.isnan(eff_a), 0.0, 0.5 * np.abs(np.log(eff_b / eff_a)))
-        trend = np.where(np.isnan(eff_a), 0.0, np.abs(np.log(eff_b / eff_a) / np.log(t_b / t_a)))
-    value = np.full(lo.shape, np.nan)
-    if ok.any():
-        from .ideal_bound import cached_efficiency_min_contact
-
-        i = ok
-        value[i] = cached_efficiency_min_contact(sensor, lo[i], hi[i], ratio[i], t_a[i], t_b[i], eff_a[i], eff_b[i],
-                                                 t_b[i], width=width, threshold=threshold)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        outside = trend * np.maximum(np.log(np.fmin(t_a, t_b) / value), 0.0)
-        se = np.hypot(np.hypot(np.maximum(mc, entry_sd), rounding), np.hypot(interp, outside)) / beta
-        low = value * np.exp(-zc * se)
-        low = np.where(np.isnan(low) | np.isnan(ideal), low, np.minimum(np.maximum(low, ideal), value))
-        high = value * np.exp(zc * se)
-    nan = ~ok
-    return {"value": value, "low": np.where(nan, np.nan, low), "high": np.where(nan, np.nan, high),
-            "efficiency": np.where(nan, np.nan, eff_b), "se_log": np.where(nan, np.nan, se)}
-
-
 # ============================================================ the noise efficiency (min-contact)
 def _interp_at(arr3d: np.ndarray, centres: np.ndarray, si: np.ndarray, j: np.ndarray, e: np.ndarray) -> np.ndarray:
     """:func:`designkit.tables.lookup.interp_e` of ``arr3d[si[p], j[p]]`` (a [slice, contact, centre] array) at
@@ -496,8 +407,8 @@ def _k_readings(op, slices, sw, ka, kb, lo, hi, extra=None):
     """The noise efficiency ``log k`` and its standard error at the tabulated contacts ``ka`` and ``kb`` (rows
     0 and 1 of the (2, n) arrays; NaN: no usable entry), per pair, from the pair's own entries (upwards at
     ``lo``, downwards at ``hi``) in the noise-ratio slices ``slices`` (n, m) weighted ``sw`` (n, m); see
-    :func:`noise_k_min_contact`. ``extra``: (lo, hi, s_lo, s_hi) of further critical noises computed in the
-    same bisection, returned third (or None)."""
+    :func:`noise_k_min_contact`. ``extra``: (lo, hi) of further pairs whose critical noises are computed in
+    the same call, returned third (or None)."""
     from .ideal_bound import cached_critical_noise, shape_norm
 
     view, tab = op.view, op.tab
@@ -536,11 +447,10 @@ def _k_readings(op, slices, sw, ka, kb, lo, hi, extra=None):
     a2, b2 = pair_of(D - h + width)
     a2 = np.maximum(a2, 0.0)
     m = P.size
-    xa, xb, xl, xh = extra if extra is not None else (np.zeros(0),) * 4
-    # one bisection: every entry at its need and one width further (and the extra pairs)
-    star = cached_critical_noise(sensor, np.concatenate([a1, a2, xa]), np.concatenate([b1, b2, xb]),
-                                 np.concatenate([0.25 * s_t, 0.25 * s_t, xl]),
-                                 np.concatenate([12.0 * s_t, 12.0 * s_t, xh]), width=width, threshold=op.phi)
+    xa, xb = extra if extra is not None else (np.zeros(0),) * 2
+    # one computation: every entry at its need and one width further (and the extra pairs)
+    star = cached_critical_noise(sensor, np.concatenate([a1, a2, xa]), np.concatenate([b1, b2, xb]), width=width,
+                                 threshold=op.phi)
     s1, s2 = star[:m], star[m:2 * m]
     with np.errstate(divide="ignore", invalid="ignore"):
         log_k = np.log(s1 / s_t)
@@ -549,13 +459,25 @@ def _k_readings(op, slices, sw, ka, kb, lo, hi, extra=None):
                       np.where(np.isfinite(DL) & (DL > h), np.log((D - h) / (DL - h)) / z_table, 0.0))
         sd = np.maximum(np.abs(gamma) * np.hypot(rnd_sd / (D - h), mc), 1e-3)
     good = np.isfinite(log_k) & np.isfinite(sd)
-    om = np.where(good, W / sd ** 2, 0.0)
+    wg = np.where(good, W, 0.0)
     lk, se = np.full((2, n), np.nan), np.full((2, n), np.nan)
     for c in (0, 1):
-        sel = Cc == c
-        num = np.bincount(P[sel], om[sel] * np.where(good[sel], log_k[sel], 0.0), minlength=n)
-        den = np.bincount(P[sel], om[sel], minlength=n)
-        var = np.bincount(P[sel], om[sel] ** 2 * np.where(good[sel], sd[sel] ** 2, 0.0), minlength=n)
+        # the noise-ratio slices of one direction share their touches and noise draws (the sweep seeds an
+        # interval's trials by the interval, not the scene; the noise is scaled): their errors are taken as
+        # fully correlated (a weighted mean of the readings and of their errors); the two directions read
+        # different rows of the staircase and are combined as independent (inverse variance)
+        num, den = np.zeros(n), np.zeros(n)
+        var = np.zeros(n)
+        for sign in (+1, -1):
+            sel = (Cc == c) & (SIGN == sign)
+            ws = np.bincount(P[sel], wg[sel], minlength=n)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                m_d = np.bincount(P[sel], wg[sel] * np.where(good[sel], log_k[sel], 0.0), minlength=n) / ws
+                s_d = np.bincount(P[sel], wg[sel] * np.where(good[sel], sd[sel], 0.0), minlength=n) / ws
+                om = np.where(ws > 0, 1.0 / s_d ** 2, 0.0)
+            num += np.where(ws > 0, om * m_d, 0.0)
+            den += om
+            var += np.where(ws > 0, om ** 2 * s_d ** 2, 0.0)
         with np.errstate(divide="ignore", invalid="ignore"):
             lk[c] = np.where(den > 0, num / den, np.nan)
             se[c] = np.where(den > 0, np.sqrt(var) / den, np.nan)
@@ -612,8 +534,9 @@ def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
     answer is the first sample time where ``k(t) s(t)`` reaches the pair's own critical noise
     (:func:`~designkit.query.ideal_bound.noise_k_contact`).
 
-    Standard error of ``log k`` at a contact: the entries' inverse-variance mean, each entry's in log k
-    the local slope ``gamma = dlog s*/dlog need`` (a second critical noise, one width further) times its
+    Standard error of ``log k`` at a contact: per direction the slices' weighted mean (their errors fully
+    correlated: the same touches), the two directions by inverse variance; each entry's in log k the local
+    slope ``gamma = dlog s*/dlog need`` (a second critical noise, one width further) times its
     need's relative error: the grid's rounding (w/sqrt(12)) and the table's Monte Carlo interval
     (``delta_lo`` / ``delta_hi``, ``z`` standard errors each). Between the two contacts: ``(1-u)`` and ``u``
     weights, plus ``u (1-u)`` times half the change of ``log k`` across the cell (interpolation; the
@@ -647,8 +570,7 @@ def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
     ka = np.where(kb > 0, kb - 1, kb + 1)
     ka = np.where(ka < nc, ka, -1)
     slices, sw = _slices(combos, n)
-    lk, se, s_pair = _k_readings(op, slices, sw, ka, kb, lo, hi,
-                                 extra=(lo, hi, np.full(n, 1e-7), np.full(n, 10.0)))
+    lk, se, s_pair = _k_readings(op, slices, sw, ka, kb, lo, hi, extra=(lo, hi))
     t_a, t_b = view.contacts[np.where(ka >= 0, ka, kb)], view.contacts[kb]
     la_, lb_, have_a, have_b, falls, wa, wb, disagree = _k_line(lk, se, t_a, t_b)
     ok = have_a | have_b
@@ -687,7 +609,7 @@ def noise_k_max_ratio(op, contact_s, r_table, r_ideal, lo, hi, *, zc: float) -> 
     view = op.view
     contact, r_table, r_ideal, lo, hi = (np.atleast_1d(a) for a in np.broadcast_arrays(*(
         np.asarray(x, dtype=np.float64) for x in (contact_s, r_table, r_ideal, lo, hi))))
-    n, C = lo.size, view.contacts
+    C = view.contacts
     kb = np.clip(np.searchsorted(C, contact, side="left"), 0, C.size - 1)  # the first contact >= the asked one
     ka = np.where(C[kb] == contact, kb, np.maximum(kb - 1, 0))
     lr, lrt = np.log(view.t.axes["noise_ratio"]), np.log(r_table)
@@ -773,7 +695,7 @@ def delta_efficiency_estimate(sensor, e, contact_s, ratio, direction, t_a, t_b, 
                               zc: float, entry_sd=0.0) -> dict[str, np.ndarray]:
     """delta-e's estimate of one direction from the SVM's efficiency against the exact ideal observer.
 
-    As :func:`efficiency_estimate` for min-contact: the SVM's efficiency ``eff = (svm need - w/2) / (ideal
+    The SVM's efficiency ``eff = (svm need - w/2) / (ideal
     need - w/2)`` at the tabulated contact times ``t_a``, ``t_b`` around ``contact_s`` (log-linear in log t;
     the known one where the other is NaN) times the ideal observer's delta(e) computed exactly at
     ``contact_s`` (:func:`designkit.query.ideal_bound.exact_ideal_delta`): no interpolation of the steep need
@@ -1161,37 +1083,6 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
     return _answer("min-contact", op, value=value, interval=interval, ideal=ideal, ideal_method=ideal_method,
                    in_grid=flags, details={}, notes=[note], check_at=(needed, noise, dt),
                    interval_kind=kind, interval_coverage=cov, computation=monte_carlo, **common)
-
-
-def _second_contact(k: int, n: int, svm, ideal) -> int | None:
-    """The tabulated contact paired with the crossing's ``k`` for the efficiency: the one before where both
-    needs (``svm(j)``, ``ideal(j)``) are known there, else the one after, else whichever has an ideal need
-    (the slope only; the efficiency is then held constant). None: neither neighbour has one."""
-    near = [j for j in (k - 1, k + 1) if 0 <= j < n]
-    for j in near:
-        if not (math.isnan(svm(j)) or math.isnan(ideal(j))):
-            return j
-    return next((j for j in near if not math.isnan(ideal(j))), None)
-
-
-def _efficiency_at(view: _View, combos, k: int, lo: float, hi: float, need_b: float, ratio: float, ideal,
-                   op: _Opened, zc: float) -> dict | None:
-    """:func:`efficiency_estimate` for one pair whose table crossing is at contact index ``k`` (None: it does
-    not apply), the second tabulated contact chosen by :func:`_second_contact`."""
-    n = view.contacts.size
-    ideal_b = view.need("ideal", combos, k, lo, hi)
-    a = _second_contact(k, n, lambda j: view.need("svm", combos, j, lo, hi),
-                        lambda j: view.need("ideal", combos, j, lo, hi))
-    if a is None:
-        return None
-    r = efficiency_estimate(op.tab.sensor, lo, hi, ratio, view.contacts[a], view.contacts[k],
-                            view.need("svm", combos, a, lo, hi), need_b, view.need("ideal", combos, a, lo, hi),
-                            ideal_b, view.need("lo", combos, k, lo, hi), view.need("hi", combos, k, lo, hi),
-                            math.nan if ideal is None else ideal, width=op.width, threshold=op.phi,
-                            z_table=table_z(op.tab), zc=zc, entry_sd=view.entry_noise(combos))
-    if math.isnan(float(r["value"])):
-        return None
-    return {key: float(v) for key, v in r.items()}
 
 
 # ============================================================ max-noise / min-delta-t

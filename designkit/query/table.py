@@ -574,7 +574,8 @@ def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
         var_k = _k_var(u, se, la_, lb_, have_a, have_b, falls, wa, wb, disagree,
                        np.log(value / np.where(have_a, t_a, t_b)))
         slope_k = np.where(have_a & have_b & (t_a != t_b), (lb_ - la_) / np.log(t_b / t_a), 0.0)
-        beta_g = np.log(shape_norm(sensor, value * 1.05) / shape_norm(sensor, value / 1.05)) / (2 * math.log(1.05))
+        v_ok = np.where(ok, value, 1.0)  # (shape_norm takes finite contact times only)
+        beta_g = np.log(shape_norm(sensor, v_ok * 1.05) / shape_norm(sensor, v_ok / 1.05)) / (2 * math.log(1.05))
         se_t = np.sqrt(var_k) / np.maximum(beta_g - slope_k, 0.05)
         low, high = value * np.exp(-zc * se_t), value * np.exp(zc * se_t)
         k_at = np.exp(np.maximum(la_ + slope_k * np.log(value / t_a), 0.0))
@@ -1034,7 +1035,7 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
     interval: tuple = (None, None)
     kind, cov = "none", None
     eff = None
-    if value is not None and op.tab.fidelity == "svm" and op.closed and "delta_up_lo" in view.t.arrays:
+    if value is not None and op.tab.fidelity == "svm" and op.closed and "delta_up_ideal" in view.t.arrays:
         r = noise_k_min_contact(op, combos, [k_cross], [lo], [hi], [noise / abs(dt)], zc=z_of_coverage(coverage))
         if not math.isnan(float(r["value"][0])):
             eff = {key: float(v[0]) for key, v in r.items()}
@@ -1183,7 +1184,8 @@ def _ratio_question(question: str, e1, e2, m1, m2, objects, contact_s, noise_c, 
     kind, cov = "none", None
     computation = {"monte_carlo_interval": list(mc)}
     kr = None
-    if where in ("inside", "cell") and op.tab.fidelity == "svm" and op.closed and out["ideal"][1] != "below":
+    if (where in ("inside", "cell") and op.tab.fidelity == "svm" and op.closed and out["ideal"][1] != "below"
+            and "delta_up_ideal" in view.t.arrays):
         kr = noise_k_max_ratio(op, contact, r, out["ideal"][0], lo, hi, zc=z_of_coverage(coverage))
         kr = None if math.isnan(float(kr["value"][0])) else {key: float(v[0]) for key, v in kr.items()}
     if kr is not None:

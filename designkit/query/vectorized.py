@@ -316,7 +316,7 @@ def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> None
     k_cross = np.full(lo.size, -1)
     n_prev, n_at = _nan(lo.size), _nan(lo.size)  # the svm need at the contact before the crossing, and at it
     # the scalar route's noise-efficiency estimate (table.noise_k_min_contact, the same function), per scene
-    efficiency = svm and op.closed and "delta_up_lo" in view.t.arrays
+    efficiency = svm and op.closed and "delta_up_ideal" in view.t.arrays
     eff = {k: _nan(lo.size) for k in ("value", "low", "high")}
     for (noise, dt), idx in _groups(x["noise_c"], x["delta_t_c"]):
         combos, flags = view.scene_weights(noise, dt)
@@ -487,7 +487,8 @@ def _ratio(question, x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> 
     low, high = _nan(n), _nan(n)
     # the scalar route's noise-efficiency estimate (table.noise_k_max_ratio, the same function) where it applies
     by_k = np.zeros(n, dtype=bool)
-    if svm and op.closed and (cand := ((where_all == _INSIDE) | (where_all == _CELL)) & ~np.isnan(ri)).any():
+    if (svm and op.closed and "delta_up_ideal" in view.t.arrays
+            and (cand := ((where_all == _INSIDE) | (where_all == _CELL)) & ~np.isnan(ri)).any()):
         i = np.nonzero(cand)[0]
         kr = _table_route.noise_k_max_ratio(op, x["contact_s"][i], r_all[i], ri[i], lo[i], hi[i], zc=zc)
         got = ~np.isnan(kr["value"])

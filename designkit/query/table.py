@@ -457,21 +457,26 @@ def _k_readings(op, slices, sw, ka, kb, lo, hi, extra=None):
         gamma = np.log(s2 / s1) / np.log((D - h + width) / (D - h))
         mc = np.where(np.isfinite(DH) & np.isfinite(DL) & (DL > h), np.log((DH - h) / (DL - h)) / (2.0 * z_table),
                       np.where(np.isfinite(DL) & (DL > h), np.log((D - h) / (DL - h)) / z_table, 0.0))
-        sd = np.maximum(np.abs(gamma) * np.hypot(rnd_sd / (D - h), mc), 1e-3)
+        rnd = np.abs(gamma) * rnd_sd / (D - h)
+        mck = np.abs(gamma) * mc
+        sd = np.maximum(np.hypot(rnd, mck), 1e-3)
     good = np.isfinite(log_k) & np.isfinite(sd)
-    # the entries' errors are combined as independent (inverse variance, times the slices' interpolation
-    # weights): measured on svm-paper, the residuals of log k about each slice's trend correlate 0.14 between
-    # neighbouring noise-ratio slices and 0.07 between neighbouring contact times (same row and direction)
+    # the entries' Monte Carlo errors are combined as independent (measured on svm-paper, the residuals of
+    # log k about each slice's trend correlate 0.14 between neighbouring noise-ratio slices and 0.07 between
+    # neighbouring contact times, needs >= 5 widths); their rounding errors are not: the grid rounds the
+    # similar needs of neighbouring entries the same way (at needs under 5 widths neighbouring readings of
+    # log k are identical), so the rounding term is the entries' weighted mean, not reduced by averaging
     om = np.where(good, W / sd ** 2, 0.0)
     lk, se = np.full((2, n), np.nan), np.full((2, n), np.nan)
     for c in (0, 1):
         sel = Cc == c
         num = np.bincount(P[sel], om[sel] * np.where(good[sel], log_k[sel], 0.0), minlength=n)
         den = np.bincount(P[sel], om[sel], minlength=n)
-        var = np.bincount(P[sel], om[sel] ** 2 * np.where(good[sel], sd[sel] ** 2, 0.0), minlength=n)
+        var = np.bincount(P[sel], om[sel] ** 2 * np.where(good[sel], mck[sel] ** 2, 0.0), minlength=n)
+        rnd_mean = np.bincount(P[sel], om[sel] * np.where(good[sel], rnd[sel], 0.0), minlength=n)
         with np.errstate(divide="ignore", invalid="ignore"):
             lk[c] = np.where(den > 0, num / den, np.nan)
-            se[c] = np.where(den > 0, np.sqrt(var) / den, np.nan)
+            se[c] = np.where(den > 0, np.hypot(np.sqrt(var) / den, rnd_mean / den), np.nan)
     return lk, se, (star[2 * m:] if extra is not None else None)
 
 
@@ -525,8 +530,9 @@ def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
     answer is the first sample time where ``k(t) s(t)`` reaches the pair's own critical noise
     (:func:`~designkit.query.ideal_bound.noise_k_contact`).
 
-    Standard error of ``log k`` at a contact: the entries' inverse-variance mean (their errors are nearly
-    independent, measured on the table), each entry's in log k the local slope
+    Standard error of ``log k`` at a contact: the entries' inverse-variance mean (their Monte Carlo errors
+    nearly independent, measured on the table; their rounding errors alike, so that term is not reduced by
+    averaging), each entry's in log k the local slope
     ``gamma = dlog s*/dlog need`` (a second critical noise, one width further) times its need's relative
     error: the grid's rounding (w/sqrt(12)) and the table's Monte Carlo interval
     (``delta_lo`` / ``delta_hi``, ``z`` standard errors each). Between the two contacts: ``(1-u)`` and ``u``

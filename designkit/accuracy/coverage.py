@@ -255,11 +255,11 @@ def summarize(results: Iterable[Mapping[str, Any]], question: str, route: str, *
               min_gap: float | None = None) -> dict[str, Any]:
     """Coverage and error of one (question, route) over benchmark results.
 
-    Only cases with both an answer and a reference value count for the error; only those
-    with a stated coverage for ``coverage``. ``min_gap``: only pairs at least this far apart.
+    Only cases with both an answer and a reference estimate (a reference with a stated coverage, not
+    a search bracket) count for the error; only those with a stated coverage for ``coverage``. ``min_gap``: only pairs at least this far apart.
 
-    >>> r = [{"question": "q", "reference": {"value": 1.0}, "table": {"value": 1.1, "low": 0.9, "high": 1.2,
-    ...       "coverage": 0.9}}]
+    >>> r = [{"question": "q", "reference": {"value": 1.0, "coverage": 0.9}, "table": {"value": 1.1, "low": 0.9,
+    ...       "high": 1.2, "coverage": 0.9}}]
     >>> s = summarize(r, "q", "table"); s["coverage"], round(s["median_rel"], 3)
     (1.0, 0.1)
     """
@@ -267,8 +267,15 @@ def summarize(results: Iterable[Mapping[str, Any]], question: str, route: str, *
     # an answer at the edge of a table's axis ("separable even at the largest noise ratio: at least this")
     # is a one-sided bound, not an estimate: counted apart, not as an error
     edge = [r for r in rows if r[route]["value"] is not None and r[route].get("in_grid") is False]
+    # a reference that is only a search bracket (too few informative evaluations for a fit: no stated
+    # coverage, its value the bracket's geometric middle) is no measurement: counted apart, with how often
+    # the answer lies inside that bracket
+    bracket = [r for r in rows if r[route]["value"] is not None and r["reference"]["value"] is not None
+               and not isinstance(r["reference"]["value"], bool) and not r["reference"].get("coverage")
+               and r[route].get("in_grid") is not False]
     both = [r for r in rows if r[route]["value"] is not None and r["reference"]["value"] is not None
-            and not isinstance(r["reference"]["value"], bool) and r[route].get("in_grid") is not False]
+            and not isinstance(r["reference"]["value"], bool) and r[route].get("in_grid") is not False
+            and r["reference"].get("coverage")]
     err = np.array([abs(r[route]["value"] - r["reference"]["value"]) for r in both], dtype=np.float64)
     rel = np.array([abs(r[route]["value"] - r["reference"]["value"]) / abs(r["reference"]["value"])
                     for r in both if r["reference"]["value"] != 0], dtype=np.float64)
@@ -283,6 +290,9 @@ def summarize(results: Iterable[Mapping[str, Any]], question: str, route: str, *
         "unstated_contains": float(np.mean([_covered(r[route], r["reference"]["value"]) for r in unstated]))
         if unstated else None,
         "n_no_answer": sum(1 for r in rows if r[route]["value"] is None),
+        "n_reference_bracket": len(bracket),
+        "reference_bracket_contains": sum(1 for r in bracket if (r["reference"]["low"] or -math.inf)
+                                          <= r[route]["value"] <= (r["reference"]["high"] or math.inf)),
         "n_edge_bound": len(edge),
         "edge_bound_holds": sum(1 for r in edge if r["reference"]["value"] is not None and _covered(
             r[route], r["reference"]["value"])),

@@ -68,11 +68,13 @@ INTERVAL_MEANING = {
                       "(rescaled from the table's z to the coverage) combined with the interpolation error "
                       "between grid points (the difference between linear and log-log interpolation); "
                       "never beyond the ideal-observer bound",
-    "table-efficiency": "interval at the stated coverage: the SVM's efficiency (its tabulated delta(e) over the "
-                        "ideal observer's, at the two tabulated contact times around the crossing, log-linear in "
-                        "log t) applied to the exact ideal observer in between; it combines the table's Monte Carlo "
-                        "interval, the rounding of tabulated deltas to the grid and the efficiency's change across "
-                        "the cell; never below the ideal-observer bound",
+    "table-efficiency": "interval at the stated coverage: the SVM's efficiency read from the table at the "
+                        "tabulated contact times around the answer (min-contact, max-noise, min-delta-t: its noise "
+                        "efficiency, the noise at which the ideal observer needs the tabulated separation over the "
+                        "table's; delta-e: its tabulated delta(e) over the ideal observer's), log-linear in log t, "
+                        "applied to the exact ideal observer; it combines the tabulated needs' rounding and Monte "
+                        "Carlo interval and the efficiency's change across the cell; never beyond the "
+                        "ideal-observer bound",
     "table-cell": "the grid cell the crossing lies in, from the last tabulated value where the pair is not "
                   "separable to the first where it is: the grid cannot support an interval of stated "
                   "coverage here (a neighbour is beyond the grid)",

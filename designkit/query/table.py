@@ -18,15 +18,14 @@ The ideal bound comes from an ideal-observer table (``ideal_table``) or the
 SVM table's own ideal arrays, interpolated the same way; ``distinguishable``
 computes the ideal F1 in closed form.
 
-``min-contact`` on an SVM table with ideal arrays (the closed-form ideal
-observer's, as ``designkit sweep`` writes them), where the model has a
-closed-form ideal observer, does not interpolate the SVM's need between
-tabulated contact times (it falls steeply there: interpolation missed the
-crossing by up to 40 %): it reads the SVM's *efficiency* (its need over the
-ideal observer's) at the tabulated contact times around the crossing and
-applies it to the exact ideal observer in between
-(:func:`efficiency_estimate`; on the coverage benchmark's pairs the 95th
-percentile error fell from 31 % to 12 %, docs/accuracy.md).
+``min-contact``, ``max-noise`` and ``min-delta-t`` on an SVM table, where the model
+has a closed-form ideal observer, do not interpolate the SVM's need between
+tabulated points (it falls steeply there): they read the SVM's *noise
+efficiency* k at the tabulated contact times around the answer (the noise at
+which the ideal observer needs the tabulated separation, over the table's) and
+apply it to the exact ideal observer (:func:`noise_k_min_contact`,
+:func:`noise_k_max_ratio`; docs/accuracy.md has their coverage). ``delta-e``
+reads the ratio of the needs (:func:`delta_efficiency_estimate`).
 
 Examples
 --------
@@ -67,7 +66,6 @@ __all__ = [
     "DEFAULT_IDEAL_TABLE",
     "CLOSED_FORM_MAX_CONTACT_S",
     "CLOSED_FORM_RATIO_BRACKET",
-    "efficiency_estimate",
     "delta_efficiency_estimate",
     "DEFAULT_TABLE",
     "GRID_RTOL",
@@ -81,6 +79,8 @@ __all__ = [
     "max_noise",
     "min_contact",
     "min_delta_t",
+    "noise_k_max_ratio",
+    "noise_k_min_contact",
     "open_table",
     "ratio_estimate",
     "stated_log",
@@ -389,91 +389,245 @@ def _table_se_log(svm, ideal, mc_lo, mc_hi, *, width: float, z_table: float) -> 
     return rounding, np.where(np.isfinite(mc), mc, 0.0)
 
 
-def efficiency_estimate(sensor, lo, hi, ratio, t_a, t_b, svm_a, svm_b, ideal_a, ideal_b, mc_lo, mc_hi, ideal, *,
-                        width: float, threshold: float, z_table: float, zc: float,
-                        entry_sd: float = 0.0) -> dict[str, np.ndarray]:
-    """min-contact's estimate from the SVM's *efficiency* against the exact ideal observer, elementwise.
+# ============================================================ the noise efficiency (min-contact)
+def _interp_at(arr3d: np.ndarray, centres: np.ndarray, si: np.ndarray, j: np.ndarray, e: np.ndarray) -> np.ndarray:
+    """:func:`designkit.tables.lookup.interp_e` of ``arr3d[si[p], j[p]]`` (a [slice, contact, centre] array) at
+    ``e[p]``, per p."""
+    n = centres.size
+    c = np.clip(np.searchsorted(centres, e, side="right") - 1, 0, n - 2)
+    a, b = arr3d[si, j, c], arr3d[si, j, c + 1]
+    w = (e - centres[c]) / (centres[c + 1] - centres[c])
+    with np.errstate(invalid="ignore"):
+        out = np.where(w == 0.0, a, np.where(np.isnan(a) | np.isnan(b), np.nan, a + w * (b - a)))
+    out = np.where(e >= centres[-1], arr3d[si, j, n - 1], out)
+    return np.where(e <= centres[0], arr3d[si, j, 0], out)
 
-    Between tabulated contact times the SVM's need falls steeply, and interpolating it (linear or log-log)
-    misses the crossing by up to 40 % (docs/accuracy.md). The ideal observer's need has the same shape and is
-    exact at any contact time; what the table adds is how much more the SVM needs, its efficiency
-    ``eff = (svm need - w/2) / (ideal need - w/2)`` (both tabulated deltas are rounded up to the grid's width
-    ``w``: on average w/2). That ratio changes slowly, so it is read at the crossing's tabulated contact
-    ``t_b`` and the one before, ``t_a`` (log-linear in log t; constant where ``t_a``'s is unknown), and the
-    crossing is the first sample time where the ideal observer separates the pair with the gap divided by it
-    (:func:`designkit.query.ideal_bound.efficiency_min_contact`), searched up to ``t_b``. ``t_a`` may also be
-    the tabulated contact after ``t_b`` (where the one before has no need within the grid).
 
-    Its standard error in log t is that of log(eff) over the ideal need's local log-log slope ``beta``
-    (``t ~ (gap / eff)^(-1/beta)``): in quadrature, the Monte Carlo error of a tabulated need (the larger of
-    the table's own interval, its ``delta_lo``/``delta_hi`` needs ``mc_lo``/``mc_hi`` at ``t_b`` each ``z_table``
-    standard errors from the value, and ``entry_sd``, the scatter of the table's entries about their smooth
-    trend measured on the table itself: ``_View.entry_noise``), the rounding of both needs (SD ``w/sqrt(12)``
-    each), half the efficiency's change across the cell (the interpolation), and where the estimate lies
-    outside the two contact times (below the table's first), the change the efficiency's trend would make
-    over that distance (it is held constant there).
+def _k_readings(op, slices, sw, ka, kb, lo, hi, extra=None):
+    """The noise efficiency ``log k`` and its standard error at the tabulated contacts ``ka`` and ``kb`` (rows
+    0 and 1 of the (2, n) arrays; NaN: no usable entry), per pair, from the pair's own entries (upwards at
+    ``lo``, downwards at ``hi``) in the noise-ratio slices ``slices`` (n, m) weighted ``sw`` (n, m); see
+    :func:`noise_k_min_contact`. ``extra``: (lo, hi) of further pairs whose critical noises are computed in
+    the same call, returned third (or None)."""
+    from .ideal_bound import cached_critical_noise, shape_norm
+
+    view, tab = op.view, op.tab
+    sensor, width = tab.sensor, op.width
+    z_table = table_z(tab)
+    n = lo.size
+    h, rnd_sd = 0.5 * width, width / math.sqrt(12.0)
+    ratios = view.t.axes["noise_ratio"]
+    P, Cc, W, D, DL, DH, SIGN, RS, T = ([] for _ in range(9))
+    for c, j in ((0, ka), (1, kb)):
+        ok_j = (j >= 0) & (j < view.contacts.size)
+        jj = np.clip(j, 0, view.contacts.size - 1)
+        t = view.contacts[jj]
+        for col in range(slices.shape[1]):
+            si, ws = slices[:, col], sw[:, col]
+            for sign, e, name in ((+1, lo, "delta_up"), (-1, hi, "delta_down")):
+                d = _interp_at(view.t.arrays[name], view.centres, si, jj, e)
+                dl = _interp_at(view.t.arrays[f"{name}_lo"], view.centres, si, jj, e)
+                dh = _interp_at(view.t.arrays[f"{name}_hi"], view.centres, si, jj, e)
+                ok = np.isfinite(d) & (d > width) & ok_j & (ws > 0)
+                if sign < 0:
+                    ok &= e - (d - h) > 0
+                p = np.nonzero(ok)[0]
+                P.append(p), Cc.append(np.full(p.size, c)), W.append(ws[p]), D.append(d[p])
+                DL.append(dl[p]), DH.append(dh[p]), SIGN.append(np.full(p.size, sign))
+                RS.append(ratios[si[p]]), T.append(t[p])
+    P, Cc, W, D, DL, DH, SIGN, RS, T = (np.concatenate(x) for x in (P, Cc, W, D, DL, DH, SIGN, RS, T))
+    P, Cc = P.astype(np.int64), Cc.astype(np.int64)
+    e_ref = np.where(SIGN > 0, lo[P], hi[P])
+    s_t = RS / shape_norm(sensor, T) if T.size else np.zeros(0)
+
+    def pair_of(d):  # the entry's pair of lower edges at distance d from its reference
+        return np.where(SIGN > 0, e_ref, e_ref - d), np.where(SIGN > 0, e_ref + d, e_ref)
+
+    a1, b1 = pair_of(D - h)
+    a2, b2 = pair_of(D - h + width)
+    a2 = np.maximum(a2, 0.0)
+    m = P.size
+    xa, xb = extra if extra is not None else (np.zeros(0),) * 2
+    # one computation: every entry at its need and one width further (and the extra pairs)
+    star = cached_critical_noise(sensor, np.concatenate([a1, a2, xa]), np.concatenate([b1, b2, xb]), width=width,
+                                 threshold=op.phi)
+    s1, s2 = star[:m], star[m:2 * m]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        log_k = np.log(s1 / s_t)
+        gamma = np.log(s2 / s1) / np.log((D - h + width) / (D - h))
+        mc = np.where(np.isfinite(DH) & np.isfinite(DL) & (DL > h), np.log((DH - h) / (DL - h)) / (2.0 * z_table),
+                      np.where(np.isfinite(DL) & (DL > h), np.log((D - h) / (DL - h)) / z_table, 0.0))
+        rnd = np.abs(gamma) * rnd_sd / (D - h)
+        mck = np.abs(gamma) * mc
+        sd = np.maximum(np.hypot(rnd, mck), 1e-3)
+    good = np.isfinite(log_k) & np.isfinite(sd)
+    # the entries' Monte Carlo errors are combined as independent (measured on svm-paper, the residuals of
+    # log k about each slice's trend correlate 0.14 between neighbouring noise-ratio slices and 0.07 between
+    # neighbouring contact times, needs >= 5 widths); their rounding errors are not: the grid rounds the
+    # similar needs of neighbouring entries the same way (at needs under 5 widths neighbouring readings of
+    # log k are identical), so the rounding term is the entries' weighted mean, not reduced by averaging
+    om = np.where(good, W / sd ** 2, 0.0)
+    lk, se = np.full((2, n), np.nan), np.full((2, n), np.nan)
+    for c in (0, 1):
+        sel = Cc == c
+        num = np.bincount(P[sel], om[sel] * np.where(good[sel], log_k[sel], 0.0), minlength=n)
+        den = np.bincount(P[sel], om[sel], minlength=n)
+        var = np.bincount(P[sel], om[sel] ** 2 * np.where(good[sel], mck[sel] ** 2, 0.0), minlength=n)
+        rnd_mean = np.bincount(P[sel], om[sel] * np.where(good[sel], rnd[sel], 0.0), minlength=n)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            lk[c] = np.where(den > 0, num / den, np.nan)
+            se[c] = np.where(den > 0, np.hypot(np.sqrt(var) / den, rnd_mean / den), np.nan)
+    return lk, se, (star[2 * m:] if extra is not None else None)
+
+
+def _k_line(lk, se, t_a, t_b):
+    """``log k`` at ``t_a`` and ``t_b`` (one held at the other's where it has no reading; two that fall pooled:
+    k never falls with contact time, on svm-paper the slice medians rise at every step in every slice), the
+    weights and the readings' disagreement where they fell."""
+    have_a, have_b = np.isfinite(lk[0]), np.isfinite(lk[1])
+    la_, lb_ = np.where(have_a, lk[0], lk[1]), np.where(have_b, lk[1], lk[0])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        wa, wb = np.where(have_a, 1.0 / se[0] ** 2, 0.0), np.where(have_b, 1.0 / se[1] ** 2, 0.0)
+        falls = have_a & have_b & ((lb_ - la_) * np.sign(np.log(t_b / t_a)) < 0)
+        pooled = (np.nan_to_num(la_) * wa + np.nan_to_num(lb_) * wb) / (wa + wb)
+        disagree = np.where(falls, np.abs(lb_ - la_), 0.0)
+    la_, lb_ = np.where(falls, pooled, la_), np.where(falls, pooled, lb_)
+    return la_, lb_, have_a, have_b, falls, wa, wb, disagree
+
+
+def _k_var(u, se, la_, lb_, have_a, have_b, falls, wa, wb, disagree, far):
+    """Variance of ``log k`` at fraction ``u`` of the way from ``t_a`` to ``t_b`` (``far``: log distance to
+    the one reading where only one exists)."""
+    dk = np.abs(lb_ - la_)
+    v = np.where(have_a & have_b, ((1 - u) * se[0]) ** 2 + (u * se[1]) ** 2 + (u * (1 - u) * dk / 2) ** 2,
+                 np.where(have_a, se[0], se[1]) ** 2 + (0.5 * far) ** 2)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(falls, 1.0 / (wa + wb) + (disagree / 2) ** 2, v)
+
+
+def _slices(combos, n):
+    """Shared scene weights as per-pair slice arrays (n, m)."""
+    live = [(idx[0], w) for idx, w in combos if w]
+    return (np.tile(np.array([i for i, _ in live], dtype=np.int64), (n, 1)),
+            np.tile(np.array([w for _, w in live], dtype=np.float64), (n, 1)))
+
+
+def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
+                        max_contact_s: float = CLOSED_FORM_MAX_CONTACT_S) -> dict[str, np.ndarray]:
+    """min-contact from the SVM's *noise efficiency* against the exact ideal observer, for pairs of one scene.
+
+    The SVM separates a pair when the ideal observer would at a larger noise: ``k(t)`` times the projection
+    noise ``s(t) = (sigma/dT) / |g(t)|`` (:mod:`designkit.query.ideal_bound`). Every tabulated need gives
+    one reading of ``k``: the noise at which the ideal observer needs exactly that separation (less the
+    grid's rounding, w/2: :func:`~designkit.query.ideal_bound.critical_noise`) over ``s(t)`` of its slice.
+    ``k`` is a property of the classifier and the contact time (on svm-paper it is the same for every
+    sigma/dT, direction and effusivity to about 1 %, docs/accuracy.md), unlike the ratio of the needs in
+    effusivity, which changes with the pair's width because the signal ``w(e) = e / (e_s + e)`` is concave
+    (that ratio, read at pairs narrower and wider than the asked one, put the answers late). ``k`` is read at
+    the crossing's tabulated contact ``t_b`` (index ``k_cross``) and the one before, ``t_a`` (after, where
+    ``t_b`` is the first), from the pair's own entries (upwards at ``lo``, downwards at ``hi``) in every
+    scene slice the question interpolates between; ``log k`` is linear in ``log t`` through them. The
+    answer is the first sample time where ``k(t) s(t)`` reaches the pair's own critical noise
+    (:func:`~designkit.query.ideal_bound.noise_k_contact`).
+
+    Standard error of ``log k`` at a contact: the entries' inverse-variance mean (their Monte Carlo errors
+    nearly independent, measured on the table; their rounding errors alike, so that term is not reduced by
+    averaging), each entry's in log k the local slope
+    ``gamma = dlog s*/dlog need`` (a second critical noise, one width further) times its need's relative
+    error: the grid's rounding (w/sqrt(12)) and the table's Monte Carlo interval
+    (``delta_lo`` / ``delta_hi``, ``z`` standard errors each). Between the two contacts: ``(1-u)`` and ``u``
+    weights, plus ``u (1-u)`` times half the change of ``log k`` across the cell (interpolation; the
+    measured curvature of log k in log t on the table is below this). In log t it is that over
+    ``beta_g - beta_k``, the local log-log slopes of ``|g|`` and ``k``.
 
     Parameters
     ----------
-    sensor : Sensor
+    op : the opened table (:func:`open_table`)
+    combos : scene weights (``view.scene_weights``)
+    k_cross : array_like of int
+        Index of the first tabulated contact whose need suffices, per pair (>= 0).
     lo, hi, ratio : array_like
-        Pair [J s^-1/2 K^-1 m^-2] and sigma/dT [-].
-    t_a, t_b : array_like
-        Tabulated contact times around the crossing [s] (``t_b``: the first that suffices).
-    svm_a, svm_b, ideal_a, ideal_b : array_like
-        The SVM and the (tabulated) ideal needs there [J s^-1/2 K^-1 m^-2] (NaN: not within the grid).
-    mc_lo, mc_hi : array_like
-        The table's Monte Carlo ends of the SVM need at ``t_b``.
-    ideal : array_like
-        The exact ideal bound [s] (NaN: not computed); the interval never reaches below it unless the
-        estimate does.
-    width, threshold, z_table, zc : float
-        Grid width, F1 threshold, the table's z and the asked coverage's.
+        Pairs [J s^-1/2 K^-1 m^-2] and the asked sigma/dT.
+    zc : float
+        z of the asked coverage.
 
     Returns
     -------
     dict of ndarray
-        ``value``, ``low``, ``high`` [s], ``efficiency`` (at ``t_b``) and ``se_log`` (NaN where it does
-        not apply: unknown needs or slope; the caller falls back to interpolation).
-
-    Examples
-    --------
-    The guideline pair on the shipped table's needs at 1.5 and 2 s (sigma/dT 0.005):
-
-    >>> from designkit.sensor import load_sensor
-    >>> r = efficiency_estimate(load_sensor("paper"), 20000.0, 35000.0, 0.005, 2.0, 1.5, 9040.0, 12240.0,
-    ...                         5840.0, 8880.0, 11200.0, 12240.0, 1.05, width=80.0, threshold=0.9,
-    ...                         z_table=2.0, zc=1.645, entry_sd=0.04)
-    >>> round(float(r["efficiency"]), 2), 1.05 < float(r["low"]) < float(r["value"]) < float(r["high"]) < 1.5
-    (1.38, True)
+        ``value``, ``low``, ``high`` [s], ``k_a``, ``k_b`` (NaN: no reading there), ``t_a``, ``t_b``,
+        ``se_log`` (of the answer, log); ``value`` NaN where the route does not apply.
     """
-    arrs = np.broadcast_arrays(*(np.asarray(a, dtype=np.float64) for a in (
-        lo, hi, ratio, t_a, t_b, svm_a, svm_b, ideal_a, ideal_b, mc_lo, mc_hi, ideal)))
-    lo, hi, ratio, t_a, t_b, svm_a, svm_b, ideal_a, ideal_b, mc_lo, mc_hi, ideal = arrs
-    h = 0.5 * width
-    eff_a, eff_b = _efficiency(svm_a, ideal_a, width), _efficiency(svm_b, ideal_b, width)
-    rounding, mc = _table_se_log(svm_b, ideal_b, mc_lo, mc_hi, width=width, z_table=z_table)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        beta = np.abs(np.log((ideal_a - h) / (ideal_b - h)) / np.log(t_a / t_b))
-        ok = ~np.isnan(eff_b) & np.isfinite(beta) & (beta > 0)
-        interp = np.where(np.isnan(eff_a), 0.0, 0.5 * np.abs(np.log(eff_b / eff_a)))
-        trend = np.where(np.isnan(eff_a), 0.0, np.abs(np.log(eff_b / eff_a) / np.log(t_b / t_a)))
-    value = np.full(lo.shape, np.nan)
-    if ok.any():
-        from .ideal_bound import cached_efficiency_min_contact
+    from .ideal_bound import noise_k_contact, shape_norm
 
-        i = ok
-        value[i] = cached_efficiency_min_contact(sensor, lo[i], hi[i], ratio[i], t_a[i], t_b[i], eff_a[i], eff_b[i],
-                                                 t_b[i], width=width, threshold=threshold)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        outside = trend * np.maximum(np.log(np.fmin(t_a, t_b) / value), 0.0)
-        se = np.hypot(np.hypot(np.maximum(mc, entry_sd), rounding), np.hypot(interp, outside)) / beta
-        low = value * np.exp(-zc * se)
-        low = np.where(np.isnan(low) | np.isnan(ideal), low, np.minimum(np.maximum(low, ideal), value))
-        high = value * np.exp(zc * se)
+    view, sensor = op.view, op.tab.sensor
+    lo, hi, ratio, kb = (np.atleast_1d(a) for a in np.broadcast_arrays(
+        np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64), np.asarray(ratio, dtype=np.float64),
+        np.asarray(k_cross, dtype=np.int64)))
+    nc, n = view.contacts.size, lo.size
+    ka = np.where(kb > 0, kb - 1, kb + 1)
+    ka = np.where(ka < nc, ka, -1)
+    slices, sw = _slices(combos, n)
+    lk, se, s_pair = _k_readings(op, slices, sw, ka, kb, lo, hi, extra=(lo, hi))
+    t_a, t_b = view.contacts[np.where(ka >= 0, ka, kb)], view.contacts[kb]
+    la_, lb_, have_a, have_b, falls, wa, wb, disagree = _k_line(lk, se, t_a, t_b)
+    ok = have_a | have_b
+    value = np.full(n, np.nan)
+    if ok.any():
+        value[ok] = noise_k_contact(sensor, ratio[ok], s_pair[ok], t_a[ok], t_b[ok], la_[ok], lb_[ok], max_contact_s)
+    ok &= np.isfinite(value)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        u = np.log(value / t_a) / np.log(t_b / t_a)
+        var_k = _k_var(u, se, la_, lb_, have_a, have_b, falls, wa, wb, disagree,
+                       np.log(value / np.where(have_a, t_a, t_b)))
+        slope_k = np.where(have_a & have_b & (t_a != t_b), (lb_ - la_) / np.log(t_b / t_a), 0.0)
+        v_ok = np.where(ok, value, 1.0)  # (shape_norm takes finite contact times only)
+        beta_g = np.log(shape_norm(sensor, v_ok * 1.05) / shape_norm(sensor, v_ok / 1.05)) / (2 * math.log(1.05))
+        se_t = np.sqrt(var_k) / np.maximum(beta_g - slope_k, 0.05)
+        low, high = value * np.exp(-zc * se_t), value * np.exp(zc * se_t)
+        k_at = np.exp(np.maximum(la_ + slope_k * np.log(value / t_a), 0.0))
     nan = ~ok
-    return {"value": value, "low": np.where(nan, np.nan, low), "high": np.where(nan, np.nan, high),
-            "efficiency": np.where(nan, np.nan, eff_b), "se_log": np.where(nan, np.nan, se)}
+    return {"value": np.where(nan, np.nan, value), "low": np.where(nan, np.nan, low),
+            "high": np.where(nan, np.nan, high), "k_a": np.where(have_a & ok, np.exp(lk[0]), np.nan),
+            "k_b": np.where(have_b & ok, np.exp(lk[1]), np.nan), "t_a": t_a, "t_b": t_b,
+            "k": np.where(nan, np.nan, k_at), "se_log": np.where(nan, np.nan, se_t)}
+
+
+def noise_k_max_ratio(op, contact_s, r_table, r_ideal, lo, hi, *, zc: float) -> dict[str, np.ndarray]:
+    """max-noise / min-delta-t from the SVM's noise efficiency (:func:`noise_k_min_contact`): the SVM separates
+    the pair up to ``sigma/dT = r_ideal / k(contact)``, ``r_ideal`` the ideal observer's exact largest
+    sigma/dT, ``k`` read at the two tabulated contacts around ``contact_s`` (log-linear in log t) in the two
+    noise-ratio slices around ``r_table`` (the table's own crossing), elementwise. Standard error in log:
+    that of ``log k`` there (as min-contact's), no slope to divide by.
+
+    Returns
+    -------
+    dict of ndarray
+        ``value``, ``low``, ``high`` (sigma/dT), ``k``, ``se_log``; NaN where it does not apply.
+    """
+    view = op.view
+    contact, r_table, r_ideal, lo, hi = (np.atleast_1d(a) for a in np.broadcast_arrays(*(
+        np.asarray(x, dtype=np.float64) for x in (contact_s, r_table, r_ideal, lo, hi))))
+    C = view.contacts
+    kb = np.clip(np.searchsorted(C, contact, side="left"), 0, C.size - 1)  # the first contact >= the asked one
+    ka = np.where(C[kb] == contact, kb, np.maximum(kb - 1, 0))
+    lr, lrt = np.log(view.t.axes["noise_ratio"]), np.log(r_table)
+    i0 = np.clip(np.searchsorted(lr, lrt, side="right") - 1, 0, lr.size - 2)
+    w1 = np.clip((lrt - lr[i0]) / (lr[i0 + 1] - lr[i0]), 0.0, 1.0)
+    slices, sw = np.stack([i0, i0 + 1], axis=1), np.stack([1.0 - w1, w1], axis=1)
+    lk, se, _ = _k_readings(op, slices, sw, ka, kb, lo, hi)
+    t_a, t_b = C[ka], C[kb]
+    la_, lb_, have_a, have_b, falls, wa, wb, disagree = _k_line(lk, se, t_a, t_b)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        u = np.where(t_a != t_b, np.log(contact / t_a) / np.log(t_b / t_a), 1.0)
+        log_k = np.maximum((1 - u) * la_ + u * lb_, 0.0)
+        var_k = _k_var(u, se, la_, lb_, have_a, have_b, falls, wa, wb, disagree,
+                       np.log(contact / np.where(have_a, t_a, t_b)))
+        sd = np.sqrt(var_k)
+    ok = (have_a | have_b) & np.isfinite(r_ideal) & np.isfinite(sd)
+    value = r_ideal * np.exp(-log_k)
+    return {"value": np.where(ok, value, np.nan), "low": np.where(ok, value * np.exp(-zc * sd), np.nan),
+            "high": np.where(ok, value * np.exp(zc * sd), np.nan), "k": np.where(ok, np.exp(log_k), np.nan),
+            "se_log": np.where(ok, sd, np.nan)}
 
 
 def ratio_estimate(raw, r_c, r_lin, r_rnd, r_geo, end_lo, end_hi, ideal, *, z_table: float,
@@ -539,7 +693,7 @@ def delta_efficiency_estimate(sensor, e, contact_s, ratio, direction, t_a, t_b, 
                               zc: float, entry_sd=0.0) -> dict[str, np.ndarray]:
     """delta-e's estimate of one direction from the SVM's efficiency against the exact ideal observer.
 
-    As :func:`efficiency_estimate` for min-contact: the SVM's efficiency ``eff = (svm need - w/2) / (ideal
+    The SVM's efficiency ``eff = (svm need - w/2) / (ideal
     need - w/2)`` at the tabulated contact times ``t_a``, ``t_b`` around ``contact_s`` (log-linear in log t;
     the known one where the other is NaN) times the ideal observer's delta(e) computed exactly at
     ``contact_s`` (:func:`designkit.query.ideal_bound.exact_ideal_delta`): no interpolation of the steep need
@@ -888,14 +1042,17 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
     kind, cov = "none", None
     eff = None
     if value is not None and op.tab.fidelity == "svm" and op.closed and "delta_up_ideal" in view.t.arrays:
-        eff = _efficiency_at(view, combos, k_cross, lo, hi, needs[k_cross], noise / abs(dt), ideal, op,
-                             z_of_coverage(coverage))
+        r = noise_k_min_contact(op, combos, [k_cross], [lo], [hi], [noise / abs(dt)], zc=z_of_coverage(coverage))
+        if not math.isnan(float(r["value"][0])):
+            eff = {key: float(v[0]) for key, v in r.items()}
     if eff is not None:
-        # the SVM's efficiency against the exact ideal observer (efficiency_estimate): no interpolation of
-        # the steep need between grid points
+        # the SVM's noise efficiency against the exact ideal observer (noise_k_min_contact): no interpolation
+        # of the steep need between grid points
         raw = value
-        value, interval, kind, cov = eff["value"], (eff["low"], eff["high"]), "table-efficiency", coverage
-        monte_carlo.update(efficiency=eff["efficiency"], efficiency_se_log=eff["se_log"], table_crossing_s=raw)
+        low = eff["low"] if ideal is None else min(max(eff["low"], ideal), eff["value"])
+        value, interval, kind, cov = eff["value"], (low, eff["high"]), "table-efficiency", coverage
+        monte_carlo.update(efficiency=eff["k"], efficiency_se_log=eff["se_log"], table_crossing_s=raw,
+                           noise_efficiency_at_s={f"{eff['t_a']:g}": eff["k_a"], f"{eff['t_b']:g}": eff["k_b"]})
     elif value is not None:
         prev_need = needs[k_cross - 1] if k_cross > 0 else math.nan
         if k_cross > 0 and not math.isnan(prev_need):
@@ -924,37 +1081,6 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
     return _answer("min-contact", op, value=value, interval=interval, ideal=ideal, ideal_method=ideal_method,
                    in_grid=flags, details={}, notes=[note], check_at=(needed, noise, dt),
                    interval_kind=kind, interval_coverage=cov, computation=monte_carlo, **common)
-
-
-def _second_contact(k: int, n: int, svm, ideal) -> int | None:
-    """The tabulated contact paired with the crossing's ``k`` for the efficiency: the one before where both
-    needs (``svm(j)``, ``ideal(j)``) are known there, else the one after, else whichever has an ideal need
-    (the slope only; the efficiency is then held constant). None: neither neighbour has one."""
-    near = [j for j in (k - 1, k + 1) if 0 <= j < n]
-    for j in near:
-        if not (math.isnan(svm(j)) or math.isnan(ideal(j))):
-            return j
-    return next((j for j in near if not math.isnan(ideal(j))), None)
-
-
-def _efficiency_at(view: _View, combos, k: int, lo: float, hi: float, need_b: float, ratio: float, ideal,
-                   op: _Opened, zc: float) -> dict | None:
-    """:func:`efficiency_estimate` for one pair whose table crossing is at contact index ``k`` (None: it does
-    not apply), the second tabulated contact chosen by :func:`_second_contact`."""
-    n = view.contacts.size
-    ideal_b = view.need("ideal", combos, k, lo, hi)
-    a = _second_contact(k, n, lambda j: view.need("svm", combos, j, lo, hi),
-                        lambda j: view.need("ideal", combos, j, lo, hi))
-    if a is None:
-        return None
-    r = efficiency_estimate(op.tab.sensor, lo, hi, ratio, view.contacts[a], view.contacts[k],
-                            view.need("svm", combos, a, lo, hi), need_b, view.need("ideal", combos, a, lo, hi),
-                            ideal_b, view.need("lo", combos, k, lo, hi), view.need("hi", combos, k, lo, hi),
-                            math.nan if ideal is None else ideal, width=op.width, threshold=op.phi,
-                            z_table=table_z(op.tab), zc=zc, entry_sd=view.entry_noise(combos))
-    if math.isnan(float(r["value"])):
-        return None
-    return {key: float(v) for key, v in r.items()}
 
 
 # ============================================================ max-noise / min-delta-t
@@ -1063,7 +1189,21 @@ def _ratio_question(question: str, e1, e2, m1, m2, objects, contact_s, noise_c, 
     interval: tuple = (None, None)
     kind, cov = "none", None
     computation = {"monte_carlo_interval": list(mc)}
-    if where == "inside" and op.tab.fidelity == "svm":
+    kr = None
+    if (where in ("inside", "cell") and op.tab.fidelity == "svm" and op.closed and out["ideal"][1] != "below"
+            and "delta_up_ideal" in view.t.arrays):
+        kr = noise_k_max_ratio(op, contact, r, out["ideal"][0], lo, hi, zc=z_of_coverage(coverage))
+        kr = None if math.isnan(float(kr["value"][0])) else {key: float(v[0]) for key, v in kr.items()}
+    if kr is not None:
+        # the SVM's noise efficiency against the exact ideal observer (noise_k_max_ratio)
+        raw = r
+        r = min(kr["value"], out["ideal"][0])
+        value = to_answer(r)
+        iv = [to_answer(kr["low"]), to_answer(min(kr["high"], out["ideal"][0]))]
+        interval = tuple(iv) if question == "max-noise" else (iv[1], iv[0])
+        kind, cov = "table-efficiency", coverage
+        computation.update(table_crossing_noise_ratio=raw, efficiency=kr["k"], efficiency_se_log=kr["se_log"])
+    elif where == "inside" and op.tab.fidelity == "svm":
         # as min-contact: the tabulated deltas are rounded up to the grid (on average half a width late),
         # so the raw crossing tolerates too little noise; the answer subtracts w/2 from the need and
         # interpolates log-log, the interval carries the interpolants' difference and the rounding's SD

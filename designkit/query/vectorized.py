@@ -315,9 +315,9 @@ def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> None
     todo = np.zeros(lo.size, dtype=bool)
     k_cross = np.full(lo.size, -1)
     n_prev, n_at = _nan(lo.size), _nan(lo.size)  # the svm need at the contact before the crossing, and at it
-    # the scalar route's _efficiency_at, per element
+    # the scalar route's noise-efficiency estimate (table.noise_k_min_contact, the same function), per scene
     efficiency = svm and op.closed and "delta_up_ideal" in view.t.arrays
-    eff_in = {k: _nan(lo.size) for k in ("t_a", "svm_a", "ideal_a", "ideal_b", "mc_lo", "mc_hi", "entry_sd")}
+    eff = {k: _nan(lo.size) for k in ("value", "low", "high")}
     for (noise, dt), idx in _groups(x["noise_c"], x["delta_t_c"]):
         combos, flags = view.scene_weights(noise, dt)
         if not all(flags.values()):
@@ -341,26 +341,10 @@ def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> None
                 if all(iflags.values()):
                     res["ideal"][idx] = _crossing(op.iview.contacts, _need(op.iview, op.ikind, icombos, l, h),
                                                   gap)[0]
-        if efficiency:
-            ideal_need = _need(view, "ideal", combos, l, h)
-            kk = np.maximum(k, 0)
-            # table._second_contact per element: before with both needs, after with both, before / after with
-            # an ideal need (slope only)
-            a = np.full(k.shape, -1)
-            for j, both in ((k - 1, True), (k + 1, True), (k - 1, False), (k + 1, False)):
-                inside = (k >= 0) & (j >= 0) & (j < grid.size)
-                jc = np.clip(j, 0, grid.size - 1)
-                known = ~np.isnan(ideal_need[jc, cols]) & (~np.isnan(need[jc, cols]) if both else True)
-                a = np.where((a < 0) & inside & known, j, a)
-            has_a = a >= 0
-            ac = np.maximum(a, 0)
-            eff_in["t_a"][idx] = np.where(has_a, grid[ac], np.nan)
-            eff_in["svm_a"][idx] = np.where(has_a, need[ac, cols], np.nan)
-            eff_in["ideal_a"][idx] = np.where(has_a, ideal_need[ac, cols], np.nan)
-            eff_in["ideal_b"][idx] = ideal_need[kk, cols]
-            eff_in["mc_lo"][idx] = _need(view, "lo", combos, l, h)[kk, cols]
-            eff_in["mc_hi"][idx] = _need(view, "hi", combos, l, h)[kk, cols]
-            eff_in["entry_sd"][idx] = view.entry_noise(combos)
+        if efficiency and (has := k >= 0).any():
+            r = _table_route.noise_k_min_contact(op, combos, k[has], l[has], h[has], noise / abs(dt), zc=zc)
+            for key in eff:
+                eff[key][idx[has]] = r[key]
         res["value"][idx], res["low"][idx], res["high"][idx] = value, ilo, ihi
         res["in_grid"][idx] = True
         todo[idx] = True
@@ -377,17 +361,11 @@ def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> None
     low, high = _nan(lo.size), _nan(lo.size)
     value = raw.copy()
     by_eff = np.zeros(lo.size, dtype=bool)
-    if efficiency and (cand := ~np.isnan(raw) & ~np.isnan(eff_in["t_a"])).any():
-        i = np.nonzero(cand)[0]
-        ratio = x["noise_c"] / np.abs(x["delta_t_c"])
-        r = _table_route.efficiency_estimate(
-            op.tab.sensor, lo[i], hi[i], ratio[i], eff_in["t_a"][i], grid[k_cross[i]], eff_in["svm_a"][i], n_at[i],
-            eff_in["ideal_a"][i], eff_in["ideal_b"][i], eff_in["mc_lo"][i], eff_in["mc_hi"][i], ideal[i],
-            width=op.width, threshold=op.phi, z_table=_table_route.table_z(op.tab), zc=zc,
-            entry_sd=eff_in["entry_sd"][i])
-        got = ~np.isnan(r["value"])
-        j = i[got]
-        value[j], low[j], high[j] = r["value"][got], r["low"][got], r["high"][got]
+    if efficiency and (got := ~np.isnan(raw) & ~np.isnan(eff["value"])).any():
+        j = np.nonzero(got)[0]
+        value[j], high[j] = eff["value"][j], eff["high"][j]
+        low[j] = np.where(np.isnan(ideal[j]), eff["low"][j], np.minimum(np.maximum(eff["low"][j], ideal[j]),
+                                                                         eff["value"][j]))
         by_eff[j] = True
     est = (k_cross > 0) & ~np.isnan(n_prev) & ~np.isnan(raw) & ~by_eff
     cell = ~np.isnan(raw) & ~est & ~by_eff
@@ -507,7 +485,21 @@ def _ratio(question, x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> 
         return (a, b) if question == "max-noise" else (b, a)
 
     low, high = _nan(n), _nan(n)
-    inside = where_all == _INSIDE
+    # the scalar route's noise-efficiency estimate (table.noise_k_max_ratio, the same function) where it applies
+    by_k = np.zeros(n, dtype=bool)
+    if (svm and op.closed and "delta_up_ideal" in view.t.arrays
+            and (cand := ((where_all == _INSIDE) | (where_all == _CELL)) & ~np.isnan(ri)).any()):
+        i = np.nonzero(cand)[0]
+        kr = _table_route.noise_k_max_ratio(op, x["contact_s"][i], r_all[i], ri[i], lo[i], hi[i], zc=zc)
+        got = ~np.isnan(kr["value"])
+        j = i[got]
+        r_k = np.minimum(kr["value"][got], ri[j])
+        k_low, k_high = _nan(n), _nan(n)
+        k_low[j], k_high[j] = kr["low"][got], np.minimum(kr["high"][got], ri[j])
+        a, b = ordered(k_low, k_high)
+        low[j], high[j], r_all[j] = a[j], b[j], r_k
+        by_k[j] = True
+    inside = (where_all == _INSIDE) & ~by_k
     if svm and inside.any():  # the scalar route's estimate (table.ratio_estimate, the same function)
         est = _table_route.ratio_estimate(r_all, alt["c"], alt["lin"], alt["rnd"], alt["geo"], ends["hi"], ends["lo"], ri,
                                           z_table=_table_route.table_z(op.tab), zc=zc)
@@ -519,7 +511,7 @@ def _ratio(question, x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> 
         both = ~np.isnan(mc[0]) & ~np.isnan(mc[1])
         low = np.where(inside, np.where(both, np.fmin(*mc), mc[0]), low)
         high = np.where(inside, np.where(both, np.fmax(*mc), mc[1]), high)
-    cell = where_all == _CELL
+    cell = (where_all == _CELL) & ~by_k
     if cell.any():  # a neighbour beyond the grid: the grid cell, up to the next ratio (or the bound)
         k = np.searchsorted(ratios, np.where(cell, r_all, ratios[0]))
         nxt = ratios[np.minimum(k + 1, ratios.size - 1)]

@@ -317,7 +317,8 @@ def test_cr2_covariance_and_bell_mccaffrey_degrees_of_freedom_match_the_dense_fo
     sizes = [30, 8, 12, 25, 5, 20]
     cl = np.repeat(np.arange(len(sizes)), sizes)
     n = cl.size
-    J = np.column_stack([np.ones(n), rng.normal(size=n), (cl == 4) * rng.normal(3.0, 1.0, n) + 0.2 * rng.normal(size=n)])
+    carried = (cl == 4) * rng.normal(3.0, 1.0, n) + 0.2 * rng.normal(size=n)   # mostly touch 4's
+    J = np.column_stack([np.ones(n), rng.normal(size=n), carried])
     r = rng.normal(size=n) * (1 + cl)
     r -= J @ np.linalg.lstsq(J, r, rcond=None)[0]      # residuals orthogonal to J, as at a least-squares optimum
     cov, df = _sandwich(J, r, cl)

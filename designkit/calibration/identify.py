@@ -70,6 +70,7 @@ from .trials import Trial
 
 __all__ = [
     "CANDIDATES",
+    "FORCE_SMOOTHING_S",
     "HOST_SMOOTHING",
     "Candidate",
     "Comparison",

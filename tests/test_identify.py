@@ -304,3 +304,40 @@ def test_passive_object_temp_reads_the_object_through_the_passive_response():
     got = passive_object_temp(touches, w)
     assert got == pytest.approx(to, abs=1e-9)
     assert passive[0, -1] - got[0] > 8.0 and got[2] - passive[2, -1] > 4.0   # the end reading is far off
+
+
+def test_cr2_covariance_and_bell_mccaffrey_degrees_of_freedom_match_the_dense_formulas():
+    """_sandwich against the textbook formulas written with dense N x N matrices (Imbens & Kolesar 2016,
+    eqs. for V_CR2 and K_BM): unequal touches, one of which carries most of a parameter."""
+    from scipy.linalg import sqrtm
+
+    from designkit.calibration.identify import _sandwich
+
+    rng = np.random.default_rng(5)
+    sizes = [30, 8, 12, 25, 5, 20]
+    cl = np.repeat(np.arange(len(sizes)), sizes)
+    n = cl.size
+    carried = (cl == 4) * rng.normal(3.0, 1.0, n) + 0.2 * rng.normal(size=n)   # mostly touch 4's
+    J = np.column_stack([np.ones(n), rng.normal(size=n), carried])
+    r = rng.normal(size=n) * (1 + cl)
+    r -= J @ np.linalg.lstsq(J, r, rcond=None)[0]      # residuals orthogonal to J, as at a least-squares optimum
+    cov, df = _sandwich(J, r, cl)
+    B = np.linalg.inv(J.T @ J)
+    H = J @ B @ J.T
+    meat = np.zeros((3, 3))
+    cols = []
+    for g in range(len(sizes)):
+        s = cl == g
+        A = np.real(np.linalg.inv(sqrtm(np.eye(s.sum()) - H[np.ix_(s, s)])))
+        u = J[s].T @ A @ r[s]
+        meat += np.outer(u, u)
+        cols.append(A @ J[s] @ B)
+    assert cov == pytest.approx(B @ meat @ B, rel=1e-8)
+    for k in range(3):
+        G = np.zeros((n, len(sizes)))
+        for g in range(len(sizes)):
+            G[cl == g, g] = cols[g][:, k]
+        lam = np.linalg.eigvalsh(G.T @ (np.eye(n) - H) @ G)
+        assert df[k] == pytest.approx(min(lam.sum() ** 2 / np.sum(lam ** 2), len(sizes) - 1), rel=1e-8)
+    # the parameter one short touch carries has about one degree of freedom, not touches - 1
+    assert df[2] < 2.0 < df[0]

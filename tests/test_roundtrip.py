@@ -104,3 +104,19 @@ def test_round_trip_over_a_pty_recovers_every_identifiable_parameter(case, tmp_p
 def test_unknown_case_is_named():
     with pytest.raises(InputError, match="unknown round-trip case 'slab'"):
         round_trip("slab", 0)
+
+
+def test_varied_presses_span_quick_and_slow_touches():
+    """The protocol that identifies c within 2 % presses at widely varied pace (docs/sensor-models.md)."""
+    from designkit.calibration.roundtrip import CHAIN_PLAN, VARIED_PRESS
+
+    case = CASES["contact+drift+area"]
+    ramps = {}
+    for press in (None, VARIED_PRESS):
+        emu = Emulator(load_profile("designkit"), SENSOR, [EmulatedMaterial("wood", 400.0)],
+                       plan=TouchPlan(**case.plan(10, press)), model=get_model(dict(case.model)), seed=7)
+        ramps[press] = [emu.touch_ramp_s(j) for j in range(10)]
+    mean, spread = CHAIN_PLAN["ramp_s"], CHAIN_PLAN["ramp_spread"]
+    lo, hi = mean * (1 - spread), mean * (1 + spread)
+    assert all(lo <= r <= hi for r in ramps[None])
+    assert min(ramps[VARIED_PRESS]) < lo and max(ramps[VARIED_PRESS]) > hi

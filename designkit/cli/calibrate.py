@@ -250,7 +250,9 @@ def _record_materials(port: str, profile, out: Path, materials: list[str], trial
             if prompt:
                 con = console(stderr=True)
                 con.print(f"[bold]Next: {trials} touches of {material}.[/] Put the sample under the sensor, "
-                          "then press Enter.")
+                          "then press Enter. Press each touch to the same force, some quickly and some slowly "
+                          "(about 0.2 to 1.5 s to full force): that tells where the contact area starts from "
+                          "when the heat flows.")
                 sys.stdin.readline()
                 rec.flush_input()
             elif i > 0:

@@ -90,6 +90,11 @@ def _hints():
         raise NeedsInput(f"{exc} ({hint})" if hint else str(exc), exc.what) from None
 
 
+#: The questions a table with varied initial conditions answers (its noise and dT are separate axes, not
+#: sigma/dT: max-noise and min-delta-t need the exact route there).
+SPREAD_TABLE_QUESTIONS = ("min-contact", "delta-e", "distinguishable")
+
+
 def _ask(question: str, *, exact: bool, table: Optional[str], ideal_table: str, threshold: float, sensor: str,
          model, conductance, thickness, backing, diffusivity, width: float, trials: int, repeats: int, seed: int,
          jobs: int, n_mc: int, objects: dict, scene: dict, exact_extra: Optional[dict] = None,
@@ -113,8 +118,14 @@ def _ask(question: str, *, exact: bool, table: Optional[str], ideal_table: str, 
         # the shipped tables are for the paper sensor and the semi-infinite model: another sensor or model is
         # computed unless a table is named (a named table built for another one is refused, never used);
         # varied initial conditions: no shipped table holds them, computed for the pair
-        reroute = None if exact or spread > 0 or table is not None else table_reroute(sen, fm)
-        route = "exact" if exact or spread > 0 or reroute else "table"
+        reroute = None if exact or table is not None else table_reroute(sen, fm)
+        # varied initial conditions: the shipped table for the paper's spread (2.5 degC), else computed
+        varied = None
+        if spread > 0 and not exact and table is None and reroute is None and question in SPREAD_TABLE_QUESTIONS:
+            from ..query.table import shipped_spread_table
+
+            varied = shipped_spread_table(spread)
+        route = "exact" if exact or reroute or (spread > 0 and table is None and varied is None) else "table"
         if spread > 0:
             extra["sensor_temp_spread_c"] = spread
         if route == "table":
@@ -124,8 +135,9 @@ def _ask(question: str, *, exact: bool, table: Optional[str], ideal_table: str, 
                 raise NeedsInput("a diffusivity was given but tables answer for effusivity alone",
                                  "diffusivity-unused")
             return query.ask(question, route="table", **objects, **scene, threshold=threshold,
-                             table=table or "svm-paper", ideal_table=ideal_table,
-                             sensor=None if sensor == "paper" else sen, model=fm, coverage=extra["coverage"])
+                             table=table or varied or "svm-paper", ideal_table=ideal_table,
+                             sensor=None if sensor == "paper" else sen, model=fm, coverage=extra["coverage"],
+                             sensor_temp_spread_c=spread)
         kw = dict(threshold=threshold, sensor=sen, model=fm, diffusivity_m2_s=diffusivity, width=width,
                   trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc, **extra)
         with _exact_display(question, progress) as report:

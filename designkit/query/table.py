@@ -43,7 +43,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from .._validation import InputError
+from .._validation import InputError, check_nonnegative
 from ..tables import lookup
 from ..tables.lookup import GRID_RTOL
 from ..tables.store import Table, load_table, resolve_table
@@ -68,6 +68,7 @@ __all__ = [
     "CLOSED_FORM_RATIO_BRACKET",
     "delta_efficiency_estimate",
     "DEFAULT_TABLE",
+    "VARIED_TABLE",
     "GRID_RTOL",
     "clear_table_cache",
     "contact_estimate",
@@ -84,9 +85,14 @@ __all__ = [
     "open_table",
     "ratio_estimate",
     "stated_log",
+    "shipped_spread_table",
+    "table_spread",
 ]
 
 DEFAULT_TABLE = "svm-paper"
+#: The shipped table for the paper's second setting (the sensor's temperature drawn per touch, uniform in
+#: 30-35 degC with the object at 25 degC: dT 7.5 degC, spread 2.5 degC): a question with that spread reads it.
+VARIED_TABLE = "svm-paper-varied"
 #: Longest contact [s] the closed-form ideal bound examines (the exact route's default).
 CLOSED_FORM_MAX_CONTACT_S = 10.0
 #: sigma/dT the closed-form ideal bound searches (the exact route's bracket).
@@ -809,11 +815,43 @@ def _ideal_view(svm: _View, ideal_table: "Table | str | None") -> tuple[_View, s
     return None, "", None
 
 
-def _open(table, ideal_table, *, threshold, sensor, model) -> _Opened:
-    """Load ``table`` and refuse it when it was built for another threshold, sensor or model."""
+def table_spread(tab: Table) -> float:
+    """Half-width [degC] of the per-touch sensor temperature a table was built with (0: fixed conditions)."""
+    return float(tab.header.get("config", {}).get("sensor_temp_spread_c") or 0.0)
+
+
+def shipped_spread_table(spread: float) -> str | None:
+    """The shipped table that answers questions with sensor temperature spread ``spread`` [degC], or None.
+
+    >>> shipped_spread_table(2.5)
+    'svm-paper-varied'
+    >>> shipped_spread_table(1.0) is None
+    True
+    """
+    if spread > 0 and math.isclose(table_spread(_as_table(VARIED_TABLE)), spread, rel_tol=1e-9):
+        return VARIED_TABLE
+    return None
+
+
+def _spread_words(spread: float) -> str:
+    return (f"the sensor temperature drawn per touch within +-{spread:g} degC" if spread > 0
+            else "fixed initial conditions")
+
+
+def _open(table, ideal_table, *, threshold, sensor, model, spread: float = 0.0) -> _Opened:
+    """Load ``table`` and refuse it when it was built for another threshold, sensor, model or sensor
+    temperature spread (``spread`` [degC]: the question's; a spread reads :data:`VARIED_TABLE` by default)."""
     from ..models import get_model
 
+    spread = check_nonnegative("sensor temperature spread [degC]", spread)
+    if spread > 0 and isinstance(table, str) and table == DEFAULT_TABLE:
+        table = VARIED_TABLE
     tab = _as_table(table)
+    held = table_spread(tab)
+    if not math.isclose(spread, held, rel_tol=1e-9, abs_tol=1e-12) or tab.header.get("config", {}).get(
+            "ambient_temp_spread_c"):
+        raise TableMismatch(f"table {tab.name} was built with {_spread_words(held)}, not with "
+                            f"{_spread_words(spread)} (the exact route answers any spread)")
     if threshold is not None and not math.isclose(check_threshold(threshold), tab.threshold, rel_tol=1e-9):
         raise TableMismatch(f"table {tab.name} was built for threshold {tab.threshold:g}, not {threshold:g}")
     if sensor is not None:
@@ -944,7 +982,8 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
                 m2: str | None = None, objects=None, noise_c: float = 0.05, delta_t_c: float = 10.0,
                 threshold: float | None = None, table: "Table | str" = DEFAULT_TABLE,
                 ideal_table: "Table | str | None" = DEFAULT_IDEAL_TABLE, sensor=None, model=None,
-                coverage: float = 0.9) -> Answer:
+                coverage: float = 0.9,
+                sensor_temp_spread_c: float = 0.0) -> Answer:
     """Shortest contact time [s] that separates two objects, from a table.
 
     Parameters
@@ -986,7 +1025,8 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
     """
     noise, dt = scene_inputs(noise_c, delta_t_c)
     coverage = check_coverage(coverage)
-    op = _open(table, ideal_table, threshold=threshold, sensor=sensor, model=model)
+    op = _open(table, ideal_table, threshold=threshold, sensor=sensor, model=model,
+               spread=sensor_temp_spread_c)
     pq = pair_question(e1, e2, m1, m2, objects=objects, width=op.width, model=op.model)
     scene = _scene(None, noise, dt)
     if pq.classes is None:
@@ -1121,7 +1161,8 @@ def _max_ratio(view: _View, kind: str, contact_s: float, lo: float, hi: float, *
 
 
 def _ratio_question(question: str, e1, e2, m1, m2, objects, contact_s, noise_c, delta_t_c, threshold, table,
-                    ideal_table, sensor, model, coverage: float = 0.9) -> Answer:
+                    ideal_table, sensor, model, coverage: float = 0.9,
+                    sensor_temp_spread_c: float = 0.0) -> Answer:
     contact = check_contact(contact_s)
     coverage = check_coverage(coverage)
     if question == "max-noise":
@@ -1132,7 +1173,8 @@ def _ratio_question(question: str, e1, e2, m1, m2, objects, contact_s, noise_c, 
         if noise == 0:
             raise InputError("noise sigma is 0: any temperature difference separates them (no smallest one)")
         scene = _scene(contact, noise, None)
-    op = _open(table, ideal_table, threshold=threshold, sensor=sensor, model=model)
+    op = _open(table, ideal_table, threshold=threshold, sensor=sensor, model=model,
+               spread=sensor_temp_spread_c)
     if "noise_ratio" not in op.tab.axes:
         raise TableMismatch(f"table {op.tab.name} has separate noise and temperature axes (varied initial "
                             f"conditions): it cannot answer {question}; the exact route can")
@@ -1258,30 +1300,33 @@ def _ratio_question(question: str, e1, e2, m1, m2, objects, contact_s, noise_c, 
 
 def max_noise(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact_s: float, delta_t_c: float = 10.0,
               threshold=None, table=DEFAULT_TABLE, ideal_table=DEFAULT_IDEAL_TABLE, sensor=None,
-              model=None, coverage: float = 0.9) -> Answer:
+              model=None, coverage: float = 0.9,
+              sensor_temp_spread_c: float = 0.0) -> Answer:
     """Largest noise sigma [degC] at which ``contact_s`` still separates the objects (table).
 
     Arguments as :func:`min_contact`; ``contact_s`` [s] is the contact time.
     """
     return _ratio_question("max-noise", e1, e2, m1, m2, objects, contact_s, None, delta_t_c, threshold, table,
-                           ideal_table, sensor, model, coverage)
+                           ideal_table, sensor, model, coverage, sensor_temp_spread_c)
 
 
 def min_delta_t(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact_s: float, noise_c: float = 0.05,
                 threshold=None, table=DEFAULT_TABLE, ideal_table=DEFAULT_IDEAL_TABLE, sensor=None,
-                model=None, coverage: float = 0.9) -> Answer:
+                model=None, coverage: float = 0.9,
+                sensor_temp_spread_c: float = 0.0) -> Answer:
     """Smallest sensor-object temperature difference [degC] that separates the objects (table).
 
     Arguments as :func:`min_contact`; ``contact_s`` [s] is the contact time.
     """
     return _ratio_question("min-delta-t", e1, e2, m1, m2, objects, contact_s, noise_c, None, threshold, table,
-                           ideal_table, sensor, model, coverage)
+                           ideal_table, sensor, model, coverage, sensor_temp_spread_c)
 
 
 # ============================================================ delta-e
 def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, noise_c: float = 0.05,
             delta_t_c: float = 10.0, threshold=None, table=DEFAULT_TABLE, ideal_table=DEFAULT_IDEAL_TABLE,
-            sensor=None, model=None, coverage: float = 0.9) -> Answer:
+            sensor=None, model=None, coverage: float = 0.9,
+            sensor_temp_spread_c: float = 0.0) -> Answer:
     """delta(e) towards lower and higher effusivity [J s^-1/2 K^-1 m^-2] (table).
 
     ``value`` is the smaller of the two; ``details["lower"]`` and
@@ -1295,7 +1340,8 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
     contact = check_contact(contact_s)
     coverage = check_coverage(coverage)
     noise, dt = scene_inputs(noise_c, delta_t_c)
-    op = _open(table, ideal_table, threshold=threshold, sensor=sensor, model=model)
+    op = _open(table, ideal_table, threshold=threshold, sensor=sensor, model=model,
+               spread=sensor_temp_spread_c)
     ref = reference_class(e, m, width=op.width, model=op.model)
     x = ref.e_range[0]
     view = op.view
@@ -1399,17 +1445,21 @@ _IDEAL_F1: "OrderedDict[tuple, tuple[float, str]]" = OrderedDict()
 _IDEAL_F1_SIZE = 4096
 
 
-def _ideal_pair_f1(classes, op, contact: float, noise: float, dt: float) -> tuple[float, str]:
-    """:func:`designkit.recognition.ideal.ideal_pair`'s F1 and method for the table route's pair, cached."""
+def _ideal_pair_f1(classes, op, contact: float, noise: float, dt: float, spread: float = 0.0) -> tuple[float, str]:
+    """:func:`designkit.recognition.ideal.ideal_pair`'s F1 and method for the table route's pair, cached
+    (``spread`` [degC]: the sensor temperature drawn per touch within +-spread of Ta + dT, Ta 25 degC, as the
+    exact route's scene; the ideal observer is then a Monte Carlo one)."""
     from ..recognition.ideal import ideal_pair
     from ..scene import Scene
 
     sen = op.tab.sensor
     key = (tuple(classes), float(sen.effusivity), float(sen.tau_s),
-           float(sen.sample_rate_hz), contact, noise, dt, op.tab.header["content_hash"], op.model.name)
+           float(sen.sample_rate_hz), contact, noise, dt, spread, op.tab.header["content_hash"], op.model.name)
     if key not in _IDEAL_F1:
-        res = ideal_pair(*classes, sen, Scene.from_delta_t(contact_s=contact, noise_c=noise, delta_t_c=dt),
-                         model=op.model)
+        scene = (Scene.from_delta_t(contact_s=contact, noise_c=noise, delta_t_c=dt) if spread == 0 else
+                 Scene(contact_s=contact, noise_c=noise, sensor_temp_c=25.0 + dt, ambient_temp_c=25.0,
+                       sensor_temp_spread_c=spread))
+        res = ideal_pair(*classes, sen, scene, model=op.model)
         _IDEAL_F1[key] = (float(res.f1), res.method)
         while len(_IDEAL_F1) > _IDEAL_F1_SIZE:
             _IDEAL_F1.popitem(last=False)
@@ -1419,7 +1469,8 @@ def _ideal_pair_f1(classes, op, contact: float, noise: float, dt: float) -> tupl
 
 def distinguishable(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact_s: float, noise_c: float = 0.05,
                     delta_t_c: float = 10.0, threshold=None, table=DEFAULT_TABLE, ideal_table=DEFAULT_IDEAL_TABLE,
-                    sensor=None, model=None, coverage: float = 0.9) -> Answer:
+                    sensor=None, model=None, coverage: float = 0.9,
+                    sensor_temp_spread_c: float = 0.0) -> Answer:
     """Whether ``contact_s`` separates the objects (table), with the ideal observer's F1 (closed form).
 
     ``value`` is True or False; the SVM's F1 of the pair itself is not in a
@@ -1432,7 +1483,8 @@ def distinguishable(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact
     coverage = check_coverage(coverage)
     contact = check_contact(contact_s)
     noise, dt = scene_inputs(noise_c, delta_t_c)
-    op = _open(table, ideal_table, threshold=threshold, sensor=sensor, model=model)
+    op = _open(table, ideal_table, threshold=threshold, sensor=sensor, model=model,
+               spread=sensor_temp_spread_c)
     pq = pair_question(e1, e2, m1, m2, objects=objects, width=op.width, model=op.model)
     scene = _scene(contact, noise, dt)
     empty = {"distinguishable": None, "svm_f1": None, "svm_standard_error": None, "verdict": None,
@@ -1457,9 +1509,10 @@ def distinguishable(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact
 
     yes = verdict("svm")
     verdicts = (verdict("hi"), verdict("lo")) if op.tab.fidelity == "svm" else (yes, yes)
-    ideal_f1, ideal_method = _ideal_pair_f1(pq.classes, op, contact, noise, dt)
+    ideal_f1, ideal_method = _ideal_pair_f1(pq.classes, op, contact, noise, dt, table_spread(op.tab))
     # how sure the verdict is: the contact against the table's interval of the shortest separating contact
     mc = min_contact(objects=pq.classes, noise_c=noise, delta_t_c=dt, table=op.tab, ideal_table=None,
+                     sensor_temp_spread_c=sensor_temp_spread_c,
                      coverage=coverage) if op.tab.fidelity == "svm" else None
     sure = None
     if mc is not None and mc.interval_coverage is not None and mc.interval[0] is not None:
@@ -1485,7 +1538,7 @@ def _fmt_or_open(x) -> str:
 
 # ============================================================ for the array route (designkit.query.vectorized)
 def open_table(table: "Table | str" = DEFAULT_TABLE, ideal_table: "Table | str | None" = DEFAULT_IDEAL_TABLE, *,
-               threshold=None, sensor=None, model=None):
+               threshold=None, sensor=None, model=None, sensor_temp_spread_c: float = 0.0):
     """The table checked against the question, as this route opens it (for the array route).
 
     Returns an object with ``tab`` (the :class:`~designkit.tables.store.Table`), ``view`` (its
@@ -1493,7 +1546,8 @@ def open_table(table: "Table | str" = DEFAULT_TABLE, ideal_table: "Table | str |
     ``e_hi``), ``phi``, ``model``, ``width``, ``closed`` (the ideal bound is computed in closed form),
     ``iview`` / ``ikind`` (the ideal bound's view and array kind when read from a grid).
     """
-    return _open(table, ideal_table, threshold=threshold, sensor=sensor, model=model)
+    return _open(table, ideal_table, threshold=threshold, sensor=sensor, model=model,
+                 spread=sensor_temp_spread_c)
 
 
 def delta_e_ideal_view(opened, ideal_table: "Table | str | None" = DEFAULT_IDEAL_TABLE):

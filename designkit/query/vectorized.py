@@ -687,8 +687,10 @@ def answer_arrays(question: str, scalar: Callable[..., Answer], route: str, argu
         op = _table_route.open_table(others.get("table", _table_route.DEFAULT_TABLE),
                                      others.get("ideal_table", _table_route.DEFAULT_IDEAL_TABLE),
                                      threshold=others.get("threshold"), sensor=others.get("sensor"),
-                                     model=others.get("model"))
-        unknown = set(others) - {"table", "ideal_table", "threshold", "sensor", "model", "coverage"}
+                                     model=others.get("model"),
+                                     sensor_temp_spread_c=others.get("sensor_temp_spread_c", 0.0))
+        unknown = set(others) - {"table", "ideal_table", "threshold", "sensor", "model", "coverage",
+                                 "sensor_temp_spread_c"}
         if unknown:
             raise InputError(f"{question} from a table takes no {', '.join(sorted(unknown))}")
         zc = z_of_coverage(check_coverage(others.get("coverage", 0.9)))

@@ -345,6 +345,7 @@ SHIPPED_CONTENT_HASHES = frozenset({
     "sha256:6290aff2cd7e4de3f9d1dc5ef445e66fdbb24a7cadd8e448a8733f373d111a60",  # f1-matrix-paper
     "sha256:1820bf01e2ffe9e79d35e4c0b9f8b310b10bbe7c8d481db47c9c09aa57564bae",  # ideal-paper
     "sha256:fb51017379fcac6a31e872004c42d77bb2f0cd72bbdf4b10d3c8874e288d783e",  # svm-paper
+    "sha256:7d72c28a50ff7ab6de9bfb6a3366e5c4dc5a4f6ed750a70de91c8b0098abd7b5",  # svm-paper-varied
 })
 
 

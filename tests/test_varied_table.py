@@ -1,0 +1,76 @@
+"""The shipped table for varied initial conditions (issue 13): the paper's second setting, read by spread.
+
+``svm-paper-varied`` holds delta(e) with the sensor's temperature drawn per touch within +-2.5 degC of
+Ta + 7.5 degC (the paper's Ts0 uniform in 30-35 degC, object at 25 degC). A question with that spread reads
+it; any other spread, or a question without one, is refused by it (and the CLI computes those instead).
+"""
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+import designkit.query as q
+from designkit.query.inputs import TableMismatch
+from designkit.query.table import VARIED_TABLE, shipped_spread_table, table_spread
+from designkit.tables.store import load_table
+
+
+def test_the_varied_table_holds_the_papers_spread_and_verifies():
+    t = load_table(VARIED_TABLE)
+    assert t.shipped and table_spread(t) == 2.5
+    assert [a for a in t.axes][:2] == ["noise_c", "delta_t_c"]
+    assert shipped_spread_table(2.5) == VARIED_TABLE
+    assert shipped_spread_table(1.0) is None and shipped_spread_table(0.0) is None
+
+
+def test_a_question_with_the_papers_spread_is_answered_from_the_varied_table():
+    varied = q.min_contact(35000, 20000, noise_c=0.05, delta_t_c=7.5, sensor_temp_spread_c=2.5)
+    fixed = q.min_contact(35000, 20000, noise_c=0.05, delta_t_c=7.5)
+    assert varied.table == VARIED_TABLE and varied.route == "table"
+    assert fixed.table == "svm-paper"
+    # drawing the sensor's temperature per touch costs contact time, for the SVM and the ideal observer
+    assert varied.value > fixed.value
+    assert varied.ideal >= fixed.ideal
+    lo, hi = varied.interval
+    assert lo <= varied.value <= hi
+
+
+def test_the_varied_table_refuses_another_spread_and_fixed_conditions():
+    with pytest.raises(TableMismatch, match=r"\+-2.5 degC, not with fixed initial conditions"):
+        q.min_contact(35000, 20000, delta_t_c=7.5, table=VARIED_TABLE)
+    with pytest.raises(TableMismatch, match=r"not with the sensor temperature drawn per touch within \+-1 degC"):
+        q.min_contact(35000, 20000, delta_t_c=7.5, sensor_temp_spread_c=1.0, route="table")
+    with pytest.raises(ValueError, match="spread"):
+        q.min_contact(35000, 20000, delta_t_c=7.5, sensor_temp_spread_c=-1.0, route="table")
+
+
+def test_array_questions_take_the_spread_too():
+    a = q.min_contact([35000, 30000], 20000, noise_c=0.05, delta_t_c=7.5, sensor_temp_spread_c=2.5)
+    b = q.min_contact(30000, 20000, noise_c=0.05, delta_t_c=7.5, sensor_temp_spread_c=2.5)
+    assert a.table == VARIED_TABLE
+    assert float(a.value[1]) == b.value
+
+
+def test_the_cli_reads_the_varied_table_for_the_papers_spread():
+    r = subprocess.run([sys.executable, "-m", "designkit", "min-contact", "--e1", "35000", "--e2", "20000",
+                        "--delta-t", "7.5", "--sensor-temp-spread", "2.5", "--json"],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    d = json.loads(r.stdout)
+    assert d["route"] == "table" and d["table"]["name"] == VARIED_TABLE
+
+
+def test_the_exact_route_finds_the_first_crossing_when_f1_falls_again_at_long_contact():
+    """With the sensor temperature varied per touch the SVM's F1 peaks and falls (below Phi at 10 s for this
+    pair): the exact route used to answer "not separable up to 10 s"; it now finds the first crossing, which
+    lies in the varied table's cell."""
+    exact = q.min_contact(35000, 20000, noise_c=0.05, delta_t_c=7.5, sensor_temp_spread_c=2.5, exact=True,
+                          solver="batched")
+    table = q.min_contact(35000, 20000, noise_c=0.05, delta_t_c=7.5, sensor_temp_spread_c=2.5)
+    assert exact.value is not None and exact.value >= exact.ideal
+    assert any("not monotone in contact time" in n for n in exact.notes)
+    lo, hi = exact.interval
+    t_lo, t_hi = table.interval
+    assert lo <= t_hi and t_lo <= hi  # the exact estimate's interval meets the table's cell

@@ -74,3 +74,14 @@ def test_the_exact_route_finds_the_first_crossing_when_f1_falls_again_at_long_co
     lo, hi = exact.interval
     t_lo, t_hi = table.interval
     assert lo <= t_hi and t_lo <= hi  # the exact estimate's interval meets the table's cell
+
+
+def test_tables_show_says_which_initial_conditions_a_table_holds():
+    r = subprocess.run([sys.executable, "-m", "designkit", "tables", "show", VARIED_TABLE, "--json"],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert json.loads(r.stdout)["initial_conditions"] == {"fixed": False, "sensor_temp_spread_c": 2.5,
+                                                          "ambient_temp_spread_c": 0.0}
+    r = subprocess.run([sys.executable, "-m", "designkit", "tables", "show", "svm-paper"],
+                       capture_output=True, text=True, timeout=120)
+    assert "initial conditions fixed" in r.stdout

@@ -106,10 +106,18 @@ def tables_show(
             continue
         vals = ", ".join(f"{v:g}" for v in a.get("values", [])) or f"{a['min']:g} .. {a['max']:g}"
         con.print(escape(f"  axis {a['name']} [{a['units']}, {a['scale']}]: {vals}"))
+    ic = s["initial_conditions"]
+    if ic["fixed"]:
+        con.print("  initial conditions fixed (every touch starts at Ta + dT)")
+    else:
+        amb = (f", ambient within +-{ic['ambient_temp_spread_c']:g} degC" if ic["ambient_temp_spread_c"] else "")
+        con.print(f"  initial conditions varied per touch: sensor temperature within +-{ic['sensor_temp_spread_c']:g} "
+                  f"degC of Ta + dT{amb} (questions must give the same --sensor-temp-spread)")
     con.print(f"  threshold F1 >= {s['threshold']:g}; {s['trials']} trials per interval, {s['folds']} folds, seed {s['seed']}")
     st = s.get("stats", {})
     if st.get("svm_fits_total"):
-        con.print(f"  built with {st['svm_fits_total']} SVM fits, {st['compute_s_total'] / 3600:.2f} CPU-hours "
+        # compute_s is each chunk's wall time in its worker, summed: worker time, CPU time when the cores were free
+        con.print(f"  built with {st['svm_fits_total']} SVM fits, {st['compute_s_total'] / 3600:.2f} worker-hours "
                   f"({st['svm_fits_per_scene_mean']:.0f} fits and {st['compute_s_per_scene_mean']:.0f} s per scene)")
     con.print(f"  designkit {s['designkit_version']}, created {s['created']}")
     con.print(f"  arrays: {', '.join(s['arrays'])}")

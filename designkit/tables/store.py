@@ -276,6 +276,10 @@ class Table:
                 "min": min(a["values"]), "max": max(a["values"]), "points": len(a["values"]),
                 **({"values": a["values"]} if len(a["values"]) <= 40 else {})} for a in h["axes"]],
             "arrays": sorted(h["arrays"]),
+            "initial_conditions": {
+                "fixed": self.fixed_initial_conditions,
+                "sensor_temp_spread_c": float(h.get("config", {}).get("sensor_temp_spread_c") or 0.0),
+                "ambient_temp_spread_c": float(h.get("config", {}).get("ambient_temp_spread_c") or 0.0)},
             "threshold": h["threshold"],
             "trials": h["trials"],
             "folds": h["folds"],

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from designkit import SENSORS, InputError, Scene
+from designkit import SENSORS, InputError
 from designkit.models import MODELS, ForwardModel, get_model, model_names
 from designkit.models.contact import Contact
 from designkit.models.semi_infinite import SemiInfinite

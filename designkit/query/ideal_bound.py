@@ -283,16 +283,9 @@ def _gaussian_sample_guess(sensor, lo, hi, width, ratio, threshold, cum: np.ndar
     ``n`` with ``ratio / sqrt(cum[n]) <= s*``. Only a starting bracket for the exact bisection (which
     decides every answer): NaN where the approximation says no noise is small enough.
     """
-    cdf, _ = _phi_table()
-    z = float(np.interp(threshold, cdf, np.arange(-_PHI_Z, _PHI_Z + _PHI_H / 2, _PHI_H)))
-    e_s = sensor.effusivity
-    wl = _weight(e_s, np.stack([lo, lo + width]))
-    wh = _weight(e_s, np.stack([hi, hi + width]))
-    spread2 = ((wl[1] - wl[0]) ** 2 + (wh[1] - wh[0]) ** 2) / 24.0
-    dw = np.abs(0.5 * (wh[0] + wh[1] - wl[0] - wl[1]))
+    s_star = _gaussian_noise_guess(sensor, lo, hi, width, threshold)
     with np.errstate(divide="ignore", invalid="ignore"):
-        s2 = (dw / (2.0 * z)) ** 2 - spread2
-        need = np.where(s2 > 0, ratio * ratio / s2, np.nan)
+        need = np.where(s_star > 0, (ratio / s_star) ** 2, np.nan)
     n = np.searchsorted(cum, np.nan_to_num(need, nan=np.inf)).astype(np.float64)
     return np.where(np.isfinite(need) & (n < cum.size), n, np.nan)
 

@@ -73,21 +73,6 @@ def test_the_gaussian_guess_lands_near_the_exact_count():
     assert np.max(np.abs(guess[both] / exact[both] - 1.0)) < ib._GUESS_SPAN
 
 
-def test_efficiency_min_contact_is_the_first_sample_where_both_partners_separate():
-    # constant efficiency 1.3 over the range: the decision is monotone and the guessed bracket is used
-    lo, hi, ratio = 20000.0, 35000.0, 0.005
-    t = float(ib.efficiency_min_contact(PAPER, lo, hi, ratio, 1.0, 2.0, 1.3, 1.3, 4.0))
-    fs = float(PAPER.sample_rate_hz)
-    n = int(round(t * fs))
-    g = (hi - lo) / 1.3
-
-    def holds(k):
-        return _decides(lo, lo + g, ratio, k) and _decides(hi - g, hi, ratio, k)
-
-    assert holds(n) and not holds(n - 1)
-    assert t > float(ib.exact_ideal_min_contact(PAPER, lo, hi, ratio))
-
-
 @pytest.mark.parametrize("n", [5, 20, 40, 64])
 def test_the_quadrature_rule_is_numpys_gauss_legendre(n):
     x, w = np.polynomial.legendre.leggauss(n)

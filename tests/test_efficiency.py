@@ -8,7 +8,7 @@ import pytest
 
 from designkit.query import min_contact
 from designkit.query import table as q
-from designkit.query.ideal_bound import efficiency_min_contact, exact_ideal_min_contact
+from designkit.query.ideal_bound import exact_ideal_min_contact
 from designkit.sensor import load_sensor
 from designkit.sweep import SweepConfig
 from designkit.sweep.run import run_sweep
@@ -50,20 +50,6 @@ def test_a_classifier_as_good_as_the_ideal_observer_gets_the_exact_bound(ideal_a
     assert ans.interval[0] <= exact <= ans.value <= ans.interval[1]
     if pair[1] - pair[0] >= 5 * width:  # needs of many widths: the rounding is small, the answer the exact one
         assert ans.value == pytest.approx(exact, rel=0.02)
-
-
-def test_efficiency_moves_the_answer_the_right_way():
-    # a classifier needing 1.5x the ideal observer's separation needs a longer contact; 1.0x gives the bound
-    s = PAPER
-    bound = float(exact_ideal_min_contact(s, 20000.0, 35000.0, 0.005))
-    one = float(efficiency_min_contact(s, 20000.0, 35000.0, 0.005, 1.0, 2.0, 1.0, 1.0, 4.0))
-    worse = float(efficiency_min_contact(s, 20000.0, 35000.0, 0.005, 1.0, 2.0, 1.5, 1.5, 4.0))
-    even_worse = float(efficiency_min_contact(s, 20000.0, 35000.0, 0.005, 1.0, 2.0, 2.0, 2.0, 4.0))
-    assert one == bound < worse < even_worse <= 4.0
-    # below 1 is read as 1 (no classifier beats the ideal observer)
-    assert float(efficiency_min_contact(s, 20000.0, 35000.0, 0.005, 1.0, 2.0, 0.5, 0.5, 4.0)) == bound
-    # never beyond the search's end
-    assert float(efficiency_min_contact(s, 20000.0, 35000.0, 0.005, 1.0, 2.0, 50.0, 50.0, 1.5)) == 1.5
 
 
 def test_shipped_table_answers_lie_between_the_bound_and_the_grid_crossing():

@@ -39,13 +39,11 @@ __all__ = [
     "projection_noise",
     "cached_ideal_max_ratio",
     "cached_ideal_min_contact",
-    "cached_efficiency_min_contact",
     "cached_ideal_delta",
     "clear_bound_cache",
     "exact_ideal_delta",
     "exact_ideal_max_ratio",
     "exact_ideal_min_contact",
-    "efficiency_min_contact",
     "ideal_f1",
     "noise_k_contact",
     "shape_norm",
@@ -391,104 +389,6 @@ def exact_ideal_min_contact(sensor, lo, hi, ratio, *, width: float = 80.0, thres
     if (last := np.nonzero(n == n_max)[0]).size:
         top[last] = ok(n[last], last)
     return np.where(top, n / fs, np.nan).reshape(shape)
-
-
-def efficiency_min_contact(sensor, lo, hi, ratio, t0, t1, eff0, eff1, upper_s, *, width: float = 80.0,
-                           threshold: float = 0.9) -> np.ndarray:
-    """Shortest contact [s] for a classifier that needs ``eff(t)`` times the ideal observer's separation.
-
-    A classifier's *efficiency* ``eff(t) = delta_classifier(t) / delta_ideal(t)`` (>= 1) is the ratio of
-    the effusivity difference it needs to the ideal observer's at the same contact time. Given it at two
-    contact times (log-linear in log t between them, constant beyond; ``eff1`` alone where ``eff0`` is NaN;
-    never below 1: the ideal observer is a bound), the
-    classifier separates classes ``[lo, lo+w)`` and ``[hi, hi+w)`` once the ideal observer separates each
-    of them from a partner ``(hi - lo) / eff(t)`` away (upwards from ``lo`` and downwards from ``hi``,
-    the two directions a table's delta(e) has). This is the first sample time up to ``upper_s`` where
-    that holds (bisection on the sample count; ``upper_s`` where it never does), vectorized.
-
-    Parameters
-    ----------
-    sensor : Sensor
-    lo, hi : array_like
-        Lower edges of the two classes [J s^-1/2 K^-1 m^-2].
-    ratio : array_like
-        sigma/dT [-].
-    t0, t1 : array_like
-        Contact times [s] where the efficiency is known (``t0 < t1``).
-    eff0, eff1 : array_like
-        Efficiency there [-] (``eff0`` NaN: constant ``eff1``).
-    upper_s : array_like
-        Longest contact examined [s] (for example the table's crossing).
-    width, threshold : float
-        Class width [J s^-1/2 K^-1 m^-2] and F1 threshold.
-
-    Returns
-    -------
-    ndarray
-        Contact time [s].
-
-    Examples
-    --------
-    >>> from designkit.sensor import load_sensor
-    >>> s = load_sensor("paper")
-    >>> ideal = float(exact_ideal_min_contact(s, 20000.0, 35000.0, 0.005))
-    >>> float(efficiency_min_contact(s, 20000.0, 35000.0, 0.005, 1.0, 2.0, 1.0, 1.0, 4.0)) == ideal
-    True
-    >>> 1.2 < float(efficiency_min_contact(s, 20000.0, 35000.0, 0.005, 1.0, 2.0, float("nan"), 1.5, 4.0))
-    True
-    """
-    cols = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64) for x in (lo, hi, ratio, t0, t1, eff0, eff1,
-                                                                            upper_s)))
-    shape = cols[0].shape
-    lo, hi, ratio, t0, t1, eff0, eff1, upper = (c.ravel() for c in cols)
-    fs = float(sensor.sample_rate_hz)
-    b = last_sample_index(upper, fs)
-    a = np.zeros(b.shape, dtype=np.int64)  # n = 0: one sample at contact, no information
-    cum = _cumulative_g2(float(sensor.tau_s), fs, int(max(np.max(b), 1)))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        slope = np.where(np.isnan(eff0), 0.0, np.log(eff1 / eff0) / np.log(t1 / t0))
-
-    t_min, t_max = np.fmin(t0, t1), np.fmax(t0, t1)
-
-    def partner(n, rows):  # the separation the classifier needs at sample count n [J s^-1/2 K^-1 m^-2]
-        t = np.minimum(np.maximum(n / fs, t_min[rows]), t_max[rows])  # constant beyond the two known points
-        with np.errstate(divide="ignore", invalid="ignore"):
-            return (hi[rows] - lo[rows]) / np.maximum(eff1[rows] * np.exp(slope[rows] * np.log(t / t1[rows])), 1.0)
-
-    def ok(n, rows):
-        lo_, hi_ = np.broadcast_to(lo[rows], n.shape), np.broadcast_to(hi[rows], n.shape)
-        g = partner(n, rows)
-        with np.errstate(divide="ignore"):
-            s = ratio[rows] / np.sqrt(cum[n])
-        # both directions in one vectorized call (each element's decision is independent of the others)
-        both = _ok(sensor, np.stack([lo_, np.maximum(hi_ - g, 0.0)]), np.stack([lo_ + g, hi_]), width,
-                   np.stack([s, s]), threshold)
-        return both[0] & both[1] & (g > 0)
-
-    # the starting guess: the Gaussian count for the partner the efficiency asks at the guessed count, a few
-    # fixed-point steps from the efficiency at t1 (the bisection decides; the guess only brackets it). Only
-    # where the efficiency does not grow with time up to ``upper_s``: then the decision is monotone in n, and
-    # the bracket finds
-    # the same first sample as the plain bisection; where it grows, a later sample can fail again (the
-    # partner shrinks faster than the noise), and the plain bisection keeps its answer unchanged.
-    every = np.arange(lo.size)
-    guess = np.full(lo.shape, cum.size - 1.0)
-    for _ in range(3):
-        g = partner(np.nan_to_num(guess, nan=cum.size - 1.0), every)
-        guess = np.fmax(_gaussian_sample_guess(sensor, lo, lo + g, width, ratio, threshold, cum),
-                        _gaussian_sample_guess(sensor, np.maximum(hi - g, 0.0), hi, width, ratio, threshold, cum))
-    guess[(slope > 0) & (b / fs > t_min)] = np.nan  # constant efficiency up to the upper end: monotone too
-    return (_first_good_sample(ok, a, b, guess) / fs).reshape(shape)
-
-
-def cached_efficiency_min_contact(sensor, lo, hi, ratio, t0, t1, eff0, eff1, upper_s, *,
-                                  width: float = 80.0, threshold: float = 0.9) -> np.ndarray:
-    """:func:`efficiency_min_contact` through the per-process cache (same answers, same arguments)."""
-    def compute(*cols):
-        return efficiency_min_contact(sensor, *cols, width=width, threshold=threshold)
-    eff0 = np.where(np.isnan(eff0), eff1, eff0)  # the same answer (constant eff1), and a key NaN cannot spoil
-    return _cached("efficiency-min-contact", sensor, (lo, hi, ratio, t0, t1, eff0, eff1, upper_s),
-                   (float(width), float(threshold)), compute)
 
 
 def exact_ideal_max_ratio(sensor, lo, hi, contact_s, *, width: float = 80.0, threshold: float = 0.9,

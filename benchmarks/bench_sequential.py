@@ -166,7 +166,7 @@ def figure(hist, path):
 
     plt = pyplot()
     keep = [h for h in hist if h[0] in (0.1, 0.01, 0.001)] or hist
-    fig, axes = plt.subplots(len(keep), 1, figsize=(7.5, 2.3 * len(keep) + 0.6), sharex=True,
+    fig, axes = plt.subplots(len(keep), 1, figsize=(10.0, 2.3 * len(keep) + 0.6), sharex=True,
                              constrained_layout=True, squeeze=False)
     bins = np.arange(0.3, 2.2, 0.02)
     for ax, (eps, times, ideal_t, svm_t, bound_t, opt_times) in zip(axes[:, 0], keep):
@@ -183,7 +183,7 @@ def figure(hist, path):
         ax.axvline(ideal_t / 2, color="r", lw=0.8, alpha=0.6, label="2x target (half the ideal fixed)")
         ax.set_ylabel("touches")
         ax.set_title(f"requested error rate {eps:g}", fontsize=9)
-        ax.legend(fontsize=7, loc="upper left")  # the histograms sit right of the 2x line: the left is free
+        ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)  # beside: no overlap
     axes[-1, 0].set_xlabel("time to decision [s]")
     fig.suptitle("35,000 vs 20,000 J s^-1/2 K^-1 m^-2, noise 0.05 °C, dT 10 °C, paper sensor, "
                  f"{len(keep[0][1]):,} touches", fontsize=9)

@@ -851,7 +851,7 @@ def _open(table, ideal_table, *, threshold, sensor, model, spread: float = 0.0) 
     if not math.isclose(spread, held, rel_tol=1e-9, abs_tol=1e-12) or tab.header.get("config", {}).get(
             "ambient_temp_spread_c"):
         raise TableMismatch(f"table {tab.name} was built with {_spread_words(held)}, not with "
-                            f"{_spread_words(spread)} (the exact route answers any spread)")
+                            f"{_spread_words(spread)}")
     if threshold is not None and not math.isclose(check_threshold(threshold), tab.threshold, rel_tol=1e-9):
         raise TableMismatch(f"table {tab.name} was built for threshold {tab.threshold:g}, not {threshold:g}")
     if sensor is not None:

@@ -81,3 +81,24 @@ def test_the_quadrature_rule_is_numpys_gauss_legendre(n):
     assert np.max(np.abs(gw - w)) < 1e-14
     # and it integrates polynomials up to degree 2n - 1 exactly
     assert abs(np.sum(gw * gx ** (2 * n - 2)) - 2.0 / (2 * n - 1)) < 1e-13
+
+
+def test_noise_k_contact_is_the_first_sample_where_the_classifier_separates():
+    """The bisection (monotone k) and the dense scan (steep k) both give the definition's first sample."""
+    rng = np.random.default_rng(5)
+    m = 3000
+    ratio, star = 10.0 ** rng.uniform(-3.5, -1.3, m), 10.0 ** rng.uniform(-3.0, -1.0, m)
+    t_a = rng.choice([0.5, 0.75, 1.0, 1.5, 2.0, 3.0, 4.0], m)
+    t_b = t_a * rng.choice([1.5, 2.0], m)
+    ka = rng.uniform(0.0, 1.2, m)
+    kb = ka + rng.uniform(-0.2, 0.5, m)  # slopes up to 1.2 per log t: both branches
+    got = ib.noise_k_contact(PAPER, ratio, star, t_a, t_b, ka, kb, 10.0)
+    fs = float(PAPER.sample_rate_hz)
+    n = np.arange(1, 2001)
+    cum = ib._cumulative_g2(float(PAPER.tau_s), fs, 2000)
+    slope = (kb - ka) / np.log(t_b / t_a)
+    log_k = np.maximum(ka[:, None] + slope[:, None] * (np.log(n / fs)[None, :] - np.log(t_a)[:, None]), 0.0)
+    ok = log_k + np.log(ratio)[:, None] - 0.5 * np.log(cum[n])[None, :] <= np.log(star)[:, None]
+    want = np.where(ok.any(axis=1), n[np.argmax(ok, axis=1)] / fs, np.nan)
+    assert np.array_equal(got, want, equal_nan=True)
+    assert (slope > 0.5).sum() > 100 and (slope <= 0.5).sum() > 100 and np.isnan(want).sum() > 10

@@ -84,7 +84,7 @@ def test_the_quadrature_rule_is_numpys_gauss_legendre(n):
 
 
 def test_noise_k_contact_is_the_first_sample_where_the_classifier_separates():
-    """The bisection (monotone k) and the dense scan (steep k) both give the definition's first sample."""
+    """The bisection (monotone k, many pairs) and the dense scan (steep k, or few pairs) give the definition's first sample."""
     rng = np.random.default_rng(5)
     m = 3000
     ratio, star = 10.0 ** rng.uniform(-3.5, -1.3, m), 10.0 ** rng.uniform(-3.0, -1.0, m)
@@ -102,3 +102,13 @@ def test_noise_k_contact_is_the_first_sample_where_the_classifier_separates():
     want = np.where(ok.any(axis=1), n[np.argmax(ok, axis=1)] / fs, np.nan)
     assert np.array_equal(got, want, equal_nan=True)
     assert (slope > 0.5).sum() > 100 and (slope <= 0.5).sum() > 100 and np.isnan(want).sum() > 10
+
+
+def test_noise_k_contact_answers_a_pair_alone_as_in_a_crowd():
+    rng = np.random.default_rng(6)
+    m = 500
+    args = (10.0 ** rng.uniform(-3.5, -1.3, m), 10.0 ** rng.uniform(-3.0, -1.0, m), np.full(m, 1.0), np.full(m, 2.0),
+            rng.uniform(0.0, 1.0, m), rng.uniform(0.0, 1.2, m))
+    crowd = ib.noise_k_contact(PAPER, *args, 10.0)  # > 64 pairs: bisection where k is not steep
+    alone = np.array([float(ib.noise_k_contact(PAPER, *(a[i] for a in args), 10.0)) for i in range(0, m, 10)])
+    assert np.array_equal(alone, crowd[::10], equal_nan=True)

@@ -124,11 +124,17 @@ def _as_table(table: "Table | str") -> Table:
     return t
 
 
+#: :meth:`_View.entry_noise` per table content and scene slices (a view is made per question; the measure is
+#: the table's: computed once per process, not on every question).
+_ENTRY_NOISE: dict[tuple, float] = {}
+
+
 def clear_table_cache() -> None:
     """Forget the tables this process has loaded (they are re-read and re-verified on next use), and the
     noise-efficiency readings taken from them."""
     _LOADED.clear()
     _K_READINGS.clear()
+    _ENTRY_NOISE.clear()
 
 
 # ============================================================ interpolation
@@ -144,7 +150,6 @@ class _View:
         self.e_lo = float(table.header["effusivity"]["min"])
         self.e_hi = float(table.header["effusivity"]["max"])
         self._needs: dict[tuple, float] = {}  # need() is a function of its arguments: asked again, not recomputed
-        self._entry_noise: dict[tuple, float] = {}
 
     # ---- scene axes -> weights
     def scene_weights(self, noise_c: float, delta_t_c: float) -> tuple[list[tuple[tuple[int, ...], float]], dict[str, bool]]:
@@ -212,8 +217,8 @@ class _View:
         their median absolute deviation x 1.4826. Entries whose SVM need is under four widths (rounding
         dominates there; it has its own term) are left out. 0 when the table has no ideal needs.
         """
-        key = tuple(idx for idx, w in combos if w)
-        hit = self._entry_noise.get(key)
+        key = (self.t.header.get("content_hash"), tuple(idx for idx, w in combos if w))
+        hit = _ENTRY_NOISE.get(key) if key[0] is not None else None  # a table without a hash: not cached
         if hit is not None:
             return hit
         arrays, h = self.t.arrays, 0.5 * float(self.t.header["effusivity"]["width"])
@@ -222,7 +227,7 @@ class _View:
         for d in ("up", "down"):
             if f"delta_{d}_ideal" not in arrays:
                 continue
-            for idx in key:
+            for idx in key[1]:
                 svm, ideal = arrays[f"delta_{d}"][idx], arrays[f"delta_{d}_ideal"][idx]  # [contact, e_ref]
                 with np.errstate(invalid="ignore", divide="ignore"):
                     le = np.where(svm >= 8.0 * h, np.log((svm - h) / (ideal - h)), np.nan)
@@ -232,7 +237,8 @@ class _View:
                     res.append(r[np.isfinite(r)])
         r = np.concatenate(res) if res else np.zeros(0)
         value = float(1.4826 * _median(np.abs(r - _median(r)))) if r.size >= 20 else 0.0
-        self._entry_noise[key] = value
+        if key[0] is not None:
+            _ENTRY_NOISE[key] = value
         return value
 
     def e_in_grid(self, *es: float) -> bool:
@@ -423,6 +429,8 @@ def _k_readings(op, slices, sw, ka, kb, lo, hi, extra=None):
     if lo.size > _K_READINGS_PAIRS:
         return _k_readings_computed(op, slices, sw, ka, kb, lo, hi, extra)
     arrays = (slices, sw, ka, kb, lo, hi) + (tuple(extra) if extra is not None else ())
+    if op.tab.header.get("content_hash") is None:  # a table without a hash: its content is not a key
+        return _k_readings_computed(op, slices, sw, ka, kb, lo, hi, extra)
     key = (op.tab.header.get("content_hash"), float(op.width), float(op.phi), extra is not None) + tuple(
         (a.dtype.str, a.shape, a.tobytes()) for a in (np.ascontiguousarray(x) for x in arrays))
     hit = _K_READINGS.get(key)

@@ -127,6 +127,8 @@ def _as_table(table: "Table | str") -> Table:
 #: :meth:`_View.entry_noise` per table content and scene slices (a view is made per question; the measure is
 #: the table's: computed once per process, not on every question).
 _ENTRY_NOISE: dict[tuple, float] = {}
+#: :meth:`_View.need` per table content (at most 65,536 a table, then forgotten).
+_NEEDS: dict[str, dict[tuple, float]] = {}
 
 
 def clear_table_cache() -> None:
@@ -135,6 +137,7 @@ def clear_table_cache() -> None:
     _LOADED.clear()
     _K_READINGS.clear()
     _ENTRY_NOISE.clear()
+    _NEEDS.clear()
 
 
 # ============================================================ interpolation
@@ -149,7 +152,10 @@ class _View:
         self.scene_axes = [n for n in table.axis_names if n not in ("contact_s", "e_ref")]
         self.e_lo = float(table.header["effusivity"]["min"])
         self.e_hi = float(table.header["effusivity"]["max"])
-        self._needs: dict[tuple, float] = {}  # need() is a function of its arguments: asked again, not recomputed
+        # need() is a function of the table's content and its arguments: asked again (by any question on this
+        # table in this process: a view is made per question), not recomputed
+        h = table.header.get("content_hash")
+        self._needs: dict[tuple, float] = _NEEDS.setdefault(h, {}) if h is not None else {}
 
     # ---- scene axes -> weights
     def scene_weights(self, noise_c: float, delta_t_c: float) -> tuple[list[tuple[tuple[int, ...], float]], dict[str, bool]]:

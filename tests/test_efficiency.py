@@ -1,5 +1,6 @@
-"""min-contact's efficiency route: the SVM's tabulated need over the ideal observer's, applied to the exact
-ideal observer between a table's contact times (designkit.query.table.efficiency_estimate)."""
+"""The table's efficiency routes: min-contact, max-noise and min-delta-t read the SVM's noise efficiency k
+(designkit.query.table.noise_k_min_contact / noise_k_max_ratio), delta-e its ratio of needs
+(delta_efficiency_estimate), each applied to the exact ideal observer between a table's contact times."""
 
 from __future__ import annotations
 

@@ -528,11 +528,17 @@ def cached_ideal_max_ratio(sensor, lo, hi, contact_s, *, width: float = 80.0, th
 
 
 # ============================================================ the noise at which the ideal observer just separates
+@functools.lru_cache(maxsize=8)
+def _z_of(threshold: float) -> float:
+    """``Phi^-1(threshold)``, read off :func:`_phi_table` (enough for a starting guess)."""
+    cdf, _ = _phi_table()
+    return float(np.interp(threshold, cdf, np.arange(-_PHI_Z, _PHI_Z + _PHI_H / 2, _PHI_H)))
+
+
 def _gaussian_noise_guess(sensor, lo, hi, width, threshold) -> np.ndarray:
     """The projection noise :func:`_gaussian_sample_guess` takes as the largest that still separates
     ``[lo, lo+w)`` from ``[hi, hi+w)`` (NaN where the approximation says none does)."""
-    cdf, _ = _phi_table()
-    z = float(np.interp(threshold, cdf, np.arange(-_PHI_Z, _PHI_Z + _PHI_H / 2, _PHI_H)))
+    z = _z_of(float(threshold))
     e_s = sensor.effusivity
     wl = _weight(e_s, np.stack([lo, lo + width]))
     wh = _weight(e_s, np.stack([hi, hi + width]))
@@ -651,12 +657,8 @@ def noise_k_contact(sensor, ratio, s_star, t_a, t_b, log_k_a, log_k_b, max_conta
     if mono.size:
         top = ok(np.full(mono.size, max(n_max, 1)), mono)
         rows = mono[top]
-        a, b = np.zeros(rows.size, dtype=np.int64), np.full(rows.size, max(n_max, 1), dtype=np.int64)
-        while (open_ := np.nonzero(b - a > 1)[0]).size:
-            mid = (a[open_] + b[open_]) // 2
-            g = ok(mid, rows[open_])
-            b[open_] = np.where(g, mid, b[open_])
-            a[open_] = np.where(g, a[open_], mid)
-        # n = 0 (the sample at contact) carries no signal (cum[0] = 0): the first good sample is b >= 1
+        # n = 0 (the sample at contact) carries no signal (cum[0] = 0): the first good sample is >= 1
+        b = _first_good_sample(lambda n, r: ok(n, rows[r]), np.zeros(rows.size, dtype=np.int64),
+                               np.full(rows.size, max(n_max, 1), dtype=np.int64))
         out[rows] = b / fs
     return out.reshape(shape)

@@ -34,7 +34,7 @@ from numpy.typing import ArrayLike
 from .._validation import InputError
 from . import exact as _exact_route
 from . import table as _table_route
-from .answer import QUANTITIES, Answer
+from .answer import Answer, QuestionQuantity
 from .vectorized import ArrayAnswer, answer_arrays, is_array_call
 
 __all__ = ["QUESTIONS", "ROUTES", "Question", "ask", "delta_e", "distinguishable", "max_noise", "min_contact",
@@ -44,7 +44,7 @@ ROUTES = ("table", "exact")
 
 
 @dataclass(frozen=True)
-class Question:
+class Question(QuestionQuantity):
     """One design question: its name, what it answers, and its two routes.
 
     Attributes
@@ -66,12 +66,9 @@ class Question:
     exact: Callable[..., Answer]
 
     @property
-    def quantity(self) -> str:
-        return QUANTITIES[self.name][0]
-
-    @property
-    def unit(self) -> str:
-        return QUANTITIES[self.name][1]
+    def question(self) -> str:
+        """Its name (what :class:`~designkit.query.answer.QuestionQuantity` reads ``quantity`` and ``unit`` by)."""
+        return self.name
 
     def route(self, name: str) -> Callable[..., Answer]:
         """The function answering this question by route ``name``."""

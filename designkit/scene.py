@@ -55,11 +55,14 @@ class Scene:
 
     @classmethod
     def from_delta_t(cls, *, contact_s: float = 2.0, noise_c: float = 0.05,
-                     delta_t_c: float = 10.0, ambient_temp_c: float = 25.0) -> "Scene":
-        """A fixed-condition scene with the sensor ``delta_t_c`` above ambient."""
+                     delta_t_c: float = 10.0, ambient_temp_c: float = 25.0,
+                     sensor_temp_spread_c: float = 0.0) -> "Scene":
+        """A scene with the sensor ``delta_t_c`` above ambient [degC]; with ``sensor_temp_spread_c`` > 0 each
+        touch's sensor temperature is drawn within +-that of it (varied initial conditions), else fixed."""
         dt = check_finite("temperature difference [degC]", delta_t_c)
         amb = check_finite("ambient temperature [degC]", ambient_temp_c)
-        return cls(contact_s=contact_s, noise_c=noise_c, sensor_temp_c=amb + dt, ambient_temp_c=amb)
+        return cls(contact_s=contact_s, noise_c=noise_c, sensor_temp_c=amb + dt, ambient_temp_c=amb,
+                   sensor_temp_spread_c=sensor_temp_spread_c)
 
     @property
     def delta_t_c(self) -> float:

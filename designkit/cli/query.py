@@ -90,11 +90,6 @@ def _hints():
         raise NeedsInput(f"{exc} ({hint})" if hint else str(exc), exc.what) from None
 
 
-#: The questions a table with varied initial conditions answers (its noise and dT are separate axes, not
-#: sigma/dT: max-noise and min-delta-t need the exact route there).
-SPREAD_TABLE_QUESTIONS = ("min-contact", "delta-e", "distinguishable")
-
-
 def _ask(question: str, *, exact: bool, table: Optional[str], ideal_table: str, threshold: float, sensor: str,
          model, conductance, thickness, backing, diffusivity, width: float, trials: int, repeats: int, seed: int,
          jobs: int, n_mc: int, objects: dict, scene: dict, exact_extra: Optional[dict] = None,
@@ -121,10 +116,10 @@ def _ask(question: str, *, exact: bool, table: Optional[str], ideal_table: str, 
         reroute = None if exact or table is not None else table_reroute(sen, fm)
         # varied initial conditions: the shipped table for the paper's spread (2.5 degC), else computed
         varied = None
-        if spread > 0 and not exact and table is None and reroute is None and question in SPREAD_TABLE_QUESTIONS:
+        if spread > 0 and not exact and table is None and reroute is None:
             from ..query.table import shipped_spread_table
 
-            varied = shipped_spread_table(spread)
+            varied = shipped_spread_table(spread, question)
         route = "exact" if exact or reroute or (spread > 0 and table is None and varied is None) else "table"
         if spread > 0:
             extra["sensor_temp_spread_c"] = spread

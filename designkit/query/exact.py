@@ -199,10 +199,8 @@ class _Run:
         +-``spread`` degC of it when the question has a sensor temperature spread (varied initial conditions)."""
         from ..scene import Scene
 
-        if self.spread == 0:
-            return Scene.from_delta_t(contact_s=contact_s, noise_c=noise_c, delta_t_c=delta_t_c)
-        return Scene(contact_s=contact_s, noise_c=noise_c, sensor_temp_c=25.0 + delta_t_c, ambient_temp_c=25.0,
-                     sensor_temp_spread_c=self.spread)
+        return Scene.from_delta_t(contact_s=contact_s, noise_c=noise_c, delta_t_c=delta_t_c,
+                                  sensor_temp_spread_c=self.spread)
 
     def closed_form(self, *classes: ObjectClass) -> bool:
         """Whether the vectorized closed form answers (shared shape, fixed initial conditions, every class

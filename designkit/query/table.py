@@ -68,6 +68,7 @@ __all__ = [
     "CLOSED_FORM_RATIO_BRACKET",
     "delta_efficiency_estimate",
     "DEFAULT_TABLE",
+    "SPREAD_TABLE_QUESTIONS",
     "VARIED_TABLE",
     "GRID_RTOL",
     "clear_table_cache",
@@ -861,14 +862,21 @@ def table_spread(tab: Table) -> float:
     return float(tab.header.get("config", {}).get("sensor_temp_spread_c") or 0.0)
 
 
-def shipped_spread_table(spread: float) -> str | None:
-    """The shipped table that answers questions with sensor temperature spread ``spread`` [degC], or None.
+#: The questions a table with varied initial conditions answers (its noise and dT are separate axes, not
+#: sigma/dT: max-noise and min-delta-t are refused by it and need the exact route).
+SPREAD_TABLE_QUESTIONS = ("min-contact", "delta-e", "distinguishable")
+
+
+def shipped_spread_table(spread: float, question: str = "min-contact") -> str | None:
+    """The shipped table that answers ``question`` with sensor temperature spread ``spread`` [degC], or None.
 
     >>> shipped_spread_table(2.5)
     'svm-paper-varied'
-    >>> shipped_spread_table(1.0) is None
-    True
+    >>> shipped_spread_table(1.0) is None, shipped_spread_table(2.5, "max-noise") is None
+    (True, True)
     """
+    if question not in SPREAD_TABLE_QUESTIONS:
+        return None
     if spread > 0 and math.isclose(table_spread(_as_table(VARIED_TABLE)), spread, rel_tol=1e-9):
         return VARIED_TABLE
     return None
@@ -1497,9 +1505,7 @@ def _ideal_pair_f1(classes, op, contact: float, noise: float, dt: float, spread:
     key = (tuple(classes), float(sen.effusivity), float(sen.tau_s),
            float(sen.sample_rate_hz), contact, noise, dt, spread, op.tab.header["content_hash"], op.model.name)
     if key not in _IDEAL_F1:
-        scene = (Scene.from_delta_t(contact_s=contact, noise_c=noise, delta_t_c=dt) if spread == 0 else
-                 Scene(contact_s=contact, noise_c=noise, sensor_temp_c=25.0 + dt, ambient_temp_c=25.0,
-                       sensor_temp_spread_c=spread))
+        scene = Scene.from_delta_t(contact_s=contact, noise_c=noise, delta_t_c=dt, sensor_temp_spread_c=spread)
         res = ideal_pair(*classes, sen, scene, model=op.model)
         _IDEAL_F1[key] = (float(res.f1), res.method)
         while len(_IDEAL_F1) > _IDEAL_F1_SIZE:

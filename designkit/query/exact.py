@@ -355,8 +355,10 @@ def exact_min_contact(e1=None, e2=None, *, m1=None, m2=None, objects=None, noise
         ideal = bisect(ideal_ok, floor, tmax, itol) if ideal_ok(tmax) else None
     # the SVM needs at least the ideal observer's contact: search from there
     start = max(floor, ideal if ideal is not None else floor)
-    est = estimate_crossing(lambda c: run.svm(cls, scene(c)), start, tmax, run.phi, coverage=cov,
-                            progress=progress)
+    def svm_at(c):
+        return run.svm(cls, scene(c))
+
+    est = estimate_crossing(svm_at, start, tmax, run.phi, coverage=cov, progress=progress)
     falls = None
     if est.value is None and est.low is None and est.evaluations:
         # below Phi at the longest contact: the SVM's F1 need not rise for ever (with the sensor temperature
@@ -367,10 +369,9 @@ def exact_min_contact(e1=None, e2=None, *, m1=None, m2=None, objects=None, noise
         f_top = est.evaluations[-1]["svm_f1"]
         c = 2.0 * start
         while c < tmax:
-            f_c = run.svm(cls, scene(c))
+            f_c = svm_at(c)
             if f_c[0] >= run.phi:
-                est = estimate_crossing(lambda x: run.svm(cls, scene(x)), start, c, run.phi, coverage=cov,
-                                        progress=progress)
+                est = estimate_crossing(svm_at, start, c, run.phi, coverage=cov, progress=progress)
                 falls = (c, f_c[0], tmax, f_top)
                 break
             c *= 2.0

@@ -125,6 +125,29 @@ def test_batched_f1_equals_the_reference_except_on_near_ties(paper_sensor):
     assert all(nd > 0 for _, nd in f1_differs), f1_differs  # F1 differs only through such predictions
 
 
+@pytest.mark.parametrize("contact,gap", [(0.5, 160.0), (2.0, 800.0), (2.0, 80.0)])
+def test_a_starting_guess_changes_the_path_not_the_solution(paper_sensor, contact, gap):
+    """The folds after the first start from the states the earlier folds found (batched_cv_f1); any
+    guess, however wrong, must give the all-free start's solution bit for bit."""
+    from sklearn.preprocessing import StandardScaler
+
+    lo, hi = _pair(paper_sensor, 20000.0, 20000.0 + gap, contact, 0.01, 3)
+    X = StandardScaler().fit_transform(np.vstack([lo[:67], hi[:67]]))
+    K = (X @ X.T)[None]
+    y = np.r_[np.ones(67), -np.ones(67)]
+    a0, rho0, info0 = solve_svc_duals(K, y)
+    rng = np.random.default_rng(0)
+    for _ in range(4):
+        state = rng.integers(0, 3, size=(1, y.size))
+        a, rho, info = solve_svc_duals(K, y, start=(state == 1, state == 2))
+        np.testing.assert_array_equal(a, a0)
+        np.testing.assert_array_equal(rho, rho0)
+    free = (a0 > 0) & (a0 < 1.0)
+    a, _, info = solve_svc_duals(K, y, start=(free, a0 >= 1.0))  # the right guess: one solve
+    np.testing.assert_array_equal(a, a0)
+    assert info["iterations"][0] == 1 < info0["iterations"][0]
+
+
 def test_float64_gram_list_input_and_chunking_give_the_same_answers(paper_sensor):
     feats = [_pair(paper_sensor, 20000.0, 20000.0 + g, 1.0, 0.01, k, trials=40) for k, g in enumerate([80, 800, 8000])]
     seeds = [0, [1, 2], 7]

@@ -17,8 +17,8 @@ noise ratio, ``--trials`` touches per interval, the sweep's own seeds):
 Printed for each: wall [s], SVM fits, fits per second and the ratios to the
 naive loop and to the sklearn staircase; the agreement of the two staircases
 (references whose ``J``, ``J_lo``, ``J_hi`` differ, and by how many intervals);
-and the parallel efficiency of the batched sweep (``run_sweep`` with one block per
-core, at least 2) on ``--jobs 1`` and ``2`` local processes: ``T1 / (jobs x Tjobs)``,
+and the parallel efficiency of the batched sweep (``run_sweep`` with two blocks per
+core, so that no worker waits long for the other's last block) on ``--jobs 1`` and ``2`` local processes: ``T1 / (jobs x Tjobs)``,
 with the wall of the sweep on every core against the naive loop (on one core, as
 the paper's loop runs, and spread perfectly over the same cores). CPU seconds
 are this process's (the in-process routes; the naive loop's extrapolated like its
@@ -147,11 +147,11 @@ def main(argv=None):
         for jobs in sorted({1, 2, os.cpu_count() or 1}):
             def go(jobs=jobs):
                 with tempfile.TemporaryDirectory() as tmp:
-                    cfg = SweepConfig(name="bench", solver="batched", blocks=max(2, os.cpu_count() or 1), **base)
+                    cfg = SweepConfig(name="bench", solver="batched", blocks=2 * (os.cpu_count() or 1), **base)
                     run_sweep(cfg, Path(tmp), jobs=jobs, backend="loky" if jobs > 1 else "sequential")
             walls[jobs], _ = _median_run(go, args.repeat)
         eff = walls[1] / (2 * walls[2])
-        print(f"\nParallel (batched solver, {max(2, os.cpu_count() or 1)} blocks): --jobs 1 {walls[1]:.1f} s, --jobs 2 {walls[2]:.1f} s: "
+        print(f"\nParallel (batched solver, {2 * (os.cpu_count() or 1)} blocks): --jobs 1 {walls[1]:.1f} s, --jobs 2 {walls[2]:.1f} s: "
               f"speed-up {walls[1] / walls[2]:.2f}x, efficiency {eff:.0%} (process start-up included)")
         # the engine as a user runs it on this machine (every core), against the paper's loop as it runs
         # (one process) and against that loop spread perfectly over the same cores (its wall / cores)

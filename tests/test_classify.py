@@ -45,6 +45,42 @@ def test_classify_text_output_names_decision_and_time(cli):
     assert "touch 1: a after" in r.output and "s of contact" in r.output
 
 
+def test_classify_uses_the_calibrated_sensors_time_offset(cli, tmp_path):
+    """The emulator's onset detection lags the heat flow by 0.25 s (as a rig's force threshold does): with a
+    sensor file that recorded that offset, no --time-offset is needed (decided at an offset of 0, wood reads as
+    the faster-drawing aluminium)."""
+    sensor = tmp_path / "cal.yaml"
+    with _emulator([EmulatedMaterial("wood", 420.0)], seed=4) as emu:
+        offset = emu.expected_time_offset_s
+        PAPER.replace(name="calibrated", model={"name": "semi-infinite", "params": {}, "time_offset_s": offset}).to_yaml(sensor)
+        r = cli("classify", "--port", emu.port, "--sensor", str(sensor), "--m", "wood", "--m", "aluminium alloys",
+                "--touches", "2", "--json")
+    assert r.exit_code == 0, r.output
+    out = json.loads(r.stdout)
+    assert out["time_offset_s"] == pytest.approx(offset) and offset < -0.1
+    assert [(d["state"], d["material"]) for d in out["decisions"]] == [("decided", "Wood")] * 2
+
+
+def test_classify_decides_with_the_measured_noise_when_the_stream_is_noisier(cli):
+    """A test told 0.01 °C on a 0.05 °C stream would decide after a few samples and often wrongly; the
+    scatter before contact says so, and the touch is decided with it (said in one line per touch)."""
+    mats = [EmulatedMaterial("metal", 20000.0), EmulatedMaterial("wood", 420.0)]
+    with _emulator(mats, seed=5) as emu:
+        r = cli("classify", "--port", emu.port, "--m", "metal=12767:25972", "--m", "wood=331:506.46",
+                "--noise", "0.01", "--touches", "4", "--time-offset", str(emu.expected_time_offset_s),
+                "--error-rate", "0.001", "--json")
+    assert r.exit_code == 0, r.output
+    out = json.loads(r.stdout)
+    assert [(d["state"], d["material"]) for d in out["decisions"]] == [("decided", "metal"), ("decided", "wood")] * 2
+    for d in out["decisions"]:
+        assert 0.04 < d["pre_contact_noise_c"] < 0.06 and d["noise_c"] == d["pre_contact_noise_c"]
+    with _emulator(mats, seed=5, noise=0.01) as emu:  # matched: the test keeps its own noise
+        r = cli("classify", "--port", emu.port, "--m", "metal=12767:25972", "--m", "wood=331:506.46",
+                "--noise", "0.01", "--time-offset", str(emu.expected_time_offset_s), "--json")
+    d = json.loads(r.stdout)["decisions"][0]
+    assert d["noise_c"] == 0.01 and d["pre_contact_noise_c"] < 0.015
+
+
 def test_classify_sample_rate_mismatch_is_one_line_exit_2(cli, tmp_path):
     sensor = tmp_path / "s.yaml"
     PAPER.replace(sample_rate_hz=100.0, name="slow").to_yaml(sensor)

@@ -5,8 +5,12 @@
 object [degC], force [N]): it detects the contact onset with the profile's
 force rule, takes the sensor's temperature before contact (Ts0, the mean over
 the profile's ``pre_s``) and the object's (Ta: the object channel's mean over
-the same window, or a given temperature), builds a
-:class:`~designkit.recognition.sequential.SequentialTest` for that touch and
+the same window, or a given temperature) and the scatter of the sensor's samples
+about a straight line over that window, builds a
+:class:`~designkit.recognition.sequential.SequentialTest` for that touch (with the
+measured scatter instead of the test's noise where it is clearly larger: a test
+that assumes less noise than the stream carries decides too soon and too often
+wrongly) and
 feeds it every sample after the onset, until it decides, gives up at the
 longest contact, or says no contact will do. :class:`LiveClassifier` is the
 :class:`~designkit.calibration.recorder.SerialRecorder` (its port handling,
@@ -33,7 +37,7 @@ from ..recognition.sequential import SequentialTest
 from .profiles import DeviceProfile
 from .recorder import RecordEvent, SerialRecorder
 
-__all__ = ["LiveClassifier", "TouchDecider", "TouchDecision"]
+__all__ = ["LiveClassifier", "NOISE_MISMATCH", "TouchDecider", "TouchDecision", "pre_contact_noise_c"]
 
 
 @dataclass(frozen=True)
@@ -57,6 +61,10 @@ class TouchDecision:
         Samples used.
     sensor_temp_c, ambient_temp_c : float
         Ts0 and Ta the test used [degC].
+    noise_c : float
+        White-noise sigma the test used [degC].
+    pre_contact_noise_c : float
+        Scatter of the sensor's samples before contact about a straight line [degC].
     """
 
     index: int
@@ -67,11 +75,39 @@ class TouchDecision:
     n_samples: int
     sensor_temp_c: float
     ambient_temp_c: float
+    noise_c: float = float("nan")
+    pre_contact_noise_c: float = float("nan")
 
     def to_dict(self) -> dict:
         return {"index": self.index, "onset_s": self.onset_s, "state": self.state, "material": self.material,
                 "time_to_decision_s": self.time_to_decision_s, "n_samples": self.n_samples,
-                "sensor_temp_c": self.sensor_temp_c, "ambient_temp_c": self.ambient_temp_c}
+                "sensor_temp_c": self.sensor_temp_c, "ambient_temp_c": self.ambient_temp_c,
+                "noise_c": self.noise_c, "pre_contact_noise_c": self.pre_contact_noise_c}
+
+
+#: A touch is decided with the scatter measured before contact instead of the test's noise when that scatter
+#: exceeds the test's noise by this factor. With the 100 samples of a 0.5 s window at 200 Hz the scatter's own
+#: relative standard error is about 7 %, so 1.5 is never reached by chance; a drifting heater is taken out by
+#: the straight line the scatter is measured about.
+NOISE_MISMATCH = 1.5
+
+
+def pre_contact_noise_c(samples_c) -> float:
+    """Scatter of samples about their least-squares straight line [degC] (``ddof = 2``; NaN for < 3).
+
+    Examples
+    --------
+    >>> round(pre_contact_noise_c([0.0, 1.0, 2.0, 3.0]), 12)
+    0.0
+    >>> round(pre_contact_noise_c([0.0, 1.0, 0.0, 1.0]), 3)
+    0.632
+    """
+    y = np.asarray(samples_c, dtype=np.float64)
+    if y.size < 3:
+        return float("nan")
+    x = np.arange(y.size, dtype=np.float64)
+    resid = y - np.polyval(np.polyfit(x, y, 1), x)
+    return float(np.sqrt(np.sum(resid * resid) / (y.size - 2)))
 
 
 class TouchDecider:
@@ -81,8 +117,9 @@ class TouchDecider:
     ----------
     profile : DeviceProfile
         Its contact rule must be ``force``; its sample rate must be the sensor's.
-    make_test : callable(sensor_temp_c, ambient_temp_c) -> SequentialTest
-        Builds the test of one touch.
+    make_test : callable(sensor_temp_c, ambient_temp_c, noise_c=None) -> SequentialTest
+        Builds the test of one touch; ``noise_c`` (when not None) replaces the test's own noise,
+        for touches whose samples before contact scatter more than :data:`NOISE_MISMATCH` times it.
     time_offset_s : float
         Heat-flow start minus detected onset [s] (<= 0 in practice).
     ambient_temp_c : float, optional
@@ -166,6 +203,13 @@ class TouchDecider:
                 ts0 = float(pre[:, 0].mean())
                 ta = self.ambient_temp_c if self.ambient_temp_c is not None else float(pre[:, 1].mean())
                 self._test = self.make_test(ts0, ta)
+                self._pre_noise = pre_contact_noise_c(pre[:, 0])
+                if self._pre_noise > NOISE_MISMATCH * self._test.noise_c:
+                    events.append(RecordEvent("noise", (
+                        f"touch {len(self.written) + 1}: the samples before contact scatter {self._pre_noise:.3g} °C, "
+                        f"{self._pre_noise / self._test.noise_c:.1f}x the {self._test.noise_c:.3g} °C the test "
+                        f"assumes: deciding with {self._pre_noise:.3g} °C (set it with --noise)")))
+                    self._test = self.make_test(ts0, ta, noise_c=self._pre_noise)
                 self._onset, self._ts0, self._ta = ti, ts0, ta
                 self._state = self.DECIDING
                 k = -self.offset_k
@@ -179,7 +223,8 @@ class TouchDecider:
         return events
 
     def _done(self, state, material, t, n, events) -> None:
-        dec = TouchDecision(len(self.written), self._onset, state, material, float(t), int(n), self._ts0, self._ta)
+        dec = TouchDecision(len(self.written), self._onset, state, material, float(t), int(n), self._ts0, self._ta,
+                            float(self._test.noise_c), self._pre_noise)
         self.written.append(dec)
         what = material if state == "decided" else f"{state}" + (f" (most likely {material})" if material else "")
         events.append(RecordEvent("decision", f"touch {dec.index + 1}: {what} after {t:.3f} s of contact"))

@@ -86,9 +86,9 @@ def classify(
                           "(each touch uses its own, measured before contact).")] = 10.0,
     object_temp: Annotated[Optional[float], typer.Option(
         "--object-temp", help="Object temperature [°C] (default: the profile's object thermistor before contact).")] = None,
-    time_offset: Annotated[float, typer.Option(
-        "--time-offset", help="Heat-flow start minus detected onset [s] (calibration's time offset; the "
-                              "emulator's is -0.25 s).")] = 0.0,
+    time_offset: Annotated[Optional[float], typer.Option(
+        "--time-offset", help="Heat-flow start minus detected onset [s] (default: the time offset the sensor "
+                              "file's calibration found, else 0; the emulator's is -0.25 s).")] = None,
     touches: Annotated[int, typer.Option("--touches", help="Touches to decide, then stop (1 to 1000).")] = 1,
     timeout: Annotated[Optional[float], typer.Option(
         "--timeout", help="Give up when the device sends nothing for this long [s] (default: the profile's).")] = None,
@@ -104,7 +104,9 @@ def classify(
     the error rate you ask for; prints each touch's decision and its time to decision. Exit 3 when no
     contact up to --max-contact can separate the materials at that error rate.
 
-    Example: `designkit classify --port /dev/pts/3 --profile designkit --m wood --m "aluminium alloys" --touches 5`
+    Example: `designkit classify --port /dev/ttyACM0 --sensor my-sensor.yaml --m wood --m "aluminium alloys" --touches 5`
+
+    Example: `designkit classify --port /dev/pts/3 --m wood --m "aluminium alloys" --time-offset -0.25` (the emulator)
 
     Example: `designkit classify --m wood --m "aluminium alloys" --error-rate 0.001 --export-c robot_seq.h`
     """
@@ -124,16 +126,18 @@ def classify(
         raise InputError(f"--timeout must be a positive, finite number of seconds, got {timeout:g}")
     if not (math.isfinite(delta_t) and delta_t != 0):
         raise InputError(f"--delta-t must be a non-zero temperature difference [°C], got {delta_t:g}")
-    if not math.isfinite(time_offset) or abs(time_offset) > 5:
+    if time_offset is not None and (not math.isfinite(time_offset) or abs(time_offset) > 5):
         raise InputError(f"--time-offset must be within ±5 s, got {time_offset:g}")
     sens = load_sensor(sensor)
     sigma = noise if noise is not None else (sens.noise_c if sens.noise_c else 0.05)
+    if time_offset is None:  # the calibrated sensor's own offset: its onset detection is what this run uses
+        time_offset = float((sens.model or {}).get("time_offset_s") or 0.0)
     prof = load_profile(profile)
     cands = parse_candidates(m)
 
-    def make_test(ts0: float, ta: float) -> SequentialTest:
-        return SequentialTest(cands, sens, noise_c=sigma, sensor_temp_c=ts0, ambient_temp_c=ta,
-                              error_rate=error_rate, max_contact_s=max_contact)
+    def make_test(ts0: float, ta: float, noise_c: Optional[float] = None) -> SequentialTest:
+        return SequentialTest(cands, sens, noise_c=sigma if noise_c is None else noise_c, sensor_temp_c=ts0,
+                              ambient_temp_c=ta, error_rate=error_rate, max_contact_s=max_contact)
 
     check = make_test(35.0, 35.0 - delta_t)
     if export_c is not None:
@@ -148,7 +152,8 @@ def classify(
         else:
             console().print(f"wrote {export_c} ({len(data):,} bytes): {check.plan.reason}", highlight=False)
         raise typer.Exit(0 if check.plan.separable else EXIT_NO_DECISION)
-    payload = {"port": port, "profile": prof.name, "sensor": sens.name, "noise_c": sigma, "error_rate": error_rate,
+    payload = {"port": port, "profile": prof.name, "sensor": sens.name, "noise_c": sigma, "time_offset_s": time_offset,
+               "error_rate": error_rate,
                "plan": check.plan.to_dict(), "decisions": [], "interrupted": False}
     if not check.plan.separable:
         if json_:
@@ -165,7 +170,7 @@ def classify(
             live_view.update(_table(clf.decider.written, clf.decider.live, check.candidates))
 
     def on_event(e) -> None:
-        if not json_ and live_view is None and e.kind in ("decision", "skipped", "gap", "bad_line"):
+        if not json_ and live_view is None and e.kind in ("decision", "skipped", "gap", "bad_line", "noise"):
             con.print(e.message, highlight=False)
         refresh()
 

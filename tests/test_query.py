@@ -469,3 +469,16 @@ def test_tables_named_by_string_are_loaded_once_per_process_while_unchanged(tmp_
     with pytest.raises(InputError):
         qt._as_table(path)
     qt.clear_table_cache()
+
+
+@pytest.mark.parametrize("question", ["min-contact", "distinguishable"])
+def test_overlapping_materials_exit_3_with_the_reason(cli, question):
+    """No scene separates materials whose effusivity ranges overlap: no answer, the documented status 3 (as
+    `design` gives for the same pair), the reason in the text and null in --json."""
+    r = cli(question, "--m1", "copper", "--m2", "aluminium")
+    assert r.exit_code == 3, r.output
+    assert "overlap" in r.output
+    r = cli(question, "--m1", "copper", "--m2", "aluminium", "--json")
+    assert r.exit_code == 3
+    d = json.loads(r.stdout)
+    assert d["value"] is None and any("overlap" in n for n in d["notes"])

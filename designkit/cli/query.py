@@ -59,10 +59,11 @@ SpreadOpt = Annotated[float, typer.Option(
 CoverageOpt = Annotated[float, typer.Option(
     "--coverage", help="Coverage of the answer's interval, in (0, 1) (table and --exact).")]
 
-#: Exit status of a question the table cannot answer (outside its grid along an axis, or nothing
-#: tabulated separates the pair), for every question: distinct from bad input (2), so scripts can
-#: tell "no answer here" from an answer (0). The message names the axis and its range in the
-#: user's units.
+#: Exit status of a question without an answer, on either route: the table cannot answer it (outside
+#: its grid along an axis, or nothing tabulated separates the pair), the materials' effusivity ranges
+#: overlap (no scene separates them), or nothing up to the longest contact / noise searched does.
+#: Distinct from bad input (2), so scripts can tell "no answer here" from an answer (0). The message
+#: says why in the user's units.
 EXIT_NO_ANSWER = 3
 
 #: Questions whose exact route reports its progress evaluation by evaluation (a progress bar); the
@@ -114,12 +115,12 @@ def _ask(question: str, *, exact: bool, table: Optional[str], ideal_table: str, 
         # computed unless a table is named (a named table built for another one is refused, never used);
         # varied initial conditions: no shipped table holds them, computed for the pair
         reroute = None if exact or table is not None else table_reroute(sen, fm)
-        # varied initial conditions: the shipped table for the paper's spread (2.5 degC), else computed
+        # varied initial conditions: the shipped table for the paper's spread (2.5 degC) and dT, else computed
         varied = None
         if spread > 0 and not exact and table is None and reroute is None:
             from ..query.table import shipped_spread_table
 
-            varied = shipped_spread_table(spread, question)
+            varied = shipped_spread_table(spread, question, scene.get("delta_t_c"))
         route = "exact" if exact or reroute or (spread > 0 and table is None and varied is None) else "table"
         if spread > 0:
             extra["sensor_temp_spread_c"] = spread
@@ -190,8 +191,7 @@ def _render(ans, json_: bool) -> None:
         emit_json(d)
     else:
         _render_text(d)
-    if d["route"] == "table" and d["value"] is None and d["limiting_pair"] and (
-            d["question"] != "delta-e" or not all(d["in_grid"].values())):
+    if d["value"] is None and (d["question"] != "delta-e" or not all(d["in_grid"].values())):
         raise typer.Exit(EXIT_NO_ANSWER)
 
 

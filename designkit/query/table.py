@@ -867,19 +867,30 @@ def table_spread(tab: Table) -> float:
 SPREAD_TABLE_QUESTIONS = ("min-contact", "delta-e", "distinguishable")
 
 
-def shipped_spread_table(spread: float, question: str = "min-contact") -> str | None:
+def shipped_spread_table(spread: float, question: str = "min-contact", delta_t_c: float | None = None) -> str | None:
     """The shipped table that answers ``question`` with sensor temperature spread ``spread`` [degC], or None.
+
+    With ``delta_t_c`` [degC], also None where the table holds no such temperature difference: its dT is an
+    axis of its own (the spread is about the sensor's temperature, so sigma/dT is no invariance there), and
+    a question at another dT is computed for the pair instead of refused as outside the grid.
 
     >>> shipped_spread_table(2.5)
     'svm-paper-varied'
     >>> shipped_spread_table(1.0) is None, shipped_spread_table(2.5, "max-noise") is None
     (True, True)
+    >>> shipped_spread_table(2.5, delta_t_c=7.5), shipped_spread_table(2.5, delta_t_c=10.0)
+    ('svm-paper-varied', None)
     """
-    if question not in SPREAD_TABLE_QUESTIONS:
+    if question not in SPREAD_TABLE_QUESTIONS or not spread > 0:
         return None
-    if spread > 0 and math.isclose(table_spread(_as_table(VARIED_TABLE)), spread, rel_tol=1e-9):
-        return VARIED_TABLE
-    return None
+    tab = _as_table(VARIED_TABLE)
+    if not math.isclose(table_spread(tab), spread, rel_tol=1e-9):
+        return None
+    if delta_t_c is not None:
+        held = tab.axes.get("delta_t_c")
+        if held is not None and not np.any(np.isclose(held, abs(float(delta_t_c)), rtol=1e-9)):
+            return None
+    return VARIED_TABLE
 
 
 def _spread_words(spread: float) -> str:

@@ -54,8 +54,9 @@ NmcQ = Annotated[int, typer.Option(
 MaxContact = Annotated[float, typer.Option("--max-contact", help="--exact: longest contact time to consider [s].")]
 SpreadOpt = Annotated[float, typer.Option(
     "--sensor-temp-spread", help="Varied initial conditions: each touch's sensor temperature uniform within "
-    "+-this [°C] of ambient + dT (the paper's robot: --delta-t 7.5 --sensor-temp-spread 2.5); computed like "
-    "--exact (the shipped tables are for fixed conditions). Must stay below |dT|.")]
+    "+-this [°C] of ambient + dT (the paper's robot: --delta-t 7.5 --sensor-temp-spread 2.5, answered from the "
+    "shipped table svm-paper-varied for min-contact, delta-e and distinguishable); any other case is computed "
+    "like --exact. Must stay below |dT|.")]
 CoverageOpt = Annotated[float, typer.Option(
     "--coverage", help="Coverage of the answer's interval, in (0, 1) (table and --exact).")]
 

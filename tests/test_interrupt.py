@@ -1,0 +1,45 @@
+"""Ctrl-C while a computation runs in worker processes: exit 130, no traceback, at most one line.
+
+A real process and a real SIGINT to its process group (what a terminal sends), sent once the exact
+route's worker processes are computing (each has used a second of CPU: past their start-up)."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import psutil
+import pytest
+
+
+def _busy_workers(proc: psutil.Process, n: int, cpu_s: float) -> bool:
+    try:
+        kids = proc.children(recursive=True)
+        return sum(k.cpu_times().user >= cpu_s for k in kids) >= n
+    except psutil.Error:
+        return False
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="process groups and SIGINT are POSIX")
+def test_ctrl_c_while_the_exact_route_runs_workers_is_quiet():
+    proc = subprocess.Popen([sys.executable, "-m", "designkit", "min-contact", "--e1", "20000", "--e2", "18000",
+                             "--exact", "--repeats", "32", "--json", "--jobs", "2"], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, start_new_session=True, text=True)
+    try:
+        me = psutil.Process(proc.pid)
+        deadline = time.monotonic() + 120
+        while not _busy_workers(me, 2, 1.0):
+            if proc.poll() is not None or time.monotonic() > deadline:
+                pytest.fail("the exact route's workers never got busy")
+            time.sleep(0.05)
+        os.killpg(proc.pid, signal.SIGINT)
+        out, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+    assert proc.returncode == 130, (proc.returncode, err)
+    assert "Traceback" not in err and "Warning" not in err, err
+    assert err.strip() in ("", "Interrupted."), err  # typer exits 130 quietly, as a shell's ^C

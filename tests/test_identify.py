@@ -396,7 +396,18 @@ def test_force_noise_does_not_bias_the_identified_ratios(monkeypatch):
     rng = np.random.default_rng(104)
     noisy = [Trial(t.time_s, t.sensor_c, t.object_c, t.force_n + rng.normal(0, 0.009, t.time_s.size), t.material,
                    source=t.source) for t in clean]
-    ref = identify(clean, CHAIN, ranges=RANGES).ratios["granite"].value
+    fit = identify(clean, CHAIN, ranges=RANGES)
+    ref = fit.ratios["granite"].value
     assert abs(identify(noisy, CHAIN, ranges=RANGES).ratios["granite"].value / ref - 1) < 0.0006
+    # a reading simulated from a measured (noisy) force: with its band it is the clean force's on the plateau
+    from designkit.calibration.identify import FORCE_NOISE_BAND_SD, force_noise, relative_force
+
+    tr, tn = clean[-1], noisy[-1]
+    late = tr.time_s >= 3.0
+    v0 = fit.reading(tr.time_s, "granite", force=relative_force(tr), force_time_s=tr.time_s)[late]
+    band = FORCE_NOISE_BAND_SD * force_noise(tn)
+    v_band = fit.reading(tr.time_s, "granite", force=relative_force(tn), force_time_s=tr.time_s, force_band=band)
+    v_cap = fit.reading(tr.time_s, "granite", force=relative_force(tn), force_time_s=tr.time_s)
+    assert abs(np.mean(v_band[late] / v0) - 1) < 0.2 * abs(np.mean(v_cap[late] / v0) - 1)
     monkeypatch.setattr(ident, "FORCE_NOISE_BAND_SD", 0.0)      # the map capped at the plateau, as before
     assert identify(noisy, CHAIN, ranges=RANGES).ratios["granite"].value / ref - 1 > 0.001

@@ -965,7 +965,7 @@ class Identification:
         return get_model(self.candidate.model, **kw)
 
     def reading(self, time_s, material: str, *, conductance_factor=None, force=None, force_time_s=None,
-                drift: bool = False):
+                drift: bool = False, force_band=0.0):
         """The identified normalized reading ``v`` of ``material`` at times after the detected onset.
 
         ``T = Ts0 + (To - Ts0) v`` (``+ s b`` for a candidate with ``drift``): with the fitted time
@@ -988,6 +988,10 @@ class Identification:
             offset on.
         force_time_s : array_like, shape (p,), optional
             Times of ``force`` after the detected onset [s].
+        force_band : float or array_like, shape (k,)
+            Each ``force`` row's noise band (:func:`contact_area`): for a measured force
+            ``FORCE_NOISE_BAND_SD * force_noise(trial)``, as the fit reads it; 0 (default) caps the
+            area at the plateau, right for a noise-free or smoothed force.
         drift : bool
             Also return the drift basis ``b`` (smoothed ``t (1 - u)``, see :class:`Candidate`).
 
@@ -1023,7 +1027,9 @@ class Identification:
             ft = np.asarray(force_time_s, dtype=np.float64)
             c = self.parameter("contact_force_fraction").value if "contact_force_fraction" in self.candidate.free \
                 else 0.0
-            areas = [contact_area(np.interp(grid, ft, row), c) for row in np.atleast_2d(force)]
+            rows = np.atleast_2d(force)
+            bands = np.broadcast_to(np.asarray(force_band, dtype=np.float64), (rows.shape[0],))
+            areas = [contact_area(np.interp(grid, ft, row), c, b) for row, b in zip(rows, bands)]
         n = max(len(factors), len(areas))
         if len(factors) not in (1, n) or len(areas) not in (1, n):
             raise InputError(f"reading: {len(factors)} conductance factors and {len(areas)} force rows")

@@ -341,3 +341,73 @@ def test_cr2_covariance_and_bell_mccaffrey_degrees_of_freedom_match_the_dense_fo
         assert df[k] == pytest.approx(min(lam.sum() ** 2 / np.sum(lam ** 2), len(sizes) - 1), rel=1e-8)
     # the parameter one short touch carries has about one degree of freedom, not touches - 1
     assert df[2] < 2.0 < df[0]
+
+
+# ------------------------------------------------------------------ the force's noise and the area's cap
+def _plateau_trials(n: int, sigma_n: float, plateau_n: float, seed: int) -> list[Trial]:
+    rng = np.random.default_rng(seed)
+    t = np.arange(-200, 1401) / 200.0
+    out = []
+    for i in range(n):
+        ramp = rng.uniform(0.2, 0.9)     # at its plateau by 1 s, where relative_force's plateau is taken
+        force = plateau_n * np.clip(t / ramp, 0.0, 1.0) + rng.normal(0.0, sigma_n, t.size)
+        out.append(Trial(t, np.zeros(t.size), np.zeros(t.size), force, "granite", source=f"t{i}.csv"))
+    return out
+
+
+@pytest.mark.parametrize("sigma_n, plateau_n", [(0.02, 10.0), (0.05, 4.5), (0.002, 4.5)])
+def test_force_noise_reads_the_white_noise_of_the_averaged_relative_force(sigma_n, plateau_n):
+    from designkit.calibration.identify import force_noise
+
+    width = 5   # the 25 ms average at 200 Hz
+    got = [force_noise(tr) for tr in _plateau_trials(20, sigma_n, plateau_n, seed=1)]
+    assert np.median(got) == pytest.approx(sigma_n / plateau_n / math.sqrt(width), rel=0.05)
+    # a smoothed force (the shared recordings' host smoothing) has no white noise left to read
+    smooth = _plateau_trials(1, 0.0, plateau_n, seed=1)[0]
+    assert force_noise(smooth) < 1e-9
+
+
+def test_the_noise_band_keeps_the_plateau_area_whole_on_average():
+    """The capped map reads a noisy plateau's area low by sigma E[max(Z, 0)] / (1 - c); the band does not."""
+    from designkit.calibration.identify import FORCE_NOISE_BAND_SD, contact_area, force_noise, relative_force
+
+    c, sigma_n, plateau_n = 0.3, 0.02, 10.0
+    trials = _plateau_trials(200, sigma_n, plateau_n, seed=2)
+    late = trials[0].time_s >= 2.0     # after every ramp
+    f = np.array([relative_force(tr) for tr in trials])[:, late]
+    band = FORCE_NOISE_BAND_SD * np.array([force_noise(tr) for tr in trials])[:, None]
+    s = sigma_n / plateau_n / math.sqrt(5)          # SD of the 25-ms average, a share of the plateau
+    capped = 1.0 - float(np.mean(contact_area(f, c)))
+    assert capped == pytest.approx(s / math.sqrt(2 * math.pi) / (1 - c), rel=0.05)   # E[max(Z, 0)] = 1/sqrt(2 pi)
+    assert abs(1.0 - float(np.mean(contact_area(f, c, band)))) < 0.05 * capped
+    # where the force overshoots by more than its noise the cap holds
+    assert float(contact_area(1.2, c, band[0, 0])) == pytest.approx(1.0, abs=4 * s / (1 - c))
+
+
+def test_force_noise_does_not_bias_the_identified_ratios(monkeypatch):
+    """The same touches with and without white force noise (0.2 % of the plateau) give the same e_o/e_s.
+
+    Paired, so the temperature noise cancels: with the area capped at the plateau (no noise band) the
+    noise moved granite's ratio by +0.16-0.18 % (seeds 3-5), with the band by 0.02 % at most.
+    """
+    import designkit.calibration.identify as ident
+
+    clean = _chain_touches(seed=4)
+    rng = np.random.default_rng(104)
+    noisy = [Trial(t.time_s, t.sensor_c, t.object_c, t.force_n + rng.normal(0, 0.009, t.time_s.size), t.material,
+                   source=t.source) for t in clean]
+    fit = identify(clean, CHAIN, ranges=RANGES)
+    ref = fit.ratios["granite"].value
+    assert abs(identify(noisy, CHAIN, ranges=RANGES).ratios["granite"].value / ref - 1) < 0.0006
+    # a reading simulated from a measured (noisy) force: with its band it is the clean force's on the plateau
+    from designkit.calibration.identify import FORCE_NOISE_BAND_SD, force_noise, relative_force
+
+    tr, tn = clean[-1], noisy[-1]
+    late = tr.time_s >= 3.0
+    v0 = fit.reading(tr.time_s, "granite", force=relative_force(tr), force_time_s=tr.time_s)[late]
+    band = FORCE_NOISE_BAND_SD * force_noise(tn)
+    v_band = fit.reading(tr.time_s, "granite", force=relative_force(tn), force_time_s=tr.time_s, force_band=band)
+    v_cap = fit.reading(tr.time_s, "granite", force=relative_force(tn), force_time_s=tr.time_s)
+    assert abs(np.mean(v_band[late] / v0) - 1) < 0.2 * abs(np.mean(v_cap[late] / v0) - 1)
+    monkeypatch.setattr(ident, "FORCE_NOISE_BAND_SD", 0.0)      # the map capped at the plateau, as before
+    assert identify(noisy, CHAIN, ranges=RANGES).ratios["granite"].value / ref - 1 > 0.001

@@ -70,6 +70,7 @@ from .trials import Trial
 
 __all__ = [
     "CANDIDATES",
+    "FORCE_NOISE_BAND_SD",
     "FORCE_SMOOTHING_S",
     "HOST_SMOOTHING",
     "Candidate",
@@ -79,6 +80,7 @@ __all__ = [
     "candidate",
     "compare_models",
     "contact_area",
+    "force_noise",
     "identify",
     "nominal_force_profile",
     "relative_force",
@@ -259,6 +261,7 @@ class _Group:
     trials: tuple[int, ...]
     affine: bool = False   # To = passive + offset + slope (passive - reference): a rig calibration of the channel
     force: np.ndarray | None = None       # (n, m) force / its plateau, each touch (force-area candidates)
+    force_band: np.ndarray | None = None  # (n,) the plateau's noise band of each touch's relative force
 
 
 @dataclass(frozen=True)
@@ -319,9 +322,9 @@ _OBJECT_MODES = ("passive", "passive-end", "free", "passive-affine", "passive-en
 
 
 #: The force is averaged over this window [s] (centred) before it sets the contact area: the force sensor's
-#: white noise, clipped where the area is whole, would otherwise read the plateau's area low (errors in
-#: variables: granite's e_o/e_s +0.43 % in pty round trips, +0.21 % after it; docs/sensor-models.md). A
-#: finger presses over 0.3 s or more: 25 ms rounds only the ramp's corners.
+#: white noise, clipped where the area is whole, reads the plateau's area low (errors in variables: granite's
+#: e_o/e_s +0.43 % in pty round trips, +0.21 % after it; :data:`FORCE_NOISE_BAND_SD` removes the rest;
+#: docs/sensor-models.md). A finger presses over 0.3 s or more: 25 ms rounds only the ramp's corners.
 FORCE_SMOOTHING_S = 0.025
 
 
@@ -339,28 +342,94 @@ def relative_force(trial: Trial) -> np.ndarray:
     >>> relative_force(tr)[[0, 300, 398, 400, 402]].round(4).tolist()
     [0.0, 0.5, 0.99, 0.997, 1.0]
     """
-    from scipy.ndimage import uniform_filter1d
-
     t, f = np.asarray(trial.time_s), np.asarray(trial.force_n, dtype=np.float64)
     late = (t >= 1.0) & np.isfinite(f)
     if not late.any() or not np.isfinite(f).all():
         raise InputError(f"trial {trial.source}: a force-driven contact area needs the force channel on every "
                          "sample, to 1 s after the onset or later")
-    dt = np.diff(t)
-    if not np.allclose(dt, dt[0], rtol=1e-6, atol=1e-9):
-        raise InputError(f"trial {trial.source}: a force-driven contact area needs a uniform time grid")
-    width = 2 * int(round(0.5 * FORCE_SMOOTHING_S / float(dt[0]))) + 1
-    if width > 1:
-        f = uniform_filter1d(f, width, mode="nearest")
+    f = _averaged_force(f, _force_window(trial))
     plateau = float(np.median(f[late]))
     if plateau <= 0:
         raise InputError(f"trial {trial.source}: the force's plateau is {plateau:.3g} N (no contact?)")
     return f / plateau
 
 
-#: Share of the final contact area in contact, ``clip((F / F_p - c) / (1 - c), 0, 1)``: the forward model's
-#: rule (:func:`designkit.models.ramp.area_share`), the one the identification fits ``c`` of.
-contact_area = area_share
+def _force_window(trial: Trial) -> int:
+    """Samples of the :data:`FORCE_SMOOTHING_S` average (odd); InputError on a non-uniform grid."""
+    dt = np.diff(np.asarray(trial.time_s))
+    if dt.size == 0 or not np.allclose(dt, dt[0], rtol=1e-6, atol=1e-9):
+        raise InputError(f"trial {trial.source}: a force-driven contact area needs a uniform time grid")
+    return 2 * int(round(0.5 * FORCE_SMOOTHING_S / float(dt[0]))) + 1
+
+
+def _averaged_force(f: np.ndarray, width: int) -> np.ndarray:
+    from scipy.ndimage import uniform_filter1d
+
+    return uniform_filter1d(f, width, mode="nearest") if width > 1 else f
+
+
+#: The contact area is capped at its whole only where the measured force exceeds its plateau by more than this
+#: many SDs of its own noise (:func:`force_noise`). On the plateau the true force *is* the plateau, so half the
+#: noisy samples lie above it; capping those at once reads the area low by ``0.4 sigma / (1 - c)`` on average
+#: (errors in variables: granite's e_o/e_s +0.20 % in the pty round trips, interval coverage 0.74), a bias that
+#: does not shrink with more touches. Within the band the map stays linear, so the noise averages out; beyond
+#: it (an overshoot of the press, larger than noise) the cap holds. The bias left is ``sigma psi(-3) / (1 - c)``,
+#: a thousandth of the capped map's (``psi(z) = z Phi(z) + phi(z)``); an overshoot reads at most ``3 sigma /
+#: (1 - c)`` too much area. Not tuned: three SDs, the usual band of a Gaussian noise. A noise-free force (a
+#: smoothed recording) keeps today's map.
+FORCE_NOISE_BAND_SD = 3.0
+
+
+def force_noise(trial: Trial) -> float:
+    """SD of the white noise on :func:`relative_force`'s plateau (a share of the plateau force).
+
+    From the force's own residuals: the second differences of the raw force from 1 s
+    after the onset (where the plateau is taken), whose spread is ``sqrt(6) sigma``
+    for white noise of SD ``sigma`` and hardly feels a slow drift or a ramp's corner
+    (median absolute deviation, 1.4826 MAD for a Gaussian), divided by the square
+    root of the :data:`FORCE_SMOOTHING_S` average's width and by the plateau. A
+    smoothed recording's force reads nearly 0.
+
+    Examples
+    --------
+    >>> t = np.arange(-200, 1400) / 200.0
+    >>> f = np.clip(t, 0.0, 1.0) * 10.0 + 0.02 * np.random.default_rng(0).standard_normal(t.size)
+    >>> tr = Trial(t, np.zeros(t.size), np.zeros(t.size), f, "wood")
+    >>> round(force_noise(tr) / (0.02 / 10 / 5 ** 0.5), 1)     # 0.02 N on 10 N, averaged over 5 samples
+    1.0
+    """
+    t, f = np.asarray(trial.time_s), np.asarray(trial.force_n, dtype=np.float64)
+    late = t >= 1.0
+    width = _force_window(trial)
+    d2 = np.diff(f[late], 2)
+    if d2.size < 10:
+        return 0.0
+    sigma = 1.4826 * float(np.median(np.abs(d2 - np.median(d2)))) / math.sqrt(6.0)
+    plateau = float(np.median(_averaged_force(f, width)[late]))
+    return sigma / math.sqrt(width) / plateau if plateau > 0 else 0.0
+
+
+def contact_area(force_rel, fraction: float, band=0.0) -> np.ndarray:
+    """Share of the final contact area in contact, ``clip((F / F_p - c) / (1 - c), 0, (1 + b - c) / (1 - c))``.
+
+    The forward model's rule (:func:`designkit.models.ramp.area_share`, ``b = 0``) on a
+    measured force: the cap applies only beyond the plateau's noise band ``b``
+    (:data:`FORCE_NOISE_BAND_SD` times :func:`force_noise`; broadcast against
+    ``force_rel``), so the force's noise does not read the plateau's area low.
+
+    Examples
+    --------
+    >>> contact_area([0.1, 0.3, 0.65, 1.0, 1.002, 1.2], 0.3).round(4).tolist()
+    [0.0, 0.0, 0.5, 1.0, 1.0, 1.0]
+    >>> contact_area([0.1, 0.3, 0.65, 1.0, 1.002, 1.2], 0.3, band=0.003).round(4).tolist()
+    [0.0, 0.0, 0.5, 1.0, 1.0029, 1.0043]
+    """
+    if np.all(np.asarray(band) == 0):
+        return area_share(force_rel, fraction)
+    c = float(fraction)
+    area_share(0.0, c)  # validates c
+    b = np.asarray(band, dtype=np.float64)
+    return np.clip((np.asarray(force_rel, dtype=np.float64) - c) / (1.0 - c), 0.0, (1.0 + b - c) / (1.0 - c))
 
 
 def _prepare(trials: Sequence[Trial], names: Sequence[str], object_temps: Mapping[str, Any],
@@ -439,7 +508,9 @@ def _prepare(trials: Sequence[Trial], names: Sequence[str], object_temps: Mappin
         out.append(_Group(k, trials[members[0]].time_s.copy(), np.array([trials[i].sensor_c for i in members]),
                           np.array(tos), mode == "free", tuple(members),
                           isinstance(mode, str) and mode.endswith("-affine"),
-                          np.array([relative_force(trials[i]) for i in members]) if force_area else None))
+                          np.array([relative_force(trials[i]) for i in members]) if force_area else None,
+                          np.array([FORCE_NOISE_BAND_SD * force_noise(trials[i]) for i in members])
+                          if force_area else None))
     noise = math.sqrt(ssr / dof) if dof > 0 else math.nan
     ref = dict(refs or {})
     for n in names:  # the reference reading of an affine channel: the fitted touches' mean (kept for scoring)
@@ -631,7 +702,8 @@ class _Problem:
         """Share of the final contact area (n, m) of a force-area group's touches (None: full contact)."""
         if g.force is None:
             return None
-        return contact_area(g.force, self.params_value(x, "contact_force_fraction", 0.0))
+        band = 0.0 if g.force_band is None else g.force_band[:, None]
+        return contact_area(g.force, self.params_value(x, "contact_force_fraction", 0.0), band)
 
     def params_value(self, x: np.ndarray, name: str, default: float) -> float:
         """A free parameter's natural value in ``x`` (``default`` when the candidate does not fit it)."""
@@ -893,7 +965,7 @@ class Identification:
         return get_model(self.candidate.model, **kw)
 
     def reading(self, time_s, material: str, *, conductance_factor=None, force=None, force_time_s=None,
-                drift: bool = False):
+                drift: bool = False, force_band=0.0):
         """The identified normalized reading ``v`` of ``material`` at times after the detected onset.
 
         ``T = Ts0 + (To - Ts0) v`` (``+ s b`` for a candidate with ``drift``): with the fitted time
@@ -916,6 +988,10 @@ class Identification:
             offset on.
         force_time_s : array_like, shape (p,), optional
             Times of ``force`` after the detected onset [s].
+        force_band : float or array_like, shape (k,)
+            Each ``force`` row's noise band (:func:`contact_area`): for a measured force
+            ``FORCE_NOISE_BAND_SD * force_noise(trial)``, as the fit reads it; 0 (default) caps the
+            area at the plateau, right for a noise-free or smoothed force.
         drift : bool
             Also return the drift basis ``b`` (smoothed ``t (1 - u)``, see :class:`Candidate`).
 
@@ -951,7 +1027,9 @@ class Identification:
             ft = np.asarray(force_time_s, dtype=np.float64)
             c = self.parameter("contact_force_fraction").value if "contact_force_fraction" in self.candidate.free \
                 else 0.0
-            areas = [contact_area(np.interp(grid, ft, row), c) for row in np.atleast_2d(force)]
+            rows = np.atleast_2d(force)
+            bands = np.broadcast_to(np.asarray(force_band, dtype=np.float64), (rows.shape[0],))
+            areas = [contact_area(np.interp(grid, ft, row), c, b) for row, b in zip(rows, bands)]
         n = max(len(factors), len(areas))
         if len(factors) not in (1, n) or len(areas) not in (1, n):
             raise InputError(f"reading: {len(factors)} conductance factors and {len(areas)} force rows")

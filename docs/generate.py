@@ -20,8 +20,8 @@ exported header, a compiled program) is thrown away and the checkout stays clean
 command runs this checkout's designkit, whichever one is installed.
 
 Files covered: README.md, docs/*.md, examples/*/README.md, calibration/README.md and
-tables/README.md. ``tests/test_docs_current.py`` also checks that the Python snippets of these
-files define every name they use (pyflakes).
+tables/README.md (``FILES``). ``tests/test_docs_current.py`` also checks that the repository paths
+these files name exist, and that calibration/README.md's library snippet defines every name it uses.
 
 Usage::
 
@@ -101,6 +101,11 @@ def run(cmd: str, folder: Path | None = None) -> str:
     return r.stdout + r.stderr
 
 
+def _shown(path: Path) -> str:
+    """A covered file's name as the stale list shows it: relative to the repository when inside it."""
+    return str(path.relative_to(REPO)) if path.is_relative_to(REPO) else str(path)
+
+
 def blocks(text: str):
     """(command, slow, current output, match) for every generated block."""
     for m in BLOCK.finditer(text):
@@ -120,7 +125,7 @@ def main(argv=None) -> int:
                 continue
             got = run(cmd, path.parent)
             if not same(out, got):
-                stale.append(f"{path.relative_to(REPO)}: {cmd}")
+                stale.append(f"{_shown(path)}: {cmd}")
                 new = new[:m.start("out")] + got + new[m.end("out"):]
         if not args.check and new != text:
             path.write_text(new, encoding="utf-8")

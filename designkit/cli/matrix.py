@@ -135,7 +135,13 @@ def read_material_names(path: str) -> list[str]:
     import sys
     from pathlib import Path
 
-    text = sys.stdin.read() if path == "-" else Path(path).read_text(encoding="utf-8")
+    try:
+        text = sys.stdin.read() if path == "-" else Path(path).read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        from .._validation import InputError
+
+        why = exc.strerror if isinstance(exc, OSError) and exc.strerror else "not a UTF-8 text file"
+        raise InputError(f"--from {path}: cannot read it ({why})") from None
     lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
     if not lines:
         from .._validation import InputError

@@ -12,6 +12,8 @@ and this script runs each command (``designkit`` as ``python -m designkit`` with
 and replaces the text between the markers with what it prints.
 ``<!-- generated slow: ... -->`` marks a command that takes more than a few seconds:
 ``--check`` (what the test suite runs) skips those; a plain run regenerates them too.
+``<!-- generated needs make,cc: ... -->`` names programs the command needs besides designkit:
+where one is not installed, ``--check`` says so and skips the block.
 
 A command that is not a plain ``designkit ...`` line (a ``make`` target, a pipeline, ``&&``) runs
 under ``bash`` in a temporary copy of the Markdown file's own folder, so what it builds (an
@@ -57,7 +59,10 @@ VOLATILE = re.compile(r"(?<=in )[\d.]+ s \([\d.]+ s CPU\)|(?<=per class, )[\d.]+
 def same(old: str, new: str) -> bool:
     """Whether two outputs agree, apart from the run's own timings (VOLATILE)."""
     return VOLATILE.sub("#", old) == VOLATILE.sub("#", new)
-BLOCK = re.compile(r"(<!-- generated( slow)?: (?P<cmd>.+?) -->\n```text\n)(?P<out>.*?)(```\n<!-- /generated -->)",
+
+
+BLOCK = re.compile(r"(<!-- generated( slow)?(?: needs (?P<needs>[\w.,+-]+))?: (?P<cmd>.+?) -->\n```text\n)"
+                   r"(?P<out>.*?)(```\n<!-- /generated -->)",
                    re.S)
 
 
@@ -122,6 +127,10 @@ def main(argv=None) -> int:
         new = text
         for cmd, slow, out, m in reversed(list(blocks(text))):
             if args.check and slow:
+                continue
+            missing = [prog for prog in (m.group("needs") or "").split(",") if prog and not shutil.which(prog)]
+            if args.check and missing:
+                print(f"skipped (needs {', '.join(missing)}): {_shown(path)}: {cmd}")
                 continue
             got = run(cmd, path.parent)
             if not same(out, got):

@@ -56,6 +56,18 @@ def test_check_finds_a_stale_block(tmp_path, monkeypatch):
 
 
 @needs_checkout
+def test_check_skips_a_block_whose_program_is_missing(tmp_path, monkeypatch, capsys):
+    gen = _generator()
+    doc = tmp_path / "x" / "README.md"
+    doc.parent.mkdir()
+    doc.write_text("<!-- generated needs no-such-program-dk: no-such-program-dk run -->\n```text\nold\n```\n"
+                   "<!-- /generated -->\n")
+    monkeypatch.setitem(gen["main"].__globals__, "FILES", [doc])
+    assert gen["main"](["--check"]) == 0
+    assert "skipped (needs no-such-program-dk)" in capsys.readouterr().out
+
+
+@needs_checkout
 def test_timings_alone_do_not_make_a_block_stale():
     same = _generator()["same"]
     assert same("searched 80 designs (ideal observer) in 17.07 s (6.72 s CPU)\n",

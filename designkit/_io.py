@@ -7,7 +7,21 @@ import os
 import tempfile
 from pathlib import Path
 
-__all__ = ["atomic_write_bytes", "atomic_write_text"]
+__all__ = ["WriteError", "atomic_write_bytes", "atomic_write_text"]
+
+
+class WriteError(OSError):
+    """A file could not be written; its message is one line naming the file the caller asked for.
+
+    An :class:`OSError` (``errno`` kept) whose text has no ``[Errno N]`` and no temporary file name.
+    """
+
+    def __str__(self) -> str:
+        return str(self.strerror)
+
+
+def _cannot_write(path: Path, exc: OSError) -> WriteError:
+    return WriteError(exc.errno, f"cannot write {path}: {exc.strerror or exc}")
 
 
 def atomic_write_bytes(path: Path, data: bytes) -> Path:
@@ -19,7 +33,14 @@ def atomic_write_bytes(path: Path, data: bytes) -> Path:
     A destination that exists and is not a regular file (``/dev/null``, a
     terminal, a FIFO) is written to as it is: renaming over it would replace
     the device with a file (as root, ``--out /dev/null`` did exactly that).
-    A folder is refused.
+    A folder is refused. Errors are :class:`WriteError` naming ``path``, never the temporary file:
+
+    >>> import tempfile
+    >>> with tempfile.NamedTemporaryFile() as f:  # doctest: +ELLIPSIS
+    ...     atomic_write_bytes(Path(f.name) / "x.h", b"")  # a file where a folder should be
+    Traceback (most recent call last):
+    ...
+    designkit._io.WriteError: cannot write /.../x.h: Not a directory
     """
     import stat
 
@@ -29,15 +50,18 @@ def atomic_write_bytes(path: Path, data: bytes) -> Path:
     except FileNotFoundError:
         mode = None
     except OSError as exc:
-        raise OSError(exc.errno, f"cannot write {path}: {exc.strerror}", str(path)) from None
+        raise _cannot_write(path, exc) from None
     if mode is not None and stat.S_ISDIR(mode):
         raise IsADirectoryError(21, f"cannot write {path}: it is a folder", str(path))
     if mode is not None and not stat.S_ISREG(mode):
         with open(path, "wb") as fh:
             fh.write(data)
         return path
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    except OSError as exc:  # name the file the user asked for, not the temporary one beside it
+        raise _cannot_write(path, exc) from None
     try:
         os.fchmod(fd, 0o666 & ~_umask())  # mkstemp makes 0600; give the usual permissions
         with os.fdopen(fd, "wb") as fh:
@@ -45,11 +69,13 @@ def atomic_write_bytes(path: Path, data: bytes) -> Path:
             fh.flush()
             os.fsync(fh.fileno())
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as exc:
         try:
             os.unlink(tmp)
         except OSError:
             pass
+        if isinstance(exc, OSError):
+            raise _cannot_write(path, exc) from None
         raise
     return path
 

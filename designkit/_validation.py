@@ -14,6 +14,7 @@ if TYPE_CHECKING:  # numpy loads where a seed is used, not with every input chec
     import numpy as np
 
 __all__ = [
+    "MAX_EFFUSIVITY",
     "InputError",
     "as_generator",
     "check_effusivity",
@@ -132,12 +133,26 @@ def check_nonnegative(name: str, value: float) -> float:
     return v
 
 
+#: Largest finite effusivity accepted where infinity is not [J s^-1/2 K^-1 m^-2]: about 100x diamond's (~6e4),
+#: the highest of any solid. Above it a value is a typo (1e30 for 1e3), and an interval of 80 around it has no
+#: width in float64.
+MAX_EFFUSIVITY = 1e7
+
+
 def check_effusivity(name: str, value: float, *, allow_zero: bool = False,
                      allow_inf: bool = False) -> float:
     """Check one effusivity [J s^-1/2 K^-1 m^-2].
 
     The physics layer accepts the limits 0 and infinity (a perfect insulator and a
-    perfect conductor); recognition and query inputs do not.
+    perfect conductor); recognition and query inputs do not, nor anything above
+    :data:`MAX_EFFUSIVITY`.
+
+    >>> check_effusivity("e1", 35000)
+    35000.0
+    >>> check_effusivity("e1", 1e30)
+    Traceback (most recent call last):
+    ...
+    designkit._validation.InputError: effusivity e1 must be at most 1e+07 J s^-1/2 K^-1 m^-2 (the highest of any material, diamond's, is about 6e4), got 1e+30
     """
     try:
         v = float(value)
@@ -149,6 +164,9 @@ def check_effusivity(name: str, value: float, *, allow_zero: bool = False,
         raise InputError(f"effusivity {name} must be positive, got {_fmt(v)}")
     if math.isinf(v) and not allow_inf:
         raise InputError(f"effusivity {name} must be finite, got {_fmt(v)}")
+    if v > MAX_EFFUSIVITY and not allow_inf:
+        raise InputError(f"effusivity {name} must be at most {MAX_EFFUSIVITY:g} J s^-1/2 K^-1 m^-2 (the highest of any "
+                         f"material, diamond's, is about 6e4), got {_fmt(v)}")
     return v
 
 

@@ -116,9 +116,10 @@ def plot_matrix(result, path) -> Path:
     ax.set_yticks(range(n), names, fontsize=8)
     ax.set_xlim(-0.5, n - 0.5)
     ax.set_ylim(n - 0.5, -0.5)
-    unit = f" [{result.unit}]" if result.unit else ""
+    unit = f" [{'°C' if result.unit == 'degC' else result.unit}]" if result.unit else ""
+    word = {"contact_s": "contact", "noise_c": "noise", "delta_t_c": "dT"}.get(result.quantity, result.quantity)
     cb = fig.colorbar(im, ax=ax, shrink=0.8)
-    cb.set_label(f"{result.quantity}{unit}" if result.question != "distinguishable" else "distinguishable (1 = yes)")
+    cb.set_label(f"{word}{unit}" if result.question != "distinguishable" else "distinguishable (1 = yes)")
     ax.set_title(f"{result.question}{unit}: hatched = overlapping ranges, red = limiting pair", fontsize=9)
     if curve is not None:
         ax2 = fig.add_subplot(grid[0, 1])

@@ -157,13 +157,81 @@ def test_cli_csv_is_a_header_and_rows_only(cli):
     assert not any(line.startswith("#") for line in r.output.splitlines())
 
 
-def test_cli_csv_reads_with_pandas_defaults(cli):
+def test_cli_csv_reads_with_pandas_defaults(cli):  # (cells are the table's text: "≥0.2" stays a string)
     pd = pytest.importorskip("pandas")
     r = cli("matrix", "--m", "copper", "--m", "stainless steel", "--m", "glass", "--format", "csv")
     assert r.exit_code == 0, r.output
     df = pd.read_csv(io.StringIO(r.output), index_col=0)
     assert list(df.index) == list(df.columns)
     assert df.shape == (3, 3) and np.isnan(df.values[0, 0])
+
+
+FOUR = ["--m", "copper", "--m", "stainless steel", "--m", "glass", "--m", "granite"]
+OVERLAPPING = ["--m", "Soda-lime glass", "--m", "Borosilicate glass", "--m", "porcelain", "--m", "granite"]
+
+
+def _table_cells(output: str) -> dict:
+    """{(row, column): text} of the rich table the command prints by default."""
+    rows = [[c.strip() for c in ln.strip("│").split("│")] for ln in output.splitlines() if ln.startswith("│")]
+    head = next(ln for ln in output.splitlines() if ln.startswith("┃"))
+    cols = [c.strip() for c in head.strip("┃").split("┃")]
+    return {(r[0], cols[k]): r[k] for r in rows for k in range(1, len(cols))}
+
+
+def test_cli_csv_keeps_the_bounds_the_table_shows(cli):
+    r = cli("matrix", *FOUR, "-q", "max-noise", "--contact", "2", "--format", "csv", "--no-multiclass")
+    assert r.exit_code == 0, r.output
+    lib = material_matrix(["copper", "stainless steel", "glass", "granite"], "max-noise", contact_s=2.0,
+                          multiclass=False)
+    bounded = [c for c in lib.cells if c.bound == "at-least"]
+    assert bounded, "the scene was chosen so that some answers lie beyond the table's noise grid"
+    rows = list(csv.DictReader(io.StringIO(r.output)))
+    names = lib.names
+    for c in bounded:
+        assert rows[c.i][names[c.j]] == f"≥{c.value:.3g}"
+    table = _table_cells(cli("matrix", *FOUR, "-q", "max-noise", "--contact", "2", "--no-multiclass").output)
+    for row in rows:
+        for name in names:
+            want = table[row["material"], name]
+            assert row[name] == ("" if want == "·" else want)
+
+
+def test_cli_csv_tells_overlap_from_the_diagonal(cli):
+    r = cli("matrix", *OVERLAPPING, "--format", "csv", "--no-multiclass")
+    assert r.exit_code == 0, r.output
+    rows = list(csv.reader(io.StringIO(r.output)))
+    lib = material_matrix(["Soda-lime glass", "Borosilicate glass", "porcelain", "granite"], multiclass=False)
+    st = lib.status()
+    assert (st == "overlap").any() and (st == "answered").any()
+    for i in range(4):
+        assert rows[i + 1][i + 1] == ""
+        for j in range(4):
+            if i != j:
+                assert (rows[i + 1][j + 1] == "overlap") == (st[i, j] == "overlap")
+    assert "overlap" in cli("matrix", "--help").output
+
+
+def test_cli_speaks_the_users_words(cli):
+    r = cli("matrix", *FOUR, "-q", "max-noise", "--contact", "2")
+    assert r.exit_code == 0, r.output
+    first = r.output.splitlines()[0]
+    assert first.startswith("max-noise [°C] for 4 materials (contact 2 s, dT 10 °C;"), first
+    assert "the smallest noise of all" in r.output and "--svm-trials N" in r.output
+    for internal in ("noise_c", "delta_t_c", "contact_s", "svm_trials", "degC"):
+        assert internal not in r.output
+    r = cli("matrix", *FOUR, "--noise", "0.05")
+    assert "(noise 0.05 °C, dT 10 °C;" in r.output.splitlines()[0] and "noise_c" not in r.output
+    j = json.loads(cli("matrix", *FOUR, "-q", "max-noise", "--contact", "2", "--json").output)
+    assert j["quantity"] == "noise_c" and "contact_s" in j["scene"]  # --json keeps the library's keys
+
+
+def test_matrix_figure_labels_the_colorbar_in_the_users_words(tmp_path):
+    mpl = pytest.importorskip("matplotlib")
+    from designkit.figures import plot_matrix
+
+    with mpl.rc_context({"svg.fonttype": "none"}):  # text as text, so the test can read it
+        svg = plot_matrix(material_matrix(THREE, multiclass=False), tmp_path / "m.svg").read_text()
+    assert "contact [s]" in svg and "contact_s" not in svg
 
 
 def test_cli_json_is_the_library_dict(cli):

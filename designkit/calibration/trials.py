@@ -250,6 +250,22 @@ def _sidecar_rows(folder: Path) -> list[tuple[str, str, Any]]:
     return rows
 
 
+def _first_bad_row(text: str, columns: int) -> str:
+    """Why numpy could not read a trial's rows, in the file's terms (line number, what is wrong)."""
+    for n, row in enumerate(csv.reader(io.StringIO(text, newline="")), start=1):
+        if n == 1 or not row:
+            continue
+        if len(row) != columns:
+            return (f"line {n} has {len(row)} of the header's {columns} columns (a truncated or damaged file; "
+                    "record the trial again or delete that line)")
+        for k, v in enumerate(row):
+            try:
+                float(v)
+            except ValueError:
+                return f"line {n}, column {k + 1}: {v.strip()!r} is not a number"
+    return "a row is not numbers separated by commas"
+
+
 def read_trial_csv(path: Path, material: str = "") -> Trial:
     """Read a trial CSV (the shared recordings' columns; passive and force optional)."""
     from .._schemas import load_json, read_text, schemas, validate
@@ -266,8 +282,8 @@ def read_trial_csv(path: Path, material: str = "") -> Trial:
                          f"(expected {','.join(COLUMNS)})")
     try:
         data = np.loadtxt(io.StringIO(text, newline=None), delimiter=",", skiprows=1, ndmin=2, dtype=np.float64)
-    except ValueError as exc:
-        raise InputError(f"trial {path} has a value that is not a number ({str(exc).splitlines()[0]})") from None
+    except ValueError:
+        raise InputError(f"trial {path}: {_first_bad_row(text, len(header))}") from None
     if data.shape[0] < 3 or data.shape[1] != len(header):
         raise InputError(f"trial {path}: need at least 3 rows of {len(header)} columns, got {data.shape}")
 

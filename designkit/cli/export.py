@@ -48,6 +48,8 @@ def export_cmd(
     Example: `designkit export --table svm-paper --format c --noise 0.05 --delta-t 10 --out designkit_table.h`
     writes a C99 header with `designkit_min_contact_s`, `designkit_delta_e` and
     `designkit_distinguishable` for one sensor noise and temperature difference.
+
+    The folder of --out must exist (it is not created).
     """
     from ..export import export_bytes, export_table
 
@@ -58,6 +60,12 @@ def export_cmd(
     if out == "-":
         _to_stdout(export_bytes, table, fmt, json_, slice_opts)
         return
+    folder = Path(out).expanduser().parent
+    if not folder.is_dir():  # like cp and cc -o: a typo in the folder is not silently made into new folders
+        from .._validation import InputError
+
+        why = "is not a folder" if folder.exists() else "does not exist (create it first)"
+        raise InputError(f"--out {out}: folder {folder} {why}")
     res = export_table(table, Path(out), fmt, **slice_opts)
     if json_:
         emit_json(res.to_dict())

@@ -68,6 +68,11 @@ def matrix(
     Example: `designkit matrix --m copper --m "stainless steel" --m glass --m granite -q max-noise --contact 2 --format csv`
 
     Example: `designkit materials list --family metals --format csv | designkit matrix --from -`
+
+    Cells (table, md and csv alike): the value; ≥ / ≤ before it when the answer lies beyond the table's grid
+    (at least / at most that value); 'overlap' when the two effusivity ranges overlap (never told apart);
+    'n/a' when the table has no answer; the diagonal is empty. --json gives plain numbers with a status and a
+    bound per pair.
     """
     from ..query.inputs import TableMismatch
     from ..query.matrix import material_matrix
@@ -115,9 +120,8 @@ def matrix(
         for j, b in enumerate(names):
             row[b] = None if i == j else _cell(result.question, vals[i, j], status[i, j], bounds.get((i, j), ""))
         rows.append(row)
-    if fmt == "csv":  # pandas-ready: plain values, the matrix with the materials as index
-        rows = [{"material": a, **{b: (None if i == j else (None if vals[i, j] != vals[i, j] else float(vals[i, j])))
-                                  for j, b in enumerate(names)}} for i, a in enumerate(names)]
+    # csv keeps the table's cell text ("≥0.2", "overlap", "n/a", "yes"/"no"; the diagonal empty): a plain number
+    # would drop the bound and make an overlap look like the diagonal. --json has plain numbers and a status.
     emit_rows(rows, ["material", *names], fmt=fmt, out=out, payload=result.to_dict(), title=_title(result),
               notes=_notes(result), text=lambda _c, v: "·" if v is None else str(v),
               justify={"material": "left", **{n: "right" for n in names}})
@@ -131,7 +135,13 @@ def read_material_names(path: str) -> list[str]:
     import sys
     from pathlib import Path
 
-    text = sys.stdin.read() if path == "-" else Path(path).read_text(encoding="utf-8")
+    try:
+        text = sys.stdin.read() if path == "-" else Path(path).read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        from .._validation import InputError
+
+        why = exc.strerror if isinstance(exc, OSError) and exc.strerror else "not a UTF-8 text file"
+        raise InputError(f"--from {path}: cannot read it ({why})") from None
     lines = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
     if not lines:
         from .._validation import InputError
@@ -154,13 +164,35 @@ def _cell(question: str, v: float, status: str, bound: str) -> str:
     return {"at-most": "≤", "at-least": "≥"}.get(bound, "") + f"{v:.3g}"
 
 
+#: The library's names of the scene's quantities, as the user wrote them on the command line, with units.
+_WORDS = {"contact_s": ("contact", "s"), "noise_c": ("noise", "°C"), "delta_t_c": ("dT", "°C"),
+          "threshold": ("F1 threshold", "")}
+
+
+def _unit(unit: str) -> str:
+    return "°C" if unit == "degC" else unit
+
+
+def _user_words(text: str, r) -> str:
+    """The library's sentence in the command line's words: its quantity name and units, the --svm-trials flag."""
+    if r.quantity in _WORDS:
+        text = text.replace(f" {r.quantity} ", f" {_WORDS[r.quantity][0]} ")
+    return (text.replace(" degC", " °C").replace("with svm_trials, designkit matrix --svm-trials N",
+                                                  "with designkit matrix --svm-trials N"))
+
+
 def _title(r) -> str:
-    unit = f" [{r.unit}]" if r.unit else ""
-    sc = ", ".join(f"{k} {v:g}" for k, v in r.scene.items() if v is not None and k != "noise_ratio")
+    unit = f" [{_unit(r.unit)}]" if r.unit else ""
+    sc = ", ".join(f"{_WORDS.get(k, (k,))[0]} {v:g}" + (f" {_WORDS[k][1]}" if _WORDS.get(k, ("", ""))[1] else "")
+                   for k, v in r.scene.items() if v is not None and k != "noise_ratio")
     return f"{r.question}{unit} for {len(r.materials)} materials ({sc}; table {r.table})"
 
 
 def _notes(r) -> list[str]:
+    return [_user_words(n, r) for n in _raw_notes(r)]
+
+
+def _raw_notes(r) -> list[str]:
     notes = [f"Limiting pair: {r.limiting.why}."]
     if r.question != "min-contact":
         notes.append("≤ / ≥: the answer lies beyond the table's grid, at most / at least the value shown; overlap: "

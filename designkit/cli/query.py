@@ -251,13 +251,16 @@ def _scalar(words: str, unit: str):
 
 def _delta_lines(con, d):
     x = d["details"]
+    dash = False  # the legend only when a "—" is printed
     for words, side in (("towards lower e ", "lower"), ("towards higher e", "upper")):
         s = x[side]
         iv = s["interval"]
         cov = f"{s['coverage']:.0%} interval" if s.get("coverage") else "interval, coverage not stated"
         ivs = f"({cov} {_fmt(iv[0], '', 4)} to {_fmt(iv[1], '', 4)})" if s["value"] is not None else ""
         con.print(f"  {words}: SVM [bold green]{_fmt(s['value'], '', 4)}[/] {ivs}, ideal {_fmt(s['ideal'], '', 4)}")
-    con.print("  [dim]— : no distinguishable effusivity in that direction within the range examined[/]")
+        dash = dash or s["value"] is None or s["ideal"] is None or None in iv
+    if dash:
+        con.print("  [dim]— : no distinguishable effusivity in that direction within the range examined[/]")
 
 
 def _distinguishable_lines(con, d):

@@ -23,8 +23,9 @@ def reproduce(
     tables: Annotated[Optional[Path], typer.Option(
         "--tables", help="Folder searched for lookup tables before the shipped ones.")] = None,
     robot_data: Annotated[Optional[Path], typer.Option(
-        "--robot-data", help="Folder of the real robot recordings (default: $DESIGNKIT_ROBOT_DATA, "
-                             "else ../shared/data/robot-thermal-recordings).")] = None,
+        "--robot-data", help="Folder of the real robot recordings (default: $DESIGNKIT_ROBOT_DATA, else "
+                             "shared/data/robot-thermal-recordings in the current folder or the nearest folder "
+                             "above it that has one).")] = None,
     quick: Annotated[bool, typer.Option(
         "--quick", help="Fewer Monte Carlo repeats and trials in the parts computed now (a first look; tests).")] = False,
     jobs: Annotated[int, typer.Option("--jobs", "-j", help="Worker processes for the computed queries (-1: all cores).")] = 1,

@@ -24,22 +24,40 @@ __all__ = [
 ]
 
 
-def default_robot_data_dir() -> Path:
+def default_robot_data_dir(cwd: Path | str | None = None) -> Path:
     """Where the shared robot recordings are looked for.
 
-    ``$DESIGNKIT_ROBOT_DATA`` if set, else ``<repo>/../shared/data/robot-thermal-recordings``
-    for a source checkout, else the same path relative to the working directory.
+    ``$DESIGNKIT_ROBOT_DATA`` if set; else the first ``shared/data/robot-thermal-recordings`` (with its
+    ``index.csv``) in the working directory ``cwd`` or one of its parents, so that running from a
+    repository (or any folder in it) beside ``shared/`` finds them; else the same folder beside the
+    source checkout designkit is imported from (never inside an installed package's site-packages).
+    When none has the recordings: ``../shared/data/robot-thermal-recordings`` from ``cwd``, which the
+    report names as where it looked.
+
+    >>> import os, tempfile
+    >>> from pathlib import Path
+    >>> old = os.environ.pop("DESIGNKIT_ROBOT_DATA", None)
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     data = Path(tmp, "shared", "data", "robot-thermal-recordings")
+    ...     data.mkdir(parents=True); _ = (data / "index.csv").write_text("")
+    ...     Path(tmp, "repo", "examples").mkdir(parents=True)
+    ...     default_robot_data_dir(Path(tmp, "repo", "examples")) == data.resolve()
+    True
+    >>> if old is not None: os.environ["DESIGNKIT_ROBOT_DATA"] = old
     """
     env = os.environ.get("DESIGNKIT_ROBOT_DATA")
     if env:
         return Path(env)
-    rel = Path("..") / "shared" / "data" / "robot-thermal-recordings"
-    repo = Path(__file__).resolve().parents[2]
-    for base in (repo, Path.cwd()):
-        cand = (base / rel).resolve()
+    sub = Path("shared") / "data" / "robot-thermal-recordings"
+    here = (Path.cwd() if cwd is None else Path(cwd)).resolve()
+    candidates = [base / sub for base in (here, *here.parents)]
+    checkout = Path(__file__).resolve().parents[2]
+    if (checkout / "pyproject.toml").is_file() and (checkout / "designkit").is_dir():  # a source checkout
+        candidates.append(checkout.parent / sub)
+    for cand in candidates:
         if (cand / "index.csv").is_file():
             return cand
-    return (repo / rel).resolve()
+    return here.parent / sub
 
 
 @dataclass(frozen=True)

@@ -131,6 +131,23 @@ def test_delta_e_from_the_shipped_table_states_an_exact_bound_below_it():
         assert s["table_value"] > 0 and s["efficiency"] > 1.0
 
 
+def test_delta_e_on_a_grid_point_is_the_middle_of_what_the_tabulated_need_allows():
+    # contact 2 s and sigma/dT 0.005 are on svm-paper's grid: one entry, no interpolation between entries.
+    # Its tabulated delta S says the SVM's crossing lies in (S - w, S]; the ideal observer's need, computed
+    # exactly, is a lower bound of it: the estimate is the middle of [max(ideal, S - w), S]
+    from designkit.query import delta_e
+    from designkit.query.ideal_bound import exact_ideal_delta
+
+    ans = delta_e(20000.0, contact_s=2.0, noise_c=0.05)
+    for side, sign in (("lower", -1), ("upper", +1)):
+        s = ans.details[side]
+        ideal = float(exact_ideal_delta(PAPER, ans.details["e"], 2.0, 0.005, direction=sign, width=80.0))
+        need = s["table_value"]
+        assert s["ideal"] == pytest.approx(ideal, rel=1e-12)
+        assert s["value"] == pytest.approx(0.5 * (max(ideal, need - 80.0) + need), rel=1e-9)
+        assert s["ideal"] < s["interval"][0] < s["value"] < s["interval"][1]
+
+
 def test_critical_noise_is_where_the_ideal_f1_crosses_the_threshold():
     from designkit.query.ideal_bound import critical_noise, ideal_f1
 

@@ -25,7 +25,8 @@ efficiency* k at the tabulated contact times around the answer (the noise at
 which the ideal observer needs the tabulated separation, over the table's) and
 apply it to the exact ideal observer (:func:`noise_k_min_contact`,
 :func:`noise_k_max_ratio`; docs/accuracy.md has their coverage). ``delta-e``
-reads the ratio of the needs (:func:`delta_efficiency_estimate`).
+reads the ratio of the SVM's tabulated need to the ideal observer's, computed
+exactly at each tabulated entry (:func:`delta_efficiency_estimate`).
 
 Examples
 --------
@@ -1461,8 +1462,8 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
         wanted = {**_scene_wanted(view, noise, dt), "contact_s": contact, "effusivity": (x,)}
         return _answer("delta-e", op, value=None, interval=(None, None), ideal=None, in_grid=flags,
                        details=_delta_details(x, {}), notes=_outside_notes(view, flags, wanted), **common)
-    # delta(e)'s bound is read from the ideal grid even where a closed form exists: its bisection over
-    # effusivity costs ~0.3 s a call, too slow for a table question (the exact route computes it)
+    # the grid's ideal delta(e) (the bound of the route without a closed form; with one, the efficiency route
+    # below computes the bound exactly and keeps this beside it as "table_ideal")
     iview, ikind, _ = (op.iview, op.ikind, None) if not op.closed else _ideal_view(view, ideal_table)
     icombos, _ = iview.scene_weights(noise, dt) if iview is not None else ([], {})
     icw, _ = _contact_weights(iview, contact) if iview is not None else ([], False)

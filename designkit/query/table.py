@@ -1493,6 +1493,8 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
 
     efficiency = op.tab.fidelity == "svm" and op.closed and "delta_up_ideal" in view.t.arrays
     ends = (cw[0][0], cw[-1][0])  # the tabulated contacts around the asked one (the same where it is on one)
+    both = (_delta_efficiency_both(op, combos, ends, x, contact, noise / abs(dt), zc) if efficiency
+            else {"down": None, "up": None})
     sides = {}
     for direction, side in (("down", "lower"), ("up", "upper")):
         val = at(view, combos, cw, f"delta_{direction}")
@@ -1502,8 +1504,8 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
         ideal_side = at(iview, icombos, icw, iname)
         stated, cov_side, method = [None, None], None, "none"
         eff = None
-        if val is not None and efficiency:
-            eff = _delta_efficiency_one(op, combos, ends, direction, x, contact, noise / abs(dt), zc)
+        if val is not None:
+            eff = both[direction]
         if eff is not None:  # the SVM's efficiency against the exact ideal observer (delta_efficiency_estimate)
             sides[side] = {"value": eff["value"], "interval": [eff["low"], eff["high"]], "ideal": eff["ideal"],
                            "coverage": coverage, "estimate_method": "table-efficiency", "monte_carlo_interval": iv,
@@ -1530,27 +1532,31 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
                    check_at=(contact, noise, dt), **common)
 
 
-#: The scalar route's efficiency estimates (:func:`delta_efficiency_estimate`), per process (least recently used
-#: out): a question asked again reads them from here (the estimate re-reads 12 table entries and 5 cached ideal
-#: deltas a direction, ~1 ms of numpy overhead). A pure function of the key: the table's content and the arguments.
-_DELTA_EFF: "OrderedDict[tuple, dict | None]" = OrderedDict()
+#: The scalar route's efficiency estimates (:func:`delta_efficiency_estimate`, both directions), per process (least
+#: recently used out): a question asked again reads them from here (the estimate re-reads 24 table entries and 10
+#: cached ideal deltas, ~1 ms of numpy overhead). A pure function of the key: the table's content and the arguments.
+_DELTA_EFF: "OrderedDict[tuple, dict]" = OrderedDict()
 _DELTA_EFF_MAX = 4096
 
 
-def _delta_efficiency_one(op, combos, ends, direction: str, x: float, contact: float, ratio: float,
-                          zc: float) -> dict[str, float] | None:
-    """One direction's :func:`delta_efficiency_estimate` for the scalar route, cached (None: it does not apply)."""
+def _delta_efficiency_both(op, combos, ends, x: float, contact: float, ratio: float,
+                           zc: float) -> dict[str, dict[str, float] | None]:
+    """Both directions' :func:`delta_efficiency_estimate` for the scalar route in one computation (the ideal
+    observer's bisections of both directions at once), cached; per direction ("down", "up") a dict, or None
+    where it does not apply."""
     h = op.tab.header.get("content_hash")
-    key = (h, float(op.width), float(op.phi), tuple(combos), tuple(ends), direction, x, contact, ratio, zc)
+    key = (h, float(op.width), float(op.phi), tuple(combos), tuple(ends), x, contact, ratio, zc)
     if h is not None and key in _DELTA_EFF:
         _DELTA_EFF.move_to_end(key)
         return _DELTA_EFF[key]
     view = op.view
+    (ratios, weights, *down), (_, _, *up) = (delta_entries(view, combos, ends, d, x) for d in ("down", "up"))
     r = delta_efficiency_estimate(
-        op.tab.sensor, x, contact, ratio, -1.0 if direction == "down" else 1.0,
-        *(view.contacts[k] for k in ends), *delta_entries(view, combos, ends, direction, x), width=op.width,
+        op.tab.sensor, np.array([x, x]), contact, ratio, np.array([-1.0, 1.0]), *(view.contacts[k] for k in ends),
+        ratios, weights, *(np.concatenate([a, b], axis=2) for a, b in zip(down, up)), width=op.width,
         threshold=op.phi, e_max=view.e_hi, z_table=table_z(op.tab), zc=zc, mc_factor=view.mc_calibration())
-    out = None if math.isnan(float(r["value"][0])) else {k: float(v[0]) for k, v in r.items()}
+    out = {d: None if math.isnan(float(r["value"][i])) else {k: float(v[i]) for k, v in r.items()}
+           for i, d in enumerate(("down", "up"))}
     if h is not None:  # a table without a hash: its content is not a key
         _DELTA_EFF[key] = out
         while len(_DELTA_EFF) > _DELTA_EFF_MAX:

@@ -417,19 +417,29 @@ def exact_ideal_max_ratio(sensor, lo, hi, contact_s, *, width: float = 80.0, thr
     return np.where(ok_lo, out, np.nan)
 
 
-def exact_ideal_delta(sensor, e, contact_s, ratio, *, direction: int = +1, width: float = 80.0,
+def exact_ideal_delta(sensor, e, contact_s, ratio, *, direction=+1, width: float = 80.0,
                       threshold: float = 0.9, e_max: float = 40000.0, tol: float = 0.5) -> np.ndarray:
     """Ideal observer's delta(e) [J s^-1/2 K^-1 m^-2] towards higher (+1) or lower (-1) e, vectorized.
 
     Reference class ``[e, e+w)``, partner ``[e +- d, e +- d + w)`` (as
     :func:`designkit.query.exact_delta_e`); bisection on ``d`` to ``tol``.
-    NaN where no partner inside ``(0, e_max]`` is distinguishable.
+    NaN where no partner inside ``(0, e_max]`` is distinguishable. ``direction`` may be an array (elementwise,
+    each element's bisection its own: the answers are those of one call per direction).
+
+    >>> from designkit.sensor import load_sensor
+    >>> s = load_sensor("paper")
+    >>> both = exact_ideal_delta(s, [20000.0, 20000.0], 2.0, 0.005, direction=np.array([-1.0, 1.0]))
+    >>> [float(both[0]), float(both[1])] == [float(exact_ideal_delta(s, 20000.0, 2.0, 0.005, direction=d))
+    ...                                      for d in (-1, 1)]
+    True
     """
-    e, contact, ratio = (np.asarray(x, dtype=np.float64) for x in np.broadcast_arrays(e, contact_s, ratio))
+    e, contact, ratio, direction = (np.asarray(x, dtype=np.float64) for x in np.broadcast_arrays(
+        e, contact_s, ratio, direction))
     norm = shape_norm(sensor, contact)
     with np.errstate(divide="ignore"):
         s = np.where(norm > 0, ratio / norm, np.inf)
-    limit = (e_max - e - width) if direction > 0 else (e - width)
+    direction = np.where(direction > 0, 1.0, -1.0)
+    limit = np.where(direction > 0, e_max - e - width, e - width)
 
     def ok(d):
         p = e + direction * d
@@ -505,14 +515,9 @@ def cached_ideal_min_contact(sensor, lo, hi, ratio, *, width: float = 80.0, thre
 def cached_ideal_delta(sensor, e, contact_s, ratio, direction, *, width: float = 80.0, threshold: float = 0.9,
                        e_max: float = 40000.0, tol: float = 0.5) -> np.ndarray:
     """:func:`exact_ideal_delta` through the per-process cache, ``direction`` (+1 / -1) elementwise."""
-    def compute(a, c, r, d):
-        out = np.full(a.shape, np.nan)
-        for sign in (+1, -1):
-            m = d == sign
-            if m.any():
-                out[m] = exact_ideal_delta(sensor, a[m], c[m], r[m], direction=sign, width=width,
-                                           threshold=threshold, e_max=e_max, tol=tol)
-        return out
+    def compute(a, c, r, d):  # both directions in one bisection (each element's its own)
+        return exact_ideal_delta(sensor, a, c, r, direction=np.where(d > 0, 1.0, -1.0), width=width,
+                                 threshold=threshold, e_max=e_max, tol=tol)
     return _cached("delta", sensor, (e, contact_s, ratio, direction),
                    (float(width), float(threshold), float(e_max), float(tol)), compute)
 

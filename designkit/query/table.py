@@ -25,7 +25,8 @@ efficiency* k at the tabulated contact times around the answer (the noise at
 which the ideal observer needs the tabulated separation, over the table's) and
 apply it to the exact ideal observer (:func:`noise_k_min_contact`,
 :func:`noise_k_max_ratio`; docs/accuracy.md has their coverage). ``delta-e``
-reads the ratio of the needs (:func:`delta_efficiency_estimate`).
+reads the ratio of the SVM's tabulated need to the ideal observer's, computed
+exactly at each tabulated entry (:func:`delta_efficiency_estimate`).
 
 Examples
 --------
@@ -67,6 +68,7 @@ __all__ = [
     "CLOSED_FORM_MAX_CONTACT_S",
     "CLOSED_FORM_RATIO_BRACKET",
     "delta_efficiency_estimate",
+    "delta_entries",
     "DEFAULT_TABLE",
     "SPREAD_TABLE_QUESTIONS",
     "VARIED_TABLE",
@@ -125,9 +127,9 @@ def _as_table(table: "Table | str") -> Table:
     return t
 
 
-#: :meth:`_View.entry_noise` per table content and scene slices (a view is made per question; the measure is
-#: the table's: computed once per process, not on every question).
-_ENTRY_NOISE: dict[tuple, float] = {}
+#: :meth:`_View.mc_calibration` per table content (a view is made per question; the measure is the table's:
+#: computed once per process, not on every question).
+_MC_CALIBRATION: dict[str, float] = {}
 #: :meth:`_View.need` per table content (at most 65,536 a table, then forgotten).
 _NEEDS: dict[str, dict[tuple, float]] = {}
 
@@ -137,7 +139,8 @@ def clear_table_cache() -> None:
     noise-efficiency readings taken from them."""
     _LOADED.clear()
     _K_READINGS.clear()
-    _ENTRY_NOISE.clear()
+    _MC_CALIBRATION.clear()
+    _DELTA_EFF.clear()
     _NEEDS.clear()
 
 
@@ -214,38 +217,62 @@ class _View:
             return math.nan
         return max(up, down)
 
-    def entry_noise(self, combos) -> float:
-        """Robust standard deviation of one tabulated SVM need about its smooth trend, in log(efficiency).
+    def mc_calibration(self) -> float:
+        """Factor on the table's Monte Carlo standard errors that matches the scatter of its own entries.
 
-        Measured on the table itself, for the scene slices ``combos`` use: every interior contact's log
-        efficiency (SVM need over ideal need, each less half a width; both directions) is predicted from its
-        two neighbours on the contact axis (log-linear in log t), and the residuals, each divided by
-        ``sqrt(1 + w^2 + (1 - w)^2)`` (what independent scatter of three entries gives), are summarized by
-        their median absolute deviation x 1.4826. Entries whose SVM need is under four widths (rounding
-        dominates there; it has its own term) are left out. 0 when the table has no ideal needs.
+        Measured on the table itself (leave one contact out): every interior contact's log efficiency
+        ``log((svm need - w/2) / (ideal need - w/2))`` (both directions, every noise-ratio slice and
+        effusivity) is predicted from its two neighbours on the contact axis (linear in log t); each residual
+        is standardized by the SD its three entries' stated errors give: ``f`` times the table's Monte Carlo
+        SE of each SVM need (``delta_lo`` / ``delta_hi``, ``z`` SEs each) and the rounding of both needs
+        (``w/sqrt(12)`` each). The factor ``f`` is the one that makes the standardized residuals' robust SD
+        (1.4826 x median |r|) 1. Entries whose ideal need is under four widths (rounding dominates there)
+        are left out. The residuals also carry the need's curvature across two cells, so ``f`` errs high
+        (on svm-paper 0.78: its Monte Carlo intervals are a quarter wider than its entries scatter).
+        1 where the table has no ideal needs or no Monte Carlo interval to calibrate (fewer than 20
+        residuals).
         """
-        key = (self.t.header.get("content_hash"), tuple(idx for idx, w in combos if w))
-        hit = _ENTRY_NOISE.get(key) if key[0] is not None else None  # a table without a hash: not cached
+        key = self.t.header.get("content_hash")
+        hit = _MC_CALIBRATION.get(key) if key is not None else None  # a table without a hash: not cached
         if hit is not None:
             return hit
         arrays, h = self.t.arrays, 0.5 * float(self.t.header["effusivity"]["width"])
+        rnd_sd, z = 2.0 * h / math.sqrt(12.0), table_z(self.t)
         lt = np.log(self.contacts)
-        res = []
+        res, vm, vr = [], [], []
         for d in ("up", "down"):
-            if f"delta_{d}_ideal" not in arrays:
+            if f"delta_{d}_ideal" not in arrays or f"delta_{d}_lo" not in arrays:
                 continue
-            for idx in key[1]:
-                svm, ideal = arrays[f"delta_{d}"][idx], arrays[f"delta_{d}_ideal"][idx]  # [contact, e_ref]
-                with np.errstate(invalid="ignore", divide="ignore"):
-                    le = np.where(svm >= 8.0 * h, np.log((svm - h) / (ideal - h)), np.nan)
-                for k in range(1, lt.size - 1):
-                    w = (lt[k] - lt[k - 1]) / (lt[k + 1] - lt[k - 1])
-                    r = (le[k] - ((1.0 - w) * le[k - 1] + w * le[k + 1])) / math.sqrt(1.0 + w * w + (1.0 - w) ** 2)
-                    res.append(r[np.isfinite(r)])
-        r = np.concatenate(res) if res else np.zeros(0)
-        value = float(1.4826 * _median(np.abs(r - _median(r)))) if r.size >= 20 else 0.0
-        if key[0] is not None:
-            _ENTRY_NOISE[key] = value
+            svm, ideal = arrays[f"delta_{d}"], arrays[f"delta_{d}_ideal"]  # [slice, contact, e_ref]
+            lo, hi = arrays[f"delta_{d}_lo"], arrays[f"delta_{d}_hi"]
+            with np.errstate(invalid="ignore", divide="ignore"):
+                le = np.log((svm - h) / (ideal - h))
+                rnd2 = (rnd_sd / (svm - h)) ** 2 + (rnd_sd / (ideal - h)) ** 2
+                mc = np.where(np.isfinite(hi) & (lo > h), np.log((hi - h) / (lo - h)) / (2.0 * z),
+                              np.where(lo > h, np.log((svm - h) / (lo - h)) / z, np.nan))
+            for k in range(1, lt.size - 1):
+                w = (lt[k] - lt[k - 1]) / (lt[k + 1] - lt[k - 1])
+                r = le[:, k] - ((1.0 - w) * le[:, k - 1] + w * le[:, k + 1])
+                v_mc = mc[:, k] ** 2 + ((1.0 - w) * mc[:, k - 1]) ** 2 + (w * mc[:, k + 1]) ** 2
+                v_rnd = rnd2[:, k] + (1.0 - w) ** 2 * rnd2[:, k - 1] + w ** 2 * rnd2[:, k + 1]
+                with np.errstate(invalid="ignore"):
+                    ok = (np.isfinite(r) & np.isfinite(v_mc) & (v_mc > 0) & np.isfinite(v_rnd)
+                          & (np.fmin(np.fmin(ideal[:, k - 1], ideal[:, k]), ideal[:, k + 1]) >= 8.0 * h))
+                res.append(r[ok]), vm.append(v_mc[ok]), vr.append(v_rnd[ok])
+        r = np.abs(np.concatenate(res)) if res else np.zeros(0)
+        value = 1.0
+        if r.size >= 20:
+            v_mc, v_rnd = np.concatenate(vm), np.concatenate(vr)
+            a, b = math.log(0.05), math.log(20.0)  # bisection on log f: the robust SD falls as f grows
+            for _ in range(30):
+                f = math.exp(0.5 * (a + b))
+                if 1.4826 * _median(r / np.sqrt(f * f * v_mc + v_rnd)) > 1.0:
+                    a = math.log(f)
+                else:
+                    b = math.log(f)
+            value = math.exp(0.5 * (a + b))
+        if key is not None:
+            _MC_CALIBRATION[key] = value
         return value
 
     def e_in_grid(self, *es: float) -> bool:
@@ -389,25 +416,6 @@ def contact_estimate(x0, x1, n0, n1, gap, raw, mc_lo, mc_hi, ideal, *, width: fl
     ideal = np.asarray(ideal, dtype=np.float64)
     low = np.where(np.isnan(low) | np.isnan(ideal), low, np.minimum(np.maximum(low, ideal), value))
     return {"value": value, "low": low, "high": high, "interp": interp, "rounding": rounding}
-
-
-def _efficiency(svm, ideal, width: float) -> np.ndarray:
-    """``(svm need - w/2) / (ideal need - w/2)`` (both tabulated deltas are rounded up to the grid's width
-    ``w``: on average w/2); NaN unless both needs exceed w/2."""
-    h = 0.5 * width
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where((svm > h) & (ideal > h), (svm - h) / (ideal - h), np.nan)
-
-
-def _table_se_log(svm, ideal, mc_lo, mc_hi, *, width: float, z_table: float) -> tuple[np.ndarray, np.ndarray]:
-    """Standard errors in log of an efficiency read from the table: the rounding of its two needs (SD
-    ``w/sqrt(12)`` each) and the table's Monte Carlo interval of the SVM need (``mc_lo``/``mc_hi``, each
-    ``z_table`` standard errors from the value; 0 where an end is missing)."""
-    h, sd = 0.5 * width, width / math.sqrt(12.0)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        rounding = np.hypot(sd / (svm - h), sd / (ideal - h))
-        mc = np.abs(np.log((mc_hi - h) / (mc_lo - h))) / (2.0 * z_table)
-    return rounding, np.where(np.isfinite(mc), mc, 0.0)
 
 
 # ============================================================ the noise efficiency (min-contact)
@@ -736,36 +744,64 @@ def delta_estimate(value, mc_lo, mc_hi, geometric, ideal, *, width: float, z_tab
     return low, high
 
 
-def delta_efficiency_estimate(sensor, e, contact_s, ratio, direction, t_a, t_b, svm_a, svm_b, ideal_a, ideal_b,
-                              mc_lo, mc_hi, *, width: float, threshold: float, e_max: float, z_table: float,
-                              zc: float, entry_sd=0.0) -> dict[str, np.ndarray]:
+def delta_entries(view, combos, ends, direction: str, e) -> tuple[np.ndarray, ...]:
+    """The tabulated SVM delta(e) towards ``direction`` (``"up"`` / ``"down"``) and its Monte Carlo ends at
+    effusivities ``e`` (interpolated between centres as :func:`designkit.tables.lookup.interp_e`), at the
+    contact indices ``ends`` (two) in each weighted noise-ratio slice of ``combos``: the slices' sigma/dT (m,),
+    their weights (m,), and the delta, its low and its high end, each (2, m, n) (NaN: none within the grid);
+    what :func:`delta_efficiency_estimate` takes."""
+    live = [(idx[0], w) for idx, w in combos if w]
+    e = np.atleast_1d(np.asarray(e, dtype=np.float64))
+    si = np.array([i for i, _ in live], dtype=np.int64)
+    shape = (2, si.size, e.size)
+    sl, kk, ee = (np.broadcast_to(a, shape).ravel() for a in (
+        si[None, :, None], np.asarray(ends, dtype=np.int64)[:, None, None], e[None, None, :]))
+    out = [_interp_at(view.t.arrays[f"delta_{direction}{suffix}"], view.centres, sl, kk, ee).reshape(shape)
+           for suffix in ("", "_lo", "_hi")]
+    return (view.t.axes["noise_ratio"][si], np.array([w for _, w in live], dtype=np.float64), *out)
+
+
+def delta_efficiency_estimate(sensor, e, contact_s, ratio, direction, t_a, t_b, slice_ratios, slice_weights, svm,
+                              svm_lo, svm_hi, *, width: float, threshold: float, e_max: float, z_table: float,
+                              zc: float, mc_factor: float = 1.0) -> dict[str, np.ndarray]:
     """delta-e's estimate of one direction from the SVM's efficiency against the exact ideal observer.
 
-    The SVM's efficiency ``eff = (svm need - w/2) / (ideal
-    need - w/2)`` at the tabulated contact times ``t_a``, ``t_b`` around ``contact_s`` (log-linear in log t;
-    the known one where the other is NaN) times the ideal observer's delta(e) computed exactly at
-    ``contact_s`` (:func:`designkit.query.ideal_bound.exact_ideal_delta`): no interpolation of the steep need
-    itself, and an ideal bound computed, not read from a grid. Standard error in log: the larger of the
-    table's Monte Carlo error at the asked contact (``mc_lo``/``mc_hi``, ``z_table`` SEs from the value each)
-    and ``entry_sd`` (averaged over the two entries' weights), the rounding of both needs and the
-    interpolation error, ``2 w (1 - w)`` times the efficiency's change across the cell (half of it mid-cell).
+    The SVM's efficiency is its need over the ideal observer's for the asked reference class and direction,
+    ``eff = s / i``. At every tabulated entry around the question (the contact times ``t_a``, ``t_b`` and the
+    noise-ratio slices ``slice_ratios``) the ideal need ``i`` is computed exactly
+    (:func:`designkit.query.ideal_bound.cached_ideal_delta`; the table's own ideal needs are rounded up to its
+    grid, and at small needs that rounding dominated the ratio) and the SVM's ``s`` is the middle of what its
+    tabulated need ``S`` allows: the first grid distance whose F1 reaches Phi, so the crossing lies in
+    ``(S - w, S]``, and never below the ideal observer's, ``[max(i, S - w), S]`` (SD its length / sqrt(12)).
+    ``log eff`` is interpolated linearly in log t between the two contacts and with ``slice_weights`` between
+    the slices, floored at 1 (no classifier beats the ideal observer), and applied to the ideal observer's
+    delta(e) computed exactly at the asked contact and sigma/dT: no interpolation of the steep need itself.
+
+    Standard error in log, each term measured on the table (docs/accuracy.md): the entries' Monte Carlo
+    errors (the table's ``delta_lo`` / ``delta_hi``, ``z_table`` SEs each, times ``mc_factor``, the table's
+    own calibration :meth:`_View.mc_calibration`), combined as independent (the table's entries are
+    separate simulations); their rounding errors combined as alike (neighbouring needs round the same way),
+    the weighted mean, not reduced by averaging; and the interpolation across the cell, ``u (1 - u)`` times
+    half the change of ``log eff`` across it (as min-contact's noise efficiency). Where one contact's
+    entries cannot be read (a need beyond the grid) the other's stand alone.
 
     Parameters
     ----------
-    e : array_like
+    e : array_like, shape (n,)
         Reference class's lower edge [J s^-1/2 K^-1 m^-2].
-    contact_s, ratio : array_like
-        Contact time [s] and sigma/dT [-].
-    direction : array_like
-        +1 (towards higher effusivity) or -1.
-    t_a, t_b, svm_a, svm_b, ideal_a, ideal_b : array_like
-        Tabulated contact times [s] and the SVM and ideal deltas there.
-    mc_lo, mc_hi : array_like
-        The table's Monte Carlo ends of the SVM delta at the asked contact.
+    contact_s, ratio, direction : array_like, shape (n,) or scalar
+        Contact time [s], sigma/dT [-], and +1 (towards higher effusivity) or -1.
+    t_a, t_b : array_like
+        The tabulated contact times [s] around ``contact_s`` (equal where it is one).
+    slice_ratios, slice_weights : array_like, shape (m,) or (m, n)
+        The noise-ratio slices the question interpolates between and their weights.
+    svm, svm_lo, svm_hi : array_like, shape (2, m, n)
+        The tabulated SVM delta and its Monte Carlo ends at ``e`` (interpolated in effusivity) at ``t_a``
+        (row 0) and ``t_b`` (row 1) in each slice [J s^-1/2 K^-1 m^-2].
     width, threshold, e_max, z_table, zc : float
         Grid width, F1 threshold, upper end of the effusivity range, the table's z and the asked coverage's.
-    entry_sd : float or array_like
-        Scatter of one tabulated efficiency about its trend, log (``_View.entry_noise``).
+    mc_factor : float
+        Calibration of the table's Monte Carlo errors (:meth:`_View.mc_calibration`).
 
     Returns
     -------
@@ -776,44 +812,66 @@ def delta_efficiency_estimate(sensor, e, contact_s, ratio, direction, t_a, t_b, 
     Examples
     --------
     >>> from designkit.sensor import load_sensor
-    >>> r = delta_efficiency_estimate(load_sensor("paper"), 20000.0, 1.75, 0.005, +1, 1.5, 2.0, 8760.0, 5000.0,
-    ...                               4920.0, 2680.0, 6200.0, 7300.0, width=80.0, threshold=0.9, e_max=40000.0,
-    ...                               z_table=2.0, zc=1.645, entry_sd=0.04)
-    >>> float(r["ideal"]) < float(r["low"]) < float(r["value"]) < float(r["high"])
+    >>> S = [[[8760.0]], [[5000.0]]]
+    >>> r = delta_efficiency_estimate(load_sensor("paper"), 20000.0, 1.75, 0.005, +1, 1.5, 2.0, [0.005], [1.0],
+    ...                               S, [[[8300.0]], [[4750.0]]], [[[9200.0]], [[5300.0]]], width=80.0,
+    ...                               threshold=0.9, e_max=40000.0, z_table=2.0, zc=1.645)
+    >>> float(r["ideal"][0]) < float(r["low"][0]) < float(r["value"][0]) < float(r["high"][0])
     True
     """
-    arrs = np.broadcast_arrays(*(np.asarray(a, dtype=np.float64) for a in (
-        e, contact_s, ratio, direction, t_a, t_b, svm_a, svm_b, ideal_a, ideal_b, mc_lo, mc_hi, entry_sd)))
-    e, contact, ratio, direction, t_a, t_b, svm_a, svm_b, ideal_a, ideal_b, mc_lo, mc_hi, entry_sd = arrs
-    eff_a, eff_b = _efficiency(svm_a, ideal_a, width), _efficiency(svm_b, ideal_b, width)
-    near_svm, near_ideal = np.where(np.isnan(eff_b), svm_a, svm_b), np.where(np.isnan(eff_b), ideal_a, ideal_b)
-    rounding, mc = _table_se_log(near_svm, near_ideal, mc_lo, mc_hi, width=width, z_table=z_table)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        both = ~np.isnan(eff_a) & ~np.isnan(eff_b) & (t_a != t_b)
-        w = np.where(both, np.log(contact / t_a) / np.log(t_b / t_a), 0.0)
-        log_eff = np.where(both, (1.0 - w) * np.log(eff_a) + w * np.log(eff_b),
-                           np.where(np.isnan(eff_a), np.log(eff_b), np.log(eff_a)))
-        eff = np.maximum(np.exp(log_eff), 1.0)  # no classifier beats the ideal observer
-        # linear interpolation's error vanishes at the grid points and peaks mid-cell (shape w (1 - w));
-        # at mid-cell it is taken as half the change across the cell, as min-contact's
-        interp = np.where(both, 2.0 * w * (1.0 - w) * np.abs(np.log(eff_b / eff_a)), 0.0)
-        # two tabulated entries' scatter, weighted (1 - w) and w, averages down
-        entry = entry_sd * np.where(both, np.sqrt((1.0 - w) ** 2 + w ** 2), 1.0)
-        se = np.hypot(np.maximum(mc, entry), np.hypot(rounding, interp))
-    ok = np.isfinite(log_eff) & np.isfinite(se)
-    ideal = np.full(e.shape, np.nan)
-    if ok.any():
-        from .ideal_bound import cached_ideal_delta
+    from .ideal_bound import cached_ideal_delta
 
-        ideal[ok] = cached_ideal_delta(sensor, e[ok], contact[ok], ratio[ok], direction[ok], width=width,
-                                       threshold=threshold, e_max=e_max)
-    ok &= ~np.isnan(ideal)
+    S, L, H = (np.asarray(a, dtype=np.float64) for a in (svm, svm_lo, svm_hi))
+    m, n = S.shape[1], S.shape[2]
+    e, contact, ratio, direction, t_a, t_b = (np.broadcast_to(np.asarray(a, dtype=np.float64), (n,)) for a in (
+        e, contact_s, ratio, direction, t_a, t_b))
+    rs = np.broadcast_to(np.asarray(slice_ratios, dtype=np.float64).reshape(m, -1), (m, n))
+    ws = np.broadcast_to(np.asarray(slice_weights, dtype=np.float64).reshape(m, -1), (m, n))
+    h = 0.5 * width
+    with np.errstate(invalid="ignore", divide="ignore"):
+        u = np.where(t_a != t_b, np.log(contact / t_a) / np.log(t_b / t_a), 0.0)
+    wc = np.stack([1.0 - u, u])  # (2, n): the contacts' weights
+    needed = (wc[:, None, :] > 0) & (ws[None, :, :] > 0)
+    live = needed & np.isfinite(S) & (S > 0)
+    # the ideal observer's delta at every live entry and at the asked point: one (cached) computation
+    shape = (2, m, n)
+    cols = [np.concatenate([np.broadcast_to(a, shape)[live], b]) for a, b in (
+        (e, e), (np.stack([t_a, t_b])[:, None, :], contact), (rs[None], ratio), (direction, direction))]
+    ideal_all = cached_ideal_delta(sensor, *cols, width=width, threshold=threshold, e_max=e_max)
+    k = int(live.sum())
+    i_entry = np.full(shape, np.nan)
+    i_entry[live] = ideal_all[:k]
+    ideal = ideal_all[k:]
+    usable = live & np.isfinite(i_entry) & (i_entry > 0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        lower = np.minimum(np.maximum(i_entry, S - width), S)
+        mid = 0.5 * (lower + S)
+        rnd = (S - lower) / math.sqrt(12.0) / mid
+        le = np.log(mid / i_entry)
+        mc = np.where(np.isfinite(H) & (L > h), np.log((H - h) / (L - h)) / (2.0 * z_table),
+                      np.where(L > h, np.log((S - h) / (L - h)) / z_table, 0.0))
+        mc = np.where(np.isfinite(mc), mc, 0.0)
+        # a contact counts where all its weighted slices are usable; where only one does, it stands alone
+        ok_c = (wc > 0) & np.all(usable | ~needed, axis=1)
+        wcn = np.where(ok_c, wc, 0.0)
+        wcn = wcn / wcn.sum(axis=0)
+        wsn = ws / ws.sum(axis=0)
+        W = np.where(usable, wcn[:, None, :] * wsn[None, :, :], 0.0)
+        log_eff = np.sum(W * np.where(usable, le, 0.0), axis=(0, 1))
+        var_mc = np.sum((W * mc) ** 2, axis=(0, 1))
+        rounding = np.sum(W * np.where(usable, rnd, 0.0), axis=(0, 1))
+        per_c = np.sum(wsn[None] * np.where(usable, le, 0.0), axis=1)  # log eff at each contact
+        both = ok_c.all(axis=0)
+        interp = np.where(both, u * (1.0 - u) * np.abs(per_c[1] - per_c[0]) / 2.0, 0.0)
+        se = np.sqrt(mc_factor ** 2 * var_mc + rounding ** 2 + interp ** 2)
+        eff = np.maximum(np.exp(log_eff), 1.0)  # no classifier beats the ideal observer
+    ok = ok_c.any(axis=0) & np.isfinite(log_eff) & np.isfinite(se) & np.isfinite(ideal)
     with np.errstate(invalid="ignore"):
         value = np.where(ok, eff * ideal, np.nan)
         low = np.where(ok, np.maximum(value * np.exp(-zc * se), ideal), np.nan)
         high = np.where(ok, value * np.exp(zc * se), np.nan)
-    return {"value": value, "low": low, "high": high, "ideal": ideal, "efficiency": np.where(ok, eff, np.nan),
-            "se_log": np.where(ok, se, np.nan)}
+    return {"value": value, "low": low, "high": high, "ideal": np.where(ok, ideal, np.nan),
+            "efficiency": np.where(ok, eff, np.nan), "se_log": np.where(ok, se, np.nan)}
 
 
 # ============================================================ opening a table for a question
@@ -1415,8 +1473,8 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
         wanted = {**_scene_wanted(view, noise, dt), "contact_s": contact, "effusivity": (x,)}
         return _answer("delta-e", op, value=None, interval=(None, None), ideal=None, in_grid=flags,
                        details=_delta_details(x, {}), notes=_outside_notes(view, flags, wanted), **common)
-    # delta(e)'s bound is read from the ideal grid even where a closed form exists: its bisection over
-    # effusivity costs ~0.3 s a call, too slow for a table question (the exact route computes it)
+    # the grid's ideal delta(e) (the bound of the route without a closed form; with one, the efficiency route
+    # below computes the bound exactly and keeps this beside it as "table_ideal")
     iview, ikind, _ = (op.iview, op.ikind, None) if not op.closed else _ideal_view(view, ideal_table)
     icombos, _ = iview.scene_weights(noise, dt) if iview is not None else ([], {})
     icw, _ = _contact_weights(iview, contact) if iview is not None else ([], False)
@@ -1446,6 +1504,8 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
 
     efficiency = op.tab.fidelity == "svm" and op.closed and "delta_up_ideal" in view.t.arrays
     ends = (cw[0][0], cw[-1][0])  # the tabulated contacts around the asked one (the same where it is on one)
+    both = (_delta_efficiency_both(op, combos, ends, x, contact, noise / abs(dt), zc) if efficiency
+            else {"down": None, "up": None})
     sides = {}
     for direction, side in (("down", "lower"), ("up", "upper")):
         val = at(view, combos, cw, f"delta_{direction}")
@@ -1455,17 +1515,8 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
         ideal_side = at(iview, icombos, icw, iname)
         stated, cov_side, method = [None, None], None, "none"
         eff = None
-        if val is not None and efficiency:
-            r = delta_efficiency_estimate(
-                op.tab.sensor, x, contact, noise / abs(dt), -1.0 if direction == "down" else 1.0,
-                *(view.contacts[k] for k in ends),
-                *(view.delta_at(f"delta_{direction}", combos, k, x) for k in ends),
-                *(view.delta_at(f"delta_{direction}_ideal", combos, k, x) for k in ends),
-                math.nan if iv[0] is None else iv[0], math.nan if iv[1] is None else iv[1], width=op.width,
-                threshold=op.phi, e_max=view.e_hi, z_table=table_z(op.tab), zc=z_of_coverage(coverage),
-                entry_sd=view.entry_noise(combos))
-            if not math.isnan(float(r["value"])):
-                eff = {k: float(v) for k, v in r.items()}
+        if val is not None:
+            eff = both[direction]
         if eff is not None:  # the SVM's efficiency against the exact ideal observer (delta_efficiency_estimate)
             sides[side] = {"value": eff["value"], "interval": [eff["low"], eff["high"]], "ideal": eff["ideal"],
                            "coverage": coverage, "estimate_method": "table-efficiency", "monte_carlo_interval": iv,
@@ -1490,6 +1541,38 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
                    ideal=min(ifinite) if ifinite else None, ideal_method="closed-form" if closed else "table",
                    in_grid=flags, details=_delta_details(x, sides),
                    check_at=(contact, noise, dt), **common)
+
+
+#: The scalar route's efficiency estimates (:func:`delta_efficiency_estimate`, both directions), per process (least
+#: recently used out): a question asked again reads them from here (the estimate re-reads 24 table entries and 10
+#: cached ideal deltas, ~1 ms of numpy overhead). A pure function of the key: the table's content and the arguments.
+_DELTA_EFF: "OrderedDict[tuple, dict]" = OrderedDict()
+_DELTA_EFF_MAX = 4096
+
+
+def _delta_efficiency_both(op, combos, ends, x: float, contact: float, ratio: float,
+                           zc: float) -> dict[str, dict[str, float] | None]:
+    """Both directions' :func:`delta_efficiency_estimate` for the scalar route in one computation (the ideal
+    observer's bisections of both directions at once), cached; per direction ("down", "up") a dict, or None
+    where it does not apply."""
+    h = op.tab.header.get("content_hash")
+    key = (h, float(op.width), float(op.phi), tuple(combos), tuple(ends), x, contact, ratio, zc)
+    if h is not None and key in _DELTA_EFF:
+        _DELTA_EFF.move_to_end(key)
+        return _DELTA_EFF[key]
+    view = op.view
+    (ratios, weights, *down), (_, _, *up) = (delta_entries(view, combos, ends, d, x) for d in ("down", "up"))
+    r = delta_efficiency_estimate(
+        op.tab.sensor, np.array([x, x]), contact, ratio, np.array([-1.0, 1.0]), *(view.contacts[k] for k in ends),
+        ratios, weights, *(np.concatenate([a, b], axis=2) for a, b in zip(down, up)), width=op.width,
+        threshold=op.phi, e_max=view.e_hi, z_table=table_z(op.tab), zc=zc, mc_factor=view.mc_calibration())
+    out = {d: None if math.isnan(float(r["value"][i])) else {k: float(v[i]) for k, v in r.items()}
+           for i, d in enumerate(("down", "up"))}
+    if h is not None:  # a table without a hash: its content is not a key
+        _DELTA_EFF[key] = out
+        while len(_DELTA_EFF) > _DELTA_EFF_MAX:
+            _DELTA_EFF.popitem(last=False)
+    return out
 
 
 def _delta_details(e: float, sides: dict) -> dict[str, Any]:

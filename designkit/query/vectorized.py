@@ -609,13 +609,12 @@ def _table_delta_e(x: dict[str, np.ndarray], op, ideal_table, zc: float) -> dict
             mc_hi = at(view, combos, cw, f"delta_{direction}_hi") if svm else None
             by_eff = np.zeros(xe.size, dtype=bool)
             if efficiency:  # the scalar route's delta_efficiency_estimate where the tabulated value exists
-                sv = _delta(view, f"delta_{direction}", combos, xe)
-                iv_ = _delta(view, f"delta_{direction}_ideal", combos, xe)
                 r = _table_route.delta_efficiency_estimate(
                     op.tab.sensor, xe, contact, noise / abs(dt), -1.0 if direction == "down" else 1.0,
-                    view.contacts[ends[0]], view.contacts[ends[1]], sv[ends[0]], sv[ends[1]], iv_[ends[0]],
-                    iv_[ends[1]], mc_lo, mc_hi, width=op.width, threshold=op.phi, e_max=view.e_hi,
-                    z_table=_table_route.table_z(op.tab), zc=zc, entry_sd=view.entry_noise(combos))
+                    view.contacts[ends[0]], view.contacts[ends[1]],
+                    *_table_route.delta_entries(view, combos, ends, direction, xe), width=op.width,
+                    threshold=op.phi, e_max=view.e_hi, z_table=_table_route.table_z(op.tab), zc=zc,
+                    mc_factor=view.mc_calibration())
                 by_eff = ~np.isnan(val) & ~np.isnan(r["value"])
                 val = np.where(by_eff, r["value"], val)
                 ideal = np.where(by_eff, r["ideal"], ideal)

@@ -292,8 +292,11 @@ def _source_lines(con, d):
                  "delta_t_c": "temperature difference"}
         bad = [words.get(k, k) for k, ok in d["in_grid"].items() if not ok]
         where = "inside its grid" if not bad else "OUTSIDE its grid along " + ", ".join(bad)
-        how = ("the SVM's tabulated efficiency applied to the exact ideal observer between grid points"
-               if d["interval"].get("method") == "table-efficiency" else "interpolated")
+        eff = "the SVM's tabulated efficiency applied to the exact ideal observer between grid points"
+        how = eff if d["interval"].get("method") == "table-efficiency" else "interpolated"
+        if d["question"] == "distinguishable":  # the verdict is the contact against min-contact's answer
+            how = "the contact against min-contact's answer" + (
+                f" ({eff})" if d["computation"].get("min_contact_interval_kind") == "table-efficiency" else "")
         con.print(f"  [dim]from table {d['table']['name']} ({where}), {how}; --exact computes it for this pair[/]")
     else:
         c = d["computation"]

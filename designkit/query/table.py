@@ -18,6 +18,12 @@ The ideal bound comes from an ideal-observer table (``ideal_table``) or the
 SVM table's own ideal arrays, interpolated the same way; ``distinguishable``
 computes the ideal F1 in closed form.
 
+``distinguishable`` does not compare the need interpolated at the asked contact
+with the pair's distance (that grid-only verdict, what an export answers, is kept
+beside it: :func:`grid_answer`): its yes / no is the asked contact against
+:func:`min_contact`'s answer for the pair at the asked noise and dT, and it is
+"confident" only outside min-contact's stated interval, so the questions agree.
+
 ``min-contact``, ``max-noise`` and ``min-delta-t`` on an SVM table, where the model
 has a closed-form ideal observer, do not interpolate the SVM's need between
 tabulated points (it falls steeply there): they read the SVM's *noise
@@ -78,6 +84,8 @@ __all__ = [
     "cross2",
     "delta_e",
     "delta_e_ideal_view",
+    "GRID_KINDS",
+    "grid_answer",
     "delta_estimate",
     "distinguishable",
     "max_noise",
@@ -1614,12 +1622,25 @@ def distinguishable(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact
                     sensor_temp_spread_c: float = 0.0) -> Answer:
     """Whether ``contact_s`` separates the objects (table), with the ideal observer's F1 (closed form).
 
-    ``value`` is True or False; the SVM's F1 of the pair itself is not in a
-    table (``details["svm_f1"]`` None; the exact route computes it), so there is
-    no interval of the F1: the answer says so. ``details["verdict"]`` is
-    ``"confident"`` when ``contact_s`` lies outside the table's ``coverage``
-    interval of the shortest separating contact (:func:`min_contact`),
-    ``"uncertain"`` inside it, None where that interval is not stated.
+    ``value`` follows from the same estimate :func:`min_contact` gives for the pair at the asked noise and
+    dT (on a fixed-condition SVM table the noise-efficiency route, elsewhere the table's crossing): True iff
+    ``contact_s`` is at least that shortest separating contact, so the two questions never contradict each
+    other. ``details["verdict"]`` is ``"confident"`` when ``contact_s`` lies outside min-contact's
+    ``coverage`` interval, ``"uncertain"`` inside it (the table cannot tell; the exact route computes the
+    pair's F1), ``"uncertain"`` inside a grid cell whose interval has no stated coverage, None where no
+    interval is stated (none within the grid separates, or outside the cell). The SVM's F1 of the pair
+    itself is not in a table (``details["svm_f1"]`` None): no interval of the F1.
+
+    What the table's grid interpolation alone answers (the need ``max(delta_up(lo), delta_down(hi))``
+    interpolated at ``contact_s``, compared with the pair's distance: what ``designkit export``'s lookup
+    functions answer) is kept in ``computation["grid_verdicts"]`` (:func:`grid_answer` reads it).
+
+    Examples
+    --------
+    >>> a = distinguishable(35000, 20000, contact_s=1.45)
+    >>> m = min_contact(35000, 20000)
+    >>> a.value == (1.45 >= m.value), a.details["verdict"]
+    (True, 'confident')
     """
     coverage = check_coverage(coverage)
     contact = check_contact(contact_s)
@@ -1629,7 +1650,7 @@ def distinguishable(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact
     pq = pair_question(e1, e2, m1, m2, objects=objects, width=op.width, model=op.model)
     scene = _scene(contact, noise, dt)
     empty = {"distinguishable": None, "svm_f1": None, "svm_standard_error": None, "verdict": None,
-             "ideal_f1": None, "ideal_distinguishable": None}
+             "ideal_f1": None, "ideal_distinguishable": None, "min_contact_s": None}
     if pq.classes is None:
         return _no_pair("distinguishable", op, pq, scene, empty)
     lo, hi = pq.points
@@ -1644,33 +1665,162 @@ def distinguishable(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact
         return _answer("distinguishable", op, value=None, interval=(None, None), ideal=None, in_grid=flags,
                        details=empty, notes=_outside_notes(view, flags, wanted), **common)
 
-    def verdict(kind):
+    def grid_verdict(kind):  # the grid's need interpolated at the contact (what an export answers)
         nd = _need_at_contact(view, kind, combos, cw, lo, hi)
         return not math.isnan(nd) and nd <= hi - lo
 
-    yes = verdict("svm")
-    verdicts = (verdict("hi"), verdict("lo")) if op.tab.fidelity == "svm" else (yes, yes)
+    svm = op.tab.fidelity == "svm"
+    grid = {k: grid_verdict(k) for k in (("svm", "lo", "hi") if svm else ("svm",))}
+    if not svm:
+        grid["lo"] = grid["hi"] = grid["svm"]
     ideal_f1, ideal_method = _ideal_pair_f1(pq.classes, op, contact, noise, dt, table_spread(op.tab))
-    # how sure the verdict is: the contact against the table's interval of the shortest separating contact
-    mc = min_contact(objects=pq.classes, noise_c=noise, delta_t_c=dt, table=op.tab, ideal_table=None,
-                     sensor_temp_spread_c=sensor_temp_spread_c,
-                     coverage=coverage) if op.tab.fidelity == "svm" else None
-    sure = None
-    if mc is not None and mc.interval_coverage is not None and mc.interval[0] is not None:
-        lo_c, hi_c = mc.interval
-        sure = "uncertain" if lo_c <= contact <= (hi_c if hi_c is not None else math.inf) else "confident"
+    # the answer: the contact against min-contact's own estimate for this pair and scene
+    mc = min_contact(objects=pq.classes, noise_c=noise, delta_t_c=dt, table=op.tab, ideal_table=ideal_table,
+                     sensor_temp_spread_c=sensor_temp_spread_c, coverage=coverage)
+    t_min = mc.value
+    yes = t_min is not None and contact >= t_min
+    sure, note = _contact_verdict(contact, mc, coverage)
+    if sure == "uncertain":  # inside min-contact's interval: max-noise or delta-e may still be sure of it
+        ask = dict(table=op.tab, ideal_table=ideal_table, sensor_temp_spread_c=sensor_temp_spread_c,
+                   coverage=coverage)
+        mn = (max_noise(objects=pq.classes, contact_s=contact, delta_t_c=dt, **ask)
+              if "noise_ratio" in op.tab.axes else None)
+        de = [delta_e(e, contact_s=contact, noise_c=noise, delta_t_c=dt, **ask) for e in (lo, hi)]
+        reads = _other_readings(noise, hi - lo, None if mn is None else (mn.value, *mn.interval)
+                                if mn.interval_coverage is not None else None,
+                                [(d.details[side]["value"], *d.details[side]["interval"])
+                                 if d.details[side].get("coverage") is not None else None
+                                 for d, side in zip(de, ("upper", "lower"))])
+        said = {v for _, v, _ in reads}
+        a, b = mc.interval
+        inside = (f"{contact:g} s lies inside min-contact's interval ({t_min:.3g} s, {a:.3g} to {_fmt_or_open(b)} s)"
+                  if a is not None else f"{contact:g} s is near min-contact's {t_min:.3g} s")
+        if len(said) == 1:
+            yes, sure = said.pop(), "confident"
+            note = f"verdict confident: {' and '.join(w for _, _, w in reads)} (while {inside})"
+        elif said:
+            note += "; " + " but ".join(w for _, _, w in reads) + " (they disagree here)"
     details = {"distinguishable": yes, "svm_f1": None, "svm_standard_error": None, "verdict": sure,
-               "ideal_f1": ideal_f1, "ideal_distinguishable": ideal_f1 >= op.phi}
-    note = "no interval: a table holds delta(e), not this pair's F1 (the exact route states the F1's interval)"
-    if sure is not None:
-        note += (f"; verdict {sure}: {contact:g} s lies {'inside' if sure == 'uncertain' else 'outside'} the "
-                 f"{coverage:.0%} interval of the shortest separating contact, {mc.interval[0]:.3g} to "
-                 f"{_fmt_or_open(mc.interval[1])} s")
+               "ideal_f1": ideal_f1, "ideal_distinguishable": ideal_f1 >= op.phi, "min_contact_s": t_min}
+    notes = ["no interval: a table holds delta(e), not this pair's F1 (the exact route states the F1's interval)",
+             note]
+    if grid["svm"] != yes:
+        notes.append(f"the table's grid interpolated at {contact:g} s alone (what designkit export answers) says "
+                     f"{'yes' if grid['svm'] else 'no'}: min-contact's estimate is finer than the grid")
     return _answer("distinguishable", op, value=yes, interval=(None, None), ideal=ideal_f1,
                    ideal_method=ideal_method, in_grid=flags, details=details, check_at=(contact, noise, dt),
-                   notes=[note], interval_kind="none",
-                   computation={"monte_carlo_verdicts": list(verdicts),
-                                "min_contact_interval_s": None if mc is None else list(mc.interval)}, **common)
+                   notes=notes, interval_kind="none",
+                   computation={"grid_verdicts": grid, "monte_carlo_verdicts": [grid["hi"], grid["lo"]],
+                                "min_contact_s": t_min, "min_contact_interval_s": list(mc.interval),
+                                "min_contact_interval_kind": mc.interval_kind}, **common)
+
+
+def _other_readings(noise: float, gap: float, mn, needs) -> list[tuple[str, bool, str]]:
+    """The verdicts max-noise and delta-e are sure of, where min-contact is not: the asked ``noise`` [degC]
+    outside max-noise's interval ``mn`` = (value, low, high) (None: not stated), the pair's distance ``gap``
+    outside the interval of the need ``max(delta_up(lo), delta_down(hi))`` from ``needs`` (each direction's
+    (value, low, high) or None) [J s^-1/2 K^-1 m^-2]. Per sure answer: its name, its verdict and the words.
+
+    >>> [(q, v) for q, v, _ in _other_readings(0.05, 3000.0, (0.04, 0.035, 0.045), [None, None])]
+    [('max-noise', False)]
+    >>> [(q, v) for q, v, _ in _other_readings(0.05, 3000.0, None, [(2000.0, 1900.0, 2100.0), (2500.0, 2400.0, 2600.0)])]
+    [('delta-e', True)]
+    """
+    out = []
+    if mn is not None and mn[1] is not None and mn[2] is not None and not mn[1] <= noise <= mn[2]:
+        out.append(("max-noise", noise <= mn[0], f"the noise {noise:g} degC lies {'below' if noise < mn[1] else 'above'}"
+                    f" max-noise's interval ({mn[1]:.3g} to {mn[2]:.3g} degC)"))
+    if all(n is not None and None not in n for n in needs):
+        low, high, value = (max(n[i] for n in needs) for i in (1, 2, 0))
+        if not low <= gap <= high:
+            out.append(("delta-e", gap >= value, f"the pair's distance {gap:.4g} lies {'below' if gap < low else 'above'}"
+                        f" delta-e's interval of the need ({low:.4g} to {high:.4g} J s^-1/2 K^-1 m^-2)"))
+    return out
+
+
+def _contact_verdict(contact: float, mc: Answer, coverage: float) -> tuple[str | None, str]:
+    """How sure a yes/no on ``contact`` [s] against min-contact's answer ``mc`` is, and the note saying why."""
+    t, (a, b) = mc.value, mc.interval
+    if t is None:
+        return None, "no: no contact time within the table's grid separates them (min-contact answers none)"
+    said = f"min-contact {t:.3g} s"
+    if mc.interval_coverage is not None and a is not None:
+        inside = a <= contact <= (b if b is not None else math.inf)
+        iv = (f"the {coverage:.0%} interval of the shortest separating contact ({said}, {a:.3g} to "
+              f"{_fmt_or_open(b)} s)")
+        if inside:
+            return "uncertain", (f"verdict uncertain: {contact:g} s lies inside {iv}: the table cannot tell; "
+                                 "--exact computes this pair's F1")
+        return "confident", f"verdict confident: {contact:g} s lies {'above' if contact > t else 'below'} {iv}"
+    if mc.interval_kind == "table-cell" and a is not None and a < contact <= (b if b is not None else math.inf):
+        return "uncertain", (f"verdict uncertain: {contact:g} s lies in the grid cell ({a:.3g}, {_fmt_or_open(b)}] "
+                             f"s where the shortest separating contact is ({said}; no stated coverage there)")
+    return None, f"{contact:g} s against {said} (no interval of stated coverage there)"
+
+
+#: The kinds :func:`grid_answer` reads: the SVM's tabulated answer, its Monte Carlo ends, the grid's ideal observer.
+GRID_KINDS = ("svm", "lo", "hi", "ideal")
+
+
+def grid_answer(answer: Answer, kind: str = "svm", part: str | None = None):
+    """The table's grid interpolation alone, behind a table-route ``answer``: what ``designkit export``'s lookup
+    functions (C header, Python module; :mod:`designkit.export`) answer for the same question.
+
+    An export carries the table's arrays and interpolates them (:mod:`designkit.tables.lookup`); it cannot run
+    the exact ideal observer that the table route's estimates apply the SVM's efficiency to. This reads the
+    grid's own answer the route keeps beside its estimate: min-contact the crossing of the tabulated need
+    (``computation["table_crossing_s"]``, or the value where it was not refined), delta-e each direction's
+    tabulated delta(e) (``details[side]["table_value"]``), distinguishable the need at the contact against the
+    pair's distance (``computation["grid_verdicts"]``).
+
+    Parameters
+    ----------
+    answer : Answer
+        A table-route answer of min-contact, delta-e or distinguishable, inside the grid.
+    kind : str
+        ``"svm"`` (the tabulated answer), ``"lo"`` / ``"hi"`` (the ends of the table's Monte Carlo interval),
+        ``"ideal"`` (the grid's ideal-observer arrays; not for distinguishable).
+    part : str, optional
+        delta-e only: ``"lower"`` or ``"upper"`` (one direction); default the smaller of the two.
+
+    Returns
+    -------
+    float, bool or None
+        Seconds (min-contact), J s^-1/2 K^-1 m^-2 (delta-e), a verdict (distinguishable); None: none.
+
+    Examples
+    --------
+    >>> a = min_contact(35000, 20000)
+    >>> t = grid_answer(a)
+    >>> t >= a.value, t == a.computation["table_crossing_s"]
+    (True, True)
+    """
+    if kind not in GRID_KINDS:
+        raise InputError(f"grid answer kind must be one of {', '.join(GRID_KINDS)}, got {kind!r}")
+    comp, d = answer.computation, answer.details
+    if answer.question == "min-contact":
+        mc = comp.get("monte_carlo_interval", [None, None])
+        return {"svm": comp.get("table_crossing_s", answer.value), "lo": mc[0], "hi": mc[1],
+                "ideal": comp.get("table_ideal_s", answer.ideal_bound.value)}[kind]
+    if answer.question == "distinguishable":
+        if kind == "ideal":
+            raise InputError("the table route answers the ideal observer's F1 in closed form, not from the grid")
+        return comp["grid_verdicts"][kind]
+    if answer.question != "delta-e":
+        raise InputError(f"no grid answer kept for {answer.question}")
+    sides = {}
+    for s in ("lower", "upper"):
+        x = d[s]
+        if kind == "svm":
+            sides[s] = x.get("table_value", x["value"])
+        elif kind == "ideal":
+            sides[s] = x.get("table_ideal", x["ideal"])
+        else:
+            sides[s] = (x.get("monte_carlo_interval") or [None, None])[0 if kind == "lo" else 1]
+    if part is not None:
+        return sides[part]
+    finite = [v for v in sides.values() if v is not None]
+    return min(finite) if finite else None
 
 
 def _fmt_or_open(x) -> str:

@@ -98,7 +98,13 @@ class ArrayAnswer(QuestionQuantity):
         Table read (None on the exact route).
     details : mapping of str to ndarray
         Question-specific arrays: delta-e's ``lower`` / ``upper`` (each
-        direction's value) and ``lower_ideal`` / ``upper_ideal``.
+        direction's value), ``lower_ideal`` / ``upper_ideal`` and (table route)
+        each direction's interval ``lower_low`` / ``lower_high`` / ``upper_low`` /
+        ``upper_high``; distinguishable's
+        (table route, effusivities as numbers) ``min_contact_s`` and its interval
+        ``min_contact_low`` / ``min_contact_high``, the min-contact answer the verdict
+        compares the contact with (the low end not held to the ideal bound with
+        ``ideal_bound=False``).
     """
 
     question: str
@@ -291,7 +297,7 @@ def _nan(n: int) -> np.ndarray:
 
 # ============================================================ the table route, vectorized
 def _table_pair(question: str, x: dict[str, np.ndarray], op, ideal_bound: bool,
-                zc: float) -> dict[str, np.ndarray]:
+                zc: float, ideal_table=None) -> dict[str, np.ndarray]:
     e1, e2 = x["e1"], x["e2"]
     lo, hi = np.minimum(e1, e2), np.maximum(e1, e2)
     n = lo.size
@@ -304,7 +310,7 @@ def _table_pair(question: str, x: dict[str, np.ndarray], op, ideal_bound: bool,
     elif question in ("max-noise", "min-delta-t"):
         _ratio(question, x, op, lo, hi, e_in, res, ideal_bound, zc)
     else:
-        _distinguishable(x, op, lo, hi, e_in, res, ideal_bound)
+        _distinguishable(x, op, lo, hi, e_in, res, ideal_bound, zc, ideal_table)
     return res
 
 
@@ -379,6 +385,8 @@ def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> None
     low = np.where(cell, np.where(np.isnan(ideal), prev, np.maximum(prev, ideal)), low)
     high = np.where(cell, raw, high)
     res["value"], res["low"], res["high"] = value, low, high
+    if "stated" in res:  # (for distinguishable) where the interval has a stated coverage, as the scalar answer's
+        res["stated"] = by_eff | est
 
 
 _BELOW, _INSIDE, _ABOVE, _CELL = 0, 1, 2, 3  # where a largest separating ratio lies (the scalar route's words)
@@ -500,6 +508,8 @@ def _ratio(question, x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> 
         low[j], high[j], r_all[j] = a[j], b[j], r_k
         by_k[j] = True
     inside = (where_all == _INSIDE) & ~by_k
+    if "stated" in res:  # (for distinguishable) where the interval has a stated coverage, as the scalar answer's
+        res["stated"] = by_k | (inside if svm else False)
     if svm and inside.any():  # the scalar route's estimate (table.ratio_estimate, the same function)
         est = _table_route.ratio_estimate(r_all, alt["c"], alt["lin"], alt["rnd"], alt["geo"], ends["hi"], ends["lo"], ri,
                                           z_table=_table_route.table_z(op.tab), zc=zc)
@@ -530,19 +540,29 @@ def _ratio(question, x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> 
     res["ideal"] = np.where(answered, to_answer(ri), np.nan)
 
 
-def _distinguishable(x, op, lo, hi, e_in, res, ideal_bound: bool) -> None:
+def _distinguishable(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float, ideal_table) -> None:
     view = op.view
     todo = np.zeros(lo.size, dtype=bool)
-    for _, combos, cw, idx in _scenes_in_grid(x, view, e_in):
-        l, h = lo[idx], hi[idx]
-
-        def verdict(kind):
-            nd = _at_contact(cw, _need(view, kind, combos, l, h))
-            return (~np.isnan(nd) & (nd <= h - l)).astype(np.float64)
-
-        res["value"][idx] = verdict("svm")  # no interval: a table holds delta(e), not the pair's F1 (NaN)
+    for _, _, _, idx in _scenes_in_grid(x, view, e_in):
         res["in_grid"][idx] = True
         todo[idx] = True
+    # the scalar route's rule (table.distinguishable): the contact against min-contact's answer for the pair at
+    # its noise and dT (_min_contact, the same estimate, its interval always held to the ideal bound as the
+    # scalar's); where the contact lies inside that interval, a max-noise or delta-e answer sure of it decides
+    mc = {k: _nan(lo.size) for k in ("value", "low", "high", "ideal")}
+    mc["in_grid"], mc["stated"] = np.zeros(lo.size, dtype=bool), np.zeros(lo.size, dtype=bool)
+    if todo.any():
+        _min_contact(x, op, lo, hi, todo, mc, True, zc)
+    t, a, b, c = mc["value"], mc["low"], mc["high"], x["contact_s"]
+    with np.errstate(invalid="ignore"):
+        yes = ~np.isnan(t) & (c >= t)
+        below_high = (c <= b) | np.isnan(b)
+        unsure = todo & ~np.isnan(t) & ~np.isnan(a) & below_high & np.where(mc["stated"], a <= c, a < c)
+    if unsure.any():
+        yes = _others_decide(x, op, lo, hi, np.nonzero(unsure)[0], yes, zc, ideal_table)
+    res["value"] = np.where(todo, yes.astype(np.float64), np.nan)
+    for key, name in (("value", "min_contact_s"), ("low", "min_contact_low"), ("high", "min_contact_high")):
+        res[name] = np.where(todo, mc[key], np.nan)
     if not (ideal_bound and todo.any()):
         return
     if op.closed:
@@ -561,6 +581,39 @@ def _distinguishable(x, op, lo, hi, e_in, res, ideal_bound: bool) -> None:
                                        delta_t_c=float(x["delta_t_c"][i]))
             res["ideal"][i] = ideal_pair((lo[i], lo[i] + op.width), (hi[i], hi[i] + op.width), op.tab.sensor, scene,
                                          model=op.model).f1
+
+
+def _others_decide(x, op, lo, hi, i: np.ndarray, yes: np.ndarray, zc: float, ideal_table) -> np.ndarray:
+    """``yes`` where max-noise (the asked noise outside its stated interval) or delta-e (the pair's distance
+    outside the interval of the need ``max(delta_up(lo), delta_down(hi))``) is sure, for elements ``i`` whose
+    contact lies inside min-contact's interval; both sure and disagreeing: unchanged (the scalar route's
+    ``table._other_readings``)."""
+    n = i.size
+    noise, dt, c = x["noise_c"][i], x["delta_t_c"][i], x["contact_s"][i]
+    l, h = lo[i], hi[i]
+    sure = {}
+    if "noise_ratio" in op.tab.axes:
+        mn = {k: _nan(n) for k in ("value", "low", "high", "ideal")}
+        mn["in_grid"], mn["stated"] = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
+        _ratio("max-noise", {"contact_s": c, "delta_t_c": dt}, op, l, h, np.ones(n, dtype=bool), mn, True, zc)
+        with np.errstate(invalid="ignore"):
+            out = mn["stated"] & ~np.isnan(mn["low"]) & ~np.isnan(mn["high"]) & ~(
+                (mn["low"] <= noise) & (noise <= mn["high"]))
+            sure["max-noise"] = (out, noise <= mn["value"])
+    de = _table_delta_e({"e": np.concatenate([l, h]), "contact_s": np.tile(c, 2), "noise_c": np.tile(noise, 2),
+                         "delta_t_c": np.tile(dt, 2)}, op, ideal_table, zc)
+    parts = [(de[f"{side}"][sl], de[f"{side}_low"][sl], de[f"{side}_high"][sl])
+             for side, sl in (("upper", slice(0, n)), ("lower", slice(n, 2 * n)))]
+    with np.errstate(invalid="ignore"):
+        ok = np.all([np.isfinite(p) for part in parts for p in part], axis=0)
+        value, low, high = (np.fmax(parts[0][k], parts[1][k]) for k in range(3))
+        gap = h - l
+        sure["delta-e"] = (ok & ~((low <= gap) & (gap <= high)), gap >= value)
+    (o1, v1), (o2, v2) = sure.get("max-noise", (np.zeros(n, dtype=bool), np.zeros(n, dtype=bool))), sure["delta-e"]
+    decided = np.where(o1 & o2, np.where(v1 == v2, v1, yes[i]), np.where(o1, v1, np.where(o2, v2, yes[i])))
+    out = yes.copy()
+    out[i] = decided
+    return out
 
 
 def _table_delta_e(x: dict[str, np.ndarray], op, ideal_table, zc: float) -> dict[str, np.ndarray]:
@@ -633,7 +686,7 @@ def _table_delta_e(x: dict[str, np.ndarray], op, ideal_table, zc: float) -> dict
     # the interval of the direction giving the value (the lower one on a tie, as the scalar route)
     lower = ~np.isnan(res["lower"]) & (np.isnan(res["upper"]) | (res["lower"] <= res["upper"]))
     for end in ("low", "high"):
-        res[end] = np.where(lower, res.pop(f"lower_{end}"), res.pop(f"upper_{end}"))
+        res[end] = np.where(lower, res[f"lower_{end}"], res[f"upper_{end}"])
     return res
 
 
@@ -693,7 +746,8 @@ def answer_arrays(question: str, scalar: Callable[..., Answer], route: str, argu
         if unknown:
             raise InputError(f"{question} from a table takes no {', '.join(sorted(unknown))}")
         zc = z_of_coverage(check_coverage(others.get("coverage", 0.9)))
-        res = (_table_pair(question, flat, op, ideal_bound, zc) if pair
+        res = (_table_pair(question, flat, op, ideal_bound, zc,
+                           others.get("ideal_table", _table_route.DEFAULT_IDEAL_TABLE)) if pair
                else _table_delta_e(flat, op, others.get("ideal_table", _table_route.DEFAULT_IDEAL_TABLE), zc))
         res = {k: v.reshape(shape) for k, v in res.items()}
         table = op.tab.name
@@ -702,6 +756,8 @@ def answer_arrays(question: str, scalar: Callable[..., Answer], route: str, argu
         answers = [scalar(**others, **{k: float(v[i]) for k, v in flat.items()}) for i in range(n)]
         res = _from_answers(answers, shape, question)
         table = answers[0].table if answers else None
-    details = {k: res.pop(k) for k in ("lower", "upper", "lower_ideal", "upper_ideal") if k in res}
+    details = {k: res.pop(k) for k in ("lower", "upper", "lower_ideal", "upper_ideal", "lower_low", "lower_high",
+                                       "upper_low", "upper_high", "min_contact_s", "min_contact_low",
+                                       "min_contact_high") if k in res}
     in_grid = res.pop("in_grid")
     return ArrayAnswer(question=question, route=route, table=table, in_grid=in_grid, details=details, **res)

@@ -117,7 +117,8 @@ OPS = ("min_contact", "delta_e", "delta_e_lower", "delta_e_upper", "distinguisha
 
 
 def reference(tab, kind: str, op: str, args):
-    """designkit.query.table's answer: float, None (nothing suffices), bool, or 'outside' / 'invalid'.
+    """designkit.query.table's grid-interpolation answer (:func:`designkit.query.table.grid_answer`): float,
+    None (nothing suffices), bool, or 'outside' / 'invalid'.
 
     Asked with the table's own sensor temperature spread (an exported table answers for the conditions it
     was built with; the query route refuses a table built for another spread)."""
@@ -138,31 +139,15 @@ def reference(tab, kind: str, op: str, args):
         return "outside" if "at most 10000 degC" in str(exc) else "invalid"
     if not all(a.in_grid.values()):
         return "outside"
-    if op == "min_contact":
-        comp = a.to_dict()["computation"]  # the arrays' own answers (value/interval/ideal are refined)
-        mc = comp.get("monte_carlo_interval", [None, None])
-        svm = comp.get("table_crossing_s", a.value)  # the grid's raw crossing (the answer is bias-corrected)
-        return {"svm": svm, "lo": mc[0], "hi": mc[1], "ideal": comp.get("table_ideal_s", a.ideal)}[kind]
+    # what an export answers is the table's grid interpolation alone (the CLI refines it between grid points
+    # with the exact ideal observer, which an export cannot run): designkit.query.table.grid_answer reads it
     if op == "distinguishable":
         assert kind != "ideal", "the table route answers the ideal observer's F1 in closed form, not by delta"
-        mv = a.computation["monte_carlo_verdicts"]  # the arrays' own verdicts (the interval is the F1's)
-        return bool({"svm": a.value, "hi": mv[0], "lo": mv[1]}[kind])
-    x = a.extra
-    d = a.details  # where the answer is the efficiency estimate, the arrays' own values are kept beside it
-    if kind == "svm":
-        lower, upper = (d[s].get("table_value", x[f"delta_e_{s}"]) for s in ("lower", "upper"))
-    elif kind == "ideal":
-        lower, upper = (d[s].get("table_ideal", x[f"delta_e_{s}_ideal"]) for s in ("lower", "upper"))
-    else:
-        i = 0 if kind == "lo" else 1
-        d = a.details  # the arrays' own Monte Carlo ends (the stated interval is refined)
-        lower, upper = d["lower"]["monte_carlo_interval"][i], d["upper"]["monte_carlo_interval"][i]
-    if op == "delta_e_lower":
-        return lower
-    if op == "delta_e_upper":
-        return upper
-    finite = [v for v in (lower, upper) if v is not None]
-    return min(finite) if finite else None
+        return bool(q.grid_answer(a, kind))
+    if op == "min_contact":
+        return q.grid_answer(a, kind)
+    part = {"delta_e_lower": "lower", "delta_e_upper": "upper"}.get(op)
+    return q.grid_answer(a, kind, part)
 
 
 def _f32(x: float) -> float:

@@ -39,6 +39,11 @@ def _check_elementwise(arr: ArrayAnswer, scalar, inputs: dict, *, ideal_rtol=1e-
             for side in ("lower", "upper"):
                 assert _same(float(arr.details[side][idx]), _num(one.details[side]["value"]), 1e-12), where
                 assert _same(float(arr.details[f"{side}_ideal"][idx]), _num(one.details[side]["ideal"]), 1e-12)
+                if f"{side}_low" in arr.details:  # each direction's interval (table route)
+                    for end, got in zip(("low", "high"), one.details[side]["interval"]):
+                        assert _same(float(arr.details[f"{side}_{end}"][idx]), _num(got), 1e-12), where
+        if one.question == "distinguishable" and "min_contact_s" in arr.details:  # the answer it compared with
+            assert _same(float(arr.details["min_contact_s"][idx]), _num(one.details["min_contact_s"]), 1e-12), where
 
 
 RNG = np.random.default_rng(16)
@@ -77,7 +82,8 @@ def test_distinguishable_and_delta_e_equal_scalar_calls():
     # the vectorized ideal F1 is the closed form of ideal_bound (agrees with scipy's route to 1e-9)
     _check_elementwise(a, distinguishable, {"e1": e1, "e2": e2, "contact_s": contact}, ideal_rtol=1e-8)
     d = delta_e(E1, contact_s=np.array([[1.0], [3.3]]), noise_c=0.05)
-    assert d.shape == (2, 9) and set(d.details) == {"lower", "upper", "lower_ideal", "upper_ideal"}
+    assert d.shape == (2, 9) and set(d.details) == {"lower", "upper", "lower_ideal", "upper_ideal", "lower_low",
+                                                    "lower_high", "upper_low", "upper_high"}
     _check_elementwise(d, delta_e, {"e": E1, "contact_s": np.array([[1.0], [3.3]]), "noise_c": 0.05})
 
 

@@ -1650,7 +1650,7 @@ def distinguishable(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact
     pq = pair_question(e1, e2, m1, m2, objects=objects, width=op.width, model=op.model)
     scene = _scene(contact, noise, dt)
     empty = {"distinguishable": None, "svm_f1": None, "svm_standard_error": None, "verdict": None,
-             "ideal_f1": None, "ideal_distinguishable": None, "min_contact_s": None}
+             "ideal_f1": None, "ideal_distinguishable": None}
     if pq.classes is None:
         return _no_pair("distinguishable", op, pq, scene, empty)
     lo, hi = pq.points
@@ -1701,7 +1701,7 @@ def distinguishable(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact
         elif said:
             note += "; " + " but ".join(w for _, _, w in reads) + " (they disagree here)"
     details = {"distinguishable": yes, "svm_f1": None, "svm_standard_error": None, "verdict": sure,
-               "ideal_f1": ideal_f1, "ideal_distinguishable": ideal_f1 >= op.phi, "min_contact_s": t_min}
+               "ideal_f1": ideal_f1, "ideal_distinguishable": ideal_f1 >= op.phi}
     notes = ["no interval: a table holds delta(e), not this pair's F1 (the exact route states the F1's interval)",
              note]
     if grid["svm"] != yes:

@@ -32,7 +32,7 @@ import math
 import numpy as np
 
 from ...tables.lookup import GRID_RTOL
-from .._common import (c_comment, c_double, c_string, check_prefix, fill_template, log_grid, read_template,
+from .._common import (CLI_RELATION, c_comment, c_double, c_string, check_prefix, fill_template, log_grid, read_template,
                        regenerate_command, slice_lines)
 from ..slicing import Exported
 
@@ -114,6 +114,7 @@ def write(exp: Exported, prefix: str = "designkit") -> bytes:
         "SCENE_UNDEFS": "\n".join(undefs),
         "SCENE_WORDS": "sigma and linearly in dT" if varied else "sigma/dT",
         "SLICE": "\n".join(" * " + c_comment(line) for line in slice_lines(exp)),
+        "RELATION": "\n".join(" *   " + c_comment(line) for line in CLI_RELATION),
         "COMMAND": c_comment(regenerate_command(exp, "c", prefix)),
         "VERSION": c_comment(p["designkit_version"]), "TABLE": c_comment(p["source_table"]),
         "HASH": c_comment(p["source_content_hash"]), "CREATED": c_comment(p["source_created"]),

@@ -31,7 +31,7 @@ from importlib import resources
 
 import numpy as np
 
-from .._common import fill_template, log_grid, printable, py_docstring, py_literal, read_template, \
+from .._common import CLI_RELATION, fill_template, log_grid, printable, py_docstring, py_literal, read_template, \
     regenerate_command, slice_lines
 from ..slicing import Exported
 
@@ -69,8 +69,8 @@ def _docstring(exp: Exported) -> str:
         f"Export hash: {p['export_hash']}",
         *slice_lines(exp),
         "",
-        "Functions (the interpolation and decision rule of designkit.query, in the code of",
-        "designkit.tables.lookup carried below):",
+        "Functions (the interpolation and decision rule of designkit.query's table, in the code",
+        "of designkit.tables.lookup carried below):",
         "",
         "    delta_e(e, noise_c, delta_t_c, contact_s)        -> float or None",
         "    delta_e_lower(...), delta_e_upper(...)          -> float or None",
@@ -86,6 +86,8 @@ def _docstring(exp: Exported) -> str:
         "invalid input (NaN, infinite, e <= 0, noise < 0, dT == 0, contact <= 0, e1 == e2)",
         "raises ValueError. Two effusivities lo < hi are distinguishable when",
         "hi - lo >= max(delta_up(lo), delta_down(hi)).",
+        "",
+        *CLI_RELATION,
     ]
     return py_docstring("\n".join(printable(line) for line in lines))
 

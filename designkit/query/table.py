@@ -94,6 +94,7 @@ __all__ = [
     "noise_k_max_ratio",
     "noise_k_min_contact",
     "open_table",
+    "partner_in_grid",
     "ratio_estimate",
     "stated_log",
     "shipped_spread_table",
@@ -1522,9 +1523,9 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
         iname = f"delta_{direction}_ideal" if ikind == "ideal" else f"delta_{direction}"
         ideal_side = at(iview, icombos, icw, iname)
         stated, cov_side, method = [None, None], None, "none"
-        eff = None
-        if val is not None:
-            eff = both[direction]
+        eff = both[direction]
+        if eff is not None and val is None and not partner_in_grid(view, x, eff["value"], direction):
+            eff = None
         if eff is not None:  # the SVM's efficiency against the exact ideal observer (delta_efficiency_estimate)
             sides[side] = {"value": eff["value"], "interval": [eff["low"], eff["high"]], "ideal": eff["ideal"],
                            "coverage": coverage, "estimate_method": "table-efficiency", "monte_carlo_interval": iv,
@@ -1549,6 +1550,23 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
                    ideal=min(ifinite) if ifinite else None, ideal_method="closed-form" if closed else "table",
                    in_grid=flags, details=_delta_details(x, sides),
                    check_at=(contact, noise, dt), **common)
+
+
+def partner_in_grid(view: _View, e, delta, direction: str):
+    """Whether ``e`` moved by ``delta`` towards ``direction`` ("up" / "down") stays inside the table's effusivity
+    range, elementwise. Where the tabulated delta(e) is beyond the grid at one of the two contacts around the
+    asked one (the interpolated value is then none), the efficiency estimate from the other contact answers
+    only where its partner lies inside the range (at 1.3 s upwards from 20000 on svm-paper: none within the
+    grid at 1 s, 8680 at 1.5 s; min-contact says 35000 separates from 1.22 s).
+
+    >>> from designkit.query.table import open_table
+    >>> v = open_table("svm-paper").view
+    >>> partner_in_grid(v, 20000.0, 9000.0, "up"), partner_in_grid(v, 35000.0, 9000.0, "up")
+    (True, False)
+    """
+    with np.errstate(invalid="ignore"):
+        out = e + delta <= view.e_hi if direction == "up" else e - delta > view.e_lo
+    return bool(out) if np.ndim(out) == 0 else out
 
 
 #: The scalar route's efficiency estimates (:func:`delta_efficiency_estimate`, both directions), per process (least
@@ -1628,8 +1646,14 @@ def distinguishable(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact
     other. ``details["verdict"]`` is ``"confident"`` when ``contact_s`` lies outside min-contact's
     ``coverage`` interval, ``"uncertain"`` inside it (the table cannot tell; the exact route computes the
     pair's F1), ``"uncertain"`` inside a grid cell whose interval has no stated coverage, None where no
-    interval is stated (none within the grid separates, or outside the cell). The SVM's F1 of the pair
-    itself is not in a table (``details["svm_f1"]`` None): no interval of the F1.
+    interval is stated (none within the grid separates, or outside the cell). Where the contact lies
+    inside min-contact's interval but :func:`max_noise` (the asked noise outside its interval) or
+    :func:`delta_e` (the pair's distance outside the interval of the need ``max(delta_up(lo),
+    delta_down(hi))``) is sure, that answer decides and the verdict is ``"confident"`` (both sure and
+    disagreeing: min-contact's, ``"uncertain"``, the note says so); so ``value`` never contradicts any of
+    the three where the asked point lies outside its interval (tests/test_table_agreement.py). The SVM's
+    F1 of the pair itself is not in a table (``details["svm_f1"]`` None): no interval of the F1.
+    ``computation["min_contact_s"]`` / ``["min_contact_interval_s"]`` hold the answer compared with.
 
     What the table's grid interpolation alone answers (the need ``max(delta_up(lo), delta_down(hi))``
     interpolated at ``contact_s``, compared with the pair's distance: what ``designkit export``'s lookup

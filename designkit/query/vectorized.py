@@ -668,7 +668,10 @@ def _table_delta_e(x: dict[str, np.ndarray], op, ideal_table, zc: float) -> dict
                     *_table_route.delta_entries(view, combos, ends, direction, xe), width=op.width,
                     threshold=op.phi, e_max=view.e_hi, z_table=_table_route.table_z(op.tab), zc=zc,
                     mc_factor=view.mc_calibration())
-                by_eff = ~np.isnan(val) & ~np.isnan(r["value"])
+                # where the tabulated value is none (beyond the grid at one of the two contacts), the estimate
+                # from the other contact, when its partner lies inside the range (table.partner_in_grid)
+                by_eff = ~np.isnan(r["value"]) & (~np.isnan(val) | _table_route.partner_in_grid(
+                    view, xe, r["value"], direction))
                 val = np.where(by_eff, r["value"], val)
                 ideal = np.where(by_eff, r["ideal"], ideal)
             res[side][idx], res[f"{side}_ideal"][idx] = val, ideal

@@ -475,7 +475,7 @@ def _fit_rows(result) -> list[dict[str, Any]]:
 def _run_identify(index: Path, model: str, fit_sets: str, ranges: list[str], only: Optional[list[str]],
                   object_temps: list[str], depth_um: float, out: Optional[Path], json_: bool,
                   touch_conductance: Optional[str] = None, name: Optional[str] = None,
-                  force: bool = False, rows_fmt: Optional[str] = None) -> None:
+                  force: bool = False, rows_fmt: Optional[str] = None, plot: Optional[Path] = None) -> None:
     """``calibrate fit --model``: identify one model or compare them all on held-out touches."""
     from rich.markup import escape
     from rich.table import Table
@@ -518,6 +518,10 @@ def _run_identify(index: Path, model: str, fit_sets: str, ranges: list[str], onl
         cmp = compare_models(fit, held, cands, **kw)   # no held-out touches: selected by BIC
     results, scores, selected = cmp.results, cmp.held_out_rms_c, cmp.selected
     best = next(r for r in results if r.candidate.label == selected)
+    if plot is not None:  # before the sensor file: a refused fit is worth seeing too
+        from ..calibration.identify import plot_identification
+
+        plot_identification(results, selected, fit, held, plot, held_out_rms_c=scores, object_temps=temps)
     if out is not None:
         _write_identified(best, trials, out, name, index, force, names)
     if rows_fmt is not None:  # the selected model's parameters (the comparison stays in the report and --json)
@@ -534,7 +538,7 @@ def _run_identify(index: Path, model: str, fit_sets: str, ranges: list[str], onl
         return
     if json_:
         emit_json({"index": str(index), "n_fit": len(fit), "n_held_out": len(held), "selected": selected,
-                   "out": str(out) if out is not None else None,
+                   "out": str(out) if out is not None else None, "plot": str(plot) if plot is not None else None,
                    "results": [dict(r.to_dict(), held_out_rms_c=dict(sc)) for r, sc in zip(results, scores)]})
         return
     con = console()
@@ -565,6 +569,8 @@ def _run_identify(index: Path, model: str, fit_sets: str, ranges: list[str], onl
         con.print(f"[yellow]note:[/] {escape(note)}")
     if out is not None:
         con.print(f"wrote {out} with the {selected} model  (use it with --sensor {out})")
+    if plot is not None:
+        con.print(f"wrote {plot}")
 
 
 # ------------------------------------------------------------------ record
@@ -665,7 +671,8 @@ def fit(
     only_list = [s.strip() for item in only for s in item.split(",") if s.strip()] if only else None
     if model is not None:
         _run_identify(index, model, fit_sets, range_ or [], only_list, object_temp or [], depth_um, out,
-                      fmt == "json", touch_conductance, name=name, force=force, rows_fmt=fmt if rows_only else None)
+                      fmt == "json", touch_conductance, name=name, force=force, rows_fmt=fmt if rows_only else None,
+                      plot=plot)
         return
     result = _run_fit(index, range_ or [], only_list, object_temp or [], settings, out, name, plot,
                       quiet=fmt != "table", force=force)

@@ -41,3 +41,93 @@ def test_a_refused_model_fit_still_writes_its_plot(cli, tmp_path):
     assert r.exit_code == 2 and "not written" in r.stderr
     assert not out.exists()
     _png_size(plot)
+
+
+# ------------------------------------ emulate and the guided run agree on the protocol
+def _labels_against_truth(emu, index) -> list[tuple[str, str]]:
+    """(label the recording gave, material the emulator touched) for each recorded trial, in order."""
+    from designkit.calibration.trials import load_index
+
+    out = []
+    for tr in load_index(index):
+        onset = tr.meta["onset_device_time_s"]
+        j = min(range(200), key=lambda k: abs(emu.touch(k).expected_onset_s - onset))
+        out.append((tr.material, emu.touch(j).material))
+    return out
+
+
+def _two_materials(per_material: int, seed: int = 0):
+    from designkit import SENSORS
+    from designkit.calibration.emulator import EmulatedMaterial, Emulator, TouchPlan
+    from designkit.calibration.profiles import load_profile
+
+    return Emulator(load_profile("designkit"), SENSORS["paper"],
+                    [EmulatedMaterial("metal", 17530.0), EmulatedMaterial("wood", 400.0)], noise_c=0.05,
+                    plan=TouchPlan(touch_every_s=13.0, touches_per_material=per_material), speed=100.0, seed=seed)
+
+
+def test_guided_run_records_what_the_emulator_touches(cli, tmp_path):
+    out = tmp_path / "run"
+    with _two_materials(2) as emu:
+        r = cli("calibrate", "--port", emu.port, "--material", "metal", "--material", "wood", "--trials", "2",
+                *RANGES, "--out", out, "--bootstrap", "0", "--yes", "--json")
+        assert r.exit_code == 0, r.output
+        pairs = _labels_against_truth(emu, out / "index.csv")
+    assert [a for a, _ in pairs] == ["metal", "metal", "wood", "wood"]
+    assert all(a == b for a, b in pairs), pairs
+
+
+def test_guided_run_refuses_an_emulator_that_alternates(cli, tmp_path):
+    """The old default: the emulator alternated while the guided run recorded all of metal first."""
+    out = tmp_path / "run"
+    with _two_materials(1) as emu:
+        r = cli("calibrate", "--port", emu.port, "--material", "metal", "--material", "wood", "--trials", "2",
+                *RANGES, "--out", out, "--bootstrap", "0", "--yes")
+    assert r.exit_code == 2
+    errors = [ln for ln in r.stderr.strip().splitlines() if ln.startswith("Error:")]
+    assert len(errors) == 1 and errors[0].startswith("Error: the emulator touches metal, wood, metal, wood in turn")
+    assert "--touches-per-material 2" in errors[0] and r.stderr.strip().endswith(errors[0])
+    assert not (out / "index.csv").exists()
+
+
+def test_emulate_and_guided_defaults_agree(cli):
+    from designkit.cli import calibrate as cal
+
+    r = cli("emulate", "--help")
+    assert r.exit_code == 0
+    import inspect
+
+    emulate_default = inspect.signature(cal.emulate).parameters["touches_per_material"].default
+    guided_default = inspect.signature(cal.guided).parameters["trials"].default
+    assert emulate_default == guided_default == cal.DEFAULT_TRIALS
+
+
+@pytest.mark.slow
+def test_the_emulators_hint_pastes_into_a_shell_and_labels_right(cli, tmp_path, ctrl_c_able):
+    """A material name with a space: the printed command is quoted, and running it records right."""
+    import signal
+    import subprocess
+
+    from test_calibration_cli import _exe, _read_json_object
+
+    proc = subprocess.Popen(_exe() + ["emulate", "--material", "Aluminium alloys", "--material", "wood",
+                                      "--touches-per-material", "2", "--touch-every", "13", "--speed", "50",
+                                      "--duration", "60", "--json"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, **ctrl_c_able)
+    try:
+        info = _read_json_object(proc.stdout)
+        args = shlex.split(info["try"])
+        assert args[:2] == ["designkit", "calibrate"]
+        assert args[args.index("--material") + 1] == "Aluminium alloys"
+        assert args[args.index("--trials") + 1] == "2" and "--yes" in args
+        args[args.index("--out") + 1] = str(tmp_path / "trials")
+        r = cli(*args[1:], "--bootstrap", "0", "--json", "--force")
+        assert r.exit_code == 0, r.output
+        labels = [json.loads((tmp_path / "trials" / p).with_suffix(".json").read_text())["material"]
+                  for p in json.loads(r.stdout)["record"]["trials"]]
+    finally:
+        proc.send_signal(signal.SIGINT)
+        proc.communicate(timeout=20)
+    played = [m["label"] for m in info["materials"]]    # database names as the database spells them
+    assert played[0] == "Aluminium alloys" and played[1].lower() == "wood"
+    assert labels == [played[0]] * 2 + [played[1]] * 2

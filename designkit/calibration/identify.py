@@ -1725,7 +1725,7 @@ def plot_identification(results: Sequence[Identification], selected: str, fit_tr
             axes[1].plot(th, rh, color=f"C{k}", lw=1.0, ls=":", label=f"{n}, held-out touches")
     axes[0].set_xlabel("time after detected onset [s]")
     axes[0].set_ylabel("sensor temperature [°C]")
-    axes[0].set_title(f"selected {selected}: reading (solid) and model (dashed)", fontsize=9)
+    axes[0].set_title("reading (solid) and the selected model (dashed)", fontsize=9)
     axes[0].legend(fontsize=7)
     axes[1].axhline(0, color="k", lw=0.5)
     axes[1].set_xlabel("time after detected onset [s]")

@@ -32,6 +32,9 @@ PortOpt = Annotated[Optional[str], typer.Option(
 ProfileOpt = Annotated[str, typer.Option(
     "--profile", help="Device profile: a shipped name ('designkit', 'adc12-thermistor') or a profile YAML file.")]
 TrialsOpt = Annotated[int, typer.Option("--trials", help="Touches to record per material (at most 1000).")]
+#: Touches per material the guided run records and the emulator plays by default: the same, so that
+#: 'designkit emulate' with two materials and the guided run agree on which touch is which.
+DEFAULT_TRIALS = 10
 TimeoutOpt = Annotated[Optional[float], typer.Option(
     "--timeout", help="Give up when the device sends nothing for this long [s] (default: the profile's).")]
 RangeOpt = Annotated[Optional[list[str]], typer.Option(
@@ -215,6 +218,42 @@ class _CommentWatch:
                   "make the rig send its messages with a different prefix")
 
 
+def _check_emulator_plan(message: str, materials: list[str], trials: int, port: str) -> None:
+    """Refuse, before its first trial, a run whose labels an emulator's announced touch plan contradicts."""
+    from ..calibration.emulator import parse_greeting
+
+    plan = parse_greeting(message)
+    if plan is None:
+        return
+    why = plan.mislabels(materials, trials)
+    if why is None:
+        return
+    from .._validation import InputError
+
+    n = plan.touches_per_material
+    fix = _guided_command(port, None, list(plan.labels), n)
+    raise InputError(
+        f"{why}: every trial would get a wrong label, so none is recorded. Record what the emulator plays "
+        f"(e.g. '{fix}'), or restart it with its --material options in the order of this run's and "
+        f"--touches-per-material {trials}")
+
+
+def _guided_command(port: str, profile: Optional[str], materials: list[str], trials: int,
+                    ranges: Optional[list[str]] = None) -> str:
+    """A guided ``designkit calibrate`` command line a shell reads back as these arguments."""
+    import shlex
+
+    args = ["designkit", "calibrate", "--port", port]
+    if profile is not None:
+        args += ["--profile", profile]
+    for m in materials:
+        args += ["--material", m]
+    for r in ranges or []:
+        args += ["--range", r]
+    args += ["--trials", str(trials), "--out", "trials/", "--yes"]
+    return shlex.join(args)
+
+
 def _record_materials(port: str, profile, out: Path, materials: list[str], trials: int, timeout: Optional[float],
                       quiet: bool, prompt: bool):
     """Record each material in turn on one open connection; returns (recorder, paths, interrupted).
@@ -239,6 +278,8 @@ def _record_materials(port: str, profile, out: Path, materials: list[str], trial
         if not (e.kind == "device" and comments.n >= 3 and rec.status.lines_ok == 0):
             display.event(e)  # a stream of nothing but messages: show the first few, then the verdict
         comments(e, rec.status.lines_ok)
+        if e.kind == "device":
+            _check_emulator_plan(e.message, materials, trials, port)
 
     rec = SerialRecorder(port, profile, out, no_data_timeout_s=timeout, on_event=on_event,
                          on_status=on_status)
@@ -579,7 +620,7 @@ def record(
     port: PortOpt = None,
     profile: ProfileOpt = "designkit",
     material: Annotated[Optional[str], typer.Option("--material", help="Label of the material being touched.")] = None,
-    trials: TrialsOpt = 10,
+    trials: TrialsOpt = DEFAULT_TRIALS,
     out: Annotated[Optional[Path], typer.Option("--out", help="Folder for the trials (CSV + JSON each, index.csv).")] = None,
     timeout: TimeoutOpt = None,
     json_: Json = False,
@@ -695,7 +736,7 @@ def guided(
     profile: ProfileOpt = "designkit",
     material: Annotated[Optional[list[str]], typer.Option(
         "--material", help="A material to touch (repeatable; recorded in this order).")] = None,
-    trials: TrialsOpt = 10,
+    trials: TrialsOpt = DEFAULT_TRIALS,
     out: Annotated[Optional[Path], typer.Option("--out", help="Folder for the trials.")] = None,
     sensor_out: Annotated[Optional[Path], typer.Option(
         "--sensor-out", help="Sensor YAML to write (default: OUT/sensor.yaml).")] = None,
@@ -713,6 +754,12 @@ def guided(
     json_: Json = False,
 ) -> None:
     """Guided calibration: record every material over serial, then fit and write the sensor file.
+
+    Records --trials touches of the first --material, then of the next, and so on. Against
+    'designkit emulate': it touches each of its materials --touches-per-material times (default 10,
+    as --trials here) in the order given, starting when the port is opened; give the same materials
+    in the same order and --yes (the emulator does not wait for Enter). The command it prints after
+    'try:' does this; a run whose labels its plan contradicts stops before recording.
 
     Example: `designkit calibrate --port /dev/pts/5 --material wood --material metal --out trials/ --yes`
     """
@@ -764,6 +811,23 @@ def guided(
 
 
 # ----------------------------------------------------------------- emulate
+def _hint_ranges(mats) -> list[str]:
+    """--range options the guided run needs for emulated materials the materials database does not know.
+
+    The emulator knows their effusivity exactly; the hint gives it +-10 %, as an effusivity meter would.
+    """
+    from .._validation import InputError
+    from ..materials import get_material
+
+    out = []
+    for m in mats:
+        try:
+            get_material(m.label)
+        except InputError:
+            out.append(f"{m.label}={0.9 * m.effusivity:.4g}:{1.1 * m.effusivity:.4g}")
+    return out
+
+
 @app.command(rich_help_panel=_app.SENSOR)
 def emulate(
     profile: ProfileOpt = "designkit",
@@ -773,7 +837,8 @@ def emulate(
     e: Annotated[Optional[float], typer.Option("--e", help="Effusivity of the object [J s^-1/2 K^-1 m^-2].")] = None,
     touch_every: Annotated[float, typer.Option("--touch-every", help="Seconds (device time) between touches.")] = 20.0,
     touches_per_material: Annotated[int, typer.Option(
-        "--touches-per-material", help="Touches of each material before the next one.")] = 1,
+        "--touches-per-material", help="Touches of each material before the next one (as the guided "
+                                       "'calibrate --trials' records them).")] = DEFAULT_TRIALS,
     noise: Noise = 0.05,
     sensor: SensorOpt = "paper",
     sensor_temp: Annotated[float, typer.Option("--sensor-temp", help="Heater set point [°C].")] = 35.0,
@@ -828,7 +893,10 @@ def emulate(
                    plan=TouchPlan(touch_every_s=touch_every, touches_per_material=touches_per_material),
                    speed=speed, faults=Faults.parse(fault or []), seed=seed, model=fm)
     port = emu.start()
+    try_cmd = _guided_command(port, profile, [m.label for m in mats], touches_per_material,
+                              _hint_ranges(mats))
     info = {"port": port, "profile": prof.name, "speed": speed, "touch_every_s": touch_every,
+            "touches_per_material": touches_per_material, "try": try_cmd,
             "materials": [{"label": m.label, "effusivity": m.effusivity} for m in mats],
             "noise_c": noise, "sensor": emu.sensor.to_dict(), "model": fm.to_dict(),
             "time_offset_s": emu.expected_time_offset_s,
@@ -836,21 +904,21 @@ def emulate(
     if json_:
         emit_json(info)
     else:
+        from rich.markup import escape
+
         con = console()
         con.print(f"Emulating a '{prof.name}' rig on [bold]{port}[/]  (speed {speed:g}x; Ctrl-C to stop)")
         con.print("  touching " + ", ".join(f"{m.label} (e = {m.effusivity:g})" for m in mats)
                   + f" every {touch_every:g} s; noise {noise:g} °C; sensor e_s = {emu.sensor.effusivity:g}, "
                     f"tau = {emu.sensor.tau_s:.3f} s")
         if fm.name != "semi-infinite":
-            from rich.markup import escape
-
             played = fm.describe() if fm.name != "force-ramp" else (
                 f"{fm.base.describe()} with the contact area following the emulator's force ramp "
                 f"({emu.plan.ramp_s:g} s) at c = {emu.plan.contact_force_fraction:.3g}")
             con.print(escape(f"  model {played} (recorded in sensor file {emu.sensor.name}; the wire "
                              "carries the raw reading: any host smoothing is the host's)"))
-        con.print(f"  try: designkit calibrate record --port {port} --profile {profile} "
-                  f"--material {mats[0].label} --out trials/")
+        con.print(f"  touches {touches_per_material} of each material in turn, from when a program opens the port")
+        con.print(f"  try: {escape(try_cmd)}", soft_wrap=True)
         sys.stdout.flush()
     start = time.monotonic()
     announced = -1

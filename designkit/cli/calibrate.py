@@ -20,12 +20,22 @@ from ._app import EXIT_INTERRUPTED, app, console, emit_json, sub_app
 from . import _app
 from ._options import Json, Noise, Seed, SensorOpt, sensor_and_model
 
-calibrate_app = sub_app(
-    "calibrate",
-    "Calibrate your sensor: record touches over serial ('record'), identify e_s and alpha_s ('fit'), "
-    "or both in one guided run ('designkit calibrate --port PORT --material NAME ...').",
-    panel=_app.SENSOR,
-)
+#: ``designkit calibrate --help``: the group's and the guided run's (the group's callback) help in one,
+#: since typer shows the group's text, not the callback's docstring.
+_CALIBRATE_HELP = """Calibrate your sensor: record touches over serial ('record'), identify e_s and alpha_s ('fit'), \
+or both in one guided run (the options below).
+
+The guided run records --trials touches of the first --material, then of the next, and so on, then fits \
+and writes the sensor file. Against 'designkit emulate': it touches each of its materials \
+--touches-per-material times (default 10, as --trials here) in the order given, starting when the port \
+is opened; give the same materials in the same order and --yes (the emulator does not wait for Enter). \
+The command it prints after 'try:' does this; a run whose labels its plan contradicts stops before \
+recording.
+
+Example: `designkit calibrate --port /dev/pts/5 --material wood --material metal --out trials/ --yes`
+"""
+
+calibrate_app = sub_app("calibrate", _CALIBRATE_HELP, panel=_app.SENSOR)
 
 PortOpt = Annotated[Optional[str], typer.Option(
     "--port", help="Serial port of the rig (/dev/ttyACM0, COM3, or the pty 'designkit emulate' prints).")]
@@ -755,13 +765,7 @@ def guided(
 ) -> None:
     """Guided calibration: record every material over serial, then fit and write the sensor file.
 
-    Records --trials touches of the first --material, then of the next, and so on. Against
-    'designkit emulate': it touches each of its materials --touches-per-material times (default 10,
-    as --trials here) in the order given, starting when the port is opened; give the same materials
-    in the same order and --yes (the emulator does not wait for Enter). The command it prints after
-    'try:' does this; a run whose labels its plan contradicts stops before recording.
-
-    Example: `designkit calibrate --port /dev/pts/5 --material wood --material metal --out trials/ --yes`
+    Its ``--help`` text is :data:`_CALIBRATE_HELP` (the group's).
     """
     from .._validation import InputError
 

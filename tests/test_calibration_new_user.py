@@ -44,14 +44,14 @@ def test_a_refused_model_fit_still_writes_its_plot(cli, tmp_path):
 
 
 # ------------------------------------ emulate and the guided run agree on the protocol
-def _two_materials(per_material: int, seed: int = 0):
+def _two_materials(per_material: int, seed: int = 0, speed: float = 100.0):
     from designkit import SENSORS
     from designkit.calibration.emulator import EmulatedMaterial, Emulator, TouchPlan
     from designkit.calibration.profiles import load_profile
 
     return Emulator(load_profile("designkit"), SENSORS["paper"],
                     [EmulatedMaterial("metal", 17530.0), EmulatedMaterial("wood", 400.0)], noise_c=0.05,
-                    plan=TouchPlan(touch_every_s=13.0, touches_per_material=per_material), speed=100.0, seed=seed)
+                    plan=TouchPlan(touch_every_s=13.0, touches_per_material=per_material), speed=speed, seed=seed)
 
 
 def test_guided_run_refuses_an_emulator_that_alternates(cli, tmp_path):
@@ -108,3 +108,51 @@ def test_the_emulators_hint_pastes_into_a_shell_and_labels_right(cli, tmp_path, 
     played = [m["label"] for m in info["materials"]]    # database names as the database spells them
     assert played[0] == "Aluminium alloys" and played[1].lower() == "wood"
     assert labels == [played[0]] * 2 + [played[1]] * 2
+
+
+def test_a_run_out_of_step_with_the_emulator_stops_before_a_wrong_label(cli, tmp_path):
+    """Another program read the emulator's first line and touch 1 (as a run waiting for Enter loses
+    touches): the run sees no plan, but each touch is announced as it starts, and touch 3 (wood)
+    stops a run that records metal before it is written."""
+    import serial
+
+    out = tmp_path / "run"
+    with _two_materials(2, speed=20.0) as emu:
+        with serial.Serial(emu.port, timeout=0.05) as first:
+            seen = b""
+            while b'touch 1 of "metal" starts' not in seen:
+                seen += first.read(4096)
+        r = cli("calibrate", "record", "--port", emu.port, "--material", "metal", "--trials", "2", "--out", out)
+    assert r.exit_code == 2
+    errors = [ln for ln in r.stderr.strip().splitlines() if ln.startswith("Error:")]
+    assert len(errors) == 1 and errors[0].startswith(
+        f"Error: the emulator on {emu.port} starts touch 3 with wood while this run records metal (this run's "
+        "touches of metal so far were metal)"), r.stderr
+    assert "1 trial(s) kept" in errors[0]
+    from designkit.calibration.trials import load_index
+
+    assert [tr.material for tr in load_index(out / "index.csv")] == ["metal"]
+
+
+@pytest.mark.parametrize("materials, trials, touches, expect", [
+    (["metal", "wood"], 2, ["metal", "metal", "wood", "wood"], None),
+    (["a", "b"], 2, ["metal", "metal", "wood", "wood"], None),            # any names, one per material
+    (["metal", "wood"], 2, ["metal", "wood"], "while this run records metal (this run's touches of metal so far"),
+    (["a", "b"], 1, ["metal", "metal"], "while this run records b (this run recorded metal as a)"),
+])
+def test_each_announced_touch_is_checked_against_the_label(tmp_path, materials, trials, touches, expect):
+    from designkit._validation import InputError
+    from designkit.cli.calibrate import _EmulatorWatch
+
+    watch = _EmulatorWatch(materials, trials, "/dev/pts/9", tmp_path)   # its first line not seen: no plan
+    recording = [m for m in materials for _ in range(trials)]
+    try:
+        for j, (label, ours) in enumerate(zip(touches, recording)):
+            watch(f'# designkit emulator: touch {j + 1} of "{label}" starts', ours)
+        got = None
+    except InputError as exc:
+        got = str(exc)
+    if expect is None:
+        assert got is None
+    else:
+        assert got is not None and expect in got and "--yes" in got

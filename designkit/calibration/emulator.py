@@ -50,7 +50,8 @@ from ..models.semi_infinite import object_weight, response_shape
 from ..sensor import Sensor
 from .profiles import DeviceProfile, Linear, Thermistor
 
-__all__ = ["AnnouncedPlan", "EmulatedMaterial", "Emulator", "Faults", "TouchPlan", "TouchRecord", "parse_greeting"]
+__all__ = ["AnnouncedPlan", "EmulatedMaterial", "Emulator", "Faults", "TouchPlan", "TouchRecord", "parse_announcement",
+           "parse_greeting"]
 
 _MAX_PENDING = 1 << 16
 #: Real seconds between a client opening the port and the first sample (a rig's reset on open).
@@ -249,6 +250,25 @@ class AnnouncedPlan:
                 f"{sum(1 for _ in g)} x {lab}" for lab, g in itertools.groupby(seq))
         return (f"the emulator touches {runs(theirs)} in turn, but this run labels its first {len(ours)} touches "
                 f"{runs(ours)}")
+
+
+_ANNOUNCEMENT = re.compile(r"designkit emulator: touch (?P<j>\d+) of (?P<label>\".*\") starts")
+
+
+def parse_announcement(message: str) -> tuple[int, str] | None:
+    """(touch number from 1, material label) of an emulator's touch announcement; None for other messages.
+
+    >>> parse_announcement('# designkit emulator: touch 3 of "Aluminium alloys" starts')
+    (3, 'Aluminium alloys')
+    """
+    m = _ANNOUNCEMENT.search(message)
+    if not m:
+        return None
+    try:
+        label = json.loads(m.group("label"))
+    except ValueError:
+        return None
+    return (int(m.group("j")), label) if isinstance(label, str) else None
 
 
 def parse_greeting(message: str) -> AnnouncedPlan | None:
@@ -655,8 +675,24 @@ class Emulator:
                     line = delim.join(parts)
                     self.lines_faulty += 1
                 out.append(line.encode(prof.encoding))
-            return b"\n".join(out) + b"\n"
-        return ("\n".join(text) + "\n").encode(prof.encoding) if text else b""
+        else:
+            out = [line.encode(prof.encoding) for line in text]
+        if prof.comment and out:  # each touch announced as it starts (before its onset): a device message
+            p = self.plan
+            fs = prof.sample_rate_hz
+            j0 = max(0, int(math.ceil((k0 / fs - p.first_touch_s) / p.touch_every_s - 1e-9)))
+            for j in range(j0, j0 + len(out) + 1):
+                k = int(math.ceil((p.first_touch_s + j * p.touch_every_s) * fs - 1e-9))
+                if k >= k1:
+                    break
+                if k >= k0:
+                    out.insert(k - k0 + (j - j0), self.announcement(j).encode(prof.encoding))
+        return b"\n".join(out) + b"\n" if out else b""
+
+    def announcement(self, j: int) -> str:
+        """The device message sent as touch ``j`` (0-based) starts; :func:`parse_announcement` reads it."""
+        label = json.dumps(self.material_of_touch(j).label, ensure_ascii=False)
+        return f"{self.profile.comment or '#'} designkit emulator: touch {j + 1} of {label} starts"
 
     # ---------------------------------------------------------------- pty
     @property

@@ -791,8 +791,8 @@ class SerialRecorder:
             t0 = float(t[0])
             if ver.last_t is not None:
                 if t0 < ver.last_t and t0 > RESTART_MAX_S:
-                    reasons.append(f"the device clock went back from {ver.last_t:.2f} s to {t0:.2f} s, not to a "
-                                   f"restart near 0 (a reset restarts it)")
+                    reasons.append(f"the device clock went back from {ver.last_t:.2f} s to {t0:.2f} s, where a "
+                                   "reset restarts it near 0")
                 elif t0 >= ver.last_t and t0 - ver.last_t > CLOCK_SLACK_S + 2 * ver.away_s:
                     reasons.append(f"the device clock jumped ahead by {t0 - ver.last_t:.1f} s while the device was "
                                    f"away {ver.away_s:.1f} s")

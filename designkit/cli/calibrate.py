@@ -228,24 +228,64 @@ class _CommentWatch:
                   "make the rig send its messages with a different prefix")
 
 
-def _check_emulator_plan(message: str, materials: list[str], trials: int, port: str) -> None:
-    """Refuse, before its first trial, a run whose labels an emulator's announced touch plan contradicts."""
-    from ..calibration.emulator import parse_greeting
+class _EmulatorWatch:
+    """``designkit emulate``'s own announcements (device messages) against this run's labels.
 
-    plan = parse_greeting(message)
-    if plan is None:
-        return
-    why = plan.mislabels(materials, trials)
-    if why is None:
-        return
-    from .._validation import InputError
+    Its first line announces the plan: a run whose labels it contradicts is refused before its
+    first trial. Each touch is announced as it starts (before its onset): a touch that would get
+    another material's label (a run out of step: touches lost while waiting for Enter) stops the
+    run before it is recorded. Each of the run's names must stand for one of the emulator's
+    materials and no two for the same; a name that is one of its labels (any case) for that one.
+    """
 
-    n = plan.touches_per_material
-    fix = _guided_command(port, None, list(plan.labels), n)
-    raise InputError(
-        f"{why}: every trial would get a wrong label, so none is recorded. Record what the emulator plays "
-        f"(e.g. '{fix}'), or restart it with its --material options in the order of this run's and "
-        f"--touches-per-material {trials}")
+    def __init__(self, materials: list[str], trials: int, port: str, out: Path) -> None:
+        self.materials, self.trials, self.port, self.out = materials, trials, port, out
+        self.pairs: dict[str, str] = {}
+        self.labels: set[str] = set()
+        self.before: set[Path] = set()
+
+    def _kept(self) -> str:
+        from ..calibration.trials import recorded_trials
+
+        n = len(set(recorded_trials(self.out)) - self.before)
+        return f"{n} trial(s) kept" + (f" in {self.out}" if n else "")
+
+    def __call__(self, message: str, material: str) -> None:
+        from .._validation import InputError
+        from ..calibration.emulator import parse_announcement, parse_greeting
+
+        advice = ("with the emulator, give its materials in its order, --trials equal to its "
+                  "--touches-per-material, and --yes (the command it prints after 'try:')")
+        plan = parse_greeting(message)
+        if plan is not None:
+            self.labels |= {lab.lower() for lab in plan.labels}
+            why = plan.mislabels(self.materials, self.trials)
+            if why is not None:
+                fix = _guided_command(self.port, None, list(plan.labels), plan.touches_per_material)
+                raise InputError(
+                    f"{why}: every trial would get a wrong label, so none is recorded. Record what the emulator "
+                    f"plays (e.g. '{fix}'), or restart it with its --material options in the order of this run's "
+                    f"and --touches-per-material {self.trials}")
+            return
+        touch = parse_announcement(message)
+        if touch is None:
+            return
+        j, label = touch
+        self.labels.add(label.lower())
+        prev = self.pairs.get(material)
+        other = next((m for m, lab in self.pairs.items() if lab == label and m != material), None)
+        if prev is not None and prev != label:
+            why = f"this run's touches of {material} so far were {prev}"
+        elif other is not None:
+            why = f"this run recorded {label} as {other}"
+        elif material.lower() in self.labels and material.lower() != label.lower():
+            why = f"{material} is another of its materials"
+        else:
+            self.pairs[material] = label
+            return
+        raise InputError(f"the emulator on {self.port} starts touch {j} with {label} while this run records "
+                         f"{material} ({why}): recording stops before a touch gets the wrong label; "
+                         f"{self._kept()}. {advice[0].upper()}{advice[1:]}")
 
 
 def _guided_command(port: str, profile: Optional[str], materials: list[str], trials: int,
@@ -289,11 +329,13 @@ def _record_materials(port: str, profile, out: Path, materials: list[str], trial
             display.event(e)  # a stream of nothing but messages: show the first few, then the verdict
         comments(e, rec.status.lines_ok)
         if e.kind == "device":
-            _check_emulator_plan(e.message, materials, trials, port)
+            emulator(e.message, rec.status.material)
 
+    emulator = _EmulatorWatch(materials, trials, port, out)
     rec = SerialRecorder(port, profile, out, no_data_timeout_s=timeout, on_event=on_event,
                          on_status=on_status)
     before = set(recorded_trials(out))
+    emulator.before = before
     interrupted = False
     try:
         rec.open()

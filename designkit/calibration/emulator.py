@@ -195,7 +195,8 @@ class TouchPlan:
     drift_lead_s: float = 1.5
 
 
-_GREETING = re.compile(r"designkit emulator, profile .*?; touches (?P<n>\d+) of each of (?P<labels>\[.*\]) in turn")
+_GREETING = re.compile(r"designkit emulator, profile .*?; touches \d+ of each of \[.*\] in turn")
+_PLAN = re.compile(r"touches (?P<n>\d+) of each of (?P<labels>\[.*\]) in turn")
 
 
 @dataclass(frozen=True)
@@ -252,14 +253,18 @@ class AnnouncedPlan:
                 f"{runs(ours)}")
 
 
-_ANNOUNCEMENT = re.compile(r"designkit emulator: touch (?P<j>\d+) of (?P<label>\".*\") starts")
+_ANNOUNCEMENT = re.compile(r'designkit emulator: touch (?P<j>\d+) of (?P<label>"(?:[^"\\]|\\.)*") starts')
 
 
-def parse_announcement(message: str) -> tuple[int, str] | None:
-    """(touch number from 1, material label) of an emulator's touch announcement; None for other messages.
+def parse_announcement(message: str) -> tuple[int, str, AnnouncedPlan | None] | None:
+    """(touch number from 1, material label, the plan it repeats) of an emulator's touch announcement;
+    None for other messages.
 
-    >>> parse_announcement('# designkit emulator: touch 3 of "Aluminium alloys" starts')
-    (3, 'Aluminium alloys')
+    >>> j, label, plan = parse_announcement(
+    ...     '# designkit emulator: touch 3 of "Aluminium alloys" starts; touches 2 of each of ["Aluminium alloys", '
+    ...     '"wood"] in turn')
+    >>> j, label, plan.labels
+    (3, 'Aluminium alloys', ('Aluminium alloys', 'wood'))
     """
     m = _ANNOUNCEMENT.search(message)
     if not m:
@@ -268,12 +273,19 @@ def parse_announcement(message: str) -> tuple[int, str] | None:
         label = json.loads(m.group("label"))
     except ValueError:
         return None
-    return (int(m.group("j")), label) if isinstance(label, str) else None
+    if not isinstance(label, str):
+        return None
+    plan = _plan(message[m.end():])
+    return int(m.group("j")), label, plan
 
 
 def parse_greeting(message: str) -> AnnouncedPlan | None:
     """The plan an emulator's first line announces (None: ``message`` is no such line)."""
-    m = _GREETING.search(message)
+    return _plan(message) if _GREETING.search(message) else None
+
+
+def _plan(text: str) -> AnnouncedPlan | None:
+    m = _PLAN.search(text)
     if not m:
         return None
     try:
@@ -690,9 +702,12 @@ class Emulator:
         return b"\n".join(out) + b"\n" if out else b""
 
     def announcement(self, j: int) -> str:
-        """The device message sent as touch ``j`` (0-based) starts; :func:`parse_announcement` reads it."""
+        """The device message sent as touch ``j`` (0-based) starts, with the plan; :func:`parse_announcement`
+        reads it."""
         label = json.dumps(self.material_of_touch(j).label, ensure_ascii=False)
-        return f"{self.profile.comment or '#'} designkit emulator: touch {j + 1} of {label} starts"
+        labels = json.dumps([m.label for m in self.materials], ensure_ascii=False)
+        return (f"{self.profile.comment or '#'} designkit emulator: touch {j + 1} of {label} starts; touches "
+                f"{self.plan.touches_per_material} of each of {labels} in turn")
 
     # ---------------------------------------------------------------- pty
     @property

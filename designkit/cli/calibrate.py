@@ -270,8 +270,10 @@ class _EmulatorWatch:
         touch = parse_announcement(message)
         if touch is None:
             return
-        j, label = touch
+        j, label, plan = touch
         self.labels.add(label.lower())
+        if plan is not None:
+            self.labels |= {lab.lower() for lab in plan.labels}
         prev = self.pairs.get(material)
         other = next((m for m, lab in self.pairs.items() if lab == label and m != material), None)
         if prev is not None and prev != label:

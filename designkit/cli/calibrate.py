@@ -264,7 +264,7 @@ class _EmulatorWatch:
                 fix = _guided_command(self.port, None, list(plan.labels), plan.touches_per_material)
                 raise InputError(
                     f"{why}: every trial would get a wrong label, so none is recorded. Record what the emulator "
-                    f"plays (e.g. '{fix}'), or restart it with its --material options in the order of this run's "
+                    f"plays (e.g. {fix}), or restart it with its --material options in the order of this run's "
                     f"and --touches-per-material {self.trials}")
             return
         touch = parse_announcement(message)

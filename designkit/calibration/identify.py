@@ -1747,8 +1747,6 @@ def plot_identification(results: Sequence[Identification], selected: str, fit_tr
     ax.legend(fontsize=7)
     for a in axes:
         a.grid(alpha=0.3)
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    from ..figures import save_figure
+
+    return save_figure(fig, path, dpi=110)

@@ -27,7 +27,7 @@ def pyplot():
 
 
 def plot_curves(path: Path, time_s, temperature_c, *, title: str = "") -> Path:
-    """Sensor temperature against time, one line per trial, saved as PNG."""
+    """Sensor temperature against time, one line per trial, saved by the suffix of ``path`` (png, svg or pdf)."""
     plt = pyplot()
     temps = np.atleast_2d(temperature_c)
     fig, ax = plt.subplots(figsize=(6.4, 4.0), constrained_layout=True)
@@ -39,11 +39,7 @@ def plot_curves(path: Path, time_s, temperature_c, *, title: str = "") -> Path:
     if title:
         ax.set_title(title, fontsize=9)
     ax.grid(alpha=0.3)
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, dpi=120)
 
 
 def save_figure(fig, path, *, dpi: int = 200) -> Path:

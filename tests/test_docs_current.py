@@ -100,3 +100,16 @@ def test_calibration_readme_snippet_defines_every_name():
     for code in snippets:
         out = io.StringIO()
         assert api.check(code, "calibration/README.md", Reporter(out, out)) == 0, out.getvalue()
+
+
+def test_the_readmes_python_examples_run():
+    """README's library examples (```python blocks) run as written in a fresh interpreter (the array
+    example asserts its shape and that it agrees with a single call)."""
+    import subprocess
+
+    blocks = re.findall(r"```python\n(.*?)```", (REPO / "README.md").read_text(encoding="utf-8"), re.S)
+    assert len(blocks) >= 2
+    for code in blocks:
+        r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600, cwd=REPO)
+        assert r.returncode == 0, (code, r.stderr[-2000:])
+        assert r.stdout.strip(), code

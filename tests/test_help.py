@@ -16,6 +16,8 @@ def _commands():
     def walk(cmd, path):
         subs = getattr(cmd, "commands", None)
         if subs:
+            if path and cmd.invoke_without_command:   # a group that runs on its own (the guided calibrate)
+                out.append(path)
             for name, sub in subs.items():
                 walk(sub, path + [name])
         else:

@@ -31,8 +31,11 @@ the line is silent), a device that vanishes, and one that never speaks.
 from __future__ import annotations
 
 import fcntl
+import itertools
+import json
 import math
 import os
+import re
 import select
 import threading
 import time
@@ -47,7 +50,8 @@ from ..models.semi_infinite import object_weight, response_shape
 from ..sensor import Sensor
 from .profiles import DeviceProfile, Linear, Thermistor
 
-__all__ = ["EmulatedMaterial", "Emulator", "Faults", "TouchPlan", "TouchRecord"]
+__all__ = ["AnnouncedPlan", "EmulatedMaterial", "Emulator", "Faults", "TouchPlan", "TouchRecord", "parse_announcement",
+           "parse_greeting"]
 
 _MAX_PENDING = 1 << 16
 #: Real seconds between a client opening the port and the first sample (a rig's reset on open).
@@ -191,6 +195,108 @@ class TouchPlan:
     drift_lead_s: float = 1.5
 
 
+_GREETING = re.compile(r"designkit emulator, profile .*?; touches \d+ of each of \[.*\] in turn")
+_PLAN = re.compile(r"touches (?P<n>\d+) of each of (?P<labels>\[.*\]) in turn")
+
+
+@dataclass(frozen=True)
+class AnnouncedPlan:
+    """The touch sequence an emulator announces in its first line (a device message).
+
+    Parameters
+    ----------
+    labels : tuple of str
+        Materials, touched in this order.
+    touches_per_material : int
+        Touches of each before the next one (then the first again).
+
+    Examples
+    --------
+    >>> plan = parse_greeting('# designkit emulator, profile designkit; touches 2 of each of ["wood", "metal"] in turn')
+    >>> plan.sequence(5)
+    ['wood', 'wood', 'metal', 'metal', 'wood']
+    >>> plan.mislabels(["metal", "wood"], 2)   # doctest: +ELLIPSIS
+    'the emulator touches wood, wood, metal, metal in turn, but this run labels its first 4 touches metal, ...'
+    >>> plan.mislabels(["block", "slab"], 2) is None   # any names, as long as each stands for one material
+    True
+    """
+
+    labels: tuple[str, ...]
+    touches_per_material: int
+
+    def sequence(self, n: int) -> list[str]:
+        """Labels of the first ``n`` touches."""
+        k = self.touches_per_material
+        return [self.labels[(j // k) % len(self.labels)] for j in range(n)]
+
+    def mislabels(self, materials: Sequence[str], trials: int) -> str | None:
+        """Why a recording of ``trials`` touches of each of ``materials`` in turn would mislabel them (None: it
+        would not).
+
+        A recording may name the materials as it likes, but each of its names must stand for one of the
+        emulator's materials and no two for the same; a name that is one of the emulator's labels (any case)
+        must stand for that one.
+        """
+        ours = [m for m in materials for _ in range(trials)]
+        theirs = self.sequence(len(ours))
+        pairs = set(zip(ours, theirs))
+        known = {lab.lower() for lab in self.labels}
+        ok = (len(pairs) == len({a for a, _ in pairs}) == len({b for _, b in pairs})
+              and all(a.lower() == b.lower() for a, b in pairs if a.lower() in known))
+        if ok:
+            return None
+
+        def runs(seq: list[str]) -> str:
+            return ", ".join(seq) if len(seq) <= 6 else ", ".join(
+                f"{sum(1 for _ in g)} x {lab}" for lab, g in itertools.groupby(seq))
+        return (f"the emulator touches {runs(theirs)} in turn, but this run labels its first {len(ours)} touches "
+                f"{runs(ours)}")
+
+
+_ANNOUNCEMENT = re.compile(r'designkit emulator: touch (?P<j>\d+) of (?P<label>"(?:[^"\\]|\\.)*") starts')
+
+
+def parse_announcement(message: str) -> tuple[int, str, AnnouncedPlan | None] | None:
+    """(touch number from 1, material label, the plan it repeats) of an emulator's touch announcement;
+    None for other messages.
+
+    >>> j, label, plan = parse_announcement(
+    ...     '# designkit emulator: touch 3 of "Aluminium alloys" starts; touches 2 of each of ["Aluminium alloys", '
+    ...     '"wood"] in turn')
+    >>> j, label, plan.labels
+    (3, 'Aluminium alloys', ('Aluminium alloys', 'wood'))
+    """
+    m = _ANNOUNCEMENT.search(message)
+    if not m:
+        return None
+    try:
+        label = json.loads(m.group("label"))
+    except ValueError:
+        return None
+    if not isinstance(label, str):
+        return None
+    plan = _plan(message[m.end():])
+    return int(m.group("j")), label, plan
+
+
+def parse_greeting(message: str) -> AnnouncedPlan | None:
+    """The plan an emulator's first line announces (None: ``message`` is no such line)."""
+    return _plan(message) if _GREETING.search(message) else None
+
+
+def _plan(text: str) -> AnnouncedPlan | None:
+    m = _PLAN.search(text)
+    if not m:
+        return None
+    try:
+        labels = json.loads(m.group("labels"))
+    except ValueError:
+        return None
+    if not labels or not all(isinstance(x, str) for x in labels) or int(m.group("n")) < 1:
+        return None
+    return AnnouncedPlan(tuple(labels), int(m.group("n")))
+
+
 @dataclass(frozen=True)
 class TouchRecord:
     """Ground truth of one emulated touch (device time)."""
@@ -325,6 +431,16 @@ class Emulator:
         self.samples_sent = 0
         self.lines_faulty = 0
         self.vanished = False
+
+    def greeting(self) -> str:
+        """The first line sent (a device message, with the profile's comment prefix): the touch plan.
+
+        A recorder reads it back with :func:`parse_greeting` and can refuse a run that would label
+        the touches wrongly.
+        """
+        labels = json.dumps([m.label for m in self.materials], ensure_ascii=False)
+        return (f"{self.profile.comment or '#'} designkit emulator, profile {self.profile.name}; touches "
+                f"{self.plan.touches_per_material} of each of {labels} in turn, every {self.plan.touch_every_s:g} s")
 
     # ----------------------------------------------------------------- truth
     def _touch_draws(self, j: int) -> tuple[float, float]:
@@ -571,8 +687,27 @@ class Emulator:
                     line = delim.join(parts)
                     self.lines_faulty += 1
                 out.append(line.encode(prof.encoding))
-            return b"\n".join(out) + b"\n"
-        return ("\n".join(text) + "\n").encode(prof.encoding) if text else b""
+        else:
+            out = [line.encode(prof.encoding) for line in text]
+        if prof.comment and out:  # each touch announced as it starts (before its onset): a device message
+            p = self.plan
+            fs = prof.sample_rate_hz
+            j0 = max(0, int(math.ceil((k0 / fs - p.first_touch_s) / p.touch_every_s - 1e-9)))
+            for j in range(j0, j0 + len(out) + 1):
+                k = int(math.ceil((p.first_touch_s + j * p.touch_every_s) * fs - 1e-9))
+                if k >= k1:
+                    break
+                if k >= k0:
+                    out.insert(k - k0 + (j - j0), self.announcement(j).encode(prof.encoding))
+        return b"\n".join(out) + b"\n" if out else b""
+
+    def announcement(self, j: int) -> str:
+        """The device message sent as touch ``j`` (0-based) starts, with the plan; :func:`parse_announcement`
+        reads it."""
+        label = json.dumps(self.material_of_touch(j).label, ensure_ascii=False)
+        labels = json.dumps([m.label for m in self.materials], ensure_ascii=False)
+        return (f"{self.profile.comment or '#'} designkit emulator: touch {j + 1} of {label} starts; touches "
+                f"{self.plan.touches_per_material} of each of {labels} in turn")
 
     # ---------------------------------------------------------------- pty
     @property
@@ -672,9 +807,8 @@ class Emulator:
         rate = fs * self.speed  # samples per real second
         chunk = max(1, int(rate * 0.02))
         pending = bytearray()
-        if self.profile.comment:
-            pending += f"{self.profile.comment} designkit emulator, profile {self.profile.name}\n".encode(
-                self.profile.encoding)
+        if self.profile.comment:  # a newline first: a client drops the line it may have opened in the middle of
+            pending += f"\n{self.greeting()}\n".encode(self.profile.encoding)
         k = 0
         anchor = time.monotonic()
         hold_until = 0.0

@@ -1161,11 +1161,9 @@ def plot_fit(result: CalibrationResult, path: Path) -> Path:
     ax.set_title("profile over e_s (other parameters refitted)", fontsize=9)
     for a in axes:
         a.grid(alpha=0.3)
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    from ..figures import save_figure
+
+    return save_figure(fig, path, dpi=110)
 
 
 # --------------------------------------------------------------- checks

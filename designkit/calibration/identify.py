@@ -83,6 +83,7 @@ __all__ = [
     "force_noise",
     "identify",
     "nominal_force_profile",
+    "plot_identification",
     "relative_force",
     "residual_series",
     "score",
@@ -1678,3 +1679,74 @@ def compare_models(fit_trials: Sequence[Trial], held_out: Sequence[Trial],
     best = min(range(len(results)), key=lambda i: (held[i].get("all", 0.0), results[i].bic))
     return Comparison(tuple(results), tuple(held), results[best].candidate.label, len(fit_trials), len(held_out),
                       time.perf_counter() - t0)
+
+
+# ------------------------------------------------------------------ figure
+def plot_identification(results: Sequence[Identification], selected: str, fit_trials: Sequence[Trial],
+                        held_out: Sequence[Trial], path: "Path | str", *,
+                        held_out_rms_c: Sequence[Mapping[str, float]] = (),
+                        object_temps: Mapping[str, Any] | None = None) -> Path:
+    """Figure of an identification (``calibrate fit --model NAME --plot f.png``); returns ``path``.
+
+    Left: the selected model's mean prediction (dashed) over the mean reading (solid) [degC] of each
+    material's fitted touches, each touch with its own Ts0 and To (as :func:`score`). Middle: the
+    mean residual (prediction - reading) [degC] on the fitted (solid) and held-out (dotted) touches.
+    Right: residual RMS of every candidate on the fitted and on the held-out touches [degC].
+    Where the touches of a material lie on different time grids, each is interpolated onto the
+    first one's.
+    """
+    from ..figures import pyplot
+
+    best = next(r for r in results if r.candidate.label == selected)
+
+    def by_material(trials: Sequence[Trial]) -> dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]:
+        """Per material: (time grid [s], mean reading, mean residual) over its touches."""
+        if not trials:
+            return {}
+        rows = residual_series(best, trials, object_temps=object_temps)
+        out: dict[str, list] = {}
+        for tr, (name, t, r) in zip(trials, rows):
+            grid = out.setdefault(name, [t, [], []])[0]
+            out[name][1].append(np.interp(grid, t, tr.sensor_c))
+            out[name][2].append(np.interp(grid, t, r))
+        return {n: (g, np.mean(y, axis=0), np.mean(r, axis=0)) for n, (g, y, r) in out.items()}
+
+    fitted, held = by_material(fit_trials), by_material(held_out)
+    plt = pyplot()
+    fig, axes = plt.subplots(1, 3, figsize=(15.0, 4.2), constrained_layout=True,
+                             gridspec_kw={"width_ratios": [1.0, 1.0, 0.9]})
+    for k, (n, (t, y, r)) in enumerate(fitted.items()):
+        count = sum(tr.material == n for tr in fit_trials)
+        axes[0].plot(t, y, color=f"C{k}", lw=1.3, label=f"{n}: reading (mean of {count})")
+        axes[0].plot(t, y + r, color=f"C{k}", lw=1.0, ls="--", label=f"{n}: {selected}")
+        axes[1].plot(t, r, color=f"C{k}", lw=1.0, label=f"{n}, fitted touches")
+        if n in held:
+            th, _, rh = held[n]
+            axes[1].plot(th, rh, color=f"C{k}", lw=1.0, ls=":", label=f"{n}, held-out touches")
+    axes[0].set_xlabel("time after detected onset [s]")
+    axes[0].set_ylabel("sensor temperature [°C]")
+    axes[0].set_title("reading (solid) and the selected model (dashed)", fontsize=9)
+    axes[0].legend(fontsize=7)
+    axes[1].axhline(0, color="k", lw=0.5)
+    axes[1].set_xlabel("time after detected onset [s]")
+    axes[1].set_ylabel("mean residual (model - reading) [°C]")
+    axes[1].set_title("residual, each touch with its own Ts0 and To", fontsize=9)
+    axes[1].legend(fontsize=7)
+    ax = axes[2]
+    labels = [r.candidate.label for r in results]
+    pos = np.arange(len(results))
+    fit_rms = [r.rms_c for r in results]
+    held_rms = [h.get("all", math.nan) for h in held_out_rms_c] if held_out_rms_c else [math.nan] * len(results)
+    ax.barh(pos - 0.2, fit_rms, height=0.4, color="C0", label="fitted touches")
+    if np.isfinite(held_rms).any():
+        ax.barh(pos + 0.2, held_rms, height=0.4, color="C1", label="held-out touches")
+    ax.set_yticks(pos, [lab + (" *" if lab == selected else "") for lab in labels], fontsize=7)
+    ax.set_ylim(len(results) - 0.2, -0.8)   # top to bottom, with room for the legend
+    ax.set_xlabel("residual RMS [°C]")
+    ax.set_title("candidates (* selected)", fontsize=9)
+    ax.legend(fontsize=7)
+    for a in axes:
+        a.grid(alpha=0.3)
+    from ..figures import save_figure
+
+    return save_figure(fig, path, dpi=110)

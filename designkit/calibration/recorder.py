@@ -20,6 +20,22 @@ Two layers:
   that never speaks (``no_data_timeout_s``). Trials already written are never
   touched again; Ctrl-C (KeyboardInterrupt) leaves them all in place.
 
+A reopened port is a new device until its stream shows otherwise: a pty path
+(or a USB port) the device left may now belong to another program's device.
+After a reconnect the recorder holds the samples back until it has seen
+``VERIFY_S`` of them out of contact and compares them with what the session
+saw before the disconnect: the device clock must restart near zero (a reset,
+``RESTART_MAX_S``) or continue (``CLOCK_SLACK_S`` plus twice the real time
+away), one sample must come every session's sample interval (within
+``RATE_TOLERANCE``) with at least ``MIN_ARRIVING_FRACTION`` of them arriving
+(two programs reading one port split its lines), and the pre-contact sensor
+and object temperatures must stay within ``SENSOR_TOLERANCE_C`` and
+``OBJECT_TOLERANCE_C`` of the session's (the median of its last 20 s out of
+contact). A stream that matches is recorded from, its held samples first; one
+that does not stops the recording (:class:`DeviceChanged`, naming what
+differs; trials already written stay), so that no touch of another device is
+labelled with this session's material.
+
 Without a timestamp channel, time is the count of lines received divided by
 the sample rate; a line that cannot be read still counts (its sample is
 missing from the trial, the times of the others stay right).
@@ -38,6 +54,7 @@ from __future__ import annotations
 
 import datetime as _dt
 import errno
+import math
 import os
 import stat
 import time
@@ -51,10 +68,30 @@ from .._validation import InputError, check_positive
 from .profiles import ROLES, DeviceProfile
 from .trials import check_trial_folder, write_trial
 
-__all__ = ["MIN_READABLE_FRACTION", "RecordEvent", "RecorderStatus", "SerialRecorder", "TrialCutter"]
+__all__ = ["CLOCK_SLACK_S", "DeviceChanged", "MIN_ARRIVING_FRACTION", "MIN_READABLE_FRACTION", "OBJECT_TOLERANCE_C",
+           "RATE_TOLERANCE", "RESTART_MAX_S", "RecordEvent", "RecorderStatus", "SENSOR_TOLERANCE_C",
+           "SerialRecorder", "TrialCutter", "VERIFY_S"]
 
 #: Fewest samples of a trial's window that must be readable for the trial to be kept.
 MIN_READABLE_FRACTION = 0.8
+
+# After a reconnect (module docstring): is it still the session's device?
+#: Device seconds of samples out of contact read (and held back) before trusting a reopened port.
+VERIFY_S = 1.0
+#: Largest change of the pre-contact sensor temperature [degC] (a regulated heater holds its set point).
+SENSOR_TOLERANCE_C = 1.0
+#: Largest change of the pre-contact object (passive) temperature [degC] (the room drifts slowly).
+OBJECT_TOLERANCE_C = 2.0
+#: Largest first device time [s] after reopening that counts as a clock restarted by a reset.
+RESTART_MAX_S = 5.0
+#: Largest advance [s] of a continuing device clock beyond twice the real seconds the device was away.
+CLOCK_SLACK_S = 10.0
+#: Largest relative change of the median sample interval.
+RATE_TOLERANCE = 0.2
+#: Fewest of the samples (by device time) that must arrive: two readers of one port split its lines.
+MIN_ARRIVING_FRACTION = 0.8
+#: Device seconds of samples out of contact the session's reference temperatures are the median of.
+_REFERENCE_S = 20.0
 
 _S, _O, _F = 0, 1, 2  # columns of the cutter's value buffer
 _BAD_KIND_TEXT = {
@@ -314,6 +351,23 @@ class TooManyBadLines(InputError):
     """So many lines are unreadable that no trial can be kept (see the module docstring)."""
 
 
+class DeviceChanged(InputError):
+    """After a reconnect the port streams data unlike the session's device (see the module docstring)."""
+
+
+@dataclass
+class _Verification:
+    """A reopened port on probation: samples held back until they show the same device."""
+
+    sensor_c: float          # the session's pre-contact medians [degC] (NaN: none seen)
+    object_c: float
+    last_t: float | None     # the session's last device time [s]
+    dt_s: float              # the session's median sample interval [s]
+    away_s: float            # real seconds between the disconnect and the reopening
+    t: list = field(default_factory=list)
+    v: list = field(default_factory=list)
+
+
 class SerialRecorder:
     """Record touches from a serial port into a folder.
 
@@ -367,6 +421,10 @@ class SerialRecorder:
         self._bad_window = max(200, int(round(window * fs)) + 1)  # lines the give-up rule looks at
         self._recent_bad = np.zeros(0, dtype=bool)
         self._last_bad_text = ""
+        self._pre_contact: list[tuple[float, float]] = []   # the trials' (sensor, object) before contact
+        self._idle_t = np.zeros(0)        # recent samples out of contact: the session's reference
+        self._idle_v = np.zeros((0, 3))
+        self._verify: _Verification | None = None
 
     # ------------------------------------------------------------ port
     def open(self) -> None:
@@ -530,13 +588,17 @@ class SerialRecorder:
 
     def _device_lost(self, cutter: TrialCutter, exc: BaseException) -> None:
         in_trial = cutter.in_trial
+        last_t = self._last_t
         self._discontinuity(cutter, "the device disconnected")
         self.close()
-        deadline = time.monotonic() + self.profile.serial.reconnect_s
+        lost_at = time.monotonic()
+        deadline = lost_at + self.profile.serial.reconnect_s
         while True:
             try:
                 self.open()
-                self._emit(RecordEvent("reconnect", f"reopened {self.port}"))
+                self._verify = self._probation(last_t, time.monotonic() - lost_at)
+                self._emit(RecordEvent("reconnect", f"reopened {self.port}; checking that it streams this "
+                                                    "session's device before recording from it"))
                 return
             except InputError:
                 if time.monotonic() >= deadline:
@@ -593,7 +655,12 @@ class SerialRecorder:
             self._check_readable(unreadable, cutter)
             return
         self._valid_seen = True
-        self._feed_checked(t, vals, cutter)  # first, so that a trial this completes is kept
+        if self._verify is not None:
+            self._verify.t.append(t)
+            self._verify.v.append(vals)
+            self._check_device(cutter)   # feeds what it held back once the stream shows the same device
+        else:
+            self._feed_checked(t, vals, cutter)  # first, so that a trial this completes is kept
         last = vals[-1]
         self.status.sensor_c, self.status.object_c, self.status.force_n = (float(x) for x in last)
         self.status.device_time_s = float(t[-1])
@@ -650,8 +717,116 @@ class SerialRecorder:
             self._feed(t[start:], vals[start:], cutter)
         self._last_t = float(t[-1])
 
+    # ------------------------------------------------------- same device?
+    def _out_of_contact(self, vals: np.ndarray) -> np.ndarray:
+        """Rows of ``vals`` taken with nothing touching: force below release (without force: every row)."""
+        f = vals[:, _F]
+        if self.profile.contact.rule != "force" or not np.isfinite(f).any():
+            return np.ones(f.size, dtype=bool)
+        return np.isfinite(f) & (f < self.profile.contact.release_n)
+
+    def _remember_idle(self, t: np.ndarray, vals: np.ndarray) -> None:
+        """Keep the last ``_REFERENCE_S`` of samples out of contact (the session's reference)."""
+        idle = self._out_of_contact(vals)
+        if not idle.any():
+            return
+        keep = int(round(_REFERENCE_S * self.profile.sample_rate_hz))
+        self._idle_t = np.concatenate([self._idle_t, t[idle]])[-keep:]
+        self._idle_v = np.concatenate([self._idle_v, vals[idle]])[-keep:]
+
+    def _note_pre_contact(self, path: Path) -> None:
+        """Remember a written trial's pre-contact temperatures (its sidecar) as the session's reference."""
+        import json
+
+        try:
+            meta = json.loads(Path(path).with_suffix(".json").read_text())
+            obj = meta.get("object_temp_before_c")
+            self._pre_contact.append((float(meta["sensor_temp_before_c"]),
+                                      float("nan") if obj is None else float(obj)))
+        except (OSError, ValueError, KeyError, TypeError):
+            pass   # the idle samples remain the reference
+
+    def _probation(self, last_t: float | None, away_s: float) -> _Verification:
+        v, t = self._idle_v, self._idle_t
+        if self._pre_contact:   # the recorded trials' own pre-contact means: steady by construction
+            v = np.array([[s, o, np.nan] for s, o in self._pre_contact[-10:]], dtype=np.float64)
+        with np.errstate(all="ignore"):
+            sensor = float(np.nanmedian(v[:, _S])) if np.isfinite(v[:, _S]).any() else float("nan")
+            obj = float(np.nanmedian(v[:, _O])) if np.isfinite(v[:, _O]).any() else float("nan")
+        d = np.diff(t)
+        d = d[(d > 0) & (d < 3.0 / self.profile.sample_rate_hz)]
+        dt = float(np.median(d)) if d.size >= 10 else 1.0 / self.profile.sample_rate_hz
+        return _Verification(sensor, obj, last_t, dt, away_s)
+
+    def _check_device(self, cutter: TrialCutter) -> None:
+        """Judge a reopened port once ``VERIFY_S`` of samples out of contact arrived (module docstring).
+
+        Raises
+        ------
+        DeviceChanged
+            The stream differs from the session's device; nothing of it was fed to the cutter.
+        """
+        ver = self._verify
+        t, vals = np.concatenate(ver.t), np.concatenate(ver.v)
+        need = max(2, int(round(VERIFY_S * self.profile.sample_rate_hz)))
+        idle = np.flatnonzero(self._out_of_contact(vals))[-need:]   # the latest VERIFY_S out of contact
+        if t.size < 10 * need:
+            if idle.size < need:
+                return                                  # not enough seen yet
+            s = vals[idle, _S]
+            if abs(np.median(s[need // 2:]) - np.median(s[:need // 2])) > SENSOR_TOLERANCE_C / 4:
+                return                                  # still settling (a heater recovering from a touch)
+        if idle.size == 0:
+            idle = np.arange(t.size)
+        reasons, same = [], []
+        sensor = float(np.nanmedian(vals[idle, _S]))
+        if math.isfinite(ver.sensor_c):
+            (reasons if abs(sensor - ver.sensor_c) > SENSOR_TOLERANCE_C else same).append(
+                f"sensor {sensor:.2f} °C out of contact, the session's {ver.sensor_c:.2f} °C")
+        if math.isfinite(ver.object_c) and np.isfinite(vals[idle, _O]).any():
+            obj = float(np.nanmedian(vals[idle, _O]))
+            (reasons if abs(obj - ver.object_c) > OBJECT_TOLERANCE_C else same).append(
+                f"object {obj:.2f} °C, the session's {ver.object_c:.2f} °C")
+        if self.profile.has_timestamp:
+            t0 = float(t[0])
+            if ver.last_t is not None:
+                if t0 < ver.last_t and t0 > RESTART_MAX_S:
+                    reasons.append(f"the device clock went back from {ver.last_t:.2f} s to {t0:.2f} s, where a "
+                                   "reset restarts it near 0")
+                elif t0 >= ver.last_t and t0 - ver.last_t > CLOCK_SLACK_S + 2 * ver.away_s:
+                    reasons.append(f"the device clock jumped ahead by {t0 - ver.last_t:.1f} s while the device was "
+                                   f"away {ver.away_s:.1f} s")
+                else:
+                    same.append("clock restarted" if t0 < ver.last_t else "clock continued")
+            d = np.diff(t)
+            d = d[d > 0]
+            if d.size >= 10:
+                dt = float(np.median(d))
+                if abs(dt / ver.dt_s - 1.0) > RATE_TOLERANCE:
+                    reasons.append(f"a sample every {1e3 * dt:.3g} ms, the session's {1e3 * ver.dt_s:.3g} ms")
+                span = float(t[-1] - t[0])
+                if span > 0:
+                    frac = t.size / (span / ver.dt_s + 1.0)
+                    if frac < MIN_ARRIVING_FRACTION:
+                        reasons.append(f"only {100 * frac:.0f} % of the samples arrive (another program reading "
+                                       "the same port splits its lines)")
+        if reasons:
+            self._verify = None
+            raise DeviceChanged(
+                f"after reconnecting, {self.port} streams another device than this session's ("
+                + "; ".join(reasons) + "): its port may now belong to another program's device, so nothing "
+                f"more is recorded from it; {self._kept(cutter)}. Check what is on {self.port} and record the "
+                "remaining touches in a new run")
+        self._verify = None
+        self._emit(RecordEvent("reconnect", f"{self.port} streams this session's device again ("
+                                            + (", ".join(same) or "nothing to compare yet") + "); recording on"))
+        self._feed_checked(t, vals, cutter)
+
     def _feed(self, t, vals, cutter: TrialCutter) -> None:
+        self._remember_idle(t, vals)
         for e in cutter.feed(t, vals):
+            if e.kind == "trial" and e.path is not None:
+                self._note_pre_contact(e.path)
             if e.kind == "skipped":
                 self.status.skipped += 1
             self._emit(e)

@@ -20,18 +20,31 @@ from ._app import EXIT_INTERRUPTED, app, console, emit_json, sub_app
 from . import _app
 from ._options import Json, Noise, Seed, SensorOpt, sensor_and_model
 
-calibrate_app = sub_app(
-    "calibrate",
-    "Calibrate your sensor: record touches over serial ('record'), identify e_s and alpha_s ('fit'), "
-    "or both in one guided run ('designkit calibrate --port PORT --material NAME ...').",
-    panel=_app.SENSOR,
-)
+#: ``designkit calibrate --help``: the group's and the guided run's (the group's callback) help in one,
+#: since typer shows the group's text, not the callback's docstring.
+_CALIBRATE_HELP = """Calibrate your sensor: record touches over serial ('record'), identify e_s and alpha_s ('fit'), \
+or both in one guided run (the options below).
+
+The guided run records --trials touches of the first --material, then of the next, and so on, then fits \
+and writes the sensor file. Against 'designkit emulate': it touches each of its materials \
+--touches-per-material times (default 10, as --trials here) in the order given, starting when the port \
+is opened; give the same materials in the same order and --yes (the emulator does not wait for Enter). \
+The command it prints after 'try:' does this; a run whose labels its plan contradicts stops before \
+recording.
+
+Example: `designkit calibrate --port /dev/pts/5 --material wood --material metal --out trials/ --yes`
+"""
+
+calibrate_app = sub_app("calibrate", _CALIBRATE_HELP, panel=_app.SENSOR)
 
 PortOpt = Annotated[Optional[str], typer.Option(
     "--port", help="Serial port of the rig (/dev/ttyACM0, COM3, or the pty 'designkit emulate' prints).")]
 ProfileOpt = Annotated[str, typer.Option(
     "--profile", help="Device profile: a shipped name ('designkit', 'adc12-thermistor') or a profile YAML file.")]
 TrialsOpt = Annotated[int, typer.Option("--trials", help="Touches to record per material (at most 1000).")]
+#: Touches per material the guided run records and the emulator plays by default: the same, so that
+#: 'designkit emulate' with two materials and the guided run agree on which touch is which.
+DEFAULT_TRIALS = 10
 TimeoutOpt = Annotated[Optional[float], typer.Option(
     "--timeout", help="Give up when the device sends nothing for this long [s] (default: the profile's).")]
 RangeOpt = Annotated[Optional[list[str]], typer.Option(
@@ -215,6 +228,84 @@ class _CommentWatch:
                   "make the rig send its messages with a different prefix")
 
 
+class _EmulatorWatch:
+    """``designkit emulate``'s own announcements (device messages) against this run's labels.
+
+    Its first line announces the plan: a run whose labels it contradicts is refused before its
+    first trial. Each touch is announced as it starts (before its onset): a touch that would get
+    another material's label (a run out of step: touches lost while waiting for Enter) stops the
+    run before it is recorded. Each of the run's names must stand for one of the emulator's
+    materials and no two for the same; a name that is one of its labels (any case) for that one.
+    """
+
+    def __init__(self, materials: list[str], trials: int, port: str, out: Path) -> None:
+        self.materials, self.trials, self.port, self.out = materials, trials, port, out
+        self.pairs: dict[str, str] = {}
+        self.labels: set[str] = set()
+        self.before: set[Path] = set()
+
+    def _kept(self) -> str:
+        from ..calibration.trials import recorded_trials
+
+        n = len(set(recorded_trials(self.out)) - self.before)
+        return f"{n} trial(s) kept" + (f" in {self.out}" if n else "")
+
+    def __call__(self, message: str, material: str) -> None:
+        from .._validation import InputError
+        from ..calibration.emulator import parse_announcement, parse_greeting
+
+        advice = ("with the emulator, give its materials in its order, --trials equal to its "
+                  "--touches-per-material, and --yes (the command it prints after 'try:')")
+        plan = parse_greeting(message)
+        if plan is not None:
+            self.labels |= {lab.lower() for lab in plan.labels}
+            why = plan.mislabels(self.materials, self.trials)
+            if why is not None:
+                fix = _guided_command(self.port, None, list(plan.labels), plan.touches_per_material)
+                raise InputError(
+                    f"{why}: every trial would get a wrong label, so none is recorded. Record what the emulator "
+                    f"plays (e.g. {fix}), or restart it with its --material options in the order of this run's "
+                    f"and --touches-per-material {self.trials}")
+            return
+        touch = parse_announcement(message)
+        if touch is None:
+            return
+        j, label, plan = touch
+        self.labels.add(label.lower())
+        if plan is not None:
+            self.labels |= {lab.lower() for lab in plan.labels}
+        prev = self.pairs.get(material)
+        other = next((m for m, lab in self.pairs.items() if lab == label and m != material), None)
+        if prev is not None and prev != label:
+            why = f"this run's touches of {material} so far were {prev}"
+        elif other is not None:
+            why = f"this run recorded {label} as {other}"
+        elif material.lower() in self.labels and material.lower() != label.lower():
+            why = f"{material} is another of its materials"
+        else:
+            self.pairs[material] = label
+            return
+        raise InputError(f"the emulator on {self.port} starts touch {j} with {label} while this run records "
+                         f"{material} ({why}): recording stops before a touch gets the wrong label; "
+                         f"{self._kept()}. {advice[0].upper()}{advice[1:]}")
+
+
+def _guided_command(port: str, profile: Optional[str], materials: list[str], trials: int,
+                    ranges: Optional[list[str]] = None) -> str:
+    """A guided ``designkit calibrate`` command line a shell reads back as these arguments."""
+    import shlex
+
+    args = ["designkit", "calibrate", "--port", port]
+    if profile is not None:
+        args += ["--profile", profile]
+    for m in materials:
+        args += ["--material", m]
+    for r in ranges or []:
+        args += ["--range", r]
+    args += ["--trials", str(trials), "--out", "trials/", "--yes"]
+    return shlex.join(args)
+
+
 def _record_materials(port: str, profile, out: Path, materials: list[str], trials: int, timeout: Optional[float],
                       quiet: bool, prompt: bool):
     """Record each material in turn on one open connection; returns (recorder, paths, interrupted).
@@ -239,10 +330,14 @@ def _record_materials(port: str, profile, out: Path, materials: list[str], trial
         if not (e.kind == "device" and comments.n >= 3 and rec.status.lines_ok == 0):
             display.event(e)  # a stream of nothing but messages: show the first few, then the verdict
         comments(e, rec.status.lines_ok)
+        if e.kind == "device":
+            emulator(e.message, rec.status.material)
 
+    emulator = _EmulatorWatch(materials, trials, port, out)
     rec = SerialRecorder(port, profile, out, no_data_timeout_s=timeout, on_event=on_event,
                          on_status=on_status)
     before = set(recorded_trials(out))
+    emulator.before = before
     interrupted = False
     try:
         rec.open()
@@ -475,7 +570,7 @@ def _fit_rows(result) -> list[dict[str, Any]]:
 def _run_identify(index: Path, model: str, fit_sets: str, ranges: list[str], only: Optional[list[str]],
                   object_temps: list[str], depth_um: float, out: Optional[Path], json_: bool,
                   touch_conductance: Optional[str] = None, name: Optional[str] = None,
-                  force: bool = False, rows_fmt: Optional[str] = None) -> None:
+                  force: bool = False, rows_fmt: Optional[str] = None, plot: Optional[Path] = None) -> None:
     """``calibrate fit --model``: identify one model or compare them all on held-out touches."""
     from rich.markup import escape
     from rich.table import Table
@@ -518,6 +613,10 @@ def _run_identify(index: Path, model: str, fit_sets: str, ranges: list[str], onl
         cmp = compare_models(fit, held, cands, **kw)   # no held-out touches: selected by BIC
     results, scores, selected = cmp.results, cmp.held_out_rms_c, cmp.selected
     best = next(r for r in results if r.candidate.label == selected)
+    if plot is not None:  # before the sensor file: a refused fit is worth seeing too
+        from ..calibration.identify import plot_identification
+
+        plot_identification(results, selected, fit, held, plot, held_out_rms_c=scores, object_temps=temps)
     if out is not None:
         _write_identified(best, trials, out, name, index, force, names)
     if rows_fmt is not None:  # the selected model's parameters (the comparison stays in the report and --json)
@@ -534,7 +633,7 @@ def _run_identify(index: Path, model: str, fit_sets: str, ranges: list[str], onl
         return
     if json_:
         emit_json({"index": str(index), "n_fit": len(fit), "n_held_out": len(held), "selected": selected,
-                   "out": str(out) if out is not None else None,
+                   "out": str(out) if out is not None else None, "plot": str(plot) if plot is not None else None,
                    "results": [dict(r.to_dict(), held_out_rms_c=dict(sc)) for r, sc in zip(results, scores)]})
         return
     con = console()
@@ -565,6 +664,8 @@ def _run_identify(index: Path, model: str, fit_sets: str, ranges: list[str], onl
         con.print(f"[yellow]note:[/] {escape(note)}")
     if out is not None:
         con.print(f"wrote {out} with the {selected} model  (use it with --sensor {out})")
+    if plot is not None:
+        con.print(f"wrote {plot}")
 
 
 # ------------------------------------------------------------------ record
@@ -573,7 +674,7 @@ def record(
     port: PortOpt = None,
     profile: ProfileOpt = "designkit",
     material: Annotated[Optional[str], typer.Option("--material", help="Label of the material being touched.")] = None,
-    trials: TrialsOpt = 10,
+    trials: TrialsOpt = DEFAULT_TRIALS,
     out: Annotated[Optional[Path], typer.Option("--out", help="Folder for the trials (CSV + JSON each, index.csv).")] = None,
     timeout: TimeoutOpt = None,
     json_: Json = False,
@@ -665,7 +766,8 @@ def fit(
     only_list = [s.strip() for item in only for s in item.split(",") if s.strip()] if only else None
     if model is not None:
         _run_identify(index, model, fit_sets, range_ or [], only_list, object_temp or [], depth_um, out,
-                      fmt == "json", touch_conductance, name=name, force=force, rows_fmt=fmt if rows_only else None)
+                      fmt == "json", touch_conductance, name=name, force=force, rows_fmt=fmt if rows_only else None,
+                      plot=plot)
         return
     result = _run_fit(index, range_ or [], only_list, object_temp or [], settings, out, name, plot,
                       quiet=fmt != "table", force=force)
@@ -688,7 +790,7 @@ def guided(
     profile: ProfileOpt = "designkit",
     material: Annotated[Optional[list[str]], typer.Option(
         "--material", help="A material to touch (repeatable; recorded in this order).")] = None,
-    trials: TrialsOpt = 10,
+    trials: TrialsOpt = DEFAULT_TRIALS,
     out: Annotated[Optional[Path], typer.Option("--out", help="Folder for the trials.")] = None,
     sensor_out: Annotated[Optional[Path], typer.Option(
         "--sensor-out", help="Sensor YAML to write (default: OUT/sensor.yaml).")] = None,
@@ -707,7 +809,7 @@ def guided(
 ) -> None:
     """Guided calibration: record every material over serial, then fit and write the sensor file.
 
-    Example: `designkit calibrate --port /dev/pts/5 --material wood --material metal --out trials/ --yes`
+    Its ``--help`` text is :data:`_CALIBRATE_HELP` (the group's).
     """
     from .._validation import InputError
 
@@ -757,6 +859,23 @@ def guided(
 
 
 # ----------------------------------------------------------------- emulate
+def _hint_ranges(mats) -> list[str]:
+    """--range options the guided run needs for emulated materials the materials database does not know.
+
+    The emulator knows their effusivity exactly; the hint gives it +-10 %, as an effusivity meter would.
+    """
+    from .._validation import InputError
+    from ..materials import get_material
+
+    out = []
+    for m in mats:
+        try:
+            get_material(m.label)
+        except InputError:
+            out.append(f"{m.label}={0.9 * m.effusivity:.4g}:{1.1 * m.effusivity:.4g}")
+    return out
+
+
 @app.command(rich_help_panel=_app.SENSOR)
 def emulate(
     profile: ProfileOpt = "designkit",
@@ -766,7 +885,8 @@ def emulate(
     e: Annotated[Optional[float], typer.Option("--e", help="Effusivity of the object [J s^-1/2 K^-1 m^-2].")] = None,
     touch_every: Annotated[float, typer.Option("--touch-every", help="Seconds (device time) between touches.")] = 20.0,
     touches_per_material: Annotated[int, typer.Option(
-        "--touches-per-material", help="Touches of each material before the next one.")] = 1,
+        "--touches-per-material", help="Touches of each material before the next one (as the guided "
+                                       "'calibrate --trials' records them).")] = DEFAULT_TRIALS,
     noise: Noise = 0.05,
     sensor: SensorOpt = "paper",
     sensor_temp: Annotated[float, typer.Option("--sensor-temp", help="Heater set point [°C].")] = 35.0,
@@ -821,7 +941,10 @@ def emulate(
                    plan=TouchPlan(touch_every_s=touch_every, touches_per_material=touches_per_material),
                    speed=speed, faults=Faults.parse(fault or []), seed=seed, model=fm)
     port = emu.start()
+    try_cmd = _guided_command(port, profile, [m.label for m in mats], touches_per_material,
+                              _hint_ranges(mats))
     info = {"port": port, "profile": prof.name, "speed": speed, "touch_every_s": touch_every,
+            "touches_per_material": touches_per_material, "try": try_cmd,
             "materials": [{"label": m.label, "effusivity": m.effusivity} for m in mats],
             "noise_c": noise, "sensor": emu.sensor.to_dict(), "model": fm.to_dict(),
             "time_offset_s": emu.expected_time_offset_s,
@@ -829,21 +952,21 @@ def emulate(
     if json_:
         emit_json(info)
     else:
+        from rich.markup import escape
+
         con = console()
         con.print(f"Emulating a '{prof.name}' rig on [bold]{port}[/]  (speed {speed:g}x; Ctrl-C to stop)")
         con.print("  touching " + ", ".join(f"{m.label} (e = {m.effusivity:g})" for m in mats)
                   + f" every {touch_every:g} s; noise {noise:g} °C; sensor e_s = {emu.sensor.effusivity:g}, "
                     f"tau = {emu.sensor.tau_s:.3f} s")
         if fm.name != "semi-infinite":
-            from rich.markup import escape
-
             played = fm.describe() if fm.name != "force-ramp" else (
                 f"{fm.base.describe()} with the contact area following the emulator's force ramp "
                 f"({emu.plan.ramp_s:g} s) at c = {emu.plan.contact_force_fraction:.3g}")
             con.print(escape(f"  model {played} (recorded in sensor file {emu.sensor.name}; the wire "
                              "carries the raw reading: any host smoothing is the host's)"))
-        con.print(f"  try: designkit calibrate record --port {port} --profile {profile} "
-                  f"--material {mats[0].label} --out trials/")
+        con.print(f"  touches {touches_per_material} of each material in turn, from when a program opens the port")
+        con.print(f"  try: {escape(try_cmd)}", soft_wrap=True)
         sys.stdout.flush()
     start = time.monotonic()
     announced = -1

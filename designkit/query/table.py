@@ -261,10 +261,11 @@ class _View:
                               np.where(lo > h, np.log((svm - h) / (lo - h)) / z, np.nan))
             for k in range(1, lt.size - 1):
                 w = (lt[k] - lt[k - 1]) / (lt[k + 1] - lt[k - 1])
-                r = le[:, k] - ((1.0 - w) * le[:, k - 1] + w * le[:, k + 1])
-                v_mc = mc[:, k] ** 2 + ((1.0 - w) * mc[:, k - 1]) ** 2 + (w * mc[:, k + 1]) ** 2
-                v_rnd = rnd2[:, k] + (1.0 - w) ** 2 * rnd2[:, k - 1] + w ** 2 * rnd2[:, k + 1]
-                with np.errstate(invalid="ignore"):
+                # entries at or below half a width give infinite logs (inf - inf here): left out by `ok`
+                with np.errstate(invalid="ignore", over="ignore"):
+                    r = le[:, k] - ((1.0 - w) * le[:, k - 1] + w * le[:, k + 1])
+                    v_mc = mc[:, k] ** 2 + ((1.0 - w) * mc[:, k - 1]) ** 2 + (w * mc[:, k + 1]) ** 2
+                    v_rnd = rnd2[:, k] + (1.0 - w) ** 2 * rnd2[:, k - 1] + w ** 2 * rnd2[:, k + 1]
                     ok = (np.isfinite(r) & np.isfinite(v_mc) & (v_mc > 0) & np.isfinite(v_rnd)
                           & (np.fmin(np.fmin(ideal[:, k - 1], ideal[:, k]), ideal[:, k + 1]) >= 8.0 * h))
                 res.append(r[ok]), vm.append(v_mc[ok]), vr.append(v_rnd[ok])

@@ -24,10 +24,10 @@ def _busy_workers(proc: psutil.Process, n: int, cpu_s: float) -> bool:
 
 
 @pytest.mark.skipif(sys.platform == "win32", reason="process groups and SIGINT are POSIX")
-def test_ctrl_c_while_the_exact_route_runs_workers_is_quiet():
+def test_ctrl_c_while_the_exact_route_runs_workers_is_quiet(ctrl_c_able):
     proc = subprocess.Popen([sys.executable, "-m", "designkit", "min-contact", "--e1", "20000", "--e2", "18000",
                              "--exact", "--repeats", "32", "--json", "--jobs", "2"], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, start_new_session=True, text=True)
+                            stderr=subprocess.PIPE, start_new_session=True, text=True, **ctrl_c_able)
     try:
         me = psutil.Process(proc.pid)
         deadline = time.monotonic() + 120

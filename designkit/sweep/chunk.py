@@ -24,7 +24,7 @@ from .scorer import PairCell, PairScorer
 from .search import (ANCHOR_EVERY, IDEAL_UNKNOWN, closed_form_model, ideal_bound_s, ideal_staircase,
                      staircase_search, staircase_searches, with_anchors)
 
-__all__ = ["ChunkResult", "run_chunk", "run_scene", "search_window"]
+__all__ = ["ChunkResult", "estimated_costs", "run_chunk", "run_scene", "search_window"]
 
 
 @dataclass(frozen=True)
@@ -178,6 +178,41 @@ def _svm_staircases(cfg: SweepConfig, scorer: PairScorer, rows, floor):
         for name, v in (("J", J), ("J_lo", J_lo), ("J_hi", J_hi)):
             out[name][part] = v[where]
     return out["J"], out["J_lo"], out["J_hi"]
+
+
+#: The SVM's need over the ideal observer's, for :func:`estimated_costs` only (an ordering, not a result): the
+#: noise efficiency measured on svm-paper is 1.3 at 0.5 s, 1.7 at 2 s, 2.1 at 4 s of contact.
+_SVM_OVER_IDEAL = 1.7
+
+
+def estimated_costs(cfg: SweepConfig, point: tuple[int, ...], contact_index: int) -> np.ndarray:
+    """Relative cost of each block of one scene point and contact, to hand the costly chunks out first.
+
+    Nothing computed depends on it. An SVM chunk's cost is its staircase searches: about ``1 + log2(g)``
+    probes for a reference whose partner is ``g`` intervals away, next to nothing where the partner lies
+    beyond the grid; each probe a fit over ``contact_s`` seconds of samples. ``g`` is guessed as
+    ``1.7`` times the closed-form ideal observer's (at every :data:`ANCHOR_EVERY`-th reference, one
+    vectorized call for all blocks); where no closed form holds, every reference counts 1.
+
+    Measured on one 500-interval scene (2 s, sigma/dT 0.005) in 4 blocks: 6.2, 14.3, 20.0 and 0.6 s of CPU
+    (the highest effusivities mostly have no partner in the grid); estimated 52, 95, 119 and 0.
+    """
+    blocks = cfg.blocks_of()
+    contact = float(cfg.contact_s[contact_index])
+    sizes = np.array([b.size for b in blocks], dtype=np.float64)
+    if cfg.fidelity == "ideal":
+        return contact * sizes
+    sensor = cfg.resolved_sensor()
+    scene = cfg.scene(point, contact)
+    if closed_form_model(cfg, sensor, scene) is None:
+        return contact * sizes
+    sample = [b[::ANCHOR_EVERY] for b in blocks]
+    rows = np.concatenate(sample)
+    gap = _SVM_OVER_IDEAL * (ideal_staircase(cfg, sensor, ideal_bound_s(cfg, sensor, scene), rows) - rows)
+    live = rows + gap < cfg.intervals
+    probes = np.where(live, 1.0 + np.log2(np.maximum(gap, 1.0)), 0.0)
+    ends = np.cumsum([r.size for r in sample])[:-1]
+    return contact * ANCHOR_EVERY * np.array([p.sum() for p in np.split(probes, ends)])
 
 
 def search_window(scorer: PairScorer) -> int:

@@ -20,7 +20,7 @@ from typing import Callable, Iterator
 import numpy as np
 
 from .._validation import InputError
-from .chunk import ChunkResult, run_chunk
+from .chunk import ChunkResult, estimated_costs, run_chunk
 from .config import SweepConfig
 from .search import assemble, chunk_wall_s
 
@@ -97,6 +97,11 @@ def prepare_workdir(cfg: SweepConfig, workdir: Path, *, resume: bool, fresh: boo
     atomic_write_text(meta, json.dumps({"digest": cfg.digest(), "config": cfg.to_dict()}, indent=2))
 
 
+#: Up to this many chunks per worker, the chunks are ordered by estimated cost (a few milliseconds per scene
+#: point and contact); with more, handing them out as workers free up balances them well enough.
+_FEW_CHUNKS_PER_WORKER = 8
+
+
 def iter_sweep(cfg: SweepConfig, workdir: Path, *, jobs: int = 1, backend: str = "loky",
                scheduler: str | None = None) -> Iterator[tuple[ChunkResult, bool]]:
     """Run the missing chunks, all at once (no waves: chunks do not depend on each other).
@@ -104,7 +109,10 @@ def iter_sweep(cfg: SweepConfig, workdir: Path, *, jobs: int = 1, backend: str =
     Yields ``(chunk, computed)`` for every chunk of the sweep, reading the
     finished ones from ``workdir`` and computing the rest in parallel; each
     computed chunk is written atomically before it is yielded. Longest contact
-    times are submitted first so that the slowest chunks do not start last.
+    times are submitted first so that the slowest chunks do not start last; where
+    there are few chunks per worker (a single scene's blocks), the costliest by
+    :func:`~designkit.sweep.chunk.estimated_costs` go first, so that no worker
+    starts a long one while the others run out of work.
     """
     from joblib import Parallel, delayed
 
@@ -120,7 +128,14 @@ def iter_sweep(cfg: SweepConfig, workdir: Path, *, jobs: int = 1, backend: str =
                     todo.append((p, b, k))
     if not todo:
         return
-    todo.sort(key=lambda t: -t[2])
+    if 1 < len(todo) <= _FEW_CHUNKS_PER_WORKER * max(1, jobs) and (jobs != 1 or backend == "dask"):
+        cost = {}
+        for p, k in {(p, k) for p, _, k in todo}:
+            for b, c in enumerate(estimated_costs(cfg, p, k).tolist()):
+                cost[(p, b, k)] = c
+        todo.sort(key=lambda t: -cost[t])
+    else:
+        todo.sort(key=lambda t: -t[2])
     with _executor(backend, jobs, scheduler) as (ctx, n_jobs):
         calls = [delayed(run_chunk)(cfg, p, b, k) for p, b, k in todo]
         with ctx():

@@ -192,7 +192,7 @@ def estimated_costs(cfg: SweepConfig, point: tuple[int, ...], contact_index: int
     probes for a reference whose partner is ``g`` intervals away, next to nothing where the partner lies
     beyond the grid; each probe a fit over ``contact_s`` seconds of samples. ``g`` is guessed as
     ``1.7`` times the closed-form ideal observer's (at every :data:`ANCHOR_EVERY`-th reference, one
-    vectorized call for all blocks); where no closed form holds, every reference counts 1.
+    vectorized call for all blocks, about 0.2 s); where no closed form holds, every reference counts 1.
 
     Measured on one 500-interval scene (2 s, sigma/dT 0.005) in 4 blocks: 6.2, 14.3, 20.0 and 0.6 s of CPU
     (the highest effusivities mostly have no partner in the grid); estimated 52, 95, 119 and 0.

@@ -97,8 +97,9 @@ def prepare_workdir(cfg: SweepConfig, workdir: Path, *, resume: bool, fresh: boo
     atomic_write_text(meta, json.dumps({"digest": cfg.digest(), "config": cfg.to_dict()}, indent=2))
 
 
-#: Up to this many chunks per worker, the chunks are ordered by estimated cost (a few milliseconds per scene
-#: point and contact); with more, handing them out as workers free up balances them well enough.
+#: Up to this many chunks per worker, the chunks are ordered by estimated cost (about 0.2 s per scene point and
+#: contact, in the parent before any chunk starts); with more, handing them out as workers free up balances
+#: them well enough.
 _FEW_CHUNKS_PER_WORKER = 8
 
 

@@ -123,16 +123,18 @@ def reference(tab, kind: str, op: str, args):
     Asked with the table's own sensor temperature spread (an exported table answers for the conditions it
     was built with; the query route refuses a table built for another spread)."""
     kw = dict(table=tab, ideal_table=None, sensor_temp_spread_c=q.table_spread(tab))
+    # the grid read needs no Monte Carlo ideal bound (varied tables): the table route's own floor
+    from designkit.query import table as table_route
     try:
         if op == "min_contact":
             e1, e2, noise, dt = args
-            a = q.min_contact(e1, e2, noise_c=noise, delta_t_c=dt, **kw)
+            a = table_route.min_contact(e1, e2, noise_c=noise, delta_t_c=dt, ideal_bound=False, **kw)
         elif op == "distinguishable":
             e1, e2, noise, dt, c = args
             a = q.distinguishable(e1, e2, contact_s=c, noise_c=noise, delta_t_c=dt, **kw)
         else:
             e, noise, dt, c = args
-            a = q.delta_e(e, contact_s=c, noise_c=noise, delta_t_c=dt, **kw)
+            a = table_route.delta_e(e, contact_s=c, noise_c=noise, delta_t_c=dt, ideal_bound=False, **kw)
     except InputError as exc:
         # the library refuses temperatures and noise beyond 1e4 degC as bad input; a grid-bound export
         # (which never had them in its grid) calls the same question "outside"

@@ -244,8 +244,12 @@ def _scalar(words: str, unit: str):
             con.print(f"  SVM (the paper's classifier): {words} [bold green]{_fmt(d['value'], unit)}[/] "
                       f"{_interval(d, unit)}")
         ideal = d["ideal"]
+        iv = ideal.get("interval")
+        ends = (f", {iv['coverage']:.0%} interval {_fmt(iv['low'], unit)} to {_fmt(iv['high'], unit)}"
+                if iv else "")
         con.print(f"  ideal observer bound:         {_fmt(ideal['value'], unit)}"
-                  + (f"  ({ideal['method']}; no classifier does better)" if ideal["value"] is not None else ""))
+                  + (f"  ({ideal['method']}{ends}; no classifier does better)" if ideal["value"] is not None
+                     else ""))
     return line
 
 

@@ -115,14 +115,23 @@ class IdealBound:
         ``"closed-form"``, ``"monte-carlo"``, ``"closed-form+monte-carlo"`` (both were
         used along the search), ``"table"`` (interpolated from a table) or
         ``"none"`` (not available, see the answer's notes).
+    interval : (float or None, float or None, float) or None
+        ``(low, high, coverage)`` of a Monte Carlo bound estimated at query time
+        (:mod:`designkit.query.ideal_mc_bound`); None for a closed form (exact to its tolerance) or a table.
+        In ``to_dict`` only where present.
     """
 
     value: float | None
     method: str
+    interval: tuple | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        return {"value": number(self.value) if not isinstance(self.value, bool) else self.value,
-                "method": self.method}
+        out = {"value": number(self.value) if not isinstance(self.value, bool) else self.value,
+               "method": self.method}
+        if self.interval is not None:
+            low, high, cov = self.interval
+            out["interval"] = {"low": number(low), "high": number(high), "coverage": cov}
+        return out
 
 
 @dataclass(frozen=True)

@@ -218,6 +218,11 @@ class _Run:
                                  "standard_error": r.standard_error, "method": r.method})
         return r.f1
 
+    def ideal_method_at(self, classes, scene) -> str:
+        """How :meth:`ideal_f1` scores this scene (``"closed-form"`` or ``"monte-carlo"``), logged as a call."""
+        self.ideal_f1(classes, scene)
+        return self.ideal_calls[-1]["method"]
+
     def ideal_method(self, closed: bool) -> str:
         if closed:
             return "closed-form"
@@ -227,7 +232,7 @@ class _Run:
     # ---------------------------------------------------------------- the answer
     def answer(self, question: str, *, value, interval, ideal, ideal_method: str, objects, limiting, rule: str,
                scene: dict, details: dict, check_classes, check_at, notes=(), interval_coverage=None,
-               interval_kind=None, **computation) -> Answer:
+               interval_kind=None, ideal_interval=None, **computation) -> Answer:
         check = None
         if check_classes:
             c, n, d = check_at
@@ -240,7 +245,8 @@ class _Run:
         return Answer(
             question=question, route="exact", value=value, interval=tuple(interval),
             ideal_bound=IdealBound(ideal if isinstance(ideal, bool) else number(ideal),
-                                   ideal_method if ideal is not None else "none"),
+                                   ideal_method if ideal is not None else "none",
+                                   ideal_interval if ideal is not None else None),
             objects=tuple(objects), limiting_pair=tuple(limiting), materials_rule=rule, scene=scene,
             sensor=self.sensor.to_dict(), model=self.model.to_dict(), model_check=check, threshold=self.phi,
             details=details, computation=comp, notes=tuple(n for n in notes if n),
@@ -343,16 +349,26 @@ def exact_min_contact(e1=None, e2=None, *, m1=None, m2=None, objects=None, noise
     cov = check_coverage(coverage)
     floor = 1.0 / run.sensor.sample_rate_hz
     closed = run.closed_form(*cls)
+    ideal_interval = None
     if closed:
         from .ideal_bound import exact_ideal_min_contact
 
         ideal = number(exact_ideal_min_contact(run.sensor, cls[0].e_range[0], cls[1].e_range[0],
                                                noise / abs(dt), width=run.width, threshold=run.phi,
                                                max_contact_s=tmax))
-    else:
+    elif run.ideal_method_at(cls, scene(tmax)) == "closed-form":
+        # a model whose extra physics is invisible in this scene: the closed form along the search
         ideal_ok = lambda c: run.ideal_f1(cls, scene(c)) >= run.phi  # noqa: E731
-        itol = min(0.01, tolerance_s)
-        ideal = bisect(ideal_ok, floor, tmax, itol) if ideal_ok(tmax) else None
+        ideal = bisect(ideal_ok, floor, tmax, min(0.01, tolerance_s)) if ideal_ok(tmax) else None
+    else:  # Monte Carlo: the crossing of the ideal F1 estimated with its interval (ideal_mc_bound)
+        from .ideal_mc_bound import mc_ideal_min_contact
+
+        mcb = mc_ideal_min_contact(cls[0], cls[1], run.sensor, noise_c=noise, delta_t_c=dt,
+                                   sensor_temp_spread_c=run.spread, model=run.model, threshold=run.phi,
+                                   max_contact_s=tmax, n_mc=run.n_mc, seed=run.seed, coverage=cov)
+        run.ideal_calls.extend(dict(e) for e in mcb.evaluations)
+        ideal = mcb.value
+        ideal_interval = None if mcb.coverage is None else (mcb.low, mcb.high, mcb.coverage)
     # the SVM needs at least the ideal observer's contact: search from there
     start = max(floor, ideal if ideal is not None else floor)
     def svm_at(c):
@@ -376,7 +392,9 @@ def exact_min_contact(e1=None, e2=None, *, m1=None, m2=None, objects=None, noise
                 break
             c *= 2.0
     value = est.value if est.value is None or ideal is None else max(est.value, ideal)
-    interval = (est.low if est.low is None or ideal is None else max(est.low, ideal), est.high)
+    # the SVM's interval never reaches below the ideal observer's (a Monte Carlo bound: its low end)
+    ideal_floor = ideal if ideal_interval is None else ideal_interval[0]
+    interval = (est.low if est.low is None or ideal_floor is None else max(est.low, ideal_floor), est.high)
     evaluations = [{"contact_s": e["x"], "svm_f1": e["svm_f1"], "standard_error": e["standard_error"]}
                    for e in est.evaluations]
     needed = tmax if value is None else max(x for x in (value, ideal, interval[1]) if x is not None)
@@ -384,7 +402,7 @@ def exact_min_contact(e1=None, e2=None, *, m1=None, m2=None, objects=None, noise
     if falls is not None:
         note = (f"the SVM's F1 is not monotone in contact time here: {falls[1]:.3f} at {falls[0]:.3g} s but "
                 f"{falls[3]:.3f} at {falls[2]:g} s; the answer is its first crossing")
-    return run.answer("min-contact", value=value, interval=interval, ideal=ideal,
+    return run.answer("min-contact", value=value, interval=interval, ideal=ideal, ideal_interval=ideal_interval,
                       ideal_method=run.ideal_method(closed), objects=pq.objects_dicts(),
                       limiting=pq.limiting_dicts(), rule=pq.rule, scene=scene_d, details={}, check_classes=cls,
                       check_at=(needed, noise, dt), notes=[note], evaluations=evaluations, max_contact_s=tmax,
@@ -430,37 +448,50 @@ def _exact_ratio(question: str, kw: dict) -> Answer:
             return run.scene(contact, noise, noise / r)
 
     closed = run.closed_form(*cls)
+    ideal_iv = None  # (low, high) in sigma/dT of a Monte Carlo bound
     if closed:
         from .ideal_bound import exact_ideal_max_ratio
 
         ideal_r = number(exact_ideal_max_ratio(run.sensor, cls[0].e_range[0], cls[1].e_range[0], contact,
                                                width=run.width, threshold=run.phi, bracket=RATIO_BRACKET))
-    else:
+    elif run.ideal_method_at(cls, scene(lo_r)) == "closed-form":  # extra physics invisible here
         ideal_r = None
         if run.ideal_f1(cls, scene(lo_r)) >= run.phi:
             ideal_r = hi_r if run.ideal_f1(cls, scene(hi_r)) >= run.phi else \
                 bisect(lambda x: run.ideal_f1(cls, scene(x)) < run.phi, lo_r, hi_r, 2e-3, log=True)
-    # no classifier tolerates more noise than the ideal observer: search below its ratio. The mean SVM F1
-    # falls with sigma/dT; one crossing in log(sigma/dT) answers both max-noise and min-delta-t
-    top = hi_r if ideal_r is None else min(hi_r, ideal_r)
+    else:  # Monte Carlo: the crossing estimated with its interval (ideal_mc_bound)
+        from .ideal_mc_bound import mc_ideal_max_ratio
+
+        mcb = mc_ideal_max_ratio(cls[0], cls[1], run.sensor, scene, lo_r, hi_r, model=run.model,
+                                 threshold=run.phi, n_mc=run.n_mc, seed=run.seed, coverage=cov)
+        run.ideal_calls.extend({"contact_s": contact, **e} for e in mcb.evaluations)
+        ideal_r = mcb.value
+        if mcb.coverage is not None:
+            ideal_iv = (mcb.low, mcb.high)
+    # no classifier tolerates more noise than the ideal observer: search below its ratio (a Monte Carlo
+    # bound's high end). The mean SVM F1 falls with sigma/dT; one crossing in log(sigma/dT) answers both
+    ideal_cap = ideal_r if ideal_iv is None else ideal_iv[1]
+    top = hi_r if ideal_cap is None else min(hi_r, ideal_cap)
     est = estimate_crossing(lambda x: run.svm(cls, scene(x)), lo_r, max(top, lo_r * 1.0001), run.phi,
                             increasing=False, coverage=cov, progress=kw.get("progress"))
     r, r_lo, r_hi = est.value, est.low, est.high
     if ideal_r is not None:
-        r, r_hi = (None if r is None else min(r, ideal_r)), (None if r_hi is None else min(r_hi, ideal_r))
+        r, r_hi = (None if r is None else min(r, ideal_r)), (None if r_hi is None else min(r_hi, ideal_cap))
     if question == "max-noise":
         conv = lambda x: None if x is None else x * abs(dt)  # noqa: E731
         interval = (conv(r_lo), conv(r_hi))
+        ideal_interval = None if ideal_iv is None else (conv(ideal_iv[0]), conv(ideal_iv[1]), cov)
     else:
         conv = lambda x: None if x is None else noise / x  # noqa: E731
         interval = (conv(r_hi), conv(r_lo))
+        ideal_interval = None if ideal_iv is None else (conv(ideal_iv[1]), conv(ideal_iv[0]), cov)
     evaluations = [{"noise_ratio": e["x"], "svm_f1": e["svm_f1"], "standard_error": e["standard_error"]}
                    for e in est.evaluations]
     # the model check at the answer: the smaller sigma/dT of the SVM's and the ideal observer's is the stricter
     r_check = min([x for x in (r, ideal_r) if x is not None], default=lo_r)
     check_at = (contact, r_check * abs(dt), dt) if question == "max-noise" else (contact, noise, noise / r_check)
     note = "" if r is not None else f"not separable even at sigma/dT = {lo_r:g}"
-    return run.answer(question, value=conv(r), interval=interval, ideal=conv(ideal_r),
+    return run.answer(question, value=conv(r), interval=interval, ideal=conv(ideal_r), ideal_interval=ideal_interval,
                       ideal_method=run.ideal_method(closed), objects=pq.objects_dicts(),
                       limiting=pq.limiting_dicts(), rule=pq.rule, scene=scene_d, details={}, check_classes=cls,
                       check_at=check_at, notes=[note], evaluations=evaluations, estimate_method=est.method,
@@ -597,16 +628,26 @@ def exact_delta_e(e: float | None = None, *, m: str | None = None, contact_s: fl
             lo = x + sign * d
             return ObjectClass(f"{lo:g}", (lo, lo + w), ref.diffusivity_range_m2_s)
 
+        ideal_interval = None
         if closed:
             from .ideal_bound import exact_ideal_delta
 
             ideal = number(exact_ideal_delta(run.sensor, x, contact, noise / abs(dt), direction=sign, width=w,
                                              threshold=run.phi, e_max=e_max))
-        else:
+        elif run.ideal_method_at((ref, part(limit)), scene) == "closed-form":  # extra physics invisible here
             def iok(d, part=part):
                 return run.ideal_f1((ref, part(d)), scene) >= run.phi
 
             ideal = bisect(iok, 0.0, limit, 1.0) if iok(limit) else None
+        else:  # Monte Carlo: the crossing estimated with its interval (ideal_mc_bound)
+            from .ideal_mc_bound import mc_ideal_delta
+
+            mcb = mc_ideal_delta(ref, sign, run.sensor, contact_s=contact, noise_c=noise, delta_t_c=dt,
+                                 sensor_temp_spread_c=run.spread, model=run.model, threshold=run.phi, e_max=e_max,
+                                 n_mc=run.n_mc, seed=run.seed, coverage=cov)
+            run.ideal_calls.extend({"contact_s": contact, **e} for e in mcb.evaluations)
+            ideal = mcb.value
+            ideal_interval = None if mcb.coverage is None else [mcb.low, mcb.high]
         if ideal is None:  # not even the ideal observer separates a partner within the range: nor does the SVM
             sides[side] = {"value": None, "interval": [None, None], "ideal": None, "coverage": None,
                            "estimate_method": "none", "evaluations": []}
@@ -616,9 +657,10 @@ def exact_delta_e(e: float | None = None, *, m: str | None = None, contact_s: fl
         est = estimate_crossing(lambda d, part=part: run.svm((ref, part(d)), scene), start, limit, run.phi,
                                 coverage=cov, progress=progress)
         val, lo_d, hi_d = est.value, est.low, est.high
+        ideal_floor = ideal if ideal_interval is None else ideal_interval[0]
         if ideal is not None and val is not None:
-            val, lo_d = max(val, ideal), (None if lo_d is None else max(lo_d, ideal))
-        sides[side] = {"value": val, "interval": [lo_d, hi_d], "ideal": ideal,
+            val, lo_d = max(val, ideal), (None if lo_d is None else max(lo_d, ideal_floor))
+        sides[side] = {"value": val, "interval": [lo_d, hi_d], "ideal": ideal, "ideal_interval": ideal_interval,
                        "coverage": cov if est.stated else None, "estimate_method": est.method,
                        "evaluations": [{"delta_e": e["x"], "svm_f1": e["svm_f1"],
                                         "standard_error": e["standard_error"]} for e in est.evaluations]}
@@ -631,7 +673,11 @@ def exact_delta_e(e: float | None = None, *, m: str | None = None, contact_s: fl
     best = min((s for s in sides.values() if s["value"] is not None), key=lambda s: s["value"], default=None)
     interval = tuple(best["interval"]) if best is not None else (None, None)
     stated = best is not None and best.get("coverage") is not None
+    from .ideal_mc_bound import nearer_side_interval
+
+    ideal_interval = nearer_side_interval(sides, cov)
     return run.answer("delta-e", value=min(finite) if finite else None, interval=interval,
+                      ideal_interval=ideal_interval,
                       interval_coverage=cov if stated else None,
                       interval_kind="exact-estimate" if stated else "exact",
                       ideal=min(ifinite) if ifinite else None, ideal_method=run.ideal_method(closed),

@@ -1059,7 +1059,7 @@ def _scene_wanted(view: _View, noise, dt) -> dict[str, Any]:
 def _answer(question: str, op: _Opened, *, objects, limiting, rule: str, scene: dict, value, interval,
             ideal, ideal_method: str = "table", in_grid: dict, details: dict, notes: Sequence[str] = (),
             check_at: tuple[float, float, float] | None = None, classes=(), interval_kind=None,
-            interval_coverage=None, computation: dict | None = None) -> Answer:
+            interval_coverage=None, computation: dict | None = None, ideal_interval=None) -> Answer:
     check = None
     if check_at is not None and classes:
         c, n, d = check_at
@@ -1068,7 +1068,8 @@ def _answer(question: str, op: _Opened, *, objects, limiting, rule: str, scene: 
     return Answer(
         question=question, route="table", value=value, interval=tuple(interval),
         ideal_bound=IdealBound(number(ideal) if not isinstance(ideal, bool) else ideal,
-                               ideal_method if ideal is not None else "none"),
+                               ideal_method if ideal is not None else "none",
+                               ideal_interval if ideal is not None else None),
         objects=tuple(objects), limiting_pair=tuple(limiting), materials_rule=rule, scene=scene,
         sensor=op.tab.sensor.to_dict(), model=op.model.to_dict(), model_check=check, threshold=op.phi,
         table=op.tab.name, table_hash=op.tab.header.get("content_hash"), ideal_table=ideal_table,
@@ -1111,7 +1112,7 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
                 threshold: float | None = None, table: "Table | str" = DEFAULT_TABLE,
                 ideal_table: "Table | str | None" = DEFAULT_IDEAL_TABLE, sensor=None, model=None,
                 coverage: float = 0.9,
-                sensor_temp_spread_c: float = 0.0) -> Answer:
+                sensor_temp_spread_c: float = 0.0, ideal_bound: bool = True) -> Answer:
     """Shortest contact time [s] that separates two objects, from a table.
 
     Parameters
@@ -1136,6 +1137,13 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
         Must be the table's (default: whatever the table was built with).
     coverage : float
         Nominal coverage of the interval, in (0, 1).
+    sensor_temp_spread_c : float
+        Half-width [degC] of the per-touch sensor temperature; must be the table's.
+    ideal_bound : bool
+        Where the bound has no closed form (varied initial conditions), estimate it by Monte Carlo at
+        query time (:mod:`designkit.query.ideal_mc_bound`, 1-2 s). False: read the table's own floor
+        instead (method ``"table"``; for a varied table an observer told each touch's Ts0, looser): what
+        the grid reads of exports and :func:`grid_answer` need, and distinguishable's own readings.
 
     Returns
     -------
@@ -1192,16 +1200,27 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
     monte_carlo = {"monte_carlo_interval": list(mc_interval)}  # the table's delta_lo / delta_hi answers alone
     if "delta_up_ideal" in view.t.arrays:  # the grid's own bound, beside the exact one (its interpolation error)
         monte_carlo["table_ideal_s"] = contact_for(view, "ideal", combos)
+    ideal_interval = None
     if op.closed:
         from .ideal_bound import cached_ideal_min_contact
 
         ideal = number(cached_ideal_min_contact(op.tab.sensor, lo, hi, noise / abs(dt), width=op.width,
                                                threshold=op.phi, max_contact_s=CLOSED_FORM_MAX_CONTACT_S))
         ideal_method = "closed-form"
-    else:
+    elif not ideal_bound:  # the table's own floor (no Monte Carlo)
         icombos, iflags = op.iview.scene_weights(noise, dt) if op.iview is not None else ([], {"ideal": False})
         ideal = contact_for(op.iview, op.ikind, icombos) if all(iflags.values()) else None
         ideal_method = "table"
+    else:  # no closed form (varied initial conditions, per-object shapes): Monte Carlo at query time
+        from .ideal_mc_bound import cached_mc_ideal_min_contact
+
+        mcb = cached_mc_ideal_min_contact(*pq.classes, op.tab.sensor, noise_c=noise, delta_t_c=dt,
+                                          sensor_temp_spread_c=table_spread(op.tab), model=op.model,
+                                          threshold=op.phi, max_contact_s=CLOSED_FORM_MAX_CONTACT_S,
+                                          coverage=coverage)
+        ideal, ideal_method = mcb.value, "monte-carlo"
+        ideal_interval = None if mcb.coverage is None else (mcb.low, mcb.high, mcb.coverage)
+        monte_carlo["ideal_monte_carlo"] = {"n_mc": mcb.n_mc, "evaluations": len(mcb.evaluations)}
     note = "" if value is not None else (
         f"no tabulated contact time up to {view.contacts[-1]:g} s separates them "
         "(the exact route examines longer contacts)")
@@ -1229,7 +1248,8 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
             # the crossing of a log-log interpolation (the need falls roughly as a power of the contact time)
             raw = value
             est = contact_estimate(grid[k_cross - 1], grid[k_cross], needs[k_cross - 1], needs[k_cross], hi - lo,
-                                   raw, _arr(mc_interval[0]), _arr(mc_interval[1]), _arr(ideal), width=op.width,
+                                   raw, _arr(mc_interval[0]), _arr(mc_interval[1]),
+                                   _arr(ideal if ideal_interval is None else ideal_interval[0]), width=op.width,
                                    svm=op.tab.fidelity == "svm", z_table=table_z(op.tab),
                                    zc=z_of_coverage(coverage))
             value, low, high = float(est["value"]), _opt(est["low"]), _opt(est["high"])
@@ -1238,7 +1258,8 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
             monte_carlo.update(interpolation_error_log=interp, rounding_error_log=rounding, table_crossing_s=raw)
         else:
             prev = grid[k_cross - 1] if k_cross > 0 else 0.0
-            low = max(prev, ideal) if ideal is not None else prev
+            ideal_floor = ideal if ideal_interval is None else ideal_interval[0]
+            low = max(prev, ideal_floor) if ideal_floor is not None else prev
             interval, kind = (low, value), "table-cell"
             why = ("the table's first contact time" if k_cross == 0 else
                    f"the table's next contact time after {prev:g} s, where they are not separable within its "
@@ -1247,7 +1268,7 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
                     "support an interval of stated coverage there (the exact route estimates it)")
     needed = value if value is not None else float(view.contacts[-1])
     return _answer("min-contact", op, value=value, interval=interval, ideal=ideal, ideal_method=ideal_method,
-                   in_grid=flags, details={}, notes=[note], check_at=(needed, noise, dt),
+                   ideal_interval=ideal_interval, in_grid=flags, details={}, notes=[note], check_at=(needed, noise, dt),
                    interval_kind=kind, interval_coverage=cov, computation=monte_carlo, **common)
 
 
@@ -1454,7 +1475,7 @@ def min_delta_t(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact_s: 
 def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, noise_c: float = 0.05,
             delta_t_c: float = 10.0, threshold=None, table=DEFAULT_TABLE, ideal_table=DEFAULT_IDEAL_TABLE,
             sensor=None, model=None, coverage: float = 0.9,
-            sensor_temp_spread_c: float = 0.0) -> Answer:
+            sensor_temp_spread_c: float = 0.0, ideal_bound: bool = True) -> Answer:
     """delta(e) towards lower and higher effusivity [J s^-1/2 K^-1 m^-2] (table).
 
     ``value`` is the smaller of the two; ``details["lower"]`` and
@@ -1463,7 +1484,8 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
     error: linear against log-space interpolation over contact time and sigma/dT)
     and ideal bound (None: nothing distinguishable within the grid that way).
     ``interval`` is the interval of the direction giving ``value``. ``m``: a
-    material, its range's middle as the reference.
+    material, its range's middle as the reference. ``ideal_bound``: as :func:`min_contact`'s (each
+    direction's bound by Monte Carlo where no closed form holds, or False: the table's own floor).
     """
     contact = check_contact(contact_s)
     coverage = check_coverage(coverage)
@@ -1523,6 +1545,17 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
               if op.tab.fidelity == "svm" else [val, val])
         iname = f"delta_{direction}_ideal" if ikind == "ideal" else f"delta_{direction}"
         ideal_side = at(iview, icombos, icw, iname)
+        ideal_floor, extra = ideal_side, {}
+        if not op.closed and ideal_bound:  # no closed form: Monte Carlo at query time, the grid's kept beside it
+            from .ideal_mc_bound import cached_mc_ideal_delta
+
+            mcb = cached_mc_ideal_delta(ref, 1 if direction == "up" else -1, op.tab.sensor, contact_s=contact,
+                                        noise_c=noise, delta_t_c=dt, sensor_temp_spread_c=table_spread(op.tab),
+                                        model=op.model, threshold=op.phi, coverage=coverage)
+            extra = {"table_ideal": ideal_side,
+                     "ideal_interval": None if mcb.coverage is None else [mcb.low, mcb.high]}
+            ideal_side = mcb.value
+            ideal_floor = mcb.value if mcb.coverage is None else mcb.low
         stated, cov_side, method = [None, None], None, "none"
         eff = both[direction]
         if eff is not None and val is None and not partner_in_grid(view, x, eff["value"], direction):
@@ -1534,21 +1567,26 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
             continue
         if val is not None and op.tab.fidelity == "svm":
             geo = at(view, combos, gcw, f"delta_{direction}", geometric=True)
-            low, high = (_opt(v) for v in delta_estimate(val, _arr(iv[0]), _arr(iv[1]), _arr(geo), _arr(ideal_side),
+            low, high = (_opt(v) for v in delta_estimate(val, _arr(iv[0]), _arr(iv[1]), _arr(geo), _arr(ideal_floor),
                                                          width=op.width, z_table=z_t, zc=zc))
             stated, cov_side, method = [low, high], coverage, "table-estimate"
         sides[side] = {"value": val, "interval": stated, "ideal": ideal_side, "coverage": cov_side,
-                       "estimate_method": method, "monte_carlo_interval": iv}
+                       "estimate_method": method, "monte_carlo_interval": iv, **extra}
     finite = [s["value"] for s in sides.values() if s["value"] is not None]
     ifinite = [s["ideal"] for s in sides.values() if s["ideal"] is not None]
     best = min((s for s in sides.values() if s["value"] is not None), key=lambda s: s["value"], default=None)
     stated = best is not None and best["coverage"] is not None
     closed = best is not None and best["estimate_method"] == "table-efficiency"
+    from .ideal_mc_bound import nearer_side_interval
+
     return _answer("delta-e", op, value=min(finite) if finite else None,
                    interval=tuple(best["interval"]) if stated else (None, None),
                    interval_kind=best["estimate_method"] if stated else "none",
                    interval_coverage=coverage if stated else None,
-                   ideal=min(ifinite) if ifinite else None, ideal_method="closed-form" if closed else "table",
+                   ideal=min(ifinite) if ifinite else None,
+                   ideal_method="closed-form" if closed else "table" if op.closed or not ideal_bound
+                   else "monte-carlo",
+                   ideal_interval=nearer_side_interval(sides, coverage),
                    in_grid=flags, details=_delta_details(x, sides),
                    check_at=(contact, noise, dt), **common)
 
@@ -1699,9 +1737,10 @@ def distinguishable(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact
     if not svm:
         grid["lo"] = grid["hi"] = grid["svm"]
     ideal_f1, ideal_method = _ideal_pair_f1(pq.classes, op, contact, noise, dt, table_spread(op.tab))
-    # the answer: the contact against min-contact's own estimate for this pair and scene
+    # the answer: the contact against min-contact's own estimate for this pair and scene (where the bound has
+    # no closed form, with the table's own floor under its interval: the verdict needs no Monte Carlo bound)
     mc = min_contact(objects=pq.classes, noise_c=noise, delta_t_c=dt, table=op.tab, ideal_table=ideal_table,
-                     sensor_temp_spread_c=sensor_temp_spread_c, coverage=coverage)
+                     sensor_temp_spread_c=sensor_temp_spread_c, coverage=coverage, ideal_bound=False)
     t_min = mc.value
     yes = t_min is not None and contact >= t_min
     sure, note = _contact_verdict(contact, mc, coverage)
@@ -1710,7 +1749,8 @@ def distinguishable(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact
                    coverage=coverage)
         mn = (max_noise(objects=pq.classes, contact_s=contact, delta_t_c=dt, **ask)
               if "noise_ratio" in op.tab.axes else None)
-        de = [delta_e(e, contact_s=contact, noise_c=noise, delta_t_c=dt, **ask) for e in (lo, hi)]
+        de = [delta_e(e, contact_s=contact, noise_c=noise, delta_t_c=dt, ideal_bound=False, **ask)
+              for e in (lo, hi)]
         reads = _other_readings(noise, hi - lo, None if mn is None else (mn.value, *mn.interval)
                                 if mn.interval_coverage is not None else None,
                                 [(d.details[side]["value"], *d.details[side]["interval"])

@@ -314,6 +314,11 @@ def _table_pair(question: str, x: dict[str, np.ndarray], op, ideal_bound: bool,
     return res
 
 
+def _coverage_of(zc: float) -> float:
+    """The coverage whose two-sided normal quantile is ``zc`` (inverse of :func:`z_of_coverage`, to 1e-12)."""
+    return round(math.erf(zc / math.sqrt(2.0)), 12)
+
+
 def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> None:
     view = op.view
     grid = view.contacts
@@ -341,12 +346,10 @@ def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> None
         n_at[idx] = need[np.maximum(k, 0), cols]
         ilo = _crossing(grid, _need(view, "lo", combos, l, h), gap)[0] if svm else value
         ihi = _crossing(grid, _need(view, "hi", combos, l, h), gap)[0] if svm else value
-        if not op.closed:
-            if op.iview is not None:
-                icombos, iflags = op.iview.scene_weights(noise, dt)
-                if all(iflags.values()):
-                    res["ideal"][idx] = _crossing(op.iview.contacts, _need(op.iview, op.ikind, icombos, l, h),
-                                                  gap)[0]
+        if not op.closed and not ideal_bound and op.iview is not None:  # the table's own floor (the scalar's)
+            icombos, iflags = op.iview.scene_weights(noise, dt)
+            if all(iflags.values()):
+                res["ideal"][idx] = _crossing(op.iview.contacts, _need(op.iview, op.ikind, icombos, l, h), gap)[0]
         if efficiency and (has := k >= 0).any():
             r = _table_route.noise_k_min_contact(op, combos, k[has], l[has], h[has], noise / abs(dt), zc=zc)
             for key in eff:
@@ -361,9 +364,26 @@ def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> None
         res["ideal"][todo] = cached_ideal_min_contact(
             op.tab.sensor, lo[todo], hi[todo], ratio[todo], width=op.width, threshold=op.phi,
             max_contact_s=_table_route.CLOSED_FORM_MAX_CONTACT_S)
+    # no closed form (varied initial conditions, per-object shapes): the scalar route's Monte Carlo bound, one
+    # call per element (remembered per distinct question); the intervals below are floored at its low end
+    ideal_floor = res["ideal"]
+    if not op.closed and ideal_bound and todo.any():
+        from ..objects import ObjectClass
+        from .ideal_mc_bound import cached_mc_ideal_min_contact
+
+        ideal_floor = res["ideal"].copy()
+        spread = _table_route.table_spread(op.tab)
+        for i in np.nonzero(todo)[0]:
+            mcb = cached_mc_ideal_min_contact(
+                ObjectClass("a", (lo[i], lo[i] + op.width)), ObjectClass("b", (hi[i], hi[i] + op.width)),
+                op.tab.sensor, noise_c=float(x["noise_c"][i]), delta_t_c=float(x["delta_t_c"][i]),
+                sensor_temp_spread_c=spread, model=op.model, threshold=op.phi,
+                max_contact_s=_table_route.CLOSED_FORM_MAX_CONTACT_S, coverage=_coverage_of(zc))
+            res["ideal"][i] = np.nan if mcb.value is None else mcb.value
+            ideal_floor[i] = np.nan if mcb.value is None else mcb.low if mcb.coverage is not None else mcb.value
     # the scalar route's interval: an estimate where the crossing is interpolated between two tabulated needs
     # (table.contact_estimate, the same function), else the grid cell, never below the ideal bound
-    raw, ideal = res["value"], res["ideal"]
+    raw, ideal = res["value"], ideal_floor
     low, high = _nan(lo.size), _nan(lo.size)
     value = raw.copy()
     by_eff = np.zeros(lo.size, dtype=bool)
@@ -552,7 +572,7 @@ def _distinguishable(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float, ide
     mc = {k: _nan(lo.size) for k in ("value", "low", "high", "ideal")}
     mc["in_grid"], mc["stated"] = np.zeros(lo.size, dtype=bool), np.zeros(lo.size, dtype=bool)
     if todo.any():
-        _min_contact(x, op, lo, hi, todo, mc, True, zc)
+        _min_contact(x, op, lo, hi, todo, mc, op.closed, zc)  # no Monte Carlo bound (the scalar's)
     t, a, b, c = mc["value"], mc["low"], mc["high"], x["contact_s"]
     with np.errstate(invalid="ignore"):
         yes = ~np.isnan(t) & (c >= t)
@@ -601,7 +621,7 @@ def _others_decide(x, op, lo, hi, i: np.ndarray, yes: np.ndarray, zc: float, ide
                 (mn["low"] <= noise) & (noise <= mn["high"]))
             sure["max-noise"] = (out, noise <= mn["value"])
     de = _table_delta_e({"e": np.concatenate([l, h]), "contact_s": np.tile(c, 2), "noise_c": np.tile(noise, 2),
-                         "delta_t_c": np.tile(dt, 2)}, op, ideal_table, zc)
+                         "delta_t_c": np.tile(dt, 2)}, op, ideal_table, zc, ideal_bound=False)
     parts = [(de[f"{side}"][sl], de[f"{side}_low"][sl], de[f"{side}_high"][sl])
              for side, sl in (("upper", slice(0, n)), ("lower", slice(n, 2 * n)))]
     with np.errstate(invalid="ignore"):
@@ -616,7 +636,27 @@ def _others_decide(x, op, lo, hi, i: np.ndarray, yes: np.ndarray, zc: float, ide
     return out
 
 
-def _table_delta_e(x: dict[str, np.ndarray], op, ideal_table, zc: float) -> dict[str, np.ndarray]:
+def _mc_delta_bounds(op, e: np.ndarray, direction: int, contact: float, noise: float, dt: float,
+                     zc: float) -> tuple[np.ndarray, np.ndarray]:
+    """Per reference: the Monte Carlo ideal delta(e) of one direction and the low end of its interval (the
+    scalar route's :func:`~designkit.query.ideal_mc_bound.cached_mc_ideal_delta`; NaN: none)."""
+    from ..objects import ObjectClass
+    from .ideal_mc_bound import cached_mc_ideal_delta
+
+    value, floor = _nan(e.size), _nan(e.size)
+    for i, xe in enumerate(e.tolist()):
+        mcb = cached_mc_ideal_delta(ObjectClass("r", (xe, xe + op.width)), direction, op.tab.sensor,
+                                    contact_s=contact, noise_c=noise, delta_t_c=dt,
+                                    sensor_temp_spread_c=_table_route.table_spread(op.tab), model=op.model,
+                                    threshold=op.phi, coverage=_coverage_of(zc))
+        if mcb.value is not None:
+            value[i] = mcb.value
+            floor[i] = mcb.low if mcb.coverage is not None else mcb.value
+    return value, floor
+
+
+def _table_delta_e(x: dict[str, np.ndarray], op, ideal_table, zc: float,
+                   ideal_bound: bool = True) -> dict[str, np.ndarray]:
     e = x["e"]
     n = e.size
     view = op.view
@@ -658,6 +698,9 @@ def _table_delta_e(x: dict[str, np.ndarray], op, ideal_table, zc: float) -> dict
             val = at(view, combos, cw, f"delta_{direction}")
             iname = f"delta_{direction}_ideal" if ikind == "ideal" else f"delta_{direction}"
             ideal = at(iview, icombos, icw, iname)
+            floor = ideal
+            if not op.closed and ideal_bound:  # the scalar route's Monte Carlo bound, one call per element
+                ideal, floor = _mc_delta_bounds(op, xe, 1 if direction == "up" else -1, contact, noise, dt, zc)
             mc_lo = at(view, combos, cw, f"delta_{direction}_lo") if svm else None
             mc_hi = at(view, combos, cw, f"delta_{direction}_hi") if svm else None
             by_eff = np.zeros(xe.size, dtype=bool)
@@ -677,7 +720,7 @@ def _table_delta_e(x: dict[str, np.ndarray], op, ideal_table, zc: float) -> dict
             res[side][idx], res[f"{side}_ideal"][idx] = val, ideal
             if svm:  # the scalar route's interval (table.delta_estimate, the same function)
                 low, high = _table_route.delta_estimate(
-                    val, mc_lo, mc_hi, at_geometric(view, combos, gcw, f"delta_{direction}"), ideal, width=op.width,
+                    val, mc_lo, mc_hi, at_geometric(view, combos, gcw, f"delta_{direction}"), floor, width=op.width,
                     z_table=_table_route.table_z(op.tab), zc=zc)
                 if efficiency:
                     low, high = np.where(by_eff, r["low"], low), np.where(by_eff, r["high"], high)
@@ -751,7 +794,8 @@ def answer_arrays(question: str, scalar: Callable[..., Answer], route: str, argu
         zc = z_of_coverage(check_coverage(others.get("coverage", 0.9)))
         res = (_table_pair(question, flat, op, ideal_bound, zc,
                            others.get("ideal_table", _table_route.DEFAULT_IDEAL_TABLE)) if pair
-               else _table_delta_e(flat, op, others.get("ideal_table", _table_route.DEFAULT_IDEAL_TABLE), zc))
+               else _table_delta_e(flat, op, others.get("ideal_table", _table_route.DEFAULT_IDEAL_TABLE), zc,
+                                   ideal_bound))
         res = {k: v.reshape(shape) for k, v in res.items()}
         table = op.tab.name
     else:

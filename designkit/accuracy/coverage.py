@@ -36,6 +36,7 @@ Examples
 from __future__ import annotations
 
 import math
+from contextlib import nullcontext
 from statistics import NormalDist
 from typing import Any, Callable, Iterable, Mapping, Sequence
 
@@ -411,13 +412,16 @@ def run_cases(question: str, n: int, *, seed: int, jobs: int = 1, done: Callable
     called as each finishes (for progress and saving)."""
     from joblib import Parallel, delayed
 
+    from .._workers import local_processes
+
     rng = as_generator([int(seed), COVERAGE_QUESTIONS.index(question)])
     cases = [draw_case(question, rng) for _ in range(int(n))]
     results = []
-    gen = Parallel(n_jobs=jobs, return_as="generator_unordered")(
-        delayed(coverage_case)(question, c, i, **options) for i, c in enumerate(cases) if i >= start)
-    for r in gen:
-        results.append(r)
-        if done is not None:
-            done(r)
+    with local_processes() if jobs != 1 else nullcontext():
+        gen = Parallel(n_jobs=jobs, return_as="generator_unordered")(
+            delayed(coverage_case)(question, c, i, **options) for i, c in enumerate(cases) if i >= start)
+        for r in gen:
+            results.append(r)
+            if done is not None:
+                done(r)
     return sorted(results, key=lambda r: r["index"])

@@ -30,6 +30,7 @@ Examples
 from __future__ import annotations
 
 import math
+from contextlib import nullcontext
 import time
 from dataclasses import dataclass, field
 from typing import Any, Callable
@@ -155,15 +156,17 @@ class _Run:
         (fresh seeds at every call, :meth:`seeds`)."""
         from joblib import Parallel, delayed
 
+        from .._workers import local_processes
         from ..recognition.svm import pair_f1
 
         a, b = classes
         if self.solver == "batched":
             return self._svm_batched(a, b, scene)
         jobs = self.jobs if self.repeats > 1 else 1
-        results = Parallel(n_jobs=jobs, prefer="processes" if jobs != 1 else None)(
-            delayed(pair_f1)(a, b, self.sensor, scene, model=self.model, trials=self.trials, folds=self.folds,
-                             seed=s) for s in self.seeds())
+        with local_processes() if jobs != 1 else nullcontext():
+            results = Parallel(n_jobs=jobs)(
+                delayed(pair_f1)(a, b, self.sensor, scene, model=self.model, trials=self.trials, folds=self.folds,
+                                 seed=s) for s in self.seeds())
         f1 = np.array([r.f1 for r in results])
         se_fold = math.sqrt(float(np.mean([r.standard_error ** 2 for r in results])))
         se_rep = float(np.std(f1, ddof=1)) if f1.size > 1 else 0.0

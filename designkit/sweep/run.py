@@ -150,11 +150,15 @@ def _executor(backend: str, jobs: int, scheduler: str | None):
     """``(joblib context factory, n_jobs)`` for a backend; a dask client lives as long as the sweep."""
     from joblib import parallel_config
 
+    from .._workers import local_processes
+
     if backend not in BACKENDS:
         raise InputError(f"backend must be loky, sequential or dask, got {backend!r}")
     if backend != "dask":
-        local = "loky" if backend == "loky" and jobs != 1 else "sequential"
-        yield (lambda: parallel_config(backend=local)), jobs
+        if backend == "loky" and jobs != 1:
+            yield local_processes, jobs
+        else:
+            yield (lambda: parallel_config(backend="sequential")), jobs
         return
     try:
         from dask.distributed import Client

@@ -19,7 +19,8 @@ PKG = Path(designkit.__file__).resolve().parent
 
 # Layers, lowest first. A module may import from its own layer and the layers below, never above.
 LAYERS = [
-    {"designkit._validation", "designkit._schemas", "designkit._io", "designkit._resources"},
+    {"designkit._validation", "designkit._schemas", "designkit._io", "designkit._resources",
+     "designkit._workers"},
     {"designkit.properties", "designkit.sensor", "designkit.scene", "designkit.materials", "designkit.objects",
      "designkit.figures"},
     {"designkit.models"},

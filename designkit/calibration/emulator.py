@@ -825,6 +825,7 @@ class Emulator:
                 if t1 >= vanish:
                     pending += self.lines(k, int(math.ceil(vanish * fs)))
                     self._flush(pending, deadline=time.monotonic() + 1.0)
+                    self._read_by_host(deadline=time.monotonic() + 1.0)
                     self.vanished = True
                     self._close()
                     return
@@ -864,6 +865,22 @@ class Emulator:
             # nobody reading (or a slow reader): pause instead of catching up later
             if (time.monotonic() - anchor) * rate - k > 0.5 * rate + chunk and len(pending) >= _MAX_PENDING:
                 anchor = time.monotonic() - k / rate
+
+    def _read_by_host(self, deadline: float) -> None:
+        """Wait (until ``deadline``) for the host to read what was sent: the device vanishes after its last
+        sample reached the host. Closing the pty discards what the host has not read yet, so without this
+        wait how much of the stream the host saw would depend on how busy it was (a test saw the third
+        touch's start lost at speed 50, where 3 s of device time are 60 ms)."""
+        import termios
+
+        while self._slave is not None and time.monotonic() < deadline and not self._stop.is_set():
+            try:
+                waiting = int.from_bytes(fcntl.ioctl(self._slave, termios.FIONREAD, b"\0\0\0\0"), "little")
+            except OSError:
+                return
+            if waiting == 0:
+                return
+            time.sleep(0.005)
 
     def _flush(self, pending: bytearray, deadline: float) -> None:
         master = self._master

@@ -222,9 +222,11 @@ class _Run:
         return r.f1
 
     def ideal_method_at(self, classes, scene) -> str:
-        """How :meth:`ideal_f1` scores this scene (``"closed-form"`` or ``"monte-carlo"``), logged as a call."""
-        self.ideal_f1(classes, scene)
-        return self.ideal_calls[-1]["method"]
+        """How :meth:`ideal_f1` would score this scene (``"closed-form"`` or ``"monte-carlo"``), without
+        scoring it (:func:`designkit.recognition.ideal.ideal_method`)."""
+        from ..recognition.ideal import ideal_method
+
+        return ideal_method(classes[0], classes[1], self.sensor, scene, model=self.model)
 
     def ideal_method(self, closed: bool) -> str:
         if closed:

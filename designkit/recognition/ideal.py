@@ -360,13 +360,10 @@ def ideal_pair(range_a, range_b, sensor: Sensor, scene: Scene, *, n_mc: int = 20
     if a.e_range == b.e_range and a.diffusivity_range_m2_s == b.diffusivity_range_m2_s:
         lo_, hi_ = a.e_range
         raise InputError(f"the two effusivity ranges are identical ([{lo_:g}, {hi_:g})): nothing to separate")
-    if not fm.shared_shape:
-        eq = fm.equivalent_shared_shape((a, b), sensor, contact_s=scene.contact_s,
-                                        tolerance=_invisible_tolerance(sensor, scene))
-        if eq is None:
-            from .ideal_mc import ideal_pair_mc
+    if not _shape_shared_here(fm, a, b, sensor, scene):
+        from .ideal_mc import ideal_pair_mc
 
-            return ideal_pair_mc(a, b, sensor, scene, model=fm, n_mc=n_mc, seed=seed)
+        return ideal_pair_mc(a, b, sensor, scene, model=fm, n_mc=n_mc, seed=seed)
     low, high = sorted([a.e_range, b.e_range])
     if scene.fixed_initial_conditions:
         s = projection_noise(sensor, scene)
@@ -374,6 +371,34 @@ def ideal_pair(range_a, range_b, sensor: Sensor, scene: Scene, *, n_mc: int = 20
         return IdealResult(f1=float(f1), accuracy=float(acc), method="closed-form",
                            projection_noise=s)
     return _ideal_monte_carlo(low, high, sensor, scene, n_mc, seed)
+
+
+def ideal_method(range_a, range_b, sensor: Sensor, scene: Scene, *, model=None) -> str:
+    """How :func:`ideal_pair` scores this pair and scene, without scoring it: ``"closed-form"`` or
+    ``"monte-carlo"``.
+
+    Examples
+    --------
+    >>> from designkit import SENSORS, Scene
+    >>> ideal_method((35000, 35080), (20000, 20080), SENSORS["paper"], Scene(contact_s=1))
+    'closed-form'
+    >>> ideal_method((35000, 35080), (20000, 20080), SENSORS["paper"],
+    ...              Scene(contact_s=1, sensor_temp_c=32.5, sensor_temp_spread_c=2.5))
+    'monte-carlo'
+    """
+    from ..models import get_model
+
+    fm = get_model(model)
+    a, b = _as_class(range_a, "e1"), _as_class(range_b, "e2")
+    closed = _shape_shared_here(fm, a, b, sensor, scene) and scene.fixed_initial_conditions
+    return "closed-form" if closed else "monte-carlo"
+
+
+def _shape_shared_here(fm, a, b, sensor: Sensor, scene: Scene) -> bool:
+    """Whether the model's curves share one shape for these classes in this scene (its own, or its extra
+    physics invisible here, :meth:`ForwardModel.equivalent_shared_shape`)."""
+    return fm.shared_shape or fm.equivalent_shared_shape(
+        (a, b), sensor, contact_s=scene.contact_s, tolerance=_invisible_tolerance(sensor, scene)) is not None
 
 
 #: A model's extra physics below this fraction of the noise over the whole

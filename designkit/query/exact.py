@@ -40,6 +40,7 @@ import numpy as np
 from .._validation import InputError, check_positive
 from ..objects import DEFAULT_CLASS_WIDTH, ObjectClass
 from .answer import Answer, IdealBound, number
+from .ideal_mc_bound import ideal_floor
 from .inputs import (
     REFERENCE_RULE,
     check_contact,
@@ -398,8 +399,8 @@ def exact_min_contact(e1=None, e2=None, *, m1=None, m2=None, objects=None, noise
             c *= 2.0
     value = est.value if est.value is None or ideal is None else max(est.value, ideal)
     # the SVM's interval never reaches below the ideal observer's (a Monte Carlo bound: its low end)
-    ideal_floor = ideal if ideal_interval is None else ideal_interval[0]
-    interval = (est.low if est.low is None or ideal_floor is None else max(est.low, ideal_floor), est.high)
+    floor = ideal_floor(ideal, ideal_interval)
+    interval = (est.low if est.low is None or floor is None else max(est.low, floor), est.high)
     evaluations = [{"contact_s": e["x"], "svm_f1": e["svm_f1"], "standard_error": e["standard_error"]}
                    for e in est.evaluations]
     needed = tmax if value is None else max(x for x in (value, ideal, interval[1]) if x is not None)
@@ -662,9 +663,8 @@ def exact_delta_e(e: float | None = None, *, m: str | None = None, contact_s: fl
         est = estimate_crossing(lambda d, part=part: run.svm((ref, part(d)), scene), start, limit, run.phi,
                                 coverage=cov, progress=progress)
         val, lo_d, hi_d = est.value, est.low, est.high
-        ideal_floor = ideal if ideal_interval is None else ideal_interval[0]
         if ideal is not None and val is not None:
-            val, lo_d = max(val, ideal), (None if lo_d is None else max(lo_d, ideal_floor))
+            val, lo_d = max(val, ideal), (None if lo_d is None else max(lo_d, ideal_floor(ideal, ideal_interval)))
         sides[side] = {"value": val, "interval": [lo_d, hi_d], "ideal": ideal, "ideal_interval": ideal_interval,
                        "coverage": cov if est.stated else None, "estimate_method": est.method,
                        "evaluations": [{"delta_e": e["x"], "svm_f1": e["svm_f1"],

@@ -25,9 +25,9 @@ from __future__ import annotations
 
 import functools
 import math
-from collections import OrderedDict
 
 import numpy as np
+from cachetools import LRUCache
 
 from ..sensor import last_sample_index
 
@@ -463,7 +463,7 @@ def exact_ideal_delta(sensor, e, contact_s, ratio, *, direction=+1, width: float
 #: exactly what a computation would (each element's bisection is independent of the others).
 BOUND_CACHE_SIZE = 262144  # a 10,000-query array call reads ~120,000 critical noises: they must fit
 _CACHE_BLOCK = 4096  # elements per vectorized search call (each element's answer is independent of the block)
-_BOUNDS: "OrderedDict[tuple, float]" = OrderedDict()
+_BOUNDS: "LRUCache[tuple, float]" = LRUCache(BOUND_CACHE_SIZE)
 
 
 def clear_bound_cache() -> None:
@@ -478,6 +478,7 @@ def _cached(kind: str, sensor, columns: tuple, params: tuple, compute) -> np.nda
     width = len(cols)
     keys = [head + k for k in zip(*(c.ravel().tolist() for c in cols))]
     missing = list(dict.fromkeys(k for k in keys if k not in _BOUNDS))
+    fresh = {}  # this call's computed values: a call with more misses than the cache holds evicts its own
     if missing:
         m = np.array([k[-width:] for k in missing], dtype=np.float64).reshape(len(missing), width)
         # in blocks: a search's temporaries are (elements x thresholds x quadrature nodes); 120,000 elements at
@@ -485,13 +486,10 @@ def _cached(kind: str, sensor, columns: tuple, params: tuple, compute) -> np.nda
         for start in range(0, len(missing), _CACHE_BLOCK):
             block = m[start:start + _CACHE_BLOCK]
             for k, v in zip(missing[start:start + _CACHE_BLOCK], np.asarray(compute(*block.T)).tolist()):
-                _BOUNDS[k] = v
+                _BOUNDS[k] = fresh[k] = v
     out = np.empty(len(keys))
     for i, k in enumerate(keys):
-        out[i] = _BOUNDS[k]
-        _BOUNDS.move_to_end(k)
-    while len(_BOUNDS) > BOUND_CACHE_SIZE:
-        _BOUNDS.popitem(last=False)
+        out[i] = fresh[k] if k in fresh else _BOUNDS[k]
     return out.reshape(cols[0].shape)
 
 

@@ -30,8 +30,10 @@ from __future__ import annotations
 import math
 import struct
 import zlib
-from collections import OrderedDict
 from dataclasses import dataclass
+from typing import Sequence
+
+from cachetools import LRUCache
 
 from ..objects import ObjectClass
 from ..scene import Scene
@@ -78,6 +80,12 @@ class MonteCarloBound:
     coverage: float | None
     n_mc: int
     evaluations: tuple = ()
+
+    @property
+    def floor(self) -> float | None:
+        """What no classifier beats at the bound's stated confidence: the interval's low end, or the estimate
+        where no interval is stated (:func:`ideal_floor`)."""
+        return ideal_floor(self.value, None if self.coverage is None else (self.low, self.high))
 
     def to_dict(self) -> dict:
         return {"value": self.value, "low": self.low, "high": self.high, "coverage": self.coverage,
@@ -300,9 +308,19 @@ def nearer_side_interval(sides: dict, coverage: float):
     return (*best["ideal_interval"], coverage)
 
 
+def ideal_floor(value: float | None, interval: Sequence | None) -> float | None:
+    """The floor an SVM answer's interval is held above: the ideal bound's low end where the bound is a
+    Monte Carlo estimate with an interval (``(low, high, ...)``), else the bound itself.
+
+    >>> ideal_floor(1.41, (1.39, 1.42, 0.9)), ideal_floor(1.05, None)
+    (1.39, 1.05)
+    """
+    return value if interval is None else interval[0]
+
+
 #: Most distinct questions :func:`cached_mc_ideal_min_contact` remembers per process.
 _CACHE_SIZE = 64
-_CACHE: "OrderedDict[tuple, MonteCarloBound]" = OrderedDict()
+_CACHE: "LRUCache[tuple, MonteCarloBound]" = LRUCache(_CACHE_SIZE)
 
 
 def cached_mc_ideal_min_contact(a: ObjectClass, b: ObjectClass, sensor: Sensor, *, noise_c: float,
@@ -325,10 +343,7 @@ def cached_mc_ideal_min_contact(a: ObjectClass, b: ObjectClass, sensor: Sensor, 
 
 
 def _remember(key: tuple, compute) -> MonteCarloBound:
-    if key in _CACHE:
-        _CACHE.move_to_end(key)
-        return _CACHE[key]
-    r = _CACHE[key] = compute()
-    while len(_CACHE) > _CACHE_SIZE:
-        _CACHE.popitem(last=False)
+    r = _CACHE.get(key)
+    if r is None:
+        r = _CACHE[key] = compute()
     return r

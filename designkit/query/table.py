@@ -44,17 +44,18 @@ Examples
 from __future__ import annotations
 
 import math
-from collections import OrderedDict
 from dataclasses import dataclass
 from typing import Any, Sequence
 
 import numpy as np
+from cachetools import LRUCache
 
 from .._validation import InputError, check_nonnegative
 from ..tables import lookup
 from ..tables.lookup import GRID_RTOL
 from ..tables.store import Table, load_table, resolve_table
 from .answer import Answer, IdealBound, number
+from .ideal_mc_bound import ideal_floor
 from .crossing import check_coverage, z_of_coverage
 from .inputs import (
     REFERENCE_RULE,
@@ -114,8 +115,7 @@ DEFAULT_IDEAL_TABLE = "ideal-paper"
 
 #: Tables loaded (and verified) by this process, keyed by their files' identity: a name or path is
 #: read and hashed once, not on every question (12 ms -> 0.6 ms a call). Least recently used out.
-_LOADED: "OrderedDict[tuple, Table]" = OrderedDict()
-_LOADED_MAX = 16
+_LOADED: "LRUCache[tuple, Table]" = LRUCache(16)
 
 
 def _as_table(table: "Table | str") -> Table:
@@ -129,10 +129,9 @@ def _as_table(table: "Table | str") -> Table:
                     for st in (p.stat(),))
     except OSError:  # let load_table say what is missing
         return load_table(npz)
-    t = _LOADED.pop(key, None) or load_table(npz)
-    _LOADED[key] = t
-    while len(_LOADED) > _LOADED_MAX:
-        _LOADED.popitem(last=False)
+    t = _LOADED.get(key)
+    if t is None:
+        t = _LOADED[key] = load_table(npz)
     return t
 
 
@@ -445,8 +444,8 @@ def _interp_at(arr3d: np.ndarray, centres: np.ndarray, si: np.ndarray, j: np.nda
 #: The noise-efficiency readings of small calls (a single question's), kept per process (least recently used
 #: out): a question asked again reads them from here instead of re-reading 12 table entries and their critical
 #: noises (1.5 ms of numpy overhead a call). Pure functions of the key: the table's content and the arguments.
-_K_READINGS: "OrderedDict[tuple, tuple]" = OrderedDict()
-_K_READINGS_MAX, _K_READINGS_PAIRS = 4096, 16
+_K_READINGS_PAIRS = 16
+_K_READINGS: "LRUCache[tuple, tuple]" = LRUCache(4096)
 
 
 def _k_readings(op, slices, sw, ka, kb, lo, hi, extra=None):
@@ -462,9 +461,6 @@ def _k_readings(op, slices, sw, ka, kb, lo, hi, extra=None):
     if hit is None:
         hit = _k_readings_computed(op, slices, sw, ka, kb, lo, hi, extra)
         _K_READINGS[key] = hit
-        while len(_K_READINGS) > _K_READINGS_MAX:
-            _K_READINGS.popitem(last=False)
-    _K_READINGS.move_to_end(key)
     lk, se, star = hit
     return lk.copy(), se.copy(), None if star is None else star.copy()
 
@@ -1258,8 +1254,8 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
             monte_carlo.update(interpolation_error_log=interp, rounding_error_log=rounding, table_crossing_s=raw)
         else:
             prev = grid[k_cross - 1] if k_cross > 0 else 0.0
-            ideal_floor = ideal if ideal_interval is None else ideal_interval[0]
-            low = max(prev, ideal_floor) if ideal_floor is not None else prev
+            floor = ideal_floor(ideal, ideal_interval)
+            low = max(prev, floor) if floor is not None else prev
             interval, kind = (low, value), "table-cell"
             why = ("the table's first contact time" if k_cross == 0 else
                    f"the table's next contact time after {prev:g} s, where they are not separable within its "
@@ -1545,7 +1541,7 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
               if op.tab.fidelity == "svm" else [val, val])
         iname = f"delta_{direction}_ideal" if ikind == "ideal" else f"delta_{direction}"
         ideal_side = at(iview, icombos, icw, iname)
-        ideal_floor, extra = ideal_side, {}
+        side_floor, extra = ideal_side, {}
         if not op.closed and ideal_bound:  # no closed form: Monte Carlo at query time, the grid's kept beside it
             from .ideal_mc_bound import cached_mc_ideal_delta
 
@@ -1555,7 +1551,7 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
             extra = {"table_ideal": ideal_side,
                      "ideal_interval": None if mcb.coverage is None else [mcb.low, mcb.high]}
             ideal_side = mcb.value
-            ideal_floor = mcb.value if mcb.coverage is None else mcb.low
+            side_floor = mcb.floor
         stated, cov_side, method = [None, None], None, "none"
         eff = both[direction]
         if eff is not None and val is None and not partner_in_grid(view, x, eff["value"], direction):
@@ -1567,7 +1563,7 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
             continue
         if val is not None and op.tab.fidelity == "svm":
             geo = at(view, combos, gcw, f"delta_{direction}", geometric=True)
-            low, high = (_opt(v) for v in delta_estimate(val, _arr(iv[0]), _arr(iv[1]), _arr(geo), _arr(ideal_floor),
+            low, high = (_opt(v) for v in delta_estimate(val, _arr(iv[0]), _arr(iv[1]), _arr(geo), _arr(side_floor),
                                                          width=op.width, z_table=z_t, zc=zc))
             stated, cov_side, method = [low, high], coverage, "table-estimate"
         sides[side] = {"value": val, "interval": stated, "ideal": ideal_side, "coverage": cov_side,
@@ -1611,8 +1607,7 @@ def partner_in_grid(view: _View, e, delta, direction: str):
 #: The scalar route's efficiency estimates (:func:`delta_efficiency_estimate`, both directions), per process (least
 #: recently used out): a question asked again reads them from here (the estimate re-reads 24 table entries and 10
 #: cached ideal deltas, ~1 ms of numpy overhead). A pure function of the key: the table's content and the arguments.
-_DELTA_EFF: "OrderedDict[tuple, dict]" = OrderedDict()
-_DELTA_EFF_MAX = 4096
+_DELTA_EFF: "LRUCache[tuple, dict]" = LRUCache(4096)
 
 
 def _delta_efficiency_both(op, combos, ends, x: float, contact: float, ratio: float,
@@ -1622,9 +1617,9 @@ def _delta_efficiency_both(op, combos, ends, x: float, contact: float, ratio: fl
     where it does not apply."""
     h = op.tab.header.get("content_hash")
     key = (h, float(op.width), float(op.phi), tuple(combos), tuple(ends), x, contact, ratio, zc)
-    if h is not None and key in _DELTA_EFF:
-        _DELTA_EFF.move_to_end(key)
-        return _DELTA_EFF[key]
+    hit = _DELTA_EFF.get(key) if h is not None else None
+    if hit is not None:
+        return hit
     view = op.view
     (ratios, weights, *down), (_, _, *up) = (delta_entries(view, combos, ends, d, x) for d in ("down", "up"))
     r = delta_efficiency_estimate(
@@ -1635,8 +1630,6 @@ def _delta_efficiency_both(op, combos, ends, x: float, contact: float, ratio: fl
            for i, d in enumerate(("down", "up"))}
     if h is not None:  # a table without a hash: its content is not a key
         _DELTA_EFF[key] = out
-        while len(_DELTA_EFF) > _DELTA_EFF_MAX:
-            _DELTA_EFF.popitem(last=False)
     return out
 
 
@@ -1649,8 +1642,7 @@ def _delta_details(e: float, sides: dict) -> dict[str, Any]:
 #: Ideal F1 of a pair at a scene, per process (the closed form's search costs ~30 ms; a loop of
 #: ``distinguishable`` calls asks the same pair again): a function of its key, so a hit returns exactly
 #: what the computation would.
-_IDEAL_F1: "OrderedDict[tuple, tuple[float, str]]" = OrderedDict()
-_IDEAL_F1_SIZE = 4096
+_IDEAL_F1: "LRUCache[tuple, tuple[float, str]]" = LRUCache(4096)
 
 
 def _ideal_pair_f1(classes, op, contact: float, noise: float, dt: float, spread: float = 0.0) -> tuple[float, str]:
@@ -1663,14 +1655,12 @@ def _ideal_pair_f1(classes, op, contact: float, noise: float, dt: float, spread:
     sen = op.tab.sensor
     key = (tuple(classes), float(sen.effusivity), float(sen.tau_s),
            float(sen.sample_rate_hz), contact, noise, dt, spread, op.tab.header["content_hash"], op.model.name)
-    if key not in _IDEAL_F1:
+    hit = _IDEAL_F1.get(key)
+    if hit is None:
         scene = Scene.from_delta_t(contact_s=contact, noise_c=noise, delta_t_c=dt, sensor_temp_spread_c=spread)
         res = ideal_pair(*classes, sen, scene, model=op.model)
-        _IDEAL_F1[key] = (float(res.f1), res.method)
-        while len(_IDEAL_F1) > _IDEAL_F1_SIZE:
-            _IDEAL_F1.popitem(last=False)
-    _IDEAL_F1.move_to_end(key)
-    return _IDEAL_F1[key]
+        hit = _IDEAL_F1[key] = (float(res.f1), res.method)
+    return hit
 
 
 def distinguishable(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact_s: float, noise_c: float = 0.05,

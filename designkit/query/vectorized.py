@@ -380,7 +380,7 @@ def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> None
                 sensor_temp_spread_c=spread, model=op.model, threshold=op.phi,
                 max_contact_s=_table_route.CLOSED_FORM_MAX_CONTACT_S, coverage=_coverage_of(zc))
             res["ideal"][i] = np.nan if mcb.value is None else mcb.value
-            ideal_floor[i] = np.nan if mcb.value is None else mcb.low if mcb.coverage is not None else mcb.value
+            ideal_floor[i] = np.nan if mcb.value is None else mcb.floor
     # the scalar route's interval: an estimate where the crossing is interpolated between two tabulated needs
     # (table.contact_estimate, the same function), else the grid cell, never below the ideal bound
     raw, ideal = res["value"], ideal_floor
@@ -651,7 +651,7 @@ def _mc_delta_bounds(op, e: np.ndarray, direction: int, contact: float, noise: f
                                     threshold=op.phi, coverage=_coverage_of(zc))
         if mcb.value is not None:
             value[i] = mcb.value
-            floor[i] = mcb.low if mcb.coverage is not None else mcb.value
+            floor[i] = mcb.floor
     return value, floor
 
 

@@ -19,10 +19,11 @@ inputs stay under :data:`BATCH_MB`.
 from __future__ import annotations
 
 import math
-from collections import OrderedDict
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
+from cachetools import LRUCache
 
 from .._validation import InputError
 from ..recognition.features import feature_matrix
@@ -138,9 +139,9 @@ class PairScorer:
         self.edges = cfg.edges
         # features of (interval, seed), least recently used first; they are a deterministic function
         # of their key, so evicting one only costs its regeneration, never changes a result
-        self._features: OrderedDict[tuple[int, int], np.ndarray] = OrderedDict()
         per_entry = cfg.trials * 2 * self.n_samples * 8  # raw samples + slope, float64
         self.max_features = max(8, int(FEATURE_CACHE_MB * 2**20 // max(per_entry, 1)))  # cache entries
+        self._features: LRUCache[tuple[int, int], Any] = LRUCache(self.max_features)
         self._prepare = cfg.solver == "batched"  # numpy's batched path: cache PreparedFeatures
         self.scored: dict[tuple[int, int], PairCell] = {}  # every pair scored so far
         self.fits = 0
@@ -152,9 +153,7 @@ class PairScorer:
         solver reads; as many bytes as the float64 matrix, prepared once per cache entry)."""
         key = (k, rep)
         feats = self._features.get(key)
-        if feats is not None:
-            self._features.move_to_end(key)
-        else:
+        if feats is None:
             cfg = self.cfg
             draws = draw_trials(self.edges[k], self.edges[k + 1], cfg.trials, self.n_samples,
                                 seed=[cfg.seed, k, rep],
@@ -167,8 +166,6 @@ class PairScorer:
 
                 feats = prepare_features(feats)
             self._features[key] = feats
-            while len(self._features) > self.max_features:
-                self._features.popitem(last=False)
         return feats
 
     def score_many(self, keys: list[tuple[int, int, int]]) -> list[tuple[float, float]]:

@@ -417,7 +417,7 @@ def run_cases(question: str, n: int, *, seed: int, jobs: int = 1, done: Callable
     rng = as_generator([int(seed), COVERAGE_QUESTIONS.index(question)])
     cases = [draw_case(question, rng) for _ in range(int(n))]
     results = []
-    with local_processes() if jobs != 1 else nullcontext():
+    with local_processes(jobs) if jobs != 1 else nullcontext():
         gen = Parallel(n_jobs=jobs, return_as="generator_unordered")(
             delayed(coverage_case)(question, c, i, **options) for i, c in enumerate(cases) if i >= start)
         for r in gen:

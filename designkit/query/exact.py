@@ -108,6 +108,7 @@ class _Run:
     t0: float = field(default_factory=time.perf_counter)
     ideal_calls: list = field(default_factory=list)
     svm_calls: int = 0
+    pool_started: bool = False  # the worker pool was started for this run (designkit._workers.local_processes)
 
     @classmethod
     def make(cls, *, sensor, model, threshold, width, trials, folds, seed, repeats, z, jobs, n_mc,
@@ -164,7 +165,8 @@ class _Run:
         if self.solver == "batched":
             return self._svm_batched(a, b, scene)
         jobs = self.jobs if self.repeats > 1 else 1
-        with local_processes() if jobs != 1 else nullcontext():
+        with local_processes(jobs, start=not self.pool_started) if jobs != 1 else nullcontext():
+            self.pool_started = jobs != 1
             results = Parallel(n_jobs=jobs)(
                 delayed(pair_f1)(a, b, self.sensor, scene, model=self.model, trials=self.trials, folds=self.folds,
                                  seed=s) for s in self.seeds())

@@ -156,7 +156,7 @@ def _executor(backend: str, jobs: int, scheduler: str | None):
         raise InputError(f"backend must be loky, sequential or dask, got {backend!r}")
     if backend != "dask":
         if backend == "loky" and jobs != 1:
-            yield local_processes, jobs
+            yield (lambda: local_processes(jobs)), jobs
         else:
             yield (lambda: parallel_config(backend="sequential")), jobs
         return

@@ -92,3 +92,28 @@ def test_ctrl_c_while_the_workers_start_is_quiet(ctrl_c_able):
                 os.killpg(proc.pid, signal.SIGKILL)
         assert proc.returncode == 130, (proc.returncode, err)
         assert "Traceback" not in err and "Error" not in err, (after_s, err)
+
+
+_LEAK = """
+import sys
+from joblib.externals.loky.backend import resource_tracker
+if sys.argv[1] == "designkit":
+    from designkit._workers import local_processes
+    with local_processes(2):
+        pass
+else:
+    resource_tracker.ensure_running()
+resource_tracker.register("/designkit-test-leak", "semlock")  # as a worker killed on Ctrl-C leaves it
+"""
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="loky's semaphores and the POSIX resource tracker")
+def test_the_resource_tracker_cleans_up_after_killed_workers_without_warnings():
+    """A semaphore still registered when the program ends (a worker killed holding it): loky's tracker
+    process warns of it on the terminal, unless started by designkit's pool (a CI-like run once saw the
+    warning under a quiet Ctrl-C). The stderr pipe stays open until the tracker itself has exited."""
+    def stderr_of(how):
+        return subprocess.run([sys.executable, "-c", _LEAK, how], capture_output=True, text=True,
+                              timeout=60).stderr
+    assert "leaked semlock" in stderr_of("loky")  # the warning this guards against, where it is not quieted
+    assert stderr_of("designkit") == ""

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any, Mapping
+from typing import Any, Mapping, Sequence
 
 __all__ = ["ANSWER_KEYS", "INTERVAL_MEANING", "QUANTITIES", "Answer", "IdealBound", "QuestionQuantity", "number"]
 
@@ -276,3 +276,13 @@ class Answer(QuestionQuantity):
         else:
             out.update(d)
         return out
+
+
+def ideal_floor(value: float | None, interval: Sequence | None) -> float | None:
+    """The floor an SVM answer's interval is held above: the ideal bound's low end where the bound is a
+    Monte Carlo estimate with an interval (``(low, high, ...)``), else the bound itself.
+
+    >>> ideal_floor(1.41, (1.39, 1.42, 0.9)), ideal_floor(1.05, None)
+    (1.39, 1.05)
+    """
+    return value if interval is None else interval[0]

@@ -39,8 +39,7 @@ import numpy as np
 
 from .._validation import InputError, check_positive
 from ..objects import DEFAULT_CLASS_WIDTH, ObjectClass
-from .answer import Answer, IdealBound, number
-from .ideal_mc_bound import ideal_floor
+from .answer import Answer, IdealBound, ideal_floor, number
 from .inputs import (
     REFERENCE_RULE,
     check_contact,

@@ -31,13 +31,13 @@ import math
 import struct
 import zlib
 from dataclasses import dataclass
-from typing import Sequence
 
 from cachetools import LRUCache
 
 from ..objects import ObjectClass
 from ..scene import Scene
 from ..sensor import Sensor
+from .answer import ideal_floor
 from .crossing import check_coverage, estimate_crossing
 
 __all__ = ["MC_BOUND_TOUCHES", "MonteCarloBound", "cached_mc_ideal_delta", "cached_mc_ideal_min_contact",
@@ -306,16 +306,6 @@ def nearer_side_interval(sides: dict, coverage: float):
     if best is None or best.get("ideal_interval") is None:
         return None
     return (*best["ideal_interval"], coverage)
-
-
-def ideal_floor(value: float | None, interval: Sequence | None) -> float | None:
-    """The floor an SVM answer's interval is held above: the ideal bound's low end where the bound is a
-    Monte Carlo estimate with an interval (``(low, high, ...)``), else the bound itself.
-
-    >>> ideal_floor(1.41, (1.39, 1.42, 0.9)), ideal_floor(1.05, None)
-    (1.39, 1.05)
-    """
-    return value if interval is None else interval[0]
 
 
 #: Most distinct questions :func:`cached_mc_ideal_min_contact` remembers per process.

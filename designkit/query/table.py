@@ -54,8 +54,7 @@ from .._validation import InputError, check_nonnegative
 from ..tables import lookup
 from ..tables.lookup import GRID_RTOL
 from ..tables.store import Table, load_table, resolve_table
-from .answer import Answer, IdealBound, number
-from .ideal_mc_bound import ideal_floor
+from .answer import Answer, IdealBound, ideal_floor, number
 from .crossing import check_coverage, z_of_coverage
 from .inputs import (
     REFERENCE_RULE,

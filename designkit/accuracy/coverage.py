@@ -140,8 +140,12 @@ def answer_reading(question: str, ans) -> dict[str, Any]:
 
 def coverage_case(question: str, case: Mapping[str, Any], index: int, *, repeats: int = 4,
                   ref_repeats: int = 16, trials: int = 100, coverage: float = 0.9,
-                  table: str = "svm-paper", exact_solver: str = "sklearn") -> dict[str, Any]:
+                  table: str = "svm-paper", exact_solver: str = "sklearn",
+                  sensor_temp_spread_c: float = 0.0) -> dict[str, Any]:
     """Ask one case by the table, by ``--exact`` and by the reference; return all three readings.
+
+    ``sensor_temp_spread_c`` [degC]: varied initial conditions (each touch's sensor temperature drawn within
+    +-that), on every route (``table`` then a varied table, such as ``svm-paper-varied``).
 
     Seeds: the answer uses ``1000 + index``, the reference ``500000 + index`` (disjoint streams).
     For ``min-delta-t`` the exact answer is the same estimate in sigma/dT as ``max-noise``'s
@@ -153,6 +157,8 @@ def coverage_case(question: str, case: Mapping[str, Any], index: int, *, repeats
     from ..query import exact as ex
 
     args = case_arguments(question, case)
+    if sensor_temp_spread_c:
+        args["sensor_temp_spread_c"] = float(sensor_temp_spread_c)
     out: dict[str, Any] = {"question": question, "index": index, **case}
     t0 = time.perf_counter()
     try:

@@ -111,6 +111,20 @@ def test_one_case_of_each_route_states_its_interval():
     assert s["n_compared"] == 1 and s["violations"] == 0
 
 
+def test_a_varied_case_asks_every_route_with_the_spread():
+    """``sensor_temp_spread_c`` reaches the table (a varied table's answer) and both exact routes: their
+    ideal bounds are the Monte Carlo observer's, later than the closed form's at fixed conditions."""
+    case = {"e1": 1000.0, "e2": 600.0, "gap": 400.0, "noise_c": 0.05, "delta_t_c": 7.5, "contact_s": 1.0}
+    r = coverage_case("min-contact", case, 0, repeats=2, ref_repeats=2, trials=30, table="svm-paper-varied",
+                      sensor_temp_spread_c=2.5)
+    fixed = query.ask("min-contact", route="table", e1=1000.0, e2=600.0, noise_c=0.05, delta_t_c=7.5).ideal
+    for route in ("table", "exact", "reference"):
+        assert r[route]["ideal"] > fixed, (route, r[route]["ideal"], fixed)
+    # the varied table states no coverage: measured not to hold there (bench_coverage_varied.py)
+    assert r["table"]["method"] == "table-varied" and r["table"]["coverage"] is None
+    assert r["exact"]["coverage"] == 0.9
+
+
 def test_stated_interval_schema_and_refusals():
     a = query.ask("min-contact", route="table", e1=3000, e2=1500)
     iv = a.to_dict()["interval"]

@@ -232,7 +232,8 @@ def _interval(d, unit):
     ends = f"{_fmt(iv['low'], unit)} to {_fmt(iv['high'], unit)}"
     if iv.get("coverage"):
         return f"({iv['coverage']:.0%} interval {ends})"
-    why = {"table-cell": "the grid cell, coverage not stated", "exact": "the search bracket, coverage not stated"}
+    why = {"table-cell": "the grid cell, coverage not stated", "exact": "the search bracket, coverage not stated",
+           "table-varied": "the varied table's, coverage not stated: see below"}
     return f"(interval {ends}: {why.get(iv.get('method'), 'coverage not stated')})"
 
 

@@ -78,6 +78,9 @@ INTERVAL_MEANING = {
     "table-cell": "the grid cell the crossing lies in, from the last tabulated value where the pair is not "
                   "separable to the first where it is: the grid cannot support an interval of stated "
                   "coverage here (a neighbour is beyond the grid)",
+    "table-varied": "on a table with varied initial conditions: the interval the table gives (interpolated, or "
+                    "the grid cell), with no coverage stated because measured coverage did not hold there (the "
+                    "answer's notes give the figures); --exact states one",
     "none": "no interval: see the answer's notes for why",
     "distinguishable": "the verdict at the ends of the table's Monte Carlo interval (1 = yes; coverage not "
                        "stated)",

@@ -35,26 +35,41 @@ def _ignores_sigint(pid: int) -> bool:
     return bool(mask >> (signal.SIGINT - 1) & 1)
 
 
-@pytest.mark.skipif(sys.platform == "win32", reason="process groups and SIGINT are POSIX")
-def test_ctrl_c_while_the_exact_route_runs_workers_is_quiet(ctrl_c_able):
+def _interrupt_exact_run(ctrl_c_able, ready, what: str, poll_s: float, after_s: float = 0.0, check=None):
+    """Start a real ``--exact --jobs 2`` run in its own process group, wait until ``ready(process)``
+    (``what`` names it for the failure message), wait ``after_s`` more, run ``check(process)``, send the
+    group SIGINT as a terminal does; return ``(exit status, stderr)``."""
     proc = subprocess.Popen([sys.executable, "-m", "designkit", "min-contact", "--e1", "20000", "--e2", "18000",
                              "--exact", "--repeats", "32", "--json", "--jobs", "2"], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, start_new_session=True, text=True, **ctrl_c_able)
     try:
         me = psutil.Process(proc.pid)
         deadline = time.monotonic() + 120
-        while not _busy_workers(me, 2, 1.0):
+        while not ready(me):
             if proc.poll() is not None or time.monotonic() > deadline:
-                pytest.fail("the exact route's workers never got busy")
-            time.sleep(0.05)
-        if sys.platform.startswith("linux"):
-            assert not [k.pid for k in me.children(recursive=True) if not _ignores_sigint(k.pid)]
+                pytest.fail(f"the exact route's workers never {what}")
+            time.sleep(poll_s)
+        time.sleep(after_s)
+        if check is not None:
+            check(me)
         os.killpg(proc.pid, signal.SIGINT)
-        out, err = proc.communicate(timeout=60)
+        _, err = proc.communicate(timeout=60)
     finally:
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGKILL)
-    assert proc.returncode == 130, (proc.returncode, err)
+    return proc.returncode, err
+
+
+def _all_ignore_sigint(me: psutil.Process) -> None:
+    if sys.platform.startswith("linux"):
+        assert not [k.pid for k in me.children(recursive=True) if not _ignores_sigint(k.pid)]
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="process groups and SIGINT are POSIX")
+def test_ctrl_c_while_the_exact_route_runs_workers_is_quiet(ctrl_c_able):
+    rc, err = _interrupt_exact_run(ctrl_c_able, lambda me: _busy_workers(me, 2, 1.0), "got busy", 0.05,
+                                   check=_all_ignore_sigint)
+    assert rc == 130, (rc, err)
     assert "Traceback" not in err and "Warning" not in err, err
     assert err.strip() in ("", "Interrupted."), err  # typer exits 130 quietly, as a shell's ^C
 
@@ -74,23 +89,8 @@ def test_ctrl_c_while_the_workers_start_is_quiet(ctrl_c_able):
     0.85 and 1.05 s after the start did, measured), and the program, which held it while the pool started,
     exits 130 (before, a Ctrl-C there could also end in joblib's "cannot join thread before it is started")."""
     for after_s in (0.05, 0.1, 0.15, 0.2):  # after they appear: while they import
-        proc = subprocess.Popen([sys.executable, "-m", "designkit", "min-contact", "--e1", "20000", "--e2", "18000",
-                                 "--exact", "--repeats", "32", "--json", "--jobs", "2"], stdout=subprocess.PIPE,
-                                stderr=subprocess.PIPE, start_new_session=True, text=True, **ctrl_c_able)
-        try:
-            me = psutil.Process(proc.pid)
-            deadline = time.monotonic() + 120
-            while not _starting_workers(me):
-                if proc.poll() is not None or time.monotonic() > deadline:
-                    pytest.fail("the exact route's workers never started")
-                time.sleep(0.002)
-            time.sleep(after_s)
-            os.killpg(proc.pid, signal.SIGINT)
-            out, err = proc.communicate(timeout=60)
-        finally:
-            if proc.poll() is None:
-                os.killpg(proc.pid, signal.SIGKILL)
-        assert proc.returncode == 130, (proc.returncode, err)
+        rc, err = _interrupt_exact_run(ctrl_c_able, _starting_workers, "started", 0.002, after_s)
+        assert rc == 130, (rc, err)
         assert "Traceback" not in err and "Error" not in err, (after_s, err)
 
 

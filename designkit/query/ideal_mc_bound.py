@@ -82,19 +82,44 @@ class MonteCarloBound:
     evaluations: tuple = ()
 
     @property
+    def interval(self) -> tuple | None:
+        """``(low, high, coverage)``, as :class:`~designkit.query.answer.IdealBound` takes it; None where no
+        coverage is stated."""
+        return None if self.coverage is None else (self.low, self.high, self.coverage)
+
+    @property
     def floor(self) -> float | None:
         """What no classifier beats at the bound's stated confidence: the interval's low end, or the estimate
         where no interval is stated (:func:`ideal_floor`)."""
-        return ideal_floor(self.value, None if self.coverage is None else (self.low, self.high))
+        return ideal_floor(self.value, self.interval)
 
     def to_dict(self) -> dict:
         return {"value": self.value, "low": self.low, "high": self.high, "coverage": self.coverage,
                 "n_mc": self.n_mc, "evaluations": [dict(e) for e in self.evaluations]}
 
 
-def _contact_seed(seed: int, contact_s: float) -> list[int]:
-    """The seed of one evaluation: the asked seed and a stable 31-bit hash of the contact time's bits."""
-    return [int(seed), zlib.crc32(struct.pack("<d", float(contact_s))) & 0x7FFFFFFF]
+def _point_seed(seed: int, x: float) -> list[int]:
+    """The seed of one evaluation: the asked seed and a stable 31-bit hash of the evaluated point's bits."""
+    return [int(seed), zlib.crc32(struct.pack("<d", float(x))) & 0x7FFFFFFF]
+
+
+def _estimate(score, name: str, x_lo: float, x_hi: float, threshold: float, *, seed: int, coverage: float,
+              progress=None, increasing: bool = True, snap=None):
+    """The crossing of the mean ideal F1 along one quantity (``name``: its key in each evaluation record):
+    ``score(x, seed)`` is the :class:`~designkit.recognition.scores.IdealResult` at ``x`` with that seed
+    (:func:`_point_seed`: independent touches per point), ``x`` first moved by ``snap`` where given.
+    Returns ``(estimate, evaluations sorted by x)``."""
+    evals: list[dict] = []
+
+    def f(x: float) -> tuple[float, float]:
+        x = snap(x) if snap is not None else x
+        r = score(x, _point_seed(seed, x))
+        evals.append({name: x, "f1": r.f1, "standard_error": r.standard_error, "method": r.method})
+        return r.f1, r.standard_error
+
+    est = estimate_crossing(f, float(x_lo), float(x_hi), threshold, increasing=increasing, coverage=coverage,
+                            progress=progress, bracket_ratio=BRACKET_RATIO)
+    return est, tuple(sorted(evals, key=lambda e: e[name]))
 
 
 def mc_ideal_min_contact(a: ObjectClass, b: ObjectClass, sensor: Sensor, *, noise_c: float, delta_t_c: float,
@@ -146,22 +171,16 @@ def mc_ideal_min_contact(a: ObjectClass, b: ObjectClass, sensor: Sensor, *, nois
     from ..recognition.ideal import ideal_pair
 
     cov = check_coverage(coverage)
-    evals: list[dict] = []
-
     fs = float(sensor.sample_rate_hz)
 
-    def f(c: float) -> tuple[float, float]:
-        c = max(1, round(c * fs)) / fs  # evaluated at a sample time: the curve through those is smooth
+    def score(c, point_seed):
         scene = Scene.from_delta_t(contact_s=c, noise_c=noise_c, delta_t_c=delta_t_c,
                                    sensor_temp_spread_c=sensor_temp_spread_c)
-        r = ideal_pair(a, b, sensor, scene, model=model, n_mc=n_mc, seed=_contact_seed(seed, c))
-        evals.append({"contact_s": c, "f1": r.f1, "standard_error": r.standard_error, "method": r.method})
-        return r.f1, r.standard_error
+        return ideal_pair(a, b, sensor, scene, model=model, n_mc=n_mc, seed=point_seed)
 
-    floor = 1.0 / sensor.sample_rate_hz
-    est = estimate_crossing(f, floor, float(max_contact_s), threshold, coverage=cov, progress=progress,
-                            bracket_ratio=BRACKET_RATIO)
-    evs = tuple(sorted(evals, key=lambda e: e["contact_s"]))
+    # evaluated at sample times: the curve through those is smooth
+    est, evs = _estimate(score, "contact_s", 1.0 / fs, max_contact_s, threshold, seed=seed, coverage=cov,
+                         progress=progress, snap=lambda c: max(1, round(c * fs)) / fs)
     if est.value is None:
         return MonteCarloBound(None, None, None, None, int(n_mc), evs)
 
@@ -222,18 +241,13 @@ def mc_ideal_delta(ref: ObjectClass, direction: int, sensor: Sensor, *, contact_
         return MonteCarloBound(None, None, None, None, int(n_mc), ())
     scene = Scene.from_delta_t(contact_s=contact_s, noise_c=noise_c, delta_t_c=delta_t_c,
                                sensor_temp_spread_c=sensor_temp_spread_c)
-    evals: list[dict] = []
 
-    def f(d: float) -> tuple[float, float]:
+    def score(d, point_seed):
         lo = x + sign * d
         part = ObjectClass(f"{lo:g}", (lo, lo + w), ref.diffusivity_range_m2_s)
-        r = ideal_pair(ref, part, sensor, scene, model=model, n_mc=n_mc, seed=_contact_seed(seed, d))
-        evals.append({"delta_e": d, "f1": r.f1, "standard_error": r.standard_error, "method": r.method})
-        return r.f1, r.standard_error
+        return ideal_pair(ref, part, sensor, scene, model=model, n_mc=n_mc, seed=point_seed)
 
-    est = estimate_crossing(f, w / 2.0, float(limit), threshold, coverage=cov, progress=progress,
-                            bracket_ratio=BRACKET_RATIO)
-    evs = tuple(sorted(evals, key=lambda e: e["delta_e"]))
+    est, evs = _estimate(score, "delta_e", w / 2.0, limit, threshold, seed=seed, coverage=cov, progress=progress)
     if est.value is None:
         return MonteCarloBound(None, None, None, None, int(n_mc), evs)
     return MonteCarloBound(est.value, est.low, est.high, cov if est.stated else None, int(n_mc), evs)
@@ -286,16 +300,10 @@ def mc_ideal_max_ratio(a: ObjectClass, b: ObjectClass, sensor: Sensor, scene_of,
     from ..recognition.ideal import ideal_pair
 
     cov = check_coverage(coverage)
-    evals: list[dict] = []
-
-    def f(x: float) -> tuple[float, float]:
-        r = ideal_pair(a, b, sensor, scene_of(x), model=model, n_mc=n_mc, seed=_contact_seed(seed, x))
-        evals.append({"noise_ratio": x, "f1": r.f1, "standard_error": r.standard_error, "method": r.method})
-        return r.f1, r.standard_error
-
-    est = estimate_crossing(f, float(ratio_lo), float(ratio_hi), threshold, increasing=False, coverage=cov,
-                            progress=progress, bracket_ratio=BRACKET_RATIO)
-    evs = tuple(sorted(evals, key=lambda e: e["noise_ratio"]))
+    est, evs = _estimate(lambda r, point_seed: ideal_pair(a, b, sensor, scene_of(r), model=model, n_mc=n_mc,
+                                                          seed=point_seed),
+                         "noise_ratio", ratio_lo, ratio_hi, threshold, seed=seed, coverage=cov, progress=progress,
+                         increasing=False)
     return MonteCarloBound(est.value, est.low, est.high, cov if est.stated else None, int(n_mc), evs)
 
 

@@ -40,7 +40,7 @@ import numpy as np
 
 from .._validation import InputError
 
-__all__ = ["CrossingEstimate", "check_coverage", "estimate_crossing", "z_of_coverage"]
+__all__ = ["CrossingEstimate", "check_coverage", "coverage_of_z", "estimate_crossing", "z_of_coverage"]
 
 
 def check_coverage(coverage: float) -> float:
@@ -105,6 +105,15 @@ class CrossingEstimate:
     def stated(self) -> bool:
         """Whether ``(low, high)`` has the stated coverage (the fit); a bracket has none."""
         return self.method == "wls-logit-log"
+
+
+def coverage_of_z(z: float) -> float:
+    """The coverage whose two-sided normal quantile is ``z``: the inverse of :func:`z_of_coverage` (to 1e-12).
+
+    >>> coverage_of_z(z_of_coverage(0.9))
+    0.9
+    """
+    return round(math.erf(z / math.sqrt(2.0)), 12)
 
 
 def _logit(m):

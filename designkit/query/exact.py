@@ -30,8 +30,8 @@ Examples
 from __future__ import annotations
 
 import math
-from contextlib import nullcontext
 import time
+from contextlib import nullcontext
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
@@ -374,8 +374,7 @@ def exact_min_contact(e1=None, e2=None, *, m1=None, m2=None, objects=None, noise
                                    sensor_temp_spread_c=run.spread, model=run.model, threshold=run.phi,
                                    max_contact_s=tmax, n_mc=run.n_mc, seed=run.seed, coverage=cov)
         run.ideal_calls.extend(dict(e) for e in mcb.evaluations)
-        ideal = mcb.value
-        ideal_interval = None if mcb.coverage is None else (mcb.low, mcb.high, mcb.coverage)
+        ideal, ideal_interval = mcb.value, mcb.interval
     # the SVM needs at least the ideal observer's contact: search from there
     start = max(floor, ideal if ideal is not None else floor)
     def svm_at(c):
@@ -473,8 +472,7 @@ def _exact_ratio(question: str, kw: dict) -> Answer:
                                  threshold=run.phi, n_mc=run.n_mc, seed=run.seed, coverage=cov)
         run.ideal_calls.extend({"contact_s": contact, **e} for e in mcb.evaluations)
         ideal_r = mcb.value
-        if mcb.coverage is not None:
-            ideal_iv = (mcb.low, mcb.high)
+        ideal_iv = mcb.interval[:2] if mcb.interval else None
     # no classifier tolerates more noise than the ideal observer: search below its ratio (a Monte Carlo
     # bound's high end). The mean SVM F1 falls with sigma/dT; one crossing in log(sigma/dT) answers both
     ideal_cap = ideal_r if ideal_iv is None else ideal_iv[1]
@@ -654,7 +652,7 @@ def exact_delta_e(e: float | None = None, *, m: str | None = None, contact_s: fl
                                  n_mc=run.n_mc, seed=run.seed, coverage=cov)
             run.ideal_calls.extend({"contact_s": contact, **e} for e in mcb.evaluations)
             ideal = mcb.value
-            ideal_interval = None if mcb.coverage is None else [mcb.low, mcb.high]
+            ideal_interval = list(mcb.interval[:2]) if mcb.interval else None
         if ideal is None:  # not even the ideal observer separates a partner within the range: nor does the SVM
             sides[side] = {"value": None, "interval": [None, None], "ideal": None, "coverage": None,
                            "estimate_method": "none", "evaluations": []}

@@ -1230,8 +1230,7 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
                                           sensor_temp_spread_c=table_spread(op.tab), model=op.model,
                                           threshold=op.phi, max_contact_s=CLOSED_FORM_MAX_CONTACT_S,
                                           coverage=coverage)
-        ideal, ideal_method = mcb.value, "monte-carlo"
-        ideal_interval = None if mcb.coverage is None else (mcb.low, mcb.high, mcb.coverage)
+        ideal, ideal_method, ideal_interval = mcb.value, "monte-carlo", mcb.interval
         monte_carlo["ideal_monte_carlo"] = {"n_mc": mcb.n_mc, "evaluations": len(mcb.evaluations)}
     note = "" if value is not None else (
         f"no tabulated contact time up to {view.contacts[-1]:g} s separates them "
@@ -1261,7 +1260,7 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
             raw = value
             est = contact_estimate(grid[k_cross - 1], grid[k_cross], needs[k_cross - 1], needs[k_cross], hi - lo,
                                    raw, _arr(mc_interval[0]), _arr(mc_interval[1]),
-                                   _arr(ideal if ideal_interval is None else ideal_interval[0]), width=op.width,
+                                   _arr(ideal_floor(ideal, ideal_interval)), width=op.width,
                                    svm=op.tab.fidelity == "svm", z_table=table_z(op.tab),
                                    zc=z_of_coverage(coverage))
             value, low, high = float(est["value"]), _opt(est["low"]), _opt(est["high"])
@@ -1567,7 +1566,7 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
                                         noise_c=noise, delta_t_c=dt, sensor_temp_spread_c=table_spread(op.tab),
                                         model=op.model, threshold=op.phi, coverage=coverage)
             extra = {"table_ideal": ideal_side,
-                     "ideal_interval": None if mcb.coverage is None else [mcb.low, mcb.high]}
+                     "ideal_interval": list(mcb.interval[:2]) if mcb.interval else None}
             ideal_side = mcb.value
             side_floor = mcb.floor
         stated, cov_side, method = [None, None], None, "none"

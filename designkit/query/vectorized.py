@@ -53,7 +53,7 @@ from numpy.typing import NDArray
 from .._validation import InputError, check_effusivity, check_positive, check_temperature
 from . import table as _table_route
 from .answer import Answer, QuestionQuantity
-from .crossing import check_coverage, z_of_coverage
+from .crossing import check_coverage, coverage_of_z, z_of_coverage
 
 __all__ = ["ARRAY_INPUTS", "ArrayAnswer", "answer_arrays", "is_array_call"]
 
@@ -314,11 +314,6 @@ def _table_pair(question: str, x: dict[str, np.ndarray], op, ideal_bound: bool,
     return res
 
 
-def _coverage_of(zc: float) -> float:
-    """The coverage whose two-sided normal quantile is ``zc`` (inverse of :func:`z_of_coverage`, to 1e-12)."""
-    return round(math.erf(zc / math.sqrt(2.0)), 12)
-
-
 def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> None:
     view = op.view
     grid = view.contacts
@@ -378,7 +373,7 @@ def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> None
                 ObjectClass("a", (lo[i], lo[i] + op.width)), ObjectClass("b", (hi[i], hi[i] + op.width)),
                 op.tab.sensor, noise_c=float(x["noise_c"][i]), delta_t_c=float(x["delta_t_c"][i]),
                 sensor_temp_spread_c=spread, model=op.model, threshold=op.phi,
-                max_contact_s=_table_route.CLOSED_FORM_MAX_CONTACT_S, coverage=_coverage_of(zc))
+                max_contact_s=_table_route.CLOSED_FORM_MAX_CONTACT_S, coverage=coverage_of_z(zc))
             res["ideal"][i] = np.nan if mcb.value is None else mcb.value
             ideal_floor[i] = np.nan if mcb.value is None else mcb.floor
     # the scalar route's interval: an estimate where the crossing is interpolated between two tabulated needs
@@ -648,7 +643,7 @@ def _mc_delta_bounds(op, e: np.ndarray, direction: int, contact: float, noise: f
         mcb = cached_mc_ideal_delta(ObjectClass("r", (xe, xe + op.width)), direction, op.tab.sensor,
                                     contact_s=contact, noise_c=noise, delta_t_c=dt,
                                     sensor_temp_spread_c=_table_route.table_spread(op.tab), model=op.model,
-                                    threshold=op.phi, coverage=_coverage_of(zc))
+                                    threshold=op.phi, coverage=coverage_of_z(zc))
         if mcb.value is not None:
             value[i] = mcb.value
             floor[i] = mcb.floor

@@ -37,6 +37,7 @@ import math
 import os
 import re
 import select
+import termios
 import threading
 import time
 import tty
@@ -871,8 +872,6 @@ class Emulator:
         sample reached the host. Closing the pty discards what the host has not read yet, so without this
         wait how much of the stream the host saw would depend on how busy it was (a test saw the third
         touch's start lost at speed 50, where 3 s of device time are 60 ms)."""
-        import termios
-
         while self._slave is not None and time.monotonic() < deadline and not self._stop.is_set():
             try:
                 waiting = int.from_bytes(fcntl.ioctl(self._slave, termios.FIONREAD, b"\0\0\0\0"), "little")

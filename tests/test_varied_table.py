@@ -85,3 +85,21 @@ def test_tables_show_says_which_initial_conditions_a_table_holds():
     r = subprocess.run([sys.executable, "-m", "designkit", "tables", "show", "svm-paper"],
                        capture_output=True, text=True, timeout=120)
     assert "initial conditions fixed" in r.stdout
+
+
+def test_exact_answers_none_where_the_monte_carlo_bound_reaches_the_longest_contact():
+    """A pair whose Monte Carlo ideal bound is estimated at the end of the examined range (10 s) left the
+    SVM search an empty range: ``math domain error`` (found by bench_coverage_varied.py --seed 2)."""
+    from designkit.query.exact import exact_min_contact
+
+    a = exact_min_contact(9842.2, 9652.3, noise_c=0.0488, delta_t_c=7.5, sensor_temp_spread_c=2.5, seed=21054,
+                          repeats=1, trials=30, jobs=1)
+    assert a.ideal == 10.0  # the case itself: the bound's estimate at the range's end
+    assert a.value is None and a.notes == ("not separable by any contact time up to 10 s",)
+
+
+def test_a_crossing_estimate_refuses_an_empty_range():
+    from designkit.query.crossing import estimate_crossing
+
+    with pytest.raises(ValueError, match=r"0 < x_lo < x_hi, not \[10.0, 10.0\]"):
+        estimate_crossing(lambda x: (1.0, 0.0), 10.0, 10.0, 0.9)

@@ -158,6 +158,8 @@ def estimate_crossing(f: Callable[[float], tuple[float, float]], x_lo: float, x_
     -------
     CrossingEstimate
     """
+    if not 0.0 < x_lo < x_hi:
+        raise ValueError(f"the range examined must satisfy 0 < x_lo < x_hi, not [{x_lo!r}, {x_hi!r}]")
     z = z_of_coverage(coverage)
     evals: dict[float, tuple[float, float]] = {}
     n_bisect = max(1, math.ceil(math.log2(math.log(x_hi / x_lo) / math.log(bracket_ratio))))

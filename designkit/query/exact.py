@@ -375,8 +375,9 @@ def exact_min_contact(e1=None, e2=None, *, m1=None, m2=None, objects=None, noise
                                    max_contact_s=tmax, n_mc=run.n_mc, seed=run.seed, coverage=cov)
         run.ideal_calls.extend(dict(e) for e in mcb.evaluations)
         ideal, ideal_interval = mcb.value, mcb.interval
-    # the SVM needs at least the ideal observer's contact: search from there
-    start = max(floor, ideal if ideal is not None else floor)
+    # the SVM needs at least the ideal observer's contact: search from there (from just below the longest
+    # contact where the Monte Carlo bound's estimate reaches it: the search needs a range)
+    start = min(max(floor, ideal if ideal is not None else floor), tmax / 1.0001)
     def svm_at(c):
         return run.svm(cls, scene(c))
 

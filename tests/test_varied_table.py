@@ -6,9 +6,11 @@ it; any other spread, or a question without one, is refused by it (and the CLI c
 """
 
 import json
+import math
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
 import designkit.query as q
@@ -85,6 +87,69 @@ def test_tables_show_says_which_initial_conditions_a_table_holds():
     r = subprocess.run([sys.executable, "-m", "designkit", "tables", "show", "svm-paper"],
                        capture_output=True, text=True, timeout=120)
     assert "initial conditions fixed" in r.stdout
+
+
+def test_off_grid_noise_interpolates_the_slices_answers_in_log_time():
+    """Between two tabulated noises the varied table answers each slice on its own and interpolates the
+    answers (log time, linear in log noise), with a stated 90 % interval: a need beyond the effusivity range
+    in one slice no longer pushes the answer a contact later (benchmarks/bench_coverage_varied.py)."""
+    kw = dict(delta_t_c=7.5, sensor_temp_spread_c=2.5)
+    a, b = (q.min_contact(38361.8, 23984.9, noise_c=n, **kw) for n in (0.01, 0.02))
+    mid = q.min_contact(38361.8, 23984.9, noise_c=0.0107, **kw)
+    u = math.log(0.0107 / 0.01) / math.log(2.0)
+    assert mid.value == pytest.approx(math.exp((1 - u) * math.log(a.value) + u * math.log(b.value)), rel=1e-12)
+    # the grid rule (the larger direction's need, interpolated across noise) waited until 1.5 s here, where
+    # 16 seeds of the exact route put the answer at 0.905 s
+    assert mid.value < 1.0 and mid.interval[0] < 0.905 < mid.interval[1]
+    d = mid.to_dict()["interval"]
+    assert d["method"] == "table-varied-estimate" and d["coverage"] == 0.9
+    assert a.interval[0] < a.value < a.interval[1] and b.interval[0] < b.value < b.interval[1]
+
+
+def test_the_array_route_gives_the_scalar_routes_varied_estimates():
+    rng = np.random.default_rng(11)
+    e1 = rng.uniform(5000, 39000, 12)
+    e2 = e1 * rng.uniform(0.3, 0.7, 12)
+    noise = np.exp(rng.uniform(math.log(0.01), math.log(0.1), 12)).round(4)
+    arr = q.min_contact(e1, e2, noise_c=noise, delta_t_c=7.5, sensor_temp_spread_c=2.5)
+    n_estimates = 0
+    for i in range(e1.size):
+        s = q.min_contact(float(e1[i]), float(e2[i]), noise_c=float(noise[i]), delta_t_c=7.5,
+                          sensor_temp_spread_c=2.5)
+        if s.value is None:
+            assert np.isnan(arr.value[i])
+            continue
+        assert float(arr.value[i]) == pytest.approx(s.value, rel=1e-12), i
+        ends = [None if np.isnan(x) else float(x) for x in (arr.low[i], arr.high[i])]
+        assert ends == [None if x is None else pytest.approx(x, rel=1e-12) for x in s.interval], i
+        n_estimates += s.to_dict()["interval"]["method"] == "table-varied-estimate"
+    assert n_estimates >= 4
+
+
+def test_a_direction_beyond_the_range_enters_the_pair_need_at_its_least_possible_value():
+    from designkit.query.table import _View, _as_table, _pair_need_both
+
+    view = _View(_as_table(VARIED_TABLE))
+    t = view.t
+    w = float(t.header["effusivity"]["width"])
+    lo, hi = np.array([24040.0]), np.array([38040.0])  # both on reference centres: no interpolation in e
+    j_lo = int(np.searchsorted(view.centres, 24040.0))
+    j_hi = int(np.searchsorted(view.centres, 38040.0))
+    seen = set()
+    for s in range(t.axes["noise_c"].size):
+        need = _pair_need_both(view, "svm", (s, 0), lo, hi)[:, 0]
+        for k in range(view.contacts.size):
+            up, down = t.arrays["delta_up"][s, 0, k, j_lo], t.arrays["delta_down"][s, 0, k, j_hi]
+            seen.add((bool(np.isnan(up)), bool(np.isnan(down))))
+            if np.isnan(up) and np.isnan(down):
+                assert np.isnan(need[k])
+                continue
+            up = view.e_hi - 24040.0 + w if np.isnan(up) else up
+            down = 38040.0 - view.e_lo + w if np.isnan(down) else down
+            assert need[k] == pytest.approx(math.sqrt(up * down), rel=1e-12)
+    # both directions finite, and the upward partner beyond 40,000 with the downward one inside the range
+    # (the shipped table has no pair with both beyond it: a downward partner leaves the range only below 200)
+    assert {(False, False), (True, False)} <= seen
 
 
 def test_exact_answers_none_where_the_monte_carlo_bound_reaches_the_longest_contact():

@@ -78,6 +78,12 @@ INTERVAL_MEANING = {
     "table-cell": "the grid cell the crossing lies in, from the last tabulated value where the pair is not "
                   "separable to the first where it is: the grid cannot support an interval of stated "
                   "coverage here (a neighbour is beyond the grid)",
+    "table-varied-estimate": "interval at the stated coverage from a table with varied initial conditions "
+                             "(min-contact): each scene slice around the question (noise, dT) estimates the "
+                             "crossing from its tabulated needs, both directions averaged, with the table's Monte "
+                             "Carlo interval and the interpolation error between contact times; the slices' "
+                             "answers are interpolated (log time) and their change across the cell adds an "
+                             "interpolation error; never beyond the ideal-observer bound",
     "table-varied": "on a table with varied initial conditions: the interval the table gives (interpolated, or "
                     "the grid cell), with no coverage stated because measured coverage did not hold there (the "
                     "answer's notes give the figures); --exact states one",

@@ -201,19 +201,6 @@ def _raise(message: str):
 
 
 # ============================================================ vectorized interpolation (lookup's rule)
-def _interp_rows(rows: np.ndarray, centres: np.ndarray, e: np.ndarray) -> np.ndarray:
-    """:func:`designkit.tables.lookup.interp_e` for every row of ``rows`` [contact, centre] at every ``e``:
-    shape [contact, len(e)]."""
-    n = centres.size
-    j = np.clip(np.searchsorted(centres, e, side="right") - 1, 0, n - 2)
-    a, b = rows[:, j], rows[:, j + 1]
-    w = (e - centres[j]) / (centres[j + 1] - centres[j])
-    with np.errstate(invalid="ignore"):
-        out = np.where(w == 0.0, a, np.where(np.isnan(a) | np.isnan(b), np.nan, a + w * (b - a)))
-    out = np.where(e >= centres[-1], rows[:, -1:], out)
-    return np.where(e <= centres[0], rows[:, :1], out)
-
-
 def _delta(view, name: str, combos, e: np.ndarray) -> np.ndarray:
     """``view.delta_at`` at every contact of the table and every ``e``: [contact, len(e)]."""
     arr = view.t.arrays[name]
@@ -222,7 +209,7 @@ def _delta(view, name: str, combos, e: np.ndarray) -> np.ndarray:
     for idx, w in combos:
         if w == 0:
             continue
-        v = _interp_rows(arr[idx], view.centres, e)
+        v = _table_route.interp_e_rows(arr[idx], view.centres, e)
         bad |= np.isnan(v)
         total = total + w * v
     return np.where(bad, np.nan, total)
@@ -324,6 +311,9 @@ def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> None
     # the scalar route's noise-efficiency estimate (table.noise_k_min_contact, the same function), per scene
     efficiency = svm and op.closed and "delta_up_ideal" in view.t.arrays
     eff = {k: _nan(lo.size) for k in ("value", "low", "high")}
+    # varied initial conditions: the scalar route's per-slice estimate (table.varied_contact_estimate)
+    varied = svm and _table_route.table_spread(op.tab) > 0 and "delta_up_lo" in view.t.arrays
+    varied_groups = []
     for (noise, dt), idx in _groups(x["noise_c"], x["delta_t_c"]):
         combos, flags = view.scene_weights(noise, dt)
         if not all(flags.values()):
@@ -352,6 +342,8 @@ def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> None
         res["value"][idx], res["low"][idx], res["high"][idx] = value, ilo, ihi
         res["in_grid"][idx] = True
         todo[idx] = True
+        if varied:
+            varied_groups.append((combos, idx))
     if op.closed and ideal_bound and todo.any():
         from .ideal_bound import cached_ideal_min_contact
 
@@ -387,6 +379,13 @@ def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> None
         value[j], high[j] = eff["value"][j], eff["high"][j]
         low[j] = np.where(np.isnan(ideal[j]), eff["low"][j], np.minimum(np.maximum(eff["low"][j], ideal[j]),
                                                                          eff["value"][j]))
+        by_eff[j] = True
+    for combos, idx in varied_groups:
+        r = _table_route.varied_contact_estimate(view, combos, lo[idx], hi[idx], ideal[idx], width=op.width,
+                                                 z_table=_table_route.table_z(op.tab), zc=zc)
+        got = ~np.isnan(r["value"])
+        j = idx[got]
+        value[j], low[j], high[j] = r["value"][got], r["low"][got], r["high"][got]
         by_eff[j] = True
     est = (k_cross > 0) & ~np.isnan(n_prev) & ~np.isnan(raw) & ~by_eff
     cell = ~np.isnan(raw) & ~est & ~by_eff
@@ -679,7 +678,7 @@ def _table_delta_e(x: dict[str, np.ndarray], op, ideal_table, zc: float,
                     for i, wi in cmb:
                         if not wi:
                             continue
-                        y = _interp_rows(v.t.arrays[name][i][k:k + 1], v.centres, xe)[0]
+                        y = _table_route.interp_e_rows(v.t.arrays[name][i][k:k + 1], v.centres, xe)[0]
                         bad |= np.isnan(y) | (y <= 0)
                         total = total + w * wi * np.log(y)
                 return np.where(bad, np.nan, np.exp(total))

@@ -1,4 +1,4 @@
-"""Coverage of min-contact's stated 90 % intervals under varied initial conditions (the paper's robot setting).
+"""Coverage of min-contact's (or delta-e's) 90 % intervals under varied initial conditions (the robot setting).
 
 The coverage benchmark (``bench_coverage.py``, docs/accuracy.md) draws its cases at fixed initial
 conditions, on ``svm-paper``. This asks min-contact with the sensor temperature drawn per touch within
@@ -10,10 +10,13 @@ batched solver, the same classifier), with :func:`designkit.accuracy.coverage.co
 
 Cases: pairs as ``bench_coverage.py`` draws them (effusivities 100-39,000 J s^-1/2 K^-1 m^-2, three in four
 at least 400 apart), noise uniform on a log scale over the varied table's axis (0.01-0.1 degC).
+``--question delta-e``: references uniform in 500-39,500, contact log-uniform over the table's axis
+(0.5-4 s); the table's interval is delta-e's interpolated estimate (kind ``table-estimate``).
 
 Run from the repository root::
 
     python benchmarks/bench_coverage_varied.py --n 60 --jobs 2 --json out.json
+    python benchmarks/bench_coverage_varied.py --question delta-e --n 100 --jobs 2
 """
 
 from __future__ import annotations
@@ -34,13 +37,15 @@ from designkit.accuracy.coverage import coverage_case, diluted_coverage, draw_ca
 SPREAD_C, DT_C = 2.5, 7.5
 
 
-def cases(n: int, seed: int) -> list[dict]:
-    rng = np.random.default_rng([seed, 7])
+def cases(n: int, seed: int, question: str = "min-contact") -> list[dict]:
+    rng = np.random.default_rng([seed, 7] if question == "min-contact" else [seed, 7, 1])
     out = []
     for _ in range(n):
-        c = draw_case("min-contact", rng)
+        c = draw_case(question, rng)
         c["noise_c"] = round(float(np.exp(rng.uniform(math.log(0.01), math.log(0.1)))), 4)
         c["delta_t_c"] = DT_C
+        if question == "delta-e":  # a contact inside the varied table's axis (0.5-4 s)
+            c["contact_s"] = round(float(np.exp(rng.uniform(math.log(0.5), math.log(4.0)))), 3)
         out.append(c)
     return out
 
@@ -50,26 +55,27 @@ def main() -> None:
     ap.add_argument("--n", type=int, default=60)
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--question", choices=("min-contact", "delta-e"), default="min-contact")
     ap.add_argument("--json", type=Path)
     a = ap.parse_args()
-    todo = cases(a.n, a.seed)
+    todo = cases(a.n, a.seed, a.question)
     t0 = time.perf_counter()
     results = []
     with Progress() as bar, local_processes(a.jobs):
-        task = bar.add_task("varied min-contact cases", total=len(todo))
+        task = bar.add_task(f"varied {a.question} cases", total=len(todo))
         for r in Parallel(n_jobs=a.jobs, return_as="generator_unordered")(
-                delayed(coverage_case)("min-contact", c, 20000 + i, table="svm-paper-varied",
+                delayed(coverage_case)(a.question, c, 20000 + i, table="svm-paper-varied",
                                        sensor_temp_spread_c=SPREAD_C) for i, c in enumerate(todo)):
             results.append(r)
             bar.advance(task)
     wall = time.perf_counter() - t0
     results.sort(key=lambda r: r["index"])
-    print(f"min-contact, sensor temperature varied +-{SPREAD_C} degC at dT {DT_C} degC: {len(results)} cases, "
+    print(f"{a.question}, sensor temperature varied +-{SPREAD_C} degC at dT {DT_C} degC: {len(results)} cases, "
           f"{wall:.0f} s wall on {a.jobs} processes")
     print(f"an exactly calibrated 90 % interval covers {diluted_coverage(0.9, 0.5):.1%} of references with half "
           "its standard error (bench_coverage.py)")
     for route in ("table", "exact"):
-        s = summarize(results, "min-contact", route)
+        s = summarize(results, a.question, route)
         kinds: dict[str, int] = {}
         for r in results:
             kinds[r[route].get("method") or "none"] = kinds.get(r[route].get("method") or "none", 0) + 1

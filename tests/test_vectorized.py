@@ -33,6 +33,7 @@ def _check_elementwise(arr: ArrayAnswer, scalar, inputs: dict, *, ideal_rtol=1e-
         assert _same(float(arr.value[idx]), _num(one.value), 1e-12), where
         assert _same(float(arr.low[idx]), _num(one.interval[0]), 1e-12), where
         assert _same(float(arr.high[idx]), _num(one.interval[1]), 1e-12), where
+        assert _same(float(arr.coverage[idx]), _num(one.interval_coverage), 1e-12), where  # what it claims
         assert _same(float(arr.ideal[idx]), _num(one.ideal_bound.value), ideal_rtol), where
         assert bool(arr.in_grid[idx]) == all(one.in_grid.values()), where
         if one.question == "delta-e":

@@ -89,6 +89,10 @@ class ArrayAnswer(QuestionQuantity):
         The answer's interval per element (``Answer.interval``; NaN: None): at the
         call's ``coverage`` where the scalar answer states one, else the grid cell or
         a one-sided bound, as the scalar answer (``distinguishable``: NaN, no interval).
+    coverage : ndarray of float
+        The coverage each element's interval states (``Answer.interval_coverage``): the
+        call's ``coverage`` where the scalar answer states one, NaN where it states none
+        (a grid cell, a search bracket, a varied table's grid reading, no interval).
     ideal : ndarray of float
         The ideal observer's answer per element (``Answer.ideal_bound.value``;
         ``distinguishable``: the ideal F1); NaN: none, or not computed.
@@ -112,6 +116,7 @@ class ArrayAnswer(QuestionQuantity):
     value: FloatArray
     low: FloatArray
     high: FloatArray
+    coverage: FloatArray
     ideal: FloatArray
     in_grid: NDArray[np.bool_]
     table: str | None = None
@@ -135,7 +140,7 @@ class ArrayAnswer(QuestionQuantity):
             return np.where(np.isfinite(a), a, None).tolist() if a.ndim else (float(a) if np.isfinite(a) else None)
         return {"question": self.question, "route": self.route, "quantity": self.quantity, "unit": self.unit,
                 "shape": list(self.shape), "value": lst(self.value), "interval_low": lst(self.low),
-                "interval_high": lst(self.high), "ideal": lst(self.ideal), "in_grid": self.in_grid.tolist(),
+                "interval_high": lst(self.high), "interval_coverage": lst(self.coverage), "ideal": lst(self.ideal), "in_grid": self.in_grid.tolist(),
                 "table": self.table, "details": {k: lst(v) for k, v in self.details.items()}}
 
 
@@ -290,7 +295,7 @@ def _table_pair(question: str, x: dict[str, np.ndarray], op, ideal_bound: bool,
     n = lo.size
     view = op.view
     res = {k: _nan(n) for k in ("value", "low", "high", "ideal")}
-    res["in_grid"] = np.zeros(n, dtype=bool)
+    res["in_grid"], res["stated"] = np.zeros(n, dtype=bool), np.zeros(n, dtype=bool)
     e_in = (view.e_lo < lo) & (lo <= view.e_hi) & (view.e_lo < hi) & (hi <= view.e_hi)
     if question == "min-contact":
         _min_contact(x, op, lo, hi, e_in, res, ideal_bound, zc)
@@ -399,8 +404,9 @@ def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> None
     low = np.where(cell, np.where(np.isnan(ideal), prev, np.maximum(prev, ideal)), low)
     high = np.where(cell, raw, high)
     res["value"], res["low"], res["high"] = value, low, high
-    if "stated" in res:  # (for distinguishable) where the interval has a stated coverage, as the scalar answer's
-        res["stated"] = by_eff | est
+    if "stated" in res:  # where the interval has a stated coverage, as the scalar answer's (a varied table's
+        # grid-rule estimate states none: table.VARIED_COVERAGE_NOTE)
+        res["stated"] = by_eff | (est & ~(_table_route.table_spread(op.tab) > 0))
 
 
 _BELOW, _INSIDE, _ABOVE, _CELL = 0, 1, 2, 3  # where a largest separating ratio lies (the scalar route's words)
@@ -522,7 +528,7 @@ def _ratio(question, x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> 
         low[j], high[j], r_all[j] = a[j], b[j], r_k
         by_k[j] = True
     inside = (where_all == _INSIDE) & ~by_k
-    if "stated" in res:  # (for distinguishable) where the interval has a stated coverage, as the scalar answer's
+    if "stated" in res:  # where the interval has a stated coverage, as the scalar answer's
         res["stated"] = by_k | (inside if svm else False)
     if svm and inside.any():  # the scalar route's estimate (table.ratio_estimate, the same function)
         est = _table_route.ratio_estimate(r_all, alt["c"], alt["lin"], alt["rnd"], alt["geo"], ends["hi"], ends["lo"], ri,
@@ -723,6 +729,7 @@ def _table_delta_e(x: dict[str, np.ndarray], op, ideal_table, zc: float,
         res["in_grid"][idx] = True
     res["value"] = np.fmin(res["lower"], res["upper"])
     res["ideal"] = np.fmin(res["lower_ideal"], res["upper_ideal"])
+    res["stated"] = np.full(n, svm) & ~np.isnan(res["value"])  # an SVM table's estimate (as the scalar route)
     # the interval of the direction giving the value (the lower one on a tie, as the scalar route)
     lower = ~np.isnan(res["lower"]) & (np.isnan(res["upper"]) | (res["lower"] <= res["upper"]))
     for end in ("low", "high"):
@@ -739,6 +746,7 @@ def _from_answers(answers: list[Answer], shape: tuple[int, ...], question: str) 
         "value": np.array([num(a.value) for a in answers]),
         "low": np.array([num(a.interval[0]) for a in answers]),
         "high": np.array([num(a.interval[1]) for a in answers]),
+        "coverage": np.array([num(a.interval_coverage) for a in answers]),
         "ideal": np.array([num(a.ideal_bound.value) for a in answers]),
         "in_grid": np.array([all(a.in_grid.values()) for a in answers], dtype=bool),
     }
@@ -790,6 +798,10 @@ def answer_arrays(question: str, scalar: Callable[..., Answer], route: str, argu
                            others.get("ideal_table", _table_route.DEFAULT_IDEAL_TABLE)) if pair
                else _table_delta_e(flat, op, others.get("ideal_table", _table_route.DEFAULT_IDEAL_TABLE), zc,
                                    ideal_bound))
+        stated = res.pop("stated")
+        res["coverage"] = np.where(stated, check_coverage(others.get("coverage", 0.9)), np.nan)
+        if question == "distinguishable":  # no interval (the scalar answer's)
+            res["coverage"] = _nan(stated.size)
         res = {k: v.reshape(shape) for k, v in res.items()}
         table = op.tab.name
     else:

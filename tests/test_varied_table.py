@@ -111,6 +111,8 @@ def test_the_array_route_gives_the_scalar_routes_varied_estimates():
     e1 = rng.uniform(5000, 39000, 12)
     e2 = e1 * rng.uniform(0.3, 0.7, 12)
     noise = np.exp(rng.uniform(math.log(0.01), math.log(0.1), 12)).round(4)
+    # and a pair separable at the table's first contact: a grid cell, no stated coverage
+    e1, e2, noise = np.append(e1, 13190.9), np.append(e2, 1120.5), np.append(noise, 0.03)
     arr = q.min_contact(e1, e2, noise_c=noise, delta_t_c=7.5, sensor_temp_spread_c=2.5)
     n_estimates = 0
     for i in range(e1.size):
@@ -122,8 +124,14 @@ def test_the_array_route_gives_the_scalar_routes_varied_estimates():
         assert float(arr.value[i]) == pytest.approx(s.value, rel=1e-12), i
         ends = [None if np.isnan(x) else float(x) for x in (arr.low[i], arr.high[i])]
         assert ends == [None if x is None else pytest.approx(x, rel=1e-12) for x in s.interval], i
+        # the array says which intervals state a coverage, as each scalar answer does
+        assert (None if np.isnan(arr.coverage[i]) else float(arr.coverage[i])) == s.interval_coverage, i
         n_estimates += s.to_dict()["interval"]["method"] == "table-varied-estimate"
-    assert n_estimates >= 4
+    assert n_estimates >= 4 and np.isnan(arr.coverage).any()  # some stated, some not
+    d = q.delta_e(e1[:4], contact_s=2.0, noise_c=noise[:4], delta_t_c=7.5, sensor_temp_spread_c=2.5)
+    for i in range(4):
+        s = q.delta_e(float(e1[i]), contact_s=2.0, noise_c=float(noise[i]), delta_t_c=7.5, sensor_temp_spread_c=2.5)
+        assert float(d.value[i]) == pytest.approx(s.value, rel=1e-12) and float(d.coverage[i]) == s.interval_coverage
 
 
 def test_a_direction_beyond_the_range_enters_the_pair_need_at_its_least_possible_value():
@@ -180,3 +188,19 @@ def test_the_varied_table_states_coverage_only_where_it_was_measured_to_hold():
     c = cell.to_dict()["interval"]
     assert c["method"] == "table-varied" and c["coverage"] is None and cell.value == 0.5
     assert any("grid cell" in n and "6 of 14" in n for n in cell.notes)
+
+
+def test_distinguishable_inside_a_varied_cell_is_uncertain_and_the_array_route_agrees():
+    """Inside the (a, b] a varied table states no coverage for, the verdict is uncertain (as in a fixed
+    table's grid cell), not silent; the array route, which already treated it as unsure, gives the same."""
+    kw = dict(noise_c=0.0271, delta_t_c=7.5, sensor_temp_spread_c=2.5)
+    m = q.min_contact(14697.4, 1500.5, **kw)
+    assert m.to_dict()["interval"]["method"] == "table-varied" and m.interval == (0.5, 0.75)
+    contacts = np.array([0.6, 0.7, 0.8])
+    arr = q.distinguishable(np.full(3, 14697.4), 1500.5, contact_s=contacts, **kw)
+    verdicts = []
+    for i, c in enumerate(contacts):
+        s = q.distinguishable(14697.4, 1500.5, contact_s=float(c), **kw)
+        assert float(arr.value[i]) == float(s.value)
+        verdicts.append(s.details["verdict"])
+    assert verdicts == ["uncertain", "uncertain", None]

@@ -1949,8 +1949,10 @@ def _contact_verdict(contact: float, mc: Answer, coverage: float) -> tuple[str |
             return "uncertain", (f"verdict uncertain: {contact:g} s lies inside {iv}: the table cannot tell; "
                                  "--exact computes this pair's F1")
         return "confident", f"verdict confident: {contact:g} s lies {'above' if contact > t else 'below'} {iv}"
-    if mc.interval_kind == "table-cell" and a is not None and a < contact <= (b if b is not None else math.inf):
-        return "uncertain", (f"verdict uncertain: {contact:g} s lies in the grid cell ({a:.3g}, {_fmt_or_open(b)}] "
+    if (mc.interval_kind in ("table-cell", "table-varied") and a is not None
+            and a < contact <= (b if b is not None else math.inf)):
+        where = "the grid cell" if mc.interval_kind == "table-cell" else "the interval"
+        return "uncertain", (f"verdict uncertain: {contact:g} s lies in {where} ({a:.3g}, {_fmt_or_open(b)}] "
                              f"s where the shortest separating contact is ({said}; no stated coverage there)")
     return None, f"{contact:g} s against {said} (no interval of stated coverage there)"
 

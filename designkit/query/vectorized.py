@@ -140,7 +140,8 @@ class ArrayAnswer(QuestionQuantity):
             return np.where(np.isfinite(a), a, None).tolist() if a.ndim else (float(a) if np.isfinite(a) else None)
         return {"question": self.question, "route": self.route, "quantity": self.quantity, "unit": self.unit,
                 "shape": list(self.shape), "value": lst(self.value), "interval_low": lst(self.low),
-                "interval_high": lst(self.high), "interval_coverage": lst(self.coverage), "ideal": lst(self.ideal), "in_grid": self.in_grid.tolist(),
+                "interval_high": lst(self.high), "interval_coverage": lst(self.coverage), "ideal": lst(self.ideal),
+                "in_grid": self.in_grid.tolist(),
                 "table": self.table, "details": {k: lst(v) for k, v in self.details.items()}}
 
 

@@ -298,7 +298,9 @@ def _source_lines(con, d):
         bad = [words.get(k, k) for k, ok in d["in_grid"].items() if not ok]
         where = "inside its grid" if not bad else "OUTSIDE its grid along " + ", ".join(bad)
         eff = "the SVM's tabulated efficiency applied to the exact ideal observer between grid points"
-        how = eff if d["interval"].get("method") == "table-efficiency" else "interpolated"
+        how = {"table-efficiency": eff,
+               "table-varied-estimate": "each noise slice's estimate around the question, interpolated in log time"
+               }.get(d["interval"].get("method"), "interpolated")
         if d["question"] == "distinguishable":  # the verdict is the contact against min-contact's answer
             how = "the contact against min-contact's answer" + (
                 f" ({eff})" if d["computation"].get("min_contact_interval_kind") == "table-efficiency" else "")

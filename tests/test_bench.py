@@ -302,7 +302,36 @@ def test_the_shipped_page_renders_from_its_own_json():
         from designkit.accuracy.render import coverage_markdown, insert_coverage
 
         md = insert_coverage(md, coverage_markdown(json.loads(cov.read_text()), "accuracy_coverage.png"))
+    varied = REPO / "docs" / "accuracy_coverage_varied.json"
+    if varied.is_file():  # and the varied-conditions one (benchmarks/bench_coverage_varied.py --docs)
+        from designkit.accuracy.render import insert_varied_coverage, varied_coverage_markdown
+
+        md = insert_varied_coverage(md, varied_coverage_markdown(json.loads(varied.read_text())))
     assert md == (REPO / "docs" / "accuracy.md").read_text()
+
+
+def test_a_varied_coverage_run_replaces_its_own_earlier_run_and_keeps_the_others(tmp_path):
+    from designkit.accuracy.render import VARIED_COVERAGE_FILE, write_varied_coverage
+
+    (tmp_path / "accuracy.md").write_text("# Accuracy\n\n<!-- COVERAGE START -->\nc\n<!-- COVERAGE END -->\n## Next\n")
+    s = {"n": 100, "n_compared": 50, "n_stated": 40, "coverage": 0.9, "n_unstated": 2, "unstated_contains": 0.5,
+         "n_no_answer": 10, "median_rel": 0.03, "p95_rel": 0.2, "violations": 0}
+    run = {"question": "min-contact", "seed": 1, "wall_s": 500.0, "cpus": 2, "spread_c": 2.5, "delta_t_c": 7.5,
+           "routes": {"table": s, "exact": s}, "sharp": None,
+           "regions": [{"noise_band": [0.01, 0.02], "e_band": [0, 2000], "n": 4, "median_rel": 0.1, "max_rel": 0.2,
+                        "coverage": 0.75}]}
+    write_varied_coverage(run, tmp_path)
+    write_varied_coverage({**run, "seed": 2}, tmp_path)
+    page = write_varied_coverage({**run, "routes": {"table": {**s, "coverage": 0.5}}}, tmp_path).read_text()
+    doc = json.loads((tmp_path / VARIED_COVERAGE_FILE).read_text())
+    assert sorted((r["question"], r["seed"]) for r in doc["runs"]) == [("min-contact", 1), ("min-contact", 2)]
+    rows = [ln for ln in page.splitlines() if ln.startswith("| `min-contact`")]
+    assert [r.split(" | ")[1:3] + [r.split(" | ")[6]] for r in rows] == [
+        ["1", "table", "50 %"], ["2", "table", "90 %"], ["2", "exact", "90 %"]]
+    # one section, after the coverage section and before the next heading
+    assert page.count("VARIED COVERAGE START") == 1
+    assert page.index("COVERAGE END") < page.index("VARIED COVERAGE START") < page.index("## Next")
+    assert "noise 0.01-0.02 degC, e 0-2000: 10 % (4 cases, coverage 75 %)" in page
 
 
 def test_every_accuracy_module_declares_its_public_names_and_imports_no_private_ones():

@@ -182,3 +182,20 @@ def test_normal_quantile_of_the_query_path_against_the_standard_library():
 
     for c in (0.5, 0.8, 0.9, 0.95, 0.99, 0.999):
         assert z_of_coverage(c) == pytest.approx(NormalDist().inv_cdf(0.5 + 0.5 * c), rel=1e-12)
+
+
+def test_worst_regions_group_continuous_noise_by_band():
+    from designkit.accuracy.coverage import worst_regions
+
+    def case(noise, e2, value, ref, cov=0.9):
+        return {"question": "min-contact", "noise_c": noise, "e2": e2,
+                "table": {"value": value, "low": value * 0.9, "high": value * 1.1, "coverage": cov},
+                "reference": {"value": ref}}
+    results = [case(0.012, 500.0, 1.0, 1.0), case(0.018, 900.0, 1.2, 1.0), case(0.03, 500.0, 2.0, 1.0),
+               case(0.07, 30000.0, 1.0, 1.0)]
+    got = worst_regions(results, "min-contact", "table", noise_bands=((0.01, 0.02), (0.02, 0.05), (0.05, 0.1)))
+    assert [(g["noise_band"], g["e_band"], g["n"]) for g in got] == [
+        ([0.02, 0.05], [0, 2000], 1), ([0.01, 0.02], [0, 2000], 2), ([0.05, 0.1], [20000, 40000], 1)]
+    assert got[1]["median_rel"] == pytest.approx(0.1) and got[1]["coverage"] == 0.5  # 1.2 vs 1: not inside
+    # the fixed levels as before (no case at exactly 0.01, 0.05 or 0.1 here)
+    assert worst_regions(results, "min-contact", "table") == []

@@ -391,20 +391,28 @@ def synthetic_coverage(n: int, *, seed: int, coverage: float = 0.9, repeats: int
             "z_sd": float(np.std(zs)) if zs else None}
 
 
-def worst_regions(results: Sequence[Mapping[str, Any]], question: str, route: str) -> list[dict[str, Any]]:
-    """Relative error by noise level and effusivity band (of the pair's lower edge), worst first."""
+def worst_regions(results: Sequence[Mapping[str, Any]], question: str, route: str, *,
+                  noise_bands: Sequence[tuple[float, float]] | None = None) -> list[dict[str, Any]]:
+    """Relative error by noise level and effusivity band (of the pair's lower edge), worst first.
+
+    ``noise_bands``: ``[lo, hi)`` ranges of noise [degC] instead of the benchmark's three levels (cases drawn
+    from a continuous noise range); each region then has ``noise_band`` instead of ``noise_c``.
+    """
     bands = ((0, 2000), (2000, 8000), (8000, 20000), (20000, 40000))
+    levels = [(n, n) for n in _NOISES_C] if noise_bands is None else list(noise_bands)
     out = []
-    for noise in _NOISES_C:
+    for n_lo, n_hi in levels:
         for lo, hi in bands:
-            sel = [r for r in results if r["question"] == question and r["noise_c"] == noise
+            sel = [r for r in results if r["question"] == question
+                   and (r["noise_c"] == n_lo if noise_bands is None else n_lo <= r["noise_c"] < n_hi)
                    and lo <= (r.get("e2", r.get("e", 0.0))) < hi and r[route]["value"] is not None
                    and r["reference"]["value"] not in (None, 0)]
             if not sel:
                 continue
             rel = [abs(r[route]["value"] - r["reference"]["value"]) / abs(r["reference"]["value"]) for r in sel]
             stated = [r for r in sel if r[route].get("coverage")]
-            out.append({"noise_c": noise, "e_band": [lo, hi], "n": len(sel), "median_rel": float(np.median(rel)),
+            noise = {"noise_c": n_lo} if noise_bands is None else {"noise_band": [n_lo, n_hi]}
+            out.append({**noise, "e_band": [lo, hi], "n": len(sel), "median_rel": float(np.median(rel)),
                         "max_rel": float(np.max(rel)),
                         "coverage": float(np.mean([_covered(r[route], r["reference"]["value"]) for r in stated]))
                         if stated else None})

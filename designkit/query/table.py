@@ -429,17 +429,23 @@ def contact_estimate(x0, x1, n0, n1, gap, raw, mc_lo, mc_hi, ideal, *, width: fl
     return {"value": value, "low": low, "high": high, "interp": interp, "rounding": rounding}
 
 
+def _interp_e_by(at, centres: np.ndarray, e: np.ndarray) -> np.ndarray:
+    """:func:`designkit.tables.lookup.interp_e`'s rule over arrays: ``at(c)`` gives the tabulated values at
+    centre indices ``c`` (an array shaped as ``e``), and the result is shaped as what ``at`` returns."""
+    n = centres.size
+    c = np.clip(np.searchsorted(centres, e, side="right") - 1, 0, n - 2)
+    a, b = at(c), at(c + 1)
+    w = (e - centres[c]) / (centres[c + 1] - centres[c])
+    with np.errstate(invalid="ignore"):
+        out = np.where(w == 0.0, a, np.where(np.isnan(a) | np.isnan(b), np.nan, a + w * (b - a)))
+    out = np.where(e >= centres[-1], at(np.full_like(c, n - 1)), out)
+    return np.where(e <= centres[0], at(np.zeros_like(c)), out)
+
+
 def interp_e_rows(rows: np.ndarray, centres: np.ndarray, e: np.ndarray) -> np.ndarray:
     """:func:`designkit.tables.lookup.interp_e` for every row of ``rows`` [contact, centre] at every ``e``:
     shape [contact, len(e)]."""
-    n = centres.size
-    j = np.clip(np.searchsorted(centres, e, side="right") - 1, 0, n - 2)
-    a, b = rows[:, j], rows[:, j + 1]
-    w = (e - centres[j]) / (centres[j + 1] - centres[j])
-    with np.errstate(invalid="ignore"):
-        out = np.where(w == 0.0, a, np.where(np.isnan(a) | np.isnan(b), np.nan, a + w * (b - a)))
-    out = np.where(e >= centres[-1], rows[:, -1:], out)
-    return np.where(e <= centres[0], rows[:, :1], out)
+    return _interp_e_by(lambda c: rows[:, c], centres, e)
 
 
 def _pair_need_both(view: _View, kind: str, idx: tuple[int, ...], lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
@@ -533,14 +539,7 @@ def varied_contact_estimate(view: _View, combos, lo, hi, ideal, *, width: float,
 def _interp_at(arr3d: np.ndarray, centres: np.ndarray, si: np.ndarray, j: np.ndarray, e: np.ndarray) -> np.ndarray:
     """:func:`designkit.tables.lookup.interp_e` of ``arr3d[si[p], j[p]]`` (a [slice, contact, centre] array) at
     ``e[p]``, per p."""
-    n = centres.size
-    c = np.clip(np.searchsorted(centres, e, side="right") - 1, 0, n - 2)
-    a, b = arr3d[si, j, c], arr3d[si, j, c + 1]
-    w = (e - centres[c]) / (centres[c + 1] - centres[c])
-    with np.errstate(invalid="ignore"):
-        out = np.where(w == 0.0, a, np.where(np.isnan(a) | np.isnan(b), np.nan, a + w * (b - a)))
-    out = np.where(e >= centres[-1], arr3d[si, j, n - 1], out)
-    return np.where(e <= centres[0], arr3d[si, j, 0], out)
+    return _interp_e_by(lambda c: arr3d[si, j, c], centres, e)
 
 
 #: The noise-efficiency readings of small calls (a single question's), kept per process (least recently used

@@ -379,22 +379,22 @@ def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> None
     raw, ideal = res["value"], ideal_floor
     low, high = _nan(lo.size), _nan(lo.size)
     value = raw.copy()
-    by_eff = np.zeros(lo.size, dtype=bool)
+    by_estimate = np.zeros(lo.size, dtype=bool)
     if efficiency and (got := ~np.isnan(raw) & ~np.isnan(eff["value"])).any():
         j = np.nonzero(got)[0]
         value[j], high[j] = eff["value"][j], eff["high"][j]
         low[j] = np.where(np.isnan(ideal[j]), eff["low"][j], np.minimum(np.maximum(eff["low"][j], ideal[j]),
                                                                          eff["value"][j]))
-        by_eff[j] = True
+        by_estimate[j] = True
     for combos, idx in varied_groups:
         r = _table_route.varied_contact_estimate(view, combos, lo[idx], hi[idx], ideal[idx], width=op.width,
                                                  z_table=_table_route.table_z(op.tab), zc=zc)
         got = ~np.isnan(r["value"])
         j = idx[got]
         value[j], low[j], high[j] = r["value"][got], r["low"][got], r["high"][got]
-        by_eff[j] = True
-    est = (k_cross > 0) & ~np.isnan(n_prev) & ~np.isnan(raw) & ~by_eff
-    cell = ~np.isnan(raw) & ~est & ~by_eff
+        by_estimate[j] = True
+    est = (k_cross > 0) & ~np.isnan(n_prev) & ~np.isnan(raw) & ~by_estimate
+    cell = ~np.isnan(raw) & ~est & ~by_estimate
     if est.any():
         i = np.nonzero(est)[0]
         r = _table_route.contact_estimate(
@@ -405,9 +405,8 @@ def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> None
     low = np.where(cell, np.where(np.isnan(ideal), prev, np.maximum(prev, ideal)), low)
     high = np.where(cell, raw, high)
     res["value"], res["low"], res["high"] = value, low, high
-    if "stated" in res:  # where the interval has a stated coverage, as the scalar answer's (a varied table's
-        # grid-rule estimate states none: table.VARIED_COVERAGE_NOTE)
-        res["stated"] = by_eff | (est & ~(_table_route.table_spread(op.tab) > 0))
+    if "stated" in res:  # where the interval has a stated coverage, as the scalar answer's
+        res["stated"] = by_estimate | (est & _table_route.states_coverage(op.tab, "min-contact", "table-estimate"))
 
 
 _BELOW, _INSIDE, _ABOVE, _CELL = 0, 1, 2, 3  # where a largest separating ratio lies (the scalar route's words)
@@ -730,7 +729,9 @@ def _table_delta_e(x: dict[str, np.ndarray], op, ideal_table, zc: float,
         res["in_grid"][idx] = True
     res["value"] = np.fmin(res["lower"], res["upper"])
     res["ideal"] = np.fmin(res["lower_ideal"], res["upper_ideal"])
-    res["stated"] = np.full(n, svm) & ~np.isnan(res["value"])  # an SVM table's estimate (as the scalar route)
+    # an SVM table's estimate (table-efficiency or table-estimate) states its coverage, as the scalar route's
+    states = svm and _table_route.states_coverage(op.tab, "delta-e", "table-estimate")
+    res["stated"] = np.full(n, states) & ~np.isnan(res["value"])
     # the interval of the direction giving the value (the lower one on a tie, as the scalar route)
     lower = ~np.isnan(res["lower"]) & (np.isnan(res["upper"]) | (res["lower"] <= res["upper"]))
     for end in ("low", "high"):
@@ -799,10 +800,8 @@ def answer_arrays(question: str, scalar: Callable[..., Answer], route: str, argu
                            others.get("ideal_table", _table_route.DEFAULT_IDEAL_TABLE)) if pair
                else _table_delta_e(flat, op, others.get("ideal_table", _table_route.DEFAULT_IDEAL_TABLE), zc,
                                    ideal_bound))
-        stated = res.pop("stated")
+        stated = res.pop("stated") & (question != "distinguishable")  # (it has no interval, as the scalar)
         res["coverage"] = np.where(stated, check_coverage(others.get("coverage", 0.9)), np.nan)
-        if question == "distinguishable":  # no interval (the scalar answer's)
-            res["coverage"] = _nan(stated.size)
         res = {k: v.reshape(shape) for k, v in res.items()}
         table = op.tab.name
     else:

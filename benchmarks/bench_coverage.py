@@ -202,16 +202,10 @@ def main(argv=None) -> int:
     meta["load_end"] = os.getloadavg()[0]
     results = _load(cases_path)
     if a.rescore_table:
-        from designkit import query
-        from designkit.accuracy.coverage import answer_reading, case_arguments
+        from designkit.accuracy.coverage import table_reading
 
         for r in results:
-            try:
-                ans = query.ask(r["question"], route="table", table="svm-paper", coverage=0.9,
-                                **case_arguments(r["question"], r))
-                r["table"] = answer_reading(r["question"], ans)
-            except Exception as exc:  # noqa: BLE001 - recorded as the benchmark does
-                r["table"] = {**answer_reading(r["question"], None), "error": str(exc)}
+            r["table"] = table_reading(r["question"], r, table="svm-paper", coverage=0.9)
         meta["table_rescored"] = True
     doc = report(results, synthetic, meta, a.out)
     fig = figure(results, a.out)

@@ -34,7 +34,7 @@ from joblib import Parallel, delayed
 from rich.progress import Progress
 
 from designkit._workers import local_processes
-from designkit.accuracy.coverage import coverage_case, diluted_coverage, draw_case, summarize
+from designkit.accuracy.coverage import coverage_case, diluted_coverage, draw_case, summarize, table_reading
 
 SPREAD_C, DT_C = 2.5, 7.5
 
@@ -50,16 +50,6 @@ def cases(n: int, seed: int, question: str = "min-contact") -> list[dict]:
             c["contact_s"] = round(float(np.exp(rng.uniform(math.log(0.5), math.log(4.0)))), 3)
         out.append(c)
     return out
-
-
-def _table_reading(question: str, case: dict) -> dict:
-    """The table route's reading of one case, with the code as it is now (``--rescore-table``)."""
-    from designkit import query
-    from designkit.accuracy.coverage import answer_reading, case_arguments
-
-    ans = query.ask(question, route="table", table="svm-paper-varied", coverage=0.9,
-                    sensor_temp_spread_c=SPREAD_C, **case_arguments(question, case))
-    return answer_reading(question, ans)
 
 
 def main() -> None:
@@ -84,7 +74,8 @@ def main() -> None:
                 task = bar.add_task(f"re-asking the table: {a.question}", total=len(results))
                 readings = []
                 for reading in Parallel(n_jobs=a.jobs, return_as="generator")(
-                        delayed(_table_reading)(a.question, r) for r in results):
+                        delayed(table_reading)(a.question, r, table="svm-paper-varied", coverage=0.9,
+                                               sensor_temp_spread_c=SPREAD_C) for r in results):
                     readings.append(reading)
                     bar.advance(task)
             results = [{**r, "table": t} for r, t in zip(results, readings)]

@@ -31,7 +31,8 @@ from __future__ import annotations
 
 from .cost import cost_curve, cost_curve_specs, cost_curves
 from .coverage import (COVERAGE_QUESTIONS, answer_reading, calibration_z, case_arguments, coverage_case,
-                       diluted_coverage, draw_case, run_cases, summarize, synthetic_coverage, worst_regions)
+                       diluted_coverage, draw_case, run_cases, summarize, synthetic_coverage, table_reading,
+                       worst_regions)
 from .delta import delta_rows, grid_rows, staircase_vs_full
 from .instruments import ProcessCost, fit_exponent, measure, process_cost, reset_peak_memory, resident_mb, timed
 from .physics import physics_rows, slab_rows
@@ -50,7 +51,7 @@ __all__ = [
     "insert_varied_coverage", "varied_coverage_markdown", "write_varied_coverage",
     "BenchReport", "CostCurve", "ProcessCost", "Row",
     "answer_reading", "calibration_z", "case_arguments", "check_sections", "coverage_case", "coverage_markdown", "diluted_coverage",
-    "draw_case", "insert_coverage", "run_cases", "summarize", "synthetic_coverage", "worst_regions", "write_coverage",
+    "draw_case", "insert_coverage", "run_cases", "summarize", "synthetic_coverage", "table_reading", "worst_regions", "write_coverage",
     "cost_curve", "cost_curve_specs", "cost_curves", "curves_markdown", "delta_rows",
     "density_rows", "environment", "fit_exponent", "format_time", "format_value", "grid_rows", "ideal_mc_rows",
     "markdown_cell", "measure", "p95", "paper_sensor", "pareto_figure", "physics_rows", "plot_costs",

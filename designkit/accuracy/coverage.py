@@ -55,6 +55,7 @@ __all__ = [
     "run_cases",
     "summarize",
     "synthetic_coverage",
+    "table_reading",
     "worst_regions",
 ]
 
@@ -138,6 +139,22 @@ def answer_reading(question: str, ans) -> dict[str, Any]:
             "verdict": d["value"] if question == "distinguishable" else None}
 
 
+def table_reading(question: str, case: Mapping[str, Any], *, table: str = "svm-paper", coverage: float = 0.9,
+                  sensor_temp_spread_c: float = 0.0) -> dict[str, Any]:
+    """One case asked by the table route (:func:`answer_reading`); an error is recorded in the reading
+    (``"error"``), not raised, so that a benchmark goes on. ``sensor_temp_spread_c`` [degC]: varied initial
+    conditions (``table`` then a varied table)."""
+    from .. import query
+
+    args = case_arguments(question, case)
+    if sensor_temp_spread_c:
+        args["sensor_temp_spread_c"] = float(sensor_temp_spread_c)
+    try:
+        return answer_reading(question, query.ask(question, route="table", table=table, coverage=coverage, **args))
+    except Exception as exc:  # noqa: BLE001 - recorded, the benchmark goes on
+        return {**answer_reading(question, None), "error": str(exc)}
+
+
 def coverage_case(question: str, case: Mapping[str, Any], index: int, *, repeats: int = 4,
                   ref_repeats: int = 16, trials: int = 100, coverage: float = 0.9,
                   table: str = "svm-paper", exact_solver: str = "sklearn",
@@ -153,7 +170,6 @@ def coverage_case(question: str, case: Mapping[str, Any], index: int, *, repeats
     """
     import time
 
-    from .. import query
     from ..query import exact as ex
 
     args = case_arguments(question, case)
@@ -161,11 +177,8 @@ def coverage_case(question: str, case: Mapping[str, Any], index: int, *, repeats
         args["sensor_temp_spread_c"] = float(sensor_temp_spread_c)
     out: dict[str, Any] = {"question": question, "index": index, **case}
     t0 = time.perf_counter()
-    try:
-        out["table"] = answer_reading(question, query.ask(question, route="table", table=table, coverage=coverage,
-                                                    **args))
-    except Exception as exc:  # noqa: BLE001 - recorded, the benchmark goes on
-        out["table"] = {**answer_reading(question, None), "error": str(exc)}
+    out["table"] = table_reading(question, case, table=table, coverage=coverage,
+                                 sensor_temp_spread_c=sensor_temp_spread_c)
     t1 = time.perf_counter()
     fn = {"min-contact": ex.exact_min_contact, "max-noise": ex.exact_max_noise,
           "min-delta-t": ex.exact_min_delta_t, "delta-e": ex.exact_delta_e,

@@ -1403,7 +1403,7 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
                    "effusivity range")
             note = (f"{value:g} s is {why}: the shortest time lies in ({low:g}, {value:g}] s and the grid cannot "
                     "support an interval of stated coverage there (the exact route estimates it)")
-            if table_spread(op.tab) > 0:  # measured not to hold there (VARIED_COVERAGE_NOTE): no claim
+            if not states_coverage(op.tab, "min-contact", "table-cell"):  # VARIED_COVERAGE_NOTE: no claim
                 note = f"{value:g} s is {why}: the grid cell is ({low:g}, {value:g}] s"
     needed = value if value is not None else float(view.contacts[-1])
     return _answer("min-contact", op, value=value, interval=interval, ideal=ideal, ideal_method=ideal_method,

@@ -73,3 +73,49 @@ def test_odd_numbers_go_to_typers_own_coercion_and_its_messages(cli, value, mess
     assert r.exit_code == 2 and message in r.output, r.output
     r = _py("-m", "designkit", "min-contact", "--e1", value, "--e2", "20000")
     assert r.returncode == 2 and message in r.stderr, r.stderr
+
+
+@pytest.mark.parametrize("name", list_tables())
+def test_every_shipped_table_is_listed_by_file_digest_and_its_arrays_pass_the_long_check(name):
+    from designkit.tables.store import SHIPPED_FILE_DIGESTS, content_hash, file_digest
+
+    t = load_table(name)
+    digest = file_digest(t.path.with_suffix(".json").read_bytes(), t.path.read_bytes())
+    assert digest in SHIPPED_FILE_DIGESTS, (f"shipped table {name} (files {digest}) is not in "
+                                            "designkit.tables.store.SHIPPED_FILE_DIGESTS: add it there")
+    assert content_hash(dict(t.arrays), t.header) == t.header["content_hash"]  # what the digest stands for
+
+
+def test_a_shipped_table_decompresses_only_the_arrays_a_question_reads():
+    # a fresh process: within this one, another test's question may have cached the table's view
+    code = """
+import numpy as np
+from designkit.query import min_contact
+from designkit.tables.store import _NpzArrays, load_table
+t = load_table("svm-paper")
+assert isinstance(t.arrays, _NpzArrays) and not t.arrays._loaded
+assert set(t.arrays) == set(t.header["arrays"]) and "fits" in t.arrays
+assert min_contact(35000, 20000, noise_c=0.05, delta_t_c=10, table=t).value > 0
+read = set(t.arrays._loaded)
+assert read and "fits" not in read, read
+full = load_table(t.path, verify=False)  # the long way: every array from the file
+for k in read:
+    np.testing.assert_array_equal(t.arrays[k], full.arrays[k])
+print(sorted(read))
+"""
+    r = _py("-c", code)
+    assert r.returncode == 0, r.stderr
+    assert "delta_up" in r.stdout
+
+
+def test_one_changed_byte_in_a_shipped_npz_takes_the_long_check_and_is_refused(tmp_path):
+    src = load_table("svm-paper").path
+    (tmp_path / "t.json").write_bytes(src.with_suffix(".json").read_bytes())
+    blob = bytearray(src.read_bytes())
+    assert load_table(src).shipped
+    (tmp_path / "t.npz").write_bytes(bytes(blob))
+    assert load_table(tmp_path / "t.npz").shipped  # the same bytes elsewhere: the shipped content
+    blob[len(blob) // 2] ^= 0x01  # inside some array's compressed stream
+    (tmp_path / "t.npz").write_bytes(bytes(blob))
+    with pytest.raises(ValueError, match="corrupted|content check"):
+        load_table(tmp_path / "t.npz")

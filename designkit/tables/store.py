@@ -51,7 +51,8 @@ import zipfile
 import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Mapping
+from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
 
@@ -59,6 +60,8 @@ from .._validation import InputError
 
 __all__ = [
     "SHIPPED_CONTENT_HASHES",
+    "SHIPPED_FILE_DIGESTS",
+    "file_digest",
     "SCHEMA_VERSION",
     "Table",
     "content_hash",
@@ -212,6 +215,41 @@ def write_table(path: str | Path, header: dict, arrays: Mapping[str, np.ndarray]
     return path
 
 
+class _NpzArrays(Mapping):
+    """A table's arrays, each decompressed on first use from the verified bytes of its .npz.
+
+    A question reads the few arrays it needs (min-contact: ``delta_*`` and their
+    intervals, not the ideal observer's or ``fits``): on the fine shipped table
+    decompressing all of them cost a fresh ``designkit min-contact`` a fifth of its
+    time. The bytes are read (and their digest checked) once, at load, so a file
+    replaced afterwards changes nothing. Plain data: picklable.
+    """
+
+    def __init__(self, blob: bytes):
+        self._blob = blob
+        with zipfile.ZipFile(io.BytesIO(blob)) as z:
+            self._names = tuple(n[:-4] for n in z.namelist() if n.endswith(".npy"))
+        self._loaded: dict[str, np.ndarray] = {}
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        a = self._loaded.get(name)
+        if a is None:
+            if name not in self._names:
+                raise KeyError(name)
+            with np.load(io.BytesIO(self._blob), allow_pickle=False) as z:
+                a = self._loaded[name] = z[name]
+        return a
+
+    def __iter__(self):
+        return iter(self._names)
+
+    def __len__(self) -> int:
+        return len(self._names)
+
+    def __contains__(self, name) -> bool:
+        return name in self._names
+
+
 @dataclass(frozen=True)
 class Table:
     """A loaded lookup table: header plus arrays, verified."""
@@ -219,7 +257,8 @@ class Table:
     name: str
     path: Path
     header: dict
-    arrays: dict
+    #: name -> array (a shipped table's: decompressed on first use, :class:`_NpzArrays`)
+    arrays: Mapping[str, np.ndarray]
     #: Loaded content is a shipped table's (its hash is in :data:`SHIPPED_CONTENT_HASHES`): schema-checked already.
     shipped: bool = field(default=False, compare=False)
 
@@ -342,6 +381,23 @@ def resolve_table(name_or_path: str | Path) -> Path:
 #: that content, so loading it skips the schema step (importing pydantic and building the schemas cost a
 #: fresh ``designkit min-contact`` more than its question). Every other table is validated in full.
 #: Rebuilding a shipped table: add its new hash here (tests/test_tables.py names it).
+#: SHA-256 of each shipped table's two files as shipped (:func:`file_digest`: the .json header, then the
+#: .npz). Files with one of these digests are a shipped content byte for byte, checked in full when it was
+#: shipped (tests/test_startup.py checks every shipped table again, the long way), so loading them checks
+#: the digest (1.5 ms for the 1.3 MB of svm-fine) instead of hashing every decompressed array (35 ms), and
+#: decompresses an array only when a question reads it. Files that differ (a rebuilt table, an edited one,
+#: a header rewritten with other line endings) take the long way: hash, schema, consistency.
+#: Rebuilding a shipped table: add its new digest here (tests/test_startup.py names it).
+SHIPPED_FILE_DIGESTS = frozenset({
+    "sha256:4cae2db965cc4456a6f38dfac3fbb6c9114cbbe66adc07f74c149255ffc3244d",  # evidence-gradient-slope
+    "sha256:2de4c8e0d1b2734aa36702f67478efe584b7cf9f50720a8e70e4f1a0292f3f6d",  # f1-matrix-2s
+    "sha256:f5f0d1fc7629dcd7dbf409b59657f568fa746ddbc215bb74e8ab17b04e4780d3",  # f1-matrix-fine-low
+    "sha256:e5fb77b8a47e504895166f858ac998fa377484ae558bf93486ce636a9d0cf6f4",  # f1-matrix-paper
+    "sha256:ca343b5cd4d113bdfdf94fccd8a95c978d144c21acb4173efa82a1d60648a58a",  # ideal-paper
+    "sha256:9a627ef35cfb030e7341a31bcc030a7a280f8c03391545b3f93621b7b61312f3",  # svm-paper
+    "sha256:b2b6f064a5a485b7117e810a0a7632756673eb84ae56b17bca2ec45fab749098",  # svm-paper-varied
+})
+
 SHIPPED_CONTENT_HASHES = frozenset({
     "sha256:b992e905af3f0312038aee27fcf71f1e96d444a9346caabd2bda2b9504f0399e",  # evidence-gradient-slope
     "sha256:60fa880ce4e50749e3aad5c48d061e41f743d89a6ca512f840793d16ade75c37",  # f1-matrix-2s
@@ -351,6 +407,19 @@ SHIPPED_CONTENT_HASHES = frozenset({
     "sha256:fb51017379fcac6a31e872004c42d77bb2f0cd72bbdf4b10d3c8874e288d783e",  # svm-paper
     "sha256:7d72c28a50ff7ab6de9bfb6a3366e5c4dc5a4f6ed750a70de91c8b0098abd7b5",  # svm-paper-varied
 })
+
+
+def file_digest(header_bytes: bytes, npz_bytes: bytes) -> str:
+    """SHA-256 of a table's two files, as listed in :data:`SHIPPED_FILE_DIGESTS`.
+
+    >>> file_digest(b"{}", b"")[:15]
+    'sha256:5fdf8f10'
+    """
+    h = hashlib.sha256(b"designkit-table-files\0")
+    h.update(len(header_bytes).to_bytes(8, "little"))
+    h.update(header_bytes)
+    h.update(npz_bytes)
+    return "sha256:" + h.hexdigest()
 
 
 def _read_header(path: Path, *, schema: bool = True) -> dict:
@@ -381,18 +450,34 @@ def _check_schema(header: dict, path: Path) -> None:
 
 def load_table(name_or_path: str | Path, *, verify: bool = True) -> Table:
     """Load and verify a table (shipped name or path): its content hash (header and arrays) and its
-    header's schema and consistency with the arrays."""
+    header's schema and consistency with the arrays.
+
+    Files that are a shipped table byte for byte (:data:`SHIPPED_FILE_DIGESTS`) are checked by
+    their digest instead, and their arrays decompressed when first read."""
     path = resolve_table(name_or_path)
     header = _read_header(path, schema=False)
+    blob = None
+    if verify:
+        from .._schemas import check_regular_file
+
+        check_regular_file(path, "table")
+        try:
+            blob = path.read_bytes()
+            digest = file_digest(path.with_suffix(".json").read_bytes(), blob)
+        except OSError as exc:
+            raise InputError(f"cannot read table {path.name}: {exc.strerror or exc}") from None
+        if digest in SHIPPED_FILE_DIGESTS and header.get("content_hash") in SHIPPED_CONTENT_HASHES:
+            return Table(name=header["name"], path=path, header=header, arrays=_NpzArrays(blob), shipped=True)
     # a shipped table's content is checked by its hash instead of the schema (see SHIPPED_CONTENT_HASHES)
     known = verify and isinstance(header.get("content_hash"), str) and header["content_hash"] in SHIPPED_CONTENT_HASHES
     if not known:
         _check_schema(header, path)
-    from .._schemas import check_regular_file
+    if blob is None:
+        from .._schemas import check_regular_file
 
-    check_regular_file(path, "table")
+        check_regular_file(path, "table")
     try:
-        with np.load(path, allow_pickle=False) as z:
+        with np.load(path if blob is None else io.BytesIO(blob), allow_pickle=False) as z:
             arrays = {k: z[k] for k in z.files}
     except (zipfile.BadZipFile, ValueError, OSError, EOFError, KeyError, zlib.error) as exc:
         raise InputError(f"table {path.name} is corrupted or truncated ({type(exc).__name__}); "

@@ -127,12 +127,13 @@ def main() -> None:
                                       "results": results}, indent=1, default=float))
     if a.docs:
         from designkit.accuracy.coverage import worst_regions
-        from designkit.accuracy.render import write_varied_coverage
+        from designkit.accuracy.render import varied_coverage_cases, write_varied_coverage
 
         bands = ((0.01, 0.02), (0.02, 0.05), (0.05, 0.1001))
         run = {"question": a.question, "seed": a.seed, "wall_s": wall, "cpus": a.jobs, "spread_c": SPREAD_C,
                "delta_t_c": DT_C, "routes": summaries, "sharp": sharp,
-               "regions": worst_regions(results, a.question, "table", noise_bands=bands)}
+               "regions": worst_regions(results, a.question, "table", noise_bands=bands),
+               "cases": varied_coverage_cases(results)}
         print(f"page: {write_varied_coverage(run, a.docs)}")
 
 

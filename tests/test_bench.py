@@ -306,7 +306,9 @@ def test_the_shipped_page_renders_from_its_own_json():
     if varied.is_file():  # and the varied-conditions one (benchmarks/bench_coverage_varied.py --docs)
         from designkit.accuracy.render import insert_varied_coverage, varied_coverage_markdown
 
-        md = insert_varied_coverage(md, varied_coverage_markdown(json.loads(varied.read_text())))
+        fig = "accuracy_coverage_varied.png"
+        md = insert_varied_coverage(md, varied_coverage_markdown(json.loads(varied.read_text()),
+                                                                 fig if (REPO / "docs" / fig).is_file() else None))
     assert md == (REPO / "docs" / "accuracy.md").read_text()
 
 
@@ -332,6 +334,34 @@ def test_a_varied_coverage_run_replaces_its_own_earlier_run_and_keeps_the_others
     assert page.count("VARIED COVERAGE START") == 1
     assert page.index("COVERAGE END") < page.index("VARIED COVERAGE START") < page.index("## Next")
     assert "noise 0.01-0.02 degC, e 0-2000: 10 % (4 cases, coverage 75 %)" in page
+    assert "accuracy_coverage_varied.png" not in page and not (tmp_path / "accuracy_coverage_varied.png").exists()
+
+
+def test_a_varied_run_with_its_cases_gets_a_figure_linked_from_its_section(tmp_path):
+    pytest.importorskip("matplotlib")
+    from designkit.accuracy.render import VARIED_COVERAGE_FIGURE, varied_coverage_cases, write_varied_coverage
+
+    def reading(v, lo=None, hi=None, cov=None):
+        return {"value": v, "low": lo, "high": hi, "coverage": cov, "method": "m", "ideal": None}
+
+    ref = reading(1.0, 0.9, 1.1, 0.9)
+    results = [{"noise_c": 0.02, "table": reading(1.05, 0.95, 1.2, 0.9), "exact": reading(1.0, 0.9, 1.1, 0.9),
+                "reference": ref},  # held
+               {"noise_c": 0.05, "table": reading(1.5, 1.3, 1.7, 0.9), "exact": reading(None), "reference": ref},
+               {"noise_c": 0.05, "table": reading(1.5, 1.0, 1.5), "exact": reading(None), "reference": ref}]
+    cases = varied_coverage_cases(results)
+    assert cases[1] == {"noise_c": 0.05, "table": {"value": 1.5, "low": 1.3, "high": 1.7, "coverage": 0.9,
+                                                   "method": "m"},
+                        "exact": {"value": None, "low": None, "high": None, "coverage": None, "method": "m"},
+                        "reference": {"value": 1.0, "low": 0.9, "high": 1.1, "coverage": 0.9, "method": "m"}}
+    s = {"n": 3, "n_compared": 3, "n_stated": 2, "coverage": 0.5, "n_unstated": 1, "unstated_contains": 1.0,
+         "n_no_answer": 0, "median_rel": 0.05, "p95_rel": 0.5, "violations": 0}
+    run = {"question": "min-contact", "seed": 1, "wall_s": 5.0, "cpus": 2, "spread_c": 2.5, "delta_t_c": 7.5,
+           "routes": {"table": s, "exact": s}, "sharp": None, "regions": [], "cases": cases}
+    page = write_varied_coverage(run, tmp_path).read_text()
+    png = tmp_path / VARIED_COVERAGE_FIGURE
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert f"]({VARIED_COVERAGE_FIGURE})" in page
 
 
 def test_every_accuracy_module_declares_its_public_names_and_imports_no_private_ones():

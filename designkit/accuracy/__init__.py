@@ -38,17 +38,20 @@ from .instruments import ProcessCost, fit_exponent, measure, process_cost, reset
 from .physics import physics_rows, slab_rows
 from .queries import GAP_BINS, QUESTIONS, density_rows, query_rows, subsample_table, svm_query_rows
 from .recognition import RECOGNITION_PAIRS, ideal_mc_rows, recognition_rows
-from .render import (COVERAGE_FILES, FIGURES_HINT, VARIED_COVERAGE_FILE, coverage_markdown, curves_markdown,
+from .render import (COVERAGE_FILES, FIGURES_HINT, VARIED_COVERAGE_FIGURE, VARIED_COVERAGE_FILE, coverage_markdown,
+                     curves_markdown,
                      format_time, format_value, insert_coverage, insert_varied_coverage, markdown_cell, pareto_figure,
                      plot_costs, plot_pareto, render_markdown, require_figures, rows_markdown,
-                     varied_coverage_markdown, write_coverage, write_report, write_varied_coverage)
+                     varied_coverage_cases, varied_coverage_figure, varied_coverage_markdown, write_coverage,
+                     write_report, write_varied_coverage)
 from .results import PAPER_RATIO, CostCurve, Row, p95, paper_sensor, worst
 from .run import SECTIONS, BenchReport, check_sections, environment, run_bench
 
 __all__ = [
     "COVERAGE_FILES", "COVERAGE_QUESTIONS", "FIGURES_HINT", "GAP_BINS", "PAPER_RATIO", "QUESTIONS",
-    "RECOGNITION_PAIRS", "SECTIONS", "VARIED_COVERAGE_FILE",
-    "insert_varied_coverage", "varied_coverage_markdown", "write_varied_coverage",
+    "RECOGNITION_PAIRS", "SECTIONS", "VARIED_COVERAGE_FIGURE", "VARIED_COVERAGE_FILE",
+    "insert_varied_coverage", "varied_coverage_cases", "varied_coverage_figure", "varied_coverage_markdown",
+    "write_varied_coverage",
     "BenchReport", "CostCurve", "ProcessCost", "Row",
     "answer_reading", "calibration_z", "case_arguments", "check_sections", "coverage_case", "coverage_markdown", "diluted_coverage",
     "draw_case", "insert_coverage", "run_cases", "summarize", "synthetic_coverage", "table_reading", "worst_regions", "write_coverage",

@@ -20,10 +20,10 @@ from .results import CostCurve, Row
 if TYPE_CHECKING:  # pragma: no cover
     from .run import BenchReport
 
-__all__ = ["COVERAGE_FILES", "FIGURES_HINT", "VARIED_COVERAGE_FILE", "coverage_markdown", "curves_markdown", "format_time", "format_value",
+__all__ = ["COVERAGE_FILES", "FIGURES_HINT", "VARIED_COVERAGE_FIGURE", "VARIED_COVERAGE_FILE", "coverage_markdown", "curves_markdown", "format_time", "format_value",
            "insert_coverage", "insert_varied_coverage", "markdown_cell", "pareto_figure", "plot_costs", "plot_pareto", "render_markdown",
-           "require_figures", "rows_markdown", "varied_coverage_markdown", "write_coverage", "write_report",
-           "write_varied_coverage"]
+           "require_figures", "rows_markdown", "varied_coverage_cases", "varied_coverage_figure",
+           "varied_coverage_markdown", "write_coverage", "write_report", "write_varied_coverage"]
 
 #: The coverage benchmark's record and figure beside ``accuracy.md`` (benchmarks/bench_coverage.py --docs).
 COVERAGE_FILES = ("accuracy_coverage.json", "accuracy_coverage.png")
@@ -32,6 +32,8 @@ _COV_START, _COV_END = "<!-- COVERAGE START -->", "<!-- COVERAGE END -->"
 #: The coverage record under varied initial conditions beside ``accuracy.md``
 #: (benchmarks/bench_coverage_varied.py --docs).
 VARIED_COVERAGE_FILE = "accuracy_coverage_varied.json"
+#: Its figure (:func:`varied_coverage_figure`), beside it.
+VARIED_COVERAGE_FIGURE = "accuracy_coverage_varied.png"
 _VAR_START, _VAR_END = "<!-- VARIED COVERAGE START -->", "<!-- VARIED COVERAGE END -->"
 
 #: What to install for the report's figures.
@@ -561,7 +563,9 @@ def write_report(report: BenchReport, out_dir) -> dict[str, Path]:
                                                        cov_png.name if cov_png.exists() else None))
     varied_json = out_dir / VARIED_COVERAGE_FILE
     if varied_json.exists():  # and so does the varied-conditions one
-        page = insert_varied_coverage(page, varied_coverage_markdown(json.loads(varied_json.read_text())))
+        var_png = out_dir / VARIED_COVERAGE_FIGURE
+        page = insert_varied_coverage(page, varied_coverage_markdown(json.loads(varied_json.read_text()),
+                                                                     var_png.name if var_png.exists() else None))
     md = atomic_write_text(out_dir / "accuracy.md", page)
     js = atomic_write_text(out_dir / "accuracy.json",
                            json.dumps(_jsonable(report.to_dict()), indent=1, allow_nan=False) + "\n")
@@ -705,7 +709,7 @@ def write_coverage(doc: Mapping[str, Any], figure, out_dir) -> Path:
 
 
 # ============================================================ the varied-conditions coverage section
-def varied_coverage_markdown(doc: Mapping[str, Any]) -> list[str]:
+def varied_coverage_markdown(doc: Mapping[str, Any], figure: str | None = None) -> list[str]:
     """The section of ``accuracy.md`` on varied initial conditions, from its record
     (``benchmarks/bench_coverage_varied.py --docs``): one row per run and route, and each run's worst
     regions for the table.
@@ -756,7 +760,88 @@ def varied_coverage_markdown(doc: Mapping[str, Any]) -> list[str]:
         parts = [f"noise {g['noise_band'][0]:.2g}-{g['noise_band'][1]:.2g} degC, e {g['e_band'][0]:g}-{g['e_band'][1]:g}: "
                  f"{_pct(g['median_rel'])} ({g['n']} cases, coverage {_pct(g['coverage'])})" for g in worst]
         out.append(f"- `{r['question']}` seed {r['seed']}: " + "; ".join(parts) + ".")
+    if figure:
+        out += ["", "Each case's answer over its reference, with its stated interval (blue: the interval holds the "
+                "reference, red: it misses, grey: no coverage stated; open markers: references wider than a "
+                "factor 1.5; circles seed 1, triangles held out):", "",
+                f"![varied conditions: answers against the reference, with their intervals]({figure})"]
     return out
+
+
+def varied_coverage_cases(results: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
+    """The per-case readings a run's figure needs (``benchmarks/bench_coverage_varied.py`` results), compact:
+    the case's noise, and for each route and the reference its value, interval and stated coverage."""
+    keep = ("value", "low", "high", "coverage", "method")
+    return [{"noise_c": r.get("noise_c"), **{k: {f: r[k].get(f) for f in keep}
+                                             for k in ("table", "exact", "reference")}} for r in results]
+
+
+def varied_coverage_figure(doc: Mapping[str, Any], path) -> Path | None:
+    """Each case's answer over its reference, with the stated interval, per question and route
+    (``accuracy_coverage_varied.png``); None where no run of the record kept its cases.
+
+    Blue: a stated 90 % interval that holds the reference; red: one that misses it; grey: an answer whose
+    interval states no coverage (grid cells and grid-rule readings). Open markers: references whose own
+    90 % interval spans more than a factor 1.5 (F1 not monotone in contact time). Circles: seed 1 (the
+    cases the varied min-contact rule was designed on); triangles: later seeds (held out).
+    """
+    runs = [r for r in doc.get("runs", []) if r.get("cases")]
+    if not runs:
+        return None
+    from ..figures import pyplot
+
+    plt = pyplot()
+    questions = sorted({r["question"] for r in runs}, key=lambda q: (q != "min-contact", q))
+    fig, axes = plt.subplots(len(questions), 2, figsize=(10, 3.6 * len(questions)), squeeze=False,
+                             constrained_layout=True)
+    units = {"min-contact": "reference contact time [s]", "delta-e": "reference delta(e) [J s^-1/2 K^-1 m^-2]"}
+    for i, q in enumerate(questions):
+        for j, route in enumerate(("table", "exact")):
+            ax = axes[i][j]
+            n = {"held": 0, "missed": 0, "unstated": 0}
+            for run in (r for r in runs if r["question"] == q):
+                marker = "o" if run["seed"] == 1 else "^"
+                for c in run["cases"]:
+                    ref, ans = c["reference"], c[route]
+                    if not (ref.get("value") and ref.get("coverage") and ans.get("value")):
+                        continue
+                    x, y = ref["value"], ans["value"] / ref["value"]
+                    sharp = bool(ref.get("low") and ref.get("high") and ref["high"] < 1.5 * ref["low"])
+                    lo, hi = ans.get("low"), ans.get("high")
+                    if ans.get("coverage"):
+                        held = (lo is None or lo <= x) and (hi is None or x <= hi)
+                        color = "tab:blue" if held else "tab:red"
+                        n["held" if held else "missed"] += 1
+                    else:
+                        color = "0.55"
+                        n["unstated"] += 1
+                    if lo is not None or hi is not None:
+                        ylo = (lo if lo is not None else ans["value"]) / x
+                        yhi = (hi if hi is not None else ans["value"]) / x
+                        ax.plot([x, x], [max(ylo, 1 / 3), min(yhi, 3.0)], color=color, lw=0.8, alpha=0.5)
+                    ax.plot([x], [min(max(y, 1 / 3), 3.0)], marker, ms=4.5, color=color,
+                            mfc=color if sharp else "none", alpha=0.9)
+            ax.axhline(1.0, color="k", lw=0.7)
+            _log_axes(ax)
+            ax.set_ylim(1 / 3, 3.0)
+            ticks = [0.4, 0.5, 0.67, 0.8, 1.0, 1.25, 1.5, 2.0, 2.5]
+            ax.set_yticks(ticks, [f"{t:g}" for t in ticks])
+            if q == "min-contact":
+                xt = [0.5, 1.0, 2.0, 5.0]
+                ax.set_xticks(xt, [f"{t:g}" for t in xt])
+            ax.set_xlabel(units.get(q, "reference"))
+            ax.set_ylabel("answer / reference")
+            ax.grid(alpha=0.3, which="both")
+            stated = n["held"] + n["missed"]
+            ax.set_title(f"{q}, {'table' if route == 'table' else '--exact'}: stated 90 % intervals held "
+                         f"{n['held']} of {stated}" + (f"\n{n['unstated']} answer{'s' if n['unstated'] != 1 else ''} without a stated coverage (grey)"
+                                                       if n["unstated"] else ""), fontsize=9)
+    spreads = sorted({(r["spread_c"], r["delta_t_c"]) for r in runs})
+    fig.suptitle("Varied initial conditions (" + ", ".join(f"+-{a:g} degC at dT {b:g} degC" for a, b in spreads)
+                 + "): each answer over its 16-seed reference, bars its stated interval (clipped at 1/3 and 3)\n"
+                 "blue held, red missed, grey no coverage stated; circles seed 1, triangles held-out seeds; "
+                 "open markers: references wider than a factor 1.5", fontsize=9)
+    return _save(fig, path, plt)
 
 
 def insert_varied_coverage(page: str, section: Sequence[str]) -> str:
@@ -778,6 +863,8 @@ def write_varied_coverage(run: Mapping[str, Any], out_dir) -> Path:
     doc["runs"] = [r for r in doc["runs"] if (r["question"], r["seed"]) != (run["question"], run["seed"])]
     doc["runs"].append(dict(run))
     atomic_write_text(js, json.dumps(_jsonable(doc), indent=1, allow_nan=False) + "\n")
+    png = varied_coverage_figure(doc, out_dir / VARIED_COVERAGE_FIGURE)
     page = out_dir / "accuracy.md"
     text = page.read_text() if page.exists() else "# Accuracy against run time\n"
-    return atomic_write_text(page, insert_varied_coverage(text, varied_coverage_markdown(doc)))
+    section = varied_coverage_markdown(doc, png.name if png is not None else None)
+    return atomic_write_text(page, insert_varied_coverage(text, section))

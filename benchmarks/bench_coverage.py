@@ -154,6 +154,8 @@ def main(argv=None) -> int:
     ap.add_argument("--rescore-table", action="store_true",
                     help="re-ask every case's table answer with the code now installed (table answers take "
                          "milliseconds; the exact answers and references are kept)")
+    ap.add_argument("--table", default=None,
+                    help="SVM table the table route reads (default: the query layer's, DEFAULT_TABLE)")
     ap.add_argument("--run-wall-s", type=float, default=None,
                     help="--render-only: wall time of the run(s) that produced the cases [s], for the record")
     ap.add_argument("--run-load", type=float, default=None,
@@ -166,7 +168,9 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     a.out.mkdir(parents=True, exist_ok=True)
     cases_path = a.out / "cases.jsonl"
-    meta = {"notes": a.note, "exact_solver": a.exact_solver, "pairs": a.pairs, "seed": a.seed,
+    from designkit.query.table import DEFAULT_TABLE
+
+    meta = {"notes": a.note, "table": a.table or DEFAULT_TABLE, "exact_solver": a.exact_solver, "pairs": a.pairs, "seed": a.seed,
             "repeats": a.repeats, "ref_repeats": a.ref_repeats, "jobs": a.jobs,
             "load_start": os.getloadavg()[0], "cpus": os.cpu_count()}
     t0 = time.perf_counter()
@@ -195,7 +199,7 @@ def main(argv=None) -> int:
                     bar.advance(task)
 
                 run_cases(q, a.pairs, seed=a.seed, jobs=a.jobs, done=done, repeats=a.repeats,
-                          ref_repeats=a.ref_repeats, exact_solver=a.exact_solver, start=a.start)
+                          ref_repeats=a.ref_repeats, exact_solver=a.exact_solver, start=a.start, table=a.table)
     meta["wall_s"] = a.run_wall_s if a.render_only and a.run_wall_s else time.perf_counter() - t0
     if a.render_only and a.run_load is not None:
         meta["load_start"] = a.run_load
@@ -205,7 +209,7 @@ def main(argv=None) -> int:
         from designkit.accuracy.coverage import table_reading
 
         for r in results:
-            r["table"] = table_reading(r["question"], r, table="svm-paper", coverage=0.9)
+            r["table"] = table_reading(r["question"], r, table=a.table, coverage=0.9)
         meta["table_rescored"] = True
     doc = report(results, synthetic, meta, a.out)
     fig = figure(results, a.out)

@@ -139,12 +139,16 @@ def answer_reading(question: str, ans) -> dict[str, Any]:
             "verdict": d["value"] if question == "distinguishable" else None}
 
 
-def table_reading(question: str, case: Mapping[str, Any], *, table: str = "svm-paper", coverage: float = 0.9,
+def table_reading(question: str, case: Mapping[str, Any], *, table: str | None = None, coverage: float = 0.9,
                   sensor_temp_spread_c: float = 0.0) -> dict[str, Any]:
     """One case asked by the table route (:func:`answer_reading`); an error is recorded in the reading
-    (``"error"``), not raised, so that a benchmark goes on. ``sensor_temp_spread_c`` [degC]: varied initial
-    conditions (``table`` then a varied table)."""
+    (``"error"``), not raised, so that a benchmark goes on. ``table``: the query layer's default
+    (:data:`designkit.query.table.DEFAULT_TABLE`) unless given. ``sensor_temp_spread_c`` [degC]: varied
+    initial conditions (``table`` then a varied table)."""
     from .. import query
+    from ..query.table import DEFAULT_TABLE
+
+    table = DEFAULT_TABLE if table is None else table
 
     args = case_arguments(question, case)
     if sensor_temp_spread_c:
@@ -157,7 +161,7 @@ def table_reading(question: str, case: Mapping[str, Any], *, table: str = "svm-p
 
 def coverage_case(question: str, case: Mapping[str, Any], index: int, *, repeats: int = 4,
                   ref_repeats: int = 16, trials: int = 100, coverage: float = 0.9,
-                  table: str = "svm-paper", exact_solver: str = "sklearn",
+                  table: str | None = None, exact_solver: str = "sklearn",
                   sensor_temp_spread_c: float = 0.0) -> dict[str, Any]:
     """Ask one case by the table, by ``--exact`` and by the reference; return all three readings.
 

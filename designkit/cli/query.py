@@ -131,8 +131,10 @@ def _ask(question: str, *, exact: bool, table: Optional[str], ideal_table: str, 
 
                 raise NeedsInput("a diffusivity was given but tables answer for effusivity alone",
                                  "diffusivity-unused")
+            from ..query.table import DEFAULT_TABLE
+
             return query.ask(question, route="table", **objects, **scene, threshold=threshold,
-                             table=table or varied or "svm-paper", ideal_table=ideal_table,
+                             table=table or varied or DEFAULT_TABLE, ideal_table=ideal_table,
                              sensor=None if sensor == "paper" else sen, model=fm, coverage=extra["coverage"],
                              sensor_temp_spread_c=spread)
         kw = dict(threshold=threshold, sensor=sen, model=fm, diffusivity_m2_s=diffusivity, width=width,

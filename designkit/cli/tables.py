@@ -71,7 +71,8 @@ def tables_show(
     out: OutOpt = None,
     json_: Json = False,
 ) -> None:
-    """Describe one table: grid, units, sensor, forward model, fidelity, provenance, content hash.
+    """Describe one table: grid, units, sensor, forward model, fidelity, provenance, content hash
+    (checked in full: every array read and hashed, a shipped table's too).
 
     Example: `designkit tables show svm-paper` (or `--format csv` for its axes, one row each)
     """
@@ -79,7 +80,7 @@ def tables_show(
 
     from rich.markup import escape
 
-    table = load_table(name)
+    table = load_table(name, thorough=True)
     s = table.summary()
     if json_:
         emit_json(s)

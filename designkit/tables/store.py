@@ -184,8 +184,12 @@ def _model_of(cfg):
     return get_model(getattr(cfg, "model", None))
 
 
-def write_table(path: str | Path, header: dict, arrays: Mapping[str, np.ndarray]) -> Path:
+def write_table(path: str | Path, header: dict, arrays: Mapping[str, np.ndarray], *, compress: bool = True) -> Path:
     """Write ``path`` (.npz) and its .json header atomically; returns the .npz path.
+
+    ``compress=False`` stores the arrays uncompressed (``np.savez``): larger on disk, but a shipped table
+    stored so is mapped from the file and a question reads only the slices it needs (:class:`_NpzArrays`).
+    The content hash is the same either way.
 
     The arrays are written first, the header (with the content hash) last, so
     a crash leaves either the old table or a header-less npz that loading
@@ -209,45 +213,89 @@ def write_table(path: str | Path, header: dict, arrays: Mapping[str, np.ndarray]
     header["schema_version"] = SCHEMA_VERSION
     header["content_hash"] = content_hash(arrays, header)
     buf = io.BytesIO()
-    np.savez_compressed(buf, **arrays)
+    (np.savez_compressed if compress else np.savez)(buf, **arrays)
     atomic_write_bytes(path, buf.getvalue())
     atomic_write_text(path.with_suffix(".json"), json.dumps(header, indent=1, allow_nan=False) + "\n")
     return path
 
 
-class _NpzArrays(Mapping):
-    """A table's arrays, each decompressed on first use from the verified bytes of its .npz.
+def _zip_members(z: zipfile.ZipFile) -> dict[str, zipfile.ZipInfo]:
+    return {i.filename[:-4]: i for i in z.infolist() if i.filename.endswith(".npy")}
 
-    A question reads the few arrays it needs (min-contact: ``delta_*`` and their
-    intervals, not the ideal observer's or ``fits``): on the fine shipped table
-    decompressing all of them cost a fresh ``designkit min-contact`` a fifth of its
-    time. The bytes are read (and their digest checked) once, at load, so a file
-    replaced afterwards changes nothing. Plain data: picklable.
+
+def _read_member(path: Path, info: zipfile.ZipInfo) -> np.ndarray:
+    """One array of an .npz: a member stored uncompressed is mapped from the file, read-only, so that only
+    the pages a question touches are read; a compressed one is decompressed (and its CRC checked)."""
+    import mmap
+    import struct
+
+    if info.compress_type != zipfile.ZIP_STORED:
+        with np.load(path, allow_pickle=False) as z:
+            return z[info.filename[:-4]]
+    with open(path, "rb") as fh:
+        fh.seek(info.header_offset)
+        local = fh.read(30)
+        if len(local) != 30 or local[:4] != b"PK\x03\x04":
+            raise zipfile.BadZipFile(f"no local header for {info.filename}")
+        name_len, extra_len = struct.unpack("<HH", local[26:30])
+        fh.seek(info.header_offset + 30 + name_len + extra_len)
+        version = np.lib.format.read_magic(fh)
+        read_header = {(1, 0): np.lib.format.read_array_header_1_0,
+                       (2, 0): np.lib.format.read_array_header_2_0}.get(version)
+        if read_header is None:
+            raise ValueError(f"npy format version {version}")
+        shape, fortran, dtype = read_header(fh)
+        if dtype.hasobject:
+            raise ValueError("object arrays")
+        offset = fh.tell()
+        size = int(np.prod(shape, dtype=np.int64)) * dtype.itemsize
+        if offset + size > info.header_offset + 30 + name_len + extra_len + info.file_size:
+            raise ValueError(f"{info.filename} is shorter than its shape")
+        if size == 0:
+            return np.zeros(shape, dtype=dtype)
+        mm = mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ)
+    return np.ndarray(shape, dtype=dtype, buffer=mm, offset=offset, order="F" if fortran else "C")
+
+
+class _NpzArrays(Mapping):
+    """A shipped table's arrays, each read when a question first asks for it.
+
+    A question reads a few slices of a few arrays (min-contact: the noise slices around its own, of
+    ``delta_*`` and their intervals). Members stored uncompressed (the fine shipped table,
+    :func:`write_table` with ``compress=False``) are mapped from the file, so only those pages are
+    read: decompressing all of svm-fine's 22 MB cost a fresh ``designkit min-contact`` 27 ms, more than
+    its question. Compressed members are decompressed whole, CRC-checked. Plain data: picklable.
     """
 
-    def __init__(self, blob: bytes):
-        self._blob = blob
-        with zipfile.ZipFile(io.BytesIO(blob)) as z:
-            self._names = tuple(n[:-4] for n in z.namelist() if n.endswith(".npy"))
+    def __init__(self, path: Path, members: Mapping[str, zipfile.ZipInfo]):
+        self._path = Path(path)
+        self._members = dict(members)
         self._loaded: dict[str, np.ndarray] = {}
 
     def __getitem__(self, name: str) -> np.ndarray:
         a = self._loaded.get(name)
         if a is None:
-            if name not in self._names:
+            info = self._members.get(name)
+            if info is None:
                 raise KeyError(name)
-            with np.load(io.BytesIO(self._blob), allow_pickle=False) as z:
-                a = self._loaded[name] = z[name]
+            try:
+                a = self._loaded[name] = _read_member(self._path, info)
+            except (zipfile.BadZipFile, ValueError, OSError, EOFError, zlib.error) as exc:
+                raise InputError(f"table {self._path.name}: array {name} is corrupted or truncated "
+                                 f"({type(exc).__name__}); rebuild it with designkit sweep") from None
         return a
 
     def __iter__(self):
-        return iter(self._names)
+        return iter(self._members)
 
     def __len__(self) -> int:
-        return len(self._names)
+        return len(self._members)
 
     def __contains__(self, name) -> bool:
-        return name in self._names
+        return name in self._members
+
+    def __getstate__(self):  # the mapped arrays stay behind (a worker maps its own)
+        return {"_path": self._path, "_members": self._members, "_loaded": {}}
 
 
 @dataclass(frozen=True)
@@ -381,21 +429,21 @@ def resolve_table(name_or_path: str | Path) -> Path:
 #: that content, so loading it skips the schema step (importing pydantic and building the schemas cost a
 #: fresh ``designkit min-contact`` more than its question). Every other table is validated in full.
 #: Rebuilding a shipped table: add its new hash here (tests/test_tables.py names it).
-#: SHA-256 of each shipped table's two files as shipped (:func:`file_digest`: the .json header, then the
-#: .npz). Files with one of these digests are a shipped content byte for byte, checked in full when it was
-#: shipped (tests/test_startup.py checks every shipped table again, the long way), so loading them checks
-#: the digest (1.5 ms for the 1.3 MB of svm-fine) instead of hashing every decompressed array (35 ms), and
-#: decompresses an array only when a question reads it. Files that differ (a rebuilt table, an edited one,
-#: a header rewritten with other line endings) take the long way: hash, schema, consistency.
+#: Digests of each shipped table's files as shipped (:func:`file_digest`: the .json header and the .npz's
+#: directory). Files with one of these digests are a shipped content, checked in full when it was shipped
+#: (tests/test_startup.py checks every shipped table again, the long way), so loading them checks the
+#: digest (well under a millisecond) instead of hashing every decompressed array (35 ms on svm-fine), and
+#: reads an array only when a question asks for it. Files that differ (a rebuilt table, an edited one, a
+#: header rewritten with other line endings) take the long way: hash, schema, consistency.
 #: Rebuilding a shipped table: add its new digest here (tests/test_startup.py names it).
 SHIPPED_FILE_DIGESTS = frozenset({
-    "sha256:4cae2db965cc4456a6f38dfac3fbb6c9114cbbe66adc07f74c149255ffc3244d",  # evidence-gradient-slope
-    "sha256:2de4c8e0d1b2734aa36702f67478efe584b7cf9f50720a8e70e4f1a0292f3f6d",  # f1-matrix-2s
-    "sha256:f5f0d1fc7629dcd7dbf409b59657f568fa746ddbc215bb74e8ab17b04e4780d3",  # f1-matrix-fine-low
-    "sha256:e5fb77b8a47e504895166f858ac998fa377484ae558bf93486ce636a9d0cf6f4",  # f1-matrix-paper
-    "sha256:ca343b5cd4d113bdfdf94fccd8a95c978d144c21acb4173efa82a1d60648a58a",  # ideal-paper
-    "sha256:9a627ef35cfb030e7341a31bcc030a7a280f8c03391545b3f93621b7b61312f3",  # svm-paper
-    "sha256:b2b6f064a5a485b7117e810a0a7632756673eb84ae56b17bca2ec45fab749098",  # svm-paper-varied
+    "sha256:911e1adf9e1fa85eca6275993399f491d3006aefd443bd03e0ef6b1404c3d638",  # evidence-gradient-slope
+    "sha256:d39c9fbf935896606db255017df138f92fce5fcbcc0ff680b2ddeda2458f0ae8",  # f1-matrix-2s
+    "sha256:1f7cc68036078992caf4c20e0d201193b83d37dc3f3868688edb6a90e6cf7eb0",  # f1-matrix-fine-low
+    "sha256:d32ead9cde594f2c4d0d29e02aa369b6665b71cb0dd87bc71df0796163fbdcad",  # f1-matrix-paper
+    "sha256:ef844209edc8dcebd324634fea7fcdb146b0fc58fa814b05f76dfabf82c4e7f5",  # ideal-paper
+    "sha256:fc461c7468fefb61c903a609f9b86d1d680821fc405c987daf2727d7ed607d8e",  # svm-paper
+    "sha256:882e12fdd88e94f6dc0c0cd97172281e52fcc64852c8b0daaa62c7a505a15c0f",  # svm-paper-varied
 })
 
 SHIPPED_CONTENT_HASHES = frozenset({
@@ -409,16 +457,23 @@ SHIPPED_CONTENT_HASHES = frozenset({
 })
 
 
-def file_digest(header_bytes: bytes, npz_bytes: bytes) -> str:
-    """SHA-256 of a table's two files, as listed in :data:`SHIPPED_FILE_DIGESTS`.
+def file_digest(header_bytes: bytes, members: Mapping[str, zipfile.ZipInfo]) -> str:
+    """SHA-256 of a table's header file and its .npz's directory, as listed in :data:`SHIPPED_FILE_DIGESTS`.
 
-    >>> file_digest(b"{}", b"")[:15]
+    The directory records each array's CRC-32, sizes, compression and place in the file: any array
+    rewritten changes it. (A compressed array's bytes are CRC-checked when decompressed; an
+    uncompressed one is mapped as it lies, unchecked, so that a question reads only its pages.)
+
+    >>> file_digest(b"{}", {})[:15]
     'sha256:5fdf8f10'
     """
     h = hashlib.sha256(b"designkit-table-files\0")
     h.update(len(header_bytes).to_bytes(8, "little"))
     h.update(header_bytes)
-    h.update(npz_bytes)
+    for name in sorted(members):
+        i = members[name]
+        h.update(f"{name}\0{i.CRC}\0{i.compress_size}\0{i.file_size}\0{i.compress_type}\0{i.header_offset}\n"
+                 .encode())
     return "sha256:" + h.hexdigest()
 
 
@@ -448,36 +503,37 @@ def _check_schema(header: dict, path: Path) -> None:
     validate(schemas()["table"], header, f"table header {path.with_suffix('.json')}")
 
 
-def load_table(name_or_path: str | Path, *, verify: bool = True) -> Table:
+def load_table(name_or_path: str | Path, *, verify: bool = True, thorough: bool = False) -> Table:
     """Load and verify a table (shipped name or path): its content hash (header and arrays) and its
     header's schema and consistency with the arrays.
 
-    Files that are a shipped table byte for byte (:data:`SHIPPED_FILE_DIGESTS`) are checked by
-    their digest instead, and their arrays decompressed when first read."""
+    Files of a shipped table as shipped (:data:`SHIPPED_FILE_DIGESTS`) are checked by their digest
+    instead, and each array is read when a question first asks for it; ``thorough=True`` takes the
+    long way for them too (``designkit tables show`` does)."""
     path = resolve_table(name_or_path)
     header = _read_header(path, schema=False)
-    blob = None
     if verify:
         from .._schemas import check_regular_file
 
         check_regular_file(path, "table")
         try:
-            blob = path.read_bytes()
-            digest = file_digest(path.with_suffix(".json").read_bytes(), blob)
-        except OSError as exc:
-            raise InputError(f"cannot read table {path.name}: {exc.strerror or exc}") from None
-        if digest in SHIPPED_FILE_DIGESTS and header.get("content_hash") in SHIPPED_CONTENT_HASHES:
-            return Table(name=header["name"], path=path, header=header, arrays=_NpzArrays(blob), shipped=True)
+            with zipfile.ZipFile(path) as z:
+                members = _zip_members(z)
+            digest = file_digest(path.with_suffix(".json").read_bytes(), members)
+        except (zipfile.BadZipFile, OSError, ValueError, EOFError):
+            digest = None  # the long way says what is wrong
+        if not thorough and digest in SHIPPED_FILE_DIGESTS and header.get("content_hash") in SHIPPED_CONTENT_HASHES:
+            return Table(name=header["name"], path=path, header=header, arrays=_NpzArrays(path, members),
+                         shipped=True)
     # a shipped table's content is checked by its hash instead of the schema (see SHIPPED_CONTENT_HASHES)
     known = verify and isinstance(header.get("content_hash"), str) and header["content_hash"] in SHIPPED_CONTENT_HASHES
     if not known:
         _check_schema(header, path)
-    if blob is None:
-        from .._schemas import check_regular_file
+    from .._schemas import check_regular_file
 
-        check_regular_file(path, "table")
+    check_regular_file(path, "table")
     try:
-        with np.load(path if blob is None else io.BytesIO(blob), allow_pickle=False) as z:
+        with np.load(path, allow_pickle=False) as z:
             arrays = {k: z[k] for k in z.files}
     except (zipfile.BadZipFile, ValueError, OSError, EOFError, KeyError, zlib.error) as exc:
         raise InputError(f"table {path.name} is corrupted or truncated ({type(exc).__name__}); "

@@ -106,6 +106,22 @@ def test_sweep_cli_writes_a_loadable_table_that_tables_show_describes(reference,
 
 
 @pytest.mark.slow
+def test_a_finished_sweep_rewritten_uncompressed_is_the_same_content_stored_as_is(reference, tmp_path):
+    import zipfile
+
+    cfg, ref = reference
+    out = tmp_path / "tiny.npz"
+    r = _run(_sweep_cmd(cfg, ref.parent / "work", out, "--resume", "--uncompressed", "--json"))
+    assert r.returncode == 0, r.stderr
+    assert json.loads(r.stdout)["chunks_computed"] == 0  # every chunk was there: only the table is written
+    assert load_table(out).header["content_hash"] == load_table(ref).header["content_hash"]
+    _same_table(out, ref)
+    with zipfile.ZipFile(out) as z, zipfile.ZipFile(ref) as zr:
+        assert {i.compress_type for i in z.infolist()} == {zipfile.ZIP_STORED}
+        assert {i.compress_type for i in zr.infolist()} == {zipfile.ZIP_DEFLATED}
+
+
+@pytest.mark.slow
 def test_kill_9_then_resume_recomputes_nothing_finished_and_gives_the_same_table(reference, tmp_path):
     cfg, ref = reference
     work, out = tmp_path / "work", tmp_path / "tiny.npz"

@@ -62,6 +62,7 @@ def sweep(
     out: Annotated[Optional[Path], typer.Option("--out", help="Table file or folder (default: WORKDIR/NAME.npz).")] = None,
     resume: Annotated[bool, typer.Option("--resume", help="Continue an interrupted sweep in WORKDIR.")] = False,
     fresh: Annotated[bool, typer.Option("--fresh", help="Discard WORKDIR's finished chunks first.")] = False,
+    uncompressed: Annotated[bool, typer.Option("--uncompressed", help="Store the table's arrays uncompressed: larger on disk, but a question maps only the slices it reads (large shipped tables; the content hash is the same).")] = False,
     json_: Json = False,
 ) -> None:
     """Sweep the physics + classifier model and write a delta(e) lookup table (resumable).
@@ -141,7 +142,7 @@ def sweep(
                           highlight=False)
     try:
         path = run_sweep(cfg, wd, out=target, jobs=jobs, backend=backend, scheduler=scheduler, resume=resume,
-                         fresh=fresh, on_chunk=on_chunk)
+                         fresh=fresh, on_chunk=on_chunk, compress=not uncompressed)
     except SweepInterrupted as exc:
         if progress is not None:
             progress.stop()

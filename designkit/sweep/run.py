@@ -195,7 +195,8 @@ def check_batches(cfg: SweepConfig) -> None:
 
 def run_sweep(cfg: SweepConfig, workdir: str | Path, *, out: str | Path | None = None, jobs: int = 1,
               backend: str = "loky", scheduler: str | None = None, resume: bool = False,
-              fresh: bool = False, on_chunk: Callable[[ChunkResult, bool, int, int], None] | None = None) -> Path:
+              fresh: bool = False, on_chunk: Callable[[ChunkResult, bool, int, int], None] | None = None,
+              compress: bool = True) -> Path:
     """Run (or resume) a sweep and write its table; returns the table's path.
 
     Parameters
@@ -216,6 +217,9 @@ def run_sweep(cfg: SweepConfig, workdir: str | Path, *, out: str | Path | None =
     on_chunk : callable, optional
         Called as ``on_chunk(chunk, computed, done, total)`` after each chunk
         (progress display).
+    compress : bool
+        Deflate the table's arrays (default); ``False`` stores them as they are, so that a
+        question maps only the slices it reads (:func:`designkit.tables.store.write_table`).
     """
     from ..tables.store import table_header, write_table
 
@@ -242,4 +246,4 @@ def run_sweep(cfg: SweepConfig, workdir: str | Path, *, out: str | Path | None =
                                             "solver": cfg.solver, "compute_s_total": float(wall.sum()),
                                             "chunk_wall_s": wall.tolist()})
     path = Path(out) if out is not None else workdir / f"{cfg.name}.npz"
-    return write_table(path, header, arrays)
+    return write_table(path, header, arrays, compress=compress)

@@ -207,7 +207,23 @@ def test_the_varied_table_states_coverage_only_where_it_was_measured_to_hold():
     cell = q.min_contact(13190.9, 1120.5, **kw)  # separable at 0.5 s, the table's first contact
     c = cell.to_dict()["interval"]
     assert c["method"] == "table-varied" and c["coverage"] is None and cell.value == 0.5
-    assert any("grid cell" in n and "6 of 14" in n for n in cell.notes)
+    assert any("grid cell" in n and "10 of 14" in n for n in cell.notes)
+
+
+def test_a_varied_cell_after_an_unseparable_contact_starts_at_the_ideal_bound():
+    """Not separable at 0.5 s does not bound the answer from below when the initial temperature varies: F1 need not
+    rise with contact time (16 exact seeds put this pair at 0.443 s, below the table's 0.5 s, where the table finds
+    it not separable). The cell was (0.5, 0.75] s; it is now (ideal bound, 0.75] s, scalar and array alike."""
+    kw = dict(noise_c=0.0271, delta_t_c=7.5, sensor_temp_spread_c=2.5)
+    a = q.min_contact(14697.0, 1500.0, **kw)
+    assert a.value == 0.75 and a.interval_coverage is None
+    assert a.interval[0] == pytest.approx(a.ideal_bound.interval[0], rel=1e-12) and a.interval[0] < 0.443 < 0.5
+    assert any("F1 need not rise with contact time" in n for n in a.notes)
+    arr = q.min_contact(np.array([14697.0, 13190.9]), np.array([1500.0, 1120.5]), noise_c=np.array([0.0271, 0.03]),
+                        delta_t_c=7.5, sensor_temp_spread_c=2.5)
+    assert float(arr.low[0]) == pytest.approx(a.interval[0], rel=1e-12) and float(arr.high[0]) == 0.75
+    fixed = q.min_contact(14697.0, 1500.0, noise_c=0.0271 * 10 / 7.5, delta_t_c=10.0)  # fixed: monotone, unchanged
+    assert fixed.interval_kind != "table-cell" or fixed.interval[0] >= 0.5
 
 
 def test_distinguishable_inside_a_varied_cell_is_uncertain_and_the_array_route_agrees():
@@ -215,7 +231,7 @@ def test_distinguishable_inside_a_varied_cell_is_uncertain_and_the_array_route_a
     table's grid cell), not silent; the array route, which already treated it as unsure, gives the same."""
     kw = dict(noise_c=0.0271, delta_t_c=7.5, sensor_temp_spread_c=2.5)
     m = q.min_contact(14697.4, 1500.5, **kw)
-    assert m.to_dict()["interval"]["method"] == "table-varied" and m.interval == (0.5, 0.75)
+    assert m.to_dict()["interval"]["method"] == "table-varied" and m.interval == (m.ideal_bound.interval[0], 0.75)
     contacts = np.array([0.6, 0.7, 0.8])
     arr = q.distinguishable(np.full(3, 14697.4), 1500.5, contact_s=contacts, **kw)
     verdicts = []

@@ -402,6 +402,8 @@ def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> None
             res["high"][i], ideal[i], width=op.width, svm=svm, z_table=_table_route.table_z(op.tab), zc=zc)
         value[i], low[i], high[i] = r["value"], r["low"], r["high"]
     prev = np.where(k_cross > 0, grid[np.maximum(k_cross - 1, 0)], 0.0)
+    if varied:  # the scalar route's rule: F1 need not rise with contact time, the cell starts at the bound
+        prev = np.zeros_like(prev)
     low = np.where(cell, np.where(np.isnan(ideal), prev, np.maximum(prev, ideal)), low)
     high = np.where(cell, raw, high)
     res["value"], res["low"], res["high"] = value, low, high

@@ -1322,7 +1322,15 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
         x, _ = _crossing(v.contacts, needs_read(v, kind, cmb)[1], hi - lo)  # read up to the crossing
         return x
 
-    monte_carlo: dict[str, Any] = {}
+    needs, lazy = needs_read(view, "svm", combos)
+    value, k_cross = _crossing(view.contacts, lazy, hi - lo)  # needs[:k_cross + 1] read
+    if op.tab.fidelity == "svm":
+        mc_interval = (contact_for(view, "lo", combos), contact_for(view, "hi", combos))
+    else:
+        mc_interval = (value, value)
+    monte_carlo = {"monte_carlo_interval": list(mc_interval)}  # the table's delta_lo / delta_hi answers alone
+    if "delta_up_ideal" in view.t.arrays:  # the grid's own bound, beside the exact one (its interpolation error)
+        monte_carlo["table_ideal_s"] = contact_for(view, "ideal", combos)
     ideal_interval = None
     if op.closed:
         from .ideal_bound import cached_ideal_min_contact
@@ -1349,18 +1357,6 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
                                     z_table=table_z(op.tab), zc=z_of_coverage(coverage))
         if not math.isnan(float(r["value"][0])):
             varied = {key: float(v[0]) for key, v in r.items()}
-    needs: list[float] = []
-    value, k_cross = None, None
-    if varied is None:  # the grid rule's readings (a varied estimate has its own; they would only mislead)
-        needs, lazy = needs_read(view, "svm", combos)
-        value, k_cross = _crossing(view.contacts, lazy, hi - lo)  # needs[:k_cross + 1] read
-        if op.tab.fidelity == "svm":
-            mc_interval = (contact_for(view, "lo", combos), contact_for(view, "hi", combos))
-        else:
-            mc_interval = (value, value)
-        monte_carlo["monte_carlo_interval"] = list(mc_interval)  # the table's delta_lo / delta_hi answers alone
-        if "delta_up_ideal" in view.t.arrays:  # the grid's own bound, beside the exact one (its interpolation error)
-            monte_carlo["table_ideal_s"] = contact_for(view, "ideal", combos)
     note = "" if value is not None or varied is not None else (
         f"no tabulated contact time up to {view.contacts[-1]:g} s separates them "
         "(the exact route examines longer contacts)")
@@ -1375,9 +1371,11 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
     if varied is not None:
         # varied initial conditions: each scene slice's estimate, both directions averaged, interpolated across
         # the slices (varied_contact_estimate)
+        raw = value
         value, interval = varied["value"], (_opt(varied["low"]), _opt(varied["high"]))
         kind, cov = "table-varied-estimate", coverage
-        monte_carlo.update(interpolation_error_log=varied["interp"], rounding_error_log=varied["rounding"])
+        monte_carlo.update(interpolation_error_log=varied["interp"], rounding_error_log=varied["rounding"],
+                           table_crossing_s=raw)
     elif eff is not None:
         # the SVM's noise efficiency against the exact ideal observer (noise_k_min_contact): no interpolation
         # of the steep need between grid points

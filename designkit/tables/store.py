@@ -49,9 +49,9 @@ import json
 import math
 import zipfile
 import zlib
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -305,7 +305,7 @@ class Table:
     name: str
     path: Path
     header: dict
-    #: name -> array (a shipped table's: decompressed on first use, :class:`_NpzArrays`)
+    #: name -> array (a shipped table's: each read on first use, :class:`_NpzArrays`)
     arrays: Mapping[str, np.ndarray]
     #: Loaded content is a shipped table's (its hash is in :data:`SHIPPED_CONTENT_HASHES`): schema-checked already.
     shipped: bool = field(default=False, compare=False)
@@ -429,6 +429,16 @@ def resolve_table(name_or_path: str | Path) -> Path:
 #: that content, so loading it skips the schema step (importing pydantic and building the schemas cost a
 #: fresh ``designkit min-contact`` more than its question). Every other table is validated in full.
 #: Rebuilding a shipped table: add its new hash here (tests/test_tables.py names it).
+SHIPPED_CONTENT_HASHES = frozenset({
+    "sha256:b992e905af3f0312038aee27fcf71f1e96d444a9346caabd2bda2b9504f0399e",  # evidence-gradient-slope
+    "sha256:60fa880ce4e50749e3aad5c48d061e41f743d89a6ca512f840793d16ade75c37",  # f1-matrix-2s
+    "sha256:f4ecf487aec590490a63ec41215c6511218f038794ad33b52d5077bc1e5cf7ca",  # f1-matrix-fine-low
+    "sha256:6290aff2cd7e4de3f9d1dc5ef445e66fdbb24a7cadd8e448a8733f373d111a60",  # f1-matrix-paper
+    "sha256:1820bf01e2ffe9e79d35e4c0b9f8b310b10bbe7c8d481db47c9c09aa57564bae",  # ideal-paper
+    "sha256:fb51017379fcac6a31e872004c42d77bb2f0cd72bbdf4b10d3c8874e288d783e",  # svm-paper
+    "sha256:7d72c28a50ff7ab6de9bfb6a3366e5c4dc5a4f6ed750a70de91c8b0098abd7b5",  # svm-paper-varied
+})
+
 #: Digests of each shipped table's files as shipped (:func:`file_digest`: the .json header and the .npz's
 #: directory). Files with one of these digests are a shipped content, checked in full when it was shipped
 #: (tests/test_startup.py checks every shipped table again, the long way), so loading them checks the
@@ -444,16 +454,6 @@ SHIPPED_FILE_DIGESTS = frozenset({
     "sha256:ef844209edc8dcebd324634fea7fcdb146b0fc58fa814b05f76dfabf82c4e7f5",  # ideal-paper
     "sha256:fc461c7468fefb61c903a609f9b86d1d680821fc405c987daf2727d7ed607d8e",  # svm-paper
     "sha256:882e12fdd88e94f6dc0c0cd97172281e52fcc64852c8b0daaa62c7a505a15c0f",  # svm-paper-varied
-})
-
-SHIPPED_CONTENT_HASHES = frozenset({
-    "sha256:b992e905af3f0312038aee27fcf71f1e96d444a9346caabd2bda2b9504f0399e",  # evidence-gradient-slope
-    "sha256:60fa880ce4e50749e3aad5c48d061e41f743d89a6ca512f840793d16ade75c37",  # f1-matrix-2s
-    "sha256:f4ecf487aec590490a63ec41215c6511218f038794ad33b52d5077bc1e5cf7ca",  # f1-matrix-fine-low
-    "sha256:6290aff2cd7e4de3f9d1dc5ef445e66fdbb24a7cadd8e448a8733f373d111a60",  # f1-matrix-paper
-    "sha256:1820bf01e2ffe9e79d35e4c0b9f8b310b10bbe7c8d481db47c9c09aa57564bae",  # ideal-paper
-    "sha256:fb51017379fcac6a31e872004c42d77bb2f0cd72bbdf4b10d3c8874e288d783e",  # svm-paper
-    "sha256:7d72c28a50ff7ab6de9bfb6a3366e5c4dc5a4f6ed750a70de91c8b0098abd7b5",  # svm-paper-varied
 })
 
 

@@ -4,13 +4,17 @@ Usage::
 
     nice -n 10 python benchmarks/bench_coverage.py --out /tmp/coverage --pairs 100 --jobs 2
     python benchmarks/bench_coverage.py --out /tmp/coverage --render-only   # summary + figure again
+    # another table, or a changed table rule, against the references kept in docs (no simulation):
+    python benchmarks/bench_coverage.py --out /tmp/coverage --cases docs/accuracy_coverage_cases.jsonl \
+        --rescore-table --table svm-fine --run-wall-s 3800 --run-load 2.0 --docs docs
 
 Each finished case is appended to ``OUT/cases.jsonl`` as it completes (an interrupted run
 keeps what it did; ``--resume`` skips the cases already there). At the end it prints, per
 (question, route), the coverage of the stated 90 % intervals, the median and 95th-percentile
 error (absolute and relative) against the reference, the ideal-bound violations, the worst
 regions of effusivity and noise, and writes ``OUT/coverage.json`` and ``OUT/coverage.png``
-(``docs/accuracy.md`` is regenerated from them by ``designkit.accuracy.render``).
+(``docs/accuracy.md`` is regenerated from them by ``designkit.accuracy.render``; with ``--docs``
+the cases are kept beside it, in ``accuracy_coverage_cases.jsonl``).
 The synthetic-curve check (known truth) runs first, in seconds.
 """
 
@@ -165,9 +169,14 @@ def main(argv=None) -> int:
                     "(the draws are seeded: a later run extends an earlier one)")
     ap.add_argument("--resume", action="store_true")
     ap.add_argument("--render-only", action="store_true")
+    ap.add_argument("--cases", type=Path, metavar="FILE", default=None,
+                    help="render from cases kept by an earlier run (docs/accuracy_coverage_cases.jsonl) instead "
+                         "of OUT/cases.jsonl; with --rescore-table, their table route is asked again (--table)")
     a = ap.parse_args(argv)
     a.out.mkdir(parents=True, exist_ok=True)
     cases_path = a.out / "cases.jsonl"
+    if a.cases is not None:
+        cases_path, a.render_only = a.cases, True
     from designkit.query.table import DEFAULT_TABLE
 
     meta = {"notes": a.note, "table": a.table or DEFAULT_TABLE, "exact_solver": a.exact_solver, "pairs": a.pairs, "seed": a.seed,
@@ -217,6 +226,12 @@ def main(argv=None) -> int:
         from designkit.accuracy.render import write_coverage
 
         print(f"page: {write_coverage(doc, fig, a.docs)}")
+        # the cases themselves (one line each), so that a later table or rule is measured against the
+        # same references without computing them again (--cases)
+        kept = a.docs / "accuracy_coverage_cases.jsonl"
+        if cases_path.resolve() != kept.resolve():
+            kept.write_text("".join(json.dumps({k: v for k, v in r.items() if k != "wall_s"}) + "\n"
+                                    for r in results))
     print(f"figure: {fig}; wall {meta['wall_s']:.0f} s, load {meta['load_start']:.1f} -> "
           f"{meta['load_end']:.1f} on {meta['cpus']} CPUs")
     return 0

@@ -437,6 +437,7 @@ SHIPPED_CONTENT_HASHES = frozenset({
     "sha256:1820bf01e2ffe9e79d35e4c0b9f8b310b10bbe7c8d481db47c9c09aa57564bae",  # ideal-paper
     "sha256:fb51017379fcac6a31e872004c42d77bb2f0cd72bbdf4b10d3c8874e288d783e",  # svm-paper
     "sha256:7d72c28a50ff7ab6de9bfb6a3366e5c4dc5a4f6ed750a70de91c8b0098abd7b5",  # svm-paper-varied
+    "sha256:d5125d90db8caf3809621e33fcf8b6a6484fecabb013d2acb47e87a0b10f10e5",  # svm-fine
 })
 
 #: Digests of each shipped table's files as shipped (:func:`file_digest`: the .json header and the .npz's
@@ -454,6 +455,7 @@ SHIPPED_FILE_DIGESTS = frozenset({
     "sha256:ef844209edc8dcebd324634fea7fcdb146b0fc58fa814b05f76dfabf82c4e7f5",  # ideal-paper
     "sha256:fc461c7468fefb61c903a609f9b86d1d680821fc405c987daf2727d7ed607d8e",  # svm-paper
     "sha256:882e12fdd88e94f6dc0c0cd97172281e52fcc64852c8b0daaa62c7a505a15c0f",  # svm-paper-varied
+    "sha256:b8fc4777f487d2351cb8e5ae299a5ffb21f790a817727002b2562194d7df84ca",  # svm-fine
 })
 
 

@@ -682,6 +682,32 @@ def _slices(combos, n):
             np.tile(np.array([w for _, w in live], dtype=np.float64), (n, 1)))
 
 
+#: The shortest span in contact time [ratio] over which min-contact reads the slope of ``log k`` in ``log t``.
+#: Each reading of ``k`` carries the table's Monte Carlo error (about 3 % on svm-fine), so two readings 0.1 s
+#: apart give a slope that is mostly noise (measured on svm-fine: 1.70 at 2.4 s, 1.80 at 2.5 s, a slope of
+#: 1.4 against the signal's 0.3-0.5, which put 33,906 vs 22,141 at 0.1 degC at 1.83 s with an interval to
+#: 666 s, where 16 seeds give 2.28 s). 1.14 is just under the closest step of svm-paper's axis (8/7), so its
+#: answers are unchanged.
+K_SLOPE_SPAN = 1.14
+
+
+def k_baseline(contacts_s, k_cross):
+    """Index of the contact where min-contact reads ``k`` beside the crossing's contact ``k_cross``: the
+    latest at or below ``contacts_s[k_cross] / K_SLOPE_SPAN`` (at least one step back, and the first contact
+    where none lies that far back), or, where ``k_cross`` is the first, the first at or above
+    ``contacts_s[0] * K_SLOPE_SPAN``; -1 where none.
+
+    >>> c = np.array([0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.5, 2.0])
+    >>> k_baseline(c, np.array([5, 6, 7, 0, 1])).tolist()
+    [3, 5, 6, 1, 0]
+    """
+    c, kb = np.asarray(contacts_s, dtype=np.float64), np.asarray(k_cross, dtype=np.int64)
+    back = np.clip(np.searchsorted(c, c[kb] / K_SLOPE_SPAN * (1 + 1e-12), side="right") - 1, 0, kb - 1)
+    ahead = np.searchsorted(c, c[0] * K_SLOPE_SPAN * (1 - 1e-12), side="left")
+    ka = np.where(kb > 0, back, ahead)
+    return np.where((ka >= 0) & (ka < c.size) & (ka != kb), ka, -1)
+
+
 def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
                         max_contact_s: float = CLOSED_FORM_MAX_CONTACT_S) -> dict[str, np.ndarray]:
     """min-contact from the SVM's *noise efficiency* against the exact ideal observer, for pairs of one scene.
@@ -694,9 +720,9 @@ def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
     sigma/dT, direction and effusivity to about 1 %, docs/accuracy.md), unlike the ratio of the needs in
     effusivity, which changes with the pair's width because the signal ``w(e) = e / (e_s + e)`` is concave
     (that ratio, read at pairs narrower and wider than the asked one, put the answers late). ``k`` is read at
-    the crossing's tabulated contact ``t_b`` (index ``k_cross``) and the one before, ``t_a`` (after, where
-    ``t_b`` is the first), from the pair's own entries (upwards at ``lo``, downwards at ``hi``) in every
-    scene slice the question interpolates between; ``log k`` is linear in ``log t`` through them. The
+    the crossing's tabulated contact ``t_b`` (index ``k_cross``) and one before, ``t_a`` (after, where
+    ``t_b`` is the first), at least a factor :data:`K_SLOPE_SPAN` away (:func:`k_baseline`), from the pair's
+    own entries (upwards at ``lo``, downwards at ``hi``) in every scene slice the question interpolates between; ``log k`` is linear in ``log t`` through them. The
     answer is the first sample time where ``k(t) s(t)`` reaches the pair's own critical noise
     (:func:`~designkit.query.ideal_bound.noise_k_contact`).
 
@@ -734,8 +760,7 @@ def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
         np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64), np.asarray(ratio, dtype=np.float64),
         np.asarray(k_cross, dtype=np.int64)))
     nc, n = view.contacts.size, lo.size
-    ka = np.where(kb > 0, kb - 1, kb + 1)
-    ka = np.where(ka < nc, ka, -1)
+    ka = k_baseline(view.contacts, kb)
     slices, sw = _slices(combos, n)
     lk, se, s_pair = _k_readings(op, slices, sw, ka, kb, lo, hi, extra=(lo, hi))
     t_a, t_b = view.contacts[np.where(ka >= 0, ka, kb)], view.contacts[kb]

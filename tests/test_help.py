@@ -70,3 +70,19 @@ def test_a_command_runs_with_only_its_own_module_imported():
     assert r.returncode == 0, r.stderr
     assert r.stdout.startswith("name,family")
     assert "LOADED ['materials']" in r.stderr
+
+
+def test_the_table_options_name_the_query_layers_default_table():
+    """The CLI's --table help spells the default out (it must not import the query layer to say it)."""
+    import typer.main
+
+    from designkit.cli import app
+    from designkit.query.table import DEFAULT_TABLE
+
+    group = typer.main.get_command(app)
+    seen = 0
+    for name in ("min-contact", "max-noise", "min-delta-t", "delta-e", "distinguishable", "matrix"):
+        opt = [p for p in group.commands[name].params if "--table" in getattr(p, "opts", ())]
+        assert opt and f"(default: {DEFAULT_TABLE})" in opt[0].help, name
+        seen += 1
+    assert seen == 6

@@ -14,6 +14,8 @@ import pytest
 
 from designkit import query
 from designkit.query.matrix import material_matrix, multiclass_ideal_accuracy, resolve_materials
+from designkit.query.table import DEFAULT_TABLE
+from designkit.tables.store import load_table
 
 THREE = ["paper12:glass", "paper12:stainless steel", "paper12:copper"]
 
@@ -283,4 +285,5 @@ def test_progress_counts_pairs_then_svm_contacts():
     pytest.importorskip("sklearn")
     seen = []
     material_matrix(THREE, svm_trials=3, progress=lambda d, t: seen.append((d, t)))
-    assert seen[0] == (1, 3 + 12) and seen[-1] == (15, 15) and [d for d, _ in seen] == list(range(1, 16))
+    n = 3 + load_table(DEFAULT_TABLE).axes["contact_s"].size  # 3 pairs, then the table's contact times
+    assert seen[0] == (1, n) and seen[-1] == (n, n) and [d for d, _ in seen] == list(range(1, n + 1))

@@ -427,14 +427,14 @@ def test_a_question_the_table_cannot_answer_exits_3_and_bad_coverage_exits_2(cli
     r = cli("min-contact", "--e1", "35000", "--e2", "20000", "--coverage", "1.5")
     assert r.exit_code == 2 and "coverage must lie in (0, 1)" in r.output
     # outside the table's axes: every question exits 3 and names the axis and its range in user units
-    for cmd in (("min-contact", "--e1", "35000", "--e2", "20000", "--noise", "0.5"),
+    for cmd in (("min-contact", "--e1", "35000", "--e2", "20000", "--noise", "1"),
                 ("max-noise", "--e1", "35000", "--e2", "20000", "--contact", "20"),
                 ("min-delta-t", "--e1", "35000", "--e2", "20000", "--contact", "0.2"),
-                ("delta-e", "--e", "20000", "--noise", "0.5"),
+                ("delta-e", "--e", "20000", "--noise", "1"),
                 ("distinguishable", "--e1", "35000", "--e2", "20000", "--contact", "20")):
         r = cli(*cmd)
         assert r.exit_code == 3, (cmd, r.output)
-        assert ("noise 0.005 to 0.2 degC" in r.output or "contact time" in r.output), r.output
+        assert ("noise 0.005 to 0.5 degC" in r.output or "contact time" in r.output), r.output
         assert cli(*cmd, "--coverage", "0").exit_code == 2
 
 

@@ -110,10 +110,13 @@ def test_varied_table_verdict_follows_its_own_min_contact():
         assert a.value == (c >= m.value), c
 
 
-def test_grid_answer_what_exports_give_errs_on_the_safe_side_of_the_cli():
+@pytest.mark.parametrize("table, mc_floor", [("svm-paper", 1.0), ("svm-fine", 0.995)])
+def test_grid_answer_what_exports_give_errs_on_the_safe_side_of_the_cli(table, mc_floor):
     """The exports' documented relation to the CLI (designkit.export._common.CLI_RELATION), on random inputs:
-    the grid's min-contact at or above the CLI's estimate, its distinguishable 'yes' only where the CLI says
-    yes, its delta(e) at most 1.5 % below the CLI's (measured: 33 of 723 directions below, by at most 1.4 %)."""
+    the grid's min-contact at or above the CLI's estimate (svm-fine's crossings, 0.1 s apart, lie so close to
+    it that interpolation can put them 0.3 % below: measured 1 of 139), its distinguishable 'yes' only where
+    the CLI says yes, its delta(e) at most 1.5 % below the CLI's (measured: 33 of 723 directions below, by at
+    most 1.4 %, on svm-paper; 24 of 199, at most 0.8 %, on svm-fine)."""
     rng = np.random.default_rng(7)
     n_mc = n_d = n_de = 0
     for _ in range(30):
@@ -121,16 +124,16 @@ def test_grid_answer_what_exports_give_errs_on_the_safe_side_of_the_cli():
         if abs(e1 - e2) < 400:
             continue
         noise = float(np.exp(rng.uniform(math.log(0.005), math.log(0.2))))
-        m = min_contact(e1, e2, noise_c=noise, delta_t_c=DT)
+        m = min_contact(e1, e2, noise_c=noise, delta_t_c=DT, table=table)
         if m.value is None:
             continue
-        assert grid_answer(m) >= m.value, (e1, e2, noise)
+        assert grid_answer(m) >= mc_floor * m.value, (e1, e2, noise)
         n_mc += 1
         c = float(np.clip(m.value * math.exp(rng.uniform(-0.4, 0.4)), 0.5, 10.0))
-        a = distinguishable(e1, e2, contact_s=c, noise_c=noise, delta_t_c=DT)
+        a = distinguishable(e1, e2, contact_s=c, noise_c=noise, delta_t_c=DT, table=table)
         assert a.value or not grid_answer(a), (e1, e2, noise, c)
         n_d += 1
-        d = delta_e(float(rng.uniform(200, 39500)), contact_s=c, noise_c=noise, delta_t_c=DT)
+        d = delta_e(float(rng.uniform(200, 39500)), contact_s=c, noise_c=noise, delta_t_c=DT, table=table)
         for side in ("lower", "upper"):
             v, g = d.details[side]["value"], grid_answer(d, "svm", side)
             if v is not None and g is not None:

@@ -10,6 +10,7 @@ import pytest
 from designkit import InputError
 from designkit.sweep import SweepConfig
 from designkit.query import table as q
+from designkit.query.table import DEFAULT_TABLE
 from designkit.tables.store import SCHEMA_VERSION, content_hash, list_tables, load_table, table_header, write_table
 
 
@@ -129,7 +130,7 @@ def test_shipped_svm_table_reproduces_the_papers_guideline():
     table must say the same, bracket its answer by its Monte Carlo interval, and never need less
     contact than the ideal observer (a bound no classifier beats)."""
     ans = q.min_contact(35000, 20000, noise_c=0.05, delta_t_c=10.0)
-    assert ans.table == "svm-paper" and ans.source == "table" and all(ans.in_grid.values())
+    assert ans.table == DEFAULT_TABLE and ans.source == "table" and all(ans.in_grid.values())
     assert 1.0 < ans.value <= 2.0
     lo, hi = ans.interval
     assert lo <= ans.value and (hi is None or ans.value <= hi)

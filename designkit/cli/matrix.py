@@ -42,7 +42,7 @@ def matrix(
     = None,
     threshold: Annotated[Optional[float], typer.Option(
         "--threshold", help="F1 threshold; must be the table's (0.9 for the shipped tables).")] = None,
-    table: Annotated[Optional[str], typer.Option("--table", help="Lookup table (default: svm-paper).")] = None,
+    table: Annotated[Optional[str], typer.Option("--table", help="Lookup table (default: svm-fine).")] = None,
     ideal_table: Annotated[str, typer.Option("--ideal-table", help="Table for the ideal-observer bound.")]
     = "ideal-paper",
     multiclass: Annotated[bool, typer.Option(

@@ -41,7 +41,7 @@ Contact = Annotated[float, typer.Option("--contact", help="Contact time [s].")]
 Exact = Annotated[bool, typer.Option(
     "--exact", help="Compute for this pair and scene (seconds) instead of reading a table.")]
 TableOpt = Annotated[Optional[str], typer.Option(
-    "--table", help="Lookup table (name or path) for the SVM answer (default: svm-paper).")]
+    "--table", help="Lookup table (name or path) for the SVM answer (default: svm-fine).")]
 IdealTableOpt = Annotated[str, typer.Option("--ideal-table", help="Lookup table for the ideal-observer bound.")]
 TrialsQ = Annotated[int, typer.Option("--trials", help="--exact: simulated touches per class.")]
 RepeatsQ = Annotated[int, typer.Option("--repeats", help="--exact: seeds per evaluation (Monte Carlo error).")]

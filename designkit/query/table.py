@@ -104,7 +104,7 @@ __all__ = [
     "table_spread",
 ]
 
-DEFAULT_TABLE = "svm-paper"
+DEFAULT_TABLE = "svm-fine"
 #: The shipped table for the paper's second setting (the sensor's temperature drawn per touch, uniform in
 #: 30-35 degC with the object at 25 degC: dT 7.5 degC, spread 2.5 degC): a question with that spread reads it.
 VARIED_TABLE = "svm-paper-varied"
@@ -232,13 +232,15 @@ class _View:
 
         Measured on the table itself (leave one contact out): every interior contact's log efficiency
         ``log((svm need - w/2) / (ideal need - w/2))`` (both directions, every noise-ratio slice and
-        effusivity) is predicted from its two neighbours on the contact axis (linear in log t); each residual
+        effusivity) is predicted from its two neighbours on the contact axis at least :data:`K_SLOPE_SPAN`
+        away on each side (linear in log t); each residual
         is standardized by the SD its three entries' stated errors give: ``f`` times the table's Monte Carlo
         SE of each SVM need (``delta_lo`` / ``delta_hi``, ``z`` SEs each) and the rounding of both needs
         (``w/sqrt(12)`` each). The factor ``f`` is the one that makes the standardized residuals' robust SD
         (1.4826 x median |r|) 1. Entries whose ideal need is under four widths (rounding dominates there)
         are left out. The residuals also carry the need's curvature across two cells, so ``f`` errs high
-        (on svm-paper 0.78: its Monte Carlo intervals are a quarter wider than its entries scatter).
+        (on svm-paper 0.78: its Monte Carlo intervals are a quarter wider than its entries scatter; on
+        svm-fine 0.72).
         1 where the table has no ideal needs or no Monte Carlo interval to calibrate (fewer than 20
         residuals).
         """
@@ -260,15 +262,24 @@ class _View:
                 rnd2 = (rnd_sd / (svm - h)) ** 2 + (rnd_sd / (ideal - h)) ** 2
                 mc = np.where(np.isfinite(hi) & (lo > h), np.log((hi - h) / (lo - h)) / (2.0 * z),
                               np.where(lo > h, np.log((svm - h) / (lo - h)) / z, np.nan))
+            span = math.log(K_SLOPE_SPAN) * (1.0 - 1e-9)
             for k in range(1, lt.size - 1):
-                w = (lt[k] - lt[k - 1]) / (lt[k + 1] - lt[k - 1])
+                # the neighbours at least K_SLOPE_SPAN away: entries closer than that share most of their
+                # touches (a shorter contact is a prefix of a longer one) and their Monte Carlo errors
+                # correlate, which shrinks the residuals (on svm-fine f is 0.65 from neighbours 0.1 s apart,
+                # 0.71, 0.75, 0.77 from 0.2, 0.3, 0.4 s); on svm-paper's axis these are the next contacts
+                a, b = np.flatnonzero(lt <= lt[k] - span), np.flatnonzero(lt >= lt[k] + span)
+                if a.size == 0 or b.size == 0:
+                    continue
+                a, b = a[-1], b[0]
+                w = (lt[k] - lt[a]) / (lt[b] - lt[a])
                 # entries at or below half a width give infinite logs (inf - inf here): left out by `ok`
                 with np.errstate(invalid="ignore", over="ignore"):
-                    r = le[:, k] - ((1.0 - w) * le[:, k - 1] + w * le[:, k + 1])
-                    v_mc = mc[:, k] ** 2 + ((1.0 - w) * mc[:, k - 1]) ** 2 + (w * mc[:, k + 1]) ** 2
-                    v_rnd = rnd2[:, k] + (1.0 - w) ** 2 * rnd2[:, k - 1] + w ** 2 * rnd2[:, k + 1]
+                    r = le[:, k] - ((1.0 - w) * le[:, a] + w * le[:, b])
+                    v_mc = mc[:, k] ** 2 + ((1.0 - w) * mc[:, a]) ** 2 + (w * mc[:, b]) ** 2
+                    v_rnd = rnd2[:, k] + (1.0 - w) ** 2 * rnd2[:, a] + w ** 2 * rnd2[:, b]
                     ok = (np.isfinite(r) & np.isfinite(v_mc) & (v_mc > 0) & np.isfinite(v_rnd)
-                          & (np.fmin(np.fmin(ideal[:, k - 1], ideal[:, k]), ideal[:, k + 1]) >= 8.0 * h))
+                          & (np.fmin(np.fmin(ideal[:, a], ideal[:, k]), ideal[:, b]) >= 8.0 * h))
                 res.append(r[ok]), vm.append(v_mc[ok]), vr.append(v_rnd[ok])
         r = np.abs(np.concatenate(res)) if res else np.zeros(0)
         value = 1.0

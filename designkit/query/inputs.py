@@ -261,7 +261,7 @@ def reference_class(e: float | None = None, m: str | None = None, *, width: floa
 def table_reroute(sensor, model, table_sensor=None, table_model=None) -> str | None:
     """Why a question about ``sensor`` under ``model`` cannot be read from a table built for another one.
 
-    The shipped tables (``svm-paper``, ``ideal-paper``) are for the paper's
+    The shipped tables (``svm-fine``, ``svm-paper``, ``ideal-paper``) are for the paper's
     sensor and the semi-infinite model; by default ``table_sensor`` /
     ``table_model`` are those. Returns None when the table answers for this
     sensor and model, else one sentence for the answer's notes (the caller

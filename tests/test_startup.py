@@ -27,7 +27,7 @@ def _py(*args: str) -> subprocess.CompletedProcess:
 def test_every_shipped_table_is_listed_by_hash_and_passes_its_schema(name):
     t = load_table(name)
     assert t.shipped, (f"shipped table {name} (content hash {t.header['content_hash']}) is not in "
-                       "designkit.tables.store.SHIPPED_CONTENT_HASHES: add it there")
+                       "designkit.tables.store.SHIPPED_CONTENT_HASHES: add it to SHIPPED_TABLES")
     validate(schemas()["table"], t.header, name)  # the step its hash stands for
     validate(schemas()["sensor"], dict(t.header["sensor"]), name)
 
@@ -85,7 +85,7 @@ def test_every_shipped_table_is_listed_by_file_digest_and_its_arrays_pass_the_lo
     with zipfile.ZipFile(t.path) as z:
         digest = file_digest(t.path.with_suffix(".json").read_bytes(), _zip_members(z))
     assert digest in SHIPPED_FILE_DIGESTS, (f"shipped table {name} (files {digest}) is not in "
-                                            "designkit.tables.store.SHIPPED_FILE_DIGESTS: add it there")
+                                            "designkit.tables.store.SHIPPED_FILE_DIGESTS: add it to SHIPPED_TABLES")
     assert content_hash(dict(t.arrays), t.header) == t.header["content_hash"]  # what the digest stands for
     assert not load_table(name, thorough=True).arrays.__class__.__name__.startswith("_")  # the long way
 

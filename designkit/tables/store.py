@@ -424,39 +424,49 @@ def resolve_table(name_or_path: str | Path) -> Path:
     raise InputError(f"no table {s!r} (shipped tables: {shipped}; or give a path to a .npz with its .json)")
 
 
-#: Content hashes of the shipped tables (``tables/*.json``). Their headers passed the schema when they were
-#: built and a test checks that each still does; a table whose header and arrays hash to one of these *is*
-#: that content, so loading it skips the schema step (importing pydantic and building the schemas cost a
-#: fresh ``designkit min-contact`` more than its question). Every other table is validated in full.
-#: Rebuilding a shipped table: add its new hash here (tests/test_tables.py names it).
-SHIPPED_CONTENT_HASHES = frozenset({
-    "sha256:b992e905af3f0312038aee27fcf71f1e96d444a9346caabd2bda2b9504f0399e",  # evidence-gradient-slope
-    "sha256:60fa880ce4e50749e3aad5c48d061e41f743d89a6ca512f840793d16ade75c37",  # f1-matrix-2s
-    "sha256:f4ecf487aec590490a63ec41215c6511218f038794ad33b52d5077bc1e5cf7ca",  # f1-matrix-fine-low
-    "sha256:6290aff2cd7e4de3f9d1dc5ef445e66fdbb24a7cadd8e448a8733f373d111a60",  # f1-matrix-paper
-    "sha256:1820bf01e2ffe9e79d35e4c0b9f8b310b10bbe7c8d481db47c9c09aa57564bae",  # ideal-paper
-    "sha256:fb51017379fcac6a31e872004c42d77bb2f0cd72bbdf4b10d3c8874e288d783e",  # svm-paper
-    "sha256:7d72c28a50ff7ab6de9bfb6a3366e5c4dc5a4f6ed750a70de91c8b0098abd7b5",  # svm-paper-varied
-    "sha256:d5125d90db8caf3809621e33fcf8b6a6484fecabb013d2acb47e87a0b10f10e5",  # svm-fine
-})
+#: Each shipped table (``tables/*.json``): its content hash, then the digest of its files as shipped.
+#: Rebuilding a shipped table: put its new pair here (tests/test_tables.py and tests/test_startup.py name
+#: the hash and the digest of a table missing from it).
+SHIPPED_TABLES: dict[str, tuple[str, str]] = {
+    "evidence-gradient-slope": (
+        "sha256:b992e905af3f0312038aee27fcf71f1e96d444a9346caabd2bda2b9504f0399e",
+        "sha256:911e1adf9e1fa85eca6275993399f491d3006aefd443bd03e0ef6b1404c3d638"),
+    "f1-matrix-2s": (
+        "sha256:60fa880ce4e50749e3aad5c48d061e41f743d89a6ca512f840793d16ade75c37",
+        "sha256:d39c9fbf935896606db255017df138f92fce5fcbcc0ff680b2ddeda2458f0ae8"),
+    "f1-matrix-fine-low": (
+        "sha256:f4ecf487aec590490a63ec41215c6511218f038794ad33b52d5077bc1e5cf7ca",
+        "sha256:1f7cc68036078992caf4c20e0d201193b83d37dc3f3868688edb6a90e6cf7eb0"),
+    "f1-matrix-paper": (
+        "sha256:6290aff2cd7e4de3f9d1dc5ef445e66fdbb24a7cadd8e448a8733f373d111a60",
+        "sha256:d32ead9cde594f2c4d0d29e02aa369b6665b71cb0dd87bc71df0796163fbdcad"),
+    "ideal-paper": (
+        "sha256:1820bf01e2ffe9e79d35e4c0b9f8b310b10bbe7c8d481db47c9c09aa57564bae",
+        "sha256:ef844209edc8dcebd324634fea7fcdb146b0fc58fa814b05f76dfabf82c4e7f5"),
+    "svm-paper": (
+        "sha256:fb51017379fcac6a31e872004c42d77bb2f0cd72bbdf4b10d3c8874e288d783e",
+        "sha256:fc461c7468fefb61c903a609f9b86d1d680821fc405c987daf2727d7ed607d8e"),
+    "svm-paper-varied": (
+        "sha256:7d72c28a50ff7ab6de9bfb6a3366e5c4dc5a4f6ed750a70de91c8b0098abd7b5",
+        "sha256:882e12fdd88e94f6dc0c0cd97172281e52fcc64852c8b0daaa62c7a505a15c0f"),
+    "svm-fine": (
+        "sha256:d5125d90db8caf3809621e33fcf8b6a6484fecabb013d2acb47e87a0b10f10e5",
+        "sha256:b8fc4777f487d2351cb8e5ae299a5ffb21f790a817727002b2562194d7df84ca"),
+}
 
-#: Digests of each shipped table's files as shipped (:func:`file_digest`: the .json header and the .npz's
-#: directory). Files with one of these digests are a shipped content, checked in full when it was shipped
+#: Content hashes of the shipped tables. Their headers passed the schema when they were built and a test
+#: checks that each still does; a table whose header and arrays hash to one of these *is* that content, so
+#: loading it skips the schema step (importing pydantic and building the schemas cost a fresh ``designkit
+#: min-contact`` more than its question). Every other table is validated in full.
+SHIPPED_CONTENT_HASHES = frozenset(content for content, _ in SHIPPED_TABLES.values())
+
+#: Digests of the shipped tables' files (:func:`file_digest`: the .json header and the .npz's directory).
+#: Files with one of these digests are a shipped content, checked in full when it was shipped
 #: (tests/test_startup.py checks every shipped table again, the long way), so loading them checks the
 #: digest (well under a millisecond) instead of hashing every decompressed array (35 ms on svm-fine), and
 #: reads an array only when a question asks for it. Files that differ (a rebuilt table, an edited one, a
 #: header rewritten with other line endings) take the long way: hash, schema, consistency.
-#: Rebuilding a shipped table: add its new digest here (tests/test_startup.py names it).
-SHIPPED_FILE_DIGESTS = frozenset({
-    "sha256:911e1adf9e1fa85eca6275993399f491d3006aefd443bd03e0ef6b1404c3d638",  # evidence-gradient-slope
-    "sha256:d39c9fbf935896606db255017df138f92fce5fcbcc0ff680b2ddeda2458f0ae8",  # f1-matrix-2s
-    "sha256:1f7cc68036078992caf4c20e0d201193b83d37dc3f3868688edb6a90e6cf7eb0",  # f1-matrix-fine-low
-    "sha256:d32ead9cde594f2c4d0d29e02aa369b6665b71cb0dd87bc71df0796163fbdcad",  # f1-matrix-paper
-    "sha256:ef844209edc8dcebd324634fea7fcdb146b0fc58fa814b05f76dfabf82c4e7f5",  # ideal-paper
-    "sha256:fc461c7468fefb61c903a609f9b86d1d680821fc405c987daf2727d7ed607d8e",  # svm-paper
-    "sha256:882e12fdd88e94f6dc0c0cd97172281e52fcc64852c8b0daaa62c7a505a15c0f",  # svm-paper-varied
-    "sha256:b8fc4777f487d2351cb8e5ae299a5ffb21f790a817727002b2562194d7df84ca",  # svm-fine
-})
+SHIPPED_FILE_DIGESTS = frozenset(files for _, files in SHIPPED_TABLES.values())
 
 
 def file_digest(header_bytes: bytes, members: Mapping[str, zipfile.ZipInfo]) -> str:

@@ -262,16 +262,14 @@ class _View:
                 rnd2 = (rnd_sd / (svm - h)) ** 2 + (rnd_sd / (ideal - h)) ** 2
                 mc = np.where(np.isfinite(hi) & (lo > h), np.log((hi - h) / (lo - h)) / (2.0 * z),
                               np.where(lo > h, np.log((svm - h) / (lo - h)) / z, np.nan))
-            span = math.log(K_SLOPE_SPAN) * (1.0 - 1e-9)
-            for k in range(1, lt.size - 1):
-                # the neighbours at least K_SLOPE_SPAN away: entries closer than that share most of their
-                # touches (a shorter contact is a prefix of a longer one) and their Monte Carlo errors
-                # correlate, which shrinks the residuals (on svm-fine f is 0.65 from neighbours 0.1 s apart,
-                # 0.71, 0.75, 0.77 from 0.2, 0.3, 0.4 s); on svm-paper's axis these are the next contacts
-                a, b = np.flatnonzero(lt <= lt[k] - span), np.flatnonzero(lt >= lt[k] + span)
-                if a.size == 0 or b.size == 0:
+            # the neighbours at least K_SLOPE_SPAN away: entries closer than that share most of their touches (a
+            # shorter contact is a prefix of a longer one) and their Monte Carlo errors correlate, which shrinks the
+            # residuals (on svm-fine f is 0.65 from neighbours 0.1 s apart, 0.71, 0.75, 0.77 from 0.2, 0.3, 0.4 s);
+            # on svm-paper's axis these are the next contacts
+            backs, aheads = span_neighbours(self.contacts, np.arange(lt.size))
+            for k, a, b in zip(range(lt.size), backs, aheads):
+                if a < 0 or b < 0:
                     continue
-                a, b = a[-1], b[0]
                 w = (lt[k] - lt[a]) / (lt[b] - lt[a])
                 # entries at or below half a width give infinite logs (inf - inf here): left out by `ok`
                 with np.errstate(invalid="ignore", over="ignore"):
@@ -702,6 +700,21 @@ def _slices(combos, n):
 K_SLOPE_SPAN = 1.14
 
 
+def span_neighbours(contacts_s, k):
+    """The contacts at least :data:`K_SLOPE_SPAN` away from ``contacts_s[k]`` on each side: the index of the latest
+    at or below ``contacts_s[k] / K_SLOPE_SPAN`` and of the first at or above ``contacts_s[k] * K_SLOPE_SPAN``
+    (-1 where none), elementwise over the indices ``k``.
+
+    >>> c = np.array([0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.5, 2.0])
+    >>> [a.tolist() for a in span_neighbours(c, np.array([0, 1, 5, 7]))]
+    [[-1, 0, 3, 6], [1, 2, 6, -1]]
+    """
+    c, k = np.asarray(contacts_s, dtype=np.float64), np.asarray(k, dtype=np.int64)
+    back = np.searchsorted(c, c[k] / K_SLOPE_SPAN * (1 + 1e-12), side="right") - 1
+    ahead = np.searchsorted(c, c[k] * K_SLOPE_SPAN * (1 - 1e-12), side="left")
+    return back, np.where(ahead < c.size, ahead, -1)
+
+
 def k_baseline(contacts_s, k_cross):
     """Index of the contact where min-contact reads ``k`` beside the crossing's contact ``k_cross``: the
     latest at or below ``contacts_s[k_cross] / K_SLOPE_SPAN`` (at least one step back, and the first contact
@@ -712,11 +725,9 @@ def k_baseline(contacts_s, k_cross):
     >>> k_baseline(c, np.array([5, 6, 7, 0, 1])).tolist()
     [3, 5, 6, 1, 0]
     """
-    c, kb = np.asarray(contacts_s, dtype=np.float64), np.asarray(k_cross, dtype=np.int64)
-    back = np.clip(np.searchsorted(c, c[kb] / K_SLOPE_SPAN * (1 + 1e-12), side="right") - 1, 0, kb - 1)
-    ahead = np.searchsorted(c, c[0] * K_SLOPE_SPAN * (1 - 1e-12), side="left")
-    ka = np.where(kb > 0, back, ahead)
-    return np.where((ka >= 0) & (ka < c.size) & (ka != kb), ka, -1)
+    kb = np.asarray(k_cross, dtype=np.int64)
+    back, ahead = span_neighbours(contacts_s, kb)  # (where kb is the first contact, ahead is read from it)
+    return np.where(kb > 0, np.maximum(back, 0), ahead)
 
 
 def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
@@ -733,8 +744,8 @@ def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
     (that ratio, read at pairs narrower and wider than the asked one, put the answers late). ``k`` is read at
     the crossing's tabulated contact ``t_b`` (index ``k_cross``) and one before, ``t_a`` (after, where
     ``t_b`` is the first), at least a factor :data:`K_SLOPE_SPAN` away (:func:`k_baseline`), from the pair's
-    own entries (upwards at ``lo``, downwards at ``hi``) in every scene slice the question interpolates between; ``log k`` is linear in ``log t`` through them. The
-    answer is the first sample time where ``k(t) s(t)`` reaches the pair's own critical noise
+    own entries (upwards at ``lo``, downwards at ``hi``) in every scene slice the question interpolates
+    between; ``log k`` is linear in ``log t`` through them. The answer is the first sample time where ``k(t) s(t)`` reaches the pair's own critical noise
     (:func:`~designkit.query.ideal_bound.noise_k_contact`).
 
     Standard error of ``log k`` at a contact: the entries' inverse-variance mean (their Monte Carlo errors
@@ -770,7 +781,7 @@ def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
     lo, hi, ratio, kb = (np.atleast_1d(a) for a in np.broadcast_arrays(
         np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64), np.asarray(ratio, dtype=np.float64),
         np.asarray(k_cross, dtype=np.int64)))
-    nc, n = view.contacts.size, lo.size
+    n = lo.size
     ka = k_baseline(view.contacts, kb)
     slices, sw = _slices(combos, n)
     lk, se, s_pair = _k_readings(op, slices, sw, ka, kb, lo, hi, extra=(lo, hi))

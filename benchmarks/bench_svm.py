@@ -20,8 +20,10 @@ is a near-tie), the largest |decision| difference overall, and the solver stages
 Speed: 2 s contact, 100 trials per class, 3 folds: CPU time per pair
 (``time.process_time`` of this process, median of repeats) of the reference and of
 the batched solver at several batch sizes, with the batched stages (fold
-assignment, standardization, Gram products, dual solves, test decisions), and the
-peak memory traced per pair. BLAS threads are limited (``--threads``, default 1)
+assignment, standardization, Gram products, dual solves, test decisions), the
+peak memory traced per pair, and the floor of any exact solver on this CPU (the
+Gram products and one factorization of each fold's free block, measured on the
+first pair in the same run: the best ratio to the reference this CPU allows). BLAS threads are limited (``--threads``, default 1)
 for both paths; the load average is printed because the machines are shared.
 """
 
@@ -139,7 +141,8 @@ def speed(batches, repeats: int, seed: int, n_ref: int) -> dict:
         for i in range(n_ref):
             f1_from_features(lo[i], hi[i], seed=seeds[i])
         ref.append((time.process_time() - t) / n_ref)
-    out = {"reference_cpu_s_per_pair": statistics.median(ref), "batched": []}
+    out = {"reference_cpu_s_per_pair": statistics.median(ref), "batched": [],
+           "floor": floor(lo[0], hi[0], seeds[0])}
     batched_cv_f1(lo[:2], hi[:2], seeds=seeds[:2])
     for b in batches:
         per, stages = [], []
@@ -168,6 +171,52 @@ def speed(batches, repeats: int, seed: int, n_ref: int) -> dict:
             per_l.append((time.process_time() - t) / b)
         out["batched"][-1]["cpu_s_per_pair_lists"] = statistics.median(per_l)
     return out
+
+
+def floor(lo, hi, seed, repeats: int = 200) -> dict:
+    """CPU time of the two steps every exact solver of this classifier must take in each fold.
+
+    Per fold: the Gram product of the fold's standardized training touches (float32,
+    ``Z @ Z.T`` as the batched solver forms it) and one factorization of the free block
+    of the dual at its solution (LAPACK ``dposv``, ridged as the active set solves it).
+    The batched active set factors that block 3-4 times per fold (its iterations); a
+    solver that guessed the final active set would still factor it once. Their sum over
+    the folds is a floor on the CPU time per fit of any exact solver written on this
+    BLAS and LAPACK: the best ratio to the reference that this CPU allows.
+    """
+    from scipy.linalg.lapack import dposv
+
+    from designkit.recognition.batched_svm import _RIDGE, solve_svc_duals, stratified_test_folds
+
+    X = np.vstack([lo, hi])
+    test = stratified_test_folds(len(lo), len(hi), seed, 3)
+    y_all = np.r_[np.ones(len(lo)), -np.ones(len(hi))]  # libsvm: the lower class is +1
+    gram, chol, free = [], [], []
+    for f in range(3):
+        tr = test != f
+        Xt = X[tr]
+        sd = Xt.std(axis=0)
+        Z = ((Xt - Xt.mean(axis=0)) / np.where(sd > 0, sd, 1.0)).astype(np.float32)
+        ts = []
+        for _ in range(repeats):
+            t = time.process_time()
+            K32 = Z @ Z.T
+            ts.append(time.process_time() - t)
+        gram.append(statistics.median(ts))
+        K = K32.astype(np.float64)
+        a, _, _ = solve_svc_duals(K[None], y_all[tr])
+        F = np.flatnonzero((a[0] > 0) & (a[0] < 1.0))
+        free.append(F.size)
+        A0 = K[np.ix_(F, F)] + _RIDGE * float(np.mean(np.diag(K))) * np.eye(F.size)
+        rhs0 = np.ones((F.size, 2), order="F")
+        ts = []
+        for _ in range(repeats):
+            A, rhs = np.array(A0, order="F"), rhs0.copy(order="F")
+            t = time.process_time()
+            dposv(A, rhs, overwrite_a=1, overwrite_b=1)
+            ts.append(time.process_time() - t)
+        chol.append(statistics.median(ts))
+    return {"gram_s": sum(gram), "factor_s": sum(chol), "free": free}
 
 
 def main(argv=None):
@@ -200,6 +249,12 @@ def main(argv=None):
                 print(f"      peak traced memory {b['peak_mb']:.1f} MB for the batch "
                       f"({b['peak_mb'] / b['batch']:.2f} MB per pair; inputs {b['input_mb_per_pair']:.2f} MB per pair, "
                       "not counted)")
+            fl = s["floor"]
+            low = fl["gram_s"] + fl["factor_s"]
+            print(f"  floor of an exact solver on this CPU, measured on the first pair: Gram products "
+                  f"{fl['gram_s'] * 1e3:.3f} ms + one factorization of each fold's free block "
+                  f"({'/'.join(map(str, fl['free']))} free variables) {fl['factor_s'] * 1e3:.3f} ms = "
+                  f"{low * 1e3:.3f} ms per fit: at most {r / low:.1f}x less CPU than the reference")
         if not args.skip_agreement:
             a = agreement(args.pairs, args.seed)
             d = a["differing_predictions"]

@@ -267,21 +267,24 @@ def _delta_lines(con, d):
         con.print(f"  {words}: SVM [bold green]{_fmt(s['value'], '', 4)}[/] {ivs}, ideal {_fmt(s['ideal'], '', 4)}")
         dash = dash or s["value"] is None or s["ideal"] is None or None in iv
     if dash:
-        con.print("  [dim]— : no distinguishable effusivity in that direction within the range examined[/]")
+        outside = d["route"] == "table" and not all(d["in_grid"].values())
+        con.print("  [dim]— : " + ("no answer from the table (see below), or " if outside else "")
+                  + "no distinguishable effusivity in that direction within the range examined[/]")
 
 
 def _distinguishable_lines(con, d):
     x = d["details"]
     if x["distinguishable"] is None:
         con.print("  [yellow]no answer[/]")
-        return
-    yes = "[bold green]yes[/]" if x["distinguishable"] else "[bold red]no[/]"
-    iv = d["interval"]
-    f1 = (f", F1 {x['svm_f1']:.3f} ({iv['coverage']:.0%} interval {iv['low']:.3f} to {iv['high']:.3f}; "
-          f"{x['verdict']})" if x["svm_f1"] is not None else "")
-    con.print(f"  SVM (the paper's classifier): {yes}{f1}")
-    con.print(f"  ideal observer: F1 {x['ideal_f1']:.3f} ({d['ideal']['method']})"
-              + (" (distinguishable)" if x["ideal_distinguishable"] else " (not even in principle)"))
+    else:
+        yes = "[bold green]yes[/]" if x["distinguishable"] else "[bold red]no[/]"
+        iv = d["interval"]
+        f1 = (f", F1 {x['svm_f1']:.3f} ({iv['coverage']:.0%} interval {iv['low']:.3f} to {iv['high']:.3f}; "
+              f"{x['verdict']})" if x["svm_f1"] is not None else "")
+        con.print(f"  SVM (the paper's classifier): {yes}{f1}")
+    if x["ideal_f1"] is not None:  # also where the table has no answer: the closed form needs no table
+        con.print(f"  ideal observer: F1 {x['ideal_f1']:.3f} ({d['ideal']['method']})"
+                  + (" (distinguishable)" if x["ideal_distinguishable"] else " (not even in principle)"))
 
 
 _VALUE_LINES = {

@@ -3,7 +3,8 @@
 delta(e) is interpolated linearly in effusivity and contact time and
 log-linearly in sigma/dT between the table's grid points. A question outside
 the grid gets no value (``in_grid`` says which axis, the notes say the range
-in the user's units), never an extrapolation. A table built for another
+in the user's units), never an extrapolation; where the ideal observer has a
+closed form its bound is still given (it needs no table). A table built for another
 forward model, sensor or threshold than the one asked is refused
 (:class:`~designkit.query.inputs.TableMismatch`). This route imports neither
 scikit-learn nor matplotlib.
@@ -1284,6 +1285,32 @@ def _need_at_contact(view: _View, kind: str, combos, cw, lo: float, hi: float) -
 
 
 # ============================================================ min-contact
+def _outside_ideal_contact(op: _Opened, lo: float, hi: float, noise: float, dt: float) -> float | None:
+    """The closed-form ideal bound of min-contact for a question outside the table's grid, or None.
+
+    The ideal observer needs no table where its F1 has a closed form (fixed initial conditions, a
+    shared-shape model): a question the table cannot answer still gets the floor no classifier beats.
+    Without a closed form (its bound would be a Monte Carlo run) it is left out, as the answer is.
+    """
+    if not op.closed:
+        return None
+    from .ideal_bound import cached_ideal_min_contact
+
+    return number(cached_ideal_min_contact(op.tab.sensor, lo, hi, noise / abs(dt), width=op.width,
+                                           threshold=op.phi, max_contact_s=CLOSED_FORM_MAX_CONTACT_S))
+
+
+def _outside_ideal_ratio(op: _Opened, lo: float, hi: float, contact: float) -> float | None:
+    """The ideal observer's largest separating sigma/dT for a question outside the table's grid (closed
+    form, as :func:`_outside_ideal_contact`), or None (no closed form, or not separable in the bracket)."""
+    if not op.closed:
+        return None
+    from .ideal_bound import cached_ideal_max_ratio
+
+    return number(cached_ideal_max_ratio(op.tab.sensor, lo, hi, contact, width=op.width, threshold=op.phi,
+                                         bracket=CLOSED_FORM_RATIO_BRACKET))
+
+
 def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | None = None,
                 m2: str | None = None, objects=None, noise_c: float = 0.05, delta_t_c: float = 10.0,
                 threshold: float | None = None, table: "Table | str" = DEFAULT_TABLE,
@@ -1353,8 +1380,10 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
                   classes=pq.classes)
     if not all(flags.values()):
         wanted = {**_scene_wanted(view, noise, dt), "effusivity": (lo, hi)}
-        return _answer("min-contact", op, value=None, interval=(None, None), ideal=None, in_grid=flags,
-                       details={}, notes=_outside_notes(view, flags, wanted), **common)
+        ideal = _outside_ideal_contact(op, lo, hi, noise, dt) if ideal_bound else None
+        return _answer("min-contact", op, value=None, interval=(None, None), ideal=ideal,
+                       ideal_method="closed-form", in_grid=flags, details={},
+                       notes=_outside_notes(view, flags, wanted), **common)
     def needs_read(v: _View, kind: str, cmb) -> tuple[list[float], Any]:
         """The needs read lazily up to the crossing (a generator), and the list of those read so far."""
         read: list[float] = []
@@ -1536,15 +1565,17 @@ def _ratio_question(question: str, e1, e2, m1, m2, objects, contact_s, noise_c, 
     flags = {"contact_s": c_ok, "effusivity": view.e_in_grid(lo, hi)}
     common = dict(objects=pq.objects_dicts(), limiting=pq.limiting_dicts(), rule=pq.rule, scene=scene,
                   classes=pq.classes)
-    if not all(flags.values()):
-        notes = _outside_notes(view, flags, {"contact_s": contact, "effusivity": (lo, hi)})
-        return _answer(question, op, value=None, interval=(None, None), ideal=None, in_grid=flags, details={},
-                       notes=notes, **common)
 
     def to_answer(r):
         if r is None:
             return None
         return r * abs(dt) if question == "max-noise" else noise / r
+
+    if not all(flags.values()):
+        notes = _outside_notes(view, flags, {"contact_s": contact, "effusivity": (lo, hi)})
+        return _answer(question, op, value=None, interval=(None, None),
+                       ideal=to_answer(_outside_ideal_ratio(op, lo, hi, contact)), ideal_method="closed-form",
+                       in_grid=flags, details={}, notes=notes, **common)
 
     out = {}
     for kind, v in (("svm", view), ("lo", view), ("hi", view), ("ideal", op.iview)):
@@ -1703,8 +1734,11 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
                   classes=(ref,))
     if not all(flags.values()):
         wanted = {**_scene_wanted(view, noise, dt), "contact_s": contact, "effusivity": (x,)}
-        return _answer("delta-e", op, value=None, interval=(None, None), ideal=None, in_grid=flags,
-                       details=_delta_details(x, {}), notes=_outside_notes(view, flags, wanted), **common)
+        sides = _outside_ideal_delta(op, x, contact, noise / abs(dt)) if ideal_bound and flags["effusivity"] else {}
+        ideals = [sd["ideal"] for sd in sides.values() if sd["ideal"] is not None]
+        return _answer("delta-e", op, value=None, interval=(None, None), ideal=min(ideals) if ideals else None,
+                       ideal_method="closed-form", in_grid=flags, details=_delta_details(x, sides),
+                       notes=_outside_notes(view, flags, wanted), **common)
     # the grid's ideal delta(e) (the bound of the route without a closed form; with one, the efficiency route
     # below computes the bound exactly and keeps this beside it as "table_ideal")
     iview, ikind, _ = (op.iview, op.ikind, None) if not op.closed else _ideal_view(view, ideal_table)
@@ -1837,6 +1871,19 @@ def _delta_efficiency_both(op, combos, ends, x: float, contact: float, ratio: fl
     return out
 
 
+def _outside_ideal_delta(op: _Opened, e: float, contact: float, ratio: float) -> dict[str, dict]:
+    """Both sides of delta-e with only the ideal observer's delta(e) (closed form, inside the table's effusivity
+    range) for a question whose scene lies outside the table's grid; empty without a closed form."""
+    if not op.closed:
+        return {}
+    from .ideal_bound import cached_ideal_delta
+
+    down, up = cached_ideal_delta(op.tab.sensor, np.array([e, e]), contact, ratio, np.array([-1.0, 1.0]),
+                                  width=op.width, threshold=op.phi, e_max=op.view.e_hi)
+    return {side: {"value": None, "interval": [None, None], "ideal": number(v), "coverage": None,
+                   "estimate_method": "none"} for side, v in (("lower", down), ("upper", up))}
+
+
 def _delta_details(e: float, sides: dict) -> dict[str, Any]:
     empty = {"value": None, "interval": [None, None], "ideal": None, "coverage": None, "estimate_method": "none"}
     return {"e": e, "lower": sides.get("lower", empty), "upper": sides.get("upper", empty)}
@@ -1919,8 +1966,13 @@ def distinguishable(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact
                   classes=pq.classes)
     if not all(flags.values()):
         wanted = {**_scene_wanted(view, noise, dt), "contact_s": contact, "effusivity": (lo, hi)}
-        return _answer("distinguishable", op, value=None, interval=(None, None), ideal=None, in_grid=flags,
-                       details=empty, notes=_outside_notes(view, flags, wanted), **common)
+        ideal_f1, ideal_method, details = None, "none", dict(empty)
+        if op.closed:  # the ideal observer's F1 needs no table where it has a closed form
+            ideal_f1, ideal_method = _ideal_pair_f1(pq.classes, op, contact, noise, dt)
+            details.update(ideal_f1=ideal_f1, ideal_distinguishable=ideal_f1 >= op.phi)
+        return _answer("distinguishable", op, value=None, interval=(None, None), ideal=ideal_f1,
+                       ideal_method=ideal_method, in_grid=flags, details=details,
+                       notes=_outside_notes(view, flags, wanted), **common)
 
     def grid_verdict(kind):  # the grid's need interpolated at the contact (what an export answers)
         nd = _need_at_contact(view, kind, combos, cw, lo, hi)

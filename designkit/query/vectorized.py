@@ -350,12 +350,12 @@ def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> None
         todo[idx] = True
         if varied:
             varied_groups.append((combos, idx))
-    if op.closed and ideal_bound and todo.any():
+    if op.closed and ideal_bound:  # every element, outside the grid too: the closed form needs no table
         from .ideal_bound import cached_ideal_min_contact
 
         ratio = x["noise_c"] / np.abs(x["delta_t_c"])
-        res["ideal"][todo] = cached_ideal_min_contact(
-            op.tab.sensor, lo[todo], hi[todo], ratio[todo], width=op.width, threshold=op.phi,
+        res["ideal"][:] = cached_ideal_min_contact(
+            op.tab.sensor, lo, hi, ratio, width=op.width, threshold=op.phi,
             max_contact_s=_table_route.CLOSED_FORM_MAX_CONTACT_S)
     # no closed form (varied initial conditions, per-object shapes): the scalar route's Monte Carlo bound, one
     # call per element (remembered per distinct question); the intervals below are floored at its low end
@@ -498,14 +498,11 @@ def _ratio(question, x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> 
                             ("rnd", dict(gcw=gcw, shift=0.5 * w + w / math.sqrt(12))), ("geo", dict(gcw=gcw))):
                 a_r, a_w = _max_ratio(view, "svm", cw, le, he, **kw)
                 alt[key][j] = np.where(a_w == _INSIDE, a_r, np.nan)
-    if op.closed:
-        todo = where_all >= 0
-        if ideal_bound and todo.any():
-            from .ideal_bound import cached_ideal_max_ratio
+    if op.closed and ideal_bound:  # every element, outside the grid too: the closed form needs no table
+        from .ideal_bound import cached_ideal_max_ratio
 
-            ri[todo] = cached_ideal_max_ratio(op.tab.sensor, lo[todo], hi[todo], x["contact_s"][todo],
-                                              width=op.width, threshold=op.phi,
-                                              bracket=_table_route.CLOSED_FORM_RATIO_BRACKET)
+        ri[:] = cached_ideal_max_ratio(op.tab.sensor, lo, hi, x["contact_s"], width=op.width, threshold=op.phi,
+                                       bracket=_table_route.CLOSED_FORM_RATIO_BRACKET)
 
     def to_answer(r):
         return r * np.abs(x["delta_t_c"]) if question == "max-noise" else x["noise_c"] / r
@@ -559,7 +556,7 @@ def _ratio(question, x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> 
     answered = where_all >= 0
     res["value"] = np.where(answered & (where_all != _BELOW), v, np.nan)
     res["low"], res["high"] = np.where(answered, low, np.nan), np.where(answered, high, np.nan)
-    res["ideal"] = np.where(answered, to_answer(ri), np.nan)
+    res["ideal"] = np.where(answered | op.closed, to_answer(ri), np.nan)
 
 
 def _distinguishable(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float, ideal_table) -> None:
@@ -585,15 +582,15 @@ def _distinguishable(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float, ide
     res["value"] = np.where(todo, yes.astype(np.float64), np.nan)
     for key, name in (("value", "min_contact_s"), ("low", "min_contact_low"), ("high", "min_contact_high")):
         res[name] = np.where(todo, mc[key], np.nan)
-    if not (ideal_bound and todo.any()):
+    if not ideal_bound:
         return
-    if op.closed:
+    if op.closed:  # every element, outside the grid too: the closed form needs no table
         from .ideal_bound import ideal_f1, shape_norm
 
-        norm = shape_norm(op.tab.sensor, x["contact_s"][todo])
+        norm = shape_norm(op.tab.sensor, x["contact_s"])
         with np.errstate(divide="ignore"):
-            s = np.where(norm > 0, (x["noise_c"][todo] / np.abs(x["delta_t_c"][todo])) / norm, np.inf)
-        res["ideal"][todo] = ideal_f1(lo[todo], hi[todo], op.width, op.tab.sensor.effusivity, s)
+            s = np.where(norm > 0, (x["noise_c"] / np.abs(x["delta_t_c"])) / norm, np.inf)
+        res["ideal"][:] = ideal_f1(lo, hi, op.width, op.tab.sensor.effusivity, s)
     else:  # Monte Carlo ideal observer (varied initial conditions, per-object shapes): one call per element
         from ..recognition.ideal import ideal_pair
         from ..scene import Scene
@@ -729,6 +726,15 @@ def _table_delta_e(x: dict[str, np.ndarray], op, ideal_table, zc: float,
                 res[f"{side}_low"][idx] = np.where(np.isnan(val), np.nan, low)
                 res[f"{side}_high"][idx] = np.where(np.isnan(val), np.nan, high)
         res["in_grid"][idx] = True
+    out = np.nonzero(~res["in_grid"] & e_in)[0]  # the scene outside the grid, the reference inside its range
+    if op.closed and ideal_bound and out.size:  # the closed form needs no table (the scalar's _outside_ideal_delta)
+        from .ideal_bound import cached_ideal_delta
+
+        ratio = x["noise_c"][out] / np.abs(x["delta_t_c"][out])
+        for side, sign in (("lower", -1.0), ("upper", 1.0)):
+            res[f"{side}_ideal"][out] = cached_ideal_delta(op.tab.sensor, e[out], x["contact_s"][out], ratio,
+                                                           np.full(out.size, sign), width=op.width,
+                                                           threshold=op.phi, e_max=view.e_hi)
     res["value"] = np.fmin(res["lower"], res["upper"])
     res["ideal"] = np.fmin(res["lower_ideal"], res["upper_ideal"])
     # an SVM table's estimate (table-efficiency or table-estimate) states its coverage, as the scalar route's

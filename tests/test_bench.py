@@ -98,6 +98,20 @@ def test_exact_ideal_max_ratio_brackets_the_threshold():
         assert _f1(a, b, ci, ri) >= 0.9 > _f1(a, b, ci, ri * 1.001)
 
 
+def test_exact_ideal_max_ratio_searches_above_its_bracket():
+    """The bracket's top is not a bound: where the ideal observer still separates there, the search goes on
+    upwards (at 10 s it separates 500 from 39,000 up to sigma/dT 4.6; clipped at 1, a max-noise bound of
+    10 degC at dT 10 would have claimed what the ideal observer beats)."""
+    lo, hi, c = np.array([500.0, 20000.0, 20000.0]), np.array([39000.0, 35000.0, 35000.0]), np.array([10.0, 10.0, 2.0])
+    r = ideal_bound.exact_ideal_max_ratio(PAPER, lo, hi, c, bracket=(1e-5, 1.0))
+    assert r[0] > 1.0 and r[1] < 1.0
+    for a, b, ci, ri in zip(lo, hi, c, r):
+        assert _f1(a, b, ci, ri) >= 0.9 > _f1(a, b, ci, ri * 1.001)
+    # the elements inside the bracket answer as they would alone (each element's bisection is its own)
+    alone = ideal_bound.exact_ideal_max_ratio(PAPER, lo[1:], hi[1:], c[1:], bracket=(1e-5, 1.0))
+    np.testing.assert_array_equal(r[1:], alone)
+
+
 def test_exact_ideal_delta_brackets_the_threshold_in_both_directions():
     e = np.array([20000.0, 2000.0])
     for direction in (+1, -1):

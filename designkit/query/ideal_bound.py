@@ -391,12 +391,27 @@ def exact_ideal_min_contact(sensor, lo, hi, ratio, *, width: float = 80.0, thres
     return np.where(top, n / fs, np.nan).reshape(shape)
 
 
+#: Largest sigma/dT [-] the ideal observer's max-ratio search reaches above its bracket (a touch has at most
+#: 1e6 samples, each at a signal of at most dT: no pair separates near this noise).
+RATIO_CEILING = 1e6
+
+
 def exact_ideal_max_ratio(sensor, lo, hi, contact_s, *, width: float = 80.0, threshold: float = 0.9,
-                          bracket=(1e-6, 1.0), rel_tol: float = 1e-5) -> np.ndarray:
+                          bracket=(1e-6, 1.0), rel_tol: float = 1e-5, _extend: bool = True) -> np.ndarray:
     """Ideal observer's largest sigma/dT [-] that still separates the classes, vectorized (log bisection).
 
-    NaN where even ``bracket[0]`` does not separate them; ``bracket[1]`` when
-    it still does. ``contact_s`` [s], other arguments as :func:`exact_ideal_min_contact`.
+    NaN where even ``bracket[0]`` does not separate them. Where ``bracket[1]`` still
+    does, the search goes on upwards a decade at a time (the answer is a bound, and the
+    bracket's top is not one: at 10 s of contact the ideal observer separates 500 from
+    39,000 up to sigma/dT 4.6), up to :data:`RATIO_CEILING`; infinity beyond it.
+    ``contact_s`` [s], other arguments as :func:`exact_ideal_min_contact`.
+
+    Examples
+    --------
+    >>> from designkit.sensor import load_sensor
+    >>> r = exact_ideal_max_ratio(load_sensor("paper"), 500.0, 39000.0, 10.0, bracket=(1e-5, 1.0))
+    >>> 4.6 < float(r) < 4.7
+    True
     """
     lo, hi, contact = (np.asarray(x, dtype=np.float64) for x in np.broadcast_arrays(lo, hi, contact_s))
     norm = shape_norm(sensor, contact)
@@ -414,7 +429,18 @@ def exact_ideal_max_ratio(sensor, lo, hi, contact_s, *, width: float = 80.0, thr
         good = ok(mid)
         la, lb = np.where(active & good, mid, la), np.where(active & ~good, mid, lb)
     out = np.where(ok_hi, bracket[1], np.exp(la))
-    return np.where(ok_lo, out, np.nan)
+    out = np.where(ok_lo, out, np.nan)
+    up = np.flatnonzero(ok_lo & ok_hi)  # separable at the bracket's top: the bound lies above it
+    top = float(bracket[1])
+    while _extend and up.size and top < RATIO_CEILING:
+        nxt = min(10.0 * top, RATIO_CEILING)
+        sub = exact_ideal_max_ratio(sensor, lo.flat[up], hi.flat[up], contact.flat[up], width=width,
+                                    threshold=threshold, bracket=(top, nxt), rel_tol=rel_tol, _extend=False)
+        out.flat[up] = sub
+        up, top = up[sub >= nxt], nxt
+    if _extend and up.size:
+        out.flat[up] = np.inf
+    return out
 
 
 def exact_ideal_delta(sensor, e, contact_s, ratio, *, direction=+1, width: float = 80.0,

@@ -501,8 +501,9 @@ def _ratio(question, x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> 
     if op.closed and ideal_bound:  # every element, outside the grid too: the closed form needs no table
         from .ideal_bound import cached_ideal_max_ratio
 
-        ri[:] = cached_ideal_max_ratio(op.tab.sensor, lo, hi, x["contact_s"], width=op.width, threshold=op.phi,
-                                       bracket=_table_route.CLOSED_FORM_RATIO_BRACKET)
+        ok = _table_route.bound_computable(op.tab.sensor, x["contact_s"])
+        ri[ok] = cached_ideal_max_ratio(op.tab.sensor, lo[ok], hi[ok], x["contact_s"][ok], width=op.width,
+                                        threshold=op.phi, bracket=_table_route.CLOSED_FORM_RATIO_BRACKET)
 
     def to_answer(r):
         return r * np.abs(x["delta_t_c"]) if question == "max-noise" else x["noise_c"] / r
@@ -587,10 +588,11 @@ def _distinguishable(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float, ide
     if op.closed:  # every element, outside the grid too: the closed form needs no table
         from .ideal_bound import ideal_f1, shape_norm
 
-        norm = shape_norm(op.tab.sensor, x["contact_s"])
+        ok = _table_route.bound_computable(op.tab.sensor, x["contact_s"])
+        norm = shape_norm(op.tab.sensor, x["contact_s"][ok])
         with np.errstate(divide="ignore"):
-            s = np.where(norm > 0, (x["noise_c"] / np.abs(x["delta_t_c"])) / norm, np.inf)
-        res["ideal"][:] = ideal_f1(lo, hi, op.width, op.tab.sensor.effusivity, s)
+            s = np.where(norm > 0, (x["noise_c"][ok] / np.abs(x["delta_t_c"][ok])) / norm, np.inf)
+        res["ideal"][ok] = ideal_f1(lo[ok], hi[ok], op.width, op.tab.sensor.effusivity, s)
     else:  # Monte Carlo ideal observer (varied initial conditions, per-object shapes): one call per element
         from ..recognition.ideal import ideal_pair
         from ..scene import Scene
@@ -726,7 +728,8 @@ def _table_delta_e(x: dict[str, np.ndarray], op, ideal_table, zc: float,
                 res[f"{side}_low"][idx] = np.where(np.isnan(val), np.nan, low)
                 res[f"{side}_high"][idx] = np.where(np.isnan(val), np.nan, high)
         res["in_grid"][idx] = True
-    out = np.nonzero(~res["in_grid"] & e_in)[0]  # the scene outside the grid, the reference inside its range
+    # the scene outside the grid, the reference inside its range, the touch within the closed form's limit
+    out = np.nonzero(~res["in_grid"] & e_in & _table_route.bound_computable(op.tab.sensor, x["contact_s"]))[0]
     if op.closed and ideal_bound and out.size:  # the closed form needs no table (the scalar's _outside_ideal_delta)
         from .ideal_bound import cached_ideal_delta
 

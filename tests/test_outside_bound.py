@@ -1,4 +1,6 @@
-"""A question outside a table's grid: no SVM answer, but the ideal observer's bound where it has a closed form.
+"""Bounds at the edges: outside a table's grid, and above a search's bracket.
+
+A question outside a table's grid: no SVM answer, but the ideal observer's bound where it has a closed form.
 
 The table cannot answer outside its axes (nothing is extrapolated), but the ideal observer's
 bound needs no table where its F1 has a closed form. Each bound is checked here against its
@@ -98,3 +100,29 @@ def test_the_cli_prints_the_bound_and_still_exits_3(cli):
     assert r.exit_code == 3 and "ideal observer: F1 1.000 (closed-form)" in r.output
     r = cli("delta-e", "--e", "20000", "--contact", "20")
     assert r.exit_code == 3 and "no answer from the table (see below)" in r.output
+
+
+def test_the_exact_route_searches_up_to_the_ideal_bound_above_its_bracket():
+    """At 10 s the ideal observer separates 500 from 39,000 up to sigma/dT 4.6: the SVM's max-noise is searched
+    below that, not cut at the bracket's sigma/dT 1 (10 degC at dT 10, where the answer was the bracket's end)."""
+    from designkit.query import exact_max_noise
+
+    a = exact_max_noise(500, 39000, contact_s=10.0, delta_t_c=10.0, trials=30, repeats=1, jobs=1)
+    assert a.ideal_bound.value == pytest.approx(46.4, rel=0.01)
+    assert 10.0 < a.value < a.ideal_bound.value
+    assert a.interval[1] <= a.ideal_bound.value  # the interval is held to the bound, as below the bracket
+
+
+@pytest.mark.parametrize("contact", [1e4, 1e30])
+def test_beyond_the_closed_forms_sample_limit_the_bound_is_left_out_not_an_error(contact):
+    """A touch of more than 1e6 samples (every route's limit) is outside the table and beyond what the closed
+    form computes: the answer stays "outside" with no bound, on both routes (an absurd contact once reached the
+    sample-index arithmetic and failed inside it)."""
+    for ask, kw in ((query.max_noise, {}), (query.min_delta_t, {"noise_c": 0.05}), (query.distinguishable, {})):
+        a = ask(35000, 20000, contact_s=contact, **kw)
+        assert a.value is None and a.in_grid["contact_s"] is False and a.ideal_bound.value is None
+        arr = ask(35000, np.array([20000.0, 20000.0]), contact_s=np.array([contact, 2.0]), **kw)
+        assert np.isnan(arr.ideal[0]) and np.isfinite(arr.ideal[1])
+    d = query.delta_e(20000, contact_s=contact)
+    assert d.value is None and d.ideal_bound.value is None
+    assert np.isnan(query.delta_e(np.array([20000.0]), contact_s=np.array([contact])).ideal[0])

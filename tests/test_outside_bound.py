@@ -126,3 +126,15 @@ def test_beyond_the_closed_forms_sample_limit_the_bound_is_left_out_not_an_error
     d = query.delta_e(20000, contact_s=contact)
     assert d.value is None and d.ideal_bound.value is None
     assert np.isnan(query.delta_e(np.array([20000.0]), contact_s=np.array([contact])).ideal[0])
+
+
+def test_a_noiseless_or_instant_touch_answers_without_numpy_warnings():
+    """sigma 0 or a contact before the second sample: the closed form's noise per unit signal is 0/0 there;
+    the answer says 'no information yet' without a RuntimeWarning reaching the caller."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert query.min_contact(35000, 20000, noise_c=0.0).ideal_bound.value == pytest.approx(0.005)
+        d = query.delta_e(20000, contact_s=1e-6, noise_c=0.0)
+        assert d.value is None and d.ideal_bound.value is None

@@ -376,8 +376,8 @@ def exact_ideal_min_contact(sensor, lo, hi, ratio, *, width: float = 80.0, thres
     lo, hi, ratio, width = lo.ravel(), hi.ravel(), ratio.ravel(), width.ravel()
 
     def ok(n, rows):
-        with np.errstate(divide="ignore"):
-            s = ratio[rows] / np.sqrt(cum[n])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            s = ratio[rows] / np.sqrt(cum[n])  # n = 0 (no signal yet): s infinite, or NaN at ratio 0 (F1 NaN: not ok)
         return _ok(sensor, lo[rows], hi[rows], width[rows], s, threshold)
 
     a = np.zeros(lo.shape, dtype=np.int64)  # n = 0: one sample at contact, no information
@@ -462,7 +462,7 @@ def exact_ideal_delta(sensor, e, contact_s, ratio, *, direction=+1, width: float
     e, contact, ratio, direction = (np.asarray(x, dtype=np.float64) for x in np.broadcast_arrays(
         e, contact_s, ratio, direction))
     norm = shape_norm(sensor, contact)
-    with np.errstate(divide="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore"):  # no signal yet (norm 0): s infinite, whatever the ratio
         s = np.where(norm > 0, ratio / norm, np.inf)
     direction = np.where(direction > 0, 1.0, -1.0)
     limit = np.where(direction > 0, e_max - e - width, e - width)

@@ -502,8 +502,9 @@ def _ratio(question, x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> 
         from .ideal_bound import cached_ideal_max_ratio
 
         ok = _table_route.bound_computable(op.tab.sensor, x["contact_s"])
-        ri[ok] = cached_ideal_max_ratio(op.tab.sensor, lo[ok], hi[ok], x["contact_s"][ok], width=op.width,
-                                        threshold=op.phi, bracket=_table_route.CLOSED_FORM_RATIO_BRACKET)
+        if ok.any():
+            ri[ok] = cached_ideal_max_ratio(op.tab.sensor, lo[ok], hi[ok], x["contact_s"][ok], width=op.width,
+                                            threshold=op.phi, bracket=_table_route.CLOSED_FORM_RATIO_BRACKET)
 
     def to_answer(r):
         return r * np.abs(x["delta_t_c"]) if question == "max-noise" else x["noise_c"] / r
@@ -585,12 +586,14 @@ def _distinguishable(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float, ide
         res[name] = np.where(todo, mc[key], np.nan)
     if not ideal_bound:
         return
-    if op.closed:  # every element, outside the grid too: the closed form needs no table
+    if op.closed:  # every element, outside the grid too (within the sample limit): the closed form needs no table
         from .ideal_bound import ideal_f1, shape_norm
 
         ok = _table_route.bound_computable(op.tab.sensor, x["contact_s"])
+        if not ok.any():
+            return
         norm = shape_norm(op.tab.sensor, x["contact_s"][ok])
-        with np.errstate(divide="ignore"):
+        with np.errstate(divide="ignore", invalid="ignore"):  # no signal yet (norm 0): s infinite
             s = np.where(norm > 0, (x["noise_c"][ok] / np.abs(x["delta_t_c"][ok])) / norm, np.inf)
         res["ideal"][ok] = ideal_f1(lo[ok], hi[ok], op.width, op.tab.sensor.effusivity, s)
     else:  # Monte Carlo ideal observer (varied initial conditions, per-object shapes): one call per element

@@ -12,7 +12,8 @@ noise ratio, ``--trials`` touches per interval, the sweep's own seeds):
   ``n (n - 1) / 2``; timed on ``--naive-pairs`` random pairs and extrapolated
   (wall per fit times the number of pairs);
 * **staircase + sklearn**: ``run_chunk`` with ``solver: sklearn`` (the reference);
-* **staircase + batched**: ``run_chunk`` with ``solver: batched``.
+* **staircase + batched**: ``run_chunk`` with ``solver: batched``;
+* with ``--dask``, the sweep also on a dask ``LocalCluster`` (one worker process per core).
 
 Printed for each: wall [s], SVM fits, fits per second and the ratios to the
 naive loop and to the sklearn staircase; the agreement of the two staircases
@@ -95,6 +96,9 @@ def main(argv=None):
     p.add_argument("--naive-pairs", type=int, default=30, help="pairs timed for the naive loop's extrapolation")
     p.add_argument("--repeat", type=int, default=1, help="runs per wall figure (median)")
     p.add_argument("--skip-parallel", action="store_true")
+    p.add_argument("--dask", action="store_true",
+                   help="also the sweep on a dask LocalCluster of one worker process per core (cluster start-up "
+                        "included), against --jobs 1")
     args = p.parse_args(argv)
 
     base = dict(intervals=args.intervals, trials=args.trials, noise_ratio=(args.noise_ratio,),
@@ -159,6 +163,14 @@ def main(argv=None):
         print(f"  the sweep on {cores} cores (--jobs {cores}): {walls[cores]:.1f} s wall, "
               f"{naive_wall / walls[cores]:.1f}x less than the naive loop on one core, "
               f"{naive_wall / cores / walls[cores]:.1f}x less than the naive loop spread over {cores} cores")
+        if args.dask:  # the backend that goes past one machine, on a real local cluster of this machine's cores
+            def go_dask():
+                with tempfile.TemporaryDirectory() as tmp:
+                    cfg = SweepConfig(name="bench", solver="batched", blocks=2 * cores, **base)
+                    run_sweep(cfg, Path(tmp), jobs=cores, backend="dask")
+            wd, _ = _median_run(go_dask, args.repeat)
+            print(f"  dask LocalCluster, {cores} worker processes (--backend dask --jobs {cores}): {wd:.1f} s wall, "
+                  f"efficiency {walls[1] / (cores * wd):.0%} against --jobs 1 (cluster start-up included)")
     load1 = os.getloadavg()
     print(f"\nload average {load1[0]:.2f} {load1[1]:.2f} {load1[2]:.2f} at the end (2 cores shared with other users: "
           "wall figures are upper bounds)")

@@ -164,7 +164,18 @@ def _executor(backend: str, jobs: int, scheduler: str | None):
         from dask.distributed import Client
     except ImportError:
         raise InputError("the dask backend needs dask.distributed: pip install 'designkit[distributed]'") from None
-    client = Client(scheduler) if scheduler else Client(processes=True, n_workers=max(jobs, 1), threads_per_worker=1)
+    if scheduler:
+        client = Client(scheduler)
+    else:
+        import dask
+
+        # dask's nanny spawns workers with MALLOC_TRIM_THRESHOLD_=65536 (to hand freed memory back sooner), and
+        # the solver's per-fold arrays are then mapped and faulted in afresh at every allocation: a 500-interval
+        # scene's chunks ran 15-30 % slower than in local processes (22.7-26.0 s of wall against 19.7-20.1 s
+        # with it unset, measured; benchmarks/bench_engine.py --dask). The cluster designkit starts leaves it
+        # unset; a worker's memory stays bounded by the chunk's own limits (scorer.BATCH_MB, the feature cache).
+        with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
+            client = Client(processes=True, n_workers=max(jobs, 1), threads_per_worker=1)
     try:
         yield (lambda: parallel_config(backend="dask")), -1
     finally:

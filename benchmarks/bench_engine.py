@@ -147,16 +147,23 @@ def main(argv=None):
           f"(max |dF1| {dF.max() if dF.size else 0:.4f})")
 
     if not args.skip_parallel:
-        walls = {}
+        walls, busy = {}, {}  # busy: the chunks' own walls summed (last run of each), to tell contention from idling
         for jobs in sorted({1, 2, os.cpu_count() or 1}):
             def go(jobs=jobs):
+                busy[jobs] = 0.0
+
+                def add(res, computed, done, total):
+                    busy[jobs] += res.wall_s
                 with tempfile.TemporaryDirectory() as tmp:
                     cfg = SweepConfig(name="bench", solver="batched", blocks=2 * (os.cpu_count() or 1), **base)
-                    run_sweep(cfg, Path(tmp), jobs=jobs, backend="loky" if jobs > 1 else "sequential")
+                    run_sweep(cfg, Path(tmp), jobs=jobs, backend="loky" if jobs > 1 else "sequential", on_chunk=add)
             walls[jobs], _ = _median_run(go, args.repeat)
         eff = walls[1] / (2 * walls[2])
         print(f"\nParallel (batched solver, {2 * (os.cpu_count() or 1)} blocks): --jobs 1 {walls[1]:.1f} s, --jobs 2 {walls[2]:.1f} s: "
               f"speed-up {walls[1] / walls[2]:.2f}x, efficiency {eff:.0%} (process start-up included)")
+        print(f"  the chunks' own walls summed: {busy[1]:.1f} s one at a time, {busy[2]:.1f} s two side by side "
+              f"({busy[2] / busy[1]:.2f}x: what sharing the cores' cache and memory bandwidth costs; "
+              f"{busy[1] / (2 * walls[2]):.0%} of the wall on two workers is their work as alone)")
         # the engine as a user runs it on this machine (every core), against the paper's loop as it runs
         # (one process) and against that loop spread perfectly over the same cores (its wall / cores)
         cores = os.cpu_count() or 1

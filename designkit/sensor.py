@@ -21,7 +21,7 @@ from ._validation import InputError, check_nonnegative, check_positive
 from .properties import time_constant
 
 __all__ = ["MAX_SAMPLES_PER_TOUCH", "MODEL_KEYS", "SENSORS", "Sensor", "last_sample_index", "load_sensor",
-           "sample_times_s"]
+           "sample_times_s", "within_sample_limit"]
 
 SENSOR_FILE_VERSION = 1
 
@@ -62,6 +62,22 @@ def last_sample_index(contact_s, sample_rate_hz: float) -> np.ndarray:
                     + _SAMPLE_TOLERANCE).astype(np.int64)
 
 
+def within_sample_limit(contact_s, sample_rate_hz: float) -> np.ndarray:
+    """Whether a touch of ``contact_s`` [s] has fewer samples than :data:`MAX_SAMPLES_PER_TOUCH`, vectorized.
+
+    The rule :func:`sample_times_s` refuses beyond (an infinite or NaN product is beyond it);
+    for callers that leave such a touch out instead of refusing it.
+
+    Examples
+    --------
+    >>> within_sample_limit([2.0, 4999.0, 5000.0, 1e308], 200.0).tolist()
+    [True, True, False, False]
+    """
+    with np.errstate(over="ignore", invalid="ignore"):
+        n_float = np.asarray(contact_s, dtype=np.float64) * float(sample_rate_hz) + _SAMPLE_TOLERANCE
+        return n_float < MAX_SAMPLES_PER_TOUCH
+
+
 def sample_times_s(contact_s: float, sample_rate_hz: float) -> np.ndarray:
     """Sample times of one touch: ``k / fs`` for ``k = 0 .. floor(contact_s * fs)``.
 
@@ -83,8 +99,8 @@ def sample_times_s(contact_s: float, sample_rate_hz: float) -> np.ndarray:
     """
     contact_s = check_positive("contact time [s]", contact_s)
     fs = check_positive("sample rate [Hz]", sample_rate_hz)
-    n_float = contact_s * fs + _SAMPLE_TOLERANCE  # may be inf (1e308 s): compared before math.floor sees it
-    if not n_float < MAX_SAMPLES_PER_TOUCH:
+    n_float = contact_s * fs + _SAMPLE_TOLERANCE  # may be inf (1e308 s): checked before math.floor sees it
+    if not within_sample_limit(contact_s, fs):
         raise InputError(f"a touch of {contact_s:g} s at {fs:g} Hz has {n_float + 1:.4g} samples; the limit is "
                          f"{MAX_SAMPLES_PER_TOUCH:.0e} per touch (shorten the contact or lower the sample rate)")
     n = int(math.floor(n_float))

@@ -55,6 +55,7 @@ import numpy as np
 from cachetools import LRUCache
 
 from .._validation import InputError, check_nonnegative
+from ..sensor import within_sample_limit
 from ..tables import lookup
 from ..tables.lookup import GRID_RTOL
 from ..tables.store import Table, load_table, resolve_table
@@ -1285,16 +1286,6 @@ def _need_at_contact(view: _View, kind: str, combos, cw, lo: float, hi: float) -
 
 
 # ============================================================ min-contact
-def bound_computable(sensor, contact_s) -> np.ndarray:
-    """Whether a contact of ``contact_s`` [s] is short enough for the ideal observer's closed form (at most
-    :data:`~designkit.sensor.MAX_SAMPLES_PER_TOUCH` samples, the limit every route refuses beyond),
-    elementwise: outside a table's grid the bound is stated only there, and left out beyond."""
-    from ..sensor import MAX_SAMPLES_PER_TOUCH
-
-    with np.errstate(invalid="ignore", over="ignore"):
-        return np.asarray(contact_s, dtype=np.float64) * sensor.sample_rate_hz < MAX_SAMPLES_PER_TOUCH - 1
-
-
 def _outside_ideal_contact(op: _Opened, lo: float, hi: float, noise: float, dt: float) -> float | None:
     """The closed-form ideal bound of min-contact for a question outside the table's grid, or None.
 
@@ -1313,7 +1304,7 @@ def _outside_ideal_contact(op: _Opened, lo: float, hi: float, noise: float, dt: 
 def _outside_ideal_ratio(op: _Opened, lo: float, hi: float, contact: float) -> float | None:
     """The ideal observer's largest separating sigma/dT for a question outside the table's grid (closed
     form, as :func:`_outside_ideal_contact`), or None (no closed form, or not separable in the bracket)."""
-    if not (op.closed and bound_computable(op.tab.sensor, contact)):
+    if not (op.closed and within_sample_limit(contact, op.tab.sensor.sample_rate_hz)):
         return None
     from .ideal_bound import cached_ideal_max_ratio
 
@@ -1884,7 +1875,7 @@ def _delta_efficiency_both(op, combos, ends, x: float, contact: float, ratio: fl
 def _outside_ideal_delta(op: _Opened, e: float, contact: float, ratio: float) -> dict[str, dict]:
     """Both sides of delta-e with only the ideal observer's delta(e) (closed form, inside the table's effusivity
     range) for a question whose scene lies outside the table's grid; empty without a closed form."""
-    if not (op.closed and bound_computable(op.tab.sensor, contact)):
+    if not (op.closed and within_sample_limit(contact, op.tab.sensor.sample_rate_hz)):
         return {}
     from .ideal_bound import cached_ideal_delta
 
@@ -1977,7 +1968,7 @@ def distinguishable(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact
     if not all(flags.values()):
         wanted = {**_scene_wanted(view, noise, dt), "contact_s": contact, "effusivity": (lo, hi)}
         ideal_f1, ideal_method, details = None, "none", dict(empty)
-        if op.closed and bound_computable(op.tab.sensor, contact):  # the closed form needs no table
+        if op.closed and within_sample_limit(contact, op.tab.sensor.sample_rate_hz):  # the closed form: no table
             ideal_f1, ideal_method = _ideal_pair_f1(pq.classes, op, contact, noise, dt)
             details.update(ideal_f1=ideal_f1, ideal_distinguishable=ideal_f1 >= op.phi)
         return _answer("distinguishable", op, value=None, interval=(None, None), ideal=ideal_f1,

@@ -51,6 +51,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from .._validation import InputError, check_effusivity, check_positive, check_temperature
+from ..sensor import within_sample_limit
 from . import table as _table_route
 from .answer import Answer, QuestionQuantity
 from .crossing import check_coverage, coverage_of_z, z_of_coverage
@@ -501,7 +502,7 @@ def _ratio(question, x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> 
     if op.closed and ideal_bound:  # every element, outside the grid too: the closed form needs no table
         from .ideal_bound import cached_ideal_max_ratio
 
-        ok = _table_route.bound_computable(op.tab.sensor, x["contact_s"])
+        ok = within_sample_limit(x["contact_s"], op.tab.sensor.sample_rate_hz)
         if ok.any():
             ri[ok] = cached_ideal_max_ratio(op.tab.sensor, lo[ok], hi[ok], x["contact_s"][ok], width=op.width,
                                             threshold=op.phi, bracket=_table_route.CLOSED_FORM_RATIO_BRACKET)
@@ -589,7 +590,7 @@ def _distinguishable(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float, ide
     if op.closed:  # every element, outside the grid too (within the sample limit): the closed form needs no table
         from .ideal_bound import ideal_f1, shape_norm
 
-        ok = _table_route.bound_computable(op.tab.sensor, x["contact_s"])
+        ok = within_sample_limit(x["contact_s"], op.tab.sensor.sample_rate_hz)
         if not ok.any():
             return
         norm = shape_norm(op.tab.sensor, x["contact_s"][ok])
@@ -732,7 +733,7 @@ def _table_delta_e(x: dict[str, np.ndarray], op, ideal_table, zc: float,
                 res[f"{side}_high"][idx] = np.where(np.isnan(val), np.nan, high)
         res["in_grid"][idx] = True
     # the scene outside the grid, the reference inside its range, the touch within the closed form's limit
-    out = np.nonzero(~res["in_grid"] & e_in & _table_route.bound_computable(op.tab.sensor, x["contact_s"]))[0]
+    out = np.nonzero(~res["in_grid"] & e_in & within_sample_limit(x["contact_s"], op.tab.sensor.sample_rate_hz))[0]
     if op.closed and ideal_bound and out.size:  # the closed form needs no table (the scalar's _outside_ideal_delta)
         from .ideal_bound import cached_ideal_delta
 

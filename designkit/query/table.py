@@ -1286,12 +1286,12 @@ def _need_at_contact(view: _View, kind: str, combos, cw, lo: float, hi: float) -
 
 
 # ============================================================ min-contact
-def _outside_ideal_contact(op: _Opened, lo: float, hi: float, noise: float, dt: float) -> float | None:
-    """The closed-form ideal bound of min-contact for a question outside the table's grid, or None.
+def _closed_ideal_contact(op: _Opened, lo: float, hi: float, noise: float, dt: float) -> float | None:
+    """min-contact's ideal bound in closed form, inside the table's grid or outside it, or None.
 
     The ideal observer needs no table where its F1 has a closed form (fixed initial conditions, a
     shared-shape model): a question the table cannot answer still gets the floor no classifier beats.
-    Without a closed form (its bound would be a Monte Carlo run) it is left out, as the answer is.
+    Without a closed form (its bound would be a Monte Carlo run) None, and the caller decides.
     """
     if not op.closed:
         return None
@@ -1301,9 +1301,9 @@ def _outside_ideal_contact(op: _Opened, lo: float, hi: float, noise: float, dt: 
                                            threshold=op.phi, max_contact_s=CLOSED_FORM_MAX_CONTACT_S))
 
 
-def _outside_ideal_ratio(op: _Opened, lo: float, hi: float, contact: float) -> float | None:
-    """The ideal observer's largest separating sigma/dT for a question outside the table's grid (closed
-    form, as :func:`_outside_ideal_contact`), or None (no closed form, or not separable in the bracket)."""
+def _closed_ideal_ratio(op: _Opened, lo: float, hi: float, contact: float) -> float | None:
+    """The ideal observer's largest separating sigma/dT in closed form (as :func:`_closed_ideal_contact`), or
+    None: no closed form, a touch beyond the sample limit, or not separable even at the bracket's low end."""
     if not (op.closed and within_sample_limit(contact, op.tab.sensor.sample_rate_hz)):
         return None
     from .ideal_bound import cached_ideal_max_ratio
@@ -1381,7 +1381,7 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
                   classes=pq.classes)
     if not all(flags.values()):
         wanted = {**_scene_wanted(view, noise, dt), "effusivity": (lo, hi)}
-        ideal = _outside_ideal_contact(op, lo, hi, noise, dt) if ideal_bound else None
+        ideal = _closed_ideal_contact(op, lo, hi, noise, dt) if ideal_bound else None
         return _answer("min-contact", op, value=None, interval=(None, None), ideal=ideal,
                        ideal_method="closed-form", in_grid=flags, details={},
                        notes=_outside_notes(view, flags, wanted), **common)
@@ -1410,11 +1410,7 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
         monte_carlo["table_ideal_s"] = contact_for(view, "ideal", combos)
     ideal_interval = None
     if op.closed:
-        from .ideal_bound import cached_ideal_min_contact
-
-        ideal = number(cached_ideal_min_contact(op.tab.sensor, lo, hi, noise / abs(dt), width=op.width,
-                                               threshold=op.phi, max_contact_s=CLOSED_FORM_MAX_CONTACT_S))
-        ideal_method = "closed-form"
+        ideal, ideal_method = _closed_ideal_contact(op, lo, hi, noise, dt), "closed-form"
     elif not ideal_bound:  # the table's own floor (no Monte Carlo)
         icombos, iflags = op.iview.scene_weights(noise, dt) if op.iview is not None else ([], {"ideal": False})
         ideal = contact_for(op.iview, op.ikind, icombos) if all(iflags.values()) else None
@@ -1575,16 +1571,13 @@ def _ratio_question(question: str, e1, e2, m1, m2, objects, contact_s, noise_c, 
     if not all(flags.values()):
         notes = _outside_notes(view, flags, {"contact_s": contact, "effusivity": (lo, hi)})
         return _answer(question, op, value=None, interval=(None, None),
-                       ideal=to_answer(_outside_ideal_ratio(op, lo, hi, contact)), ideal_method="closed-form",
+                       ideal=to_answer(_closed_ideal_ratio(op, lo, hi, contact)), ideal_method="closed-form",
                        in_grid=flags, details={}, notes=notes, **common)
 
     out = {}
     for kind, v in (("svm", view), ("lo", view), ("hi", view), ("ideal", op.iview)):
         if kind == "ideal" and op.closed:
-            from .ideal_bound import cached_ideal_max_ratio
-
-            ri = number(cached_ideal_max_ratio(op.tab.sensor, lo, hi, contact, width=op.width, threshold=op.phi,
-                                              bracket=CLOSED_FORM_RATIO_BRACKET))
+            ri = _closed_ideal_ratio(op, lo, hi, contact)
             out[kind] = (ri, "inside" if ri is not None else "below")
             continue
         if op.tab.fidelity == "ideal" and kind in ("lo", "hi"):
@@ -1881,13 +1874,16 @@ def _outside_ideal_delta(op: _Opened, e: float, contact: float, ratio: float) ->
 
     down, up = cached_ideal_delta(op.tab.sensor, np.array([e, e]), contact, ratio, np.array([-1.0, 1.0]),
                                   width=op.width, threshold=op.phi, e_max=op.view.e_hi)
-    return {side: {"value": None, "interval": [None, None], "ideal": number(v), "coverage": None,
-                   "estimate_method": "none"} for side, v in (("lower", down), ("upper", up))}
+    return {"lower": _no_side(number(down)), "upper": _no_side(number(up))}
+
+
+def _no_side(ideal: float | None = None) -> dict[str, Any]:
+    """One side of delta-e's details with no answer from the table (a new dict each time)."""
+    return {"value": None, "interval": [None, None], "ideal": ideal, "coverage": None, "estimate_method": "none"}
 
 
 def _delta_details(e: float, sides: dict) -> dict[str, Any]:
-    empty = {"value": None, "interval": [None, None], "ideal": None, "coverage": None, "estimate_method": "none"}
-    return {"e": e, "lower": sides.get("lower", empty), "upper": sides.get("upper", empty)}
+    return {"e": e, "lower": sides.get("lower") or _no_side(), "upper": sides.get("upper") or _no_side()}
 
 
 # ============================================================ distinguishable

@@ -397,7 +397,7 @@ RATIO_CEILING = 1e6
 
 
 def exact_ideal_max_ratio(sensor, lo, hi, contact_s, *, width: float = 80.0, threshold: float = 0.9,
-                          bracket=(1e-6, 1.0), rel_tol: float = 1e-5, _extend: bool = True) -> np.ndarray:
+                          bracket=(1e-6, 1.0), rel_tol: float = 1e-5) -> np.ndarray:
     """Ideal observer's largest sigma/dT [-] that still separates the classes, vectorized (log bisection).
 
     NaN where even ``bracket[0]`` does not separate them. Where ``bracket[1]`` still
@@ -414,10 +414,26 @@ def exact_ideal_max_ratio(sensor, lo, hi, contact_s, *, width: float = 80.0, thr
     True
     """
     lo, hi, contact = (np.asarray(x, dtype=np.float64) for x in np.broadcast_arrays(lo, hi, contact_s))
+    shape = lo.shape
     norm = shape_norm(sensor, contact)
     with np.errstate(divide="ignore"):
-        per_ratio = np.where(norm > 0, 1.0 / norm, np.inf)  # s = ratio * this
+        per_ratio = np.where(norm > 0, 1.0 / norm, np.inf).ravel()  # s = ratio * this
+    lo, hi = lo.ravel(), hi.ravel()
+    out = _max_ratio_in(sensor, lo, hi, per_ratio, width, threshold, bracket, rel_tol)
+    up = np.flatnonzero(out >= bracket[1])  # separable at the bracket's top: the bound lies above it
+    top = float(bracket[1])
+    while up.size and top < RATIO_CEILING:
+        nxt = min(10.0 * top, RATIO_CEILING)
+        sub = _max_ratio_in(sensor, lo[up], hi[up], per_ratio[up], width, threshold, (top, nxt), rel_tol)
+        out[up] = sub
+        up, top = up[sub >= nxt], nxt
+    out[up] = np.inf
+    return out.reshape(shape)
 
+
+def _max_ratio_in(sensor, lo, hi, per_ratio, width, threshold, bracket, rel_tol) -> np.ndarray:
+    """:func:`exact_ideal_max_ratio` inside ``bracket`` alone: NaN where its low end does not separate, its top
+    where that still does (1-D arrays; ``per_ratio``: the projection noise per unit sigma/dT)."""
     def ok(log_r):
         return _ok(sensor, lo, hi, width, np.exp(log_r) * per_ratio, threshold)
 
@@ -428,19 +444,7 @@ def exact_ideal_max_ratio(sensor, lo, hi, contact_s, *, width: float = 80.0, thr
         mid = 0.5 * (la + lb)                    # depend on the other elements of the call (nor on a cache)
         good = ok(mid)
         la, lb = np.where(active & good, mid, la), np.where(active & ~good, mid, lb)
-    out = np.where(ok_hi, bracket[1], np.exp(la))
-    out = np.where(ok_lo, out, np.nan)
-    up = np.flatnonzero(ok_lo & ok_hi)  # separable at the bracket's top: the bound lies above it
-    top = float(bracket[1])
-    while _extend and up.size and top < RATIO_CEILING:
-        nxt = min(10.0 * top, RATIO_CEILING)
-        sub = exact_ideal_max_ratio(sensor, lo.flat[up], hi.flat[up], contact.flat[up], width=width,
-                                    threshold=threshold, bracket=(top, nxt), rel_tol=rel_tol, _extend=False)
-        out.flat[up] = sub
-        up, top = up[sub >= nxt], nxt
-    if _extend and up.size:
-        out.flat[up] = np.inf
-    return out
+    return np.where(ok_lo, np.where(ok_hi, bracket[1], np.exp(la)), np.nan)
 
 
 def exact_ideal_delta(sensor, e, contact_s, ratio, *, direction=+1, width: float = 80.0,

@@ -477,11 +477,10 @@ def _exact_ratio(question: str, kw: dict) -> Answer:
     # no classifier tolerates more noise than the ideal observer: search below its ratio (a Monte Carlo
     # bound's high end). The mean SVM F1 falls with sigma/dT; one crossing in log(sigma/dT) answers both
     ideal_cap = ideal_r if ideal_iv is None else ideal_iv[1]
-    top = hi_r if ideal_cap is None else min(hi_r, ideal_cap)
-    if ideal_cap is not None and ideal_cap > hi_r == RATIO_BRACKET[1]:
-        # the ideal observer separates them above the bracket (no physical cap on the ratio here): the SVM's
-        # crossing lies below the ideal's, so that is the top of its search rather than the bracket's end
-        top = ideal_cap
+    # the SVM's crossing lies below the ideal's, so that is the top of its search, above the bracket's end too
+    # where nothing else caps the ratio (min-delta-t with varied Ts0 caps it: dT must stay above the spread)
+    capped = hi_r < RATIO_BRACKET[1]
+    top = hi_r if ideal_cap is None else min(hi_r, ideal_cap) if capped else ideal_cap
     est = estimate_crossing(lambda x: run.svm(cls, scene(x)), lo_r, max(top, lo_r * 1.0001), run.phi,
                             increasing=False, coverage=cov, progress=kw.get("progress"))
     r, r_lo, r_hi = est.value, est.low, est.high

@@ -308,7 +308,9 @@ def _table_pair(question: str, x: dict[str, np.ndarray], op, ideal_bound: bool,
     return res
 
 
-def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> None:
+def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float, outside: bool = True) -> None:
+    """min-contact of the elements ``e_in`` marks; with ``outside`` the closed-form bound of the others too
+    (a question outside the grid still gets it; ``distinguishable`` needs it only inside)."""
     view = op.view
     grid = view.contacts
     svm = op.tab.fidelity == "svm"
@@ -351,12 +353,13 @@ def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> None
         todo[idx] = True
         if varied:
             varied_groups.append((combos, idx))
-    if op.closed and ideal_bound:  # every element, outside the grid too: the closed form needs no table
+    sel = np.ones(lo.size, dtype=bool) if outside else todo
+    if op.closed and ideal_bound and sel.any():  # outside the grid too: the closed form needs no table
         from .ideal_bound import cached_ideal_min_contact
 
         ratio = x["noise_c"] / np.abs(x["delta_t_c"])
-        res["ideal"][:] = cached_ideal_min_contact(
-            op.tab.sensor, lo, hi, ratio, width=op.width, threshold=op.phi,
+        res["ideal"][sel] = cached_ideal_min_contact(
+            op.tab.sensor, lo[sel], hi[sel], ratio[sel], width=op.width, threshold=op.phi,
             max_contact_s=_table_route.CLOSED_FORM_MAX_CONTACT_S)
     # no closed form (varied initial conditions, per-object shapes): the scalar route's Monte Carlo bound, one
     # call per element (remembered per distinct question); the intervals below are floored at its low end
@@ -559,7 +562,7 @@ def _ratio(question, x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> 
     answered = where_all >= 0
     res["value"] = np.where(answered & (where_all != _BELOW), v, np.nan)
     res["low"], res["high"] = np.where(answered, low, np.nan), np.where(answered, high, np.nan)
-    res["ideal"] = np.where(answered | op.closed, to_answer(ri), np.nan)
+    res["ideal"] = to_answer(ri)  # NaN where it was not computed
 
 
 def _distinguishable(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float, ideal_table) -> None:
@@ -574,7 +577,7 @@ def _distinguishable(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float, ide
     mc = {k: _nan(lo.size) for k in ("value", "low", "high", "ideal")}
     mc["in_grid"], mc["stated"] = np.zeros(lo.size, dtype=bool), np.zeros(lo.size, dtype=bool)
     if todo.any():
-        _min_contact(x, op, lo, hi, todo, mc, op.closed, zc)  # no Monte Carlo bound (the scalar's)
+        _min_contact(x, op, lo, hi, todo, mc, op.closed, zc, outside=False)  # no Monte Carlo bound (the scalar's)
     t, a, b, c = mc["value"], mc["low"], mc["high"], x["contact_s"]
     with np.errstate(invalid="ignore"):
         yes = ~np.isnan(t) & (c >= t)
@@ -732,9 +735,10 @@ def _table_delta_e(x: dict[str, np.ndarray], op, ideal_table, zc: float,
                 res[f"{side}_low"][idx] = np.where(np.isnan(val), np.nan, low)
                 res[f"{side}_high"][idx] = np.where(np.isnan(val), np.nan, high)
         res["in_grid"][idx] = True
-    # the scene outside the grid, the reference inside its range, the touch within the closed form's limit
+    # the scene outside the grid, the reference inside its range, the touch within the sample limit: the closed
+    # form needs no table (the scalar's _outside_ideal_delta)
     out = np.nonzero(~res["in_grid"] & e_in & within_sample_limit(x["contact_s"], op.tab.sensor.sample_rate_hz))[0]
-    if op.closed and ideal_bound and out.size:  # the closed form needs no table (the scalar's _outside_ideal_delta)
+    if op.closed and ideal_bound and out.size:
         from .ideal_bound import cached_ideal_delta
 
         ratio = x["noise_c"][out] / np.abs(x["delta_t_c"][out])

@@ -13,7 +13,8 @@ noise ratio, ``--trials`` touches per interval, the sweep's own seeds):
   (wall per fit times the number of pairs);
 * **staircase + sklearn**: ``run_chunk`` with ``solver: sklearn`` (the reference);
 * **staircase + batched**: ``run_chunk`` with ``solver: batched``;
-* with ``--dask``, the sweep also on a dask ``LocalCluster`` (one worker process per core).
+* with ``--dask``, the sweep also on a dask ``LocalCluster`` (one worker process per core), once started by
+  the sweep (``--backend dask``) and once already running (``--scheduler``, start-up not timed).
 
 Printed for each: wall [s], SVM fits, fits per second and the ratios to the
 naive loop and to the sklearn staircase; the agreement of the two staircases
@@ -49,6 +50,7 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 
 from designkit.sweep import SweepConfig, run_chunk, run_sweep  # noqa: E402
+from designkit.sweep.run import local_cluster  # noqa: E402
 from designkit.sweep.scorer import CV_KEY, PairScorer  # noqa: E402
 
 
@@ -178,6 +180,21 @@ def main(argv=None):
             wd, _ = _median_run(go_dask, args.repeat)
             print(f"  dask LocalCluster, {cores} worker processes (--backend dask --jobs {cores}): {wd:.1f} s wall, "
                   f"efficiency {walls[1] / (cores * wd):.0%} against --jobs 1 (cluster start-up included)")
+            # as on a cluster that is already running (--scheduler ADDRESS): the same LocalCluster, started
+            # (and its workers' imports warmed by one small task) before the clock starts
+            client = local_cluster(cores)
+            try:
+                client.run(lambda: __import__("designkit.sweep.chunk"))
+
+                def go_running():
+                    with tempfile.TemporaryDirectory() as tmp:
+                        cfg = SweepConfig(name="bench", solver="batched", blocks=2 * cores, **base)
+                        run_sweep(cfg, Path(tmp), jobs=cores, backend="dask", scheduler=client.cluster.scheduler_address)
+                wr, _ = _median_run(go_running, args.repeat)
+            finally:
+                client.close()
+            print(f"  the same cluster already running (--scheduler ADDRESS): {wr:.1f} s wall, "
+                  f"efficiency {walls[1] / (cores * wr):.0%} against --jobs 1")
     load1 = os.getloadavg()
     print(f"\nload average {load1[0]:.2f} {load1[1]:.2f} {load1[2]:.2f} at the end (2 cores shared with other users: "
           "wall figures are upper bounds)")

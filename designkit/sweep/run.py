@@ -170,23 +170,27 @@ def _executor(backend: str, jobs: int, scheduler: str | None):
         from dask.distributed import Client
     except ImportError:
         raise InputError("the dask backend needs dask.distributed: pip install 'designkit[distributed]'") from None
-    if scheduler:
-        client = Client(scheduler)
-    else:
-        import dask
-
-        # dask's nanny spawns workers with MALLOC_TRIM_THRESHOLD_=65536 (to hand freed memory back sooner), and
-        # the solver's per-fold arrays are then handed back and faulted in afresh: one chunk of a 500-interval
-        # scene took 3.1 million minor page faults and 3.6 s of system CPU instead of 1.0 million and 1.4 s
-        # (14.3 s of wall against 12.0 s), and the whole scene on two workers 22.7-26.0 s against 19.7-20.1 s
-        # with it unset (measured; benchmarks/bench_engine.py --dask). The cluster designkit starts leaves it
-        # unset; a worker's memory stays bounded by the chunk's own limits (scorer.BATCH_MB, the feature cache).
-        with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
-            client = Client(processes=True, n_workers=max(jobs, 1), threads_per_worker=1)
+    client = Client(scheduler) if scheduler else local_cluster(jobs)
     try:
         yield (lambda: parallel_config(backend="dask")), -1
     finally:
         client.close()
+
+
+def local_cluster(jobs: int):
+    """A dask client of a new ``LocalCluster`` of ``jobs`` worker processes, one thread each, as
+    ``--backend dask`` without ``--scheduler`` starts it (close it when done)."""
+    import dask
+    from dask.distributed import Client
+
+    # dask's nanny spawns workers with MALLOC_TRIM_THRESHOLD_=65536 (to hand freed memory back sooner), and
+    # the solver's per-fold arrays are then handed back and faulted in afresh: one chunk of a 500-interval
+    # scene took 3.1 million minor page faults and 3.6 s of system CPU instead of 1.0 million and 1.4 s
+    # (14.3 s of wall against 12.0 s), and the whole scene on two workers 22.7-26.0 s against 19.7-20.1 s
+    # with it unset (measured; benchmarks/bench_engine.py --dask). The cluster designkit starts leaves it
+    # unset; a worker's memory stays bounded by the chunk's own limits (scorer.BATCH_MB, the feature cache).
+    with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
+        return Client(processes=True, n_workers=max(jobs, 1), threads_per_worker=1)
 
 
 def check_batches(cfg: SweepConfig) -> None:

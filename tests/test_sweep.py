@@ -202,13 +202,11 @@ def test_the_dask_cluster_a_sweep_starts_leaves_malloc_trimming_to_glibc(monkeyp
     (benchmarks/bench_engine.py --dask). The cluster ``--backend dask`` starts itself (no --scheduler) leaves it
     unset in its real worker processes."""
     pytest.importorskip("distributed", reason="dask.distributed is in the test extra")
-    from dask.distributed import get_client
-
-    from designkit.sweep.run import _executor
+    from designkit.sweep.run import local_cluster
 
     monkeypatch.delenv("MALLOC_TRIM_THRESHOLD_", raising=False)
-    with _executor("dask", 2, None) as (ctx, n_jobs):
-        envs = get_client().run(lambda: (os.getpid(), os.environ.get("MALLOC_TRIM_THRESHOLD_")))
+    with local_cluster(2) as client:
+        envs = client.run(lambda: (os.getpid(), os.environ.get("MALLOC_TRIM_THRESHOLD_")))
     assert len(envs) == 2 and len({pid for pid, _ in envs.values()} | {os.getpid()}) == 3  # two worker processes
     assert {value for _, value in envs.values()} == {None}
 
@@ -232,11 +230,12 @@ def _in_flight_plugin():
 
 
 @pytest.mark.slow
-def test_a_dask_sweep_keeps_one_chunk_in_flight_per_worker(tmp_path):
+def test_a_dask_sweep_keeps_one_chunk_in_flight_per_worker_and_follows_a_growing_cluster(tmp_path):
     """dask assigns each submitted task to a worker at once, and a worker runs its own in order; with more
     chunks in flight than workers, a worker that finished early ran a small chunk while a costlier one waited
     behind the busy worker (benchmarks/bench_engine.py --dask). The sweep hands a chunk out only as a worker
-    frees up, so the costliest-first order holds on dask as on local processes."""
+    thread frees up, so the costliest-first order holds on dask as on local processes, and it counts the
+    threads at each hand-out, so a worker that joins mid-sweep gets chunks."""
     distributed = pytest.importorskip("distributed", reason="dask.distributed is in the test extra")
     from designkit.sweep import SweepConfig
     from designkit.sweep.run import iter_sweep
@@ -244,12 +243,18 @@ def test_a_dask_sweep_keeps_one_chunk_in_flight_per_worker(tmp_path):
     cfg = SweepConfig(name="inflight", intervals=24, trials=12, noise_ratio=(0.005,), contact_s=(0.5, 1.0),
                       blocks=4, max_repeats=1)
     plugin = _in_flight_plugin()
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
-                                  dashboard_address=":0") as cluster:
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                  dashboard_address=":0") as cluster, distributed.Client(cluster) as client:
         cluster.scheduler.add_plugin(plugin)
-        got = list(iter_sweep(cfg, tmp_path, jobs=2, backend="dask", scheduler=cluster.scheduler_address))
+        sweep = iter_sweep(cfg, tmp_path, jobs=1, backend="dask", scheduler=cluster.scheduler_address)
+        got = [next(sweep)]
+        alone = plugin.most
+        cluster.scale(2)
+        client.wait_for_workers(2)
+        got += list(sweep)
     assert len(got) == 8 and all(computed for _, computed in got)
-    assert plugin.most == 2, f"{plugin.most} chunks were assigned to the 2 workers at once"
+    assert alone == 1, f"{alone} chunks were assigned to the one worker at once"
+    assert plugin.most == 2, f"{plugin.most} chunks were assigned at once once a second worker joined"
 
 # ------------------------------------------------------------------ forward models through the sweep
 # One scene, one contact, 10 intervals: a second or two per sweep, in-process.

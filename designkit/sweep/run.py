@@ -1,7 +1,7 @@
 """Running a whole sweep: chunks in parallel (joblib processes or a dask cluster), resumable.
 
 Work is cut into chunks, one per (scene point, block of references, contact
-time), run through joblib (local processes, or a dask cluster) and written
+time), run on local processes (joblib) or a dask cluster and written
 atomically as they finish; an interrupted sweep resumes without recomputing
 finished chunks and gives bit-identical results. A working folder records its
 sweep's :meth:`~designkit.sweep.config.SweepConfig.digest`: resuming it with
@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import json
 import time
-from contextlib import contextmanager
 from pathlib import Path
 from typing import Callable, Iterator
 
@@ -115,8 +114,8 @@ def iter_sweep(cfg: SweepConfig, workdir: Path, *, jobs: int = 1, backend: str =
     :func:`~designkit.sweep.chunk.estimated_costs` go first, so that no worker
     starts a long one while the others run out of work.
     """
-    from joblib import Parallel, delayed
-
+    if backend not in BACKENDS:
+        raise InputError(f"backend must be loky, sequential or dask, got {backend!r}")
     workdir = Path(workdir)
     todo = []
     for k in range(len(cfg.contact_s)):
@@ -137,42 +136,52 @@ def iter_sweep(cfg: SweepConfig, workdir: Path, *, jobs: int = 1, backend: str =
         todo.sort(key=lambda t: -cost[t])
     else:
         todo.sort(key=lambda t: -t[2])
-    with _executor(backend, jobs, scheduler) as (ctx, n_jobs):
-        calls = [delayed(run_chunk)(cfg, p, b, k) for p, b, k in todo]
-        # dask assigns every submitted task to a worker at once, round robin, and a worker runs its own in
-        # submission order: with joblib's default of 2 x n_jobs in flight, a worker that finished early ran
-        # the smallest block next while a costlier one waited on the busy worker (a 500-interval scene in
-        # 4 blocks on 2 workers: 18.3-19.7 s, against 17.4-18.5 s with one chunk in flight per worker,
-        # measured in alternation). loky's workers take chunks from one queue, in order, as they free up.
-        pre_dispatch = "n_jobs" if backend == "dask" else "2*n_jobs"
-        with ctx():
-            for res in Parallel(n_jobs=n_jobs, return_as="generator_unordered", pre_dispatch=pre_dispatch)(calls):
-                _save_chunk(_chunk_path(workdir, res.point, res.block, res.contact_index), res, cfg)
-                yield res, True
+    results = _on_dask(cfg, todo, jobs, scheduler) if backend == "dask" else _on_joblib(cfg, todo, backend, jobs)
+    for res in results:
+        _save_chunk(_chunk_path(workdir, res.point, res.block, res.contact_index), res, cfg)
+        yield res, True
 
 
-@contextmanager
-def _executor(backend: str, jobs: int, scheduler: str | None):
-    """``(joblib context factory, n_jobs)`` for a backend; a dask client lives as long as the sweep."""
-    from joblib import parallel_config
+def _on_joblib(cfg: SweepConfig, todo, backend: str, jobs: int) -> Iterator[ChunkResult]:
+    """The chunks ``todo`` on local processes (loky) or in this process, as they finish."""
+    from joblib import Parallel, delayed, parallel_config
 
     from .._workers import local_processes
 
-    if backend not in BACKENDS:
-        raise InputError(f"backend must be loky, sequential or dask, got {backend!r}")
-    if backend != "dask":
-        if backend == "loky" and jobs != 1:
-            yield (lambda: local_processes(jobs)), jobs
-        else:
-            yield (lambda: parallel_config(backend="sequential")), jobs
-        return
+    with local_processes(jobs) if backend == "loky" and jobs != 1 else parallel_config(backend="sequential"):
+        yield from Parallel(n_jobs=jobs, return_as="generator_unordered")(
+            delayed(run_chunk)(cfg, p, b, k) for p, b, k in todo)
+
+
+def _on_dask(cfg: SweepConfig, todo, jobs: int, scheduler: str | None) -> Iterator[ChunkResult]:
+    """The chunks ``todo`` on a dask cluster, as they finish, each handed out when a worker thread frees up.
+
+    dask assigns a submitted task to a worker at once and a worker runs its own in turn, so with more chunks
+    submitted than threads a worker that finished early ran a small chunk while a costlier one waited behind
+    a busy worker (joblib's dask backend keeps 2 per thread in flight: a 500-interval scene in 4 blocks on 2
+    workers took 18.3-19.7 s, against 17.4-18.5 s with one per thread, measured in alternation). The number
+    of threads is asked again at each hand-out, so the chunks follow a cluster that grows (an adaptive one
+    sees the work of its running chunks; with no worker yet, one chunk waits for it).
+    """
     try:
-        from dask.distributed import Client
+        from dask.distributed import Client, as_completed
     except ImportError:
         raise InputError("the dask backend needs dask.distributed: pip install 'designkit[distributed]'") from None
     client = Client(scheduler) if scheduler else local_cluster(jobs)
     try:
-        yield (lambda: parallel_config(backend="dask")), -1
+        running, waiting = as_completed(), list(reversed(todo))
+
+        def hand_out():
+            threads = max(1, sum(client.nthreads().values()))
+            while waiting and running.count() < threads:
+                running.add(client.submit(run_chunk, cfg, *waiting.pop(), pure=False))
+
+        hand_out()
+        for future in running:
+            res = future.result()
+            future.release()
+            hand_out()
+            yield res
     finally:
         client.close()
 

@@ -450,8 +450,8 @@ SHIPPED_TABLES: dict[str, tuple[str, str]] = {
         "sha256:7d72c28a50ff7ab6de9bfb6a3366e5c4dc5a4f6ed750a70de91c8b0098abd7b5",
         "sha256:882e12fdd88e94f6dc0c0cd97172281e52fcc64852c8b0daaa62c7a505a15c0f"),
     "svm-fine": (
-        "sha256:d5125d90db8caf3809621e33fcf8b6a6484fecabb013d2acb47e87a0b10f10e5",
-        "sha256:b8fc4777f487d2351cb8e5ae299a5ffb21f790a817727002b2562194d7df84ca"),
+        "sha256:579969bb66d390b4c6b48c5e25b586ece1db27ed9da0fa7b51224e4d56278c90",
+        "sha256:9fcb85950b49d6a98003061aa324b6ebf04ad7bebd319c78946e1aaa589f5a81"),
 }
 
 #: Content hashes of the shipped tables. Their headers passed the schema when they were built and a test

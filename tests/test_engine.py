@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -188,6 +192,43 @@ def test_rows_beside_a_block_boundary_do_not_depend_on_the_split():
     for blocks in (3, 5):
         split = _staircases_by_row(SweepConfig(blocks=blocks, **base))
         assert split == ref, [r for r in ref if split[r] != ref[r]]
+
+
+@pytest.mark.slow
+def test_the_boundary_recomputation_script_restores_exactly_the_rows_it_names(tmp_path):
+    """benchmarks/recompute_boundary_rows.py (how the shipped svm-fine was brought up to the fix above)
+    recomputes the rows whose anchors lie in another block, and only those: a chunk whose boundary rows
+    hold stale staircases and cells gets the fresh build's values back, and a stale row elsewhere is left."""
+    from designkit.sweep import run_sweep
+    from designkit.sweep.chunk import ChunkResult
+    from designkit.sweep.config import stamp_chunk
+
+    cfg = SweepConfig(name="b", blocks=3, intervals=60, trials=20, noise_ratio=(0.005,), contact_s=(1.0,), seed=5,
+                      max_repeats=2)
+    work = tmp_path / "work"
+    run_sweep(cfg, work, jobs=1, backend="sequential")
+    chunk = work / "chunks" / "p000-b001-c000.npz"  # rows 20-39; rows 20-23 need anchor 16, 33-39 anchor 40
+    with np.load(chunk, allow_pickle=False) as z:
+        arrays = {k: z[k] for k in z.files}
+    good = ChunkResult.from_arrays(arrays)
+    stale = {k: v.copy() for k, v in arrays.items() if k != "identity"}
+    for name in ("J", "J_lo", "J_hi"):
+        stale[name][[0, 1, 19]] += 1  # rows 20, 21 (anchor 16 outside) and 39 (anchor 40 outside)
+    stale["J_lo"][8] += 1  # row 28: anchors 24 and 32, both inside the block
+    stale["cells"] = stale["cells"][~np.isin(stale["cells"][:, 0], [20, 21, 39])]
+    np.savez(chunk, **stamp_chunk(stale, cfg, (0,), 1, 0))
+    root = Path(__file__).resolve().parents[1]
+    r = subprocess.run([sys.executable, str(root / "benchmarks" / "recompute_boundary_rows.py"), str(work)],
+                       capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    assert "3 chunks: 2 with rows beside a block boundary (14 rows recomputed), 1 changed" in r.stdout  # 17-23, 33-39
+    with np.load(chunk, allow_pickle=False) as z:
+        fixed = ChunkResult.from_arrays({k: z[k] for k in z.files})
+    for name in ("J", "J_hi"):
+        np.testing.assert_array_equal(getattr(fixed, name), getattr(good, name), err_msg=name)
+    assert fixed.J_lo[8] == good.J_lo[8] + 1 and np.array_equal(np.delete(fixed.J_lo, 8), np.delete(good.J_lo, 8))
+    np.testing.assert_array_equal(fixed.cells, good.cells)
+    assert fixed.fits == good.fits
 
 def test_the_batched_solver_decides_as_the_reference_except_near_ties():
     """Same staircases with both solvers on a small scene; any cell they score differently is close."""

@@ -444,8 +444,8 @@ SHIPPED_TABLES: dict[str, tuple[str, str]] = {
         "sha256:1820bf01e2ffe9e79d35e4c0b9f8b310b10bbe7c8d481db47c9c09aa57564bae",
         "sha256:ef844209edc8dcebd324634fea7fcdb146b0fc58fa814b05f76dfabf82c4e7f5"),
     "svm-paper": (
-        "sha256:fb51017379fcac6a31e872004c42d77bb2f0cd72bbdf4b10d3c8874e288d783e",
-        "sha256:fc461c7468fefb61c903a609f9b86d1d680821fc405c987daf2727d7ed607d8e"),
+        "sha256:55fdcf465d925b26f0ad45119eed7b7493efc8e6fb3d4983a86950354f136cab",
+        "sha256:b3704e57210bafc70b83a1015b44f1fbc54c9a8fcf5a1dfd5001fc6391a73a4f"),
     "svm-paper-varied": (
         "sha256:7d72c28a50ff7ab6de9bfb6a3366e5c4dc5a4f6ed750a70de91c8b0098abd7b5",
         "sha256:882e12fdd88e94f6dc0c0cd97172281e52fcc64852c8b0daaa62c7a505a15c0f"),

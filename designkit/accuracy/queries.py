@@ -469,7 +469,8 @@ def _svm_min_contact_row(svm_table, res, trials, repeats) -> tuple[Row, dict[str
               f"--exact (SVM, {trials} trials x {repeats} seeds, bisection to 0.05 s)", t_ex, int(err.size),
               f"exact inside the table's interval for {in_table_iv}/{len(both)}, table inside the exact "
               f"interval for {in_exact_iv}/{len(both)}" + (f"; {missing} without both answers" if missing else ""))
-    summary = {"p95": p95(err), "worst": worst(err), "n": int(err.size), "exact_in_table_interval": in_table_iv,
+    summary = {"p95": p95(err), "worst": worst(err), "n": int(err.size), "drawn": len(res),
+               "exact_in_table_interval": in_table_iv,
                "table_in_exact_interval": in_exact_iv, "exact_wall_s_mean": t_ex}
     return row, summary
 

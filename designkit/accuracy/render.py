@@ -233,7 +233,9 @@ def _md_svm(name: str | None, s: Mapping[str, Any] | None) -> list[str]:
     dd = s.get("distinguishable", {})
     return [
         f"`{name}` (the paper's SVM) against `--exact` ({s['trials']} trials per class, {s['repeats']} seeds per "
-        f"evaluation) over {mcs.get('n')} random pairs: `min-contact` error 95th percentile "
+        f"evaluation) over {mcs.get('n')} random pairs"
+        + (f" ({mcs['drawn'] - mcs['n']} more drawn without both answers)" if mcs.get("drawn", 0) > mcs.get("n", 0)
+           else "") + ": `min-contact` error 95th percentile "
         f"{format_value(mcs.get('p95'), 3)} s, worst {format_value(mcs.get('worst'), 3)} s; the exact answer lay "
         f"inside the table's Monte Carlo interval for {mcs.get('exact_in_table_interval')} of {mcs.get('n')} pairs. "
         f"`distinguishable`: {dd.get('wrong')} wrong verdicts of {dd.get('n')} near-boundary cases "

@@ -97,8 +97,9 @@ def run_chunk(cfg: SweepConfig, point: tuple[int, ...], block: int, contact_inde
     A chunk is the unit of parallelism: everything inside it runs sequentially in its
     worker. (Where joblib's active backend is dask, as on the workers of joblib's dask
     backend, scikit-learn's own joblib calls, such as the folds of cross-validation, would
-    otherwise be sent back to the cluster one by one: measured 5x slower per chunk.) BLAS and LAPACK run on one
-    thread for the same reason: the batched solver's small factorizations (133 x 133)
+    otherwise be sent back to the cluster one by one: measured 5x slower per chunk.) BLAS
+    and LAPACK run on one thread for the same reason: the batched solver's small
+    factorizations (133 x 133)
     spent most of their time in idle threads of a multithreaded BLAS on a loaded machine
     (measured: one 60-interval chunk at 4 s, 43 s of CPU with the default threads, 3.7 s
     with one), and one thread everywhere makes the floating-point order the same

@@ -23,7 +23,8 @@ from .chunk import ChunkResult, estimated_costs, run_chunk
 from .config import SweepConfig
 from .search import assemble, chunk_wall_s
 
-__all__ = ["BACKENDS", "SweepInterrupted", "check_batches", "iter_sweep", "prepare_workdir", "run_sweep"]
+__all__ = ["BACKENDS", "SweepInterrupted", "check_batches", "iter_sweep", "local_cluster", "prepare_workdir",
+           "run_sweep"]
 
 #: Where chunks run: local processes, this process, or a dask cluster.
 BACKENDS = ("loky", "sequential", "dask")
@@ -159,7 +160,7 @@ def _on_dask(cfg: SweepConfig, todo, jobs: int, scheduler: str | None) -> Iterat
     dask assigns a submitted task to a worker at once and a worker runs its own in turn, so with more chunks
     submitted than threads a worker that finished early ran a small chunk while a costlier one waited behind
     a busy worker (joblib's dask backend keeps 2 per thread in flight: a 500-interval scene in 4 blocks on 2
-    workers took 18.3-19.7 s, against 17.4-18.5 s with one per thread, measured in alternation). The number
+    workers took 18.3-19.7 s, against 17.4-18.7 s with one per thread, measured in alternation). The number
     of threads is asked again at each hand-out, so the chunks follow a cluster that grows (an adaptive one
     sees the work of its running chunks; with no worker yet, one chunk waits for it).
     """

@@ -29,21 +29,21 @@ def recompute(workdir: str, name: str) -> tuple[str, int, bool]:
     """``(chunk file, rows recomputed, whether anything changed)`` for one chunk, rewritten in place."""
     from threadpoolctl import threadpool_limits
 
-    from designkit.sweep.chunk import ChunkResult, _svm_staircases
-    from designkit.sweep.config import SweepConfig
-    from designkit.sweep.run import _load_chunk, _save_chunk
+    from designkit.sweep.chunk import ChunkResult, _svm_staircases, ideal_floor
+    from designkit.sweep.config import SweepConfig, check_chunk
+    from designkit.sweep.run import _save_chunk
     from designkit.sweep.scorer import PairScorer
-    from designkit.sweep.search import ANCHOR_EVERY, closed_form_model, ideal_bound_s, ideal_staircase, with_anchors
+    from designkit.sweep.search import ANCHOR_EVERY, with_anchors
 
     cfg = SweepConfig.from_mapping(json.loads((Path(workdir) / "sweep.json").read_text())["config"])
     path = Path(workdir) / "chunks" / name
     with np.load(path, allow_pickle=False) as z:
-        slot = ChunkResult.from_arrays({k: z[k] for k in z.files})
-    res = _load_chunk(path, cfg, slot.point, slot.block, slot.contact_index)  # the chunk's identity checked
+        arrays = {k: z[k] for k in z.files}
+    res = ChunkResult.from_arrays(arrays)
+    check_chunk(arrays, cfg, res.point, res.block, res.contact_index, path)  # its identity: this sweep's chunk
     t0 = time.process_time()
     n, rows = cfg.intervals, res.rows
-    need = with_anchors(rows, n, ANCHOR_EVERY)
-    outside = set(np.setdiff1d(need, rows).tolist())
+    outside = set(np.setdiff1d(with_anchors(rows, n, ANCHOR_EVERY), rows).tolist())
     aff = np.array([i for i in rows.tolist() if outside & set(with_anchors([i], n, ANCHOR_EVERY).tolist())],
                    dtype=np.int64)
     if aff.size == 0 or cfg.fidelity != "svm" or cfg.full_matrix or not cfg.ideal_bound:
@@ -51,10 +51,9 @@ def recompute(workdir: str, name: str) -> tuple[str, int, bool]:
     with threadpool_limits(limits=1):
         sensor = cfg.resolved_sensor()
         scene = cfg.scene(res.point, cfg.contact_s[res.contact_index])
-        if closed_form_model(cfg, sensor, scene) is None:  # no ideal floor: nothing was searched from one
+        floor = ideal_floor(cfg, sensor, scene, rows)  # the floor the fixed engine searches from
+        if floor is None:  # no closed form: nothing was searched from an ideal floor
             return name, 0, False
-        floor = np.zeros(n, dtype=np.int64)
-        floor[need] = ideal_staircase(cfg, sensor, ideal_bound_s(cfg, sensor, scene), need)
         assert np.array_equal(floor[rows], res.J_ideal)
         scorer = PairScorer(cfg, sensor, scene)
         new = dict(zip(("J", "J_lo", "J_hi"), _svm_staircases(cfg, scorer, aff, floor)))

@@ -117,17 +117,8 @@ def _run_chunk(cfg: SweepConfig, point, block: int, contact_index: int) -> Chunk
     sensor = cfg.resolved_sensor()
     scene = cfg.scene(point, cfg.contact_s[contact_index])
     rows = cfg.blocks_of()[block]
-    floor = None  # the ideal observer's staircase, a lower bound of every J, where it has a closed form
-    if closed_form_model(cfg, sensor, scene) is not None:
-        # for the rows and the anchors their guided search starts from, inside this block or not: an anchor
-        # searched from another floor than in its own block may find another crossing of noisy decisions, and
-        # the rows guessed from it follow (--blocks 3 moved J_lo / J_hi of a 500-interval scene, measured)
-        need = with_anchors(rows, cfg.intervals, ANCHOR_EVERY)
-        floor = np.zeros(cfg.intervals, dtype=np.int64)
-        floor[need] = ideal_staircase(cfg, sensor, ideal_bound_s(cfg, sensor, scene), need)
-        J_ideal = floor[rows]
-    else:
-        J_ideal = np.full(rows.size, IDEAL_UNKNOWN, dtype=np.int64)
+    floor = ideal_floor(cfg, sensor, scene, rows)
+    J_ideal = floor[rows] if floor is not None else np.full(rows.size, IDEAL_UNKNOWN, dtype=np.int64)
 
     if cfg.fidelity == "ideal":
         J = _ideal_mc_staircase(cfg, sensor, scene, rows, floor) if cfg.varied else J_ideal
@@ -148,6 +139,23 @@ def _run_chunk(cfg: SweepConfig, point, block: int, contact_index: int) -> Chunk
     fits = int(cells[:, 4].sum()) if not cfg.full_matrix else scorer.fits
     return ChunkResult(point, block, contact_index, rows, J, J_lo, J_hi, J_ideal, fits,
                        cells, time.perf_counter() - t0, f1_rows)
+
+
+def ideal_floor(cfg: SweepConfig, sensor: Sensor, scene: Scene, rows) -> np.ndarray | None:
+    """The ideal observer's ``J`` (closed form), a lower bound of every ``J``, for ``rows`` and the anchor rows
+    their guided search starts from (:func:`~designkit.sweep.search.with_anchors`), indexed by interval (0
+    elsewhere); None where the model and scene have no closed form.
+
+    The anchors get it too, inside the block or not: an anchor searched from another floor than in its own
+    block may find another crossing of noisy decisions, and the rows guessed from it follow (``--blocks 3``
+    moved ``J_lo`` / ``J_hi`` of a 500-interval scene, measured).
+    """
+    if closed_form_model(cfg, sensor, scene) is None:
+        return None
+    need = with_anchors(rows, cfg.intervals, ANCHOR_EVERY)
+    floor = np.zeros(cfg.intervals, dtype=np.int64)
+    floor[need] = ideal_staircase(cfg, sensor, ideal_bound_s(cfg, sensor, scene), need)
+    return floor
 
 
 def _svm_staircases(cfg: SweepConfig, scorer: PairScorer, rows, floor):

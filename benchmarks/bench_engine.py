@@ -99,8 +99,8 @@ def main(argv=None):
     p.add_argument("--repeat", type=int, default=1, help="runs per wall figure (median)")
     p.add_argument("--skip-parallel", action="store_true")
     p.add_argument("--dask", action="store_true",
-                   help="also the sweep on a dask LocalCluster of one worker process per core (cluster start-up "
-                        "included), against --jobs 1")
+                   help="also the sweep on a dask LocalCluster of one worker process per core, against --jobs 1: "
+                        "started by the sweep (start-up included) and already running (--scheduler)")
     args = p.parse_args(argv)
 
     base = dict(intervals=args.intervals, trials=args.trials, noise_ratio=(args.noise_ratio,),
@@ -173,26 +173,18 @@ def main(argv=None):
               f"{naive_wall / walls[cores]:.1f}x less than the naive loop on one core, "
               f"{naive_wall / cores / walls[cores]:.1f}x less than the naive loop spread over {cores} cores")
         if args.dask:  # the backend that goes past one machine, on a real local cluster of this machine's cores
-            def go_dask():
+            def go_dask(scheduler=None):
                 with tempfile.TemporaryDirectory() as tmp:
                     cfg = SweepConfig(name="bench", solver="batched", blocks=2 * cores, **base)
-                    run_sweep(cfg, Path(tmp), jobs=cores, backend="dask")
+                    run_sweep(cfg, Path(tmp), jobs=cores, backend="dask", scheduler=scheduler)
             wd, _ = _median_run(go_dask, args.repeat)
             print(f"  dask LocalCluster, {cores} worker processes (--backend dask --jobs {cores}): {wd:.1f} s wall, "
                   f"efficiency {walls[1] / (cores * wd):.0%} against --jobs 1 (cluster start-up included)")
             # as on a cluster that is already running (--scheduler ADDRESS): the same LocalCluster, started
             # (and its workers' imports warmed by one small task) before the clock starts
-            client = local_cluster(cores)
-            try:
+            with local_cluster(cores) as client:
                 client.run(lambda: __import__("designkit.sweep.chunk"))
-
-                def go_running():
-                    with tempfile.TemporaryDirectory() as tmp:
-                        cfg = SweepConfig(name="bench", solver="batched", blocks=2 * cores, **base)
-                        run_sweep(cfg, Path(tmp), jobs=cores, backend="dask", scheduler=client.cluster.scheduler_address)
-                wr, _ = _median_run(go_running, args.repeat)
-            finally:
-                client.close()
+                wr, _ = _median_run(lambda: go_dask(client.cluster.scheduler_address), args.repeat)
             print(f"  the same cluster already running (--scheduler ADDRESS): {wr:.1f} s wall, "
                   f"efficiency {walls[1] / (cores * wr):.0%} against --jobs 1")
     load1 = os.getloadavg()

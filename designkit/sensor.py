@@ -58,8 +58,14 @@ def last_sample_index(contact_s, sample_rate_hz: float) -> np.ndarray:
     >>> int(last_sample_index(2.0, 200.0)), last_sample_index([0.0, 0.004, 0.005], 200.0).tolist()
     (400, [0, 0, 1])
     """
-    return np.floor(np.asarray(contact_s, dtype=np.float64) * float(sample_rate_hz)
-                    + _SAMPLE_TOLERANCE).astype(np.int64)
+    return np.floor(_last_index_float(contact_s, sample_rate_hz)).astype(np.int64)
+
+
+def _last_index_float(contact_s, sample_rate_hz: float) -> np.ndarray:
+    """``contact_s * fs`` plus the sampling tolerance, before the floor: the one rule of the sample count
+    (may be inf or NaN for absurd inputs; callers compare it before converting)."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        return np.asarray(contact_s, dtype=np.float64) * float(sample_rate_hz) + _SAMPLE_TOLERANCE
 
 
 def within_sample_limit(contact_s, sample_rate_hz: float) -> np.ndarray:
@@ -73,9 +79,8 @@ def within_sample_limit(contact_s, sample_rate_hz: float) -> np.ndarray:
     >>> within_sample_limit([2.0, 4999.0, 5000.0, 1e308], 200.0).tolist()
     [True, True, False, False]
     """
-    with np.errstate(over="ignore", invalid="ignore"):
-        n_float = np.asarray(contact_s, dtype=np.float64) * float(sample_rate_hz) + _SAMPLE_TOLERANCE
-        return n_float < MAX_SAMPLES_PER_TOUCH
+    with np.errstate(invalid="ignore"):
+        return _last_index_float(contact_s, sample_rate_hz) < MAX_SAMPLES_PER_TOUCH
 
 
 def sample_times_s(contact_s: float, sample_rate_hz: float) -> np.ndarray:
@@ -99,8 +104,8 @@ def sample_times_s(contact_s: float, sample_rate_hz: float) -> np.ndarray:
     """
     contact_s = check_positive("contact time [s]", contact_s)
     fs = check_positive("sample rate [Hz]", sample_rate_hz)
-    n_float = contact_s * fs + _SAMPLE_TOLERANCE  # may be inf (1e308 s): checked before math.floor sees it
-    if not within_sample_limit(contact_s, fs):
+    n_float = float(_last_index_float(contact_s, fs))  # may be inf (1e308 s): checked before math.floor sees it
+    if not n_float < MAX_SAMPLES_PER_TOUCH:
         raise InputError(f"a touch of {contact_s:g} s at {fs:g} Hz has {n_float + 1:.4g} samples; the limit is "
                          f"{MAX_SAMPLES_PER_TOUCH:.0e} per touch (shorten the contact or lower the sample rate)")
     n = int(math.floor(n_float))

@@ -211,7 +211,6 @@ def test_the_dask_cluster_a_sweep_starts_leaves_malloc_trimming_to_glibc(monkeyp
     assert {value for _, value in envs.values()} == {None}
 
 
-
 def _in_flight_plugin():
     """A scheduler plugin counting the most tasks assigned to workers at once (the ``processing`` state)."""
     from distributed.diagnostics.plugin import SchedulerPlugin
@@ -255,6 +254,7 @@ def test_a_dask_sweep_keeps_one_chunk_in_flight_per_worker_and_follows_a_growing
     assert len(got) == 8 and all(computed for _, computed in got)
     assert alone == 1, f"{alone} chunks were assigned to the one worker at once"
     assert plugin.most == 2, f"{plugin.most} chunks were assigned at once once a second worker joined"
+
 
 # ------------------------------------------------------------------ forward models through the sweep
 # One scene, one contact, 10 intervals: a second or two per sweep, in-process.

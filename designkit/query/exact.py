@@ -479,8 +479,12 @@ def _exact_ratio(question: str, kw: dict) -> Answer:
     ideal_cap = ideal_r if ideal_iv is None else ideal_iv[1]
     # the SVM's crossing lies below the ideal's, so that is the top of its search, above the bracket's end too
     # where nothing else caps the ratio (min-delta-t with varied Ts0 caps it: dT must stay above the spread)
-    capped = hi_r < RATIO_BRACKET[1]
-    top = hi_r if ideal_cap is None else min(hi_r, ideal_cap) if capped else ideal_cap
+    if ideal_cap is None:
+        top = hi_r
+    elif hi_r < RATIO_BRACKET[1]:  # capped below the bracket's end
+        top = min(hi_r, ideal_cap)
+    else:
+        top = ideal_cap
     est = estimate_crossing(lambda x: run.svm(cls, scene(x)), lo_r, max(top, lo_r * 1.0001), run.phi,
                             increasing=False, coverage=cov, progress=kw.get("progress"))
     r, r_lo, r_hi = est.value, est.low, est.high

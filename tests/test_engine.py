@@ -173,6 +173,60 @@ def test_a_table_is_a_function_of_its_config_whatever_the_split(solver, tmp_path
 
 
 
+#: An older x86-64 CPU as one machine can emulate it: OpenBLAS's Nehalem kernels (numpy's wheels are built
+#: with DYNAMIC_ARCH) and numpy's loops without AVX, AVX2 or AVX-512 (its SSE4.2 baseline only).
+OLDER_CPU = {"OPENBLAS_CORETYPE": "Nehalem", "NPY_DISABLE_CPU_FEATURES": "X86_V3 X86_V4 AVX512_ICL AVX512_SPR"}
+_ON_OLDER_CPU = """
+import json, sys, numpy as np, threadpoolctl
+from designkit.sweep import SweepConfig, run_chunk
+from designkit.sweep.scorer import CV_KEY, PairScorer
+from designkit.recognition.batched_svm import batched_cv_f1
+cfg = SweepConfig(**json.loads(sys.argv[1]))
+r = run_chunk(cfg, (0,), 0, 0)
+sc = PairScorer(cfg, cfg.resolved_sensor(), cfg.scene((0,), cfg.contact_s[0]))
+pairs = [(i, i + 3) for i in range(0, 30, 5)]
+dec = batched_cv_f1([sc.features(i, 0) for i, _ in pairs], [sc.features(j, 0) for _, j in pairs],
+                    seeds=[[cfg.seed, i, j, 0, CV_KEY] for i, j in pairs]).decision
+print(json.dumps({"blas": sorted({i.get("architecture") for i in threadpoolctl.threadpool_info()}),
+                  "J": [r.J.tolist(), r.J_lo.tolist(), r.J_hi.tolist()], "fits": int(r.fits),
+                  "cells": np.asarray(r.cells).tolist(), "decision": dec.tolist()}))
+"""
+
+
+@pytest.mark.skipif(__import__("platform").machine() not in ("x86_64", "AMD64"),
+                    reason="emulates an older x86-64 CPU (OpenBLAS core types, numpy's x86 dispatch)")
+def test_a_table_is_the_same_on_an_older_cpu_whose_arithmetic_rounds_differently():
+    """Another machine runs other SIMD code in numpy and other BLAS kernels (the solver's float32 Gram
+    products), so its decision values differ in their last bits; the table must not. Both halves are
+    asserted: the emulated CPU's decisions differ from this one's (else the test proves nothing), its
+    staircases, fits and F1 cells do not. benchmarks/bench_machines.py does the same on svm-paper scenes."""
+    import json
+    import os
+
+    from designkit.recognition.batched_svm import batched_cv_f1
+    from designkit.sweep.scorer import CV_KEY, PairScorer
+
+    base = dict(intervals=40, trials=30, noise_ratio=(0.005,), contact_s=(1.0,), seed=2, max_repeats=2)
+    r = subprocess.run([sys.executable, "-c", _ON_OLDER_CPU, json.dumps(base)], capture_output=True, text=True,
+                       timeout=300, env={**os.environ, **OLDER_CPU})
+    assert r.returncode == 0, r.stderr
+    older = json.loads(r.stdout)
+    if older["blas"] != ["Nehalem"]:
+        pytest.skip(f"this BLAS does not take OPENBLAS_CORETYPE (it runs {older['blas']}): nothing emulated")
+    cfg = SweepConfig(**base)
+    here = run_chunk(cfg, (0,), 0, 0)
+    sc = PairScorer(cfg, cfg.resolved_sensor(), cfg.scene((0,), 1.0))
+    pairs = [(i, i + 3) for i in range(0, 30, 5)]
+    dec = batched_cv_f1([sc.features(i, 0) for i, _ in pairs], [sc.features(j, 0) for _, j in pairs],
+                        seeds=[[cfg.seed, i, j, 0, CV_KEY] for i, j in pairs]).decision
+    moved = np.abs(np.asarray(older["decision"]) - dec)
+    assert moved.max() > 0, "the emulated CPU computed bit-identical decisions: the emulation did not take"
+    assert moved.max() < 1e-4  # rounding, not another classifier
+    assert older["J"] == [here.J.tolist(), here.J_lo.tolist(), here.J_hi.tolist()]
+    assert older["fits"] == here.fits
+    np.testing.assert_array_equal(np.asarray(older["cells"]), np.asarray(here.cells))
+
+
 def _staircases_by_row(cfg: SweepConfig) -> dict[int, tuple[int, int, int]]:
     out = {}
     for b in range(len(cfg.blocks_of())):

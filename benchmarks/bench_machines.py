@@ -22,6 +22,10 @@ each emulated CPU, in a fresh process, this script
    arithmetic moves a decision, and how many predictions lie nearer a tie than that
    (only those could change side, and with them an F1).
 
+A GPU is another machine too: the last row runs the code a GPU build runs (the batched
+solver's generic array-API path, which ``--solver batched-cupy`` runs on CuPy) on numpy,
+``--solver batched-array-api``, in place of the numpy fast path every other row runs.
+
 Where the emulation does not take (no x86-64, a BLAS without ``DYNAMIC_ARCH``) the
 CPU's line says so and its comparison is left out.
 """
@@ -41,13 +45,16 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 
-#: Emulated CPUs: (name, OPENBLAS_CORETYPE, NPY_DISABLE_CPU_FEATURES). numpy 2's dispatch groups are X86_V2
-#: (SSE4.2, its baseline), X86_V3 (AVX2, FMA3) and X86_V4 plus AVX512_ICL / AVX512_SPR (AVX-512).
+#: Emulated CPUs: (name, OPENBLAS_CORETYPE, NPY_DISABLE_CPU_FEATURES, solver). numpy 2's dispatch groups are
+#: X86_V2 (SSE4.2, its baseline), X86_V3 (AVX2, FMA3) and X86_V4 plus AVX512_ICL / AVX512_SPR (AVX-512). The last
+#: row is a GPU's code path on this CPU: the batched solver's generic array-API code, which `batched-cupy` runs,
+#: on numpy (`--solver batched-array-api`) instead of its numpy fast path.
 CPUS = (
-    ("native", None, None),
-    ("AVX2 + FMA (Haswell)", "Haswell", "X86_V4 AVX512_ICL AVX512_SPR"),
-    ("AVX, no FMA (Sandy Bridge)", "Sandybridge", "X86_V3 X86_V4 AVX512_ICL AVX512_SPR"),
-    ("SSE4.2 (Nehalem)", "Nehalem", "X86_V3 X86_V4 AVX512_ICL AVX512_SPR"),
+    ("native", None, None, "batched"),
+    ("AVX2 + FMA (Haswell)", "Haswell", "X86_V4 AVX512_ICL AVX512_SPR", "batched"),
+    ("AVX, no FMA (Sandy Bridge)", "Sandybridge", "X86_V3 X86_V4 AVX512_ICL AVX512_SPR", "batched"),
+    ("SSE4.2 (Nehalem)", "Nehalem", "X86_V3 X86_V4 AVX512_ICL AVX512_SPR", "batched"),
+    ("a GPU's code path, on this CPU", None, None, "batched-array-api"),
 )
 
 
@@ -67,7 +74,7 @@ def worker(args) -> int:
 
     from designkit.recognition.batched_svm import batched_cv_f1
     from designkit.sweep.config import SweepConfig
-    from designkit.sweep.scorer import CV_KEY, PairScorer
+    from designkit.sweep.scorer import CV_KEY, PairScorer, array_namespace
 
     from numpy._core._multiarray_umath import __cpu_dispatch__, __cpu_features__
 
@@ -78,11 +85,12 @@ def worker(args) -> int:
     out = {}
     for key, plist in pairs.items():
         noise, contact = map(float, key.split("|"))
-        cfg = SweepConfig.from_yaml(args.config, noise_ratio=[noise], contact_s=[contact])
+        cfg = SweepConfig.from_yaml(args.config, noise_ratio=[noise], contact_s=[contact], solver=args.solver)
         sensor = cfg.resolved_sensor()
         scorer = PairScorer(cfg, sensor, cfg.scene((0,), contact))
         r = batched_cv_f1([scorer.features(i, 0) for i, _ in plist], [scorer.features(j, 0) for _, j in plist],
-                          seeds=[[cfg.seed, i, j, 0, CV_KEY] for i, j in plist], folds=cfg.folds)
+                          seeds=[[cfg.seed, i, j, 0, CV_KEY] for i, j in plist], folds=cfg.folds,
+                          xp=array_namespace(args.solver))
         out[key] = r.decision
     np.savez(args.worker, **out)
     Path(args.worker + ".json").write_text(json.dumps({"blas": blas, "simd": simd}))
@@ -118,6 +126,7 @@ def main(argv=None) -> int:
     p.add_argument("--jobs", type=int, default=2)
     p.add_argument("--worker", help=argparse.SUPPRESS)
     p.add_argument("--pairs", help=argparse.SUPPRESS)
+    p.add_argument("--solver", default="batched", help=argparse.SUPPRESS)
     args = p.parse_args(argv)
     if args.worker:
         return worker(args)
@@ -132,9 +141,10 @@ def main(argv=None) -> int:
           f"{' '.join(f'{x:.2f}' for x in os.getloadavg())}")
     print(f"slice of {Path(args.config).name}: sigma/dT {noises} x contact {contacts} s, {full.intervals} intervals "
           f"({len(noises) * len(contacts) * full.intervals} references)")
-    shipped = None
+    shipped, table_fits = None, None
     if args.table:
         with np.load(args.table) as z:
+            table_fits = int(z["fits"].sum())
             ni = [list(full.noise_ratio).index(x) for x in noises]
             ci = [list(full.contact_s).index(x) for x in contacts]
             shipped = {k: z[k][np.ix_(ni, ci)] for k in z.files if k.startswith("delta") or k == "fits"}
@@ -143,12 +153,13 @@ def main(argv=None) -> int:
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         pairs_file = tmp / "pairs.json"
-        for name, coretype, disable in CPUS:
+        for name, coretype, disable, solver in CPUS:
             env = _env(coretype, disable)
             out = tmp / f"{len(results)}.npz"
             t = time.perf_counter()
             cmd = [sys.executable, "-m", "designkit", "sweep", "--config", args.config,
                    "--noise-ratio", args.noise_ratio, "--contact", args.contact, "--jobs", str(args.jobs),
+                   "--solver", solver,
                    "--workdir", str(tmp / f"w{len(results)}"), "--out", str(out)]
             run = subprocess.run(cmd, env=env, capture_output=True, text=True)
             wall = time.perf_counter() - t
@@ -170,7 +181,7 @@ def main(argv=None) -> int:
                 pairs_file.write_text(json.dumps(plist))
             dec_out = str(tmp / f"d{len(results)}.npz")
             w = subprocess.run([sys.executable, __file__, "--worker", dec_out, "--pairs", str(pairs_file),
-                                "--config", args.config], env=env, capture_output=True, text=True)
+                                "--config", args.config, "--solver", solver], env=env, capture_output=True, text=True)
             if w.returncode != 0:
                 print(f"{name}: the decision worker failed: {w.stderr.strip().splitlines()[-1:]}")
                 return 1
@@ -217,9 +228,11 @@ def main(argv=None) -> int:
         print(f"\nsmallest |decision| in the native sample: {smallest:.2e}; {in_band} of {all_native.size} lie within "
               f"{band:g} of a tie. Taking their density as flat below {band:g}, a prediction changes side on another "
               f"CPU with probability about {expected:.1e} (the largest mean move over the CPUs, {mean_move:.1e}): "
-              f"{1e6 * expected:.2g} per million predictions, {expected * 200 * 336_596:.2g} over svm-paper's "
-              f"336,596 fits of 200 predictions each. A changed prediction moves one fold's F1; it changes the table "
-              f"only where the pair's F1 then crosses the threshold or the re-scoring band.")
+              f"{1e6 * expected:.2g} per million predictions"
+              + (f", {expected * 2 * full.trials * table_fits:.2g} over the {table_fits:,} fits of "
+                 f"{Path(args.table).name} ({2 * full.trials} predictions each)" if table_fits else "")
+              + ". A changed prediction moves one fold's F1; it changes the table only where the pair's F1 then "
+                "crosses the threshold or the re-scoring band.")
     print("every emulated CPU gave the native arrays" + (" and the shipped table's" if shipped is not None else "")
           if ok_all else "SOME ARRAYS DIFFER (above)")
     return 0 if ok_all else 1

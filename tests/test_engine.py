@@ -173,6 +173,26 @@ def test_a_table_is_a_function_of_its_config_whatever_the_split(solver, tmp_path
 
 
 
+def test_the_gpu_code_path_run_on_numpy_gives_the_numpy_table(tmp_path):
+    """``--solver batched-array-api`` runs the batched solver's generic array-API code, the code
+    ``batched-cupy`` runs on a GPU, on numpy instead of the numpy fast path (which folds the
+    standardization into float32 products of prepared deviations). The arithmetic differs, the table
+    must not: what a GPU build should give, checked without a GPU."""
+    pytest.importorskip("array_api_compat", reason="array-api-compat is in the test and gpu extras")
+    from designkit.sweep import run_sweep
+    from designkit.tables.store import load_table
+
+    base = dict(intervals=40, trials=30, noise_ratio=(0.005, 0.02), contact_s=(0.5, 2.0), seed=2, max_repeats=2)
+    fast = load_table(run_sweep(SweepConfig(name="fast", **base), tmp_path / "fast", backend="sequential"))
+    generic = load_table(run_sweep(SweepConfig(name="generic", solver="batched-array-api", **base),
+                                   tmp_path / "generic", backend="sequential"))
+    assert generic.header["stats"]["run"]["solver"] == "batched-array-api"
+    assert sorted(generic.arrays) == sorted(fast.arrays)
+    for name in fast.arrays:
+        np.testing.assert_array_equal(generic.arrays[name], fast.arrays[name], err_msg=name)
+    assert fast.arrays["fits"].sum() > 100  # the SVM was fitted, not only the ideal floor
+
+
 #: An older x86-64 CPU as one machine can emulate it: OpenBLAS's Nehalem kernels (numpy's wheels are built
 #: with DYNAMIC_ARCH) and numpy's loops without AVX, AVX2 or AVX-512 (its SSE4.2 baseline only).
 OLDER_CPU = {"OPENBLAS_CORETYPE": "Nehalem", "NPY_DISABLE_CPU_FEATURES": "X86_V3 X86_V4 AVX512_ICL AVX512_SPR"}
@@ -295,7 +315,7 @@ def test_the_batched_solver_decides_as_the_reference_except_near_ties():
 
 
 def test_an_unknown_solver_is_refused():
-    with pytest.raises(InputError, match="solver must be one of batched, sklearn, batched-cupy"):
+    with pytest.raises(InputError, match="solver must be one of batched, sklearn, batched-cupy, batched-array-api"):
         SweepConfig(solver="libsvm")
 
 

@@ -368,7 +368,7 @@ def test_the_contact_model_through_a_table_query_and_an_export(cli, tmp_path):
 
 
 def test_an_unknown_solver_or_a_batch_that_cannot_fit_is_one_line_before_any_work(cli, tmp_path):
-    cases = [(("--solver", "libsvm"), "solver must be one of batched, sklearn, batched-cupy"),
+    cases = [(("--solver", "libsvm"), "solver must be one of batched, sklearn, batched-cupy, batched-array-api"),
              (("--solver", "batched", "--contact", "2000"), "does not fit in the batched solver")]
     if importlib.util.find_spec("cupy") is None:  # a GPU library that is not installed: refused before work
         cases.append((("--solver", "batched-cupy"), "the cupy array library is not usable here"))

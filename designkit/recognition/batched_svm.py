@@ -91,14 +91,17 @@ def _namespace(xp, *arrays):
 
 
 #: Array libraries the batched solver runs on by name (``array_library``); numpy is the default.
-ARRAY_LIBRARIES = ("numpy", "cupy")
+ARRAY_LIBRARIES = ("numpy", "cupy", "array-api")
 
 
 def array_library(name: str):
     """The array namespace of a library by name, or one clear error if it is not installed.
 
-    ``"numpy"`` is numpy itself; ``"cupy"`` is CuPy through ``array_api_compat``
-    (``pip install 'designkit[gpu]'``): the same solver code then runs on the GPU.
+    ``"numpy"`` is numpy itself (the solver's numpy fast path); ``"cupy"`` is CuPy through
+    ``array_api_compat`` (``pip install 'designkit[gpu]'``): the same solver code then runs
+    on the GPU; ``"array-api"`` is numpy through ``array_api_compat``'s wrapper namespace,
+    which runs the code the GPU runs (the generic array-API path, not the numpy fast path)
+    on the CPU: what a GPU build should give, checked without a GPU.
 
     Raises
     ------
@@ -114,6 +117,13 @@ def array_library(name: str):
         raise InputError(f"array library must be one of {', '.join(ARRAY_LIBRARIES)}, got {name!r}")
     if name == "numpy":
         return np
+    if name == "array-api":
+        try:
+            from array_api_compat import numpy as xp
+        except ImportError as exc:
+            raise InputError(f"the array-api solver needs array-api-compat ({exc}); install it with "
+                             "pip install 'designkit[gpu]' or pip install array-api-compat") from None
+        return xp
     try:
         import cupy  # noqa: F401
         from array_api_compat import cupy as xp

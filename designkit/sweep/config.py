@@ -42,8 +42,9 @@ MAX_TRIALS = 1_000_000
 FIDELITIES = ("svm", "ideal")
 
 #: What fits the SVM: the batched libsvm-equivalent solver (default; ``batched-cupy`` is the same code
-#: on a GPU through CuPy) or scikit-learn's pipeline one pair at a time (the reference).
-SOLVERS = ("batched", "sklearn", "batched-cupy")
+#: on a GPU through CuPy, ``batched-array-api`` that GPU code on numpy, to check a GPU build's table on
+#: a CPU) or scikit-learn's pipeline one pair at a time (the reference).
+SOLVERS = ("batched", "sklearn", "batched-cupy", "batched-array-api")
 
 
 @dataclass(frozen=True)

@@ -9,7 +9,7 @@ repeat), so a bounded cache never changes a result.
 
 Two solvers score a fit (``SweepConfig.solver``): ``sklearn``, scikit-learn's
 pipeline one pair at a time (the reference), and ``batched`` (the default; ``batched-cupy``
-is the same code on CuPy arrays),
+is the same code on CuPy arrays, ``batched-array-api`` that code on numpy),
 :func:`~designkit.recognition.batched_svm.batched_cv_f1` on every pair a
 search step asks for at once (the same classifier; predictions can differ
 from the reference's only on near-ties). Batches are cut so that their
@@ -80,7 +80,8 @@ CHUNK_PAIRS = 8
 
 
 def array_namespace(solver: str):
-    """Array namespace of a batched solver's name (``batched``: numpy; ``batched-cupy``: CuPy).
+    """Array namespace of a batched solver's name (``batched``: numpy; ``batched-cupy``: CuPy;
+    ``batched-array-api``: numpy through array_api_compat, the GPU's code path).
 
     Raises :class:`~designkit.InputError` (one line) where the library is not installed.
 

@@ -54,7 +54,7 @@ def sweep(
     thickness: Thickness = None,
     backing: BackingOpt = None,
     diffusivity: Diffusivity = None,
-    solver: Annotated[Optional[str], typer.Option("--solver", help="SVM solver: batched (default: many pairs at once, same classifier), sklearn (the reference, one pair at a time) batched-cupy (the batched solver on a GPU; pip install 'designkit[gpu]') or batched-array-api (the GPU's code on numpy: what a GPU build should give, checked on the CPU).")] = None,
+    solver: Annotated[Optional[str], typer.Option("--solver", help="SVM solver: batched (default: many pairs at once, same classifier), sklearn (the reference, one pair at a time), batched-cupy (the batched solver on a GPU; pip install 'designkit[gpu]') or batched-array-api (the GPU's code on numpy: what a GPU build should give, checked on the CPU).")] = None,
     jobs: Annotated[int, typer.Option("--jobs", "-j", help="Local worker processes (-1: all cores).")] = -1,
     backend: Annotated[str, typer.Option("--backend", help="loky (local processes) or dask.")] = "loky",
     scheduler: Annotated[Optional[str], typer.Option("--scheduler", help="Dask scheduler address (with --backend dask).")] = None,

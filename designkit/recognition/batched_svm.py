@@ -122,7 +122,7 @@ def array_library(name: str):
             from array_api_compat import numpy as xp
         except ImportError as exc:
             raise InputError(f"the array-api solver needs array-api-compat ({exc}); install it with "
-                             "pip install 'designkit[gpu]' or pip install array-api-compat") from None
+                             "pip install array-api-compat") from None
         return xp
     try:
         import cupy  # noqa: F401

@@ -384,3 +384,19 @@ def test_the_batched_solver_through_the_cli(cli, tmp_path):
     assert r.exit_code == 0, r.output
     header = json.loads(out.with_suffix(".json").read_text())
     assert header["config"]["solver"] == "batched" and header["stats"]["run"]["solver"] == "batched"
+
+
+def test_the_gpu_code_path_without_array_api_compat_is_one_line_before_any_work(tmp_path):
+    """A base install (README command 1) has no array-api-compat: --solver batched-array-api is refused
+    naming the package, before a chunk is written. The import is made to fail as Python lets a program
+    do it (``sys.modules[name] = None``), in a process of its own."""
+    cfg = tmp_path / "tiny.yaml"
+    cfg.write_text(CONFIG)
+    code = ("import sys; sys.modules['array_api_compat'] = None; from designkit.cli import main; "
+            "sys.argv = ['designkit'] + sys.argv[1:]; main()")
+    r = _run([sys.executable, "-c", code, "sweep", "--config", str(cfg), "--workdir", str(tmp_path / "w"),
+              "--out", str(tmp_path / "t.npz"), "--solver", "batched-array-api"])
+    err = r.stderr.strip()
+    assert r.returncode == 2 and len(err.splitlines()) == 1, err
+    assert "needs array-api-compat" in err and "pip install array-api-compat" in err
+    assert not (tmp_path / "w").exists() and not (tmp_path / "t.npz").exists()

@@ -379,6 +379,29 @@ def test_an_unknown_solver_or_a_batch_that_cannot_fit_is_one_line_before_any_wor
         assert not (tmp_path / f"work-s{k}").exists() and not out.exists()
 
 
+def test_a_scheduler_that_cannot_be_used_is_one_line_before_any_work(cli, tmp_path):
+    """A scheduler address without --backend dask was ignored (the sweep ran on local processes, not on
+    the cluster asked for); a TCP port where nothing listens waited for dask's 30 s connect timeout; a
+    malformed address failed inside dask with "invalid literal for int()". Each is one line naming the
+    address now, before a chunk or the workdir is written."""
+    pytest.importorskip("distributed", reason="dask.distributed is in the test extra")
+    import socket
+
+    with socket.socket() as s:  # a port nothing listens on once this closes
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    cases = [(("--scheduler", "tcp://127.0.0.1:8786"), "use it with --backend dask"),
+             (("--backend", "dask", "--scheduler", f"tcp://127.0.0.1:{port}"), f"nothing listens on port {port}"),
+             (("--backend", "dask", "--scheduler", "tcp:/nohost"), "'tcp:/nohost' is not a dask scheduler address"),
+             (("--backend", "dask", "--scheduler", "localhost"), "missing port number"),
+             (("--backend", "dask", "--scheduler", "tcp://no-such-host.invalid:8786"), "not found")]
+    for k, (options, needle) in enumerate(cases):
+        bad, out = _model_sweep(cli, tmp_path, f"d{k}", "", *options)
+        err = bad.stderr.strip()
+        assert bad.exit_code == 2 and len(err.splitlines()) == 1 and needle in err, (options, err)
+        assert not (tmp_path / f"work-d{k}").exists() and not out.exists()
+
+
 def test_the_batched_solver_through_the_cli(cli, tmp_path):
     r, out = _model_sweep(cli, tmp_path, "b", "", "--solver", "batched")
     assert r.exit_code == 0, r.output

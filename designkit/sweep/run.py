@@ -23,8 +23,8 @@ from .chunk import ChunkResult, estimated_costs, run_chunk
 from .config import SweepConfig
 from .search import assemble, chunk_wall_s
 
-__all__ = ["BACKENDS", "SweepInterrupted", "check_batches", "iter_sweep", "local_cluster", "prepare_workdir",
-           "run_sweep"]
+__all__ = ["BACKENDS", "SweepInterrupted", "check_batches", "check_scheduler", "iter_sweep", "local_cluster",
+           "prepare_workdir", "run_sweep"]
 
 #: Where chunks run: local processes, this process, or a dask cluster.
 BACKENDS = ("loky", "sequential", "dask")
@@ -115,8 +115,7 @@ def iter_sweep(cfg: SweepConfig, workdir: Path, *, jobs: int = 1, backend: str =
     :func:`~designkit.sweep.chunk.estimated_costs` go first, so that no worker
     starts a long one while the others run out of work.
     """
-    if backend not in BACKENDS:
-        raise InputError(f"backend must be loky, sequential or dask, got {backend!r}")
+    check_scheduler(backend, scheduler)
     workdir = Path(workdir)
     todo = []
     for k in range(len(cfg.contact_s)):
@@ -203,6 +202,59 @@ def local_cluster(jobs: int):
         return Client(processes=True, n_workers=max(jobs, 1), threads_per_worker=1)
 
 
+def check_scheduler(backend: str, scheduler: str | None) -> None:
+    """Refuse, before any work, a backend or a dask scheduler address that cannot be used.
+
+    A scheduler address without ``backend="dask"`` would be ignored (the sweep would run on local
+    processes, not on the cluster asked for), a malformed one fails deep inside dask, and a TCP
+    address where nothing listens waits for dask's connect timeout (30 s) before failing: each is
+    one clear error here instead. A TCP port that neither accepts nor refuses (a firewall, a slow
+    network) is left to dask's own connection attempt, which waits and says why.
+
+    Raises
+    ------
+    InputError
+        Unknown backend; a scheduler with another backend; an address dask cannot parse; a host
+        that does not resolve; a port that refuses the connection.
+
+    Examples
+    --------
+    >>> check_scheduler("loky", None)
+    >>> check_scheduler("loky", "tcp://10.0.0.5:8786")
+    Traceback (most recent call last):
+    ...
+    designkit._validation.InputError: --scheduler is the address of a dask scheduler: use it with --backend dask
+    """
+    if backend not in BACKENDS:
+        raise InputError(f"backend must be loky, sequential or dask, got {backend!r}")
+    if scheduler is None:
+        return
+    if backend != "dask":
+        raise InputError("--scheduler is the address of a dask scheduler: use it with --backend dask")
+    try:
+        from distributed.comm import parse_address
+        from distributed.comm.addressing import parse_host_port
+    except ImportError:
+        raise InputError("the dask backend needs dask.distributed: pip install 'designkit[distributed]'") from None
+    try:
+        scheme, location = parse_address(scheduler)
+        host, port = parse_host_port(location) if scheme in ("tcp", "tls") else (None, None)
+    except (ValueError, TypeError) as exc:
+        raise InputError(f"--scheduler {scheduler!r} is not a dask scheduler address (tcp://HOST:PORT): {exc}") from None
+    if host is None:
+        return  # another transport (inproc, ucx, ...): dask's to check
+    import socket
+
+    try:
+        socket.create_connection((host, port), timeout=5).close()
+    except ConnectionRefusedError:
+        raise InputError(f"no dask scheduler at {scheduler}: nothing listens on port {port} of {host}") from None
+    except socket.gaierror as exc:
+        raise InputError(f"no dask scheduler at {scheduler}: host {host!r} not found ({exc.strerror})") from None
+    except OSError:
+        pass  # no answer within 5 s (a firewall, a slow network): dask's own attempt decides
+
+
 def check_batches(cfg: SweepConfig) -> None:
     """Refuse, before any work, a batched-solver sweep that cannot run here.
 
@@ -256,6 +308,7 @@ def run_sweep(cfg: SweepConfig, workdir: str | Path, *, out: str | Path | None =
     from ..tables.store import table_header, write_table
 
     workdir = Path(workdir)
+    check_scheduler(backend, scheduler)
     check_batches(cfg)
     prepare_workdir(cfg, workdir, resume=resume, fresh=fresh)
     total = len(cfg.scene_points()) * len(cfg.blocks_of()) * len(cfg.contact_s)

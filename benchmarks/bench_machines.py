@@ -72,9 +72,8 @@ def worker(args) -> int:
     """In the emulated process: what the CPU looks like, and the decisions of the sample pairs."""
     import threadpoolctl
 
-    from designkit.recognition.batched_svm import batched_cv_f1
     from designkit.sweep.config import SweepConfig
-    from designkit.sweep.scorer import CV_KEY, PairScorer, array_namespace
+    from designkit.sweep.scorer import PairScorer
 
     from numpy._core._multiarray_umath import __cpu_dispatch__, __cpu_features__
 
@@ -86,12 +85,8 @@ def worker(args) -> int:
     for key, plist in pairs.items():
         noise, contact = map(float, key.split("|"))
         cfg = SweepConfig.from_yaml(args.config, noise_ratio=[noise], contact_s=[contact], solver=args.solver)
-        sensor = cfg.resolved_sensor()
-        scorer = PairScorer(cfg, sensor, cfg.scene((0,), contact))
-        r = batched_cv_f1([scorer.features(i, 0) for i, _ in plist], [scorer.features(j, 0) for _, j in plist],
-                          seeds=[[cfg.seed, i, j, 0, CV_KEY] for i, j in plist], folds=cfg.folds,
-                          xp=array_namespace(args.solver))
-        out[key] = r.decision
+        out[key] = PairScorer(cfg, cfg.resolved_sensor(), cfg.scene((0,), contact)).decisions(
+            [(i, j, 0) for i, j in plist])
     np.savez(args.worker, **out)
     Path(args.worker + ".json").write_text(json.dumps({"blas": blas, "simd": simd}))
     return 0

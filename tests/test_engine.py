@@ -199,14 +199,11 @@ OLDER_CPU = {"OPENBLAS_CORETYPE": "Nehalem", "NPY_DISABLE_CPU_FEATURES": "X86_V3
 _CHUNK_AND_DECISIONS = """
 import json, sys, numpy as np, threadpoolctl
 from designkit.sweep import SweepConfig, run_chunk
-from designkit.sweep.scorer import CV_KEY, PairScorer
-from designkit.recognition.batched_svm import batched_cv_f1
+from designkit.sweep.scorer import PairScorer
 cfg = SweepConfig(**json.loads(sys.argv[1]))
 r = run_chunk(cfg, (0,), 0, 0)
 sc = PairScorer(cfg, cfg.resolved_sensor(), cfg.scene((0,), cfg.contact_s[0]))
-pairs = [(i, i + 3) for i in range(0, 30, 5)]
-dec = batched_cv_f1([sc.features(i, 0) for i, _ in pairs], [sc.features(j, 0) for _, j in pairs],
-                    seeds=[[cfg.seed, i, j, 0, CV_KEY] for i, j in pairs]).decision
+dec = sc.decisions([(i, i + 3, 0) for i in range(0, 30, 5)])
 print(json.dumps({"blas": sorted({i.get("architecture") for i in threadpoolctl.threadpool_info()}),
                   "J": [r.J.tolist(), r.J_lo.tolist(), r.J_hi.tolist()], "fits": int(r.fits),
                   "cells": np.asarray(r.cells).tolist(), "decision": dec.tolist()}))

@@ -173,6 +173,22 @@ class PairScorer:
         """``(F1, standard error)`` of each ``(i, j, repeat)``, by the config's solver."""
         if self.cfg.solver == "sklearn":
             return [self.score(i, j, rep) for i, j, rep in keys]
+        out: list[tuple[float, float]] = []
+        for part, r in self._batched(keys):
+            self.fits += len(part)
+            self.calls += 1
+            out += [(float(f), float(e)) for f, e in zip(r.f1, r.standard_error)]
+        return out
+
+    def decisions(self, keys: list[tuple[int, int, int]]) -> np.ndarray:
+        """Cross-validated decision value of every touch of each ``(i, j, repeat)``, shape ``(len(keys), 2
+        trials)``, with the batched solver, the features and the fold seeds the sweep scores that pair with
+        (lower class first; >= 0 predicts the higher). Not counted as fits: what comparisons of the solver's
+        arithmetic across machines read (``benchmarks/bench_machines.py``)."""
+        return np.concatenate([r.decision for _, r in self._batched(keys)])
+
+    def _batched(self, keys: list[tuple[int, int, int]]):
+        """``(part of keys, BatchedF1)`` of each call of the batched solver that scores ``keys``."""
         from ..recognition.batched_svm import batched_cv_f1
 
         size = batch_pairs(self.cfg.trials, self.n_samples, self.cfg.folds)
@@ -180,18 +196,13 @@ class PairScorer:
             raise InputError(f"one pair of {self.cfg.trials} trials x {self.n_samples} samples does not fit "
                              f"in the batched solver's {BATCH_MB} MiB; use --solver sklearn")
         xp = array_namespace(self.cfg.solver)
-        out: list[tuple[float, float]] = []
         for part in self._calls(keys):
             # the solver stacks the features one chunk of `size` pairs at a time: a call of any length
             # needs one chunk's working memory, plus the features it references (bounded in _calls)
-            r = batched_cv_f1([self.features(i, rep) for i, _, rep in part],
-                              [self.features(j, rep) for _, j, rep in part],
-                              seeds=[[self.cfg.seed, i, j, rep, CV_KEY] for i, j, rep in part],
-                              folds=self.cfg.folds, chunk_size=min(size, CHUNK_PAIRS), xp=xp)
-            self.fits += len(part)
-            self.calls += 1
-            out += [(float(f), float(e)) for f, e in zip(r.f1, r.standard_error)]
-        return out
+            yield part, batched_cv_f1([self.features(i, rep) for i, _, rep in part],
+                                      [self.features(j, rep) for _, j, rep in part],
+                                      seeds=[[self.cfg.seed, i, j, rep, CV_KEY] for i, j, rep in part],
+                                      folds=self.cfg.folds, chunk_size=min(size, CHUNK_PAIRS), xp=xp)
 
     def _calls(self, keys: list[tuple[int, int, int]]):
         """Consecutive runs of ``keys`` whose distinct feature matrices fit a quarter of the feature cache.

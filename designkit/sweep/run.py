@@ -116,7 +116,12 @@ def iter_sweep(cfg: SweepConfig, workdir: Path, *, jobs: int = 1, backend: str =
     starts a long one while the others run out of work.
     """
     check_scheduler(backend, scheduler)
-    workdir = Path(workdir)
+    yield from _iter_sweep(cfg, Path(workdir), jobs, backend, scheduler)
+
+
+def _iter_sweep(cfg: SweepConfig, workdir: Path, jobs: int, backend: str, scheduler: str | None):
+    """:func:`iter_sweep` once its backend and scheduler are checked (``run_sweep`` checks them before it
+    prepares the workdir: the scheduler is probed once)."""
     todo = []
     for k in range(len(cfg.contact_s)):
         for p in cfg.scene_points():
@@ -316,7 +321,7 @@ def run_sweep(cfg: SweepConfig, workdir: str | Path, *, out: str | Path | None =
     t0 = time.perf_counter()
     computed = 0
     try:
-        for res, was_computed in iter_sweep(cfg, workdir, jobs=jobs, backend=backend, scheduler=scheduler):
+        for res, was_computed in _iter_sweep(cfg, workdir, jobs, backend, scheduler):
             chunks.append(res)
             computed += was_computed
             if on_chunk is not None:

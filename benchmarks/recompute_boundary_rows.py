@@ -43,8 +43,8 @@ def recompute(workdir: str, name: str) -> tuple[str, int, bool]:
     check_chunk(arrays, cfg, res.point, res.block, res.contact_index, path)  # its identity: this sweep's chunk
     t0 = time.process_time()
     n, rows = cfg.intervals, res.rows
-    outside = set(np.setdiff1d(with_anchors(rows, n, ANCHOR_EVERY), rows).tolist())
-    aff = np.array([i for i in rows.tolist() if outside & set(with_anchors([i], n, ANCHOR_EVERY).tolist())],
+    in_block = set(rows.tolist())  # the rows whose guided search needs an anchor outside the block
+    aff = np.array([i for i in rows.tolist() if not set(with_anchors([i], n, ANCHOR_EVERY).tolist()) <= in_block],
                    dtype=np.int64)
     if aff.size == 0 or cfg.fidelity != "svm" or cfg.full_matrix or not cfg.ideal_bound:
         return name, 0, False

@@ -79,8 +79,7 @@ def within_sample_limit(contact_s, sample_rate_hz: float) -> np.ndarray:
     >>> within_sample_limit([2.0, 4999.0, 5000.0, 1e308], 200.0).tolist()
     [True, True, False, False]
     """
-    with np.errstate(invalid="ignore"):
-        return _last_index_float(contact_s, sample_rate_hz) < MAX_SAMPLES_PER_TOUCH
+    return _last_index_float(contact_s, sample_rate_hz) < MAX_SAMPLES_PER_TOUCH
 
 
 def sample_times_s(contact_s: float, sample_rate_hz: float) -> np.ndarray:

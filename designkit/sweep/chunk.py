@@ -99,11 +99,11 @@ def run_chunk(cfg: SweepConfig, point: tuple[int, ...], block: int, contact_inde
     backend, scikit-learn's own joblib calls, such as the folds of cross-validation, would
     otherwise be sent back to the cluster one by one: measured 5x slower per chunk.) BLAS
     and LAPACK run on one thread for the same reason: the batched solver's small
-    factorizations (133 x 133)
-    spent most of their time in idle threads of a multithreaded BLAS on a loaded machine
-    (measured: one 60-interval chunk at 4 s, 43 s of CPU with the default threads, 3.7 s
-    with one), and one thread everywhere makes the floating-point order the same
-    whatever machine or worker count.
+    factorizations (133 x 133) spent most of their time in idle threads of a
+    multithreaded BLAS on a loaded machine (measured: one 60-interval chunk at 4 s, 43 s
+    of CPU with the default threads, 3.7 s with one), and one thread everywhere makes the
+    floating-point order the same whatever the worker count. (Other CPUs run other
+    kernels and round differently; docs/engine.md measures that the tables do not move.)
     """
     from joblib import parallel_config
     from threadpoolctl import threadpool_limits

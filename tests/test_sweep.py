@@ -211,6 +211,51 @@ def test_the_dask_cluster_a_sweep_starts_leaves_malloc_trimming_to_glibc(monkeyp
     assert {value for _, value in envs.values()} == {None}
 
 
+def _mmapped_bytes() -> int:
+    """glibc's count of bytes this process holds in mmap'd chunks (``mallinfo2().hblkhd``)."""
+    import ctypes
+
+    class Mallinfo2(ctypes.Structure):
+        _fields_ = [(name, ctypes.c_size_t) for name in ("arena", "ordblks", "smblks", "hblks", "hblkhd",
+                                                          "usmblks", "fsmblks", "uordblks", "fordblks", "keepcost")]
+
+    libc = ctypes.CDLL(None)
+    libc.mallinfo2.restype = Mallinfo2
+    return int(libc.mallinfo2().hblkhd)
+
+
+def test_a_chunk_takes_its_arrays_from_a_kept_heap_and_sets_everything_back_after():
+    """Inside steady_heap (what run_chunk runs in) a 16 MB array comes from the heap, not fresh mmap'd pages,
+    and numpy's huge-page advice is off; after it, glibc's default threshold and numpy's advice are back."""
+    import ctypes
+    import platform
+
+    from designkit._workers import _numpy_hugepage_setter, steady_heap
+
+    if platform.system() != "Linux" or platform.libc_ver()[0] != "glibc" or not hasattr(ctypes.CDLL(None),
+                                                                                       "mallinfo2"):
+        pytest.skip("needs glibc 2.33 or later (mallopt, mallinfo2)")
+    advise = _numpy_hugepage_setter()
+
+    def advice():
+        now = advise(True)
+        advise(now)
+        return now
+
+    before = advice()
+    with steady_heap():
+        assert advice() is False
+        held = _mmapped_bytes()
+        x = np.ones(2 * 2**20)  # 16 MiB
+        assert _mmapped_bytes() == held
+        del x
+    assert advice() == before
+    held = _mmapped_bytes()
+    x = np.ones(2 * 2**20)
+    assert _mmapped_bytes() >= held + x.nbytes
+    del x
+
+
 def _in_flight_plugin():
     """A scheduler plugin counting the most tasks assigned to workers at once (the ``processing`` state)."""
     from distributed.diagnostics.plugin import SchedulerPlugin

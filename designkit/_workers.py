@@ -128,11 +128,15 @@ def steady_heap() -> Iterator[None]:
     2026-11-24): 4.0 -> 3.6 ms of CPU per SVM fit at 2 s of contact (page faults 333,000 ->
     56,000), 15.2 -> 13.3 ms at 10 s; the same peak memory; the same arrays (nothing
     computed changes, only where memory comes from). Either setting alone gains little.
+    A whole svm-paper build: 1,749 -> 1,628 CPU s, the same content hash
+    (``benchmarks/results/svm-paper-rebuild.txt``).
 
     Inside: glibc's mmap threshold 32 MiB (arrays below it come from the heap) and its
     trim threshold 1 GiB (freed heap is kept), numpy's huge-page advice off. On exit the
-    previous huge-page advice and glibc's default thresholds are set back and the free heap
-    is given back to the system (``malloc_trim``). Where the C library is not glibc only
+    previous huge-page advice and glibc's default thresholds (128 KiB; glibc then no
+    longer raises them by itself, as it does from the start of a process) are set back and
+    the free heap is given back to the system (``malloc_trim``): an interactive process
+    that ran a chunk does not keep its working set. Where the C library is not glibc only
     numpy's advice changes.
 
     >>> import numpy as np

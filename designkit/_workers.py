@@ -114,6 +114,14 @@ def _start_pool(n_jobs: int) -> None:
 _M_TRIM_THRESHOLD, _M_MMAP_THRESHOLD = -1, -3
 _GLIBC_DEFAULT_THRESHOLD = 128 * 1024
 
+#: The allocator's settings belong to the process, not to a chunk: where several chunks run at once
+#: in one process (a dask worker with several threads), the first one in sets them and the last one
+#: out sets them back (a chunk ending must not undo them under one still running).
+_HEAP_LOCK = threading.Lock()
+_HEAP_USERS = [0]
+_HEAP_BEFORE: list = [None]
+
+
 
 @contextmanager
 def steady_heap() -> Iterator[None]:
@@ -124,7 +132,7 @@ def steady_heap() -> Iterator[None]:
     such an array from fresh pages of the kernel (``mmap``, or heap it gave back at the last
     ``free``), and numpy asks the kernel to back every array of 4 MiB or more with 2 MiB
     huge pages (``madvise``): each allocation then pays page faults and the kernel's
-    zeroing of those pages. Measured on svm-paper chunks (``benchmarks/profile_chunk.py``,
+    zeroing of those pages. Measured on 50-reference svm-paper chunks (``benchmarks/profile_chunk.py``,
     2026-11-24): 4.0 -> 3.6 ms of CPU per SVM fit at 2 s of contact (page faults 333,000 ->
     56,000), 15.2 -> 13.3 ms at 10 s; the same peak memory; the same arrays (nothing
     computed changes, only where memory comes from). Either setting alone gains little.
@@ -136,8 +144,9 @@ def steady_heap() -> Iterator[None]:
     previous huge-page advice and glibc's default thresholds (128 KiB; glibc then no
     longer raises them by itself, as it does from the start of a process) are set back and
     the free heap is given back to the system (``malloc_trim``): an interactive process
-    that ran a chunk does not keep its working set. Where the C library is not glibc only
-    numpy's advice changes.
+    that ran a chunk does not keep its working set. Where several threads of one process
+    are inside at once, the last one out sets them back. Where the C library is not glibc
+    only numpy's advice changes.
 
     >>> import numpy as np
     >>> with steady_heap():
@@ -145,21 +154,27 @@ def steady_heap() -> Iterator[None]:
     >>> total
     3000000.0
     """
-    libc = _glibc()
-    advise = _numpy_hugepage_setter()
-    before = advise(False) if advise is not None else None
-    if libc is not None:
-        libc.mallopt(_M_MMAP_THRESHOLD, 32 * 2**20)
-        libc.mallopt(_M_TRIM_THRESHOLD, 2**30)
+    with _HEAP_LOCK:
+        _HEAP_USERS[0] += 1
+        if _HEAP_USERS[0] == 1:  # the first chunk in: set (later ones find it set)
+            libc, advise = _glibc(), _numpy_hugepage_setter()
+            _HEAP_BEFORE[0] = advise(False) if advise is not None else None
+            if libc is not None:
+                libc.mallopt(_M_MMAP_THRESHOLD, 32 * 2**20)
+                libc.mallopt(_M_TRIM_THRESHOLD, 2**30)
     try:
         yield
     finally:
-        if libc is not None:
-            libc.mallopt(_M_MMAP_THRESHOLD, _GLIBC_DEFAULT_THRESHOLD)
-            libc.mallopt(_M_TRIM_THRESHOLD, _GLIBC_DEFAULT_THRESHOLD)
-            libc.malloc_trim(0)
-        if advise is not None:
-            advise(before)
+        with _HEAP_LOCK:
+            _HEAP_USERS[0] -= 1
+            if _HEAP_USERS[0] == 0:  # the last chunk out: set back
+                libc, advise = _glibc(), _numpy_hugepage_setter()
+                if libc is not None:
+                    libc.mallopt(_M_MMAP_THRESHOLD, _GLIBC_DEFAULT_THRESHOLD)
+                    libc.mallopt(_M_TRIM_THRESHOLD, _GLIBC_DEFAULT_THRESHOLD)
+                    libc.malloc_trim(0)
+                if advise is not None and _HEAP_BEFORE[0] is not None:
+                    advise(_HEAP_BEFORE[0])
 
 
 def _glibc():

@@ -30,6 +30,49 @@ from contextlib import contextmanager
 from typing import Iterator
 
 
+#: Most local worker processes per core a computation may start: each sweep worker takes up to 1 GB,
+#: and a mistyped ``--jobs 100000`` started processes until the machine stalled (load average 43 on
+#: 2 cores, seen).
+MAX_JOBS_PER_CORE = 4
+
+
+def worker_count(jobs: int) -> int:
+    """Local worker processes that ``jobs`` asks for on this machine, by joblib's convention.
+
+    ``jobs > 0`` is that many, ``-1`` all cores, ``-2`` all but one, and so on (the cores
+    this process may use: ``joblib.cpu_count()``). Raises :class:`~designkit.InputError`
+    (one line) where that is no worker at all (0, or more cores left out than there are) or
+    more than :data:`MAX_JOBS_PER_CORE` per core.
+
+    >>> worker_count(1)
+    1
+    >>> import joblib
+    >>> worker_count(-1) == joblib.cpu_count()
+    True
+    """
+    from joblib import cpu_count
+
+    from ._validation import InputError
+
+    try:
+        j = int(jobs)
+    except (TypeError, ValueError):
+        raise InputError(f"jobs must be a whole number of worker processes, got {jobs!r}") from None
+    cores = cpu_count()
+    if j == 0:
+        raise InputError(f"jobs = 0 is no worker process: give how many (1 to {MAX_JOBS_PER_CORE * cores} here), "
+                         "or -1 for all cores")
+    n = j if j > 0 else cores + 1 + j
+    if n < 1:
+        raise InputError(f"jobs = {j} leaves out {-j - 1} of this machine's {cores} cores: none would work "
+                         "(-1: all cores, -2: all but one)")
+    if n > MAX_JOBS_PER_CORE * cores:
+        raise InputError(f"jobs = {j} is more worker processes than {MAX_JOBS_PER_CORE} per core on this machine's "
+                         f"{cores} cores (each may take up to 1 GB): give at most {MAX_JOBS_PER_CORE * cores}, "
+                         "or -1 for all cores")
+    return n
+
+
 def ignore_ctrl_c() -> None:
     """Worker initializer: SIGINT ignored in this process (the parent handles it)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)

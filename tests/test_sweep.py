@@ -427,6 +427,30 @@ def test_an_unknown_solver_or_a_batch_that_cannot_fit_is_one_line_before_any_wor
         assert not (tmp_path / f"work-s{k}").exists() and not out.exists()
 
 
+def test_a_worker_count_that_means_none_or_too_many_is_one_line_before_any_work(cli, tmp_path):
+    """--jobs 0 failed with joblib's "n_jobs == 0 in Parallel has no meaning" after the workdir was made;
+    --jobs 100000 started processes until the machine stalled (seen: load average 43 on 2 cores); a
+    negative count beyond the cores silently ran one worker. Each is one line naming the count now,
+    before any work, for a sweep and for an exact question; later options (``-1``) keep joblib's sense."""
+    import joblib
+
+    cores = joblib.cpu_count()
+    for k, jobs in enumerate(["0", str(10**5), str(-cores - 1)]):
+        bad, out = _model_sweep(cli, tmp_path, f"j{k}", "", "--jobs", jobs)
+        err = bad.stderr.strip()
+        assert bad.exit_code == 2 and len(err.splitlines()) == 1 and f"jobs = {jobs}" in err, (jobs, err)
+        assert not (tmp_path / f"work-j{k}").exists() and not out.exists()
+    exact = cli("min-contact", "--e1", "35000", "--e2", "20000", "--exact", "--jobs", "0")
+    assert exact.exit_code == 2 and "jobs = 0 is no worker process" in exact.stderr
+    from designkit.sweep.run import _workers_asked
+
+    # the CLI's default (-1) on a dask cluster the sweep starts: one worker per core (it started one worker)
+    assert _workers_asked(-1, "dask", None) == _workers_asked(-1, "loky", None) == cores
+    if cores > 1:
+        assert _workers_asked(-2, "loky", None) == cores - 1
+    assert _workers_asked(-1, "dask", "tcp://127.0.0.1:8786") == -1  # a running cluster's own workers work
+
+
 def test_a_scheduler_that_cannot_be_used_is_one_line_before_any_work(cli, tmp_path):
     """A scheduler address without --backend dask was ignored (the sweep ran on local processes, not on
     the cluster asked for); a TCP port where nothing listens waited for dask's 30 s connect timeout; a

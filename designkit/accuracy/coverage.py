@@ -443,8 +443,9 @@ def run_cases(question: str, n: int, *, seed: int, jobs: int = 1, done: Callable
     called as each finishes (for progress and saving)."""
     from joblib import Parallel, delayed
 
-    from .._workers import local_processes
+    from .._workers import local_processes, worker_count
 
+    jobs = worker_count(jobs)
     rng = as_generator([int(seed), COVERAGE_QUESTIONS.index(question)])
     cases = [draw_case(question, rng) for _ in range(int(n))]
     results = []

@@ -126,13 +126,14 @@ class _Run:
         if solver not in SOLVERS:
             raise InputError(f"unknown solver {solver!r}; known: {', '.join(SOLVERS)}")
         from .._validation import check_nonnegative
+        from .._workers import worker_count
         from ..models import sensor_model
 
         spread = check_nonnegative("sensor temperature spread [degC]", sensor_temp_spread_c)
         sen = load_sensor(sensor if sensor is not None else "paper")
         return cls(sen, sensor_model(sen) if model is None else get_model(model),  # a sensor file's own model
                    check_threshold(threshold), check_positive("class width", width), int(trials), int(folds),
-                   int(seed), int(repeats), check_positive("z", z), int(jobs), int(n_mc), solver, spread)
+                   int(seed), int(repeats), check_positive("z", z), worker_count(jobs), int(n_mc), solver, spread)
 
     # ---------------------------------------------------------------- the SVM
     def seeds(self) -> list[list[int]]:

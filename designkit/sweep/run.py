@@ -116,12 +116,21 @@ def iter_sweep(cfg: SweepConfig, workdir: Path, *, jobs: int = 1, backend: str =
     starts a long one while the others run out of work.
     """
     check_scheduler(backend, scheduler)
-    yield from _iter_sweep(cfg, Path(workdir), jobs, backend, scheduler)
+    yield from _iter_sweep(cfg, Path(workdir), _workers_asked(jobs, backend, scheduler), backend, scheduler)
+
+
+def _workers_asked(jobs: int, backend: str, scheduler: str | None) -> int:
+    """The local worker processes ``jobs`` means (:func:`~designkit._workers.worker_count`: ``-1`` all cores),
+    refused before any work where that is none or absurdly many; ``jobs`` as given on a running dask cluster
+    (``scheduler``), whose own workers do the work."""
+    from .._workers import worker_count
+
+    return int(jobs) if backend == "dask" and scheduler else worker_count(jobs)
 
 
 def _iter_sweep(cfg: SweepConfig, workdir: Path, jobs: int, backend: str, scheduler: str | None):
-    """:func:`iter_sweep` once its backend and scheduler are checked (``run_sweep`` checks them before it
-    prepares the workdir: the scheduler is probed once)."""
+    """:func:`iter_sweep` once its backend, scheduler and worker count are checked (``run_sweep`` checks them
+    before it prepares the workdir: the scheduler is probed once); ``jobs`` is a count of workers."""
     todo = []
     for k in range(len(cfg.contact_s)):
         for p in cfg.scene_points():
@@ -297,7 +306,8 @@ def run_sweep(cfg: SweepConfig, workdir: str | Path, *, out: str | Path | None =
         Table path (``.npz``; a ``.json`` header is written beside it).
         Default: ``workdir / f"{cfg.name}.npz"``.
     jobs : int
-        Local worker processes (``-1``: all cores).
+        Local worker processes (``-1``: all cores, ``-2``: all but one; the header's run stats record the
+        count); unused on a running dask cluster (``scheduler``).
     backend : {"loky", "sequential", "dask"}
     scheduler : str, optional
         Address of a dask scheduler (with ``backend="dask"``).
@@ -314,6 +324,7 @@ def run_sweep(cfg: SweepConfig, workdir: str | Path, *, out: str | Path | None =
 
     workdir = Path(workdir)
     check_scheduler(backend, scheduler)
+    jobs = _workers_asked(jobs, backend, scheduler)
     check_batches(cfg)
     prepare_workdir(cfg, workdir, resume=resume, fresh=fresh)
     total = len(cfg.scene_points()) * len(cfg.blocks_of()) * len(cfg.contact_s)

@@ -442,6 +442,9 @@ def test_a_worker_count_that_means_none_or_too_many_is_one_line_before_any_work(
         assert not (tmp_path / f"work-j{k}").exists() and not out.exists()
     exact = cli("min-contact", "--e1", "35000", "--e2", "20000", "--exact", "--jobs", "0")
     assert exact.exit_code == 2 and "jobs = 0 is no worker process" in exact.stderr
+    report = cli("reproduce", "--jobs", str(10**5), "--out", tmp_path / "report")  # before any section runs
+    assert report.exit_code == 2 and f"jobs = {10**5} is more worker processes" in report.stderr
+    assert not (tmp_path / "report").exists()
     from designkit.sweep.run import _workers_asked
 
     # the CLI's default (-1) on a dask cluster the sweep starts: one worker per core (it started one worker)

@@ -454,6 +454,16 @@ def test_a_worker_count_that_means_none_or_too_many_is_one_line_before_any_work(
     assert _workers_asked(-1, "dask", "tcp://127.0.0.1:8786") == -1  # a running cluster's own workers work
 
 
+def test_a_seed_count_without_end_is_one_line_before_any_work(cli, tmp_path):
+    """--max-repeats 1000000000 re-scored pairs at the threshold without end (seen: a one-scene sweep still
+    running after a minute), and --exact --repeats 1000000000 the same; both are refused by name now."""
+    bad, out = _model_sweep(cli, tmp_path, "r0", "", "--max-repeats", str(10**9))
+    assert bad.exit_code == 2 and "max_repeats must be a whole number from 1 to 1000" in bad.stderr
+    assert not (tmp_path / "work-r0").exists() and not out.exists()
+    exact = cli("min-contact", "--e1", "35000", "--e2", "20000", "--exact", "--repeats", str(10**9))
+    assert exact.exit_code == 2 and "repeats must be a whole number from 1 to 1000" in exact.stderr
+
+
 def test_a_scheduler_that_cannot_be_used_is_one_line_before_any_work(cli, tmp_path):
     """A scheduler address without --backend dask was ignored (the sweep ran on local processes, not on
     the cluster asked for); a TCP port where nothing listens waited for dask's 30 s connect timeout; a

@@ -37,7 +37,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .._validation import InputError, check_positive
+from .._validation import InputError, check_positive, check_repeats
 from ..objects import DEFAULT_CLASS_WIDTH, ObjectClass
 from .answer import Answer, IdealBound, ideal_floor, number
 from .inputs import (
@@ -119,8 +119,7 @@ class _Run:
             raise InputError(f"folds must be >= 2, got {folds}")
         if int(trials) < int(folds):
             raise InputError(f"trials per class ({trials}) must be at least the number of folds ({folds})")
-        if int(repeats) < 1:
-            raise InputError(f"repeats must be >= 1, got {repeats}")
+        check_repeats("repeats", repeats)
         if int(n_mc) < 10:
             raise InputError(f"the Monte Carlo ideal observer needs at least 10 touches per class, got {n_mc}")
         if solver not in SOLVERS:

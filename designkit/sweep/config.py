@@ -20,7 +20,7 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from .._validation import InputError, check_positive
+from .._validation import InputError, check_positive, check_repeats
 from ..models import get_model
 from ..objects import ObjectClass
 from ..recognition.features import DEFAULT_SLOPE_WINDOW_S
@@ -169,8 +169,7 @@ class SweepConfig:
             raise InputError(f"trials per interval ({self.trials}) must be at least the number of folds ({self.folds})")
         if not (2 / 3 < self.threshold < 1):
             raise InputError(f"threshold must be in (2/3, 1) (F1 of a blind all-positive guess is 2/3), got {self.threshold:g}")
-        if int(self.max_repeats) != self.max_repeats or self.max_repeats < 1:
-            raise InputError(f"max_repeats must be >= 1, got {self.max_repeats}")
+        check_repeats("max_repeats", self.max_repeats)
         check_positive("z", self.z)
         if int(self.blocks) != self.blocks or self.blocks < 1:
             raise InputError(f"blocks must be >= 1, got {self.blocks}")

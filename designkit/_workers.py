@@ -165,7 +165,6 @@ _HEAP_USERS = [0]
 _HEAP_BEFORE: list = [None]
 
 
-
 @contextmanager
 def steady_heap() -> Iterator[None]:
     """Freed memory kept in the process for reuse, and no transparent huge pages for numpy, while inside.

@@ -59,13 +59,10 @@ CPUS = (
 
 
 def _env(coretype, disable):
-    env = dict(os.environ)
-    for key, value in (("OPENBLAS_CORETYPE", coretype), ("NPY_DISABLE_CPU_FEATURES", disable)):
-        if value is None:
-            env.pop(key, None)
-        else:
-            env[key] = value
-    return env
+    """This process's environment with the emulation's two variables set as asked (None: unset)."""
+    asked = {"OPENBLAS_CORETYPE": coretype, "NPY_DISABLE_CPU_FEATURES": disable}
+    return {**{k: v for k, v in os.environ.items() if k not in asked},
+            **{k: v for k, v in asked.items() if v is not None}}
 
 
 def worker(args) -> int:

@@ -22,6 +22,7 @@ caught between two tasks (in loky's own loop, seen in CI) or while it starts
 from __future__ import annotations
 
 import ctypes
+import functools
 import os
 import platform
 import signal
@@ -56,8 +57,10 @@ def worker_count(jobs: int) -> int:
 
     try:
         j = int(jobs)
-    except (TypeError, ValueError):
-        raise InputError(f"jobs must be a whole number of worker processes, got {jobs!r}") from None
+    except (TypeError, ValueError, OverflowError):
+        j = None
+    if j is None or j != jobs:
+        raise InputError(f"jobs must be a whole number of worker processes, got {jobs!r}")
     cores = cpu_count()
     if j == 0:
         raise InputError(f"jobs = 0 is no worker process: give how many (1 to {MAX_JOBS_PER_CORE * cores} here), "
@@ -219,8 +222,9 @@ def steady_heap() -> Iterator[None]:
                     advise(_HEAP_BEFORE[0])
 
 
+@functools.cache
 def _glibc():
-    """This process's C library where it is glibc (``mallopt``, ``malloc_trim``), else None."""
+    """This process's C library where it is glibc (``mallopt``, ``malloc_trim``), else None (looked up once)."""
     if platform.system() != "Linux" or platform.libc_ver()[0] != "glibc":
         return None
     try:
@@ -232,8 +236,9 @@ def _glibc():
     return libc
 
 
+@functools.cache
 def _numpy_hugepage_setter():
-    """numpy's runtime switch of its huge-page advice (returns the previous setting), or None.
+    """numpy's runtime switch of its huge-page advice (returns the previous setting), or None (looked up once).
 
     numpy documents the switch as the environment variable ``NUMPY_MADVISE_HUGEPAGE``, read at
     import; this is the function behind it (``numpy._core.multiarray``, numpy >= 1.19).

@@ -119,7 +119,7 @@ class _Run:
             raise InputError(f"folds must be >= 2, got {folds}")
         if int(trials) < int(folds):
             raise InputError(f"trials per class ({trials}) must be at least the number of folds ({folds})")
-        check_repeats("repeats", repeats)
+        repeats = check_repeats("repeats", repeats)
         if int(n_mc) < 10:
             raise InputError(f"the Monte Carlo ideal observer needs at least 10 touches per class, got {n_mc}")
         if solver not in SOLVERS:
@@ -132,7 +132,7 @@ class _Run:
         sen = load_sensor(sensor if sensor is not None else "paper")
         return cls(sen, sensor_model(sen) if model is None else get_model(model),  # a sensor file's own model
                    check_threshold(threshold), check_positive("class width", width), int(trials), int(folds),
-                   int(seed), int(repeats), check_positive("z", z), worker_count(jobs), int(n_mc), solver, spread)
+                   int(seed), repeats, check_positive("z", z), worker_count(jobs), int(n_mc), solver, spread)
 
     # ---------------------------------------------------------------- the SVM
     def seeds(self) -> list[list[int]]:

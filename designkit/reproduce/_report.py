@@ -93,11 +93,9 @@ class ReproduceSettings:
     def __post_init__(self) -> None:
         if int(self.seed) != self.seed or self.seed < 0:
             raise InputError(f"seed must be a non-negative integer, got {self.seed}")
-        if int(self.jobs) != self.jobs:
-            raise InputError(f"jobs must be a whole number of worker processes, got {self.jobs}")
         from .._workers import worker_count
 
-        worker_count(self.jobs)  # none or absurdly many: refused here, before any section runs
+        worker_count(self.jobs)  # not a count, none or absurdly many: refused here, before any section runs
         fmt = str(self.figure_format).strip().lower()
         if fmt not in ("png", "svg", "pdf"):
             raise InputError(f"figure format must be png, svg or pdf, got {self.figure_format!r}")

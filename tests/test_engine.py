@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -295,6 +296,66 @@ def test_the_boundary_recomputation_script_restores_exactly_the_rows_it_names(tm
     assert fixed.J_lo[8] == good.J_lo[8] + 1 and np.array_equal(np.delete(fixed.J_lo, 8), np.delete(good.J_lo, 8))
     np.testing.assert_array_equal(fixed.cells, good.cells)
     assert fixed.fits == good.fits
+
+
+def test_crossing_fits_are_the_repeats_of_j_minus_one_and_j_of_each_staircase():
+    """A hand-worked chunk: only the pairs J - 1 and J of J, J_lo and J_hi count (shared pairs once, none at or
+    below the reference itself), each with its repeats; the probes elsewhere are what the search spent."""
+    import importlib.util
+    from types import SimpleNamespace
+
+    path = Path(__file__).resolve().parents[1] / "benchmarks" / "profile_chunk.py"
+    spec = importlib.util.spec_from_file_location("profile_chunk", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    cells = np.array([(0, 1, 0.5, 0.1, 1), (0, 2, 0.8, 0.1, 2), (0, 3, 0.9, 0.1, 2), (0, 4, 0.95, 0.1, 1),
+                      (0, 6, 1.0, 0.0, 1),  # a galloping probe beyond J_hi: spent, not certifying
+                      (1, 4, 0.85, 0.1, 2), (1, 5, 0.92, 0.1, 1), (1, 7, 0.96, 0.1, 1), (1, 8, 0.97, 0.1, 1),
+                      (1, 9, 0.99, 0.1, 2)], dtype=float)
+    res = SimpleNamespace(rows=np.array([0, 1]), J=np.array([3, 5]), J_lo=np.array([2, 5]), J_hi=np.array([4, 9]),
+                          cells=cells)
+    # row 0: pairs 1-4 (2+3, 1+2, 3+4) = 1 + 2 + 2 + 1; row 1: pairs 4, 5, 8, 9 = 2 + 1 + 1 + 2
+    assert mod.crossing_fits(res, 10) == 12
+    res.J_lo = np.array([3, 5])  # row 0's J_lo at J: pair 1 no longer certifies anything
+    assert mod.crossing_fits(res, 10) == 11
+    # right above row 0: pair (0, 0) is none
+    res.J, res.J_lo, res.J_hi = np.array([1, 5]), np.array([1, 5]), np.array([1, 9])
+    assert mod.crossing_fits(res, 10) == 1 + 6
+
+
+def test_profile_chunk_counts_a_finished_builds_fits_and_its_crossing_fits(tmp_path):
+    """benchmarks/profile_chunk.py --workdir (docs/engine.md: the search against a search told the answers):
+    every J inside the grid was scored (a row's search ends only on a passing probe at J), so the crossing
+    fits are at least one per such staircase answer, never more than the fits, and the totals are the chunks'."""
+    from designkit.sweep import run_sweep
+    from designkit.sweep.chunk import ChunkResult
+
+    cfg = SweepConfig(name="oc", blocks=2, intervals=40, trials=20, noise_ratio=(0.005,), contact_s=(1.0, 2.0), seed=3,
+                      max_repeats=2)
+    work = tmp_path / "work"
+    run_sweep(cfg, work, jobs=1, backend="sequential")
+    fits = answers = 0
+    for path in sorted((work / "chunks").glob("*.npz")):
+        with np.load(path, allow_pickle=False) as z:
+            res = ChunkResult.from_arrays({k: z[k] for k in z.files})
+        scored = {(int(i), int(j)) for i, j in res.cells[:, :2]}
+        inside = {(int(i), int(J)) for name in ("J", "J_lo", "J_hi")
+                  for i, J in zip(res.rows, getattr(res, name)) if J < cfg.intervals}
+        assert inside <= scored
+        answers += len(inside)
+        fits += res.fits
+    root = Path(__file__).resolve().parents[1]
+    r = subprocess.run([sys.executable, str(root / "benchmarks" / "profile_chunk.py"), "--workdir", str(work)],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    m = re.search(r"oc \(.*\): ([\d,]+) fits, ([\d,]+) on crossing pairs", r.stdout)
+    assert m, r.stdout
+    total, crossing = (int(g.replace(",", "")) for g in m.groups())
+    assert total == fits > 0
+    assert 0 < crossing <= total
+    assert crossing >= answers > 0  # each answer's pair, with at least one fit
+    assert len(re.findall(r"^\s+[12]\s+[\d,]+\s+[\d,]+\s+\d", r.stdout, flags=re.M)) == 2  # one line per contact
+
 
 def test_the_batched_solver_decides_as_the_reference_except_near_ties():
     """Same staircases with both solvers on a small scene; any cell they score differently is close."""

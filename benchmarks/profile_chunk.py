@@ -100,12 +100,18 @@ def search_overhead(workdir: str) -> None:
     import json
     from pathlib import Path
 
-    cfg = json.loads((Path(workdir) / "sweep.json").read_text())["config"]
-    n, contacts = int(cfg["intervals"]), cfg["contact_s"]
+    try:
+        cfg = json.loads((Path(workdir) / "sweep.json").read_text())["config"]
+        n, contacts = int(cfg["intervals"]), cfg["contact_s"]
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        raise ValueError(f"{workdir} is no sweep's working folder: its sweep.json is missing or unreadable ({exc})") from None
     per: dict[float, list[float]] = {}
     for path in sorted((Path(workdir) / "chunks").glob("*.npz")):
-        with np.load(path, allow_pickle=False) as z:
-            res = chunk.ChunkResult.from_arrays({k: z[k] for k in z.files})
+        try:
+            with np.load(path, allow_pickle=False) as z:
+                res = chunk.ChunkResult.from_arrays({k: z[k] for k in z.files})
+        except Exception as exc:  # numpy's and zipfile's errors for a damaged file, KeyError for a foreign one
+            raise ValueError(f"chunk {path} is unreadable ({exc})") from None
         c = crossing_fits(res, n)
         a = per.setdefault(float(contacts[res.contact_index]), [0, 0, 0.0, 0.0])
         a[0] += res.fits
@@ -113,7 +119,7 @@ def search_overhead(workdir: str) -> None:
         a[2] += res.wall_s
         a[3] += res.wall_s * (1.0 - c / res.fits) if res.fits else 0.0
     if not per:
-        raise SystemExit(f"{workdir}: no finished chunks")
+        raise ValueError(f"{workdir}: no finished chunks")
     tot = np.sum(list(per.values()), axis=0)
     print(f"{cfg['name']} ({workdir}): {int(tot[0]):,} fits, {int(tot[1]):,} on crossing pairs "
           f"({tot[0] / tot[1]:.2f}x); chunk wall {tot[2]:.0f} s, of which a search told the answers would "
@@ -134,7 +140,11 @@ def main(argv=None) -> int:
     p.add_argument("--workdir", help="a finished sweep's working folder: its search against the crossing fits")
     a = p.parse_args(argv)
     if a.workdir:
-        search_overhead(a.workdir)
+        try:
+            search_overhead(a.workdir)
+        except ValueError as exc:  # a folder that is no finished sweep's: one line, exit 2
+            print(f"error: {exc}", file=sys.stderr)
+            return 2
         return 0
     print(f"# {' '.join(sys.argv)}; {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}; "
           f"load average {' '.join(f'{x:.2f}' for x in os.getloadavg())}; {os.cpu_count()} cores")

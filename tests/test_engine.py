@@ -355,6 +355,11 @@ def test_profile_chunk_counts_a_finished_builds_fits_and_its_crossing_fits(tmp_p
     assert 0 < crossing <= total
     assert crossing >= answers > 0  # each answer's pair, with at least one fit
     assert len(re.findall(r"^\s+[12]\s+[\d,]+\s+[\d,]+\s+\d", r.stdout, flags=re.M)) == 2  # one line per contact
+    (work / "chunks" / "p000-b000-c000.npz").write_bytes(b"not a chunk")
+    for folder, says in ((work, "p000-b000-c000.npz is unreadable"), (tmp_path, "is no sweep's working folder")):
+        r = subprocess.run([sys.executable, str(root / "benchmarks" / "profile_chunk.py"), "--workdir", str(folder)],
+                           capture_output=True, text=True, timeout=120)
+        assert r.returncode == 2 and says in r.stderr and len(r.stderr.strip().splitlines()) == 1, r.stderr
 
 
 def test_the_batched_solver_decides_as_the_reference_except_near_ties():

@@ -850,6 +850,23 @@ def test_cli_refuses_an_injected_table_name_and_a_prefix_with_a_newline(cli, tmp
     assert not list(out.iterdir())
 
 
+def test_an_export_never_writes_over_the_table_it_reads(cli, tmp_path):
+    """--out (or a CSV's provenance sidecar) naming the source table's .npz or .json, also through a hard link,
+    is refused in one line before anything is written; the table still loads, with its content hash."""
+    base = random_ratio_table()
+    src = write_table(tmp_path / "own.npz", base.header, dict(base.arrays))
+    before = {p.name: p.read_bytes() for p in (src, src.with_suffix(".json"))}
+    (tmp_path / "link.npz").hardlink_to(src)
+    for out, fmt in (("own.npz", "npz"), ("own.json", "json"), ("own", "csv"), ("link.npz", "npz")):
+        r = cli("export", "--table", src, "--format", fmt, "--out", tmp_path / out)
+        assert r.exit_code == 2 and "is the table being exported" in r.stderr and r.stderr.count("\n") == 1, (out, r.output)
+        with pytest.raises(InputError, match="is the table being exported"):
+            export_table(load_table(src), tmp_path / out, fmt)
+    assert {p.name: p.read_bytes() for p in (src, src.with_suffix(".json"))} == before
+    assert load_table(src).header["content_hash"] == base.header["content_hash"]
+    assert cli("export", "--table", src, "--format", "npz", "--out", tmp_path / "other.npz").exit_code == 0
+
+
 def test_cli_writes_to_standard_output(cli, tmp_path):
     r = cli("export", "--table", "ideal-paper", "--noise", "0.05", "--delta-t", "10", "--contact", "2",
             "--format", "csv", "--out", "-")

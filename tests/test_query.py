@@ -263,6 +263,22 @@ def test_query_cli_json_is_the_answer_schema(cli, cmd, quantity):
         assert p["value"] is True and p["details"]["svm_f1"] is None and p["details"]["ideal_f1"] > 0.9
 
 
+@pytest.mark.parametrize("cmd", [
+    ["min-contact", "--e1", "35000", "--e2", "20000"],
+    ["delta-e", "--e", "20000", "--contact", "2"],
+    ["distinguishable", "--e1", "35000", "--e2", "20000", "--contact", "2"],
+])
+def test_an_ideal_observer_tables_answer_is_not_called_the_svms(cli, cmd):
+    """With --table ideal-paper the main line is the ideal observer's on that table's grid, never "SVM"; delta-e
+    prints no empty interval, and no legend for a dash it did not print."""
+    r = cli(*cmd, "--table", "ideal-paper")
+    assert r.exit_code == 0, r.output
+    assert "SVM" not in r.stdout and "ideal observer on table ideal-paper's grid" in r.stdout, r.stdout
+    assert "—" not in r.stdout, r.stdout
+    svm = cli(*cmd)  # the default table is an SVM table: its answer keeps its name
+    assert svm.exit_code == 0 and ("SVM (the paper's classifier)" in svm.stdout or "SVM " in svm.stdout)
+
+
 def test_the_same_question_has_the_same_keys_on_every_route():
     """Table, exact (semi-infinite) and exact with a slab (the former thin route): identical --json keys,
     at every level that is not route-specific (``computation`` is)."""

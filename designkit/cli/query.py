@@ -239,12 +239,21 @@ def _interval(d, unit):
     return f"(interval {ends}: {why.get(iv.get('method'), 'coverage not stated')})"
 
 
+def _answerer(d) -> str:
+    """Whose answer the main line gives: the paper's SVM, or the ideal observer where the table holds that."""
+    if (d.get("computation") or {}).get("fidelity") == "ideal":
+        from rich.markup import escape
+
+        return f"ideal observer on table {escape(d['table']['name'])}'s grid"
+    return "SVM (the paper's classifier)"
+
+
 def _scalar(words: str, unit: str):
     def line(con, d):
         if d["value"] is None:
-            con.print("  SVM (the paper's classifier): [red]no answer[/] (see below)")
+            con.print(f"  {_answerer(d)}: [red]no answer[/] (see below)")
         else:
-            con.print(f"  SVM (the paper's classifier): {words} [bold green]{_fmt(d['value'], unit)}[/] "
+            con.print(f"  {_answerer(d)}: {words} [bold green]{_fmt(d['value'], unit)}[/] "
                       f"{_interval(d, unit)}")
         ideal = d["ideal"]
         iv = ideal.get("interval")
@@ -259,13 +268,16 @@ def _scalar(words: str, unit: str):
 def _delta_lines(con, d):
     x = d["details"]
     dash = False  # the legend only when a "—" is printed
+    who = "SVM" if _answerer(d).startswith("SVM") else _answerer(d)
     for words, side in (("towards lower e ", "lower"), ("towards higher e", "upper")):
         s = x[side]
         iv = s["interval"]
         cov = f"{s['coverage']:.0%} interval" if s.get("coverage") else "interval, coverage not stated"
-        ivs = f"({cov} {_fmt(iv[0], '', 4)} to {_fmt(iv[1], '', 4)})" if s["value"] is not None else ""
-        con.print(f"  {words}: SVM [bold green]{_fmt(s['value'], '', 4)}[/] {ivs}, ideal {_fmt(s['ideal'], '', 4)}")
-        dash = dash or s["value"] is None or s["ideal"] is None or None in iv
+        shown = s["value"] is not None and any(v is not None for v in iv)  # an ideal table's has no ends
+        ivs = f" ({cov} {_fmt(iv[0], '', 4)} to {_fmt(iv[1], '', 4)})" if shown else ""
+        con.print(f"  {words}: {who} [bold green]{_fmt(s['value'], '', 4)}[/]{ivs}, "
+                  f"ideal {_fmt(s['ideal'], '', 4)}")
+        dash = dash or s["value"] is None or s["ideal"] is None or (shown and None in iv)
     if dash:
         outside = d["route"] == "table" and not all(d["in_grid"].values())
         con.print("  [dim]— : " + ("no answer from the table (see below), or " if outside else "")
@@ -281,7 +293,7 @@ def _distinguishable_lines(con, d):
         iv = d["interval"]
         f1 = (f", F1 {x['svm_f1']:.3f} ({iv['coverage']:.0%} interval {iv['low']:.3f} to {iv['high']:.3f}; "
               f"{x['verdict']})" if x["svm_f1"] is not None else "")
-        con.print(f"  SVM (the paper's classifier): {yes}{f1}")
+        con.print(f"  {_answerer(d)}: {yes}{f1}")
     if x["ideal_f1"] is not None:  # also where the table has no answer: the closed form needs no table
         con.print(f"  ideal observer: F1 {x['ideal_f1']:.3f} ({d['ideal']['method']})"
                   + (" (distinguishable)" if x["ideal_distinguishable"] else " (not even in principle)"))

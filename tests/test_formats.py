@@ -176,3 +176,44 @@ def test_out_to_a_fifo_nothing_reads_is_refused_not_waited_on(cli, tmp_path):
         time.sleep(0.01)
     reader.join(timeout=30)
     assert r.exit_code == 0 and got and got[0].startswith("name,")
+
+
+@pytest.mark.parametrize("cmd", [
+    ["delta-e", "--e", "20000", "--contact", "2"],
+    ["delta-e", "--e", "39000", "--contact", "20"],  # no answer (exit 3): still its output
+    ["materials", "show", "copper"],
+    ["tables", "show", "ideal-paper"],
+])
+@pytest.mark.parametrize("json_", [False, True])
+def test_out_file_holds_what_the_command_prints_without_format(cli, tmp_path, cmd, json_):
+    """--out FILE without --format: the file holds the description for people (or --json's JSON) that stdout
+    would have shown, and stdout gets none of it (it was silently printed instead, with exit 0)."""
+    flags = ["--json"] if json_ else []
+    shown = cli(*cmd, *flags)
+    out = tmp_path / "answer.txt"
+    r = cli(*cmd, *flags, "--out", out)
+    assert r.exit_code == shown.exit_code and r.exit_code in (0, 3), r.output
+    assert r.stdout == "" and out.read_text() == shown.stdout and shown.stdout.strip()
+    if json_:
+        json.loads(out.read_text())
+
+
+def test_out_file_in_a_missing_folder_is_refused_before_any_work(cli, tmp_path):
+    r = cli("delta-e", "--e", "20000", "--out", tmp_path / "nope" / "a.txt")
+    assert r.exit_code == 2 and "does not exist" in r.stderr and r.stderr.count("\n") == 1
+
+
+def test_tables_show_prints_names_from_the_file_as_text(cli, tmp_path):
+    """A table's name holding rich markup or control characters is shown as written (markup) or escaped
+    (control characters), never interpreted: '[/]' was an internal error with exit 1, an escape sequence
+    reached the terminal."""
+    from designkit.tables.store import load_table, write_table
+
+    base = load_table("ideal-paper")
+    for i, name in enumerate(["bad[/]", "[red]RED[/red] table", "esc\x1b[2Jclear", "two\nlines"]):
+        path = write_table(tmp_path / f"t{i}.npz", {**base.header, "name": name}, dict(base.arrays))
+        r = cli("tables", "show", path)
+        assert r.exit_code == 0, r.output
+        first = r.stdout.splitlines()[0]
+        assert first.startswith(name if name.isprintable() else repr(name)[1:-1]), first
+        assert "\x1b" not in r.stdout

@@ -32,6 +32,7 @@ import io
 import json
 import math
 import sys
+from contextlib import contextmanager, redirect_stdout
 from pathlib import Path
 from typing import Annotated, Any, Callable, Mapping, Optional, Sequence
 
@@ -171,9 +172,7 @@ def write_output(text: str, out: str | None) -> None:
     import os
     import stat
 
-    p = Path(out)
-    if p.parent and not p.parent.is_dir():
-        raise InputError(f"cannot write {p}: folder {p.parent} does not exist")
+    p = check_out(out)
     try:
         fifo = stat.S_ISFIFO(os.stat(p).st_mode)
     except OSError:
@@ -187,7 +186,51 @@ def write_output(text: str, out: str | None) -> None:
         with os.fdopen(fd, "w", encoding="utf-8") as fh:
             fh.write(text)
         return
-    p.write_text(text, encoding="utf-8")
+    try:
+        p.write_text(text, encoding="utf-8")
+    except OSError as exc:
+        raise InputError(f"cannot write {p}: {exc.strerror or exc}") from None
+
+
+def check_out(out: str) -> Path:
+    """``out`` as a path to write, or an error if its folder is missing or it is a folder."""
+    p = Path(out)
+    if p.parent and not p.parent.is_dir():
+        raise InputError(f"cannot write {p}: folder {p.parent} does not exist")
+    if p.is_dir():
+        raise InputError(f"cannot write {p}: it is a folder; give a file name")
+    return p
+
+
+@contextmanager
+def output_to(out: str | None):
+    """Send what the block prints on stdout to ``out`` instead (None or ``-``: stdout, as it is).
+
+    For the commands whose default output is text for people (or ``--json``): their ``--out FILE``
+    holds exactly what they would have printed, without colour (an answer with exit status 3 too).
+    The folder is checked before the block runs; nothing is written if the block fails.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> out = pathlib.Path(tempfile.mkdtemp()) / "answer.txt"
+    >>> with output_to(str(out)):
+    ...     print("1.23 s")
+    >>> out.read_text()
+    '1.23 s\n'
+    """
+    if out is None or str(out) == "-":
+        yield
+        return
+    check_out(out)
+    buf = io.StringIO()
+    try:
+        with redirect_stdout(buf):
+            yield
+    except typer.Exit:  # an answer that says there is none (exit 3) is still the output
+        write_output(buf.getvalue(), out)
+        raise
+    write_output(buf.getvalue(), out)
 
 
 def emit_rows(rows: Sequence[Mapping[str, Any]], columns: Sequence[str] | None = None, *, fmt: str = "table",

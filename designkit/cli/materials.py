@@ -8,7 +8,7 @@ import typer
 
 from . import _app
 from ._app import console, emit_json, sub_app
-from ._format import FormatOpt, OutOpt, check_format, emit_rows
+from ._format import FormatOpt, OutOpt, check_format, emit_rows, output_to
 from ._options import Json
 
 materials_app = sub_app(
@@ -107,7 +107,8 @@ def show(
 
     m = get_material(name, set=set_)
     if json_:
-        emit_json(m.to_dict())
+        with output_to(out):
+            emit_json(m.to_dict())
         return
     if format_ is not None:
         fmt = check_format(format_)
@@ -125,6 +126,12 @@ def show(
                   title=f"{m.name} ({m.family_label}; {m.set} set)", notes=[f"source: {m.source}"],
                   payload=rows if fmt == "json" else None)
         return
+    with output_to(out):
+        _print_material(m)
+
+
+def _print_material(m) -> None:
+    """``materials show``'s description for people."""
     con = console()
     con.print(f"[bold]{m.name}[/]  ({m.family_label}; {m.set} set)")
     if m.aliases:

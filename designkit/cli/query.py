@@ -18,7 +18,7 @@ import typer
 
 from . import _app
 from ._app import app, emit_json
-from ._format import OutOpt, check_format, emit_rows
+from ._format import OutOpt, check_format, check_out, emit_rows, output_to
 from ._options import (
     E1,
     E2,
@@ -429,6 +429,8 @@ def delta_e_cmd(
     Example: `designkit delta-e --e 20000 --contact 2` (`--format csv` for one row per direction)
     """
     fmt = None if json_ or format_ is None else check_format(format_)
+    if out not in (None, "-"):
+        check_out(out)  # before the work: an --exact answer is not computed for a folder that does not exist
     ans = _ask("delta-e", exact=exact, table=table, ideal_table=ideal_table, threshold=threshold, sensor=sensor,
                model=model, conductance=conductance, thickness=thickness, backing=backing, diffusivity=diffusivity,
                width=width, trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc,
@@ -445,7 +447,8 @@ def delta_e_cmd(
         emit_rows(rows, list(rows[0]), fmt=fmt, out=out, title=f"delta(e) at {d['details']['e']:g}",
                   payload=rows if fmt == "json" else None)
         return
-    _render(ans, json_)
+    with output_to(out):
+        _render(ans, json_)
 
 
 @app.command("distinguishable", rich_help_panel=_app.ASK)

@@ -9,7 +9,7 @@ import typer
 
 from . import _app
 from ._app import console, emit_json, sub_app
-from ._format import FormatOpt, OutOpt, check_format, emit_rows
+from ._format import FormatOpt, OutOpt, check_format, emit_rows, output_to
 from ._options import Json
 
 tables_app = sub_app("tables", "Shipped lookup tables: list them, or show one's grid and provenance.",
@@ -78,12 +78,11 @@ def tables_show(
     """
     from ..tables.store import load_table
 
-    from rich.markup import escape
-
     table = load_table(name, thorough=True)
     s = table.summary()
     if json_:
-        emit_json(s)
+        with output_to(out):
+            emit_json(s)
         return
     if format_ is not None:
         fmt = check_format(format_)
@@ -93,11 +92,25 @@ def tables_show(
         emit_rows(rows, ["axis", "units", "scale", "points", "min", "max", "values"], fmt=fmt, out=out,
                   title=f"{s['name']}: axes", payload=s["axes"] if fmt == "json" else None)
         return
+    with output_to(out):
+        _print_table(table, s)
+
+
+def _visible(x) -> str:
+    """``str(x)`` with rich markup escaped and control characters (escape sequences, newlines) shown as escapes."""
+    from rich.markup import escape
+
+    return escape("".join(ch if ch.isprintable() else repr(ch)[1:-1] for ch in str(x)))
+
+
+def _print_table(table, s: dict) -> None:
+    """``tables show``'s description for people (every text from the file made visible: it may hold markup)."""
+    v = _visible
     con = console()
-    con.print(f"[bold]{s['name']}[/]  ({s['fidelity']} fidelity, {s['path']})")
-    con.print(escape(f"  model {table.model.describe()}"))
+    con.print(f"[bold]{v(s['name'])}[/]  ({v(s['fidelity'])} fidelity, {v(s['path'])})")
+    con.print(f"  model {v(table.model.describe())}")
     sen = s["sensor"]
-    con.print(f"  sensor {sen['name']}: e_s = {sen['effusivity']:g} J s^-1/2 K^-1 m^-2, alpha_s = "
+    con.print(f"  sensor {v(sen['name'])}: e_s = {sen['effusivity']:g} J s^-1/2 K^-1 m^-2, alpha_s = "
               f"{sen['diffusivity_m2_s']:.3g} m^2/s, depth {sen['depth_m'] * 1e6:g} um, tau = {sen['tau_s']:.4g} s, "
               f"{sen['sample_rate_hz']:g} Hz")
     eff = s["effusivity"]
@@ -105,8 +118,8 @@ def tables_show(
     for a in s["axes"]:
         if a["name"] == "e_ref":
             continue
-        vals = ", ".join(f"{v:g}" for v in a.get("values", [])) or f"{a['min']:g} .. {a['max']:g}"
-        con.print(escape(f"  axis {a['name']} [{a['units']}, {a['scale']}]: {vals}"))
+        vals = ", ".join(f"{x:g}" for x in a.get("values", [])) or f"{a['min']:g} .. {a['max']:g}"
+        con.print(v(f"  axis {a['name']} [{a['units']}, {a['scale']}]: {vals}"))
     ic = s["initial_conditions"]
     if ic["fixed"]:
         con.print("  initial conditions fixed (every touch starts at Ta + dT)")
@@ -120,6 +133,6 @@ def tables_show(
         # compute_s is each chunk's wall time in its worker, summed: worker time, CPU time when the cores were free
         con.print(f"  built with {st['svm_fits_total']} SVM fits, {st['compute_s_total'] / 3600:.2f} worker-hours "
                   f"({st['svm_fits_per_scene_mean']:.0f} fits and {st['compute_s_per_scene_mean']:.0f} s per scene)")
-    con.print(f"  designkit {s['designkit_version']}, created {s['created']}")
-    con.print(f"  arrays: {', '.join(s['arrays'])}")
-    con.print(f"  {s['content_hash']}  ({s['size_bytes'] / 1024:.0f} KiB)")
+    con.print(f"  designkit {v(s['designkit_version'])}, created {v(s['created'])}")
+    con.print(f"  arrays: {v(', '.join(s['arrays']))}")
+    con.print(f"  {v(s['content_hash'])}  ({s['size_bytes'] / 1024:.0f} KiB)")

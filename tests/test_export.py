@@ -867,6 +867,31 @@ def test_an_export_never_writes_over_the_table_it_reads(cli, tmp_path):
     assert cli("export", "--table", src, "--format", "npz", "--out", tmp_path / "other.npz").exit_code == 0
 
 
+@pytest.mark.parametrize("fmt,suffix", [("c", ".h"), ("python", ".py")])
+def test_the_regenerate_line_writes_the_same_export_again(cli, tmp_path, fmt, suffix):
+    """The "Regenerate:" command of an export, run as printed, writes the same file: for a shipped table it
+    names the table; for a user's table (here one whose header says svm-paper, in a folder with a space) its
+    path, where the name would have exported the shipped svm-paper instead."""
+    import shlex
+
+    base = load_table("ideal-paper")
+    folder = tmp_path / "my tables"
+    mine = write_table(folder / "mine.npz", {**base.header, "name": "svm-paper"}, dict(base.arrays))
+    for table, named in (("ideal-paper", "--table ideal-paper "), (str(mine), f"--table {shlex.quote(str(mine))} ")):
+        first = tmp_path / f"first{suffix}"
+        r = cli("export", "--table", table, "--format", fmt, "--noise", "0.05", "--delta-t", "10", "--out", first)
+        assert r.exit_code == 0, r.output
+        line = next(x for x in first.read_text().splitlines() if "Regenerate:" in x)
+        command = line.split("Regenerate:", 1)[1].strip()
+        assert named in command, command
+        args = shlex.split(command)
+        assert args[:2] == ["designkit", "export"] and args[-2:] == ["--out", "FILE"]
+        again = tmp_path / f"again{suffix}"
+        r = cli(*args[1:-1], again)
+        assert r.exit_code == 0, r.output
+        assert again.read_text() == first.read_text()
+
+
 def test_cli_writes_to_standard_output(cli, tmp_path):
     r = cli("export", "--table", "ideal-paper", "--noise", "0.05", "--delta-t", "10", "--contact", "2",
             "--format", "csv", "--out", "-")

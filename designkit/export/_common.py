@@ -246,7 +246,8 @@ def log_grid(a: "Axis") -> list[float]:
 def regenerate_command(exp: "Exported", fmt: str, prefix: str | None) -> str:
     """The ``designkit export`` command line that writes this export again (shell-quoted)."""
     p, s = exp.provenance, exp.provenance["slice"]
-    cmd = [f"designkit export --table {shlex.quote(str(p['source_table']))} --format {fmt}"]
+    table = exp.source_ref if exp.source_ref is not None else p["source_table"]
+    cmd = [f"designkit export --table {shlex.quote(str(table))} --format {fmt}"]
     if s["scene"]:
         cmd.append(f"--noise {s['scene']['noise_c']!r} --delta-t {s['scene']['delta_t_c']!r}")
     if s["contact_s"]:

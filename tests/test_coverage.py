@@ -75,6 +75,23 @@ def test_decreasing_curve_crossing_and_its_ends():
     assert est.value is None
 
 
+@pytest.mark.parametrize("increasing", [True, False])
+def test_a_steep_curve_is_bracketed_around_its_crossing_not_answered_by_the_coarse_brackets_middle(increasing):
+    """F1 jumps from 0.84 to 1 over a few percent of x (a pair of very different materials at short contacts):
+    too few points are informative for the fit. The answer was the middle of the coarse bracket (0.5 s for a
+    crossing at 0.43 s); now the bracket is narrowed around the crossing, to at most fine_ratio."""
+    truth, k = 0.43, 40.0
+
+    def f(x):  # the fit's own family (logit linear in log x), so steep that F1 is 0.5 or 1 a few % away
+        r = x / truth if increasing else truth / x
+        return (0.5 + 0.5 / (1.0 + 0.25 * r ** -k), 0.005)  # 0.9 at the truth
+
+    est = estimate_crossing(f, 0.41, 10.0, 0.9, increasing=increasing)
+    assert est.low <= truth <= est.high, (est.low, est.high)
+    assert abs(est.value - truth) / truth < 0.03
+    if est.method == "bracket":
+        assert est.high / est.low <= 1.05 + 1e-12
+
 def test_ideal_bound_never_above_the_exact_ideal_observer():
     # the query-time bound (math.erfc closed form) against an independent bisection on the scipy closed form
     sensor = load_sensor("paper")

@@ -498,3 +498,16 @@ def test_overlapping_materials_exit_3_with_the_reason(cli, question):
     assert r.exit_code == 3
     d = json.loads(r.stdout)
     assert d["value"] is None and any("overlap" in n for n in d["notes"])
+
+
+@pytest.mark.parametrize("args", [
+    ["min-contact", "--e1", "35000", "--e2", "20000", "--exact", "--trials", "0"],
+    ["max-noise", "--e1", "35000", "--e2", "20000", "--contact", "2", "--exact", "--repeats", "0"],
+    ["min-contact", "--e1", "35000", "--e2", "20000", "--exact", "--sensor-temp-spread", "10"],
+])
+def test_an_exact_questions_bad_input_is_one_line_on_stderr(cli, args):
+    """Refused before any work, with nothing else on stderr: the progress bar drawn where stderr is no
+    terminal put a blank line before the error."""
+    r = cli(*args)
+    assert r.exit_code == 2, r.output
+    assert r.stderr.startswith("Error: ") and r.stderr.count("\n") == 1, repr(r.stderr)

@@ -148,8 +148,11 @@ def _ask(question: str, *, exact: bool, table: Optional[str], ideal_table: str, 
 @contextmanager
 def _exact_display(question: str, progress: bool):
     """What the exact route shows while it runs: a bar of SVM evaluations for a question that reports its
-    steps (yields the callback to pass as ``progress``), a spinner for one that does not, nothing when quiet."""
-    if not progress:
+    steps (yields the callback to pass as ``progress``), a spinner for one that does not, nothing when quiet
+    or where stderr is no terminal (rich's bar then left a blank line before the answer's error, if any)."""
+    import sys
+
+    if not progress or not (hasattr(sys.stderr, "isatty") and sys.stderr.isatty()):
         yield None
         return
     if question not in _STEPWISE:  # no step-by-step progress from this question's exact route: a spinner

@@ -229,3 +229,16 @@ def test_monte_carlo_calibration_does_not_depend_on_how_densely_the_table_sample
     arrays = {k: (np.asarray(v)[:, keep] if np.ndim(v) >= 2 else v) for k, v in t.arrays.items()}
     thinned = q._View(dataclasses.replace(t, header=header, arrays=arrays)).mc_calibration()
     assert op.view.mc_calibration() == pytest.approx(thinned, rel=0.1)
+
+
+@pytest.mark.parametrize("e1,e2,noise", [(1000.0, 20000.0, 0.05), (500.0, 30000.0, 0.05), (2000.0, 39000.0, 0.02)])
+def test_min_contact_below_the_tables_first_contact_is_its_grid_cell_not_an_extrapolation(e1, e2, noise):
+    """Where the pair separates already at the table's first contact time, the SVM's efficiency is not
+    extrapolated below it (1,000 vs 20,000 answered 0.435 s "inside" svm-fine's 0.5-10 s grid): the answer is
+    the first contact time, its interval the grid cell down to the ideal bound, with no stated coverage."""
+    d = min_contact(e1, e2, noise_c=noise, delta_t_c=10.0).to_dict()
+    first = d["computation"]["table_contacts_s"][0]
+    assert d["table"]["name"] == "svm-fine" and first == 0.5
+    assert d["value"] == first and d["ideal"]["value"] < first
+    iv = d["interval"]
+    assert (iv["low"], iv["high"], iv["coverage"], iv["method"]) == (d["ideal"]["value"], first, None, "table-cell")

@@ -1439,7 +1439,9 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
     eff = None
     if value is not None and op.tab.fidelity == "svm" and op.closed and "delta_up_ideal" in view.t.arrays:
         r = noise_k_min_contact(op, combos, [k_cross], [lo], [hi], [noise / abs(dt)], zc=z_of_coverage(coverage))
-        if not math.isnan(float(r["value"][0])):
+        # below the table's first contact time the efficiency would be extrapolated (1,000 vs 20,000 answered
+        # 0.435 s "inside its grid" of 0.5-10 s): there the grid cell (below) says what the table knows
+        if not math.isnan(float(r["value"][0])) and float(r["value"][0]) >= grid[0]:
             eff = {key: float(v[0]) for key, v in r.items()}
     if varied is not None:
         # varied initial conditions: each scene slice's estimate, both directions averaged, interpolated across

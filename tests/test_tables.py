@@ -197,3 +197,25 @@ def test_a_chunk_is_checked_against_its_slot_and_sweep():
         check_chunk(stamped, cfg, (0,), 0, 0, "p000-b000-c000.npz")  # copied into another slot
     with pytest.raises(InputError, match="another sweep"):
         check_chunk(stamped, SweepConfig(name="c", intervals=5, contact_s=(1.0, 2.0), fidelity="ideal"), (0,), 0, 1)
+
+
+def test_tables_list_of_a_folder_skips_a_damaged_table_and_says_when_there_are_none(cli, tmp_path):
+    """One damaged table in a folder is said on stderr (one line) and the others are listed (the whole listing
+    was refused); a folder without tables says so (it printed an empty line)."""
+    import shutil
+
+    from designkit._resources import shipped_tables_dir
+
+    src = shipped_tables_dir()
+    for suffix in (".npz", ".json"):
+        shutil.copy(src / f"ideal-paper{suffix}", tmp_path / f"good{suffix}")
+    shutil.copy(src / "svm-paper.json", tmp_path / "bad.json")
+    (tmp_path / "bad.npz").write_bytes((src / "svm-paper.npz").read_bytes()[:1000])
+    r = cli("tables", "list", "--folder", tmp_path, "--format", "csv")
+    assert r.exit_code == 0, r.output
+    assert [line.split(",")[0] for line in r.stdout.splitlines()] == ["name", "good"]
+    assert r.stderr.startswith("skipped: table bad.npz is corrupted") and r.stderr.count("\n") == 1
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    r = cli("tables", "list", "--folder", empty)
+    assert r.exit_code == 0 and r.stdout == f"no designkit tables in {empty}\n"

@@ -9,7 +9,7 @@ import typer
 
 from . import _app
 from ._app import console, emit_json, sub_app
-from ._format import FormatOpt, OutOpt, check_format, emit_rows, output_to
+from ._format import FormatOpt, OutOpt, check_format, emit_rows, output_to, write_output
 from ._options import Json
 
 tables_app = sub_app("tables", "Shipped lookup tables: list them, or show one's grid and provenance.",
@@ -29,10 +29,18 @@ def tables_list(
     """
     from ..tables.store import list_tables, load_table
 
+    from .._validation import InputError
+
     fmt = "json" if json_ else check_format(format_)
     rows = []
     for name in list_tables(folder):
-        t = load_table(name if folder is None else folder / f"{name}.npz")
+        try:
+            t = load_table(name if folder is None else folder / f"{name}.npz")
+        except InputError as exc:  # one damaged file in a folder of tables: said, and the others listed
+            if folder is None:
+                raise
+            console(stderr=True).print(f"skipped: {_visible(exc)}")
+            continue
         s = t.summary()
         rows.append({"name": name, "fidelity": s["fidelity"], "sensor": s["sensor"]["name"], "model": s["model"],
                      "axes": {a["name"]: [a["min"], a["max"], a["points"]] for a in s["axes"]},
@@ -51,6 +59,9 @@ def tables_list(
                      "intervals": ax["e_ref"][2], "size_bytes": r["size_bytes"], "path": r["path"]})
     if fmt == "csv":
         emit_rows(flat, fmt="csv", out=out)
+        return
+    if not flat and fmt == "table":
+        write_output(f"no designkit tables in {folder if folder is not None else 'the shipped folder'}\n", out)
         return
     people = [{"name": f["name"], "fidelity": f["fidelity"], "sensor": f["sensor"], "model": f["model"],
                "sigma/dT" if f["noise_axis"] == "noise_ratio" else "noise [degC]":

@@ -232,13 +232,18 @@ def test_monte_carlo_calibration_does_not_depend_on_how_densely_the_table_sample
 
 
 @pytest.mark.parametrize("e1,e2,noise", [(1000.0, 20000.0, 0.05), (500.0, 30000.0, 0.05), (2000.0, 39000.0, 0.02)])
-def test_min_contact_below_the_tables_first_contact_is_its_grid_cell_not_an_extrapolation(e1, e2, noise):
-    """Where the pair separates already at the table's first contact time, the SVM's efficiency is not
-    extrapolated below it (1,000 vs 20,000 answered 0.435 s "inside" svm-fine's 0.5-10 s grid): the answer is
-    the first contact time, its interval the grid cell down to the ideal bound, with no stated coverage."""
+def test_min_contact_below_the_tables_first_contact_says_it_is_extrapolated(cli, e1, e2, noise):
+    """Where the SVM's efficiency puts the answer below the table's first contact time, the answer says so: it
+    was labelled "inside its grid" (1,000 vs 20,000: 0.435 s on svm-fine's 0.5-10 s). The estimate is kept (on
+    the coverage benchmark's 13 such cases, recomputed with the exact route's narrowed brackets, 11 of the 13
+    references lie in its interval), and it never goes below the ideal observer."""
     d = min_contact(e1, e2, noise_c=noise, delta_t_c=10.0).to_dict()
     first = d["computation"]["table_contacts_s"][0]
     assert d["table"]["name"] == "svm-fine" and first == 0.5
-    assert d["value"] == first and d["ideal"]["value"] < first
-    iv = d["interval"]
-    assert (iv["low"], iv["high"], iv["coverage"], iv["method"]) == (d["ideal"]["value"], first, None, "table-cell")
+    assert d["ideal"]["value"] <= d["interval"]["low"] <= d["value"] < first
+    assert d["interval"]["method"] == "table-efficiency" and d["computation"]["below_grid"] is True
+    assert any("below the table's first contact time" in n for n in d["notes"])
+    r = cli("min-contact", "--e1", e1, "--e2", e2, "--noise", noise)
+    assert r.exit_code == 0 and "below its contact times: extrapolated" in r.stdout and "inside its grid" not in r.stdout
+    inside = min_contact(35000.0, 20000.0).to_dict()  # the README's pair: inside, no such note
+    assert "below_grid" not in inside["computation"] and not any("first contact time" in n for n in inside["notes"])

@@ -317,6 +317,8 @@ def _source_lines(con, d):
                  "delta_t_c": "temperature difference"}
         bad = [words.get(k, k) for k, ok in d["in_grid"].items() if not ok]
         where = "inside its grid" if not bad else "OUTSIDE its grid along " + ", ".join(bad)
+        if not bad and d["computation"].get("below_grid"):
+            where = "below its contact times: extrapolated"
         eff = "the SVM's tabulated efficiency applied to the exact ideal observer between grid points"
         how = {"table-efficiency": eff,
                "table-varied-estimate": "each noise slice's estimate around the question, interpolated in log time"

@@ -1439,9 +1439,7 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
     eff = None
     if value is not None and op.tab.fidelity == "svm" and op.closed and "delta_up_ideal" in view.t.arrays:
         r = noise_k_min_contact(op, combos, [k_cross], [lo], [hi], [noise / abs(dt)], zc=z_of_coverage(coverage))
-        # below the table's first contact time the efficiency would be extrapolated (1,000 vs 20,000 answered
-        # 0.435 s "inside its grid" of 0.5-10 s): there the grid cell (below) says what the table knows
-        if not math.isnan(float(r["value"][0])) and float(r["value"][0]) >= grid[0]:
+        if not math.isnan(float(r["value"][0])):
             eff = {key: float(v[0]) for key, v in r.items()}
     if varied is not None:
         # varied initial conditions: each scene slice's estimate, both directions averaged, interpolated across
@@ -1459,6 +1457,11 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
         value, interval, kind, cov = eff["value"], (low, eff["high"]), "table-efficiency", coverage
         monte_carlo.update(efficiency=eff["k"], efficiency_se_log=eff["se_log"], table_crossing_s=raw,
                            noise_efficiency_at_s={f"{eff['t_a']:g}": eff["k_a"], f"{eff['t_b']:g}": eff["k_b"]})
+        if value < grid[0]:  # the efficiency at the first contact times, applied below them: said, not hidden
+            monte_carlo["below_grid"] = True
+            note = (f"{value:.3g} s lies below the table's first contact time, {grid[0]:g} s: the SVM's noise "
+                    "efficiency read there is applied to the exact ideal observer (an extrapolation in contact "
+                    "time; docs/accuracy.md measures it)")
     elif value is not None:
         prev_need = needs[k_cross - 1] if k_cross > 0 else math.nan
         if k_cross > 0 and not math.isnan(prev_need):

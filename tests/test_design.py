@@ -64,6 +64,9 @@ def test_cli_json_with_svm_confirmation(cli, tmp_path):
     (["--m", "a=1000", "--m", "b=2000", "--max-rate", "10", "--max-contact", "0.05"], 2, "contradict"),
     (["--m", "a=1000"], 2, "at least two"),
     (["--m", "a=1000", "--m", "b=2000", "--noise", "-1"], 2, "noise floor"),
+    # a touch of more samples than any other command allows: the search ran on, 8-9 GB in 25 s
+    (["--m", "a=1000", "--m", "b=2000", "--max-rate", "1e9"], 2, "samples per touch; the limit is 1e+06"),
+    (["--m", "a=1000", "--m", "b=2000", "--max-contact", "1e6"], 2, "samples per touch; the limit is 1e+06"),
 ])
 def test_cli_no_design_and_bad_input(cli, args, code, msg):
     r = cli("design", "--no-svm", *args)

@@ -299,6 +299,31 @@ def test_a_sensor_colder_than_the_object_is_a_wiring_error(cli, tmp_path):
     assert "reads colder than the object" in r.output and "side of its divider" in r.output
 
 
+@pytest.mark.parametrize("how", ["heater off", "flat"])
+def test_touches_in_which_no_heat_flows_are_refused_not_fitted(cli, tmp_path, how):
+    """The heater off (the sensor at the object's temperature, only noise), or a sensor channel stuck at one
+    value: a fit gave e_s 132 (true 892) or 3.6e9 "at upper bound", called it set-identified and wrote the
+    file with exit 0. Now: one problem that says no heat flowed, exit 2, no file (--force still writes)."""
+    rng = np.random.default_rng(8)
+    trials = make_trials(n=3, seed=7)
+    if how == "heater off":
+        cold = [Trial(tr.time_s, tr.object_c + rng.normal(0.0, 0.05, tr.time_s.size), tr.object_c, tr.force_n,
+                      tr.material) for tr in trials]
+    else:
+        cold = [Trial(tr.time_s, np.full(tr.time_s.size, 35.0), tr.object_c, tr.force_n, tr.material)
+                for tr in trials]
+    index = _write(tmp_path / "t", cold)
+    out = tmp_path / "s.yaml"
+    args = ("calibrate", "fit", index, "--range", "metal=aluminium", "--out", out, "--bootstrap", "0")
+    r = cli(*args)
+    assert r.exit_code == 2 and not out.exists(), r.output
+    assert "does not respond to contact in 6 of 6 touches" in r.output and "no heat flowed" in r.output
+    assert cli(*args, "--force").exit_code == 0 and out.exists()
+    good = _write(tmp_path / "good", trials)  # the same touches with the heater on: no such problem
+    r = cli("calibrate", "fit", good, "--range", "metal=aluminium", "--out", tmp_path / "g.yaml", "--bootstrap", "0")
+    assert "does not respond" not in r.output
+
+
 def test_touches_below_the_contact_threshold_get_a_hint_with_their_peak_force(cli, tmp_path):
     """The emulated rig presses with 4.2 N; the profile's threshold is 5 N: no touch would ever be recorded."""
     from designkit import SENSORS

@@ -1216,17 +1216,43 @@ def check_calibration(result: "CalibrationResult | None", trials: Sequence[Trial
     * **mislabelled**: a touch whose normalized response at 2 s (``(Ts0 - T) / (Ts0 - To)``) lies
       within 2 robust SDs of another material's median and beyond 5 of its own's (touches recorded
       while another sample was under the sensor);
-    * **conflict**: no e_s keeps every material inside its effusivity range (``result``).
+    * **conflict**: no e_s keeps every material inside its effusivity range (``result``);
+    * **no-response**: in most touches the sensor's reading moves by less than 5 pre-contact noise SDs
+      (and 0.05 °C) over the contact: no heat flowed (the heater off, sensor and object at one
+      temperature, a disconnected channel), so the touches hold nothing about e_s, whatever a fit says.
 
     Examples
     --------
     >>> import numpy as np
     >>> t = np.arange(-200, 801) / 200.0
-    >>> cold = Trial(t, np.full(t.size, 20.0), np.full(t.size, 25.0), np.zeros(t.size), "wood")
+    >>> warming = np.where(t < 0, 20.0, 20.0 + 2.0 * (1.0 - np.exp(-np.maximum(t, 0.0))))
+    >>> cold = Trial(t, warming, np.full(t.size, 25.0), np.zeros(t.size), "wood")
     >>> [p.kind for p in check_calibration(None, [cold, cold])]
     ['wiring']
+    >>> flat = Trial(t, np.full(t.size, 35.0), np.full(t.size, 25.0), np.zeros(t.size), "wood")
+    >>> [p.kind for p in check_calibration(None, [flat, flat])]
+    ['no-response']
     """
     out: list[CalibrationProblem] = []
+    moved = []  # (largest move over the contact, pre-contact noise SD, sensor - object before contact) [degC]
+    for tr in trials:
+        pre, post = tr.time_s < 0, tr.time_s >= 0
+        if pre.sum() >= 3 and post.sum() >= 3:
+            ts0 = float(np.mean(tr.sensor_c[pre]))
+            obj = tr.object_c[pre]
+            diff = ts0 - float(np.nanmean(obj)) if np.isfinite(obj).any() else math.nan
+            moved.append((float(np.max(np.abs(tr.sensor_c[post] - ts0))), float(np.std(tr.sensor_c[pre])), diff))
+    still = [m for m in moved if m[0] < max(5.0 * m[1], 0.05)]
+    if moved and len(still) > len(moved) / 2:
+        diffs = [m[2] for m in still if math.isfinite(m[2])]
+        why = (f"; sensor minus object before contact {np.mean(diffs):+.2f} °C on average" if diffs else "")
+        out.append(CalibrationProblem(
+            "no-response", f"the sensor's reading does not respond to contact in {len(still)} of {len(moved)} "
+                           f"touches (it moves by at most {max(m[0] for m in still):.3g} °C, against a pre-contact "
+                           f"noise of {np.mean([m[1] for m in still]):.2g} °C{why}): no heat flowed, so these "
+                           "touches say nothing about the sensor",
+            "Heat the sensor above the object (its set point), check that the thermistor channel is "
+            "connected and that the object is under the sensor when a touch is recorded, then record again"))
     cold = []
     for tr in trials:
         pre = tr.time_s < 0

@@ -129,3 +129,35 @@ def test_classify_export_c_writes_a_header_that_compiles(cli, tmp_path):
         assert subprocess.run([str(tmp_path / "m")]).returncode == 0
     r = cli("classify", "--m", "a=1", "--m", "b=2", "--export-c", str(out), "--prefix", "9bad")
     assert r.exit_code == 2 and "prefix" in r.output
+
+
+def test_a_device_that_vanishes_mid_session_keeps_the_decisions_made(cli):
+    """The pty closes after two touches: the two decisions are in --json's document beside the error (only the
+    error was there, saying "trial(s) kept in None"), exit 2, and the text route prints them before its one
+    error line."""
+    from designkit.calibration.emulator import Faults
+
+    mats = [EmulatedMaterial("metal", 20000.0), EmulatedMaterial("wood", 420.0)]
+    for json_ in (True, False):
+        plan = TouchPlan(touch_every_s=10.0, contact_s=4.0, touches_per_material=1)
+        with Emulator(load_profile("designkit"), PAPER, mats, noise_c=0.05, sensor_temp_c=35.0, ambient_c=25.0,
+                      plan=plan, speed=25.0, seed=3, faults=Faults(vanish_after_s=25.0)) as emu:
+            r = cli("classify", "--port", emu.port, "--profile", "designkit", "--m", "metal=12767:25972",
+                    "--m", "wood=331:506.46", "--touches", "6", "--time-offset", str(emu.expected_time_offset_s),
+                    "--error-rate", "0.001", "--timeout", "5", *(["--json"] if json_ else []))
+        assert r.exit_code == 2, r.output
+        last = r.stderr.splitlines()[-1]  # the text route streams its events on stderr before
+        assert last.startswith("Error: the device on") and r.stderr.count("Error:") == 1, r.stderr
+        assert not json_ or r.stderr.count("\n") == 1
+        import re
+
+        m = re.search(r"; (\d+) touch\(es\) decided$", last)
+        assert m and int(m.group(1)) >= 2 and "None" not in r.stderr and "trial" not in r.stderr, r.stderr
+        n = int(m.group(1))
+        if json_:
+            out = json.loads(r.stdout)
+            assert [d["material"] for d in out["decisions"]] == ["metal", "wood"] * (n // 2) + ["metal"] * (n % 2)
+            assert out["interrupted"] is True and out["error"]["exit_status"] == 2
+        else:
+            assert "touch 1: metal after" in r.stdout and "touch 2: wood after" in r.stdout
+            assert r.stdout.count("\ntouch ") == n

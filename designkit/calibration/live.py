@@ -256,6 +256,9 @@ class LiveClassifier(SerialRecorder):
     def _new_cutter(self, material: str) -> TouchDecider:  # type: ignore[override]
         return self.decider
 
+    def _kept_words(self) -> str:
+        return f"{len(self.decider.written)} touch(es) decided"
+
     def classify(self, touches: int) -> list[TouchDecision]:
         """Decide ``touches`` touches; returns their decisions (Ctrl-C passes through, decisions stay)."""
         self.record("live", touches)

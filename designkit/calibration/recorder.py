@@ -569,10 +569,13 @@ class SerialRecorder:
 
     def _kept(self, cutter: TrialCutter) -> str:
         self._sync(cutter)
-        n = len(self.written)
-        where = f" in {self.out_dir}" if n else ""
         lost = " (the trial in progress was discarded)" if cutter.in_trial else ""
-        return f"{n} trial(s) kept{where}{lost}"
+        return self._kept_words() + lost
+
+    def _kept_words(self) -> str:
+        """What the session kept so far, for a message that ends it (a classifier keeps decisions, not trials)."""
+        n = len(self.written)
+        return f"{n} trial(s) kept" + (f" in {self.out_dir}" if n else "")
 
     def _publish(self, cutter: TrialCutter) -> None:
         self.status.state = cutter.state
@@ -605,11 +608,9 @@ class SerialRecorder:
                     break
                 time.sleep(0.1)
         self._sync(cutter)
-        n = len(self.written)
         lost = "; the trial in progress was discarded" if in_trial else ""
-        where = f" in {self.out_dir}" if n else ""
         raise DeviceGone(f"the device on {self.port} disappeared ({_short(exc)}) and did not come back within "
-                         f"{self.profile.serial.reconnect_s:g} s; {n} trial(s) kept{where}{lost}")
+                         f"{self.profile.serial.reconnect_s:g} s; {self._kept_words()}{lost}")
 
     def _consume(self, chunk: bytes, cutter: TrialCutter) -> None:
         prof = self.profile

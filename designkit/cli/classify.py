@@ -4,7 +4,9 @@ Exit status: 0 when every touch was answered, 2 for bad input (a stream whose
 sample rate differs from the sensor file's, unknown materials, ...), 3 when no
 contact time up to ``--max-contact`` can separate the materials at the requested
 error rates (said before the first touch), 130 on Ctrl-C (decisions so far are
-printed).
+printed). A device that disappears or falls silent mid-session ends it with 2,
+after the decisions made so far (under ``--json`` in the same document, with
+``"interrupted": true`` and the ``"error"``).
 """
 
 from __future__ import annotations
@@ -178,14 +180,20 @@ def classify(
                          ambient_temp_c=object_temp, no_data_timeout_s=timeout, on_event=on_event,
                          on_status=refresh)
     interrupted = False
+    failed = None  # the device went away or fell silent mid-session: the decisions made so far still count
+    from .._validation import InputError
+
     try:
-        clf.open()
+        clf.open()  # a port that cannot be opened is refused as it is (nothing decided yet)
         if not json_ and con.is_terminal:
             from rich.live import Live
 
             live_view = Live(console=con, refresh_per_second=8)
             live_view.__enter__()
-        clf.classify(touches)
+        try:
+            clf.classify(touches)
+        except InputError as exc:
+            failed, interrupted = exc, True
     except KeyboardInterrupt:
         interrupted = True
     finally:
@@ -195,15 +203,20 @@ def classify(
     decisions = clf.decider.written
     payload["decisions"] = [d.to_dict() for d in decisions]
     payload["interrupted"] = interrupted
+    if failed is not None:
+        payload["error"] = {"kind": "input", "message": str(failed), "exit_status": 2}
     if json_:
         emit_json(payload)
     else:
-        out = console(stderr=interrupted)
+        out = console(stderr=interrupted and failed is None)  # Ctrl-C: the decisions so far on stderr
         out.print(f"{check.plan.reason}.", highlight=False)
         for d in decisions:
             what = d.material if d.state == "decided" else d.state
             out.print(f"touch {d.index + 1}: {what} after {d.time_to_decision_s:.3f} s of contact "
                       f"({d.n_samples} samples; Ts0 {d.sensor_temp_c:.2f} °C, Ta {d.ambient_temp_c:.2f} °C)",
                       highlight=False)
+    if failed is not None:
+        typer.echo(f"Error: {failed}", err=True)
+        raise typer.Exit(2)
     if interrupted:
         raise typer.Exit(EXIT_INTERRUPTED)

@@ -77,7 +77,7 @@ def test_held_out_scoring_and_comparison_pick_the_true_model():
 def test_bad_inputs_are_one_line_errors():
     with pytest.raises(InputError, match="no fittable parameter"):
         Candidate("x", "layered", ("thickness",))
-    with pytest.raises(InputError, match="unknown forward model"):
+    with pytest.raises(InputError, match="no sensor model .nosuch. to identify: give one of semi-infinite, contact"):
         identify(_touches(seed=1, n_per=1), "nosuch")
     with pytest.raises(InputError, match="leave"):
         split_by_trial_set(_touches(seed=1, n_per=1), [1])

@@ -52,7 +52,7 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 from scipy import special
 
-from .._validation import InputError, as_generator, check_positive
+from .._validation import InputError, as_generator, check_positive, check_temperature
 from .trials import Trial
 
 __all__ = [
@@ -170,6 +170,7 @@ def parse_object_temps(specs: Sequence[str]) -> dict[str, str | float]:
             except ValueError:
                 raise InputError(f"--object-temp {spec!r}: use passive, passive-end, free or a temperature "
                                  "in °C") from None
+            check_temperature(f"--object-temp {name}", out[name])  # NaN was taken, and fitted
     return out
 
 

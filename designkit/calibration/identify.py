@@ -244,9 +244,12 @@ def candidate(name: str) -> Candidate:
         return fullest[-1]
     from ..models import model_class
 
-    cls = model_class(key)  # unknown names: the registry's error
-    raise InputError(f"no identification set up for model {cls.name!r}; candidates: "
-                     f"{', '.join(c.label for c in CANDIDATES)}")
+    labels = ", ".join(dict.fromkeys(c.label for c in CANDIDATES))
+    try:
+        cls = model_class(key)
+    except InputError:  # the registry's error would list models, not what can be identified
+        raise InputError(f"no sensor model {name!r} to identify: give one of {labels} (or all)") from None
+    raise InputError(f"no identification set up for model {cls.name!r}; candidates: {labels}")
 
 
 # ------------------------------------------------------------ data

@@ -829,9 +829,19 @@ def guided(
 
     prof = load_profile(profile)
     settings = _fit_settings(depth_um, bootstrap, 0)
-    resolve_ranges(list(dict.fromkeys(material)), parse_ranges(range_ or []))  # fail before recording
-    parse_object_temps(object_temp or [])
     materials = list(dict.fromkeys(material))
+    # everything the fit will need is checked before the first touch (a session's work was lost to a typo)
+    resolve_ranges(materials, parse_ranges(range_ or []))
+    unknown = [n for n in parse_object_temps(object_temp or []) if n not in materials]
+    if unknown:
+        raise InputError(f"--object-temp names {', '.join(map(repr, unknown))}, not a material of this run "
+                         f"({', '.join(materials)})")
+    if model is not None and model.strip().lower() != "all":
+        from ..calibration.identify import candidate
+
+        candidate(model)
+    if sensor_out is not None:
+        _check_writable(sensor_out, "--sensor-out")
     rec, paths, interrupted = _record_materials(port, prof, out, materials, trials, timeout, quiet=json_,
                                                 prompt=not yes)
     if interrupted:
@@ -856,6 +866,24 @@ def guided(
         return
     console().print(f"Recorded {len(paths)} trial(s) in {out}")
     _print_fit(result, sensor_path, None)
+
+
+def _check_writable(path: Path, what: str) -> None:
+    """Refuse, before any recording, a file that could not be written at the end of it."""
+    import tempfile
+
+    from .._validation import InputError
+
+    folder = Path(path).expanduser().parent
+    if Path(path).is_dir():
+        raise InputError(f"{what} {path} is a folder; give a file name")
+    if not folder.is_dir():
+        raise InputError(f"{what} {path}: folder {folder} does not exist (create it first)")
+    try:
+        with tempfile.NamedTemporaryFile(dir=folder, prefix=".designkit-probe-"):
+            pass
+    except OSError as exc:
+        raise InputError(f"{what} {path}: cannot write in {folder} ({exc.strerror or exc})") from None
 
 
 # ----------------------------------------------------------------- emulate

@@ -102,7 +102,13 @@ def test_classify_hopeless_exits_3_before_touching(cli):
     (["--m", "a=1:2"], "two or more"),
     (["--m", "a=x", "--m", "b=3"], "NAME=MIN:MAX"),
     (["--m", "wood", "--m", "nosuchmaterial"], "nosuchmaterial"),
-    (["--m", "a=1", "--m", "b=2", "--error-rate", "0.9"], "error rate"),
+    (["--m", "a=1", "--m", "b=2", "--error-rate", "0.9"], "--error-rate must be in (0, 0.5), got 0.9"),
+    # each was taken, or refused naming another option or a material
+    (["--m", "a=1", "--m", "b=2", "--error-rate", "0"], "--error-rate must be in (0, 0.5), got 0"),
+    (["--m", "a=1", "--m", "b=2", "--object-temp", "1e9"], "--object-temp must be at most 10000 degC"),
+    (["--m", "a=1", "--m", "b=2", "--object-temp", "nan"], "--object-temp must be finite, got nan"),
+    # a 411 MB header and 3 GB of memory with --export-c
+    (["--m", "a=400", "--m", "b=20000", "--max-contact", "1e5"], "samples per touch; the limit is 1e+06"),
 ])
 def test_classify_bad_input_is_one_line(cli, args, msg):
     r = cli("classify", "--port", "/dev/null", *args)

@@ -130,7 +130,19 @@ def classify(
         raise InputError(f"--delta-t must be a non-zero temperature difference [°C], got {delta_t:g}")
     if time_offset is not None and (not math.isfinite(time_offset) or abs(time_offset) > 5):
         raise InputError(f"--time-offset must be within ±5 s, got {time_offset:g}")
+    from .._validation import check_probability, check_temperature
+    from ..sensor import MAX_SAMPLES_PER_TOUCH, within_sample_limit
+
+    if object_temp is not None:  # 1e9 degC was taken (and printed as Ta); NaN got another option's message
+        check_temperature("--object-temp", object_temp)
+    check_probability("--error-rate", error_rate, low=0.0, high=0.5)
     sens = load_sensor(sensor)
+    if not (math.isfinite(max_contact) and max_contact > 0):
+        raise InputError(f"--max-contact must be a positive, finite time [s], got {max_contact:g}")
+    if not within_sample_limit(max_contact, sens.sample_rate_hz):  # a 411 MB header, 3 GB of memory at 1e5 s
+        raise InputError(f"--max-contact {max_contact:g} s at the sensor's {sens.sample_rate_hz:g} Hz is "
+                         f"{max_contact * sens.sample_rate_hz:.4g} samples per touch; the limit is "
+                         f"{MAX_SAMPLES_PER_TOUCH:.0e}")
     sigma = noise if noise is not None else (sens.noise_c if sens.noise_c else 0.05)
     if time_offset is None:  # the calibrated sensor's own offset: its onset detection is what this run uses
         time_offset = float((sens.model or {}).get("time_offset_s") or 0.0)

@@ -58,6 +58,9 @@ def test_cli_json_with_svm_confirmation(cli, tmp_path):
 
 @pytest.mark.parametrize("args,code,msg", [
     (["--m", "wood", "--m", "Polymethyl methacrylate (Acrylic, PMMA)"], 3, "overlap"),
+    # two single values 50 apart: the classes judged, and why they overlap, are said
+    (["--m", "a=400", "--m", "b=450"], 3, "a [400, 480) and b [450, 530) overlap in effusivity (each material is "
+                                          "judged as a class 80"),
     (["--m", "a=20000", "--m", "b=20100", "--max-contact", "0.5", "--skin", PEEK, "--depth-um", "400:400"], 3,
      "no allowed design"),
     (["--m", "a=1000", "--m", "b=2000", "--depth-um", "500:20"], 2, "contradict"),

@@ -184,14 +184,18 @@ def _range_target(name: str, rng: tuple[float, float]) -> Target:
     return Target(name, math.nan, rng)
 
 
-def _pair_classes(a: Target, b: Target) -> tuple[float, float, float] | None:
-    """Lower edges and width of the classes judged for a pair (lower material first), None if they overlap."""
+def _class_edges(a: Target, b: Target) -> tuple[float, float, float]:
+    """Lower edges and width of the classes judged for a pair (lower material first), overlapping or not."""
     w = min(a.width, b.width)
     lo = a.e_low if math.isfinite(a.e_low) else max(a.e_range[1] - w, a.e_range[0])
     hi = b.e_low if math.isfinite(b.e_low) else b.e_range[0]
-    if hi < lo + w:
-        return None
     return lo, hi, w
+
+
+def _pair_classes(a: Target, b: Target) -> tuple[float, float, float] | None:
+    """Lower edges and width of the classes judged for a pair (lower material first), None if they overlap."""
+    lo, hi, w = _class_edges(a, b)
+    return None if hi < lo + w else (lo, hi, w)
 
 
 def _grid(c: Constraints, n_depth: int) -> np.ndarray:
@@ -214,10 +218,16 @@ def recommend(targets: list[Target], constraints: Constraints, *, skins=SKIN_SET
     ratio = c.noise_c / c.max_delta_t_c
     pairs = [(targets[i], targets[i + 1]) for i in range(len(targets) - 1)]
     edges = [_pair_classes(a, b) for a, b in pairs]
-    bad = [(a.name, b.name) for (a, b), e in zip(pairs, edges) if e is None]
+    bad = [(a, b) for (a, b), e in zip(pairs, edges) if e is None]
     if bad:
-        return DesignResult(None, (), (), (), c, f"{bad[0][0]} and {bad[0][1]} overlap in effusivity: no sensor "
-                                                 "separates every object of one from every object of the other")
+        a, b = bad[0]
+        lo, hi, w = _class_edges(a, b)
+        # the classes judged, with their width: two single values 50 apart "overlapped" with no word of why
+        return DesignResult(None, (), (), (), c, f"{a.name} [{lo:g}, {lo + w:g}) and {b.name} [{hi:g}, {hi + w:g}) "
+                                                 f"overlap in effusivity (each material is judged as a class {w:g} "
+                                                 "J s^-1/2 K^-1 m^-2 wide; NAME=E is the class [E, E + "
+                                                 f"{w:g})): no sensor separates every object of one from every "
+                                                 "object of the other")
     lo = np.array([e[0] for e in edges])
     hi = np.array([e[1] for e in edges])
     wd = np.array([e[2] for e in edges])

@@ -173,3 +173,30 @@ def test_each_announced_touch_is_checked_against_the_label(tmp_path, materials, 
         assert got is None
     else:
         assert got is not None and expect in got and "--yes" in got
+
+
+@pytest.mark.slow
+def test_the_emulators_classify_hint_decides_its_touches_right(cli, ctrl_c_able):
+    """classify's --time-offset defaults to 0 (a calibrated sensor file carries its own): against the emulator
+    every touch was decided as the same material. The emulator now prints a classify line with its offset;
+    run as printed, it decides the alternating touches right."""
+    import signal
+    import subprocess
+
+    from test_calibration_cli import _exe, _read_json_object
+
+    proc = subprocess.Popen(_exe() + ["emulate", "--material", "a=400", "--material", "b=600",
+                                      "--touches-per-material", "1", "--touch-every", "13", "--speed", "40",
+                                      "--duration", "60", "--json"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, **ctrl_c_able)
+    try:
+        info = _read_json_object(proc.stdout)
+        args = shlex.split(info["try_classify"])
+        assert args[:2] == ["designkit", "classify"] and args[args.index("--time-offset") + 1] == "-0.25"
+        r = cli(*args[1:], "--touches", "4", "--json")
+        assert r.exit_code == 0, r.output
+        got = [d["material"] for d in json.loads(r.stdout)["decisions"]]
+    finally:
+        proc.send_signal(signal.SIGINT)
+        proc.communicate(timeout=20)
+    assert got == ["a", "b", "a", "b"]

@@ -971,8 +971,16 @@ def emulate(
     port = emu.start()
     try_cmd = _guided_command(port, profile, [m.label for m in mats], touches_per_material,
                               _hint_ranges(mats))
+    # classify's default --time-offset is 0 (a calibrated sensor file carries its own); this emulator's onset
+    # detection lags by expected_time_offset_s, and without it every touch was decided as the same material
+    import shlex
+
+    classify_cmd = None if len(mats) < 2 else (
+        f"designkit classify --port {port}" + ("" if profile is None else f" --profile {shlex.quote(profile)}")
+        + "".join(f" --m {shlex.quote(f'{m.label}={m.effusivity:g}')}" for m in mats)
+        + f" --time-offset {emu.expected_time_offset_s:g}")
     info = {"port": port, "profile": prof.name, "speed": speed, "touch_every_s": touch_every,
-            "touches_per_material": touches_per_material, "try": try_cmd,
+            "touches_per_material": touches_per_material, "try": try_cmd, "try_classify": classify_cmd,
             "materials": [{"label": m.label, "effusivity": m.effusivity} for m in mats],
             "noise_c": noise, "sensor": emu.sensor.to_dict(), "model": fm.to_dict(),
             "time_offset_s": emu.expected_time_offset_s,
@@ -995,6 +1003,8 @@ def emulate(
                              "carries the raw reading: any host smoothing is the host's)"))
         con.print(f"  touches {touches_per_material} of each material in turn, from when a program opens the port")
         con.print(f"  try: {escape(try_cmd)}", soft_wrap=True)
+        if classify_cmd is not None:
+            con.print(f"  or:  {escape(classify_cmd)}", soft_wrap=True)
         sys.stdout.flush()
     start = time.monotonic()
     announced = -1

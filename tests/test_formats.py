@@ -86,6 +86,15 @@ def test_matrix_reads_one_name_a_line(cli, tmp_path):
     assert r.stdout.splitlines()[0] == "material,Glass,Copper"
 
 
+def test_matrix_reads_a_one_column_csv_with_its_name_header(cli, tmp_path):
+    """Its header was taken for a material: "unknown material 'name'"."""
+    p = tmp_path / "bin.csv"
+    p.write_text("name\npaper12:glass\npaper12:copper\n")
+    r = cli("matrix", "--from", str(p), "--format", "csv", "--no-multiclass")
+    assert r.exit_code == 0, r.output
+    assert r.stdout.splitlines()[0] == "material,Glass,Copper"
+
+
 # ---------------------------------------------------------------- figures: vector formats on request
 @pytest.mark.parametrize("fmt, magic", [("svg", b"<?xml"), ("pdf", b"%PDF"), ("png", b"\x89PNG")])
 def test_report_figures_in_the_format_asked(tmp_path, fmt, magic):

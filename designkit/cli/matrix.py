@@ -148,7 +148,7 @@ def read_material_names(path: str) -> list[str]:
 
         raise InputError(f"no material names in {'stdin' if path == '-' else path}")
     header = next(csv.reader([lines[0]]))
-    if "name" in header and len(header) > 1:
+    if "name" in header:  # a CSV with a 'name' column, a one-column one too (its header was read as a material)
         rows = list(csv.DictReader(io.StringIO("\n".join(lines))))
         return [f"{r['set']}:{r['name']}" if r.get("set") else r["name"] for r in rows if r.get("name")]
     return [ln.strip() for ln in lines]

@@ -145,3 +145,25 @@ def test_bad_model_options_are_one_line_and_exit_2(cli, args, needle):
     assert r.exit_code == 2, r.output
     err = r.stderr.strip()
     assert len(err.splitlines()) == 1 and err.startswith("Error:") and needle in err, err
+
+
+def test_simulate_out_dash_prints_the_csv_and_writes_no_file(cli, tmp_path, monkeypatch):
+    """'--out -' wrote a file named '-' and said "wrote -"; the README's vocabulary: '-' is standard output."""
+    monkeypatch.chdir(tmp_path)
+    r = cli("simulate", "--e", "20000", "--contact", "0.02", "--trials", "2", "--out", "-")
+    assert r.exit_code == 0, r.output
+    lines = r.stdout.splitlines()
+    assert lines[0] == "time_s,trial_1,trial_2" and len(lines) == 1 + 5 and not (tmp_path / "-").exists()
+    r = cli("simulate", "--e", "20000", "--out", "-", "--json")
+    assert r.exit_code == 2 and "--out - and --json would both print" in r.stderr
+
+
+def test_calibrate_fit_refuses_out_dash_and_a_missing_folder_before_fitting(cli, tmp_path):
+    """'--out -' wrote a file named '-' (and advised '--sensor -'); a missing folder was created from the root."""
+    index = tmp_path / "index.csv"
+    index.write_text("file,material\n")  # never read: the output is refused first
+    r = cli("calibrate", "fit", index, "--out", "-")
+    assert r.exit_code == 2 and "give the sensor file a name" in r.stderr and r.stderr.count("\n") == 1
+    r = cli("calibrate", "fit", index, "--out", tmp_path / "no" / "such" / "s.yaml")
+    assert r.exit_code == 2 and "does not exist (create it first)" in r.stderr
+    assert not (tmp_path / "no").exists()

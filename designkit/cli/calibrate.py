@@ -761,6 +761,12 @@ def fit(
     from ._format import check_format, emit_rows
 
     fmt = "json" if json_ else check_format(format_)
+    if out is not None:
+        if str(out) == "-":  # it wrote a file named '-' and advised '--sensor -'
+            from .._validation import InputError
+
+            raise InputError("--out - : give the sensor file a name (it is read back with --sensor FILE)")
+        _check_writable(out, "--out")  # before the fit: a fit's minutes were lost to an unwritable path
     rows_only = fmt in ("csv", "md")
     settings = _fit_settings(depth_um, bootstrap, seed, baseline, offset_range, fit_to)
     only_list = [s.strip() for item in only for s in item.split(",") if s.strip()] if only else None

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 import time
 from pathlib import Path
 from typing import Annotated, Optional
@@ -25,7 +26,7 @@ def simulate(
     trials: Annotated[int, typer.Option("--trials", help="Number of touches.")] = 1,
     seed: Seed = 0,
     sensor: SensorOpt = "paper",
-    out: Annotated[Optional[Path], typer.Option("--out", help="Write a CSV: time_s, then one column per trial.")] = None,
+    out: Annotated[Optional[Path], typer.Option("--out", help="Write a CSV: time_s, then one column per trial ('-': standard output, instead of the summary).")] = None,
     plot: Annotated[Optional[Path], typer.Option("--plot", help="Write a PNG of the curves (needs designkit[figures]).")] = None,
     model: ModelOpt = None,
     conductance: Conductance = None,
@@ -44,6 +45,9 @@ def simulate(
 
     if trials < 1:
         raise ValueError(f"trials must be >= 1, got {trials}")
+    to_stdout = out is not None and str(out) == "-"  # it wrote a file named '-'
+    if to_stdout and json_:
+        raise ValueError("--out - and --json would both print on standard output: give --out a file name")
     check_temperature("--sensor-temp [°C]", sensor_temp)
     check_temperature("--ambient [°C]", ambient)
     check_temperature("--noise [°C]", noise, nonnegative=True)
@@ -55,7 +59,10 @@ def simulate(
     # the paper's contact temperature (eq. 1): where the surface jumps at once under a shared-shape
     # model; other models reach it later (a contact's lag) or never (a slab on its backing)
     tc = float(contact_temperature(sensor_temp, ambient, sen.effusivity, e)) if fm.shared_shape else None
-    if out is not None:
+    if to_stdout:
+        sys.stdout.write(_curves_csv(result.time_s, result.temperature_c))
+        sys.stdout.flush()
+    elif out is not None:
         _write_curves_csv(out, result.time_s, result.temperature_c)
     if plot is not None:
         from ..figures import plot_curves
@@ -77,6 +84,8 @@ def simulate(
             "out": str(out) if out else None,
             "plot": str(plot) if plot else None,
         })
+        return
+    if to_stdout:  # the CSV is the output
         return
     from rich.markup import escape
 
@@ -133,18 +142,22 @@ def _touches(e: float, sensor, scene, trials: int, seed: int, model, diffusivity
     return render_trials(draws, sensor, scene, model, alpha)
 
 
-def _write_curves_csv(path: Path, time_s, temps) -> None:
+def _curves_csv(time_s, temps) -> str:
     import io
 
     import numpy as np
-
-    from .._io import atomic_write_text
 
     buf = io.StringIO()
     header = ["time_s"] + [f"trial_{i + 1}" for i in range(temps.shape[0])]
     np.savetxt(buf, np.column_stack([time_s, temps.T]), delimiter=",", header=",".join(header),
                comments="", fmt="%.10g")
-    atomic_write_text(path, buf.getvalue())
+    return buf.getvalue()
+
+
+def _write_curves_csv(path: Path, time_s, temps) -> None:
+    from .._io import atomic_write_text
+
+    atomic_write_text(path, _curves_csv(time_s, temps))
 
 
 @app.command(rich_help_panel=_app.MODEL)

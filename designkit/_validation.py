@@ -192,8 +192,22 @@ def check_effusivity(name: str, value: float, *, allow_zero: bool = False,
 
 
 def check_effusivity_range(name: str, low: float, high: float) -> tuple[float, float]:
-    """Check an effusivity class [low, high) with 0 <= low < high < inf."""
+    """Check an effusivity class [low, high) with 0 <= low < high < inf.
+
+    >>> check_effusivity_range("e1", 9999999.0, 10000079.0)
+    Traceback (most recent call last):
+    ...
+    designkit._validation.InputError: effusivity class e1, [9999999, 10000079), ends above the highest effusivity accepted, 1e+07 J s^-1/2 K^-1 m^-2 (a value E is the class [E, E + 80)): give at most 9999920
+    """
     lo = check_effusivity(f"{name} lower bound", low, allow_zero=True)
+    try:
+        hi = float(high)
+    except (TypeError, ValueError):
+        hi = math.nan
+    if lo <= MAX_EFFUSIVITY < hi < math.inf:  # the class's end, which the user did not type, is what is too high
+        raise InputError(f"effusivity class {name}, [{lo:.10g}, {hi:.10g}), ends above the highest effusivity "
+                         f"accepted, {MAX_EFFUSIVITY:g} J s^-1/2 K^-1 m^-2 (a value E is the class [E, E + "
+                         f"{hi - lo:.10g})): give at most {MAX_EFFUSIVITY - (hi - lo):.10g}")
     hi = check_effusivity(f"{name} upper bound", high)
     if not hi > lo:
         raise InputError(

@@ -113,7 +113,7 @@ def object_class(e: float | None = None, material: str | None = None, *, width: 
     v = check_effusivity("e", e)
     w = check_positive("class width", width)
     d = None if diffusivity_m2_s is None else (check_positive("diffusivity [m^2/s]", diffusivity_m2_s),) * 2
-    return ObjectClass(f"{v:g}", (v, v + w), d)
+    return ObjectClass(f"{v:.10g}", (v, v + w), d)  # the value as typed (9999999, not 1e+07)
 
 
 def ordered_pair(a: ObjectClass, b: ObjectClass) -> tuple[ObjectClass, ObjectClass]:

@@ -511,3 +511,13 @@ def test_an_exact_questions_bad_input_is_one_line_on_stderr(cli, args):
     r = cli(*args)
     assert r.exit_code == 2, r.output
     assert r.stderr.startswith("Error: ") and r.stderr.count("\n") == 1, repr(r.stderr)
+
+
+def test_an_effusivity_whose_class_ends_above_the_cap_is_refused_naming_the_class(cli):
+    """9999999 is below the cap of 1e7, its 80-wide class is not: the message said "effusivity 1e+07 upper bound
+    must be at most 1e+07 ..., got 1.00001e+07" (a value the user did not type, rounded into the cap)."""
+    r = cli("min-contact", "--e1", "9999999", "--e2", "20000")
+    assert r.exit_code == 2 and r.stderr.count("\n") == 1
+    assert r.stderr.startswith("Error: effusivity class 9999999, [9999999, 10000079), ends above the highest")
+    assert "give at most 9999920" in r.stderr
+    assert cli("min-contact", "--e1", "9999920", "--e2", "20000").exit_code != 2  # the largest value accepted

@@ -219,3 +219,13 @@ def test_tables_list_of_a_folder_skips_a_damaged_table_and_says_when_there_are_n
     empty.mkdir()
     r = cli("tables", "list", "--folder", empty)
     assert r.exit_code == 0 and r.stdout == f"no designkit tables in {empty}\n"
+
+
+def test_a_sweep_config_given_as_a_table_is_named_for_what_it_is(cli):
+    """It was read as a zip: "table svm-paper.yaml is corrupted or truncated (ValueError)"."""
+    from designkit._resources import shipped_tables_dir
+
+    cfg = shipped_tables_dir() / "svm-paper.yaml"
+    r = cli("tables", "show", cfg)
+    assert r.exit_code == 2 and r.stderr.count("\n") == 1
+    assert "is a sweep config, not a table: build its table with 'designkit sweep --config" in r.stderr

@@ -38,7 +38,7 @@ def export_cmd(
     contact: Annotated[Optional[List[str]], typer.Option("--contact", help="Keep the contact times a robot uses [s]: a value, a range 1:4, or a comma list; repeatable.")] = None,
     e_min: Annotated[Optional[float], typer.Option("--e-min", help="Keep effusivities from this value [J s^-1/2 K^-1 m^-2] (plus one interval of margin).")] = None,
     e_max: Annotated[Optional[float], typer.Option("--e-max", help="Keep effusivities up to this value (plus one interval of margin).")] = None,
-    prefix: Annotated[str, typer.Option("--prefix", help="C: prefix of every function, constant and macro.")] = "designkit",
+    prefix: Annotated[str, typer.Option("--prefix", help="C: prefix of every function, constant and macro (macros take it upper-cased: two headers in one program need prefixes that differ in more than case).")] = "designkit",
     kind: Annotated[str, typer.Option("--kind", help="Which delta: svm (the table's classifier), lo / hi (ends of its Monte Carlo interval; hi is the conservative one) or ideal.")] = "svm",
     sensor: Annotated[Optional[str], typer.Option("--sensor", help="Check that the table was built for this sensor (preset or sensor YAML) and the model its file records; refused otherwise.")] = None,
     json_: Json = False,

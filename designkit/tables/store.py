@@ -413,6 +413,9 @@ def resolve_table(name_or_path: str | Path) -> Path:
     if "\0" in s:
         raise InputError(f"table name {s!r} holds a NUL character")
     p = Path(s)
+    if p.suffix.lower() in (".yaml", ".yml"):  # was read as a zip: "corrupted or truncated (ValueError)"
+        raise InputError(f"{s} is a sweep config, not a table: build its table with 'designkit sweep --config "
+                         f"{s}', or give the table's .npz")
     candidates = [p, p.with_suffix(".npz")] if p.suffix in ("", ".json", ".npz") else [p]
     if p.suffix == "" and "/" not in s:
         candidates.insert(0, shipped_tables_dir() / f"{s}.npz")

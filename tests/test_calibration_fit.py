@@ -379,3 +379,14 @@ def test_data_lines_that_start_with_the_comment_prefix_are_named(cli, tmp_path):
     assert r.exit_code == 2, r.output
     assert "start with the profile's comment prefix '#'" in r.output and "look like data lines" in r.output
     assert "Set the profile's comment" in r.output
+
+
+def test_an_index_listing_a_trial_twice_is_refused_naming_its_lines(cli, tmp_path):
+    """The same touch listed twice was fitted as two touches, without a word (overstated confidence)."""
+    index = _write(tmp_path / "t", make_trials(n=2, seed=9))
+    lines = index.read_text().splitlines()
+    index.write_text("\n".join(lines + [lines[1]]) + "\n")
+    r = cli("calibrate", "fit", index, "--range", "metal=aluminium", "--bootstrap", "0", "--force")
+    name = lines[1].split(",")[0]
+    assert r.exit_code == 2 and r.stderr.count("\n") == 1, r.output
+    assert f"lists {name} twice (lines 2 and {len(lines) + 1})" in r.stderr

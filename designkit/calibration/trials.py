@@ -351,8 +351,14 @@ def load_index(index_csv: Path, only: Sequence[str] | None = None) -> list[Trial
                              f"(it has {', '.join(materials)})")
         numbered = [(n, r) for n, r in numbered if r["material"] in set(only)]
     trials = []
+    seen: dict[Path, int] = {}
     for line_no, r in numbered:
         if not r.get("file") or not r.get("material"):
             raise InputError(f"index {index_csv} line {line_no}: empty file or material")
+        path = (index_csv.parent / r["file"]).resolve()
+        if path in seen:  # fitted twice, it counted as two touches: a confidence the data does not have
+            raise InputError(f"index {index_csv} lists {r['file']} twice (lines {seen[path]} and {line_no}); "
+                             "remove one of them")
+        seen[path] = line_no
         trials.append(read_trial_csv(index_csv.parent / r["file"], r["material"]))
     return trials

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import shlex
 
@@ -79,20 +80,29 @@ def test_emulate_and_guided_defaults_agree(cli):
     assert emulate_default == guided_default == cal.DEFAULT_TRIALS
 
 
-@pytest.mark.slow
-def test_the_emulators_hint_pastes_into_a_shell_and_labels_right(cli, tmp_path, ctrl_c_able):
-    """A material name with a space: the printed command is quoted, and running it records right."""
+@contextlib.contextmanager
+def _emulator_process(ctrl_c_able, *args):
+    """``designkit emulate ARGS --json`` in its own process: yields what it announces, stopped with Ctrl-C after."""
     import signal
     import subprocess
 
     from test_calibration_cli import _exe, _read_json_object
 
-    proc = subprocess.Popen(_exe() + ["emulate", "--material", "Aluminium alloys", "--material", "wood",
-                                      "--touches-per-material", "2", "--touch-every", "13", "--speed", "50",
-                                      "--duration", "60", "--json"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, **ctrl_c_able)
+    proc = subprocess.Popen(_exe() + ["emulate", *args, "--json"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            **ctrl_c_able)
     try:
-        info = _read_json_object(proc.stdout)
+        yield _read_json_object(proc.stdout)
+    finally:
+        proc.send_signal(signal.SIGINT)
+        proc.communicate(timeout=20)
+
+
+@pytest.mark.slow
+def test_the_emulators_hint_pastes_into_a_shell_and_labels_right(cli, tmp_path, ctrl_c_able):
+    """A material name with a space: the printed command is quoted, and running it records right."""
+    with _emulator_process(ctrl_c_able, "--material", "Aluminium alloys", "--material", "wood",
+                           "--touches-per-material", "2", "--touch-every", "13", "--speed", "50",
+                           "--duration", "60") as info:
         args = shlex.split(info["try"])
         assert args[:2] == ["designkit", "calibrate"]
         assert args[args.index("--material") + 1] == "Aluminium alloys"
@@ -102,9 +112,6 @@ def test_the_emulators_hint_pastes_into_a_shell_and_labels_right(cli, tmp_path, 
         assert r.exit_code == 0, r.output
         labels = [json.loads((tmp_path / "trials" / p).with_suffix(".json").read_text())["material"]
                   for p in json.loads(r.stdout)["record"]["trials"]]
-    finally:
-        proc.send_signal(signal.SIGINT)
-        proc.communicate(timeout=20)
     played = [m["label"] for m in info["materials"]]    # database names as the database spells them
     assert played[0] == "Aluminium alloys" and played[1].lower() == "wood"
     assert labels == [played[0]] * 2 + [played[1]] * 2
@@ -180,23 +187,11 @@ def test_the_emulators_classify_hint_decides_its_touches_right(cli, ctrl_c_able)
     """classify's --time-offset defaults to 0 (a calibrated sensor file carries its own): against the emulator
     every touch was decided as the same material. The emulator now prints a classify line with its offset;
     run as printed, it decides the alternating touches right."""
-    import signal
-    import subprocess
-
-    from test_calibration_cli import _exe, _read_json_object
-
-    proc = subprocess.Popen(_exe() + ["emulate", "--material", "a=400", "--material", "b=600",
-                                      "--touches-per-material", "1", "--touch-every", "13", "--speed", "40",
-                                      "--duration", "60", "--json"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, **ctrl_c_able)
-    try:
-        info = _read_json_object(proc.stdout)
+    with _emulator_process(ctrl_c_able, "--material", "a=400", "--material", "b=600", "--touches-per-material",
+                           "1", "--touch-every", "13", "--speed", "40", "--duration", "60") as info:
         args = shlex.split(info["try_classify"])
         assert args[:2] == ["designkit", "classify"] and args[args.index("--time-offset") + 1] == "-0.25"
         r = cli(*args[1:], "--touches", "4", "--json")
         assert r.exit_code == 0, r.output
         got = [d["material"] for d in json.loads(r.stdout)["decisions"]]
-    finally:
-        proc.send_signal(signal.SIGINT)
-        proc.communicate(timeout=20)
     assert got == ["a", "b", "a", "b"]

@@ -78,18 +78,13 @@ def test_materials_csv_pipes_into_matrix_from_stdin(cli):
     assert len(d["cells"]) == 66
 
 
-def test_matrix_reads_one_name_a_line(cli, tmp_path):
+@pytest.mark.parametrize("text", [
+    "# the bin\npaper12:glass\n\npaper12:copper\n",  # one name a line
+    "name\npaper12:glass\npaper12:copper\n",  # a one-column CSV: its header was taken for a material
+])
+def test_matrix_reads_one_name_a_line_or_a_name_column(cli, tmp_path, text):
     p = tmp_path / "bin.txt"
-    p.write_text("# the bin\npaper12:glass\n\npaper12:copper\n")
-    r = cli("matrix", "--from", str(p), "--format", "csv", "--no-multiclass")
-    assert r.exit_code == 0, r.output
-    assert r.stdout.splitlines()[0] == "material,Glass,Copper"
-
-
-def test_matrix_reads_a_one_column_csv_with_its_name_header(cli, tmp_path):
-    """Its header was taken for a material: "unknown material 'name'"."""
-    p = tmp_path / "bin.csv"
-    p.write_text("name\npaper12:glass\npaper12:copper\n")
+    p.write_text(text)
     r = cli("matrix", "--from", str(p), "--format", "csv", "--no-multiclass")
     assert r.exit_code == 0, r.output
     assert r.stdout.splitlines()[0] == "material,Glass,Copper"

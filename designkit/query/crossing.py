@@ -192,13 +192,16 @@ def estimate_crossing(f: Callable[[float], tuple[float, float]], x_lo: float, x_
         if increasing:  # reaches phi already at x_lo
             return CrossingEstimate(x_lo, None, x_lo, coverage, "none", log_of(evals))
         return CrossingEstimate(None, None, None, coverage, "none", log_of(evals))  # never reaches phi
-    a, b = x_lo, x_hi
-    while b / a > bracket_ratio:
-        mid = math.sqrt(a * b)
-        if beyond(mid):
-            b = mid
-        else:
-            a = mid
+    def bisect(a: float, b: float, ratio: float) -> tuple[float, float]:  # a before the crossing, b past it
+        while b / a > ratio:
+            mid = math.sqrt(a * b)
+            if beyond(mid):
+                b = mid
+            else:
+                a = mid
+        return a, b
+
+    a, b = bisect(x_lo, x_hi, bracket_ratio)
     # 2. design points across the bracket, widened a little on both sides
     la, lb = math.log(a), math.log(b)
     pad = 0.25 * (lb - la)
@@ -219,15 +222,8 @@ def estimate_crossing(f: Callable[[float], tuple[float, float]], x_lo: float, x_
             break
         if attempt:
             return CrossingEstimate(math.sqrt(a * b), a, b, coverage, "bracket", log_of(evals))
-        past = [x for x in evals if beyond(x)]  # cached: no new evaluation
-        b = min(past)
-        a = max([x for x in evals if x < b and not beyond(x)], default=a)
-        while b / a > fine_ratio:
-            mid = math.sqrt(a * b)
-            if beyond(mid):
-                b = mid
-            else:
-                a = mid
+        b = min(x for x in evals if beyond(x))  # cached: no new evaluation
+        a, b = bisect(max([x for x in evals if x < b and not beyond(x)], default=a), b, fine_ratio)
     u = np.log(xs[use])
     y, w = _logit(ms[use]), 1.0 / _logit_se(ms[use], ss[use]) ** 2
     X = np.column_stack([np.ones_like(u), u])

@@ -216,8 +216,8 @@ def output_to(out: str | None):
     >>> out = pathlib.Path(tempfile.mkdtemp()) / "answer.txt"
     >>> with output_to(str(out)):
     ...     print("1.23 s")
-    >>> out.read_text()
-    '1.23 s\n'
+    >>> out.read_text().splitlines()
+    ['1.23 s']
     """
     if out is None or str(out) == "-":
         yield

@@ -82,6 +82,24 @@ def within_sample_limit(contact_s, sample_rate_hz: float) -> np.ndarray:
     return _last_index_float(contact_s, sample_rate_hz) < MAX_SAMPLES_PER_TOUCH
 
 
+def check_samples_per_touch(contact_s: float, sample_rate_hz: float, what: str = "a touch",
+                            advice: str = "shorten the contact or lower the sample rate") -> float:
+    """The last sample index of a touch (float), or a one-line InputError beyond :data:`MAX_SAMPLES_PER_TOUCH`.
+
+    The one limit on a touch's length in samples, whoever asks: a simulated touch, a design's longest
+    contact at its highest rate, a live test's longest contact (each ran without end, or wrote hundreds
+    of MB, before it was checked). ``what`` names the request, ``advice`` what to change.
+
+    >>> int(check_samples_per_touch(2.0, 200.0))  # index 400 (with a tolerance of 1e-9 samples): 401 samples
+    400
+    """
+    n_float = float(_last_index_float(contact_s, sample_rate_hz))  # may be inf (1e308 s)
+    if not n_float < MAX_SAMPLES_PER_TOUCH:
+        raise InputError(f"{what} of {contact_s:g} s at {sample_rate_hz:g} Hz has {n_float + 1:.4g} samples per "
+                         f"touch; the limit is {MAX_SAMPLES_PER_TOUCH:.0e} ({advice})")
+    return n_float
+
+
 def sample_times_s(contact_s: float, sample_rate_hz: float) -> np.ndarray:
     """Sample times of one touch: ``k / fs`` for ``k = 0 .. floor(contact_s * fs)``.
 
@@ -103,10 +121,7 @@ def sample_times_s(contact_s: float, sample_rate_hz: float) -> np.ndarray:
     """
     contact_s = check_positive("contact time [s]", contact_s)
     fs = check_positive("sample rate [Hz]", sample_rate_hz)
-    n_float = float(_last_index_float(contact_s, fs))  # may be inf (1e308 s): checked before math.floor sees it
-    if not n_float < MAX_SAMPLES_PER_TOUCH:
-        raise InputError(f"a touch of {contact_s:g} s at {fs:g} Hz has {n_float + 1:.4g} samples; the limit is "
-                         f"{MAX_SAMPLES_PER_TOUCH:.0e} per touch (shorten the contact or lower the sample rate)")
+    n_float = check_samples_per_touch(contact_s, fs)  # before math.floor sees an infinite count
     n = int(math.floor(n_float))
     return np.arange(n + 1, dtype=np.float64) / fs
 

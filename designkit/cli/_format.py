@@ -192,13 +192,29 @@ def write_output(text: str, out: str | None) -> None:
         raise InputError(f"cannot write {p}: {exc.strerror or exc}") from None
 
 
-def check_out(out: str) -> Path:
-    """``out`` as a path to write, or an error if its folder is missing or it is a folder."""
-    p = Path(out)
-    if p.parent and not p.parent.is_dir():
-        raise InputError(f"cannot write {p}: folder {p.parent} does not exist")
+def check_out(out: str | Path, what: str | None = None, *, probe: bool = False) -> Path:
+    """``out`` as a file to write, or a one-line error naming ``what`` (an option) and the reason.
+
+    Refused: a folder; a file in a folder that is missing or no folder (like ``cp`` and ``cc -o``, no
+    folders are made for a typo); with ``probe``, a folder this process cannot write in (tried with a
+    temporary file: for outputs written only after minutes of work, such as a calibration's).
+    """
+    p = Path(out).expanduser()
+    label = f"{what} {p}" if what else f"cannot write {p}"
     if p.is_dir():
-        raise InputError(f"cannot write {p}: it is a folder; give a file name")
+        raise InputError(f"{label}: it is a folder; give a file name")
+    folder = p.parent
+    if not folder.is_dir():
+        why = "is not a folder" if folder.exists() else "does not exist (create it first)"
+        raise InputError(f"{label}: folder {folder} {why}")
+    if probe:
+        import tempfile
+
+        try:
+            with tempfile.NamedTemporaryFile(dir=folder, prefix=".designkit-probe-"):
+                pass
+        except OSError as exc:
+            raise InputError(f"{label}: cannot write in {folder} ({exc.strerror or exc})") from None
     return p
 
 

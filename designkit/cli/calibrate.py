@@ -758,7 +758,7 @@ def fit(
 
     Example (the parameters as CSV): `designkit calibrate fit trials/index.csv --model all --format csv`
     """
-    from ._format import check_format, emit_rows
+    from ._format import check_format, check_out, emit_rows
 
     fmt = "json" if json_ else check_format(format_)
     if out is not None:
@@ -766,7 +766,7 @@ def fit(
             from .._validation import InputError
 
             raise InputError("--out - : give the sensor file a name (it is read back with --sensor FILE)")
-        _check_writable(out, "--out")  # before the fit: a fit's minutes were lost to an unwritable path
+        check_out(out, "--out", probe=True)  # before the fit: its minutes were lost to an unwritable path
     rows_only = fmt in ("csv", "md")
     settings = _fit_settings(depth_um, bootstrap, seed, baseline, offset_range, fit_to)
     only_list = [s.strip() for item in only for s in item.split(",") if s.strip()] if only else None
@@ -847,7 +847,9 @@ def guided(
 
         candidate(model)
     if sensor_out is not None:
-        _check_writable(sensor_out, "--sensor-out")
+        from ._format import check_out
+
+        check_out(sensor_out, "--sensor-out", probe=True)
     rec, paths, interrupted = _record_materials(port, prof, out, materials, trials, timeout, quiet=json_,
                                                 prompt=not yes)
     if interrupted:
@@ -872,24 +874,6 @@ def guided(
         return
     console().print(f"Recorded {len(paths)} trial(s) in {out}")
     _print_fit(result, sensor_path, None)
-
-
-def _check_writable(path: Path, what: str) -> None:
-    """Refuse, before any recording, a file that could not be written at the end of it."""
-    import tempfile
-
-    from .._validation import InputError
-
-    folder = Path(path).expanduser().parent
-    if Path(path).is_dir():
-        raise InputError(f"{what} {path} is a folder; give a file name")
-    if not folder.is_dir():
-        raise InputError(f"{what} {path}: folder {folder} does not exist (create it first)")
-    try:
-        with tempfile.NamedTemporaryFile(dir=folder, prefix=".designkit-probe-"):
-            pass
-    except OSError as exc:
-        raise InputError(f"{what} {path}: cannot write in {folder} ({exc.strerror or exc})") from None
 
 
 # ----------------------------------------------------------------- emulate

@@ -112,11 +112,11 @@ def classify(
 
     Example: `designkit classify --m wood --m "aluminium alloys" --error-rate 0.001 --export-c robot_seq.h`
     """
-    from .._validation import InputError
+    from .._validation import InputError, check_positive, check_probability, check_temperature
     from ..calibration.live import LiveClassifier
     from ..calibration.profiles import load_profile
     from ..recognition.sequential import SequentialTest
-    from ..sensor import load_sensor
+    from ..sensor import check_samples_per_touch, load_sensor
 
     if port is None and export_c is None:
         raise InputError("give --port (the serial device of the rig), or --export-c FILE for a C header")
@@ -130,19 +130,12 @@ def classify(
         raise InputError(f"--delta-t must be a non-zero temperature difference [°C], got {delta_t:g}")
     if time_offset is not None and (not math.isfinite(time_offset) or abs(time_offset) > 5):
         raise InputError(f"--time-offset must be within ±5 s, got {time_offset:g}")
-    from .._validation import check_probability, check_temperature
-    from ..sensor import MAX_SAMPLES_PER_TOUCH, within_sample_limit
-
     if object_temp is not None:  # 1e9 degC was taken (and printed as Ta); NaN got another option's message
         check_temperature("--object-temp", object_temp)
     check_probability("--error-rate", error_rate, low=0.0, high=0.5)
     sens = load_sensor(sensor)
-    if not (math.isfinite(max_contact) and max_contact > 0):
-        raise InputError(f"--max-contact must be a positive, finite time [s], got {max_contact:g}")
-    if not within_sample_limit(max_contact, sens.sample_rate_hz):  # a 411 MB header, 3 GB of memory at 1e5 s
-        raise InputError(f"--max-contact {max_contact:g} s at the sensor's {sens.sample_rate_hz:g} Hz is "
-                         f"{max_contact * sens.sample_rate_hz:.4g} samples per touch; the limit is "
-                         f"{MAX_SAMPLES_PER_TOUCH:.0e}")
+    check_samples_per_touch(check_positive("--max-contact [s]", max_contact), sens.sample_rate_hz,
+                            "--max-contact", "lower --max-contact")  # a 411 MB header, 3 GB of memory at 1e5 s
     sigma = noise if noise is not None else (sens.noise_c if sens.noise_c else 0.05)
     if time_offset is None:  # the calibrated sensor's own offset: its onset detection is what this run uses
         time_offset = float((sens.model or {}).get("time_offset_s") or 0.0)
@@ -193,8 +186,6 @@ def classify(
                          on_status=refresh)
     interrupted = False
     failed = None  # the device went away or fell silent mid-session: the decisions made so far still count
-    from .._validation import InputError
-
     try:
         clf.open()  # a port that cannot be opened is refused as it is (nothing decided yet)
         if not json_ and con.is_terminal:

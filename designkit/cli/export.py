@@ -11,7 +11,6 @@ path needs numpy only (and scipy for ``.mat``).
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 from typing import Annotated, List, Optional
 
 import typer
@@ -60,13 +59,9 @@ def export_cmd(
     if out == "-":
         _to_stdout(export_bytes, table, fmt, json_, slice_opts)
         return
-    folder = Path(out).expanduser().parent
-    if not folder.is_dir():  # like cp and cc -o: a typo in the folder is not silently made into new folders
-        from .._validation import InputError
+    from ._format import check_out
 
-        why = "is not a folder" if folder.exists() else "does not exist (create it first)"
-        raise InputError(f"--out {out}: folder {folder} {why}")
-    res = export_table(table, Path(out), fmt, **slice_opts)
+    res = export_table(table, check_out(out, "--out"), fmt, **slice_opts)
     if json_:
         emit_json(res.to_dict())
         return

@@ -11,6 +11,7 @@ forward model other than the tables' (``--thickness``, ``--conductance``,
 
 from __future__ import annotations
 
+import sys
 from contextlib import contextmanager
 from typing import Annotated, Optional
 
@@ -150,8 +151,6 @@ def _exact_display(question: str, progress: bool):
     """What the exact route shows while it runs: a bar of SVM evaluations for a question that reports its
     steps (yields the callback to pass as ``progress``), a spinner for one that does not, nothing when quiet
     or where stderr is no terminal (rich's bar then left a blank line before the answer's error, if any)."""
-    import sys
-
     if not progress or not (hasattr(sys.stderr, "isatty") and sys.stderr.isatty()):
         yield None
         return
@@ -271,7 +270,8 @@ def _scalar(words: str, unit: str):
 def _delta_lines(con, d):
     x = d["details"]
     dash = False  # the legend only when a "—" is printed
-    who = "SVM" if _answerer(d).startswith("SVM") else _answerer(d)
+    who = _answerer(d)
+    who = "SVM" if who.startswith("SVM") else who
     for words, side in (("towards lower e ", "lower"), ("towards higher e", "upper")):
         s = x[side]
         iv = s["interval"]

@@ -26,7 +26,7 @@ import numpy as np
 from .._validation import InputError
 from ..materials import get_material, list_materials
 from ..query.ideal_bound import exact_ideal_min_contact
-from ..sensor import MAX_SAMPLES_PER_TOUCH, Sensor, within_sample_limit
+from ..sensor import Sensor, check_samples_per_touch
 
 __all__ = ["SKIN_SET", "Constraints", "Design", "DesignResult", "Target", "confirm_with_svm", "recommend",
            "targets_from"]
@@ -92,10 +92,8 @@ class Constraints:
         if self.max_contact_s * self.max_rate_hz < 1.0:
             raise InputError(f"constraints contradict each other: {self.max_contact_s:g} s at {self.max_rate_hz:g} Hz "
                              "is less than one sample after contact")
-        if not within_sample_limit(self.max_contact_s, self.max_rate_hz):  # the search ran without end (8 GB)
-            raise InputError(f"longest contact and highest sampling rate: {self.max_contact_s:g} s at "
-                             f"{self.max_rate_hz:g} Hz is {self.max_contact_s * self.max_rate_hz:.4g} samples per "
-                             f"touch; the limit is {MAX_SAMPLES_PER_TOUCH:.0e} (lower --max-contact or --max-rate)")
+        check_samples_per_touch(self.max_contact_s, self.max_rate_hz, "the longest contact",
+                                "lower --max-contact or --max-rate")  # the search ran without end (8 GB)
 
 
 @dataclass(frozen=True)

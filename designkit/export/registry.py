@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import Any
 
 from .._validation import InputError
-from ..tables.store import Table, resolve_table
+from ..tables.store import Table, load_table
 from ._common import check_prefix, printable
 from .slicing import EXPORT_FORMAT, Exported, slice_table
 
@@ -231,8 +231,9 @@ def export_table(table: "Table | str", out: str | Path, fmt: str | None = None, 
     side_path = writer.sidecar_path(path)
     if side_path is not None and side_path.is_dir():
         raise InputError(f"the sidecar {printable(str(side_path))} would replace a folder")
-    _check_not_the_source(table, path, side_path)
-    res = export_bytes(table, fmt, prefix=prefix, noise_c=noise_c, delta_t_c=delta_t_c, contact=contact,
+    tab = table if isinstance(table, Table) else load_table(table)  # loaded once: checked here, sliced below
+    _check_not_the_source(tab, path, side_path)
+    res = export_bytes(tab, fmt, prefix=prefix, noise_c=noise_c, delta_t_c=delta_t_c, contact=contact,
                        e_min=e_min, e_max=e_max, kind=kind)
     atomic_write_bytes(path, res.data)
     if side_path is not None:
@@ -241,9 +242,9 @@ def export_table(table: "Table | str", out: str | Path, fmt: str | None = None, 
                         sidecar=side_path)
 
 
-def _check_not_the_source(table: "Table | str", path: Path, sidecar: Path | None) -> None:
+def _check_not_the_source(table: Table, path: Path, sidecar: Path | None) -> None:
     """Refuse an export whose file or sidecar is the table it is read from (its ``.npz`` or ``.json``)."""
-    src = table.path if isinstance(table, Table) else resolve_table(table)
+    src = table.path
     for out, what in ((path, f"--out {printable(str(path))}"),
                       (sidecar, f"the provenance sidecar {printable(str(sidecar))} of --out {printable(str(path))}")):
         if out is not None and out.exists() and any(out.samefile(f) for f in (src, src.with_suffix(".json"))):

@@ -45,7 +45,7 @@ import numpy as np
 
 from .._validation import InputError, check_finite, check_nonnegative, check_positive
 from ..tables.lookup import axis_weights
-from ..tables.store import E_UNITS, SHIPPED_TABLES, Table, content_hash, list_tables, load_table
+from ..tables.store import E_UNITS, SHIPPED_TABLES, Table, content_hash, load_table
 from ._common import check_name, printable
 
 __all__ = [
@@ -493,7 +493,6 @@ def slice_table(table: "Table | str", *, noise_c: float | None = None, delta_t_c
     }
     _plain_json(tab, provenance)
     # a table another with its name could shadow (a user's svm-paper) is named by its path in "Regenerate:" lines
-    shipped = SHIPPED_TABLES.get(tab.name, (None,))[0] == hdr.get("content_hash") and tab.name in list_tables()
-    ref = tab.name if shipped else str(tab.path)
+    ref = tab.name if SHIPPED_TABLES.get(tab.name, (None,))[0] == hdr.get("content_hash") else str(tab.path)
     return Exported(axes=axes, delta_up=up, delta_down=down, contact_adjacent=adjacent, e_lo=float(e_lo),
                     e_hi=float(e_hi), e_lo_inclusive=inclusive, provenance=provenance, source_ref=ref)

@@ -58,6 +58,10 @@ _PARITY = {"none": "N", "even": "E", "odd": "O", "mark": "M", "space": "S",
 
 
 # ---------------------------------------------------------------------- helpers
+#: Longest duration a profile may give (a trial window, a timeout) [s]: a day.
+MAX_PROFILE_SECONDS = 86400.0
+
+
 class _Reader:
     """Walks a YAML mapping, remembering the key path for error messages."""
 
@@ -104,6 +108,8 @@ class _Reader:
             raise self.err(key, f"must be a number, got {value!r}") from None
         if not math.isfinite(v):
             raise self.err(key, f"must be finite, got {value!r}")
+        if key.endswith("_s") and abs(v) > MAX_PROFILE_SECONDS:  # 1e308 s overflowed a count of samples
+            raise self.err(key, f"must be at most {MAX_PROFILE_SECONDS:g} s (a day), got {v:g}")
         if positive and v <= 0:
             raise self.err(key, f"must be > 0, got {v:g}")
         if nonnegative and v < 0:
@@ -779,6 +785,10 @@ def _parse_profile(data: Any, source: str) -> DeviceProfile:
     tr.done()
     if trial.pre_s * sample_rate < 3:
         raise InputError(f"{source}: trial.pre_s must hold at least 3 samples at {sample_rate:g} Hz")
+    from ..sensor import check_samples_per_touch
+
+    check_samples_per_touch(trial.pre_s + trial.post_s, sample_rate, f"{source}: a trial window (pre_s + post_s)",
+                            "shorten trial.pre_s and trial.post_s or lower reading.sample_rate_hz")
     rd.done()
     return DeviceProfile(name=str(name), description=description, serial=serial, delimiter=delimiter,
                          comment=comment, encoding=encoding, fields=fields, channels=channels,
@@ -811,7 +821,7 @@ def load_profile(name_or_path: "str | Path | DeviceProfile") -> DeviceProfile:
     from .._schemas import load_yaml
 
     # a regular UTF-8 file (a FIFO or a folder is refused before reading), parsed by the one YAML reader
-    data = load_yaml(path, "profile", empty_ok=True)
+    data = load_yaml(path, "profile")  # an empty file: "is empty" (it said "got NoneType")
     return _parse_profile(data, f"profile {path}")
 
 

@@ -37,8 +37,14 @@ def bench_cmd(
 
     accuracy = import_lab("accuracy", "bench")
 
+    from ._format import check_out_dir
+
     sections = accuracy.check_sections(section or accuracy.SECTIONS)
+    from .._workers import worker_count
+
+    worker_count(jobs)  # the one rule of --jobs, before minutes of measuring (0 was taken)
     if out is not None:
+        check_out_dir(out, "--out")  # a file there failed "File exists" after the whole run
         accuracy.require_figures()  # refuse now, not after minutes of measuring
     err = console(stderr=True)
     started = time.perf_counter()

@@ -937,6 +937,9 @@ def emulate(
     for spec in material or []:
         label, sep, value = spec.partition("=")
         if sep:
+            from .._validation import check_label
+
+            check_label(f"--material {spec!r}: the label", label)  # '=400' and a newline were taken
             try:
                 mats.append(EmulatedMaterial(label.strip(), float(value), object_temp))
             except ValueError:

@@ -101,6 +101,14 @@ def _ask(question: str, *, exact: bool, table: Optional[str], ideal_table: str, 
     from .. import query
     from ..query.crossing import check_coverage
 
+    from ._options import refuse_together
+
+    refuse_together(("--exact", exact), ("--table", table),
+                    why="--exact computes the answer for the pair, --table reads it from a table")
+    from .._validation import MAX_EFFUSIVITY, InputError, check_positive
+
+    if check_positive("--width", width) > MAX_EFFUSIVITY:  # on either route (the table's is its own): 1e308 was taken
+        raise InputError(f"--width must be at most {MAX_EFFUSIVITY:g} J s^-1/2 K^-1 m^-2, got {width:g}")
     extra = dict(exact_extra or {})
     extra["coverage"] = check_coverage(coverage)  # bad input before any work, on either route
 

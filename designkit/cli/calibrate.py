@@ -315,7 +315,7 @@ def _record_materials(port: str, profile, out: Path, materials: list[str], trial
     interrupt may come between a trial's commit and its being remembered).
     """
     from ..calibration.recorder import SerialRecorder
-    from ..calibration.trials import recorded_trials
+    from ..calibration.trials import recorded_trials, session_trials
 
     display = _Display(quiet)
     watch = _ForceWatch(profile)
@@ -360,7 +360,8 @@ def _record_materials(port: str, profile, out: Path, materials: list[str], trial
     finally:
         rec.close()
     order = {p: i for i, p in enumerate(rec.written)}  # recording order; index order for any other
-    paths = sorted((p for p in recorded_trials(out) if p not in before), key=lambda p: order.get(p, len(order)))
+    # this session's trials (their sidecars name it), not others a rebuilt index lists too
+    paths = sorted(session_trials(out, rec.session), key=lambda p: order.get(p, len(order)))
     return rec, paths, interrupted
 
 
@@ -688,8 +689,9 @@ def record(
 
     if port is None or material is None or out is None:
         raise InputError("give --port, --material and --out")
-    if not material.strip():
-        raise InputError("--material must not be empty (it names the trials in the index)")
+    from ..calibration.trials import check_material_label
+
+    check_material_label(material, "--material")  # before recording: a label that cannot name a trial lost it
     _check_trials(trials)
     _check_timeout(timeout)
     prof = load_profile(profile)
@@ -826,8 +828,10 @@ def guided(
     if port is None or not material or out is None:
         raise InputError("the guided run needs --port, at least one --material and --out "
                          "(or use 'calibrate record' and 'calibrate fit')")
-    if not all(m.strip() for m in material):
-        raise InputError("--material must not be empty (it names the trials in the index)")
+    from ..calibration.trials import check_material_label
+
+    for m in material:  # before anything is recorded: a label that cannot name a trial lost 8 s of touch
+        check_material_label(m, "--material")
     _check_trials(trials)
     _check_timeout(timeout)
     from ..calibration.fit import parse_object_temps, parse_ranges, resolve_ranges
@@ -914,7 +918,8 @@ def emulate(
     speed: Annotated[float, typer.Option("--speed", help="Device seconds per real second (20: 20x real time).")] = 1.0,
     fault: Annotated[Optional[list[str]], typer.Option(
         "--fault", help="Inject a fault (repeatable): garbled=P, partial=P, non-numeric=P, field-count=P, "
-                        "out-of-range=P (per-line probabilities, from device time line-faults-after=S on), "
+                        "out-of-range=P, out-of-order=P, duplicate=P, corrupt=P (per-line probabilities, from device time "
+                        "line-faults-after=S on), "
                         "burst=EVERY_S[:HOLD_S], gap=EVERY_S[:SILENT_S], vanish=AFTER_S, silent.")] = None,
     duration: Annotated[Optional[float], typer.Option(
         "--duration", help="Stop after this many real seconds (default: run until Ctrl-C).")] = None,

@@ -144,7 +144,7 @@ _BAD_KIND_TEXT = {
     "checksum": "a missing or wrong checksum (the line changed on the wire)",
     "duplicate": "a repeated timestamp (the line was sent twice)",
     "out_of_order": "a timestamp before the previous line's (out of order)",
-    "time_jump": "a timestamp far ahead of the lines around it",
+    "time_jump": "a timestamp ahead of the lines around it (out of order, or damaged)",
     "implausible": "a physically impossible jump (outside its neighbours' range by more than "
                    f"{SPIKE_SIGMAS:g} times the stream's noise)",
 }
@@ -830,16 +830,18 @@ class SerialRecorder:
     def _feed_checked(self, t: np.ndarray, vals: np.ndarray, cutter: TrialCutter) -> None:
         """Feed samples whose device times follow on; skip the lines whose times cannot be right.
 
-        With device timestamps, a sample within ``stall_s`` after the last one
-        kept continues the stream (shorter holes are samples lost to
-        unreadable lines, tolerated). One that is not (the same time, an
-        earlier one, one far ahead) is held back: if a later sample continues
-        from the last one kept, the held ones were bad lines (a line sent
-        twice, out of order, a damaged time) and are skipped, the trial in
-        progress goes on; if ``CONFIRM_SAMPLES`` of them in a row continue
-        from each other, the clock really jumped (a reset, samples lost): a
-        discontinuity. Counted time (no timestamp) has no holes to check: lost
-        samples are found from silences instead (see :meth:`record`).
+        With device timestamps, a sample up to 1.5 sample periods after the
+        last one kept continues the stream. Any other (the same time, an
+        earlier one, a hole) is held back, and the samples after it decide,
+        each going with whichever it follows more closely, the last one kept
+        or the held ones: when a sample follows the last one kept, the held
+        ones were bad lines (sent twice, out of order, a damaged time) and are
+        skipped, the trial in progress goes on; when ``CONFIRM_SAMPLES`` held
+        samples follow each other, they are the stream: after a hole of at
+        most ``stall_s`` (lines lost to garbling) it simply goes on, after a
+        longer one or a step back the clock really jumped (samples lost, a
+        reset): a discontinuity. Counted time (no timestamp) has no holes to
+        check: lost samples are found from silences instead (see :meth:`record`).
         """
         fs = self.profile.sample_rate_hz
         if not self.profile.has_timestamp:
@@ -847,50 +849,67 @@ class SerialRecorder:
             self._last_t = float(t[-1])
             return
         hole = max(self.profile.serial.stall_s, 1.5 / fs)
+        step_max = 1.5 / fs
         last = self._last_t
         run: list[int] = []       # indices of t continuing the stream, fed in one go
         for i, ti in enumerate(t.tolist()):
-            if last is None or 0.0 < ti - last <= hole:
-                if self._pend:
-                    self._skip_times(last)
+            if last is None or (not self._pend and 0.0 < ti - last <= step_max):
                 run.append(i)
                 last = ti
                 continue
-            if self._pend and 0.0 < ti - self._pend[-1][0] <= hole:
+            d_last = ti - last
+            d_pend = ti - self._pend[-1][0] if self._pend else -1.0
+            follows_last = 0.0 < d_last <= hole
+            follows_pend = 0.0 < d_pend <= hole
+            if follows_pend and (not follows_last or d_pend < d_last):
                 self._pend.append((ti, vals[i]))
                 if len(self._pend) < CONFIRM_SAMPLES:
                     continue
-                if run:                               # the samples before the jump, then the jump
+                confirmed, self._pend = self._pend, []
+                step = confirmed[0][0] - last
+                if run:                               # the samples before them go first
                     self._feed(t[run], vals[run], cutter)
                     run = []
-                confirmed = self._pend
-                step = confirmed[0][0] - last
-                if step < 0:
-                    reason = (f"the device clock went back by {-step:.3f} s, from {last:.3f} s to "
-                              f"{confirmed[0][0]:.3f} s (device reset?)")
-                else:
-                    reason = f"{step - 1.0 / fs:.3f} s of samples missing at device time {last:.2f} s"
-                self.status.gaps += 1
-                self._discontinuity(cutter, reason)   # clears _pend
+                if not 0.0 < step <= hole:
+                    if step < 0:
+                        reason = (f"the device clock went back by {-step:.3f} s, from {last:.3f} s to "
+                                  f"{confirmed[0][0]:.3f} s (device reset?)")
+                    elif step == 0:
+                        reason = f"the device clock restarted at {last:.3f} s"
+                    else:
+                        reason = f"{step - 1.0 / fs:.3f} s of samples missing at device time {last:.2f} s"
+                    self.status.gaps += 1
+                    self._discontinuity(cutter, reason)
                 self._feed(np.array([c[0] for c in confirmed]), np.array([c[1] for c in confirmed]), cutter)
                 last = confirmed[-1][0]
                 continue
-            if self._pend:                            # what was held continues nothing: bad lines too
-                self._skip_times(last)
-            self._pend = [(ti, vals[i])]
+            if self._pend:                            # the held samples continue nothing: bad lines
+                self._skip_times(last, ti)
+            if follows_last and d_last <= step_max:
+                run.append(i)
+                last = ti
+            else:
+                self._pend = [(ti, vals[i])]
         if run:
             self._feed(t[run], vals[run], cutter)
         self._last_t = last
 
-    def _skip_times(self, last: float) -> None:
-        """The held samples were lines with wrong times (see :meth:`_feed_checked`): count and report them."""
+    def _skip_times(self, last: float, nxt: float) -> None:
+        """The held samples were lines with wrong times (see :meth:`_feed_checked`): count and report them.
+
+        ``last``: the last time kept; ``nxt``: the time that showed them wrong.
+        """
+        hole = max(self.profile.serial.stall_s, 1.5 / self.profile.sample_rate_hz)
         for ti, _ in self._pend:
             if ti == last:
                 self._bad("duplicate", f"time {ti:.4f} s twice")
+            elif last < nxt < ti <= nxt + hole:
+                self._bad("out_of_order", f"time {ti:.4f} s before {nxt:.4f} s")
             elif ti < last:
                 self._bad("out_of_order", f"time {ti:.4f} s after {last:.4f} s")
             else:
-                self._bad("time_jump", f"time {ti:.4f} s after {last:.4f} s")
+                self._bad("time_jump", f"time {ti:.4f} s after {last:.4f} s, the next line continuing from "
+                                       f"{last:.4f} s")
         self._pend = []
 
     # ------------------------------------------------------- same device?

@@ -940,12 +940,13 @@ def emulate(
 
     mats = []
     for spec in material or []:
-        label, sep, value = spec.partition("=")
+        label, sep, value = spec.rpartition("=")   # the effusivity follows the last "="
         if sep:
             try:
-                mats.append(EmulatedMaterial(label.strip(), float(value), object_temp))
+                e_label = float(value)
             except ValueError:
                 raise InputError(f"--material {spec!r}: use NAME or LABEL=EFFUSIVITY") from None
+            mats.append(EmulatedMaterial(label.strip(" "), e_label, object_temp))  # a newline is refused, not cut
         else:
             from ..materials import get_material
 

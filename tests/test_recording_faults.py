@@ -284,7 +284,7 @@ def test_a_stream_that_never_lets_a_touch_be_kept_gives_up_with_what_it_kept(tmp
         took = time.monotonic() - t0
     assert r.returncode == 2 and took < 30
     last = r.stderr.strip().splitlines()[-1]   # after the events (gaps, touches skipped) as they came
-    assert last.startswith("Error: ") and "touches in a row could not be kept" in last and "0 trial(s) kept" in last
+    assert last.startswith("Error: ") and "touches in a row were skipped and none kept" in last and "0 trial(s) kept" in last
     with _emulator(prof, faults=Faults(gap_every_s=5.0, gap_s=0.02)) as emu, \
             SerialRecorder(emu.port, prof, tmp_path / "u") as rec:
         with pytest.raises(NoProgress) as exc:
@@ -343,3 +343,17 @@ def test_order_faults_keep_the_other_faults_draws():
     a = _emulator(prof, faults=Faults(garbled=0.05), seed=3).lines(0, 2000)
     b = _emulator(prof, faults=Faults(garbled=0.05, duplicate=0.01), seed=3).lines(0, 2000)
     assert b != a and set(b.split(b"\n")) == set(a.split(b"\n"))
+
+
+def test_classify_gives_up_on_a_stream_that_never_lets_a_touch_be_decided(cli):
+    """Samples lost every 1.5 s of device time: no touch has the second of quiet data it needs before contact."""
+    mats = [EmulatedMaterial("metal", 20000.0), EmulatedMaterial("wood", 420.0)]
+    plan = TouchPlan(touch_every_s=10.0, contact_s=4.0, touches_per_material=1)
+    with _emulator(load_profile("designkit"), faults=Faults(gap_every_s=1.5, gap_s=0.02), materials=mats,
+                   plan=plan, speed=25.0) as emu:
+        r = cli("classify", "--port", emu.port, "--m", "metal=12767:25972", "--m", "wood=331:506.46", "--touches",
+                "4", "--time-offset", str(emu.expected_time_offset_s), "--json")
+    assert r.exit_code == 2, r.output
+    out = json.loads(r.stdout)
+    assert out["interrupted"] is True and out["decisions"] == []
+    assert "touches in a row were skipped and none decided" in out["error"]["message"]

@@ -544,6 +544,9 @@ class SerialRecorder:
         #: Stream seconds without a touch kept (and GIVE_UP_TOUCHES skipped) after which the recorder gives up.
         self.give_up_s = GIVE_UP_WINDOWS * win
 
+    #: What becomes of a touch that is not skipped (messages of the give-up rule).
+    _KEPT = "kept"
+
     # ------------------------------------------------------------ port
     def open(self) -> None:
         """Lock the trial folder, then open the port with the profile's settings (one-line error if it cannot).
@@ -1110,9 +1113,9 @@ class SerialRecorder:
         if span < self.give_up_s:
             return
         raise NoProgress(
-            f"{len(self._skips)} touches in a row could not be kept and none was in the last {span:.0f} s of stream "
-            f"from {self.port} (the last: {self._skips[-1]}): the stream is too damaged to cut a trial from; "
-            f"check the cable and the device; {self._kept(cutter)}")
+            f"{len(self._skips)} touches in a row were skipped and none {self._KEPT} in the last {span:.0f} s of "
+            f"stream from {self.port} (the last: {self._skips[-1]}): the stream is too damaged for a touch; check "
+            f"the cable and the device; {self._kept(cutter)}")
 
     def _bad(self, kind: str, text: str) -> None:
         self._last_bad_text = text

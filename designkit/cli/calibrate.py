@@ -370,6 +370,7 @@ def _record_payload(rec, paths, out: Path, interrupted: bool) -> dict:
     return {
         "trials": [str(p) for p in paths],
         "n_trials": len(paths),
+        "session": rec.session,   # named in each of these trials' sidecars
         "out": str(out),
         "index": str(out / "index.csv") if paths else None,
         "interrupted": interrupted,

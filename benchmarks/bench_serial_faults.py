@@ -71,6 +71,12 @@ def _env(tree: Path) -> dict:
     return env
 
 
+def _popen(cmd, tree: Path, **kw) -> subprocess.Popen:
+    """Start a recorder from ``tree`` (run there: ``python -m`` puts the working folder first on sys.path)."""
+    return subprocess.Popen(cmd, env=_env(tree), cwd=str(tree), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, **kw)
+
+
 def _emu(prof, faults=Faults(), seed=0, speed=50.0, materials=None, plan=PLAN) -> Emulator:
     return Emulator(prof, SENSORS["paper"], materials or [EmulatedMaterial("wood", 400.0)], noise_c=0.05,
                     sensor_temp_c=35.0, ambient_c=25.0, plan=plan, speed=speed, faults=faults, seed=seed)
@@ -107,13 +113,13 @@ def _wrong(folder: Path, emu: Emulator) -> tuple[int, float]:
         k = np.rint((d[:, 0] + meta["onset_device_time_s"]) * fs).astype(int)
         clean = emu.values(int(k.min()), int(k.max()) + 1)
         i = k - k.min()
-        conv = emu.profile.channels["sensor"].conversion
-        if hasattr(conv, "decimals") and emu.profile.has_timestamp:
-            err = np.maximum(np.abs(d[:, 2] - np.round(clean["sensor"][i], conv.decimals)),
-                             np.abs(d[:, 1] - np.round(clean["object"][i], conv.decimals)))
-            bad = err > 2e-4
-            n += int(bad.sum())
-            worst = max(worst, float(err.max()))
+        err = np.zeros(k.size)
+        for role, col in (("sensor", 2), ("object", 1)):   # what a clean wire carried, read back
+            conv = emu.profile.channels[role].conversion
+            want = conv.to_value(conv.encode(clean[role][i]))
+            err = np.maximum(err, np.abs(d[:, col] - want))
+        n += int(np.sum(err > 2e-4))
+        worst = max(worst, float(err.max()))
     return n, worst
 
 
@@ -129,10 +135,9 @@ def _kept(folder: Path) -> int:
     return len(recorded_trials(folder))
 
 
-def _run(cmd, env, limit=LIMIT_S, on_start=None):
+def _run(cmd, tree, limit=LIMIT_S, on_start=None):
     t0 = time.monotonic()
-    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    proc = _popen(cmd, tree, preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     if on_start is not None:
         on_start(proc)
     try:
@@ -182,7 +187,7 @@ def record_scenario(tree, tmp, name, *, profile="designkit", faults=Faults(), sp
     with emu:
         code, so, se, secs = _run(_recorder(tree, ["calibrate", "record", "--port", emu.port, "--profile",
                                                    str(profile), "--material", label, "--trials", str(touches),
-                                                   "--out", str(out), "--json"]), _env(tree), limit, on_start)
+                                                   "--out", str(out), "--json"]), tree, limit, on_start)
         device_s = at_signal.get("device_s", emu.samples_sent / prof.sample_rate_hz)
         # at a signal, a touch that ended in the last 2 device-seconds may not be written yet by anyone
         sent = _whole_touches(emu, device_s - (2.0 if signal_after else 0.0), faults)
@@ -207,8 +212,7 @@ def two_recorders(tree, tmp):
         cmds = [_recorder(tree, ["calibrate", "record", "--port", e.port, "--material", "wood", "--trials",
                                  str(TOUCHES), "--out", str(out), "--json"]) for e in (a, b)]
         t0 = time.monotonic()
-        procs = [subprocess.Popen(c, env=_env(tree), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-                 for c in cmds]
+        procs = [_popen(c, tree) for c in cmds]
         results = [p.communicate(timeout=LIMIT_S) for p in procs]
         secs = time.monotonic() - t0
         sent = sum(min(_whole_touches(e, e.samples_sent / 200.0, Faults()), TOUCHES) for e in (a, b))
@@ -227,7 +231,7 @@ def classify_scenario(tree, name, faults, limit=LIMIT_S):
     with emu:
         code, so, se, secs = _run(_recorder(tree, [
             "classify", "--port", emu.port, "--m", "metal=12767:25972", "--m", "wood=331:506.46", "--touches", "4",
-            "--time-offset", str(emu.expected_time_offset_s), "--error-rate", "0.001", "--json"]), _env(tree), limit)
+            "--time-offset", str(emu.expected_time_offset_s), "--error-rate", "0.001", "--json"]), tree, limit)
     try:
         got = [(d["state"], d["material"]) for d in json.loads(so)["decisions"]]
     except (ValueError, KeyError):
@@ -262,6 +266,12 @@ def scenarios(tree: Path, tmp: Path, only: set[str] | None):
         ("corrupt", lambda: record_scenario(tree, tmp, "corrupted digit 1 %", faults=Faults(corrupt=0.01))),
         ("corrupt-xor8", lambda: record_scenario(tree, tmp, "corrupted digit 1 %, xor8 profile", profile=ck,
                                                  faults=Faults(corrupt=0.01))),
+        ("order-5", lambda: record_scenario(tree, tmp, "out-of-order 5 %, duplicated 5 %",
+                                            faults=Faults(out_of_order=0.05, duplicate=0.05))),
+        ("adc-corrupt", lambda: record_scenario(tree, tmp, "corrupted digit 1 % (adc12, no timestamp)",
+                                                profile="adc12-thermistor", faults=Faults(corrupt=0.01))),
+        ("adc-dup", lambda: record_scenario(tree, tmp, "duplicated 1 % (adc12, no timestamp)",
+                                            profile="adc12-thermistor", faults=Faults(duplicate=0.01))),
         ("garbled", lambda: record_scenario(tree, tmp, "garbled/dropped lines 5 % (adc12)",
                                             profile="adc12-thermistor", faults=Faults(garbled=0.03, partial=0.02))),
         ("gap", lambda: record_scenario(tree, tmp, "samples lost (gap every 20 s)",
@@ -305,6 +315,9 @@ def main() -> None:
            f"{'worst':>6s} {'exit':>5s} {'s':>5s}  last line"
     print(head)
     for label, tree in trees:
+        where = subprocess.run([sys.executable, "-c", "import designkit; print(designkit.__file__)"], env=_env(tree),
+                               cwd=str(tree), capture_output=True, text=True).stdout.strip()
+        print(f"# {label}: recorder from {where}", flush=True)
         with tempfile.TemporaryDirectory(prefix="designkit-faults-") as tmp:
             for r in scenarios(tree, Path(tmp), set(args.only) if args.only else None):
                 r["tree"] = label

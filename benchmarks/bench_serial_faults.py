@@ -38,7 +38,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import shutil
 import signal
 import subprocess
 import sys
@@ -54,7 +53,7 @@ sys.path.insert(0, str(ROOT))
 
 from designkit import SENSORS  # noqa: E402
 from designkit.calibration.emulator import EmulatedMaterial, Emulator, Faults, TouchPlan  # noqa: E402
-from designkit.calibration.profiles import list_profiles, load_profile, profile_from_dict  # noqa: E402
+from designkit.calibration.profiles import list_profiles, load_profile  # noqa: E402
 
 PLAN = TouchPlan(touch_every_s=13.0)
 TOUCHES = 3

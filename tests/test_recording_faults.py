@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import errno
 import json
+import re
 import signal
 import subprocess
 import sys
@@ -21,6 +22,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from designkit import SENSORS
 from designkit._validation import InputError
@@ -29,7 +32,7 @@ from designkit.calibration.profiles import list_profiles, load_profile, profile_
 from designkit.calibration.recorder import (SPIKE_SIGMAS, NoProgress, SerialRecorder, TrialCutter,
                                             TrialNotWritten)
 from designkit.calibration.trials import (MAX_STEM_CHARS, FolderBusy, FolderLock, check_material_label,
-                                          load_index, recorded_trials, write_trial)
+                                          load_index, recorded_trials, trial_stem, write_trial)
 
 PAPER = SENSORS["paper"]
 PLAN = TouchPlan(touch_every_s=13.0)   # touches at 2, 15, 28 ... s of device time
@@ -357,3 +360,23 @@ def test_classify_gives_up_on_a_stream_that_never_lets_a_touch_be_decided(cli):
     out = json.loads(r.stdout)
     assert out["interrupted"] is True and out["decisions"] == []
     assert "touches in a row were skipped and none decided" in out["error"]["message"]
+
+
+@settings(max_examples=40, deadline=None)
+@given(label=st.text(min_size=0, max_size=140))
+def test_any_label_is_refused_in_one_line_or_names_its_trials_safely(label):
+    """Labels come from the command line: any text either is refused in one line, or makes a file name of
+    letters, digits and '_' no longer than MAX_STEM_CHARS, while the label itself is kept whole."""
+    try:
+        check_material_label(label)
+    except InputError as exc:
+        assert "\n" not in str(exc) and str(exc).strip()
+        return
+    stem = trial_stem(label)
+    assert re.fullmatch(r"[a-z0-9_]{1,%d}" % MAX_STEM_CHARS, stem)
+    with tempfile.TemporaryDirectory() as tmp:
+        t = np.arange(-200, 1401) / 200.0
+        path = write_trial(Path(tmp), label, t, np.full(t.size, 35.0), np.full(t.size, 25.0),
+                           np.full(t.size, 8.0), {})
+        assert path.name == f"{stem}_001.csv"
+        assert [tr.material for tr in load_index(Path(tmp) / "index.csv")] == [label]

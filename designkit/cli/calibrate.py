@@ -242,12 +242,12 @@ class _EmulatorWatch:
         self.materials, self.trials, self.port, self.out = materials, trials, port, out
         self.pairs: dict[str, str] = {}
         self.labels: set[str] = set()
-        self.before: set[Path] = set()
+        self.session = ""   # the recorder's: its trials' sidecars name it
 
     def _kept(self) -> str:
-        from ..calibration.trials import recorded_trials
+        from ..calibration.trials import session_trials
 
-        n = len(set(recorded_trials(self.out)) - self.before)
+        n = len(session_trials(self.out, self.session))
         return f"{n} trial(s) kept" + (f" in {self.out}" if n else "")
 
     def __call__(self, message: str, material: str) -> None:
@@ -315,7 +315,7 @@ def _record_materials(port: str, profile, out: Path, materials: list[str], trial
     interrupt may come between a trial's commit and its being remembered).
     """
     from ..calibration.recorder import SerialRecorder
-    from ..calibration.trials import recorded_trials, session_trials
+    from ..calibration.trials import session_trials
 
     display = _Display(quiet)
     watch = _ForceWatch(profile)
@@ -336,8 +336,7 @@ def _record_materials(port: str, profile, out: Path, materials: list[str], trial
     emulator = _EmulatorWatch(materials, trials, port, out)
     rec = SerialRecorder(port, profile, out, no_data_timeout_s=timeout, on_event=on_event,
                          on_status=on_status)
-    before = set(recorded_trials(out))
-    emulator.before = before
+    emulator.session = rec.session
     interrupted = False
     try:
         rec.open()

@@ -242,12 +242,12 @@ class _EmulatorWatch:
         self.materials, self.trials, self.port, self.out = materials, trials, port, out
         self.pairs: dict[str, str] = {}
         self.labels: set[str] = set()
-        self.before: set[Path] = set()
+        self.session = ""   # the recorder's: its trials' sidecars name it
 
     def _kept(self) -> str:
-        from ..calibration.trials import recorded_trials
+        from ..calibration.trials import session_trials
 
-        n = len(set(recorded_trials(self.out)) - self.before)
+        n = len(session_trials(self.out, self.session))
         return f"{n} trial(s) kept" + (f" in {self.out}" if n else "")
 
     def __call__(self, message: str, material: str) -> None:
@@ -315,7 +315,7 @@ def _record_materials(port: str, profile, out: Path, materials: list[str], trial
     interrupt may come between a trial's commit and its being remembered).
     """
     from ..calibration.recorder import SerialRecorder
-    from ..calibration.trials import recorded_trials
+    from ..calibration.trials import session_trials
 
     display = _Display(quiet)
     watch = _ForceWatch(profile)
@@ -336,8 +336,7 @@ def _record_materials(port: str, profile, out: Path, materials: list[str], trial
     emulator = _EmulatorWatch(materials, trials, port, out)
     rec = SerialRecorder(port, profile, out, no_data_timeout_s=timeout, on_event=on_event,
                          on_status=on_status)
-    before = set(recorded_trials(out))
-    emulator.before = before
+    emulator.session = rec.session
     interrupted = False
     try:
         rec.open()
@@ -360,7 +359,8 @@ def _record_materials(port: str, profile, out: Path, materials: list[str], trial
     finally:
         rec.close()
     order = {p: i for i, p in enumerate(rec.written)}  # recording order; index order for any other
-    paths = sorted((p for p in recorded_trials(out) if p not in before), key=lambda p: order.get(p, len(order)))
+    # this session's trials (their sidecars name it), not others a rebuilt index lists too
+    paths = sorted(session_trials(out, rec.session), key=lambda p: order.get(p, len(order)))
     return rec, paths, interrupted
 
 
@@ -369,6 +369,7 @@ def _record_payload(rec, paths, out: Path, interrupted: bool) -> dict:
     return {
         "trials": [str(p) for p in paths],
         "n_trials": len(paths),
+        "session": rec.session,   # named in each of these trials' sidecars
         "out": str(out),
         "index": str(out / "index.csv") if paths else None,
         "interrupted": interrupted,
@@ -688,8 +689,9 @@ def record(
 
     if port is None or material is None or out is None:
         raise InputError("give --port, --material and --out")
-    if not material.strip():
-        raise InputError("--material must not be empty (it names the trials in the index)")
+    from ..calibration.trials import check_material_label
+
+    check_material_label(material, "--material")  # before recording: a label that cannot name a trial lost it
     _check_trials(trials)
     _check_timeout(timeout)
     prof = load_profile(profile)
@@ -826,8 +828,10 @@ def guided(
     if port is None or not material or out is None:
         raise InputError("the guided run needs --port, at least one --material and --out "
                          "(or use 'calibrate record' and 'calibrate fit')")
-    if not all(m.strip() for m in material):
-        raise InputError("--material must not be empty (it names the trials in the index)")
+    from ..calibration.trials import check_material_label
+
+    for m in material:  # before anything is recorded: a label that cannot name a trial lost 8 s of touch
+        check_material_label(m, "--material")
     _check_trials(trials)
     _check_timeout(timeout)
     from ..calibration.fit import parse_object_temps, parse_ranges, resolve_ranges
@@ -914,7 +918,8 @@ def emulate(
     speed: Annotated[float, typer.Option("--speed", help="Device seconds per real second (20: 20x real time).")] = 1.0,
     fault: Annotated[Optional[list[str]], typer.Option(
         "--fault", help="Inject a fault (repeatable): garbled=P, partial=P, non-numeric=P, field-count=P, "
-                        "out-of-range=P (per-line probabilities, from device time line-faults-after=S on), "
+                        "out-of-range=P, out-of-order=P, duplicate=P, corrupt=P (per-line probabilities, from device time "
+                        "line-faults-after=S on), "
                         "burst=EVERY_S[:HOLD_S], gap=EVERY_S[:SILENT_S], vanish=AFTER_S, silent.")] = None,
     duration: Annotated[Optional[float], typer.Option(
         "--duration", help="Stop after this many real seconds (default: run until Ctrl-C).")] = None,
@@ -935,15 +940,16 @@ def emulate(
 
     mats = []
     for spec in material or []:
-        label, sep, value = spec.partition("=")
+        label, sep, value = spec.rpartition("=")   # the effusivity follows the last "="
         if sep:
             from .._validation import check_label
 
             check_label(f"--material {spec!r}: the label", label)  # '=400' and a newline were taken
             try:
-                mats.append(EmulatedMaterial(label.strip(), float(value), object_temp))
+                e_label = float(value)
             except ValueError:
                 raise InputError(f"--material {spec!r}: use NAME or LABEL=EFFUSIVITY") from None
+            mats.append(EmulatedMaterial(label.strip(" "), e_label, object_temp))  # a newline is refused, not cut
         else:
             from ..materials import get_material
 

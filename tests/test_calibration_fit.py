@@ -236,7 +236,7 @@ def test_guided_run_against_the_emulator_records_its_first_touch_and_labels_ever
                   plan=TouchPlan(touch_every_s=13.0, touches_per_material=3)) as emu:
         r = cli("calibrate", "--port", emu.port, "--profile", "designkit", "--material", "wood", "--material",
                 "metal", "--trials", "3", "--range", "wood=380:420", "--range", "metal=16700:18400", "--out", out,
-                "--bootstrap", "0", "--yes", "--json")
+                "--model", "semi-infinite", "--yes", "--json")
     assert r.exit_code == 0, r.output
     onsets = {}
     for side in sorted(out.glob("*.json")):
@@ -246,9 +246,9 @@ def test_guided_run_against_the_emulator_records_its_first_touch_and_labels_ever
     for name, t in onsets.items():                    # touches 1-3 are wood, 4-6 metal
         touch = int(round((t - first) / 13.0))
         assert name.startswith("wood" if touch < 3 else "metal"), onsets
-    fit = json.loads(r.stdout)["fit"]
-    assert fit["identification"] != "conflict"
-    assert fit["effusivity"]["ci95"][0] <= paper.effusivity <= fit["effusivity"]["ci95"][1]
+    res = json.loads(r.stdout)["fit"]["results"][0]
+    assert res["consistent"]
+    assert res["effusivity"]["ci95"][0] <= paper.effusivity <= res["effusivity"]["ci95"][1]
 
 
 def _write(folder, trials):
@@ -268,11 +268,11 @@ def test_mislabelled_touches_stop_the_fit_from_writing_a_sensor_file(cli, tmp_pa
     swapped += [Trial(tr.time_s, tr.sensor_c, tr.object_c, tr.force_n, "metal") for tr in metal[1:] + wood[3:]]
     index = _write(tmp_path / "t", swapped)
     out = tmp_path / "s.yaml"
-    r = cli("calibrate", "fit", index, "--range", "metal=aluminium", "--out", out, "--bootstrap", "0")
+    r = cli("calibrate", "fit", index, "--range", "metal=aluminium", "--out", out, "--model", "semi-infinite")
     assert r.exit_code == 2 and not out.exists(), r.output
     assert "look like another material" in r.output and "looks like metal" in r.output
     assert "record those materials again" in r.output and "not written" in r.output
-    r = cli("calibrate", "fit", index, "--range", "metal=aluminium", "--out", out, "--bootstrap", "0", "--force")
+    r = cli("calibrate", "fit", index, "--range", "metal=aluminium", "--out", out, "--model", "semi-infinite", "--force")
     assert r.exit_code == 0 and out.exists() and "warning:" in r.output
 
 
@@ -281,7 +281,7 @@ def test_conflicting_ranges_stop_the_fit_unless_forced(cli, tmp_path):
     out = tmp_path / "s.yaml"
     # wood's range put where no e_s agrees with metal's
     args = ("calibrate", "fit", index, "--range", "wood=40:50", "--range", "metal=aluminium", "--out", out,
-            "--bootstrap", "0")
+            "--model", "semi-infinite")
     r = cli(*args)
     assert r.exit_code == 2 and not out.exists(), r.output
     assert "ranges conflict" in r.output and "--force" in r.output and "calibrate fit --model all" in r.output
@@ -294,7 +294,7 @@ def test_a_sensor_colder_than_the_object_is_a_wiring_error(cli, tmp_path):
     mirrored = [Trial(tr.time_s, 50.0 - tr.sensor_c, tr.object_c, tr.force_n, tr.material)
                 for tr in make_trials(n=3, seed=6)]     # 35 degC read as 15, as from the wrong side of a divider
     index = _write(tmp_path / "t", mirrored)
-    r = cli("calibrate", "fit", index, "--range", "metal=aluminium", "--out", tmp_path / "s.yaml", "--bootstrap", "0")
+    r = cli("calibrate", "fit", index, "--range", "metal=aluminium", "--out", tmp_path / "s.yaml", "--model", "semi-infinite")
     assert r.exit_code == 2, r.output
     assert "reads colder than the object" in r.output and "side of its divider" in r.output
 
@@ -314,13 +314,13 @@ def test_touches_in_which_no_heat_flows_are_refused_not_fitted(cli, tmp_path, ho
                 for tr in trials]
     index = _write(tmp_path / "t", cold)
     out = tmp_path / "s.yaml"
-    args = ("calibrate", "fit", index, "--range", "metal=aluminium", "--out", out, "--bootstrap", "0")
+    args = ("calibrate", "fit", index, "--range", "metal=aluminium", "--out", out, "--model", "semi-infinite")
     r = cli(*args)
     assert r.exit_code == 2 and not out.exists(), r.output
     assert "does not respond to contact in 6 of 6 touches" in r.output and "no heat flowed" in r.output
     assert cli(*args, "--force").exit_code == 0 and out.exists()
     good = _write(tmp_path / "good", trials)  # the same touches with the heater on: no such problem
-    r = cli("calibrate", "fit", good, "--range", "metal=aluminium", "--out", tmp_path / "g.yaml", "--bootstrap", "0")
+    r = cli("calibrate", "fit", good, "--range", "metal=aluminium", "--out", tmp_path / "g.yaml", "--model", "semi-infinite")
     assert "does not respond" not in r.output
 
 
@@ -338,7 +338,7 @@ def test_touches_below_the_contact_threshold_get_a_hint_with_their_peak_force(cl
     with Emulator(rig, SENSORS["paper"], [EmulatedMaterial("wood", 400.0)], noise_c=0.05, speed=20.0, seed=1,
                   plan=TouchPlan(touch_every_s=13.0, press_force_n=4.2)) as emu:
         r = cli("calibrate", "--port", emu.port, "--profile", "designkit", "--material", "wood", "--trials", "2",
-                "--range", "wood=380:420", "--out", tmp_path / "run", "--bootstrap", "0", "--yes", "--timeout", "30")
+                "--range", "wood=380:420", "--out", tmp_path / "run", "--model", "semi-infinite", "--yes", "--timeout", "30")
     assert r.exit_code == 2, r.output
     assert "touches were not recorded" in r.output and "threshold of 5 N" in r.output and "4.2 N" in r.output
     assert "force_threshold_n" in r.output
@@ -370,7 +370,7 @@ def test_data_lines_that_start_with_the_comment_prefix_are_named(cli, tmp_path):
     th.start()
     try:
         r = cli("calibrate", "--port", port, "--profile", "designkit", "--material", "wood", "--trials", "1",
-                "--range", "wood=380:420", "--out", tmp_path / "run", "--bootstrap", "0", "--yes", "--timeout", "20")
+                "--range", "wood=380:420", "--out", tmp_path / "run", "--model", "semi-infinite", "--yes", "--timeout", "20")
     finally:
         stop.set()
         th.join(2)
@@ -386,7 +386,7 @@ def test_an_index_listing_a_trial_twice_is_refused_naming_its_lines(cli, tmp_pat
     index = _write(tmp_path / "t", make_trials(n=2, seed=9))
     lines = index.read_text().splitlines()
     index.write_text("\n".join(lines + [lines[1]]) + "\n")
-    r = cli("calibrate", "fit", index, "--range", "metal=aluminium", "--bootstrap", "0", "--force")
+    r = cli("calibrate", "fit", index, "--range", "metal=aluminium", "--model", "semi-infinite", "--force")
     name = lines[1].split(",")[0]
     assert r.exit_code == 2 and r.stderr.count("\n") == 1, r.output
     assert f"lists {name} twice (lines 2 and {len(lines) + 1})" in r.stderr

@@ -60,7 +60,7 @@ def test_guided_run_refuses_an_emulator_that_alternates(cli, tmp_path):
     out = tmp_path / "run"
     with _two_materials(1) as emu:
         r = cli("calibrate", "--port", emu.port, "--material", "metal", "--material", "wood", "--trials", "2",
-                *RANGES, "--out", out, "--bootstrap", "0", "--yes")
+                *RANGES, "--out", out, "--model", "semi-infinite", "--yes")
     assert r.exit_code == 2
     errors = [ln for ln in r.stderr.strip().splitlines() if ln.startswith("Error:")]
     assert len(errors) == 1 and errors[0].startswith("Error: the emulator touches metal, wood, metal, wood in turn")
@@ -108,7 +108,7 @@ def test_the_emulators_hint_pastes_into_a_shell_and_labels_right(cli, tmp_path, 
         assert args[args.index("--material") + 1] == "Aluminium alloys"
         assert args[args.index("--trials") + 1] == "2" and "--yes" in args
         args[args.index("--out") + 1] = str(tmp_path / "trials")
-        r = cli(*args[1:], "--bootstrap", "0", "--json", "--force")
+        r = cli(*args[1:], "--model", "semi-infinite", "--json", "--force")
         assert r.exit_code == 0, r.output
         labels = [json.loads((tmp_path / "trials" / p).with_suffix(".json").read_text())["material"]
                   for p in json.loads(r.stdout)["record"]["trials"]]

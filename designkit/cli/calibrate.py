@@ -413,12 +413,7 @@ def _write_identified(best, trials, out: Path, name: Optional[str], index: Path,
     from .._validation import InputError
     from ..calibration.fit import check_calibration
 
-    problems = [p.text() for p in check_calibration(None, trials) if p.fatal]
-    if best.consistent is False:
-        why = next((n for n in best.notes if "conflict" in n), "the materials' ranges conflict under this model")
-        problems.append(f"{why}. Check each material's label, range (--range NAME=MIN:MAX) and object temperature "
-                        "(--object-temp NAME=free for an object not at room temperature), or let calibrate choose "
-                        f"among every sensor model (calibrate fit --model all, the default), not {best.candidate.label}")
+    problems = [p.text() for p in check_calibration(best, trials) if p.fatal]
     con = console(stderr=True)
     for text in problems:
         con.print(f"[bold red]{'warning' if force else 'error'}:[/] {escape(text)}")

@@ -169,7 +169,7 @@ def test_per_touch_contact_conductance_explains_touches_that_differ_in_contact()
 
 def test_sim_to_real_with_the_identified_model_beats_the_paper(robot_data_dir):
     """Simulator = the layered sensor identified on trial sets 1-4; tested on the real touches of sets 5-20."""
-    from designkit.reproduce.robot import CALIBRATION_SETS, calibrate_model, load_real, sim_to_real
+    from designkit_lab.reproduce.robot import CALIBRATION_SETS, calibrate_model, load_real, sim_to_real
 
     touches = load_real(robot_data_dir)
     test = touches.select(~np.isin(touches.trial_set, CALIBRATION_SETS))
@@ -180,7 +180,7 @@ def test_sim_to_real_with_the_identified_model_beats_the_paper(robot_data_dir):
     assert r["mean_f1"] >= 0.90 and r["multiclass"]["accuracy"] >= 0.80, r
     assert r["pairs"]["wood vs cold wood"]["f1"] >= 0.95
     # the cooled block's temperature read from the passive channel alone is far below its end reading
-    from designkit.reproduce.robot import passive_object_temp
+    from designkit_lab.reproduce.robot import passive_object_temp
 
     to = passive_object_temp(test, setup.passive_response)
     cold = test.material == "cold_wood"
@@ -291,7 +291,7 @@ def test_real_touches_drift_and_force_area_reach_the_held_out_target(robot_data_
 
 def test_passive_object_temp_reads_the_object_through_the_passive_response():
     """A passive channel approaching To along a known response gives To back, from that channel alone."""
-    from designkit.reproduce.robot import RealTouches, passive_object_temp
+    from designkit_lab.reproduce.robot import RealTouches, passive_object_temp
 
     t = np.arange(801) / 200.0
     w = 1.0 - np.exp(-t / 9.0)                      # a slow thermistor: 36 % of the way at 4 s

@@ -116,7 +116,7 @@ def test_delta_e_legend_only_when_a_dash_is_shown(cli):
 
 # ------------------------------------------------------------------ reproduce's robot data
 def test_robot_data_found_from_the_folder_the_user_runs_in(tmp_path, monkeypatch):
-    from designkit.reproduce import default_robot_data_dir
+    from designkit_lab.reproduce import default_robot_data_dir
 
     monkeypatch.delenv("DESIGNKIT_ROBOT_DATA", raising=False)
     data = tmp_path / "shared" / "data" / "robot-thermal-recordings"
@@ -135,6 +135,6 @@ def test_reproduce_says_where_it_looked_and_keeps_robot_data(cli, tmp_path, monk
     monkeypatch.delenv("DESIGNKIT_ROBOT_DATA", raising=False)
     r = cli("reproduce", "--help")
     assert "--robot-data" in r.output and "current folder" in " ".join(r.output.split())
-    from designkit.reproduce import ReproduceSettings
+    from designkit_lab.reproduce import ReproduceSettings
 
     assert ReproduceSettings(robot_data=tmp_path).robot_data_dir == tmp_path

@@ -40,7 +40,7 @@ covariance is the cluster-robust sandwich with touches as clusters (as in
 touch's residuals un-shrunk by its block of the hat matrix), and each interval
 takes Student's t with that parameter's Bell-McCaffrey degrees of freedom: a
 parameter carried by a few touches gets few (:func:`_sandwich`; measured by
-the pty round trips of :mod:`~designkit.calibration.roundtrip`). The Jacobian's singular values (columns
+the pty round trips of :mod:`~designkit_lab.roundtrip`). The Jacobian's singular values (columns
 scaled to unit norm) give its numerical rank; a parameter is reported *not
 identified* when the Jacobian is rank-deficient along it, its interval spans
 more than a factor of 10, or it sits on a search bound.

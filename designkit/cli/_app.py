@@ -262,6 +262,22 @@ def _jsonable(obj: Any) -> Any:
     return obj
 
 
+def import_lab(module: str, command: str) -> Any:
+    """``designkit_lab.<module>``: the lab (benchmarks, the paper's report) ships beside the core and is
+    imported only by the commands that need it; missing, it is one line naming what to install."""
+    import importlib
+
+    try:
+        return importlib.import_module(f"designkit_lab.{module}")
+    except ModuleNotFoundError as exc:
+        if exc.name not in ("designkit_lab", f"designkit_lab.{module}"):
+            raise
+        from .._validation import InputError
+
+        raise InputError(f"`designkit {command}` needs the designkit_lab package, which is not installed here: "
+                         "reinstall designkit (pip install 'designkit[lab]' also adds its figures' libraries)") from None
+
+
 def emit_json(payload: Any) -> None:
     """Print ``payload`` as JSON on stdout (NaN and inf become null)."""
     sys.stdout.write(json.dumps(_jsonable(payload), indent=2, allow_nan=False) + "\n")

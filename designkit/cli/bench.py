@@ -7,7 +7,7 @@ from typing import Annotated, List, Optional
 
 import typer
 
-from ._app import app, console, emit_json
+from ._app import app, console, emit_json, import_lab
 from . import _app
 from ._options import Json
 
@@ -35,7 +35,7 @@ def bench_cmd(
     """
     import time
 
-    from .. import accuracy
+    accuracy = import_lab("accuracy", "bench")
 
     sections = accuracy.check_sections(section or accuracy.SECTIONS)
     if out is not None:
@@ -76,7 +76,8 @@ def bench_cmd(
 def _print_report(report, written) -> None:
     from rich.table import Table
 
-    from ..accuracy import format_time, format_value
+    lab = import_lab("accuracy", "bench")
+    format_time, format_value = lab.format_time, lab.format_value
 
     con = console()
     if not con.is_terminal:

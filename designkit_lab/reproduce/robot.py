@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._validation import InputError
+from designkit._validation import InputError
 from ._report import Comparison, Context, SectionResult, fmt, md_table
 from .paper import REAL_ROBOT
 
@@ -113,7 +113,7 @@ class RealTouches:
 
 def load_real(data_dir: Path, contact_s: float = CONTACT_S, sample_rate_hz: float = 200.0) -> RealTouches:
     """Read the recordings listed in ``data_dir/index.csv`` (file, material, trial_set)."""
-    from ..calibration.trials import read_index_rows, read_trial_csv
+    from designkit.calibration.trials import read_index_rows, read_trial_csv
 
     index = Path(data_dir) / "index.csv"
     rows = read_index_rows(index)
@@ -141,7 +141,7 @@ def load_real(data_dir: Path, contact_s: float = CONTACT_S, sample_rate_hz: floa
 # ============================================================ train real, test real
 def real_pair_f1(touches: RealTouches, pair: tuple[str, str], *, repeats: int, seed: int) -> dict:
     """Cross-validated F1 (3 folds, ``repeats`` shuffles) of the paper's SVM on one real pair."""
-    from ..recognition.svm import cross_validated_f1
+    from designkit.recognition.svm import cross_validated_f1
 
     lo, hi = touches.of(pair[0]), touches.of(pair[1])
     fs = 1.0 / (touches.time_s[1] - touches.time_s[0])
@@ -164,9 +164,9 @@ def real_multiclass(touches: RealTouches, *, repeats: int, seed: int) -> dict:
     import sklearn
     from sklearn.model_selection import StratifiedKFold, cross_val_predict
 
-    from .._validation import as_generator
-    from ..recognition.features import feature_matrix
-    from ..recognition.svm import make_classifier
+    from designkit._validation import as_generator
+    from designkit.recognition.features import feature_matrix
+    from designkit.recognition.svm import make_classifier
 
     fs = 1.0 / (touches.time_s[1] - touches.time_s[0])
     X = feature_matrix(touches.sensor_c, fs)
@@ -209,7 +209,7 @@ class SimToRealSetup:
 
 
 def _paper_setup(why: str) -> SimToRealSetup:
-    from ..sensor import SENSORS
+    from designkit.sensor import SENSORS
 
     return SimToRealSetup(SENSORS["paper"], PAPER_FALLBACK["time_offset_s"], {k: PAPER_FALLBACK[k] for k in CLASSES},
                           f"the paper's sensor and identified effusivities, heat flow 0.5 s before onset ({why})",
@@ -227,7 +227,7 @@ def calibrate(touches: RealTouches, *, seed: int) -> SimToRealSetup:
     if sub.material.size == 0:
         sub = touches.select(np.isin(touches.material, CALIBRATED))
     try:
-        from ..calibration.fit import FitSettings, fit_sensor, resolve_ranges
+        from designkit.calibration.fit import FitSettings, fit_sensor, resolve_ranges
     except ImportError as exc:  # pragma: no cover - calibration ships with designkit
         return _paper_setup(f"calibration unavailable: {exc}")
     names = sorted(set(sub.material))
@@ -275,7 +275,7 @@ def _touch_curves(ident, material: str, trial, time_s: np.ndarray, pressed=None)
 
     ``pressed``: touches (Trial) whose forces to use instead, one reading each.
     """
-    from ..calibration.identify import relative_force
+    from designkit.calibration.identify import relative_force
 
     if not ident.candidate.force_area:
         return ident.reading(time_s, material, drift=True)
@@ -333,7 +333,7 @@ def calibrate_model(touches: RealTouches, *, candidate: str = SIM_MODEL,
     ``touch_conductance``: materials whose touches each get their own contact conductance (the
     simulator draws a simulated touch's conductance from the fitted spread).
     """
-    from ..calibration.identify import identify
+    from designkit.calibration.identify import identify
 
     temps = {"metal": "passive", "wood": "passive", "cold_wood": "passive-response"}
     temps.update(object_temp or {})
@@ -377,8 +377,8 @@ def _simulate_model(test: RealTouches, setup: SimToRealSetup, noise_c: float, pe
     pre-contact temperature Tp0 towards the same To, with the calibrated passive response where there
     is one (else the identified reading shape), and its own noise.
     """
-    from .._validation import as_generator
-    from ..models.layered import savgol_smooth
+    from designkit._validation import as_generator
+    from designkit.models.layered import savgol_smooth
 
     rng = as_generator([seed, 229])
     ident = setup.identification
@@ -404,7 +404,7 @@ def _simulate_model(test: RealTouches, setup: SimToRealSetup, noise_c: float, pe
         for k in idx:
             tr = test.trials[k]
             if cls in contact:
-                from ..calibration.identify import relative_force
+                from designkit.calibration.identify import relative_force
 
                 mu, sd = contact[cls]
                 v, b = ident.reading(test.time_s, mat, conductance_factor=np.exp(rng.normal(mu, sd, per_trial)),
@@ -446,8 +446,8 @@ def _simulate_model(test: RealTouches, setup: SimToRealSetup, noise_c: float, pe
 def _simulate_like(test: RealTouches, setup: SimToRealSetup, noise_c: float, per_trial: int, seed: int,
                    object_temp: str = "passive") -> tuple[np.ndarray, np.ndarray]:
     """Simulated touches for each test touch's own Ts0 and Ta, the class effusivity, on its time grid."""
-    from .._validation import as_generator
-    from ..simulation import noisy_readings
+    from designkit._validation import as_generator
+    from designkit.simulation import noisy_readings
 
     rng = as_generator([seed, 227])
     n = test.material.size
@@ -474,12 +474,12 @@ def sim_to_real(test: RealTouches, setup: SimToRealSetup, noise_c: float, *, per
     """
     import sklearn
 
-    from ..recognition.features import feature_matrix
-    from ..recognition.svm import binary_f1, make_classifier
+    from designkit.recognition.features import feature_matrix
+    from designkit.recognition.svm import binary_f1, make_classifier
 
     fs = 1.0 / (test.time_s[1] - test.time_s[0])
     if two_sensor:
-        from ..recognition.two_sensor import two_sensor_features
+        from designkit.recognition.two_sensor import two_sensor_features
 
         if setup.identification is None or test.object_c is None or not np.isfinite(test.object_c).all():
             raise InputError("two-sensor sim-to-real needs an identified model and a passive channel in every "
@@ -584,7 +584,7 @@ def _data_or_skip(ctx: Context, name: str, title: str, t0: float):
 
 
 def _confusion_figure(ctx: Context, mats: list[tuple[str, np.ndarray]], labels, name: str) -> str:
-    from ..figures import pyplot
+    from designkit.figures import pyplot
 
     plt = pyplot()
     fig, axes = plt.subplots(1, len(mats), figsize=(4.0 * len(mats), 3.6), constrained_layout=True)

@@ -248,10 +248,10 @@ def test_guided_run_over_a_replayed_real_rig_writes_a_sensor_file_that_holds(cli
     from designkit.calibration.profiles import load_profile
 
     text = (Path(__file__).parents[1] / "calibration" / "profiles" / "designkit.yaml").read_text()
-    prof_path = tmp_path / "rig.yaml"   # the rig presses at 4-5 N: contact from 1 N, released below 0.5 N
+    prof_path = tmp_path / "rig.yaml"   # the rig presses at 4-5 N: contact from 2 N (its recorder's onset), release 1 N
     data = yaml.safe_load(text)
     data["name"] = "rig"
-    data["contact"].update(force_threshold_n=1.0, release_n=0.5)
+    data["contact"].update(force_threshold_n=2.0, release_n=1.0)
     prof_path.write_text(yaml.safe_dump(data))
     out = tmp_path / "run"
     with _replay_rig(robot_data_dir, 30, load_profile(str(prof_path))) as emu:

@@ -376,12 +376,13 @@ def _ranges_text(values: Sequence[int]) -> str:
 
 def choose_split(trials: Sequence[Trial], index_csv: Path | str | None = None,
                  fit_sets: Sequence[int] | None = None, *, require: bool = False,
-                 fit_share: float | None = None) -> Split:
+                 fit_share: float | None = None, sets: Sequence[int | None] | None = None) -> Split:
     """Choose disjoint fitted and held-out touches from the trial sets present.
 
-    Trial sets come from :func:`trial_sets` (the index's ``trial_set`` column or ``setNN_`` file
-    names); a recording without them is split in touch order (touch k of each material counts as
-    set k, so sessions recorded one after another stay apart). ``fit_sets`` given: those sets are
+    Trial sets come from ``sets`` (one per touch, None where unknown) or :func:`trial_sets` (the
+    index's ``trial_set`` column or ``setNN_`` file names); a recording without them is split in
+    touch order (touch k of each material counts as set k, so sessions recorded one after another
+    stay apart). ``fit_sets`` given: those sets are
     fitted and every other set present is held out; otherwise the first ``ceil(fit_share * n)``
     sets of the ``n`` present (at least one; ``fit_share`` by default :data:`FIT_SHARE`, or
     :data:`FIT_SHARE_TOUCH_ORDER` in touch order). Every material must have touches on both sides.
@@ -398,7 +399,7 @@ def choose_split(trials: Sequence[Trial], index_csv: Path | str | None = None,
     >>> sp.fit_sets, sp.held_sets, sp.describe()
     ((3,), (4, 7, 9, 11), 'fitted on trial sets 3 (2 touches), scored on trial sets 4, 7, 9, 11 (8 touches)')
     """
-    sets = trial_sets(trials, index_csv)
+    sets = trial_sets(trials, index_csv) if sets is None else list(sets)
     names = sorted({tr.material for tr in trials})
     if not trials:
         raise InputError("no touches to split")
@@ -1081,6 +1082,8 @@ class Identification:
     object_refs: Mapping[str, float] = field(default_factory=dict)
     touch_conductance: tuple[str, ...] = ()
     force_profile: Mapping[str, Any] | None = None
+    #: the rig's operating conditions in the fitted touches (:func:`designkit.rig.rig_conditions`, as a dict)
+    conditions: Mapping[str, Any] | None = None
 
     def parameter(self, name: str) -> IdentifiedParameter:
         for p in self.parameters:
@@ -1201,16 +1204,23 @@ class Identification:
         """The identified :class:`~designkit.sensor.Sensor` (e_s from the ranges, alpha_s at the fixed depth)."""
         from ..sensor import Sensor
 
+        from ..rig import record_start_s
+
         es = self.effusivity.value if self.effusivity is not None else 1.0
         alpha = self.parameter("diffusivity_m2_s").value if "diffusivity_m2_s" in self.candidate.free \
             else _SENSOR_DIFF.start
+        record = self.model_record()
+        conditions = None
+        if self.conditions is not None:
+            start = record_start_s(record)
+            conditions = {**dict(self.conditions), "onset_offset_s": None if start is None else round(start, 4)}
         return Sensor(effusivity=es, diffusivity_m2_s=alpha, depth_m=self.depth_m,
                       sample_rate_hz=self.sample_rate_hz, name=name, noise_c=self.noise_c,
                       provenance={"method": f"designkit.calibration.identify ({self.candidate.label})",
                                   "rms_c": self.rms_c, "consistent": self.consistent,
                                   "parameters": [p.to_dict() for p in self.parameters],
                                   "notes": list(self.notes)},
-                      model=self.model_record())
+                      model=record, conditions=conditions)
 
     def model_record(self) -> dict[str, Any]:
         """What a sensor file records of the identified model (:data:`designkit.sensor.MODEL_KEYS`).
@@ -1263,6 +1273,7 @@ class Identification:
             "singular_values": [float(v) for v in self.singular_values], "fit_time_s": self.fit_time_s,
             "noise_c": self.noise_c, "object_temperature": dict(self.object_modes), "object_reference_c": dict(self.object_refs),
             "notes": list(self.notes), "force_profile": None if self.force_profile is None else dict(self.force_profile),
+            "conditions": None if self.conditions is None else dict(self.conditions),
         }
 
 
@@ -1440,6 +1451,8 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
     """
     from scipy.optimize import least_squares
 
+    from ..rig import rig_conditions
+
     t0 = time.perf_counter()
     cand = model if isinstance(model, Candidate) else candidate(model)
     names = tuple(sorted({tr.material for tr in trials}))
@@ -1598,7 +1611,10 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
                           rms_by, n_s, k_par, aic, bic, rank, x.size, sv, time.perf_counter() - t0,
                           data.noise_c, x, names, depth_m, data.sample_rate_hz, dict(data.modes), tuple(notes),
                           dict(data.refs), tuple(touch_conductance),
-                          nominal_force_profile(data) if cand.force_area else None)
+                          nominal_force_profile(data) if cand.force_area else None,
+                          rig_conditions(trials, pre_contact_noise_c=data.noise_c,
+                                         residual_rms_c=float(np.sqrt(np.mean(r ** 2))),
+                                         onset_offset_s=math.nan).to_dict())
 
 
 #: The nominal force ramp a sensor file records: F / F_p from 1 s before the onset to 1.5 s after, every 20 ms.

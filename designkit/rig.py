@@ -229,7 +229,8 @@ def resolve_scene(sensor, given: Mapping[str, float | None]) -> RigScene:
 
     ``given`` holds the keys the question takes (``noise_c``, ``delta_t_c``,
     ``sensor_temp_spread_c``, ``contact_s``), None where the user gave nothing. A contact time
-    counts from the rig's detected onset when the sensor file records one.
+    counts from the rig's detected onset when the sensor file records one. The rig's spread of dT
+    is recorded but not played unless given (a note says how).
 
     Examples
     --------
@@ -239,8 +240,9 @@ def resolve_scene(sensor, given: Mapping[str, float | None]) -> RigScene:
     ({'noise_c': 0.05, 'delta_t_c': 7.0}, {'noise_c': 'default', 'delta_t_c': 'user'})
     """
     cond = getattr(sensor, "conditions", None) or {}
-    from_file = {"noise_c": cond.get("noise_c"), "delta_t_c": (cond.get("delta_t_c") or {}).get("mean"),
-                 "sensor_temp_spread_c": cond.get("sensor_temp_spread_c")}
+    # the touch-to-touch spread of dT is recorded, not played by default: varied initial conditions are
+    # computed pair by pair, and the Monte Carlo ideal observer of some models (force-ramp) takes fixed ones only
+    from_file = {"noise_c": cond.get("noise_c"), "delta_t_c": (cond.get("delta_t_c") or {}).get("mean")}
     values, sources, notes = {}, {}, []
     for key, v in given.items():
         if key == "contact_s":
@@ -261,6 +263,10 @@ def resolve_scene(sensor, given: Mapping[str, float | None]) -> RigScene:
     used = [f"{k} {values[k]:g} ({sources[k]})" for k in values if k != "contact_s"]
     if cond:
         notes.append(f"the rig as calibrated (sensor file {sensor.name}): " + ", ".join(used))
+        spread = cond.get("sensor_temp_spread_c")
+        if spread and given.get("sensor_temp_spread_c") is None and "sensor_temp_spread_c" in given:
+            notes.append(f"the rig's dT varied from touch to touch (SD {(cond.get('delta_t_c') or {}).get('sd', 0):.2g}"
+                         f" °C): not played by default; --sensor-temp-spread {spread:.2g} plays it")
     if start is not None:
         notes.append(f"contact time counts from the rig's detected onset ({cond.get('onset') or 'as recorded'}), "
                      f"as its controller measures it; the model's heat flow starts {start:+.3g} s from it")
@@ -292,6 +298,9 @@ def for_rig(answer, scene: RigScene, asked_contact_s: float | None = None):
         sc["contact_s"] = asked_contact_s
     sc["conditions"] = scene.conditions(asked_contact_s)
     changes["scene"] = sc
-    notes = tuple(answer.notes) + tuple(n for n in scene.notes if n not in answer.notes)
+    notes = tuple(answer.notes)
+    if scene.start_s is not None:  # the model's own time 0 no longer counts: the onset does
+        notes = tuple(n.replace(", from which the contact time counts", "") for n in notes)
+    notes += tuple(n for n in scene.notes if n not in notes)
     changes["notes"] = notes
     return dataclasses.replace(answer, **changes)

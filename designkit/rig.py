@@ -23,18 +23,13 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from ._validation import InputError
+from .sensor import CONDITION_KEYS
 
 __all__ = ["CONDITION_KEYS", "DEFAULTS", "RigConditions", "RigScene", "for_rig", "from_model_contact",
            "model_start_s", "resolve_scene", "rig_conditions", "to_model_contact"]
 
 #: A question's scene without a sensor file's conditions (and for the paper's sensor): noise [degC], dT [degC].
 DEFAULTS = {"noise_c": 0.05, "delta_t_c": 10.0, "sensor_temp_spread_c": 0.0}
-#: The keys of a sensor file's ``conditions`` record.
-CONDITION_KEYS = ("noise_c", "noise_source", "pre_contact_noise_c", "residual_rms_c", "sensor_temp_c",
-                  "object_temp_c", "delta_t_c", "sensor_temp_spread_c", "onset", "onset_offset_s", "contact_ramp",
-                  "n_touches")
-
-
 @dataclass(frozen=True)
 class RigConditions:
     """Operating conditions of a rig as its calibration touches show them.
@@ -103,8 +98,8 @@ def rig_conditions(trials: Sequence[Any], *, pre_contact_noise_c: float, residua
     >>> trs = [Trial(t, np.full(t.size, 30.0 + d), np.full(t.size, 22.0), np.clip(t, 0, 0.5) * 8, "wood")
     ...        for d in (-0.2, 0.0, 0.2)]
     >>> c = rig_conditions(trs, pre_contact_noise_c=0.001, residual_rms_c=0.03, onset_offset_s=-0.2)
-    >>> c.delta_t_c, c.noise_c, c.contact_ramp
-    ((8.0, 0.2), 0.03, {'rise_s': 0.45, 'to_share': 0.9})
+    >>> [round(v, 6) for v in c.delta_t_c], c.noise_c, c.contact_ramp
+    ([8.0, 0.2], 0.03, {'rise_s': 0.45, 'to_share': 0.9})
     """
     if not trials:
         raise InputError("no touches to read the rig's conditions from")
@@ -205,12 +200,16 @@ class RigScene:
     start_s : float or None
         The model's time 0 relative to the detected onset (None: the model's own t = 0 counts).
     notes : tuple of str
+    calibrated : bool
+        The sensor file records the rig's conditions (else the answer is left as it is: presets and
+        older files answer with the defaults, as before).
     """
 
     values: Mapping[str, float]
     sources: Mapping[str, str]
     start_s: float | None
     notes: tuple[str, ...] = field(default=())
+    calibrated: bool = True
 
     def conditions(self, asked_contact_s: float | None = None) -> dict[str, Any]:
         """``{key: {"value", "source"}}`` for ``--json`` (the contact as asked, from the onset)."""
@@ -270,7 +269,7 @@ def resolve_scene(sensor, given: Mapping[str, float | None]) -> RigScene:
     if start is not None:
         notes.append(f"contact time counts from the rig's detected onset ({cond.get('onset') or 'as recorded'}), "
                      f"as its controller measures it; the model's heat flow starts {start:+.3g} s from it")
-    return RigScene(values, sources, start, tuple(notes))
+    return RigScene(values, sources, start, tuple(notes), bool(cond))
 
 
 def for_rig(answer, scene: RigScene, asked_contact_s: float | None = None):
@@ -278,10 +277,13 @@ def for_rig(answer, scene: RigScene, asked_contact_s: float | None = None):
 
     A min-contact answer (and its interval and ideal bound) is counted from the rig's detected onset
     (the model's time plus :attr:`RigScene.start_s`, at least 0); the scene gets the conditions and
-    their sources (``scene["conditions"]``), the notes say so.
+    their sources (``scene["conditions"]``), the notes say so. Unchanged for a sensor without
+    recorded conditions.
     """
     import dataclasses
 
+    if not scene.calibrated:
+        return answer
     changes: dict[str, Any] = {}
     if answer.question == "min-contact" and scene.start_s is not None:
         def shift(v):

@@ -200,8 +200,6 @@ class Sensor:
         if self.conditions is not None:
             if not isinstance(self.conditions, Mapping):
                 raise InputError(f"sensor conditions: expected a mapping, got {type(self.conditions).__name__}")
-            from .rig import CONDITION_KEYS
-
             unknown = sorted(set(self.conditions) - set(CONDITION_KEYS))
             if unknown:
                 raise InputError(f"sensor conditions: unknown key(s) {', '.join(unknown)} "
@@ -324,6 +322,11 @@ class Sensor:
         data = load_yaml(p, "sensor file")  # a regular UTF-8 file (a FIFO is refused, not waited on)
         return cls.from_dict(data, source=f"sensor file {p}")
 
+
+#: The keys of a sensor file's ``conditions`` record (:class:`designkit.rig.RigConditions`).
+CONDITION_KEYS = ("noise_c", "noise_source", "pre_contact_noise_c", "residual_rms_c", "sensor_temp_c",
+                  "object_temp_c", "delta_t_c", "sensor_temp_spread_c", "onset", "onset_offset_s", "contact_ramp",
+                  "n_touches")
 
 #: The keys of a sensor's ``model`` record (what calibration writes beside the sensor fields).
 MODEL_KEYS = ("name", "params", "time_offset_s", "contact_spread", "object_temperature", "candidate", "contact_area",

@@ -300,6 +300,7 @@ def schemas() -> dict[str, type]:
         noise_c: Optional[Number] = None
         provenance: dict[str, Any] = {}
         model: Optional[SensorModel] = None
+        conditions: Optional[dict[str, Any]] = None   # the rig as calibrated (designkit.rig; file version 2)
 
     class EffusivityGrid(_Strict):
         min: Optional[Number] = None

@@ -23,7 +23,10 @@ from .properties import time_constant
 __all__ = ["MAX_SAMPLES_PER_TOUCH", "MODEL_KEYS", "SENSORS", "Sensor", "last_sample_index", "load_sensor",
            "sample_times_s", "within_sample_limit"]
 
-SENSOR_FILE_VERSION = 1
+#: Version of the sensor files this designkit writes. 2: a calibrated file records the rig's operating
+#: conditions (``conditions``, :mod:`designkit.rig`). Version 1 files (no conditions) still load.
+SENSOR_FILE_VERSION = 2
+_READABLE_VERSIONS = (1, 2)
 
 #: The most samples one touch may have (10 000 s at 100 Hz, 1 s at 1 MHz): 8 MB per touch curve.
 #: A longer touch or a faster sensor is refused before anything is allocated.
@@ -167,6 +170,10 @@ class Sensor:
         estimates it from pre-contact samples). Scenes set their own noise.
     provenance : mapping
         Free-form record of where the numbers came from (not compared).
+    conditions : mapping or None
+        The rig's operating conditions seen in calibration (:class:`designkit.rig.RigConditions`,
+        sensor file version 2): questions about the sensor take them as their defaults. None:
+        presets and files from before version 2.
     model : mapping or None
         The forward model the sensor was identified with, as calibration
         records it (:data:`MODEL_KEYS`): ``{"name", "params", "time_offset_s",
@@ -196,6 +203,7 @@ class Sensor:
     noise_c: float | None = None
     provenance: Mapping[str, Any] = field(default_factory=dict, compare=False, hash=False)
     model: Mapping[str, Any] | None = field(default=None, hash=False)
+    conditions: Mapping[str, Any] | None = field(default=None, compare=False, hash=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "effusivity", check_positive("sensor effusivity e_s", self.effusivity))
@@ -215,6 +223,14 @@ class Sensor:
         object.__setattr__(self, "provenance", dict(self.provenance))
         if self.model is not None:
             object.__setattr__(self, "model", _model_block(self.model, "sensor model"))
+        if self.conditions is not None:
+            if not isinstance(self.conditions, Mapping):
+                raise InputError(f"sensor conditions: expected a mapping, got {type(self.conditions).__name__}")
+            unknown = sorted(set(self.conditions) - set(CONDITION_KEYS))
+            if unknown:
+                raise InputError(f"sensor conditions: unknown key(s) {', '.join(unknown)} "
+                                 f"(known: {', '.join(CONDITION_KEYS)})")
+            object.__setattr__(self, "conditions", _plain(self.conditions))
 
     @property
     def tau_s(self) -> float:
@@ -247,6 +263,8 @@ class Sensor:
             out["provenance"] = _plain(self.provenance)
         if self.model is not None:
             out["model"] = _plain(self.model)
+        if self.conditions is not None:
+            out["conditions"] = _plain(self.conditions)
         return out
 
     @property
@@ -270,10 +288,13 @@ class Sensor:
 
         if not isinstance(data, Mapping):
             raise InputError(f"{source}: a sensor must be a mapping of fields, got {type(data).__name__}")
-        version = data.get("designkit_sensor", SENSOR_FILE_VERSION)
-        if version != SENSOR_FILE_VERSION:
-            raise InputError(f"{source}: unsupported sensor file version {version!r} "
-                             f"(this designkit reads version {SENSOR_FILE_VERSION})")
+        version = data.get("designkit_sensor", 1)
+        if version not in _READABLE_VERSIONS:
+            newer = isinstance(version, int) and not isinstance(version, bool) and version > SENSOR_FILE_VERSION
+            raise InputError(f"{source}: sensor file version {version!r}, this designkit reads versions "
+                             f"{', '.join(map(str, _READABLE_VERSIONS))}"
+                             + (": it was written by a newer designkit; upgrade designkit (pip install -U designkit)"
+                                if newer else ": recalibrate with 'designkit calibrate fit' to write a current one"))
         missing = [k for k in ("effusivity", "diffusivity_m2_s") if k not in data]
         if missing:
             raise InputError(f"{source}: missing sensor field(s) {', '.join(missing)}")
@@ -331,6 +352,11 @@ class Sensor:
                              f"file written by designkit (calibration writes one; add the line to a file of your own)")
         return sensor
 
+
+#: The keys of a sensor file's ``conditions`` record (:class:`designkit.rig.RigConditions`).
+CONDITION_KEYS = ("noise_c", "noise_source", "pre_contact_noise_c", "residual_rms_c", "sensor_temp_c",
+                  "object_temp_c", "delta_t_c", "sensor_temp_spread_c", "onset", "onset_offset_s", "contact_ramp",
+                  "n_touches")
 
 #: The keys of a sensor's ``model`` record (what calibration writes beside the sensor fields).
 MODEL_KEYS = ("name", "params", "time_offset_s", "contact_spread", "object_temperature", "candidate", "contact_area",

@@ -27,7 +27,7 @@ LAYERS = [
      "designkit._workers"},
     {"designkit.properties", "designkit.sensor", "designkit.scene", "designkit.materials", "designkit.objects",
      "designkit.figures"},
-    {"designkit.models"},
+    {"designkit.models", "designkit.rig"},
     {"designkit.simulation"},
     {"designkit.recognition"},
     {"designkit.tables"},

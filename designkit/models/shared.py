@@ -152,19 +152,24 @@ class SharedResponse:
         n = 2
         if w_hi <= w_lo or n > limit // 2:
             return cls(model, t, lo, hi, np.empty(0), np.empty((0, t.size)), float(tolerance), 0.0, True, es)
-        w = _lobatto(n, w_lo, w_hi)
-        values = model.response(t, _effusivity(w, es), sensor, tolerance=0.1 * tolerance)
-        while 2 * n <= limit:
+        # the first level and its check points in one reading (one pass of the model's fixed costs)
+        w_all = _lobatto(2 * n, w_lo, w_hi)
+        v_all = model.response(t, _effusivity(w_all, es), sensor, tolerance=0.1 * tolerance)
+        w, values, w_new, u_new = w_all[0::2], v_all[0::2], w_all[1::2], v_all[1::2]
+        while True:
+            error = float(np.max(np.abs(_interpolate(w, values, w_new) - u_new)))
+            if error <= tolerance:
+                return cls(model, t, lo, hi, w_all, v_all, float(tolerance), error, False, es)
+            n *= 2
+            if 2 * n > limit:
+                break
+            w, values = w_all, v_all
             w_new = _lobatto(2 * n, w_lo, w_hi)[1::2]      # the points interlacing the current ones
             u_new = model.response(t, _effusivity(w_new, es), sensor, tolerance=0.1 * tolerance)
-            error = float(np.max(np.abs(_interpolate(w, values, w_new) - u_new)))
             w_all = np.empty(2 * n + 1)
             w_all[0::2], w_all[1::2] = w, w_new
             v_all = np.empty((2 * n + 1, t.size))
             v_all[0::2], v_all[1::2] = values, u_new
-            if error <= tolerance:
-                return cls(model, t, lo, hi, w_all, v_all, float(tolerance), error, False, es)
-            w, values, n = w_all, v_all, 2 * n
         return cls(model, t, lo, hi, np.empty(0), np.empty((0, t.size)), float(tolerance), 0.0, True, es)
 
     def readings(self, e_object) -> np.ndarray:
@@ -187,9 +192,13 @@ def _interpolate(x_nodes: np.ndarray, values: np.ndarray, x: np.ndarray) -> np.n
     """The polynomial through ``(x_nodes, values)`` (rows) at ``x``: shape (len(x), m)."""
     from scipy.interpolate import BarycentricInterpolator
 
-    # the Lagrange basis at x (scipy's barycentric weights), then one matrix product for every time
+    # the Lagrange basis at x (scipy's barycentric weights), then a sum of the nodes' rows: n passes over
+    # (K, m), no BLAS (whose threads cost more than they save on a few rows, and vary the rounding)
     basis = np.atleast_2d(BarycentricInterpolator(x_nodes, np.eye(x_nodes.size), axis=0)(x))
-    return basis @ values
+    out = basis[:, :1] * values[0]
+    for j in range(1, x_nodes.size):
+        out += basis[:, j:j + 1] * values[j]
+    return out
 
 
 def class_readings(model: ForwardModel, time_s, e_object, sensor, *, tolerance: float,

@@ -41,6 +41,7 @@ from ._validation import (
 )
 from .models import ForwardModel, get_model
 from .models.semi_infinite import object_weight, response_shape
+from .models.shared import class_readings
 from .objects import ObjectClass
 from .scene import Scene
 from .sensor import Sensor
@@ -265,7 +266,8 @@ def render_trials(draws: TrialDraws, sensor: Sensor, scene: Scene, model: "Forwa
         temps = noisy_readings(time_s, draws.effusivity, ts, ta, sensor, scene.noise_c, draws.noise, model=fm)
     else:
         tol = response_tolerance(scene.noise_ratio, draws.n_samples)
-        u = fm.response(time_s, draws.effusivity, sensor, diffusivity_m2_s=diffusivity_m2_s, tolerance=tol)
+        # a costly model is read at a few effusivities of the class and interpolated within tol
+        u = class_readings(fm, time_s, draws.effusivity, sensor, diffusivity_m2_s=diffusivity_m2_s, tolerance=tol)
         temps = ts[:, None] + (ta - ts)[:, None] * u
         if scene.noise_c > 0:
             temps = temps + scene.noise_c * draws.noise

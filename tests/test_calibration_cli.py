@@ -383,7 +383,8 @@ def test_record_refuses_an_empty_material(cli, tmp_path, command, extra):
     """An empty label was recorded as 'material_001.csv' into an index that 'calibrate fit' then refused."""
     r = cli("calibrate", *command, "--port", "/dev/whatever", "--material", " ", "--out", tmp_path / "out", *extra)
     assert r.exit_code == 2
-    assert r.stderr.strip().splitlines() == ["Error: --material must not be empty (it names the trials in the index)"]
+    (line,) = r.stderr.strip().splitlines()  # one line, naming the option and what is wrong with it
+    assert line.startswith("Error:") and "--material" in line and "empty" in line, line
 
 
 def test_record_checks_the_out_folder_before_waiting_for_touches(cli, tmp_path):

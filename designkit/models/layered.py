@@ -154,8 +154,15 @@ def talbot_invert(transform, time_s, *, nodes: int = TALBOT_NODES) -> np.ndarray
 
 
 def _talbot_sum(F: np.ndarray, weights: np.ndarray) -> np.ndarray:
-    """``Re sum_k W_ik F_..ik`` over the last axis: the real part taken term by term (no complex sum)."""
-    return np.einsum("...mn,mn->...m", F.real, weights.real) - np.einsum("...mn,mn->...m", F.imag, weights.imag)
+    """``Re sum_k W_ik F_..ik`` over the last axis, term by term in a fixed order (elementwise operations
+    only: no reduction whose rounding could depend on memory alignment, so every run gives the same bits)."""
+    F = np.broadcast_to(F, np.broadcast_shapes(F.shape, weights.shape))
+    Fr, Fi, Wr, Wi = F.real, F.imag, weights.real, weights.imag
+    out = Fr[..., 0] * Wr[:, 0] - Fi[..., 0] * Wi[:, 0]
+    for k in range(1, weights.shape[1]):
+        out += Fr[..., k] * Wr[:, k]
+        out -= Fi[..., k] * Wi[:, k]
+    return out
 
 
 def savgol_smooth(values, window: int, order: int, *, pad_before: int | None = None) -> np.ndarray:

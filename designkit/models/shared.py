@@ -69,7 +69,7 @@ def _effusivity(w: np.ndarray, e_sensor: float) -> np.ndarray:
         return np.where(w >= 1.0, np.inf, e_sensor * w / np.where(w >= 1.0, 1.0, 1.0 - w))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # holds arrays: compared by identity
 class SharedResponse:
     """A class's readings on one time grid: the model at a few effusivities, interpolated between them.
 

@@ -63,12 +63,37 @@ for contact in (2.0, 10.0):
 print(json.dumps(out))
 '''
 
+DIRECT = r'''
+import json
+import numpy as np
+from designkit.sensor import Sensor
+from designkit.models import get_model
+from designkit.models.ramp import ForceRamp
 
-def run(pythonpath: str, repeats: int) -> dict:
+rng = np.random.default_rng(2024)
+out = []
+for case in range(12):   # random layered models and ramps, read directly (no interpolation) at random objects
+    sensor = Sensor(float(rng.uniform(500, 3000)), float(rng.uniform(5e-9, 5e-8)), depth_m=float(rng.uniform(2e-5, 2e-4)))
+    lay = get_model("layered", film_thickness_m=float(rng.uniform(5e-5, 5e-4)),
+                    backing_effusivity_ws05_m2k=float(rng.uniform(200, 5e5)),
+                    conductance_w_m2k=float(rng.choice([np.inf, rng.uniform(500, 5e4)])),
+                    lag_s=float(rng.choice([0.0, rng.uniform(0.05, 3.0)])),
+                    smoothing_window=int(rng.choice([0, 99])), smoothing_order=3)
+    tp = np.arange(0, 60) * 0.02
+    model = lay if case % 2 == 0 else ForceRamp.from_force_profile(lay, tp, np.clip(tp / float(rng.uniform(0.3, 1.1)), 0, 1),
+                                                                    float(rng.uniform(0.0, 0.4)))
+    t = np.arange(int(rng.integers(201, 801))) / 200.0
+    e = rng.uniform(20, 30000, 7)
+    out.append(model.response(t, e, sensor).tolist())
+print(json.dumps(out))
+'''
+
+
+def run(pythonpath: str, repeats: int, code: str = CASE) -> dict:
     env = dict(os.environ, PYTHONPATH=pythonpath, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1",
                MKL_NUM_THREADS="1")  # one core per process, as a sweep worker has
     with tempfile.TemporaryDirectory() as cwd:  # python -c puts its working directory first on sys.path
-        res = subprocess.run([sys.executable, "-c", CASE, str(repeats)], env=env, capture_output=True, text=True,
+        res = subprocess.run([sys.executable, "-c", code, str(repeats)], env=env, capture_output=True, text=True,
                              check=True, cwd=cwd)
     return json.loads(res.stdout.strip().splitlines()[-1])
 
@@ -89,11 +114,13 @@ def main() -> None:
                              check=True).stdout
         subprocess.run(["tar", "-x", "-C", tmp], input=tar, check=True)
         old = run(tmp, args.repeats)
+        old_direct = run(tmp, 0, DIRECT)
     new = run(str(root), args.repeats)
+    new_direct = run(str(root), 0, DIRECT)
     print(f"per-touch simulation cost (draw + render, 100 touches of wood, 200 Hz), old = {args.baseline}, "
           "new = this tree; ratio to the semi-infinite touch of the same code")
     print(f"{'model':<14}{'contact':>8}{'old warm':>11}{'ratio':>7}{'new warm':>11}{'ratio':>7}"
-          f"{'new cold':>11}{'ratio':>7}{'max |du|':>11}{'tol':>10}")
+          f"{'new cold':>11}{'ratio':>7}{'max|du|':>11}{'tol':>10}")
     for key in new:
         name, contact = key.split("@")
         base_o, base_n = old[f"semi-infinite@{contact}"], new[f"semi-infinite@{contact}"]
@@ -104,6 +131,12 @@ def main() -> None:
         print(f"{name:<14}{contact + ' s':>8}{o['warm_s'] * 1e3:>9.3f}ms{o['warm_s'] / base_o['warm_s']:>7.1f}"
               f"{n['warm_s'] * 1e3:>9.3f}ms{n['warm_s'] / base_n['warm_s']:>7.1f}"
               f"{n['cold_s'] * 1e3:>9.3f}ms{n['cold_s'] / base_n['warm_s']:>7.1f}{du:>11.2e}{tol:>10.1e}")
+    o = np.concatenate([np.ravel(a) for a in old_direct])
+    n = np.concatenate([np.ravel(a) for a in new_direct])
+    big = np.abs(o) > 1e-6
+    print(f"direct evaluation (no interpolation), 12 random layered models and ramps, {o.size} readings: "
+          f"max |new - old| = {np.max(np.abs(n - o)):.2e}, max relative difference where u > 1e-6: "
+          f"{np.max(np.abs(n - o)[big] / np.abs(o[big])):.2e}")
 
 
 if __name__ == "__main__":

@@ -268,9 +268,10 @@ def render_trials(draws: TrialDraws, sensor: Sensor, scene: Scene, model: "Forwa
         tol = response_tolerance(scene.noise_ratio, draws.n_samples)
         # a costly model is read at a few effusivities of the class and interpolated within tol
         u = class_readings(fm, time_s, draws.effusivity, sensor, diffusivity_m2_s=diffusivity_m2_s, tolerance=tol)
-        temps = ts[:, None] + (ta - ts)[:, None] * u
+        temps = np.multiply(u, (ta - ts)[:, None], out=u)        # in place: ts + (ta - ts) u, as before
+        temps += ts[:, None]
         if scene.noise_c > 0:
-            temps = temps + scene.noise_c * draws.noise
+            temps += scene.noise_c * draws.noise
     return Trials(time_s, temps, draws.effusivity, ts, ta,
                   None if diffusivity_m2_s is None else np.asarray(diffusivity_m2_s, dtype=np.float64), fm.name)
 

@@ -97,3 +97,21 @@ def test_the_layered_transform_is_its_object_independent_parts_divided_per_objec
     U = laplace_reading(p, np.array([400.0, np.inf]), **kw)
     np.testing.assert_allclose(U[0], C / (A + B / 400.0), rtol=1e-14)
     np.testing.assert_allclose(U[1], C / A, rtol=1e-14)
+
+
+def test_the_same_seed_gives_the_same_ramp_touches_in_another_process():
+    """No alignment-, thread- or process-dependent sum enters the interpolated readings (tables stay bit for bit)."""
+    import json
+    import os
+    import subprocess
+    import sys
+
+    code = ("import json, numpy as np; exec(open('tests/test_shared_response.py').read().split('@pytest')[0]);"
+            "from designkit.simulation import draw_trials, render_trials; from designkit import Scene;"
+            "d = draw_trials(331.0, 506.0, 30, 161, [4, 2]);"
+            "print(json.dumps(render_trials(d, SENSOR, Scene(contact_s=0.8), RAMP).temperature_c.tolist()))")
+    env = dict(os.environ, PYTHONHASHSEED="321", OPENBLAS_NUM_THREADS="1")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True,
+                         cwd=os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    here = render_trials(draw_trials(331.0, 506.0, 30, 161, [4, 2]), SENSOR, Scene(contact_s=0.8), RAMP)
+    assert np.array_equal(np.array(json.loads(out.stdout)), here.temperature_c)

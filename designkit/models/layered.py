@@ -154,8 +154,15 @@ def talbot_invert(transform, time_s, *, nodes: int = TALBOT_NODES) -> np.ndarray
 
 
 def _talbot_sum(F: np.ndarray, weights: np.ndarray) -> np.ndarray:
-    """``Re sum_k W_ik F_..ik`` over the last axis: the real part taken term by term (no complex sum)."""
-    return np.einsum("...mn,mn->...m", F.real, weights.real) - np.einsum("...mn,mn->...m", F.imag, weights.imag)
+    """``Re sum_k W_ik F_..ik`` over the last axis, term by term in a fixed order (elementwise operations
+    only: no reduction whose rounding could depend on memory alignment, so every run gives the same bits)."""
+    F = np.broadcast_to(F, np.broadcast_shapes(F.shape, weights.shape))
+    Fr, Fi, Wr, Wi = F.real, F.imag, weights.real, weights.imag
+    out = Fr[..., 0] * Wr[:, 0] - Fi[..., 0] * Wi[:, 0]
+    for k in range(1, weights.shape[1]):
+        out += Fr[..., k] * Wr[:, k]
+        out -= Fi[..., k] * Wi[:, k]
+    return out
 
 
 def savgol_smooth(values, window: int, order: int, *, pad_before: int | None = None) -> np.ndarray:
@@ -315,8 +322,9 @@ def _scene_parts(kwargs: tuple, time_bytes: bytes, nodes: int):
     """
     t = np.frombuffer(time_bytes, dtype=np.float64)
     p, weights = talbot_points(t, nodes)
-    parts = laplace_parts(p, **dict(kwargs))
-    out = (weights,) + tuple(np.ascontiguousarray(a) for a in parts)
+    A, B, C = laplace_parts(p, **dict(kwargs))
+    # U = C / (A + B / e_o) = (C / B) / (A / B + 1 / e_o): per object one real addition and one division
+    out = (weights, C / B, A / B)
     for a in out:
         a.setflags(write=False)
     return out
@@ -454,8 +462,10 @@ class Layered(ForwardModel):
         live = eo > 0
         if pos.any() and live.any():
             kw = tuple(sorted(self._laplace_kwargs(sensor).items()))
-            weights, *parts = _scene_parts(kw, np.ascontiguousarray(t[pos]).tobytes(), int(nodes))
-            out[np.ix_(live, pos)] = _talbot_sum(_object_reading(parts, eo[live]), weights)
+            weights, num, den = _scene_parts(kw, np.ascontiguousarray(t[pos]).tobytes(), int(nodes))
+            x = eo[live]
+            inv = np.where(np.isinf(x), 0.0, 1.0 / np.where(np.isinf(x), 1.0, x))
+            out[np.ix_(live, pos)] = _talbot_sum(num / (den + inv[:, None, None]), weights)
         zero = t == 0
         if zero.any():
             out[:, zero] = self.initial_value(eo, sensor)[:, None]

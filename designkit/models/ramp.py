@@ -238,11 +238,14 @@ class ForceRamp(ForwardModel):
             if live.any():
                 S[:, live] = step.response(lag[live], e_object, sensor, diffusivity_m2_s=diffusivity_m2_s,
                                            tolerance=tolerance)
-            for j in group:
-                lo = max(0, -int(whole[j]))                               # first sample with n_j + i >= 0
+            buf = np.empty(out.shape)
+            for n_j, d_j in zip(whole[group].tolist(), da[group].tolist()):
+                lo = -n_j if n_j < 0 else 0                               # first sample with n_j + i >= 0
                 if lo >= m:
                     continue
-                out[:, lo:] += da[j] * S[:, int(whole[j]) + lo:int(whole[j]) + m]
+                part = buf[:, lo:]
+                np.multiply(S[:, n_j + lo:n_j + m], d_j, out=part)
+                out[:, lo:] += part
         return out
 
     def response(self, time_s, e_object, sensor, *, diffusivity_m2_s=None, tolerance: float = 1e-9) -> np.ndarray:

@@ -69,7 +69,7 @@ def _effusivity(w: np.ndarray, e_sensor: float) -> np.ndarray:
         return np.where(w >= 1.0, np.inf, e_sensor * w / np.where(w >= 1.0, 1.0, 1.0 - w))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # holds arrays: compared by identity
 class SharedResponse:
     """A class's readings on one time grid: the model at a few effusivities, interpolated between them.
 
@@ -180,7 +180,8 @@ class SharedResponse:
         if e.size and (np.min(e) < self.e_low or np.max(e) > self.e_high):
             raise InputError(f"effusivities [{np.min(e):g}, {np.max(e):g}] outside the class response's range "
                              f"[{self.e_low:g}, {self.e_high:g}]")
-        return np.clip(_interpolate(self.weights, self.values, object_weight(self.e_sensor, e)), 0.0, 1.0)
+        out = _interpolate(self.weights, self.values, object_weight(self.e_sensor, e))
+        return np.clip(out, 0.0, 1.0, out=out)
 
     @property
     def nodes(self) -> np.ndarray:
@@ -189,14 +190,31 @@ class SharedResponse:
 
 
 def _interpolate(x_nodes: np.ndarray, values: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """The polynomial through ``(x_nodes, values)`` (rows) at ``x``: shape (len(x), m)."""
-    from scipy.interpolate import BarycentricInterpolator
+    """The polynomial through ``(x_nodes, values)`` (rows; Chebyshev-Lobatto nodes) at ``x``: shape (len(x), m).
 
-    # the Lagrange basis at x (scipy's barycentric weights), then a sum of the nodes' rows: n passes over
-    # (K, m), no BLAS (whose threads cost more than they save on a few rows, and vary the rounding)
-    basis = np.atleast_2d(BarycentricInterpolator(x_nodes, np.eye(x_nodes.size), axis=0)(x))
+    The barycentric formula with the Chebyshev-Lobatto weights ``(-1)^j`` (halved at the ends;
+    Berrut & Trefethen, SIAM Review 46 (2004) 501), summed node by node in a fixed order: elementwise
+    operations only (no BLAS, whose sums may depend on threads and memory alignment), so the same
+    inputs give the same readings bit for bit on every run.
+    """
+    x = np.atleast_1d(np.asarray(x, dtype=np.float64))
+    n = x_nodes.size
+    lam = np.where(np.arange(n) % 2 == 0, 1.0, -1.0)
+    lam[0] *= 0.5
+    lam[-1] *= 0.5
+    diff = x[:, None] - x_nodes[None, :]                     # (K, n)
+    hit = diff == 0.0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        c = lam[None, :] / diff
+        total = c[:, 0].copy()
+        for j in range(1, n):
+            total += c[:, j]
+        basis = c / total[:, None]
+    exact = hit.any(axis=1)
+    if exact.any():                                          # x on a node: that node's value
+        basis[exact] = hit[exact].astype(np.float64)
     out = basis[:, :1] * values[0]
-    for j in range(1, x_nodes.size):
+    for j in range(1, n):
         out += basis[:, j:j + 1] * values[j]
     return out
 

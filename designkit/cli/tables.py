@@ -42,18 +42,20 @@ def tables_list(
             console(stderr=True).print(f"skipped: {_visible(exc)}")
             continue
         s = t.summary()
-        rows.append({"name": name, "fidelity": s["fidelity"], "sensor": s["sensor"]["name"], "model": s["model"],
-                     "axes": {a["name"]: [a["min"], a["max"], a["points"]] for a in s["axes"]},
-                     "size_bytes": s["size_bytes"], "path": s["path"]})
+        # the keys and shapes of `tables show` (docs/schema.md): the sensor and the axes as there
+        rows.append({"name": name, "fidelity": s["fidelity"], "sensor": s["sensor"], "model": s["model"],
+                     "axes": s["axes"], "content_hash": s.get("content_hash"), "size_bytes": s["size_bytes"],
+                     "path": s["path"]})
     if fmt == "json":
         emit_rows(rows, fmt="json", out=out, payload=rows)
         return
     flat = []
     for r in rows:  # one plain value per column (csv: full precision; table/md: ranges for people)
-        ax = r["axes"]
+        ax = {a["name"]: [a["min"], a["max"], a["points"]] for a in r["axes"]}
         noise_axis = "noise_ratio" if "noise_ratio" in ax else "noise_c"
         noise, contact = ax[noise_axis], ax["contact_s"]
-        flat.append({"name": r["name"], "fidelity": r["fidelity"], "sensor": r["sensor"], "model": r["model"]["name"],
+        flat.append({"name": r["name"], "fidelity": r["fidelity"], "sensor": r["sensor"]["name"],
+                     "model": r["model"]["name"],
                      "noise_axis": noise_axis, "noise_min": noise[0], "noise_max": noise[1], "noise_points": noise[2],
                      "contact_min_s": contact[0], "contact_max_s": contact[1], "contact_points": contact[2],
                      "intervals": ax["e_ref"][2], "size_bytes": r["size_bytes"], "path": r["path"]})

@@ -186,7 +186,7 @@ def test_min_contact_of_a_3mm_acrylic_sheet_says_the_semi_infinite_answer_holds(
                             **FAST)
     assert ans.value is not None and ans.value < 2.0 and ans.ideal <= ans.value + 0.05
     chk = ans.model_check
-    assert chk["model"] == "slab" and chk["details"]["semi_infinite_holds"]
+    assert chk["name"] == "slab" and chk["details"]["semi_infinite_holds"]
     assert "semi-infinite model and its tables hold" in chk["message"]
     assert ans.model["thickness_m"] == 0.003 and ans.model["backing"]["name"] == "Low carbon steel"
     # the materials rule: the facing edges of acrylic's and glass's ranges

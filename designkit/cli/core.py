@@ -73,7 +73,7 @@ def simulate(
         emit_json({
             "time_s": result.time_s,
             "temperature_c": result.temperature_c,
-            "e": e,
+            "effusivity": e,
             "contact_temperature_c": tc,
             "scene": scene.to_dict(),
             "sensor": sen.to_dict(),

@@ -99,10 +99,10 @@ def tables_show(
         return
     if format_ is not None:
         fmt = check_format(format_)
-        rows = [{"axis": a["name"], "units": a.get("units"), "scale": a.get("scale"), "points": a.get("points"),
+        rows = [{"axis": a["name"], "unit": a.get("unit"), "scale": a.get("scale"), "points": a.get("points"),
                  "min": a.get("min"), "max": a.get("max"),
                  "values": " ".join(f"{v:g}" for v in a.get("values", []))} for a in s["axes"]]
-        emit_rows(rows, ["axis", "units", "scale", "points", "min", "max", "values"], fmt=fmt, out=out,
+        emit_rows(rows, ["axis", "unit", "scale", "points", "min", "max", "values"], fmt=fmt, out=out,
                   title=f"{s['name']}: axes", payload=s["axes"] if fmt == "json" else None)
         return
     with output_to(out):
@@ -126,13 +126,13 @@ def _print_table(table, s: dict) -> None:
     con.print(f"  sensor {v(sen['name'])}: e_s = {sen['effusivity']:g} J s^-1/2 K^-1 m^-2, alpha_s = "
               f"{sen['diffusivity_m2_s']:.3g} m^2/s, depth {sen['depth_m'] * 1e6:g} um, tau = {sen['tau_s']:.4g} s, "
               f"{sen['sample_rate_hz']:g} Hz")
-    eff = s["effusivity"]
+    eff = s["effusivity_grid"]
     con.print(f"  effusivity ({eff['min']:g}, {eff['max']:g}] in {eff['intervals']} intervals of {eff['width']:g}")
     for a in s["axes"]:
         if a["name"] == "e_ref":
             continue
         vals = ", ".join(f"{x:g}" for x in a.get("values", [])) or f"{a['min']:g} .. {a['max']:g}"
-        con.print(v(f"  axis {a['name']} [{a['units']}, {a['scale']}]: {vals}"))
+        con.print(v(f"  axis {a['name']} [{a['unit']}, {a['scale']}]: {vals}"))
     ic = s["initial_conditions"]
     if ic["fixed"]:
         con.print("  initial conditions fixed (every touch starts at Ta + dT)")

@@ -121,7 +121,7 @@ class Design:
         return {"skin": self.skin, "effusivity": self.e_sensor, "diffusivity_m2_s": self.diffusivity_m2_s,
                 "depth_um": self.depth_um, "tau_s": self.tau_s, "sample_rate_hz": self.sample_rate_hz,
                 "delta_t_c": self.delta_t_c, "ideal": _ideal(self.min_contact_s),
-                "limiting_pair": list(self.limiting_pair)}
+                "limiting": {"a": self.limiting_pair[0], "b": self.limiting_pair[1]} if self.limiting_pair else None}
 
 
 @dataclass(frozen=True)
@@ -140,8 +140,8 @@ class DesignResult:
         return {"best": None if self.best is None else self.best.to_dict(), "reason": self.reason,
                 "constraints": {"max_contact_s": c.max_contact_s, "noise_c": c.noise_c,
                                 "max_delta_t_c": c.max_delta_t_c, "max_rate_hz": c.max_rate_hz,
-                                "depth_um": list(c.depth_um), "threshold": c.threshold},
-                "pairs": [{"pair": [a, b], "ideal": _ideal(t)} for a, b, t in self.pairs],
+                                "depth_range_um": list(c.depth_um), "threshold": c.threshold},
+                "pairs": [{"a": a, "b": b, "ideal": _ideal(t)} for a, b, t in self.pairs],
                 "pareto_noise_ratio_vs_contact": [{"noise_ratio": r, "ideal": _ideal(t)} for r, t in self.pareto],
                 "designs_searched": len(self.designs)}
 

@@ -131,6 +131,17 @@ def documents():
     return out
 
 
+@pytest.mark.slow
+def test_the_exact_route_has_the_same_schema(cli):
+    """The exact route (seconds: a small SVM run) prints the keys and shapes the table route does."""
+    r = cli("distinguishable", "--e1", "35000", "--e2", "20000", "--contact", "1", "--exact", "--trials", "30",
+            "--repeats", "2", "--jobs", "1", "--json")
+    assert r.exit_code == 0, r.output
+    bad: list[str] = []
+    _check(json.loads(r.stdout), "distinguishable --exact", bad, {})
+    assert not bad, "\n".join(dict.fromkeys(bad))
+
+
 def test_the_schema_page_parses():
     assert {"effusivity", "effusivity_range", "interval", "ideal", "table", "value"} <= set(CONCEPTS)
     assert all(s in SHAPES or s == "bool" for shapes in CONCEPTS.values() for s in shapes)

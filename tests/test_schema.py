@@ -168,8 +168,13 @@ def test_retired_names_appear_nowhere(documents):
 
 
 def test_format_json_prints_the_json_document(cli):
-    for args in (COMMANDS["delta-e"], COMMANDS["materials show"], COMMANDS["materials list"], COMMANDS["tables list"]):
-        assert json.loads(cli(*args, "--format", "json").stdout) == json.loads(cli(*args, "--json").stdout), args
+    for args in (COMMANDS["delta-e"], COMMANDS["materials show"], COMMANDS["materials list"], COMMANDS["tables list"],
+                 COMMANDS["tables show"], COMMANDS["matrix"]):
+        docs = [json.loads(cli(*args, *fmt).stdout) for fmt in (("--format", "json"), ("--json",))]
+        for d in docs:
+            if isinstance(d, dict):
+                (d.get("computation") or {}).pop("wall_s", None)  # the one figure two runs differ in
+        assert docs[0] == docs[1], args
 
 
 def test_library_to_dict_is_the_cli_document(documents):

@@ -103,7 +103,7 @@ def tables_show(
                  "min": a.get("min"), "max": a.get("max"),
                  "values": " ".join(f"{v:g}" for v in a.get("values", []))} for a in s["axes"]]
         emit_rows(rows, ["axis", "unit", "scale", "points", "min", "max", "values"], fmt=fmt, out=out,
-                  title=f"{s['name']}: axes", payload=s["axes"] if fmt == "json" else None)
+                  title=f"{s['name']}: axes", payload=s)  # json: the --json document
         return
     with output_to(out):
         _print_table(table, s)

@@ -188,7 +188,7 @@ class Material:
         return f"{self.set}:{self.name}"
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain-data form (JSON output); ranges as ``[min, max]`` lists."""
+        """Plain-data form (JSON output; docs/schema.md): ranges as ``[min, max]`` lists under ``*_range*`` keys."""
 
         def rng(lo, hi):
             return None if lo is None else [lo, hi]
@@ -198,12 +198,12 @@ class Material:
             "family": self.family,
             "family_label": self.family_label,
             "set": self.set,
-            "effusivity": [self.e_min, self.e_max],
+            "effusivity_range": [self.e_min, self.e_max],
             "identified": self.identified,
-            "conductivity_w_mk": rng(self.conductivity_min_w_mk, self.conductivity_max_w_mk),
-            "density_kg_m3": rng(self.density_min_kg_m3, self.density_max_kg_m3),
-            "specific_heat_j_kgk": rng(self.specific_heat_min_j_kgk, self.specific_heat_max_j_kgk),
-            "diffusivity_m2_s": [self.diffusivity_min_m2_s, self.diffusivity_max_m2_s],
+            "conductivity_range_w_mk": rng(self.conductivity_min_w_mk, self.conductivity_max_w_mk),
+            "density_range_kg_m3": rng(self.density_min_kg_m3, self.density_max_kg_m3),
+            "specific_heat_range_j_kgk": rng(self.specific_heat_min_j_kgk, self.specific_heat_max_j_kgk),
+            "diffusivity_range_m2_s": [self.diffusivity_min_m2_s, self.diffusivity_max_m2_s],
             "aliases": list(self.aliases),
             "source": self.source,
             "diffusivity_from": self.diffusivity_from,

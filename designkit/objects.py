@@ -78,7 +78,7 @@ class ObjectClass:
         return self
 
     def to_dict(self) -> dict[str, Any]:
-        return {"label": self.label, "material": self.material, "e_range": list(self.e_range),
+        return {"label": self.label, "material": self.material, "effusivity_range": list(self.e_range),
                 "diffusivity_range_m2_s": None if self.diffusivity_range_m2_s is None
                 else list(self.diffusivity_range_m2_s)}
 

@@ -37,9 +37,9 @@ def test_recommendation_is_the_grid_minimum_and_matches_the_ideal_observer():
 
 
 def test_paper12_at_identified_effusivities_and_overlapping_ranges():
-    r = recommend(targets_from(set_name="paper12"), Constraints(), skins=(PEEK,), n_depth=2)
+    r = recommend(targets_from(set_name="paper12", identified=True), Constraints(), skins=(PEEK,), n_depth=2)
     assert r.best is not None and len(r.pairs) == 66
-    names = {t.name for t in targets_from(set_name="paper12")}
+    names = {t.name for t in targets_from(set_name="paper12", identified=True)}
     assert set(r.best.limiting_pair) <= names
     # the paper's database ranges overlap (wood and acrylic): no design separates them
     r = recommend(targets_from(["wood", "Polymethyl methacrylate (Acrylic, PMMA)"]), Constraints(), skins=(PEEK,))
@@ -51,8 +51,8 @@ def test_cli_json_with_svm_confirmation(cli, tmp_path):
             "--plot", str(tmp_path / "d.png"))
     assert r.exit_code == 0, r.output
     out = json.loads(r.stdout)
-    assert out["best"]["skin"] == PEEK and out["svm"]["svm_min_contact_s"] is not None
-    assert out["svm"]["svm_min_contact_s"] >= out["best"]["min_contact_s"]  # no classifier beats the bound
+    assert out["best"]["skin"] == PEEK and out["svm"]["value"] is not None
+    assert out["svm"]["value"] >= out["best"]["ideal"]["value"]  # no classifier beats the bound
     assert (tmp_path / "d.png").stat().st_size > 10_000
 
 
@@ -75,3 +75,13 @@ def test_cli_no_design_and_bad_input(cli, args, code, msg):
     r = cli("design", "--no-svm", *args)
     assert r.exit_code == code, r.output
     assert msg in r.output and len(r.output.strip().splitlines()) == 1
+
+
+def test_set_means_ranges_as_in_matrix_unless_identified_is_asked():
+    """`--set paper12` is the set's ranges in design as in matrix (one meaning per flag); the paper's
+    handbook ranges overlap (Cardboard / Wood), so only the identified effusivities give a design."""
+    ranges = {t.name: t.e_range for t in targets_from(set_name="paper12")}
+    assert all(t.e_low != t.e_low for t in targets_from(set_name="paper12"))  # NaN: judged by its range
+    from designkit.query.matrix import resolve_materials
+    assert ranges == {m.name: (m.e_min, m.e_max) for m in resolve_materials(set="paper12")}
+    assert recommend(targets_from(set_name="paper12"), Constraints(), skins=(PEEK,), n_depth=2).best is None

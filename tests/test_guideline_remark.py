@@ -21,7 +21,7 @@ def test_main_job_prints_the_paper_figure_beside_the_answer(cli, pair):
     i = next(k for k, line in enumerate(lines) if _paper_words() in line)
     # right under the answer and its ideal bound, with the answer placed on the paper's grid
     assert "ideal observer bound" in lines[i - 1] and "SVM" in lines[i - 2]
-    value = float(lines[i - 2].split("at least ")[1].split(" s")[0])
+    value = float(lines[i - 2].split("shortest contact ")[1].split(" s")[0])
     on_grid = min(c for c in GUIDELINE["contact_grid_s"] if c >= value)
     assert f"rounds up to {on_grid:g} s there" in lines[i]
 

@@ -377,13 +377,13 @@ def test_cli_list_json_and_filters():
     assert payload["count"] == len(list_materials()) == len(payload["materials"])
     first = payload["materials"][0]
     m = get_material(first["name"])
-    assert first["effusivity"] == [m.e_min, m.e_max]
-    assert first["diffusivity_m2_s"] == [m.diffusivity_min_m2_s, m.diffusivity_max_m2_s]
+    assert first["effusivity_range"] == [m.e_min, m.e_max]
+    assert first["diffusivity_range_m2_s"] == [m.diffusivity_min_m2_s, m.diffusivity_max_m2_s]
 
     res = runner.invoke(app, ["materials", "list", "--family", "metals", "--sort", "effusivity", "--json"])
     mats = json.loads(res.stdout)["materials"]
     assert {x["family"] for x in mats} == {"metals"}
-    assert [x["effusivity"][0] for x in mats] == sorted(x["effusivity"][0] for x in mats)
+    assert [x["effusivity_range"][0] for x in mats] == sorted(x["effusivity_range"][0] for x in mats)
     assert mats[-1]["name"] == "Silver"
 
     res = runner.invoke(app, ["materials", "list", "--set", "paper12", "--json"])
@@ -406,7 +406,7 @@ def test_cli_show():
     assert res.exit_code == 0, res.output
     d = json.loads(res.stdout)
     assert d["name"] == "Stainless steel" and d["set"] == "database"
-    assert d["effusivity"][0] == pytest.approx(math.sqrt(12 * 7600 * 450))
+    assert d["effusivity_range"][0] == pytest.approx(math.sqrt(12 * 7600 * 450))
     res = runner.invoke(app, ["materials", "show", "mdf", "--set", "paper12"])
     assert res.exit_code == 0
     text = " ".join(res.stdout.split())  # rich wraps at the terminal width
@@ -443,7 +443,7 @@ def test_console_script_subprocess():
                          capture_output=True, text=True, timeout=60)
     assert out.returncode == 0, out.stderr
     d = json.loads(out.stdout)
-    assert (d["name"], d["identified"], d["effusivity"]) == ("Copper", 23049.18, [23049.18, 36761.16])
+    assert (d["name"], d["identified"], d["effusivity_range"]) == ("Copper", 23049.18, [23049.18, 36761.16])
     bad = subprocess.run([exe, "materials", "show", "unobtainium"], capture_output=True, text=True, timeout=60)
     assert bad.returncode == 2 and bad.stdout == ""
     assert bad.stderr.startswith("Error: unknown material 'unobtainium'") and bad.stderr.count("\n") == 1

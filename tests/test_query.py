@@ -190,7 +190,7 @@ def test_materials_rule_answers_for_the_facing_edges(cli):
     assert ans.value == edge.value and ans.ideal == edge.ideal
     assert ans.materials_rule.startswith("materials: the hardest pair")
     assert [o["material"] for o in ans.to_dict()["objects"]] == ["Copper", "Stainless Steel"]
-    assert [o["e_range"] for o in ans.to_dict()["limiting_pair"]] == [list(ss.e_range), list(cu.e_range)]
+    assert [o["effusivity_range"] for o in ans.to_dict()["limiting_pair"]] == [list(ss.e_range), list(cu.e_range)]
     overlap = q.min_contact(m1="paper12:copper", m2="paper12:aluminum", table="ideal-paper")
     assert overlap.value is None and "overlap" in overlap.note and overlap.to_dict()["limiting_pair"] == []
     r = cli("min-contact", "--m1", "copper", "--m2", "stainless steel", "--table", "ideal-paper", "--json")
@@ -258,7 +258,7 @@ def test_query_cli_json_is_the_answer_schema(cli, cmd, quantity):
     assert set(p["interval"]) == {"low", "high", "meaning", "coverage", "method"}
     assert set(p["ideal"]) == {"value", "method"}
     if cmd[0] == "delta-e":
-        assert set(p["details"]) == {"e", "lower", "upper"}
+        assert set(p["details"]) == {"effusivity", "lower", "upper"}
     if cmd[0] == "distinguishable":
         assert p["value"] is True and p["details"]["svm_f1"] is None and p["details"]["ideal_f1"] > 0.9
 
@@ -430,7 +430,7 @@ def test_the_table_routes_bound_is_never_above_the_exact_bound():
         hi = lo + float(rng.uniform(400, 8000))
         noise = float(rng.choice([0.01, 0.05, 0.1]))
         a = qt.min_contact(hi, lo, noise_c=noise, delta_t_c=10.0)
-        edges = [c["e_range"][0] if "e_range" in c else None for c in a.to_dict()["limiting_pair"]]
+        edges = [c["effusivity_range"][0] if "effusivity_range" in c else None for c in a.to_dict()["limiting_pair"]]
         exact = exact_ideal_min_contact(paper, *(edges if None not in edges else (lo, hi)), noise / 10.0)
         if a.ideal is not None:
             assert a.ideal <= float(exact) + 1e-12 and a.ideal_bound.method == "closed-form"

@@ -64,7 +64,7 @@ def test_the_lean_app_answers_as_the_whole_app(cli):
     whole = cli(*args)
     assert r.returncode == whole.exit_code == 0, r.stderr
     a, b = json.loads(r.stdout), json.loads(whole.stdout)
-    assert a == b and a["objects"][1]["e_range"][0] == 20000.0
+    assert a == b and a["objects"][1]["effusivity_range"][0] == 20000.0
 
 
 @pytest.mark.parametrize("value, message", [("abc", "Invalid value for '--e1'"), ("12abc", "Invalid value")])

@@ -186,13 +186,13 @@ def test_min_contact_of_a_3mm_acrylic_sheet_says_the_semi_infinite_answer_holds(
                             **FAST)
     assert ans.value is not None and ans.value < 2.0 and ans.ideal <= ans.value + 0.05
     chk = ans.model_check
-    assert chk["model"] == "slab" and chk["details"]["semi_infinite_holds"]
+    assert chk["name"] == "slab" and chk["details"]["semi_infinite_holds"]
     assert "semi-infinite model and its tables hold" in chk["message"]
     assert ans.model["thickness_m"] == 0.003 and ans.model["backing"]["name"] == "Low carbon steel"
     # the materials rule: the facing edges of acrylic's and glass's ranges
     lo, hi = ans.to_dict()["limiting_pair"]
     assert "Acrylic" in lo["material"] and hi["material"] == "Glass"
-    assert hi["e_range"][1] - hi["e_range"][0] == pytest.approx(80.0)
+    assert hi["effusivity_range"][1] - hi["effusivity_range"][0] == pytest.approx(80.0)
 
 
 def test_model_check_says_when_a_sheet_stops_being_semi_infinite():

@@ -136,8 +136,8 @@ def test_to_dict_is_json_ready():
     import json
 
     a = min_contact(np.array([35000.0, 45000.0]), 20000)
-    d = json.loads(json.dumps(a.to_dict()))
-    assert d["shape"] == [2] and d["value"][1] is None and d["unit"] == "s"
+    d = json.loads(json.dumps(a.to_dict()))  # one record per element (docs/schema.md, "Records")
+    assert len(d) == 2 and d[1]["value"] is None and d[0]["unit"] == "s" and d[0]["value"] > 0
 
 
 def test_scipy_free_class_survival_and_projection_noise_agree_with_the_recognition_layer():

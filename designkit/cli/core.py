@@ -79,7 +79,7 @@ def simulate(
         emit_json({
             "time_s": result.time_s,
             "temperature_c": result.temperature_c,
-            "e": e,
+            "effusivity": e,
             "contact_temperature_c": tc,
             "scene": scene.to_dict(),
             "sensor": sen.to_dict(),
@@ -248,7 +248,6 @@ def f1(
         _f1_two_sensor(obj1, obj2, object_temp1, object_temp2, sen, fm, source, scene, trials, folds, seed,
                        threshold, json_)
         return
-    ra, rb = obj1.e_range, obj2.e_range
     t0 = time.perf_counter()
     with _app.busy("f1: simulating touches, fitting the SVM, the ideal observer", quiet=json_):
         svm = pair_f1(obj1, obj2, sen, scene, model=fm, trials=trials, folds=folds, seed=seed)
@@ -266,8 +265,7 @@ def f1(
         "threshold": threshold,
         "distinguishable": svm.f1 >= threshold,
         "ideal_distinguishable": ideal.f1 >= threshold,
-        "e1_range": list(ra),
-        "e2_range": list(rb),
+        "objects": [obj1.to_dict(), obj2.to_dict()],  # as every answer's (docs/schema.md)
         "positive_class": "higher effusivity",
         "trials": trials,
         "folds": folds,

@@ -59,7 +59,10 @@ def design(
     m: Annotated[Optional[list[str]], typer.Option(
         "--m", help="A material to tell apart (repeatable): database name, NAME=MIN:MAX or NAME=E.")] = None,
     set_: Annotated[Optional[str], typer.Option(
-        "--set", help="A named set of materials ('paper12': the paper's 12, at their identified effusivities).")] = None,
+        "--set", help="Every material of a named set, by its range as in 'matrix --set' ('paper12': the paper's 12).")] = None,
+    identified: Annotated[bool, typer.Option(
+        "--identified", help="Judge the --set's materials at their identified effusivities (paper12: the paper's "
+                             "calibration), 80-wide classes, instead of their ranges.")] = False,
     max_contact: Annotated[float, typer.Option("--max-contact", help="Longest acceptable contact [s].")] = 4.0,
     noise: Annotated[float, typer.Option("--noise", help="Noise floor of the electronics, sigma per sample [°C].")] = 0.05,
     max_delta_t: Annotated[float, typer.Option(
@@ -80,7 +83,7 @@ def design(
     confirms the recommended design with the paper's SVM and says how far apart they are.
     Exit 3 when no allowed design separates the materials.
 
-    Example: `designkit design --set paper12 --max-contact 2 --noise 0.05 --max-delta-t 10 --plot design.png`
+    Example: `designkit design --set paper12 --identified --max-contact 2 --noise 0.05 --max-delta-t 10 --plot design.png`
     """
     from .._validation import InputError
     from ..design.search import SKIN_SET, Constraints, confirm_with_svm, recommend, targets_from
@@ -97,7 +100,7 @@ def design(
         check_out(plot, "--plot")  # before the search; a missing folder is not made
     cons = Constraints(max_contact_s=max_contact, noise_c=noise, max_delta_t_c=max_delta_t, max_rate_hz=max_rate,
                        depth_um=depths, threshold=threshold)
-    targets = targets_from(m or (), set_)
+    targets = targets_from(m or (), set_, identified=identified)
     skins = tuple(get_material(s).name for s in skin) if skin else SKIN_SET
     t0, c0 = time.perf_counter(), time.process_time()
     with _app.busy(f"design: searching skins x depths with the ideal observer ({len(skins)} skins)", quiet=json_):
@@ -125,18 +128,18 @@ def design(
               f"({search['cpu_s']:.2f} s CPU)", highlight=False)
     s = payload["svm"]
     if s is not None:
-        if s["svm_min_contact_s"] is not None:
+        if s["value"] is not None:
             runs = f"{s['seeds']} x {s['trials']} touches per class"
             if s["svm_minus_ideal_s"] > 0:  # checked from the ideal bound up in steps: the last step fell short
-                prev = s["svm_min_contact_s"] - s["grid_step_s"]
+                prev = s["value"] - s["grid_step_s"]
                 con.print(f"  SVM (the paper's classifier) on the limiting pair: F1 >= {threshold:g} at "
-                          f"{s['svm_min_contact_s']:.3g} s, not yet at {prev:.3g} s (contacts checked from the "
+                          f"{s['value']:.3g} s, not yet at {prev:.3g} s (contacts checked from the "
                           f"ideal bound in {s['grid_step_s']:g} s steps, {runs}): its shortest contact lies in "
-                          f"({prev:.3g}, {s['svm_min_contact_s']:.3g}] s, at most {s['svm_minus_ideal_s']:.3g} s "
+                          f"({prev:.3g}, {s['value']:.3g}] s, at most {s['svm_minus_ideal_s']:.3g} s "
                           "above the ideal bound", highlight=False)
             else:
                 con.print(f"  SVM (the paper's classifier) on the limiting pair: F1 >= {threshold:g} already at the "
-                          f"ideal bound, {s['svm_min_contact_s']:.3g} s ({runs})", highlight=False)
+                          f"ideal bound, {s['value']:.3g} s ({runs})", highlight=False)
         else:
             con.print(f"  SVM: {s['note']}", highlight=False)
     worst = sorted((p for p in result.pairs), key=lambda p: -(p[2] if p[2] == p[2] else 1e9))[:3]

@@ -124,7 +124,7 @@ def show(
                          "max": m.identified, "unit": "J s^-1/2 K^-1 m^-2"})
         emit_rows(rows, ["material", "property", "min", "max", "unit"], fmt=fmt, out=out,
                   title=f"{m.name} ({m.family_label}; {m.set} set)", notes=[f"source: {m.source}"],
-                  payload=rows if fmt == "json" else None)
+                  payload=m.to_dict())  # json: the library's data, as --json
         return
     with output_to(out):
         _print_material(m)

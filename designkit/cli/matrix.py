@@ -200,14 +200,10 @@ def _notes(r) -> list[str]:
 
 def _raw_notes(r) -> list[str]:
     notes = [f"Limiting pair: {r.limiting.why}."]
-    if r.question != "min-contact":
-        notes.append("≤ / ≥: the answer lies beyond the table's grid, at most / at least the value shown; overlap: "
-                     "the effusivity ranges overlap, no scene tells every object of one from every object of the "
-                     "other; n/a: no answer within the table.")
-    else:
-        notes.append("≤: separable already at the table's shortest contact time; overlap: the effusivity "
-                     "ranges overlap, no scene tells every object of one from every object of the other; n/a: no "
-                     "answer within the table.")
+    # one legend for every question: ≤ / ≥ are the answer's own bound (Answer.bound), as min-contact prints it
+    notes.append("≤ / ≥: the answer lies beyond the table's grid, at most / at least the value shown; overlap: "
+                 "the effusivity ranges overlap, no scene tells every object of one from every object of the "
+                 "other; n/a: no answer within the table.")
     mc = r.multiclass
     if mc is not None:
         if mc.ideal_accuracy is not None:

@@ -291,8 +291,9 @@ def _scalar(words: str, unit: str):
         if d["value"] is None:
             con.print(f"  {_answerer(d)}: [red]no answer[/] (see below)")
         else:
-            con.print(f"  {_answerer(d)}: {words} [bold green]{_fmt(d['value'], unit)}[/] "
-                      f"{_interval(d, unit)}")
+            qual = {"at-most": "at most ", "at-least": "at least "}.get(d.get("bound") or "", "")  # Answer.bound
+            iv = "(a bound: the table's grid ends there, see below)" if qual else _interval(d, unit)
+            con.print(f"  {_answerer(d)}: {words} {qual}[bold green]{_fmt(d['value'], unit)}[/] {iv}")
         ideal = d["ideal"]
         iv = ideal.get("interval")
         ends = (f", {iv['coverage']:.0%} interval {_fmt(iv['low'], unit)} to {_fmt(iv['high'], unit)}"
@@ -311,12 +312,12 @@ def _delta_lines(con, d):
     for words, side in (("towards lower e ", "lower"), ("towards higher e", "upper")):
         s = x[side]
         iv = s["interval"]
-        cov = f"{s['coverage']:.0%} interval" if s.get("coverage") else "interval, coverage not stated"
-        shown = s["value"] is not None and any(v is not None for v in iv)  # an ideal table's has no ends
-        ivs = f" ({cov} {_fmt(iv[0], '', 4)} to {_fmt(iv[1], '', 4)})" if shown else ""
+        cov = f"{iv['coverage']:.0%} interval" if iv.get("coverage") else "interval, coverage not stated"
+        shown = s["value"] is not None and (iv["low"], iv["high"]) != (None, None)  # an ideal table's has no ends
+        ivs = f" ({cov} {_fmt(iv['low'], '', 4)} to {_fmt(iv['high'], '', 4)})" if shown else ""
         con.print(f"  {words}: {who} [bold green]{_fmt(s['value'], '', 4)}[/]{ivs}, "
-                  f"ideal {_fmt(s['ideal'], '', 4)}")
-        dash = dash or s["value"] is None or s["ideal"] is None or (shown and None in iv)
+                  f"ideal {_fmt(s['ideal']['value'], '', 4)}")
+        dash = dash or s["value"] is None or s["ideal"]["value"] is None or (shown and None in (iv["low"], iv["high"]))
     if dash:
         outside = d["route"] == "table" and not all(d["in_grid"].values())
         con.print("  [dim]— : " + ("no answer from the table (see below), or " if outside else "")
@@ -339,7 +340,7 @@ def _distinguishable_lines(con, d):
 
 
 _VALUE_LINES = {
-    "min-contact": _scalar("contact of at least", " s"),
+    "min-contact": _scalar("shortest contact", " s"),
     "max-noise": _scalar("largest noise", " °C"),
     "min-delta-t": _scalar("smallest temperature difference", " °C"),
     "delta-e": _delta_lines,
@@ -361,7 +362,7 @@ def _source_lines(con, d):
                }.get(d["interval"].get("method"), "interpolated")
         if d["question"] == "distinguishable":  # the verdict is the contact against min-contact's answer
             how = "the contact against min-contact's answer" + (
-                f" ({eff})" if d["computation"].get("min_contact_interval_kind") == "table-efficiency" else "")
+                f" ({eff})" if (d["computation"].get("min_contact_interval") or {}).get("method") == "table-efficiency" else "")
         con.print(f"  [dim]from table {d['table']['name']} ({where}), {how}; --exact computes it for this pair[/]")
     else:
         c = d["computation"]
@@ -478,15 +479,14 @@ def delta_e_cmd(
                objects=dict(e=e, m=m), scene=dict(contact_s=contact, noise_c=noise, delta_t_c=delta_t),
                coverage=coverage, progress=not json_, spread=sensor_temp_spread)
     if fmt is not None:
-        d = ans.to_dict()
-        rows = [{"direction": side, "e": d["details"]["e"], "delta": d["details"][side]["value"],
-                 "interval_low": (d["details"][side]["interval"] or [None, None])[0],
-                 "interval_high": (d["details"][side]["interval"] or [None, None])[1],
-                 "ideal": d["details"][side]["ideal"], "unit": d["unit"], "route": d["route"],
-                 "table": d["table"]["name"] if isinstance(d["table"], dict) else d["table"]}
+        d = ans.to_dict()  # rows: each direction as a record (docs/schema.md); json: the answer, as --json
+        x = d["details"]
+        rows = [{"direction": side, "effusivity": x["effusivity"], "delta_e": x[side]["value"],
+                 "interval_low": x[side]["interval"]["low"], "interval_high": x[side]["interval"]["high"],
+                 "ideal_value": x[side]["ideal"]["value"], "unit": d["unit"], "route": d["route"],
+                 "table_name": (d["table"] or {}).get("name")}
                 for side in ("lower", "upper")]
-        emit_rows(rows, list(rows[0]), fmt=fmt, out=out, title=f"delta(e) at {d['details']['e']:g}",
-                  payload=rows if fmt == "json" else None)
+        emit_rows(rows, list(rows[0]), fmt=fmt, out=out, title=f"delta(e) at {x['effusivity']:g}", payload=d)
         return
     with output_to(out):
         _render(ans, json_)

@@ -42,18 +42,20 @@ def tables_list(
             console(stderr=True).print(f"skipped: {_visible(exc)}")
             continue
         s = t.summary()
-        rows.append({"name": name, "fidelity": s["fidelity"], "sensor": s["sensor"]["name"], "model": s["model"],
-                     "axes": {a["name"]: [a["min"], a["max"], a["points"]] for a in s["axes"]},
-                     "size_bytes": s["size_bytes"], "path": s["path"]})
+        # the keys and shapes of `tables show` (docs/schema.md): the sensor and the axes as there
+        rows.append({"name": name, "fidelity": s["fidelity"], "sensor": s["sensor"], "model": s["model"],
+                     "axes": s["axes"], "content_hash": s.get("content_hash"), "size_bytes": s["size_bytes"],
+                     "path": s["path"]})
     if fmt == "json":
         emit_rows(rows, fmt="json", out=out, payload=rows)
         return
     flat = []
     for r in rows:  # one plain value per column (csv: full precision; table/md: ranges for people)
-        ax = r["axes"]
+        ax = {a["name"]: [a["min"], a["max"], a["points"]] for a in r["axes"]}
         noise_axis = "noise_ratio" if "noise_ratio" in ax else "noise_c"
         noise, contact = ax[noise_axis], ax["contact_s"]
-        flat.append({"name": r["name"], "fidelity": r["fidelity"], "sensor": r["sensor"], "model": r["model"]["name"],
+        flat.append({"name": r["name"], "fidelity": r["fidelity"], "sensor": r["sensor"]["name"],
+                     "model": r["model"]["name"],
                      "noise_axis": noise_axis, "noise_min": noise[0], "noise_max": noise[1], "noise_points": noise[2],
                      "contact_min_s": contact[0], "contact_max_s": contact[1], "contact_points": contact[2],
                      "intervals": ax["e_ref"][2], "size_bytes": r["size_bytes"], "path": r["path"]})
@@ -97,11 +99,11 @@ def tables_show(
         return
     if format_ is not None:
         fmt = check_format(format_)
-        rows = [{"axis": a["name"], "units": a.get("units"), "scale": a.get("scale"), "points": a.get("points"),
+        rows = [{"axis": a["name"], "unit": a.get("unit"), "scale": a.get("scale"), "points": a.get("points"),
                  "min": a.get("min"), "max": a.get("max"),
                  "values": " ".join(f"{v:g}" for v in a.get("values", []))} for a in s["axes"]]
-        emit_rows(rows, ["axis", "units", "scale", "points", "min", "max", "values"], fmt=fmt, out=out,
-                  title=f"{s['name']}: axes", payload=s["axes"] if fmt == "json" else None)
+        emit_rows(rows, ["axis", "unit", "scale", "points", "min", "max", "values"], fmt=fmt, out=out,
+                  title=f"{s['name']}: axes", payload=s)  # json: the --json document
         return
     with output_to(out):
         _print_table(table, s)
@@ -124,13 +126,13 @@ def _print_table(table, s: dict) -> None:
     con.print(f"  sensor {v(sen['name'])}: e_s = {sen['effusivity']:g} J s^-1/2 K^-1 m^-2, alpha_s = "
               f"{sen['diffusivity_m2_s']:.3g} m^2/s, depth {sen['depth_m'] * 1e6:g} um, tau = {sen['tau_s']:.4g} s, "
               f"{sen['sample_rate_hz']:g} Hz")
-    eff = s["effusivity"]
+    eff = s["effusivity_grid"]
     con.print(f"  effusivity ({eff['min']:g}, {eff['max']:g}] in {eff['intervals']} intervals of {eff['width']:g}")
     for a in s["axes"]:
         if a["name"] == "e_ref":
             continue
         vals = ", ".join(f"{x:g}" for x in a.get("values", [])) or f"{a['min']:g} .. {a['max']:g}"
-        con.print(v(f"  axis {a['name']} [{a['units']}, {a['scale']}]: {vals}"))
+        con.print(v(f"  axis {a['name']} [{a['unit']}, {a['scale']}]: {vals}"))
     ic = s["initial_conditions"]
     if ic["fixed"]:
         con.print("  initial conditions fixed (every touch starts at Ta + dT)")

@@ -66,8 +66,8 @@ def validity(
             raise InputError("give either --m or --e with --diffusivity, not both")
         mv = material_validity(material, L, back, sen, **kw)
         nominal, worst, name = mv.nominal, mv.worst, mv.material.name
-        ranges = {"effusivity": [mv.material.e_min, mv.material.e_max],
-                  "diffusivity_m2_s": [mv.material.diffusivity_min_m2_s, mv.material.diffusivity_max_m2_s]}
+        ranges = {"effusivity_range": [mv.material.e_min, mv.material.e_max],
+                  "diffusivity_range_m2_s": [mv.material.diffusivity_min_m2_s, mv.material.diffusivity_max_m2_s]}
     else:
         if e is None or alpha is None:
             raise InputError("give --m MATERIAL, or both --e and --diffusivity (formerly --alpha)")
@@ -94,7 +94,7 @@ def validity(
         "tolerance_c": tolerance,
         "delta_t_c": delta_t,
         "horizon_s": horizon,
-        "sensor": sen.name,
+        "sensor": sen.to_dict(),
         "deviation_c": {f"{t:g}": float(d) for t, d in zip(REPORT_TIMES_S, dev_c)},
         "plot": str(plot) if plot else None,
     }
@@ -105,12 +105,14 @@ def validity(
     what = name if name else f"object (e {nominal.e_object:.4g}, alpha {nominal.alpha_object_m2_s:.3g} m²/s)"
     con.print(f"[bold]{L * 1e3:g} mm {what}[/] on {back.name}")
     con.print(f"  (backing e_b {back.effusivity:.4g}; {sen.name} sensor {delta_t:g} °C above the object)")
-    fo = f" (Fo = {nominal.fourier_number:.3g})" if math.isfinite(nominal.time_s) else ""
-    con.print(f"  semi-infinite model within {tolerance:g} °C up to "
-              f"[bold]{_fmt_time(nominal.time_s, horizon)}[/] of contact{fo}")
+    # the headline is the answer --json gives (valid_up_to_s: the worst case over the material's ranges)
+    fo = f" (Fo = {worst.fourier_number:.3g})" if math.isfinite(worst.time_s) else ""
+    over = " over the material's ranges" if name is not None else ""
+    con.print(f"  semi-infinite model within {tolerance:g} °C{over} up to "
+              f"[bold]{_fmt_time(worst.time_s, horizon)}[/] of contact{fo}")
     if name is not None:
-        con.print(f"  worst case over the material's ranges: [bold]{_fmt_time(worst.time_s, horizon)}[/] "
-                  f"(e {worst.e_object:.4g}, alpha {worst.alpha_object_m2_s:.3g} m²/s)")
+        con.print(f"  limited by e {worst.e_object:.4g}, alpha {worst.alpha_object_m2_s:.3g} m²/s; at the ranges' "
+                  f"middle (e {nominal.e_object:.4g}): {_fmt_time(nominal.time_s, horizon)}")
     # below 1e-9 degC the difference is the solvers' own rounding (they agree to 1e-10): not a reading
     cells = ", ".join(f"{t:g} s " + (f"{d + 0.0:.2g}" if abs(d) >= 1e-9 else "<1e-9") for t, d in zip(REPORT_TIMES_S, dev_c))
     con.print(f"  slab minus semi-infinite reading [°C]: {cells}")

@@ -8,9 +8,11 @@ With white noise per sample, more samples and a larger ``dT`` never hurt the ide
 recommended sampling rate and ``dT`` are the largest allowed (the trade-off curves show what each
 costs); the search is over skin material x depth, exhaustive on a grid (vectorized over pairs).
 
-Materials rule: each material is an 80-wide class (the paper's) at its identified effusivity when
-the set gives one (``paper12``, the paper's calibration), else the hardest 80-wide classes of its
-range (the nearest ends of two ranges: ranges that overlap cannot be separated by any design). For
+Materials rule: each material is judged by the hardest 80-wide classes of its range (the nearest
+ends of two ranges: ranges that overlap cannot be separated by any design), as everywhere in
+designkit (``matrix``, ``min-contact --m1``); ``identified=True`` judges a set's materials instead as
+an 80-wide class (the paper's) at the identified effusivity the set gives (``paper12``, the paper's
+calibration). For
 "all at once" the limiting pair is the hardest one; for ordered classes it is always between
 neighbours in effusivity (the ideal observer separates farther classes sooner), so only
 neighbouring pairs are searched, and every pair is scored for the recommended design.
@@ -122,10 +124,11 @@ class Design:
                       name=f"design: {self.skin}, {self.depth_um:.3g} um")
 
     def to_dict(self) -> dict:
-        return {"skin": self.skin, "e_sensor": self.e_sensor, "diffusivity_m2_s": self.diffusivity_m2_s,
+        # the sensor's effusivity as Sensor.to_dict names it; the bound as every answer's ideal (docs/schema.md)
+        return {"skin": self.skin, "effusivity": self.e_sensor, "diffusivity_m2_s": self.diffusivity_m2_s,
                 "depth_um": self.depth_um, "tau_s": self.tau_s, "sample_rate_hz": self.sample_rate_hz,
-                "delta_t_c": self.delta_t_c, "min_contact_s": _num(self.min_contact_s),
-                "limiting_pair": list(self.limiting_pair)}
+                "delta_t_c": self.delta_t_c, "ideal": _ideal(self.min_contact_s),
+                "limiting": {"a": self.limiting_pair[0], "b": self.limiting_pair[1]} if self.limiting_pair else None}
 
 
 @dataclass(frozen=True)
@@ -144,9 +147,9 @@ class DesignResult:
         return {"best": None if self.best is None else self.best.to_dict(), "reason": self.reason,
                 "constraints": {"max_contact_s": c.max_contact_s, "noise_c": c.noise_c,
                                 "max_delta_t_c": c.max_delta_t_c, "max_rate_hz": c.max_rate_hz,
-                                "depth_um": list(c.depth_um), "threshold": c.threshold},
-                "pairs": [{"pair": [a, b], "ideal_min_contact_s": _num(t)} for a, b, t in self.pairs],
-                "pareto_noise_ratio_vs_contact": [{"noise_ratio": r, "min_contact_s": _num(t)} for r, t in self.pareto],
+                                "depth_range_um": list(c.depth_um), "threshold": c.threshold},
+                "pairs": [{"a": a, "b": b, "ideal": _ideal(t)} for a, b, t in self.pairs],
+                "pareto_noise_ratio_vs_contact": [{"noise_ratio": r, "ideal": _ideal(t)} for r, t in self.pareto],
                 "designs_searched": len(self.designs)}
 
 
@@ -154,12 +157,21 @@ def _num(x):
     return None if x is None or not math.isfinite(x) else float(x)
 
 
-def targets_from(names=(), set_name: str | None = None) -> list[Target]:
-    """Materials (names, ``NAME=MIN:MAX``, ``NAME=E``, or a named set) as design targets, sorted by effusivity."""
+def _ideal(t) -> dict:
+    """The ideal observer's shortest contact [s] as every answer gives it: ``{value, method}``."""
+    return {"value": _num(t), "method": "closed-form"}
+
+
+def targets_from(names=(), set_name: str | None = None, *, identified: bool = False) -> list[Target]:
+    """Materials (names, ``NAME=MIN:MAX``, ``NAME=E``, or a named set) as design targets, sorted by effusivity.
+
+    A set's materials are their ranges, as a named material's (the materials rule); ``identified=True``:
+    the set's identified effusivities (points) where it gives them.
+    """
     out = []
     mats = list(list_materials(set=set_name)) if set_name else []
     for m in mats:
-        e = m.identified
+        e = m.identified if identified else None
         out.append(Target(m.name, float(e), (float(m.e_min), float(m.e_max)), POINT_WIDTH)
                    if e else _range_target(m.name, (float(m.e_min), float(m.e_max))))
     for spec in names:
@@ -300,10 +312,10 @@ def confirm_with_svm(result: DesignResult, targets: list[Target], *, trials: int
         f1 = [pair_f1(ObjectClass("lo", (lo, lo + w)), ObjectClass("hi", (hi, hi + w)), sensor, scene,
                       trials=trials, seed=[s, 17]).f1 for s in range(seeds)]
         if float(np.mean(f1)) >= c.threshold:
-            return {"svm_min_contact_s": round(t, 6), "svm_f1": float(np.mean(f1)), "ideal_min_contact_s": best.min_contact_s,
+            return {"value": round(t, 6), "svm_f1": float(np.mean(f1)), "ideal": _ideal(best.min_contact_s),
                     "svm_minus_ideal_s": round(t - best.min_contact_s, 6), "grid_step_s": step_s,
                     "trials": trials, "seeds": seeds}
         t = round(t + step_s, 9)
-    return {"svm_min_contact_s": None, "ideal_min_contact_s": best.min_contact_s, "svm_minus_ideal_s": None,
+    return {"value": None, "ideal": _ideal(best.min_contact_s), "svm_minus_ideal_s": None,
             "grid_step_s": step_s, "trials": trials, "seeds": seeds,
             "note": f"the SVM does not reach F1 {c.threshold:g} by {c.max_contact_s:g} s"}

@@ -62,7 +62,7 @@ class ModelCheck:
     details: Mapping[str, Any] = dataclasses.field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
-        return {"model": self.model, "holds": self.holds, "message": self.message, "details": dict(self.details)}
+        return {"name": self.model, "holds": self.holds, "message": self.message, "details": dict(self.details)}
 
 
 @dataclass(frozen=True)

@@ -14,7 +14,7 @@ effusivity [J s^-1/2 K^-1 m^-2], diffusivity ``*_m2_s`` [m^2 s^-1].
 Examples
 --------
 >>> sorted(ANSWER_KEYS)[:4]
-['computation', 'details', 'ideal', 'ideal_table']
+['bound', 'computation', 'details', 'ideal']
 >>> QUANTITIES["min-contact"]
 ('contact_s', 's')
 """
@@ -25,7 +25,8 @@ import math
 from dataclasses import dataclass, field
 from typing import Any, Mapping, Sequence
 
-__all__ = ["ANSWER_KEYS", "INTERVAL_MEANING", "QUANTITIES", "Answer", "IdealBound", "QuestionQuantity", "number"]
+__all__ = ["ANSWER_KEYS", "INTERVAL_MEANING", "QUANTITIES", "Answer", "IdealBound", "QuestionQuantity", "bound_of",
+           "interval_dict", "number", "to_record"]
 
 #: question -> (quantity name of ``value``, its unit).
 QUANTITIES: dict[str, tuple[str, str]] = {
@@ -94,10 +95,63 @@ INTERVAL_MEANING = {
 
 #: The keys of every answer's dictionary (the ``--json`` schema), whatever the question and route.
 ANSWER_KEYS = frozenset({
-    "question", "route", "quantity", "unit", "value", "interval", "ideal", "objects", "limiting_pair",
+    "question", "route", "quantity", "unit", "value", "interval", "bound", "ideal", "objects", "limiting_pair",
     "materials_rule", "scene", "sensor", "model", "model_check", "threshold", "table", "ideal_table",
     "in_grid", "details", "computation", "notes",
 })
+
+
+def interval_dict(ends: Sequence | None, **more: Any) -> dict[str, Any]:
+    """An interval in the schema's one shape: ``{"low", "high", ...}`` (docs/schema.md; None: an open end).
+
+    >>> interval_dict([1.0, float("inf")], coverage=0.9)
+    {'low': 1.0, 'high': None, 'coverage': 0.9}
+    """
+    low, high = (None, None) if ends is None else ends
+    return {"low": number(low), "high": number(high), **more}
+
+
+def bound_of(low: Any, high: Any) -> str:
+    """Which way a value is only a bound, from its interval's ends: ``"at-most"`` (no low end: the true
+    answer is this or less), ``"at-least"`` (no high end) or ``""`` (both ends, or neither).
+
+    >>> bound_of(None, 2.0), bound_of(0.5, None), bound_of(0.46, 0.49)
+    ('at-most', 'at-least', '')
+    """
+    lo, hi = number(low), number(high)
+    return "at-most" if lo is None and hi is not None else ("at-least" if hi is None and lo is not None else "")
+
+
+def _side(side: Mapping[str, Any], ideal_method: str) -> dict[str, Any]:
+    """One direction of delta-e in the schema's shapes (its interval and ideal as everywhere else)."""
+    out = {k: v for k, v in side.items() if k not in ("interval", "coverage", "estimate_method", "ideal")}
+    out["value"] = number(side.get("value"))
+    out["interval"] = interval_dict(side.get("interval"), coverage=side.get("coverage"),
+                                    method=side.get("estimate_method"))
+    out["ideal"] = {"value": number(side.get("ideal")), "method": ideal_method}
+    if "monte_carlo_interval" in side:
+        out["monte_carlo_interval"] = interval_dict(side["monte_carlo_interval"])
+    return out
+
+
+def _schema_shapes(part: Mapping[str, Any], ideal_method: str) -> dict[str, Any]:
+    """``details`` / ``computation`` with the schema's shapes: every interval ``{low, high}``, delta-e's
+    directions as answers (docs/schema.md); the routes keep building plain lists."""
+    out: dict[str, Any] = {}
+    for k, v in part.items():
+        if k in ("lower", "upper") and isinstance(v, Mapping):
+            out[k] = _side(v, ideal_method)
+        elif k == "min_contact_interval_s":
+            out["min_contact_interval"] = interval_dict(v, method=part.get("min_contact_interval_kind"))
+        elif k == "min_contact_interval_kind":
+            continue
+        elif k == "e":  # delta-e's reference: one effusivity is `effusivity` everywhere
+            out["effusivity"] = v
+        elif k.endswith("interval") and isinstance(v, (list, tuple)) and len(v) == 2:
+            out[k] = interval_dict(v)
+        else:
+            out[k] = v
+    return out
 
 
 def number(x: Any) -> float | None:
@@ -139,7 +193,7 @@ class IdealBound:
                "method": self.method}
         if self.interval is not None:
             low, high, cov = self.interval
-            out["interval"] = {"low": number(low), "high": number(high), "coverage": cov}
+            out["interval"] = interval_dict((low, high), coverage=cov)
         return out
 
 
@@ -222,6 +276,14 @@ class Answer(QuestionQuantity):
         return self.ideal_bound.value
 
     @property
+    def bound(self) -> str:
+        """``"at-most"`` / ``"at-least"`` where ``value`` is only a bound (its interval open at one end, e.g. an
+        answer at a table's edge), else ``""``: the one source of the words "at most" / "at least" (and ≤ / ≥)."""
+        if self.value is None or isinstance(self.value, bool):
+            return ""
+        return bound_of(*self.interval)
+
+    @property
     def note(self) -> str:
         """``notes`` as one string."""
         return "; ".join(self.notes)
@@ -239,8 +301,8 @@ class Answer(QuestionQuantity):
             "quantity": self.quantity,
             "unit": self.unit,
             "value": value,
-            "interval": {"low": number(self.interval[0]), "high": number(self.interval[1]),
-                         "coverage": self.interval_coverage, "method": kind, "meaning": meaning},
+            "interval": interval_dict(self.interval, coverage=self.interval_coverage, method=kind, meaning=meaning),
+            "bound": self.bound or None,
             "ideal": self.ideal_bound.to_dict(),
             "objects": [dict(o) for o in self.objects],
             "limiting_pair": [dict(o) for o in self.limiting_pair],
@@ -254,8 +316,8 @@ class Answer(QuestionQuantity):
             "ideal_table": None if self.ideal_table is None else {"name": self.ideal_table,
                                                                   "content_hash": self.ideal_table_hash},
             "in_grid": dict(self.in_grid),
-            "details": dict(self.details),
-            "computation": dict(self.computation),
+            "details": _schema_shapes(self.details, self.ideal_bound.method),
+            "computation": _schema_shapes(self.computation, self.ideal_bound.method),
             "notes": list(self.notes),
         }
 
@@ -285,6 +347,34 @@ class Answer(QuestionQuantity):
         else:
             out.update(d)
         return out
+
+
+#: The parts of an answer's dictionary a record (one flat row: CSV, pandas) keeps, flattened ``part_key``;
+#: ``scene``'s keys keep their own names (``contact_s`` ...).
+RECORD_PARTS = ("interval", "ideal", "table", "ideal_table")
+
+
+def to_record(answer: Mapping[str, Any]) -> dict[str, Any]:
+    """An answer's dictionary (:meth:`Answer.to_dict`) as one flat record: the scalars, ``interval_low``,
+    ``ideal_value``, ``table_name`` ... (nested keys joined by ``_``), the scene's quantities; the same keys
+    as each record of :meth:`designkit.query.vectorized.ArrayAnswer.to_dict` (docs/schema.md, "Records").
+
+    >>> to_record({"value": 1.0, "interval": {"low": 0.5, "high": 2.0, "meaning": "..."}, "notes": []})
+    {'value': 1.0, 'interval_low': 0.5, 'interval_high': 2.0}
+    """
+    out: dict[str, Any] = {}
+    for k, v in answer.items():
+        if k == "scene" and isinstance(v, Mapping):
+            out.update(v)
+        elif k in RECORD_PARTS and isinstance(v, Mapping):
+            out.update({f"{k}_{kk}": vv for kk, vv in v.items() if kk != "meaning" and not isinstance(vv, (dict, list))})
+        elif k in RECORD_PARTS and v is None:
+            out[f"{k}_name" if "table" in k else f"{k}_value"] = None
+        elif k == "in_grid" and isinstance(v, Mapping):
+            out[k] = all(v.values())
+        elif not isinstance(v, (dict, list, tuple)):
+            out[k] = v
+    return out
 
 
 def ideal_floor(value: float | None, interval: Sequence | None) -> float | None:

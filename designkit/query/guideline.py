@@ -32,8 +32,8 @@ def guideline_remark(answer: Mapping[str, Any]) -> str | None:
 
     >>> d = {"question": "min-contact", "value": 1.5, "threshold": 0.9, "sensor": {"name": "paper"},
     ...      "model": {"name": "semi-infinite"}, "scene": {"noise_c": 0.05, "delta_t_c": 10.0},
-    ...      "objects": [{"material": None, "e_range": [35000.0, 35080.0]},
-    ...                  {"material": None, "e_range": [20000.0, 20080.0]}], "computation": {}}
+    ...      "objects": [{"material": None, "effusivity_range": [35000.0, 35080.0]},
+    ...                  {"material": None, "effusivity_range": [20000.0, 20080.0]}], "computation": {}}
     >>> print(guideline_remark(d))
     the paper (section VIII-B): at least 2 s on its 1-s grid (1, 2, 3, 4 s); 1.5 s rounds up to 2 s there
     >>> guideline_remark({**d, "scene": {"noise_c": 0.1, "delta_t_c": 10.0}}) is None
@@ -45,7 +45,7 @@ def guideline_remark(answer: Mapping[str, Any]) -> str | None:
                 and answer["model"]["name"] == "semi-infinite"
                 and not (answer.get("computation") or {}).get("sensor_temp_spread_c")
                 and all(o.get("material") is None for o in answer["objects"])
-                and sorted(o["e_range"][0] for o in answer["objects"]) == sorted((g["e1"], g["e2"]))
+                and sorted(o["effusivity_range"][0] for o in answer["objects"]) == sorted((g["e1"], g["e2"]))
                 and math.isclose(answer["scene"]["noise_c"], g["noise_c"])
                 and math.isclose(answer["scene"]["delta_t_c"], g["delta_t_c"])
                 and math.isclose(answer["threshold"], g["threshold"]))

@@ -35,8 +35,8 @@ Examples
 ('Glass', 'Stainless Steel', 'Copper')
 >>> r.limiting.names
 ('Stainless Steel', 'Copper')
->>> r.to_dict()["limiting_pair"]["materials"]
-['Stainless Steel', 'Copper']
+>>> r.to_dict()["limiting"]["a"], r.to_dict()["limiting"]["b"]
+('Stainless Steel', 'Copper')
 """
 
 from __future__ import annotations
@@ -50,7 +50,7 @@ import numpy as np
 
 from .._validation import InputError
 from ..materials import Material, get_material, list_materials
-from .answer import QUANTITIES, Answer, QuestionQuantity, number
+from .answer import QUANTITIES, Answer, QuestionQuantity, interval_dict, number
 from .questions import QUESTIONS, ask
 
 __all__ = [
@@ -96,11 +96,10 @@ class MatrixCell:
     note : str
         The answer's notes.
     bound : str
-        ``"at-most"`` or ``"at-least"`` when the value is one end of the
-        table's grid and the true answer lies beyond it (``min-contact``
-        separable already at the table's shortest contact time: at most that;
-        ``max-noise`` still separable at the table's largest noise ratio: at
-        least that); ``""`` otherwise.
+        ``"at-most"`` or ``"at-least"`` when the value is only a bound (the
+        answer's :attr:`~designkit.query.Answer.bound`: its interval open at one
+        end, e.g. ``max-noise`` still separable at the table's largest noise
+        ratio: at least that); ``""`` otherwise.
     answer : Answer
         The full answer of this cell.
     """
@@ -116,10 +115,11 @@ class MatrixCell:
 
     def to_dict(self, names: Sequence[str]) -> dict[str, Any]:
         value = self.value if isinstance(self.value, bool) else number(self.value)
-        return {"a": names[self.i], "b": names[self.j], "value": value, "ideal": number(self.ideal),
+        # the keys and shapes of a single answer's (docs/schema.md): ideal {value, method}, interval {low, high}
+        return {"a": names[self.i], "b": names[self.j], "value": value, "ideal": self.answer.ideal_bound.to_dict(),
                 "status": self.status, "bound": self.bound or None,
-                "interval": [x if isinstance(x, bool) else number(x) for x in self.answer.interval],
-                "limiting_classes": [dict(c) for c in self.answer.limiting_pair], "note": self.note}
+                "interval": interval_dict(self.answer.interval, coverage=self.answer.interval_coverage),
+                "limiting_pair": [dict(c) for c in self.answer.limiting_pair], "note": self.note}
 
 
 @dataclass(frozen=True)
@@ -137,8 +137,8 @@ class LimitingPair:
 
     def to_dict(self) -> dict[str, Any]:
         value = self.value if isinstance(self.value, bool) else number(self.value)
-        return {"materials": list(self.names), "value": value, "ideal": number(self.ideal), "status": self.status,
-                "why": self.why}
+        a, b = self.names if self.names else (None, None)
+        return {"a": a, "b": b, "value": value, "status": self.status, "why": self.why}
 
 
 @dataclass(frozen=True)
@@ -248,6 +248,13 @@ class MaterialMatrix(QuestionQuantity):
                  "bound": c.bound or None, "ideal": number(c.ideal), "status": c.status, "note": c.note}
                 for c in self.cells]
 
+    def _table_dict(self, name: str | None, which: str) -> dict[str, Any] | None:
+        """A table as every answer names it: ``{name, content_hash}`` (the hash as the cells' answers read it)."""
+        if name is None:
+            return None
+        hashes = [getattr(c.answer, which + "_hash") for c in self.cells if getattr(c.answer, which) == name]
+        return {"name": name, "content_hash": next((h for h in hashes if h), None)}
+
     def to_dict(self) -> dict[str, Any]:
         """Plain data, JSON-ready (no NaN): the ``--format json`` schema."""
         vals, ideal, st = self.values(), self.values(ideal=True), self.status()
@@ -266,16 +273,16 @@ class MaterialMatrix(QuestionQuantity):
             "quantity": self.quantity,
             "unit": self.unit,
             "materials": [{"name": m.name, "set": m.set, "qualified_name": m.qualified_name,
-                           "effusivity": [m.e_min, m.e_max]} for m in self.materials],
+                           "effusivity_range": [m.e_min, m.e_max]} for m in self.materials],
             "matrix": {"value": [[cell(vals, i, j) for j in range(n)] for i in range(n)],
                        "ideal": [[cell(ideal, i, j) for j in range(n)] for i in range(n)],
                        "status": [[st[i, j] or None for j in range(n)] for i in range(n)]},
             "cells": [c.to_dict(self.names) for c in self.cells],
-            "limiting_pair": self.limiting.to_dict(),
+            "limiting": self.limiting.to_dict(),
             "multiclass": None if self.multiclass is None else self.multiclass.to_dict(),
             "scene": dict(self.scene),
-            "table": self.table,
-            "ideal_table": self.ideal_table,
+            "table": self._table_dict(self.table, "table"),
+            "ideal_table": self._table_dict(self.ideal_table, "ideal_table"),
             "threshold": self.threshold,
             "computation": {"queries": len(self.cells), "wall_s": self.wall_s},
         }
@@ -481,12 +488,7 @@ def _bound(question: str, a: Answer) -> str:
     """Whether the value is a grid end beyond which the true answer lies (see :class:`MatrixCell`)."""
     if a.value is None or isinstance(a.value, bool):
         return ""
-    if question == "min-contact":
-        contacts = a.computation.get("table_contacts_s") or []
-        return "at-most" if contacts and float(a.value) <= contacts[0] else ""
-    if a.in_grid.get("noise_ratio") is False:  # separable even at the table's largest noise ratio
-        return "at-least" if question == "max-noise" else "at-most"
-    return ""
+    return a.bound  # the answer's own (its interval open at one end): one source for every surface
 
 
 def _worse_key(question: str) -> Callable[[MatrixCell], tuple]:

@@ -1600,8 +1600,9 @@ def _ratio_question(question: str, e1, e2, m1, m2, objects, contact_s, noise_c, 
         value = None
         note = f"not separable even at the table's smallest noise ratio sigma/dT = {ratios[0]:g}"
     elif where == "above":
+        more = "at least" if question == "max-noise" else "at most"  # a larger ratio: more noise, a smaller dT
         note = (f"separable even at the table's largest noise ratio sigma/dT = {ratios[-1]:g}: "
-                "the answer is at least this (the exact route looks further)")
+                f"the answer is {more} this (the exact route looks further)")
         flags["noise_ratio"] = False
     # the Monte Carlo ends: more noise allowed at the optimistic end ('lo': ratio >= the answer's)
     ends = [to_answer(out[k][0]) if out[k][1] != "below" else None for k in ("hi", "lo")]

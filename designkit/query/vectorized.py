@@ -134,16 +134,37 @@ class ArrayAnswer(QuestionQuantity):
     def __len__(self) -> int:
         return len(self.value)
 
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready: nested lists (None for NaN), the shape, and what the arrays measure."""
-        def lst(a):
-            a = np.asarray(a, dtype=np.float64)
-            return np.where(np.isfinite(a), a, None).tolist() if a.ndim else (float(a) if np.isfinite(a) else None)
-        return {"question": self.question, "route": self.route, "quantity": self.quantity, "unit": self.unit,
-                "shape": list(self.shape), "value": lst(self.value), "interval_low": lst(self.low),
-                "interval_high": lst(self.high), "interval_coverage": lst(self.coverage), "ideal": lst(self.ideal),
-                "in_grid": self.in_grid.tolist(),
-                "table": self.table, "details": {k: lst(v) for k, v in self.details.items()}}
+    def to_dict(self) -> list[dict[str, Any]]:
+        """One record per element (C order), JSON-ready (None for NaN): ``pandas.DataFrame(a.to_dict())``
+        reads it as is. The keys are those of a single answer's record (:func:`designkit.query.answer.to_record`:
+        ``value``, ``interval_low``, ``interval_high``, ``interval_coverage``, ``bound``, ``ideal_value``,
+        ``in_grid``, ``table_name`` ...), then ``details``' arrays under their own names; ``shape`` gives the
+        arrays' shape (``np.reshape`` a column back)."""
+        from .answer import bound_of
+
+        def col(a):
+            a = np.asarray(a, dtype=np.float64).ravel()
+            return [float(x) if np.isfinite(x) else None for x in a]
+
+        n = self.size
+        cols = {"value": col(np.broadcast_to(self.value, self.shape)), "interval_low": col(self.low),
+                "interval_high": col(self.high), "interval_coverage": col(self.coverage),
+                "ideal_value": col(self.ideal)}
+        cols.update({k: col(np.broadcast_to(v, self.shape)) for k, v in self.details.items()})
+        in_grid = np.broadcast_to(self.in_grid, self.shape).ravel().tolist()
+        fixed = {"question": self.question, "route": self.route, "quantity": self.quantity, "unit": self.unit}
+        out = []
+        for i in range(n):
+            rec = dict(fixed)
+            rec.update({k: v[i] for k, v in cols.items()})
+            if self.question == "distinguishable":
+                rec["value"] = None if rec["value"] is None else bool(rec["value"])
+            numeric = rec["value"] is not None and not isinstance(rec["value"], bool)
+            rec["bound"] = (bound_of(rec["interval_low"], rec["interval_high"]) or None) if numeric else None
+            rec["in_grid"] = bool(in_grid[i])
+            rec["table_name"] = self.table
+            out.append(rec)
+        return out
 
 
 def is_array_call(question: str, arguments: Mapping[str, Any]) -> bool:

@@ -160,7 +160,7 @@ class Candidate:
     error_rate: float
 
     def to_dict(self) -> dict:
-        return {"name": self.name, "e_range": list(self.e_range), "pieces": len(self.log_mass),
+        return {"name": self.name, "effusivity_range": list(self.e_range), "pieces": len(self.log_mass),
                 "error_rate": self.error_rate}
 
 

@@ -475,8 +475,9 @@ class Table:
             "fidelity": h["fidelity"],
             "sensor": h["sensor"],
             "model": self.model.to_dict(),
-            "effusivity": h["effusivity"],
-            "axes": [{k: a[k] for k in ("name", "units", "scale")} | {
+            # docs/schema.md: a unit is `unit` (a string) everywhere; the effusivity classes are a grid
+            "effusivity_grid": {("unit" if k == "units" else k): v for k, v in h["effusivity"].items()},
+            "axes": [{"name": a["name"], "unit": a["units"], "scale": a["scale"]} | {
                 "min": min(a["values"]), "max": max(a["values"]), "points": len(a["values"]),
                 **({"values": a["values"]} if len(a["values"]) <= 40 else {})} for a in h["axes"]],
             "arrays": sorted(h["arrays"]),

@@ -638,6 +638,12 @@ class SerialRecorder:
             The port vanished and did not come back within ``reconnect_s``.
         TooManyBadLines
             Too many lines unreadable to keep any trial (module docstring).
+        NoProgress
+            Touch after touch skipped and none kept for ``give_up_s`` of stream (module docstring).
+        TrialNotWritten
+            The folder could not take a trial; the message says where it was kept instead.
+        FolderBusy
+            Another recorder holds the trial folder (raised by :meth:`open`, before any touch).
         InputError
             An empty material label, or the trial folder cannot be created.
         KeyboardInterrupt

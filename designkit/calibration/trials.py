@@ -200,9 +200,13 @@ class FolderLock:
 
     def acquire(self) -> "FolderLock":
         """Take the lock; FolderBusy (one line) if another program holds it past ``wait_s``."""
-        import fcntl
-
         if self._fd is not None:
+            return self
+        try:
+            import fcntl
+        except ImportError:   # pragma: no cover - Windows: no flock; one recorder per folder is then on the user
+            self.folder.mkdir(parents=True, exist_ok=True)
+            self._fd = -1
             return self
         try:
             self.folder.mkdir(parents=True, exist_ok=True)
@@ -229,7 +233,8 @@ class FolderLock:
 
     def release(self) -> None:
         if self._fd is not None:
-            os.close(self._fd)   # closing the descriptor releases the flock
+            if self._fd >= 0:
+                os.close(self._fd)   # closing the descriptor releases the flock
             self._fd = None
 
     def __enter__(self) -> "FolderLock":

@@ -15,6 +15,8 @@ the time it all takes are printed by the last test (``pytest -s``).
 
 from __future__ import annotations
 
+import re
+
 import os
 import signal
 import time
@@ -428,7 +430,7 @@ def _files36(root: Path) -> dict[str, str]:
 
         sensor = "".join(f"{k}: {v}\n" for k, v in SENSORS["paper"].to_dict().items() if not isinstance(v, dict))
         (d / "ok.yaml").write_text(sensor)
-        (d / "noversion.yaml").write_text(sensor.replace("designkit_sensor: 1\n", ""))
+        (d / "noversion.yaml").write_text(re.sub(r"^designkit_sensor: \d+\n", "", sensor, flags=re.M))
         (d / "dup.yaml").write_text(sensor + "effusivity: 900\n")
         (d / "e308.yaml").write_text(sensor.replace("effusivity: 892.0", "effusivity: 1e308"))
         (d / "fast.yaml").write_text(sensor.replace("sample_rate_hz: 200.0", "sample_rate_hz: 1e12"))
@@ -436,7 +438,6 @@ def _files36(root: Path) -> dict[str, str]:
         (d / "abs.yaml").write_text(f"name: {d / 'escaped'}\nfidelity: ideal\nintervals: 4\ncontact_s: [1]\n")
         from designkit.calibration.profiles import list_profiles
 
-        import re
 
         prof = list_profiles()["designkit"].read_text()
         (d / "post.yaml").write_text(re.sub(r"post_s: .*", "post_s: 1e308", prof))

@@ -9,7 +9,7 @@ import pytest
 
 from designkit._validation import InputError
 from designkit.query import ArrayAnswer, ask, delta_e, distinguishable, max_noise, min_contact, min_delta_t
-from designkit.query.ideal_bound import cached_ideal_min_contact, clear_bound_cache, exact_ideal_min_contact
+from designkit.query.ideal_bound import clear_bound_cache, critical_noise, pair_critical_noise
 from designkit.sensor import load_sensor
 
 
@@ -124,11 +124,11 @@ def test_ideal_bound_false_skips_the_bound_only():
 
 def test_bound_cache_returns_what_a_computation_returns():
     s = load_sensor("paper")
-    lo, hi, r = np.array([20000.0, 9000.0]), np.array([35000.0, 9500.0]), np.array([0.005, 0.002])
+    lo, hi = np.array([20000.0, 9000.0, 20000.0]), np.array([35000.0, 9500.0, 35000.0])
     clear_bound_cache()
-    first = cached_ideal_min_contact(s, lo, hi, r)
-    again = cached_ideal_min_contact(s, lo[::-1], hi[::-1], r[::-1])  # hits, another order
-    alone = [float(exact_ideal_min_contact(s, a, b, c)) for a, b, c in zip(lo, hi, r)]
+    first = pair_critical_noise(s, lo, hi)
+    again = pair_critical_noise(s, lo[::-1], hi[::-1])  # hits, another order
+    alone = [float(critical_noise(s, a, b)) for a, b in zip(lo, hi)]
     assert first.tolist() == alone and again.tolist() == alone[::-1]
 
 

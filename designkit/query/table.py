@@ -590,7 +590,7 @@ def _k_readings_computed(op, slices, sw, ka, kb, lo, hi, extra=None):
     ``lo``, downwards at ``hi``) in the noise-ratio slices ``slices`` (n, m) weighted ``sw`` (n, m); see
     :func:`noise_k_min_contact`. ``extra``: (lo, hi) of further pairs whose critical noises are computed in
     the same call, returned third (or None)."""
-    from .ideal_bound import cached_critical_noise, shape_norm
+    from .ideal_bound import pair_critical_noise, shape_norm
 
     view, tab = op.view, op.tab
     sensor, width = tab.sensor, op.width
@@ -630,7 +630,7 @@ def _k_readings_computed(op, slices, sw, ka, kb, lo, hi, extra=None):
     m = P.size
     xa, xb = extra if extra is not None else (np.zeros(0),) * 2
     # one computation: every entry at its need and one width further (and the extra pairs)
-    star = cached_critical_noise(sensor, np.concatenate([a1, a2, xa]), np.concatenate([b1, b2, xb]), width=width,
+    star = pair_critical_noise(sensor, np.concatenate([a1, a2, xa]), np.concatenate([b1, b2, xb]), width=width,
                                  threshold=op.phi)
     s1, s2 = star[:m], star[m:2 * m]
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -1295,9 +1295,9 @@ def _closed_ideal_contact(op: _Opened, lo: float, hi: float, noise: float, dt: f
     """
     if not op.closed:
         return None
-    from .ideal_bound import cached_ideal_min_contact
+    from .ideal_bound import exact_ideal_min_contact
 
-    return number(cached_ideal_min_contact(op.tab.sensor, lo, hi, noise / abs(dt), width=op.width,
+    return number(exact_ideal_min_contact(op.tab.sensor, lo, hi, noise / abs(dt), width=op.width,
                                            threshold=op.phi, max_contact_s=CLOSED_FORM_MAX_CONTACT_S))
 
 
@@ -1306,9 +1306,9 @@ def _closed_ideal_ratio(op: _Opened, lo: float, hi: float, contact: float) -> fl
     None: no closed form, a touch beyond the sample limit, or not separable even at the bracket's low end."""
     if not (op.closed and within_sample_limit(contact, op.tab.sensor.sample_rate_hz)):
         return None
-    from .ideal_bound import cached_ideal_max_ratio
+    from .ideal_bound import exact_ideal_max_ratio
 
-    return number(cached_ideal_max_ratio(op.tab.sensor, lo, hi, contact, width=op.width, threshold=op.phi,
+    return number(exact_ideal_max_ratio(op.tab.sensor, lo, hi, contact, width=op.width, threshold=op.phi,
                                          bracket=CLOSED_FORM_RATIO_BRACKET))
 
 

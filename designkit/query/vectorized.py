@@ -355,10 +355,10 @@ def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float, outside
             varied_groups.append((combos, idx))
     sel = np.ones(lo.size, dtype=bool) if outside else todo
     if op.closed and ideal_bound and sel.any():  # outside the grid too: the closed form needs no table
-        from .ideal_bound import cached_ideal_min_contact
+        from .ideal_bound import exact_ideal_min_contact
 
         ratio = x["noise_c"] / np.abs(x["delta_t_c"])
-        res["ideal"][sel] = cached_ideal_min_contact(
+        res["ideal"][sel] = exact_ideal_min_contact(
             op.tab.sensor, lo[sel], hi[sel], ratio[sel], width=op.width, threshold=op.phi,
             max_contact_s=_table_route.CLOSED_FORM_MAX_CONTACT_S)
     # no closed form (varied initial conditions, per-object shapes): the scalar route's Monte Carlo bound, one
@@ -503,11 +503,11 @@ def _ratio(question, x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> 
                 a_r, a_w = _max_ratio(view, "svm", cw, le, he, **kw)
                 alt[key][j] = np.where(a_w == _INSIDE, a_r, np.nan)
     if op.closed and ideal_bound:  # every element, outside the grid too: the closed form needs no table
-        from .ideal_bound import cached_ideal_max_ratio
+        from .ideal_bound import exact_ideal_max_ratio
 
         ok = within_sample_limit(x["contact_s"], op.tab.sensor.sample_rate_hz)
         if ok.any():
-            ri[ok] = cached_ideal_max_ratio(op.tab.sensor, lo[ok], hi[ok], x["contact_s"][ok], width=op.width,
+            ri[ok] = exact_ideal_max_ratio(op.tab.sensor, lo[ok], hi[ok], x["contact_s"][ok], width=op.width,
                                             threshold=op.phi, bracket=_table_route.CLOSED_FORM_RATIO_BRACKET)
 
     def to_answer(r):

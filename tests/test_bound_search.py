@@ -10,16 +10,17 @@ import numpy as np
 import pytest
 
 from designkit.query import ideal_bound as ib
+from designkit.recognition import ideal as cf
 from designkit.sensor import load_sensor
 
 PAPER = load_sensor("paper")
 
 
 def _decides(lo, hi, ratio, n):
-    cum = ib._cumulative_g2(float(PAPER.tau_s), float(PAPER.sample_rate_hz), 2000)
+    cum = cf.cumulative_g2(float(PAPER.tau_s), float(PAPER.sample_rate_hz), 2000)
     with np.errstate(divide="ignore"):
         s = ratio / np.sqrt(cum[n])
-    return bool(ib._ok(PAPER, np.array([lo]), np.array([hi]), 80.0, np.array([s]), 0.9)[0])
+    return bool(cf.separates(PAPER, np.array([lo]), np.array([hi]), 80.0, np.array([s]), 0.9)[0])
 
 
 @pytest.mark.parametrize("seed", [0, 1])
@@ -56,22 +57,22 @@ def test_the_critical_noise_is_where_the_best_f1_crosses_the_threshold():
     lo = rng.uniform(1.0, 39000.0, 300)
     width = rng.choice([80.0, 400.0, 2000.0], 300)
     hi = lo + width + rng.uniform(1.0, 15000.0, 300)
-    star = ib.critical_noise(PAPER, lo, hi, width=width)
+    star = cf.critical_noise(PAPER, lo, hi, width=width)
     assert np.all(np.isfinite(star))
-    f1 = ib.ideal_f1(lo, hi, width, PAPER.effusivity, star)
+    f1 = cf.ideal_f1(lo, hi, width, PAPER.effusivity, star)
     assert np.max(np.abs(f1 - 0.9)) < 1e-9
-    plain = ib._max_ratio_in(PAPER, lo, hi, np.ones(lo.size), width, 0.9, (1e-9, 10.0), 1e-10)
+    plain = cf._bisect_noise(PAPER, lo, hi, np.ones(lo.size), width, 0.9, (1e-9, 10.0), 1e-10)
     np.testing.assert_allclose(star, plain, rtol=1e-8)
 
 
 def test_classes_the_ideal_observer_cannot_order_have_no_critical_noise():
     # the "higher" class below the lower one: no threshold on v reaches F1 0.9 at any noise
-    assert np.isnan(ib.critical_noise(PAPER, 35000.0, 20000.0))
+    assert np.isnan(cf.critical_noise(PAPER, 35000.0, 20000.0))
 
 
 def test_the_first_sample_is_the_first_count_whose_projection_noise_reaches_the_critical_one():
     rng = np.random.default_rng(6)
-    cum = ib._cumulative_g2(float(PAPER.tau_s), float(PAPER.sample_rate_hz), 600)
+    cum = cf.cumulative_g2(float(PAPER.tau_s), float(PAPER.sample_rate_hz), 600)
     ratio = 10.0 ** rng.uniform(-4.0, -1.0, 500)
     star = 10.0 ** rng.uniform(-4.0, -1.0, 500)
     n = ib.first_sample_at(cum, ratio, star)
@@ -86,7 +87,7 @@ def test_the_first_sample_is_the_first_count_whose_projection_noise_reaches_the_
 @pytest.mark.parametrize("n", [5, 20, 40, 64])
 def test_the_quadrature_rule_is_numpys_gauss_legendre(n):
     x, w = np.polynomial.legendre.leggauss(n)
-    gx, gw = ib._gauss_legendre(n)
+    gx, gw = cf._gauss_legendre(n)
     assert np.max(np.abs(gx - x)) < 1e-15
     assert np.max(np.abs(gw - w)) < 1e-14
     # and it integrates polynomials up to degree 2n - 1 exactly
@@ -105,7 +106,7 @@ def test_noise_k_contact_is_the_first_sample_where_the_classifier_separates():
     got = ib.noise_k_contact(PAPER, ratio, star, t_a, t_b, ka, kb, 10.0)
     fs = float(PAPER.sample_rate_hz)
     n = np.arange(1, 2001)
-    cum = ib._cumulative_g2(float(PAPER.tau_s), fs, 2000)
+    cum = cf.cumulative_g2(float(PAPER.tau_s), fs, 2000)
     slope = (kb - ka) / np.log(t_b / t_a)
     log_k = np.maximum(ka[:, None] + slope[:, None] * (np.log(n / fs)[None, :] - np.log(t_a)[:, None]), 0.0)
     ok = log_k + np.log(ratio)[:, None] - 0.5 * np.log(cum[n])[None, :] <= np.log(star)[:, None]

@@ -59,7 +59,6 @@ __all__ = [
     "MatrixCell",
     "MulticlassCurve",
     "material_matrix",
-    "multiclass_ideal_accuracies",
     "multiclass_ideal_accuracy",
     "multiclass_svm_accuracy",
     "resolve_materials",
@@ -337,67 +336,29 @@ def multiclass_ideal_accuracy(ranges, sensor, scene, *, max_bins: int = _MAX_BIN
     >>> round(acc, 6)
     1.0
     """
-    return float(multiclass_ideal_accuracies(ranges, sensor, [scene], max_bins=max_bins)[0])
-
-
-def multiclass_ideal_accuracies(ranges, sensor, scenes, *, max_bins: int = _MAX_BINS) -> np.ndarray:
-    """:func:`multiclass_ideal_accuracy` at each of ``scenes`` (fixed initial conditions), in one vectorized
-    evaluation of every class's survival at every scene's bin edges.
-
-    >>> from designkit.scene import Scene
-    >>> from designkit.sensor import SENSORS
-    >>> acc = multiclass_ideal_accuracies([(400, 500), (20000, 30000)], SENSORS["paper"],
-    ...                                   [Scene.from_delta_t(contact_s=c) for c in (0.0, 2.0)])
-    >>> acc.round(6).tolist()
-    [0.5, 1.0]
-    """
     from ..models.semi_infinite import object_weight
-    from .ideal_bound import class_survival, shape_norm  # scipy-free: importing scipy cost more than this
+    from ..recognition.ideal import class_survival, projection_noise
 
     r = np.asarray(ranges, dtype=np.float64)
+    s = projection_noise(sensor, scene)
     K = r.shape[0]
-    norm = shape_norm(sensor, np.array([sc.contact_s for sc in scenes], dtype=np.float64))
-    ratio = np.array([sc.noise_ratio for sc in scenes], dtype=np.float64)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        s_all = np.where((norm > 0) & np.isfinite(ratio), ratio / norm, np.inf)
-    out = np.full(len(scenes), 1.0 / K)
+    if not np.isfinite(s):
+        return 1.0 / K
     w = object_weight(sensor.effusivity, r)
-    # every (scene, class) segment of bin edges where the class's survival is neither 0 nor 1, as one array
-    t_parts, a_parts, b_parts, s_parts, bins, n_bins = [], [], [], [], [], []
-    for k, s in enumerate(s_all.tolist()):
-        if not math.isfinite(s):
+    lo, hi = float(w.min()) - 9.0 * s, float(w.max()) + 9.0 * s
+    step = max(s / 8.0, (hi - lo) / max_bins)
+    edges = np.arange(lo, hi + step, step)
+    best = np.zeros(edges.size - 1)
+    for (a, b), (wa, wb) in zip(r, w):
+        # outside [w(a) - 8.5 s, w(b) + 8.5 s] the class's survival is exactly 1 or 0: its bin mass is 0
+        i0 = max(int(np.searchsorted(edges, wa - _CUT * s - step)) - 1, 0)
+        i1 = min(int(np.searchsorted(edges, wb + _CUT * s + step)) + 1, edges.size)
+        if i1 - i0 < 2:
             continue
-        lo, hi = float(w.min()) - 9.0 * s, float(w.max()) + 9.0 * s
-        step = max(s / 8.0, (hi - lo) / max_bins)
-        edges = np.arange(lo, hi + step, step)
-        base = sum(n_bins)
-        n_bins.append(edges.size - 1)
-        for (a, b), (wa, wb) in zip(r, w):
-            # outside [w(a) - 8.5 s, w(b) + 8.5 s] the class's survival is exactly 1 or 0: its bin mass is 0
-            i0 = max(int(np.searchsorted(edges, wa - _CUT * s - step)) - 1, 0)
-            i1 = min(int(np.searchsorted(edges, wb + _CUT * s + step)) + 1, edges.size)
-            if i1 - i0 < 2:
-                continue
-            t_parts.append(edges[i0:i1])
-            a_parts.append(a), b_parts.append(b), s_parts.append(s)
-            bins.append((k, base + i0))
-    if not t_parts:
-        return out
-    sizes = np.array([t.size for t in t_parts])
-    t_all, a_all, b_all, s_all_ = (np.concatenate(t_parts), np.repeat(a_parts, sizes), np.repeat(b_parts, sizes),
-                                   np.repeat(s_parts, sizes))
-    surv = np.concatenate([class_survival(t_all[i:i + 4096], a_all[i:i + 4096], b_all[i:i + 4096],
-                                          sensor.effusivity, s_all_[i:i + 4096])  # blocks: temporaries in cache
-                           for i in range(0, t_all.size, 4096)])
-    best = np.zeros(sum(n_bins))
-    first = np.cumsum(sizes) - sizes  # each segment's first position in ``surv``
-    pos = np.concatenate([np.arange(p, p + m - 1) for p, m in zip(first.tolist(), sizes.tolist())])
-    index = np.concatenate([np.arange(b0, b0 + m - 1) for (_, b0), m in zip(bins, sizes.tolist())])
-    np.maximum.at(best, index, surv[pos] - surv[pos + 1])
-    scene_of_bin = np.repeat(np.arange(len(n_bins)), n_bins)
-    acc = np.bincount(scene_of_bin, best, minlength=len(n_bins)) / K
-    out[np.flatnonzero(np.isfinite(s_all))] = acc
-    return out
+        surv = class_survival(edges[i0:i1], a, b, sensor.effusivity, s)
+        seg = best[i0:i1 - 1]
+        np.maximum(seg, surv[:-1] - surv[1:], out=seg)
+    return float(np.sum(best) / K)
 
 
 def multiclass_svm_accuracy(ranges, trials: int, sensor, scene, seed) -> dict:
@@ -471,7 +432,7 @@ def _multiclass(mats, tab, *, noise_c: float, delta_t_c: float, svm_trials: int 
         return MulticlassCurve(contacts, None, svm, 1.0 / len(mats), scene,
                                f"ideal accuracy not computed: the closed form needs the semi-infinite model with "
                                f"fixed initial conditions (table {tab.name}: {model.describe()}); " + svm_note)
-    acc = multiclass_ideal_accuracies(ranges, sensor, scenes)
+    acc = np.array([multiclass_ideal_accuracy(ranges, sensor, sc) for sc in scenes])
     note = ("ideal observer: exact Bayes accuracy (equal priors), each material uniform over its whole effusivity "
             "range; " + svm_note)
     return MulticlassCurve(contacts, acc, svm, 1.0 / len(mats), scene, note)
@@ -511,7 +472,7 @@ def _prefill_bounds(question: str, mats, tab, itab, given: dict) -> None:
                 **given)
         else:
             exact_ideal_max_ratio(op.tab.sensor, los, his, check_contact(given["contact_s"]), width=op.width,
-                                   threshold=op.phi, bracket=table_route.CLOSED_FORM_RATIO_BRACKET)
+                                  threshold=op.phi, bracket=table_route.CLOSED_FORM_RATIO_BRACKET)
     except (InputError, KeyError):
         return
 

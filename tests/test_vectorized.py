@@ -9,7 +9,8 @@ import pytest
 
 from designkit._validation import InputError
 from designkit.query import ArrayAnswer, ask, delta_e, distinguishable, max_noise, min_contact, min_delta_t
-from designkit.query.ideal_bound import clear_bound_cache, critical_noise, pair_critical_noise
+from designkit.query.ideal_bound import clear_bound_cache, pair_critical_noise
+from designkit.recognition.ideal import critical_noise
 from designkit.sensor import load_sensor
 
 

@@ -1,25 +1,26 @@
-"""The closed-form bounds' search over the sample count: a guessed bracket never changes an answer.
+"""The closed-form bounds: the critical noise and the search over the sample count.
 
 The ideal observer's min-contact (and the efficiency route's) is the first sample count at which a
-monotone decision holds. The search starts from a Gaussian guess of that count and bisects inside a
-bracket around it; these tests check the answers against the definition (the decision fails one sample
-earlier and holds at the answer) and against the plain bisection with guesses that are wrong on purpose.
+monotone decision holds: the projection noise falls to the pair's critical noise. These tests check the
+answers against the definition (the grid-maximized F1 fails one sample earlier and holds at the answer),
+the critical noise against a plain bisection, and the sample search against a brute-force scan.
 """
 
 import numpy as np
 import pytest
 
 from designkit.query import ideal_bound as ib
+from designkit.recognition import ideal as cf
 from designkit.sensor import load_sensor
 
 PAPER = load_sensor("paper")
 
 
 def _decides(lo, hi, ratio, n):
-    cum = ib._cumulative_g2(float(PAPER.tau_s), float(PAPER.sample_rate_hz), 2000)
+    cum = cf.cumulative_g2(float(PAPER.tau_s), float(PAPER.sample_rate_hz), 2000)
     with np.errstate(divide="ignore"):
         s = ratio / np.sqrt(cum[n])
-    return bool(ib._ok(PAPER, np.array([lo]), np.array([hi]), 80.0, np.array([s]), 0.9)[0])
+    return bool(cf.separates(PAPER, np.array([lo]), np.array([hi]), 80.0, np.array([s]), 0.9)[0])
 
 
 @pytest.mark.parametrize("seed", [0, 1])
@@ -39,44 +40,54 @@ def test_ideal_min_contact_is_the_first_sample_where_the_ideal_observer_separate
     assert checked >= 6
 
 
-def test_a_wrong_guess_gives_the_plain_bisection_answer():
+def test_the_bisection_finds_the_first_count_where_a_decision_holds():
     rng = np.random.default_rng(3)
     switch = rng.integers(1, 2000, 400)  # the first count where each element's decision holds
-
-    def ok(n, rows):
-        return n >= switch[rows]
-
     a = np.zeros(400, dtype=np.int64)
     b = np.full(400, 2000, dtype=np.int64)
-    plain = ib._first_good_sample(ok, a, b)
-    assert np.array_equal(plain, switch)
-    for guess in (switch * 1.0, switch * 0.5, switch * 2.0, switch + 0.3, np.full(400, np.nan),
-                  np.zeros(400), rng.uniform(0, 3000, 400)):
-        assert np.array_equal(ib._first_good_sample(ok, a, b, guess), plain)
-    # a decision that never holds below b answers b, guessed or not
+    assert np.array_equal(ib._first_good_sample(lambda n, rows: n >= switch[rows], a, b), switch)
+    # a decision that never holds below b answers b
     never = np.full(400, 5000)
-    assert np.array_equal(ib._first_good_sample(lambda n, rows: n >= never[rows], a, b, switch * 1.0), b)
+    assert np.array_equal(ib._first_good_sample(lambda n, rows: n >= never[rows], a, b), b)
 
 
-def test_the_gaussian_guess_lands_near_the_exact_count():
-    rng = np.random.default_rng(4)
-    lo = rng.uniform(100.0, 39000.0, 200)
-    hi = lo + rng.uniform(100.0, 15000.0, 200)
-    ratio = 10.0 ** rng.uniform(-3.5, -1.5, 200)
-    fs = float(PAPER.sample_rate_hz)
-    cum = ib._cumulative_g2(float(PAPER.tau_s), fs, 2000)
-    exact = ib.exact_ideal_min_contact(PAPER, lo, hi, ratio) * fs
-    guess = ib._gaussian_sample_guess(PAPER, lo, hi, 80.0, ratio, 0.9, cum)
-    both = np.isfinite(exact) & np.isfinite(guess)
-    assert both.sum() >= 100
-    # within the second probe (else the search costs a few calls more, never a different answer)
-    assert np.max(np.abs(guess[both] / exact[both] - 1.0)) < ib._GUESS_SPAN
+def test_the_critical_noise_is_where_the_best_f1_crosses_the_threshold():
+    """Newton's root agrees with a plain bisection of the grid-maximized F1 (an independent maximizer)."""
+    rng = np.random.default_rng(5)
+    lo = rng.uniform(1.0, 39000.0, 300)
+    width = rng.choice([80.0, 400.0, 2000.0], 300)
+    hi = lo + width + rng.uniform(1.0, 15000.0, 300)
+    star = cf.critical_noise(PAPER, lo, hi, width=width)
+    assert np.all(np.isfinite(star))
+    f1 = cf.ideal_f1(lo, hi, width, PAPER.effusivity, star)
+    assert np.max(np.abs(f1 - 0.9)) < 1e-9
+    plain = cf._bisect_noise(PAPER, lo, hi, np.ones(lo.size), width, 0.9, (1e-9, 10.0), 1e-10)
+    np.testing.assert_allclose(star, plain, rtol=1e-8)
+
+
+def test_classes_the_ideal_observer_cannot_order_have_no_critical_noise():
+    # the "higher" class below the lower one: no threshold on v reaches F1 0.9 at any noise
+    assert np.isnan(cf.critical_noise(PAPER, 35000.0, 20000.0))
+
+
+def test_the_first_sample_is_the_first_count_whose_projection_noise_reaches_the_critical_one():
+    rng = np.random.default_rng(6)
+    cum = cf.cumulative_g2(float(PAPER.tau_s), float(PAPER.sample_rate_hz), 600)
+    ratio = 10.0 ** rng.uniform(-4.0, -1.0, 500)
+    star = 10.0 ** rng.uniform(-4.0, -1.0, 500)
+    n = ib.first_sample_at(cum, ratio, star)
+    with np.errstate(divide="ignore"):
+        ok = ratio[:, None] / np.sqrt(cum[None, :]) <= star[:, None]
+    ok[:, 0] = False  # the sample at contact carries no signal
+    brute = np.where(ok.any(axis=1), np.argmax(ok, axis=1), np.nan)
+    np.testing.assert_array_equal(n, brute)
+    assert ib.first_sample_at(cum, 0.0, 1e-3) == 1 and np.isnan(ib.first_sample_at(cum, 0.01, np.nan))
 
 
 @pytest.mark.parametrize("n", [5, 20, 40, 64])
 def test_the_quadrature_rule_is_numpys_gauss_legendre(n):
     x, w = np.polynomial.legendre.leggauss(n)
-    gx, gw = ib._gauss_legendre(n)
+    gx, gw = cf._gauss_legendre(n)
     assert np.max(np.abs(gx - x)) < 1e-15
     assert np.max(np.abs(gw - w)) < 1e-14
     # and it integrates polynomials up to degree 2n - 1 exactly
@@ -95,7 +106,7 @@ def test_noise_k_contact_is_the_first_sample_where_the_classifier_separates():
     got = ib.noise_k_contact(PAPER, ratio, star, t_a, t_b, ka, kb, 10.0)
     fs = float(PAPER.sample_rate_hz)
     n = np.arange(1, 2001)
-    cum = ib._cumulative_g2(float(PAPER.tau_s), fs, 2000)
+    cum = cf.cumulative_g2(float(PAPER.tau_s), fs, 2000)
     slope = (kb - ka) / np.log(t_b / t_a)
     log_k = np.maximum(ka[:, None] + slope[:, None] * (np.log(n / fs)[None, :] - np.log(t_a)[:, None]), 0.0)
     ok = log_k + np.log(ratio)[:, None] - 0.5 * np.log(cum[n])[None, :] <= np.log(star)[:, None]

@@ -149,7 +149,7 @@ def test_delta_e_on_a_grid_point_is_the_middle_of_what_the_tabulated_need_allows
 
 
 def test_critical_noise_is_where_the_ideal_f1_crosses_the_threshold():
-    from designkit.query.ideal_bound import critical_noise, ideal_f1
+    from designkit.recognition.ideal import critical_noise, ideal_f1
 
     rng = np.random.default_rng(11)
     lo = rng.uniform(100, 38000, 40)

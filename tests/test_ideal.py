@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 from scipy import optimize, stats
 
 from designkit import Scene
-from designkit.recognition.ideal import class_survival, ideal_pair, ideal_scores, projection_noise
+from designkit.recognition.ideal import class_survival, ideal_pair, ideal_scores, ndtr, projection_noise
 from designkit.models.semi_infinite import object_weight, response_shape
 
 E_S = 892.0
@@ -122,3 +122,15 @@ def test_vectorized_equals_scalar():
     for i in range(3):
         f, a = ideal_scores(lows[i], lows[i] + 80, lows[i] + 400, lows[i] + 480, E_S, s[i])
         assert f1[i] == f and acc[i] == a
+
+
+def test_normal_cdf_of_the_closed_form_bounds_against_mpmath():
+    """The normal CDF of the closed form (Hermite pieces in Horner form, numpy only)."""
+    import mpmath
+
+    rng = np.random.default_rng(7)
+    z = np.concatenate([rng.normal(0.0, 3.0, 4000), [-9.0, 9.0, -9.5, 12.0, 0.0, -1e-300, 8.999999]])
+    got = ndtr(z.reshape(-1, 1)).ravel()
+    ref = np.array([float(mpmath.ncdf(mpmath.mpf(float(v)))) for v in z])
+    assert np.max(np.abs(got - ref)) < 1e-13
+    assert np.all(np.diff(ndtr(np.linspace(-9.0, 9.0, 20001))) >= -2.3e-16)  # monotone to an ulp of 1

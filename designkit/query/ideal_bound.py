@@ -1,14 +1,14 @@
-"""The ideal observer's exact answers to the design questions, vectorized and scipy-free.
+"""The ideal observer's exact answers to the design questions, vectorized.
 
 For a shared-shape model with fixed initial conditions the ideal observer
 depends on the scene only through the projection noise
 ``s = (sigma/dT) / |g|``, ``|g|`` the Euclidean norm of the response shape
 ``g(t) = erfc(sqrt(tau/t))`` over the touch's samples
-(:mod:`designkit.recognition.ideal`). This module evaluates the same closed
-form (Gauss-Legendre quadrature of the class survival functions, golden-section
-maximization of F1 over the threshold) with :func:`math.erfc` instead of
-:mod:`scipy.special`, so that a table query can compute the bound at query
-time (importing scipy costs about 0.35 s, more than the rest of a query):
+(:mod:`designkit.recognition.ideal`, the one closed form). Every bound here is
+a cheap function of a pair's *critical noise* ``s*``
+(:func:`~designkit.recognition.ideal.critical_noise`), kept in one per-process
+memo: the shortest contact is the first sample where ``s`` falls to ``s*``, the
+largest sigma/dT is ``s* |g|``. A table query computes them at query time:
 the bound is never read from a grid.
 
 Units: effusivity [J s^-1/2 K^-1 m^-2], contact time [s], ``ratio`` = sigma/dT [-].
@@ -23,313 +23,33 @@ Examples
 
 from __future__ import annotations
 
-import functools
-import math
-
 import numpy as np
 from cachetools import LRUCache
 
+from ..recognition.ideal import critical_noise, cumulative_g2, separates, shape_norm
 from ..sensor import last_sample_index
 
 __all__ = [
     "BOUND_CACHE_SIZE",
-    "class_survival",
-    "critical_noise",
-    "cached_critical_noise",
-    "projection_noise",
-    "cached_ideal_max_ratio",
-    "cached_ideal_min_contact",
-    "cached_ideal_delta",
     "clear_bound_cache",
     "exact_ideal_delta",
     "exact_ideal_max_ratio",
     "exact_ideal_min_contact",
-    "ideal_f1",
+    "first_sample_at",
     "noise_k_contact",
-    "shape_norm",
+    "pair_critical_noise",
 ]
 
 
 
-def _gauss_legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
-    """Gauss-Legendre nodes and weights on [-1, 1] (Golub & Welsch 1969: the eigenvalues of the Jacobi matrix
-    of the Legendre recurrence, and twice the squared first components of its eigenvectors).
-
-    The same rule as ``numpy.polynomial.legendre.leggauss(n)`` (to 4e-16 in the nodes and 4e-15 in the
-    weights at n = 40, tested), without importing ``numpy.polynomial``: its classes cost a fresh table query
-    2.3 ms of a start-up that issue 16 counts (this takes 0.2 ms).
-    """
-    k = np.arange(1.0, n)
-    off = k / np.sqrt(4.0 * k * k - 1.0)
-    nodes, vectors = np.linalg.eigh(np.diag(off, 1) + np.diag(off, -1))
-    weights = 2.0 * vectors[0] ** 2
-    nodes = 0.5 * (nodes - nodes[::-1])  # exactly symmetric, as leggauss makes them
-    weights = 0.5 * (weights + weights[::-1])
-    return nodes, weights
-
-
-_GL_X, _GL_W = _gauss_legendre(40)
-_CUT = 8.5  # Phi(-8.5) = 9.5e-18: the integrand is 0 or 1 to double precision outside +-8.5 s
-_TRIVIAL_F1 = 2.0 / 3.0  # call every touch positive (designkit.recognition.scores.TRIVIAL_F1)
-_SQRT1_2 = math.sqrt(0.5)
-_PHI_H = 1.0 / 512.0  # grid step of the tabulated normal CDF (a power of two: exact node positions)
-_PHI_Z = 9.0  # beyond +-9 the CDF is 0 or 1 to 1e-19
-
-
-@functools.lru_cache(maxsize=1)
-def _phi_table() -> tuple[np.ndarray, np.ndarray]:
-    """The standard normal CDF and density on [-9, 9] every 1/512, from :func:`math.erfc` (~2 ms, once)."""
-    z = np.arange(-_PHI_Z, _PHI_Z + _PHI_H / 2, _PHI_H)
-    cdf = np.array([0.5 * math.erfc(-_SQRT1_2 * x) for x in z.tolist()])
-    return cdf, np.exp(-0.5 * z * z) / math.sqrt(2.0 * math.pi)
-
-
-@functools.lru_cache(maxsize=1)
-def _phi_horner() -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Coefficients ``c0..c3`` of the cubic Hermite piece on each interval of :func:`_phi_table`, in
-    ``x = (z + 9) * 512 - k`` on [0, 1]: ``Phi = ((c3 x + c2) x + c1) x + c0``."""
-    cdf, pdf = _phi_table()
-    p0, p1, m0, m1 = cdf[:-1], cdf[1:], _PHI_H * pdf[:-1], _PHI_H * pdf[1:]
-    return p0, m0, -3.0 * p0 - 2.0 * m0 + 3.0 * p1 - m1, 2.0 * p0 + m0 - 2.0 * p1 + m1
-
-
-def _ndtr(z: np.ndarray) -> np.ndarray:
-    """Standard normal CDF, elementwise: cubic Hermite interpolation of :func:`_phi_table`.
-
-    Interpolation error at most h^4 max|d4 Phi| / 384 = 5e-14 (h = 1/512), tested against
-    :func:`math.erfc`; a Python call of math.erfc per element costs 5x more, scipy's import 0.35 s.
-    Evaluated in Horner form from per-interval coefficients, in place, with 1-D ``take`` gathers:
-    8x faster than the textbook basis form on (3000, 40) arrays (9.1 -> 1.1 ms, same values to
-    7e-16), which was a fifth of a 12-material ``designkit matrix``.
-    """
-    c0, c1, c2, c3 = _phi_horner()
-    u = np.clip(z, -_PHI_Z, _PHI_Z)
-    u += _PHI_Z
-    u *= 1.0 / _PHI_H
-    k = u.astype(np.int64)
-    np.minimum(k, c0.size - 1, out=k)
-    u -= k
-    r = c3.take(k)
-    r *= u
-    r += c2.take(k)
-    r *= u
-    r += c1.take(k)
-    r *= u
-    r += c0.take(k)
-    return r
-
-
-@functools.lru_cache(maxsize=16)
-def _cumulative_g2(tau_s: float, rate_hz: float, n_max: int) -> np.ndarray:
-    """``sum_{k <= n} g(k/fs)^2`` for n = 0 .. n_max (the first sample is at contact, t = 0)."""
-    if tau_s == 0.0:
-        g = np.ones(n_max + 1)
-    else:
-        g = np.array([0.0] + [math.erfc(math.sqrt(tau_s * rate_hz / k)) for k in range(1, n_max + 1)])
-    return np.cumsum(g * g)
-
-
-def shape_norm(sensor, contact_s) -> np.ndarray:
-    """``|g|``, the norm of the response shape over a touch's samples, vectorized over ``contact_s`` [s].
-
-    The projection noise is ``(sigma/dT) / shape_norm`` (0 for no sample after contact: no signal).
-
-    >>> from designkit.sensor import load_sensor
-    >>> round(float(shape_norm(load_sensor("paper"), 2.0)), 4)
-    2.6732
-    """
-    n = last_sample_index(contact_s, sensor.sample_rate_hz)
-    cum = _cumulative_g2(float(sensor.tau_s), float(sensor.sample_rate_hz), int(max(np.max(n), 1)))
-    return np.sqrt(cum[n])
-
-
-def _weight(e_s: float, e):
-    """``w = e / (e_s + e)`` (:func:`designkit.models.semi_infinite.object_weight`), for e > 0."""
-    with np.errstate(divide="ignore"):
-        return 1.0 / (1.0 + e_s / e)
-
-
-def _survival(t, a, b, wa, wb, e_s, s):
-    """``P(w(e) + s N(0,1) > t)`` with ``e ~ U[a, b)`` (as :func:`designkit.recognition.ideal.class_survival`).
-
-    ``wa, wb`` are ``w(a), w(b)``; the cuts outside the class use its exact ends.
-    """
-    def cut(w_cut):
-        w = np.minimum(np.maximum(w_cut, wa), wb)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            e = e_s * w / (1.0 - w)
-        e = np.minimum(np.maximum(e, a), b)
-        return np.where(w_cut <= wa, a, np.where(w_cut >= wb, b, e))
-
-    e_lo, e_hi = cut(t - _CUT * s), cut(t + _CUT * s)
-    half, mid = 0.5 * (e_hi - e_lo), 0.5 * (e_hi + e_lo)
-    nodes = mid[..., None] + half[..., None] * _GL_X
-    with np.errstate(divide="ignore", invalid="ignore"):
-        z = (_weight(e_s, nodes) - t[..., None]) / s[..., None]
-    z[np.isnan(z)] = 0.0
-    middle = half * (_ndtr(z) @ _GL_W)
-    return np.minimum(np.maximum(((b - e_hi) + middle) / (b - a), 0.0), 1.0)
-
-
-def class_survival(t, e_low: float, e_high: float, e_sensor: float, s: float) -> np.ndarray:
-    """``P(w(e) + s N(0,1) > t)`` for ``e ~ U[e_low, e_high)``, at every threshold ``t`` (scipy-free).
-
-    The same closed form as :func:`designkit.recognition.ideal.class_survival` (agrees to 1e-12,
-    tested), without importing scipy (the query layer's multi-class view uses it).
-
-    >>> float(class_survival([0.0], 20000.0, 20080.0, 892.0, 0.01)[0])
-    1.0
-    """
-    t = np.asarray(t, dtype=np.float64)
-    return _survival(t, float(e_low), float(e_high), _weight(e_sensor, float(e_low)), _weight(e_sensor, float(e_high)),
-                     e_sensor, np.full(t.shape, float(s)))
-
-
-def projection_noise(sensor, contact_s: float, ratio: float) -> float:
-    """Projection noise ``s = (sigma/dT) / |g|`` (inf: no sample after contact), as
-    :func:`designkit.recognition.ideal.projection_noise` for fixed initial conditions."""
-    norm = float(shape_norm(sensor, contact_s))
-    return math.inf if norm == 0.0 or math.isinf(ratio) else ratio / norm
-
-
-def ideal_f1(lo, hi, width, e_sensor: float, s, *, points: int = 17, passes: int = 7,
-             stop_at: float | None = None) -> np.ndarray:
-    """Best F1 of the ideal observer for classes ``[lo, lo+width)`` and ``[hi, hi+width)``, vectorized.
-
-    Parameters
-    ----------
-    lo, hi : array_like
-        Lower edges of the lower and higher class [J s^-1/2 K^-1 m^-2] (``hi`` positive).
-    width : float or array_like
-        Class width [J s^-1/2 K^-1 m^-2].
-    e_sensor : float
-        Sensor effusivity [J s^-1/2 K^-1 m^-2].
-    s : array_like
-        Projection noise [-] (>= 0, may be inf: no signal).
-    points, passes : int
-        Thresholds per pass and passes (each zooms onto the best cell: the
-        threshold is located to ``(2 / (points - 1)) ** passes`` of its bracket).
-    stop_at : float, optional
-        Stop zooming once every element's F1 reaches this (a decision ``F1 >= stop_at``
-        needs no more: F1 only grows with the passes). The values returned are then
-        lower bounds, exact as decisions.
-
-    Returns
-    -------
-    ndarray
-        F1 in [2/3, 1] (agrees with :func:`designkit.recognition.ideal.ideal_scores` to 1e-9, tested).
-
-    Examples
-    --------
-    >>> round(float(ideal_f1(20000.0, 35000.0, 80.0, 892.0, 0.0)), 6)
-    1.0
-    """
-    lo, hi, width, s = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64) for x in (lo, hi, width, s)))
-    shape = lo.shape
-    lo, hi, width, s = (x.ravel() for x in (lo, hi, width, s))
-    out = np.full(lo.shape, _TRIVIAL_F1)
-    ok = np.isfinite(s)
-    if not ok.any():
-        return out.reshape(shape)
-    la, lb, ha, hb, s = lo[ok], lo[ok] + width[ok], hi[ok], hi[ok] + width[ok], s[ok]
-
-    cols = [x[:, None] for x in (ha, hb, _weight(e_sensor, ha), _weight(e_sensor, hb),
-                                 la, lb, _weight(e_sensor, la), _weight(e_sensor, lb), s)]
-
-    def f1(t, rows):  # t: (len(rows), k) thresholds per pair of ``rows``
-        c = cols if rows is None else [x[rows] for x in cols]
-        tpr = _survival(t, *c[0:4], e_sensor, c[8])
-        fpr = _survival(t, *c[4:8], e_sensor, c[8])
-        return 2.0 * tpr / (1.0 + tpr + fpr)
-
-    # F1 is quasi-concave in the threshold: a grid, then zooms onto the best cell (one vectorized
-    # call per pass instead of one per golden-section step: the small-array overhead dominates)
-    a = _weight(e_sensor, np.minimum(la, ha)) - (_CUT + 1) * s
-    b = _weight(e_sensor, np.maximum(lb, hb)) + (_CUT + 1) * s
-    best = np.full(la.shape, -np.inf)
-    u = np.linspace(0.0, 1.0, points)
-    rows = None  # the elements still zooming (None: all); with stop_at, those below it
-    for _ in range(passes):
-        ra, rb = (a, b) if rows is None else (a[rows], b[rows])
-        t = ra[:, None] + (rb - ra)[:, None] * u
-        f = f1(t, rows)
-        k = np.argmax(f, axis=1)
-        top = f[np.arange(k.size), k]
-        step = (rb - ra) / (points - 1)
-        centre = t[np.arange(k.size), k]
-        if rows is None:
-            best = np.maximum(best, top)
-            a, b = centre - step, centre + step
-        else:
-            best[rows] = np.maximum(best[rows], top)
-            a[rows], b[rows] = centre - step, centre + step
-        if stop_at is not None:
-            rows = np.nonzero(best < stop_at)[0]
-            if rows.size == 0:
-                break
-    out[ok] = np.maximum(best, _TRIVIAL_F1)
-    return out.reshape(shape)
-
-
-def _gaussian_sample_guess(sensor, lo, hi, width, ratio, threshold, cum: np.ndarray) -> np.ndarray:
-    """A guess of the first sample count where the ideal observer separates ``[lo, lo+w)`` from ``[hi, hi+w)``.
-
-    Each class's weight ``w(e)`` is taken as Gaussian with its uniform spread (variance ``(w(b) - w(a))^2 / 12``)
-    added to the projection noise; for two equal Gaussians the best F1 is about ``Phi(d/2)`` with
-    ``d = (w_hi - w_lo) / s_total``, so the largest projection noise that still reaches ``threshold`` is
-    ``s* = sqrt((dw / (2 z))^2 - spread^2)`` with ``z = Phi^-1(threshold)``, and the count is the first
-    ``n`` with ``ratio / sqrt(cum[n]) <= s*``. Only a starting bracket for the exact bisection (which
-    decides every answer): NaN where the approximation says no noise is small enough.
-    """
-    s_star = _gaussian_noise_guess(sensor, lo, hi, width, threshold)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        need = np.where(s_star > 0, (ratio / s_star) ** 2, np.nan)
-    n = np.searchsorted(cum, np.nan_to_num(need, nan=np.inf)).astype(np.float64)
-    return np.where(np.isfinite(need) & (n < cum.size), n, np.nan)
-
-
-def _ok(sensor, lo, hi, width, s, threshold) -> np.ndarray:
-    return ideal_f1(lo, hi, width, sensor.effusivity, s, stop_at=threshold) >= threshold
-
-
-#: How far beyond a wrong guess the second probe looks, relative to the guess: the Gaussian guess was within
-#: 1.9 % of the exact count on 2,748 random pairs and scenes (exact at the paper's guideline scene).
-_GUESS_SPAN = 0.02
-
-
-def _first_good_sample(ok, a: np.ndarray, b: np.ndarray, guess: np.ndarray | None = None) -> np.ndarray:
+def _first_good_sample(ok, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Bisection on the sample count, elementwise: the first ``n`` in ``(a, b]`` where ``ok(n, rows)`` holds,
     for a decision false at ``a`` and true from some ``n`` on (``b`` where it never turns true below ``b``).
 
-    ``ok(n, rows)`` decides the elements ``rows`` (an index array) at counts ``n`` shaped ``(len(rows),)``
-    or ``(2, len(rows))`` (two counts per element); each step decides only the elements still bracketed
-    wider than one sample. With a ``guess`` (a float sample count per element, NaN: none) the search first
-    decides the guessed count and the one before it (one call: an exact guess ends the search there), then,
-    on the side where the switch lies, the count 2 % beyond the guess, and bisects what is left: the same
-    answer as without a guess (the decision is monotone in ``n``), in one call instead of about
-    ``log2(b - a)`` where the guess is right, and at most two calls more where it is not.
+    ``ok(n, rows)`` decides the elements ``rows`` (an index array) at counts ``n`` shaped ``(len(rows),)``;
+    each step decides only the elements still bracketed wider than one sample.
     """
     a, b = a.copy(), b.copy()
-    if guess is not None:
-        rows = np.nonzero(np.isfinite(guess) & (b - a > 1))[0]
-        if rows.size:
-            ar, br = a[rows], b[rows]
-            hi = np.clip(np.round(guess[rows]), ar + 1, br).astype(np.int64)
-            lo = hi - 1
-            ok_lo, ok_hi = ok(np.stack([lo, hi]), rows)
-            ok_lo &= lo > ar  # n = a is false by the contract
-            a[rows] = np.where(ok_lo, ar, np.where(ok_hi, lo, hi))
-            b[rows] = np.where(ok_lo, lo, np.where(ok_hi, hi, br))
-            # the guess was off: probe 2 % beyond it, on the side where the switch lies
-            miss = (b[rows] - a[rows] > 1)
-            if miss.any():
-                r, g = rows[miss], guess[rows][miss]
-                below = ok_lo[miss]
-                probe = np.where(below, np.floor(g * (1.0 - _GUESS_SPAN)), np.ceil(g * (1.0 + _GUESS_SPAN)))
-                probe = np.clip(probe, a[r] + 1, np.maximum(b[r] - 1, a[r] + 1)).astype(np.int64)
-                good = ok(probe, r)
-                b[r] = np.where(good, probe, b[r])
-                a[r] = np.where(good, a[r], probe)
     while (rows := np.nonzero(b - a > 1)[0]).size:
         mid = (a[rows] + b[rows]) // 2
         good = ok(mid, rows)
@@ -342,10 +62,11 @@ def exact_ideal_min_contact(sensor, lo, hi, ratio, *, width: float = 80.0, thres
                             max_contact_s: float = 10.0) -> np.ndarray:
     """Ideal observer's shortest contact [s] for classes ``[lo, lo+w)``, ``[hi, hi+w)``, vectorized.
 
-    Exact to the sample: F1 only changes when a sample arrives, so this is the
-    first sample time ``n / fs`` at which the ideal F1 reaches ``threshold``
-    (bisection on the sample count ``n``; F1 never falls with more samples).
-    NaN where ``max_contact_s`` does not suffice.
+    Exact to the sample: F1 only changes when a sample arrives, and only through the projection noise
+    ``s = (sigma/dT) / |g|``, which falls with every sample; so this is the first sample time ``n / fs``
+    at which ``s`` reaches the pair's critical noise
+    (:func:`~designkit.recognition.ideal.critical_noise`). NaN where ``max_contact_s`` does not suffice.
+    Through the per-process memo (a pure function of its arguments: a hit returns what a computation would).
 
     Parameters
     ----------
@@ -355,7 +76,7 @@ def exact_ideal_min_contact(sensor, lo, hi, ratio, *, width: float = 80.0, thres
         Lower edges of the two classes [J s^-1/2 K^-1 m^-2].
     ratio : array_like
         Noise sigma over temperature difference, sigma/dT [-].
-    width : float
+    width : float or array_like
         Class width [J s^-1/2 K^-1 m^-2].
     threshold : float
         F1 threshold Phi.
@@ -366,45 +87,56 @@ def exact_ideal_min_contact(sensor, lo, hi, ratio, *, width: float = 80.0, thres
     -------
     ndarray
         Contact time [s] (NaN: none up to ``max_contact_s``).
+
+    Examples
+    --------
+    >>> from designkit.sensor import load_sensor
+    >>> round(float(exact_ideal_min_contact(load_sensor("paper"), 20000.0, 35000.0, 0.005)), 3)
+    1.05
     """
-    lo, hi, ratio, width = (np.asarray(x, dtype=np.float64) for x in np.broadcast_arrays(lo, hi, ratio, width))
     fs = float(sensor.sample_rate_hz)
-    n_max = int(last_sample_index(max_contact_s, fs))
-    cum = _cumulative_g2(float(sensor.tau_s), fs, max(n_max, 1))
+    n_max = max(int(last_sample_index(max_contact_s, fs)), 1)
 
-    shape = lo.shape
-    lo, hi, ratio, width = lo.ravel(), hi.ravel(), ratio.ravel(), width.ravel()
+    def compute(a, b, r, w):
+        star = pair_critical_noise(sensor, a, b, width=w, threshold=threshold)
+        return first_sample_at(cumulative_g2(float(sensor.tau_s), fs, n_max), r, star) / fs
+    return _cached("min-contact", sensor, (lo, hi, ratio, width), (float(threshold), float(max_contact_s)),
+                   compute)
 
-    def ok(n, rows):
+
+def first_sample_at(cum: np.ndarray, ratio, s_star) -> np.ndarray:
+    """First sample count ``n >= 1`` with ``ratio / sqrt(cum[n]) <= s_star`` (``cum``: the cumulative squared
+    response shape, :func:`~designkit.recognition.ideal.cumulative_g2`), elementwise; NaN where no count up
+    to ``cum.size - 1`` is."""
+    ratio, s_star = np.broadcast_arrays(np.asarray(ratio, dtype=np.float64), np.asarray(s_star, dtype=np.float64))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        need = np.where(s_star > 0, (ratio / s_star) ** 2, np.where(ratio > 0, np.inf, 0.0))
+    need = np.where(np.isnan(s_star) | np.isnan(ratio), np.inf, need)
+    top = cum.size - 1
+    n = 1 + np.searchsorted(cum[1:], need, side="left")
+    # the decision itself, as written, at the count and the one before (rounding of the square)
+    def ok(k):
         with np.errstate(divide="ignore", invalid="ignore"):
-            s = ratio[rows] / np.sqrt(cum[n])  # n = 0 (no signal yet): s infinite, or NaN at ratio 0 (F1 NaN: not ok)
-        return _ok(sensor, lo[rows], hi[rows], width[rows], s, threshold)
-
-    a = np.zeros(lo.shape, dtype=np.int64)  # n = 0: one sample at contact, no information
-    b = np.full(lo.shape, n_max, dtype=np.int64)
-    guess = _gaussian_sample_guess(sensor, lo, hi, width, ratio, threshold, cum)
-    n = _first_good_sample(ok, a, b, guess)
-    # an answer below n_max was decided true; one at n_max may be "never": decide those alone
-    top = np.ones(lo.shape, dtype=bool)
-    if (last := np.nonzero(n == n_max)[0]).size:
-        top[last] = ok(n[last], last)
-    return np.where(top, n / fs, np.nan).reshape(shape)
+            return ratio / np.sqrt(cum[np.clip(k, 1, top)]) <= s_star
+    n = np.where((n <= top) & ~ok(n), n + 1, n)
+    n = np.where((n > 1) & (n - 1 <= top) & ok(n - 1), n - 1, n)
+    return np.where((n <= top) & np.isfinite(need), n, np.nan)
 
 
-#: Largest sigma/dT [-] the ideal observer's max-ratio search reaches above its bracket (a touch has at most
-#: 1e6 samples, each at a signal of at most dT: no pair separates near this noise).
+#: Largest sigma/dT [-] the ideal observer's max-ratio answers (a touch has at most 1e6 samples, each at a
+#: signal of at most dT: no pair separates near this noise); infinity beyond it.
 RATIO_CEILING = 1e6
 
 
 def exact_ideal_max_ratio(sensor, lo, hi, contact_s, *, width: float = 80.0, threshold: float = 0.9,
-                          bracket=(1e-6, 1.0), rel_tol: float = 1e-5) -> np.ndarray:
-    """Ideal observer's largest sigma/dT [-] that still separates the classes, vectorized (log bisection).
+                          bracket=(1e-6, 1.0)) -> np.ndarray:
+    """Ideal observer's largest sigma/dT [-] that still separates the classes, vectorized: the pair's critical
+    noise (:func:`~designkit.recognition.ideal.critical_noise`) times the response shape's norm at ``contact_s`` [s].
 
-    NaN where even ``bracket[0]`` does not separate them. Where ``bracket[1]`` still
-    does, the search goes on upwards a decade at a time (the answer is a bound, and the
-    bracket's top is not one: at 10 s of contact the ideal observer separates 500 from
-    39,000 up to sigma/dT 4.6), up to :data:`RATIO_CEILING`; infinity beyond it.
-    ``contact_s`` [s], other arguments as :func:`exact_ideal_min_contact`.
+    NaN where even ``bracket[0]`` does not separate them. The bracket's top is no bound (at 10 s of contact
+    the ideal observer separates 500 from 39,000 up to sigma/dT 4.6): answers run up to
+    :data:`RATIO_CEILING`, infinity beyond it. Other arguments as :func:`exact_ideal_min_contact` (and
+    through the same memo).
 
     Examples
     --------
@@ -413,38 +145,10 @@ def exact_ideal_max_ratio(sensor, lo, hi, contact_s, *, width: float = 80.0, thr
     >>> 4.6 < float(r) < 4.7
     True
     """
-    lo, hi, contact = (np.asarray(x, dtype=np.float64) for x in np.broadcast_arrays(lo, hi, contact_s))
-    shape = lo.shape
-    norm = shape_norm(sensor, contact)
-    with np.errstate(divide="ignore"):
-        per_ratio = np.where(norm > 0, 1.0 / norm, np.inf).ravel()  # s = ratio * this
-    lo, hi = lo.ravel(), hi.ravel()
-    out = _max_ratio_in(sensor, lo, hi, per_ratio, width, threshold, bracket, rel_tol)
-    up = np.flatnonzero(out >= bracket[1])  # separable at the bracket's top: the bound lies above it
-    top = float(bracket[1])
-    while up.size and top < RATIO_CEILING:
-        nxt = min(10.0 * top, RATIO_CEILING)
-        sub = _max_ratio_in(sensor, lo[up], hi[up], per_ratio[up], width, threshold, (top, nxt), rel_tol)
-        out[up] = sub
-        up, top = up[sub >= nxt], nxt
-    out[up] = np.inf
-    return out.reshape(shape)
-
-
-def _max_ratio_in(sensor, lo, hi, per_ratio, width, threshold, bracket, rel_tol) -> np.ndarray:
-    """:func:`exact_ideal_max_ratio` inside ``bracket`` alone: NaN where its low end does not separate, its top
-    where that still does (1-D arrays; ``per_ratio``: the projection noise per unit sigma/dT)."""
-    def ok(log_r):
-        return _ok(sensor, lo, hi, width, np.exp(log_r) * per_ratio, threshold)
-
-    la = np.full(lo.shape, math.log(bracket[0]))
-    lb = np.full(lo.shape, math.log(bracket[1]))
-    ok_lo, ok_hi = ok(la), ok(lb)
-    while np.any(active := lb - la > rel_tol):  # an element stops when it converges: its answer does not
-        mid = 0.5 * (la + lb)                    # depend on the other elements of the call (nor on a cache)
-        good = ok(mid)
-        la, lb = np.where(active & good, mid, la), np.where(active & ~good, mid, lb)
-    return np.where(ok_lo, np.where(ok_hi, bracket[1], np.exp(la)), np.nan)
+    def compute(a, b, c, w):
+        r = pair_critical_noise(sensor, a, b, width=w, threshold=threshold) * shape_norm(sensor, c)
+        return np.where(r >= bracket[0], np.where(r > RATIO_CEILING, np.inf, r), np.nan)
+    return _cached("max-ratio", sensor, (lo, hi, contact_s, width), (float(threshold), float(bracket[0])), compute)
 
 
 def exact_ideal_delta(sensor, e, contact_s, ratio, *, direction=+1, width: float = 80.0,
@@ -454,7 +158,8 @@ def exact_ideal_delta(sensor, e, contact_s, ratio, *, direction=+1, width: float
     Reference class ``[e, e+w)``, partner ``[e +- d, e +- d + w)`` (as
     :func:`designkit.query.exact_delta_e`); bisection on ``d`` to ``tol``.
     NaN where no partner inside ``(0, e_max]`` is distinguishable. ``direction`` may be an array (elementwise,
-    each element's bisection its own: the answers are those of one call per direction).
+    each element's bisection its own: the answers are those of one call per direction). Through the
+    per-process memo, as :func:`exact_ideal_min_contact`.
 
     >>> from designkit.sensor import load_sensor
     >>> s = load_sensor("paper")
@@ -463,8 +168,13 @@ def exact_ideal_delta(sensor, e, contact_s, ratio, *, direction=+1, width: float
     ...                                      for d in (-1, 1)]
     True
     """
-    e, contact, ratio, direction = (np.asarray(x, dtype=np.float64) for x in np.broadcast_arrays(
-        e, contact_s, ratio, direction))
+    def compute(a, c, r, d):  # both directions in one bisection (each element's its own)
+        return _ideal_delta(sensor, a, c, r, np.where(d > 0, 1.0, -1.0), width, threshold, e_max, tol)
+    return _cached("delta", sensor, (e, contact_s, ratio, np.where(np.asarray(direction) > 0, 1.0, -1.0)),
+                   (float(width), float(threshold), float(e_max), float(tol)), compute)
+
+
+def _ideal_delta(sensor, e, contact, ratio, direction, width, threshold, e_max, tol) -> np.ndarray:
     norm = shape_norm(sensor, contact)
     with np.errstate(divide="ignore", invalid="ignore"):  # no signal yet (norm 0): s infinite, whatever the ratio
         s = np.where(norm > 0, ratio / norm, np.inf)
@@ -473,7 +183,7 @@ def exact_ideal_delta(sensor, e, contact_s, ratio, *, direction=+1, width: float
 
     def ok(d):
         p = e + direction * d
-        return _ok(sensor, np.minimum(e, p), np.maximum(e, p), width, s, threshold)
+        return separates(sensor, np.minimum(e, p), np.maximum(e, p), width, s, threshold)
 
     valid = limit >= width
     lim = np.where(valid, limit, width)
@@ -523,122 +233,20 @@ def _cached(kind: str, sensor, columns: tuple, params: tuple, compute) -> np.nda
     return out.reshape(cols[0].shape)
 
 
-def cached_ideal_min_contact(sensor, lo, hi, ratio, *, width: float = 80.0, threshold: float = 0.9,
-                             max_contact_s: float = 10.0) -> np.ndarray:
-    """:func:`exact_ideal_min_contact` through the per-process cache (same answers, same arguments).
+def pair_critical_noise(sensor, lo, hi, *, width=80.0, threshold: float = 0.9) -> np.ndarray:
+    """:func:`~designkit.recognition.ideal.critical_noise` through the per-process memo, elementwise over
+    ``lo``, ``hi``, ``width`` (the
+    distinct misses in one vectorized call): every closed-form bound of a pair (its shortest contact, its
+    largest sigma/dT, the efficiency route's readings) is a cheap function of it.
 
     >>> from designkit.sensor import load_sensor
     >>> s = load_sensor("paper")
-    >>> float(cached_ideal_min_contact(s, 20000.0, 35000.0, 0.005)) == float(exact_ideal_min_contact(
-    ...     s, 20000.0, 35000.0, 0.005))
+    >>> float(pair_critical_noise(s, 20000.0, 35000.0)) == float(critical_noise(s, 20000.0, 35000.0))
     True
     """
-    def compute(a, b, r):
-        return exact_ideal_min_contact(sensor, a, b, r, width=width, threshold=threshold,
-                                       max_contact_s=max_contact_s)
-    return _cached("min-contact", sensor, (lo, hi, ratio), (float(width), float(threshold), float(max_contact_s)),
-                   compute)
-
-
-def cached_ideal_delta(sensor, e, contact_s, ratio, direction, *, width: float = 80.0, threshold: float = 0.9,
-                       e_max: float = 40000.0, tol: float = 0.5) -> np.ndarray:
-    """:func:`exact_ideal_delta` through the per-process cache, ``direction`` (+1 / -1) elementwise."""
-    def compute(a, c, r, d):  # both directions in one bisection (each element's its own)
-        return exact_ideal_delta(sensor, a, c, r, direction=np.where(d > 0, 1.0, -1.0), width=width,
-                                 threshold=threshold, e_max=e_max, tol=tol)
-    return _cached("delta", sensor, (e, contact_s, ratio, direction),
-                   (float(width), float(threshold), float(e_max), float(tol)), compute)
-
-
-def cached_ideal_max_ratio(sensor, lo, hi, contact_s, *, width: float = 80.0, threshold: float = 0.9,
-                           bracket=(1e-6, 1.0), rel_tol: float = 1e-5) -> np.ndarray:
-    """:func:`exact_ideal_max_ratio` through the per-process cache (same answers, same arguments)."""
-    def compute(a, b, c):
-        return exact_ideal_max_ratio(sensor, a, b, c, width=width, threshold=threshold, bracket=bracket,
-                                     rel_tol=rel_tol)
-    return _cached("max-ratio", sensor, (lo, hi, contact_s),
-                   (float(width), float(threshold), float(bracket[0]), float(bracket[1]), float(rel_tol)), compute)
-
-
-# ============================================================ the noise at which the ideal observer just separates
-@functools.lru_cache(maxsize=8)
-def _z_of(threshold: float) -> float:
-    """``Phi^-1(threshold)``, read off :func:`_phi_table` (enough for a starting guess)."""
-    cdf, _ = _phi_table()
-    return float(np.interp(threshold, cdf, np.arange(-_PHI_Z, _PHI_Z + _PHI_H / 2, _PHI_H)))
-
-
-def _gaussian_noise_guess(sensor, lo, hi, width, threshold) -> np.ndarray:
-    """The projection noise :func:`_gaussian_sample_guess` takes as the largest that still separates
-    ``[lo, lo+w)`` from ``[hi, hi+w)`` (NaN where the approximation says none does)."""
-    z = _z_of(float(threshold))
-    e_s = sensor.effusivity
-    wl = _weight(e_s, np.stack([lo, lo + width]))
-    wh = _weight(e_s, np.stack([hi, hi + width]))
-    spread2 = ((wl[1] - wl[0]) ** 2 + (wh[1] - wh[0]) ** 2) / 24.0
-    dw = np.abs(0.5 * (wh[0] + wh[1] - wl[0] - wl[1]))
-    with np.errstate(invalid="ignore"):
-        return np.sqrt((dw / (2.0 * z)) ** 2 - spread2)
-
-
-#: Half-width [log s] of the two-point probe of :func:`critical_noise` around its current estimate.
-_CRIT_H = 0.04
-
-
-def critical_noise(sensor, lo, hi, *, width: float = 80.0, threshold: float = 0.9,
-                   rounds: int = 8) -> np.ndarray:
-    """Projection noise ``s*`` [-] at which the ideal observer's F1 of ``[lo, lo+w)``, ``[hi, hi+w)`` is
-    ``threshold``, vectorized (the F1 falls as the noise grows).
-
-    A classifier that needs the pair's separation at noise ``s`` behaves like an ideal observer at the
-    larger noise ``k s``: ``k`` (>= 1) is its *noise efficiency*, ``s*(its need) / s``
-    (:func:`designkit.query.table.noise_k_min_contact`). From the Gaussian guess
-    (:func:`_gaussian_noise_guess`, within a few per cent) each element probes the F1 at
-    ``log s +- 0.04`` in one vectorized call and takes the linear root in log s; where that root lies
-    outside the probe it moves there (at most 1 in log s a round) and probes again. One call for most
-    elements instead of a bisection's 12-15 (the main job's start-up); linear interpolation over 0.08 in
-    log s is exact to ~1e-4 in s* (tested against a bisection). An element's path depends on its own F1
-    values only (the answers are cacheable per element).
-
-    >>> from designkit.sensor import load_sensor
-    >>> s = load_sensor("paper")
-    >>> star = float(critical_noise(s, 20000.0, 35000.0))
-    >>> bool(ideal_f1(20000.0, 35000.0, 80.0, s.effusivity, 0.998 * star) >= 0.9 > ideal_f1(
-    ...     20000.0, 35000.0, 80.0, s.effusivity, 1.002 * star))
-    True
-    """
-    cols = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64) for x in (lo, hi)))
-    shape = cols[0].shape
-    lo, hi = (c.ravel() for c in cols)
-    guess = _gaussian_noise_guess(sensor, lo, hi, width, threshold)
-    centre = np.log(np.where(np.isfinite(guess) & (guess > 0), guess, 1e-4))
-    out = np.full(lo.shape, np.nan)
-    live = np.arange(lo.size)
-    for _ in range(rounds):
-        if not live.size:
-            break
-        c = centre[live]
-        pts = np.stack([c - _CRIT_H, c + _CRIT_H], axis=1)
-        f = ideal_f1(np.repeat(lo[live], 2), np.repeat(hi[live], 2), width, sensor.effusivity,
-                     np.exp(pts).ravel()).reshape(-1, 2) - threshold
-        with np.errstate(divide="ignore", invalid="ignore"):
-            root = pts[:, 0] + f[:, 0] * (2 * _CRIT_H) / (f[:, 0] - f[:, 1])
-        slope_ok = f[:, 0] > f[:, 1]
-        done = slope_ok & (root >= pts[:, 0] - 1e-9) & (root <= pts[:, 1] + 1e-9)
-        out[live[done]] = np.exp(root[done])
-        # elsewhere: towards the root (or, on a flat stretch, towards more noise where the F1 is still above)
-        step = np.where(slope_ok & np.isfinite(root), np.clip(root - c, -1.0, 1.0), np.where(f[:, 0] >= 0, 1.0, -1.0))
-        centre[live[~done]] = c[~done] + step[~done]
-        live = live[~done]
-    out[live] = np.exp(centre[live])  # not converged in ``rounds`` (not seen): the last estimate
-    return out.reshape(shape)
-
-
-def cached_critical_noise(sensor, lo, hi, *, width: float = 80.0, threshold: float = 0.9) -> np.ndarray:
-    """:func:`critical_noise` through the per-process cache (same answers, same arguments)."""
-    def compute(a, b):
-        return critical_noise(sensor, a, b, width=width, threshold=threshold)
-    return _cached("critical-noise", sensor, (lo, hi), (float(width), float(threshold)), compute)
+    def compute(a, b, w):
+        return critical_noise(sensor, a, b, width=w, threshold=threshold)
+    return _cached("critical-noise", sensor, (lo, hi, width), (float(threshold),), compute)
 
 
 def noise_k_contact(sensor, ratio, s_star, t_a, t_b, log_k_a, log_k_b, max_contact_s: float) -> np.ndarray:
@@ -663,7 +271,7 @@ def noise_k_contact(sensor, ratio, s_star, t_a, t_b, log_k_a, log_k_b, max_conta
     ratio, s_star, t_a, t_b, ka, kb = (c.ravel() for c in cols)
     fs = float(sensor.sample_rate_hz)
     n_max = int(last_sample_index(max_contact_s, fs))
-    cum = _cumulative_g2(float(sensor.tau_s), fs, max(n_max, 1))
+    cum = cumulative_g2(float(sensor.tau_s), fs, max(n_max, 1))
     with np.errstate(divide="ignore", invalid="ignore"):
         slope = np.where(t_a != t_b, (kb - ka) / np.log(t_b / t_a), 0.0)
         log_ta, log_r, log_s = np.log(t_a), np.log(ratio), np.log(s_star)

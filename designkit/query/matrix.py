@@ -344,10 +344,10 @@ def multiclass_ideal_accuracy(ranges, sensor, scene, *, max_bins: int = _MAX_BIN
     1.0
     """
     from ..models.semi_infinite import object_weight
-    from .ideal_bound import class_survival, projection_noise  # scipy-free: importing scipy cost more than this
+    from ..recognition.ideal import class_survival, projection_noise
 
     r = np.asarray(ranges, dtype=np.float64)
-    s = projection_noise(sensor, scene.contact_s, scene.noise_ratio)
+    s = projection_noise(sensor, scene)
     K = r.shape[0]
     if not np.isfinite(s):
         return 1.0 / K
@@ -454,7 +454,7 @@ def _prefill_bounds(question: str, mats, tab, itab, given: dict) -> None:
     if question not in ("min-contact", "max-noise", "min-delta-t"):
         return
     from . import table as table_route
-    from .ideal_bound import cached_ideal_max_ratio
+    from .ideal_bound import exact_ideal_max_ratio
     from .inputs import check_contact, pair_question
 
     try:
@@ -478,8 +478,8 @@ def _prefill_bounds(question: str, mats, tab, itab, given: dict) -> None:
             ask("min-contact", route="table", e1=np.array(los), e2=np.array(his), table=tab, ideal_table=itab,
                 **given)
         else:
-            cached_ideal_max_ratio(op.tab.sensor, los, his, check_contact(given["contact_s"]), width=op.width,
-                                   threshold=op.phi, bracket=table_route.CLOSED_FORM_RATIO_BRACKET)
+            exact_ideal_max_ratio(op.tab.sensor, los, his, check_contact(given["contact_s"]), width=op.width,
+                                  threshold=op.phi, bracket=table_route.CLOSED_FORM_RATIO_BRACKET)
     except (InputError, KeyError):
         return
 

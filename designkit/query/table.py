@@ -590,7 +590,8 @@ def _k_readings_computed(op, slices, sw, ka, kb, lo, hi, extra=None):
     ``lo``, downwards at ``hi``) in the noise-ratio slices ``slices`` (n, m) weighted ``sw`` (n, m); see
     :func:`noise_k_min_contact`. ``extra``: (lo, hi) of further pairs whose critical noises are computed in
     the same call, returned third (or None)."""
-    from .ideal_bound import cached_critical_noise, shape_norm
+    from ..recognition.ideal import shape_norm
+    from .ideal_bound import pair_critical_noise
 
     view, tab = op.view, op.tab
     sensor, width = tab.sensor, op.width
@@ -630,8 +631,8 @@ def _k_readings_computed(op, slices, sw, ka, kb, lo, hi, extra=None):
     m = P.size
     xa, xb = extra if extra is not None else (np.zeros(0),) * 2
     # one computation: every entry at its need and one width further (and the extra pairs)
-    star = cached_critical_noise(sensor, np.concatenate([a1, a2, xa]), np.concatenate([b1, b2, xb]), width=width,
-                                 threshold=op.phi)
+    star = pair_critical_noise(sensor, np.concatenate([a1, a2, xa]), np.concatenate([b1, b2, xb]), width=width,
+                               threshold=op.phi)
     s1, s2 = star[:m], star[m:2 * m]
     with np.errstate(divide="ignore", invalid="ignore"):
         log_k = np.log(s1 / s_t)
@@ -739,7 +740,7 @@ def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
     The SVM separates a pair when the ideal observer would at a larger noise: ``k(t)`` times the projection
     noise ``s(t) = (sigma/dT) / |g(t)|`` (:mod:`designkit.query.ideal_bound`). Every tabulated need gives
     one reading of ``k``: the noise at which the ideal observer needs exactly that separation (less the
-    grid's rounding, w/2: :func:`~designkit.query.ideal_bound.critical_noise`) over ``s(t)`` of its slice.
+    grid's rounding, w/2: :func:`~designkit.recognition.ideal.critical_noise`) over ``s(t)`` of its slice.
     ``k`` is a property of the classifier and the contact time (on svm-paper it is the same for every
     sigma/dT, direction and effusivity to about 1 %, docs/accuracy.md), unlike the ratio of the needs in
     effusivity, which changes with the pair's width because the signal ``w(e) = e / (e_s + e)`` is concave
@@ -777,7 +778,8 @@ def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
         ``value``, ``low``, ``high`` [s], ``k_a``, ``k_b`` (NaN: no reading there), ``t_a``, ``t_b``,
         ``se_log`` (of the answer, log); ``value`` NaN where the route does not apply.
     """
-    from .ideal_bound import noise_k_contact, shape_norm
+    from ..recognition.ideal import shape_norm
+    from .ideal_bound import noise_k_contact
 
     view, sensor = op.view, op.tab.sensor
     lo, hi, ratio, kb = (np.atleast_1d(a) for a in np.broadcast_arrays(
@@ -932,7 +934,7 @@ def delta_efficiency_estimate(sensor, e, contact_s, ratio, direction, t_a, t_b, 
     The SVM's efficiency is its need over the ideal observer's for the asked reference class and direction,
     ``eff = s / i``. At every tabulated entry around the question (the contact times ``t_a``, ``t_b`` and the
     noise-ratio slices ``slice_ratios``) the ideal need ``i`` is computed exactly
-    (:func:`designkit.query.ideal_bound.cached_ideal_delta`; the table's own ideal needs are rounded up to its
+    (:func:`designkit.query.ideal_bound.exact_ideal_delta`; the table's own ideal needs are rounded up to its
     grid, and at small needs that rounding dominated the ratio) and the SVM's ``s`` is the middle of what its
     tabulated need ``S`` allows: the first grid distance whose F1 reaches Phi, so the crossing lies in
     ``(S - w, S]``, and never below the ideal observer's, ``[max(i, S - w), S]`` (SD its length / sqrt(12)).
@@ -982,7 +984,7 @@ def delta_efficiency_estimate(sensor, e, contact_s, ratio, direction, t_a, t_b, 
     >>> float(r["ideal"][0]) < float(r["low"][0]) < float(r["value"][0]) < float(r["high"][0])
     True
     """
-    from .ideal_bound import cached_ideal_delta
+    from .ideal_bound import exact_ideal_delta
 
     S, L, H = (np.asarray(a, dtype=np.float64) for a in (svm, svm_lo, svm_hi))
     m, n = S.shape[1], S.shape[2]
@@ -1000,7 +1002,8 @@ def delta_efficiency_estimate(sensor, e, contact_s, ratio, direction, t_a, t_b, 
     shape = (2, m, n)
     cols = [np.concatenate([np.broadcast_to(a, shape)[live], b]) for a, b in (
         (e, e), (np.stack([t_a, t_b])[:, None, :], contact), (rs[None], ratio), (direction, direction))]
-    ideal_all = cached_ideal_delta(sensor, *cols, width=width, threshold=threshold, e_max=e_max)
+    ideal_all = exact_ideal_delta(sensor, *cols[:3], direction=cols[3], width=width, threshold=threshold,
+                                  e_max=e_max)
     k = int(live.sum())
     i_entry = np.full(shape, np.nan)
     i_entry[live] = ideal_all[:k]
@@ -1295,10 +1298,10 @@ def _closed_ideal_contact(op: _Opened, lo: float, hi: float, noise: float, dt: f
     """
     if not op.closed:
         return None
-    from .ideal_bound import cached_ideal_min_contact
+    from .ideal_bound import exact_ideal_min_contact
 
-    return number(cached_ideal_min_contact(op.tab.sensor, lo, hi, noise / abs(dt), width=op.width,
-                                           threshold=op.phi, max_contact_s=CLOSED_FORM_MAX_CONTACT_S))
+    return number(exact_ideal_min_contact(op.tab.sensor, lo, hi, noise / abs(dt), width=op.width,
+                                          threshold=op.phi, max_contact_s=CLOSED_FORM_MAX_CONTACT_S))
 
 
 def _closed_ideal_ratio(op: _Opened, lo: float, hi: float, contact: float) -> float | None:
@@ -1306,10 +1309,10 @@ def _closed_ideal_ratio(op: _Opened, lo: float, hi: float, contact: float) -> fl
     None: no closed form, a touch beyond the sample limit, or not separable even at the bracket's low end."""
     if not (op.closed and within_sample_limit(contact, op.tab.sensor.sample_rate_hz)):
         return None
-    from .ideal_bound import cached_ideal_max_ratio
+    from .ideal_bound import exact_ideal_max_ratio
 
-    return number(cached_ideal_max_ratio(op.tab.sensor, lo, hi, contact, width=op.width, threshold=op.phi,
-                                         bracket=CLOSED_FORM_RATIO_BRACKET))
+    return number(exact_ideal_max_ratio(op.tab.sensor, lo, hi, contact, width=op.width, threshold=op.phi,
+                                        bracket=CLOSED_FORM_RATIO_BRACKET))
 
 
 def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | None = None,
@@ -1876,10 +1879,11 @@ def _outside_ideal_delta(op: _Opened, e: float, contact: float, ratio: float) ->
     range) for a question whose scene lies outside the table's grid; empty without a closed form."""
     if not (op.closed and within_sample_limit(contact, op.tab.sensor.sample_rate_hz)):
         return {}
-    from .ideal_bound import cached_ideal_delta
+    from .ideal_bound import exact_ideal_delta
 
-    down, up = cached_ideal_delta(op.tab.sensor, np.array([e, e]), contact, ratio, np.array([-1.0, 1.0]),
-                                  width=op.width, threshold=op.phi, e_max=op.view.e_hi)
+    down, up = exact_ideal_delta(op.tab.sensor, np.array([e, e]), contact, ratio,
+                                 direction=np.array([-1.0, 1.0]), width=op.width, threshold=op.phi,
+                                 e_max=op.view.e_hi)
     return {"lower": _no_side(number(down)), "upper": _no_side(number(up))}
 
 

@@ -376,10 +376,10 @@ def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float, outside
             varied_groups.append((combos, idx))
     sel = np.ones(lo.size, dtype=bool) if outside else todo
     if op.closed and ideal_bound and sel.any():  # outside the grid too: the closed form needs no table
-        from .ideal_bound import cached_ideal_min_contact
+        from .ideal_bound import exact_ideal_min_contact
 
         ratio = x["noise_c"] / np.abs(x["delta_t_c"])
-        res["ideal"][sel] = cached_ideal_min_contact(
+        res["ideal"][sel] = exact_ideal_min_contact(
             op.tab.sensor, lo[sel], hi[sel], ratio[sel], width=op.width, threshold=op.phi,
             max_contact_s=_table_route.CLOSED_FORM_MAX_CONTACT_S)
     # no closed form (varied initial conditions, per-object shapes): the scalar route's Monte Carlo bound, one
@@ -524,12 +524,12 @@ def _ratio(question, x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> 
                 a_r, a_w = _max_ratio(view, "svm", cw, le, he, **kw)
                 alt[key][j] = np.where(a_w == _INSIDE, a_r, np.nan)
     if op.closed and ideal_bound:  # every element, outside the grid too: the closed form needs no table
-        from .ideal_bound import cached_ideal_max_ratio
+        from .ideal_bound import exact_ideal_max_ratio
 
         ok = within_sample_limit(x["contact_s"], op.tab.sensor.sample_rate_hz)
         if ok.any():
-            ri[ok] = cached_ideal_max_ratio(op.tab.sensor, lo[ok], hi[ok], x["contact_s"][ok], width=op.width,
-                                            threshold=op.phi, bracket=_table_route.CLOSED_FORM_RATIO_BRACKET)
+            ri[ok] = exact_ideal_max_ratio(op.tab.sensor, lo[ok], hi[ok], x["contact_s"][ok], width=op.width,
+                                           threshold=op.phi, bracket=_table_route.CLOSED_FORM_RATIO_BRACKET)
 
     def to_answer(r):
         return r * np.abs(x["delta_t_c"]) if question == "max-noise" else x["noise_c"] / r
@@ -612,7 +612,7 @@ def _distinguishable(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float, ide
     if not ideal_bound:
         return
     if op.closed:  # every element, outside the grid too (within the sample limit): the closed form needs no table
-        from .ideal_bound import ideal_f1, shape_norm
+        from ..recognition.ideal import ideal_f1, shape_norm
 
         ok = within_sample_limit(x["contact_s"], op.tab.sensor.sample_rate_hz)
         if not ok.any():
@@ -760,13 +760,13 @@ def _table_delta_e(x: dict[str, np.ndarray], op, ideal_table, zc: float,
     # form needs no table (the scalar's _outside_ideal_delta)
     out = np.nonzero(~res["in_grid"] & e_in & within_sample_limit(x["contact_s"], op.tab.sensor.sample_rate_hz))[0]
     if op.closed and ideal_bound and out.size:
-        from .ideal_bound import cached_ideal_delta
+        from .ideal_bound import exact_ideal_delta
 
         ratio = x["noise_c"][out] / np.abs(x["delta_t_c"][out])
         for side, sign in (("lower", -1.0), ("upper", 1.0)):
-            res[f"{side}_ideal"][out] = cached_ideal_delta(op.tab.sensor, e[out], x["contact_s"][out], ratio,
-                                                           np.full(out.size, sign), width=op.width,
-                                                           threshold=op.phi, e_max=view.e_hi)
+            res[f"{side}_ideal"][out] = exact_ideal_delta(op.tab.sensor, e[out], x["contact_s"][out], ratio,
+                                                          direction=np.full(out.size, sign), width=op.width,
+                                                          threshold=op.phi, e_max=view.e_hi)
     res["value"] = np.fmin(res["lower"], res["upper"])
     res["ideal"] = np.fmin(res["lower_ideal"], res["upper_ideal"])
     # an SVM table's estimate (table-efficiency or table-estimate) states its coverage, as the scalar route's

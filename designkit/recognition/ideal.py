@@ -25,7 +25,19 @@ and every optimal classifier is a threshold on ``v``. This module evaluates
 by Gauss-Legendre quadrature on the part of ``[a, b)`` where the integrand
 is not 0 or 1 to double precision (``|w - t| < 8.5 s``), which is exact at
 ``s = 0`` and accurate to about 1e-11 elsewhere (tested against mpmath), and
-maximizes accuracy and F1 over the threshold.
+maximizes accuracy and F1 over the threshold. Inverted, it gives the
+*critical noise* ``s*`` at which the best F1 equals a threshold
+(:func:`critical_noise`, Newton's method on the pair of conditions), from which
+every closed-form bound of :mod:`designkit.query.ideal_bound` follows.
+
+The normal CDF is numpy's own here (:func:`ndtr`, cubic Hermite pieces of a
+table of :func:`math.erfc`, within 5e-14, tested against mpmath), not
+:mod:`scipy.special`: this module is the one closed form for the table
+builder and for a table question asked from a fresh shell, and importing
+``scipy.special`` costs that question about 0.35 s of a 0.2 s budget (measured
+with ``python -X importtime``, issue 16; ``tests/test_startup.py`` keeps the
+question scipy-free). The Monte Carlo observer below, which needs
+``scipy.special``'s ``log_ndtr`` and ``logsumexp``, imports them when it runs.
 
 Varied initial conditions (Monte Carlo on the exact likelihood)
 ---------------------------------------------------------------
@@ -47,99 +59,453 @@ when the classes cannot be told apart; the best *accuracy* is 0.5 then.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
-from scipy import special
-
 from .._validation import InputError, check_effusivity_range
 from .scores import TRIVIAL_F1
 from .scores import IdealResult, score_llr
 from ..models.semi_infinite import object_weight, response_shape
 from ..scene import Scene
-from ..sensor import Sensor
+from ..sensor import Sensor, last_sample_index
 
 __all__ = [
     "IdealResult",
     "class_survival",
+    "critical_noise",
+    "cumulative_g2",
+    "ideal_f1",
+    "ideal_method",
     "ideal_pair",
     "ideal_scores",
     "log_ndtr_diff",
+    "ndtr",
     "projection_noise",
     "score_llr",
+    "separates",
+    "shape_norm",
 ]
 
-_GL_X, _GL_W = np.polynomial.legendre.leggauss(40)
-_CUT = 8.5  # Phi(-8.5) = 9.5e-18: outside +-8.5 s the integrand is 0 or 1 to double precision
 _GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
 
 
 # ----------------------------------------------------------------- closed form
-def projection_noise(sensor: Sensor, scene: Scene) -> float:
-    """Noise ``s`` of the projected statistic ``v`` (dimensionless, units of ``w``).
+def _gauss_legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Legendre nodes and weights on [-1, 1] (Golub & Welsch 1969: the eigenvalues of the Jacobi matrix
+    of the Legendre recurrence, and twice the squared first components of its eigenvectors).
 
-    ``s = (sigma / |Ts0 - Ta|) / |g|`` with ``|g|`` the Euclidean norm of the
-    response shape over the touch's samples. ``inf`` when there is no signal
-    (no temperature difference, or no sample after contact); 0 when noise-free.
+    The same rule as ``numpy.polynomial.legendre.leggauss(n)`` (to 4e-16 in the nodes and 4e-15 in the
+    weights at n = 40, tested), without importing ``numpy.polynomial``: its classes cost a fresh table query
+    2.3 ms of a start-up that issue 16 counts (this takes 0.2 ms).
     """
-    ratio = scene.noise_ratio
-    g = response_shape(sensor.times_s(scene.contact_s), sensor.tau_s)
-    norm = float(np.sqrt(np.dot(g, g)))
-    if math.isinf(ratio) or norm == 0.0:
-        return math.inf
-    return ratio / norm
+    k = np.arange(1.0, n)
+    off = k / np.sqrt(4.0 * k * k - 1.0)
+    nodes, vectors = np.linalg.eigh(np.diag(off, 1) + np.diag(off, -1))
+    weights = 2.0 * vectors[0] ** 2
+    nodes = 0.5 * (nodes - nodes[::-1])  # exactly symmetric, as leggauss makes them
+    weights = 0.5 * (weights + weights[::-1])
+    return nodes, weights
 
 
-def _e_of_w(w, e_sensor):
-    """Inverse of ``w = e / (e_s + e)``; inf for w >= 1."""
-    w = np.asarray(w, dtype=np.float64)
+_GL_X, _GL_W = _gauss_legendre(40)
+_CUT = 8.5  # Phi(-8.5) = 9.5e-18: the integrand is 0 or 1 to double precision outside +-8.5 s
+_SQRT1_2 = math.sqrt(0.5)
+_PHI_H = 1.0 / 512.0  # grid step of the tabulated normal CDF (a power of two: exact node positions)
+_PHI_Z = 9.0  # beyond +-9 the CDF is 0 or 1 to 1e-19
+
+
+@functools.lru_cache(maxsize=1)
+def _phi_table() -> tuple[np.ndarray, np.ndarray]:
+    """The standard normal CDF and density on [-9, 9] every 1/512, from :func:`math.erfc` (~2 ms, once)."""
+    z = np.arange(-_PHI_Z, _PHI_Z + _PHI_H / 2, _PHI_H)
+    cdf = np.array([0.5 * math.erfc(-_SQRT1_2 * x) for x in z.tolist()])
+    return cdf, np.exp(-0.5 * z * z) / math.sqrt(2.0 * math.pi)
+
+
+@functools.lru_cache(maxsize=1)
+def _phi_horner() -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Coefficients ``c0..c3`` of the cubic Hermite piece on each interval of :func:`_phi_table`, in
+    ``x = (z + 9) * 512 - k`` on [0, 1]: ``Phi = ((c3 x + c2) x + c1) x + c0``."""
+    cdf, pdf = _phi_table()
+    p0, p1, m0, m1 = cdf[:-1], cdf[1:], _PHI_H * pdf[:-1], _PHI_H * pdf[1:]
+    return p0, m0, -3.0 * p0 - 2.0 * m0 + 3.0 * p1 - m1, 2.0 * p0 + m0 - 2.0 * p1 + m1
+
+
+def ndtr(z) -> np.ndarray:
+    """Standard normal CDF, elementwise (a new array; float64): cubic Hermite interpolation of :func:`_phi_table`.
+
+    Interpolation error at most h^4 max|d4 Phi| / 384 = 5e-14 (h = 1/512), tested against
+    :func:`math.erfc`; a Python call of math.erfc per element costs 5x more, scipy's import 0.35 s.
+    Evaluated in Horner form from per-interval coefficients, in place, with 1-D ``take`` gathers:
+    8x faster than the textbook basis form on (3000, 40) arrays (9.1 -> 1.1 ms, same values to
+    7e-16), which was a fifth of a 12-material ``designkit matrix``.
+    """
+    c0, c1, c2, c3 = _phi_horner()
+    u = np.clip(z, -_PHI_Z, _PHI_Z)
+    u += _PHI_Z
+    u *= 1.0 / _PHI_H
+    k = u.astype(np.int64)
+    np.minimum(k, c0.size - 1, out=k)
+    u -= k
+    r = c3.take(k)
+    r *= u
+    r += c2.take(k)
+    r *= u
+    r += c1.take(k)
+    r *= u
+    r += c0.take(k)
+    return r
+
+
+def cumulative_g2(tau_s: float, rate_hz: float, n_max: int) -> np.ndarray:
+    """``sum_{k <= n} g(k/fs)^2`` for n = 0 .. n_max (the first sample is at contact, t = 0).
+
+    A read-only view of one array per sensor, grown to the next power of two (a running sum: its first
+    ``n_max + 1`` entries do not depend on its length), so that calls with other ``n_max`` reuse it."""
+    size = 4096
+    while size < n_max + 1:
+        size *= 2
+    return _cumulative_g2_table(float(tau_s), float(rate_hz), size)[:n_max + 1]
+
+
+@functools.lru_cache(maxsize=16)
+def _cumulative_g2_table(tau_s: float, rate_hz: float, size: int) -> np.ndarray:
+    if tau_s == 0.0:
+        g = np.ones(size)
+    else:
+        g = np.array([0.0] + [math.erfc(math.sqrt(tau_s * rate_hz / k)) for k in range(1, size)])
+    cum = np.cumsum(g * g)
+    cum.flags.writeable = False
+    return cum
+
+
+def shape_norm(sensor, contact_s) -> np.ndarray:
+    """``|g|``, the norm of the response shape over a touch's samples, vectorized over ``contact_s`` [s].
+
+    The projection noise is ``(sigma/dT) / shape_norm`` (0 for no sample after contact: no signal).
+
+    >>> from designkit.sensor import load_sensor
+    >>> round(float(shape_norm(load_sensor("paper"), 2.0)), 4)
+    2.6732
+    """
+    n = last_sample_index(contact_s, sensor.sample_rate_hz)
+    cum = cumulative_g2(float(sensor.tau_s), float(sensor.sample_rate_hz), int(max(np.max(n), 1)))
+    return np.sqrt(cum[n])
+
+
+def _weight(e_s: float, e):
+    """``w = e / (e_s + e)`` (:func:`designkit.models.semi_infinite.object_weight`), for e > 0."""
+    with np.errstate(divide="ignore"):
+        return 1.0 / (1.0 + e_s / e)
+
+
+def _survival(t, a, b, wa, wb, e_s, s):
+    """``P(w(e) + s N(0,1) > t)`` with ``e ~ U[a, b)`` (:func:`class_survival`).
+
+    ``wa, wb`` are ``w(a), w(b)``; the cuts outside the class use its exact ends.
+    """
+    def cut(w_cut):
+        w = np.minimum(np.maximum(w_cut, wa), wb)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            e = e_s * w / (1.0 - w)
+        e = np.minimum(np.maximum(e, a), b)
+        return np.where(w_cut <= wa, a, np.where(w_cut >= wb, b, e))
+
+    e_lo, e_hi = cut(t - _CUT * s), cut(t + _CUT * s)
+    half, mid = 0.5 * (e_hi - e_lo), 0.5 * (e_hi + e_lo)
+    nodes = mid[..., None] + half[..., None] * _GL_X
     with np.errstate(divide="ignore", invalid="ignore"):
-        e = np.where(w < 1.0, e_sensor * w / (1.0 - w), np.inf)
-    return np.where(w <= 0.0, 0.0, e)
+        z = (_weight(e_s, nodes) - t[..., None]) / s[..., None]
+    z[np.isnan(z)] = 0.0
+    middle = ndtr(z)
+    middle *= _GL_W  # a row's sum alone (a matrix-vector product's blocking depends on the row count)
+    middle = half * middle.sum(axis=-1)
+    return np.minimum(np.maximum(((b - e_hi) + middle) / (b - a), 0.0), 1.0)
 
 
-def _cut_point(w_cut, wa, wb, a, b, e_sensor):
-    inside = np.clip(_e_of_w(np.clip(w_cut, wa, wb), e_sensor), a, b)
-    return np.where(w_cut <= wa, a, np.where(w_cut >= wb, b, inside))
+def class_survival(t, e_low, e_high, e_sensor: float, s) -> np.ndarray:
+    """``P(w(e) + s N(0,1) > t)`` for ``e ~ U[e_low, e_high)``, elementwise (all arguments but ``e_sensor``
+    broadcast; ``s`` >= 0 and finite, 0 the exact step limit).
+
+    Gauss-Legendre quadrature (40 nodes) on the part of ``[e_low, e_high)`` where the integrand is neither
+    0 nor 1 to double precision; accurate to about 1e-11 (tested against mpmath).
+
+    >>> float(class_survival([0.0], 20000.0, 20080.0, 892.0, 0.01)[0])
+    1.0
+    """
+    t, a, b, s = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64) for x in (t, e_low, e_high, s)))
+    return _survival(t, a, b, _weight(e_sensor, a), _weight(e_sensor, b), e_sensor, s)
 
 
-def class_survival(t, e_low, e_high, e_sensor, s):
-    """``P(v > t)`` for ``v = w(e) + N(0, s^2)``, ``e ~ U[e_low, e_high)``.
-
-    All arguments broadcast. ``s = 0`` gives the exact step-function limit.
+def ideal_f1(lo, hi, width, e_sensor: float, s, *, points: int = 17, passes: int = 7,
+             stop_at: float | None = None) -> np.ndarray:
+    """Best F1 of the ideal observer for classes ``[lo, lo+width)`` and ``[hi, hi+width)``, vectorized.
 
     Parameters
     ----------
-    t : array_like
-        Threshold on ``v`` (units of ``w``).
-    e_low, e_high : array_like
-        Class range [J s^-1/2 K^-1 m^-2].
+    lo, hi : array_like
+        Lower edges of the lower and higher class [J s^-1/2 K^-1 m^-2] (``hi`` positive).
+    width : float or array_like
+        Class width [J s^-1/2 K^-1 m^-2].
     e_sensor : float
         Sensor effusivity [J s^-1/2 K^-1 m^-2].
     s : array_like
-        Projection noise (>= 0, finite).
+        Projection noise [-] (>= 0, may be inf: no signal).
+    points, passes : int
+        Thresholds per pass and passes (each zooms onto the best cell: the
+        threshold is located to ``(2 / (points - 1)) ** passes`` of its bracket).
+    stop_at : float, optional
+        Stop zooming once every element's F1 reaches this (a decision ``F1 >= stop_at``
+        needs no more: F1 only grows with the passes). The values returned are then
+        lower bounds, exact as decisions.
 
     Returns
     -------
     ndarray
-        Probability in [0, 1].
+        F1 in [2/3, 1] (agrees with :func:`ideal_scores` to 1e-9, tested).
+
+    Examples
+    --------
+    >>> round(float(ideal_f1(20000.0, 35000.0, 80.0, 892.0, 0.0)), 6)
+    1.0
     """
-    t, a, b, s = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64) for x in (t, e_low, e_high, s)))
-    wa = object_weight(e_sensor, a)
-    wb = object_weight(e_sensor, b)
-    # [e_lo, e_hi]: where Phi((w(e) - t)/s) is neither 0 nor 1 to double precision.
-    # Cuts outside the class use its exact ends: w -> e -> w does not round-trip
-    # exactly, which would matter for very narrow classes.
-    e_lo = _cut_point(t - _CUT * s, wa, wb, a, b, e_sensor)
-    e_hi = _cut_point(t + _CUT * s, wa, wb, a, b, e_sensor)
-    half = 0.5 * (e_hi - e_lo)
-    mid = 0.5 * (e_hi + e_lo)
-    nodes = mid[..., None] + half[..., None] * _GL_X
-    with np.errstate(divide="ignore", invalid="ignore"):
-        z = (object_weight(e_sensor, nodes) - t[..., None]) / s[..., None]
-    z = np.where(np.isnan(z), 0.0, z)  # s = 0 and w == t: measure zero, value irrelevant
-    middle = half * np.sum(_GL_W * special.ndtr(z), axis=-1)
-    return np.clip(((b - e_hi) + middle) / (b - a), 0.0, 1.0)
+    lo, hi, width, s = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64) for x in (lo, hi, width, s)))
+    shape = lo.shape
+    lo, hi, width, s = (x.ravel() for x in (lo, hi, width, s))
+    out = np.full(lo.shape, TRIVIAL_F1)
+    ok = np.isfinite(s)
+    if not ok.any():
+        return out.reshape(shape)
+    la, lb, ha, hb, s = lo[ok], lo[ok] + width[ok], hi[ok], hi[ok] + width[ok], s[ok]
+
+    cols = [x[:, None] for x in (ha, hb, _weight(e_sensor, ha), _weight(e_sensor, hb),
+                                 la, lb, _weight(e_sensor, la), _weight(e_sensor, lb), s)]
+
+    def f1(t, rows):  # t: (len(rows), k) thresholds per pair of ``rows``
+        c = cols if rows is None else [x[rows] for x in cols]
+        tpr = _survival(t, *c[0:4], e_sensor, c[8])
+        fpr = _survival(t, *c[4:8], e_sensor, c[8])
+        return 2.0 * tpr / (1.0 + tpr + fpr)
+
+    # F1 is quasi-concave in the threshold: a grid, then zooms onto the best cell (one vectorized
+    # call per pass instead of one per golden-section step: the small-array overhead dominates)
+    a = _weight(e_sensor, np.minimum(la, ha)) - (_CUT + 1) * s
+    b = _weight(e_sensor, np.maximum(lb, hb)) + (_CUT + 1) * s
+    best = np.full(la.shape, -np.inf)
+    u = np.linspace(0.0, 1.0, points)
+    rows = None  # the elements still zooming (None: all); with stop_at, those below it
+    for _ in range(passes):
+        ra, rb = (a, b) if rows is None else (a[rows], b[rows])
+        t = ra[:, None] + (rb - ra)[:, None] * u
+        f = f1(t, rows)
+        k = np.argmax(f, axis=1)
+        top = f[np.arange(k.size), k]
+        step = (rb - ra) / (points - 1)
+        centre = t[np.arange(k.size), k]
+        if rows is None:
+            best = np.maximum(best, top)
+            a, b = centre - step, centre + step
+        else:
+            best[rows] = np.maximum(best[rows], top)
+            a[rows], b[rows] = centre - step, centre + step
+        if stop_at is not None:
+            rows = np.nonzero(best < stop_at)[0]
+            if rows.size == 0:
+                break
+    out[ok] = np.maximum(best, TRIVIAL_F1)
+    return out.reshape(shape)
+
+
+def separates(sensor, lo, hi, width, s, threshold) -> np.ndarray:
+    """Whether the ideal observer's best F1 of ``[lo, lo+w)``, ``[hi, hi+w)`` at projection noise ``s`` reaches
+    ``threshold`` (elementwise; F1 zoomed only as far as the decision needs)."""
+    return ideal_f1(lo, hi, width, sensor.effusivity, s, stop_at=threshold) >= threshold
+
+
+def _bisect_noise(sensor, lo, hi, per_ratio, width, threshold, bracket, rel_tol) -> np.ndarray:
+    """Largest sigma/dT inside ``bracket`` at which :func:`separates` holds, by bisection in log (to ``rel_tol``):
+    NaN where its low end does not separate, its top where that still does (1-D arrays; ``per_ratio``: the
+    projection noise per unit sigma/dT). The fallback of :func:`critical_noise`."""
+    def ok(log_r):
+        return separates(sensor, lo, hi, width, np.exp(log_r) * per_ratio, threshold)
+
+    la = np.full(lo.shape, math.log(bracket[0]))
+    lb = np.full(lo.shape, math.log(bracket[1]))
+    ok_lo, ok_hi = ok(la), ok(lb)
+    while np.any(active := lb - la > rel_tol):  # an element stops when it converges: its answer does not
+        mid = 0.5 * (la + lb)                    # depend on the other elements of the call (nor on a cache)
+        good = ok(mid)
+        la, lb = np.where(active & good, mid, la), np.where(active & ~good, mid, lb)
+    return np.where(ok_lo, np.where(ok_hi, bracket[1], np.exp(la)), np.nan)
+
+
+@functools.lru_cache(maxsize=8)
+def _z_of(threshold: float) -> float:
+    """``Phi^-1(threshold)``, read off :func:`_phi_table` (enough for a starting guess)."""
+    cdf, _ = _phi_table()
+    return float(np.interp(threshold, cdf, np.arange(-_PHI_Z, _PHI_Z + _PHI_H / 2, _PHI_H)))
+
+
+def _gaussian_noise_guess(sensor, lo, hi, width, threshold) -> np.ndarray:
+    """The largest projection noise that still separates ``[lo, lo+w)`` from ``[hi, hi+w)`` if each class's
+    weight ``w(e)`` were Gaussian with its uniform spread (variance ``(w(b) - w(a))^2 / 12``) added to the
+    noise: for two equal Gaussians the best F1 is about ``Phi(d/2)``, ``d = (w_hi - w_lo) / s_total``, so
+    ``s* = sqrt((dw / (2 z))^2 - spread^2)`` with ``z = Phi^-1(threshold)``. Only the starting point of
+    :func:`critical_noise` (within a few per cent); NaN where it says no noise is small enough."""
+    z = _z_of(float(threshold))
+    e_s = sensor.effusivity
+    wl = _weight(e_s, np.stack([lo, lo + width]))
+    wh = _weight(e_s, np.stack([hi, hi + width]))
+    spread2 = ((wl[1] - wl[0]) ** 2 + (wh[1] - wh[0]) ** 2) / 24.0
+    dw = np.abs(0.5 * (wh[0] + wh[1] - wl[0] - wl[1]))
+    with np.errstate(invalid="ignore"):
+        return np.sqrt((dw / (2.0 * z)) ** 2 - spread2)
+
+
+_INV_SQRT_2PI = 1.0 / math.sqrt(2.0 * math.pi)
+#: Quadrature nodes of the cheap first Newton steps of :func:`critical_noise` (the last steps use the 40 of
+#: :func:`class_survival`, which decide the answer).
+_COARSE_NODES = 12
+
+
+@functools.lru_cache(maxsize=4)
+def _rule(n: int) -> tuple[np.ndarray, np.ndarray]:
+    return (_GL_X, _GL_W) if n == _GL_X.size else _gauss_legendre(n)
+
+
+def _survival_derivatives(t, s, a, b, wa, wb, e_s, nodes: int):
+    """``S(t, s) = P(w(e) + s N(0,1) > t)`` for ``e ~ U[a, b)`` (as :func:`_survival`) and its derivatives in
+    the threshold ``t`` and in ``x = log s``: ``S, S_t, S_x, S_tt, S_tx`` (1-D arrays; ``nodes`` quadrature
+    nodes). The window cut at +-8.5 s moves with ``t`` and ``s``, but the integrand is 0 or 1 to double
+    precision at its ends, so the derivatives are the integrals of the integrand's."""
+    gx, gw = _rule(nodes)
+
+    def cut(w_cut):
+        w = np.minimum(np.maximum(w_cut, wa), wb)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            e = e_s * w / (1.0 - w)
+        e = np.minimum(np.maximum(e, a), b)
+        return np.where(w_cut <= wa, a, np.where(w_cut >= wb, b, e))
+
+    e_lo, e_hi = cut(t - _CUT * s), cut(t + _CUT * s)
+    half, mid = 0.5 * (e_hi - e_lo), 0.5 * (e_hi + e_lo)
+    z = _weight(e_s, mid[:, None] + half[:, None] * gx)
+    z -= t[:, None]
+    z /= s[:, None]
+    pdf = np.exp(-0.5 * z * z)
+    pdf *= _INV_SQRT_2PI
+    c = half / (b - a)
+
+    def quad(f):  # a row's sum alone (a matrix-vector product's blocking depends on the row count)
+        f *= gw
+        return f.sum(axis=1)
+
+    surv = np.minimum(np.maximum(((b - e_hi) + half * quad(ndtr(z))) / (b - a), 0.0), 1.0)
+    m0 = c * quad(pdf.copy())   # (1/(b-a)) integral of phi(z) de, and of z phi, z^2 phi
+    pdf *= z
+    m1 = c * quad(pdf.copy())
+    pdf *= z
+    m2 = c * quad(pdf)
+    return surv, -m0 / s, -m1, -m1 / (s * s), (m0 - m2) / s
+
+
+def critical_noise(sensor, lo, hi, *, width=80.0, threshold: float = 0.9, iterations: int = 40) -> np.ndarray:
+    """Projection noise ``s*`` [-] at which the ideal observer's best F1 of ``[lo, lo+w)``, ``[hi, hi+w)`` is
+    ``threshold``, vectorized over ``lo``, ``hi`` and ``width`` (the F1 falls as the noise grows).
+
+    A classifier that needs the pair's separation at noise ``s`` behaves like an ideal observer at the
+    larger noise ``k s``: ``k`` (>= 1) is its *noise efficiency*, ``s*(its need) / s``
+    (:func:`designkit.query.table.noise_k_min_contact`); the ideal observer's own shortest contact is the
+    first sample where ``(sigma/dT) / |g|`` falls to ``s*``
+    (:func:`designkit.query.ideal_bound.exact_ideal_min_contact`).
+
+    Solved as one system in the threshold ``t`` and ``x = log s``: ``F1(t, s) = threshold`` and
+    ``dF1/dt = 0`` (the threshold is the best one), by Newton's method with the analytic derivatives of
+    the class survivals (:func:`_survival_derivatives`), from the Gaussian guess
+    (:func:`_gaussian_noise_guess`) and the threshold midway between the classes: steps on a 12-node
+    quadrature until they are below 1e-4, then on the 40-node one of :func:`class_survival` until ``x``
+    moves less than 1e-13 (4-6 steps in all). The F1 there equals ``threshold`` to about 1e-12
+    (tested). Elements where the system does not converge (none seen on 20,000 random pairs; e.g. classes
+    whose F1 never reaches the threshold) are decided by a bisection in log s of :func:`ideal_f1`'s F1
+    (NaN where even noise 1e-12 does not separate them). An element's path depends on its own values only
+    (the answers are cacheable per element).
+
+    >>> from designkit.sensor import load_sensor
+    >>> s = load_sensor("paper")
+    >>> star = float(critical_noise(s, 20000.0, 35000.0))
+    >>> bool(ideal_f1(20000.0, 35000.0, 80.0, s.effusivity, 0.99999 * star) >= 0.9 > ideal_f1(
+    ...     20000.0, 35000.0, 80.0, s.effusivity, 1.00001 * star))
+    True
+    """
+    cols = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64) for x in (lo, hi, width)))
+    shape = cols[0].shape
+    lo, hi, width = (c.ravel() for c in cols)
+    e_s, phi = float(sensor.effusivity), float(threshold)
+    out = np.full(lo.shape, np.nan)
+    if lo.size == 0:
+        return out.reshape(shape)
+    n = lo.size
+    a, b = np.concatenate([hi, lo]), np.concatenate([hi, lo]) + np.concatenate([width, width])
+    ends = (a, b, _weight(e_s, a), _weight(e_s, b))  # the class ends and their weights: the higher, the lower
+    guess = _gaussian_noise_guess(sensor, lo, hi, width, phi)
+    x = np.log(np.where(np.isfinite(guess) & (guess > 0), guess, 1e-4))
+    t = 0.25 * (ends[2][:n] + ends[3][:n] + ends[2][n:] + ends[3][n:])
+    live = np.arange(lo.size)
+    nodes = np.full(lo.size, _COARSE_NODES)
+    for _ in range(iterations):
+        if not live.size:
+            break
+        coarse = nodes[live] == _COARSE_NODES
+        for n_q, r in ((_COARSE_NODES, live[coarse]), (_GL_X.size, live[~coarse])):
+            if not r.size:
+                continue
+            tr, xr = t[r], x[r]
+            s = np.exp(xr)
+            k = r.size  # both classes in one evaluation: rows [0, k) the higher, [k, 2k) the lower
+            both = _survival_derivatives(np.concatenate([tr, tr]), np.concatenate([s, s]), ends[0][r2 := np.concatenate(
+                [r, r + n])], ends[1][r2], ends[2][r2], ends[3][r2], e_s, n_q)
+            (T, F), (T_t, F_t), (T_x, F_x), (T_tt, F_tt), (T_tx, F_tx) = ((v[:k], v[k:]) for v in both)
+            d2 = (1.0 + T + F) ** 2
+            g1 = 2.0 * T / (1.0 + T + F) - phi          # F1 - threshold
+            g2 = T_t * (1.0 + F) - T * F_t              # dF1/dt * (1 + T + F)^2 / 2
+            j11, j12 = 2.0 * g2 / d2, 2.0 * (T_x * (1.0 + F) - T * F_x) / d2
+            j21, j22 = T_tt * (1.0 + F) - T * F_tt, T_tx * (1.0 + F) + T_t * F_x - T_x * F_t - T * F_tx
+            with np.errstate(divide="ignore", invalid="ignore"):
+                det = j11 * j22 - j12 * j21
+                dt = (j12 * g2 - g1 * j22) / det
+                dx = (j21 * g1 - j11 * g2) / det
+            bad = ~(np.isfinite(dt) & np.isfinite(dx))
+            dx = np.clip(np.where(bad, 0.0, dx), -0.5, 0.5)
+            dt = np.clip(np.where(bad, 0.0, dt), -3.0 * s, 3.0 * s)
+            t[r], x[r] = tr + dt, xr + dx
+            small = (np.abs(dx) < 1e-4) & (np.abs(dt) < 1e-4 * s)
+            fine = n_q != _COARSE_NODES
+            nodes[r[small]] = _GL_X.size
+            # quadratic convergence: after a step below 1e-7 the error is below ~1e-14
+            done = fine & (np.abs(dx) < 1e-7) & (np.abs(dt) < 1e-7 * s) & ~bad
+            out[r[done]] = np.exp(x[r[done]])
+            nodes[r[bad]] = -1  # not converging: the bisection below
+        live = live[np.isnan(out[live]) & (nodes[live] > 0)]
+    rest = np.flatnonzero(np.isnan(out))
+    if rest.size:
+        out[rest] = _bisect_noise(sensor, lo[rest], hi[rest], np.ones(rest.size), width[rest], phi,
+                                  (1e-12, 1e3), 1e-12)
+    return out.reshape(shape)
+
+
+def projection_noise(sensor: Sensor, scene: Scene) -> float:
+    """Noise ``s`` of the projected statistic ``v`` (dimensionless, units of ``w``).
+
+    ``s = (sigma / |Ts0 - Ta|) / |g|`` with ``|g|`` the Euclidean norm of the
+    response shape over the touch's samples (:func:`shape_norm`). ``inf`` when there is no signal
+    (no temperature difference, or no sample after contact); 0 when noise-free.
+    """
+    ratio = scene.noise_ratio
+    norm = float(shape_norm(sensor, scene.contact_s))
+    if math.isinf(ratio) or norm == 0.0:
+        return math.inf
+    return ratio / norm
 
 
 def _golden_max(f, lo, hi, iters: int = 60):
@@ -235,6 +601,8 @@ def log_ndtr_diff(lo, hi):
     >>> round(float(log_ndtr_diff(40.0, 41.0)), 3)  # Phi(-40) - Phi(-41), far below double precision
     -804.608
     """
+    from scipy import special
+
     lo, hi = np.broadcast_arrays(lo, hi)
     upper = lo > 0  # both in the upper tail: use Phi(-lo) - Phi(-hi)
     a = np.where(upper, -hi, lo)
@@ -265,6 +633,8 @@ def _loglik_sensor_integrated(Y0, Y1, YY, w, ta, m, S1, S2, mu_s, h_s, sigma):
 
 
 def _class_loglik(stats, e_range, sensor, scene, g, sigma, n_grid):
+    from scipy import special
+
     Y0, Y1, YY = stats
     a, b = e_range
     e = a + (np.arange(n_grid) + 0.5) * (b - a) / n_grid

@@ -169,8 +169,9 @@ def cases(d: Path, rng: random.Random) -> list[tuple[list[str], bool]]:
     cheap_base = {"min-contact", "max-noise", "min-delta-t", "delta-e", "distinguishable", "matrix", "validity",
                   "materials", "tables", "export", "simulate", "f1", "design", "sweep", "classify"}
     # bases whose answer takes seconds: only values that are bad by any reading (an answer is then a finding)
-    odd_ok = {"min-contact", "max-noise", "min-delta-t", "delta-e", "distinguishable", "matrix", "validity",
-              "materials", "tables", "export", "simulate", "classify"}
+    # (a shared 2-core machine answered a question's exact route in seconds: the odd values, which are often
+    # valid, go only to the bases that answer in milliseconds)
+    odd_ok = {"validity", "materials", "tables", "export", "simulate"}
 
     def put(base, flag, value, bad):
         argv = list(base)

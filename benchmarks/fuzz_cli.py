@@ -310,7 +310,12 @@ def main(argv=None) -> dict:
     all_cases = cases(work, random.Random(args.seed))
     if args.limit:
         all_cases = all_cases[:args.limit]
+    import typer.testing
+
+    command = typer.testing._get_command(app)  # the runner rebuilds the click command per invoke (~0.1 s): once
+    typer.testing._get_command = lambda a: command if a is app else None
     runner = CliRunner()
+    log = open(args.json.with_suffix(".jsonl"), "w") if args.json else None  # each case as it ends
     counts: dict[str, int] = {}
     notable = []
     accepted_bad = []
@@ -324,6 +329,9 @@ def main(argv=None) -> dict:
         finally:
             os.chdir(cwd)
         results.append((argv_, res))
+        if log is not None:
+            log.write(json.dumps({"argv": argv_, "bad": bad, **res}) + "\n")
+            log.flush()
         counts[res["outcome"]] = counts.get(res["outcome"], 0) + 1
         if res["outcome"] in ("internal", "hang", "multi-line"):
             notable.append({"argv": argv_, **res})

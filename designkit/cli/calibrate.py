@@ -932,6 +932,14 @@ def emulate(
 
     sensor_temp = check_temperature("--sensor-temp [degC]", sensor_temp)
     ambient = check_temperature("--ambient [degC]", ambient)
+    check_temperature("--noise [degC]", noise, nonnegative=True)  # 1e308 was taken
+    from ..calibration.profiles import MAX_PROFILE_SECONDS
+
+    if not 0 < touch_every <= MAX_PROFILE_SECONDS:
+        raise InputError(f"--touch-every must be a positive number of seconds up to {MAX_PROFILE_SECONDS:g} (a day), "
+                         f"got {touch_every:g}")
+    if not 1 <= touches_per_material <= 1_000_000:
+        raise InputError(f"--touches-per-material must be 1 to 1000000, got {touches_per_material}")
 
     mats = []
     for spec in material or []:

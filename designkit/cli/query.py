@@ -121,6 +121,11 @@ def _ask(question: str, *, exact: bool, table: Optional[str], ideal_table: str, 
             raise InputError(f"sensor temperature spread must be >= 0 degC, got {spread:g}")
         sen, fm, source = sensor_and_model(sensor, model, conductance=conductance, thickness=thickness,
                                            backing=backing)
+        if scene.get("contact_s") is not None:  # a touch the sensor can take, on either route (1e308 s was
+            from ..sensor import check_samples_per_touch  # answered "outside the table")
+
+            check_samples_per_touch(check_positive("--contact [s]", scene["contact_s"]), sen.sample_rate_hz,
+                                    "--contact", "give a contact time a touch can last")
         # the shipped tables are for the paper sensor and the semi-infinite model: another sensor or model is
         # computed unless a table is named (a named table built for another one is refused, never used);
         # varied initial conditions: no shipped table holds them, computed for the pair

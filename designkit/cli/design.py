@@ -95,6 +95,10 @@ def design(
         from ._format import check_out
 
         check_out(plot, "--plot")  # before the search; a missing folder is not made
+    from .._validation import check_temperature
+
+    check_temperature("--noise [°C]", noise, nonnegative=True)  # 1e308 searched, then "no design"
+    check_temperature("--max-delta-t [°C]", max_delta_t)
     cons = Constraints(max_contact_s=max_contact, noise_c=noise, max_delta_t_c=max_delta_t, max_rate_hz=max_rate,
                        depth_um=depths, threshold=threshold)
     targets = targets_from(m or (), set_)

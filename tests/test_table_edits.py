@@ -97,6 +97,11 @@ def test_delta_up_halved_in_place_is_refused_by_min_contact(fine, cli):
         npy = fh.read(size)
     header_len = size - 2720000
     data = np.frombuffer(npy[header_len:], dtype="<f8") / 2
+    from designkit.query.table import clear_table_cache
+
+    # a fresh process, as from a shell: answers this process computed from the shipped content (keyed by its
+    # content hash, which the copy's header claims) are forgotten
+    clear_table_cache()
     with _Edit(fine, offset + header_len, data.tobytes()):
         r = cli("min-contact", "--m1", "copper", "--m2", "glass", "--table", str(fine))
         assert r.exit_code == 2, r.output

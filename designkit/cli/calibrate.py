@@ -820,6 +820,19 @@ def emulate(
 
     sensor_temp = check_temperature("--sensor-temp [degC]", sensor_temp)
     ambient = check_temperature("--ambient [degC]", ambient)
+    check_temperature("--noise [degC]", noise, nonnegative=True)  # 1e308 was taken
+    from ..calibration.profiles import MAX_PROFILE_SECONDS
+
+    if not 0 < touch_every <= MAX_PROFILE_SECONDS:
+        raise InputError(f"--touch-every must be a positive number of seconds up to {MAX_PROFILE_SECONDS:g} (a day), "
+                         f"got {touch_every:g}")
+    if duration is not None and not 0 < duration <= MAX_PROFILE_SECONDS:  # inf, 1e308: never stopped
+        raise InputError(f"--duration must be a positive number of seconds up to {MAX_PROFILE_SECONDS:g} (a day; "
+                         f"leave it out to run until Ctrl-C), got {duration:g}")
+    if not 0 < speed <= 1e4:
+        raise InputError(f"--speed must be a positive factor up to 10000, got {speed:g}")
+    if not 1 <= touches_per_material <= 1_000_000:
+        raise InputError(f"--touches-per-material must be 1 to 1000000, got {touches_per_material}")
 
     mats = []
     for spec in material or []:

@@ -139,6 +139,9 @@ def classify(
         raise InputError(f"--time-offset must be within ±5 s, got {time_offset:g}")
     if object_temp is not None:  # 1e9 degC was taken (and printed as Ta); NaN got another option's message
         check_temperature("--object-temp", object_temp)
+    check_temperature("--delta-t [°C]", delta_t)  # 1e308 was taken
+    if noise is not None:
+        check_temperature("--noise [°C]", noise, nonnegative=True)
     check_probability("--error-rate", error_rate, low=0.0, high=0.5)
     sens = load_sensor(sensor)
     check_samples_per_touch(check_positive("--max-contact [s]", max_contact), sens.sample_rate_hz,

@@ -100,6 +100,10 @@ def design(
         check_out(plot, "--plot")  # before the search; a missing folder is not made
     cons = Constraints(max_contact_s=max_contact, noise_c=noise, max_delta_t_c=max_delta_t, max_rate_hz=max_rate,
                        depth_um=depths, threshold=threshold)
+    from .._validation import check_temperature
+
+    check_temperature("--noise [°C]", noise, nonnegative=True)  # 1e308 searched, then "no design"
+    check_temperature("--max-delta-t [°C]", max_delta_t)
     targets = targets_from(m or (), set_, identified=identified)
     skins = tuple(get_material(s).name for s in skin) if skin else SKIN_SET
     t0, c0 = time.perf_counter(), time.process_time()

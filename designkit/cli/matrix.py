@@ -85,6 +85,17 @@ def matrix(
         check_out(plot, "--plot")  # before the work, as export's --out
     names = list(m or ()) + (read_material_names(from_) if from_ else [])
     fmt = "json" if json_ else check_format(format_)
+    from .._validation import check_positive, check_temperature
+
+    if noise is not None:  # -inf, nan and 1e400 were answered
+        check_temperature("--noise [°C]", noise, nonnegative=True)
+    if delta_t is not None:
+        check_temperature("--delta-t [°C]", delta_t)
+    if contact is not None:  # a touch the sensor can take (1e308 s: an IndexError, then "n/a")
+        from ..sensor import check_samples_per_touch, load_sensor
+
+        check_samples_per_touch(check_positive("--contact [s]", contact), load_sensor(sensor).sample_rate_hz,
+                                "--contact", "give a contact time a touch can last")
     scene = {"contact_s": contact, "noise_c": noise, "delta_t_c": delta_t, "threshold": threshold}
     if question in ("max-noise", "min-delta-t", "distinguishable") and contact is None:
         from .._validation import InputError

@@ -142,6 +142,11 @@ def _ask_scene(question: str, *, exact: bool, table: Optional[str], ideal_table:
             raise InputError(f"sensor temperature spread must be >= 0 degC, got {spread:g}")
         sen, fm, source = sensor_and_model(sensor, model, conductance=conductance, thickness=thickness,
                                            backing=backing)
+        if scene.get("contact_s") is not None:  # a touch the sensor can take, on either route (1e308 s was
+            from ..sensor import check_samples_per_touch  # answered "outside the table")
+
+            check_samples_per_touch(check_positive("--contact [s]", scene["contact_s"]), sen.sample_rate_hz,
+                                    "--contact", "give a contact time a touch can last")
         from ..rig import resolve_scene
 
         asked = scene.get("contact_s")

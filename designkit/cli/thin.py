@@ -52,6 +52,9 @@ def validity(
     from ..models.slab import material_validity, resolve_backing, semi_infinite_deviation, semi_infinite_validity
 
     L = check_positive("thickness [m]", thickness)
+    from .._validation import check_temperature
+
+    check_temperature("--tolerance [°C]", tolerance, nonnegative=True)  # 1e308 was answered
     if plot is not None:
         from ._format import check_out
 

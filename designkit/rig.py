@@ -256,7 +256,7 @@ def resolve_scene(sensor, given: Mapping[str, float | None]) -> RigScene:
     if "contact_s" in given and given["contact_s"] is not None:
         values["contact_s"] = to_model_contact(float(given["contact_s"]), start)
         sources["contact_s"] = "user"
-        if values["contact_s"] <= 0:
+        if start is not None and values["contact_s"] <= 0 < float(given["contact_s"]):
             raise InputError(f"contact {given['contact_s']:g} s after the rig's detected onset ends before the "
                              f"model's first heat flow ({start:+.3g} s from the onset): give a longer contact")
     used = [f"{k} {values[k]:g} ({sources[k]})" for k in values if k != "contact_s"]

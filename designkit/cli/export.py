@@ -30,7 +30,7 @@ _WHAT = {"json": "JSON", "csv": "CSV", "npz": "NumPy npz", "mat": "MATLAB .mat",
 @app.command("export", rich_help_panel=_app.TABLES)
 def export_cmd(
     out: Annotated[str, typer.Option("--out", "-o", help="File to write (.json, .csv, .npz, .mat, .h or .py); - for standard output (give --format; a CSV then goes without its provenance sidecar).")],
-    table: Annotated[str, typer.Option("--table", help="Lookup table (name or path).")] = "svm-paper",
+    table: Annotated[str, typer.Option("--table", help="Lookup table (name or path); default the one every question reads.")] = "svm-fine",
     fmt: Annotated[Optional[str], typer.Option("--format", "-f", help=f"Format: {_FORMATS}. Default: from --out's suffix.")] = None,
     noise: Annotated[Optional[float], typer.Option("--noise", help="Keep one scene: noise sigma per sample [°C] (with --delta-t).")] = None,
     delta_t: Annotated[Optional[float], typer.Option("--delta-t", help="Keep one scene: sensor minus object temperature [°C] (with --noise).")] = None,

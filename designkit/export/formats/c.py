@@ -35,6 +35,7 @@ from ...tables.lookup import GRID_RTOL
 from .._common import (CLI_RELATION, c_comment, c_double, c_string, check_prefix, fill_template, log_grid, read_template,
                        regenerate_command, slice_lines)
 from ..slicing import Exported
+from .python import example_answer
 
 __all__ = ["TEMPLATE", "describe_model", "write"]
 
@@ -106,7 +107,48 @@ def write(exp: Exported, prefix: str = "designkit") -> bytes:
         v = sensor.get(key)
         return float(v) if isinstance(v, (int, float)) and not isinstance(v, bool) else math.nan
 
-    text = fill_template(read_template(TEMPLATE), {
+    est = exp.estimator
+    has_est = est is not None
+    grid_is_library = not has_est and p["fidelity"] != "svm" and p["kind"] == "svm"
+    ev = {"HAS_EST": "1" if has_est else "0", "GRID_IS_LIBRARY": "1" if grid_is_library else "0",
+          "EST_VERSION": str(p["estimator"]["version"]), "EST_COVERAGE": c_double(0.9)}
+    ev.update({k: "0" for k in ("UP_LO", "DOWN_LO", "UP_HI", "DOWN_HI", "CUM", "NCUM", "SF", "NSF", "RATIOS", "NR",
+                                "E_S", "FS", "WIDTH", "ZT", "ZC", "MCF", "ELO", "EHI", "NMAX", "SA0", "SDMIN", "SU0",
+                                "SDU", "SNU", "SV0", "SDV", "SNV")})  # inside "#if 0" when absent
+    if has_est:
+        scene_vals = exp.scene_axes[0].values
+        ev.update({
+            "UP_LO": _c_float_rows(exp.more["delta_up_lo"], exp), "DOWN_LO": _c_float_rows(exp.more["delta_down_lo"], exp),
+            "UP_HI": _c_float_rows(exp.more["delta_up_hi"], exp), "DOWN_HI": _c_float_rows(exp.more["delta_down_hi"], exp),
+            "CUM": _c_doubles(est["cum"]), "NCUM": str(len(est["cum"])), "SF": _c_doubles(est["s_f"]),
+            "NSF": str(len(est["s_f"])), "RATIOS": _c_doubles(scene_vals), "NR": str(len(scene_vals)),
+            "E_S": c_double(est["e_s"]), "FS": c_double(est["fs"]), "WIDTH": c_double(est["width"]),
+            "ZT": c_double(est["z_table"]), "ZC": c_double(est["zc"]), "MCF": c_double(est["mc_factor"]),
+            "ELO": c_double(est["e_lo"]), "EHI": c_double(est["e_hi"]),
+            "NMAX": str(int(math.floor(est["max_contact_s"] * est["fs"] + 1e-9))),
+            "SA0": c_double(est["s_a0"]), "SDMIN": c_double(est["s_dmin"]), "SU0": c_double(est["s_u0"]),
+            "SDU": c_double(est["s_du"]), "SNU": str(est["s_nu"]), "SV0": c_double(est["s_v0"]),
+            "SDV": c_double(est["s_dv"]), "SNV": str(est["s_nv"])})
+    q, ans = example_answer(exp)
+    if has_est:
+        how = ["Estimator: " + p["estimator"]["name"] + ", version " + str(p["estimator"]["version"]) + ": the",
+               "functions below answer as designkit min-contact / delta-e / distinguishable do (the same value",
+               "and 90 % interval), in double precision, libm only. max-noise and min-delta-t are not here."]
+    elif grid_is_library:
+        how = ["An ideal-observer table: designkit answers it by the grid rule, which the functions below run."]
+    else:
+        how = ["Estimator: none (" + str(p["estimator"]["unavailable"]) + ").",
+               "The functions below return " + P + "_NEEDS_DESIGNKIT (-4): only designkit answers this table as",
+               "designkit does; " + prefix + "_grid_* answer by the grid rule (not designkit's estimates)."]
+    example = [f"    #include <stdio.h>", f'    #include "{prefix}_table.h"',
+               "    int main(void) {", "        double iv[3];",
+               f"        if ({prefix}_min_contact_interval({q[0]!r}, {q[1]!r}, {q[2]!r}, {q[3]!r}, iv) == 0)",
+               '            printf("%.3f s (%.3f to %.3f)\\n", iv[0], iv[1], iv[2]);',
+               "        return 0;", "    }",
+               f"    prints {ans:.3f} s ...  (cc -std=c99 main.c -lm)" if ans is not None else "    prints nothing (none)"]
+    text = fill_template(read_template(TEMPLATE), {**ev,
+        "HOW": "\n".join(" * " + c_comment(x) for x in how),
+        "EXAMPLE": "\n".join(" * " + c_comment(x).replace("\\\\", "\\") for x in example),
         "P": P, "p": prefix,
         "SCENE_VARIED": "1" if varied else "0",
         "SCENE_DEFINES": "\n".join(defines),

@@ -184,10 +184,32 @@ class Estimator:
         return b / fs
 
     # ---------------------------------------------------------------- table readings
+    def _ew(self, e):
+        """Where ``e`` lies among the centres: ``(j, w)`` as :func:`interp_e` reads it (w None: centre j alone)."""
+        c = self.t.e_ref
+        n = len(c)
+        if e <= c[0]:
+            return 0, None
+        if e >= c[n - 1]:
+            return n - 1, None
+        j = bisect.bisect_right(c, e) - 1
+        w = (e - c[j]) / (c[j + 1] - c[j])
+        return j, (None if w == 0.0 else w)
+
+    def _val(self, arr, start, ew):
+        """:func:`interp_e` of the row at ``start`` with a precomputed :meth:`_ew`."""
+        j, w = ew
+        a = arr[start + j]
+        if w is None:
+            return a
+        b = arr[start + j + 1]
+        if a != a or b != b:
+            return math.nan
+        return a + w * (b - a)
+
     def _at(self, direction, suffix, row, k, e):
-        from_lookup = self.t
-        return interp_e(self.arr[(direction, suffix)], from_lookup.e_ref, e,
-                        (row * from_lookup._nc + k) * from_lookup._ne)
+        t = self.t
+        return self._val(self.arr[(direction, suffix)], (row * t._nc + k) * t._ne, self._ew(e))
 
     def _k_readings(self, slices, ka, kb, lo, hi):
         """log k and its standard error at contacts ka (0) and kb (1) (designkit.query.table._k_readings_computed)."""
@@ -196,6 +218,8 @@ class Estimator:
         rnd_sd = w / _SQRT12
         nc = len(self.contacts)
         lk, se = [math.nan, math.nan], [math.nan, math.nan]
+        ews = {1: self._ew(lo), -1: self._ew(hi)}
+        tt = self.t
         for c, j in ((0, ka), (1, kb)):
             if not 0 <= j < nc:
                 continue
@@ -206,13 +230,14 @@ class Estimator:
                 if not ws > 0:
                     continue
                 for sign, e, name in ((1, lo, "up"), (-1, hi, "down")):
-                    d = self._at(name, "", si, j, e)
+                    start, ew = (si * tt._nc + j) * tt._ne, ews[sign]
+                    d = self._val(self.arr[(name, "")], start, ew)
                     if not (_finite(d) and d > w):
                         continue
                     if sign < 0 and not e - (d - h) > 0:
                         continue
-                    dl = self._at(name, "_lo", si, j, e)
-                    dh = self._at(name, "_hi", si, j, e)
+                    dl = self._val(self.arr[(name, "_lo")], start, ew)
+                    dh = self._val(self.arr[(name, "_hi")], start, ew)
                     s_t = self.ratios[si] / norm
                     if sign > 0:
                         a1, b1, a2, b2 = e, e + (d - h), e, e + (d - h + w)
@@ -254,24 +279,30 @@ class Estimator:
         ahead = bisect.bisect_left(c, c[kb] * _K_SLOPE_SPAN * (1 - 1e-12))
         return ahead if ahead < len(c) else -1
 
-    def _needs(self, kind, combos, lo, hi):
-        t = self.t
+    def _cross(self, kind, combos, lo, hi):
+        """The grid's crossing of the need of ``kind`` ("", "_lo", "_hi"), read lazily up to it
+        (:func:`crossing`): ``(crossing or None, index or None, the needs read)``."""
         up, down = self.arr[("up", kind)], self.arr[("down", kind)]
-        out = []
-        for k in range(len(self.contacts)):
-            a = self._delta_at(up, combos, k, lo)
-            b = self._delta_at(down, combos, k, hi)
-            out.append(math.nan if _isnan(a) or _isnan(b) else max(a, b))
-        return out
+        ew_lo, ew_hi = self._ew(lo), self._ew(hi)
+        read = []
 
-    def _delta_at(self, arr, combos, k, e):
+        def needs():
+            for k in range(len(self.contacts)):
+                a = self._delta_at(up, combos, k, ew_lo)
+                b = self._delta_at(down, combos, k, ew_hi)
+                read.append(math.nan if a != a or b != b else max(a, b))
+                yield read[-1]
+        x, kb = crossing(self.contacts, needs(), hi - lo)
+        return x, kb, read
+
+    def _delta_at(self, arr, combos, k, ew):
         t = self.t
         total = 0.0
         for row, wt in combos:
             if wt == 0:
                 continue
-            v = interp_e(arr, t.e_ref, e, (row * t._nc + k) * t._ne)
-            if _isnan(v):
+            v = self._val(arr, (row * t._nc + k) * t._ne, ew)
+            if v != v:
                 return math.nan
             total += wt * v
         return total
@@ -295,8 +326,7 @@ class Estimator:
     def _min_contact(self, lo, hi, combos, ratio):
         p, C = self.p, self.contacts
         gap = hi - lo
-        needs = self._needs("", combos, lo, hi)
-        value, kb = crossing(C, needs, gap)
+        value, kb, needs = self._cross("", combos, lo, hi)
         if value is None:
             return None, None, None
         ideal = self.ideal_min_contact(lo, hi, ratio)
@@ -342,8 +372,8 @@ class Estimator:
         # no efficiency reading: the log-log crossing between the two tabulated needs, or the grid cell
         prev = needs[kb - 1] if kb > 0 else math.nan
         if kb > 0 and not _isnan(prev):
-            mc_lo = crossing(C, self._needs("_lo", combos, lo, hi), gap)[0]
-            mc_hi = crossing(C, self._needs("_hi", combos, lo, hi), gap)[0]
+            mc_lo = self._cross("_lo", combos, lo, hi)[0]
+            mc_hi = self._cross("_hi", combos, lo, hi)[0]
             return self._contact_estimate(C[kb - 1], C[kb], prev, needs[kb], gap, value, mc_lo, mc_hi, ideal)
         start = C[kb - 1] if kb > 0 else 0.0
         return value, (max(start, ideal) if _finite(ideal) else start), value
@@ -437,7 +467,7 @@ class Estimator:
         for k, wk in cw:
             if wk == 0:
                 continue
-            y = self._delta_at(self.arr[(direction, suffix)], combos, k, x)
+            y = self._delta_at(self.arr[(direction, suffix)], combos, k, self._ew(x))
             if _isnan(y):
                 return None
             total += wk * y

@@ -115,16 +115,25 @@ class Estimator:
             return 0.0
         u = (math.log(a + p["s_a0"]) - p["s_u0"]) / p["s_du"]
         v = (math.log(d) - p["s_v0"]) / p["s_dv"]
-        nu, nv, f = p["s_nu"], p["s_nv"], p["s_f"]
-        i = min(max(int(math.floor(u)), 1), nu - 3)
-        j = min(max(int(math.floor(v)), 1), nv - 3)
-        fu, fv = u - i, v - j
-        rows = []
-        for di in (-1, 0, 1, 2):
-            base = (i + di) * nv
-            rows.append(_cr(f[base + j - 1], f[base + j], f[base + j + 1], f[base + j + 2], fv))
-        g = _cr(rows[0], rows[1], rows[2], rows[3], fu)
-        return math.exp(g) * (self.weight(b) - self.weight(a))
+        nv, f = p["s_nv"], p["s_f"]
+        i = min(max(int(u), 1), p["s_nu"] - 3)
+        j = min(max(int(v), 1), nv - 3)
+        # Catmull-Rom in both directions: its four basis weights at the fractions (the nested form of _cr)
+        t = u - i
+        t2, t3 = t * t, t * t * t
+        wu = (0.5 * (-t + 2.0 * t2 - t3), 0.5 * (2.0 - 5.0 * t2 + 3.0 * t3), 0.5 * (t + 4.0 * t2 - 3.0 * t3),
+              0.5 * (t3 - t2))
+        t = v - j
+        t2, t3 = t * t, t * t * t
+        w0, w1, w2, w3 = (0.5 * (-t + 2.0 * t2 - t3), 0.5 * (2.0 - 5.0 * t2 + 3.0 * t3),
+                          0.5 * (t + 4.0 * t2 - 3.0 * t3), 0.5 * (t3 - t2))
+        g = 0.0
+        base = (i - 1) * nv + j - 1
+        for wi in wu:
+            g += wi * (w0 * f[base] + w1 * f[base + 1] + w2 * f[base + 2] + w3 * f[base + 3])
+            base += nv
+        e_s = p["e_s"]
+        return math.exp(g) * (1.0 / (1.0 + e_s / b) - (1.0 / (1.0 + e_s / a) if a > 0 else 0.0))
 
     def ideal_delta(self, e, t, ratio, direction):
         """Ideal observer's delta(e) [J s^-1/2 K^-1 m^-2] towards ``direction`` (+1 / -1) at contact ``t`` [s]

@@ -74,10 +74,10 @@ def _sstar_grid(e_s: float, tau_s: float, fs: float, width: float, threshold: fl
 
 
 class _SensorLike:
-    """The three numbers :func:`critical_noise` reads of a sensor (a cache key of plain floats)."""
+    """What :func:`critical_noise` reads of a sensor: its effusivity."""
 
-    def __init__(self, e_s, tau_s, fs):
-        self.effusivity, self.tau_s, self.sample_rate_hz = e_s, tau_s, fs
+    def __init__(self, e_s):
+        self.effusivity = e_s
 
 
 def estimator_params(tab) -> dict:
@@ -93,8 +93,8 @@ def estimator_params(tab) -> dict:
     fs = float(sensor.sample_rate_hz)
     n_max = int(last_sample_index(CLOSED_FORM_MAX_CONTACT_S, fs))
     cum = _cumulative_g2(float(sensor.tau_s), fs, max(n_max, 1))
-    u0, du, v0, dv, f = _sstar_grid(float(sensor.effusivity), float(sensor.tau_s), fs, width, float(tab.threshold),
-                                    e_hi)
+    # one grid for every table up to 40,000 (the shipped range): computed once per process and sensor
+    u0, du, v0, dv, f = _sstar_grid(float(sensor.effusivity), width, float(tab.threshold), max(e_hi, 40000.0))
     return {
         "e_s": float(sensor.effusivity), "fs": fs, "width": width, "threshold": float(tab.threshold),
         "z_table": table_z(tab), "coverage": COVERAGE, "zc": z_of_coverage(COVERAGE),

@@ -22,6 +22,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+pytestmark = pytest.mark.slow  # ~25 s of CPU: a 12 MB header compiled, the whole svm-fine table in every format
+
 REPO = Path(__file__).resolve().parent.parent
 REFERENCE = REPO / "tests" / "data" / "export_conformance.json"
 CC = shutil.which("gcc") or shutil.which("cc")

@@ -58,9 +58,13 @@ def estimator_reason(tab, kind: str, contact_sliced: bool) -> str | None:
 
 
 @functools.lru_cache(maxsize=4)
-def _sstar_grid(e_s: float, tau_s: float, fs: float, width: float, threshold: float, e_top: float):
+def _sstar_grid(e_s: float, width: float, threshold: float, e_top: float):
+    """The critical-noise grid (a function of the sensor's effusivity, the class width and the threshold only:
+    the scene enters through the projection noise alone). Computed once per process and key (3,600 critical
+    noises, ~10 s)."""
     from ..query.ideal_bound import critical_noise
-    sensor = _SensorLike(e_s, tau_s, fs)
+
+    sensor = _SensorLike(e_s)
     u = np.linspace(math.log(_A0), math.log(e_top + 2 * width + _A0), _N)
     v = np.linspace(math.log(_D_MIN), math.log(e_top + 3 * width), _N)
     a = np.exp(u)[:, None] - _A0 + 0.0 * v[None, :]

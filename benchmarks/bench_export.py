@@ -94,7 +94,7 @@ def c_answers(header: bytes, q: dict, workdir: Path):
     """Compile the header once; one process answers every question. Returns answers and seconds per call."""
     (workdir / "dk_table.h").write_bytes(header)
     (workdir / "main.c").write_text(C_MAIN)
-    subprocess.run(["gcc", "-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-O1", "main.c", "-lm", "-o",
+    subprocess.run(["gcc", "-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-O2", "main.c", "-lm", "-o",
                     "main"], cwd=workdir, check=True)
     lines = "".join(f"{q['e1'][i]!r} {q['e2'][i]!r} {q['noise'][i]!r} {q['dt'][i]!r} {q['contact'][i]!r}\n"
                     for i in range(len(q["e1"])))

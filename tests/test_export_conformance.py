@@ -203,6 +203,13 @@ def test_the_default_table_and_the_readme_number(tmp_path):
     lo, hi = a.interval
     assert f"touch for at least {a.value:.3g} s (90% interval {lo:.3g} s to {hi:.3g} s)" in out, out
     assert "touch for at least 1.23 s" in out
+    # NaN, negative, zero or infinite input: the documented sentinel (-3), never a number
+    bad = ["nan", "-1", "0", "inf"]
+    queries = ([f"min_contact {b} 20000 0.05 10" for b in bad] + [f"delta_e 20000 0.05 10 {b}" for b in bad]
+               + [f"distinguishable 35000 20000 {b} 10 2" for b in bad[:2] + ["inf"]])
+    r = subprocess.run(["./lookup", "--batch"], cwd=tmp_path, input="\n".join(queries) + "\n", capture_output=True,
+                       text=True, timeout=60)
+    assert r.stdout.split() == ["-3"] * len(queries), r.stdout
 
 
 def test_a_table_the_estimator_cannot_answer_says_so(tmp_path):

@@ -44,9 +44,10 @@ def export_cmd(
 ) -> None:
     """Export a table, or only the slice a deployment needs, for software where designkit does not run.
 
-    Example: `designkit export --table svm-paper --format c --noise 0.05 --delta-t 10 --out designkit_table.h`
-    writes a C99 header with `designkit_min_contact_s`, `designkit_delta_e` and
-    `designkit_distinguishable` for one sensor noise and temperature difference.
+    Example: `designkit export --format c --noise 0.05 --delta-t 10 --out designkit_table.h`
+    writes a C99 header whose `designkit_min_contact_interval`, `designkit_delta_e_interval` and
+    `designkit_distinguishable` answer as `designkit min-contact / delta-e / distinguishable` do (value and
+    90% interval) for one sensor noise and temperature difference.
 
     The folder of --out must exist (it is not created).
     """
@@ -79,11 +80,16 @@ def export_cmd(
     for line in _lines_from(p):
         con.print("  " + escape(line))
     if res.format == "c":
-        con.print(f"  [dim]#include it; call {prefix}_min_contact_s, {prefix}_delta_e, {prefix}_distinguishable "
-                  f"(sentinels: -1 none suffices, -2 outside the grid, -3 invalid input)[/]")
+        con.print(f"  [dim]#include it; call {prefix}_min_contact_interval, {prefix}_delta_e_interval, "
+                  f"{prefix}_distinguishable (sentinels: -1 none suffices, -2 outside the grid, -3 invalid input, "
+                  f"-4 only designkit answers this table)[/]")
     elif res.format == "python":
-        con.print("  [dim]import it; call min_contact_s, delta_e, distinguishable (None: none suffices; "
-                  "OutsideTable / ValueError otherwise)[/]")
+        con.print("  [dim]import it; call min_contact_interval, delta_e_interval, distinguishable (None: none "
+                  "suffices; OutsideTable / ValueError otherwise)[/]")
+    est = p.get("estimator", {})
+    con.print(f"  answers as designkit does: {est.get('name')} v{est.get('version')} (90% intervals)"
+              if est.get("answers") == "library" else
+              f"  [yellow]answers by the grid rule only[/]: {escape(str(est.get('unavailable')))}")
 
 
 def _check_sensor(table: str, sensor: str) -> None:

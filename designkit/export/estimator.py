@@ -96,6 +96,9 @@ class Estimator:
         self.h = 0.5 * self.w
         self.n_max = int(math.floor(float(p["max_contact_s"]) * self.fs + _SAMPLE_TOLERANCE))
         self.contacts = list(lookup.contact_s)
+        # per sample n: log(n / fs) and log |g| (n = 0: no signal)
+        self._log_t = [-math.inf] + [math.log(n / self.fs) for n in range(1, len(self.cum))]
+        self._log_norm = [0.5 * math.log(c) if c > 0 else -math.inf for c in self.cum]
 
     # ---------------------------------------------------------------- the ideal observer
     def shape_norm(self, t):
@@ -168,12 +171,13 @@ class Estimator:
             return math.nan
         slope = (kb - ka) / math.log(t_b / t_a) if t_a != t_b else 0.0
         lta, lr, ls = math.log(t_a), math.log(ratio), math.log(s_star)
+        log_t, log_norm = self._log_t, self._log_norm
 
         def ok(n):
             if cum[n] <= 0:
                 return False
-            lk = max(ka + slope * (math.log(n / fs) - lta), 0.0)
-            return lk + lr - 0.5 * math.log(cum[n]) <= ls
+            lk = ka + slope * (log_t[n] - lta)
+            return (lk if lk > 0.0 else 0.0) + lr - log_norm[n] <= ls
 
         n_max = max(self.n_max, 1)
         if not slope <= 0.5:  # not monotone in n: every sample

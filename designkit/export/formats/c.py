@@ -6,8 +6,12 @@ The header is the template ``designkit/export/templates/designkit_lookup.h.in``
 the provenance as macros and comments. It needs only ``<math.h>``, allocates
 nothing, and answers like :mod:`designkit.tables.lookup`:
 
-``PREFIX_delta_e``, ``PREFIX_delta_e_lower``, ``PREFIX_delta_e_upper``,
-``PREFIX_min_contact_s`` (floats) and ``PREFIX_distinguishable`` (int).
+``PREFIX_min_contact_s``, ``PREFIX_min_contact_interval``, ``PREFIX_delta_e``,
+``PREFIX_delta_e_interval``, ``PREFIX_delta_e_lower`` / ``_upper``, ``PREFIX_delta_e_sides``,
+``PREFIX_distinguishable`` and ``PREFIX_distinguishable_verdict``: the library's estimator
+(:mod:`designkit.export.estimator`, in C, double precision) where the export carries it
+(``PREFIX_HAS_ESTIMATOR``), the grid rule for an ideal-observer table (which the library answers by it),
+else ``PREFIX_NEEDS_DESIGNKIT`` (-4). ``PREFIX_grid_*`` answer by the grid rule alone.
 
 ==================  ============================================
 meaning             C (float / int functions)
@@ -16,6 +20,7 @@ answer              ``>= 0`` / ``PREFIX_YES`` (1) or ``PREFIX_NO`` (0)
 nothing suffices    ``PREFIX_NONE`` (-1)
 outside the grid    ``PREFIX_OUTSIDE`` (-2) / ``PREFIX_OUTSIDE_I``
 invalid input       ``PREFIX_INVALID`` (-3) / ``PREFIX_INVALID_I``
+needs designkit     ``PREFIX_NEEDS_DESIGNKIT`` (-4) / ``_I``
 ==================  ============================================
 
 Every string from the table (names, creation time, units, hash, the forward
@@ -32,7 +37,7 @@ import math
 import numpy as np
 
 from ...tables.lookup import GRID_RTOL
-from .._common import (CLI_RELATION, c_comment, c_double, c_string, check_prefix, fill_template, log_grid, read_template,
+from .._common import (c_comment, c_double, c_string, check_prefix, fill_template, log_grid, read_template,
                        regenerate_command, slice_lines)
 from ..slicing import Exported
 from .python import example_answer
@@ -156,7 +161,6 @@ def write(exp: Exported, prefix: str = "designkit") -> bytes:
         "SCENE_UNDEFS": "\n".join(undefs),
         "SCENE_WORDS": "sigma and linearly in dT" if varied else "sigma/dT",
         "SLICE": "\n".join(" * " + c_comment(line) for line in slice_lines(exp)),
-        "RELATION": "\n".join(" *   " + c_comment(line) for line in CLI_RELATION),
         "COMMAND": c_comment(regenerate_command(exp, "c", prefix)),
         "VERSION": c_comment(p["designkit_version"]), "TABLE": c_comment(p["source_table"]),
         "HASH": c_comment(p["source_content_hash"]), "CREATED": c_comment(p["source_created"]),

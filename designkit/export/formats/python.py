@@ -150,13 +150,15 @@ def _docstring(exp: Exported) -> str:
         "",
         "Units: effusivity [J s^-1/2 K^-1 m^-2], noise sigma per sample [degC],",
         "delta_t_c = sensor minus object temperature before contact [degC], contact [s].",
-        "delta_e is the smaller of the two directions (query.delta_e's value). None means",
+        "delta_e is the smaller of the two directions (designkit delta-e's value). None means",
         "nothing in the table suffices (no tabulated contact time separates the pair; no",
-        "distinguishable effusivity within the grid in either direction). An input outside",
-        "the table's grid raises OutsideTable (a ValueError; nothing is extrapolated);",
-        "invalid input (NaN, infinite, e <= 0, noise < 0, dT == 0, contact <= 0, e1 == e2)",
-        "raises ValueError. Two effusivities lo < hi are distinguishable when",
-        "hi - lo >= max(delta_up(lo), delta_down(hi)).",
+        "distinguishable effusivity within the grid in either direction); an interval end None",
+        "is open. An input outside the table's grid raises OutsideTable (a ValueError; nothing",
+        "is extrapolated); invalid input (NaN, infinite, e <= 0, noise < 0, dT == 0,",
+        "contact <= 0, e1 == e2) raises ValueError. distinguishable is the contact against",
+        "min_contact_s for the pair (designkit distinguishable's value outside its interval).",
+        "TABLE answers by the grid rule alone: lo < hi are distinguishable when",
+        "hi - lo >= max(delta_up(lo), delta_down(hi)), delta interpolated on the grid.",
     ]
     return py_docstring("\n".join(printable(line) for line in lines))
 

@@ -85,6 +85,14 @@ int main(void) {
     t0 = clock();
     for (i = 0; i < k; i++) designkit_delta_e_interval(qs[i][0], qs[i][2], qs[i][3], qs[i][4], de);
     fprintf(stderr, "%.9g\n", (double)(clock() - t0) / CLOCKS_PER_SEC / k);
+    t0 = clock();  /* the baseline in the same run: the grid rule (what the header answered before) */
+    for (i = 0; i < k; i++) de[0] += designkit_grid_min_contact_s((float)qs[i][0], (float)qs[i][1], (float)qs[i][2],
+                                                               (float)qs[i][3]);
+    fprintf(stderr, "%.9g\n", (double)(clock() - t0) / CLOCKS_PER_SEC / k);
+    t0 = clock();
+    for (i = 0; i < k; i++) de[0] += designkit_grid_delta_e((float)qs[i][0], (float)qs[i][2], (float)qs[i][3],
+                                                         (float)qs[i][4]);
+    fprintf(stderr, "%.9g %g\n", (double)(clock() - t0) / CLOCKS_PER_SEC / k, de[0] > 0 ? 0.0 : 1.0);
     return 0;
 }
 '''
@@ -106,11 +114,12 @@ def c_answers(header: bytes, q: dict, workdir: Path):
         out["min_contact"].append(float(f[1]) if s1 == 0 else None)
         out["delta_e"].append(float(f[5]) if s2 == 0 else None)
         out["distinguishable"].append(int(f[8]) == 1)
-    mc_t, de_t = (float(x) for x in r.stderr.split())
-    return out, {"min_contact": mc_t, "delta_e": de_t}
+    mc_t, de_t, gmc_t, gde_t = (float(x) for x in r.stderr.split()[:4])
+    return out, {"min_contact": mc_t, "delta_e": de_t, "grid_min_contact": gmc_t, "grid_delta_e": gde_t}
 
 
-def estimator_answers(est, q: dict):
+def estimator_answers(est, q: dict, grid=None):
+    """Every question asked of ``est``; with ``grid`` (a Lookup) also the grid rule's per-call times (baseline)."""
     out = {"min_contact": [], "delta_e": [], "distinguishable": []}
     times = {"min_contact": 0.0, "delta_e": 0.0}
     for i in range(len(q["e1"])):
@@ -122,6 +131,13 @@ def estimator_answers(est, q: dict):
         out["delta_e"].append(est.delta_e(a[0], a[2], a[3], q["contact"][i]))
         times["delta_e"] += time.perf_counter() - t
         out["distinguishable"].append(est.distinguishable(*a, q["contact"][i]))
+        if grid is not None:
+            t = time.perf_counter()
+            grid.min_contact_s(*a)
+            times["grid_min_contact"] = times.get("grid_min_contact", 0.0) + time.perf_counter() - t
+            t = time.perf_counter()
+            grid.delta_e(a[0], a[2], a[3], q["contact"][i])
+            times["grid_delta_e"] = times.get("grid_delta_e", 0.0) + time.perf_counter() - t
     return out, {k: v / len(q["e1"]) for k, v in times.items()}
 
 
@@ -165,7 +181,7 @@ def main(argv: list[str]) -> None:
         (d / "dk.py").write_bytes(render(exp, "python"))
         sys.path.insert(0, str(d))
         import dk  # noqa: E402
-        py_ans, py_t = estimator_answers(dk._EST, q)
+        py_ans, py_t = estimator_answers(dk._EST, q, dk.TABLE)
         rows = {"C": (c_ans, c_t), "python": (py_ans, py_t)}
         for fmt in ("json", "csv", "npz"):
             f = d / f"t.{fmt}"
@@ -177,7 +193,9 @@ def main(argv: list[str]) -> None:
     for fmt, (ans, times) in rows.items():
         s = score(ans, ref, q)
         print(f"{fmt:7s} " + "  ".join(f"{k} {a}/{b} ({100 * a / max(b, 1):.1f} %)" for k, (a, b) in s.items())
-              + f"  per call: min-contact {times['min_contact'] * 1e6:.1f} us, delta-e {times['delta_e'] * 1e6:.1f} us")
+              + f"  per call: min-contact {times['min_contact'] * 1e6:.1f} us, delta-e {times['delta_e'] * 1e6:.1f} us"
+              + (f" (grid rule in the same run: {times['grid_min_contact'] * 1e6:.2f} us, "
+                 f"{times['grid_delta_e'] * 1e6:.2f} us)" if "grid_min_contact" in times else ""))
 
 
 if __name__ == "__main__":

@@ -39,7 +39,8 @@ import bisect
 import math
 
 # <package-import> (a generated module carries designkit/tables/lookup.py above this text instead)
-from designkit.tables.lookup import _contact_input, _effusivity, _pair, _scene_inputs, axis_weights, crossing, interp_e
+from designkit.tables.lookup import (axis_weights, contact_input, crossing, effusivity_input, interp_e, pair_input,
+                                     scene_inputs)
 # </package-import>
 
 __all__ = ["ESTIMATOR", "ESTIMATOR_VERSION", "Estimator"]
@@ -108,6 +109,7 @@ class Estimator:
         return math.sqrt(self.cum[n])
 
     def weight(self, e):
+        """``w(e) = e / (e_s + e)``, the object's weight in the response (0 for e <= 0)."""
         return 1.0 / (1.0 + self.p["e_s"] / e) if e > 0 else 0.0
 
     def sstar(self, a, b):
@@ -329,8 +331,8 @@ class Estimator:
         """``(value, low, high)`` [s] of designkit.query.min_contact (None for none / an open end).
 
         Raises OutsideTable (a ValueError) outside the grid, ValueError for invalid input."""
-        noise, dt = _scene_inputs(noise_c, delta_t_c)
-        lo, hi = _pair(e1, e2)
+        noise, dt = scene_inputs(noise_c, delta_t_c)
+        lo, hi = pair_input(e1, e2)
         t = self.t
         combos = t.scene_weights(noise, dt)
         t._check_e(lo, hi)
@@ -425,9 +427,9 @@ class Estimator:
         """``(yes, sure)``: whether ``contact_s`` [s] reaches min-contact's answer for the pair, and whether
         it lies outside min-contact's interval (the library's "confident"; inside it, the library may decide
         by max-noise or delta-e instead)."""
-        contact = _contact_input(contact_s)
-        noise, dt = _scene_inputs(noise_c, delta_t_c)
-        lo, hi = _pair(e1, e2)
+        contact = contact_input(contact_s)
+        noise, dt = scene_inputs(noise_c, delta_t_c)
+        lo, hi = pair_input(e1, e2)
         t = self.t
         combos = t.scene_weights(noise, dt)
         t.contact_weights(contact)
@@ -448,9 +450,9 @@ class Estimator:
     def delta_e_sides(self, e, noise_c, delta_t_c, contact_s):
         """``{"lower": (value, low, high), "upper": (...)}`` [J s^-1/2 K^-1 m^-2] of designkit delta-e (None:
         none within the grid that way / an open end)."""
-        x = _effusivity("e", e)
-        contact = _contact_input(contact_s)
-        noise, dt = _scene_inputs(noise_c, delta_t_c)
+        x = effusivity_input("e", e)
+        contact = contact_input(contact_s)
+        noise, dt = scene_inputs(noise_c, delta_t_c)
         t = self.t
         combos = t.scene_weights(noise, dt)
         cw = t.contact_weights(contact)

@@ -41,13 +41,18 @@ _A0, _D_MIN, _N = 100.0, 60.0, 60
 
 def estimator_reason(tab, kind: str, contact_sliced: bool) -> str | None:
     """Why an export of ``tab`` cannot carry the library's estimator (None: it can)."""
-    from ..query.table import _closed_form
+    from ..query.inputs import TableMismatch
+    from ..query.table import open_table, table_spread
 
     if kind != "svm":
         return f"kind {kind} exports one delta array (the estimator reads the SVM's and its Monte Carlo ends)"
     if tab.fidelity != "svm":
         return f"a {tab.fidelity}-fidelity table (the estimator reads an SVM table's efficiency)"
-    if not _closed_form(tab, tab.model):
+    try:
+        closed = open_table(tab, None, sensor_temp_spread_c=table_spread(tab)).closed
+    except TableMismatch:
+        closed = False
+    if not closed:
         return ("the table's ideal observer has no closed form (varied initial conditions or a model whose "
                 "curves differ in shape): the library estimates it by simulation")
     if any(n not in tab.arrays for n in MORE_ARRAYS):
@@ -87,8 +92,8 @@ class _SensorLike:
 def estimator_params(tab) -> dict:
     """The estimator's constants for table ``tab`` (plain JSON data: floats and lists of floats)."""
     from ..query.crossing import z_of_coverage
-    from ..query.ideal_bound import _cumulative_g2
-    from ..query.table import CLOSED_FORM_MAX_CONTACT_S, _View, table_z
+    from ..query.ideal_bound import shape_norm
+    from ..query.table import CLOSED_FORM_MAX_CONTACT_S, open_table, table_spread, table_z
     from ..sensor import last_sample_index
 
     sensor = tab.sensor
@@ -96,13 +101,13 @@ def estimator_params(tab) -> dict:
     e_lo, e_hi = float(tab.header["effusivity"]["min"]), float(tab.header["effusivity"]["max"])
     fs = float(sensor.sample_rate_hz)
     n_max = int(last_sample_index(CLOSED_FORM_MAX_CONTACT_S, fs))
-    cum = _cumulative_g2(float(sensor.tau_s), fs, max(n_max, 1))
+    cum = shape_norm(sensor, np.arange(max(n_max, 1) + 1) / fs) ** 2  # sum_{k<=n} g(k/fs)^2 per sample n
     # one grid for every table up to 40,000 (the shipped range): computed once per process and sensor
     u0, du, v0, dv, f = _sstar_grid(float(sensor.effusivity), width, float(tab.threshold), max(e_hi, 40000.0))
     return {
         "e_s": float(sensor.effusivity), "fs": fs, "width": width, "threshold": float(tab.threshold),
         "z_table": table_z(tab), "coverage": COVERAGE, "zc": z_of_coverage(COVERAGE),
-        "mc_factor": _View(tab).mc_calibration(), "e_lo": e_lo, "e_hi": e_hi,
+        "mc_factor": open_table(tab, None, sensor_temp_spread_c=table_spread(tab)).view.mc_calibration(), "e_lo": e_lo, "e_hi": e_hi,
         "max_contact_s": CLOSED_FORM_MAX_CONTACT_S, "cum": [float(x) for x in cum],
         "s_a0": _A0, "s_dmin": _D_MIN, "s_u0": u0, "s_du": du, "s_nu": _N, "s_v0": v0, "s_dv": dv, "s_nv": _N,
         "s_f": list(f),

@@ -89,6 +89,8 @@ def export_cmd(
     est = p.get("estimator", {})
     con.print(f"  answers as designkit does: {est.get('name')} v{est.get('version')} (90% intervals)"
               if est.get("answers") == "library" else
+              f"  answers as designkit does: {escape(str(est.get('answers')))}" if est.get("answers", "").startswith(
+                  "library") else
               f"  [yellow]answers by the grid rule only[/]: {escape(str(est.get('unavailable')))}")
 
 

@@ -97,6 +97,9 @@ class Estimator:
         self.h = 0.5 * self.w
         self.n_max = int(math.floor(float(p["max_contact_s"]) * self.fs + _SAMPLE_TOLERANCE))
         self.contacts = list(lookup.contact_s)
+        # False: the table's ideal observer has no closed form (designkit simulates it): the library's estimate
+        # without the efficiency route and without the ideal observer's floor under its intervals
+        self.efficiency = bool(p.get("efficiency", True))
         # per sample n: log(n / fs) and log |g| (n = 0: no signal)
         self._log_t = [-math.inf] + [math.log(n / self.fs) for n in range(1, len(self.cum))]
         self._log_norm = [0.5 * math.log(c) if c > 0 else -math.inf for c in self.cum]
@@ -344,12 +347,15 @@ class Estimator:
         value, kb, needs = self._cross("", combos, lo, hi)
         if value is None:
             return None, None, None
-        ideal = self.ideal_min_contact(lo, hi, ratio)
         zc = p["zc"]
-        # the SVM's noise efficiency against the exact ideal observer
-        ka = self._baseline(kb)
-        slices = [(row, wt) for row, wt in combos if wt]
-        lk, se = self._k_readings(slices, ka, kb, lo, hi)
+        if self.efficiency:
+            ideal = self.ideal_min_contact(lo, hi, ratio)
+            # the SVM's noise efficiency against the exact ideal observer
+            ka = self._baseline(kb)
+            slices = [(row, wt) for row, wt in combos if wt]
+            lk, se = self._k_readings(slices, ka, kb, lo, hi)
+        else:
+            ideal, ka, lk, se = math.nan, -1, [math.nan, math.nan], [math.nan, math.nan]
         t_a, t_b = C[ka if ka >= 0 else kb], C[kb]
         have_a, have_b = not _isnan(lk[0]), not _isnan(lk[1])
         if have_a or have_b:
@@ -463,7 +469,7 @@ class Estimator:
         out = {}
         for direction, side, sign in (("down", "lower", -1), ("up", "upper", 1)):
             val = self._at_contacts(direction, "", combos, cw, x)
-            eff = self._delta_efficiency(x, contact, ratio, sign, ends, slices, direction)
+            eff = self._delta_efficiency(x, contact, ratio, sign, ends, slices, direction) if self.efficiency else None
             if eff is not None and val is None:
                 d = eff[0]
                 inside = x + d <= self.p["e_hi"] if sign > 0 else x - d > self.p["e_lo"]
@@ -576,7 +582,7 @@ class Estimator:
         rounding = (self.w / _SQRT12) / val
         low, high = _stated_log(val, math.nan if lo_end is None else lo_end, math.nan if hi_end is None else hi_end,
                                 math.hypot(interp, rounding), p["z_table"], p["zc"])
-        floor = self.ideal_delta(x, contact, ratio, sign)
+        floor = self.ideal_delta(x, contact, ratio, sign) if self.efficiency else math.nan
         if not _isnan(low) and _finite(floor):
             low = min(max(low, floor), val)
         return val, (None if _isnan(low) else low), (None if _isnan(high) else high)

@@ -41,20 +41,13 @@ _A0, _D_MIN, _N = 100.0, 60.0, 60
 
 def estimator_reason(tab, kind: str, contact_sliced: bool) -> str | None:
     """Why an export of ``tab`` cannot carry the library's estimator (None: it can)."""
-    from ..query.inputs import TableMismatch
-    from ..query.table import open_table, table_spread
-
     if kind != "svm":
         return f"kind {kind} exports one delta array (the estimator reads the SVM's and its Monte Carlo ends)"
     if tab.fidelity != "svm":
         return f"a {tab.fidelity}-fidelity table (the estimator reads an SVM table's efficiency)"
-    try:
-        closed = open_table(tab, None, sensor_temp_spread_c=table_spread(tab)).closed
-    except TableMismatch:
-        closed = False
-    if not closed:
-        return ("the table's ideal observer has no closed form (varied initial conditions or a model whose "
-                "curves differ in shape): the library estimates it by simulation")
+    if "noise_ratio" not in tab.axes:
+        return ("the table varies the initial conditions (its ideal observer has no closed form: the library "
+                "estimates its answers from each scene slice and the bound by simulation)")
     if any(n not in tab.arrays for n in MORE_ARRAYS):
         return "the table holds no Monte Carlo interval (delta_*_lo / delta_*_hi)"
     if contact_sliced:
@@ -96,20 +89,27 @@ def estimator_params(tab) -> dict:
     from ..query.table import CLOSED_FORM_MAX_CONTACT_S, open_table, table_spread, table_z
     from ..sensor import last_sample_index
 
+    from ..query.table import open_table, table_spread
+
     sensor = tab.sensor
+    op = open_table(tab, None, sensor_temp_spread_c=table_spread(tab))
     width = float(tab.header["effusivity"]["width"])
     e_lo, e_hi = float(tab.header["effusivity"]["min"]), float(tab.header["effusivity"]["max"])
     fs = float(sensor.sample_rate_hz)
     n_max = int(last_sample_index(CLOSED_FORM_MAX_CONTACT_S, fs))
-    cum = shape_norm(sensor, np.arange(max(n_max, 1) + 1) / fs) ** 2  # sum_{k<=n} g(k/fs)^2 per sample n
-    # one grid for every table up to 40,000 (the shipped range): computed once per process and sensor
-    u0, du, v0, dv, f = _sstar_grid(float(sensor.effusivity), width, float(tab.threshold), max(e_hi, 40000.0))
+    if op.closed:
+        cum = shape_norm(sensor, np.arange(max(n_max, 1) + 1) / fs) ** 2  # sum_{k<=n} g(k/fs)^2 per sample n
+        # one grid for every table up to 40,000 (the shipped range): computed once per process and sensor
+        u0, du, v0, dv, f = _sstar_grid(float(sensor.effusivity), width, float(tab.threshold), max(e_hi, 40000.0))
+    else:  # no closed form: no efficiency route (and no ideal observer) to carry
+        cum, (u0, du, v0, dv, f) = [0.0], (0.0, 1.0, 0.0, 1.0, (0.0,))
     return {
         "e_s": float(sensor.effusivity), "fs": fs, "width": width, "threshold": float(tab.threshold),
         "z_table": table_z(tab), "coverage": COVERAGE, "zc": z_of_coverage(COVERAGE),
-        "mc_factor": open_table(tab, None, sensor_temp_spread_c=table_spread(tab)).view.mc_calibration(), "e_lo": e_lo, "e_hi": e_hi,
+        "efficiency": bool(op.closed), "mc_factor": op.view.mc_calibration(), "e_lo": e_lo, "e_hi": e_hi,
         "max_contact_s": CLOSED_FORM_MAX_CONTACT_S, "cum": [float(x) for x in cum],
-        "s_a0": _A0, "s_dmin": _D_MIN, "s_u0": u0, "s_du": du, "s_nu": _N, "s_v0": v0, "s_dv": dv, "s_nv": _N,
+        "s_a0": _A0, "s_dmin": _D_MIN, "s_u0": u0, "s_du": du, "s_nu": _N if op.closed else 1, "s_v0": v0,
+        "s_dv": dv, "s_nv": _N if op.closed else 1,
         "s_f": list(f),
     }
 

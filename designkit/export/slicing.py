@@ -485,6 +485,9 @@ def slice_table(table: "Table | str", *, noise_c: float | None = None, delta_t_c
     export_hash = content_hash({"delta_up": up, "delta_down": down, **more,
                                 **{f"axis_{a.name}": np.asarray(a.values) for a in axes}})
     fidelity = hdr.get("fidelity")
+    params = estimator_params(tab) if why_not is None else None
+    answers = ("grid rule only" if params is None else "library" if params["efficiency"] else
+               "library's value; interval low ends without its simulated ideal bound")
     provenance = {
         "format": EXPORT_FORMAT,
         "schema_version": EXPORT_SCHEMA,
@@ -516,7 +519,7 @@ def slice_table(table: "Table | str", *, noise_c: float | None = None, delta_t_c
                           "contact_s and delta_t_c, log-linear in noise_ratio and noise_c; no extrapolation"),
         "export_hash": export_hash,
         "estimator": {"name": ESTIMATOR, "version": ESTIMATOR_VERSION,
-                      "answers": "library" if why_not is None else "grid rule only",
+                      "answers": answers,
                       "coverage": 0.9 if why_not is None else None, "unavailable": why_not},
     }
     _plain_json(tab, provenance)
@@ -524,4 +527,4 @@ def slice_table(table: "Table | str", *, noise_c: float | None = None, delta_t_c
     ref = tab.name if SHIPPED_TABLES.get(tab.name, (None,))[0] == hdr.get("content_hash") else str(tab.path)
     return Exported(axes=axes, delta_up=up, delta_down=down, contact_adjacent=adjacent, e_lo=float(e_lo),
                     e_hi=float(e_hi), e_lo_inclusive=inclusive, provenance=provenance, source_ref=ref, more=more,
-                    estimator=estimator_params(tab) if why_not is None else None)
+                    estimator=params)

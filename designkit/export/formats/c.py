@@ -119,7 +119,7 @@ def write(exp: Exported, prefix: str = "designkit") -> bytes:
           "EST_VERSION": str(p["estimator"]["version"]), "EST_COVERAGE": c_double(0.9)}
     ev.update({k: "0" for k in ("UP_LO", "DOWN_LO", "UP_HI", "DOWN_HI", "CUM", "NCUM", "SF", "NSF", "RATIOS", "NR",
                                 "E_S", "FS", "WIDTH", "ZT", "ZC", "MCF", "ELO", "EHI", "NMAX", "SA0", "SDMIN", "SU0",
-                                "SDU", "SNU", "SV0", "SDV", "SNV")})  # inside "#if 0" when absent
+                                "SDU", "SNU", "SV0", "SDV", "SNV", "EFFICIENCY")})  # inside "#if 0" when absent
     if has_est:
         scene_vals = exp.scene_axes[0].values
         ev.update({
@@ -133,9 +133,15 @@ def write(exp: Exported, prefix: str = "designkit") -> bytes:
             "NMAX": str(int(math.floor(est["max_contact_s"] * est["fs"] + 1e-9))),
             "SA0": c_double(est["s_a0"]), "SDMIN": c_double(est["s_dmin"]), "SU0": c_double(est["s_u0"]),
             "SDU": c_double(est["s_du"]), "SNU": str(est["s_nu"]), "SV0": c_double(est["s_v0"]),
-            "SDV": c_double(est["s_dv"]), "SNV": str(est["s_nv"])})
+            "SDV": c_double(est["s_dv"]), "SNV": str(est["s_nv"]),
+            "EFFICIENCY": "1" if est.get("efficiency", True) else "0"})
     q, ans = example_answer(exp)
-    if has_est:
+    if has_est and not est.get("efficiency", True):
+        how = ["Estimator: " + p["estimator"]["name"] + ", version " + str(p["estimator"]["version"]) + ", without",
+               "its efficiency route: the table's model has no closed-form ideal observer, so designkit answers",
+               "from the table alone (as here: the same value) and simulates the ideal bound under its intervals",
+               "(not here: the low ends are the table's own). max-noise and min-delta-t are not here."]
+    elif has_est:
         how = ["Estimator: " + p["estimator"]["name"] + ", version " + str(p["estimator"]["version"]) + ": the",
                "functions below answer as designkit min-contact / delta-e / distinguishable do (the same value",
                "and 90 % interval), in double precision, libm only. max-noise and min-delta-t are not here."]

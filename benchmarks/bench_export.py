@@ -1,35 +1,20 @@
-"""Exports: size of a full table and of a one-scene slice in every format, and the time per
-lookup of the C header, the stdlib-only Python module and designkit's own Python query.
+"""Exports against the library: 1,000 random questions asked of designkit, the C header, the Python module and the
+data exports' reading rule (designkit.export.estimator_data.estimator_of), value by value, with per-call timings.
 
-Run from the repository root::
+Questions (seed 38): min-contact, delta-e, distinguishable; e uniform in [100, 40000], noise in [0.01, 0.1] degC,
+dT in [5, 15] degC, contact in [0.5, 10] s; table svm-fine (the library's default), exported whole.
 
-    /work/venv/bin/python benchmarks/bench_export.py                 # ideal-paper (and svm-paper if built)
-    /work/venv/bin/python benchmarks/bench_export.py --table svm-paper --calls 200000
+    python benchmarks/bench_export.py                 # conformance and timings
+    python benchmarks/bench_export.py --reference     # also (re)write tests/data/export_conformance.json
 
-What it measures, printed as markdown tables:
-
-1. Sizes [bytes] of the export of the whole table and of the one scene a robot
-   needs (``--noise 0.05 --delta-t 10``), plus a narrower slice (contact 1-4 s,
-   effusivity 15,000-36,000), in each format; ratios against the table's own
-   files (npz + json) and slice against full.
-2. Time per call of ``min_contact_s``, ``delta_e`` and ``distinguishable`` on
-   random inputs inside the grid: the C header (compiled with ``cc -O2`` into a
-   timing harness; the inputs are drawn once, outside the timed loop), the
-   generated stdlib module, and ``designkit.query`` on a loaded table (the
-   baseline; ``ideal_table=None`` so that it answers from the one table).
-   Ratios are against the baseline measured in the same run.
-
-Timings are wall clock on whatever machine runs it (2 shared cores when the
-numbers in the issue's closing note were taken: expect noise of tens of %).
+An answer conforms when it is within 1 % of the library's value or inside its 90 % interval (None == None);
+distinguishable's verdicts are compared where the contact lies outside min-contact's interval.
 """
 
 from __future__ import annotations
 
-import argparse
-import importlib.util
+import json
 import math
-import os
-import shutil
 import subprocess
 import sys
 import tempfile
@@ -38,195 +23,180 @@ from pathlib import Path
 
 import numpy as np
 
-from designkit.query import table as q
-from designkit.export import FORMATS, render, slice_table
-from designkit.tables.store import list_tables, load_table
+HERE = Path(__file__).resolve().parent
+REFERENCE = HERE.parent / "tests" / "data" / "export_conformance.json"
+N = 1000
+SEED = 38
 
-NOISE_C, DELTA_T_C = 0.05, 10.0
 
-HARNESS = r'''
+def questions(n: int = N, seed: int = SEED) -> dict[str, list[float]]:
+    rng = np.random.default_rng(seed)
+    q = {k: rng.uniform(a, b, n) for k, (a, b) in {"e1": (100, 40000), "e2": (100, 40000), "noise": (0.01, 0.1),
+                                                     "dt": (5, 15), "contact": (0.5, 10)}.items()}
+    return {k: [round(float(x), 6) for x in v] for k, v in q.items()}
+
+
+def library(q: dict) -> dict:
+    from designkit.query import delta_e, distinguishable, min_contact
+
+    e1, e2, noise, dt, c = (np.asarray(q[k]) for k in ("e1", "e2", "noise", "dt", "contact"))
+    out = {}
+    t = time.perf_counter()
+    a = min_contact(e1, e2, noise_c=noise, delta_t_c=dt)
+    out["min_contact"] = [a.value.tolist(), a.low.tolist(), a.high.tolist()]
+    b = delta_e(e1, contact_s=c, noise_c=noise, delta_t_c=dt)
+    out["delta_e"] = [b.value.tolist(), b.low.tolist(), b.high.tolist()]
+    d = distinguishable(e1, e2, contact_s=c, noise_c=noise, delta_t_c=dt)
+    out["distinguishable"] = [d.value.tolist()]
+    out["seconds"] = time.perf_counter() - t
+    return out
+
+
+def conforms(got, value, low, high) -> bool:
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return got is None
+    if got is None:
+        return False
+    return abs(got - value) <= 0.01 * abs(value) or (low is not None and not math.isnan(low) and low <= got
+                                                     and (high is None or math.isnan(high) or got <= high))
+
+
+C_MAIN = r'''
 #include <stdio.h>
-#include <stdlib.h>
 #include <time.h>
-#include "designkit_table.h"
-
-static double now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
-int main(int argc, char **argv)
-{
-    int n = atoi(argv[1]), reps = atoi(argv[2]), i, r;
-    float *e1 = malloc(n * sizeof *e1), *e2 = malloc(n * sizeof *e2), *c = malloc(n * sizeof *c);
-    float noise = (float)atof(argv[3]), dt = (float)atof(argv[4]);
-    double sum = 0, t0, best[3] = {1e30, 1e30, 1e30};
-    long yes = 0;
-    for (i = 0; i < n; i++)
-        if (scanf("%f %f %f", &e1[i], &e2[i], &c[i]) != 3) return 2;
-    for (r = 0; r < reps; r++) {
-        t0 = now();
-        for (i = 0; i < n; i++) sum += designkit_min_contact_s(e1[i], e2[i], noise, dt);
-        if (now() - t0 < best[0]) best[0] = now() - t0;
-        t0 = now();
-        for (i = 0; i < n; i++) sum += designkit_delta_e(e1[i], noise, dt, c[i]);
-        if (now() - t0 < best[1]) best[1] = now() - t0;
-        t0 = now();
-        for (i = 0; i < n; i++) yes += designkit_distinguishable(e1[i], e2[i], noise, dt, c[i]);
-        if (now() - t0 < best[2]) best[2] = now() - t0;
+#include "dk_table.h"
+int main(void) {
+    double e1, e2, n, dt, c, iv[3], de[3], sink = 0;
+    int k = 0, i, sure;
+    clock_t t0;
+    static double qs[4000][5];
+    while (scanf("%lf %lf %lf %lf %lf", &e1, &e2, &n, &dt, &c) == 5) {
+        int s1 = designkit_min_contact_interval(e1, e2, n, dt, iv);
+        int s2 = designkit_delta_e_interval(e1, n, dt, c, de);
+        int v = designkit_distinguishable_verdict(e1, e2, n, dt, c, &sure);
+        printf("%d %.17g %.17g %.17g %d %.17g %.17g %.17g %d %d\n", s1, iv[0], iv[1], iv[2], s2, de[0], de[1], de[2],
+               v, sure);
+        qs[k][0] = e1; qs[k][1] = e2; qs[k][2] = n; qs[k][3] = dt; qs[k][4] = c;
+        k++;
     }
-    printf("%.6g %.6g %.6g %.17g %ld\n", 1e9 * best[0] / n, 1e9 * best[1] / n, 1e9 * best[2] / n, sum, yes);
+    t0 = clock();
+    for (i = 0; i < k; i++) designkit_min_contact_interval(qs[i][0], qs[i][1], qs[i][2], qs[i][3], iv);
+    fprintf(stderr, "%.9g\n", (double)(clock() - t0) / CLOCKS_PER_SEC / k);
+    t0 = clock();
+    for (i = 0; i < k; i++) designkit_delta_e_interval(qs[i][0], qs[i][2], qs[i][3], qs[i][4], de);
+    fprintf(stderr, "%.9g\n", (double)(clock() - t0) / CLOCKS_PER_SEC / k);
+    t0 = clock();  /* the baseline in the same run: the grid rule (what the header answered before) */
+    for (i = 0; i < k; i++) sink += designkit_grid_min_contact_s((float)qs[i][0], (float)qs[i][1], (float)qs[i][2],
+                                                               (float)qs[i][3]);
+    fprintf(stderr, "%.9g\n", (double)(clock() - t0) / CLOCKS_PER_SEC / k);
+    t0 = clock();
+    for (i = 0; i < k; i++) sink += designkit_grid_delta_e((float)qs[i][0], (float)qs[i][2], (float)qs[i][3],
+                                                         (float)qs[i][4]);
+    fprintf(stderr, "%.9g %g\n", (double)(clock() - t0) / CLOCKS_PER_SEC / k, sink > 0 ? 0.0 : 1.0);
     return 0;
 }
 '''
 
-_CC_POSIX = ["-D_POSIX_C_SOURCE=199309L"]  # clock_gettime under -std=c99
+
+def c_answers(header: bytes, q: dict, workdir: Path):
+    """Compile the header once; one process answers every question. Returns answers and seconds per call."""
+    (workdir / "dk_table.h").write_bytes(header)
+    (workdir / "main.c").write_text(C_MAIN)
+    subprocess.run(["gcc", "-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-O2", "main.c", "-lm", "-o",
+                    "main"], cwd=workdir, check=True)
+    lines = "".join(f"{q['e1'][i]!r} {q['e2'][i]!r} {q['noise'][i]!r} {q['dt'][i]!r} {q['contact'][i]!r}\n"
+                    for i in range(len(q["e1"])))
+    r = subprocess.run(["./main"], cwd=workdir, input=lines, capture_output=True, text=True, check=True)
+    out = {"min_contact": [], "delta_e": [], "distinguishable": []}
+    for line in r.stdout.splitlines():
+        f = line.split()
+        s1, s2 = int(f[0]), int(f[4])
+        out["min_contact"].append(float(f[1]) if s1 == 0 else None)
+        out["delta_e"].append(float(f[5]) if s2 == 0 else None)
+        out["distinguishable"].append(int(f[8]) == 1)
+    mc_t, de_t, gmc_t, gde_t = (float(x) for x in r.stderr.split()[:4])
+    return out, {"min_contact": mc_t, "delta_e": de_t, "grid_min_contact": gmc_t, "grid_delta_e": gde_t}
 
 
-def sizes(tab) -> list[tuple[str, dict[str, int]]]:
-    full = slice_table(tab)
-    one = slice_table(tab, noise_c=NOISE_C, delta_t_c=DELTA_T_C)
-    narrow = slice_table(tab, noise_c=NOISE_C, delta_t_c=DELTA_T_C, contact="1:4", e_min=15000.0, e_max=36000.0)
-    rows = []
-    for label, exp in (("whole table", full), (f"one scene (noise {NOISE_C:g} degC, dT {DELTA_T_C:g} degC)", one),
-                       ("one scene, contact 1-4 s, e 15,000-36,000", narrow)):
-        rows.append((f"{label}: {' x '.join(str(n) for n in exp.shape)}",
-                     {fmt: len(render(exp, fmt)) for fmt in FORMATS}))
-    return rows
+def estimator_answers(est, q: dict, grid=None):
+    """Every question asked of ``est``; with ``grid`` (a Lookup) also the grid rule's per-call times (baseline)."""
+    out = {"min_contact": [], "delta_e": [], "distinguishable": []}
+    times = {"min_contact": 0.0, "delta_e": 0.0}
+    for i in range(len(q["e1"])):
+        a = (q["e1"][i], q["e2"][i], q["noise"][i], q["dt"][i])
+        t = time.perf_counter()
+        out["min_contact"].append(est.min_contact_s(*a))
+        times["min_contact"] += time.perf_counter() - t
+        t = time.perf_counter()
+        out["delta_e"].append(est.delta_e(a[0], a[2], a[3], q["contact"][i]))
+        times["delta_e"] += time.perf_counter() - t
+        out["distinguishable"].append(est.distinguishable(*a, q["contact"][i]))
+        if grid is not None:
+            t = time.perf_counter()
+            grid.min_contact_s(*a)
+            times["grid_min_contact"] = times.get("grid_min_contact", 0.0) + time.perf_counter() - t
+            t = time.perf_counter()
+            grid.delta_e(a[0], a[2], a[3], q["contact"][i])
+            times["grid_delta_e"] = times.get("grid_delta_e", 0.0) + time.perf_counter() - t
+    return out, {k: v / len(q["e1"]) for k, v in times.items()}
 
 
-def inputs(tab, n: int, rng) -> np.ndarray:
-    """Random in-grid (e1, e2, contact) as float32: e in the table's range, contact in its grid."""
-    lo, hi = float(tab.header["effusivity"]["min"]), float(tab.header["effusivity"]["max"])
-    c = tab.axes["contact_s"]
-    return np.column_stack([rng.uniform(lo + 1, hi, n), rng.uniform(lo + 1, hi, n),
-                            rng.uniform(c[0], c[-1], n)]).astype(np.float32)
+def score(ans: dict, ref: dict, q: dict) -> dict:
+    res = {}
+    for name in ("min_contact", "delta_e"):
+        v, lo, hi = ref[name]
+        ok = [conforms(g, a, b, c) for g, a, b, c in zip(ans[name], v, lo, hi)]
+        res[name] = (sum(ok), len(ok))
+    v, lo, hi = ref["min_contact"]
+    outside = [i for i in range(len(q["e1"])) if not (lo[i] is not None and not math.isnan(lo[i])
+                                                       and lo[i] <= q["contact"][i] <= (hi[i] if hi[i] is not None
+                                                                                        and not math.isnan(hi[i])
+                                                                                        else math.inf))]
+    same = sum(bool(ans["distinguishable"][i]) == (ref["distinguishable"][0][i] == 1.0) for i in outside)
+    res["distinguishable_outside_interval"] = (same, len(outside))
+    return res
 
 
-def time_c(header: bytes, x: np.ndarray, reps: int, workdir: Path) -> tuple[float, float, float] | None:
-    cc = shutil.which(os.environ.get("CC", "cc"))
-    if cc is None:
-        return None
-    (workdir / "designkit_table.h").write_bytes(header)
-    (workdir / "harness.c").write_text(HARNESS)
-    exe = workdir / "harness"
-    subprocess.run([cc, "-std=c99", "-O2", *_CC_POSIX, "-o", str(exe), str(workdir / "harness.c"), "-lm"], check=True)
-    text = "\n".join(f"{a!r} {b!r} {c!r}" for a, b, c in x.astype(float).tolist())
-    out = subprocess.run([str(exe), str(len(x)), str(reps), repr(NOISE_C), repr(DELTA_T_C)], input=text,
-                         capture_output=True, text=True, check=True).stdout.split()
-    return float(out[0]), float(out[1]), float(out[2])
+def main(argv: list[str]) -> None:
+    from designkit.export import export_bytes, read_export, render, slice_table
+    from designkit.export.estimator_data import estimator_of
 
-
-def time_python(calls, x: np.ndarray, reps: int) -> tuple[float, float, float]:
-    """Best-of-reps ns per call of (min_contact, delta_e, distinguishable) over the inputs."""
-    best = [math.inf] * 3
-    rows = x.astype(float).tolist()
-    for _ in range(reps):
-        for j, f in enumerate(calls):
-            t0 = time.perf_counter()
-            for a, b, c in rows:
-                f(a, b, c)
-            best[j] = min(best[j], time.perf_counter() - t0)
-    return tuple(1e9 * t / len(rows) for t in best)
-
-
-def module_from(src: bytes, workdir: Path, name: str):
-    path = workdir / f"{name}.py"
-    path.write_bytes(src)
-    spec = importlib.util.spec_from_file_location(name, path)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
-
-
-def stdlib_calls(mod):
-    def mc(a, b, c):
-        try:
-            return mod.min_contact_s(a, b, NOISE_C, DELTA_T_C)
-        except ValueError:
-            return None
-
-    def de(a, b, c):
-        return mod.delta_e(a, NOISE_C, DELTA_T_C, c)
-
-    def di(a, b, c):
-        try:
-            return mod.distinguishable(a, b, NOISE_C, DELTA_T_C, c)
-        except ValueError:
-            return None
-
-    return mc, de, di
-
-
-def query_calls(tab):
-    def mc(a, b, c):
-        return q.min_contact(a, b, noise_c=NOISE_C, delta_t_c=DELTA_T_C, table=tab, ideal_table=None) if a != b else None
-
-    def de(a, b, c):
-        return q.delta_e(a, contact_s=c, noise_c=NOISE_C, delta_t_c=DELTA_T_C, table=tab, ideal_table=None)
-
-    def di(a, b, c):
-        return q.distinguishable(a, b, contact_s=c, noise_c=NOISE_C, delta_t_c=DELTA_T_C, table=tab,
-                                 ideal_table=None) if a != b else None
-
-    return mc, de, di
-
-
-def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--table", action="append", help="table(s) to measure (default: ideal-paper, svm-paper if built)")
-    ap.add_argument("--calls", type=int, default=100_000, help="C calls per function and repeat")
-    ap.add_argument("--py-calls", type=int, default=150, help="Python query calls per function and repeat")
-    ap.add_argument("--reps", type=int, default=2, help="repeats (best is reported)")
-    args = ap.parse_args(argv)
-    names = args.table or ["ideal-paper"] + (["svm-paper"] if "svm-paper" in list_tables() else [])
-    rng = np.random.default_rng(0)
-    for name in names:
-        tab = load_table(name)
-        own = tab.path.stat().st_size + tab.path.with_suffix(".json").stat().st_size
-        print(f"\n## {name} ({tab.fidelity}; the table's own npz + json: {own:,} bytes)\n")
-        print("| export | " + " | ".join(FORMATS) + " |")
-        print("|---|" + "---:|" * len(FORMATS))
-        rows = sizes(tab)
-        for label, s in rows:
-            print(f"| {label} | " + " | ".join(f"{s[f]:,}" for f in FORMATS) + " |")
-        full = rows[0][1]
-        for label, s in rows[1:]:
-            print(f"| ratio to whole ({label.split(':')[0]}) | " + " | ".join(f"{s[f] / full[f]:.3f}" for f in FORMATS)
-                  + " |")
-        print("| whole / table's own files | " + " | ".join(f"{full[f] / own:.2f}" for f in FORMATS) + " |")
-
-        with tempfile.TemporaryDirectory() as tmp:
-            tmp = Path(tmp)
-            x_c = inputs(tab, args.calls, rng)
-            x_py = x_c[: args.py_calls]
-            base = time_python(query_calls(tab), x_py, args.reps)
-            print(f"\nTime per call [ns], inputs inside the grid (noise {NOISE_C:g} degC, dT {DELTA_T_C:g} degC); "
-                  f"ratio = designkit.query / this:\n")
-            print("| implementation | min_contact_s | delta_e | distinguishable | speed-up vs query |")
-            print("|---|---:|---:|---:|---:|")
-            print("| designkit.query (baseline, loaded table) | " + " | ".join(f"{t:,.0f}" for t in base) + " | 1 |")
-            note = ("query.distinguishable also computes the ideal observer's F1 in closed form, which the "
-                    "exports do not carry: most of its time")
-            for label, exp in (("whole table", slice_table(tab)),
-                               ("one scene", slice_table(tab, noise_c=NOISE_C, delta_t_c=DELTA_T_C))):
-                mod = module_from(render(exp, "python"), tmp, f"mod_{len(exp.shape)}_{exp.shape[0]}")
-                t_py = time_python(stdlib_calls(mod), x_c[: 20 * args.py_calls], args.reps)
-                print(f"| stdlib module, {label} | " + " | ".join(f"{t:,.0f}" for t in t_py) + " | "
-                      + " / ".join(f"{b / t:.0f}x" for b, t in zip(base, t_py)) + " |")
-                sub = tmp / f"c_{label.replace(' ', '_')}"
-                sub.mkdir()
-                t_c = time_c(render(exp, "c"), x_c, args.reps, sub)
-                if t_c is None:
-                    print(f"| C header, {label} | (no C compiler) | | | |")
-                    continue
-                print(f"| C header -O2, {label} | " + " | ".join(f"{t:,.0f}" for t in t_c) + " | "
-                      + " / ".join(f"{b / t:,.0f}x" for b, t in zip(base, t_c)) + " |")
-            print(f"\n({note}.)")
-    return 0
+    q = questions()
+    if "--reference" in argv or not REFERENCE.is_file():
+        print("asking the library (array route) ...", flush=True)
+        ref = library(q)
+        REFERENCE.write_text(json.dumps({"seed": SEED, "table": "svm-fine", "questions": q, "library": ref}))
+    ref = json.loads(REFERENCE.read_text())["library"]
+    print(f"library: {ref['seconds']:.1f} s for the 3 x {N} questions (array route)")
+    t = time.perf_counter()
+    exp = slice_table("svm-fine")
+    print(f"slice with estimator constants: {time.perf_counter() - t:.1f} s")
+    with tempfile.TemporaryDirectory() as d:
+        d = Path(d)
+        header = render(exp, "c")
+        print(f"C header of the whole table: {len(header) / 1e6:.1f} MB")
+        one = export_bytes("svm-fine", "c", noise_c=0.05, delta_t_c=10.0).data
+        print(f"C header of the one-scene slice (0.05 degC, 10 degC): {len(one) / 1e6:.2f} MB (target <= 2 MB)")
+        c_ans, c_t = c_answers(header, q, d)
+        (d / "dk.py").write_bytes(render(exp, "python"))
+        sys.path.insert(0, str(d))
+        import dk  # noqa: E402
+        py_ans, py_t = estimator_answers(dk._EST, q, dk.TABLE)
+        rows = {"C": (c_ans, c_t), "python": (py_ans, py_t)}
+        for fmt in ("json", "csv", "npz"):
+            f = d / f"t.{fmt}"
+            f.write_bytes(render(exp, fmt))
+            if fmt == "csv":
+                from designkit.export.formats.csv import sidecar, sidecar_path
+                sidecar_path(f).write_bytes(sidecar(exp, f.name))
+            rows[fmt] = estimator_answers(estimator_of(read_export(f)), q)
+    for fmt, (ans, times) in rows.items():
+        s = score(ans, ref, q)
+        print(f"{fmt:7s} " + "  ".join(f"{k} {a}/{b} ({100 * a / max(b, 1):.1f} %)" for k, (a, b) in s.items())
+              + f"  per call: min-contact {times['min_contact'] * 1e6:.1f} us, delta-e {times['delta_e'] * 1e6:.1f} us"
+              + (f" (grid rule in the same run: {times['grid_min_contact'] * 1e6:.2f} us, "
+                 f"{times['grid_delta_e'] * 1e6:.2f} us)" if "grid_min_contact" in times else ""))
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    main(sys.argv[1:])

@@ -21,7 +21,7 @@ from designkit import InputError
 from designkit.query import table as q
 from designkit.sweep import SweepConfig, run_sweep
 from designkit.export import FORMATS, export_table, parse_contact, read_export, render, slice_table
-from designkit.export.formats.python import LOOKUP_BEGIN, LOOKUP_END, lookup_source
+from designkit.export.formats.python import LOOKUP_BEGIN, LOOKUP_END, estimator_source, lookup_source
 from designkit.tables.store import Table, content_hash, load_table, table_header, write_table
 
 REPO = Path(__file__).resolve().parent.parent
@@ -333,7 +333,7 @@ def test_data_formats_read_with_plain_tools(tmp_path):
 def test_a_slice_is_much_smaller_than_the_full_table():
     tab = ideal_table()
     full, one = slice_table(tab), slice_table(tab, noise_c=ON_ROW[0], delta_t_c=ON_ROW[1])
-    fixed = {"python": len(lookup_source().encode())}  # the lookup code it carries, whatever the data
+    fixed = {"python": len(lookup_source().encode()) + len(estimator_source().encode())}  # the code it carries
     for fmt in FORMATS:
         size = {label: len(render(exp, fmt)) - fixed.get(fmt, 0) for label, exp in (("one", one), ("full", full))}
         assert size["one"] * 5 < size["full"], fmt
@@ -354,7 +354,7 @@ names = {"min_contact": "min_contact_s"}
 out = []
 for op, args in json.load(sys.stdin):
     try:
-        out.append({"v": getattr(m, names.get(op, op))(*args)})
+        out.append({"v": getattr(m.TABLE, names.get(op, op))(*args)})  # the grid rule (TABLE)
     except m.OutsideTable:
         out.append({"v": "outside"})
     except ValueError:
@@ -366,7 +366,8 @@ json.dump({"numpy_importable": numpy_importable, "foreign_modules": foreign, "an
 
 
 def run_module(path: Path, queries, tmp_path: Path) -> list:
-    """Answer queries with the generated module in `python -I -S` (no site-packages: no numpy)."""
+    """Answer queries with the generated module's grid rule (its ``TABLE``) in `python -I -S` (no site-packages:
+    no numpy). What its own functions answer (the library's estimator) is tests/test_export_conformance.py's."""
     driver = tmp_path / "driver.py"
     driver.write_text(DRIVER)
     proc = subprocess.run([sys.executable, "-I", "-S", str(driver), str(path)], input=json.dumps(queries),

@@ -58,7 +58,7 @@ def _build(tmp_path: Path, test: SequentialTest, flags=("-O2",)) -> Path:
     (tmp_path / "seq.h").write_bytes(write_sequential_c(test, "seq"))
     (tmp_path / "main.c").write_text(MAIN)
     exe = tmp_path / "seqmain"
-    subprocess.run([CC, "-std=c99", "-Wall", "-Wextra", "-Werror", "-Wno-unused-function", *flags,
+    subprocess.run([CC, "-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", *flags,
                     "-o", str(exe), str(tmp_path / "main.c"), "-lm"], check=True, capture_output=True)
     return exe
 
@@ -145,3 +145,15 @@ def test_c_header_escapes_names_and_validates_the_prefix(tmp_path):
     with pytest.raises(InputError, match="prefix"):
         write_sequential_c(test, "1bad")
     assert "malloc" not in text and "static" in text
+
+
+def test_c_header_compiles_strictly_in_a_program_that_calls_nothing(tmp_path):
+    """Every function is ``static inline``: a program that includes the header and calls none of them (or only
+    some) compiles under -std=c99 -Wall -Wextra -Werror -pedantic (``static`` gave -Wunused-function)."""
+    test = SequentialTest([("a", 20000.0), ("b", 35000.0)], PAPER, noise_c=0.05, sensor_temp_c=35,
+                          ambient_temp_c=25, error_rate=0.05, max_contact_s=2.0)
+    (tmp_path / "seq.h").write_bytes(write_sequential_c(test, "seq"))
+    (tmp_path / "none.c").write_text('#include "seq.h"\nint main(void) { return 0; }\n')
+    proc = subprocess.run([CC, "-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-c", "none.c"],
+                          cwd=tmp_path, capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr

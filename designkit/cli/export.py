@@ -30,7 +30,7 @@ _WHAT = {"json": "JSON", "csv": "CSV", "npz": "NumPy npz", "mat": "MATLAB .mat",
 @app.command("export", rich_help_panel=_app.TABLES)
 def export_cmd(
     out: Annotated[str, typer.Option("--out", "-o", help="File to write (.json, .csv, .npz, .mat, .h or .py); - for standard output (give --format; a CSV then goes without its provenance sidecar).")],
-    table: Annotated[str, typer.Option("--table", help="Lookup table (name or path).")] = "svm-paper",
+    table: Annotated[str, typer.Option("--table", help="Lookup table (name or path); default the one every question reads.")] = "svm-fine",
     fmt: Annotated[Optional[str], typer.Option("--format", "-f", help=f"Format: {_FORMATS}. Default: from --out's suffix.")] = None,
     noise: Annotated[Optional[float], typer.Option("--noise", help="Keep one scene: noise sigma per sample [°C] (with --delta-t).")] = None,
     delta_t: Annotated[Optional[float], typer.Option("--delta-t", help="Keep one scene: sensor minus object temperature [°C] (with --noise).")] = None,
@@ -44,9 +44,10 @@ def export_cmd(
 ) -> None:
     """Export a table, or only the slice a deployment needs, for software where designkit does not run.
 
-    Example: `designkit export --table svm-paper --format c --noise 0.05 --delta-t 10 --out designkit_table.h`
-    writes a C99 header with `designkit_min_contact_s`, `designkit_delta_e` and
-    `designkit_distinguishable` for one sensor noise and temperature difference.
+    Example: `designkit export --format c --noise 0.05 --delta-t 10 --out designkit_table.h`
+    writes a C99 header whose `designkit_min_contact_interval`, `designkit_delta_e_interval` and
+    `designkit_distinguishable` answer as `designkit min-contact / delta-e / distinguishable` do (value and
+    90% interval) for one sensor noise and temperature difference.
 
     The folder of --out must exist (it is not created).
     """
@@ -79,11 +80,18 @@ def export_cmd(
     for line in _lines_from(p):
         con.print("  " + escape(line))
     if res.format == "c":
-        con.print(f"  [dim]#include it; call {prefix}_min_contact_s, {prefix}_delta_e, {prefix}_distinguishable "
-                  f"(sentinels: -1 none suffices, -2 outside the grid, -3 invalid input)[/]")
+        con.print(f"  [dim]#include it; call {prefix}_min_contact_interval, {prefix}_delta_e_interval, "
+                  f"{prefix}_distinguishable (sentinels: -1 none suffices, -2 outside the grid, -3 invalid input, "
+                  f"-4 only designkit answers this table)[/]")
     elif res.format == "python":
-        con.print("  [dim]import it; call min_contact_s, delta_e, distinguishable (None: none suffices; "
-                  "OutsideTable / ValueError otherwise)[/]")
+        con.print("  [dim]import it; call min_contact_interval, delta_e_interval, distinguishable (None: none "
+                  "suffices; OutsideTable / ValueError otherwise)[/]")
+    est = p.get("estimator", {})
+    con.print(f"  answers as designkit does: {est.get('name')} v{est.get('version')} (90% intervals)"
+              if est.get("answers") == "library" else
+              f"  answers as designkit does: {escape(str(est.get('answers')))}" if est.get("answers", "").startswith(
+                  "library") else
+              f"  [yellow]answers by the grid rule only[/]: {escape(str(est.get('unavailable')))}")
 
 
 def _check_sensor(table: str, sensor: str) -> None:

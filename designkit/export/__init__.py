@@ -13,11 +13,18 @@ its registry:
 ``registry``
     :data:`WRITERS` (format name -> writer), :func:`export_table` (slice and
     write a file), :func:`export_bytes`, :func:`render`, :func:`read_export`.
+``estimator``
+    the library's table estimator in pure Python (min-contact, delta-e, distinguishable with their
+    90 % intervals, as :mod:`designkit.query.table` answers them): the Python module carries it
+    verbatim, the C header carries the same steps in C.
+``estimator_data``
+    the constants an export carries for it (computed at export time) and
+    :func:`~designkit.export.estimator_data.estimator_of`, the reading rule of the data exports.
 ``formats/``
     one module per format: ``json``, ``csv``, ``npz``, ``mat``, ``c``, ``python``.
 ``templates/``
     the C header and the Python module as template files; the Python module
-    carries :mod:`designkit.tables.lookup` verbatim.
+    carries :mod:`designkit.tables.lookup` and :mod:`designkit.export.estimator` verbatim.
 ``_common``
     what the writers share: name checks, escaping for C and Python, templates.
 

@@ -38,7 +38,7 @@ JSON (no NaN). Anything else is refused in one line.
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Sequence
 
 import numpy as np
@@ -128,6 +128,13 @@ class Exported:
         How ``designkit export --table`` finds the source again: a shipped
         table's name, else the path it was read from (None for an export
         read back from a file).
+    more : dict of ndarray
+        ``delta_up_lo``, ``delta_down_lo``, ``delta_up_hi``, ``delta_down_hi``
+        (the ends of the table's Monte Carlo interval, shaped as ``delta_up``)
+        where the export carries the library's estimator; else empty.
+    estimator : dict, optional
+        The estimator's constants (:func:`designkit.export.estimator_data.estimator_params`);
+        None where the export answers by the grid rule only (``provenance["estimator"]`` says why).
     """
 
     axes: tuple[Axis, ...]
@@ -139,6 +146,8 @@ class Exported:
     e_lo_inclusive: bool
     provenance: dict
     source_ref: str | None = None
+    more: dict = field(default_factory=dict)
+    estimator: dict | None = None
 
     @property
     def scene_axes(self) -> tuple[Axis, ...]:
@@ -368,7 +377,13 @@ def slice_table(table: "Table | str", *, noise_c: float | None = None, delta_t_c
     def units(name: str) -> str:
         return str(ax_meta[name].get("units", ""))
 
-    # ---- scene: one combined row
+    from .estimator import ESTIMATOR, ESTIMATOR_VERSION
+    from .estimator_data import MORE_ARRAYS, estimator_params, estimator_reason
+
+    why_not = estimator_reason(tab, kind, contact is not None)
+    more = {n: np.asarray(tab.arrays[n], dtype=np.float64) for n in MORE_ARRAYS} if why_not is None else {}
+
+    # ---- scene: one combined row (an estimator export: the one or two rows around it, kept apart)
     if (noise_c is None) != (delta_t_c is None):
         raise InputError("give --noise and --delta-t together (one scene), or neither (all scenes)")
     if noise_c is not None:
@@ -401,8 +416,16 @@ def slice_table(table: "Table | str", *, noise_c: float | None = None, delta_t_c
                 total = total + w * arr[idx]  # NaN in any weighted row stays NaN, as in the query
             return total[(None,) * len(scene_names)]
 
-        up, down = combine(up), combine(down)
-        scene_axes = [Axis(n, units(n), ax_meta[n]["scale"], (float(point[n]),)) for n in scene_names]
+        if why_not is None:  # noise_ratio layout: the rows themselves (the estimator reads each row's ratio)
+            rows = sorted({idx[0] for idx, w in combos if w != 0})
+            up, down = up[rows], down[rows]
+            more = {n: a[rows] for n, a in more.items()}
+            ratios = ax_values["noise_ratio"][rows]
+            scene_axes = [Axis("noise_ratio", units("noise_ratio"), ax_meta["noise_ratio"]["scale"],
+                               tuple(float(r) for r in ratios))]
+        else:
+            up, down = combine(up), combine(down)
+            scene_axes = [Axis(n, units(n), ax_meta[n]["scale"], (float(point[n]),)) for n in scene_names]
         slice_info["scene"] = {"noise_c": noise, "delta_t_c": dt, **point,
                                "rows": [{"index": list(idx), "weight": w} for idx, w in combos if w != 0]}
     else:
@@ -418,6 +441,7 @@ def slice_table(table: "Table | str", *, noise_c: float | None = None, delta_t_c
     else:
         cols = list(range(contacts.size))
     up, down = up[..., cols, :], down[..., cols, :]
+    more = {n: a[..., cols, :] for n, a in more.items()}
     adjacent = tuple(bool(cols[k + 1] == cols[k] + 1) for k in range(len(cols) - 1))
 
     # ---- effusivity
@@ -449,6 +473,7 @@ def slice_table(table: "Table | str", *, noise_c: float | None = None, delta_t_c
         i0, i1 = 0, centres.size - 1
     up, down = up[..., i0:i1 + 1], down[..., i0:i1 + 1]
     up, down = np.ascontiguousarray(up), np.ascontiguousarray(down)
+    more = {n: np.ascontiguousarray(a[..., i0:i1 + 1]) for n, a in more.items()}
 
     for name, arr in (("delta_up", up), ("delta_down", down)):
         finite = arr[~np.isnan(arr)]
@@ -459,9 +484,12 @@ def slice_table(table: "Table | str", *, noise_c: float | None = None, delta_t_c
         Axis("contact_s", units("contact_s"), "linear", tuple(float(contacts[k]) for k in cols)),
         Axis("e_ref", E_UNITS, "linear", tuple(float(c) for c in centres[i0:i1 + 1])),
     )
-    export_hash = content_hash({"delta_up": up, "delta_down": down,
+    export_hash = content_hash({"delta_up": up, "delta_down": down, **more,
                                 **{f"axis_{a.name}": np.asarray(a.values) for a in axes}})
     fidelity = hdr.get("fidelity")
+    params = estimator_params(tab) if why_not is None else None
+    answers = ("grid rule only" if params is None else "library" if params["efficiency"] else
+               "library's value; interval low ends without its simulated ideal bound")
     provenance = {
         "format": EXPORT_FORMAT,
         "schema_version": EXPORT_SCHEMA,
@@ -492,9 +520,13 @@ def slice_table(table: "Table | str", *, noise_c: float | None = None, delta_t_c
         "interpolation": ("linear in e_ref between interval centres (a NaN neighbour gives NaN), linear in "
                           "contact_s and delta_t_c, log-linear in noise_ratio and noise_c; no extrapolation"),
         "export_hash": export_hash,
+        "estimator": {"name": ESTIMATOR, "version": ESTIMATOR_VERSION,
+                      "answers": answers,
+                      "coverage": 0.9 if why_not is None else None, "unavailable": why_not},
     }
     _plain_json(tab, provenance)
     # a table another with its name could shadow (a user's svm-paper) is named by its path in "Regenerate:" lines
     ref = tab.name if SHIPPED_TABLES.get(tab.name, (None,))[0] == hdr.get("content_hash") else str(tab.path)
     return Exported(axes=axes, delta_up=up, delta_down=down, contact_adjacent=adjacent, e_lo=float(e_lo),
-                    e_hi=float(e_hi), e_lo_inclusive=inclusive, provenance=provenance, source_ref=ref)
+                    e_hi=float(e_hi), e_lo_inclusive=inclusive, provenance=provenance, source_ref=ref, more=more,
+                    estimator=params)

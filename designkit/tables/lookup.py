@@ -54,7 +54,8 @@ designkit.tables.lookup.OutsideTable: noise_ratio 0.05 is outside table demo's g
 import bisect
 import math
 
-__all__ = ["GRID_RTOL", "Lookup", "OutsideTable", "axis_weights", "crossing", "interp_e"]
+__all__ = ["GRID_RTOL", "Lookup", "OutsideTable", "axis_weights", "contact_input", "crossing", "effusivity_input",
+           "interp_e", "pair_input", "scene_inputs"]
 
 #: A value within this relative distance of a grid value is that grid value. A float32
 #: argument (0.05f / 10.0f, as on a microcontroller) cannot hit 0.005 exactly; the query,
@@ -214,7 +215,8 @@ def crossing(xs, needs, gap, adjacent=None):
     return None, None
 
 
-# ------------------------------------------------------------ input checks (designkit.query's rules)
+# ------------------------------------------------------------ input checks (designkit.query's rules; also the
+# exported estimator's, designkit/export/estimator.py)
 def _number(name, x):
     try:
         v = float(x)
@@ -225,14 +227,16 @@ def _number(name, x):
     return v
 
 
-def _effusivity(name, x):
+def effusivity_input(name, x):
+    """Effusivity ``name`` as a positive finite float [J s^-1/2 K^-1 m^-2] (ValueError otherwise)."""
     v = _number("effusivity " + name, x)
     if v <= 0:
         raise ValueError("effusivity " + name + " must be positive, got " + repr(v))
     return v
 
 
-def _scene_inputs(noise_c, delta_t_c):
+def scene_inputs(noise_c, delta_t_c):
+    """``(noise, dT)`` [degC]: noise >= 0 and dT != 0, both finite (ValueError otherwise)."""
     noise = _number("noise sigma [degC]", noise_c)
     if noise < 0:
         raise ValueError("noise sigma [degC] must be >= 0, got " + repr(noise))
@@ -242,15 +246,17 @@ def _scene_inputs(noise_c, delta_t_c):
     return noise, dt
 
 
-def _contact_input(contact_s):
+def contact_input(contact_s):
+    """Contact time [s] as a positive finite float (ValueError otherwise)."""
     c = _number("contact time [s]", contact_s)
     if c <= 0:
         raise ValueError("contact time [s] must be positive, got " + repr(c))
     return c
 
 
-def _pair(e1, e2):
-    a, b = _effusivity("e1", e1), _effusivity("e2", e2)
+def pair_input(e1, e2):
+    """Two different effusivities as ``(lo, hi)`` [J s^-1/2 K^-1 m^-2] (ValueError otherwise)."""
+    a, b = effusivity_input("e1", e1), effusivity_input("e2", e2)
     if a == b:
         raise ValueError("e1 and e2 are equal (" + repr(a) + "): nothing to separate")
     return (a, b) if a < b else (b, a)
@@ -389,9 +395,9 @@ class Lookup:
 
     # ---- the questions
     def _deltas(self, e, noise_c, delta_t_c, contact_s):
-        e = _effusivity("e", e)
-        contact = _contact_input(contact_s)
-        noise, dt = _scene_inputs(noise_c, delta_t_c)
+        e = effusivity_input("e", e)
+        contact = contact_input(contact_s)
+        noise, dt = scene_inputs(noise_c, delta_t_c)
         combos = self.scene_weights(noise, dt)
         cw = self.contact_weights(contact)
         self._check_e(e)
@@ -414,8 +420,8 @@ class Lookup:
 
     def min_contact_s(self, e1, e2, noise_c, delta_t_c):
         """Shortest contact time [s] that separates ``e1`` from ``e2``; None: no tabulated contact time suffices."""
-        noise, dt = _scene_inputs(noise_c, delta_t_c)
-        lo, hi = _pair(e1, e2)
+        noise, dt = scene_inputs(noise_c, delta_t_c)
+        lo, hi = pair_input(e1, e2)
         combos = self.scene_weights(noise, dt)
         self._check_e(lo, hi)
         needs = (self.need(combos, k, lo, hi) for k in range(self._nc))
@@ -423,9 +429,9 @@ class Lookup:
 
     def distinguishable(self, e1, e2, noise_c, delta_t_c, contact_s):
         """Whether ``contact_s`` [s] separates ``e1`` from ``e2`` (need <= distance)."""
-        contact = _contact_input(contact_s)
-        noise, dt = _scene_inputs(noise_c, delta_t_c)
-        lo, hi = _pair(e1, e2)
+        contact = contact_input(contact_s)
+        noise, dt = scene_inputs(noise_c, delta_t_c)
+        lo, hi = pair_input(e1, e2)
         combos = self.scene_weights(noise, dt)
         cw = self.contact_weights(contact)
         self._check_e(lo, hi)

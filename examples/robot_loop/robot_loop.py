@@ -3,7 +3,7 @@
 
 Needs only the Python standard library and a table module exported by designkit:
 
-    designkit export --table svm-paper --format python --e-min 200 --e-max 30000 --out thermal_table.py
+    designkit export --table svm-fine --format python --e-min 200 --e-max 30000 --out thermal_table.py
     python3 robot_loop.py                  # human-readable
     python3 robot_loop.py --json           # one JSON object per object (for logs and tests)
 
@@ -11,8 +11,10 @@ A sorting robot with a heated thermal tactile sensor picks objects off a conveyo
 For each object, vision narrows the material down to a few candidates; just before
 the touch the robot reads its sensor's and the object's temperatures (dT), and it
 knows its noise from calibration. The touch must separate every pair of
-candidates, so the contact time is the largest ``min_contact_s`` over the pairs
-(plus a safety margin, rounded up to the control period). When no contact time
+candidates, so the contact time is the largest over the pairs of the long end of
+``min_contact_interval`` (designkit min-contact's 90 % interval: the answer is an
+estimate, and the robot plans on the end that errs long), plus a safety margin,
+rounded up to the control period. When no contact time
 the gripper allows is enough at this dT, the robot heats the sensor further first
 (a larger dT means a smaller sigma/dT); if even the hottest allowed sensor is not
 enough, the object goes to a human.
@@ -64,7 +66,7 @@ def load_table(path: Path):
     """Import the exported table module from its file (it needs nothing but the standard library)."""
     spec = importlib.util.spec_from_file_location("thermal_table", path)
     if spec is None or not path.is_file():
-        sys.exit(f"no table module at {path}: export one with\n  designkit export --table svm-paper "
+        sys.exit(f"no table module at {path}: export one with\n  designkit export --table svm-fine "
                  f"--format python --e-min 200 --e-max 30000 --out {path}")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
@@ -72,15 +74,23 @@ def load_table(path: Path):
 
 
 def contact_needed(table, candidates, noise_c: float, delta_t_c: float):
-    """Per pair of candidates, the shortest contact time [s] (None: none in the table suffices).
+    """Per pair of candidates, the shortest contact time [s] and its 90 % interval (None: none in the table
+    suffices; an interval end None: open).
 
     Raises the table's OutsideTable when the scene lies outside the table's grid.
     """
     pairs = []
     for a, b in itertools.combinations(candidates, 2):
-        t = table.min_contact_s(MATERIALS[a], MATERIALS[b], noise_c, delta_t_c)
-        pairs.append({"a": a, "b": b, "e_a": MATERIALS[a], "e_b": MATERIALS[b], "min_contact_s": t})
+        t, low, high = table.min_contact_interval(MATERIALS[a], MATERIALS[b], noise_c, delta_t_c)
+        pairs.append({"a": a, "b": b, "e_a": MATERIALS[a], "e_b": MATERIALS[b], "min_contact_s": t,
+                      "interval_s": [low, high]})
     return pairs
+
+
+def planned(pair) -> float:
+    """The contact a pair asks for [s]: its interval's long end (its value where the interval is open)."""
+    high = pair["interval_s"][1]
+    return high if high is not None else pair["min_contact_s"]
 
 
 def plan(table, candidates, noise_c: float, delta_t_c: float, margin: float) -> dict:
@@ -90,9 +100,9 @@ def plan(table, candidates, noise_c: float, delta_t_c: float, margin: float) -> 
             pairs = contact_needed(table, candidates, noise_c, dt)
         except table.OutsideTable as exc:
             return None, None, str(exc)
-        times = [p["min_contact_s"] for p in pairs]
-        if any(t is None for t in times):
+        if any(p["min_contact_s"] is None for p in pairs):
             return pairs, None, "no tabulated contact time separates every pair"
+        times = [planned(p) for p in pairs]
         periods = math.ceil(max(times) * (1 + margin) / CONTROL_PERIOD_S - 1e-9)
         contact = round(periods * CONTROL_PERIOD_S, 6)
         if contact > MAX_CONTACT_S:
@@ -132,7 +142,9 @@ def main(argv=None) -> int:
         print(f"{name}: {' or '.join(candidates)}?  dT {decision['delta_t_c']:.1f} degC, noise {args.noise:g} degC")
         for p in decision["pairs"] or []:
             t = p["min_contact_s"]
-            print(f"    {p['a']} vs {p['b']}: " + (f"{t:.2f} s" if t is not None else "not separable at this dT"))
+            low, high = p["interval_s"]
+            span = f" (90% interval {low:.2f} to {high:.2f} s)" if low is not None and high is not None else ""
+            print(f"    {p['a']} vs {p['b']}: " + (f"{t:.2f} s{span}" if t is not None else "not separable at this dT"))
         if decision["action"] == "touch":
             print(f"  -> touch for {decision['contact_s']:.2f} s")
         elif decision["action"] == "heat":

@@ -6,8 +6,12 @@ The header is the template ``designkit/export/templates/designkit_lookup.h.in``
 the provenance as macros and comments. It needs only ``<math.h>``, allocates
 nothing, and answers like :mod:`designkit.tables.lookup`:
 
-``PREFIX_delta_e``, ``PREFIX_delta_e_lower``, ``PREFIX_delta_e_upper``,
-``PREFIX_min_contact_s`` (floats) and ``PREFIX_distinguishable`` (int).
+``PREFIX_min_contact_s``, ``PREFIX_min_contact_interval``, ``PREFIX_delta_e``,
+``PREFIX_delta_e_interval``, ``PREFIX_delta_e_lower`` / ``_upper``, ``PREFIX_delta_e_sides``,
+``PREFIX_distinguishable`` and ``PREFIX_distinguishable_verdict``: the library's estimator
+(:mod:`designkit.export.estimator`, in C, double precision) where the export carries it
+(``PREFIX_HAS_ESTIMATOR``), the grid rule for an ideal-observer table (which the library answers by it),
+else ``PREFIX_NEEDS_DESIGNKIT`` (-4). ``PREFIX_grid_*`` answer by the grid rule alone.
 
 ==================  ============================================
 meaning             C (float / int functions)
@@ -16,6 +20,7 @@ answer              ``>= 0`` / ``PREFIX_YES`` (1) or ``PREFIX_NO`` (0)
 nothing suffices    ``PREFIX_NONE`` (-1)
 outside the grid    ``PREFIX_OUTSIDE`` (-2) / ``PREFIX_OUTSIDE_I``
 invalid input       ``PREFIX_INVALID`` (-3) / ``PREFIX_INVALID_I``
+needs designkit     ``PREFIX_NEEDS_DESIGNKIT`` (-4) / ``_I``
 ==================  ============================================
 
 Every string from the table (names, creation time, units, hash, the forward
@@ -32,9 +37,10 @@ import math
 import numpy as np
 
 from ...tables.lookup import GRID_RTOL
-from .._common import (CLI_RELATION, c_comment, c_double, c_string, check_prefix, fill_template, log_grid, read_template,
+from .._common import (c_comment, c_double, c_string, check_prefix, fill_template, log_grid, read_template,
                        regenerate_command, slice_lines)
 from ..slicing import Exported
+from .python import example_answer
 
 __all__ = ["TEMPLATE", "describe_model", "write"]
 
@@ -106,7 +112,54 @@ def write(exp: Exported, prefix: str = "designkit") -> bytes:
         v = sensor.get(key)
         return float(v) if isinstance(v, (int, float)) and not isinstance(v, bool) else math.nan
 
-    text = fill_template(read_template(TEMPLATE), {
+    est = exp.estimator
+    has_est = est is not None
+    grid_is_library = not has_est and p["fidelity"] != "svm" and p["kind"] == "svm"
+    ev = {"HAS_EST": "1" if has_est else "0", "GRID_IS_LIBRARY": "1" if grid_is_library else "0",
+          "EST_VERSION": str(p["estimator"]["version"]), "EST_COVERAGE": c_double(0.9)}
+    ev.update({k: "0" for k in ("UP_LO", "DOWN_LO", "UP_HI", "DOWN_HI", "CUM", "NCUM", "SF", "NSF", "RATIOS", "NR",
+                                "E_S", "FS", "WIDTH", "ZT", "ZC", "MCF", "ELO", "EHI", "NMAX", "SA0", "SDMIN", "SU0",
+                                "SDU", "SNU", "SV0", "SDV", "SNV", "EFFICIENCY")})  # inside "#if 0" when absent
+    if has_est:
+        scene_vals = exp.scene_axes[0].values
+        ev.update({
+            "UP_LO": _c_float_rows(exp.more["delta_up_lo"], exp), "DOWN_LO": _c_float_rows(exp.more["delta_down_lo"], exp),
+            "UP_HI": _c_float_rows(exp.more["delta_up_hi"], exp), "DOWN_HI": _c_float_rows(exp.more["delta_down_hi"], exp),
+            "CUM": _c_doubles(est["cum"]), "NCUM": str(len(est["cum"])), "SF": _c_doubles(est["s_f"]),
+            "NSF": str(len(est["s_f"])), "RATIOS": _c_doubles(scene_vals), "NR": str(len(scene_vals)),
+            "E_S": c_double(est["e_s"]), "FS": c_double(est["fs"]), "WIDTH": c_double(est["width"]),
+            "ZT": c_double(est["z_table"]), "ZC": c_double(est["zc"]), "MCF": c_double(est["mc_factor"]),
+            "ELO": c_double(est["e_lo"]), "EHI": c_double(est["e_hi"]),
+            "NMAX": str(int(math.floor(est["max_contact_s"] * est["fs"] + 1e-9))),
+            "SA0": c_double(est["s_a0"]), "SDMIN": c_double(est["s_dmin"]), "SU0": c_double(est["s_u0"]),
+            "SDU": c_double(est["s_du"]), "SNU": str(est["s_nu"]), "SV0": c_double(est["s_v0"]),
+            "SDV": c_double(est["s_dv"]), "SNV": str(est["s_nv"]),
+            "EFFICIENCY": "1" if est.get("efficiency", True) else "0"})
+    q, ans = example_answer(exp)
+    if has_est and not est.get("efficiency", True):
+        how = ["Estimator: " + p["estimator"]["name"] + ", version " + str(p["estimator"]["version"]) + ", without",
+               "its efficiency route: the table's model has no closed-form ideal observer, so designkit answers",
+               "from the table alone (as here: the same value) and simulates the ideal bound under its intervals",
+               "(not here: the low ends are the table's own). max-noise and min-delta-t are not here."]
+    elif has_est:
+        how = ["Estimator: " + p["estimator"]["name"] + ", version " + str(p["estimator"]["version"]) + ": the",
+               "functions below answer as designkit min-contact / delta-e / distinguishable do (the same value",
+               "and 90 % interval), in double precision, libm only. max-noise and min-delta-t are not here."]
+    elif grid_is_library:
+        how = ["An ideal-observer table: designkit answers it by the grid rule, which the functions below run."]
+    else:
+        how = ["Estimator: none (" + str(p["estimator"]["unavailable"]) + ").",
+               "The functions below return " + P + "_NEEDS_DESIGNKIT (-4): only designkit answers this table as",
+               "designkit does; " + prefix + "_grid_* answer by the grid rule (not designkit's estimates)."]
+    example = [f"    #include <stdio.h>", f'    #include "{prefix}_table.h"',
+               "    int main(void) {", "        double iv[3];",
+               f"        if ({prefix}_min_contact_interval({q[0]!r}, {q[1]!r}, {q[2]!r}, {q[3]!r}, iv) == 0)",
+               '            printf("%.3f s (%.3f to %.3f)\\n", iv[0], iv[1], iv[2]);',
+               "        return 0;", "    }",
+               f"    prints {ans:.3f} s ...  (cc -std=c99 main.c -lm)" if ans is not None else "    prints nothing (none)"]
+    text = fill_template(read_template(TEMPLATE), {**ev,
+        "HOW": "\n".join(" * " + c_comment(x) for x in how),
+        "EXAMPLE": "\n".join(" * " + c_comment(x).replace("\\\\", "\\") for x in example),
         "P": P, "p": prefix,
         "SCENE_VARIED": "1" if varied else "0",
         "SCENE_DEFINES": "\n".join(defines),
@@ -114,7 +167,6 @@ def write(exp: Exported, prefix: str = "designkit") -> bytes:
         "SCENE_UNDEFS": "\n".join(undefs),
         "SCENE_WORDS": "sigma and linearly in dT" if varied else "sigma/dT",
         "SLICE": "\n".join(" * " + c_comment(line) for line in slice_lines(exp)),
-        "RELATION": "\n".join(" *   " + c_comment(line) for line in CLI_RELATION),
         "COMMAND": c_comment(regenerate_command(exp, "c", prefix)),
         "VERSION": c_comment(p["designkit_version"]), "TABLE": c_comment(p["source_table"]),
         "HASH": c_comment(p["source_content_hash"]), "CREATED": c_comment(p["source_created"]),

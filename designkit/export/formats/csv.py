@@ -42,14 +42,14 @@ def _num_strings(a: np.ndarray, nan: str) -> np.ndarray:
 
 
 def _columns(exp: Exported) -> list[str]:
-    return [a.name for a in exp.axes] + ["delta_up", "delta_down"]
+    return [a.name for a in exp.axes] + ["delta_up", "delta_down"] + list(exp.more)
 
 
 def write(exp: Exported) -> bytes:
     """The CSV bytes: a header line, then one line of numbers per grid point (no provenance)."""
     grids = np.meshgrid(*[np.asarray(a.values) for a in exp.axes], indexing="ij")
-    cols = [_num_strings(g, "nan") for g in grids] + [_num_strings(exp.delta_up, "nan"),
-                                                      _num_strings(exp.delta_down, "nan")]
+    cols = [_num_strings(g, "nan") for g in grids] + [_num_strings(a, "nan") for a in (
+        exp.delta_up, exp.delta_down, *exp.more.values())]
     head = io.StringIO()
     csv.writer(head, lineterminator="\n").writerow(_columns(exp))  # quoted by the csv rules, were it ever needed
     rows = map(",".join, zip(*[c.tolist() for c in cols]))
@@ -68,9 +68,12 @@ def sidecar(exp: Exported, csv_name: str) -> bytes:
                "delta_down": "smallest distinguishable difference towards lower effusivity (nan: none in the grid)"}
     columns = [{"name": a.name, "units": a.units, "scale": a.scale} for a in exp.axes]
     columns += [{"name": n, "units": E_UNITS, "meaning": meaning[n]} for n in ("delta_up", "delta_down")]
+    columns += [{"name": n, "units": E_UNITS, "meaning": "an end of the table's Monte Carlo interval of delta"}
+                for n in exp.more]
     doc = {"format": EXPORT_FORMAT, "schema_version": EXPORT_SCHEMA, "sidecar_of": csv_name,
            "columns": columns, "axes": [a.to_dict() for a in exp.axes],
-           "contact_adjacent": list(exp.contact_adjacent), "provenance": exp.provenance}
+           "contact_adjacent": list(exp.contact_adjacent), "provenance": exp.provenance,
+           "estimator": exp.estimator}
     return (json.dumps(doc, indent=1, allow_nan=False) + "\n").encode()
 
 
@@ -86,15 +89,17 @@ def read(path: Path) -> Exported:
     shape = tuple(len(a.values) for a in axes)
     data = np.genfromtxt(path, delimiter=",", names=True, dtype=np.float64)
     names = [a.name for a in axes]
-    if list(data.dtype.names) != names + ["delta_up", "delta_down"] or data.size != math.prod(shape):
+    more = [c["name"] for c in doc["columns"][len(names) + 2:]]
+    if list(data.dtype.names) != names + ["delta_up", "delta_down"] + more or data.size != math.prod(shape):
         raise ValueError(f"its columns or row count do not match its sidecar {side.name}")
     order = np.lexsort([np.atleast_1d(data[n]) for n in reversed(names)])
     for a in axes:
         got = np.unique(np.atleast_1d(data[a.name]))
         if got.size != len(a.values) or not np.array_equal(got, np.asarray(a.values)):
             raise ValueError(f"its {a.name} column does not hold the grid of its sidecar {side.name}")
-    arr = {k: np.atleast_1d(data[k])[order].reshape(shape) for k in ("delta_up", "delta_down")}
+    arr = {k: np.atleast_1d(data[k])[order].reshape(shape) for k in ("delta_up", "delta_down", *more)}
     ea = prov["effusivity_answered"]
     return Exported(axes=axes, delta_up=arr["delta_up"], delta_down=arr["delta_down"],
                     contact_adjacent=tuple(bool(x) for x in doc["contact_adjacent"]), e_lo=float(ea["min"]),
-                    e_hi=float(ea["max"]), e_lo_inclusive=bool(ea["min_inclusive"]), provenance=prov)
+                    e_hi=float(ea["max"]), e_lo_inclusive=bool(ea["min_inclusive"]), provenance=prov,
+                    more={k: arr[k] for k in more}, estimator=doc.get("estimator"))

@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from ..estimator_data import MORE_ARRAYS
 from ..slicing import EXPORT_FORMAT, EXPORT_SCHEMA, Axis, Exported
 
 __all__ = ["read", "structure", "write"]
@@ -34,10 +35,11 @@ def structure(exp: Exported) -> dict[str, Any]:
 def write(exp: Exported) -> bytes:
     """The export as JSON bytes (UTF-8; every string escaped by :func:`json.dumps`, ASCII only)."""
     doc = {"format": EXPORT_FORMAT, "schema_version": EXPORT_SCHEMA, "provenance": exp.provenance,
-           **structure(exp), "array_order": [a.name for a in exp.axes]}
+           **structure(exp), "array_order": [a.name for a in exp.axes], "estimator": exp.estimator}
     head = json.dumps(doc, indent=1, allow_nan=False)
     body = ",\n".join(f' "{name}": ' + json.dumps(_nan_to_none(arr), separators=(",", ":"), allow_nan=False)
-                      for name, arr in (("delta_up", exp.delta_up), ("delta_down", exp.delta_down)))
+                      for name, arr in (("delta_up", exp.delta_up), ("delta_down", exp.delta_down),
+                                        *exp.more.items()))
     return (head[:-2] + ",\n" + body + "\n}\n").encode()
 
 
@@ -51,4 +53,6 @@ def read(path: Path) -> Exported:
     return Exported(axes=axes, delta_up=np.array(doc["delta_up"], dtype=np.float64),  # null -> nan
                     delta_down=np.array(doc["delta_down"], dtype=np.float64),
                     contact_adjacent=tuple(bool(x) for x in doc["contact_adjacent"]), e_lo=float(ea["min"]),
-                    e_hi=float(ea["max"]), e_lo_inclusive=bool(ea["min_inclusive"]), provenance=prov)
+                    e_hi=float(ea["max"]), e_lo_inclusive=bool(ea["min_inclusive"]), provenance=prov,
+                    more={k: np.array(doc[k], dtype=np.float64) for k in MORE_ARRAYS if k in doc},
+                    estimator=doc.get("estimator"))

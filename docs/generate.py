@@ -53,7 +53,7 @@ FILES = [REPO / "README.md", *sorted((REPO / "docs").glob("*.md")),
 SHELL = re.compile(r"[|&;<>()$`]")
 #: The run's own wall and CPU times (they differ from run to run): compared with the number masked,
 #: so a block counts as stale only when something else changed.
-VOLATILE = re.compile(r"(?<=in )[\d.]+ s \([\d.]+ s CPU\)|(?<=per class, )[\d.]+ s(?=\))")
+VOLATILE = re.compile(r"(?<=in )[\d.]+ s \([\d.]+ s CPU\)|(?<=per class, )[\d.]+ s(?=\))|(?<=computed in )[\d.]+ s")
 
 
 def same(old: str, new: str) -> bool:

@@ -173,8 +173,11 @@ class _Group(TyperGroup):
         sub_args = list(getattr(ctx, "protected_args", []) or []) + list(ctx.args or [])
         try:
             return super().invoke(ctx)
-        except (typer.Exit, typer.Abort, _ClickException, KeyboardInterrupt, SystemExit, BrokenPipeError):
-            raise  # a closed pipe is not bad input: main() stops quietly
+        except BrokenPipeError:  # the reader had what it wanted (``| head -1``): not bad input, not a failure
+            _quiet_stdout()
+            raise typer.Exit(EXIT_BROKEN_PIPE) from None
+        except (typer.Exit, typer.Abort, _ClickException, KeyboardInterrupt, SystemExit):
+            raise
         except (ValueError, OSError) as exc:
             message = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
             if isinstance(exc, OSError) and exc.filename and str(exc.filename) not in message:
@@ -398,9 +401,21 @@ class busy:
             self._progress.stop()
 
 
-#: Exit status when the reader of stdout went away (``designkit ... | head -1``): click's (it stops a command
-#: that writes into a closed pipe with status 1 and no message); the same when the pipe closes at the last flush.
-EXIT_BROKEN_PIPE = 1
+#: Exit status when the reader of stdout went away (``designkit ... | head -1``): 0, like a command that wrote
+#: everything, so ``set -o pipefail`` scripts that read only the answer's first line do not fail (click's own
+#: status for a closed pipe, 1, made ``min-contact ... | head -1`` fail them); the same at the last flush.
+EXIT_BROKEN_PIPE = 0
+
+
+def _quiet_stdout() -> None:
+    """Point stdout at the null device: nothing more is written into the closed pipe, not even at exit."""
+    import os
+
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):  # pragma: no cover - stdout without a file descriptor (tests)
+        pass
 
 
 def main() -> None:
@@ -417,9 +432,6 @@ def main() -> None:
         sys.exit(EXIT_INTERRUPTED)
     except BrokenPipeError:
         # the reader closed the pipe before the last flush: stop quietly (no "Error:", no "Exception ignored"
-        # at interpreter exit), as click does when a command's write meets the closed pipe
-        import os
-
-        devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, sys.stdout.fileno())
+        # at interpreter exit)
+        _quiet_stdout()
         sys.exit(EXIT_BROKEN_PIPE)

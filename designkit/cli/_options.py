@@ -7,6 +7,9 @@ from typing import Annotated, Optional
 import typer
 
 Json = Annotated[bool, typer.Option("--json", help="Print the result as JSON on stdout.")]
+Explain = Annotated[bool, typer.Option(
+    "--explain", "-v", help="Also print how the answer was found: the method, the hardest pair of two materials, "
+                            "the paper's remark and every note (--json always has them).")]
 SensorOpt = Annotated[str, typer.Option(
     "--sensor", help="Sensor preset name ('paper') or a sensor YAML file written by calibration; a file's "
                      "recorded model answers unless --model (or --thickness, --conductance) is given.")]

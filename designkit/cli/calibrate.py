@@ -32,7 +32,7 @@ is opened; give the same materials in the same order and --yes (the emulator doe
 The command it prints after 'try:' does this; a run whose labels its plan contradicts stops before \
 recording.
 
-Example: `designkit calibrate --port /dev/pts/5 --material wood --material metal --out trials/ --yes`
+Example: `designkit calibrate --port /dev/ttyACM0 --material wood --material "aluminium alloys" --out trials/ --yes`
 """
 
 calibrate_app = sub_app("calibrate", _CALIBRATE_HELP, panel=_app.SENSOR)
@@ -756,7 +756,7 @@ def fit(
 
     Example: `designkit calibrate fit trials/index.csv --range wood=331:506 --out my-sensor.yaml`
 
-    Example (the parameters as CSV): `designkit calibrate fit trials/index.csv --model all --format csv`
+    Example (the parameters as CSV): `designkit calibrate fit trials/index.csv --format csv`
     """
     from ._format import check_format, check_out, emit_rows
 

@@ -115,9 +115,9 @@ def classify(
     the error rate you ask for; prints each touch's decision and its time to decision. Exit 3 when no
     contact up to --max-contact can separate the materials at that error rate.
 
-    Example: `designkit classify --port /dev/ttyACM0 --sensor my-sensor.yaml --m wood --m "aluminium alloys" --touches 5`
+    Example: `designkit classify --port /dev/ttyACM0 --sensor my-sensor.yaml --m wood --m "aluminium alloys"`
 
-    Example: `designkit classify --port /dev/pts/3 --m wood --m "aluminium alloys" --time-offset -0.25` (the emulator)
+    Example (the emulator's rig, its onset 0.25 s late): `designkit classify --port /dev/pts/3 --m wood --m "aluminium alloys" --time-offset -0.25`
 
     Example: `designkit classify --m wood --m "aluminium alloys" --error-rate 0.001 --export-c robot_seq.h`
     """

@@ -33,34 +33,52 @@ from ._options import (
     Json,
     ModelOpt,
     Noise,
+    PANEL_EXACT,
+    PANEL_OUTPUT,
+    PANEL_QUESTION,
+    PANEL_SCENE,
+    PANEL_SENSOR,
     SensorOpt,
     Thickness,
     Threshold,
     sensor_and_model,
 )
 
-Contact = Annotated[float, typer.Option("--contact", help="Contact time [s].")]
+Contact = Annotated[float, typer.Option("--contact", help="Contact time [s].",
+    rich_help_panel=PANEL_SCENE)]
 Exact = Annotated[bool, typer.Option(
-    "--exact", help="Compute for this pair and scene (seconds) instead of reading a table.")]
+    "--exact", help="Compute for this pair and scene (seconds) instead of reading a table.",
+    rich_help_panel=PANEL_EXACT)]
 TableOpt = Annotated[Optional[str], typer.Option(
-    "--table", help="Lookup table (name or path) for the SVM answer (default: svm-fine).")]
-IdealTableOpt = Annotated[str, typer.Option("--ideal-table", help="Lookup table for the ideal-observer bound.")]
-TrialsQ = Annotated[int, typer.Option("--trials", help="--exact: simulated touches per class.")]
-RepeatsQ = Annotated[int, typer.Option("--repeats", help="--exact: seeds per evaluation (Monte Carlo error).")]
-SeedQ = Annotated[int, typer.Option("--seed", help="--exact: random seed.")]
+    "--table", help="Lookup table (name or path) for the SVM answer (default: svm-fine).",
+    rich_help_panel=PANEL_SENSOR)]
+IdealTableOpt = Annotated[str, typer.Option("--ideal-table", help="Lookup table for the ideal-observer bound.",
+    rich_help_panel=PANEL_SENSOR)]
+TrialsQ = Annotated[int, typer.Option("--trials", help="--exact: simulated touches per class.",
+    rich_help_panel=PANEL_EXACT)]
+RepeatsQ = Annotated[int, typer.Option("--repeats", help="--exact: seeds per evaluation (Monte Carlo error).",
+    rich_help_panel=PANEL_EXACT)]
+SeedQ = Annotated[int, typer.Option("--seed", help="--exact: random seed.",
+    rich_help_panel=PANEL_EXACT)]
 WidthQ = Annotated[float, typer.Option(
-    "--width", help="--exact: class width [J s^-1/2 K^-1 m^-2] of each object (and of the materials rule).")]
-JobsQ = Annotated[int, typer.Option("--jobs", "-j", help="--exact: worker processes (-1: all cores).")]
+    "--width", help="--exact: class width [J s^-1/2 K^-1 m^-2] of each object (and of the materials rule).",
+    rich_help_panel=PANEL_EXACT)]
+JobsQ = Annotated[int, typer.Option("--jobs", "-j", help="--exact: worker processes (-1: all cores).",
+    rich_help_panel=PANEL_EXACT)]
 NmcQ = Annotated[int, typer.Option(
-    "--n-mc", help="--exact: touches per class of the Monte Carlo ideal observer (models without a shared shape).")]
-MaxContact = Annotated[float, typer.Option("--max-contact", help="--exact: longest contact time to consider [s].")]
+    "--n-mc", help="--exact: touches per class of the Monte Carlo ideal observer (models without a shared shape).",
+    rich_help_panel=PANEL_EXACT)]
+MaxContact = Annotated[float, typer.Option("--max-contact", help="--exact: longest contact time to consider [s].",
+    rich_help_panel=PANEL_EXACT)]
 SpreadOpt = Annotated[float, typer.Option(
     "--sensor-temp-spread", help="Varied initial conditions: each touch's sensor temperature uniform within "
     "+-this [°C] of ambient + dT (the paper's robot: --delta-t 7.5 --sensor-temp-spread 2.5, answered from the "
     "shipped table svm-paper-varied for min-contact, delta-e and distinguishable); any other case is computed "
-    "like --exact. Must stay below |dT|.")]
+    "like --exact. Must stay below |dT|.",
+    rich_help_panel=PANEL_SCENE)]
 CoverageOpt = Annotated[float, typer.Option(
-    "--coverage", help="Coverage of the answer's interval, in (0, 1) (table and --exact).")]
+    "--coverage", help="Coverage of the answer's interval, in (0, 1) (table and --exact).",
+    rich_help_panel=PANEL_QUESTION)]
 
 #: Exit status of a question without an answer, on either route: the table cannot answer it (outside
 #: its grid along an axis, or nothing tabulated separates the pair), the materials' effusivity ranges
@@ -397,7 +415,9 @@ def min_contact_cmd(
 ) -> None:
     """Shortest contact time that separates two materials.
 
-    Example: `designkit min-contact --e1 35000 --e2 20000` or `designkit min-contact --m1 copper --m2 "stainless steel" --exact`
+    Example: `designkit min-contact --e1 35000 --e2 20000`
+
+    Example (materials by name, the method too): `designkit min-contact --m1 wood --m2 glass --explain`
     """
     ans = _ask("min-contact", exact=exact, table=table, ideal_table=ideal_table, threshold=threshold, sensor=sensor,
                model=model, conductance=conductance, thickness=thickness, backing=backing, diffusivity=diffusivity,
@@ -458,8 +478,10 @@ def min_delta_t_cmd(
 
 @app.command("delta-e", rich_help_panel=_app.ASK)
 def delta_e_cmd(
-    e: Annotated[Optional[float], typer.Option("--e", help="Reference effusivity [J s^-1/2 K^-1 m^-2].")] = None,
-    m: Annotated[Optional[str], typer.Option("--m", help="Reference material (its range's middle).")] = None,
+    e: Annotated[Optional[float], typer.Option("--e", help="Reference effusivity [J s^-1/2 K^-1 m^-2].",
+                                               rich_help_panel=PANEL_QUESTION)] = None,
+    m: Annotated[Optional[str], typer.Option("--m", help="Reference material (its range's middle).",
+                                             rich_help_panel=PANEL_QUESTION)] = None,
     contact: Contact = 2.0, noise: Noise = 0.05, delta_t: DeltaT = 10.0, threshold: Threshold = 0.9,
     sensor: SensorOpt = "paper",
     model: ModelOpt = None, conductance: Conductance = None, thickness: Thickness = None,
@@ -469,12 +491,15 @@ def delta_e_cmd(
     n_mc: NmcQ = 1000, coverage: CoverageOpt = 0.9, sensor_temp_spread: SpreadOpt = 0.0,
     format_: Annotated[Optional[str], typer.Option(
         "--format", "-f", help="Print the two directions as rows: table, json, csv or md (default: the answer "
-                               "for people; --json: the whole answer).")] = None,
-    out: OutOpt = None, json_: Json = False, explain: Explain = False,
+                               "for people; --json: the whole answer).", rich_help_panel=PANEL_OUTPUT)] = None,
+    out: Annotated[Optional[str], typer.Option("--out", "-o", help="Write the output to this file ('-' or none: "
+                                               "stdout).", rich_help_panel=PANEL_OUTPUT)] = None, json_: Json = False, explain: Explain = False,
 ) -> None:
     """Smallest distinguishable effusivity difference delta(e), towards lower and higher effusivity.
 
-    Example: `designkit delta-e --e 20000 --contact 2` (`--format csv` for one row per direction)
+    Example: `designkit delta-e --e 20000 --contact 2`
+
+    Example (one row per direction): `designkit delta-e --e 20000 --contact 2 --format csv`
     """
     fmt = None if json_ or format_ is None else check_format(format_)
     if out not in (None, "-"):

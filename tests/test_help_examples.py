@@ -145,6 +145,7 @@ def test_the_example_runs_as_printed(path, cmd, scratch):
     if port:
         emu = _Emulator(_emulated_materials(cmd), env, folder)
         run = cmd.replace(port.group(0), f"--port {emu.info['port']}")
+    RESULTS[cmd] = -1  # a timeout counts as a failure
     try:
         r = subprocess.run(["bash", "-o", "pipefail", "-c", run], cwd=folder, env=env, capture_output=True,
                            text=True, timeout=300)

@@ -923,7 +923,7 @@ def emulate(
 ) -> None:
     """Emulate a sensor rig on a pseudo-terminal: prints its path, streams the profile's wire format.
 
-    Example: `designkit emulate --profile designkit --material wood=400 --material aluminium=20000 --speed 20`
+    Example (a rig playing two objects for 30 s; without --duration until Ctrl-C): `designkit emulate --material wood=400 --material aluminium=20000 --speed 20 --duration 30`
     """
     from .._validation import InputError
     from ..calibration.emulator import EmulatedMaterial, Emulator, Faults, TouchPlan

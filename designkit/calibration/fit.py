@@ -1135,12 +1135,14 @@ def plot_fit(result: CalibrationResult, path: Path) -> Path:
     curves = model_curves(result)
     fig, axes = plt.subplots(1, 3, figsize=(13.5, 4.0), constrained_layout=True)
     for k, (n, c) in enumerate(curves.items()):
-        axes[0].plot(c["time_s"], c["data_c"], color=f"C{k}", lw=1.2, label=f"{n} (mean of trials)")
-        axes[0].plot(c["time_s"], c["model_c"], color=f"C{k}", lw=1.0, ls="--")
+        # the data light and wide, the model dark and dashed on top: the model stays visible where it fits
+        axes[0].plot(c["time_s"], c["data_c"], color=f"C{k}", lw=3.0, alpha=0.45, label=f"{n} (mean of trials)")
+        axes[0].plot(c["time_s"], c["model_c"], color="k", lw=1.2, ls=(0, (4, 2)), zorder=4,
+                     label="fitted model" if k == 0 else None)
         axes[1].plot(c["time_s"], c["residual_c"], color=f"C{k}", lw=1.0, label=n)
     axes[0].set_xlabel("time after detected onset [s]")
-    axes[0].set_ylabel("(T - Ts0) / (To - Ts0)  [free-To materials: T - Ts0 in °C]", fontsize=8)
-    axes[0].set_title("data (solid) and fitted model (dashed)", fontsize=9)
+    axes[0].set_ylabel("(T - Ts0) / (To - Ts0)\n(free-To materials: T - Ts0 [°C])")
+    axes[0].set_title("data (wide) and fitted model (dashed)")
     axes[0].legend(fontsize=7)
     axes[1].axhline(0, color="k", lw=0.5)
     axes[1].set_xlabel("time after detected onset [s]")
@@ -1154,7 +1156,9 @@ def plot_fit(result: CalibrationResult, path: Path) -> Path:
         if "profile_threshold_rms_c" in result.curves:
             ax.axhline(result.curves["profile_threshold_rms_c"], color="C1", lw=0.8, ls="--",
                        label="within the noise below this")
-        ax.axvline(result.effusivity.value, color="C3", lw=1, label=f"e_s = {result.effusivity.value:.4g}")
+        from .._numbers import sig
+
+        ax.axvline(result.effusivity.value, color="C3", lw=1, label=f"e_s = {sig(result.effusivity.value)}")
         ax.axvline(PAPER_E_S, color="k", lw=0.8, ls=":", label=f"paper {PAPER_E_S:g}")
         ax.legend(fontsize=7)
     ax.set_xlabel("sensor effusivity e_s [J s^-1/2 K^-1 m^-2]")

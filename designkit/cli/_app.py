@@ -66,11 +66,9 @@ _MISSING = object()
 class _PlainCoercion:
     """Typer's coercion of one option, with a fast path for plain numbers and text.
 
-    Typer (0.29) converts every option through a pydantic ``TypeAdapter`` built on first use:
-    importing pydantic and building the adapters of a query's 25 options cost more start-up
-    time than the query itself (``benchmarks/bench_startup.py``). A float, int or str option
-    whose value is already of its type, or is plain decimal text, is converted here to the
-    value pydantic gives; anything else (other types, ranges, lists, odd text, bad input) goes
+    A float, int or str option whose value is already of its type, or is plain decimal text, is
+    converted here to the value pydantic gives, without building typer's pydantic adapter (why:
+    docs/decisions-log.md); anything else (other types, ranges, lists, odd text, bad input) goes
     to typer's own coercion, so its conversions and its error messages stay typer's.
     """
 
@@ -272,7 +270,7 @@ def emit_json(payload: Any) -> None:
 
 
 def console(stderr: bool = False):
-    """A rich console (imported lazily: rich costs ~50 ms).
+    """A rich console (rich is imported on first use).
 
     On a terminal it wraps to the window; piped or logged, nothing is hard-wrapped
     (a line is a line, whatever its length) and tables take the width they need.
@@ -312,9 +310,8 @@ class _PlainConsole:
     """What :func:`text_console` gives when the stream is not a terminal: rich's output without rich.
 
     Piped or logged, rich prints a line of markup as the line without its tags (no colour, no
-    wrap); this writes the same text without importing rich, which is a fifth of a fresh table
-    query's start-up (rich.console ~25 ms of ~125 ms CPU, measured with ``-X importtime``; issue 16's
-    target is 2x ``import numpy``). Anything but plain strings goes to a real rich console.
+    wrap); this writes the same text without importing rich (start-up: docs/decisions-log.md).
+    Anything but plain strings goes to a real rich console.
     """
 
     def __init__(self, stderr: bool):
@@ -341,8 +338,7 @@ def _app_for(argv: list[str]) -> typer.Typer:
     """The app with only the command ``argv`` names, when it names one first (else the whole app).
 
     Typer turns every registered command into a click command (reading each function's signature
-    and type hints) before it runs any: a fifth of a fresh query's start-up for commands it does not
-    run. The lean copy holds the one command (or command group) asked for, with the same callback,
+    and type hints) before it runs any. The lean copy holds the one command (or command group) asked for, with the same callback,
     so parsing, help, errors and output are that command's; anything else (no command, an unknown
     one, completion, options before the command) gets the whole app.
     """

@@ -338,9 +338,9 @@ def _app_for(argv: list[str]) -> typer.Typer:
     """The app with only the command ``argv`` names, when it names one first (else the whole app).
 
     Typer turns every registered command into a click command (reading each function's signature
-    and type hints) before it runs any. The lean copy holds the one command (or command group) asked for, with the same callback,
-    so parsing, help, errors and output are that command's; anything else (no command, an unknown
-    one, completion, options before the command) gets the whole app.
+    and type hints) before it runs any. The lean copy holds the one command (or command group) asked
+    for, with the same callback, so parsing, help, errors and output are that command's; anything else
+    (no command, an unknown one, completion, options before the command) gets the whole app.
     """
     import os
 

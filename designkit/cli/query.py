@@ -493,7 +493,8 @@ def delta_e_cmd(
         "--format", "-f", help="Print the two directions as rows: table, json, csv or md (default: the answer "
                                "for people; --json: the whole answer).", rich_help_panel=PANEL_OUTPUT)] = None,
     out: Annotated[Optional[str], typer.Option("--out", "-o", help="Write the output to this file ('-' or none: "
-                                               "stdout).", rich_help_panel=PANEL_OUTPUT)] = None, json_: Json = False, explain: Explain = False,
+                                               "stdout).", rich_help_panel=PANEL_OUTPUT)] = None,
+    json_: Json = False, explain: Explain = False,
 ) -> None:
     """Smallest distinguishable effusivity difference delta(e), towards lower and higher effusivity.
 

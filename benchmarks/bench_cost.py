@@ -6,7 +6,7 @@ Run from the repository root::
     /work/venv/bin/python benchmarks/bench_cost.py --full           # the full report's curves
     /work/venv/bin/python benchmarks/bench_cost.py --curve "ideal: intervals" --json cost.json
 
-Each curve runs in a fresh process (``designkit.accuracy.cost_curves``), one
+Each curve runs in a fresh process (``designkit_lab.accuracy.cost_curves``), one
 scene point per size; printed: the sizes, wall times, SVM fits, peak memory
 above the process after its imports, and the exponents ``p`` of
 ``cost ~ size^p`` by log-log least squares. The expectation the ideal engine
@@ -23,7 +23,7 @@ import json
 import math
 from pathlib import Path
 
-from designkit.accuracy import cost_curve_specs, cost_curves, curves_markdown
+from designkit_lab.accuracy import cost_curve_specs, cost_curves, curves_markdown
 
 #: Curve name -> (what the design expects of the time exponent, lower, upper bound).
 EXPECTED = {"ideal: intervals": ("about linear in intervals (staircase, no pair matrix)", 0.3, 2.0)}

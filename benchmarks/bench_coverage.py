@@ -13,7 +13,7 @@ keeps what it did; ``--resume`` skips the cases already there). At the end it pr
 (question, route), the coverage of the stated 90 % intervals, the median and 95th-percentile
 error (absolute and relative) against the reference, the ideal-bound violations, the worst
 regions of effusivity and noise, and writes ``OUT/coverage.json`` and ``OUT/coverage.png``
-(``docs/accuracy.md`` is regenerated from them by ``designkit.accuracy.render``; with ``--docs``
+(``docs/accuracy.md`` is regenerated from them by ``designkit_lab.accuracy.render``; with ``--docs``
 the cases are kept beside it, in ``accuracy_coverage_cases.jsonl``).
 The synthetic-curve check (known truth) runs first, in seconds.
 """
@@ -29,7 +29,7 @@ from pathlib import Path
 
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
-from designkit.accuracy.coverage import (COVERAGE_QUESTIONS, diluted_coverage, run_cases, summarize,
+from designkit_lab.accuracy.coverage import (COVERAGE_QUESTIONS, diluted_coverage, run_cases, summarize,
                                          synthetic_coverage, worst_regions)
 
 
@@ -215,7 +215,7 @@ def main(argv=None) -> int:
     meta["load_end"] = os.getloadavg()[0]
     results = _load(cases_path)
     if a.rescore_table:
-        from designkit.accuracy.coverage import table_reading
+        from designkit_lab.accuracy.coverage import table_reading
 
         for r in results:
             r["table"] = table_reading(r["question"], r, table=a.table, coverage=0.9)
@@ -223,7 +223,7 @@ def main(argv=None) -> int:
     doc = report(results, synthetic, meta, a.out)
     fig = figure(results, a.out)
     if a.docs is not None:
-        from designkit.accuracy.render import write_coverage
+        from designkit_lab.accuracy.render import write_coverage
 
         print(f"page: {write_coverage(doc, fig, a.docs)}")
         # the cases themselves (one line each), so that a later table or rule is measured against the

@@ -6,7 +6,7 @@ conditions, on ``svm-paper``. This asks min-contact with the sensor temperature 
 route (``svm-paper-varied``: its min-contact estimate, kind ``table-varied-estimate``, with a stated 90 %
 interval where every noise slice around the case crosses between two tabulated contacts; else the grid
 cell or the grid rule's reading, kind ``table-varied``, which state none) and by ``--exact`` (4 seeds), each against a reference of 16 other seeds (the
-batched solver, the same classifier), with :func:`designkit.accuracy.coverage.coverage_case`.
+batched solver, the same classifier), with :func:`designkit_lab.accuracy.coverage.coverage_case`.
 
 Cases: pairs as ``bench_coverage.py`` draws them (effusivities 100-39,000 J s^-1/2 K^-1 m^-2, three in four
 at least 400 apart), noise uniform on a log scale over the varied table's axis (0.01-0.1 degC).
@@ -34,7 +34,7 @@ from joblib import Parallel, delayed
 from rich.progress import Progress
 
 from designkit._workers import local_processes
-from designkit.accuracy.coverage import coverage_case, diluted_coverage, draw_case, summarize, table_reading
+from designkit_lab.accuracy.coverage import coverage_case, diluted_coverage, draw_case, summarize, table_reading
 
 SPREAD_C, DT_C = 2.5, 7.5
 
@@ -126,8 +126,8 @@ def main() -> None:
         a.json.write_text(json.dumps({"spread_c": SPREAD_C, "delta_t_c": DT_C, "wall_s": wall,
                                       "results": results}, indent=1, default=float))
     if a.docs:
-        from designkit.accuracy.coverage import worst_regions
-        from designkit.accuracy.render import varied_coverage_cases, write_varied_coverage
+        from designkit_lab.accuracy.coverage import worst_regions
+        from designkit_lab.accuracy.render import varied_coverage_cases, write_varied_coverage
 
         bands = ((0.01, 0.02), (0.02, 0.05), (0.05, 0.1001))
         run = {"question": a.question, "seed": a.seed, "wall_s": wall, "cpus": a.jobs, "spread_c": SPREAD_C,

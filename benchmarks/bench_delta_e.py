@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from designkit.accuracy import fit_exponent, staircase_vs_full
+from designkit_lab.accuracy import fit_exponent, staircase_vs_full
 
 
 def main(argv=None):

@@ -29,7 +29,7 @@ import statistics
 import sys
 from pathlib import Path
 
-from designkit.accuracy import process_cost
+from designkit_lab.accuracy import process_cost
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_query import console_script, svm_table_available  # noqa: E402

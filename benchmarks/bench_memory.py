@@ -37,7 +37,7 @@ from pathlib import Path
 
 import numpy as np
 
-from designkit.accuracy import fit_exponent, process_cost
+from designkit_lab.accuracy import fit_exponent, process_cost
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_query import console_script, svm_table_available  # noqa: E402

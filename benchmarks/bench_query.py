@@ -36,7 +36,7 @@ import sys
 import timeit
 from pathlib import Path
 
-from designkit.accuracy import process_cost
+from designkit_lab.accuracy import process_cost
 
 PAIR = ["--e1", "35000", "--e2", "20000"]
 NUMPY = "python -c 'import numpy'"

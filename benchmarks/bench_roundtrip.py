@@ -7,7 +7,7 @@ Run from the repository root (compute heavy: about 5 s a run, 200 runs; be nice 
     # the protocol that reaches 2 % (docs/sensor-models.md): more touches, presses of varied pace
     nice -n 10 python benchmarks/bench_roundtrip.py --case contact+drift+area --touches 30 --varied-press
 
-Each run (:func:`designkit.calibration.roundtrip.round_trip`): an emulated rig whose sensor follows
+Each run (:func:`designkit_lab.roundtrip.round_trip`): an emulated rig whose sensor follows
 the case's forward model streams the designkit wire format on a pseudo-terminal (one per
 material), ``SerialRecorder`` records 10 (``--touches``) touches of wood and as many of granite
 from it as from a USB rig, and ``identify`` fits the case's candidate. Printed per model and identifiable quantity: the
@@ -26,7 +26,7 @@ import os
 import time
 from pathlib import Path
 
-from designkit.calibration.roundtrip import CASES, VARIED_PRESS, round_trip, summarize
+from designkit_lab.roundtrip import CASES, VARIED_PRESS, round_trip, summarize
 
 COVERAGE_TARGET, WITHIN_TARGET = 0.90, 0.02
 

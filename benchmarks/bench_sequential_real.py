@@ -8,7 +8,7 @@ Run from the repository root (needs ../shared/data/robot-thermal-recordings or
 Protocol, fixed before looking at test touches:
 
 - the sensor (e_s, tau) and the contact time offset are identified by designkit's
-  calibration on trial sets 1-4 (metal and wood; :func:`designkit.reproduce.robot.calibrate`);
+  calibration on trial sets 1-4 (metal and wood; :func:`designkit_lab.reproduce.robot.calibrate`);
   the white-noise sigma the test assumes is that fit's residual RMS (the model's
   misfit, 40x the thermistor noise: the honest noise of this model on these data);
 - candidates: metal [12767, 25972] and wood [331, 506] J s^-1/2 K^-1 m^-2 (the
@@ -22,7 +22,7 @@ Protocol, fixed before looking at test touches:
 - the test touches (sets 5-20) are replayed sample by sample through
   :meth:`SequentialTest.update` from the calibrated onset, up to 4 s;
 - baseline: the paper's SVM trained and tested on real touches (3-fold x 10
-  shuffles, first 4 s; :func:`designkit.reproduce.robot.real_pair_f1`).
+  shuffles, first 4 s; :func:`designkit_lab.reproduce.robot.real_pair_f1`).
 
 Cold wood is the same material as wood, cooled below the room: its touches are
 replayed too, and the test's answers for them are printed (metal / wood /
@@ -39,7 +39,7 @@ from pathlib import Path
 import numpy as np
 
 from designkit.recognition.sequential import SequentialTest
-from designkit.reproduce.robot import calibrate, load_real, real_pair_f1
+from designkit_lab.reproduce.robot import calibrate, load_real, real_pair_f1
 
 
 def data_dir() -> Path | None:

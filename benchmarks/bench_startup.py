@@ -42,10 +42,10 @@ COMMANDS = {
 TARGETS = {"designkit --version": 1.5, "designkit min-contact": 2.0}
 
 
-def _run(cmd: list[str]) -> tuple[float, float]:
+def _run(cmd: list[str], env: dict | None = None) -> tuple[float, float]:
     """Wall seconds and CPU seconds (user + system, from the child's rusage) of one run."""
     t0 = time.perf_counter()
-    p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=os.environ.copy())
+    p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env or os.environ.copy())
     _, status, usage = os.wait4(p.pid, 0)
     wall = time.perf_counter() - t0
     p.returncode = os.waitstatus_to_exitcode(status)
@@ -58,14 +58,21 @@ def main(argv=None) -> dict:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--runs", type=int, default=15)
     ap.add_argument("--json", type=Path)
+    ap.add_argument("--baseline", type=Path,
+                    help="another designkit tree (e.g. /work/main): its min-contact runs in the same round robin, "
+                         "with that tree first on PYTHONPATH (a before/after in one run)")
     args = ap.parse_args(argv)
-    for cmd in COMMANDS.values():  # warm-up: page cache, .pyc files
-        _run(cmd)
-    times: dict[str, list[float]] = {k: [] for k in COMMANDS}
-    cpus: dict[str, list[float]] = {k: [] for k in COMMANDS}
+    commands = {name: (cmd, None) for name, cmd in COMMANDS.items()}
+    if args.baseline is not None:
+        env = {**os.environ, "PYTHONPATH": str(args.baseline)}
+        commands["baseline min-contact"] = (COMMANDS["designkit min-contact"], env)
+    for cmd, env in commands.values():  # warm-up: page cache, .pyc files
+        _run(cmd, env)
+    times: dict[str, list[float]] = {k: [] for k in commands}
+    cpus: dict[str, list[float]] = {k: [] for k in commands}
     for _ in range(args.runs):
-        for name, cmd in COMMANDS.items():
-            wall, cpu = _run(cmd)
+        for name, (cmd, env) in commands.items():
+            wall, cpu = _run(cmd, env)
             times[name].append(wall)
             cpus[name].append(cpu)
     base = statistics.median(times["import numpy"])

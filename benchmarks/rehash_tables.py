@@ -8,6 +8,7 @@ header and arrays, and loads the result with every check of ``load_table``. Only
 
     python benchmarks/rehash_tables.py                  # the shipped tables in tables/
     python benchmarks/rehash_tables.py path/to/T.json   # your own (check its header first)
+    python benchmarks/rehash_tables.py --members        # print designkit/tables/_shipped_members.py
 """
 
 from __future__ import annotations
@@ -38,7 +39,25 @@ def rehash(jpath: Path) -> str:
     return header["content_hash"]
 
 
+def members_module() -> str:
+    """The text of designkit/tables/_shipped_members.py for the shipped tables as they are now."""
+    from designkit.tables import _shipped_members
+    from designkit.tables.store import SHIPPED_TABLES, member_digests
+
+    root = Path(__file__).resolve().parents[1] / "tables"
+    doc = _shipped_members.__doc__
+    lines = [f'"""{doc}"""', "", "SHIPPED_MEMBER_DIGESTS: dict[str, dict[str, str]] = {"]
+    for name in SHIPPED_TABLES:
+        lines.append(f"    {name!r}: {{")
+        lines += [f"        {k!r}: {v!r}," for k, v in member_digests(root / f"{name}.npz").items()]
+        lines.append("    },")
+    return "\n".join(lines + ["}", ""])
+
+
 def main(argv: list[str]) -> None:
+    if argv == ["--members"]:
+        sys.stdout.write(members_module())
+        return
     paths = [Path(a) for a in argv] or sorted((Path(__file__).resolve().parents[1] / "tables").glob("*.json"))
     for p in paths:
         print(f"{p}: {rehash(p)}")

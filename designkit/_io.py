@@ -7,7 +7,7 @@ import os
 import tempfile
 from pathlib import Path
 
-__all__ = ["WriteError", "atomic_write_bytes", "atomic_write_text"]
+__all__ = ["WriteError", "atomic_write_bytes", "atomic_write_text", "fsync_folder"]
 
 
 class WriteError(OSError):
@@ -20,6 +20,10 @@ class WriteError(OSError):
         return str(self.strerror)
 
 
+class _IsAFolder(WriteError, IsADirectoryError):
+    """A folder where a file was to be written: one line, without ``[Errno 21]`` or the path repeated."""
+
+
 def _cannot_write(path: Path, exc: OSError) -> WriteError:
     return WriteError(exc.errno, f"cannot write {path}: {exc.strerror or exc}")
 
@@ -28,7 +32,7 @@ def atomic_write_bytes(path: Path, data: bytes) -> Path:
     """Write ``data`` to ``path`` through a temporary file and an atomic rename.
 
     A crash or kill at any moment leaves either the old file or the new one,
-    never a truncated mix. The data are flushed to disk before the rename.
+    never a truncated mix. The data are flushed to disk before the rename, and the folder after it.
 
     A destination that exists and is not a regular file (``/dev/null``, a
     terminal, a FIFO) is written to as it is: renaming over it would replace
@@ -52,7 +56,7 @@ def atomic_write_bytes(path: Path, data: bytes) -> Path:
     except OSError as exc:
         raise _cannot_write(path, exc) from None
     if mode is not None and stat.S_ISDIR(mode):
-        raise IsADirectoryError(21, f"cannot write {path}: it is a folder", str(path))
+        raise _IsAFolder(21, f"cannot write {path}: it is a folder; give a file name")
     if mode is not None and not stat.S_ISREG(mode):
         with open(path, "wb") as fh:
             fh.write(data)
@@ -77,7 +81,23 @@ def atomic_write_bytes(path: Path, data: bytes) -> Path:
         if isinstance(exc, OSError):
             raise _cannot_write(path, exc) from None
         raise
+    fsync_folder(path.parent)  # the rename itself reaches the disk: a power cut keeps the new file's name
     return path
+
+
+def fsync_folder(folder: Path) -> None:
+    """Flush a folder's entries (a rename, a new file) to disk; where a folder cannot be opened or synced
+    (some file systems, other platforms) nothing more can be done, and nothing is said."""
+    try:
+        fd = os.open(folder, os.O_RDONLY | getattr(os, "O_DIRECTORY", 0))
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
 
 
 def _umask() -> int:

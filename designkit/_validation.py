@@ -19,7 +19,9 @@ __all__ = [
     "as_generator",
     "check_effusivity",
     "check_effusivity_range",
+    "check_file_name",
     "check_finite",
+    "check_label",
     "check_memory",
     "check_temperature",
     "check_nonnegative",
@@ -110,6 +112,70 @@ def check_memory(what: str, nbytes: float) -> None:
     if not nbytes <= limit:
         raise InputError(f"{what} needs about {_bytes(float(nbytes))} of memory; the limit is {_bytes(limit)} "
                          f"(half this machine's memory; set DESIGNKIT_MEMORY_LIMIT_GB to change it)")
+
+
+#: Longest label (a sensor's or material's name) in characters: a line of a summary, not a paragraph.
+MAX_LABEL_CHARS = 200
+#: Longest name that becomes a file (a sweep's table and workdir), in characters and in UTF-8 bytes: with a
+#: suffix such as ``.npz.tmp`` and a temporary file's prefix it stays under the 255 bytes of a file name.
+MAX_FILE_NAME_CHARS = 100
+MAX_FILE_NAME_BYTES = 200
+
+
+def check_label(what: str, text: Any, *, max_chars: int = MAX_LABEL_CHARS) -> str:
+    """A label printed on one line (a sensor's name, a material's): text, not empty, no control characters
+    (a newline spilled a summary over several lines), at most ``max_chars`` characters; else one-line InputError.
+
+    >>> check_label("sensor name", "paper")
+    'paper'
+    >>> check_label("sensor name", "a\\nb")
+    Traceback (most recent call last):
+    ...
+    designkit._validation.InputError: sensor name must be one line of printable text, got 'a\\nb' (a control character at position 2)
+    """
+    if not isinstance(text, str):
+        raise InputError(f"{what} must be text, got {type(text).__name__}")
+    if not text.strip():
+        raise InputError(f"{what} is empty")
+    for i, ch in enumerate(text):
+        if ch < " " or "\x7f" <= ch <= "\x9f" or ch in "\u2028\u2029":
+            raise InputError(f"{what} must be one line of printable text, got {_short(text)} (a control character "
+                             f"at position {i + 1})")
+    if len(text) > max_chars:
+        raise InputError(f"{what} has {len(text)} characters; the limit is {max_chars}")
+    return text
+
+
+def check_file_name(what: str, name: Any) -> str:
+    """A name that becomes a file inside a folder designkit chooses (a sweep's ``name``: its table and its
+    workdir): one file name, never a path. The one rule for such names, checked before any work.
+
+    Refused, in one line: empty, separators (``/``, ``\\``: a name is not a path, so no absolute path
+    and no traversal), ``.`` and ``..``, control characters (a newline, NUL), more than
+    :data:`MAX_FILE_NAME_CHARS` characters or :data:`MAX_FILE_NAME_BYTES` bytes.
+
+    >>> check_file_name("sweep name", "svm-fine")
+    'svm-fine'
+    >>> check_file_name("sweep name", "../../escaped")
+    Traceback (most recent call last):
+    ...
+    designkit._validation.InputError: sweep name must be a file name, not a path: '../../escaped' holds '/' (give a name such as 'svm-fine'; choose the folder with --out or --workdir)
+    """
+    name = check_label(what, name, max_chars=MAX_FILE_NAME_CHARS)
+    for sep in ("/", "\\"):
+        if sep in name:
+            raise InputError(f"{what} must be a file name, not a path: {_short(name)} holds {sep!r} (give a name "
+                             f"such as 'svm-fine'; choose the folder with --out or --workdir)")
+    if name in (".", "..") or name != name.strip():
+        raise InputError(f"{what} must be a file name, got {_short(name)}"
+                         + (" (it begins or ends with a space)" if name.strip() not in (".", "..") else ""))
+    if len(name.encode("utf-8", "surrogatepass")) > MAX_FILE_NAME_BYTES:
+        raise InputError(f"{what} takes more than {MAX_FILE_NAME_BYTES} bytes as a file name")
+    return name
+
+
+def _short(text: str, n: int = 60) -> str:
+    return repr(text if len(text) <= n else text[:n] + "...")
 
 
 #: Seeds averaged per pair (a sweep's ``max_repeats``, an exact question's ``repeats``): the Monte
@@ -204,6 +270,9 @@ def check_effusivity_range(name: str, low: float, high: float) -> tuple[float, f
         hi = float(high)
     except (TypeError, ValueError):
         hi = math.nan
+    if lo <= MAX_EFFUSIVITY and hi - lo > MAX_EFFUSIVITY:  # the width itself is beyond any effusivity
+        raise InputError(f"effusivity class {name}: its width {hi - lo:.10g} is above the highest effusivity accepted, "
+                         f"{MAX_EFFUSIVITY:g} J s^-1/2 K^-1 m^-2")
     if lo <= MAX_EFFUSIVITY < hi < math.inf:  # the class's end, which the user did not type, is what is too high
         raise InputError(f"effusivity class {name}, [{lo:.10g}, {hi:.10g}), ends above the highest effusivity "
                          f"accepted, {MAX_EFFUSIVITY:g} J s^-1/2 K^-1 m^-2 (a value E is the class [E, E + "

@@ -76,9 +76,42 @@ def worker_count(jobs: int) -> int:
     return n
 
 
-def ignore_ctrl_c() -> None:
-    """Worker initializer: SIGINT ignored in this process (the parent handles it)."""
+def ignore_ctrl_c(parent_pid: int | None = None) -> None:
+    """Worker initializer: SIGINT ignored in this process (the parent handles it), and the worker exits when
+    its parent, ``parent_pid`` (default: the parent it has now), dies (:func:`watch_parent`)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    watch_parent(parent_pid)
+
+
+#: How often a worker looks whether its parent still lives [s].
+PARENT_WATCH_S = 0.5
+
+
+def watch_parent(parent_pid: int | None = None, interval_s: float = PARENT_WATCH_S) -> threading.Thread | None:
+    """Exit this process soon after its parent dies: a daemon thread compares the parent's pid every
+    ``interval_s`` (a child whose parent died is adopted by another process).
+
+    A ``kill -9`` of a sweep's main process left its loky workers (idle for loky's 300 s timeout) and, through
+    them, the resource tracker alive for about 5 minutes; a worker's work belongs to its parent alone, so it
+    exits at once (``os._exit``: nothing of the parent's to flush or clean). ``parent_pid`` is the pid that
+    started the pool: a worker still starting when its parent was killed (its imports take seconds on a loaded
+    machine) has been adopted already when this runs, and exits here.
+    """
+    parent = os.getppid() if parent_pid is None else int(parent_pid)
+    if os.getppid() != parent:
+        os._exit(1)
+
+    def watch() -> None:
+        import time
+
+        while True:
+            time.sleep(interval_s)
+            if os.getppid() != parent:
+                os._exit(1)
+
+    t = threading.Thread(target=watch, name="designkit-parent-watch", daemon=True)
+    t.start()
+    return t
 
 
 @contextmanager
@@ -101,7 +134,7 @@ def local_processes(n_jobs: int, *, start: bool = True) -> Iterator[None]:
     """
     from joblib import parallel_config
 
-    with parallel_config(backend="loky", initializer=ignore_ctrl_c):
+    with parallel_config(backend="loky", initializer=functools.partial(ignore_ctrl_c, os.getpid())):
         if start:
             _start_pool(n_jobs)
         yield

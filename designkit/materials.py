@@ -449,9 +449,13 @@ def _parse_table(data: Any, source: str) -> MaterialTable:
 def _read_table(text: str, source: str) -> MaterialTable:
     import yaml
 
-    loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml when present: 10x faster
+    from ._schemas import _DuplicateKey, _unique_key_loader
+
     try:
-        data = yaml.load(text, Loader=loader)  # noqa: S506 - a safe loader
+        data = yaml.load(text, Loader=_unique_key_loader())  # noqa: S506 - a safe loader (libyaml's when present)
+    except _DuplicateKey as exc:
+        raise InputError(f"{source}: the key {exc.key!r} is given twice (line {exc.line}): the last would win "
+                         f"unnoticed; keep one") from None
     except yaml.YAMLError as exc:
         first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         mark = getattr(exc, "problem_mark", None)

@@ -17,17 +17,26 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from ._validation import InputError, check_nonnegative, check_positive
+from ._validation import InputError, check_effusivity, check_label, check_nonnegative, check_positive
 from .properties import time_constant
 
 __all__ = ["MAX_SAMPLES_PER_TOUCH", "MODEL_KEYS", "SENSORS", "Sensor", "last_sample_index", "load_sensor",
            "sample_times_s", "within_sample_limit"]
 
-SENSOR_FILE_VERSION = 1
+#: Version of the sensor files this designkit writes. 2: a calibrated file records the rig's operating
+#: conditions (``conditions``, :mod:`designkit.rig`). Version 1 files (no conditions) still load.
+SENSOR_FILE_VERSION = 2
+_READABLE_VERSIONS = (1, 2)
 
 #: The most samples one touch may have (10 000 s at 100 Hz, 1 s at 1 MHz): 8 MB per touch curve.
 #: A longer touch or a faster sensor is refused before anything is allocated.
 MAX_SAMPLES_PER_TOUCH = 1_000_000
+
+
+#: Largest sensor diffusivity accepted [m^2/s]: 10x diamond's, the highest of any solid.
+MAX_DIFFUSIVITY_M2_S = 1e-2
+#: Deepest thermistor accepted [m]: 10 cm (a time constant of hours under any skin).
+MAX_DEPTH_M = 0.1
 
 
 #: Samples of tolerance when a contact time is turned into a sample count: keeps 2.0 s * 200 Hz = 400
@@ -38,8 +47,11 @@ _SAMPLE_TOLERANCE = 1e-9
 def last_sample_index(contact_s, sample_rate_hz: float) -> np.ndarray:
     """Index ``k`` of the last sample a contact of ``contact_s`` takes: ``floor(contact_s * fs)``, vectorized.
 
-    The rule of :func:`sample_times_s` (samples ``0 .. k``, the first at contact)
-    for arrays of contact times, without its checks: callers validate first.
+    The rule of :func:`sample_times_s` (samples ``0 .. k``, the first at contact) for arrays of contact
+    times. Every caller allocates ``k + 1`` samples, so the per-touch budget is enforced here, before any
+    allocation: a contact beyond :data:`MAX_SAMPLES_PER_TOUCH` samples (a sample rate of 1e12 Hz grew a
+    question to 24 GB; a contact of 1e308 s became index -2**63), or a negative or NaN one, is a one-line
+    InputError. Callers that leave such touches out test :func:`within_sample_limit` first.
 
     Parameters
     ----------
@@ -58,7 +70,14 @@ def last_sample_index(contact_s, sample_rate_hz: float) -> np.ndarray:
     >>> int(last_sample_index(2.0, 200.0)), last_sample_index([0.0, 0.004, 0.005], 200.0).tolist()
     (400, [0, 0, 1])
     """
-    return np.floor(_last_index_float(contact_s, sample_rate_hz)).astype(np.int64)
+    k = _last_index_float(contact_s, sample_rate_hz)
+    ok = (k >= 0) & (k < MAX_SAMPLES_PER_TOUCH)
+    if not np.all(ok):
+        bad = float(np.broadcast_to(np.asarray(contact_s, dtype=np.float64), k.shape)[~ok].flat[0])
+        if bad < 0:
+            raise InputError(f"contact time must be >= 0 s, got {bad:g}")
+        check_samples_per_touch(bad, sample_rate_hz)  # says why, in one line
+    return np.floor(k).astype(np.int64)
 
 
 def _last_index_float(contact_s, sample_rate_hz: float) -> np.ndarray:
@@ -94,6 +113,9 @@ def check_samples_per_touch(contact_s: float, sample_rate_hz: float, what: str =
     400
     """
     n_float = float(_last_index_float(contact_s, sample_rate_hz))  # may be inf (1e308 s)
+    if n_float != n_float:
+        raise InputError(f"{what}: contact time and sample rate must be numbers, got {contact_s!r} s at "
+                         f"{sample_rate_hz!r} Hz")
     if not n_float < MAX_SAMPLES_PER_TOUCH:
         raise InputError(f"{what} of {contact_s:g} s at {sample_rate_hz:g} Hz has {n_float + 1:.4g} samples per "
                          f"touch; the limit is {MAX_SAMPLES_PER_TOUCH:.0e} ({advice})")
@@ -148,6 +170,10 @@ class Sensor:
         estimates it from pre-contact samples). Scenes set their own noise.
     provenance : mapping
         Free-form record of where the numbers came from (not compared).
+    conditions : mapping or None
+        The rig's operating conditions seen in calibration (:class:`designkit.rig.RigConditions`,
+        sensor file version 2): questions about the sensor take them as their defaults. None:
+        presets and files from before version 2.
     model : mapping or None
         The forward model the sensor was identified with, as calibration
         records it (:data:`MODEL_KEYS`): ``{"name", "params", "time_offset_s",
@@ -177,18 +203,34 @@ class Sensor:
     noise_c: float | None = None
     provenance: Mapping[str, Any] = field(default_factory=dict, compare=False, hash=False)
     model: Mapping[str, Any] | None = field(default=None, hash=False)
+    conditions: Mapping[str, Any] | None = field(default=None, compare=False, hash=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "effusivity", check_positive("sensor effusivity e_s", self.effusivity))
+        check_effusivity("sensor e_s", self.effusivity)  # at most 1e7: 1e308 was taken
         object.__setattr__(self, "diffusivity_m2_s",
                            check_positive("sensor diffusivity alpha_s [m^2/s]", self.diffusivity_m2_s))
+        if self.diffusivity_m2_s > MAX_DIFFUSIVITY_M2_S:
+            raise InputError(f"sensor diffusivity alpha_s must be at most {MAX_DIFFUSIVITY_M2_S:g} m^2/s (diamond's "
+                             f"is about 1e-3), got {self.diffusivity_m2_s:g}")
         object.__setattr__(self, "depth_m", check_nonnegative("thermistor depth [m]", self.depth_m))
+        if self.depth_m > MAX_DEPTH_M:
+            raise InputError(f"thermistor depth must be at most {MAX_DEPTH_M:g} m, got {self.depth_m:g}")
         object.__setattr__(self, "sample_rate_hz", check_positive("sample rate [Hz]", self.sample_rate_hz))
+        check_label("sensor name", self.name)  # one line of a summary (a newline spilled it over several)
         if self.noise_c is not None:
             object.__setattr__(self, "noise_c", check_nonnegative("sensor noise [degC]", self.noise_c))
         object.__setattr__(self, "provenance", dict(self.provenance))
         if self.model is not None:
             object.__setattr__(self, "model", _model_block(self.model, "sensor model"))
+        if self.conditions is not None:
+            if not isinstance(self.conditions, Mapping):
+                raise InputError(f"sensor conditions: expected a mapping, got {type(self.conditions).__name__}")
+            unknown = sorted(set(self.conditions) - set(CONDITION_KEYS))
+            if unknown:
+                raise InputError(f"sensor conditions: unknown key(s) {', '.join(unknown)} "
+                                 f"(known: {', '.join(CONDITION_KEYS)})")
+            object.__setattr__(self, "conditions", _plain(self.conditions))
 
     @property
     def tau_s(self) -> float:
@@ -221,6 +263,8 @@ class Sensor:
             out["provenance"] = _plain(self.provenance)
         if self.model is not None:
             out["model"] = _plain(self.model)
+        if self.conditions is not None:
+            out["conditions"] = _plain(self.conditions)
         return out
 
     @property
@@ -244,10 +288,13 @@ class Sensor:
 
         if not isinstance(data, Mapping):
             raise InputError(f"{source}: a sensor must be a mapping of fields, got {type(data).__name__}")
-        version = data.get("designkit_sensor", SENSOR_FILE_VERSION)
-        if version != SENSOR_FILE_VERSION:
-            raise InputError(f"{source}: unsupported sensor file version {version!r} "
-                             f"(this designkit reads version {SENSOR_FILE_VERSION})")
+        version = data.get("designkit_sensor", 1)
+        if version not in _READABLE_VERSIONS:
+            newer = isinstance(version, int) and not isinstance(version, bool) and version > SENSOR_FILE_VERSION
+            raise InputError(f"{source}: sensor file version {version!r}, this designkit reads versions "
+                             f"{', '.join(map(str, _READABLE_VERSIONS))}"
+                             + (": it was written by a newer designkit; upgrade designkit (pip install -U designkit)"
+                                if newer else ": recalibrate with 'designkit calibrate fit' to write a current one"))
         missing = [k for k in ("effusivity", "diffusivity_m2_s") if k not in data]
         if missing:
             raise InputError(f"{source}: missing sensor field(s) {', '.join(missing)}")
@@ -299,8 +346,17 @@ class Sensor:
 
         p = Path(path)
         data = load_yaml(p, "sensor file")  # a regular UTF-8 file (a FIFO is refused, not waited on)
-        return cls.from_dict(data, source=f"sensor file {p}")
+        sensor = cls.from_dict(data, source=f"sensor file {p}")  # what is wrong in its fields, said first
+        if "designkit_sensor" not in data:  # any YAML mapping of numbers was taken for a sensor
+            raise InputError(f"sensor file {p} has no 'designkit_sensor: {SENSOR_FILE_VERSION}' line: not a sensor "
+                             f"file written by designkit (calibration writes one; add the line to a file of your own)")
+        return sensor
 
+
+#: The keys of a sensor file's ``conditions`` record (:class:`designkit.rig.RigConditions`).
+CONDITION_KEYS = ("noise_c", "noise_source", "pre_contact_noise_c", "residual_rms_c", "sensor_temp_c",
+                  "object_temp_c", "delta_t_c", "sensor_temp_spread_c", "onset", "onset_offset_s", "contact_ramp",
+                  "n_touches")
 
 #: The keys of a sensor's ``model`` record (what calibration writes beside the sensor fields).
 MODEL_KEYS = ("name", "params", "time_offset_s", "contact_spread", "object_temperature", "candidate", "contact_area",

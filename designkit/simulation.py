@@ -41,6 +41,7 @@ from ._validation import (
 )
 from .models import ForwardModel, get_model
 from .models.semi_infinite import object_weight, response_shape
+from .models.shared import class_readings
 from .objects import ObjectClass
 from .scene import Scene
 from .sensor import Sensor
@@ -49,6 +50,7 @@ __all__ = [
     "DIFFUSIVITY_STREAM",
     "TrialDraws",
     "Trials",
+    "check_touch_budget",
     "draw_trials",
     "noisy_readings",
     "render_trials",
@@ -131,6 +133,30 @@ class Trials:
     model: str = "semi-infinite"
 
 
+#: float64 arrays of one touch's length that a simulation holds at once per touch (the noise drawn, the
+#: response rendered, the readings).
+SIMULATION_COPIES = 4
+
+
+def check_touch_budget(what: str, n_touches: int, n_samples: int, *, copies: int = SIMULATION_COPIES) -> None:
+    """The per-request budget of simulated touches, checked before anything is drawn: at most
+    :data:`designkit.sensor.MAX_SAMPLES_PER_TOUCH` samples per touch, and ``copies`` float64 arrays of
+    ``n_touches x n_samples`` within :func:`designkit._validation.memory_limit_bytes`. One line otherwise.
+
+    The one check of every command that simulates (simulate, f1, design, classify, a sweep's chunk):
+    :func:`draw_trials` applies it, and commands that hold more copies call it first with their count.
+
+    >>> check_touch_budget("f1", 200, 401)
+    """
+    from ._validation import check_memory
+    from .sensor import MAX_SAMPLES_PER_TOUCH
+
+    if not 0 < n_samples <= MAX_SAMPLES_PER_TOUCH:
+        raise InputError(f"{what}: {n_samples:g} samples per touch; the limit is {MAX_SAMPLES_PER_TOUCH:.0e} "
+                         f"(shorten the contact or lower the sample rate)")
+    check_memory(f"{what}: {n_touches:g} touches x {n_samples:g} samples", float(n_touches) * n_samples * 8 * copies)
+
+
 def draw_trials(e_low: float, e_high: float, n_trials: int, n_samples: int, seed,
                 *, vary_sensor: bool = False, vary_ambient: bool = False) -> TrialDraws:
     """Draw the random part of ``n_trials`` trials of one effusivity class.
@@ -156,6 +182,7 @@ def draw_trials(e_low: float, e_high: float, n_trials: int, n_samples: int, seed
     if int(n_trials) < 1 or int(n_samples) < 1:
         raise InputError(f"need at least one trial and one sample, got {n_trials} and {n_samples}")
     n, m = int(n_trials), int(n_samples)
+    check_touch_budget("simulated touches", n, m)  # before the draw: a 1e12 Hz sensor grew to 24 GB
     rng = as_generator(seed)
     e = rng.uniform(lo, hi, n) if hi > lo else np.full(n, lo)
     zeros = np.zeros(n)
@@ -239,7 +266,8 @@ def render_trials(draws: TrialDraws, sensor: Sensor, scene: Scene, model: "Forwa
         temps = noisy_readings(time_s, draws.effusivity, ts, ta, sensor, scene.noise_c, draws.noise, model=fm)
     else:
         tol = response_tolerance(scene.noise_ratio, draws.n_samples)
-        u = fm.response(time_s, draws.effusivity, sensor, diffusivity_m2_s=diffusivity_m2_s, tolerance=tol)
+        # a costly model is read at a few effusivities of the class and interpolated within tol
+        u = class_readings(fm, time_s, draws.effusivity, sensor, diffusivity_m2_s=diffusivity_m2_s, tolerance=tol)
         temps = ts[:, None] + (ta - ts)[:, None] * u
         if scene.noise_c > 0:
             temps = temps + scene.noise_c * draws.noise

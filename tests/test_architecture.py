@@ -1,6 +1,8 @@
 """The package's shape is a contract: layers that depend only downward, no import cycles, no
 private names imported from a peer module, every public module declaring ``__all__`` with names
-that exist, and every docstring example run (against the installed package)."""
+that exist, and every docstring example run (against the installed package). The lab
+(``designkit_lab``: benchmarks' instruments, the paper's report) sits above the core's library
+layers: it imports the core, the core never imports it (only the CLI loads it, when its command runs)."""
 
 from __future__ import annotations
 
@@ -14,8 +16,10 @@ from pathlib import Path
 import pytest
 
 import designkit
+import designkit_lab
 
 PKG = Path(designkit.__file__).resolve().parent
+ROOTS = {"designkit": PKG, "designkit_lab": Path(designkit_lab.__file__).resolve().parent}
 
 # Layers, lowest first. A module may import from its own layer and the layers below, never above.
 LAYERS = [
@@ -23,28 +27,33 @@ LAYERS = [
      "designkit._workers", "designkit._numbers"},
     {"designkit.properties", "designkit.sensor", "designkit.scene", "designkit.materials", "designkit.objects",
      "designkit.figures"},
-    {"designkit.models"},
+    {"designkit.models", "designkit.rig"},
     {"designkit.simulation"},
     {"designkit.recognition"},
     {"designkit.tables"},
     {"designkit.sweep"},
     {"designkit.query"},
     {"designkit.export", "designkit.calibration", "designkit.design"},
-    {"designkit.accuracy", "designkit.reproduce"},
+    {"designkit_lab"},
     {"designkit.cli", "designkit.__main__"},
 ]
 
 
 def _modules() -> list[str]:
-    names = ["designkit"]
-    for info in pkgutil.walk_packages([str(PKG)], prefix="designkit."):
-        names.append(info.name)
+    names = list(ROOTS)
+    for root, folder in ROOTS.items():
+        names.extend(info.name for info in pkgutil.walk_packages([str(folder)], prefix=root + "."))
     return sorted(names)
 
 
+def _file(mod: str) -> Path:
+    """Where ``mod`` would live (a folder for a package), whether or not it exists."""
+    root, *rel = mod.split(".")
+    return ROOTS[root].joinpath(*rel)
+
+
 def _path(mod: str) -> Path:
-    rel = mod.split(".")[1:]
-    p = PKG.joinpath(*rel)
+    p = _file(mod)
     return p / "__init__.py" if p.is_dir() else p.with_suffix(".py")
 
 
@@ -65,10 +74,10 @@ def _imports(mod: str) -> list[tuple[str, list[str], int]]:
                 target = ".".join(base + ([node.module] if node.module else []))
             else:
                 target = node.module or ""
-            if target.startswith("designkit"):
+            if target.split(".")[0] in ROOTS:
                 out.append((target, [a.name for a in node.names], node.lineno))
         elif isinstance(node, ast.Import):
-            out.extend((a.name, [], node.lineno) for a in node.names if a.name.startswith("designkit"))
+            out.extend((a.name, [], node.lineno) for a in node.names if a.name.split(".")[0] in ROOTS)
     return out
 
 
@@ -90,8 +99,7 @@ def test_every_module_is_in_a_layer_and_imports_only_downward():
     for mod in MODULES:
         for target, names, line in _imports(mod):
             targets = [target] + [f"{target}.{n}" for n in names if importlib.util.find_spec(target) and
-                                  (PKG.joinpath(*target.split(".")[1:], n).is_dir() or
-                                   PKG.joinpath(*target.split(".")[1:], n + ".py").is_file())]
+                                  (_file(f"{target}.{n}").is_dir() or _file(f"{target}.{n}").with_suffix(".py").is_file())]
             for t in targets:
                 if t == "designkit" and names == ["__version__"]:
                     continue
@@ -103,7 +111,7 @@ def test_every_module_is_in_a_layer_and_imports_only_downward():
 #: The designated homes of shared private helpers (pvlib's tools.py): importing from them is the point.
 SHARED = {"designkit._validation", "designkit._schemas", "designkit._io", "designkit._resources", "designkit.cli._app",
           "designkit._numbers",
-          "designkit.cli._options", "designkit.reproduce._report"}
+          "designkit.cli._options", "designkit_lab.reproduce._report"}
 
 
 def test_no_module_imports_a_private_name_from_a_peer():
@@ -170,3 +178,12 @@ def test_docstring_examples_run(mod):
     res = runner.summarize(verbose=False)
     assert res.failed == 0, f"{res.failed} of {res.attempted} docstring examples of {mod} fail (run " \
                             f"python -m pytest --doctest-modules on it to see them)"
+
+
+def test_the_core_never_imports_the_lab():
+    """The installed core answers a user's questions without the lab: no core module imports
+    ``designkit_lab``; the ``bench`` and ``reproduce`` commands load it when they run, through
+    ``designkit.cli._app.import_lab`` (one line naming what to install when it is missing)."""
+    bad = [f"{mod}:{line} imports {t}" for mod in MODULES if mod.split(".")[0] == "designkit"
+           for t, _, line in _imports(mod) if t.split(".")[0] == "designkit_lab"]
+    assert not bad, "\n".join(bad)

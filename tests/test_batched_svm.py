@@ -205,3 +205,16 @@ def test_the_array_api_path_is_the_same_solver(case, paper_sensor):
         # numpy's own path reads float32 deviations from prepared features (decisions to about 1e-6 of
         # the functional margin; libsvm itself stops at a KKT gap of 1e-3), the generic one float64
         np.testing.assert_allclose(generic.decision, ours.decision, atol=1e-5)
+
+
+def test_the_array_api_path_gives_each_pair_the_same_arithmetic_whatever_the_stack(paper_sensor):
+    """A GPU sweep stacks a whole batch of pairs (sweep/scorer.py), numpy's fast path 8: a pair's
+    decision values must not depend on how many pairs are solved beside it, bit for bit."""
+    xnp = pytest.importorskip("array_api_compat.numpy", reason="array-api-compat is in the test and gpu extras")
+    feats = [_pair(paper_sensor, 20000.0, 20000.0 + g, 1.0, 0.01, k, trials=30)
+             for k, g in enumerate([160, 400, 900, 2000, 4000])]
+    lo, hi = [f[0] for f in feats], [f[1] for f in feats]
+    one = batched_cv_f1(lo, hi, seeds=list(range(5)), xp=xnp, chunk_size=1)
+    all_ = batched_cv_f1(lo, hi, seeds=list(range(5)), xp=xnp, chunk_size=5)
+    np.testing.assert_array_equal(all_.decision, one.decision)
+    np.testing.assert_array_equal(all_.f1, one.f1)

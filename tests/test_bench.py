@@ -1,4 +1,4 @@
-"""designkit.accuracy and `designkit bench`: the measuring instruments themselves.
+"""designkit_lab.accuracy and `designkit bench`: the measuring instruments themselves.
 
 The exact references the benchmark compares tables against are checked here against
 their definitions (the ideal observer's F1 just above and just below each answer), so
@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 from designkit import Scene
-from designkit import accuracy as bench
+from designkit_lab import accuracy as bench
 from designkit.query import ideal_bound
 from designkit.recognition.ideal import ideal_pair
 from designkit.sensor import SENSORS
@@ -313,12 +313,12 @@ def test_the_shipped_page_renders_from_its_own_json():
     md = bench.render_markdown(report, {"pareto": "accuracy_pareto.png", "cost": "accuracy_cost.png"})
     cov = REPO / "docs" / "accuracy_coverage.json"
     if cov.is_file():  # the coverage benchmark's section (benchmarks/bench_coverage.py --docs) from its record
-        from designkit.accuracy.render import coverage_markdown, insert_coverage
+        from designkit_lab.accuracy.render import coverage_markdown, insert_coverage
 
         md = insert_coverage(md, coverage_markdown(json.loads(cov.read_text()), "accuracy_coverage.png"))
     varied = REPO / "docs" / "accuracy_coverage_varied.json"
     if varied.is_file():  # and the varied-conditions one (benchmarks/bench_coverage_varied.py --docs)
-        from designkit.accuracy.render import insert_varied_coverage, varied_coverage_markdown
+        from designkit_lab.accuracy.render import insert_varied_coverage, varied_coverage_markdown
 
         fig = "accuracy_coverage_varied.png"
         md = insert_varied_coverage(md, varied_coverage_markdown(json.loads(varied.read_text()),
@@ -327,7 +327,7 @@ def test_the_shipped_page_renders_from_its_own_json():
 
 
 def test_a_varied_coverage_run_replaces_its_own_earlier_run_and_keeps_the_others(tmp_path):
-    from designkit.accuracy.render import VARIED_COVERAGE_FILE, write_varied_coverage
+    from designkit_lab.accuracy.render import VARIED_COVERAGE_FILE, write_varied_coverage
 
     (tmp_path / "accuracy.md").write_text("# Accuracy\n\n<!-- COVERAGE START -->\nc\n<!-- COVERAGE END -->\n## Next\n")
     s = {"n": 100, "n_compared": 50, "n_stated": 40, "coverage": 0.9, "n_unstated": 2, "unstated_contains": 0.5,
@@ -353,7 +353,7 @@ def test_a_varied_coverage_run_replaces_its_own_earlier_run_and_keeps_the_others
 
 def test_a_varied_run_with_its_cases_gets_a_figure_linked_from_its_section(tmp_path):
     pytest.importorskip("matplotlib")
-    from designkit.accuracy.render import VARIED_COVERAGE_FIGURE, varied_coverage_cases, write_varied_coverage
+    from designkit_lab.accuracy.render import VARIED_COVERAGE_FIGURE, varied_coverage_cases, write_varied_coverage
 
     def reading(v, lo=None, hi=None, cov=None):
         return {"value": v, "low": lo, "high": hi, "coverage": cov, "method": "m", "ideal": None}
@@ -383,9 +383,9 @@ def test_every_accuracy_module_declares_its_public_names_and_imports_no_private_
     import importlib
     import pkgutil
 
-    import designkit.accuracy as pkg
+    import designkit_lab.accuracy as pkg
 
-    modules = [pkg] + [importlib.import_module(f"designkit.accuracy.{m.name}") for m in pkgutil.iter_modules(pkg.__path__)]
+    modules = [pkg] + [importlib.import_module(f"designkit_lab.accuracy.{m.name}") for m in pkgutil.iter_modules(pkg.__path__)]
     for mod in modules:
         assert all(hasattr(mod, n) for n in mod.__all__), mod.__name__
         tree = ast.parse(Path(mod.__file__).read_text())

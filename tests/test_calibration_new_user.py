@@ -5,9 +5,12 @@ from __future__ import annotations
 import contextlib
 import json
 import shlex
+from pathlib import Path
 
 import pytest
 from test_calibration_cli import METER_RANGES, _synthetic_index
+
+from designkit.sensor import load_sensor
 
 RANGES = sum((["--range", x] for x in METER_RANGES), [])
 
@@ -60,7 +63,7 @@ def test_guided_run_refuses_an_emulator_that_alternates(cli, tmp_path):
     out = tmp_path / "run"
     with _two_materials(1) as emu:
         r = cli("calibrate", "--port", emu.port, "--material", "metal", "--material", "wood", "--trials", "2",
-                *RANGES, "--out", out, "--bootstrap", "0", "--yes")
+                *RANGES, "--out", out, "--model", "semi-infinite", "--yes")
     assert r.exit_code == 2
     errors = [ln for ln in r.stderr.strip().splitlines() if ln.startswith("Error:")]
     assert len(errors) == 1 and errors[0].startswith("Error: the emulator touches metal, wood, metal, wood in turn")
@@ -108,7 +111,7 @@ def test_the_emulators_hint_pastes_into_a_shell_and_labels_right(cli, tmp_path, 
         assert args[args.index("--material") + 1] == "Aluminium alloys"
         assert args[args.index("--trials") + 1] == "2" and "--yes" in args
         args[args.index("--out") + 1] = str(tmp_path / "trials")
-        r = cli(*args[1:], "--bootstrap", "0", "--json", "--force")
+        r = cli(*args[1:], "--model", "semi-infinite", "--json", "--force")
         assert r.exit_code == 0, r.output
         labels = [json.loads((tmp_path / "trials" / p).with_suffix(".json").read_text())["material"]
                   for p in json.loads(r.stdout)["record"]["trials"]]
@@ -195,3 +198,71 @@ def test_the_emulators_classify_hint_decides_its_touches_right(cli, ctrl_c_able)
         assert r.exit_code == 0, r.output
         got = [d["material"] for d in json.loads(r.stdout)["decisions"]]
     assert got == ["a", "b", "a", "b"]
+
+
+# ------------------------------------------------ the guided run over a rig replaying real touches
+def _replay_rig(robot_data_dir, per_material: int, profile):
+    """An emulator whose touches are the shared recordings' own (metal and wood of sets 1, 2, ...), in turn.
+
+    Each recording (1 s before its onset to 7 s after, at 200 Hz) is played from its first sample on,
+    its last sample held 0.8 s longer (the recorder's window of 7 s counts from its own, later onset),
+    then released; between touches the sensor rests at the next touch's first reading.
+    """
+    import numpy as np
+
+    from designkit import SENSORS
+    from designkit.calibration.emulator import EmulatedMaterial, Emulator, TouchPlan
+    from designkit.calibration.trials import load_index
+
+    trials = load_index(robot_data_dir / "index.csv", only=["metal", "wood"])
+    recs = {m: [tr for tr in trials if tr.material == m][:per_material] for m in ("metal", "wood")}
+
+    class Replay(Emulator):
+        def values(self, k0, k1):
+            p, fs = self.plan, self.profile.sample_rate_hz
+            t = np.arange(k0, k1) / fs
+            j = np.maximum(np.floor((t - p.first_touch_s + 1.0) / p.touch_every_s), 0).astype(int)
+            rel = t - (p.first_touch_s + j * p.touch_every_s)
+            out = {k: np.zeros(t.size) for k in ("sensor", "object", "force")}
+            for jj in np.unique(j):
+                rec = recs[self.material_of_touch(int(jj)).label][int(jj) % p.touches_per_material]
+                sel = j == jj
+                idx = np.clip(np.rint((rel[sel] - rec.time_s[0]) * fs).astype(int), 0, rec.time_s.size - 1)
+                pressed = (rel[sel] >= rec.time_s[0]) & (rel[sel] < rec.time_s[-1] + 0.8)
+                out["sensor"][sel] = rec.sensor_c[idx]
+                out["object"][sel] = rec.object_c[idx]
+                out["force"][sel] = np.where(pressed, np.maximum(rec.force_n[idx], 0.0), 0.0)
+            return {**out, "timestamp": t}
+
+    return Replay(profile, SENSORS["paper"], [EmulatedMaterial("metal", 17530.0), EmulatedMaterial("wood", 400.0)],
+                  noise_c=0.0, plan=TouchPlan(touch_every_s=13.0, touches_per_material=per_material,
+                                              press_force_n=4.0), speed=100.0)
+
+
+@pytest.mark.slow
+def test_guided_run_over_a_replayed_real_rig_writes_a_sensor_file_that_holds(cli, robot_data_dir, tmp_path):
+    """Issue 34: the guided run recorded 60 real touches, then refused them (the paper's model conflicts).
+    Now it chooses the model on held-out touches (no trial sets: each material's second half) and writes it."""
+    import yaml
+
+    from designkit.calibration.profiles import load_profile
+
+    text = (Path(__file__).parents[1] / "calibration" / "profiles" / "designkit.yaml").read_text()
+    prof_path = tmp_path / "rig.yaml"   # the rig presses at 4-5 N: contact from 2 N (its recorder's onset), release 1 N
+    data = yaml.safe_load(text)
+    data["name"] = "rig"
+    data["contact"].update(force_threshold_n=2.0, release_n=1.0)
+    prof_path.write_text(yaml.safe_dump(data))
+    out = tmp_path / "run"
+    with _replay_rig(robot_data_dir, 30, load_profile(str(prof_path))) as emu:
+        r = cli("calibrate", "--port", emu.port, "--profile", prof_path, "--material", "metal", "--material", "wood",
+                "--trials", "30", "--range", "metal=aluminium", "--out", out, "--yes", "--json")
+    assert r.exit_code == 0, r.output
+    d = json.loads(r.stdout)
+    assert d["record"]["n_trials"] == 60
+    fit = d["fit"]
+    assert fit["split"]["by"] == "touch order" and fit["n_fit"] == 30 and fit["n_held_out"] == 30
+    best = next(x for x in fit["results"] if x["candidate"] == fit["selected"])
+    assert best["consistent"] and best["held_out_rms_c"]["metal"] <= 0.05 and best["held_out_rms_c"]["wood"] <= 0.05
+    sen = load_sensor(Path(d["sensor"]))
+    assert sen.model["candidate"] == fit["selected"] and not sen.problems

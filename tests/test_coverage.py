@@ -1,4 +1,4 @@
-"""The coverage machinery (designkit.accuracy.coverage, issue 13): small seeded runs, real code paths.
+"""The coverage machinery (designkit_lab.accuracy.coverage, issue 13): small seeded runs, real code paths.
 
 The full benchmark (100 cases per question) is benchmarks/bench_coverage.py; here: the crossing
 estimator covers a known truth near nominal, the ideal bound is never above the exact ideal
@@ -14,7 +14,7 @@ import pytest
 
 from designkit import query
 from designkit._validation import InputError
-from designkit.accuracy.coverage import coverage_case, diluted_coverage, draw_case, summarize, synthetic_coverage
+from designkit_lab.accuracy.coverage import coverage_case, diluted_coverage, draw_case, summarize, synthetic_coverage
 from designkit.query.crossing import estimate_crossing
 from designkit.query.ideal_bound import exact_ideal_max_ratio, exact_ideal_min_contact
 from designkit.recognition.ideal import ideal_pair
@@ -167,7 +167,7 @@ def test_stated_interval_schema_and_refusals():
 def test_calibration_z_is_one_for_calibrated_intervals_whatever_the_reference_error():
     # records drawn with known errors: answers' log-sd 0.05, references' 0.025 (a 4x-seeds reference);
     # coverage against the reference is diluted (~86 %), the z spread is not
-    from designkit.accuracy.coverage import calibration_z
+    from designkit_lab.accuracy.coverage import calibration_z
 
     rng = np.random.default_rng(8)
     z90 = 1.6448536269514722
@@ -202,7 +202,7 @@ def test_normal_quantile_of_the_query_path_against_the_standard_library():
 
 
 def test_worst_regions_group_continuous_noise_by_band():
-    from designkit.accuracy.coverage import worst_regions
+    from designkit_lab.accuracy.coverage import worst_regions
 
     def case(noise, e2, value, ref, cov=0.9):
         return {"question": "min-contact", "noise_c": noise, "e2": e2,

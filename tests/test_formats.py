@@ -95,8 +95,8 @@ def test_matrix_reads_one_name_a_line_or_a_name_column(cli, tmp_path, text):
 def test_report_figures_in_the_format_asked(tmp_path, fmt, magic):
     pytest.importorskip("matplotlib")
     from designkit.figures import pyplot
-    from designkit.reproduce import ReproduceSettings
-    from designkit.reproduce._report import Context
+    from designkit_lab.reproduce import ReproduceSettings
+    from designkit_lab.reproduce._report import Context
 
     ctx = Context(ReproduceSettings(figure_format=fmt), tmp_path)
     fig, ax = pyplot().subplots()
@@ -109,7 +109,7 @@ def test_report_figures_in_the_format_asked(tmp_path, fmt, magic):
 
 def test_unknown_figure_format_is_refused():
     from designkit._validation import InputError
-    from designkit.reproduce import ReproduceSettings
+    from designkit_lab.reproduce import ReproduceSettings
 
     with pytest.raises(InputError, match="png, svg or pdf"):
         ReproduceSettings(figure_format="jpg")
@@ -117,7 +117,7 @@ def test_unknown_figure_format_is_refused():
 
 def test_node_graph_layout_puts_every_node_somewhere_distinct():
     nx = pytest.importorskip("networkx")
-    from designkit.reproduce.matrices import graph_layout
+    from designkit_lab.reproduce.matrices import graph_layout
 
     G = nx.Graph()
     G.add_nodes_from(range(9))

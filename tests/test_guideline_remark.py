@@ -1,6 +1,6 @@
 """The main job's answer carries the paper's own guideline beside it (issue 13: "the paper's 'at least
 2 s' on its 1-s grid beside it"), in the guideline's scene only; the figures come from
-designkit.query.guideline.GUIDELINE (re-exported by designkit.reproduce.paper), never from a string in the CLI."""
+designkit.query.guideline.GUIDELINE (re-exported by designkit_lab.reproduce.paper), never from a string in the CLI."""
 
 from __future__ import annotations
 
@@ -52,6 +52,6 @@ def test_remark_for_exact_answers_and_other_questions():
 
 
 def test_reproduce_reads_the_same_guideline():
-    from designkit.reproduce import paper
+    from designkit_lab.reproduce import paper
 
     assert paper.GUIDELINE is GUIDELINE and "GUIDELINE" in paper.__all__

@@ -169,18 +169,20 @@ def test_per_touch_contact_conductance_explains_touches_that_differ_in_contact()
 
 def test_sim_to_real_with_the_identified_model_beats_the_paper(robot_data_dir):
     """Simulator = the layered sensor identified on trial sets 1-4; tested on the real touches of sets 5-20."""
-    from designkit.reproduce.robot import CALIBRATION_SETS, calibrate_model, load_real, sim_to_real
+    from designkit_lab.reproduce.robot import calibrate_model, calibration_split, load_real, sim_to_real
 
     touches = load_real(robot_data_dir)
-    test = touches.select(~np.isin(touches.trial_set, CALIBRATION_SETS))
+    cal, how = calibration_split(touches)
+    assert how.startswith("calibrated on trial sets 1-4 (36 touches), tested on trial sets 5-20")
+    test = touches.select(~cal)
     setup = calibrate_model(touches)       # cold wood: wood at the temperature its passive thermistor reads
     assert setup.rms_c < 0.05                                   # chosen before testing: the fit's residual
-    pool = touches.select(np.isin(touches.trial_set, CALIBRATION_SETS))   # forces of the calibration touches
+    pool = touches.select(cal)   # forces of the calibration touches
     r = sim_to_real(test, setup, setup.rms_c, per_trial=2, seed=0, force_pool=pool)
     assert r["mean_f1"] >= 0.90 and r["multiclass"]["accuracy"] >= 0.80, r
     assert r["pairs"]["wood vs cold wood"]["f1"] >= 0.95
     # the cooled block's temperature read from the passive channel alone is far below its end reading
-    from designkit.reproduce.robot import passive_object_temp
+    from designkit_lab.reproduce.robot import passive_object_temp
 
     to = passive_object_temp(test, setup.passive_response)
     cold = test.material == "cold_wood"
@@ -291,7 +293,7 @@ def test_real_touches_drift_and_force_area_reach_the_held_out_target(robot_data_
 
 def test_passive_object_temp_reads_the_object_through_the_passive_response():
     """A passive channel approaching To along a known response gives To back, from that channel alone."""
-    from designkit.reproduce.robot import RealTouches, passive_object_temp
+    from designkit_lab.reproduce.robot import RealTouches, passive_object_temp
 
     t = np.arange(801) / 200.0
     w = 1.0 - np.exp(-t / 9.0)                      # a slow thermistor: 36 % of the way at 4 s
@@ -411,3 +413,34 @@ def test_force_noise_does_not_bias_the_identified_ratios(monkeypatch):
     assert abs(np.mean(v_band[late] / v0) - 1) < 0.2 * abs(np.mean(v_cap[late] / v0) - 1)
     monkeypatch.setattr(ident, "FORCE_NOISE_BAND_SD", 0.0)      # the map capped at the plateau, as before
     assert identify(noisy, CHAIN, ranges=RANGES).ratios["granite"].value / ref - 1 > 0.001
+
+
+def test_reproduce_chooses_disjoint_calibration_and_test_touches_from_the_sets_present(robot_data_dir, tmp_path):
+    """Issue 34: another recording of the rig numbered otherwise was calibrated on all its touches (1-4 hard-coded);
+    now the first fifth of the sets present calibrate and the rest test, stated; one set is refused in one line."""
+    import csv
+
+    from designkit_lab.reproduce.robot import calibration_split, load_real
+
+    rows = [r for r in csv.DictReader((robot_data_dir / "index.csv").open()) if int(r["trial_set"]) <= 3]
+    renumber = {"1": 7, "2": 9, "3": 12}
+
+    def index(sets):
+        folder = tmp_path / "-".join(sets)
+        folder.mkdir()
+        with (folder / "index.csv").open("w", newline="") as f:
+            w = csv.DictWriter(f, ["file", "material", "trial_set"])
+            w.writeheader()
+            for r in rows:
+                if r["trial_set"] in sets:
+                    w.writerow({"file": str(robot_data_dir / r["file"]), "material": r["material"],
+                                "trial_set": renumber[r["trial_set"]]})
+        return load_real(folder)
+
+    touches = index(["1", "2", "3"])
+    cal, how = calibration_split(touches)
+    assert set(touches.trial_set[cal]) == {7} and set(touches.trial_set[~cal]) == {9, 12}
+    assert how == "calibrated on trial sets 7 (9 touches), tested on trial sets 9, 12 (18 touches)"
+    with pytest.raises(InputError) as exc:
+        calibration_split(index(["2"]))
+    assert str(exc.value) == "the recording has one trial set (9): no touches to hold out"

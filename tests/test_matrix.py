@@ -64,7 +64,7 @@ def test_bounds_mark_answers_beyond_the_grid():
 
 
 def test_multiclass_ideal_equals_the_reproduce_section_formula(paper12):
-    from designkit.reproduce.multiclass import bayes_accuracy
+    from designkit_lab.reproduce.multiclass import bayes_accuracy
     from designkit.scene import Scene
     from designkit.sensor import SENSORS
 
@@ -280,7 +280,7 @@ def test_cli_plot_writes_a_vector_figure(cli, tmp_path):
 
 def test_svm_multiclass_on_request_equals_the_reproduce_pipeline(paper_sensor):
     pytest.importorskip("sklearn")
-    from designkit.reproduce.multiclass import svm_multiclass
+    from designkit_lab.reproduce.multiclass import svm_multiclass
     from designkit.scene import Scene
 
     r = material_matrix(THREE, svm_trials=6, seed=3)

@@ -22,18 +22,19 @@ def test_every_subpackage_is_listed():
         pytest.skip("not running from a source checkout")
     cfg = tomllib.loads(pyproject.read_text())["tool"]["setuptools"]
     listed = set(cfg["packages"])
-    found = {".".join(p.parent.relative_to(REPO).parts) for p in (REPO / "designkit").rglob("__init__.py")
-             if "__pycache__" not in p.parts}
+    found = {".".join(p.parent.relative_to(REPO).parts) for root in ("designkit", "designkit_lab")
+             for p in (REPO / root).rglob("__init__.py") if "__pycache__" not in p.parts}
     assert found <= listed, f"add to pyproject.toml packages: {sorted(found - listed)}"
     for pkg, folder in cfg["package-dir"].items():
         assert pkg in listed and (REPO / folder).is_dir()
 
 
 def test_cli_import_stays_light():
-    """`designkit --help` and table queries must not pay for scikit-learn, matplotlib or dask."""
+    """`designkit --help` and table queries must not pay for scikit-learn, matplotlib, dask or the lab."""
     import subprocess
 
-    code = ("import sys, designkit.cli; bad = [m for m in ('sklearn', 'matplotlib', 'dask', 'scipy.optimize')"
+    code = ("import sys, designkit.cli; bad = [m for m in ('sklearn', 'matplotlib', 'dask', 'scipy.optimize',"
+            " 'designkit_lab')"
             " if m in sys.modules]; print(','.join(bad))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == ""
@@ -67,7 +68,7 @@ def test_every_data_file_in_a_package_folder_is_installed():
     data = cfg["package-data"]
     owners = {pkg: REPO / pkg.replace(".", "/") for pkg in cfg["packages"] if pkg not in folders}
     missing = []
-    for p in (REPO / "designkit").rglob("*"):
+    for p in [p for root in ("designkit", "designkit_lab") for p in (REPO / root).rglob("*")]:
         if not p.is_file() or "__pycache__" in p.parts or p.suffix in (".py", ".pyc") or p.name.startswith("."):
             continue
         pkg, folder = max(((k, f) for k, f in owners.items() if f in p.parents), key=lambda kf: len(kf[1].parts))
@@ -75,3 +76,15 @@ def test_every_data_file_in_a_package_folder_is_installed():
         if not any(fnmatch.fnmatch(rel, pat) for pat in data.get(pkg, [])):
             missing.append(f"{pkg}: {rel}")
     assert not missing, f"not in [tool.setuptools.package-data]: {missing}"
+
+
+def test_bench_without_the_lab_is_one_line_naming_what_to_install():
+    """The core runs without designkit_lab; `designkit bench` then says what is missing (exit 2), no traceback."""
+    import subprocess
+
+    code = ("import sys; sys.modules['designkit_lab'] = None; sys.argv = ['designkit', 'bench', '--quick', '--json'];"
+            " from designkit.cli import main; main()")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert out.returncode == 2, out.stderr
+    assert out.stderr.count("\n") == 1 and "designkit_lab" in out.stderr and "Traceback" not in out.stderr
+    assert '"exit_status": 2' in out.stdout

@@ -17,10 +17,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from designkit._validation import InputError
-from designkit.reproduce import SECTIONS, ReproduceSettings, parse_only, reproduce
-from designkit.reproduce.matrices import (covering_intervals, matrix_delta_up, matrix_stats,
+from designkit_lab.reproduce import SECTIONS, ReproduceSettings, parse_only, reproduce
+from designkit_lab.reproduce.matrices import (covering_intervals, matrix_delta_up, matrix_stats,
                                           staircase_percent)
-from designkit.reproduce.multiclass import bayes_accuracy
+from designkit_lab.reproduce.multiclass import bayes_accuracy
 from designkit.tables.store import Table
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
@@ -257,7 +257,7 @@ def test_real_robot_sections_skip_cleanly_without_data(small_report):
 def test_real_robot_on_the_shared_recordings(robot_data_dir, tmp_path):
     """Train real / test real on the recordings: numbers equal a direct cross-validation."""
     from designkit.recognition.svm import cross_validated_f1
-    from designkit.reproduce.robot import load_real
+    from designkit_lab.reproduce.robot import load_real
 
     res = reproduce(tmp_path / "r", ["real-robot"], ReproduceSettings(robot_data=robot_data_dir, quick=True))
     s = res.section("real-robot")

@@ -27,7 +27,8 @@ def test_unwritable_out_names_the_users_file_not_a_temporary_one(cli, tmp_path):
     blocker.write_text("")
     line = _one_error_line(cli("simulate", "--e", "20000", "--contact", "1", "--trials", "2",
                                "--out", str(blocker / "x.csv")))
-    assert f"cannot write {blocker / 'x.csv'}" in line and ".tmp" not in line
+    # refused before the work (issue 36: the output folder checked as export checks it)
+    assert f"--out {blocker / 'x.csv'}" in line and "is not a folder" in line and ".tmp" not in line
 
 
 @pytest.mark.skipif(not Path("/proc/self").is_dir(), reason="needs Linux's /proc (a folder no file can be made in)")
@@ -116,7 +117,7 @@ def test_delta_e_legend_only_when_a_dash_is_shown(cli):
 
 # ------------------------------------------------------------------ reproduce's robot data
 def test_robot_data_found_from_the_folder_the_user_runs_in(tmp_path, monkeypatch):
-    from designkit.reproduce import default_robot_data_dir
+    from designkit_lab.reproduce import default_robot_data_dir
 
     monkeypatch.delenv("DESIGNKIT_ROBOT_DATA", raising=False)
     data = tmp_path / "shared" / "data" / "robot-thermal-recordings"
@@ -135,6 +136,6 @@ def test_reproduce_says_where_it_looked_and_keeps_robot_data(cli, tmp_path, monk
     monkeypatch.delenv("DESIGNKIT_ROBOT_DATA", raising=False)
     r = cli("reproduce", "--help")
     assert "--robot-data" in r.output and "current folder" in " ".join(r.output.split())
-    from designkit.reproduce import ReproduceSettings
+    from designkit_lab.reproduce import ReproduceSettings
 
     assert ReproduceSettings(robot_data=tmp_path).robot_data_dir == tmp_path

@@ -8,7 +8,7 @@ import pytest
 from designkit import InputError
 from designkit.calibration.emulator import EmulatedMaterial, Emulator, TouchPlan
 from designkit.calibration.profiles import load_profile
-from designkit.calibration.roundtrip import CASES, round_trip, summarize
+from designkit_lab.roundtrip import CASES, round_trip, summarize
 from designkit.models import get_model
 from designkit.sensor import Sensor
 
@@ -108,7 +108,7 @@ def test_unknown_case_is_named():
 
 def test_varied_presses_span_quick_and_slow_touches():
     """The protocol that identifies c within 2 % presses at widely varied pace (docs/sensor-models.md)."""
-    from designkit.calibration.roundtrip import CHAIN_PLAN, VARIED_PRESS
+    from designkit_lab.roundtrip import CHAIN_PLAN, VARIED_PRESS
 
     case = CASES["contact+drift+area"]
     ramps = {}

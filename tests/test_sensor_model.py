@@ -162,3 +162,81 @@ def test_a_sweep_config_takes_the_sensor_file_model(contact_file):
     assert cfg.model == get_model("contact", conductance_w_m2k=3000.0)
     assert SweepConfig(sensor=str(contact_file), intervals=4, contact_s=(1.0,), model="semi-infinite"
                        ).model.name == "semi-infinite"
+
+
+# ------------------------------------------------ the rig as calibrated (issue 34): conditions and the onset
+RIG = {"noise_c": 0.02, "noise_source": "test", "pre_contact_noise_c": 0.001, "residual_rms_c": 0.02,
+       "sensor_temp_c": {"mean": 29.5, "sd": 0.1}, "object_temp_c": {"mean": 22.5, "sd": 0.3},
+       "delta_t_c": {"mean": 7.0, "sd": 0.3}, "sensor_temp_spread_c": 0.52, "onset": "force above 2 N",
+       "onset_offset_s": -0.3, "contact_ramp": {"rise_s": 0.75, "to_share": 0.9}, "n_touches": 24}
+
+
+@pytest.fixture
+def rig_file(tmp_path):
+    path = tmp_path / "rig.yaml"
+    Sensor(1500.0, 1.2e-9, name="rig", noise_c=0.001, conditions=RIG,
+           model={"name": "semi-infinite", "params": {}, "time_offset_s": -0.3}).to_yaml(path)
+    return path
+
+
+def test_sensor_file_version_2_records_the_rigs_conditions_and_older_files_load(rig_file, tmp_path):
+    text = rig_file.read_text()
+    assert "designkit_sensor: 2" in text and "conditions:" in text
+    assert load_sensor(rig_file).conditions["delta_t_c"] == {"mean": 7.0, "sd": 0.3}
+    old = tmp_path / "old.yaml"
+    old.write_text("designkit_sensor: 1\nname: old\neffusivity: 900\ndiffusivity_m2_s: 1.2e-9\n")
+    assert load_sensor(old).conditions is None
+    newer = tmp_path / "newer.yaml"
+    newer.write_text("designkit_sensor: 3\nname: new\neffusivity: 900\ndiffusivity_m2_s: 1.2e-9\n")
+    with pytest.raises(InputError) as exc:
+        load_sensor(newer)
+    assert "written by a newer designkit; upgrade designkit" in str(exc.value) and "\n" not in str(exc.value)
+    with pytest.raises(InputError, match="unknown key.*humidity"):
+        Sensor(900.0, 1.2e-9, conditions={"humidity": 0.4})
+
+
+def test_a_question_takes_the_rigs_conditions_unless_given_and_says_where_each_came_from(rig_file):
+    from designkit.rig import resolve_scene
+
+    sen = load_sensor(rig_file)
+    sc = resolve_scene(sen, {"noise_c": None, "delta_t_c": 5.0, "sensor_temp_spread_c": None, "contact_s": 1.0})
+    assert sc.values == {"noise_c": 0.02, "delta_t_c": 5.0, "sensor_temp_spread_c": 0.0, "contact_s": 1.3}
+    assert sc.sources == {"noise_c": "sensor file", "delta_t_c": "user", "sensor_temp_spread_c": "default",
+                          "contact_s": "user"}
+    assert sc.start_s == pytest.approx(-0.3) and any("detected onset (force above 2 N)" in n for n in sc.notes)
+    assert any("--sensor-temp-spread 0.52 plays it" in n for n in sc.notes)
+    paper = resolve_scene(SENSORS["paper"], {"noise_c": None, "delta_t_c": None, "contact_s": 1.0})
+    assert paper.values == {"noise_c": 0.05, "delta_t_c": 10.0, "contact_s": 1.0} and paper.start_s is None
+    with pytest.raises(InputError, match="before the model's first heat flow"):
+        resolve_scene(load_sensor(rig_file).replace(model={"name": "semi-infinite", "time_offset_s": 0.5}),
+                      {"contact_s": 0.4})
+
+
+def test_min_contact_counts_from_the_rigs_detected_onset():
+    """The model's contact counts from the first heat flow, 0.3 s before the onset here: the rig needs 0.3 s less."""
+    from designkit import query
+    from designkit.rig import RigScene, for_rig
+
+    ans = query.ask("min-contact", route="table", e1=35000.0, e2=20000.0, noise_c=0.05, delta_t_c=10.0)
+    rig = RigScene({"noise_c": 0.05, "delta_t_c": 10.0}, {"noise_c": "sensor file", "delta_t_c": "default"}, -0.3,
+                   ("contact time counts from the rig's detected onset",))
+    got = for_rig(ans, rig)
+    assert got.value == pytest.approx(ans.value - 0.3)
+    assert got.interval[0] == pytest.approx(ans.interval[0] - 0.3)
+    assert got.ideal_bound.value == pytest.approx(ans.ideal_bound.value - 0.3)
+    d = got.to_dict()
+    assert d["scene"]["conditions"]["noise_c"] == {"value": 0.05, "source": "sensor file"}
+    assert d["scene"]["conditions"]["onset_offset_s"] == {"value": -0.3, "source": "sensor file"}
+    assert "contact time counts from the rig's detected onset" in d["notes"]
+
+
+def test_the_cli_answers_for_the_rig_as_calibrated(cli, rig_file):
+    r = cli("distinguishable", "--e1", "400", "--e2", "1500", "--contact", "1", "--sensor", rig_file,
+            "--trials", "30", "--repeats", "1", "--json")
+    assert r.exit_code in (0, 3), r.output
+    d = json.loads(r.stdout)
+    c = d["scene"]["conditions"]
+    assert c["noise_c"] == {"value": 0.02, "source": "sensor file"}
+    assert c["delta_t_c"] == {"value": 7.0, "source": "sensor file"}
+    assert c["contact_s"]["value"] == 1.0 and c["contact_s"]["model_contact_s"] == pytest.approx(1.3)
+    assert c["contact_s"]["counted_from"] == "detected onset" and d["scene"]["contact_s"] == 1.0

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from designkit.recognition.sequential import SequentialTest
-from designkit.reproduce.robot import calibrate, load_real, real_pair_f1
+from designkit_lab.reproduce.robot import calibrate, load_real, real_pair_f1
 
 
 def test_replayed_real_touches_match_the_fixed_4s_svm_in_less_time(robot_data_dir):

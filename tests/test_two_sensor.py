@@ -87,7 +87,7 @@ def test_cli_f1_two_sensor_says_whether_the_passive_thermistor_resolves_the_pair
 def test_real_recordings_the_passive_channel_as_second_sensor(robot_data_dir):
     """Train and test on real touches (3 folds x 3 shuffles): the passive channel makes cold wood plain."""
     from designkit.recognition.svm import f1_from_features
-    from designkit.reproduce.robot import load_real
+    from designkit_lab.reproduce.robot import load_real
 
     touches = load_real(robot_data_dir)
     assert touches.object_c.shape == touches.sensor_c.shape and np.isfinite(touches.object_c).all()

@@ -5,9 +5,12 @@
 - :mod:`~designkit.calibration.emulator`: a simulated rig on a pseudo-terminal.
 - :mod:`~designkit.calibration.recorder`: recording touches over serial.
 - :mod:`~designkit.calibration.trials`: trials on disk (CSV + JSON sidecar + index).
-- :mod:`~designkit.calibration.fit`: identifying e_s and alpha_s (paper appendix).
+- :mod:`~designkit.calibration.identify`: the one identification engine: every sensor model (the
+  paper's semi-infinite one among them), held-out splits and the choice between models.
+- :mod:`~designkit.calibration.fit`: the materials' effusivity ranges, object temperatures and the
+  checks that make a calibration unusable.
 
 Submodules are imported on use; this package imports nothing heavy.
 """
 
-__all__ = ["emulator", "fit", "profiles", "recorder", "trials"]
+__all__ = ["emulator", "fit", "identify", "profiles", "recorder", "trials"]

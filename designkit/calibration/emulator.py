@@ -24,6 +24,8 @@ catch-up burst.
 
 Faults (:class:`Faults`) inject what real serial links do: garbled bytes,
 partial lines, non-numeric fields, wrong field counts, out-of-range counts,
+lines out of order or sent twice, a digit changed on the wire (the line still
+parses; a profile's checksum catches it),
 bursts (output held back, then delivered at once), gaps (samples lost while
 the line is silent), a device that vanishes, and one that never speaks.
 """
@@ -50,6 +52,7 @@ from .._validation import InputError, as_generator, check_effusivity, check_nonn
 from ..models.semi_infinite import object_weight, response_shape
 from ..sensor import Sensor
 from .profiles import DeviceProfile, Linear, Thermistor
+from .trials import check_material_label
 
 __all__ = ["AnnouncedPlan", "EmulatedMaterial", "Emulator", "Faults", "TouchPlan", "TouchRecord", "parse_announcement",
            "parse_greeting"]
@@ -79,6 +82,7 @@ class EmulatedMaterial:
     object_temp_c: float | None = None
 
     def __post_init__(self) -> None:
+        check_material_label(self.label, "the emulated material's label")   # it labels the recorded trials
         object.__setattr__(self, "effusivity", check_effusivity(self.label, self.effusivity))
 
 
@@ -90,8 +94,13 @@ class Faults:
     (line cut short, fields missing), ``non_numeric`` (a field replaced by
     text such as ``nan`` or ``ERR``), ``field_count`` (a field added or
     dropped), ``out_of_range`` (a sensor reading at the ADC rails or outside
-    the channel's valid range). Each faulty line replaces one sample. They
-    start at device time ``line_faults_after_s`` (0: from the first line).
+    the channel's valid range). Each faulty line replaces one sample.
+    ``out_of_order`` (a line swapped with the next one), ``duplicate`` (a
+    line sent twice) and ``corrupt`` (one digit of a mapped field changed to
+    another digit after the line's checksum was computed: the line still
+    parses, only a checksum or a plausibility filter can tell) keep every
+    sample. They start at device time ``line_faults_after_s`` (0: from the
+    first line).
 
     Timed faults (device seconds, 0 = off): every ``burst_every_s`` the
     output is held back for ``burst_hold_s`` real seconds and then delivered
@@ -106,6 +115,9 @@ class Faults:
     non_numeric: float = 0.0
     field_count: float = 0.0
     out_of_range: float = 0.0
+    out_of_order: float = 0.0
+    duplicate: float = 0.0
+    corrupt: float = 0.0
     line_faults_after_s: float = 0.0
     burst_every_s: float = 0.0
     burst_hold_s: float = 0.1
@@ -115,7 +127,8 @@ class Faults:
     silent: bool = False
 
     def __post_init__(self) -> None:
-        for name in ("garbled", "partial", "non_numeric", "field_count", "out_of_range"):
+        for name in ("garbled", "partial", "non_numeric", "field_count", "out_of_range", "out_of_order",
+                     "duplicate", "corrupt"):
             p = check_nonnegative(f"fault {name} probability", getattr(self, name))
             if p > 1:
                 raise InputError(f"fault {name} probability must be <= 1, got {p:g}")
@@ -125,16 +138,24 @@ class Faults:
 
     @property
     def line_faults(self) -> bool:
-        return any((self.garbled, self.partial, self.non_numeric, self.field_count, self.out_of_range))
+        return any((self.garbled, self.partial, self.non_numeric, self.field_count, self.out_of_range,
+                    self.out_of_order, self.duplicate, self.corrupt))
+
+    @property
+    def order_faults(self) -> bool:
+        """Faults that keep every sample but disturb the lines (order, repeats, a changed digit)."""
+        return any((self.out_of_order, self.duplicate, self.corrupt))
 
     @classmethod
     def parse(cls, specs: Sequence[str]) -> "Faults":
         """From CLI specs: ``garbled=0.01``, ``partial=P``, ``non-numeric=P``,
-        ``field-count=P``, ``out-of-range=P``, ``line-faults-after=S``,
+        ``field-count=P``, ``out-of-range=P``, ``out-of-order=P``, ``duplicate=P``,
+        ``corrupt=P``, ``line-faults-after=S``,
         ``burst=EVERY_S[:HOLD_S]``, ``gap=EVERY_S[:SILENT_S]``, ``vanish=AFTER_S``,
         ``silent``."""
         kw: dict[str, float | bool] = {}
-        probs = {"garbled", "partial", "non-numeric", "field-count", "out-of-range"}
+        probs = {"garbled", "partial", "non-numeric", "field-count", "out-of-range", "out-of-order", "duplicate",
+                 "corrupt"}
         known = sorted(probs | {"line-faults-after", "burst", "gap", "vanish", "silent"})
         for spec in specs:
             name, _, value = str(spec).partition("=")
@@ -385,6 +406,7 @@ class Emulator:
         if int(self._seed) < 0:
             raise InputError(f"seed must be a non-negative integer, got {seed}")
         self._rng = as_generator([int(self._seed), 1 << 30])  # fault draws
+        self._order_rng = as_generator([int(self._seed), 1 << 29])  # order faults' draws (Faults.order_faults)
         self._blocks: dict[int, np.ndarray] = {}
         self._curves: dict[tuple[int, float], tuple[np.ndarray, np.ndarray]] = {}
         fs = profile.sample_rate_hz
@@ -688,6 +710,8 @@ class Emulator:
                     line = delim.join(parts)
                     self.lines_faulty += 1
                 out.append(line.encode(prof.encoding))
+            if fl.order_faults:
+                out = self._order_faults(out, max(clean_until, 0))
         else:
             out = [line.encode(prof.encoding) for line in text]
         if prof.comment and out:  # each touch announced as it starts (before its onset): a device message
@@ -701,6 +725,41 @@ class Emulator:
                 if k >= k0:
                     out.insert(k - k0 + (j - j0), self.announcement(j).encode(prof.encoding))
         return b"\n".join(out) + b"\n" if out else b""
+
+    def _order_faults(self, out: list[bytes], start: int) -> list[bytes]:
+        """Apply ``corrupt``, ``duplicate`` and ``out_of_order`` to the wire lines from index ``start`` on.
+
+        Drawn from their own generator, so that the other faults' draws (and
+        the tests seeded on them) stay as they were.
+        """
+        fl, prof = self.faults, self.profile
+        rng = self._order_rng
+        n = len(out)
+        draws = rng.random((3, n))
+        delim = (prof.delimiter if prof.delimiter is not None else " ").encode(prof.encoding)
+        mapped = sorted(ch.field_index for ch in prof.channels.values())
+        for i in range(start, n):
+            if draws[0, i] < fl.corrupt:
+                body, star, tail = out[i].rpartition(b"*") if prof.checksum != "none" else (out[i], b"", b"")
+                parts = body.split(delim)
+                f = mapped[int(rng.integers(len(mapped)))]
+                if f < len(parts):
+                    digits = [k for k, c in enumerate(parts[f]) if 48 <= c <= 57]
+                    if digits:
+                        k = digits[int(rng.integers(len(digits)))]
+                        field = bytearray(parts[f])
+                        field[k] = 48 + (field[k] - 48 + int(rng.integers(1, 10))) % 10
+                        parts[f] = bytes(field)
+                        out[i] = delim.join(parts) + star + tail
+                        self.lines_faulty += 1
+        dup = [i for i in range(start, n) if draws[1, i] < fl.duplicate]
+        swap = [i for i in range(start, n - 1) if draws[2, i] < fl.out_of_order]
+        for i in swap:
+            out[i], out[i + 1] = out[i + 1], out[i]
+        self.lines_faulty += len(swap) + len(dup)
+        for i in reversed(dup):
+            out.insert(i + 1, out[i])
+        return out
 
     def announcement(self, j: int) -> str:
         """The device message sent as touch ``j`` (0-based) starts, with the plan; :func:`parse_announcement`

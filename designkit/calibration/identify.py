@@ -40,7 +40,7 @@ covariance is the cluster-robust sandwich with touches as clusters (as in
 touch's residuals un-shrunk by its block of the hat matrix), and each interval
 takes Student's t with that parameter's Bell-McCaffrey degrees of freedom: a
 parameter carried by a few touches gets few (:func:`_sandwich`; measured by
-the pty round trips of :mod:`~designkit.calibration.roundtrip`). The Jacobian's singular values (columns
+the pty round trips of :mod:`~designkit_lab.roundtrip`). The Jacobian's singular values (columns
 scaled to unit norm) give its numerical rank; a parameter is reported *not
 identified* when the Jacobian is rank-deficient along it, its interval spans
 more than a factor of 10, or it sits on a search bound.
@@ -87,6 +87,8 @@ __all__ = [
     "relative_force",
     "residual_series",
     "score",
+    "Split",
+    "choose_split",
     "split_by_trial_set",
     "trial_sets",
 ]
@@ -309,17 +311,152 @@ def trial_sets(trials: Sequence[Trial], index_csv: Path | str | None = None) -> 
 
 def split_by_trial_set(trials: Sequence[Trial], fit_sets: Sequence[int],
                        index_csv: Path | str | None = None) -> tuple[list[Trial], list[Trial]]:
-    """(trials of ``fit_sets``, the others); InputError when a trial has no set or a side is empty."""
-    sets = trial_sets(trials, index_csv)
-    if any(s is None for s in sets):
-        raise InputError("held-out scoring needs each trial's trial set (an index column trial_set, or file "
-                         "names setNN_...)")
-    keep = set(int(s) for s in fit_sets)
-    fit = [tr for tr, s in zip(trials, sets) if s in keep]
-    held = [tr for tr, s in zip(trials, sets) if s not in keep]
-    if not fit or not held:
-        raise InputError(f"trial sets {sorted(keep)} leave {len(fit)} touches to fit and {len(held)} to score")
-    return fit, held
+    """(trials of ``fit_sets``, the others): :func:`choose_split` with the fit sets given."""
+    sp = choose_split(trials, index_csv, fit_sets=fit_sets)
+    return list(sp.fit), list(sp.held_out)
+
+
+#: Share of the trial sets present that :func:`choose_split` fits by default (the first ones, at least one):
+#: 4 of the shared recordings' 20 sets, as every comparison on them was made. A recording without trial
+#: sets (one session, touches in order) fits the first half of each material's touches.
+FIT_SHARE = 0.2
+FIT_SHARE_TOUCH_ORDER = 0.5
+#: Touches of each material a recording without trial sets needs before some are held out.
+MIN_TOUCHES_TO_HOLD_OUT = 4
+
+
+@dataclass(frozen=True)
+class Split:
+    """Disjoint calibration (fitted) and test (held-out) touches, and how they were chosen.
+
+    Attributes
+    ----------
+    fit, held_out : tuple of Trial
+    fit_sets, held_sets : tuple of int
+        The trial sets on each side; where the recording has none, the touches' places in their
+        material's order (touch k of every material counted as set k).
+    by : str
+        ``"trial set"`` or ``"touch order"``.
+    reason : str
+        How the sides were chosen, or why nothing is held out (then ``held_out`` is empty).
+    """
+
+    fit: tuple[Trial, ...]
+    held_out: tuple[Trial, ...]
+    fit_sets: tuple[int, ...]
+    held_sets: tuple[int, ...]
+    by: str
+    reason: str
+
+    def describe(self) -> str:
+        """One phrase: 'fitted on trial sets 1-4 (24 touches), scored on sets 5-20 (96)'."""
+        what = "trial sets" if self.by == "trial set" else "touch numbers"
+        if not self.held_out:
+            return f"fitted on all {len(self.fit)} touches, none held out ({self.reason})"
+        return (f"fitted on {what} {_ranges_text(self.fit_sets)} ({len(self.fit)} touches), scored on "
+                f"{what} {_ranges_text(self.held_sets)} ({len(self.held_out)} touches)")
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"by": self.by, "fit_sets": list(self.fit_sets), "held_out_sets": list(self.held_sets),
+                "n_fit": len(self.fit), "n_held_out": len(self.held_out), "reason": self.reason}
+
+
+def _ranges_text(values: Sequence[int]) -> str:
+    """``[1, 2, 3, 5]`` -> ``'1-3, 5'``."""
+    vals = sorted(set(int(v) for v in values))
+    out, i = [], 0
+    while i < len(vals):
+        j = i
+        while j + 1 < len(vals) and vals[j + 1] == vals[j] + 1:
+            j += 1
+        out.append(f"{vals[i]}" if i == j else f"{vals[i]}-{vals[j]}")
+        i = j + 1
+    return ", ".join(out)
+
+
+def choose_split(trials: Sequence[Trial], index_csv: Path | str | None = None,
+                 fit_sets: Sequence[int] | None = None, *, require: bool = False,
+                 fit_share: float | None = None, sets: Sequence[int | None] | None = None) -> Split:
+    """Choose disjoint fitted and held-out touches from the trial sets present.
+
+    Trial sets come from ``sets`` (one per touch, None where unknown) or :func:`trial_sets` (the
+    index's ``trial_set`` column or ``setNN_`` file names); a recording without them is split in
+    touch order (touch k of each material counts as set k, so sessions recorded one after another
+    stay apart). ``fit_sets`` given: those sets are
+    fitted and every other set present is held out; otherwise the first ``ceil(fit_share * n)``
+    sets of the ``n`` present (at least one; ``fit_share`` by default :data:`FIT_SHARE`, or
+    :data:`FIT_SHARE_TOUCH_ORDER` in touch order). Every material must have touches on both sides.
+
+    Where no split exists (one trial set; fewer than :data:`MIN_TOUCHES_TO_HOLD_OUT` touches of a
+    material without trial sets; a material only on one side) nothing is held out and ``reason``
+    says why, unless ``fit_sets`` is given or ``require`` is set: then a one-line InputError.
+
+    Examples
+    --------
+    >>> t = np.arange(-200, 400) / 200.0
+    >>> trs = [Trial(t, t, t, t, m, f"set{s:02d}_{m}_0.csv") for s in (3, 4, 7, 9, 11) for m in ("a", "b")]
+    >>> sp = choose_split(trs)
+    >>> sp.fit_sets, sp.held_sets, sp.describe()
+    ((3,), (4, 7, 9, 11), 'fitted on trial sets 3 (2 touches), scored on trial sets 4, 7, 9, 11 (8 touches)')
+    """
+    sets = trial_sets(trials, index_csv) if sets is None else list(sets)
+    names = sorted({tr.material for tr in trials})
+    if not trials:
+        raise InputError("no touches to split")
+    if all(s is not None for s in sets):
+        by, labels = "trial set", [int(s) for s in sets]
+    else:
+        by, seen, labels = "touch order", {}, []
+        for tr in trials:
+            seen[tr.material] = seen.get(tr.material, 0) + 1
+            labels.append(seen[tr.material])
+    present = sorted(set(labels))
+    word = "trial sets" if by == "trial set" else "touch numbers"
+    aside = "" if by == "trial set" else " (no trial sets: touch k of each material counts as set k)"
+
+    def refuse(why: str) -> Split:
+        if fit_sets is not None or require:
+            raise InputError(why)
+        return Split(tuple(trials), (), tuple(present), (), by, why)
+
+    if fit_sets is not None:
+        keep = sorted(set(int(s) for s in fit_sets))
+        unknown = [s for s in keep if s not in present]
+        if unknown:
+            return refuse(f"--fit-sets names {word} {_ranges_text(unknown)} that the recording does not have "
+                          f"(it has {_ranges_text(present)}){aside}")
+        held = [s for s in present if s not in keep]
+        if not held:
+            return refuse(f"fit sets {_ranges_text(keep)} leave no touches to score: the recording has only "
+                          f"{word} {_ranges_text(present)}{aside} (leave out --fit-sets, or give 'all' to fit every "
+                          "touch)")
+        how = f"{word} {_ranges_text(keep)} fitted as asked{aside}, the others held out"
+    else:
+        if len(names) < 2 and require:
+            raise InputError(f"the recording has one material ({names[0]}): a test of recognition needs two")
+        if len(present) < 2:
+            return refuse(f"the recording has one trial set ({present[0]}): no touches to hold out"
+                          if by == "trial set" else "one touch per material: no touches to hold out")
+        if by == "touch order":
+            few = {n: sum(tr.material == n for tr in trials) for n in names}
+            short = [f"{n} ({k})" for n, k in few.items() if k < MIN_TOUCHES_TO_HOLD_OUT]
+            if short:
+                return refuse(f"no trial sets and fewer than {MIN_TOUCHES_TO_HOLD_OUT} touches of "
+                              f"{', '.join(short)}: too few to hold some out")
+        if fit_share is None:
+            fit_share = FIT_SHARE if by == "trial set" else FIT_SHARE_TOUCH_ORDER
+        n_fit = min(len(present) - 1, max(1, math.ceil(fit_share * len(present) - 1e-9)))
+        keep, held = present[:n_fit], present[n_fit:]
+        how = (f"the first {n_fit} of the {len(present)} {word} present fitted{aside} "
+               f"(a share of {fit_share:g}, at least one), the others held out")
+    fit = [tr for tr, s in zip(trials, labels) if s in set(keep)]
+    out = [tr for tr, s in zip(trials, labels) if s not in set(keep)]
+    for side, group in (("fitted", fit), ("held-out", out)):
+        missing = [n for n in names if not any(tr.material == n for tr in group)]
+        if missing:
+            return refuse(f"the {side} {word} {_ranges_text(keep if side == 'fitted' else held)}{aside} "
+                          f"have no touches of {', '.join(missing)}")
+    return Split(tuple(fit), tuple(out), tuple(keep), tuple(held), by, how)
 
 
 _OBJECT_MODES = ("passive", "passive-end", "free", "passive-affine", "passive-end-affine")
@@ -945,6 +1082,8 @@ class Identification:
     object_refs: Mapping[str, float] = field(default_factory=dict)
     touch_conductance: tuple[str, ...] = ()
     force_profile: Mapping[str, Any] | None = None
+    #: the rig's operating conditions in the fitted touches (:func:`designkit.rig.rig_conditions`, as a dict)
+    conditions: Mapping[str, Any] | None = None
 
     def parameter(self, name: str) -> IdentifiedParameter:
         for p in self.parameters:
@@ -1065,16 +1204,23 @@ class Identification:
         """The identified :class:`~designkit.sensor.Sensor` (e_s from the ranges, alpha_s at the fixed depth)."""
         from ..sensor import Sensor
 
+        from ..rig import record_start_s
+
         es = self.effusivity.value if self.effusivity is not None else 1.0
         alpha = self.parameter("diffusivity_m2_s").value if "diffusivity_m2_s" in self.candidate.free \
             else _SENSOR_DIFF.start
+        record = self.model_record()
+        conditions = None
+        if self.conditions is not None:
+            start = record_start_s(record)
+            conditions = {**dict(self.conditions), "onset_offset_s": None if start is None else round(start, 4)}
         return Sensor(effusivity=es, diffusivity_m2_s=alpha, depth_m=self.depth_m,
                       sample_rate_hz=self.sample_rate_hz, name=name, noise_c=self.noise_c,
                       provenance={"method": f"designkit.calibration.identify ({self.candidate.label})",
                                   "rms_c": self.rms_c, "consistent": self.consistent,
                                   "parameters": [p.to_dict() for p in self.parameters],
                                   "notes": list(self.notes)},
-                      model=self.model_record())
+                      model=record, conditions=conditions)
 
     def model_record(self) -> dict[str, Any]:
         """What a sensor file records of the identified model (:data:`designkit.sensor.MODEL_KEYS`).
@@ -1127,6 +1273,7 @@ class Identification:
             "singular_values": [float(v) for v in self.singular_values], "fit_time_s": self.fit_time_s,
             "noise_c": self.noise_c, "object_temperature": dict(self.object_modes), "object_reference_c": dict(self.object_refs),
             "notes": list(self.notes), "force_profile": None if self.force_profile is None else dict(self.force_profile),
+            "conditions": None if self.conditions is None else dict(self.conditions),
         }
 
 
@@ -1304,6 +1451,8 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
     """
     from scipy.optimize import least_squares
 
+    from ..rig import rig_conditions
+
     t0 = time.perf_counter()
     cand = model if isinstance(model, Candidate) else candidate(model)
     names = tuple(sorted({tr.material for tr in trials}))
@@ -1462,7 +1611,10 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
                           rms_by, n_s, k_par, aic, bic, rank, x.size, sv, time.perf_counter() - t0,
                           data.noise_c, x, names, depth_m, data.sample_rate_hz, dict(data.modes), tuple(notes),
                           dict(data.refs), tuple(touch_conductance),
-                          nominal_force_profile(data) if cand.force_area else None)
+                          nominal_force_profile(data) if cand.force_area else None,
+                          rig_conditions(trials, pre_contact_noise_c=data.noise_c,
+                                         residual_rms_c=float(np.sqrt(np.mean(r ** 2))),
+                                         onset_offset_s=math.nan).to_dict())
 
 
 #: The nominal force ramp a sensor file records: F / F_p from 1 s before the onset to 1.5 s after, every 20 ms.
@@ -1600,9 +1752,12 @@ class Comparison:
     held_out_rms_c : tuple of dict
         Per candidate, residual RMS per material (and ``"all"``) on the held-out touches.
     selected : str
-        Label of the candidate with the smallest held-out RMS.
+        Label of the candidate with the smallest held-out RMS (BIC without held-out touches) among
+        those without conflicting ranges.
     n_fit, n_held_out : int
     total_time_s : float
+    reason : str
+        Why ``selected`` was chosen, with its held-out residuals and the paper model's.
     """
 
     results: tuple[Identification, ...]
@@ -1611,6 +1766,7 @@ class Comparison:
     n_fit: int
     n_held_out: int
     total_time_s: float
+    reason: str = ""
 
     def table(self) -> list[dict[str, Any]]:
         """One row per candidate: label, fit and held-out RMS, AIC, BIC, rank, e_s and its consistency."""
@@ -1624,7 +1780,7 @@ class Comparison:
         return rows
 
     def to_dict(self) -> dict[str, Any]:
-        return {"selected": self.selected, "n_fit": self.n_fit, "n_held_out": self.n_held_out,
+        return {"selected": self.selected, "reason": self.reason, "n_fit": self.n_fit, "n_held_out": self.n_held_out,
                 "total_time_s": self.total_time_s, "table": self.table(),
                 "results": [r.to_dict() for r in self.results]}
 
@@ -1664,24 +1820,82 @@ def compare_models(fit_trials: Sequence[Trial], held_out: Sequence[Trial],
     """Fit every candidate on ``fit_trials``, score each on ``held_out``; select by held-out RMS.
 
     Each candidate starts from the fitted parameters of the last one nested in it. With no
-    held-out touches the selection is by BIC (the scores are empty). Candidates with
-    ``force_area`` are left out of a comparison of several when a touch has no force channel.
+    held-out touches the selection is by BIC (the scores are empty); candidates whose ranges
+    conflict are passed over while another is consistent (:func:`_select`). Candidates with
+    ``force_area`` are left out of a comparison of several when a touch has no force channel, or
+    none to 1 s after the onset (where the force's plateau is read).
 
     ``kwargs`` go to :func:`identify` (``ranges``, ``object_temps``, ``depth_m``, ...).
     """
     t0 = time.perf_counter()
-    results, held = [], []
-    forced = all(np.isfinite(tr.force_n).all() for tr in list(fit_trials) + list(held_out))
+    results, held, touch_ms = [], [], []
+    forced = all(np.isfinite(tr.force_n).all() and tr.time_s[-1] >= 1.0 + FORCE_SMOOTHING_S
+                 for tr in list(fit_trials) + list(held_out))
     for c in candidates:
         c = c if isinstance(c, Candidate) else candidate(c)
         if c.force_area and not forced and len(candidates) > 1:
             continue   # a force-driven contact area needs the force channel of every touch
         res = identify(fit_trials, c, x0=_warm_start(c, results), **kwargs)
         results.append(res)
-        held.append(score(res, held_out, object_temps=kwargs.get("object_temps")) if held_out else {})
-    best = min(range(len(results)), key=lambda i: (held[i].get("all", 0.0), results[i].bic))
+        if held_out:
+            rows = residual_series(res, held_out, object_temps=kwargs.get("object_temps"))
+            per: dict[str, list[np.ndarray]] = {}
+            for name, _, r in rows:
+                per.setdefault(name, []).append(r)
+            sc = {n: float(np.sqrt(np.mean(np.concatenate(v) ** 2))) for n, v in per.items()}
+            sc["all"] = float(np.sqrt(np.mean(np.concatenate([r for _, _, r in rows]) ** 2)))
+            held.append(sc)
+            touch_ms.append(np.array([float(np.mean(r ** 2)) for _, _, r in rows]))
+        else:
+            held.append({})
+    best, reason = _select(results, held, touch_ms)
     return Comparison(tuple(results), tuple(held), results[best].candidate.label, len(fit_trials), len(held_out),
-                      time.perf_counter() - t0)
+                      time.perf_counter() - t0, reason)
+
+
+def _select(results: Sequence[Identification], held: Sequence[Mapping[str, float]],
+            touch_ms: Sequence[np.ndarray] = ()) -> tuple[int, str]:
+    """Index of the selected candidate and why.
+
+    With held-out touches: the one-standard-error rule (Breiman et al. 1984; Hastie, Tibshirani and
+    Friedman, *Elements of Statistical Learning* 7.10): the simplest candidate (fewest fitted
+    parameters, per-touch ones included) whose held-out mean squared residual exceeds the best
+    one's by at most one standard error of their difference, taken over the held-out touches
+    (paired: the same touches score every candidate). On touches a simple model fits to the noise,
+    a richer one no longer wins by a hair. Without held-out touches: the lowest BIC on the fitted
+    touches. A candidate whose materials' ranges conflict (no one e_s keeps every material in
+    range) is passed over while another is consistent: its sensor file would be refused.
+    """
+    ok = [i for i in range(len(results)) if results[i].consistent is not False] or list(range(len(results)))
+    skipped = len(results) - len(ok)
+    conflict = f"; {skipped} candidate(s) passed over for conflicting ranges" if skipped else ""
+    scored = bool(held) and all(h for h in held) and len(touch_ms) == len(results)
+    if len(results) == 1:
+        return 0, f"{results[0].candidate.label}: the model asked for"
+    if not scored:
+        best = min(ok, key=lambda i: results[i].bic)
+        return best, (f"{results[best].candidate.label}: the lowest BIC on the fitted touches among "
+                      f"{len(results)} candidates (no touches held out){conflict}")
+    low = min(ok, key=lambda i: (float(np.mean(touch_ms[i])), results[i].bic))
+    simple = sorted(ok, key=lambda i: (results[i].n_parameters, i))
+    best, margin = low, 0.0
+    for i in simple:
+        d = touch_ms[i] - touch_ms[low]
+        se = float(np.std(d, ddof=1) / math.sqrt(d.size)) if d.size > 1 else 0.0
+        if float(np.mean(d)) <= se:
+            best, margin = i, se
+            break
+    label = results[best].candidate.label
+    per = ", ".join(f"{n} {v:.3f}" for n, v in held[best].items() if n != "all")
+    how = ("the smallest residual on the held-out touches" if best == low else
+           f"the simplest within one standard error of the smallest held-out residual ({results[low].candidate.label}"
+           ": " + ", ".join(f"{n} {v:.3f}" for n, v in held[low].items() if n != "all") + " °C)")
+    paper = next((h for r, h in zip(results, held) if r.candidate.label == "semi-infinite"), None)
+    versus = "" if paper is None or label == "semi-infinite" else \
+        "; the paper's semi-infinite model: " + ", ".join(f"{n} {v:.3f}" for n, v in paper.items() if n != "all") \
+        + " °C"
+    return best, (f"{label}: {how} among {len(results)} candidates, {per} °C RMS on "
+                  f"{touch_ms[best].size} held-out touches{versus}{conflict}")
 
 
 # ------------------------------------------------------------------ figure
@@ -1720,15 +1934,17 @@ def plot_identification(results: Sequence[Identification], selected: str, fit_tr
                              gridspec_kw={"width_ratios": [1.0, 1.0, 0.9]})
     for k, (n, (t, y, r)) in enumerate(fitted.items()):
         count = sum(tr.material == n for tr in fit_trials)
-        axes[0].plot(t, y, color=f"C{k}", lw=1.3, label=f"{n}: reading (mean of {count})")
-        axes[0].plot(t, y + r, color=f"C{k}", lw=1.0, ls="--", label=f"{n}: {selected}")
+        # the reading light and wide, the model dark and dashed on top: the model stays visible where it fits
+        axes[0].plot(t, y, color=f"C{k}", lw=3.0, alpha=0.45, label=f"{n}: reading (mean of {count})")
+        axes[0].plot(t, y + r, color="k", lw=1.2, ls=(0, (4, 2)), zorder=4,
+                     label=f"model {selected}" if k == 0 else None)
         axes[1].plot(t, r, color=f"C{k}", lw=1.0, label=f"{n}, fitted touches")
         if n in held:
             th, _, rh = held[n]
             axes[1].plot(th, rh, color=f"C{k}", lw=1.0, ls=":", label=f"{n}, held-out touches")
     axes[0].set_xlabel("time after detected onset [s]")
     axes[0].set_ylabel("sensor temperature [°C]")
-    axes[0].set_title("reading (solid) and the selected model (dashed)", fontsize=9)
+    axes[0].set_title("reading (wide) and the selected model (dashed)")
     axes[0].legend(fontsize=7)
     axes[1].axhline(0, color="k", lw=0.5)
     axes[1].set_xlabel("time after detected onset [s]")

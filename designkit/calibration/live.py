@@ -253,6 +253,8 @@ class LiveClassifier(SerialRecorder):
         super().__init__(port, profile, None, **kw)
         self.decider = TouchDecider(profile, make_test, time_offset_s=time_offset_s, ambient_temp_c=ambient_temp_c)
 
+    _KEPT = "decided"
+
     def _new_cutter(self, material: str) -> TouchDecider:  # type: ignore[override]
         return self.decider
 

@@ -15,6 +15,13 @@ divider and either the B-parameter equation
 497, 1968), whose inverse is the one real root of an increasing cubic, found
 by Newton's method from the ``C = 0`` root (monotone convergence).
 
+A line may end in a checksum (``line.checksum``): ``xor8`` appends ``*HH``,
+the XOR of the line's bytes before the ``*`` in two hex digits (as NMEA 0183
+sentences do), ``crc16`` appends ``*HHHH``, their CRC-16/CCITT (polynomial
+0x1021, initial value 0xFFFF, :func:`binascii.crc_hqx`). A line whose checksum
+is missing or wrong is skipped as unreadable: a digit changed on the wire
+(``24.9884`` read as ``26.9884``) still parses, and only a checksum tells.
+
 Everything is validated on load; a bad profile raises
 :class:`~designkit._validation.InputError` with one line naming the file and
 the key.
@@ -22,6 +29,7 @@ the key.
 
 from __future__ import annotations
 
+import binascii
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -32,6 +40,7 @@ import numpy as np
 from .._validation import InputError
 
 __all__ = [
+    "CHECKSUMS",
     "ROLES",
     "Channel",
     "ContactRule",
@@ -53,11 +62,36 @@ KELVIN = 273.15
 #: Channel roles a profile can map, in the order the recorder keeps them.
 ROLES = ("sensor", "object", "force", "timestamp")
 
+#: Line checksums a profile can ask for (module docstring), and the hex digits each appends after ``*``.
+CHECKSUMS = {"none": 0, "xor8": 2, "crc16": 4}
+
+
+def line_checksum(payload: bytes, kind: str) -> str:
+    """The checksum ``kind`` (``xor8`` or ``crc16``) of a line's bytes before ``*``, as upper-case hex.
+
+    >>> line_checksum(b"12.3450,34.9987,24.9975,0.012", "xor8")
+    '22'
+    >>> line_checksum(b"123456789", "crc16")   # the CRC-16/CCITT-FALSE check value
+    '29B1'
+    """
+    if kind == "xor8":
+        x = 0
+        for b in payload:
+            x ^= b
+        return f"{x:02X}"
+    if kind == "crc16":
+        return f"{binascii.crc_hqx(payload, 0xFFFF):04X}"
+    raise ValueError(f"unknown checksum {kind!r}")
+
 _PARITY = {"none": "N", "even": "E", "odd": "O", "mark": "M", "space": "S",
            "n": "N", "e": "E", "o": "O", "m": "M", "s": "S"}
 
 
 # ---------------------------------------------------------------------- helpers
+#: Longest duration a profile may give (a trial window, a timeout) [s]: a day.
+MAX_PROFILE_SECONDS = 86400.0
+
+
 class _Reader:
     """Walks a YAML mapping, remembering the key path for error messages."""
 
@@ -104,6 +138,8 @@ class _Reader:
             raise self.err(key, f"must be a number, got {value!r}") from None
         if not math.isfinite(v):
             raise self.err(key, f"must be finite, got {value!r}")
+        if key.endswith("_s") and abs(v) > MAX_PROFILE_SECONDS:  # 1e308 s overflowed a count of samples
+            raise self.err(key, f"must be at most {MAX_PROFILE_SECONDS:g} s (a day), got {v:g}")
         if positive and v <= 0:
             raise self.err(key, f"must be > 0, got {v:g}")
         if nonnegative and v < 0:
@@ -509,7 +545,7 @@ class ParsedLines:
         Index of each row's line in the batch.
     errors : list of (int, str, str)
         (line index, kind, line text) of lines that did not parse; kind is
-        ``garbled``, ``field_count`` or ``non_numeric``.
+        ``garbled``, ``checksum``, ``field_count`` or ``non_numeric``.
     messages : list of str
         Device messages (comment lines), skipped.
     slots : ndarray of int, shape (n,)
@@ -544,6 +580,7 @@ class DeviceProfile:
     contact: ContactRule
     trial: TrialWindow
     source: str = "profile"
+    checksum: str = "none"
     _index: tuple[int, ...] = field(default=(), repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -567,9 +604,10 @@ class DeviceProfile:
     def parse_lines(self, lines: Sequence[bytes]) -> ParsedLines:
         """Split lines into raw numbers; report the ones that do not parse.
 
-        A line must decode in the profile's encoding, be printable, have
-        exactly ``len(fields)`` fields, and every mapped field must be a
-        finite number. Empty lines are ignored.
+        A line must decode in the profile's encoding, be printable, carry a
+        right checksum when the profile asks for one (kind ``checksum``
+        otherwise), have exactly ``len(fields)`` fields, and every mapped
+        field must be a finite number. Empty lines are ignored.
         """
         nf = len(self.fields)
         idx = self._index
@@ -581,6 +619,7 @@ class DeviceProfile:
         slot = -1
         delim = self.delimiter
         comment = self.comment.encode(self.encoding) if self.comment else None
+        check = CHECKSUMS[self.checksum]
         for i, line in enumerate(lines):
             stripped = line.strip()
             if not stripped:
@@ -597,6 +636,13 @@ class DeviceProfile:
             if not text.isprintable():
                 errors.append((i, "garbled", text[:60]))
                 continue
+            if check:
+                payload, star, got = text.rpartition("*")
+                if not star or len(got) != check or got.upper() != line_checksum(
+                        payload.encode(self.encoding), self.checksum):
+                    errors.append((i, "checksum", text[:60]))
+                    continue
+                text = payload
             parts = text.split(delim) if delim is not None else text.split()
             if len(parts) != nf:
                 errors.append((i, "field_count", text[:60]))
@@ -661,7 +707,10 @@ class DeviceProfile:
                 raw = ch.conversion.encode(np.asarray(values[role], dtype=np.float64))
                 cols[ch.field_index] = ch.conversion.format(raw)
         delim = self.delimiter if self.delimiter is not None else " "
-        return [delim.join(parts) for parts in zip(*cols)]
+        lines = [delim.join(parts) for parts in zip(*cols)]
+        if self.checksum != "none":
+            lines = [f"{x}*{line_checksum(x.encode(self.encoding), self.checksum)}" for x in lines]
+        return lines
 
     def to_dict(self) -> dict[str, Any]:
         """Plain-data form (the YAML schema)."""
@@ -671,7 +720,8 @@ class DeviceProfile:
             "description": self.description,
             "serial": self.serial.to_dict(),
             "line": {"delimiter": "whitespace" if self.delimiter is None else self.delimiter,
-                     "comment": self.comment, "encoding": self.encoding, "fields": list(self.fields)},
+                     "comment": self.comment, "encoding": self.encoding, "fields": list(self.fields),
+                     "checksum": self.checksum},
             "sample_rate_hz": self.sample_rate_hz,
             "channels": {r: self.channels[r].to_dict() for r in ROLES if r in self.channels},
             "contact": self.contact.to_dict(),
@@ -720,6 +770,9 @@ def _parse_profile(data: Any, source: str) -> DeviceProfile:
         "x".encode(encoding)
     except LookupError:
         raise line.err("encoding", f"is not a known text encoding: {encoding!r}") from None
+    checksum = line.text("checksum", "none", choices=tuple(CHECKSUMS))
+    if checksum != "none" and delimiter is not None and "*" in delimiter:
+        raise line.err("checksum", "needs a delimiter without '*' (the checksum follows the last '*')")
     fields_raw = line.raw("fields", required=True)
     if not isinstance(fields_raw, list) or not fields_raw:
         raise line.err("fields", f"must be a non-empty list of field names, got {fields_raw!r}")
@@ -779,10 +832,14 @@ def _parse_profile(data: Any, source: str) -> DeviceProfile:
     tr.done()
     if trial.pre_s * sample_rate < 3:
         raise InputError(f"{source}: trial.pre_s must hold at least 3 samples at {sample_rate:g} Hz")
+    from ..sensor import check_samples_per_touch
+
+    check_samples_per_touch(trial.pre_s + trial.post_s, sample_rate, f"{source}: a trial window (pre_s + post_s)",
+                            "shorten trial.pre_s and trial.post_s or lower reading.sample_rate_hz")
     rd.done()
     return DeviceProfile(name=str(name), description=description, serial=serial, delimiter=delimiter,
                          comment=comment, encoding=encoding, fields=fields, channels=channels,
-                         sample_rate_hz=sample_rate, contact=contact, trial=trial, source=source)
+                         sample_rate_hz=sample_rate, contact=contact, trial=trial, source=source, checksum=checksum)
 
 
 def list_profiles() -> dict[str, Path]:
@@ -811,7 +868,7 @@ def load_profile(name_or_path: "str | Path | DeviceProfile") -> DeviceProfile:
     from .._schemas import load_yaml
 
     # a regular UTF-8 file (a FIFO or a folder is refused before reading), parsed by the one YAML reader
-    data = load_yaml(path, "profile", empty_ok=True)
+    data = load_yaml(path, "profile")  # an empty file: "is empty" (it said "got NoneType")
     return _parse_profile(data, f"profile {path}")
 
 

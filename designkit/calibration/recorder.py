@@ -40,6 +40,30 @@ Without a timestamp channel, time is the count of lines received divided by
 the sample rate; a line that cannot be read still counts (its sample is
 missing from the trial, the times of the others stay right).
 
+Lines that lie. A line that parses may still be wrong. With device
+timestamps, a line whose time is not just after the previous line's (the same
+time: sent twice; earlier: out of order; far ahead) is skipped as a bad line
+and the touch in progress goes on; only ``CONFIRM_SAMPLES`` lines in a row
+that continue from the new time make it a real clock jump (a reset, or
+samples lost), which ends the trial in progress. Every sample then passes a
+plausibility filter: a heated thermistor and a force sensor cannot reverse
+within one sample (their time constants are many sample periods), so a
+sample outside the range of its two neighbours by more than ``SPIKE_SIGMAS``
+times the stream's noise (measured on the session's samples out of contact,
+or one quantization step if larger) is a corrupted line (``24.9884`` read as
+``26.9884``): it is dropped, reported (on the event stream, and in the
+sidecar's ``dropped_samples`` of the trial it fell in, with the reason) and
+counted. A profile's line checksum (``line.checksum``) catches what is below
+that margin.
+
+Give-up rule for a stream that never lets a touch be kept: when
+``GIVE_UP_TOUCHES`` touches in a row were skipped (their trial discarded by a
+clock jump, too few readable samples, too little clean data before contact)
+and no touch was kept for ``GIVE_UP_WINDOWS`` trial windows of stream
+(``5 x (pre_s + post_s)``, 40 s of device time by default), the recorder stops
+(:class:`NoProgress`, exit 2 in the CLI, naming the last reason; trials already
+written stay).
+
 Give-up rule for unreadable lines: a trial is kept only when at least
 ``MIN_READABLE_FRACTION`` (80 %) of its samples could be read, so once the
 last trial-length of lines (``(pre_s + post_s) * sample_rate_hz + 1``, at
@@ -57,7 +81,10 @@ import errno
 import math
 import os
 import stat
+import tempfile
 import time
+import uuid
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
@@ -66,14 +93,28 @@ import numpy as np
 
 from .._validation import InputError, check_positive
 from .profiles import ROLES, DeviceProfile
-from .trials import check_trial_folder, write_trial
+from .trials import FolderLock, check_material_label, check_trial_folder, write_trial
 
-__all__ = ["CLOCK_SLACK_S", "DeviceChanged", "MIN_ARRIVING_FRACTION", "MIN_READABLE_FRACTION", "OBJECT_TOLERANCE_C",
+__all__ = ["CLOCK_SLACK_S", "CONFIRM_SAMPLES", "DeviceChanged", "GIVE_UP_TOUCHES", "GIVE_UP_WINDOWS",
+           "NoProgress", "SPIKE_SIGMAS", "MIN_ARRIVING_FRACTION", "MIN_READABLE_FRACTION", "OBJECT_TOLERANCE_C",
            "RATE_TOLERANCE", "RESTART_MAX_S", "RecordEvent", "RecorderStatus", "SENSOR_TOLERANCE_C",
-           "SerialRecorder", "TrialCutter", "VERIFY_S"]
+           "SerialRecorder", "TrialCutter", "TrialNotWritten", "VERIFY_S"]
 
 #: Fewest samples of a trial's window that must be readable for the trial to be kept.
 MIN_READABLE_FRACTION = 0.8
+
+# Lines that parse but cannot be right (module docstring, "Lines that lie")
+#: Samples in a row, each within ``stall_s`` of the one before, that make a jump of the device clock real.
+CONFIRM_SAMPLES = 3
+#: Margin of the plausibility filter in units of the stream's own noise (measured out of contact).
+SPIKE_SIGMAS = 8.0
+#: Samples out of contact the noise must be measured on before the plausibility filter acts.
+_SPIKE_MIN_REFERENCE = 50
+# Give-up rule for a stream that never lets a touch be kept (module docstring)
+#: Touches in a row not kept, at the least, before giving up.
+GIVE_UP_TOUCHES = 3
+#: Trial windows (pre_s + post_s) of stream without a touch kept, at the least, before giving up.
+GIVE_UP_WINDOWS = 5
 
 # After a reconnect (module docstring): is it still the session's device?
 #: Device seconds of samples out of contact read (and held back) before trusting a reopened port.
@@ -100,6 +141,12 @@ _BAD_KIND_TEXT = {
     "non_numeric": "a field that is not a finite number",
     "out_of_range": "a reading out of range (ADC rail, open/shorted thermistor, or outside 'valid')",
     "too_long": "a line far too long (no newline)",
+    "checksum": "a missing or wrong checksum (the line changed on the wire)",
+    "duplicate": "a repeated timestamp (the line was sent twice)",
+    "out_of_order": "a timestamp before the previous line's (out of order)",
+    "time_jump": "a timestamp ahead of the lines around it (out of order, or damaged)",
+    "implausible": "a physically impossible jump (outside its neighbours' range by more than "
+                   f"{SPIKE_SIGMAS:g} times the stream's noise)",
 }
 _EXAMPLES_PER_KIND = 3
 
@@ -152,15 +199,18 @@ class TrialCutter:
         Label written with each trial.
     meta : dict
         Extra sidecar fields (port, profile name...).
+    lock : FolderLock, optional
+        The caller's held lock of ``out_dir`` (without one, each write locks the folder itself).
     """
 
     WAIT_RELEASE, ARMED, COLLECT, WAIT_STEADY = "waiting for release", "armed", "in contact", "waiting for steady"
 
     def __init__(self, profile: DeviceProfile, out_dir: Path, material: str,
-                 meta: dict[str, Any] | None = None) -> None:
+                 meta: dict[str, Any] | None = None, lock: FolderLock | None = None) -> None:
         self.profile = profile
         self.out_dir = Path(out_dir)
-        self.material = material
+        self.material = check_material_label(material)
+        self.lock = lock
         self.meta = dict(meta or {})
         self.fs = profile.sample_rate_hz
         self.pre = profile.trial.pre_s
@@ -168,6 +218,7 @@ class TrialCutter:
         self.rule = profile.contact
         self.written: list[Path] = []
         self.events: list[RecordEvent] = []
+        self._dropped: list[tuple[float, str]] = []   # (device time [s], why) of samples dropped upstream
         self._t = np.zeros(0)
         self._v = np.zeros((0, 3))
         self._scan = 0
@@ -203,6 +254,10 @@ class TrialCutter:
         self.events.extend(events)
         return events
 
+    def note_dropped(self, time_s: float, why: str) -> None:
+        """A sample at device time ``time_s`` [s] was dropped before reaching here (the trial's sidecar says so)."""
+        self._dropped.append((float(time_s), why))
+
     def discontinuity(self, reason: str) -> list[RecordEvent]:
         """Samples were lost or the clock restarted: drop the buffer and any trial in progress."""
         events = []
@@ -211,6 +266,7 @@ class TrialCutter:
         self._state = self.WAIT_RELEASE if self.rule.rule == "force" else self.WAIT_STEADY
         self._t = np.zeros(0)
         self._v = np.zeros((0, 3))
+        self._dropped = []
         self._scan = 0
         self._clean_since = -np.inf
         self.events.extend(events)
@@ -317,12 +373,51 @@ class TrialCutter:
             "n_samples": int(tt.size),
             "n_missing": int(expected - tt.size),
         }
-        path = write_trial(self.out_dir, self.material, tt, vv[:, _S], vv[:, _O], vv[:, _F], meta)
+        dropped = [{"time_s": d - onset, "why": why} for d, why in self._dropped
+                   if onset - self.pre - eps <= d <= onset + self.post + eps]
+        if dropped:
+            meta["dropped_samples"] = dropped
+        path = self._write(tt, vv, meta, events)
         self.written.append(path)
         note = f", released at {release_s:.2f} s" if release_s is not None else ""
+        if dropped:
+            note += f"; {len(dropped)} implausible sample(s) dropped, listed in its sidecar"
         obj = f", object {to0:.2f} °C" if to0 is not None else ""
         events.append(RecordEvent("trial", f"trial {len(self.written)}: {path.name} (sensor {ts0:.2f} °C{obj}"
                                            f" before contact{note})", path))
+
+    def _write(self, tt: np.ndarray, vv: np.ndarray, meta: dict, events: list[RecordEvent]) -> Path:
+        """Write the trial; whatever fails, the touch is kept somewhere and the user is told where.
+
+        First under the label's name; then under the plain name ``trial_NNN``
+        in the same folder (a name the file system refused); then, when the
+        folder cannot take it at all (disk full, gone, read-only), in a new
+        folder under the system's temporary folder, after which recording
+        stops (:class:`TrialNotWritten`, naming both).
+        """
+        cols = (tt, vv[:, _S], vv[:, _O], vv[:, _F])
+        try:
+            return write_trial(self.out_dir, self.material, *cols, meta, lock=self.lock)
+        except (OSError, InputError) as exc:
+            first = exc
+        try:
+            path = write_trial(self.out_dir, self.material, *cols, meta, lock=self.lock, stem="trial")
+            events.append(RecordEvent("info", f"could not write the trial under its label's name "
+                                              f"({_short(first)}): written as {path.name} instead (its sidecar and "
+                                              "the index keep the label)"))
+            return path
+        except (OSError, InputError):
+            pass
+        n = len(self.written)
+        kept = f"{n} trial(s) kept in {self.out_dir}"
+        try:
+            rescue = Path(tempfile.mkdtemp(prefix="designkit-rescued-trial-"))
+            path = write_trial(rescue, self.material, *cols, meta)
+        except (OSError, InputError) as exc:
+            raise TrialNotWritten(f"cannot write the trial just recorded into {self.out_dir} ({_short(first)}), nor "
+                                  f"into a temporary folder ({_short(exc)}): that touch is lost; {kept}") from None
+        raise TrialNotWritten(f"cannot write into {self.out_dir} ({_short(first)}): the trial just recorded was kept "
+                              f"as {path} (move it and its .json into the folder once it can be written); {kept}")
 
     def _trim(self) -> None:
         if self._state == self.COLLECT or self._t.size == 0:
@@ -333,6 +428,8 @@ class TrialCutter:
             need = max(1, int(round(self.pre * self.fs))) + int(round(self.rule.slope_window_s * self.fs)) + 2
             cut = min(cut, max(0, self._scan - need))
         cut = min(cut, self._scan)
+        if self._dropped and cut < self._t.size:
+            self._dropped = [d for d in self._dropped if d[0] >= self._t[cut]]
         if cut > 0:
             self._t = self._t[cut:]
             self._v = self._v[cut:]
@@ -345,6 +442,14 @@ class DeviceGone(InputError):
 
 class NoData(InputError):
     """Nothing usable arrived within the time limit."""
+
+
+class NoProgress(InputError):
+    """Touch after touch was skipped and none kept for a long stretch of stream (module docstring)."""
+
+
+class TrialNotWritten(InputError):
+    """The trial folder cannot be written; the touch was kept elsewhere when possible (message says where)."""
 
 
 class TooManyBadLines(InputError):
@@ -401,6 +506,9 @@ class SerialRecorder:
         self.out_dir = Path(out_dir) if out_dir is not None else None  # None: a subclass writes no trials
         if self.out_dir is not None:
             check_trial_folder(self.out_dir)
+        #: Names this recording session in every trial's sidecar (``session``).
+        self.session = uuid.uuid4().hex
+        self._lock = FolderLock(self.out_dir) if self.out_dir is not None else None
         if no_data_timeout_s is None:
             no_data_timeout_s = profile.serial.no_data_timeout_s
         self.no_data_timeout_s = check_positive("no_data_timeout_s [s]", no_data_timeout_s)
@@ -425,14 +533,43 @@ class SerialRecorder:
         self._idle_t = np.zeros(0)        # recent samples out of contact: the session's reference
         self._idle_v = np.zeros((0, 3))
         self._verify: _Verification | None = None
+        self._pend: list[tuple[float, np.ndarray]] = []   # samples after a clock jump, until confirmed
+        self._held: tuple[np.ndarray, np.ndarray] | None = None   # the last sample, until its successor comes
+        self._prev_row: np.ndarray | None = None   # the last sample fed: the left neighbour of the next
+        self._idle_seen = 0   # samples out of contact remembered so far
+        self._margin: tuple[int, np.ndarray | None] = (-1, None)   # (at _idle_seen, per-channel margin)
+        self._skips: list[str] = []   # touches skipped since the last one kept
+        self._kept_at = 0   # _lines_seen when the last touch was kept (or the recording started)
+        win = profile.trial.pre_s + profile.trial.post_s
+        #: Stream seconds without a touch kept (and GIVE_UP_TOUCHES skipped) after which the recorder gives up.
+        self.give_up_s = GIVE_UP_WINDOWS * win
+
+    #: What becomes of a touch that is not skipped (messages of the give-up rule).
+    _KEPT = "kept"
 
     # ------------------------------------------------------------ port
     def open(self) -> None:
-        """Open the port with the profile's settings (one-line error if it cannot).
+        """Lock the trial folder, then open the port with the profile's settings (one-line error if it cannot).
 
-        A path that is a regular file, a folder, or a device that is not a
+        The folder is created and locked first (:class:`~designkit.calibration.trials.FolderLock`,
+        held until :meth:`close`): another recorder writing into it is refused
+        (:class:`~designkit.calibration.trials.FolderBusy`) before any touch. A
+        path that is a regular file, a folder, or a device that is not a
         terminal (``/dev/null``) is refused as not a serial device.
         """
+        locked_here = self._lock is not None and not self._lock.held
+        if locked_here:
+            self._lock.acquire()
+        try:
+            if locked_here:
+                check_trial_folder(self.out_dir)   # what it holds now, under the lock
+            self._open_port()
+        except BaseException:
+            if locked_here:   # a port that never opened records nothing: let go (a reconnect keeps the lock)
+                self._lock.release()
+            raise
+
+    def _open_port(self) -> None:
         import serial
 
         kind = _not_a_serial_device(self.port)
@@ -449,6 +586,12 @@ class SerialRecorder:
         self._restart_stream()
 
     def close(self) -> None:
+        """Close the port and let go of the trial folder."""
+        self._close_port()
+        if self._lock is not None:
+            self._lock.release()
+
+    def _close_port(self) -> None:
         if self._ser is not None:
             try:
                 self._ser.close()
@@ -474,6 +617,9 @@ class SerialRecorder:
         self._first_line = True
         self._last_t = None
         self._recent_bad = np.zeros(0, dtype=bool)
+        self._pend = []
+        self._held = None
+        self._prev_row = None
 
     def _emit(self, event: RecordEvent) -> None:
         self.events.append(event)
@@ -501,8 +647,7 @@ class SerialRecorder:
 
         if trials < 1:
             raise InputError(f"trials must be >= 1, got {trials}")
-        if not str(material).strip():
-            raise InputError("the material label must not be empty (it names the trials in the index)")
+        check_material_label(material)   # before recording: a label no file can carry lost the touch
         if self._ser is None:
             self.open()
         cutter = self._new_cutter(material)
@@ -510,6 +655,7 @@ class SerialRecorder:
         st = self.status
         st.material, st.target, st.trials, st.state = material, trials, 0, cutter.state
         start_written = len(self.written)
+        self._skips, self._kept_at = [], self._lines_seen
         last_data = time.monotonic()
         last_status = 0.0
         stall = self.profile.serial.stall_s
@@ -554,13 +700,11 @@ class SerialRecorder:
         (``feed``, ``discontinuity``, ``state``, ``in_trial``, ``written``):
         :class:`designkit.calibration.live.LiveClassifier` decides each touch live.
         """
-        try:  # now, not when the first touch is complete
-            self.out_dir.mkdir(parents=True, exist_ok=True)
-        except OSError as exc:
-            raise InputError(f"cannot create the trial folder {self.out_dir}: {exc.strerror or exc}") from None
+        self._lock.acquire()   # creates the folder: now, not when the first touch is complete (held already)
         return TrialCutter(self.profile, self.out_dir, material,
-                           meta={"profile": self.profile.name, "port": self.port,
-                                 "timestamps": "device" if self.profile.has_timestamp else "line count"})
+                           meta={"profile": self.profile.name, "port": self.port, "session": self.session,
+                                 "timestamps": "device" if self.profile.has_timestamp else "line count"},
+                           lock=self._lock)
 
     def _sync(self, cutter: TrialCutter) -> None:
         for p in cutter.written:
@@ -583,17 +727,22 @@ class SerialRecorder:
         self.on_status(self.status)
 
     def _discontinuity(self, cutter: TrialCutter, reason: str) -> None:
+        self._flush_held(cutter)   # the sample before the break belongs before it
+        self._pend = []
+        self._prev_row = None
         self._emit(RecordEvent("gap", reason))
         for e in cutter.discontinuity(reason):
             self.status.skipped += 1
+            self._skips.append(e.message)
             self._emit(e)
         self._last_t = None
+        self._check_progress(cutter)
 
     def _device_lost(self, cutter: TrialCutter, exc: BaseException) -> None:
         in_trial = cutter.in_trial
         last_t = self._last_t
         self._discontinuity(cutter, "the device disconnected")
-        self.close()
+        self._close_port()   # the folder stays locked: the session goes on
         lost_at = time.monotonic()
         deadline = lost_at + self.profile.serial.reconnect_s
         while True:
@@ -682,41 +831,89 @@ class SerialRecorder:
                 f"and the profile {self.profile.name!r}; {self._kept(cutter)}")
 
     def _feed_checked(self, t: np.ndarray, vals: np.ndarray, cutter: TrialCutter) -> None:
-        """Feed in runs without clock trouble.
+        """Feed samples whose device times follow on; skip the lines whose times cannot be right.
 
-        With device timestamps, a step back (device reset) or a hole longer
-        than the profile's ``stall_s`` is a discontinuity; shorter holes are
-        samples lost to unreadable lines and are tolerated. Counted time
-        (no timestamp) has no holes to check: lost samples are found from
-        silences instead (see :meth:`record`).
+        With device timestamps, a sample up to 1.5 sample periods after the
+        last one kept continues the stream. Any other (the same time, an
+        earlier one, a hole) is held back, and the samples after it decide,
+        each going with whichever it follows more closely, the last one kept
+        or the held ones: when a sample follows the last one kept, the held
+        ones were bad lines (sent twice, out of order, a damaged time) and are
+        skipped, the trial in progress goes on; when ``CONFIRM_SAMPLES`` held
+        samples follow each other, they are the stream: after a hole of at
+        most ``stall_s`` (lines lost to garbling) it simply goes on, after a
+        longer one or a step back the clock really jumped (samples lost, a
+        reset): a discontinuity. Counted time (no timestamp) has no holes to
+        check: lost samples are found from silences instead (see :meth:`record`).
         """
         fs = self.profile.sample_rate_hz
         if not self.profile.has_timestamp:
             self._feed(t, vals, cutter)
             self._last_t = float(t[-1])
             return
-        prev = self._last_t
-        full_t = t if prev is None else np.concatenate([[prev], t])
-        dt = np.diff(full_t)
         hole = max(self.profile.serial.stall_s, 1.5 / fs)
-        breaks = np.flatnonzero((dt <= 0) | (dt > hole)) if dt.size else np.zeros(0, int)
-        start = 0
-        offset = 0 if prev is None else 1
-        for b in breaks:
-            i = int(b) + 1 - offset  # index in t of the sample after the break
-            if i > start:
-                self._feed(t[start:i], vals[start:i], cutter)
-            step = full_t[b + 1] - full_t[b]
-            if step <= 0:
-                reason = f"the device clock went back by {-step:.3f} s (device reset?)"
+        step_max = 1.5 / fs
+        last = self._last_t
+        run: list[int] = []       # indices of t continuing the stream, fed in one go
+        for i, ti in enumerate(t.tolist()):
+            if last is None or (not self._pend and 0.0 < ti - last <= step_max):
+                run.append(i)
+                last = ti
+                continue
+            d_last = ti - last
+            d_pend = ti - self._pend[-1][0] if self._pend else -1.0
+            follows_last = 0.0 < d_last <= hole
+            follows_pend = 0.0 < d_pend <= hole
+            if follows_pend and (not follows_last or d_pend < d_last):
+                self._pend.append((ti, vals[i]))
+                if len(self._pend) < CONFIRM_SAMPLES:
+                    continue
+                confirmed, self._pend = self._pend, []
+                step = confirmed[0][0] - last
+                if run:                               # the samples before them go first
+                    self._feed(t[run], vals[run], cutter)
+                    run = []
+                if not 0.0 < step <= hole:
+                    if step < 0:
+                        reason = (f"the device clock went back by {-step:.3f} s, from {last:.3f} s to "
+                                  f"{confirmed[0][0]:.3f} s (device reset?)")
+                    elif step == 0:
+                        reason = f"the device clock restarted at {last:.3f} s"
+                    else:
+                        reason = f"{step - 1.0 / fs:.3f} s of samples missing at device time {last:.2f} s"
+                    self.status.gaps += 1
+                    self._discontinuity(cutter, reason)
+                self._feed(np.array([c[0] for c in confirmed]), np.array([c[1] for c in confirmed]), cutter)
+                last = confirmed[-1][0]
+                continue
+            if self._pend:                            # the held samples continue nothing: bad lines
+                self._skip_times(last, ti)
+            if follows_last and d_last <= step_max:
+                run.append(i)
+                last = ti
             else:
-                reason = f"{step - 1.0 / fs:.3f} s of samples missing at device time {full_t[b]:.2f} s"
-            self.status.gaps += 1
-            self._discontinuity(cutter, reason)
-            start = i
-        if start < t.size:
-            self._feed(t[start:], vals[start:], cutter)
-        self._last_t = float(t[-1])
+                self._pend = [(ti, vals[i])]
+        if run:
+            self._feed(t[run], vals[run], cutter)
+        self._last_t = last
+
+    def _skip_times(self, last: float, nxt: float) -> None:
+        """The held samples were lines with wrong times (see :meth:`_feed_checked`): count and report them.
+
+        ``last``: the last time kept; ``nxt``: the time that showed them wrong.
+        """
+        hole = max(self.profile.serial.stall_s, 1.5 / self.profile.sample_rate_hz)
+        for ti, _ in self._pend:
+            if ti == last:
+                self._bad("duplicate", f"time {ti:.4f} s twice")
+            elif last < nxt < ti <= nxt + hole:
+                self._bad("out_of_order", f"time {ti:.4f} s before {nxt:.4f} s")
+            elif ti < last:
+                self._bad("out_of_order", f"time {ti:.4f} s after {last:.4f} s")
+            else:
+                self._bad("time_jump", f"time {ti:.4f} s after {last:.4f} s, the next line continuing from "
+                                       f"{last:.4f} s")
+        self._pend = []
 
     # ------------------------------------------------------- same device?
     def _out_of_contact(self, vals: np.ndarray) -> np.ndarray:
@@ -731,6 +928,7 @@ class SerialRecorder:
         idle = self._out_of_contact(vals)
         if not idle.any():
             return
+        self._idle_seen += int(idle.sum())
         keep = int(round(_REFERENCE_S * self.profile.sample_rate_hz))
         self._idle_t = np.concatenate([self._idle_t, t[idle]])[-keep:]
         self._idle_v = np.concatenate([self._idle_v, vals[idle]])[-keep:]
@@ -824,13 +1022,100 @@ class SerialRecorder:
         self._feed_checked(t, vals, cutter)
 
     def _feed(self, t, vals, cutter: TrialCutter) -> None:
+        """Pass samples through the plausibility filter (module docstring) to the cutter.
+
+        The last sample is held back until the next one arrives: a sample is
+        judged against both its neighbours.
+        """
+        t = np.asarray(t, dtype=np.float64)
+        vals = np.asarray(vals, dtype=np.float64).reshape(-1, 3)
+        if self._held is not None:
+            t = np.concatenate([self._held[0], t])
+            vals = np.concatenate([self._held[1], vals])
+            self._held = None
+        if t.size == 0:
+            return
+        self._held = (t[-1:], vals[-1:])
+        t, vals, nxt = t[:-1], vals[:-1], vals[1:]
+        if t.size == 0:
+            return
+        margin = self._spike_margin()
+        if margin is not None and self._prev_row is not None:
+            prev = np.concatenate([self._prev_row[None, :], vals[:-1]])
+            with np.errstate(invalid="ignore"):
+                lo = np.fmin(prev, nxt) - margin
+                hi = np.fmax(prev, nxt) + margin
+                odd = (vals < lo) | (vals > hi)           # NaN (no such channel) compares False
+            bad = odd.any(axis=1)
+            for i in np.flatnonzero(bad):
+                c = int(np.flatnonzero(odd[i])[0])
+                why = (f"{('sensor', 'object', 'force')[c]} {vals[i, c]:.4f} at device time {t[i]:.3f} s between "
+                       f"neighbours {prev[i, c]:.4f} and {nxt[i, c]:.4f}")
+                self._bad("implausible", why)
+                if hasattr(cutter, "note_dropped"):
+                    cutter.note_dropped(float(t[i]), f"implausible: {why}")
+            if bad.any():
+                t, vals = t[~bad], vals[~bad]
+        if t.size:
+            self._prev_row = vals[-1].copy()
+            self._to_cutter(t, vals, cutter)
+
+    def _flush_held(self, cutter: TrialCutter) -> None:
+        """Feed the held-back last sample unjudged (it has no successor: the stream breaks after it)."""
+        if self._held is not None:
+            t, v = self._held
+            self._held = None
+            self._to_cutter(t, v, cutter)
+
+    def _spike_margin(self) -> np.ndarray | None:
+        """Per-channel margin of the plausibility filter [channel units]; None until enough samples out of contact.
+
+        ``SPIKE_SIGMAS`` times the noise (the median absolute second difference
+        of the samples out of contact, scaled to a standard deviation), or
+        times the median non-zero step when that is larger (a quantized
+        reading steadier than one step).
+        """
+        at, margin = self._margin
+        n = self._idle_v.shape[0]
+        if n < _SPIKE_MIN_REFERENCE:
+            return None
+        if margin is not None and self._idle_seen - at < 200:
+            return margin
+        ref = self._idle_v
+        with np.errstate(invalid="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)   # all-NaN: a channel the rig does not have
+            sigma = np.nanmedian(np.abs(np.diff(ref, 2, axis=0)), axis=0) * 1.4826 / math.sqrt(6.0)
+            d1 = np.abs(np.diff(ref, axis=0))
+            step = np.array([np.nanmedian(c[c > 0]) if (c > 0).any() else 0.0 for c in d1.T])
+        margin = SPIKE_SIGMAS * np.fmax(sigma, step)
+        margin = np.where(np.isfinite(margin) & (margin > 0), margin, np.inf)
+        self._margin = (self._idle_seen, margin)
+        return margin
+
+    def _to_cutter(self, t, vals, cutter: TrialCutter) -> None:
         self._remember_idle(t, vals)
         for e in cutter.feed(t, vals):
             if e.kind == "trial" and e.path is not None:
                 self._note_pre_contact(e.path)
+            if e.kind in ("trial", "decision"):
+                self._skips, self._kept_at = [], self._lines_seen
             if e.kind == "skipped":
                 self.status.skipped += 1
+                self._skips.append(e.message)
             self._emit(e)
+        self._check_progress(cutter)
+
+    def _check_progress(self, cutter: TrialCutter) -> None:
+        """Apply the give-up rule for a stream that never lets a touch be kept (module docstring)."""
+        if len(self._skips) < GIVE_UP_TOUCHES:
+            return
+        span = (self._lines_seen - self._kept_at) / self.profile.sample_rate_hz
+        if span < self.give_up_s:
+            return
+        raise NoProgress(
+            f"{len(self._skips)} touches in a row were skipped and none {self._KEPT} in the last {span:.0f} s of "
+            f"stream from {self.port} (the last: {self._skips[-1]}): the stream is too damaged for a touch; check "
+            f"the cable and the device; {self._kept(cutter)}")
 
     def _bad(self, kind: str, text: str) -> None:
         self._last_bad_text = text

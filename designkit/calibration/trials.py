@@ -24,18 +24,37 @@ no index lists; a write that fails (disk full) removes the files it wrote. Only
 a hard kill between the steps can leave a complete CSV and sidecar unlisted;
 the next trial written to the folder lists them (the index is rebuilt from the
 sidecars).
+
+One writer per folder. Trial numbers are the next free ones on disk, so two
+programs recording into one folder at once would pick the same names and
+overwrite each other's trials. A recorder holds :class:`FolderLock` (an
+exclusive ``flock`` on the folder itself, released by the kernel however the
+process ends) for its whole session, and :func:`write_trial` takes it for
+each write when its caller does not hold it: a second recorder is refused
+with one line before it records anything. Each trial's sidecar names the
+recording session (``session``), so a run reports the trials it wrote, not
+others the rebuilt index also lists.
+
+A material label is checked before anything is recorded
+(:func:`check_material_label`); the file name made from it is bounded
+(:data:`MAX_STEM_CHARS`), the label itself is kept whole in the sidecar and
+the index.
 """
 
 from __future__ import annotations
 
 import contextlib
 import csv
+import errno
+import hashlib
 import io
 import json
 import math
+import os
 import re
 import signal
 import threading
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Mapping, Sequence
@@ -45,8 +64,9 @@ import numpy as np
 from .._io import atomic_write_text
 from .._validation import InputError
 
-__all__ = ["COLUMNS", "Trial", "check_trial_folder", "load_index", "read_trial_csv", "rebuild_index",
-           "recorded_trials", "write_trial"]
+__all__ = ["COLUMNS", "FolderBusy", "FolderLock", "MAX_LABEL_CHARS", "MAX_STEM_CHARS", "Trial",
+           "check_material_label", "check_trial_folder", "load_index", "read_trial_csv", "rebuild_index",
+           "recorded_trials", "session_trials", "trial_stem", "write_trial"]
 
 COLUMNS = ("time_s", "passive_temp_c", "active_temp_c", "unused_channel", "force_n")
 TRIAL_FILE_VERSION = 1
@@ -91,9 +111,132 @@ class Trial:
         return int(self.time_s.size)
 
 
-def _slug(name: str) -> str:
-    slug = re.sub(r"[^A-Za-z0-9]+", "_", name).strip("_").lower()
-    return slug or "material"
+#: Longest material label [characters]: it is written into every trial's sidecar, the index and messages.
+MAX_LABEL_CHARS = 100
+#: Longest file-name stem made from a label (the trial number and suffix come on top; file systems allow 255 bytes).
+MAX_STEM_CHARS = 48
+#: Characters a spreadsheet opening index.csv reads as the start of a formula.
+_FORMULA_START = "=+-@"
+
+
+def check_material_label(label: object, what: str = "the material label") -> str:
+    """``label`` if it can name trials, else InputError (one line) saying why.
+
+    A label must be non-empty text of at most :data:`MAX_LABEL_CHARS` printable
+    characters (no newline, tab or other control character), without spaces at
+    either end, and must not start with ``=``, ``+``, ``-`` or ``@`` (a
+    spreadsheet opening ``index.csv`` would run it as a formula).
+
+    >>> check_material_label("Aluminium alloys")
+    'Aluminium alloys'
+    >>> check_material_label("=400")
+    Traceback (most recent call last):
+    ...
+    designkit._validation.InputError: the material label '=400' starts with '=': a spreadsheet opening index.csv would read it as a formula; start it with a letter or digit
+    """
+    if not isinstance(label, str) or not label.strip():
+        raise InputError(f"{what} must not be empty (it names the trials in the index)")
+    if len(label) > MAX_LABEL_CHARS:
+        raise InputError(f"{what} is {len(label)} characters long; at most {MAX_LABEL_CHARS} are allowed (it is "
+                         f"written into every trial's file and the index): {label[:40]!r}...")
+    bad = next((c for c in label if not c.isprintable()), None)
+    if bad is not None:
+        raise InputError(f"{what} {label!r} contains {bad!r}: use printable characters only (no newline, tab or "
+                         "control character)")
+    if label != label.strip():
+        raise InputError(f"{what} {label!r} has spaces at its start or end ('wood ' and 'wood' would be two "
+                         "materials): remove them")
+    if label[0] in _FORMULA_START:
+        raise InputError(f"{what} {label!r} starts with {label[0]!r}: a spreadsheet opening index.csv would read it "
+                         "as a formula; start it with a letter or digit")
+    return label
+
+
+def trial_stem(label: str) -> str:
+    """The file-name stem of a label's trials: letters and digits, lower case, at most :data:`MAX_STEM_CHARS`.
+
+    A longer stem is cut and given 8 hex digits of the label's SHA-256, so that
+    two long labels sharing their start stay apart.
+
+    >>> trial_stem("Aluminium alloys")
+    'aluminium_alloys'
+    >>> len(trial_stem("w" * 300)) <= MAX_STEM_CHARS
+    True
+    """
+    slug = re.sub(r"[^A-Za-z0-9]+", "_", label).strip("_").lower() or "material"
+    if len(slug) > MAX_STEM_CHARS:
+        digest = hashlib.sha256(label.encode("utf-8")).hexdigest()[:8]
+        slug = slug[:MAX_STEM_CHARS - 9].rstrip("_") + "_" + digest
+    return slug
+
+
+class FolderBusy(InputError):
+    """Another program holds the recording folder's lock."""
+
+
+class FolderLock:
+    """The exclusive right to write trials into a folder (a ``flock`` on the folder itself).
+
+    No lock file is left behind: the lock is on the folder's own descriptor,
+    and the kernel releases it when the holder closes it or ends in any way
+    (Ctrl-C, SIGTERM, kill -9). Creates the folder.
+
+    Parameters
+    ----------
+    folder : Path
+    wait_s : float
+        How long :meth:`acquire` waits for another holder to let go [s]
+        (0: refuse at once).
+    """
+
+    def __init__(self, folder: Path | str, wait_s: float = 0.0) -> None:
+        self.folder = Path(folder)
+        self.wait_s = float(wait_s)
+        self._fd: int | None = None
+
+    @property
+    def held(self) -> bool:
+        return self._fd is not None
+
+    def acquire(self) -> "FolderLock":
+        """Take the lock; FolderBusy (one line) if another program holds it past ``wait_s``."""
+        import fcntl
+
+        if self._fd is not None:
+            return self
+        try:
+            self.folder.mkdir(parents=True, exist_ok=True)
+            fd = os.open(self.folder, os.O_RDONLY | getattr(os, "O_DIRECTORY", 0))
+        except OSError as exc:
+            raise InputError(f"cannot create the trial folder {self.folder}: {exc.strerror or exc}") from None
+        deadline = time.monotonic() + self.wait_s
+        while True:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                break
+            except OSError as exc:
+                if exc.errno not in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES) or time.monotonic() >= deadline:
+                    os.close(fd)
+                    if exc.errno not in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
+                        raise InputError(f"cannot lock the trial folder {self.folder}: {exc.strerror or exc}") from None
+                    raise FolderBusy(
+                        f"another recorder is writing trials into {self.folder} (a second 'calibrate record' or "
+                        "'calibrate' with the same --out?): two at once would number their trials alike and "
+                        "overwrite each other's; let it finish, or record into another folder") from None
+                time.sleep(0.02)
+        self._fd = fd
+        return self
+
+    def release(self) -> None:
+        if self._fd is not None:
+            os.close(self._fd)   # closing the descriptor releases the flock
+            self._fd = None
+
+    def __enter__(self) -> "FolderLock":
+        return self.acquire()
+
+    def __exit__(self, *exc) -> None:
+        self.release()
 
 
 def trial_csv_text(time_s, sensor_c, object_c, force_n) -> str:
@@ -107,19 +250,24 @@ def trial_csv_text(time_s, sensor_c, object_c, force_n) -> str:
 
 
 def write_trial(folder: Path, material: str, time_s, sensor_c, object_c, force_n,
-                meta: Mapping[str, Any]) -> Path:
+                meta: Mapping[str, Any], *, lock: FolderLock | None = None, stem: str | None = None) -> Path:
     """Record one trial: write its CSV and sidecar, then the index that lists it (each atomically).
 
-    The trial number is the next free one for ``material`` in ``folder``.
-    Ctrl-C arriving meanwhile is held until the index is written (see the
-    module docstring), so on return, or on KeyboardInterrupt raised from here,
-    the trial is recorded; on any other error nothing of it is left. Returns
-    the CSV path.
+    The trial number is the next free one for ``material`` in ``folder``
+    (file names from :func:`trial_stem`, or ``stem`` when given). Ctrl-C
+    arriving meanwhile is held until the index is written (see the module
+    docstring), so on return, or on KeyboardInterrupt raised from here, the
+    trial is recorded; on any other error nothing of it is left. ``lock``: the
+    caller's held :class:`FolderLock` of ``folder``; without one the folder is
+    locked for this write (waiting up to 2 s for another writer, then
+    FolderBusy). Returns the CSV path.
     """
     folder = Path(folder)
     check_trial_folder(folder)  # before writing anything
-    folder.mkdir(parents=True, exist_ok=True)
-    slug = _slug(material)
+    if lock is None or not lock.held:
+        with FolderLock(folder, wait_s=2.0) as own:
+            return write_trial(folder, material, time_s, sensor_c, object_c, force_n, meta, lock=own, stem=stem)
+    slug = trial_stem(material) if stem is None else stem
     taken = {int(m.group(1)) for p in folder.glob(f"{slug}_*.json")
              if (m := re.fullmatch(rf"{re.escape(slug)}_(\d+)\.json", p.name))}
     taken |= {int(m.group(1)) for p in folder.glob(f"{slug}_*.csv")
@@ -320,6 +468,21 @@ def read_index_rows(index_csv: Path | str) -> list[dict[str, str]]:
     if not {"file", "material"} <= set(reader.fieldnames or ()):
         raise InputError(f"index {index_csv} needs columns file and material")
     return rows
+
+
+def session_trials(folder: Path | str, session: str) -> list[Path]:
+    """The trials of ``folder``'s index whose sidecar names recording session ``session``, in index order."""
+    from .._schemas import load_json
+
+    out = []
+    for path in recorded_trials(folder):
+        try:
+            meta = load_json(path.with_suffix(".json"), "trial sidecar")
+        except (ValueError, OSError):
+            continue
+        if isinstance(meta, dict) and meta.get("session") == session:
+            out.append(path)
+    return out
 
 
 def recorded_trials(folder: Path | str) -> list[Path]:

@@ -18,6 +18,7 @@ import json
 import math
 import re
 import sys
+from pathlib import Path
 from typing import Any
 
 import typer
@@ -25,8 +26,10 @@ from typer.core import TyperGroup
 
 try:  # recent typer vendors click; older typer uses click itself
     from typer._click.exceptions import ClickException as _ClickException
+    from typer._click.exceptions import BadParameter as _BadParameter
     from typer._click.exceptions import NoArgsIsHelpError as _NoArgsIsHelp
 except ImportError:  # pragma: no cover - depends on the installed typer
+    from click.exceptions import BadParameter as _BadParameter
     from click.exceptions import ClickException as _ClickException
     from click.exceptions import NoArgsIsHelpError as _NoArgsIsHelp
 
@@ -92,6 +95,10 @@ class _PlainCoercion:
     def coerce(self, value: Any, param: Any, ctx: Any) -> Any:
         if value is None:
             return None
+        if isinstance(value, str) and self.kind in (str, Path) and not value.strip():
+            # one rule for every text option: empty is no value (--table '' fell back to svm-fine, --out ''
+            # meant the current folder, --port '' was looked for as a device)
+            raise _BadParameter("it is empty; give a value (or leave the option out)", ctx=ctx, param=param)
         fast = self._fast(value)
         if fast is not _MISSING:
             return fast
@@ -116,7 +123,9 @@ def _plain_kind(param: Any) -> type | None:
     args = [a for a in getattr(ann, "__args__", ()) if a is not type(None)]
     if getattr(ann, "__origin__", None) is not None or args:  # Optional[X] (typing.Union[X, None])
         ann = args[0] if len(args) == 1 and len(getattr(ann, "__args__", ())) == 2 else None
-    return ann if ann in (float, int, str, bool) else None
+    if ann is Path and any(getattr(info, k, None) not in (None, False, True) for k in ("path_type",)):
+        return None
+    return ann if ann in (float, int, str, bool, Path) else None
 
 
 def _fast_coercion(command: Any, ctx: Any) -> None:
@@ -168,6 +177,29 @@ class _Group(TyperGroup):
         sys.exit(rv if isinstance(rv, int) else 0)
 
     def invoke(self, ctx: Any) -> Any:
+        """Run the command; a refusal is its one line alone: warnings raised on the way (numpy's, loadtxt's)
+        are held back, shown after a command that answers, dropped before a refusal."""
+        import warnings
+
+        held: list = []
+        answered = False
+        try:
+            with warnings.catch_warnings(record=True) as caught:
+                try:
+                    rv = self._invoke(ctx)
+                    answered = True
+                    return rv
+                except typer.Exit as exc:
+                    answered = getattr(exc, "exit_code", 0) not in (EXIT_BAD_INPUT, EXIT_BUG)
+                    raise
+                finally:
+                    held = list(caught)
+        finally:
+            if answered:
+                for w in held:
+                    warnings.showwarning(w.message, w.category, w.filename, w.lineno, w.file, w.line)
+
+    def _invoke(self, ctx: Any) -> Any:
         sub_args = list(getattr(ctx, "protected_args", []) or []) + list(ctx.args or [])
         try:
             return super().invoke(ctx)
@@ -261,6 +293,22 @@ def _jsonable(obj: Any) -> Any:
     if isinstance(obj, float) and not math.isfinite(obj):
         return None
     return obj
+
+
+def import_lab(module: str, command: str) -> Any:
+    """``designkit_lab.<module>``: the lab (benchmarks, the paper's report) ships beside the core and is
+    imported only by the commands that need it; missing, it is one line naming what to install."""
+    import importlib
+
+    try:
+        return importlib.import_module(f"designkit_lab.{module}")
+    except ModuleNotFoundError as exc:
+        if exc.name not in ("designkit_lab", f"designkit_lab.{module}"):
+            raise
+        from .._validation import InputError
+
+        raise InputError(f"`designkit {command}` needs the designkit_lab package, which is not installed here: "
+                         "reinstall designkit (pip install 'designkit[lab]' also adds its figures' libraries)") from None
 
 
 def emit_json(payload: Any) -> None:

@@ -70,12 +70,18 @@ def cell_text(v: Any) -> str:
 
 
 def _csv_text(v: Any) -> str:
+    """One CSV cell: full precision, numpy scalars as plain numbers (``repr(np.float64(x))`` is
+    ``np.float64(x)`` under numpy 2: calibrate fit --bootstrap 0 wrote such cells)."""
     if v is None:
         return ""
+    if hasattr(v, "dtype") and hasattr(v, "item") and getattr(v, "ndim", 1) == 0:
+        v = v.item()  # a numpy scalar (or 0-d array): its Python number
+    if isinstance(v, bool):
+        return str(v)
     if isinstance(v, float):
-        return "" if not math.isfinite(v) else repr(v)
+        return "" if not math.isfinite(v) else repr(float(v))
     if isinstance(v, (list, tuple, dict)):
-        return json.dumps(v)
+        return json.dumps(_jsonable(v))
     return str(v)
 
 
@@ -242,6 +248,26 @@ def check_out(out: str | Path, what: str | None = None, *, probe: bool = False) 
                 pass
         except OSError as exc:
             raise InputError(f"{label}: cannot write in {folder} ({exc.strerror or exc})") from None
+    return p
+
+
+def check_out_dir(out: str | Path, what: str) -> Path:
+    """``out`` as a folder to write into, or a one-line error naming ``what`` (an option) and the reason.
+
+    The rule of :func:`check_out` for outputs that are folders (a report, recorded trials, a sweep's
+    workdir): the folder itself is made if missing, but not a chain of missing folders above it (a typo), and
+    a file where the folder should be is refused before any work (``bench --out FILE`` failed with "File
+    exists" after its 35 s of measuring).
+    """
+    p = Path(out).expanduser()
+    if p.exists():
+        if not p.is_dir():
+            raise InputError(f"{what} {p}: it is a file, not a folder; give a folder")
+        return p
+    folder = p.parent
+    if not folder.is_dir():
+        why = "is not a folder" if folder.exists() else "does not exist (create it first)"
+        raise InputError(f"{what} {p}: folder {folder} {why}")
     return p
 
 

@@ -67,6 +67,23 @@ Diffusivity = Annotated[Optional[float], typer.Option(
                           "need it (slab).", rich_help_panel=PANEL_SENSOR)]
 
 
+def refuse_together(*groups: tuple[str, object], why: str) -> None:
+    """The one rule for options that contradict each other: of the ``(flag, value)`` pairs, at most one may be
+    given (a value other than None, False or empty); else a one-line InputError naming them and ``why``.
+
+    >>> refuse_together(("--exact", True), ("--table", None), why="x")
+    >>> refuse_together(("--exact", True), ("--table", "svm-paper"), why="--exact computes, a table is read")
+    Traceback (most recent call last):
+    ...
+    designkit._validation.InputError: --exact and --table contradict each other: --exact computes, a table is read; give one
+    """
+    from .._validation import InputError
+
+    given = [flag for flag, value in groups if value is not None and value is not False and value != [] and value != ()]
+    if len(given) > 1:
+        raise InputError(f"{' and '.join(given)} contradict each other: {why}; give one")
+
+
 def model_from_options(model: Optional[str], *, conductance: Optional[float] = None,
                        thickness: Optional[float] = None, backing: Optional[str] = None):
     """The forward model the options name (None, None, ... is the paper's semi-infinite model).

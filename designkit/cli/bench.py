@@ -7,7 +7,7 @@ from typing import Annotated, List, Optional
 
 import typer
 
-from ._app import app, console, emit_json
+from ._app import app, console, emit_json, import_lab
 from . import _app
 from ._options import Json
 
@@ -35,10 +35,16 @@ def bench_cmd(
     """
     import time
 
-    from .. import accuracy
+    accuracy = import_lab("accuracy", "bench")
+
+    from ._format import check_out_dir
 
     sections = accuracy.check_sections(section or accuracy.SECTIONS)
+    from .._workers import worker_count
+
+    worker_count(jobs)  # the one rule of --jobs, before minutes of measuring (0 was taken)
     if out is not None:
+        check_out_dir(out, "--out")  # a file there failed "File exists" after the whole run
         accuracy.require_figures()  # refuse now, not after minutes of measuring
     err = console(stderr=True)
     started = time.perf_counter()
@@ -76,7 +82,8 @@ def bench_cmd(
 def _print_report(report, written) -> None:
     from rich.table import Table
 
-    from ..accuracy import format_time, format_value
+    lab = import_lab("accuracy", "bench")
+    format_time, format_value = lab.format_time, lab.format_value
 
     con = console()
     if not con.is_terminal:

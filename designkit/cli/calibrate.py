@@ -56,40 +56,11 @@ ObjectTempOpt = Annotated[Optional[list[str]], typer.Option(
 DepthOpt = Annotated[float, typer.Option(
     "--depth-um", help="Thermistor depth below the contact surface [um], held fixed (only x^2/alpha_s is "
                        "identifiable).")]
-BootstrapOpt = Annotated[int, typer.Option(
-    "--bootstrap", help="Bootstrap replicates over trials for the uncertainties (0: Jacobian instead; at most "
-                        "10000).")]
-
 #: Most touches per material one run records (a touch takes at least the trial window, 8 s by default).
 MAX_TRIALS = 1000
-#: Most bootstrap replicates (a replicate is a whole refit, ~10 ms per 100 trials; 1000-2000 suffice for a
-#: 95 % interval, so more only costs time).
-MAX_BOOTSTRAP = 10_000
 
 
 # ---------------------------------------------------------------- helpers
-def _fit_settings(depth_um: float, bootstrap: int, seed: int, baseline: str = "mean",
-                  offset_range: str = "-1.5:1.5", fit_to: Optional[float] = None):
-    from .._validation import InputError
-    from ..calibration.fit import FitSettings
-
-    lo, sep, hi = offset_range.partition(":")
-    try:
-        bounds = (float(lo), float(hi))
-    except ValueError:
-        raise InputError(f"--offset-range must look like MIN:MAX in seconds, got {offset_range!r}") from None
-    if not sep:
-        raise InputError(f"--offset-range must look like MIN:MAX in seconds, got {offset_range!r}")
-    if not (depth_um > 0 and math.isfinite(depth_um)):
-        raise InputError(f"--depth-um must be positive, got {depth_um:g}")
-    if fit_to is not None and not (math.isfinite(fit_to) and fit_to > 0):
-        raise InputError(f"--fit-to must be a positive, finite time after onset [s], got {fit_to:g}")
-    if bootstrap != 0 and not 2 <= bootstrap <= MAX_BOOTSTRAP:
-        raise InputError(f"--bootstrap must be 0 (none) or 2 to {MAX_BOOTSTRAP} replicates, got {bootstrap}")
-    return FitSettings(depth_m=depth_um * 1e-6, bootstrap=bootstrap, seed=seed, baseline=baseline,
-                       offset_bounds_s=bounds, fit_to_s=fit_to)
-
-
 def _check_trials(trials: int) -> None:
     from .._validation import InputError
 
@@ -242,12 +213,12 @@ class _EmulatorWatch:
         self.materials, self.trials, self.port, self.out = materials, trials, port, out
         self.pairs: dict[str, str] = {}
         self.labels: set[str] = set()
-        self.before: set[Path] = set()
+        self.session = ""   # the recorder's: its trials' sidecars name it
 
     def _kept(self) -> str:
-        from ..calibration.trials import recorded_trials
+        from ..calibration.trials import session_trials
 
-        n = len(set(recorded_trials(self.out)) - self.before)
+        n = len(session_trials(self.out, self.session))
         return f"{n} trial(s) kept" + (f" in {self.out}" if n else "")
 
     def __call__(self, message: str, material: str) -> None:
@@ -315,7 +286,7 @@ def _record_materials(port: str, profile, out: Path, materials: list[str], trial
     interrupt may come between a trial's commit and its being remembered).
     """
     from ..calibration.recorder import SerialRecorder
-    from ..calibration.trials import recorded_trials
+    from ..calibration.trials import session_trials
 
     display = _Display(quiet)
     watch = _ForceWatch(profile)
@@ -336,8 +307,7 @@ def _record_materials(port: str, profile, out: Path, materials: list[str], trial
     emulator = _EmulatorWatch(materials, trials, port, out)
     rec = SerialRecorder(port, profile, out, no_data_timeout_s=timeout, on_event=on_event,
                          on_status=on_status)
-    before = set(recorded_trials(out))
-    emulator.before = before
+    emulator.session = rec.session
     interrupted = False
     try:
         rec.open()
@@ -360,7 +330,8 @@ def _record_materials(port: str, profile, out: Path, materials: list[str], trial
     finally:
         rec.close()
     order = {p: i for i, p in enumerate(rec.written)}  # recording order; index order for any other
-    paths = sorted((p for p in recorded_trials(out) if p not in before), key=lambda p: order.get(p, len(order)))
+    # this session's trials (their sidecars name it), not others a rebuilt index lists too
+    paths = sorted(session_trials(out, rec.session), key=lambda p: order.get(p, len(order)))
     return rec, paths, interrupted
 
 
@@ -369,6 +340,7 @@ def _record_payload(rec, paths, out: Path, interrupted: bool) -> dict:
     return {
         "trials": [str(p) for p in paths],
         "n_trials": len(paths),
+        "session": rec.session,   # named in each of these trials' sidecars
         "out": str(out),
         "index": str(out / "index.csv") if paths else None,
         "interrupted": interrupted,
@@ -380,127 +352,6 @@ def _record_payload(rec, paths, out: Path, interrupted: bool) -> dict:
     }
 
 
-def _interval(ci) -> str:
-    lo, hi = ci
-    if not (math.isfinite(lo) and math.isfinite(hi)):
-        return ""
-    return f"[{lo:.3g}, {'∞' if hi > 1e9 else f'{hi:.3g}'}]"
-
-
-def _print_fit(result, out: Optional[Path], plot: Optional[Path]) -> None:
-    from rich.markup import escape
-    from rich.table import Table
-
-    from ..calibration.fit import PAPER_ALPHA_S, PAPER_E_S
-
-    con = console()
-
-    def ci(p, fmt):
-        lo, hi = p.ci95
-        return f"[{lo:{fmt}}, {hi:{fmt}}]" if math.isfinite(lo) and math.isfinite(hi) else "–"
-
-    def flag(p):
-        return f" [red](at {p.at_bound} bound)[/]" if p.at_bound else ""
-
-    t = Table(title=f"Sensor identified from {result.n_trials} trials ({result.identification})",
-              title_justify="left")
-    for c in ("parameter", "value", "± std. error", "95 % interval", "paper"):
-        t.add_column(c, justify="right" if c != "parameter" else "left")
-    e, a, tau, off = result.effusivity, result.diffusivity_m2_s, result.tau_s, result.time_offset_s
-    t.add_row(escape("e_s [J s^-1/2 K^-1 m^-2]"), f"{e.value:.4g}{flag(e)}", f"{e.std_error:.3g}", ci(e, ".4g"),
-              f"{PAPER_E_S:g}")
-    t.add_row(escape("alpha_s [m^2/s]"), f"{a.value:.4g}{flag(a)}", f"{a.std_error:.3g}", ci(a, ".4g"),
-              f"{PAPER_ALPHA_S:g}")
-    t.add_row(escape(f"tau = x^2/(4 alpha_s) [s], x = {result.depth_m * 1e6:g} um"), f"{tau.value:.4g}{flag(tau)}",
-              f"{tau.std_error:.3g}", ci(tau, ".4g"), "")
-    t.add_row(escape("time offset of contact [s]"), f"{off.value:+.3f}{flag(off)}", f"{off.std_error:.3g}",
-              ci(off, "+.3f"), "")
-    con.print(t)
-    m = Table(title="Materials", title_justify="left")
-    for c in ("material", "trials", "range", "e_o fitted", "e_o / e_s [95 %]", "e_s allowed", "object temp.",
-              "residual RMS"):
-        m.add_column(escape(c), justify="left" if c in ("material", "object temp.") else "right")
-    for mf in result.materials:
-        eo = "not identified" if mf.effusivity is None else f"{mf.effusivity.value:.4g}{flag(mf.effusivity)}"
-        rho = "–" if mf.ratio is None else f"{mf.ratio.value:.4g} {_interval(mf.ratio.ci95)}"
-        allowed = "–" if mf.es_interval is None else f"{mf.es_interval[0]:.4g} – {mf.es_interval[1]:.4g}"
-        m.add_row(escape(mf.name), str(mf.n_trials), f"{mf.range.e_min:.4g} – {mf.range.e_max:.4g}", eo,
-                  escape(rho), allowed, mf.object_temp, f"{mf.rms_c:.4f} °C")
-    con.print(m)
-    con.print(f"noise sigma before contact {result.noise_c:.4g} °C; overall residual RMS {result.rms_c:.4f} °C; "
-              f"sample rate {result.sample_rate_hz:.4g} Hz")
-    con.print(f"[dim]uncertainty: {result.uncertainty_method}[/]")
-    for note in result.notes:
-        con.print(f"[yellow]note:[/] {escape(note)}")
-    if out is not None:
-        con.print(f"wrote {out}  (use it with --sensor {out})")
-    if plot is not None:
-        con.print(f"wrote {plot}")
-
-
-def _run_fit(index: Path, ranges: list[str], only: Optional[list[str]], object_temps: list[str], settings,
-             out: Optional[Path], name: Optional[str], plot: Optional[Path], quiet: bool, force: bool = False):
-    from ..calibration.fit import fit_sensor, parse_object_temps, parse_ranges, plot_fit, resolve_ranges
-    from ..calibration.trials import load_index
-
-    overrides = parse_ranges(ranges)
-    temps = parse_object_temps(object_temps)
-    trials = load_index(index, only=only)
-    if not trials:
-        raise ValueError(f"index {index} lists no trials")
-    names = sorted({tr.material for tr in trials})
-    rng = resolve_ranges(names, overrides)
-    unknown = sorted(set(temps) - set(names))
-    if unknown:
-        raise ValueError(f"--object-temp names material(s) not being fitted: {', '.join(unknown)}")
-    from rich.markup import escape
-
-    from ..calibration.fit import check_calibration
-
-    total = settings.bootstrap + settings.profile_points
-    con = console(stderr=True)
-    before = check_calibration(None, trials)  # the touches themselves: refuse before a fit that cannot help
-    if any(p.fatal for p in before) and not force:
-        from .._validation import InputError
-
-        for p in before:
-            con.print(f"[bold red]error:[/] {escape(p.text())}")
-        raise InputError(f"calibration unusable ({', '.join(sorted({p.kind for p in before}))}): "
-                         + (f"{out} not written; " if out is not None else "")
-                         + "see the messages above; --force fits and writes the sensor file anyway")
-    if not quiet and con.is_terminal and total:
-        from rich.progress import Progress
-
-        with Progress(console=con, transient=True) as progress:
-            task = progress.add_task("fitting (bootstrap and e_s profile)", total=total)
-            result = fit_sensor(trials, rng, object_temps=temps, settings=settings,
-                                progress=lambda done, tot: progress.update(task, completed=done))
-    else:
-        result = fit_sensor(trials, rng, object_temps=temps, settings=settings)
-    problems = check_calibration(result, trials)
-    fatal = [p for p in problems if p.fatal]
-    for p in problems:
-        con.print(f"[bold red]{'error' if p.fatal and not force else 'warning'}:[/] {escape(p.text())}")
-    if plot is not None:
-        plot_fit(result, plot)
-    if fatal and not force:
-        if not quiet:
-            _print_fit(result, None, None)
-        from .._validation import InputError
-
-        kinds = ", ".join(sorted({p.kind for p in fatal}))
-        raise InputError(f"calibration unusable ({kinds}): "
-                         + (f"{out} not written; " if out is not None else "")
-                         + "see the messages above; --force writes the sensor file anyway")
-    if out is not None:
-        prov = {"index": str(index), "materials_fitted": names}
-        if problems:
-            prov["problems"] = [p.text() for p in problems]
-        sensor = result.sensor(name=name or out.stem, provenance=prov)
-        sensor.to_yaml(out)
-    return result
-
-
 def _parse_sets(spec: str) -> list[int]:
     from .._validation import InputError
 
@@ -510,13 +361,50 @@ def _parse_sets(spec: str) -> list[int]:
             lo, sep, hi = part.strip().partition("-")
             out += list(range(int(lo), int(hi) + 1)) if sep else [int(lo)]
     except ValueError:
-        raise InputError(f"--fit-sets must look like 1-4 or 1,2,3, got {spec!r}") from None
+        raise InputError(f"--fit-sets must look like 1-4 or 1,2,3 (or 'all'), got {spec!r}") from None
     if not out:
         raise InputError(f"--fit-sets names no trial set: {spec!r}")
     return out
 
 
-def _write_identified(best, trials, out: Path, name: Optional[str], index: Path, force: bool, names) -> list[str]:
+def _offset_bounds(offset_range: str) -> tuple[float, float]:
+    """``--offset-range MIN:MAX`` [s], checked."""
+    from .._validation import InputError
+
+    lo, sep, hi = offset_range.partition(":")
+    try:
+        bounds = (float(lo), float(hi))
+    except ValueError:
+        raise InputError(f"--offset-range must look like MIN:MAX in seconds, got {offset_range!r}") from None
+    if not sep or not (math.isfinite(bounds[0]) and math.isfinite(bounds[1]) and bounds[0] < bounds[1]):
+        raise InputError(f"--offset-range must look like MIN:MAX in seconds with MIN < MAX, got {offset_range!r}")
+    return bounds
+
+
+def _cut(trials, fit_to: Optional[float]):
+    """The touches up to ``fit_to`` s after the onset (all of each without it)."""
+    from .._validation import InputError
+    from ..calibration.trials import Trial
+
+    if fit_to is None:
+        return trials
+    if not (math.isfinite(fit_to) and fit_to > 0):
+        raise InputError(f"--fit-to must be a positive, finite time after onset [s], got {fit_to:g}")
+    out = []
+    for tr in trials:
+        keep = tr.time_s <= fit_to
+        out.append(Trial(tr.time_s[keep], tr.sensor_c[keep], tr.object_c[keep], tr.force_n[keep], tr.material,
+                         tr.source, tr.meta))
+    return out
+
+
+#: Least contact after the detected onset [s] a touch needs for any candidate (the host smoothing's window
+#: is 0.5 s; the force-area candidates also need the force to 1 s after the onset, and are left out below it).
+MIN_CONTACT_S = 0.5
+
+
+def _write_identified(best, trials, out: Path, name: Optional[str], index: Path, force: bool, names,
+                      extra: Optional[dict] = None) -> list[str]:
     """Write the selected model's sensor file, or refuse (exit 2) when its fit is unusable and not forced.
 
     Returns the problems written into the file's provenance (so that ``--sensor`` can warn).
@@ -526,16 +414,14 @@ def _write_identified(best, trials, out: Path, name: Optional[str], index: Path,
     from .._validation import InputError
     from ..calibration.fit import check_calibration
 
-    problems = [p.text() for p in check_calibration(None, trials) if p.fatal]
-    if best.consistent is False:
-        problems += [n for n in best.notes if "conflict" in n] or ["the materials' ranges conflict under this model"]
+    problems = [p.text() for p in check_calibration(best, trials) if p.fatal]
     con = console(stderr=True)
     for text in problems:
         con.print(f"[bold red]{'warning' if force else 'error'}:[/] {escape(text)}")
     if problems and not force:
         raise InputError(f"calibration unusable ({len(problems)} problem(s) above): {out} not written; "
                          "--force writes the sensor file anyway")
-    prov = {"index": str(index), "materials_fitted": list(names)}
+    prov = {"index": str(index), "materials_fitted": list(names), **dict(extra or {})}
     if problems:
         prov["problems"] = problems
     sensor = best.sensor(name=name or out.stem)
@@ -548,42 +434,41 @@ def _write_identified(best, trials, out: Path, name: Optional[str], index: Path,
 PARAMETER_COLUMNS = ("parameter", "material", "value", "std_error", "low_95", "high_95", "unit")
 
 
-def _fit_rows(result) -> list[dict[str, Any]]:
-    """The semi-infinite fit's quantities as rows (:data:`PARAMETER_COLUMNS`)."""
-    def row(name, p, unit, material=None):
-        lo, hi = p.ci95
-        return {"parameter": name, "material": material, "value": p.value, "std_error": p.std_error,
-                "low_95": lo if math.isfinite(lo) else None, "high_95": hi if math.isfinite(hi) else None,
-                "unit": unit}
-    rows = [row("e_s", result.effusivity, "J s^-1/2 K^-1 m^-2"), row("alpha_s", result.diffusivity_m2_s, "m^2/s"),
-            row("tau", result.tau_s, "s"), row("time_offset", result.time_offset_s, "s")]
-    for mf in result.materials:
-        if mf.effusivity is not None:
-            rows.append(row("e_o", mf.effusivity, "J s^-1/2 K^-1 m^-2", mf.name))
-        if mf.ratio is not None:
-            rows.append(row("e_o/e_s", mf.ratio, "1", mf.name))
-        rows.append({"parameter": "residual_rms", "material": mf.name, "value": mf.rms_c, "std_error": None,
-                     "low_95": None, "high_95": None, "unit": "degC"})
-    return rows
+def _run_identify(index: Path, model: Optional[str], fit_sets: Optional[str], ranges: list[str],
+                  only: Optional[list[str]], object_temps: list[str], depth_um: float, out: Optional[Path],
+                  quiet: bool, touch_conductance: Optional[str] = None, name: Optional[str] = None,
+                  force: bool = False, rows_fmt: Optional[str] = None, plot: Optional[Path] = None,
+                  offset_bounds_s: tuple[float, float] = (-1.5, 1.5), fit_to: Optional[float] = None,
+                  record: Optional[dict] = None) -> Optional[dict]:
+    """Identify one model, or choose among them all (``model`` None or 'all'), and write the sensor file.
 
-
-def _run_identify(index: Path, model: str, fit_sets: str, ranges: list[str], only: Optional[list[str]],
-                  object_temps: list[str], depth_um: float, out: Optional[Path], json_: bool,
-                  touch_conductance: Optional[str] = None, name: Optional[str] = None,
-                  force: bool = False, rows_fmt: Optional[str] = None, plot: Optional[Path] = None) -> None:
-    """``calibrate fit --model``: identify one model or compare them all on held-out touches."""
+    The touches are split by :func:`~designkit.calibration.identify.choose_split` (``fit_sets``
+    None: from the trial sets present; 'all': nothing held out) and the candidate with the smallest
+    held-out residual wins (BIC where nothing is held out). Prints the report unless ``quiet``;
+    returns the JSON payload (None after ``rows_fmt`` rows).
+    """
     from rich.markup import escape
     from rich.table import Table
 
     from .._validation import InputError
-    from ..calibration.fit import parse_object_temps, parse_ranges, resolve_ranges
-    from ..calibration.identify import CANDIDATES, candidate, compare_models, split_by_trial_set, trial_sets
+    from ..calibration.fit import check_calibration, parse_object_temps, parse_ranges, resolve_ranges
+    from ..calibration.identify import CANDIDATES, Split, candidate, choose_split, compare_models
     from ..calibration.trials import load_index
 
-    cands = list(CANDIDATES) if model.strip().lower() == "all" else [candidate(model)]
+    auto = model is None or model.strip().lower() in ("all", "auto")
+    cands = list(CANDIDATES) if auto else [candidate(model)]
+    if depth_um is not None and not (depth_um > 0 and math.isfinite(depth_um)):
+        raise InputError(f"--depth-um must be positive, got {depth_um:g}")
     trials = load_index(index, only=only)
     if not trials:
         raise InputError(f"index {index} lists no trials")
+    trials = _cut(trials, fit_to)
+    short = [tr for tr in trials if tr.time_s[-1] < MIN_CONTACT_S]
+    if short:
+        raise InputError(f"{len(short)} touch(es) end before {MIN_CONTACT_S:g} s after the onset (e.g. "
+                         f"{Path(short[0].source).name}, {max(short[0].time_s[-1], 0.0):.3g} s): the sensor models "
+                         f"need at least {MIN_CONTACT_S:g} s of contact" + (" (raise --fit-to)" if fit_to else
+                                                                           "; record longer touches"))
     names = sorted({tr.material for tr in trials})
     rng = resolve_ranges(names, parse_ranges(ranges))
     affine = [spec for spec in object_temps if spec.strip().lower().endswith("-affine")]
@@ -594,6 +479,9 @@ def _run_identify(index: Path, model: str, fit_sets: str, ranges: list[str], onl
             raise InputError(f"--object-temp {spec!r}: the fitted-channel modes are passive-affine and "
                              "passive-end-affine")
         temps[mat.strip()] = mode.strip().lower()
+    unknown = sorted(set(temps) - set(names))
+    if unknown:
+        raise InputError(f"--object-temp names material(s) not being fitted: {', '.join(unknown)}")
     per_touch = [n.strip() for n in (touch_conductance or "").split(",") if n.strip()]
     unknown = sorted(set(per_touch) - set(names))
     if unknown:
@@ -604,21 +492,34 @@ def _run_identify(index: Path, model: str, fit_sets: str, ranges: list[str], onl
         if not cands:
             raise InputError(f"--touch-conductance needs a model that fits the contact conductance "
                              f"(contact, layered...), not {model}")
-    kw = dict(ranges=rng, object_temps=temps, depth_m=depth_um * 1e-6, touch_conductance=tuple(per_touch))
-    if fit_sets.strip().lower() != "all" and all(s is not None for s in trial_sets(trials, index)):
-        fit, held = split_by_trial_set(trials, _parse_sets(fit_sets), index)
+    before = [p for p in check_calibration(None, trials) if p.fatal]  # refuse before minutes of fitting
+    if before and not force:
+        con = console(stderr=True)
+        for p in before:
+            con.print(f"[bold red]error:[/] {escape(p.text())}")
+        raise InputError(f"calibration unusable ({', '.join(sorted({p.kind for p in before}))}): "
+                         + (f"{out} not written; " if out is not None else "")
+                         + "see the messages above; --force fits and writes the sensor file anyway")
+    if fit_sets is not None and fit_sets.strip().lower() == "all":
+        split = Split(tuple(trials), (), (), (), "trial set", "--fit-sets all: every touch fitted")
     else:
-        fit, held = trials, []
-    with _app.busy(f"identifying {len(cands)} model(s) on {len(fit)} touches", quiet=json_ or rows_fmt is not None):
+        split = choose_split(trials, index, None if fit_sets is None else _parse_sets(fit_sets))
+    fit, held = list(split.fit), list(split.held_out)
+    kw = dict(ranges=rng, object_temps=temps, depth_m=depth_um * 1e-6, touch_conductance=tuple(per_touch),
+              offset_bounds_s=offset_bounds_s)
+    with _app.busy(f"identifying {len(cands)} model(s) on {len(fit)} touches", quiet=quiet or rows_fmt is not None):
         cmp = compare_models(fit, held, cands, **kw)   # no held-out touches: selected by BIC
     results, scores, selected = cmp.results, cmp.held_out_rms_c, cmp.selected
     best = next(r for r in results if r.candidate.label == selected)
+    best_score = scores[results.index(best)]
     if plot is not None:  # before the sensor file: a refused fit is worth seeing too
         from ..calibration.identify import plot_identification
 
         plot_identification(results, selected, fit, held, plot, held_out_rms_c=scores, object_temps=temps)
+    selection = {"selected": selected, "reason": cmp.reason, "split": split.to_dict(),
+                 "held_out_rms_c": dict(best_score)}
     if out is not None:
-        _write_identified(best, trials, out, name, index, force, names)
+        _write_identified(best, trials, out, name, index, force, names, extra={"selection": selection})
     if rows_fmt is not None:  # the selected model's parameters (the comparison stays in the report and --json)
         from ._format import emit_rows
 
@@ -629,16 +530,18 @@ def _run_identify(index: Path, model: str, fit_sets: str, ranges: list[str], onl
         emit_rows(head + [{"parameter": q.name, "material": None, "value": q.value, "std_error": None,
                            "low_95": q.ci95[0], "high_95": q.ci95[1], "unit": q.unit} for q in best.parameters],
                   PARAMETER_COLUMNS, fmt=rows_fmt,
-                  notes=[f"model {selected}, fitted on {len(fit)} touches, {len(held)} held out"])
-        return
-    if json_:
-        emit_json({"index": str(index), "n_fit": len(fit), "n_held_out": len(held), "selected": selected,
-                   "out": str(out) if out is not None else None, "plot": str(plot) if plot is not None else None,
-                   "results": [dict(r.to_dict(), held_out_rms_c=dict(sc)) for r, sc in zip(results, scores)]})
-        return
+                  notes=[f"model {selected}, {split.describe()}"])
+        return None
+    payload = {"index": str(index), "n_fit": len(fit), "n_held_out": len(held), "selected": selected,
+               "reason": cmp.reason, "split": split.to_dict(),
+               "out": str(out) if out is not None else None, "plot": str(plot) if plot is not None else None,
+               "results": [dict(r.to_dict(), held_out_rms_c=dict(sc)) for r, sc in zip(results, scores)]}
+    if quiet:
+        return payload
     con = console()
-    t = Table(title=f"Sensor models: fitted on {len(fit)} touches, scored on {len(held)} held-out touches",
-              title_justify="left")
+    if record is not None:
+        con.print(f"Recorded {record['n_trials']} trial(s) in {record['out']}")
+    t = Table(title=f"Sensor models: {split.describe()}", title_justify="left")
     for c in ("model", "fit RMS", *(f"held-out {n}" for n in names), "AIC", "BIC", "rank", "e_s [95 %]",
               "fit time"):
         t.add_column(escape(c), justify="left" if c == "model" else "right")
@@ -649,6 +552,8 @@ def _run_identify(index: Path, model: str, fit_sets: str, ranges: list[str], onl
                   *(f"{sc[n]:.4f} °C" if n in sc else "–" for n in names), f"{r.aic:.0f}", f"{r.bic:.0f}",
                   f"{r.rank}/{r.n_nonlinear}", escape(es), f"{r.fit_time_s:.1f} s")
     con.print(t)
+    con.print(f"selected {escape(cmp.reason)}")
+    con.print(f"[dim]split: {escape(split.reason)}[/]")
     p = Table(title=f"Selected: {selected} ({best.model().describe()})", title_justify="left")
     for c in ("parameter", "value", "95 % interval", "unit", "identified"):
         p.add_column(c, justify="left" if c in ("parameter", "unit", "identified") else "right")
@@ -663,9 +568,11 @@ def _run_identify(index: Path, model: str, fit_sets: str, ranges: list[str], onl
     for note in best.notes:
         con.print(f"[yellow]note:[/] {escape(note)}")
     if out is not None:
-        con.print(f"wrote {out} with the {selected} model  (use it with --sensor {out})")
+        con.print(f"wrote {out} with the {selected} model, as fitted on the {len(fit)} fitted touches  "
+                  f"(use it with --sensor {out})")
     if plot is not None:
         con.print(f"wrote {plot}")
+    return payload
 
 
 # ------------------------------------------------------------------ record
@@ -688,8 +595,9 @@ def record(
 
     if port is None or material is None or out is None:
         raise InputError("give --port, --material and --out")
-    if not material.strip():
-        raise InputError("--material must not be empty (it names the trials in the index)")
+    from ..calibration.trials import check_material_label
+
+    check_material_label(material, "--material")  # before recording: a label that cannot name a trial lost it
     _check_trials(trials)
     _check_timeout(timeout)
     prof = load_profile(profile)
@@ -707,6 +615,15 @@ def record(
 
 
 # --------------------------------------------------------------------- fit
+ModelOpt = Annotated[Optional[str], typer.Option(
+    "--model", help="Sensor model: by default every candidate is fitted and the one with the smallest residual "
+                    "on held-out touches is chosen (BIC when none can be held out), and the report says which and "
+                    "why; or one of semi-infinite (the paper's), contact, contact+smoothing, layered, layered+lag, "
+                    "layered+lag+smoothing, layered+lag+smoothing+drift, contact+smoothing+drift+area, "
+                    "layered+lag+smoothing+drift+area (+drift: a heater still warming at contact; +area: a contact "
+                    "area growing with the measured force); 'all' is the default.")]
+
+
 @calibrate_app.command()
 def fit(
     index: Annotated[Path, typer.Argument(help="CSV with columns file and material (e.g. the index.csv that "
@@ -718,47 +635,37 @@ def fit(
     depth_um: DepthOpt = 80.0,
     out: Annotated[Optional[Path], typer.Option("--out", help="Write the sensor YAML here (for --sensor).")] = None,
     name: Annotated[Optional[str], typer.Option("--name", help="Sensor name in the file (default: file stem).")] = None,
-    bootstrap: BootstrapOpt = 100,
-    seed: Seed = 0,
-    baseline: Annotated[str, typer.Option(
-        "--baseline", help="Initial sensor temperature: 'mean' of the samples before contact, or 'trend' "
-                           "(a line through them, at the onset; for heaters that drift).")] = "mean",
     offset_range: Annotated[str, typer.Option(
         "--offset-range", help="Search range of the contact-time offset MIN:MAX [s].")] = "-1.5:1.5",
     fit_to: Annotated[Optional[float], typer.Option(
-        "--fit-to", help="Use samples up to this time after onset [s] (default: all, or to release).")] = None,
+        "--fit-to", help="Use samples up to this time after onset [s] (default: all).")] = None,
     plot: Annotated[Optional[Path], typer.Option("--plot", help="Write a PNG of the fit (needs matplotlib).")] = None,
-    model: Annotated[Optional[str], typer.Option(
-        "--model", help="Identify this sensor model instead of the paper's (semi-infinite, contact, "
-                        "contact+smoothing, layered, layered+lag, layered+lag+smoothing, "
-                        "layered+lag+smoothing+drift, contact+smoothing+drift+area, "
-                        "layered+lag+smoothing+drift+area: +drift for a heater still warming at contact, "
-                        "+area for a contact area growing with the measured force), or 'all' to compare "
-                        "them on held-out touches (default: the paper's semi-infinite fit).")] = None,
-    fit_sets: Annotated[str, typer.Option(
-        "--fit-sets", help="With --model: trial sets to fit (FIRST-LAST or a comma list); the others are held "
-                           "out and scored ('all': fit every touch, select by BIC). Indexes without trial "
-                           "sets are fitted whole.")] = "1-4",
+    model: ModelOpt = None,
+    fit_sets: Annotated[Optional[str], typer.Option(
+        "--fit-sets", help="Trial sets to fit (FIRST-LAST or a comma list); every other set present is held "
+                           "out and scored ('all': fit every touch, select by BIC). Default: the first fifth "
+                           "of the sets present (at least one); an index without trial sets: the first half "
+                           "of each material's touches.")] = None,
     force: Annotated[bool, typer.Option(
         "--force", help="Write the sensor file even when the calibration is unusable (conflicting ranges, "
                         "mislabelled touches, a sensor colder than the object).")] = False,
     touch_conductance: Annotated[Optional[str], typer.Option(
-        "--touch-conductance", help="With --model: give each touch of these materials (comma-separated) its own "
-                                    "contact conductance, e.g. metal (contact area differs between touches); "
-                                    "only models that fit h_c.")] = None,
+        "--touch-conductance", help="Give each touch of these materials (comma-separated) its own contact "
+                                    "conductance, e.g. metal (contact area differs between touches); only "
+                                    "models that fit h_c.")] = None,
     format_: Annotated[str, typer.Option(
         "--format", "-f", help="table (the report, default), json (as --json), or csv / md: the identified "
                                "sensor's parameters as rows (parameter, material, value, std_error, low_95, "
                                "high_95, unit), pandas-ready.")] = "table",
     json_: Json = False,
 ) -> None:
-    """Identify e_s and alpha_s (and each e_o, the time offset) from recorded touches (paper appendix).
+    """Identify your sensor's model from recorded touches: e_s, alpha_s, each e_o, the contact offset.
 
     Example: `designkit calibrate fit trials/index.csv --range wood=331:506 --out my-sensor.yaml`
 
-    Example (the parameters as CSV): `designkit calibrate fit trials/index.csv --format csv`
+    Example (the paper's model only, parameters as CSV): `designkit calibrate fit trials/index.csv --model semi-infinite --format csv`
     """
-    from ._format import check_format, check_out, emit_rows
+    from ._format import check_format, check_out
 
     fmt = "json" if json_ else check_format(format_)
     if out is not None:
@@ -767,25 +674,14 @@ def fit(
 
             raise InputError("--out - : give the sensor file a name (it is read back with --sensor FILE)")
         check_out(out, "--out", probe=True)  # before the fit: its minutes were lost to an unwritable path
-    rows_only = fmt in ("csv", "md")
-    settings = _fit_settings(depth_um, bootstrap, seed, baseline, offset_range, fit_to)
+    bounds = _offset_bounds(offset_range)
     only_list = [s.strip() for item in only for s in item.split(",") if s.strip()] if only else None
-    if model is not None:
-        _run_identify(index, model, fit_sets, range_ or [], only_list, object_temp or [], depth_um, out,
-                      fmt == "json", touch_conductance, name=name, force=force, rows_fmt=fmt if rows_only else None,
-                      plot=plot)
-        return
-    result = _run_fit(index, range_ or [], only_list, object_temp or [], settings, out, name, plot,
-                      quiet=fmt != "table", force=force)
-    if rows_only:
-        emit_rows(_fit_rows(result), PARAMETER_COLUMNS, fmt=fmt)
-        return
+    payload = _run_identify(index, model, fit_sets, range_ or [], only_list, object_temp or [], depth_um, out,
+                            fmt != "table", touch_conductance, name=name, force=force,
+                            rows_fmt=fmt if fmt in ("csv", "md") else None, plot=plot, offset_bounds_s=bounds,
+                            fit_to=fit_to)
     if fmt == "json":
-        payload = result.to_dict()
-        payload.update({"out": str(out) if out else None, "plot": str(plot) if plot else None, "index": str(index)})
         emit_json(payload)
-        return
-    _print_fit(result, out, plot)
 
 
 # ------------------------------------------------------------ guided run
@@ -803,14 +699,11 @@ def guided(
     range_: RangeOpt = None,
     object_temp: ObjectTempOpt = None,
     depth_um: DepthOpt = 80.0,
-    bootstrap: BootstrapOpt = 100,
     timeout: TimeoutOpt = None,
     yes: Annotated[bool, typer.Option("--yes", "-y", help="Do not wait for Enter before each material.")] = False,
     force: Annotated[bool, typer.Option(
         "--force", help="Write the sensor file even when the calibration is unusable.")] = False,
-    model: Annotated[Optional[str], typer.Option(
-        "--model", help="Identify this sensor model (as 'calibrate fit --model'; 'all': the best by BIC) and "
-                        "record it in the sensor file (default: the paper's semi-infinite fit).")] = None,
+    model: ModelOpt = None,
     json_: Json = False,
 ) -> None:
     """Guided calibration: record every material over serial, then fit and write the sensor file.
@@ -826,15 +719,18 @@ def guided(
     if port is None or not material or out is None:
         raise InputError("the guided run needs --port, at least one --material and --out "
                          "(or use 'calibrate record' and 'calibrate fit')")
-    if not all(m.strip() for m in material):
-        raise InputError("--material must not be empty (it names the trials in the index)")
+    from ..calibration.trials import check_material_label
+
+    for m in material:  # before anything is recorded: a label that cannot name a trial lost 8 s of touch
+        check_material_label(m, "--material")
     _check_trials(trials)
     _check_timeout(timeout)
+    if not (depth_um > 0 and math.isfinite(depth_um)):
+        raise InputError(f"--depth-um must be positive, got {depth_um:g}")
     from ..calibration.fit import parse_object_temps, parse_ranges, resolve_ranges
     from ..calibration.profiles import load_profile
 
     prof = load_profile(profile)
-    settings = _fit_settings(depth_um, bootstrap, 0)
     materials = list(dict.fromkeys(material))
     # everything the fit will need is checked before the first touch (a session's work was lost to a typo)
     resolve_ranges(materials, parse_ranges(range_ or []))
@@ -842,7 +738,7 @@ def guided(
     if unknown:
         raise InputError(f"--object-temp names {', '.join(map(repr, unknown))}, not a material of this run "
                          f"({', '.join(materials)})")
-    if model is not None and model.strip().lower() != "all":
+    if model is not None and model.strip().lower() not in ("all", "auto"):
         from ..calibration.identify import candidate
 
         candidate(model)
@@ -859,21 +755,11 @@ def guided(
                                    f"'designkit calibrate fit {out / 'index.csv'}'")
         raise typer.Exit(EXIT_INTERRUPTED)
     sensor_path = sensor_out or out / "sensor.yaml"
-    if model is not None:
-        if not json_:
-            console().print(f"Recorded {len(paths)} trial(s) in {out}")
-        _run_identify(out / "index.csv", model, "all", range_ or [], materials, object_temp or [], depth_um,
-                      sensor_path, json_, name=None, force=force)
-        return
-    result = _run_fit(out / "index.csv", range_ or [], materials, object_temp or [], settings, sensor_path, None,
-                      None, quiet=json_, force=force)
+    record = _record_payload(rec, paths, out, False)
+    payload = _run_identify(out / "index.csv", model, None, range_ or [], materials, object_temp or [], depth_um,
+                            sensor_path, json_, name=None, force=force, record=record)
     if json_:
-        payload = {"record": _record_payload(rec, paths, out, False), "fit": result.to_dict(),
-                   "sensor": str(sensor_path)}
-        emit_json(payload)
-        return
-    console().print(f"Recorded {len(paths)} trial(s) in {out}")
-    _print_fit(result, sensor_path, None)
+        emit_json({"record": record, "fit": payload, "sensor": str(sensor_path)})
 
 
 # ----------------------------------------------------------------- emulate
@@ -914,7 +800,8 @@ def emulate(
     speed: Annotated[float, typer.Option("--speed", help="Device seconds per real second (20: 20x real time).")] = 1.0,
     fault: Annotated[Optional[list[str]], typer.Option(
         "--fault", help="Inject a fault (repeatable): garbled=P, partial=P, non-numeric=P, field-count=P, "
-                        "out-of-range=P (per-line probabilities, from device time line-faults-after=S on), "
+                        "out-of-range=P, out-of-order=P, duplicate=P, corrupt=P (per-line probabilities, from device time "
+                        "line-faults-after=S on), "
                         "burst=EVERY_S[:HOLD_S], gap=EVERY_S[:SILENT_S], vanish=AFTER_S, silent.")] = None,
     duration: Annotated[Optional[float], typer.Option(
         "--duration", help="Stop after this many real seconds (default: run until Ctrl-C).")] = None,
@@ -935,12 +822,16 @@ def emulate(
 
     mats = []
     for spec in material or []:
-        label, sep, value = spec.partition("=")
+        label, sep, value = spec.rpartition("=")   # the effusivity follows the last "="
         if sep:
+            from .._validation import check_label
+
+            check_label(f"--material {spec!r}: the label", label)  # '=400' and a newline were taken
             try:
-                mats.append(EmulatedMaterial(label.strip(), float(value), object_temp))
+                e_label = float(value)
             except ValueError:
                 raise InputError(f"--material {spec!r}: use NAME or LABEL=EFFUSIVITY") from None
+            mats.append(EmulatedMaterial(label.strip(" "), e_label, object_temp))  # a newline is refused, not cut
         else:
             from ..materials import get_material
 

@@ -127,8 +127,15 @@ def classify(
     from ..recognition.sequential import SequentialTest
     from ..sensor import check_samples_per_touch, load_sensor
 
+    from ._format import check_out
+    from ._options import refuse_together
+
     if port is None and export_c is None:
         raise InputError("give --port (the serial device of the rig), or --export-c FILE for a C header")
+    refuse_together(("--port", port), ("--export-c", export_c),
+                    why="--port runs the test on a rig, --export-c writes it as a C header")
+    if export_c is not None:
+        check_out(export_c, "--export-c")  # a missing folder is not made (as export's --out)
     if not m or len(m) < 2:
         raise InputError("give two or more candidate materials with --m")
     if not 1 <= touches <= 1000:

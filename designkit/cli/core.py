@@ -51,6 +51,12 @@ def simulate(
     check_temperature("--sensor-temp [°C]", sensor_temp)
     check_temperature("--ambient [°C]", ambient)
     check_temperature("--noise [°C]", noise, nonnegative=True)
+    from ._format import check_out
+
+    if out is not None and not to_stdout:
+        check_out(out, "--out")  # before the work; a missing folder is not made
+    if plot is not None:
+        check_out(plot, "--plot")
     sen, fm, source = sensor_and_model(sensor, model, conductance=conductance, thickness=thickness,
                                        backing=backing)
     scene = Scene(contact_s=contact, noise_c=noise, sensor_temp_c=sensor_temp, ambient_temp_c=ambient)
@@ -111,10 +117,9 @@ def _check_touch_memory(what: str, touches: int, sensor, contact_s: float, *, co
     The samples per touch are bounded by the sensor (:data:`designkit.sensor.MAX_SAMPLES_PER_TOUCH`);
     ``copies`` counts the float64 arrays of that size the computation holds at once.
     """
-    from .._validation import check_memory
+    from ..simulation import check_touch_budget
 
-    samples = sensor.times_s(contact_s).size
-    check_memory(f"{what}: {touches:g} touches x {samples} samples", float(touches) * samples * 8 * copies)
+    check_touch_budget(what, touches, sensor.times_s(contact_s).size, copies=copies)
 
 
 def _touches(e: float, sensor, scene, trials: int, seed: int, model, diffusivity_m2_s: Optional[float]):
@@ -211,6 +216,9 @@ def f1(
     check_probability("--threshold (F1)", threshold, low=2 / 3, high=1.0)  # a blind guess scores 2/3
     check_temperature("--noise [°C]", noise, nonnegative=True)
     check_temperature("--delta-t [°C]", delta_t)
+    if delta_t == 0 and not two_sensor:  # sensor and objects at one temperature: no heat flows, nothing to tell
+        raise InputError("--delta-t must be non-zero: a sensor at the objects' temperature reads no difference "
+                         "(F1 is chance)")
     from ..sweep.config import MAX_EFFUSIVITY
 
     check_positive("--width", width)

@@ -89,6 +89,10 @@ def design(
         depths = (float(lo), float(hi)) if sep else (float(lo), float(lo))
     except ValueError:
         raise InputError(f"--depth-um must look like MIN:MAX in um, got {depth_um!r}") from None
+    if plot is not None:
+        from ._format import check_out
+
+        check_out(plot, "--plot")  # before the search; a missing folder is not made
     cons = Constraints(max_contact_s=max_contact, noise_c=noise, max_delta_t_c=max_delta_t, max_rate_hz=max_rate,
                        depth_um=depths, threshold=threshold)
     targets = targets_from(m or (), set_)

@@ -78,6 +78,12 @@ def matrix(
     from ..query.inputs import TableMismatch
     from ..query.matrix import material_matrix
 
+    from ._format import check_out
+    from ._options import refuse_together
+
+    refuse_together(("--m", m), ("--set", set_), ("--from", from_), why="each names the materials")
+    if plot:
+        check_out(plot, "--plot")  # before the work, as export's --out
     names = list(m or ()) + (read_material_names(from_) if from_ else [])
     fmt = "json" if json_ else check_format(format_)
     scene = {"contact_s": contact, "noise_c": noise, "delta_t_c": delta_t, "threshold": threshold}

@@ -19,7 +19,7 @@ import typer
 
 from . import _app
 from ._app import app, emit_json
-from ._format import OutOpt, check_format, check_out, emit_rows, output_to
+from ._format import check_format, check_out, emit_rows, output_to
 from ._options import (
     E1,
     E2,
@@ -28,11 +28,9 @@ from ._options import (
     M2,
     BackingOpt,
     Conductance,
-    DeltaT,
     Diffusivity,
     Json,
     ModelOpt,
-    Noise,
     PANEL_EXACT,
     PANEL_OUTPUT,
     PANEL_QUESTION,
@@ -70,12 +68,18 @@ NmcQ = Annotated[int, typer.Option(
     rich_help_panel=PANEL_EXACT)]
 MaxContact = Annotated[float, typer.Option("--max-contact", help="--exact: longest contact time to consider [s].",
     rich_help_panel=PANEL_EXACT)]
-SpreadOpt = Annotated[float, typer.Option(
+NoiseQ = Annotated[Optional[float], typer.Option(
+    "--noise", help="Noise sigma per sample [°C] (default 0.05, or the rig's as calibrated in a --sensor file).",
+    rich_help_panel=PANEL_SCENE)]
+DeltaTQ = Annotated[Optional[float], typer.Option(
+    "--delta-t", help="Sensor minus object temperature before contact [°C] (default 10, or the rig's as "
+                      "calibrated in a --sensor file).", rich_help_panel=PANEL_SCENE)]
+SpreadOpt = Annotated[Optional[float], typer.Option(
     "--sensor-temp-spread", help="Varied initial conditions: each touch's sensor temperature uniform within "
     "+-this [°C] of ambient + dT (the paper's robot: --delta-t 7.5 --sensor-temp-spread 2.5, answered from the "
     "shipped table svm-paper-varied for min-contact, delta-e and distinguishable); any other case is computed "
-    "like --exact. Must stay below |dT|.",
-    rich_help_panel=PANEL_SCENE)]
+    "like --exact. Must stay below |dT|. Default 0, or the rig's touch-to-touch spread of dT as calibrated in a "
+    "--sensor file.", rich_help_panel=PANEL_SCENE)]
 CoverageOpt = Annotated[float, typer.Option(
     "--coverage", help="Coverage of the answer's interval, in (0, 1) (table and --exact).",
     rich_help_panel=PANEL_QUESTION)]
@@ -115,23 +119,54 @@ def _hints():
 def _ask(question: str, *, exact: bool, table: Optional[str], ideal_table: str, threshold: float, sensor: str,
          model, conductance, thickness, backing, diffusivity, width: float, trials: int, repeats: int, seed: int,
          jobs: int, n_mc: int, objects: dict, scene: dict, exact_extra: Optional[dict] = None,
-         progress: bool = False, coverage: float = 0.9, spread: float = 0.0):
-    """The one library call of a command: the table route, or the exact one."""
+         progress: bool = False, coverage: float = 0.9, spread: Optional[float] = None):
+    """The one library call of a command: the table route, or the exact one.
+
+    The scene's values not given (None) come from the sensor file's rig conditions, else the defaults
+    (:func:`designkit.rig.resolve_scene`); the answer says which and where each came from."""
+    ans, rig, asked = _ask_scene(question, exact=exact, table=table, ideal_table=ideal_table, threshold=threshold,
+                                 sensor=sensor, model=model, conductance=conductance, thickness=thickness,
+                                 backing=backing, diffusivity=diffusivity, width=width, trials=trials,
+                                 repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc, objects=objects, scene=scene,
+                                 exact_extra=exact_extra, progress=progress, coverage=coverage, spread=spread)
+    from ..rig import for_rig
+
+    return for_rig(ans, rig, asked)
+
+
+def _ask_scene(question: str, *, exact: bool, table: Optional[str], ideal_table: str, threshold: float, sensor: str,
+               model, conductance, thickness, backing, diffusivity, width: float, trials: int, repeats: int,
+               seed: int, jobs: int, n_mc: int, objects: dict, scene: dict, exact_extra: Optional[dict] = None,
+               progress: bool = False, coverage: float = 0.9, spread: Optional[float] = None):
     from .. import query
     from ..query.crossing import check_coverage
 
+    from ._options import refuse_together
+
+    refuse_together(("--exact", exact), ("--table", table),
+                    why="--exact computes the answer for the pair, --table reads it from a table")
+    from .._validation import MAX_EFFUSIVITY, InputError, check_positive
+
+    if check_positive("--width", width) > MAX_EFFUSIVITY:  # on either route (the table's is its own): 1e308 was taken
+        raise InputError(f"--width must be at most {MAX_EFFUSIVITY:g} J s^-1/2 K^-1 m^-2, got {width:g}")
     extra = dict(exact_extra or {})
     extra["coverage"] = check_coverage(coverage)  # bad input before any work, on either route
 
     with _hints():
         from ..query.inputs import table_reroute
 
-        if spread < 0 or spread != spread:
+        if spread is not None and (spread < 0 or spread != spread):
             from .._validation import InputError
 
             raise InputError(f"sensor temperature spread must be >= 0 degC, got {spread:g}")
         sen, fm, source = sensor_and_model(sensor, model, conductance=conductance, thickness=thickness,
                                            backing=backing)
+        from ..rig import resolve_scene
+
+        asked = scene.get("contact_s")
+        rig = resolve_scene(sen, {**scene, "sensor_temp_spread_c": spread})
+        scene = {k: rig.values[k] for k in scene}
+        spread = rig.values["sensor_temp_spread_c"]
         # the shipped tables are for the paper sensor and the semi-infinite model: another sensor or model is
         # computed unless a table is named (a named table built for another one is refused, never used);
         # varied initial conditions: no shipped table holds them, computed for the pair
@@ -156,13 +191,14 @@ def _ask(question: str, *, exact: bool, table: Optional[str], ideal_table: str, 
             return query.ask(question, route="table", **objects, **scene, threshold=threshold,
                              table=table or varied or DEFAULT_TABLE, ideal_table=ideal_table,
                              sensor=None if sensor == "paper" else sen, model=fm, coverage=extra["coverage"],
-                             sensor_temp_spread_c=spread)
+                             sensor_temp_spread_c=spread), rig, asked
         kw = dict(threshold=threshold, sensor=sen, model=fm, diffusivity_m2_s=diffusivity, width=width,
                   trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc, **extra)
         with _exact_display(question, progress) as report:
             if report is not None:
                 kw["progress"] = report
-            return _noted(query.ask(question, route="exact", **objects, **scene, **kw), reroute, sen, fm, source)
+            return _noted(query.ask(question, route="exact", **objects, **scene, **kw), reroute, sen, fm,
+                          source), rig, asked
 
 
 @contextmanager
@@ -405,13 +441,14 @@ def _explain_lines(con, d):
 @app.command("min-contact", rich_help_panel=_app.ASK)
 def min_contact_cmd(
     e1: E1 = None, e2: E2 = None, m1: M1 = None, m2: M2 = None,
-    noise: Noise = 0.05, delta_t: DeltaT = 10.0, threshold: Threshold = 0.9, sensor: SensorOpt = "paper",
+    noise: NoiseQ = None, delta_t: DeltaTQ = None, threshold: Threshold = 0.9, sensor: SensorOpt = "paper",
     model: ModelOpt = None, conductance: Conductance = None, thickness: Thickness = None,
     backing: BackingOpt = None, diffusivity: Diffusivity = None,
     exact: Exact = False, table: TableOpt = None, ideal_table: IdealTableOpt = "ideal-paper",
     trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
     n_mc: NmcQ = 1000, max_contact: MaxContact = 10.0, coverage: CoverageOpt = 0.9,
-    sensor_temp_spread: SpreadOpt = 0.0, json_: Json = False, explain: Explain = False,
+    sensor_temp_spread: SpreadOpt = None, json_: Json = False,
+    explain: Explain = False,
 ) -> None:
     """Shortest contact time that separates two materials.
 
@@ -431,12 +468,12 @@ def min_contact_cmd(
 @app.command("max-noise", rich_help_panel=_app.ASK)
 def max_noise_cmd(
     e1: E1 = None, e2: E2 = None, m1: M1 = None, m2: M2 = None,
-    contact: Contact = 2.0, delta_t: DeltaT = 10.0, threshold: Threshold = 0.9, sensor: SensorOpt = "paper",
+    contact: Contact = 2.0, delta_t: DeltaTQ = None, threshold: Threshold = 0.9, sensor: SensorOpt = "paper",
     model: ModelOpt = None, conductance: Conductance = None, thickness: Thickness = None,
     backing: BackingOpt = None, diffusivity: Diffusivity = None,
     exact: Exact = False, table: TableOpt = None, ideal_table: IdealTableOpt = "ideal-paper",
     trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
-    n_mc: NmcQ = 1000, coverage: CoverageOpt = 0.9, sensor_temp_spread: SpreadOpt = 0.0, json_: Json = False,
+    n_mc: NmcQ = 1000, coverage: CoverageOpt = 0.9, sensor_temp_spread: SpreadOpt = None, json_: Json = False,
     explain: Explain = False,
 ) -> None:
     """Largest sensor noise at which a contact time still separates two materials.
@@ -455,12 +492,12 @@ def max_noise_cmd(
 @app.command("min-delta-t", rich_help_panel=_app.ASK)
 def min_delta_t_cmd(
     e1: E1 = None, e2: E2 = None, m1: M1 = None, m2: M2 = None,
-    contact: Contact = 2.0, noise: Noise = 0.05, threshold: Threshold = 0.9, sensor: SensorOpt = "paper",
+    contact: Contact = 2.0, noise: NoiseQ = None, threshold: Threshold = 0.9, sensor: SensorOpt = "paper",
     model: ModelOpt = None, conductance: Conductance = None, thickness: Thickness = None,
     backing: BackingOpt = None, diffusivity: Diffusivity = None,
     exact: Exact = False, table: TableOpt = None, ideal_table: IdealTableOpt = "ideal-paper",
     trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
-    n_mc: NmcQ = 1000, coverage: CoverageOpt = 0.9, sensor_temp_spread: SpreadOpt = 0.0, json_: Json = False,
+    n_mc: NmcQ = 1000, coverage: CoverageOpt = 0.9, sensor_temp_spread: SpreadOpt = None, json_: Json = False,
     explain: Explain = False,
 ) -> None:
     """Smallest sensor-object temperature difference that separates two materials.
@@ -482,13 +519,13 @@ def delta_e_cmd(
                                                rich_help_panel=PANEL_QUESTION)] = None,
     m: Annotated[Optional[str], typer.Option("--m", help="Reference material (its range's middle).",
                                              rich_help_panel=PANEL_QUESTION)] = None,
-    contact: Contact = 2.0, noise: Noise = 0.05, delta_t: DeltaT = 10.0, threshold: Threshold = 0.9,
+    contact: Contact = 2.0, noise: NoiseQ = None, delta_t: DeltaTQ = None, threshold: Threshold = 0.9,
     sensor: SensorOpt = "paper",
     model: ModelOpt = None, conductance: Conductance = None, thickness: Thickness = None,
     backing: BackingOpt = None, diffusivity: Diffusivity = None,
     exact: Exact = False, table: TableOpt = None, ideal_table: IdealTableOpt = "ideal-paper",
     trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
-    n_mc: NmcQ = 1000, coverage: CoverageOpt = 0.9, sensor_temp_spread: SpreadOpt = 0.0,
+    n_mc: NmcQ = 1000, coverage: CoverageOpt = 0.9, sensor_temp_spread: SpreadOpt = None,
     format_: Annotated[Optional[str], typer.Option(
         "--format", "-f", help="Print the two directions as rows: table, json, csv or md (default: the answer "
                                "for people; --json: the whole answer).", rich_help_panel=PANEL_OUTPUT)] = None,
@@ -528,13 +565,13 @@ def delta_e_cmd(
 @app.command("distinguishable", rich_help_panel=_app.ASK)
 def distinguishable_cmd(
     e1: E1 = None, e2: E2 = None, m1: M1 = None, m2: M2 = None,
-    contact: Contact = 2.0, noise: Noise = 0.05, delta_t: DeltaT = 10.0, threshold: Threshold = 0.9,
+    contact: Contact = 2.0, noise: NoiseQ = None, delta_t: DeltaTQ = None, threshold: Threshold = 0.9,
     sensor: SensorOpt = "paper",
     model: ModelOpt = None, conductance: Conductance = None, thickness: Thickness = None,
     backing: BackingOpt = None, diffusivity: Diffusivity = None,
     exact: Exact = False, table: TableOpt = None, ideal_table: IdealTableOpt = "ideal-paper",
     trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
-    n_mc: NmcQ = 1000, coverage: CoverageOpt = 0.9, sensor_temp_spread: SpreadOpt = 0.0, json_: Json = False,
+    n_mc: NmcQ = 1000, coverage: CoverageOpt = 0.9, sensor_temp_spread: SpreadOpt = None, json_: Json = False,
     explain: Explain = False,
 ) -> None:
     """Whether a scene separates two materials, with the SVM's and the ideal observer's F1.

@@ -1,4 +1,4 @@
-"""``designkit reproduce``: the paper's analyses as a report (designkit.reproduce)."""
+"""``designkit reproduce``: the paper's analyses as a report (designkit_lab.reproduce)."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ from typing import Annotated, List, Optional
 
 import typer
 
-from ._app import app, console, emit_json
+from ._app import app, console, emit_json, import_lab
 from . import _app
 from ._options import Json, Seed
 
@@ -41,7 +41,8 @@ def reproduce(
 
     Example: `designkit reproduce --out report --only multiclass,node-graphs --figure-format svg`
     """
-    from ..reproduce import ReproduceSettings, parse_only, reproduce as run
+    lab = import_lab("reproduce", "reproduce")
+    ReproduceSettings, parse_only, run = lab.ReproduceSettings, lab.parse_only, lab.reproduce
 
     names = parse_only(only)
     settings = ReproduceSettings(tables_dir=tables, robot_data=robot_data, quick=quick, seed=seed, jobs=jobs,

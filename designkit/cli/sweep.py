@@ -107,10 +107,16 @@ def sweep(
         if "noise_c" in given:
             given.setdefault("noise_ratio", None)
         cfg = SweepConfig.from_mapping(given, source="options")
+    from ._format import check_out, check_out_dir
+
+    if workdir is not None:
+        check_out_dir(workdir, "--workdir")  # before any work: as every command's output folder
     wd = workdir if workdir is not None else Path("sweeps") / cfg.name
     target = out
     if target is not None and (target.is_dir() or target.suffix == ""):
-        target = target / f"{cfg.name}.npz"
+        target = check_out_dir(target, "--out") / f"{cfg.name}.npz"
+    elif target is not None:
+        check_out(target, "--out")
     con = console(stderr=True)
     total = len(cfg.scene_points()) * len(cfg.blocks_of()) * len(cfg.contact_s)
     started = time.perf_counter()

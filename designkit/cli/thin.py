@@ -52,6 +52,10 @@ def validity(
     from ..models.slab import material_validity, resolve_backing, semi_infinite_deviation, semi_infinite_validity
 
     L = check_positive("thickness [m]", thickness)
+    if plot is not None:
+        from ._format import check_out
+
+        check_out(plot, "--plot")  # before the work; a missing folder is not made
     if delta_t == 0:
         raise InputError("--delta-t must be non-zero: an unheated sensor sees no difference to hold a tolerance to")
     sen = load_sensor(sensor)

@@ -50,6 +50,10 @@ class Target:
     width: float = 80.0
 
 
+#: Deepest thermistor considered [um]: 1 cm, a time constant of minutes under any skin.
+MAX_DEPTH_UM = 1e4
+
+
 @dataclass(frozen=True)
 class Constraints:
     """What the design must respect.
@@ -87,6 +91,9 @@ class Constraints:
         if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo <= hi):
             raise InputError(f"thermistor depths contradict each other: MIN must be positive and <= MAX, "
                              f"got {lo:g}:{hi:g} um")
+        if hi > MAX_DEPTH_UM:  # 1e308 um was searched
+            raise InputError(f"thermistor depth must be at most {MAX_DEPTH_UM:g} um (1 cm: a time constant of minutes "
+                             f"under any skin), got {hi:g} um")
         if not 0.5 < self.threshold < 1.0:
             raise InputError(f"F1 threshold must lie in (0.5, 1), got {self.threshold:g}")
         if self.max_contact_s * self.max_rate_hz < 1.0:

@@ -187,9 +187,11 @@ def parse_contact(items: Sequence[Any] | str | float | None) -> tuple[float | tu
         if isinstance(item, (int, float)):
             out.append(check_positive("contact time [s]", item))
             continue
-        for part in str(item).replace(" ", "").split(","):
-            if not part:
-                continue
+        text = str(item).replace(" ", "")
+        for part in text.split(","):
+            if not part:  # 1,,2 (a value left out), or a trailing comma: refused, not skipped
+                raise InputError(f"contact times must be values or ranges separated by single commas, got "
+                                 f"{printable(text)!r}")
             if ":" in part:
                 lo, _, hi = part.partition(":")
                 try:

@@ -92,6 +92,10 @@ class ForwardModel:
     #: Solved numerically (an inverse Laplace transform, say): a caller evaluating it at many times may
     #: interpolate it between fewer (the identification does).
     solved_numerically: ClassVar[bool] = False
+    #: Costly per object (an inverse Laplace transform per time, a sum over a force ramp): a simulation of
+    #: many touches of one class reads it at a few effusivities of the class and interpolates between them,
+    #: within the simulation's tolerance (:mod:`designkit.models.shared`).
+    shared_response: ClassVar[bool] = False
 
     # ------------------------------------------------------------ the physics
     def response(self, time_s, e_object, sensor, *, diffusivity_m2_s=None, tolerance: float = 1e-9) -> np.ndarray:

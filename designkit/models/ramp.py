@@ -109,6 +109,7 @@ class ForceRamp(ForwardModel):
 
     name = "force-ramp"
     shared_shape = False
+    shared_response = True
     units = {"ramp_time_s": "s", "ramp_area": "share of the final contact area", "force_fraction": "of F_p"}
 
     def __post_init__(self) -> None:
@@ -197,15 +198,52 @@ class ForceRamp(ForwardModel):
         out = np.zeros((k, t.size))
         if not pos.any():
             return out
-        # one evaluation of the step response at the distinct lags (on a uniform grid with the ramp on
-        # the same grid: about m + J of them, not m J)
+        dt = float(t[1] - t[0]) if t.size > 1 else 0.0
+        if dt > 0 and np.all(np.abs(np.diff(t) - dt) <= 1e-9 * dt):
+            return self._on_grid(out, t, dt, tj, da, step, e_object, sensor, diffusivity_m2_s, tolerance)
+        # any times: one evaluation of the step response at the distinct lags, then the sum share by share
         key = np.round(lags[pos] * 1e9).astype(np.int64)
         uniq, first, inverse = np.unique(key, return_index=True, return_inverse=True)
         u = step.response(lags[pos][first], e_object, sensor, diffusivity_m2_s=diffusivity_m2_s,
                           tolerance=tolerance)                           # (K, U)
-        full = np.zeros((k,) + lags.shape)
-        full[:, pos] = u[:, inverse.ravel()]
-        return np.einsum("j,kjm->km", da, full)
+        where = np.zeros(lags.shape, dtype=np.int64)
+        where[pos] = inverse.ravel()
+        for j in range(tj.size):
+            cols = np.flatnonzero(pos[j])
+            out[:, cols] += da[j] * u[:, where[j, cols]]
+        return out
+
+    @staticmethod
+    def _on_grid(out, t, dt, tj, da, step, e_object, sensor, diffusivity_m2_s, tolerance) -> np.ndarray:
+        """The Duhamel sum on a uniform grid as a (sparse) convolution: ``out[i] += dA_j S[n_j + i]``.
+
+        Share ``j``'s lags are ``t_0 + i dt - t_j = (n_j + f_j + i) dt`` with ``n_j`` whole and the phase
+        ``f_j`` in [0, 1): the shares of one phase read one step response ``S_l = u_step((f + l) dt)``
+        (a ramp on the grid's own step: one phase, about ``m`` times), each shifted by its ``n_j``.
+        """
+        shift = (t[0] - tj) / dt
+        whole = np.floor(shift + 1e-9)
+        frac = np.round(np.maximum(shift - whole, 0.0), 9)
+        whole = whole.astype(np.int64)
+        m = t.size
+        for f in np.unique(frac):
+            group = np.flatnonzero(frac == f)
+            n_hi = int(whole[group].max())
+            length = n_hi + m                                             # l = 0 .. n_j + m - 1
+            if length <= 0:
+                continue
+            lag = (f + np.arange(length)) * dt
+            live = lag > 0
+            S = np.zeros((out.shape[0], length))
+            if live.any():
+                S[:, live] = step.response(lag[live], e_object, sensor, diffusivity_m2_s=diffusivity_m2_s,
+                                           tolerance=tolerance)
+            for j in group:
+                lo = max(0, -int(whole[j]))                               # first sample with n_j + i >= 0
+                if lo >= m:
+                    continue
+                out[:, lo:] += da[j] * S[:, int(whole[j]) + lo:int(whole[j]) + m]
+        return out
 
     def response(self, time_s, e_object, sensor, *, diffusivity_m2_s=None, tolerance: float = 1e-9) -> np.ndarray:
         """Normalized reading (K, m): the area-weighted sum of the base model's step responses.

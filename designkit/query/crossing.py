@@ -19,7 +19,7 @@ a model of the curve near the crossing and solves it:
 
 The interval covers the crossing of the *mean* F1 curve (the answer with
 infinitely many seeds), at the stated coverage, to the extent the local
-linear model holds (the coverage benchmark, :mod:`designkit.accuracy.coverage`,
+linear model holds (the coverage benchmark, :mod:`designkit_lab.accuracy.coverage`,
 measures it).
 
 Examples

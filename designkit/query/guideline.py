@@ -4,7 +4,7 @@ Bai et al. conclude that separating e = 35,000 from 20,000 J s^-1/2 K^-1 m^-2 wi
 sigma 0.05 degC and the sensor 10 degC above the object takes contact "for at least
 2 s" on their grid of 1, 2, 3, 4 s (F1 >= 0.9). The main job (``designkit min-contact
 --e1 35000 --e2 20000``) is that question; :func:`guideline_remark` words the paper's
-answer beside designkit's. :mod:`designkit.reproduce.paper` re-exports :data:`GUIDELINE`
+answer beside designkit's. :mod:`designkit_lab.reproduce.paper` re-exports :data:`GUIDELINE`
 with the paper's other numbers.
 """
 

@@ -20,7 +20,7 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from .._validation import InputError, check_positive, check_repeats
+from .._validation import check_file_name, InputError, check_positive, check_repeats
 from ..models import get_model
 from ..objects import ObjectClass
 from ..recognition.features import DEFAULT_SLOPE_WINDOW_S
@@ -156,6 +156,7 @@ class SweepConfig:
         if not isinstance(self.name, str) or not isinstance(self.sensor, str):
             bad = "name" if not isinstance(self.name, str) else "sensor"
             raise InputError(f"{bad}: expected text, got {getattr(self, bad)!r}")
+        check_file_name("name (the table's file name)", self.name)  # before any work: it names files
         if int(self.intervals) != self.intervals or self.intervals < 2:
             raise InputError(f"intervals must be an integer >= 2, got {self.intervals}")
         if self.intervals > MAX_INTERVALS:

@@ -74,8 +74,12 @@ BATCH_MB = 128
 #: Most pairs in one batched-solver call (beyond this a batch is no faster per pair).
 MAX_BATCH = 64
 
-#: Pairs the batched solver stacks and solves together inside a call (its ``chunk_size``); a
-#: call itself carries every pair of a search step (bounded by the feature cache, not by this).
+#: Pairs the batched solver stacks and solves together inside a call (its ``chunk_size``) on numpy's
+#: fast path; a call itself carries every pair of a search step (bounded by the feature cache, not by
+#: this). The array-API path (``batched-cupy``, ``batched-array-api``) stacks the whole batch
+#: (:func:`batch_pairs`): on a GPU each array operation is a kernel launch whatever its size, so a
+#: stack of 8 pairs left it launch-bound. A pair's arithmetic does not depend on its neighbours in the
+#: stack, so the chunk size changes no result (tests/test_engine.py builds the same table both ways).
 CHUNK_PAIRS = 8
 
 
@@ -202,7 +206,8 @@ class PairScorer:
             yield part, batched_cv_f1([self.features(i, rep) for i, _, rep in part],
                                       [self.features(j, rep) for _, j, rep in part],
                                       seeds=[[self.cfg.seed, i, j, rep, CV_KEY] for i, j, rep in part],
-                                      folds=self.cfg.folds, chunk_size=min(size, CHUNK_PAIRS), xp=xp)
+                                      folds=self.cfg.folds, chunk_size=size if xp is not np else min(size, CHUNK_PAIRS),
+                                      xp=xp)
 
     def _calls(self, keys: list[tuple[int, int, int]]):
         """Consecutive runs of ``keys`` whose distinct feature matrices fit a quarter of the feature cache.

@@ -47,6 +47,7 @@ import hashlib
 import io
 import json
 import math
+import struct
 import zipfile
 import zlib
 from collections.abc import Mapping
@@ -62,6 +63,8 @@ __all__ = [
     "SHIPPED_CONTENT_HASHES",
     "SHIPPED_FILE_DIGESTS",
     "file_digest",
+    "member_digest",
+    "member_digests",
     "SCHEMA_VERSION",
     "Table",
     "content_hash",
@@ -223,38 +226,143 @@ def _zip_members(z: zipfile.ZipFile) -> dict[str, zipfile.ZipInfo]:
     return {i.filename[:-4]: i for i in z.infolist() if i.filename.endswith(".npy")}
 
 
-def _read_member(path: Path, info: zipfile.ZipInfo) -> np.ndarray:
-    """One array of an .npz: a member stored uncompressed is mapped from the file, read-only, so that only
-    the pages a question touches are read; a compressed one is decompressed (and its CRC checked)."""
-    import mmap
-    import struct
+class _EditedArray(ValueError):
+    """An array whose npy header or bytes differ from what the table's header (or shipped digest) says."""
 
-    if info.compress_type != zipfile.ZIP_STORED:
-        with np.load(path, allow_pickle=False) as z:
-            return z[info.filename[:-4]]
+
+def _check_npy_header(name: str, shape: tuple, fortran: bool, dtype: np.dtype, spec: Mapping[str, Any] | None) -> None:
+    """The npy header of array ``name`` against its entry in the JSON header (``spec``: shape, dtype).
+
+    :func:`write_table` writes C-ordered arrays of the listed shape and dtype; anything else (a byte-swapped
+    dtype, a permuted shape, ``fortran_order``) is an edit, refused whatever the zip directory says.
+    """
+    if dtype.hasobject:
+        raise _EditedArray(f"array {name} holds Python objects; tables hold numbers only")
+    if fortran:
+        raise _EditedArray(f"array {name} is stored in Fortran order; tables are written in C order")
+    if spec is None:
+        return  # unlisted: check_table names it
+    try:
+        want = np.dtype(str(spec["dtype"]))
+        want_shape = tuple(int(n) for n in spec["shape"])
+    except (TypeError, ValueError, KeyError):
+        raise _EditedArray(f"array {name}: the header's dtype/shape entry is not one") from None
+    if dtype != want or dtype.str != want.str or tuple(shape) != want_shape:
+        raise _EditedArray(f"array {name} is stored as {dtype.str}{list(shape)}, the header says "
+                           f"{want.str}{list(want_shape)}")
+
+
+#: Member digests this process has checked, by file identity: ``(device, inode, size, mtime_ns, ctime_ns,
+#: member) -> digest``. A table read again (another question, another view) is not hashed again; a file
+#: rewritten, even in place, has another identity. Bounded (a long-lived process reading many tables).
+_VERIFIED: dict[tuple, str] = {}
+_VERIFIED_MAX = 4096
+
+
+def _verified(key: tuple, digest: str) -> bool:
+    return _VERIFIED.get(key) == digest
+
+
+def _remember(key: tuple, digest: str) -> None:
+    if len(_VERIFIED) >= _VERIFIED_MAX:
+        _VERIFIED.clear()
+    _VERIFIED[key] = digest
+
+
+def member_digest(npy_bytes) -> str:
+    """SHA-256 of one member of a table's .npz: its whole ``.npy`` (header and data), decompressed.
+
+    What :data:`SHIPPED_MEMBER_DIGESTS` lists, and what a shipped table's array is checked against when it is
+    first read (the npy header included: dtype, shape and order as well as every byte)."""
+    return "sha256:" + hashlib.sha256(npy_bytes).hexdigest()
+
+
+def member_digests(path: str | Path) -> dict[str, str]:
+    """:func:`member_digest` of every array of the .npz at ``path``, by array name (to list a shipped table)."""
+    with zipfile.ZipFile(path) as z:
+        return {n: member_digest(z.read(i)) for n, i in sorted(_zip_members(z).items())}
+
+
+def _read_member(path: Path, info: zipfile.ZipInfo, spec: Mapping[str, Any] | None = None,
+                 digest: str | None = None) -> np.ndarray:
+    """One array of an .npz, read-only, its npy header checked against ``spec`` (the JSON header's entry).
+
+    A member stored uncompressed is mapped from the file, so that only the pages a question touches are
+    read; a compressed one is decompressed (its CRC checked). With ``digest`` (a shipped table's
+    :func:`member_digest`) the member's bytes as read or mapped are hashed and compared first: the zip
+    directory is not trusted for them. A member checked once in this process is not hashed again while its
+    file keeps its identity (device, inode, size, mtime, ctime).
+    """
+    import mmap
+    import os
+
+    name = info.filename[:-4]
     with open(path, "rb") as fh:
+        st = os.fstat(fh.fileno())
+        key = (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns, info.filename)
+        if info.compress_type != zipfile.ZIP_STORED:
+            with zipfile.ZipFile(fh) as z:
+                raw = z.read(info)  # decompressed, CRC-checked
+            if digest is not None and not _verified(key, digest):
+                if member_digest(raw) != digest:
+                    raise _EditedArray(f"array {name} differs from the shipped table's (digest mismatch)")
+                _remember(key, digest)
+            buf = io.BytesIO(raw)
+            version = np.lib.format.read_magic(buf)
+            shape, fortran, dtype = _npy_header(buf, version)
+            _check_npy_header(name, shape, fortran, dtype, spec)
+            offset = buf.tell()
+            size = int(np.prod(shape, dtype=np.int64)) * dtype.itemsize
+            if offset + size != len(raw):
+                raise ValueError(f"{info.filename} does not hold its shape")
+            return np.frombuffer(raw, dtype=dtype, count=int(np.prod(shape, dtype=np.int64)),
+                                 offset=offset).reshape(shape)
         fh.seek(info.header_offset)
         local = fh.read(30)
         if len(local) != 30 or local[:4] != b"PK\x03\x04":
             raise zipfile.BadZipFile(f"no local header for {info.filename}")
         name_len, extra_len = struct.unpack("<HH", local[26:30])
-        fh.seek(info.header_offset + 30 + name_len + extra_len)
+        start = info.header_offset + 30 + name_len + extra_len
+        if start + info.file_size > st.st_size:
+            raise ValueError(f"{info.filename} is shorter than its directory says")
+        fh.seek(start)
         version = np.lib.format.read_magic(fh)
-        read_header = {(1, 0): np.lib.format.read_array_header_1_0,
-                       (2, 0): np.lib.format.read_array_header_2_0}.get(version)
-        if read_header is None:
-            raise ValueError(f"npy format version {version}")
-        shape, fortran, dtype = read_header(fh)
-        if dtype.hasobject:
-            raise ValueError("object arrays")
+        shape, fortran, dtype = _npy_header(fh, version)
+        _check_npy_header(name, shape, fortran, dtype, spec)
         offset = fh.tell()
         size = int(np.prod(shape, dtype=np.int64)) * dtype.itemsize
-        if offset + size > info.header_offset + 30 + name_len + extra_len + info.file_size:
-            raise ValueError(f"{info.filename} is shorter than its shape")
-        if size == 0:
-            return np.zeros(shape, dtype=dtype)
+        if offset + size != start + info.file_size:
+            raise ValueError(f"{info.filename} does not hold its shape")
+        if info.file_size == 0 or st.st_size == 0:
+            raise ValueError(f"{info.filename} is empty")
         mm = mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ)
-    return np.ndarray(shape, dtype=dtype, buffer=mm, offset=offset, order="F" if fortran else "C")
+    if digest is not None and not _verified(key, digest):
+        if member_digest(memoryview(mm)[start:start + info.file_size]) != digest:
+            raise _EditedArray(f"array {name} differs from the shipped table's (digest mismatch)")
+        _remember(key, digest)
+    if size == 0:
+        return np.zeros(shape, dtype=dtype)
+    return np.ndarray(shape, dtype=dtype, buffer=mm, offset=offset, order="C")
+
+
+def _npy_header(fh, version) -> tuple:
+    read_header = {(1, 0): np.lib.format.read_array_header_1_0,
+                   (2, 0): np.lib.format.read_array_header_2_0}.get(version)
+    if read_header is None:
+        raise ValueError(f"npy format version {version}")
+    return read_header(fh)
+
+
+def _read_error(path: Path, name: str, exc: BaseException) -> InputError:
+    if isinstance(exc, _EditedArray):
+        return InputError(f"table {path.name}: {exc}: edited or corrupted; rebuild it with designkit sweep "
+                          f"(or restore the shipped file)")
+    return InputError(f"table {path.name}: array {name} is corrupted or truncated "
+                      f"({type(exc).__name__}); rebuild it with designkit sweep")
+
+
+_READ_ERRORS = (zipfile.BadZipFile, ValueError, OSError, EOFError, zlib.error, KeyError, NotImplementedError,
+                struct.error)
 
 
 class _NpzArrays(Mapping):
@@ -264,12 +372,17 @@ class _NpzArrays(Mapping):
     ``delta_*`` and their intervals). Members stored uncompressed (the fine shipped table,
     :func:`write_table` with ``compress=False``) are mapped from the file, so only those pages are
     read: decompressing all of svm-fine's 22 MB cost a fresh ``designkit min-contact`` 27 ms, more than
-    its question. Compressed members are decompressed whole, CRC-checked. Plain data: picklable.
+    its question. Each member's bytes, mapped or decompressed, are checked against the shipped table's
+    :data:`SHIPPED_MEMBER_DIGESTS` when it is first read (once per process and file), and its npy header
+    against the JSON header. Plain data: picklable.
     """
 
-    def __init__(self, path: Path, members: Mapping[str, zipfile.ZipInfo]):
+    def __init__(self, path: Path, members: Mapping[str, zipfile.ZipInfo],
+                 specs: Mapping[str, Any] | None = None, digests: Mapping[str, str] | None = None):
         self._path = Path(path)
         self._members = dict(members)
+        self._specs = dict(specs or {})
+        self._digests = dict(digests or {})
         self._loaded: dict[str, np.ndarray] = {}
 
     def __getitem__(self, name: str) -> np.ndarray:
@@ -278,11 +391,14 @@ class _NpzArrays(Mapping):
             info = self._members.get(name)
             if info is None:
                 raise KeyError(name)
+            digest = self._digests.get(name)
+            if digest is None:  # every shipped member has one: a member without is not the shipped file
+                raise InputError(f"table {self._path.name}: array {name} is not one of the shipped table's; "
+                                 f"rebuild it with designkit sweep")
             try:
-                a = self._loaded[name] = _read_member(self._path, info)
-            except (zipfile.BadZipFile, ValueError, OSError, EOFError, zlib.error) as exc:
-                raise InputError(f"table {self._path.name}: array {name} is corrupted or truncated "
-                                 f"({type(exc).__name__}); rebuild it with designkit sweep") from None
+                a = self._loaded[name] = _read_member(self._path, info, self._specs.get(name), digest)
+            except _READ_ERRORS as exc:
+                raise _read_error(self._path, name, exc) from None
         return a
 
     def __iter__(self):
@@ -295,7 +411,8 @@ class _NpzArrays(Mapping):
         return name in self._members
 
     def __getstate__(self):  # the mapped arrays stay behind (a worker maps its own)
-        return {"_path": self._path, "_members": self._members, "_loaded": {}}
+        return {"_path": self._path, "_members": self._members, "_specs": self._specs,
+                "_digests": self._digests, "_loaded": {}}
 
 
 @dataclass(frozen=True)
@@ -467,7 +584,8 @@ SHIPPED_CONTENT_HASHES = frozenset(content for content, _ in SHIPPED_TABLES.valu
 #: Files with one of these digests are a shipped content, checked in full when it was shipped
 #: (tests/test_startup.py checks every shipped table again, the long way), so loading them checks the
 #: digest (well under a millisecond) instead of hashing every decompressed array (35 ms on svm-fine), and
-#: reads an array only when a question asks for it. Files that differ (a rebuilt table, an edited one, a
+#: reads an array only when a question asks for it, hashing that array's bytes then against its shipped
+#: digest (:mod:`designkit.tables._shipped_members`). Files that differ (a rebuilt table, an edited one, a
 #: header rewritten with other line endings) take the long way: hash, schema, consistency.
 SHIPPED_FILE_DIGESTS = frozenset(files for _, files in SHIPPED_TABLES.values())
 
@@ -475,9 +593,9 @@ SHIPPED_FILE_DIGESTS = frozenset(files for _, files in SHIPPED_TABLES.values())
 def file_digest(header_bytes: bytes, members: Mapping[str, zipfile.ZipInfo]) -> str:
     """SHA-256 of a table's header file and its .npz's directory, as listed in :data:`SHIPPED_FILE_DIGESTS`.
 
-    The directory records each array's CRC-32, sizes, compression and place in the file: any array
-    rewritten changes it. (A compressed array's bytes are CRC-checked when decompressed; an
-    uncompressed one is mapped as it lies, unchecked, so that a question reads only its pages.)
+    The directory records each array's CRC-32, sizes, compression and place in the file, but it does
+    not vouch for the bytes (an array edited in place keeps it): each array of a shipped table is
+    hashed when first read, mapped or decompressed, and compared with :data:`SHIPPED_MEMBER_DIGESTS`.
 
     >>> file_digest(b"{}", {})[:15]
     'sha256:5fdf8f10'
@@ -527,33 +645,28 @@ def load_table(name_or_path: str | Path, *, verify: bool = True, thorough: bool 
     long way for them too (``designkit tables show`` does)."""
     path = resolve_table(name_or_path)
     header = _read_header(path, schema=False)
-    if verify:
-        from .._schemas import check_regular_file
+    from .._schemas import check_regular_file
 
-        check_regular_file(path, "table")
+    check_regular_file(path, "table")
+    specs = header.get("arrays") if isinstance(header.get("arrays"), dict) else {}
+    if verify:
         try:
             with zipfile.ZipFile(path) as z:
                 members = _zip_members(z)
             digest = file_digest(path.with_suffix(".json").read_bytes(), members)
         except (zipfile.BadZipFile, OSError, ValueError, EOFError):
             digest = None  # the long way says what is wrong
-        if not thorough and digest in SHIPPED_FILE_DIGESTS and header.get("content_hash") in SHIPPED_CONTENT_HASHES:
-            return Table(name=header["name"], path=path, header=header, arrays=_NpzArrays(path, members),
-                         shipped=True)
+        shipped_members = _shipped_members(digest)
+        if (not thorough and shipped_members is not None
+                and header.get("content_hash") in SHIPPED_CONTENT_HASHES):
+            return Table(name=header["name"], path=path, header=header,
+                         arrays=_NpzArrays(path, members, specs, shipped_members), shipped=True)
     # a shipped table's content is checked by its hash instead of the schema (see SHIPPED_CONTENT_HASHES)
     known = verify and isinstance(header.get("content_hash"), str) and header["content_hash"] in SHIPPED_CONTENT_HASHES
     if not known:
         _check_schema(header, path)
-    if not verify:  # (verify checked it above)
-        from .._schemas import check_regular_file
-
-        check_regular_file(path, "table")
-    try:
-        with np.load(path, allow_pickle=False) as z:
-            arrays = {k: z[k] for k in z.files}
-    except (zipfile.BadZipFile, ValueError, OSError, EOFError, KeyError, zlib.error) as exc:
-        raise InputError(f"table {path.name} is corrupted or truncated ({type(exc).__name__}); "
-                         f"rebuild it with designkit sweep") from None
+        specs = header["arrays"]
+    arrays = _read_all(path, specs)
     if verify:
         try:
             got = content_hash(arrays, header)
@@ -569,6 +682,38 @@ def load_table(name_or_path: str | Path, *, verify: bool = True, thorough: bool 
                              f"corrupted or edited; rebuild it with designkit sweep")
     check_table(header, arrays, path.name, schema=not known)
     return Table(name=header["name"], path=path, header=header, arrays=arrays, shipped=known)
+
+
+def _shipped_members(files_digest: str | None) -> dict[str, str] | None:
+    """The member digests of the shipped table whose files have ``files_digest``, or None (not shipped)."""
+    if files_digest is None or files_digest not in SHIPPED_FILE_DIGESTS:
+        return None
+    from ._shipped_members import SHIPPED_MEMBER_DIGESTS
+
+    for name, (_, files) in SHIPPED_TABLES.items():
+        if files == files_digest and name in SHIPPED_MEMBER_DIGESTS:
+            return SHIPPED_MEMBER_DIGESTS[name]
+    return None
+
+
+def _read_all(path: Path, specs: Mapping[str, Any]) -> dict[str, np.ndarray]:
+    """Every array of the .npz at ``path`` (the long way), each npy header checked against ``specs``."""
+    name = "?"
+    try:
+        with zipfile.ZipFile(path) as z:
+            members = _zip_members(z)
+            extra = [i.filename for i in z.infolist() if not i.filename.endswith(".npy")]
+        if extra:
+            raise ValueError(f"members that are not arrays: {', '.join(extra[:3])}")
+        arrays = {}
+        for name, info in members.items():
+            arrays[name] = _read_member(path, info, specs.get(name) if isinstance(specs, Mapping) else None)
+        return arrays
+    except _READ_ERRORS as exc:
+        if isinstance(exc, _EditedArray):
+            raise _read_error(path, name, exc) from None
+        raise InputError(f"table {path.name} is corrupted or truncated ({type(exc).__name__}); "
+                         f"rebuild it with designkit sweep") from None
 
 
 def check_table(header: Mapping[str, Any], arrays: Mapping[str, np.ndarray], what: str, *,

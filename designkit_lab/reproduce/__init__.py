@@ -30,7 +30,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Sequence
 
-from .._validation import InputError
+from designkit._validation import InputError
 from ._report import Context, ReproduceSettings, SectionResult, default_robot_data_dir, fmt, md_table
 
 __all__ = [
@@ -129,7 +129,7 @@ def reproduce(out_dir: "str | Path", only: "str | Sequence[str] | None" = None,
     -------
     ReproduceResult
     """
-    from .._io import atomic_write_text
+    from designkit._io import atomic_write_text
 
     names = parse_only(only)
     out = Path(out_dir)
@@ -188,7 +188,7 @@ def _jsonable(obj):
 
 def _markdown(results: Sequence[SectionResult], settings: ReproduceSettings, ctx: Context, wall: float,
               names: Sequence[str]) -> str:
-    from .. import __version__
+    from designkit import __version__
 
     lines = [
         "# The paper's analyses, reproduced with designkit",

@@ -9,9 +9,11 @@ samples + local slope, :mod:`designkit.recognition.features`) and classifier
 detected contact onset, as the paper's Table II.
 
 Sim-to-real follows section VII with the sensor identified by calibration
-(:func:`designkit.calibration.fit.fit_sensor`, the paper's appendix model) on
-a held-out calibration subset (trial sets 1-4, 12 touches per material, as the
-paper's 10 separate calibration trials); the classifier is trained only on
+(:func:`designkit.calibration.identify.identify`, the paper's semi-infinite model and
+the identified layered model) on a calibration subset chosen from the trial sets present
+(:func:`calibration_split`: the first fifth of them, sets 1-4 of the shared
+recordings' 20, 12 touches per material, as the paper's 10 separate calibration
+trials), disjoint from the test touches (the other sets); the classifier is trained only on
 curves simulated for the test touches' own initial temperatures (sensor from
 the pre-contact samples, object from the passive channel before contact) and
 tested on the real test touches.
@@ -26,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._validation import InputError
+from designkit._validation import InputError
 from ._report import Comparison, Context, SectionResult, fmt, md_table
 from .paper import REAL_ROBOT
 
@@ -37,6 +39,7 @@ __all__ = [
     "SimToRealSetup",
     "calibrate",
     "calibrate_model",
+    "calibration_split",
     "load_real",
     "passive_object_temp",
     "real_pair_f1",
@@ -53,7 +56,6 @@ PAIR_LABELS = {("wood", "metal"): "metal vs wood", ("cold_wood", "metal"): "meta
                ("wood", "cold_wood"): "wood vs cold wood"}
 #: Effusivity ranges given to calibration (the paper's aluminium and wood ranges, docs/physics.md section 3).
 CALIBRATION_RANGES = {"metal": "12767:25972", "wood": "331:506", "cold_wood": "331:506"}
-CALIBRATION_SETS = (1, 2, 3, 4)
 #: Materials calibration fits: cold wood's object temperature is unknown (its passive channel
 #: moves in contact), so it would add a free amplitude per touch and inform only tau and the offset.
 CALIBRATED = ("metal", "wood")
@@ -113,7 +115,7 @@ class RealTouches:
 
 def load_real(data_dir: Path, contact_s: float = CONTACT_S, sample_rate_hz: float = 200.0) -> RealTouches:
     """Read the recordings listed in ``data_dir/index.csv`` (file, material, trial_set)."""
-    from ..calibration.trials import read_index_rows, read_trial_csv
+    from designkit.calibration.trials import read_index_rows, read_trial_csv
 
     index = Path(data_dir) / "index.csv"
     rows = read_index_rows(index)
@@ -141,7 +143,7 @@ def load_real(data_dir: Path, contact_s: float = CONTACT_S, sample_rate_hz: floa
 # ============================================================ train real, test real
 def real_pair_f1(touches: RealTouches, pair: tuple[str, str], *, repeats: int, seed: int) -> dict:
     """Cross-validated F1 (3 folds, ``repeats`` shuffles) of the paper's SVM on one real pair."""
-    from ..recognition.svm import cross_validated_f1
+    from designkit.recognition.svm import cross_validated_f1
 
     lo, hi = touches.of(pair[0]), touches.of(pair[1])
     fs = 1.0 / (touches.time_s[1] - touches.time_s[0])
@@ -164,9 +166,9 @@ def real_multiclass(touches: RealTouches, *, repeats: int, seed: int) -> dict:
     import sklearn
     from sklearn.model_selection import StratifiedKFold, cross_val_predict
 
-    from .._validation import as_generator
-    from ..recognition.features import feature_matrix
-    from ..recognition.svm import make_classifier
+    from designkit._validation import as_generator
+    from designkit.recognition.features import feature_matrix
+    from designkit.recognition.svm import make_classifier
 
     fs = 1.0 / (touches.time_s[1] - touches.time_s[0])
     X = feature_matrix(touches.sensor_c, fs)
@@ -208,8 +210,26 @@ class SimToRealSetup:
     passive_response: np.ndarray | None = None
 
 
+def calibration_split(touches: RealTouches) -> tuple[np.ndarray, str]:
+    """Which touches calibrate (True) and which test, chosen from the trial sets present, and how.
+
+    :func:`designkit.calibration.identify.choose_split`: the first fifth of the trial sets (at least
+    one) calibrate, the others test; every class on both sides. A recording where that is
+    impossible (one trial set, one material) is refused in one line (InputError).
+    """
+    from designkit.calibration.identify import choose_split, trial_sets
+
+    sets = [int(v) if v > 0 else None for v in touches.trial_set]
+    if any(v is None for v in sets):
+        sets = trial_sets(list(touches.trials))
+    sp = choose_split(list(touches.trials), sets=sets, require=True)
+    keep = {id(tr) for tr in sp.fit}
+    return np.array([id(tr) in keep for tr in touches.trials]), sp.describe().replace("fitted on", "calibrated on") \
+        .replace("scored on", "tested on")
+
+
 def _paper_setup(why: str) -> SimToRealSetup:
-    from ..sensor import SENSORS
+    from designkit.sensor import SENSORS
 
     return SimToRealSetup(SENSORS["paper"], PAPER_FALLBACK["time_offset_s"], {k: PAPER_FALLBACK[k] for k in CLASSES},
                           f"the paper's sensor and identified effusivities, heat flow 0.5 s before onset ({why})",
@@ -217,42 +237,36 @@ def _paper_setup(why: str) -> SimToRealSetup:
 
 
 def calibrate(touches: RealTouches, *, seed: int) -> SimToRealSetup:
-    """Identify the sensor on the calibration subset (trial sets 1-4) with designkit's calibration.
+    """Identify the paper's semi-infinite sensor on the calibration touches (:func:`calibration_split`).
 
     Falls back to the paper's sensor (and its identified effusivities, 0.5 s
-    offset) when the calibration library is not available; the setup's
-    ``source`` says which.
+    offset) when the calibration fails on these touches; the setup's ``source`` says which.
     """
-    sub = touches.select(np.isin(touches.trial_set, CALIBRATION_SETS) & np.isin(touches.material, CALIBRATED))
-    if sub.material.size == 0:
-        sub = touches.select(np.isin(touches.material, CALIBRATED))
-    try:
-        from ..calibration.fit import FitSettings, fit_sensor, resolve_ranges
-    except ImportError as exc:  # pragma: no cover - calibration ships with designkit
-        return _paper_setup(f"calibration unavailable: {exc}")
+    cal, how = calibration_split(touches)
+    sub = touches.select(cal & np.isin(touches.material, CALIBRATED))
+    from designkit.calibration.fit import resolve_ranges
+    from designkit.calibration.identify import identify
+
     names = sorted(set(sub.material))
     try:
         ranges = resolve_ranges(names, {k: v for k, v in CALIBRATION_RANGES.items() if k in names})
-        res = fit_sensor(list(sub.trials), ranges, settings=FitSettings(bootstrap=0, profile_points=0, seed=seed))
+        res = identify(list(sub.trials), "semi-infinite", ranges=ranges,
+                       object_temps={n: "passive" for n in names})
     except InputError as exc:
         return _paper_setup(f"calibration failed on these recordings: {exc}")
-    eff = {}
-    for m in res.materials:
-        if m.effusivity is not None and m.object_temp != "free":
-            eff[m.name] = float(m.effusivity.value)
+    es = res.effusivity.value if res.effusivity is not None else math.nan
+    eff = {n: float(r.value * es) for n, r in res.ratios.items() if math.isfinite(es)}
     if "wood" in eff:
         eff.setdefault("cold_wood", eff["wood"])  # the same wood, cooled
     missing = [k for k in CLASSES if k not in eff]
     for k in missing:  # not identified by the fit: the paper's value for that material
         eff[k] = PAPER_FALLBACK[k]
-    d = res.to_dict()
-    d.pop("profile", None)
-    return SimToRealSetup(res.sensor(name="calibrated (shared recordings, sets 1-4)"), float(res.time_offset_s.value),
-                          eff, "designkit.calibration.fit.fit_sensor on trial sets "
-                          f"{CALIBRATION_SETS[0]}-{CALIBRATION_SETS[-1]} ({sub.material.size} touches of "
-                          f"{' and '.join(names)})"
+    return SimToRealSetup(res.sensor(name="calibrated semi-infinite"), float(res.parameter("time_offset_s").value),
+                          eff, f"designkit.calibration.identify (semi-infinite), {how}; {sub.material.size} "
+                          f"touches of {' and '.join(names)} calibrate"
+                          + ("" if res.consistent else " (their ranges conflict under this model)")
                           + (f"; the paper's effusivity for {', '.join(missing)}" if missing else ""),
-                          float(res.rms_c), float(res.noise_c), d)
+                          float(res.rms_c), float(res.noise_c), res.to_dict())
 
 
 #: The sensor model sim-to-real uses when identified (docs/sensor-models.md): the layered sensor with
@@ -275,7 +289,7 @@ def _touch_curves(ident, material: str, trial, time_s: np.ndarray, pressed=None)
 
     ``pressed``: touches (Trial) whose forces to use instead, one reading each.
     """
-    from ..calibration.identify import relative_force
+    from designkit.calibration.identify import relative_force
 
     if not ident.candidate.force_area:
         return ident.reading(time_s, material, drift=True)
@@ -323,7 +337,7 @@ def passive_object_temp(touches: RealTouches, response: np.ndarray) -> np.ndarra
 
 def calibrate_model(touches: RealTouches, *, candidate: str = SIM_MODEL,
                     object_temp: dict | None = None, touch_conductance: tuple[str, ...] = ()) -> SimToRealSetup:
-    """Identify ``candidate`` on the calibration subset (trial sets 1-4, metal and wood).
+    """Identify ``candidate`` on the calibration touches (:func:`calibration_split`), metal and wood.
 
     Metal's and wood's object temperature is the passive reading before contact (both at room
     temperature). Cold wood is the same wood: by default (``"passive-response"``) its temperature is
@@ -333,12 +347,12 @@ def calibrate_model(touches: RealTouches, *, candidate: str = SIM_MODEL,
     ``touch_conductance``: materials whose touches each get their own contact conductance (the
     simulator draws a simulated touch's conductance from the fitted spread).
     """
-    from ..calibration.identify import identify
+    from designkit.calibration.identify import identify
 
     temps = {"metal": "passive", "wood": "passive", "cold_wood": "passive-response"}
     temps.update(object_temp or {})
     mats = CALIBRATED + (("cold_wood",) if temps["cold_wood"].endswith("-affine") else ())
-    cal_sets = np.isin(touches.trial_set, CALIBRATION_SETS)
+    cal_sets, how = calibration_split(touches)
     sub = touches.select(cal_sets & np.isin(touches.material, mats))
     ranges = {k: tuple(float(v) for v in CALIBRATION_RANGES[k].split(":")) for k in mats}
     fit_temps = {k: ("passive" if temps[k] == "passive-response" else temps[k]) for k in mats}
@@ -357,12 +371,11 @@ def calibrate_model(touches: RealTouches, *, candidate: str = SIM_MODEL,
     es = res.effusivity.value if res.effusivity is not None else math.nan
     eff = {k: v.value * es for k, v in res.ratios.items()}
     eff.setdefault("cold_wood", eff["wood"])
-    return SimToRealSetup(res.sensor(name=f"identified {candidate} (shared recordings, sets 1-4)"),
+    return SimToRealSetup(res.sensor(name=f"identified {candidate}"),
                           float(res.parameter("time_offset_s").value), eff,
                           f"designkit.calibration.identify ({candidate}"
                           + (f", {' and '.join(touch_conductance)}'s contact per touch" if touch_conductance else "")
-                          + f") on trial sets {CALIBRATION_SETS[0]}-{CALIBRATION_SETS[-1]} ({sub.material.size} "
-                          f"touches of metal and wood)", float(res.rms_c), float(res.noise_c), res.to_dict(), res,
+                          + f"), {how}; {sub.material.size} touches of {' and '.join(mats)} calibrate", float(res.rms_c), float(res.noise_c), res.to_dict(), res,
                           contact or None, temps, response)
 
 
@@ -377,8 +390,8 @@ def _simulate_model(test: RealTouches, setup: SimToRealSetup, noise_c: float, pe
     pre-contact temperature Tp0 towards the same To, with the calibrated passive response where there
     is one (else the identified reading shape), and its own noise.
     """
-    from .._validation import as_generator
-    from ..models.layered import savgol_smooth
+    from designkit._validation import as_generator
+    from designkit.models.layered import savgol_smooth
 
     rng = as_generator([seed, 229])
     ident = setup.identification
@@ -404,7 +417,7 @@ def _simulate_model(test: RealTouches, setup: SimToRealSetup, noise_c: float, pe
         for k in idx:
             tr = test.trials[k]
             if cls in contact:
-                from ..calibration.identify import relative_force
+                from designkit.calibration.identify import relative_force
 
                 mu, sd = contact[cls]
                 v, b = ident.reading(test.time_s, mat, conductance_factor=np.exp(rng.normal(mu, sd, per_trial)),
@@ -446,8 +459,8 @@ def _simulate_model(test: RealTouches, setup: SimToRealSetup, noise_c: float, pe
 def _simulate_like(test: RealTouches, setup: SimToRealSetup, noise_c: float, per_trial: int, seed: int,
                    object_temp: str = "passive") -> tuple[np.ndarray, np.ndarray]:
     """Simulated touches for each test touch's own Ts0 and Ta, the class effusivity, on its time grid."""
-    from .._validation import as_generator
-    from ..simulation import noisy_readings
+    from designkit._validation import as_generator
+    from designkit.simulation import noisy_readings
 
     rng = as_generator([seed, 227])
     n = test.material.size
@@ -474,12 +487,12 @@ def sim_to_real(test: RealTouches, setup: SimToRealSetup, noise_c: float, *, per
     """
     import sklearn
 
-    from ..recognition.features import feature_matrix
-    from ..recognition.svm import binary_f1, make_classifier
+    from designkit.recognition.features import feature_matrix
+    from designkit.recognition.svm import binary_f1, make_classifier
 
     fs = 1.0 / (test.time_s[1] - test.time_s[0])
     if two_sensor:
-        from ..recognition.two_sensor import two_sensor_features
+        from designkit.recognition.two_sensor import two_sensor_features
 
         if setup.identification is None or test.object_c is None or not np.isfinite(test.object_c).all():
             raise InputError("two-sensor sim-to-real needs an identified model and a passive channel in every "
@@ -551,23 +564,18 @@ def _calibration_text(setup: "SimToRealSetup") -> str:
     if not setup.details:
         return f"Calibration was not available; the simulator uses {setup.source}."
 
-    def where(m) -> str:
-        v, (lo, hi) = m["effusivity"]["value"], m["range"]
-        if math.isclose(v, hi, rel_tol=1e-6):
-            return "at the upper bound of its range"
-        if math.isclose(v, lo, rel_tol=1e-6):
-            return "at the lower bound of its range"
-        return "inside its range"
-
-    mats = [m for m in setup.details.get("materials", []) if m.get("effusivity")]
-    text = (f"Calibration (measured, {setup.details.get('uncertainty_method', '')}): identification "
-            f"'{setup.details.get('identification')}'; "
-            + "; ".join(f"{m['name']} e_o = {m['effusivity']['value']:,.0f}, {where(m)}" for m in mats) + ".")
-    if any("conflict" in n for n in setup.details.get("notes") or []):
+    d = setup.details
+    es = (d.get("effusivity") or {}).get("value")
+    ratios = {k: v["value"] for k, v in (d.get("ratios") or {}).items()}
+    text = (f"Calibration (measured, {d.get('candidate', '')} model, cluster-robust 95 % intervals): "
+            + "; ".join(f"{k} e_o = {r * es:,.0f}" for k, r in ratios.items() if es) + "; "
+            + "; ".join(f"{k} allows e_s in [{lo:,.0f}, {hi:,.0f}]" for k, (lo, hi) in (d.get("es_allowed") or {}).items())
+            + ".")
+    if d.get("consistent") is False:
         ratio = (setup.rms_c / setup.noise_c) if setup.rms_c and setup.noise_c else math.nan
-        text += (" Under the semi-infinite model no single e_s keeps both materials inside their ranges, so the "
-                 f"fit compromises at the bounds; its residual ({fmt(setup.rms_c, 3)} °C RMS, {fmt(ratio, 2)} times "
-                 "the pre-contact noise) is model misfit, not noise, and is what the simulator gets wrong.")
+        text += (" Under the semi-infinite model no single e_s keeps both materials inside their ranges; its "
+                 f"residual ({fmt(setup.rms_c, 3)} °C RMS, {fmt(ratio, 2)} times the pre-contact noise) is model "
+                 "misfit, not noise, and is what the simulator gets wrong.")
     return text
 
 
@@ -584,7 +592,7 @@ def _data_or_skip(ctx: Context, name: str, title: str, t0: float):
 
 
 def _confusion_figure(ctx: Context, mats: list[tuple[str, np.ndarray]], labels, name: str) -> str:
-    from ..figures import pyplot
+    from designkit.figures import pyplot
 
     plt = pyplot()
     fig, axes = plt.subplots(1, len(mats), figsize=(4.0 * len(mats), 3.6), constrained_layout=True)
@@ -674,7 +682,8 @@ def section_sim_to_real(ctx: Context) -> SectionResult:
     if setup is None:
         setup = ctx.cache["sim_setup"] = calibrate(touches, seed=seed)
     ctx.step(1, 4)
-    test = touches.select(~np.isin(touches.trial_set, CALIBRATION_SETS))
+    cal, how = calibration_split(touches)
+    test = touches.select(~cal)
     per_trial = 2 if ctx.settings.quick else 5
     rms = setup.rms_c if setup.rms_c is not None and math.isfinite(setup.rms_c) else REAL_ROBOT["sim_to_real_noise_c"]
     main = sim_to_real(test, setup, rms, per_trial=per_trial, seed=seed)
@@ -685,7 +694,7 @@ def section_sim_to_real(ctx: Context) -> SectionResult:
     end = sim_to_real(test, setup, rms, per_trial=per_trial, seed=seed, object_temp="passive-end")
     ctx.step(4, 4)
     identified = []  # the identified sensor model (docs/sensor-models.md), noise = its residual on calibration
-    pool = touches.select(np.isin(touches.trial_set, CALIBRATION_SETS))   # simulated touches press as these did
+    pool = touches.select(cal)   # simulated touches press as these did
     for label, cold in ((f"identified {SIM_MODEL}; cold wood = wood at the temperature its passive thermistor "
                          f"reads through that thermistor's calibrated response", "passive-response"),
                         (f"identified {SIM_MODEL}; cold wood calibrated as its own class (its passive end "
@@ -727,8 +736,8 @@ def section_sim_to_real(ctx: Context) -> SectionResult:
         f"{setup.source}. Model residual on the calibration touches: "
         f"{fmt(setup.rms_c, 3)} °C RMS; pre-contact sensor noise {fmt(setup.noise_c, 2)} °C.",
         "",
-        f"Training: {per_trial} simulated touches per real test touch ({test.material.size} touches of trial sets "
-        f"5-20, never used by calibration), each with that touch's own Ts0 (sensor before contact) and Ta "
+        f"Split: {how}. Training: {per_trial} simulated touches per real test touch ({test.material.size} test "
+        f"touches, never used by calibration), each with that touch's own Ts0 (sensor before contact) and Ta "
         f"(passive channel before contact), white noise σ. Test: the real touches. Features and SVM as the paper; "
         f"F1 with the higher-effusivity (or the cold) class positive. The identified model's rows: each simulated "
         f"touch takes its test touch's Ts0 and drift (a line through its samples from 1 s to 0.25 s before "

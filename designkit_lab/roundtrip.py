@@ -37,7 +37,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from .._validation import InputError
+from designkit._validation import InputError
 
 __all__ = ["CASES", "VARIED_PRESS", "RoundTripCase", "RoundTripResult", "round_trip", "summarize"]
 
@@ -83,7 +83,7 @@ class RoundTripCase:
     force_area: bool = False
 
     def candidate(self):
-        from .identify import Candidate
+        from designkit.calibration.identify import Candidate
 
         free = self.free + (("contact_force_fraction",) if self.force_area else ())
         return Candidate(self.label, str(self.model["name"]), free, dict(self.fixed), self.smoothing,
@@ -188,11 +188,11 @@ class RoundTripResult:
 def _record(case: RoundTripCase, seed: int, noise_c: float, touches: int, speed: float, folder: Path,
             force_noise_n: float = 0.02, press: "tuple[float, float] | None" = None):
     """Emulate and record every material over its own pty; returns the emulated time offset [s]."""
-    from ..models import get_model
-    from ..sensor import Sensor
-    from .emulator import EmulatedMaterial, Emulator, TouchPlan
-    from .profiles import load_profile
-    from .recorder import SerialRecorder
+    from designkit.models import get_model
+    from designkit.sensor import Sensor
+    from designkit.calibration.emulator import EmulatedMaterial, Emulator, TouchPlan
+    from designkit.calibration.profiles import load_profile
+    from designkit.calibration.recorder import SerialRecorder
 
     prof = load_profile("designkit")
     sensor = Sensor(TRUE_ES, TRUE_ALPHA, depth_m=80e-6, sample_rate_hz=prof.sample_rate_hz, name="emulated")
@@ -209,9 +209,9 @@ def _record(case: RoundTripCase, seed: int, noise_c: float, touches: int, speed:
 
 
 def _host_smoothed(trials):
-    from ..models.layered import savgol_smooth
-    from .identify import HOST_SMOOTHING
-    from .trials import Trial
+    from designkit.models.layered import savgol_smooth
+    from designkit.calibration.identify import HOST_SMOOTHING
+    from designkit.calibration.trials import Trial
 
     return [Trial(t.time_s, savgol_smooth(t.sensor_c, *HOST_SMOOTHING), t.object_c, t.force_n, t.material,
                   source=t.source, meta=t.meta) for t in trials]
@@ -243,8 +243,8 @@ def round_trip(case: "str | RoundTripCase", seed: int, *, noise_c: float = 0.01,
     press : (float, float), optional
         The ``+area`` cases' force ramps: mean duration [s] and spread (:meth:`RoundTripCase.plan`).
     """
-    from .identify import identify
-    from .trials import load_index
+    from designkit.calibration.identify import identify
+    from designkit.calibration.trials import load_index
 
     c = CASES[case] if isinstance(case, str) and case in CASES else case
     if not isinstance(c, RoundTripCase):

@@ -52,7 +52,7 @@ def staircase_vs_full(intervals: int, *, contact_s: float = 1.0, noise_ratio: fl
         both directions), ``n_differ`` (references whose answer differs),
         ``J_staircase``, ``J_full``.
     """
-    from ..sweep import SweepConfig, delta_from_staircase, run_chunk
+    from designkit.sweep import SweepConfig, delta_from_staircase, run_chunk
 
     base = SweepConfig(name="bench", fidelity="svm", intervals=int(intervals), e_max=e_max, trials=trials,
                        seed=seed, max_repeats=max_repeats, noise_ratio=(noise_ratio,), contact_s=(contact_s,))
@@ -77,7 +77,7 @@ def staircase_vs_full(intervals: int, *, contact_s: float = 1.0, noise_ratio: fl
 
 def _ideal_delta_curves(n: int, ratio: float, contact: float):
     """Grid centres, delta up and down, and wall time of an ideal sweep of ``n`` intervals at one scene."""
-    from ..sweep import SweepConfig, delta_from_staircase, run_chunk
+    from designkit.sweep import SweepConfig, delta_from_staircase, run_chunk
 
     cfg = SweepConfig(name="bench", fidelity="ideal", intervals=n, noise_ratio=(ratio,), contact_s=(contact,))
     res, sec = timed(lambda: run_chunk(cfg, (0,), 0, 0))

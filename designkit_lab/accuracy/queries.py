@@ -26,8 +26,8 @@ from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
-from .._validation import InputError, as_generator
-from ..query.ideal_bound import exact_ideal_delta, exact_ideal_max_ratio, exact_ideal_min_contact
+from designkit._validation import InputError, as_generator
+from designkit.query.ideal_bound import exact_ideal_delta, exact_ideal_max_ratio, exact_ideal_min_contact
 from .results import Row, p95, worst
 
 __all__ = ["GAP_BINS", "QUESTIONS", "density_rows", "query_rows", "subsample_table", "svm_query_rows"]
@@ -53,7 +53,7 @@ def subsample_table(table, keep: Mapping[str, Sequence[int]], name: str | None =
     InputError
         When the kept indices of an axis are not increasing or not inside it.
     """
-    from ..tables.store import Table
+    from designkit.tables.store import Table
 
     names = table.axis_names
     idx = [_kept_indices(a, len(table.axes[a]), keep) for a in names]
@@ -97,7 +97,7 @@ def _number(x) -> float:
 
 def _table_answers(table, samples) -> tuple[dict[str, np.ndarray], float]:
     """Answers of every table query for the samples (ratios, not noises); seconds per query (mean over all)."""
-    from ..query import table as query
+    from designkit.query import table as query
 
     ans: dict[str, list[float]] = {k: [] for k in ("min_contact", "max_noise", "min_delta_t", "delta_up",
                                                    "delta_down")}
@@ -118,7 +118,7 @@ def _table_answers(table, samples) -> tuple[dict[str, np.ndarray], float]:
 
 def _table_verdict(table, e1, e2, contact_s, ratio, svm_table=None) -> bool:
     """The table's distinguishable verdict (``svm_table``: that table's, else ``table`` for both)."""
-    from ..query import table as query
+    from designkit.query import table as query
 
     ans = query.distinguishable(e1, e2, contact_s=float(contact_s), noise_c=float(ratio) * _DT_C, delta_t_c=_DT_C,
                                 table=svm_table or table, ideal_table=svm_table or table)
@@ -127,7 +127,7 @@ def _table_verdict(table, e1, e2, contact_s, ratio, svm_table=None) -> bool:
 
 def _svm_table_delta(svm_table, e1, ratio, contact_s) -> float | None:
     """The table's delta(e) towards higher e [J s^-1/2 K^-1 m^-2] (None: none in the grid)."""
-    from ..query import table as query
+    from designkit.query import table as query
 
     return query.delta_e(e1, contact_s=contact_s, noise_c=ratio * _DT_C, delta_t_c=_DT_C, table=svm_table,
                          ideal_table=svm_table).extra.get("delta_e_upper")
@@ -135,8 +135,8 @@ def _svm_table_delta(svm_table, e1, ratio, contact_s) -> float | None:
 
 def _exact_verdicts(table, e1, e2, contacts, ratios) -> np.ndarray:
     """The ideal observer's verdicts for classes one table interval wide (closed form)."""
-    from ..recognition.ideal import ideal_scores, projection_noise
-    from ..scene import Scene
+    from designkit.recognition.ideal import ideal_scores, projection_noise
+    from designkit.scene import Scene
 
     sensor, width = table.sensor, _effusivity_grid(table)[2]
     s = np.array([projection_noise(sensor, Scene(contact_s=float(c), noise_c=float(r), sensor_temp_c=26.0,
@@ -434,7 +434,7 @@ def _exact_kw(svm_table, trials, repeats, jobs) -> dict[str, Any]:
 
 def _svm_min_contact_cases(svm_table, pairs, seed, exact_kw, progress) -> list[dict[str, Any]]:
     """Table and ``--exact`` min-contact, their intervals and times, per pair."""
-    from .. import query
+    from designkit import query
 
     res = []
     for k, (e1, e2, r, c) in enumerate(pairs):
@@ -477,7 +477,7 @@ def _svm_min_contact_row(svm_table, res, trials, repeats) -> tuple[Row, dict[str
 
 def _svm_distinguishable(svm_table, pairs, rng, seed, exact_kw, progress) -> tuple[Row, dict[str, Any]]:
     """Table verdicts against one ``--exact`` evaluation each: the pairs, then the pairs at other contacts."""
-    from .. import query
+    from designkit import query
 
     c_lo, c_hi, _ = _contact_window(svm_table)
     m = 2 * len(pairs)

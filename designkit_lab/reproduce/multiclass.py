@@ -48,7 +48,7 @@ def bayes_accuracy(ranges, sensor, scene) -> float:
     scene : Scene
         Fixed initial conditions.
     """
-    from ..query.matrix import multiclass_ideal_accuracy
+    from designkit.query.matrix import multiclass_ideal_accuracy
 
     return multiclass_ideal_accuracy(ranges, sensor, scene, max_bins=_MAX_BINS)
 
@@ -58,7 +58,7 @@ def svm_multiclass(ranges, trials: int, sensor, scene, seed) -> dict:
 
     :func:`designkit.query.matrix.multiclass_svm_accuracy` (the one implementation).
     """
-    from ..query.matrix import multiclass_svm_accuracy
+    from designkit.query.matrix import multiclass_svm_accuracy
 
     return multiclass_svm_accuracy(ranges, trials, sensor, scene, seed)
 
@@ -66,10 +66,10 @@ def svm_multiclass(ranges, trials: int, sensor, scene, seed) -> dict:
 def section_multiclass(ctx: Context) -> SectionResult:
     """k materials at once: accuracy against k (database), and the paper's 12 materials' confusion."""
     t0 = time.perf_counter()
-    from ..materials import list_materials
-    from ..scene import Scene
-    from ..sensor import SENSORS
-    from .._validation import as_generator
+    from designkit.materials import list_materials
+    from designkit.scene import Scene
+    from designkit.sensor import SENSORS
+    from designkit._validation import as_generator
 
     title = "Multi-class recognition: k materials at once (left open by the paper)"
     quick = ctx.settings.quick
@@ -116,7 +116,7 @@ def section_multiclass(ctx: Context) -> SectionResult:
         done += 1
         ctx.step(done, steps)
 
-    from ..figures import pyplot
+    from designkit.figures import pyplot
 
     plt = pyplot()
     from matplotlib.ticker import NullLocator

@@ -14,7 +14,7 @@ import time
 from dataclasses import dataclass, field
 from typing import Any, Callable, Iterable, Mapping
 
-from .._validation import InputError
+from designkit._validation import InputError
 from .results import CostCurve, Row
 
 __all__ = ["SECTIONS", "BenchReport", "check_sections", "environment", "run_bench"]
@@ -88,7 +88,7 @@ def environment() -> dict[str, Any]:
         env["load_average_at_start"] = [round(x, 2) for x in os.getloadavg()]
     except OSError:  # pragma: no cover
         pass
-    from .. import __version__
+    from designkit import __version__
 
     env["designkit"] = __version__
     return env
@@ -127,7 +127,7 @@ def _delta(out: _Collected, quick, seed, say, **_) -> None:
 
 def _load_svm(svm_table, out: _Collected):
     """The SVM table, or None (and a line in ``skipped``) when it cannot be loaded."""
-    from ..tables.store import load_table
+    from designkit.tables.store import load_table
 
     if not svm_table:
         return None
@@ -139,7 +139,7 @@ def _load_svm(svm_table, out: _Collected):
 
 
 def _queries(out: _Collected, quick, seed, say, *, svm_table, ideal_table, jobs) -> None:
-    from ..tables.store import load_table
+    from designkit.tables.store import load_table
     from .queries import density_rows, query_rows, svm_query_rows
 
     say(f"queries: {ideal_table} against the exact ideal observer")

@@ -25,14 +25,14 @@ _WIDTH = 80.0
 
 
 def _paper_scene(contact_s: float):
-    from ..scene import Scene
+    from designkit.scene import Scene
 
     return Scene.from_delta_t(contact_s=contact_s, noise_c=0.05, delta_t_c=10.0)
 
 
 def _svm_runs(pairs, trials, pool, t_ref, r_ref, seed, progress):
     """Reference F1 per pair (mean, SE, time per seed) and ``pool`` single-seed F1s per trial count."""
-    from ..recognition.svm import interval_pair_f1
+    from designkit.recognition.svm import interval_pair_f1
 
     sensor = paper_sensor()
     est: dict[int, list[np.ndarray]] = {t: [] for t in trials}
@@ -106,7 +106,7 @@ def recognition_rows(quick: bool = True, seed: int = 0, *, pairs=None,
 
 def _ideal_runs(pairs, n_mc, seed):
     """Closed-form F1 per pair and its time; Monte Carlo (F1, SE) per pair and time per ``n_mc``."""
-    from ..recognition.ideal import ideal_pair
+    from designkit.recognition.ideal import ideal_pair
 
     sensor = paper_sensor()
     cf_vals, cf_time = [], 0.0

@@ -61,7 +61,7 @@ def _panel(ax, svm, ideal, ratio: float, label: str) -> None:
 
 
 def _delta_numbers(ctx: Context, ts0: float, sigma: float, svm_ok: bool) -> list[dict]:
-    from ..query.table import delta_e
+    from designkit.query.table import delta_e
 
     out = []
     dt = ts0 - AMBIENT_C
@@ -90,7 +90,7 @@ def section_delta_curves(ctx: Context) -> SectionResult:
     if ideal is None and svm is None:
         why = ctx.table_problem(STAIRCASE_TABLE) + "; " + ctx.table_problem(IDEAL_TABLE)
         return SectionResult("delta-curves", title, f"*Skipped: {why}.*", skipped=why, wall_s=time.perf_counter() - t0)
-    from ..figures import pyplot
+    from designkit.figures import pyplot
 
     plt = pyplot()
     figs = []
@@ -158,8 +158,8 @@ def section_effusivity(ctx: Context) -> SectionResult:
     t0 = time.perf_counter()
     from matplotlib.lines import Line2D
 
-    from ..figures import pyplot
-    from ..materials import FAMILY_LABELS, list_materials
+    from designkit.figures import pyplot
+    from designkit.materials import FAMILY_LABELS, list_materials
 
     mats = sorted(list_materials(), key=lambda m: (m.e_min, m.e_max))
     plt = pyplot()
@@ -213,7 +213,7 @@ def section_effusivity(ctx: Context) -> SectionResult:
 def section_guideline(ctx: Context) -> SectionResult:
     """The design guideline: contact time to separate e = 35,000 from 20,000 (sigma 0.05, dT 10)."""
     t0 = time.perf_counter()
-    from .. import query
+    from designkit import query
 
     title = "Guideline: 35,000 vs 20,000 needs how long a contact?"
     e1, e2, sigma, dt = GUIDELINE["e1"], GUIDELINE["e2"], GUIDELINE["noise_c"], GUIDELINE["delta_t_c"]

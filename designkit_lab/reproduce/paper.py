@@ -12,7 +12,7 @@ from __future__ import annotations
 import types
 from dataclasses import dataclass
 
-from ..query import guideline as _guideline
+from designkit.query import guideline as _guideline
 
 __all__ = [
     "GUIDELINE",

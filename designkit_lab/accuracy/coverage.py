@@ -42,7 +42,7 @@ from typing import Any, Callable, Iterable, Mapping, Sequence
 
 import numpy as np
 
-from .._validation import as_generator
+from designkit._validation import as_generator
 
 __all__ = [
     "COVERAGE_QUESTIONS",
@@ -100,8 +100,8 @@ def draw_case(question: str, rng: np.random.Generator) -> dict[str, Any]:
     case = {"e1": round(lo + gap, 1), "e2": round(lo, 1), "gap": round(gap, 1), "noise_c": noise,
             "delta_t_c": _DT_C, "contact_s": round(contact, 3)}
     if question == "distinguishable":
-        from ..query.ideal_bound import exact_ideal_min_contact
-        from ..sensor import load_sensor
+        from designkit.query.ideal_bound import exact_ideal_min_contact
+        from designkit.sensor import load_sensor
 
         t = exact_ideal_min_contact(load_sensor("paper"), case["e2"], case["e1"], noise / _DT_C, width=_WIDTH,
                                     max_contact_s=10.0)
@@ -145,8 +145,8 @@ def table_reading(question: str, case: Mapping[str, Any], *, table: str | None =
     (``"error"``), not raised, so that a benchmark goes on. ``table``: the query layer's default
     (:data:`designkit.query.table.DEFAULT_TABLE`) unless given. ``sensor_temp_spread_c`` [degC]: varied
     initial conditions (``table`` then a varied table)."""
-    from .. import query
-    from ..query.table import DEFAULT_TABLE
+    from designkit import query
+    from designkit.query.table import DEFAULT_TABLE
 
     table = DEFAULT_TABLE if table is None else table
 
@@ -174,7 +174,7 @@ def coverage_case(question: str, case: Mapping[str, Any], index: int, *, repeats
     """
     import time
 
-    from ..query import exact as ex
+    from designkit.query import exact as ex
 
     args = case_arguments(question, case)
     if sensor_temp_spread_c:
@@ -369,8 +369,8 @@ def synthetic_coverage(n: int, *, seed: int, coverage: float = 0.9, repeats: int
     spread of ``(log x_est - log x*) / sd`` with ``sd`` the interval's stated standard deviation
     in log x (1 when the stated width is right; the coverage follows from it).
     """
-    from ..query.crossing import estimate_crossing, z_of_coverage
-    from ..recognition.svm import f1_standard_error
+    from designkit.query.crossing import estimate_crossing, z_of_coverage
+    from designkit.recognition.svm import f1_standard_error
 
     rng = as_generator(seed)
     rho = float(correlation)
@@ -443,7 +443,7 @@ def run_cases(question: str, n: int, *, seed: int, jobs: int = 1, done: Callable
     called as each finishes (for progress and saving)."""
     from joblib import Parallel, delayed
 
-    from .._workers import local_processes, worker_count
+    from designkit._workers import local_processes, worker_count
 
     jobs = worker_count(jobs)
     rng = as_generator([int(seed), COVERAGE_QUESTIONS.index(question)])

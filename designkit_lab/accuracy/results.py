@@ -148,6 +148,6 @@ def worst(x) -> float:
 
 def paper_sensor():
     """The paper's sensor (:data:`designkit.sensor.SENSORS` ``["paper"]``)."""
-    from ..sensor import SENSORS
+    from designkit.sensor import SENSORS
 
     return SENSORS["paper"]

@@ -1,6 +1,6 @@
 """The accuracy report as a page: ``accuracy.md``, its figures and ``accuracy.json``.
 
-:func:`render_markdown` turns a :class:`~designkit.accuracy.run.BenchReport`
+:func:`render_markdown` turns a :class:`~designkit_lab.accuracy.run.BenchReport`
 into ``docs/accuracy.md``; :func:`write_report` writes it with its figures
 (matplotlib, from the ``figures`` extra) and the JSON record
 (``designkit bench --out docs``). Nothing here measures anything.
@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any, Mapping, Sequence
 
 import numpy as np
 
-from .._validation import InputError
+from designkit._validation import InputError
 from .results import CostCurve, Row
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -364,7 +364,7 @@ def _log_axes(ax) -> None:
 
 def _save(fig, path, plt) -> Path:
     """Save by the suffix of ``path`` (png at 200 dpi, or vector svg / pdf) and close."""
-    from ..figures import save_figure
+    from designkit.figures import save_figure
 
     return save_figure(fig, path)
 
@@ -430,7 +430,7 @@ def _label(ax, text: str, xy, **kw):
 
 def plot_pareto(report: BenchReport, path) -> Path | None:
     """Error against time per answer, one panel per question (log-log), saved as PNG (None without rows)."""
-    from ..figures import pyplot
+    from designkit.figures import pyplot
 
     fig = pareto_figure(report)
     return None if fig is None else _save(fig, path, pyplot())
@@ -472,7 +472,7 @@ def _pareto_panel(ax, question: str, rows: Sequence[Row]) -> list:
 
 def pareto_figure(report: BenchReport) -> Any:
     """The matplotlib figure of :func:`plot_pareto` (None without rows)."""
-    from ..figures import pyplot
+    from designkit.figures import pyplot
 
     plt = pyplot()
     groups = _by_question(report.rows)
@@ -497,7 +497,7 @@ def pareto_figure(report: BenchReport) -> Any:
 
 def plot_costs(report: BenchReport, path) -> Path | None:
     """The sweep's cost curves (time and memory against size), log-log, saved as PNG (None without curves)."""
-    from ..figures import pyplot
+    from designkit.figures import pyplot
 
     if not report.curves:
         return None
@@ -547,7 +547,7 @@ def write_report(report: BenchReport, out_dir) -> dict[str, Path]:
     """
     import json
 
-    from .._io import atomic_write_text
+    from designkit._io import atomic_write_text
 
     require_figures()
     out_dir = Path(out_dir)
@@ -699,7 +699,7 @@ def write_coverage(doc: Mapping[str, Any], figure, out_dir) -> Path:
     import json
     import shutil
 
-    from .._io import atomic_write_text
+    from designkit._io import atomic_write_text
 
     out_dir = Path(out_dir)
     js, png = (out_dir / n for n in COVERAGE_FILES)
@@ -791,7 +791,7 @@ def varied_coverage_figure(doc: Mapping[str, Any], path) -> Path | None:
     runs = [r for r in doc.get("runs", []) if r.get("cases")]
     if not runs:
         return None
-    from ..figures import pyplot
+    from designkit.figures import pyplot
 
     plt = pyplot()
     questions = sorted({r["question"] for r in runs}, key=lambda q: (q != "min-contact", q))
@@ -858,7 +858,7 @@ def write_varied_coverage(run: Mapping[str, Any], out_dir) -> Path:
     an earlier run of the same question and seed, and its section into the page."""
     import json
 
-    from .._io import atomic_write_text
+    from designkit._io import atomic_write_text
 
     out_dir = Path(out_dir)
     js = out_dir / VARIED_COVERAGE_FILE

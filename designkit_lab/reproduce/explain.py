@@ -41,8 +41,8 @@ def ideal_percent(depth_m: float, noise_ratio: float, contact_s: float = TABLE1_
                   intervals: int = 500, workdir: Path | None = None) -> float:
     """Ideal observer's % indistinguishable interval pairs on the paper's grid for the paper's
     sensor at thermistor depth ``depth_m`` (closed form, through the sweep engine)."""
-    from ..sweep import SweepConfig, run_scene
-    from ..sensor import SENSORS
+    from designkit.sweep import SweepConfig, run_scene
+    from designkit.sensor import SENSORS
 
     sensor = SENSORS["paper"].replace(depth_m=float(depth_m), name=f"paper-depth-{depth_m * 1e6:g}um")
     with tempfile.TemporaryDirectory(dir=workdir) as tmp:
@@ -93,7 +93,7 @@ def _f1_split(ctx: Context, ratio: float) -> dict | None:
 
 
 def _overlap_share(ctx: Context) -> dict:
-    from ..materials import list_materials
+    from designkit.materials import list_materials
 
     r = np.array([m.effusivity_range for m in list_materials()])
     K = r.shape[0]

@@ -16,7 +16,7 @@ import math
 
 import numpy as np
 
-from .._validation import as_generator
+from designkit._validation import as_generator
 from .instruments import timed
 from .results import Row, paper_sensor, p95, worst
 
@@ -36,7 +36,7 @@ def _mp_ratio(mpmath, t):
 
 
 def _shape_row(mpmath, rng, n) -> Row:
-    from ..models.semi_infinite import response_shape
+    from designkit.models.semi_infinite import response_shape
 
     t = _TAU_S / 10.0 ** rng.uniform(-3.0, math.log10(700.0), n)
     got, sec = timed(lambda: response_shape(t, _TAU_S), 3)
@@ -47,7 +47,7 @@ def _shape_row(mpmath, rng, n) -> Row:
 
 
 def _log_shape_row(mpmath, rng, n) -> Row:
-    from ..models.semi_infinite import log_response_shape
+    from designkit.models.semi_infinite import log_response_shape
 
     t = _TAU_S / 10.0 ** rng.uniform(-6.0, 6.0, n)
     got, sec = timed(lambda: log_response_shape(t, _TAU_S), 3)
@@ -58,7 +58,7 @@ def _log_shape_row(mpmath, rng, n) -> Row:
 
 
 def _change_row(mpmath, rng, n) -> Row:
-    from ..models.semi_infinite import temperature_change
+    from designkit.models.semi_infinite import temperature_change
 
     e = 10.0 ** rng.uniform(-3.0, 6.0, n)
     t = _TAU_S / 10.0 ** rng.uniform(-3.0, math.log10(700.0), n)
@@ -151,7 +151,7 @@ def slab_rows(quick: bool = True) -> list[Row]:
     -------
     list of Row
     """
-    from ..models import slab
+    from designkit.models import slab
 
     sensor = paper_sensor()
     scenes = _slab_scenes(slab)

@@ -11,7 +11,7 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from .._validation import InputError
+from designkit._validation import InputError
 
 __all__ = [
     "Comparison",
@@ -93,7 +93,7 @@ class ReproduceSettings:
     def __post_init__(self) -> None:
         if int(self.seed) != self.seed or self.seed < 0:
             raise InputError(f"seed must be a non-negative integer, got {self.seed}")
-        from .._workers import worker_count
+        from designkit._workers import worker_count
 
         worker_count(self.jobs)  # not a count, none or absurdly many: refused here, before any section runs
         fmt = str(self.figure_format).strip().lower()
@@ -209,7 +209,7 @@ class Context:
         Why a table is missing or unusable is kept for the report (:meth:`table_problem`).
         """
         if name not in self._tables:
-            from ..tables.store import load_table
+            from designkit.tables.store import load_table
 
             found, problem = None, None
             cands: list[Any] = []
@@ -243,7 +243,7 @@ class Context:
     def save_figure(self, fig, name: str) -> str:
         """Save a matplotlib figure as ``figures/NAME.png``, ``.svg`` and ``.pdf``; returns the report-relative
         path of the one in the settings' figure format (the one the report shows)."""
-        from ..figures import FIGURE_FORMATS, save_figure
+        from designkit.figures import FIGURE_FORMATS, save_figure
 
         fmt = self.settings.figure_format
         self.fig_dir.mkdir(parents=True, exist_ok=True)
@@ -258,7 +258,7 @@ class Context:
         import csv
         import io
 
-        from .._io import atomic_write_text
+        from designkit._io import atomic_write_text
 
         buf = io.StringIO()
         w = csv.writer(buf, lineterminator="\n")

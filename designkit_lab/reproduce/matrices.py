@@ -179,10 +179,10 @@ def chance_f1(ctx: Context) -> dict:
     """
     if "chance_f1" in ctx.cache:
         return ctx.cache["chance_f1"]
-    from ..recognition.svm import cross_validated_f1
-    from ..scene import Scene
-    from ..sensor import SENSORS
-    from ..simulation import simulate_interval
+    from designkit.recognition.svm import cross_validated_f1
+    from designkit.scene import Scene
+    from designkit.sensor import SENSORS
+    from designkit.simulation import simulate_interval
 
     sensor = SENSORS["paper"]
     scene = Scene(contact_s=TABLE1_CONTACT_S, noise_c=0.005, sensor_temp_c=AMBIENT_C + 1.0, ambient_temp_c=AMBIENT_C)
@@ -246,7 +246,7 @@ def material_f1(ctx: Context, noise_ratio: float) -> MaterialF1 | None:
     key = ("material_f1", round(noise_ratio, 12))
     if key in ctx.cache:
         return ctx.cache[key]
-    from ..materials import list_materials
+    from designkit.materials import list_materials
 
     coarse_t = ctx.table(COARSE_TABLE)
     coarse = f1_matrix(coarse_t, noise_ratio, TABLE1_CONTACT_S)
@@ -293,7 +293,7 @@ def section_f1_matrices(ctx: Context) -> SectionResult:
     e_min, width, n = _grid(tab)
     centres = tab.axes["e_ref"]
     phi = tab.threshold
-    from ..figures import pyplot
+    from designkit.figures import pyplot
 
     plt = pyplot()
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.8), constrained_layout=True)
@@ -559,8 +559,8 @@ def section_node_graphs(ctx: Context) -> SectionResult:
                              wall_s=time.perf_counter() - t0)
     from matplotlib.lines import Line2D
 
-    from ..figures import pyplot
-    from ..materials import FAMILY_LABELS
+    from designkit.figures import pyplot
+    from designkit.materials import FAMILY_LABELS
 
     plt = pyplot()
     fig, axes = plt.subplots(2, 1, figsize=(15, 13), constrained_layout=True)

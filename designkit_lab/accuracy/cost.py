@@ -24,7 +24,7 @@ __all__ = ["cost_curve", "cost_curve_specs", "cost_curves"]
 
 def _config(variable: str, v: float, base: Mapping[str, Any]):
     """The sweep configuration of one point of a cost curve."""
-    from ..sweep import SweepConfig
+    from designkit.sweep import SweepConfig
 
     kw = dict(base)
     if variable == "contact_s":
@@ -38,7 +38,7 @@ def _config(variable: str, v: float, base: Mapping[str, Any]):
 
 def _sweep_one_scene(cfg):
     """What a sweep does per scene point: run it, assemble the table arrays; the chunks."""
-    from ..sweep import assemble, run_scene
+    from designkit.sweep import assemble, run_scene
 
     chunks = run_scene(cfg)
     assemble(cfg, chunks)
@@ -110,7 +110,7 @@ def _curve_in_fresh_process(name, variable, values, base, setting) -> CostCurve:
     """Body of :func:`cost_curves` in a child: warm up, take the baseline, run the curve."""
     import gc
 
-    from ..sweep import SweepConfig
+    from designkit.sweep import SweepConfig
 
     _sweep_one_scene(SweepConfig(**{**base, "intervals": 4, "trials": 6, "contact_s": (0.5,)}))
     # imports, BLAS and libsvm are loaded before the baseline

@@ -1,0 +1,99 @@
+"""A class's touches read from a few effusivities (designkit.models.shared) and the ramp's sum as a convolution.
+
+The interpolated readings are checked against the model read directly at every touch's effusivity
+(the independent reference: no interpolation), within the tolerance the simulation asks; the draws
+(seeds, noise) are the same as before, so the same seed still gives the same touches bit for bit.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from designkit import Scene
+from designkit.models import get_model
+from designkit.models.ramp import ForceRamp
+from designkit.models.shared import SharedResponse, class_readings
+from designkit.sensor import Sensor
+from designkit.simulation import draw_trials, render_trials, response_tolerance
+
+SENSOR = Sensor(1980.74, 8.8e-9, depth_m=8e-5, name="rig")
+LAYERED = get_model("layered", film_thickness_m=2.2e-4, backing_effusivity_ws05_m2k=5000.0, conductance_w_m2k=18000.0,
+                    lag_s=0.8, smoothing_window=99, smoothing_order=3)
+TP = np.arange(-10, 40) * 0.02
+RAMP = ForceRamp.from_force_profile(LAYERED, TP, np.clip(0.1 + 0.9 * (TP + 0.2) / 0.9, 0, 1), 0.2)
+
+
+@pytest.mark.parametrize("model", [LAYERED, RAMP], ids=["layered", "force-ramp"])
+@pytest.mark.parametrize("e_range", [(331.0, 506.0), (2252.0, 2750.0), (20.0, 30000.0)])
+def test_interpolated_class_readings_agree_with_direct_evaluation(model, e_range):
+    t = np.arange(201) / 200.0
+    e = np.random.default_rng(7).uniform(*e_range, 60)
+    tol = 1e-6   # what a simulation asks at 0.5 % noise and a few seconds (response_tolerance)
+    got = class_readings(model, t, e, SENSOR, tolerance=tol)
+    want = model.response(t, e, SENSOR)
+    assert np.max(np.abs(got - want)) <= tol
+    table = SharedResponse.build(model, t, e.min(), e.max(), SENSOR, tolerance=tol)
+    if e_range[1] / e_range[0] < 2:   # a class of the sweep's grid: a few readings; a very wide range may read directly
+        assert not table.direct and table.error <= tol and table.weights.size <= 9
+
+
+def test_one_class_table_serves_every_draw_of_the_class():
+    t = np.arange(301) / 200.0
+    table = SharedResponse.build(RAMP, t, 331.0, 506.0, SENSOR, tolerance=1e-6)
+    assert table.weights.size <= 9 and np.all(np.diff(table.nodes) > 0)
+    for seed in (1, 2):
+        e = np.random.default_rng(seed).uniform(331.0, 506.0, 40)
+        assert np.max(np.abs(table.readings(e) - RAMP.response(t, e, SENSOR))) <= 1e-6
+    with pytest.raises(Exception, match="outside the class response's range"):
+        table.readings([600.0])
+
+
+def test_render_trials_is_within_the_asked_tolerance_and_keeps_the_draws():
+    scene = Scene(contact_s=1.5, noise_c=0.05)
+    m = SENSOR.times_s(scene.contact_s).size
+    draws = draw_trials(331.0, 506.0, 50, m, [3, 1])
+    a = render_trials(draws, SENSOR, scene, RAMP)
+    again = render_trials(draw_trials(331.0, 506.0, 50, m, [3, 1]), SENSOR, scene, RAMP)
+    other = render_trials(draw_trials(331.0, 506.0, 50, m, [3, 2]), SENSOR, scene, RAMP)
+    np.testing.assert_array_equal(a.temperature_c, again.temperature_c)          # seeds honoured, bit for bit
+    assert not np.array_equal(a.temperature_c, other.temperature_c)
+    dT = scene.ambient_temp_c - scene.sensor_temp_c
+    u = (a.temperature_c - scene.sensor_temp_c - scene.noise_c * draws.noise) / dT
+    direct = RAMP.response(a.time_s, draws.effusivity, SENSOR)
+    assert np.max(np.abs(u - direct)) <= response_tolerance(scene.noise_ratio, m) + 1e-12
+
+
+def test_few_distinct_objects_or_a_per_touch_diffusivity_are_read_directly():
+    t = np.arange(101) / 200.0
+    e = np.array([400.0, 400.0, 2500.0, 400.0])
+    np.testing.assert_array_equal(class_readings(LAYERED, t, e, SENSOR, tolerance=1e-6),
+                                  LAYERED.response(t, np.unique(e), SENSOR)[[0, 0, 1, 0]])
+    semi = get_model()
+    np.testing.assert_array_equal(class_readings(semi, t, e, SENSOR, tolerance=1e-6), semi.response(t, e, SENSOR))
+    assert SharedResponse.build(LAYERED, t, 400.0, 400.0, SENSOR, tolerance=1e-6).direct
+
+
+def test_a_ramp_off_the_sample_grid_is_the_sum_of_shifted_step_responses():
+    """Shares starting between samples (phase 0.4 of a sample) on a uniform grid: the convolution's phases."""
+    base = get_model("contact", conductance_w_m2k=2500.0)
+    dt = 1 / 200.0
+    ramp = ForceRamp(base, (0.0, 0.012, 0.05, 0.2), (0.1, 0.3, 0.7, 1.0))
+    t = np.arange(-5, 200) * dt
+    want = np.zeros((2, t.size))
+    for tj, da in zip(ramp.ramp_time_s, np.diff(ramp.ramp_area, prepend=0.0)):
+        lag = t - tj
+        pos = lag > 0
+        want[:, pos] += da * base.response(lag[pos], [400.0, 9000.0], SENSOR)
+    np.testing.assert_allclose(ramp.response(t, [400.0, 9000.0], SENSOR), want, rtol=1e-13, atol=1e-300)
+
+
+def test_the_layered_transform_is_its_object_independent_parts_divided_per_object():
+    from designkit.models.layered import laplace_parts, laplace_reading, talbot_points
+
+    p, _ = talbot_points(np.array([0.1, 1.0]))
+    kw = LAYERED._laplace_kwargs(SENSOR)
+    A, B, C = laplace_parts(p, **kw)
+    U = laplace_reading(p, np.array([400.0, np.inf]), **kw)
+    np.testing.assert_allclose(U[0], C / (A + B / 400.0), rtol=1e-14)
+    np.testing.assert_allclose(U[1], C / A, rtol=1e-14)

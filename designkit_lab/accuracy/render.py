@@ -511,8 +511,15 @@ def plot_costs(report: BenchReport, path) -> Path | None:
         if np.any(ok):
             exp = "" if c.memory_exponent is None else f" (p = {c.memory_exponent:.2f})"
             a2.plot(x[ok], mem[ok], "o-", color=f"C{i}", ms=3, label=c.name + exp)
-    for ax, lab in ((a1, "wall time [s]"), (a2, "peak memory above baseline [MB]")):
+    from designkit.figures import log_ticks
+
+    sizes = [v for c in report.curves for v in np.asarray(c.x) / c.x[0]]
+    walls = [v for c in report.curves for v in c.wall_s]
+    mems = [v for c in report.curves for v in c.peak_mb if np.isfinite(v) and v > 0.5]
+    for ax, lab, ys in ((a1, "wall time [s]", walls), (a2, "peak memory above baseline [MB]", mems)):
         _log_axes(ax)
+        log_ticks(ax.xaxis, sizes)  # the values measured: a range inside one decade showed a single tick
+        log_ticks(ax.yaxis, ys)
         ax.set_xlabel("size relative to the curve's first point")
         ax.set_ylabel(lab)
         ax.grid(alpha=0.3, which="both")

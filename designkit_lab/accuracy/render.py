@@ -9,6 +9,7 @@ into ``docs/accuracy.md``; :func:`write_report` writes it with its figures
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Mapping, Sequence
 
@@ -335,6 +336,41 @@ def render_markdown(report: BenchReport, figures: Mapping[str, str] | None = Non
     out += ["## Section wall times", "",
             ", ".join(f"{k} {v:.0f} s" for k, v in report.section_wall_s.items()) +
             f"; total {report.wall_s:.0f} s.", ""]
+    return short_paragraphs("\n".join(out))
+
+
+#: The longest paragraph (or list item) of the page [characters]; tests/test_docs_site.py holds docs/ to it.
+MAX_PARAGRAPH = 800
+_SENTENCE_END = re.compile(r"(?<=[\w%)]\.)\s+(?=[A-Za-z(])")
+_NOT_AN_END = re.compile(r"(?:\b(?:e\.g|i\.e|vs|cf|eq|Fig|et al)|\d)\.$")
+
+
+def short_paragraphs(markdown: str, limit: int = MAX_PARAGRAPH) -> str:
+    """``markdown`` with every prose line longer than ``limit`` characters cut at sentence ends into
+    paragraphs (a list item's continue under it, indented). Idempotent; code fences and tables are kept.
+
+    >>> text = "- " + "A sentence here. " * 60
+    >>> max(len(p) for p in short_paragraphs(text).split(chr(10) * 2)) <= 800
+    True
+    """
+    out, fence = [], False
+    for line in markdown.split("\n"):
+        if line.lstrip().startswith("```"):
+            fence = not fence
+        if fence or len(line) <= limit or line.lstrip().startswith(("|", "#", "<!--")):
+            out.append(line)
+            continue
+        item = re.match(r"(\s*)((?:[-*]|\d+\.)\s+)?", line)
+        indent = item.group(1) + " " * len(item.group(2) or "")
+        rest = line
+        while len(rest) > limit:
+            cuts = [m.start() for m in _SENTENCE_END.finditer(rest)
+                    if m.start() <= limit and not _NOT_AN_END.search(rest[:m.start()])]
+            if not cuts:
+                break
+            out += [rest[:cuts[-1]].rstrip(), ""]
+            rest = indent + rest[cuts[-1]:].strip()
+        out.append(rest)
     return "\n".join(out)
 
 

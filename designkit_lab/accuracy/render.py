@@ -341,7 +341,7 @@ def render_markdown(report: BenchReport, figures: Mapping[str, str] | None = Non
 
 #: The longest paragraph (or list item) of the page [characters]; tests/test_docs_site.py holds docs/ to it.
 MAX_PARAGRAPH = 800
-_SENTENCE_END = re.compile(r"(?<=[\w%)]\.)\s+(?=[A-Za-z(])")
+_SENTENCE_END = re.compile(r"(?<=[\w%)][.;])\s+(?=[A-Za-z(])")
 _NOT_AN_END = re.compile(r"(?:\b(?:e\.g|i\.e|vs|cf|eq|Fig|et al)|\d)\.$")
 
 
@@ -734,7 +734,7 @@ def _insert_section(page: str, start: str, end: str, section: Sequence[str], aft
 
 def insert_coverage(page: str, section: Sequence[str]) -> str:
     """``page`` with its coverage section replaced (between markers), or inserted before the first ``## ``."""
-    return _insert_section(page, _COV_START, _COV_END, section)
+    return short_paragraphs(_insert_section(page, _COV_START, _COV_END, section))
 
 
 def write_coverage(doc: Mapping[str, Any], figure, out_dir) -> Path:
@@ -893,7 +893,7 @@ def varied_coverage_figure(doc: Mapping[str, Any], path) -> Path | None:
 def insert_varied_coverage(page: str, section: Sequence[str]) -> str:
     """``page`` with its varied-conditions section replaced (between markers), or inserted after the coverage
     section (before the first ``## `` where there is none)."""
-    return _insert_section(page, _VAR_START, _VAR_END, section, after=_COV_END)
+    return short_paragraphs(_insert_section(page, _VAR_START, _VAR_END, section, after=_COV_END))
 
 
 def write_varied_coverage(run: Mapping[str, Any], out_dir) -> Path:

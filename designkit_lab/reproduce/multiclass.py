@@ -147,7 +147,7 @@ def section_multiclass(ctx: Context) -> SectionResult:
                     ax.text(j, i, f"{frac[i, j]:.2f}"[1:] if frac[i, j] < 1 else "1", ha="center", va="center",
                             fontsize=6, color="white" if frac[i, j] > 0.6 else "black")
         ax.grid(False)
-        fig.colorbar(im, ax=ax, shrink=0.8, label="fraction of the true material's touches")
+        fig.colorbar(im, ax=ax, shrink=0.8, label="fraction of its touches")
         ax.set_xticks(range(len(names)), names, rotation=60, ha="right", fontsize=7)
         ax.set_yticks(range(len(names)), names, fontsize=7)
         ax.set_xlabel("predicted")

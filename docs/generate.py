@@ -61,7 +61,7 @@ SHELL = re.compile(r"[|&;<>()$`]")
 #: The run's own wall and CPU times (they differ from run to run): compared with the number masked,
 #: so a block counts as stale only when something else changed.
 VOLATILE = re.compile(r"(?<=in )[\d.]+ s \([\d.]+ s CPU\)|(?<=per class, )[\d.]+ s(?=\))|(?<=computed in )[\d.]+ s"
-                      r"|(?<=, )[\d.]+ s(?= wall)|(?<=took )[\d.]+ s")
+                      r"|(?<=, )[\d.]+ s(?= wall)|(?<=took )[\d.]+ s|[\d.]+ s(?= │\n)")
 
 
 def same(old: str, new: str) -> bool:

@@ -281,7 +281,7 @@ def _scene_line(d) -> str:
     names = " vs ".join(o["material"] or f"{o['e_range'][0]:g}" for o in d["objects"])
     if d["question"] == "delta-e":
         names = f"e {names}"
-    model = "" if d["model"]["name"] == "semi-infinite" else f" ({_model_words(d)})"
+    model = "" if d["model"]["name"] == "semi-infinite" else f", model {d['model']['name']}"  # --explain: its parameters
     source = (f"table {d['table']['name']}" if d["route"] == "table"
               else f"computed in {d['computation']['wall_s']:.1f} s")
     return escape(f"{names}, {', '.join(scene)}, F1 ≥ {d['threshold']:g}, {d['sensor']['name']} sensor{model}; "
@@ -393,6 +393,10 @@ _VALUE_LINES = {
 def _explain_lines(con, d):
     """--explain: the objects with their units, the hardest pair, the paper's remark, the method, every note."""
     con.print("objects [J s^-1/2 K^-1 m^-2]: " + " vs ".join(f"[bold]{o['label']}[/]" for o in d["objects"]))
+    if d["model"]["name"] != "semi-infinite":
+        from rich.markup import escape
+
+        con.print(f"model: {escape(_model_words(d))}")
     if d["limiting_pair"] and any(o["material"] for o in d["objects"]) and d["question"] != "delta-e":
         con.print("answered for the hardest pair: " + " vs ".join(o["label"] for o in d["limiting_pair"]))
     if d["question"] == "delta-e":

@@ -1,4 +1,9 @@
-"""Figures (matplotlib, from the ``figures`` extra). Imported only when a figure is asked for."""
+"""Figures (matplotlib, from the ``figures`` extra): the one style of every designkit figure, and its saving.
+
+Imported only when a figure is asked for. :func:`pyplot` applies :data:`STYLE`; :func:`save_figure`
+writes PNG, SVG and PDF beside each other; :func:`log_ticks` labels a log axis at the values plotted;
+numbers on a figure are rounded as everywhere else (:func:`designkit._numbers.sig`).
+"""
 
 from __future__ import annotations
 
@@ -8,10 +13,18 @@ import numpy as np
 
 from ._validation import InputError
 
-__all__ = ["FIGURE_FORMATS", "plot_curves", "plot_matrix", "pyplot", "save_figure"]
+__all__ = ["FIGURE_FORMATS", "STYLE", "log_ticks", "plot_curves", "plot_matrix", "pyplot", "save_figure"]
 
-#: Formats a figure can be saved in (by file suffix): vector (svg, pdf) or raster (png).
+#: Formats a figure is saved in (every one, beside each other): vector (svg, pdf) and raster (png).
 FIGURE_FORMATS = ("png", "svg", "pdf")
+
+#: The style of every figure (matplotlib rcParams): readable labels, a light grid, lines that stay visible
+#: where curves meet (dashed lines drawn over solid ones are not hidden).
+STYLE = {
+    "font.size": 9, "axes.titlesize": 9, "axes.labelsize": 9, "xtick.labelsize": 8, "ytick.labelsize": 8,
+    "legend.fontsize": 8, "legend.framealpha": 0.85, "axes.grid": True, "grid.alpha": 0.3,
+    "lines.linewidth": 1.6, "savefig.bbox": "tight", "svg.hashsalt": "designkit",
+}
 
 
 def pyplot():
@@ -23,7 +36,27 @@ def pyplot():
     matplotlib.use("Agg", force=True)
     import matplotlib.pyplot as plt
 
+    plt.rcParams.update(STYLE)
     return plt
+
+
+def log_ticks(axis, values) -> None:
+    """Label a log-scaled ``axis`` (``ax.xaxis``) at ``values`` (the points plotted), rounded by the one rule.
+
+    Matplotlib labels only the decades of a log axis: a range inside one decade showed a single tick.
+    """
+    from matplotlib.ticker import FixedLocator, NullFormatter, NullLocator
+
+    from ._numbers import sig
+
+    ticks = sorted({float(v) for v in np.asarray(values, dtype=np.float64).ravel() if np.isfinite(v) and v > 0})
+    if len(ticks) > 8:  # at most 8 labels: every k-th value, the ends kept
+        k = int(np.ceil(len(ticks) / 8))
+        ticks = sorted(set(ticks[::k]) | {ticks[-1]})
+    axis.set_major_locator(FixedLocator(ticks))
+    axis.set_major_formatter(lambda x, _pos: sig(x))
+    axis.set_minor_locator(NullLocator())
+    axis.set_minor_formatter(NullFormatter())
 
 
 def plot_curves(path: Path, time_s, temperature_c, *, title: str = "") -> Path:
@@ -42,15 +75,20 @@ def plot_curves(path: Path, time_s, temperature_c, *, title: str = "") -> Path:
     return save_figure(fig, path, dpi=120)
 
 
-def save_figure(fig, path, *, dpi: int = 200) -> Path:
-    """Save ``fig`` by the suffix of ``path`` (:data:`FIGURE_FORMATS`; svg and pdf are vector) and close it."""
+def save_figure(fig, path, *, dpi: int = 200, formats=FIGURE_FORMATS) -> Path:
+    """Save ``fig`` as ``path`` and in the other ``formats`` beside it (same name, their suffixes), then close it.
+
+    ``path``'s suffix must be one of :data:`FIGURE_FORMATS`; svg and pdf are vector, png has ``dpi``.
+    Returns ``path``.
+    """
     path = Path(path)
     fmt = path.suffix.lower().lstrip(".")
     if fmt not in FIGURE_FORMATS:
         raise InputError(f"figure file {path.name!r}: give a .png, .svg or .pdf name")
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=dpi if fmt == "png" else None, format=fmt, bbox_inches="tight",
-                metadata=None if fmt == "png" else {"Date": None})  # no date: the same figure, the same file
+    for f in (fmt, *(x for x in formats if x != fmt)):
+        fig.savefig(path.with_suffix(f".{f}"), dpi=dpi if f == "png" else None, format=f, bbox_inches="tight",
+                    metadata=None if f == "png" else {"Date": None})  # no date: the same figure, the same file
     pyplot().close(fig)
     return path
 
@@ -63,6 +101,8 @@ def plot_matrix(result, path) -> Path:
     """
     plt = pyplot()
     from matplotlib.colors import LogNorm
+
+    from ._numbers import sig
 
     names = list(result.names)
     n = len(names)
@@ -98,7 +138,7 @@ def plot_matrix(result, path) -> Path:
                 continue
             v = vals[i, j]
             txt = "n/a" if not np.isfinite(v) else (("yes" if v else "no") if result.question == "distinguishable"
-                                                     else bounds.get((i, j), "") + f"{v:.2g}")
+                                                     else bounds.get((i, j), "") + sig(v))
             rgba = im.cmap(im.norm(v)) if np.isfinite(v) else (1, 1, 1, 1)
             dark = 0.299 * rgba[0] + 0.587 * rgba[1] + 0.114 * rgba[2] < 0.5
             ax.text(j, i, txt, ha="center", va="center", fontsize=7 if n > 8 else 9,
@@ -108,6 +148,7 @@ def plot_matrix(result, path) -> Path:
         i, j = names.index(lim.names[0]), names.index(lim.names[1])
         for a, b in ((i, j), (j, i)):
             ax.add_patch(plt.Rectangle((b - 0.5, a - 0.5), 1, 1, fill=False, edgecolor="red", lw=2.0))
+    ax.grid(False)
     ax.set_xticks(range(n), names, rotation=45, ha="right", rotation_mode="anchor", fontsize=8)
     ax.set_yticks(range(n), names, fontsize=8)
     ax.set_xlim(-0.5, n - 0.5)

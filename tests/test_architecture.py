@@ -24,7 +24,7 @@ ROOTS = {"designkit": PKG, "designkit_lab": Path(designkit_lab.__file__).resolve
 # Layers, lowest first. A module may import from its own layer and the layers below, never above.
 LAYERS = [
     {"designkit._validation", "designkit._schemas", "designkit._io", "designkit._resources",
-     "designkit._workers"},
+     "designkit._workers", "designkit._numbers"},
     {"designkit.properties", "designkit.sensor", "designkit.scene", "designkit.materials", "designkit.objects",
      "designkit.figures"},
     {"designkit.models", "designkit.rig"},
@@ -110,6 +110,7 @@ def test_every_module_is_in_a_layer_and_imports_only_downward():
 
 #: The designated homes of shared private helpers (pvlib's tools.py): importing from them is the point.
 SHARED = {"designkit._validation", "designkit._schemas", "designkit._io", "designkit._resources", "designkit.cli._app",
+          "designkit._numbers",
           "designkit.cli._options", "designkit_lab.reproduce._report"}
 
 

@@ -42,7 +42,14 @@ def test_classify_text_output_names_decision_and_time(cli):
         r = cli("classify", "--port", emu.port, "--m", "a=35000:35080", "--m", "b=20000:20080",
                 "--time-offset", str(emu.expected_time_offset_s), "--error-rate", "0.05")
     assert r.exit_code == 0, r.output
-    assert "touch 1: a after" in r.output and "s of contact" in r.output
+    assert "touch 1: a after" in r.stdout and "s of contact" in r.stdout
+    assert "touch 1:" not in r.stderr  # once, outside a terminal too (it was on stdout and stderr)
+    # time and samples from the same origin, the detected onset: samples = time x 200 Hz
+    import re
+
+    t, n = re.search(r"after ([\d.]+) s of contact, (\d+) samples at 200 Hz \(both from the detected onset",
+                     r.stdout).groups()
+    assert int(n) == round(float(t) * 200)
 
 
 def test_classify_uses_the_calibrated_sensors_time_offset(cli, tmp_path):

@@ -103,11 +103,12 @@ def test_calibration_readme_snippet_defines_every_name():
 
 
 def test_the_readmes_python_examples_run():
-    """README's library examples (```python blocks) run as written in a fresh interpreter (the array
-    example asserts its shape and that it agrees with a single call)."""
+    """The library examples of README.md and docs/library.md (```python blocks) run as written in a fresh
+    interpreter (the array example asserts its shape and that it agrees with a single call)."""
     import subprocess
 
-    blocks = re.findall(r"```python\n(.*?)```", (REPO / "README.md").read_text(encoding="utf-8"), re.S)
+    blocks = [b for f in (REPO / "README.md", REPO / "docs" / "library.md")
+              for b in re.findall(r"```python\n(.*?)```", f.read_text(encoding="utf-8"), re.S)]
     assert len(blocks) >= 2
     for code in blocks:
         r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600, cwd=REPO)

@@ -14,16 +14,18 @@ def _paper_words() -> str:
 
 
 @pytest.mark.parametrize("pair", [("35000", "20000"), ("20000", "35000")])
-def test_main_job_prints_the_paper_figure_beside_the_answer(cli, pair):
-    r = cli("min-contact", "--e1", pair[0], "--e2", pair[1])
+def test_main_job_prints_the_paper_figure_with_explain(cli, pair):
+    r = cli("min-contact", "--e1", pair[0], "--e2", pair[1], "--explain")
     assert r.exit_code == 0, r.output
     lines = r.output.splitlines()
     i = next(k for k, line in enumerate(lines) if _paper_words() in line)
-    # right under the answer and its ideal bound, with the answer placed on the paper's grid
-    assert "ideal observer bound" in lines[i - 1] and "SVM" in lines[i - 2]
-    value = float(lines[i - 2].split("shortest contact ")[1].split(" s")[0])
+    # the answer first, its ideal bound second; the paper's figure among the explanation, placed on its grid
+    assert lines[0].startswith("shortest contact: ") and "ideal observer bound" in lines[1] and i > 2
+    value = float(lines[0].split(": ")[1].split(" s")[0])
     on_grid = min(c for c in GUIDELINE["contact_grid_s"] if c >= value)
     assert f"rounds up to {on_grid:g} s there" in lines[i]
+    short = cli("min-contact", "--e1", pair[0], "--e2", pair[1])
+    assert _paper_words() not in short.output and len(short.output.splitlines()) <= 4
 
 
 @pytest.mark.parametrize("args", [("--e1", "35000", "--e2", "20000", "--noise", "0.1"),

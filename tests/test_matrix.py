@@ -216,8 +216,19 @@ def test_cli_csv_tells_overlap_from_the_diagonal(cli):
     assert "overlap" in cli("matrix", "--help").output
 
 
+def test_the_summary_under_the_matrix_is_short_and_rounded_as_its_cells(cli):
+    """At most 3 lines under the table (the limiting pair with its interval and ideal bound first); its value is
+    the cell's text (one rounding rule: "1.32" in the cell was "1.325 s" in the summary)."""
+    r = cli("matrix", "--set", "paper12", "--format", "md")
+    assert r.exit_code == 0, r.output
+    summary = r.output.split("\n\n", 2)[-1].strip().splitlines()
+    summary = [x for x in summary if x.strip()]
+    assert len(summary) <= 3 and summary[0].startswith("Limiting pair: Stainless Steel / Aluminum, 1.32 s ("), summary
+    assert "ideal bound" in summary[0] and "| 1.32 |" in r.output and "1.325" not in r.output
+
+
 def test_cli_speaks_the_users_words(cli):
-    r = cli("matrix", *FOUR, "-q", "max-noise", "--contact", "2")
+    r = cli("matrix", *FOUR, "-q", "max-noise", "--contact", "2", "--explain")
     assert r.exit_code == 0, r.output
     first = r.output.splitlines()[0]
     assert first.startswith("max-noise [°C] for 4 materials (contact 2 s, dT 10 °C;"), first

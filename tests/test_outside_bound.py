@@ -99,9 +99,11 @@ def test_the_cli_prints_the_bound_and_still_exits_3(cli):
     assert r.exit_code == 3
     assert "no answer" in r.output and "(closed-form; no classifier does better)" in r.output
     r = cli("distinguishable", "--e1", "35000", "--e2", "20000", "--contact", "20")
-    assert r.exit_code == 3 and "ideal observer: F1 1.000 (closed-form)" in r.output
+    assert r.exit_code == 3 and "ideal observer bound: F1 1.000 (closed-form)" in r.output
     r = cli("delta-e", "--e", "20000", "--contact", "20")
-    assert r.exit_code == 3 and "no answer from the table (see below)" in r.output
+    assert r.exit_code == 3 and "outside table svm-fine's" in r.output.splitlines()[3]
+    r = cli("delta-e", "--e", "20000", "--contact", "20", "--explain")
+    assert r.exit_code == 3 and "no answer from the table, or" in r.output
 
 
 def test_the_exact_route_searches_up_to_the_ideal_bound_above_its_bracket():

@@ -39,3 +39,18 @@ def test_strip_markup_matches_rich(text):
     buf = io.StringIO()
     Console(file=buf, highlight=False, soft_wrap=True, width=100_000).print(text)
     assert _app.strip_markup(text) + "\n" == buf.getvalue()
+
+
+@pytest.mark.parametrize("make", ANSWERS)
+def test_the_answer_first_in_at_most_four_lines(make, capsys):
+    """Line 1: the answer (with its interval), line 2: the ideal bound, line 3: the scene, sensor and source,
+    at most one caveat; --explain prints the rest (the method, the notes) under the same three lines."""
+    d = make().to_dict()
+    cli_query._render_text(d)
+    short = capsys.readouterr().out.splitlines()
+    assert len(short) <= 4, short
+    assert "ideal" in short[1] and ("table " in short[2] or "computed" in short[2]), short
+    cli_query._render_text(d, explain=True)
+    long = capsys.readouterr().out.splitlines()
+    assert long[:3] == short[:3] and any(x.startswith("method: ") for x in long)
+    assert all(n in "\n".join(long) for n in d["notes"])

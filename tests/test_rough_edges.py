@@ -112,7 +112,7 @@ def test_delta_e_legend_only_when_a_dash_is_shown(cli):
     assert "—" not in both.output and "no distinguishable effusivity" not in both.output
     edge = cli("delta-e", "--e", "39000", "--contact", "0.5")
     assert edge.exit_code == 0, edge.output
-    assert "SVM —" in edge.output and "— : no distinguishable effusivity" in edge.output
+    assert ": — SVM" in edge.output and "— : no distinguishable effusivity" in edge.output
 
 
 # ------------------------------------------------------------------ reproduce's robot data

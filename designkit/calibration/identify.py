@@ -1934,15 +1934,17 @@ def plot_identification(results: Sequence[Identification], selected: str, fit_tr
                              gridspec_kw={"width_ratios": [1.0, 1.0, 0.9]})
     for k, (n, (t, y, r)) in enumerate(fitted.items()):
         count = sum(tr.material == n for tr in fit_trials)
-        axes[0].plot(t, y, color=f"C{k}", lw=1.3, label=f"{n}: reading (mean of {count})")
-        axes[0].plot(t, y + r, color=f"C{k}", lw=1.0, ls="--", label=f"{n}: {selected}")
+        # the reading light and wide, the model dark and dashed on top: the model stays visible where it fits
+        axes[0].plot(t, y, color=f"C{k}", lw=3.0, alpha=0.45, label=f"{n}: reading (mean of {count})")
+        axes[0].plot(t, y + r, color="k", lw=1.2, ls=(0, (4, 2)), zorder=4,
+                     label=f"model {selected}" if k == 0 else None)
         axes[1].plot(t, r, color=f"C{k}", lw=1.0, label=f"{n}, fitted touches")
         if n in held:
             th, _, rh = held[n]
             axes[1].plot(th, rh, color=f"C{k}", lw=1.0, ls=":", label=f"{n}, held-out touches")
     axes[0].set_xlabel("time after detected onset [s]")
     axes[0].set_ylabel("sensor temperature [°C]")
-    axes[0].set_title("reading (solid) and the selected model (dashed)", fontsize=9)
+    axes[0].set_title("reading (wide) and the selected model (dashed)")
     axes[0].legend(fontsize=7)
     axes[1].axhline(0, color="k", lw=0.5)
     axes[1].set_xlabel("time after detected onset [s]")

@@ -3,12 +3,9 @@
 import os
 
 #: The BLAS thread variables a user can set; where none is set, the command-line application runs its
-#: BLAS on one thread per process. Its matrices are small (a 133 x 133 Gram matrix per SVM fold, the
-#: identification's Jacobians): extra threads cost more than they save (the sweep's chunks and the
-#: identification already limit BLAS to one thread for that reason, and parallelism comes from
-#: worker processes). It also makes the start-up cheaper: OpenBLAS starts its thread pool when numpy is
-#: imported, 50 ms of a 150 ms ``import numpy`` on a 2-core machine (benchmarks/bench_startup.py).
-#: Set in the application's entry only (before numpy is imported), never by ``import designkit``.
+#: BLAS on one thread per process (its matrices are small; parallelism comes from worker processes; why:
+#: docs/decisions-log.md). Set in the application's entry only (before numpy is imported), never by
+#: ``import designkit``.
 BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS")
 if not any(v in os.environ for v in BLAS_THREAD_VARIABLES):
     os.environ["OPENBLAS_NUM_THREADS"] = "1"
@@ -24,8 +21,7 @@ COMMAND_MODULES = ("query", "matrix", "thin", "materials", "tables", "export", "
                    "core", "sweep", "reproduce", "bench")
 
 #: Which module registers each top-level command or command group. The console script imports only the
-#: module of the command it runs (importing the other twelve cost a fresh query a few milliseconds of the
-#: start-up that issue 16 counts); anything else (help, an unknown name, shell completion) imports them all.
+#: module of the command it runs; anything else (help, an unknown name, shell completion) imports them all.
 #: tests/test_help.py checks that this map names every registered command and nothing else.
 COMMAND_MODULE = {
     "min-contact": "query", "max-noise": "query", "min-delta-t": "query", "delta-e": "query",

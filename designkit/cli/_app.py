@@ -69,11 +69,9 @@ _MISSING = object()
 class _PlainCoercion:
     """Typer's coercion of one option, with a fast path for plain numbers and text.
 
-    Typer (0.29) converts every option through a pydantic ``TypeAdapter`` built on first use:
-    importing pydantic and building the adapters of a query's 25 options cost more start-up
-    time than the query itself (``benchmarks/bench_startup.py``). A float, int or str option
-    whose value is already of its type, or is plain decimal text, is converted here to the
-    value pydantic gives; anything else (other types, ranges, lists, odd text, bad input) goes
+    A float, int or str option whose value is already of its type, or is plain decimal text, is
+    converted here to the value pydantic gives, without building typer's pydantic adapter (why:
+    docs/decisions-log.md); anything else (other types, ranges, lists, odd text, bad input) goes
     to typer's own coercion, so its conversions and its error messages stay typer's.
     """
 
@@ -205,8 +203,11 @@ class _Group(TyperGroup):
         sub_args = list(getattr(ctx, "protected_args", []) or []) + list(ctx.args or [])
         try:
             return super().invoke(ctx)
-        except (typer.Exit, typer.Abort, _ClickException, KeyboardInterrupt, SystemExit, BrokenPipeError):
-            raise  # a closed pipe is not bad input: main() stops quietly
+        except BrokenPipeError:  # the reader had what it wanted (``| head -1``): not bad input, not a failure
+            _quiet_stdout()
+            raise typer.Exit(EXIT_BROKEN_PIPE) from None
+        except (typer.Exit, typer.Abort, _ClickException, KeyboardInterrupt, SystemExit):
+            raise
         except (ValueError, OSError) as exc:
             message = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
             if isinstance(exc, OSError) and exc.filename and str(exc.filename) not in message:
@@ -317,7 +318,7 @@ def emit_json(payload: Any) -> None:
 
 
 def console(stderr: bool = False):
-    """A rich console (imported lazily: rich costs ~50 ms).
+    """A rich console (rich is imported on first use).
 
     On a terminal it wraps to the window; piped or logged, nothing is hard-wrapped
     (a line is a line, whatever its length) and tables take the width they need.
@@ -357,9 +358,8 @@ class _PlainConsole:
     """What :func:`text_console` gives when the stream is not a terminal: rich's output without rich.
 
     Piped or logged, rich prints a line of markup as the line without its tags (no colour, no
-    wrap); this writes the same text without importing rich, which is a fifth of a fresh table
-    query's start-up (rich.console ~25 ms of ~125 ms CPU, measured with ``-X importtime``; issue 16's
-    target is 2x ``import numpy``). Anything but plain strings goes to a real rich console.
+    wrap); this writes the same text without importing rich (start-up: docs/decisions-log.md).
+    Anything but plain strings goes to a real rich console.
     """
 
     def __init__(self, stderr: bool):
@@ -386,10 +386,9 @@ def _app_for(argv: list[str]) -> typer.Typer:
     """The app with only the command ``argv`` names, when it names one first (else the whole app).
 
     Typer turns every registered command into a click command (reading each function's signature
-    and type hints) before it runs any: a fifth of a fresh query's start-up for commands it does not
-    run. The lean copy holds the one command (or command group) asked for, with the same callback,
-    so parsing, help, errors and output are that command's; anything else (no command, an unknown
-    one, completion, options before the command) gets the whole app.
+    and type hints) before it runs any. The lean copy holds the one command (or command group) asked
+    for, with the same callback, so parsing, help, errors and output are that command's; anything else
+    (no command, an unknown one, completion, options before the command) gets the whole app.
     """
     import os
 
@@ -446,9 +445,21 @@ class busy:
             self._progress.stop()
 
 
-#: Exit status when the reader of stdout went away (``designkit ... | head -1``): click's (it stops a command
-#: that writes into a closed pipe with status 1 and no message); the same when the pipe closes at the last flush.
-EXIT_BROKEN_PIPE = 1
+#: Exit status when the reader of stdout went away (``designkit ... | head -1``): 0, like a command that wrote
+#: everything, so ``set -o pipefail`` scripts that read only the answer's first line do not fail (click's own
+#: status for a closed pipe, 1, made ``min-contact ... | head -1`` fail them); the same at the last flush.
+EXIT_BROKEN_PIPE = 0
+
+
+def _quiet_stdout() -> None:
+    """Point stdout at the null device: nothing more is written into the closed pipe, not even at exit."""
+    import os
+
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):  # pragma: no cover - stdout without a file descriptor (tests)
+        pass
 
 
 def main() -> None:
@@ -465,9 +476,6 @@ def main() -> None:
         sys.exit(EXIT_INTERRUPTED)
     except BrokenPipeError:
         # the reader closed the pipe before the last flush: stop quietly (no "Error:", no "Exception ignored"
-        # at interpreter exit), as click does when a command's write meets the closed pipe
-        import os
-
-        devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, sys.stdout.fileno())
+        # at interpreter exit)
+        _quiet_stdout()
         sys.exit(EXIT_BROKEN_PIPE)

@@ -15,7 +15,8 @@ once. A command that prints rows adopts it in three lines::
 format    what is printed
 ========  ===================================================================
 table     a rich table for people: names and numbers never cut (on a
-          terminal a long cell folds onto a second line; piped, no wrapping)
+          terminal a table wider than the window is printed in groups
+          of columns under the first one; piped, no wrapping)
 json      ``payload`` (the library's ``to_dict()``) if given, else the rows
 csv       a header line and one line per row: nothing else (no comments), so
           ``pandas.read_csv`` reads it with its defaults; None is empty
@@ -142,22 +143,48 @@ def render_rows(rows: Sequence[Mapping[str, Any]], columns: Sequence[str] | None
     from rich.table import Table
     from rich.text import Text
 
-    # Text, not markup: units like [s] and flags like [!] are not style tags
-    table = Table(title=Text(title) if title else None, title_justify="left")
-    for i, c in enumerate(cols):
-        # never an ellipsis: a cell too wide for the terminal folds onto another line
-        widest_word = max([len(w) for s in [c] + [row[i] for row in body] for w in s.split()] or [1])
-        table.add_column(Text(c), justify="right" if right(i) else "left", overflow="fold",
-                         min_width=min(widest_word, 30))
-    for row in body:
-        table.add_row(*(Text(x) for x in row))
+    width = _width()
     buf = io.StringIO()
-    con = Console(file=buf, highlight=False, soft_wrap=True, width=_width(), force_terminal=False,
+    con = Console(file=buf, highlight=False, soft_wrap=True, width=width, force_terminal=False,
                   color_system=None)
-    con.print(table)
+    for k, chunk in enumerate(_fold(cols, body, width)):
+        # Text, not markup: units like [s] and flags like [!] are not style tags
+        table = Table(title=Text(title) if title and k == 0 else None, title_justify="left")
+        for i in chunk:
+            # never an ellipsis: a cell too wide for the terminal folds onto another line
+            widest_word = max([len(w) for s in [cols[i]] + [row[i] for row in body] for w in s.split()] or [1])
+            table.add_column(Text(cols[i]), justify="right" if right(i) else "left", overflow="fold",
+                             min_width=min(widest_word, 30))
+        for row in body:
+            table.add_row(*(Text(row[i]) for i in chunk))
+        con.print(table)
     for n in notes:
         con.print(n, markup=False)
     return buf.getvalue()
+
+
+def _fold(cols: Sequence[str], body: Sequence[Sequence[str]], width: int) -> list[list[int]]:
+    """The columns in groups that fit ``width`` (a terminal's), each group printed as its own table under the
+    first column (the row's name), like a wide matrix in a book; one group when everything fits.
+
+    A column's width is its widest word (a header folds onto more lines at its spaces, a cell never breaks).
+
+    >>> _fold(["name", "a", "b", "c"], [["x" * 10, "1" * 20, "2" * 20, "3" * 20]], 60)
+    [[0, 1, 2], [0, 3]]
+    """
+    need = [max([len(w) for w in cols[i].split()] + [len(row[i]) for row in body] + [1]) + 3
+            for i in range(len(cols))]
+    if sum(need) + 1 <= width or len(cols) < 3:
+        return [list(range(len(cols)))]
+    groups: list[list[int]] = [[0]]
+    used = need[0] + 1
+    for i in range(1, len(cols)):
+        if used + need[i] > width and len(groups[-1]) > 1:
+            groups.append([0])
+            used = need[0] + 1
+        groups[-1].append(i)
+        used += need[i]
+    return groups
 
 
 def _width() -> int:

@@ -6,20 +6,37 @@ from typing import Annotated, Optional
 
 import typer
 
-Json = Annotated[bool, typer.Option("--json", help="Print the result as JSON on stdout.")]
+#: Help panels of a command's options (typer's rich_help_panel), in the order a user reads them.
+PANEL_QUESTION = "The question"
+PANEL_SCENE = "The scene"
+PANEL_SENSOR = "The sensor and model"
+PANEL_EXACT = "--exact only"
+PANEL_OUTPUT = "Output"
+
+Json = Annotated[bool, typer.Option("--json", help="Print the result as JSON on stdout.",
+                                    rich_help_panel=PANEL_OUTPUT)]
+Explain = Annotated[bool, typer.Option(
+    "--explain", "-v", help="Also print how the answer was found: the method, the hardest pair of two materials, "
+                            "the paper's remark and every note (--json always has them).",
+    rich_help_panel=PANEL_OUTPUT)]
 SensorOpt = Annotated[str, typer.Option(
     "--sensor", help="Sensor preset name ('paper') or a sensor YAML file written by calibration; a file's "
-                     "recorded model answers unless --model (or --thickness, --conductance) is given.")]
-Noise = Annotated[float, typer.Option("--noise", help="Noise sigma per sample [°C].")]
+                     "recorded model answers unless --model (or --thickness, --conductance) is given.",
+    rich_help_panel=PANEL_SENSOR)]
+Noise = Annotated[float, typer.Option("--noise", help="Noise sigma per sample [°C].", rich_help_panel=PANEL_SCENE)]
 DeltaT = Annotated[float, typer.Option(
-    "--delta-t", help="Sensor minus object temperature before contact [°C].")]
-Ambient = Annotated[float, typer.Option("--ambient", help="Ambient (object) temperature [°C].")]
-Contact = Annotated[float, typer.Option("--contact", help="Contact time [s].")]
+    "--delta-t", help="Sensor minus object temperature before contact [°C].", rich_help_panel=PANEL_SCENE)]
+Ambient = Annotated[float, typer.Option("--ambient", help="Ambient (object) temperature [°C].",
+    rich_help_panel=PANEL_SCENE)]
+Contact = Annotated[float, typer.Option("--contact", help="Contact time [s].", rich_help_panel=PANEL_SCENE)]
 Seed = Annotated[int, typer.Option("--seed", help="Random seed (same seed, same trials).")]
 Threshold = Annotated[float, typer.Option(
-    "--threshold", help="F1 at or above which a pair counts as distinguishable (the paper's Phi).")]
-E1 = Annotated[Optional[float], typer.Option("--e1", help="Effusivity of the first object [J s^-1/2 K^-1 m^-2].")]
-E2 = Annotated[Optional[float], typer.Option("--e2", help="Effusivity of the second object [J s^-1/2 K^-1 m^-2].")]
+    "--threshold", help="F1 at or above which a pair counts as distinguishable (the paper's Phi).",
+    rich_help_panel=PANEL_QUESTION)]
+E1 = Annotated[Optional[float], typer.Option("--e1", help="Effusivity of the first object [J s^-1/2 K^-1 m^-2].",
+    rich_help_panel=PANEL_QUESTION)]
+E2 = Annotated[Optional[float], typer.Option("--e2", help="Effusivity of the second object [J s^-1/2 K^-1 m^-2].",
+    rich_help_panel=PANEL_QUESTION)]
 Width = Annotated[float, typer.Option(
     "--width", help="Width of each effusivity class [e, e+width) [J s^-1/2 K^-1 m^-2] (paper: 80).")]
 Trials = Annotated[int, typer.Option("--trials", help="Simulated touches per class.")]
@@ -27,23 +44,27 @@ Folds = Annotated[int, typer.Option("--folds", help="Cross-validation folds.")]
 
 # ---------------------------------------------------------------- objects and forward models (one vocabulary)
 M1 = Annotated[Optional[str], typer.Option(
-    "--m1", help="First material by name (instead of --e1); see 'designkit materials list'.")]
-M2 = Annotated[Optional[str], typer.Option("--m2", help="Second material by name (instead of --e2).")]
+    "--m1", help="First material by name (instead of --e1); see 'designkit materials list'.",
+    rich_help_panel=PANEL_QUESTION)]
+M2 = Annotated[Optional[str], typer.Option("--m2", help="Second material by name (instead of --e2).",
+    rich_help_panel=PANEL_QUESTION)]
 ModelOpt = Annotated[Optional[str], typer.Option(
     "--model", help="Forward model: semi-infinite (the paper's, default), slab (a thin object: give --thickness) "
                     "or contact (finite interface conductance: give --conductance), or any registered model with "
-                    "its parameters as NAME:KEY=VALUE,... (e.g. contact:conductance_w_m2k=2000); see docs/models.md.")]
+                    "its parameters as NAME:KEY=VALUE,... (e.g. contact:conductance_w_m2k=2000); see docs/models.md.",
+    rich_help_panel=PANEL_SENSOR)]
 Conductance = Annotated[Optional[float], typer.Option(
     "--conductance", help="Sensor-object interface conductance h_c \\[W m^-2 K^-1] (contact model; implies "
-                          "--model contact).")]
+                          "--model contact).", rich_help_panel=PANEL_SENSOR)]
 Thickness = Annotated[Optional[float], typer.Option(
-    "--thickness", help="Object thickness \\[m] (e.g. 0.003 for a 3 mm sheet; slab model; implies --model slab).")]
+    "--thickness", help="Object thickness \\[m] (e.g. 0.003 for a 3 mm sheet; slab model; implies --model slab).",
+    rich_help_panel=PANEL_SENSOR)]
 BackingOpt = Annotated[Optional[str], typer.Option(
     "--backing", help="Slab model: what the object lies on: table (default: a hardwood table top), insulated, "
-                      "air, steel, or a material name.")]
+                      "air, steel, or a material name.", rich_help_panel=PANEL_SENSOR)]
 Diffusivity = Annotated[Optional[float], typer.Option(
     "--diffusivity", help="Diffusivity \\[m^2/s] of objects given as numbers (--e1/--e2/--e), for models that "
-                          "need it (slab).")]
+                          "need it (slab).", rich_help_panel=PANEL_SENSOR)]
 
 
 def refuse_together(*groups: tuple[str, object], why: str) -> None:

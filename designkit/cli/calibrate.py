@@ -32,7 +32,7 @@ is opened; give the same materials in the same order and --yes (the emulator doe
 The command it prints after 'try:' does this; a run whose labels its plan contradicts stops before \
 recording.
 
-Example: `designkit calibrate --port /dev/pts/5 --material wood --material metal --out trials/ --yes`
+Example: `designkit calibrate --port /dev/ttyACM0 --material wood --material "aluminium alloys" --out trials/ --yes`
 """
 
 calibrate_app = sub_app("calibrate", _CALIBRATE_HELP, panel=_app.SENSOR)
@@ -663,8 +663,7 @@ def fit(
 
     Example: `designkit calibrate fit trials/index.csv --range wood=331:506 --out my-sensor.yaml`
 
-    Example (the paper's model only, parameters as CSV): `designkit calibrate fit trials/index.csv --model
-    semi-infinite --format csv`
+    Example (the paper's model only, parameters as CSV): `designkit calibrate fit trials/index.csv --model semi-infinite --format csv`
     """
     from ._format import check_format, check_out
 
@@ -811,7 +810,7 @@ def emulate(
 ) -> None:
     """Emulate a sensor rig on a pseudo-terminal: prints its path, streams the profile's wire format.
 
-    Example: `designkit emulate --profile designkit --material wood=400 --material aluminium=20000 --speed 20`
+    Example (a rig playing two objects for 30 s; without --duration until Ctrl-C): `designkit emulate --material wood=400 --material aluminium=20000 --speed 20 --duration 30`
     """
     from .._validation import InputError
     from ..calibration.emulator import EmulatedMaterial, Emulator, Faults, TouchPlan

@@ -69,6 +69,15 @@ def _table(decisions, live, candidates) -> object:
     return t
 
 
+def _decision_words(d, what: str, time_offset_s: float, rate_hz: float) -> str:
+    """One touch's line: time and samples both counted from the detected contact onset (the heat flow starts
+    ``time_offset_s`` after it), so that samples = time x rate; ``--json`` keeps the test's own figures."""
+    after_onset_s = d.time_to_decision_s + time_offset_s
+    samples = int(round(after_onset_s * rate_hz))
+    return (f"touch {d.index + 1}: {what} after {after_onset_s:.3f} s of contact, {samples} samples at {rate_hz:g} Hz "
+            f"(both from the detected onset; Ts0 {d.sensor_temp_c:.2f} °C, Ta {d.ambient_temp_c:.2f} °C)")
+
+
 @app.command(rich_help_panel=_app.SENSOR)
 def classify(
     port: Annotated[Optional[str], typer.Option(
@@ -106,9 +115,9 @@ def classify(
     the error rate you ask for; prints each touch's decision and its time to decision. Exit 3 when no
     contact up to --max-contact can separate the materials at that error rate.
 
-    Example: `designkit classify --port /dev/ttyACM0 --sensor my-sensor.yaml --m wood --m "aluminium alloys" --touches 5`
+    Example: `designkit classify --port /dev/ttyACM0 --sensor my-sensor.yaml --m wood --m "aluminium alloys"`
 
-    Example: `designkit classify --port /dev/pts/3 --m wood --m "aluminium alloys" --time-offset -0.25` (the emulator)
+    Example (the emulator's rig, its onset 0.25 s late): `designkit classify --port /dev/pts/3 --m wood --m "aluminium alloys" --time-offset -0.25`
 
     Example: `designkit classify --m wood --m "aluminium alloys" --error-rate 0.001 --export-c robot_seq.h`
     """
@@ -187,7 +196,9 @@ def classify(
             live_view.update(_table(clf.decider.written, clf.decider.live, check.candidates))
 
     def on_event(e) -> None:
-        if not json_ and live_view is None and e.kind in ("decision", "skipped", "gap", "bad_line", "noise"):
+        # the decisions are printed once, on stdout at the end (and live in the terminal's table); stderr
+        # carries what is not in that summary
+        if not json_ and live_view is None and e.kind in ("skipped", "gap", "bad_line", "noise"):
             con.print(e.message, highlight=False)
         refresh()
 
@@ -225,9 +236,7 @@ def classify(
         out.print(f"{check.plan.reason}.", highlight=False)
         for d in decisions:
             what = d.material if d.state == "decided" else d.state
-            out.print(f"touch {d.index + 1}: {what} after {d.time_to_decision_s:.3f} s of contact "
-                      f"({d.n_samples} samples; Ts0 {d.sensor_temp_c:.2f} °C, Ta {d.ambient_temp_c:.2f} °C)",
-                      highlight=False)
+            out.print(_decision_words(d, what, time_offset, sens.sample_rate_hz), highlight=False)
     if failed is not None:
         typer.echo(f"Error: {failed}", err=True)
         raise typer.Exit(2)

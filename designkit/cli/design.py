@@ -21,7 +21,8 @@ EXIT_NO_DESIGN = 3
 
 
 def _plot(result, path: Path) -> Path:
-    from ..figures import pyplot, save_figure
+    from .._numbers import sig
+    from ..figures import log_ticks, pyplot, save_figure
 
     plt = pyplot()
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(10.0, 4.0), constrained_layout=True)
@@ -33,7 +34,7 @@ def _plot(result, path: Path) -> Path:
     a1.axhline(c.max_contact_s, color="0.5", ls=":", lw=1, label="longest contact")
     a1.set_xlabel("noise sigma / dT [-]  (noise floor over the heater's dT)")
     a1.set_ylabel("limiting pair's shortest contact [s]")
-    a1.set_title(f"trade-off of the recommended sensor ({result.best.skin}, {result.best.depth_um:.3g} um)", fontsize=9)
+    a1.set_title(f"trade-off of the recommended sensor ({result.best.skin}, {sig(result.best.depth_um)} µm)")
     a1.legend(fontsize=8)
     by_skin = {}
     for d in result.designs:
@@ -43,11 +44,8 @@ def _plot(result, path: Path) -> Path:
         a2.semilogx([d.depth_um for d in ds], [d.min_contact_s if d.min_contact_s < 1e9 else float("nan") for d in ds],
                     marker="o", ms=3, color=f"C{i % 10}", ls="-" if i < 10 else "--", label=skin[:40])
     a2.plot([result.best.depth_um], [result.best.min_contact_s], "k*", ms=12, label="recommended")
-    from matplotlib.ticker import NullFormatter, ScalarFormatter
-
-    a2.xaxis.set_major_formatter(ScalarFormatter())
-    a2.xaxis.set_minor_formatter(NullFormatter())
-    a2.set_xlabel("thermistor depth [um]")
+    log_ticks(a2.xaxis, [d.depth_um for d in result.designs])
+    a2.set_xlabel("thermistor depth [µm]")
     a2.set_ylabel("limiting pair's shortest contact [s] (ideal observer)")
     a2.set_title("each skin material over depth", fontsize=9)
     a2.legend(fontsize=6, ncol=2)

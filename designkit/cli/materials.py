@@ -101,7 +101,9 @@ def show(
 ) -> None:
     """Show one material: property ranges, effusivity, diffusivity and source.
 
-    Example: `designkit materials show "stainless steel"` (`--format csv` for one row per property)
+    Example: `designkit materials show "stainless steel"`
+
+    Example (one row per property): `designkit materials show "stainless steel" --format csv`
     """
     from ..materials import get_material
 

@@ -15,7 +15,7 @@ import typer
 from . import _app
 from ._app import app, console
 from ._format import FormatOpt, OutOpt, check_format, emit_rows
-from ._options import Json, SensorOpt, sensor_and_model
+from ._options import Explain, Json, SensorOpt, sensor_and_model
 
 _QUESTIONS = "min-contact, max-noise, min-delta-t or distinguishable"
 
@@ -58,6 +58,7 @@ def matrix(
     out: OutOpt = None,
     sensor: SensorOpt = "paper",
     json_: Json = False,
+    explain: Explain = False,
 ) -> None:
     """The pairwise matrix of one question over N materials, the pair that limits the design, and the
     accuracy of telling all N apart at once; from the lookup tables (the materials rule: the hardest pair of
@@ -140,7 +141,7 @@ def matrix(
     # csv keeps the table's cell text ("≥0.2", "overlap", "n/a", "yes"/"no"; the diagonal empty): a plain number
     # would drop the bound and make an overlap look like the diagonal. --json has plain numbers and a status.
     emit_rows(rows, ["material", *names], fmt=fmt, out=out, payload=result.to_dict(), title=_title(result),
-              notes=_notes(result), text=lambda _c, v: "·" if v is None else str(v),
+              notes=_notes(result, explain), text=lambda _c, v: "·" if v is None else str(v),
               justify={"material": "left", **{n: "right" for n in names}})
 
 
@@ -178,7 +179,9 @@ def _cell(question: str, v: float, status: str, bound: str) -> str:
         return "n/a"
     if question == "distinguishable":
         return "yes" if v else "no"
-    return {"at-most": "≤", "at-least": "≥"}.get(bound, "") + f"{v:.3g}"
+    from .._numbers import sig
+
+    return {"at-most": "≤", "at-least": "≥"}.get(bound, "") + sig(v)
 
 
 #: The library's names of the scene's quantities, as the user wrote them on the command line, with units.
@@ -205,8 +208,37 @@ def _title(r) -> str:
     return f"{r.question}{unit} for {len(r.materials)} materials ({sc}; table {r.table})"
 
 
-def _notes(r) -> list[str]:
-    return [_user_words(n, r) for n in _raw_notes(r)]
+def _notes(r, explain: bool = False) -> list[str]:
+    """The summary under the matrix: the limiting pair with its interval and ideal bound, the accuracy of telling
+    all N apart, a short legend (at most 3 lines); with ``explain`` the whole of it in the library's words."""
+    if explain:
+        return [_user_words(n, r) for n in _raw_notes(r)]
+    return [_user_words(n, r) for n in _short_notes(r)]
+
+
+def _short_notes(r) -> list[str]:
+    from .._numbers import sig
+
+    lim = r.limiting
+    overlaps = sum(c.status == "overlap" for c in r.cells)
+    tail = f"; {overlaps} pair(s) overlap in effusivity (never told apart)" if overlaps else ""
+    unit = _unit(r.unit) if r.unit else ""
+    if lim.names and r.question != "distinguishable" and lim.status not in ("none", "overlap"):
+        cell = next(c for c in r.cells if {r.names[c.i], r.names[c.j]} == set(lim.names))
+        low, high = cell.answer.interval[:2] if cell.answer.interval else (None, None)
+        qual = {"at-most": "at most ", "at-least": "at least "}.get(cell.bound, "")
+        iv = f" ({sig(low)} to {sig(high, unit)})" if low is not None and high is not None else ""
+        notes = [f"Limiting pair: {lim.names[0]} / {lim.names[1]}, {qual}{sig(lim.value, unit)}{iv}, "
+                 f"ideal bound {sig(lim.ideal, unit)}{tail}."]
+    else:
+        notes = [f"Limiting pair: {lim.why}."]
+    mc = r.multiclass
+    if mc is not None and mc.ideal_accuracy is not None:
+        pts = ", ".join(f"{c:g} s {a:.2f}" for c, a in zip(mc.contact_s, mc.ideal_accuracy)
+                        if c in (0.5, 1.0, 2.0, 4.0, 10.0))
+        notes.append(f"All {len(r.materials)} at once (ideal observer, chance {mc.chance:.2f}): {pts}.")
+    notes.append("≤ / ≥: beyond the table's grid; overlap: effusivity ranges overlap; --explain for more.")
+    return notes
 
 
 def _raw_notes(r) -> list[str]:

@@ -19,51 +19,70 @@ import typer
 
 from . import _app
 from ._app import app, emit_json
-from ._format import OutOpt, check_format, check_out, emit_rows, output_to
+from ._format import check_format, check_out, emit_rows, output_to
 from ._options import (
     E1,
     E2,
     M1,
+    Explain,
     M2,
     BackingOpt,
     Conductance,
     Diffusivity,
     Json,
     ModelOpt,
+    PANEL_EXACT,
+    PANEL_OUTPUT,
+    PANEL_QUESTION,
+    PANEL_SCENE,
+    PANEL_SENSOR,
     SensorOpt,
     Thickness,
     Threshold,
     sensor_and_model,
 )
 
-Contact = Annotated[float, typer.Option("--contact", help="Contact time [s].")]
+Contact = Annotated[float, typer.Option("--contact", help="Contact time [s].",
+    rich_help_panel=PANEL_SCENE)]
 Exact = Annotated[bool, typer.Option(
-    "--exact", help="Compute for this pair and scene (seconds) instead of reading a table.")]
+    "--exact", help="Compute for this pair and scene (seconds) instead of reading a table.",
+    rich_help_panel=PANEL_EXACT)]
 TableOpt = Annotated[Optional[str], typer.Option(
-    "--table", help="Lookup table (name or path) for the SVM answer (default: svm-fine).")]
-IdealTableOpt = Annotated[str, typer.Option("--ideal-table", help="Lookup table for the ideal-observer bound.")]
-TrialsQ = Annotated[int, typer.Option("--trials", help="--exact: simulated touches per class.")]
-RepeatsQ = Annotated[int, typer.Option("--repeats", help="--exact: seeds per evaluation (Monte Carlo error).")]
-SeedQ = Annotated[int, typer.Option("--seed", help="--exact: random seed.")]
+    "--table", help="Lookup table (name or path) for the SVM answer (default: svm-fine).",
+    rich_help_panel=PANEL_SENSOR)]
+IdealTableOpt = Annotated[str, typer.Option("--ideal-table", help="Lookup table for the ideal-observer bound.",
+    rich_help_panel=PANEL_SENSOR)]
+TrialsQ = Annotated[int, typer.Option("--trials", help="--exact: simulated touches per class.",
+    rich_help_panel=PANEL_EXACT)]
+RepeatsQ = Annotated[int, typer.Option("--repeats", help="--exact: seeds per evaluation (Monte Carlo error).",
+    rich_help_panel=PANEL_EXACT)]
+SeedQ = Annotated[int, typer.Option("--seed", help="--exact: random seed.",
+    rich_help_panel=PANEL_EXACT)]
 WidthQ = Annotated[float, typer.Option(
-    "--width", help="--exact: class width [J s^-1/2 K^-1 m^-2] of each object (and of the materials rule).")]
-JobsQ = Annotated[int, typer.Option("--jobs", "-j", help="--exact: worker processes (-1: all cores).")]
+    "--width", help="--exact: class width [J s^-1/2 K^-1 m^-2] of each object (and of the materials rule).",
+    rich_help_panel=PANEL_EXACT)]
+JobsQ = Annotated[int, typer.Option("--jobs", "-j", help="--exact: worker processes (-1: all cores).",
+    rich_help_panel=PANEL_EXACT)]
 NmcQ = Annotated[int, typer.Option(
-    "--n-mc", help="--exact: touches per class of the Monte Carlo ideal observer (models without a shared shape).")]
-MaxContact = Annotated[float, typer.Option("--max-contact", help="--exact: longest contact time to consider [s].")]
+    "--n-mc", help="--exact: touches per class of the Monte Carlo ideal observer (models without a shared shape).",
+    rich_help_panel=PANEL_EXACT)]
+MaxContact = Annotated[float, typer.Option("--max-contact", help="--exact: longest contact time to consider [s].",
+    rich_help_panel=PANEL_EXACT)]
 NoiseQ = Annotated[Optional[float], typer.Option(
-    "--noise", help="Noise sigma per sample [°C] (default 0.05, or the rig's as calibrated in a --sensor file).")]
+    "--noise", help="Noise sigma per sample [°C] (default 0.05, or the rig's as calibrated in a --sensor file).",
+    rich_help_panel=PANEL_SCENE)]
 DeltaTQ = Annotated[Optional[float], typer.Option(
     "--delta-t", help="Sensor minus object temperature before contact [°C] (default 10, or the rig's as "
-                      "calibrated in a --sensor file).")]
+                      "calibrated in a --sensor file).", rich_help_panel=PANEL_SCENE)]
 SpreadOpt = Annotated[Optional[float], typer.Option(
     "--sensor-temp-spread", help="Varied initial conditions: each touch's sensor temperature uniform within "
     "+-this [°C] of ambient + dT (the paper's robot: --delta-t 7.5 --sensor-temp-spread 2.5, answered from the "
     "shipped table svm-paper-varied for min-contact, delta-e and distinguishable); any other case is computed "
     "like --exact. Must stay below |dT|. Default 0, or the rig's touch-to-touch spread of dT as calibrated in a "
-    "--sensor file.")]
+    "--sensor file.", rich_help_panel=PANEL_SCENE)]
 CoverageOpt = Annotated[float, typer.Option(
-    "--coverage", help="Coverage of the answer's interval, in (0, 1) (table and --exact).")]
+    "--coverage", help="Coverage of the answer's interval, in (0, 1) (table and --exact).",
+    rich_help_panel=PANEL_QUESTION)]
 
 #: Exit status of a question without an answer, on either route: the table cannot answer it (outside
 #: its grid along an axis, or nothing tabulated separates the pair), the materials' effusivity ranges
@@ -227,41 +246,74 @@ def _noted(ans, reroute: Optional[str], sen, fm, source: str):
 
 
 # ============================================================ rendering
-def _fmt(x, unit="", digits=3) -> str:
-    return "—" if x is None else f"{x:.{digits}g}{unit}"
+# The answer first: the value with its interval and the ideal bound (lines 1-2), the scene, sensor and
+# source (line 3), at most one warning that changes how far to trust it (line 4). The rest (the method, the
+# hardest pair, the paper's remark, the notes, the materials rule) with --explain, and always in --json.
+def _fmt(x, unit="") -> str:
+    from .._numbers import sig
+
+    return sig(x, unit.strip())
 
 
-def _render(ans, json_: bool) -> None:
+def _render(ans, json_: bool, explain: bool = False) -> None:
     d = ans.to_dict()
     if json_:
         emit_json(d)
     else:
-        _render_text(d)
+        _render_text(d, explain)
     if d["value"] is None and (d["question"] != "delta-e" or not all(d["in_grid"].values())):
         raise typer.Exit(EXIT_NO_ANSWER)
 
 
-def _render_text(d) -> None:
+def _render_text(d, explain: bool = False) -> None:
     con = _app.text_console()
-    sc = d["scene"]
-    scene = [f"{w} {sc[k]:g}{u}" for k, w, u in (("noise_c", "noise", " °C"), ("delta_t_c", "dT", " °C"),
-                                                  ("contact_s", "contact", " s")) if sc.get(k) is not None]
-    names = " vs ".join(f"[bold]{o['label']}[/]" for o in d["objects"])
-    what = f"delta(e) at {names}" if d["question"] == "delta-e" else names
-    model = "" if d["model"]["name"] == "semi-infinite" else f", {_model_words(d)}"
-    con.print(f"{what} J s^-1/2 K^-1 m^-2: {', '.join(scene)}, {d['sensor']['name']} sensor{model}, "
-              f"F1 >= {d['threshold']:g}")
-    if d["limiting_pair"] and any(o["material"] for o in d["objects"]) and d["question"] != "delta-e":
-        con.print("  [dim]answered for the hardest pair: "
-                  + " vs ".join(o["label"] for o in d["limiting_pair"]) + "[/]")
     _VALUE_LINES[d["question"]](con, d)
-    if d["question"] == "min-contact":
-        from ..query.guideline import guideline_remark
+    con.print(f"[dim]{_scene_line(d)}[/]")
+    warning = _warning(d)
+    if explain:
+        _explain_lines(con, d)
+    elif warning:
+        con.print(f"[yellow]{warning}[/]")
 
-        remark = guideline_remark(d)
-        if remark:
-            con.print(f"  {remark}")
-    _source_lines(con, d)
+
+def _scene_line(d) -> str:
+    """Line 3: the objects, the scene, the sensor (and model) and where the answer came from."""
+    from rich.markup import escape
+
+    sc = d["scene"]
+    scene = [f"{w} {_fmt(sc[k], u)}" for k, w, u in (("noise_c", "noise", "°C"), ("delta_t_c", "dT", "°C"),
+                                                   ("contact_s", "contact", "s")) if sc.get(k) is not None]
+    names = " vs ".join(o["material"] or f"{o['effusivity_range'][0]:g}" for o in d["objects"])
+    if d["question"] == "delta-e":
+        names = f"e {names}"
+    model = "" if d["model"]["name"] == "semi-infinite" else f", model {d['model']['name']}"  # --explain: its parameters
+    source = (f"table {d['table']['name']}" if d["route"] == "table"
+              else f"computed in {d['computation']['wall_s']:.1f} s")
+    return escape(f"{names}, {', '.join(scene)}, F1 ≥ {d['threshold']:g}, {d['sensor']['name']} sensor{model}; "
+                  f"{source}")
+
+
+def _warning(d) -> str | None:
+    """Line 4, when the answer needs a caveat: why there is none, or where the table was left."""
+    from rich.markup import escape
+
+    if d["value"] is None and d["notes"]:
+        return escape(d["notes"][0])
+    if d["question"] == "delta-e" and any(d["details"][k][w] is None for k in ("lower", "upper")
+                                          for w in ("value", "ideal")):
+        return "— : no distinguishable effusivity in that direction within the range examined"
+    if d["route"] == "table":
+        words = {"noise_ratio": "sigma/dT", "contact_s": "contact time", "noise_c": "noise",
+                 "delta_t_c": "temperature difference"}
+        bad = [words.get(k, k) for k, ok in d["in_grid"].items() if not ok]
+        if bad:
+            return f"outside the table's grid along {', '.join(bad)}: --explain says more, --exact computes it"
+        if d["computation"].get("below_grid"):
+            return "below the table's shortest contact time: extrapolated (--explain says more)"
+    chk = d["model_check"]
+    if chk and chk.get("message") and not chk.get("holds"):
+        return escape(chk["message"])
+    return None
 
 
 def _model_words(d: dict) -> str:
@@ -273,75 +325,67 @@ def _model_words(d: dict) -> str:
 def _interval(d, unit):
     iv = d["interval"]
     if iv["low"] is None and iv["high"] is None:
-        return "(no interval: see below)"
-    ends = f"{_fmt(iv['low'], unit)} to {_fmt(iv['high'], unit)}"
+        return "(no interval: --explain)"
+    ends = f"{_fmt(iv['low'])} to {_fmt(iv['high'], unit)}"
     if iv.get("coverage"):
         return f"({iv['coverage']:.0%} interval {ends})"
-    why = {"table-cell": "the grid cell, coverage not stated", "exact": "the search bracket, coverage not stated",
-           "table-varied": "the varied table's, coverage not stated: see below"}
-    return f"(interval {ends}: {why.get(iv.get('method'), 'coverage not stated')})"
+    why = {"table-cell": "grid cell", "exact": "search bracket", "table-varied": "varied table"}
+    return f"({why.get(iv.get('method'), 'interval')} {ends}, coverage not stated)"
 
 
 def _answerer(d) -> str:
-    """Whose answer the main line gives: the paper's SVM, or the ideal observer where the table holds that."""
+    """Whose answer line 1 gives: the paper's SVM, or the ideal observer where the table holds that."""
     if (d.get("computation") or {}).get("fidelity") == "ideal":
         from rich.markup import escape
 
         return f"ideal observer on table {escape(d['table']['name'])}'s grid"
-    return "SVM (the paper's classifier)"
+    return "SVM"
 
 
 def _scalar(words: str, unit: str):
     def line(con, d):
         if d["value"] is None:
-            con.print(f"  {_answerer(d)}: [red]no answer[/] (see below)")
+            con.print(f"{words}: [red]no answer[/] ({_answerer(d)})")
         else:
             qual = {"at-most": "at most ", "at-least": "at least "}.get(d.get("bound") or "", "")  # Answer.bound
-            iv = "(a bound: the table's grid ends there, see below)" if qual else _interval(d, unit)
-            con.print(f"  {_answerer(d)}: {words} {qual}[bold green]{_fmt(d['value'], unit)}[/] {iv}")
+            iv = "(a bound: the table's grid ends there)" if qual else _interval(d, unit)
+            con.print(f"{words}: {qual}[bold green]{_fmt(d['value'], unit)}[/] {iv}, {_answerer(d)}")
         ideal = d["ideal"]
         iv = ideal.get("interval")
-        ends = (f", {iv['coverage']:.0%} interval {_fmt(iv['low'], unit)} to {_fmt(iv['high'], unit)}"
-                if iv else "")
-        con.print(f"  ideal observer bound:         {_fmt(ideal['value'], unit)}"
-                  + (f"  ({ideal['method']}{ends}; no classifier does better)" if ideal["value"] is not None
-                     else ""))
+        ends = f", {iv['coverage']:.0%} interval {_fmt(iv['low'])} to {_fmt(iv['high'], unit)}" if iv else ""
+        con.print(f"ideal observer bound: {_fmt(ideal['value'], unit)}"
+                  + (f" ({ideal['method']}{ends}; no classifier does better)" if ideal["value"] is not None else ""))
     return line
 
 
 def _delta_lines(con, d):
     x = d["details"]
-    dash = False  # the legend only when a "—" is printed
     who = _answerer(d)
-    who = "SVM" if who.startswith("SVM") else who
-    for words, side in (("towards lower e ", "lower"), ("towards higher e", "upper")):
+    for words, side in (("delta(e) towards lower e ", "lower"), ("delta(e) towards higher e", "upper")):
         s = x[side]
         iv = s["interval"]
         cov = f"{iv['coverage']:.0%} interval" if iv.get("coverage") else "interval, coverage not stated"
         shown = s["value"] is not None and (iv["low"], iv["high"]) != (None, None)  # an ideal table's has no ends
-        ivs = f" ({cov} {_fmt(iv['low'], '', 4)} to {_fmt(iv['high'], '', 4)})" if shown else ""
-        con.print(f"  {words}: {who} [bold green]{_fmt(s['value'], '', 4)}[/]{ivs}, "
-                  f"ideal {_fmt(s['ideal']['value'], '', 4)}")
-        dash = dash or s["value"] is None or s["ideal"]["value"] is None or (shown and None in (iv["low"], iv["high"]))
-    if dash:
-        outside = d["route"] == "table" and not all(d["in_grid"].values())
-        con.print("  [dim]— : " + ("no answer from the table (see below), or " if outside else "")
-                  + "no distinguishable effusivity in that direction within the range examined[/]")
+        ivs = f" ({cov} {_fmt(iv['low'])} to {_fmt(iv['high'])})" if shown else ""
+        con.print(f"{words}: [bold green]{_fmt(s['value'])}[/]{ivs} {who}, ideal bound {_fmt(s['ideal']['value'])}")
 
 
 def _distinguishable_lines(con, d):
     x = d["details"]
     if x["distinguishable"] is None:
-        con.print("  [yellow]no answer[/]")
+        con.print("distinguishable: [yellow]no answer[/]")
     else:
         yes = "[bold green]yes[/]" if x["distinguishable"] else "[bold red]no[/]"
         iv = d["interval"]
-        f1 = (f", F1 {x['svm_f1']:.3f} ({iv['coverage']:.0%} interval {iv['low']:.3f} to {iv['high']:.3f}; "
-              f"{x['verdict']})" if x["svm_f1"] is not None else "")
-        con.print(f"  {_answerer(d)}: {yes}{f1}")
+        f1 = (f", F1 {x['svm_f1']:.3f} ({iv['coverage']:.0%} interval {iv['low']:.3f} to {iv['high']:.3f})"
+              if x["svm_f1"] is not None else "")
+        verdict = f"; {x['verdict']}" if x.get("verdict") else ""
+        con.print(f"distinguishable: {yes}{f1} ({_answerer(d)}{verdict})")
     if x["ideal_f1"] is not None:  # also where the table has no answer: the closed form needs no table
-        con.print(f"  ideal observer: F1 {x['ideal_f1']:.3f} ({d['ideal']['method']})"
-                  + (" (distinguishable)" if x["ideal_distinguishable"] else " (not even in principle)"))
+        con.print(f"ideal observer bound: F1 {x['ideal_f1']:.3f} ({d['ideal']['method']})"
+                  + (", distinguishable" if x["ideal_distinguishable"] else ", not even in principle"))
+    else:
+        con.print("ideal observer bound: —")
 
 
 _VALUE_LINES = {
@@ -353,7 +397,27 @@ _VALUE_LINES = {
 }
 
 
-def _source_lines(con, d):
+def _explain_lines(con, d):
+    """--explain: the objects with their units, the hardest pair, the paper's remark, the method, every note."""
+    con.print("objects [J s^-1/2 K^-1 m^-2]: " + " vs ".join(f"[bold]{o['label']}[/]" for o in d["objects"]))
+    if d["model"]["name"] != "semi-infinite":
+        from rich.markup import escape
+
+        con.print(f"model: {escape(_model_words(d))}")
+    if d["limiting_pair"] and any(o["material"] for o in d["objects"]) and d["question"] != "delta-e":
+        con.print("answered for the hardest pair: " + " vs ".join(o["label"] for o in d["limiting_pair"]))
+    if d["question"] == "delta-e":
+        sides = [d["details"][k] for k in ("lower", "upper")]
+        if any(s["value"] is None or s["ideal"] is None for s in sides):
+            outside = d["route"] == "table" and not all(d["in_grid"].values())
+            con.print("— : " + ("no answer from the table, or " if outside else "")
+                      + "no distinguishable effusivity in that direction within the range examined")
+    if d["question"] == "min-contact":
+        from ..query.guideline import guideline_remark
+
+        remark = guideline_remark(d)
+        if remark:
+            con.print(remark)
     if d["route"] == "table":
         words = {"noise_ratio": "sigma/dT", "contact_s": "contact time", "noise_c": "noise",
                  "delta_t_c": "temperature difference"}
@@ -368,20 +432,20 @@ def _source_lines(con, d):
         if d["question"] == "distinguishable":  # the verdict is the contact against min-contact's answer
             how = "the contact against min-contact's answer" + (
                 f" ({eff})" if (d["computation"].get("min_contact_interval") or {}).get("method") == "table-efficiency" else "")
-        con.print(f"  [dim]from table {d['table']['name']} ({where}), {how}; --exact computes it for this pair[/]")
+        con.print(f"method: from table {d['table']['name']} ({where}), {how}; --exact computes it for this pair")
     else:
         c = d["computation"]
         varied = (f", sensor temperature varied per touch by ±{c['sensor_temp_spread_c']:g} °C"
                   if c.get("sensor_temp_spread_c") else "")
-        con.print(f"  [dim]computed for this pair ({c['repeats']} seeds x {c['trials']} trials per class"
-                  f"{varied}, {c['wall_s']:.1f} s)[/]")
+        con.print(f"method: computed for this pair ({c['repeats']} seeds x {c['trials']} trials per class"
+                  f"{varied}, {c['wall_s']:.1f} s)")
     for n in d["notes"]:
-        con.print(f"  [yellow]{n}[/]")
+        con.print(f"note: {n}", markup=False)
     chk = d["model_check"]
     if chk and chk.get("message"):
-        con.print(f"  {'[dim]' if chk['holds'] else '[yellow]'}{chk['message']}[/]")
+        con.print(f"{'' if chk['holds'] else '[yellow]'}model check: {chk['message']}{'' if chk['holds'] else '[/]'}")
     if any(o["material"] for o in d["objects"]):
-        con.print(f"  [dim]{d['materials_rule']}[/]")
+        con.print(d["materials_rule"], markup=False)
 
 
 # ============================================================ the commands
@@ -395,10 +459,13 @@ def min_contact_cmd(
     trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
     n_mc: NmcQ = 1000, max_contact: MaxContact = 10.0, coverage: CoverageOpt = 0.9,
     sensor_temp_spread: SpreadOpt = None, json_: Json = False,
+    explain: Explain = False,
 ) -> None:
     """Shortest contact time that separates two materials.
 
-    Example: `designkit min-contact --e1 35000 --e2 20000` or `designkit min-contact --m1 copper --m2 "stainless steel" --exact`
+    Example: `designkit min-contact --e1 35000 --e2 20000`
+
+    Example (materials by name, the method too): `designkit min-contact --m1 wood --m2 glass --explain`
     """
     ans = _ask("min-contact", exact=exact, table=table, ideal_table=ideal_table, threshold=threshold, sensor=sensor,
                model=model, conductance=conductance, thickness=thickness, backing=backing, diffusivity=diffusivity,
@@ -406,7 +473,7 @@ def min_contact_cmd(
                objects=dict(e1=e1, e2=e2, m1=m1, m2=m2), scene=dict(noise_c=noise, delta_t_c=delta_t),
                exact_extra=dict(max_contact_s=max_contact), coverage=coverage, progress=not json_,
                spread=sensor_temp_spread)
-    _render(ans, json_)
+    _render(ans, json_, explain)
 
 
 @app.command("max-noise", rich_help_panel=_app.ASK)
@@ -418,6 +485,7 @@ def max_noise_cmd(
     exact: Exact = False, table: TableOpt = None, ideal_table: IdealTableOpt = "ideal-paper",
     trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
     n_mc: NmcQ = 1000, coverage: CoverageOpt = 0.9, sensor_temp_spread: SpreadOpt = None, json_: Json = False,
+    explain: Explain = False,
 ) -> None:
     """Largest sensor noise at which a contact time still separates two materials.
 
@@ -429,7 +497,7 @@ def max_noise_cmd(
                objects=dict(e1=e1, e2=e2, m1=m1, m2=m2),
                scene=dict(contact_s=contact, delta_t_c=delta_t), coverage=coverage, progress=not json_,
                spread=sensor_temp_spread)
-    _render(ans, json_)
+    _render(ans, json_, explain)
 
 
 @app.command("min-delta-t", rich_help_panel=_app.ASK)
@@ -441,6 +509,7 @@ def min_delta_t_cmd(
     exact: Exact = False, table: TableOpt = None, ideal_table: IdealTableOpt = "ideal-paper",
     trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
     n_mc: NmcQ = 1000, coverage: CoverageOpt = 0.9, sensor_temp_spread: SpreadOpt = None, json_: Json = False,
+    explain: Explain = False,
 ) -> None:
     """Smallest sensor-object temperature difference that separates two materials.
 
@@ -452,13 +521,15 @@ def min_delta_t_cmd(
                objects=dict(e1=e1, e2=e2, m1=m1, m2=m2),
                scene=dict(contact_s=contact, noise_c=noise), coverage=coverage, progress=not json_,
                spread=sensor_temp_spread)
-    _render(ans, json_)
+    _render(ans, json_, explain)
 
 
 @app.command("delta-e", rich_help_panel=_app.ASK)
 def delta_e_cmd(
-    e: Annotated[Optional[float], typer.Option("--e", help="Reference effusivity [J s^-1/2 K^-1 m^-2].")] = None,
-    m: Annotated[Optional[str], typer.Option("--m", help="Reference material (its range's middle).")] = None,
+    e: Annotated[Optional[float], typer.Option("--e", help="Reference effusivity [J s^-1/2 K^-1 m^-2].",
+                                               rich_help_panel=PANEL_QUESTION)] = None,
+    m: Annotated[Optional[str], typer.Option("--m", help="Reference material (its range's middle).",
+                                             rich_help_panel=PANEL_QUESTION)] = None,
     contact: Contact = 2.0, noise: NoiseQ = None, delta_t: DeltaTQ = None, threshold: Threshold = 0.9,
     sensor: SensorOpt = "paper",
     model: ModelOpt = None, conductance: Conductance = None, thickness: Thickness = None,
@@ -468,12 +539,16 @@ def delta_e_cmd(
     n_mc: NmcQ = 1000, coverage: CoverageOpt = 0.9, sensor_temp_spread: SpreadOpt = None,
     format_: Annotated[Optional[str], typer.Option(
         "--format", "-f", help="Print the two directions as rows: table, json, csv or md (default: the answer "
-                               "for people; --json: the whole answer).")] = None,
-    out: OutOpt = None, json_: Json = False,
+                               "for people; --json: the whole answer).", rich_help_panel=PANEL_OUTPUT)] = None,
+    out: Annotated[Optional[str], typer.Option("--out", "-o", help="Write the output to this file ('-' or none: "
+                                               "stdout).", rich_help_panel=PANEL_OUTPUT)] = None,
+    json_: Json = False, explain: Explain = False,
 ) -> None:
     """Smallest distinguishable effusivity difference delta(e), towards lower and higher effusivity.
 
-    Example: `designkit delta-e --e 20000 --contact 2` (`--format csv` for one row per direction)
+    Example: `designkit delta-e --e 20000 --contact 2`
+
+    Example (one row per direction): `designkit delta-e --e 20000 --contact 2 --format csv`
     """
     fmt = None if json_ or format_ is None else check_format(format_)
     if out not in (None, "-"):
@@ -494,7 +569,7 @@ def delta_e_cmd(
         emit_rows(rows, list(rows[0]), fmt=fmt, out=out, title=f"delta(e) at {x['effusivity']:g}", payload=d)
         return
     with output_to(out):
-        _render(ans, json_)
+        _render(ans, json_, explain)
 
 
 @app.command("distinguishable", rich_help_panel=_app.ASK)
@@ -507,6 +582,7 @@ def distinguishable_cmd(
     exact: Exact = False, table: TableOpt = None, ideal_table: IdealTableOpt = "ideal-paper",
     trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
     n_mc: NmcQ = 1000, coverage: CoverageOpt = 0.9, sensor_temp_spread: SpreadOpt = None, json_: Json = False,
+    explain: Explain = False,
 ) -> None:
     """Whether a scene separates two materials, with the SVM's and the ideal observer's F1.
 
@@ -518,4 +594,4 @@ def distinguishable_cmd(
                n_mc=n_mc, objects=dict(e1=e1, e2=e2, m1=m1, m2=m2),
                scene=dict(contact_s=contact, noise_c=noise, delta_t_c=delta_t), coverage=coverage,
                progress=not json_, spread=sensor_temp_spread)
-    _render(ans, json_)
+    _render(ans, json_, explain)

@@ -72,7 +72,7 @@ def sweep(
     slab on the default backing, whatever the config said). A slab also needs `--diffusivity`
     (or `diffusivity_m2_s:` in the config): one object diffusivity for every interval.
 
-    Example: `designkit sweep --config tables/svm-paper.yaml --intervals 50 --contact 1,2 --conductance 2000`
+    Example (a small table of your own; hours for the paper's 500 intervals): `designkit sweep --name my-table --intervals 10 --trials 20 --contact 1,2 --noise-ratio 0.005`
     """
     import time
 

@@ -87,7 +87,9 @@ def tables_show(
     """Describe one table: grid, units, sensor, forward model, fidelity, provenance, content hash
     (checked in full: every array read and hashed, a shipped table's too).
 
-    Example: `designkit tables show svm-paper` (or `--format csv` for its axes, one row each)
+    Example: `designkit tables show svm-paper`
+
+    Example (its axes, one row each): `designkit tables show svm-paper --format csv`
     """
     from ..tables.store import load_table
 

@@ -522,7 +522,9 @@ def _limiting(question: str, cells: Sequence[MatrixCell], names: Sequence[str]) 
         quantity, unit = QUANTITIES[question]
         word = "longest" if question == "min-contact" else ("smallest" if question == "max-noise" else "largest")
         qual = {"at-most": "at most ", "at-least": "at least "}.get(c.bound, "")
-        why = (f"the {word} {quantity} of all non-overlapping pairs: {qual}{c.value:.4g} {unit} "
+        from .._numbers import sig
+
+        why = (f"the {word} {quantity} of all non-overlapping pairs: {qual}{sig(c.value, unit)} "
                f"for {pair[0]} / {pair[1]}" + tail)
     return LimitingPair(pair, c.value, c.ideal, c.status, why)
 

@@ -9,6 +9,7 @@ into ``docs/accuracy.md``; :func:`write_report` writes it with its figures
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Mapping, Sequence
 
@@ -335,6 +336,41 @@ def render_markdown(report: BenchReport, figures: Mapping[str, str] | None = Non
     out += ["## Section wall times", "",
             ", ".join(f"{k} {v:.0f} s" for k, v in report.section_wall_s.items()) +
             f"; total {report.wall_s:.0f} s.", ""]
+    return short_paragraphs("\n".join(out))
+
+
+#: The longest paragraph (or list item) of the page [characters]; tests/test_docs_site.py holds docs/ to it.
+MAX_PARAGRAPH = 800
+_SENTENCE_END = re.compile(r"(?<=[\w%)][.;])\s+(?=[A-Za-z(])")
+_NOT_AN_END = re.compile(r"(?:\b(?:e\.g|i\.e|vs|cf|eq|Fig|et al)|\d)\.$")
+
+
+def short_paragraphs(markdown: str, limit: int = MAX_PARAGRAPH) -> str:
+    """``markdown`` with every prose line longer than ``limit`` characters cut at sentence ends into
+    paragraphs (a list item's continue under it, indented). Idempotent; code fences and tables are kept.
+
+    >>> text = "- " + "A sentence here. " * 60
+    >>> max(len(p) for p in short_paragraphs(text).split(chr(10) * 2)) <= 800
+    True
+    """
+    out, fence = [], False
+    for line in markdown.split("\n"):
+        if line.lstrip().startswith("```"):
+            fence = not fence
+        if fence or len(line) <= limit or line.lstrip().startswith(("|", "#", "<!--")):
+            out.append(line)
+            continue
+        item = re.match(r"(\s*)((?:[-*]|\d+\.)\s+)?", line)
+        indent = item.group(1) + " " * len(item.group(2) or "")
+        rest = line
+        while len(rest) > limit:
+            cuts = [m.start() for m in _SENTENCE_END.finditer(rest)
+                    if m.start() <= limit and not _NOT_AN_END.search(rest[:m.start()])]
+            if not cuts:
+                break
+            out += [rest[:cuts[-1]].rstrip(), ""]
+            rest = indent + rest[cuts[-1]:].strip()
+        out.append(rest)
     return "\n".join(out)
 
 
@@ -511,8 +547,15 @@ def plot_costs(report: BenchReport, path) -> Path | None:
         if np.any(ok):
             exp = "" if c.memory_exponent is None else f" (p = {c.memory_exponent:.2f})"
             a2.plot(x[ok], mem[ok], "o-", color=f"C{i}", ms=3, label=c.name + exp)
-    for ax, lab in ((a1, "wall time [s]"), (a2, "peak memory above baseline [MB]")):
+    from designkit.figures import log_ticks
+
+    sizes = [v for c in report.curves for v in np.asarray(c.x) / c.x[0]]
+    walls = [v for c in report.curves for v in c.wall_s]
+    mems = [v for c in report.curves for v in c.peak_mb if np.isfinite(v) and v > 0.5]
+    for ax, lab, ys in ((a1, "wall time [s]", walls), (a2, "peak memory above baseline [MB]", mems)):
         _log_axes(ax)
+        log_ticks(ax.xaxis, sizes)  # the values measured: a range inside one decade showed a single tick
+        log_ticks(ax.yaxis, ys)
         ax.set_xlabel("size relative to the curve's first point")
         ax.set_ylabel(lab)
         ax.grid(alpha=0.3, which="both")
@@ -691,7 +734,7 @@ def _insert_section(page: str, start: str, end: str, section: Sequence[str], aft
 
 def insert_coverage(page: str, section: Sequence[str]) -> str:
     """``page`` with its coverage section replaced (between markers), or inserted before the first ``## ``."""
-    return _insert_section(page, _COV_START, _COV_END, section)
+    return short_paragraphs(_insert_section(page, _COV_START, _COV_END, section))
 
 
 def write_coverage(doc: Mapping[str, Any], figure, out_dir) -> Path:
@@ -850,7 +893,7 @@ def varied_coverage_figure(doc: Mapping[str, Any], path) -> Path | None:
 def insert_varied_coverage(page: str, section: Sequence[str]) -> str:
     """``page`` with its varied-conditions section replaced (between markers), or inserted after the coverage
     section (before the first ``## `` where there is none)."""
-    return _insert_section(page, _VAR_START, _VAR_END, section, after=_COV_END)
+    return short_paragraphs(_insert_section(page, _VAR_START, _VAR_END, section, after=_COV_END))
 
 
 def write_varied_coverage(run: Mapping[str, Any], out_dir) -> Path:

@@ -241,16 +241,16 @@ class Context:
 
     # ----------------------------------------------------------------- outputs
     def save_figure(self, fig, name: str) -> str:
-        """Save a matplotlib figure as ``figures/NAME.FMT`` (the settings' figure format: png at 200 dpi,
-        or vector svg / pdf); returns the report-relative path."""
-        from designkit.figures import save_figure
+        """Save a matplotlib figure as ``figures/NAME.png``, ``.svg`` and ``.pdf``; returns the report-relative
+        path of the one in the settings' figure format (the one the report shows)."""
+        from designkit.figures import FIGURE_FORMATS, save_figure
 
         fmt = self.settings.figure_format
         self.fig_dir.mkdir(parents=True, exist_ok=True)
-        path = self.fig_dir / f"{name}.{fmt}"
-        tmp = path.with_name(f".{name}.tmp.{fmt}")
+        tmp = self.fig_dir / f".{name}.tmp.{fmt}"
         save_figure(fig, tmp)
-        os.replace(tmp, path)
+        for f in FIGURE_FORMATS:
+            os.replace(tmp.with_suffix(f".{f}"), self.fig_dir / f"{name}.{f}")
         return f"figures/{name}.{fmt}"
 
     def save_csv(self, name: str, header: Sequence[str], rows) -> str:

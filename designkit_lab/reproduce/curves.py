@@ -41,7 +41,8 @@ def _panel(ax, svm, ideal, ratio: float, label: str) -> None:
     for c, col in zip(CONTACTS_S, colours):
         ideal_d = _curve(ideal, "delta_up", ratio, c)
         if ideal_d is not None:
-            ax.plot(ideal.axes["e_ref"], ideal_d, ls="--", lw=0.9, color=col, alpha=0.8)
+            # on top of every SVM curve (an ideal curve can coincide with another contact's SVM curve)
+            ax.plot(ideal.axes["e_ref"], ideal_d, ls=(0, (4, 2)), lw=1.4, color=col, zorder=4)
         d = _curve(svm, "delta_up", ratio, c)
         if d is None:
             continue
@@ -50,7 +51,7 @@ def _panel(ax, svm, ideal, ratio: float, label: str) -> None:
         if lo is not None and hi is not None:
             ok = np.isfinite(lo) & np.isfinite(hi)
             ax.fill_between(e, np.where(ok, lo, np.nan), np.where(ok, hi, np.nan), color=col, alpha=0.25, lw=0)
-        ax.plot(e, d, lw=1.3, color=col, label=f"{c:g} s")
+        ax.plot(e, d, lw=1.6, color=col, label=f"{c:g} s", zorder=2)
     ax.set_title(label, fontsize=10)
     ax.set_xlabel("reference effusivity e [J s$^{-1/2}$ K$^{-1}$ m$^{-2}$]")
     ax.set_ylabel("δ(e) [J s$^{-1/2}$ K$^{-1}$ m$^{-2}$]")

@@ -140,7 +140,14 @@ def section_multiclass(ctx: Context) -> SectionResult:
     for ax, c in zip(axes[1:], (2.0, 4.0)):
         cm = np.asarray(p12_res[c]["confusion"], dtype=np.float64)
         frac = cm / np.maximum(cm.sum(axis=1, keepdims=True), 1)
-        ax.imshow(frac, vmin=0, vmax=1, cmap="Blues")
+        im = ax.imshow(frac, vmin=0, vmax=1, cmap="Blues")
+        for i in range(frac.shape[0]):  # each cell's fraction, where it is not zero
+            for j in range(frac.shape[1]):
+                if frac[i, j] >= 0.005:
+                    ax.text(j, i, f"{frac[i, j]:.2f}"[1:] if frac[i, j] < 1 else "1", ha="center", va="center",
+                            fontsize=6, color="white" if frac[i, j] > 0.6 else "black")
+        ax.grid(False)
+        fig.colorbar(im, ax=ax, shrink=0.8, label="fraction of its touches")
         ax.set_xticks(range(len(names)), names, rotation=60, ha="right", fontsize=7)
         ax.set_yticks(range(len(names)), names, fontsize=7)
         ax.set_xlabel("predicted")

@@ -70,6 +70,15 @@ def _sstar_grid(e_s: float, width: float, threshold: float, e_top: float):
     star = critical_noise(sensor, a.ravel(), (a + d).ravel(), width=width, threshold=threshold).reshape(a.shape)
     dw = 1.0 / (1.0 + e_s / (a + d)) - np.where(a > 0, 1.0 / (1.0 + e_s / np.maximum(a, 1e-300)), 0.0)
     f = np.log(star) - np.log(dw)
+    # Classes closer than their width never separate (the critical noise is NaN there, as the library says):
+    # the bicubic reading still needs a value at such nodes next to separable ones; extend each row
+    # linearly in log distance from its first two finite nodes (no answer is read there: the estimator
+    # refuses those pairs before it reads the grid)
+    for row in f:
+        ok = np.flatnonzero(np.isfinite(row))
+        if 2 <= ok.size < row.size and ok[0] > 0 and np.all(np.diff(ok) == 1):
+            k = np.arange(ok[0])
+            row[k] = row[ok[0]] + (k - ok[0]) * (row[ok[0] + 1] - row[ok[0]])
     if not np.isfinite(f).all():
         raise InputError("the ideal observer's critical noise is not finite on the export's grid")
     return (float(u[0]), float(u[1] - u[0]), float(v[0]), float(v[1] - v[0]), tuple(f.ravel().tolist()))

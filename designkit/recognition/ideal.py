@@ -200,19 +200,22 @@ def _weight(e_s: float, e):
         return 1.0 / (1.0 + e_s / e)
 
 
+def _window(w_cut, a, b, wa, wb, e_s):
+    """The effusivity [J s^-1/2 K^-1 m^-2] at contact weight ``w_cut``, clipped to the class ``[a, b)``
+    (``wa, wb`` its weights; the class's exact ends outside it): one end of a survival integral's window."""
+    w = np.minimum(np.maximum(w_cut, wa), wb)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        e = e_s * w / (1.0 - w)
+    e = np.minimum(np.maximum(e, a), b)
+    return np.where(w_cut <= wa, a, np.where(w_cut >= wb, b, e))
+
+
 def _survival(t, a, b, wa, wb, e_s, s):
     """``P(w(e) + s N(0,1) > t)`` with ``e ~ U[a, b)`` (:func:`class_survival`).
 
     ``wa, wb`` are ``w(a), w(b)``; the cuts outside the class use its exact ends.
     """
-    def cut(w_cut):
-        w = np.minimum(np.maximum(w_cut, wa), wb)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            e = e_s * w / (1.0 - w)
-        e = np.minimum(np.maximum(e, a), b)
-        return np.where(w_cut <= wa, a, np.where(w_cut >= wb, b, e))
-
-    e_lo, e_hi = cut(t - _CUT * s), cut(t + _CUT * s)
+    e_lo, e_hi = _window(t - _CUT * s, a, b, wa, wb, e_s), _window(t + _CUT * s, a, b, wa, wb, e_s)
     half, mid = 0.5 * (e_hi - e_lo), 0.5 * (e_hi + e_lo)
     nodes = mid[..., None] + half[..., None] * _GL_X
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -381,14 +384,7 @@ def _survival_derivatives(t, s, a, b, wa, wb, e_s, nodes: int):
     precision at its ends, so the derivatives are the integrals of the integrand's."""
     gx, gw = _rule(nodes)
 
-    def cut(w_cut):
-        w = np.minimum(np.maximum(w_cut, wa), wb)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            e = e_s * w / (1.0 - w)
-        e = np.minimum(np.maximum(e, a), b)
-        return np.where(w_cut <= wa, a, np.where(w_cut >= wb, b, e))
-
-    e_lo, e_hi = cut(t - _CUT * s), cut(t + _CUT * s)
+    e_lo, e_hi = _window(t - _CUT * s, a, b, wa, wb, e_s), _window(t + _CUT * s, a, b, wa, wb, e_s)
     half, mid = 0.5 * (e_hi - e_lo), 0.5 * (e_hi + e_lo)
     z = _weight(e_s, mid[:, None] + half[:, None] * gx)
     z -= t[:, None]

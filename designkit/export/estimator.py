@@ -154,8 +154,6 @@ class Estimator:
             return math.nan
 
         def ok(d):
-            if d < w:  # classes closer than their width never separate (the library's critical noise is NaN)
-                return False
             q = e + direction * d
             return s <= self.sstar(min(e, q), max(e, q))
 

@@ -69,8 +69,8 @@ class ModelCheck:
 class ForwardModel:
     """Base of every forward model (subclass it as a frozen dataclass).
 
-    Class attributes
-    ----------------
+    Attributes
+    ----------
     name : str
         Registry name (``"semi-infinite"``, ``"slab"``, ``"contact"``).
     shared_shape : bool

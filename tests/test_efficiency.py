@@ -244,6 +244,6 @@ def test_min_contact_below_the_tables_first_contact_says_it_is_extrapolated(cli,
     assert d["interval"]["method"] == "table-efficiency" and d["computation"]["below_grid"] is True
     assert any("below the table's first contact time" in n for n in d["notes"])
     r = cli("min-contact", "--e1", e1, "--e2", e2, "--noise", noise)
-    assert r.exit_code == 0 and "below its contact times: extrapolated" in r.stdout and "inside its grid" not in r.stdout
+    assert r.exit_code == 0 and "below the table's shortest contact time: extrapolated" in r.stdout and "inside its grid" not in r.stdout
     inside = min_contact(35000.0, 20000.0).to_dict()  # the README's pair: inside, no such note
     assert "below_grid" not in inside["computation"] and not any("first contact time" in n for n in inside["notes"])

@@ -265,7 +265,7 @@ def test_cli_min_contact_with_thickness(cli):
     assert d["model_check"]["details"]["semi_infinite_holds"]
     assert d["model"]["backing"]["name"] == "Hardwood, across grain" and d["model"]["thickness_m"] == 0.003
     human = cli("min-contact", "--m1", "acrylic", "--m2", "glass", "--thickness", "0.003", "--backing", "steel",
-                "--trials", "30", "--repeats", "1", "--jobs", "1", "--max-contact", "2")
+                "--trials", "30", "--repeats", "1", "--jobs", "1", "--max-contact", "2", "--explain")
     assert human.exit_code == 0, human.output
     assert "semi-infinite model and its tables hold" in " ".join(human.output.split())
 

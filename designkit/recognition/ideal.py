@@ -32,12 +32,9 @@ every closed-form bound of :mod:`designkit.query.ideal_bound` follows.
 
 The normal CDF is numpy's own here (:func:`ndtr`, cubic Hermite pieces of a
 table of :func:`math.erfc`, within 5e-14, tested against mpmath), not
-:mod:`scipy.special`: this module is the one closed form for the table
-builder and for a table question asked from a fresh shell, and importing
-``scipy.special`` costs that question about 0.35 s of a 0.2 s budget (measured
-with ``python -X importtime``, issue 16; ``tests/test_startup.py`` keeps the
-question scipy-free). The Monte Carlo observer below, which needs
-``scipy.special``'s ``log_ndtr`` and ``logsumexp``, imports them when it runs.
+:mod:`scipy.special`, so that a table question from a fresh shell never imports
+scipy (``tests/test_startup.py``; docs/decisions-log.md). The Monte Carlo
+observer below imports ``scipy.special`` when it runs.
 
 Varied initial conditions (Monte Carlo on the exact likelihood)
 ---------------------------------------------------------------
@@ -96,8 +93,7 @@ def _gauss_legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
     of the Legendre recurrence, and twice the squared first components of its eigenvectors).
 
     The same rule as ``numpy.polynomial.legendre.leggauss(n)`` (to 4e-16 in the nodes and 4e-15 in the
-    weights at n = 40, tested), without importing ``numpy.polynomial``: its classes cost a fresh table query
-    2.3 ms of a start-up that issue 16 counts (this takes 0.2 ms).
+    weights at n = 40, tested), without importing ``numpy.polynomial`` (start-up: docs/decisions-log.md).
     """
     k = np.arange(1.0, n)
     off = k / np.sqrt(4.0 * k * k - 1.0)
@@ -117,7 +113,7 @@ _PHI_Z = 9.0  # beyond +-9 the CDF is 0 or 1 to 1e-19
 
 @functools.lru_cache(maxsize=1)
 def _phi_table() -> tuple[np.ndarray, np.ndarray]:
-    """The standard normal CDF and density on [-9, 9] every 1/512, from :func:`math.erfc` (~2 ms, once)."""
+    """The standard normal CDF and density on [-9, 9] every 1/512, from :func:`math.erfc` (once per process)."""
     z = np.arange(-_PHI_Z, _PHI_Z + _PHI_H / 2, _PHI_H)
     cdf = np.array([0.5 * math.erfc(-_SQRT1_2 * x) for x in z.tolist()])
     return cdf, np.exp(-0.5 * z * z) / math.sqrt(2.0 * math.pi)
@@ -136,10 +132,13 @@ def ndtr(z) -> np.ndarray:
     """Standard normal CDF, elementwise (a new array; float64): cubic Hermite interpolation of :func:`_phi_table`.
 
     Interpolation error at most h^4 max|d4 Phi| / 384 = 5e-14 (h = 1/512), tested against
-    :func:`math.erfc`; a Python call of math.erfc per element costs 5x more, scipy's import 0.35 s.
-    Evaluated in Horner form from per-interval coefficients, in place, with 1-D ``take`` gathers:
-    8x faster than the textbook basis form on (3000, 40) arrays (9.1 -> 1.1 ms, same values to
-    7e-16), which was a fifth of a 12-material ``designkit matrix``.
+    :func:`math.erfc`. Evaluated in Horner form from per-interval coefficients, in place, with 1-D
+    ``take`` gathers.
+
+    Examples
+    --------
+    >>> float(ndtr(np.array([0.0]))[0])
+    0.5
     """
     c0, c1, c2, c3 = _phi_horner()
     u = np.clip(z, -_PHI_Z, _PHI_Z)

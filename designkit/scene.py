@@ -32,6 +32,12 @@ class Scene:
         ("varied initial conditions"; the paper's robot used Ts0 uniform in
         30-35 degC, i.e. ``sensor_temp_c=32.5, sensor_temp_spread_c=2.5``).
         0 means fixed initial conditions.
+
+    Examples
+    --------
+    >>> s = Scene.from_delta_t(contact_s=1.0, noise_c=0.05, delta_t_c=10.0)
+    >>> s.sensor_temp_c, s.noise_ratio, s.fixed_initial_conditions
+    (35.0, 0.005, True)
     """
 
     contact_s: float = 2.0

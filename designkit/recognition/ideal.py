@@ -495,6 +495,12 @@ def projection_noise(sensor: Sensor, scene: Scene) -> float:
     ``s = (sigma / |Ts0 - Ta|) / |g|`` with ``|g|`` the Euclidean norm of the
     response shape over the touch's samples (:func:`shape_norm`). ``inf`` when there is no signal
     (no temperature difference, or no sample after contact); 0 when noise-free.
+
+    Examples
+    --------
+    >>> from designkit import SENSORS, Scene
+    >>> round(projection_noise(SENSORS["paper"], Scene(contact_s=1.0, noise_c=0.05)), 5)  # sigma/dT 0.005
+    0.00776
     """
     ratio = scene.noise_ratio
     norm = float(shape_norm(sensor, scene.contact_s))
@@ -551,6 +557,12 @@ def ideal_scores(low_a, low_b, high_a, high_b, e_sensor: float, s, *, accuracy: 
     -------
     f1, accuracy : ndarray (accuracy None when not asked for)
         Broadcast over the inputs.
+
+    Examples
+    --------
+    >>> f1, accuracy = ideal_scores(20000, 20080, 35000, 35080, 892.0, 0.01)
+    >>> round(float(f1), 3), round(float(accuracy), 3)
+    (0.818, 0.813)
     """
     la, lb, ha, hb, s = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64)
                                              for x in (low_a, low_b, high_a, high_b, s)))

@@ -497,13 +497,7 @@ class Table:
 
 
 def list_tables(folder: Path | None = None) -> list[str]:
-    """Names of the tables in ``folder`` (default: the shipped tables); a missing folder is an error.
-
-    Examples
-    --------
-    >>> "svm-fine" in list_tables()
-    True
-    """
+    """Names of the tables in ``folder`` (default: the shipped tables); a missing folder is an error."""
     from .._resources import shipped_tables_dir
 
     if folder is not None:

@@ -48,8 +48,8 @@ for name in ("wood", "aluminium alloys"):
 # %%
 # Identify the sensor with the paper's model and write its sensor file.
 fit = identify(touches, "semi-infinite", ranges=resolve_ranges(["wood", "aluminium alloys"], {}))
-path = fit.sensor("my sensor").to_yaml(Path(tempfile.mkdtemp()) / "sensor.yaml")
-mine = load_sensor(path)
+with tempfile.TemporaryDirectory() as folder:  # with a rig: --out my-sensor.yaml, kept
+    mine = load_sensor(fit.sensor("my sensor").to_yaml(Path(folder) / "sensor.yaml"))
 lo, hi = fit.effusivity.ci95
 print(f"e_s = {mine.effusivity:.4g} [{lo:.4g}, {hi:.4g}] J s^-1/2 K^-1 m^-2 (true 1200), "
       f"alpha_s = {mine.diffusivity_m2_s:.3g} m^2/s (true 1e-09), noise {mine.noise_c:.3g} °C")

@@ -18,7 +18,7 @@ import typer
 
 from ._app import EXIT_INTERRUPTED, app, console, emit_json, sub_app
 from . import _app
-from ._options import Json, Noise, Seed, SensorOpt, sensor_and_model
+from ._options import PANEL_OUTPUT, Json, Noise, Seed, SensorOpt, sensor_and_model
 
 #: ``designkit calibrate --help``: the group's and the guided run's (the group's callback) help in one,
 #: since typer shows the group's text, not the callback's docstring.
@@ -447,59 +447,17 @@ def _run_identify(index: Path, model: Optional[str], fit_sets: Optional[str], ra
     held-out residual wins (BIC where nothing is held out). Prints the report unless ``quiet``;
     returns the JSON payload (None after ``rows_fmt`` rows).
     """
-    from rich.markup import escape
-    from rich.table import Table
-
     from .._validation import InputError
-    from ..calibration.fit import check_calibration, parse_object_temps, parse_ranges, resolve_ranges
     from ..calibration.identify import CANDIDATES, Split, candidate, choose_split, compare_models
-    from ..calibration.trials import load_index
 
     auto = model is None or model.strip().lower() in ("all", "auto")
     cands = list(CANDIDATES) if auto else [candidate(model)]
     if depth_um is not None and not (depth_um > 0 and math.isfinite(depth_um)):
         raise InputError(f"--depth-um must be positive, got {depth_um:g}")
-    trials = load_index(index, only=only)
-    if not trials:
-        raise InputError(f"index {index} lists no trials")
-    trials = _cut(trials, fit_to)
-    short = [tr for tr in trials if tr.time_s[-1] < MIN_CONTACT_S]
-    if short:
-        raise InputError(f"{len(short)} touch(es) end before {MIN_CONTACT_S:g} s after the onset (e.g. "
-                         f"{Path(short[0].source).name}, {max(short[0].time_s[-1], 0.0):.3g} s): the sensor models "
-                         f"need at least {MIN_CONTACT_S:g} s of contact" + (" (raise --fit-to)" if fit_to else
-                                                                           "; record longer touches"))
+    trials = _load_trials(index, only, fit_to)
     names = sorted({tr.material for tr in trials})
-    rng = resolve_ranges(names, parse_ranges(ranges))
-    affine = [spec for spec in object_temps if spec.strip().lower().endswith("-affine")]
-    temps = parse_object_temps([spec for spec in object_temps if spec not in affine])
-    for spec in affine:  # the passive reading through a fitted offset and slope (identification only)
-        mat, _, mode = spec.partition("=")
-        if mode.strip().lower() not in ("passive-affine", "passive-end-affine"):
-            raise InputError(f"--object-temp {spec!r}: the fitted-channel modes are passive-affine and "
-                             "passive-end-affine")
-        temps[mat.strip()] = mode.strip().lower()
-    unknown = sorted(set(temps) - set(names))
-    if unknown:
-        raise InputError(f"--object-temp names material(s) not being fitted: {', '.join(unknown)}")
-    per_touch = [n.strip() for n in (touch_conductance or "").split(",") if n.strip()]
-    unknown = sorted(set(per_touch) - set(names))
-    if unknown:
-        raise InputError(f"--touch-conductance names material(s) not being fitted: {', '.join(unknown)} "
-                         f"(fitted: {', '.join(names)})")
-    if per_touch:
-        cands = [c for c in cands if "conductance_w_m2k" in c.free]
-        if not cands:
-            raise InputError(f"--touch-conductance needs a model that fits the contact conductance "
-                             f"(contact, layered...), not {model}")
-    before = [p for p in check_calibration(None, trials) if p.fatal]  # refuse before minutes of fitting
-    if before and not force:
-        con = console(stderr=True)
-        for p in before:
-            con.print(f"[bold red]error:[/] {escape(p.text())}")
-        raise InputError(f"calibration unusable ({', '.join(sorted({p.kind for p in before}))}): "
-                         + (f"{out} not written; " if out is not None else "")
-                         + "see the messages above; --force fits and writes the sensor file anyway")
+    rng, temps, per_touch, cands = _identify_inputs(names, ranges, object_temps, touch_conductance, cands, model)
+    _refuse_unusable(trials, force, out)
     if fit_sets is not None and fit_sets.strip().lower() == "all":
         split = Split(tuple(trials), (), (), (), "trial set", "--fit-sets all: every touch fitted")
     else:
@@ -523,21 +481,101 @@ def _run_identify(index: Path, model: Optional[str], fit_sets: Optional[str], ra
     if rows_fmt is not None:  # the selected model's parameters (the comparison stays in the report and --json)
         from ._format import emit_rows
 
-        es = best.effusivity
-        head = [] if es is None or not best.consistent else [
-            {"parameter": "e_s", "material": None, "value": es.value, "std_error": None, "low_95": es.ci95[0],
-             "high_95": es.ci95[1], "unit": "J s^-1/2 K^-1 m^-2"}]
-        emit_rows(head + [{"parameter": q.name, "material": None, "value": q.value, "std_error": None,
-                           "low_95": q.ci95[0], "high_95": q.ci95[1], "unit": q.unit} for q in best.parameters],
-                  PARAMETER_COLUMNS, fmt=rows_fmt,
-                  notes=[f"model {selected}, {split.describe()}"])
+        emit_rows(_parameter_rows(best), PARAMETER_COLUMNS, fmt=rows_fmt, notes=[f"model {selected}, {split.describe()}"])
         return None
     payload = {"index": str(index), "n_fit": len(fit), "n_held_out": len(held), "selected": selected,
                "reason": cmp.reason, "split": split.to_dict(),
                "out": str(out) if out is not None else None, "plot": str(plot) if plot is not None else None,
                "results": [dict(r.to_dict(), held_out_rms_c=dict(sc)) for r, sc in zip(results, scores)]}
-    if quiet:
-        return payload
+    if not quiet:
+        _print_identification(cmp, best, split, names, out, plot, len(fit), record)
+    return payload
+
+
+def _load_trials(index: Path, only: Optional[list[str]], fit_to: Optional[float]) -> list:
+    """The index's touches (``only`` these materials), cut at ``fit_to``; refused if any is too short to fit."""
+    from .._validation import InputError
+    from ..calibration.trials import load_index
+
+    trials = load_index(index, only=only)
+    if not trials:
+        raise InputError(f"index {index} lists no trials")
+    trials = _cut(trials, fit_to)
+    short = [tr for tr in trials if tr.time_s[-1] < MIN_CONTACT_S]
+    if short:
+        raise InputError(f"{len(short)} touch(es) end before {MIN_CONTACT_S:g} s after the onset (e.g. "
+                         f"{Path(short[0].source).name}, {max(short[0].time_s[-1], 0.0):.3g} s): the sensor models "
+                         f"need at least {MIN_CONTACT_S:g} s of contact" + (" (raise --fit-to)" if fit_to else
+                                                                           "; record longer touches"))
+    return trials
+
+
+def _identify_inputs(names: list[str], ranges: list[str], object_temps: list[str], touch_conductance: Optional[str],
+                     cands: list, model: Optional[str]) -> tuple:
+    """The options of an identification, checked against the materials fitted: (ranges, object temperatures,
+    materials with a conductance per touch, the candidate models that can fit them)."""
+    from .._validation import InputError
+    from ..calibration.fit import parse_object_temps, parse_ranges, resolve_ranges
+
+    rng = resolve_ranges(names, parse_ranges(ranges))
+    affine = [spec for spec in object_temps if spec.strip().lower().endswith("-affine")]
+    temps = parse_object_temps([spec for spec in object_temps if spec not in affine])
+    for spec in affine:  # the passive reading through a fitted offset and slope (identification only)
+        mat, _, mode = spec.partition("=")
+        if mode.strip().lower() not in ("passive-affine", "passive-end-affine"):
+            raise InputError(f"--object-temp {spec!r}: the fitted-channel modes are passive-affine and "
+                             "passive-end-affine")
+        temps[mat.strip()] = mode.strip().lower()
+    unknown = sorted(set(temps) - set(names))
+    if unknown:
+        raise InputError(f"--object-temp names material(s) not being fitted: {', '.join(unknown)}")
+    per_touch = [n.strip() for n in (touch_conductance or "").split(",") if n.strip()]
+    unknown = sorted(set(per_touch) - set(names))
+    if unknown:
+        raise InputError(f"--touch-conductance names material(s) not being fitted: {', '.join(unknown)} "
+                         f"(fitted: {', '.join(names)})")
+    if per_touch:
+        cands = [c for c in cands if "conductance_w_m2k" in c.free]
+        if not cands:
+            raise InputError(f"--touch-conductance needs a model that fits the contact conductance "
+                             f"(contact, layered...), not {model}")
+    return rng, temps, per_touch, cands
+
+
+def _refuse_unusable(trials: list, force: bool, out: Optional[Path]) -> None:
+    """Refuse, before minutes of fitting, touches that cannot calibrate (unless ``force``), each problem said."""
+    from rich.markup import escape
+
+    from .._validation import InputError
+    from ..calibration.fit import check_calibration
+
+    before = [p for p in check_calibration(None, trials) if p.fatal]
+    if before and not force:
+        con = console(stderr=True)
+        for p in before:
+            con.print(f"[bold red]error:[/] {escape(p.text())}")
+        raise InputError(f"calibration unusable ({', '.join(sorted({p.kind for p in before}))}): "
+                         + (f"{out} not written; " if out is not None else "")
+                         + "see the messages above; --force fits and writes the sensor file anyway")
+
+
+def _parameter_rows(best) -> list[dict]:
+    """The selected model's parameters as rows (:data:`PARAMETER_COLUMNS`): e_s first where it is known."""
+    es = best.effusivity
+    head = [] if es is None or not best.consistent else [
+        {"parameter": "e_s", "material": None, "value": es.value, "std_error": None, "low_95": es.ci95[0],
+         "high_95": es.ci95[1], "unit": "J s^-1/2 K^-1 m^-2"}]
+    return head + [{"parameter": q.name, "material": None, "value": q.value, "std_error": None,
+                    "low_95": q.ci95[0], "high_95": q.ci95[1], "unit": q.unit} for q in best.parameters]
+
+
+def _print_identification(cmp, best, split, names: list[str], out: Optional[Path], plot: Optional[Path],
+                          n_fit: int, record: Optional[dict]) -> None:
+    """The identification's report for people: the models compared, the one selected and its parameters."""
+    from rich.markup import escape
+    from rich.table import Table
+
+    results, scores, selected = cmp.results, cmp.held_out_rms_c, cmp.selected
     con = console()
     if record is not None:
         con.print(f"Recorded {record['n_trials']} trial(s) in {record['out']}")
@@ -568,11 +606,10 @@ def _run_identify(index: Path, model: Optional[str], fit_sets: Optional[str], ra
     for note in best.notes:
         con.print(f"[yellow]note:[/] {escape(note)}")
     if out is not None:
-        con.print(f"wrote {out} with the {selected} model, as fitted on the {len(fit)} fitted touches  "
+        con.print(f"wrote {out} with the {selected} model, as fitted on the {n_fit} fitted touches  "
                   f"(use it with --sensor {out})")
     if plot is not None:
         con.print(f"wrote {plot}")
-    return payload
 
 
 # ------------------------------------------------------------------ record
@@ -653,10 +690,10 @@ def fit(
         "--touch-conductance", help="Give each touch of these materials (comma-separated) its own contact "
                                     "conductance, e.g. metal (contact area differs between touches); only "
                                     "models that fit h_c.")] = None,
-    format_: Annotated[str, typer.Option(
-        "--format", "-f", help="table (the report, default), json (as --json), or csv / md: the identified "
-                               "sensor's parameters as rows (parameter, material, value, std_error, low_95, "
-                               "high_95, unit), pandas-ready.")] = "table",
+    format_: Annotated[Optional[str], typer.Option(
+        "--format", "-f", help="text (the report, default), json (as --json), or table / csv / ndjson / md: the "
+                               "identified sensor's parameters as rows (parameter, material, value, std_error, "
+                               "low_95, high_95, unit), pandas-ready.", rich_help_panel=PANEL_OUTPUT)] = None,
     json_: Json = False,
 ) -> None:
     """Identify your sensor's model from recorded touches: e_s, alpha_s, each e_o, the contact offset.
@@ -665,9 +702,9 @@ def fit(
 
     Example (the paper's model only, parameters as CSV): `designkit calibrate fit trials/index.csv --model semi-infinite --format csv`
     """
-    from ._format import check_format, check_out
+    from ._format import check_out, output_format
 
-    fmt = "json" if json_ else check_format(format_)
+    fmt = output_format(format_, json_)
     if out is not None:
         if str(out) == "-":  # it wrote a file named '-' and advised '--sensor -'
             from .._validation import InputError
@@ -677,8 +714,8 @@ def fit(
     bounds = _offset_bounds(offset_range)
     only_list = [s.strip() for item in only for s in item.split(",") if s.strip()] if only else None
     payload = _run_identify(index, model, fit_sets, range_ or [], only_list, object_temp or [], depth_um, out,
-                            fmt != "table", touch_conductance, name=name, force=force,
-                            rows_fmt=fmt if fmt in ("csv", "md") else None, plot=plot, offset_bounds_s=bounds,
+                            fmt != "text", touch_conductance, name=name, force=force,
+                            rows_fmt=None if fmt in ("text", "json") else fmt, plot=plot, offset_bounds_s=bounds,
                             fit_to=fit_to)
     if fmt == "json":
         emit_json(payload)

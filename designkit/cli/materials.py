@@ -8,7 +8,7 @@ import typer
 
 from . import _app
 from ._app import console, emit_json, sub_app
-from ._format import FormatOpt, OutOpt, check_format, emit_rows, output_to
+from ._format import FormatOpt, OutOpt, check_format, emit_rows, output_format, output_to
 from ._options import Json
 
 materials_app = sub_app(
@@ -34,7 +34,7 @@ def list_(
     set_: SetOpt = "database",
     sort: Annotated[str, typer.Option(
         "--sort", help="Order: 'file' (grouped by family), 'name' or 'effusivity' (by e_min).")] = "file",
-    format_: FormatOpt = "table",
+    format_: FormatOpt = None,
     out: OutOpt = None,
     json_: Json = False,
 ) -> None:
@@ -47,7 +47,7 @@ def list_(
     from .._validation import InputError
     from ..materials import FAMILY_LABELS, list_materials
 
-    fmt = "json" if json_ else check_format(format_)
+    fmt = output_format(format_, json_, default="table")
     if sort not in _SORTS:
         raise InputError(f"unknown sort {sort!r}; choose one of: {', '.join(_SORTS)}")
     mats = list_materials(family=family, set=set_)
@@ -58,7 +58,7 @@ def list_(
     paper = set_.strip().lower() == "paper12"
     payload = {"set": set_.strip().lower(), "family": family, "count": len(mats),
                "materials": [m.to_dict() for m in mats]}
-    if fmt in ("csv", "json"):  # plain values, full precision; a name column that 'designkit matrix --from' reads
+    if fmt in ("csv", "ndjson", "json"):  # plain values, full precision; a name column that 'designkit matrix --from' reads
         cols = ["name", "family", "set", *(["identified"] if paper else []), "e_min", "e_max",
                 "diffusivity_min_m2_s", "diffusivity_max_m2_s", "flags"]
         rows = [{"name": m.name, "family": m.family, "set": m.set, "identified": m.identified, "e_min": m.e_min,

@@ -14,7 +14,7 @@ import typer
 
 from . import _app
 from ._app import app, console
-from ._format import FormatOpt, OutOpt, check_format, emit_rows
+from ._format import FormatOpt, OutOpt, emit_rows, output_format
 from ._options import Explain, Json, SensorOpt, sensor_and_model
 
 _QUESTIONS = "min-contact, max-noise, min-delta-t or distinguishable"
@@ -54,7 +54,7 @@ def matrix(
     seed: Annotated[int, typer.Option("--seed", help="Seed of the SVM's simulated touches.")] = 0,
     plot: Annotated[Optional[str], typer.Option(
         "--plot", help="Save a figure: heatmap + multi-class accuracy (.png, .svg or .pdf).")] = None,
-    format_: FormatOpt = "table",
+    format_: FormatOpt = None,
     out: OutOpt = None,
     sensor: SensorOpt = "paper",
     json_: Json = False,
@@ -85,7 +85,7 @@ def matrix(
     if plot:
         check_out(plot, "--plot")  # before the work, as export's --out
     names = list(m or ()) + (read_material_names(from_) if from_ else [])
-    fmt = "json" if json_ else check_format(format_)
+    fmt = output_format(format_, json_, default="table")
     from .._validation import check_positive, check_temperature
 
     if noise is not None:  # -inf, nan and 1e400 were answered

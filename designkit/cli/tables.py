@@ -9,7 +9,7 @@ import typer
 
 from . import _app
 from ._app import console, emit_json, sub_app
-from ._format import FormatOpt, OutOpt, check_format, emit_rows, output_to, write_output
+from ._format import FormatOpt, OutOpt, check_format, emit_rows, output_format, output_to, write_output
 from ._options import Json
 
 tables_app = sub_app("tables", "Shipped lookup tables: list them, or show one's grid and provenance.",
@@ -19,7 +19,7 @@ tables_app = sub_app("tables", "Shipped lookup tables: list them, or show one's 
 @tables_app.command("list")
 def tables_list(
     folder: Annotated[Optional[Path], typer.Option("--folder", help="List tables in this folder instead.")] = None,
-    format_: FormatOpt = "table",
+    format_: FormatOpt = None,
     out: OutOpt = None,
     json_: Json = False,
 ) -> None:
@@ -31,7 +31,7 @@ def tables_list(
 
     from .._validation import InputError
 
-    fmt = "json" if json_ else check_format(format_)
+    fmt = output_format(format_, json_, default="table")
     rows = []
     for name in list_tables(folder):
         try:
@@ -59,8 +59,8 @@ def tables_list(
                      "noise_axis": noise_axis, "noise_min": noise[0], "noise_max": noise[1], "noise_points": noise[2],
                      "contact_min_s": contact[0], "contact_max_s": contact[1], "contact_points": contact[2],
                      "intervals": ax["e_ref"][2], "size_bytes": r["size_bytes"], "path": r["path"]})
-    if fmt == "csv":
-        emit_rows(flat, fmt="csv", out=out)
+    if fmt in ("csv", "ndjson"):
+        emit_rows(flat, fmt=fmt, out=out)
         return
     if not flat and fmt == "table":
         write_output(f"no designkit tables in {folder if folder is not None else 'the shipped folder'}\n", out)

@@ -8,7 +8,8 @@ from typing import Annotated, Optional
 
 import typer
 
-from ._app import app, console, emit_json
+from ._app import app, console
+from ._format import FormatOpt, OutOpt, check_out, emit, flat_record, output_format
 from . import _app
 from ._options import BackingOpt, DeltaT, Json, SensorOpt
 
@@ -35,6 +36,8 @@ def validity(
     horizon: Annotated[float, typer.Option("--horizon", help="Longest contact time examined \\[s].")] = 3600.0,
     plot: Annotated[Optional[Path], typer.Option(
         "--plot", help="Write a figure of the deviation against contact time (.png, or vector .svg / .pdf).")] = None,
+    format_: FormatOpt = None,
+    out: OutOpt = None,
     json_: Json = False,
 ) -> None:
     """Contact time up to which the semi-infinite model (paper eq. 2) holds for a slab of this thickness.
@@ -44,6 +47,8 @@ def validity(
     Prints the first contact time at which that difference exceeds --tolerance.
 
     Example: `designkit validity --m acrylic --thickness 0.003 --backing table`
+
+    Example (one flat record, pandas-ready): `designkit validity --m acrylic --thickness 0.003 --format csv`
     """
     import numpy as np
 
@@ -51,13 +56,14 @@ def validity(
     from ..sensor import load_sensor
     from ..models.slab import material_validity, resolve_backing, semi_infinite_deviation, semi_infinite_validity
 
+    fmt = output_format(format_, json_)
+    if out not in (None, "-"):
+        check_out(out)
     L = check_positive("thickness [m]", thickness)
     from .._validation import check_temperature
 
     check_temperature("--tolerance [°C]", tolerance, nonnegative=True)  # 1e308 was answered
     if plot is not None:
-        from ._format import check_out
-
         check_out(plot, "--plot")  # before the work; a missing folder is not made
     if delta_t == 0:
         raise InputError("--delta-t must be non-zero: an unheated sensor sees no difference to hold a tolerance to")
@@ -101,9 +107,15 @@ def validity(
         "deviation_c": {f"{t:g}": float(d) for t, d in zip(REPORT_TIMES_S, dev_c)},
         "plot": str(plot) if plot else None,
     }
-    if json_:
-        emit_json(payload)
-        return
+    emit(fmt, out, payload=payload, records=lambda: [flat_record({**{k: v for k, v in payload.items() if k not in ("sensor", "material_ranges")},
+                                        **(payload["material_ranges"] or {}), "sensor": payload["sensor"]["name"]})],
+         text=lambda: _print_validity(payload, nominal, worst, name, back, sen, L, plot))
+
+
+def _print_validity(payload: dict, nominal, worst, name, back, sen, L: float, plot) -> None:
+    """validity's text for people: the headline is the answer --json gives (the worst case over the ranges)."""
+    tolerance, delta_t, horizon = payload["tolerance_c"], payload["delta_t_c"], payload["horizon_s"]
+    dev_c = list(payload["deviation_c"].values())
     con = console()
     what = name if name else f"object (e {nominal.e_object:.4g}, alpha {nominal.alpha_object_m2_s:.3g} m²/s)"
     con.print(f"[bold]{L * 1e3:g} mm {what}[/] on {back.name}")

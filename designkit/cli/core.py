@@ -201,36 +201,13 @@ def f1(
 
     Example (a cold block of wood against room-temperature metal, one sensor and two): `designkit f1 --e1 17530 --e2 400 --width 10 --delta-t 7 --ambient 22.5 --object-temp2 8 --two-sensor`
     """
-    from .._validation import InputError, check_effusivity, check_positive, check_probability, check_temperature
+    from .._validation import InputError
     from ..objects import object_class
     from ..recognition.ideal import ideal_pair
     from ..recognition.svm import pair_f1
     from ..scene import Scene
 
-    if e1 is None or e2 is None:
-        raise InputError("give both --e1 and --e2")
-    e1 = check_effusivity("e1", e1)
-    e2 = check_effusivity("e2", e2)
-    if e1 == e2:
-        raise InputError(f"e1 and e2 are equal ({e1:g}): nothing to separate")
-    check_probability("--threshold (F1)", threshold, low=2 / 3, high=1.0)  # a blind guess scores 2/3
-    check_temperature("--noise [°C]", noise, nonnegative=True)
-    check_temperature("--delta-t [°C]", delta_t)
-    if delta_t == 0 and not two_sensor:  # sensor and objects at one temperature: no heat flows, nothing to tell
-        raise InputError("--delta-t must be non-zero: a sensor at the objects' temperature reads no difference "
-                         "(F1 is chance)")
-    from ..sweep.config import MAX_EFFUSIVITY
-
-    check_positive("--width", width)
-    for label, value in (("--width", width), ("--e1", e1 + width), ("--e2", e2 + width)):
-        if value > MAX_EFFUSIVITY:  # 1e308 overflowed the class edges
-            raise InputError(f"{label}: classes must end below {MAX_EFFUSIVITY:g} J s^-1/2 K^-1 m^-2, got one "
-                             f"ending at {value:g} (no material comes near: diamond is about 1e5)")
-    check_temperature("--ambient [°C]", ambient)
-    if folds < 2:
-        raise InputError(f"folds must be >= 2, got {folds}")
-    if trials < folds:
-        raise InputError(f"trials per class ({trials}) must be at least the number of folds ({folds})")
+    e1, e2 = _check_f1(e1, e2, threshold, noise, delta_t, two_sensor, width, ambient, folds, trials)
     sen, fm, source = sensor_and_model(sensor, model, conductance=conductance, thickness=thickness,
                                        backing=backing)
     if diffusivity is not None and "diffusivity_m2_s" not in fm.object_properties:
@@ -281,19 +258,57 @@ def f1(
     if json_:
         emit_json(payload)
         return
+    _print_f1(payload, svm, ideal, sen, fm, source, width)
+
+
+def _check_f1(e1, e2, threshold, noise, delta_t, two_sensor, width, ambient, folds, trials) -> tuple[float, float]:
+    """f1's objects and scene, each refused in one line before any simulation; the two effusivities checked."""
+    from .._validation import InputError, check_effusivity, check_positive, check_probability, check_temperature
+    from ..sweep.config import MAX_EFFUSIVITY
+
+    if e1 is None or e2 is None:
+        raise InputError("give both --e1 and --e2")
+    e1 = check_effusivity("e1", e1)
+    e2 = check_effusivity("e2", e2)
+    if e1 == e2:
+        raise InputError(f"e1 and e2 are equal ({e1:g}): nothing to separate")
+    check_probability("--threshold (F1)", threshold, low=2 / 3, high=1.0)  # a blind guess scores 2/3
+    check_temperature("--noise [°C]", noise, nonnegative=True)
+    check_temperature("--delta-t [°C]", delta_t)
+    if delta_t == 0 and not two_sensor:  # sensor and objects at one temperature: no heat flows, nothing to tell
+        raise InputError("--delta-t must be non-zero: a sensor at the objects' temperature reads no difference "
+                         "(F1 is chance)")
+    check_positive("--width", width)
+    for label, value in (("--width", width), ("--e1", e1 + width), ("--e2", e2 + width)):
+        if value > MAX_EFFUSIVITY:  # 1e308 overflowed the class edges
+            raise InputError(f"{label}: classes must end below {MAX_EFFUSIVITY:g} J s^-1/2 K^-1 m^-2, got one "
+                             f"ending at {value:g} (no material comes near: diamond is about 1e5)")
+    check_temperature("--ambient [°C]", ambient)
+    if folds < 2:
+        raise InputError(f"folds must be >= 2, got {folds}")
+    if trials < folds:
+        raise InputError(f"trials per class ({trials}) must be at least the number of folds ({folds})")
+    return e1, e2
+
+
+def _print_f1(payload: dict, svm, ideal, sen, fm, source: str, width: float) -> None:
+    """f1's answer for people: the pair and scene, the model, the SVM's F1 and verdict, the ideal bound."""
     from rich.markup import escape
 
+    sc, threshold = payload["scene"], payload["threshold"]
+    (o1, o2), diffusivity = payload["objects"], payload["diffusivity_m2_s"]
     con = console()
-    con.print(f"[bold]{e1:g}[/] vs [bold]{e2:g}[/] J s^-1/2 K^-1 m^-2 (classes {width:g} wide), contact {contact:g} s, "
-              f"noise {noise:g} °C, dT {delta_t:g} °C, {sen.name} sensor")
+    con.print(f"[bold]{o1['effusivity_range'][0]:g}[/] vs [bold]{o2['effusivity_range'][0]:g}[/] J s^-1/2 K^-1 m^-2 "
+              f"(classes {width:g} wide), contact {sc['contact_s']:g} s, noise {sc['noise_c']:g} °C, "
+              f"dT {sc['delta_t_c']:g} °C, {sen.name} sensor")
     con.print(escape("  " + model_words(sen, fm, source)
                      + (f", object diffusivity {diffusivity:g} m^2/s" if diffusivity is not None else "")))
     verdict = "[green]distinguishable[/]" if svm.f1 >= threshold else "[red]not distinguishable[/]"
     folds_txt = ", ".join(f"{f:.3f}" for f in svm.fold_f1)
-    con.print(f"  SVM F1    {svm.f1:.3f} ± {svm.standard_error:.3f}  (folds {folds_txt}; {trials} trials/class)"
-              f"  -> {verdict} at F1 >= {threshold:g}")
+    con.print(f"  SVM F1    {svm.f1:.3f} ± {svm.standard_error:.3f}  (folds {folds_txt}; {payload['trials']} "
+              f"trials/class)  -> {verdict} at F1 >= {threshold:g}")
     con.print(f"  ideal F1  {ideal.f1:.3f}, accuracy {ideal.accuracy:.3f}  ({ideal.method}; no classifier does better)")
-    con.print(f"  [dim]{(t1 - t0) * 1e3:.0f} ms SVM, {(t2 - t1) * 1e3:.0f} ms ideal[/]")
+    con.print(f"  [dim]{payload['svm_time_s'] * 1e3:.0f} ms SVM, {payload['ideal_time_s'] * 1e3:.0f} ms ideal[/]")
 
 
 def _f1_two_sensor(obj1, obj2, temp1, temp2, sen, fm, source, scene, trials, folds, seed, threshold, json_) -> None:

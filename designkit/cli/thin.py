@@ -11,7 +11,7 @@ import typer
 from ._app import app, console
 from ._format import FormatOpt, OutOpt, check_out, emit, flat_record, output_format
 from . import _app
-from ._options import BackingOpt, DeltaT, Json, SensorOpt
+from ._options import PANEL_OUTPUT, PANEL_QUESTION, BackingOpt, DeltaT, Json, SensorOpt
 
 #: Contact times [s] at which the deviation is reported (the paper's 1-4 s, and longer).
 REPORT_TIMES_S = (1.0, 2.0, 3.0, 4.0, 10.0, 30.0, 60.0)
@@ -19,23 +19,23 @@ REPORT_TIMES_S = (1.0, 2.0, 3.0, 4.0, 10.0, 30.0, 60.0)
 
 @app.command(rich_help_panel=_app.ASK)
 def validity(
-    thickness: Annotated[float, typer.Option("--thickness", help="Object thickness \\[m] (e.g. 0.003 for 3 mm).")],
+    thickness: Annotated[float, typer.Option("--thickness", help="Object thickness \\[m] (e.g. 0.003 for 3 mm).", rich_help_panel=PANEL_QUESTION)],
     material: Annotated[Optional[str], typer.Option(
         "--m", "--material", help="Object material (see 'designkit materials list'); its ranges give a worst "
-                                  "case.")] = None,
+                                  "case.", rich_help_panel=PANEL_QUESTION)] = None,
     e: Annotated[Optional[float], typer.Option(
-        "--e", help="Object effusivity [J s^-1/2 K^-1 m^-2] (instead of --m; needs --diffusivity).")] = None,
+        "--e", help="Object effusivity [J s^-1/2 K^-1 m^-2] (instead of --m; needs --diffusivity).", rich_help_panel=PANEL_QUESTION)] = None,
     alpha: Annotated[Optional[float], typer.Option(
-        "--diffusivity", "--alpha", help="Object diffusivity \\[m^2/s] (instead of --m; needs --e).")] = None,
+        "--diffusivity", "--alpha", help="Object diffusivity \\[m^2/s] (instead of --m; needs --e).", rich_help_panel=PANEL_QUESTION)] = None,
     backing: BackingOpt = None,
     tolerance: Annotated[float, typer.Option(
         "--tolerance", help="Acceptable deviation from the semi-infinite reading [°C] "
-                            "(default 0.01: the paper's smallest noise level).")] = 0.01,
+                            "(default 0.01: the paper's smallest noise level).", rich_help_panel=PANEL_QUESTION)] = 0.01,
     delta_t: DeltaT = 10.0,
     sensor: SensorOpt = "paper",
-    horizon: Annotated[float, typer.Option("--horizon", help="Longest contact time examined \\[s].")] = 3600.0,
+    horizon: Annotated[float, typer.Option("--horizon", help="Longest contact time examined \\[s].", rich_help_panel=PANEL_QUESTION)] = 3600.0,
     plot: Annotated[Optional[Path], typer.Option(
-        "--plot", help="Write a figure of the deviation against contact time (.png, or vector .svg / .pdf).")] = None,
+        "--plot", help="Write a figure of the deviation against contact time (.png, or vector .svg / .pdf).", rich_help_panel=PANEL_OUTPUT)] = None,
     format_: FormatOpt = None,
     out: OutOpt = None,
     json_: Json = False,

@@ -297,3 +297,12 @@ def test_an_answer_written_with_out(cli, tmp_path):
     r = cli("min-contact", "--e1", "35000", "--e2", "20000", "-f", "ndjson", "--out", str(out))
     assert r.exit_code == 0 and r.stdout == ""
     assert json.loads(out.read_text())["question"] == "min-contact"
+
+
+def test_f1_record_has_its_json_values(cli):
+    args = ("f1", "--e1", "35000", "--e2", "20000", "--trials", "12", "--folds", "2", "--contact", "1")
+    d = json.loads(cli(*args, "--json").stdout)
+    (row,) = list(csv.DictReader(io.StringIO(cli(*args, "--format", "csv").stdout)))
+    assert float(row["svm_f1"]) == pytest.approx(d["svm_f1"]) and float(row["ideal_f1"]) == pytest.approx(d["ideal_f1"])
+    assert float(row["contact_s"]) == d["scene"]["contact_s"] == 1.0
+    assert float(row["effusivity_min_1"]) == d["objects"][0]["effusivity_range"][0]

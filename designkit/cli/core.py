@@ -10,6 +10,7 @@ from typing import Annotated, Optional
 import typer
 
 from ._app import app, console, emit_json
+from ._format import FormatOpt, OutOpt, check_out, emit, flat_record, output_format
 from . import _app
 from ._options import (E1, E2, Ambient, BackingOpt, Conductance, Contact, DeltaT, Diffusivity, Folds, Json,
                        ModelOpt, Noise, Seed, SensorOpt, Thickness, Threshold, Trials, Width, model_words,
@@ -192,6 +193,8 @@ def f1(
     object_temp2: Annotated[Optional[float], typer.Option(
         "--object-temp2", help="With --two-sensor: temperature of the second object [°C] (default: --ambient).")]
     = None,
+    format_: FormatOpt = None,
+    out: OutOpt = None,
     json_: Json = False,
 ) -> None:
     """F1 of the paper's SVM and of the ideal observer for classes [e1, e1+width) and [e2, e2+width), under any
@@ -200,6 +203,8 @@ def f1(
     Example: `designkit f1 --e1 35000 --e2 20000 --contact 2 --thickness 0.003 --diffusivity 1e-7`
 
     Example (a cold block of wood against room-temperature metal, one sensor and two): `designkit f1 --e1 17530 --e2 400 --width 10 --delta-t 7 --ambient 22.5 --object-temp2 8 --two-sensor`
+
+    Example (one record, pandas-ready): `designkit f1 --e1 35000 --e2 20000 --trials 30 --format csv`
     """
     from .._validation import InputError
     from ..objects import object_class
@@ -207,6 +212,9 @@ def f1(
     from ..recognition.svm import pair_f1
     from ..scene import Scene
 
+    fmt = output_format(format_, json_)
+    if out not in (None, "-"):
+        check_out(out)
     e1, e2 = _check_f1(e1, e2, threshold, noise, delta_t, two_sensor, width, ambient, folds, trials)
     sen, fm, source = sensor_and_model(sensor, model, conductance=conductance, thickness=thickness,
                                        backing=backing)
@@ -222,11 +230,13 @@ def f1(
         if not two_sensor:
             raise InputError("--object-temp1/--object-temp2 go with --two-sensor (one sensor's scene has one "
                              "object temperature: --ambient, with --delta-t)")
+        if fmt not in ("text", "json") or out not in (None, "-"):
+            raise InputError("--two-sensor prints text or --json on stdout")
         _f1_two_sensor(obj1, obj2, object_temp1, object_temp2, sen, fm, source, scene, trials, folds, seed,
-                       threshold, json_)
+                       threshold, fmt == "json")
         return
     t0 = time.perf_counter()
-    with _app.busy("f1: simulating touches, fitting the SVM, the ideal observer", quiet=json_):
+    with _app.busy("f1: simulating touches, fitting the SVM, the ideal observer", quiet=fmt != "text"):
         svm = pair_f1(obj1, obj2, sen, scene, model=fm, trials=trials, folds=folds, seed=seed)
         t1 = time.perf_counter()
         ideal = ideal_pair(obj1, obj2, sen, scene, seed=seed, model=fm)
@@ -255,10 +265,12 @@ def f1(
         "svm_time_s": t1 - t0,
         "ideal_time_s": t2 - t1,
     }
-    if json_:
-        emit_json(payload)
-        return
-    _print_f1(payload, svm, ideal, sen, fm, source, width)
+    emit(fmt, out, payload=payload, text=lambda: _print_f1(payload, svm, ideal, sen, fm, source, width),
+         records=lambda: [flat_record({**{k: v for k, v in payload.items() if k not in ("sensor", "model", "objects", "scene")},
+                                       **payload["scene"],
+                                       "effusivity_range_1": payload["objects"][0]["effusivity_range"],
+                                       "effusivity_range_2": payload["objects"][1]["effusivity_range"],
+                                       "sensor": sen.name, "model": fm.name})])
 
 
 def _check_f1(e1, e2, threshold, noise, delta_t, two_sensor, width, ambient, folds, trials) -> tuple[float, float]:

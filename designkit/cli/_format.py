@@ -68,8 +68,10 @@ def check_format(fmt: str) -> str:
     return f
 
 
-def output_format(format_: Optional[str], json_: bool = False, *, default: str = "text") -> str:
-    """The format a command prints in: ``--json`` is ``--format json``; none given is ``default``.
+def output_format(format_: Optional[str], json_: bool = False, *, default: str = "text",
+                  out: Optional[str] = None) -> str:
+    """The format a command prints in: ``--json`` is ``--format json``; none given is ``default``. An ``out``
+    file is checked too (:func:`check_out`), before the command's work.
 
     >>> output_format(None, True), output_format("CSV"), output_format(None)
     ('json', 'csv', 'text')
@@ -80,7 +82,10 @@ def output_format(format_: Optional[str], json_: bool = False, *, default: str =
     """
     if json_ and format_ is not None and check_format(format_) != "json":
         raise InputError(f"--json and --format {format_} contradict each other: --json is --format json; give one")
-    return "json" if json_ else (default if format_ is None else check_format(format_))
+    fmt = "json" if json_ else (default if format_ is None else check_format(format_))
+    if out is not None and str(out) != "-":
+        check_out(out)
+    return fmt
 
 
 def flat_record(d: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:

@@ -10,7 +10,7 @@ from typing import Annotated, Optional
 import typer
 
 from ._app import app, console, emit_json
-from ._format import FormatOpt, OutOpt, check_out, emit, flat_record, output_format
+from ._format import FormatOpt, OutOpt, emit, flat_record, output_format
 from . import _app
 from ._options import (E1, E2, Ambient, BackingOpt, Conductance, Contact, DeltaT, Diffusivity, Folds, Json,
                        ModelOpt, Noise, Seed, SensorOpt, Thickness, Threshold, Trials, Width, model_words,
@@ -212,9 +212,7 @@ def f1(
     from ..recognition.svm import pair_f1
     from ..scene import Scene
 
-    fmt = output_format(format_, json_)
-    if out not in (None, "-"):
-        check_out(out)
+    fmt = output_format(format_, json_, out=out)
     e1, e2 = _check_f1(e1, e2, threshold, noise, delta_t, two_sensor, width, ambient, folds, trials)
     sen, fm, source = sensor_and_model(sensor, model, conductance=conductance, thickness=thickness,
                                        backing=backing)

@@ -19,7 +19,7 @@ import typer
 
 from . import _app
 from ._app import app
-from ._format import FormatOpt, OutOpt, check_out, emit, output_format
+from ._format import FormatOpt, OutOpt, emit, output_format
 from ._options import (
     E1,
     E2,
@@ -246,15 +246,6 @@ def _records(d: dict) -> list[dict]:
              "interval_low": x[side]["interval"]["low"], "interval_high": x[side]["interval"]["high"],
              "ideal_value": x[side]["ideal"]["value"], "unit": d["unit"], "route": d["route"],
              "table_name": (d["table"] or {}).get("name")} for side in ("lower", "upper")]
-
-
-def _start(format_: Optional[str], json_: bool, out: Optional[str]) -> str:
-    """The output format, and the output file checked, before any work (an --exact answer is not computed
-    for a folder that does not exist)."""
-    fmt = output_format(format_, json_)
-    if out not in (None, "-"):
-        check_out(out)
-    return fmt
 
 
 def _batch(question: str, path: str, fmt: str, out: Optional[str], *, objects: dict, scene: dict, exact: bool,
@@ -497,7 +488,7 @@ def min_contact_cmd(
 
     Example (one record, pandas-ready): `designkit min-contact --e1 35000 --e2 20000 --format csv`
     """
-    fmt = _start(format_, json_, out)
+    fmt = output_format(format_, json_, out=out)  # before the work: --exact is not computed for nowhere
     kw = dict(exact=exact, table=table, ideal_table=ideal_table, threshold=threshold, sensor=sensor, model=model,
               conductance=conductance, thickness=thickness, backing=backing, diffusivity=diffusivity, width=width,
               trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc, coverage=coverage,
@@ -521,7 +512,7 @@ def max_noise_cmd(
 
     Example: `designkit max-noise --e1 35000 --e2 20000 --contact 2`
     """
-    fmt = _start(format_, json_, out)
+    fmt = output_format(format_, json_, out=out)  # before the work: --exact is not computed for nowhere
     kw = dict(exact=exact, table=table, ideal_table=ideal_table, threshold=threshold, sensor=sensor, model=model,
               conductance=conductance, thickness=thickness, backing=backing, diffusivity=diffusivity, width=width,
               trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc, coverage=coverage,
@@ -545,7 +536,7 @@ def min_delta_t_cmd(
 
     Example: `designkit min-delta-t --e1 35000 --e2 20000 --contact 2 --noise 0.05`
     """
-    fmt = _start(format_, json_, out)
+    fmt = output_format(format_, json_, out=out)  # before the work: --exact is not computed for nowhere
     kw = dict(exact=exact, table=table, ideal_table=ideal_table, threshold=threshold, sensor=sensor, model=model,
               conductance=conductance, thickness=thickness, backing=backing, diffusivity=diffusivity, width=width,
               trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc, coverage=coverage,
@@ -575,7 +566,7 @@ def delta_e_cmd(
 
     Example (one row per direction): `designkit delta-e --e 20000 --contact 2 --format csv`
     """
-    fmt = _start(format_, json_, out)
+    fmt = output_format(format_, json_, out=out)  # before the work: --exact is not computed for nowhere
     kw = dict(exact=exact, table=table, ideal_table=ideal_table, threshold=threshold, sensor=sensor, model=model,
               conductance=conductance, thickness=thickness, backing=backing, diffusivity=diffusivity, width=width,
               trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc, coverage=coverage,
@@ -600,7 +591,7 @@ def distinguishable_cmd(
 
     Example: `designkit distinguishable --m1 wood --m2 glass --contact 2`
     """
-    fmt = _start(format_, json_, out)
+    fmt = output_format(format_, json_, out=out)  # before the work: --exact is not computed for nowhere
     kw = dict(exact=exact, table=table, ideal_table=ideal_table, threshold=threshold, sensor=sensor, model=model,
               conductance=conductance, thickness=thickness, backing=backing, diffusivity=diffusivity, width=width,
               trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc, coverage=coverage,

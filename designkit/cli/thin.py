@@ -56,9 +56,7 @@ def validity(
     from ..sensor import load_sensor
     from ..models.slab import material_validity, resolve_backing, semi_infinite_deviation, semi_infinite_validity
 
-    fmt = output_format(format_, json_)
-    if out not in (None, "-"):
-        check_out(out)
+    fmt = output_format(format_, json_, out=out)
     L = check_positive("thickness [m]", thickness)
     from .._validation import check_temperature
 

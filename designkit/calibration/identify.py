@@ -1016,8 +1016,10 @@ class IdentifiedParameter:
     note: str = ""
 
     def to_dict(self) -> dict[str, Any]:
-        return {"name": self.name, "value": self.value, "ci95": list(self.ci95), "unit": self.unit,
-                "identified": self.identified, "note": self.note}
+        """The schema's shape (docs/schema.md): the 95 % interval as ``interval: {low, high, coverage}``."""
+        return {"name": self.name, "value": self.value,
+                "interval": {"low": self.ci95[0], "high": self.ci95[1], "coverage": 0.95},
+                "unit": self.unit, "identified": self.identified, "note": self.note}
 
 
 @dataclass(frozen=True)

@@ -196,7 +196,7 @@ class Estimator:
         x0 = f0 = None
         probes = 0
         while hi - lo > 1:
-            k = math.ceil(r / h)
+            k = math.ceil(r / h) if r < limit else top
             k = lo + 1 if k <= lo else (hi - 1 if k >= hi else k)  # r's cell: ((k - 1) h, k h]
             if probes >= 7 and hi - lo > 2:  # the secant stalls: halve the bracket
                 k = (lo + min(hi, top)) // 2

@@ -111,6 +111,7 @@ def _estimator_values(exp: Exported, grid_is_library: bool) -> dict[str, str]:
     """The estimator's placeholders: its arrays and constants ("0" inside "#if 0" where the export has none)."""
     est = exp.estimator
     ev = {"HAS_EST": "1" if est is not None else "0", "GRID_IS_LIBRARY": "1" if grid_is_library else "0",
+          "S_ESTIMATOR": c_string(exp.provenance["estimator"]["name"]),
           "EST_VERSION": str(exp.provenance["estimator"]["version"]), "EST_COVERAGE": c_double(0.9)}
     ev.update({k: "0" for k in ("UP_LO", "DOWN_LO", "UP_HI", "DOWN_HI", "CUM", "NCUM", "SF", "NSF", "RATIOS", "NR",
                                 "E_S", "FS", "WIDTH", "ZT", "ZC", "MCF", "ELO", "EHI", "NMAX", "SA0", "SDMIN", "SU0",

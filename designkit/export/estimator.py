@@ -696,11 +696,18 @@ def _guess(solved, s, default):
     if not solved or not 0.0 < s < math.inf:
         return default, math.nan
     ls = math.log(s)
-    near = sorted(solved, key=lambda p: abs(p[0] - ls))
-    a = near[0]
-    for b in near[1:]:
-        if abs(b[0] - a[0]) > 1e-9:
-            return math.exp(a[1] + (ls - a[0]) * (b[1] - a[1]) / (b[0] - a[0])), a[2]
+    a, da = None, math.inf
+    for p in solved:  # the nearest (the first of equals)
+        d = abs(p[0] - ls)
+        if d < da:
+            a, da = p, d
+    b, db = None, math.inf
+    for p in solved:  # the nearest at another noise
+        d = abs(p[0] - ls)
+        if d < db and abs(p[0] - a[0]) > 1e-9:
+            b, db = p, d
+    if b is not None:
+        return math.exp(a[1] + (ls - a[0]) * (b[1] - a[1]) / (b[0] - a[0])), a[2]
     gamma = a[2] if _finite(a[2]) and a[2] > 0.1 else 1.0
     return math.exp(a[1] + (ls - a[0]) / gamma), a[2]
 

@@ -62,11 +62,6 @@ def _finite(x):
     return not (x != x) and x not in (math.inf, -math.inf)
 
 
-def _cr(p0, p1, p2, p3, t):
-    """Catmull-Rom cubic through p1 (t = 0) and p2 (t = 1)."""
-    return p1 + 0.5 * t * (p2 - p0 + t * (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3 + t * (3.0 * (p1 - p2) + p3 - p0)))
-
-
 class Estimator:
     """The library's answers from one table's arrays (see the module docstring).
 
@@ -120,10 +115,6 @@ class Estimator:
         n = min(max(n, 0), len(self.cum) - 1)
         return math.sqrt(self.cum[n])
 
-    def weight(self, e):
-        """``w(e) = e / (e_s + e)``, the object's weight in the response (0 for e <= 0)."""
-        return 1.0 / (1.0 + self.p["e_s"] / e) if e > 0 else 0.0
-
     def sstar(self, a, b):
         """The ideal observer's critical projection noise of classes [a, a+w), [b, b+w) (0: not separable)."""
         g = self._log_shape(a, b)
@@ -145,7 +136,7 @@ class Estimator:
         j = int(v)
         j = 1 if j < 1 else (nv - 3 if j > nv - 3 else j)
         p0, p1, p2, p3, q0, q1, q2, q3, r0, r1, r2, r3, s0, s1, s2, s3 = self._cells[i - 1][j - 1]
-        # Catmull-Rom in both directions: its four basis weights at the fractions (the nested form of _cr)
+        # Catmull-Rom in both directions: its four basis weights at the fractions
         t = v - j
         t2 = t * t
         t3 = t2 * t
@@ -292,11 +283,6 @@ class Estimator:
         if a != a or b != b:
             return math.nan
         return a + w * (b - a)
-
-    def _at(self, direction, suffix, row, k, ew):
-        """The array of ``direction`` and ``suffix`` at scene row ``row``, contact ``k``, where :meth:`_ew` says."""
-        t = self.t
-        return self._val(self.arr[(direction, suffix)], (row * t._nc + k) * t._ne, ew)
 
     def _k_readings(self, slices, ka, kb, lo, hi):
         """log k and its standard error at contacts ka (0) and kb (1) (designkit.query.table._k_readings_computed)."""

@@ -356,7 +356,7 @@ class Sensor:
 #: The keys of a sensor file's ``conditions`` record (:class:`designkit.rig.RigConditions`).
 CONDITION_KEYS = ("noise_c", "noise_source", "pre_contact_noise_c", "residual_rms_c", "sensor_temp_c",
                   "object_temp_c", "delta_t_c", "sensor_temp_spread_c", "onset", "onset_offset_s", "contact_ramp",
-                  "n_touches")
+                  "n_touches", "noise_correlation_s")
 
 #: The keys of a sensor's ``model`` record (what calibration writes beside the sensor fields).
 MODEL_KEYS = ("name", "params", "time_offset_s", "contact_spread", "object_temperature", "candidate", "contact_area",

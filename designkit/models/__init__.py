@@ -172,7 +172,8 @@ def sensor_model(sensor) -> ForwardModel:
             raise InputError(f"contact_area needs {', '.join(missing)}")
         return ForceRamp.from_force_profile(
             base, area["time_s"], area["force_share"], float(area["force_fraction"]),
-            source=f"the median force ramp of {area.get('n_touches', 'the')} calibration touches")
+            source=f"the median force ramp of {area.get('n_touches', 'the')} calibration touches",
+            touch_force_rel=area.get("touch_force_share") or ())
     except InputError as exc:
         raise InputError(f"sensor {sensor.name!r}: its recorded model: {exc}") from None
 
@@ -220,6 +221,10 @@ def sensor_model_notes(sensor, model: "ForwardModel | None" = None) -> list[str]
                    f"trace), area share clip((F/F_p - c)/(1 - c), 0, 1) with c = {fm.force_fraction:.3g}; "
                    f"the whole area is in contact {fm.ramp_duration_s:.2f} s after the first contact, from which "
                    "the contact time counts")
+        if fm.touch_ramps:
+            out.append(f"presses: each simulated touch presses as one of the {len(fm.touch_ramps)} calibration "
+                       f"touches (its own force ramp, first contact {min(d for d, _, _ in fm.touch_ramps):+.2f} to "
+                       f"{max(d for d, _, _ in fm.touch_ramps):+.2f} s from the median's)")
     if record.get("drift"):
         out.append("heater drift: fitted per touch in calibration (a nuisance like the touch's initial "
                    "temperature, not a property of the sensor); not played here: a new touch has none")

@@ -66,9 +66,10 @@ def scene_parts(sensor) -> dict[str, dict]:
     onset = {"onset_s": rig.get("onset_s", 0.0)}
     corr = {"noise_correlation_s": rig.get("noise_correlation_s", 0.0)}
     return {"before: white noise, samples from the first heat flow, the median press": ({}, False),
-            "+ the recorder's window from its detected onset": (onset, False),
-            "+ onset + correlated noise": ({**onset, **corr}, False),
-            "+ onset + each touch pressing as a calibration touch": (onset, True),
+            "+ the recorder's window from its detected onset only": (onset, False),
+            "+ noise correlated as the residual only": (corr, False),
+            "+ each touch pressing as a calibration touch only": ({}, True),
+            "onset + correlated noise": ({**onset, **corr}, False),
             "all three (the rig's scene)": ({**onset, **corr}, True)}
 
 

@@ -330,7 +330,13 @@ def resolve_scene(sensor, given: Mapping[str, float | None]) -> RigScene:
                          f" °C): not played by default; --sensor-temp-spread {spread:.2g} plays it")
     if start is not None:
         notes.append(f"contact time counts from the rig's detected onset ({cond.get('onset') or 'as recorded'}), "
-                     f"as its controller measures it; the model's heat flow starts {start:+.3g} s from it")
+                     f"as its controller measures it; the model's heat flow starts {start:+.3g} s from it"
+                     + ("; simulated touches are read from the onset on, as the rig's recognizer reads them"
+                        if start < 0 else ""))
+    if cond.get("noise_correlation_s"):
+        notes.append(f"the noise is correlated over {float(cond['noise_correlation_s']):.2g} s, as the identified "
+                     "model's residual on the calibration touches (sensor file): it wanders over a touch instead of "
+                     "averaging away")
     return RigScene(values, sources, start, tuple(notes), bool(cond))
 
 

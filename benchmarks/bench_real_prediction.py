@@ -27,7 +27,9 @@ real ones, each measured on the calibration touches and now played by the rig's 
 Alone, the correlated noise does most (worst error 0.127 -> 0.077); the onset window alone changes
 little with white noise (the samples before the onset carry almost no signal) but matters with
 correlated noise (they would let the SVM read the wander's level before the signal); the presses
-alone lower F1 at 0.25 s only. Together: the table this prints.
+alone lower F1 at 0.25 s only. Together: the table this prints. (That table scores each scene with
+:func:`~designkit.recognition.svm.pair_f1` and 2 seeds, the headline with the exact route and 4: they
+differ by Monte Carlo error, about 0.03 at 0.25 s.)
 
 Measured and not adopted (an exploratory simulation from the identified model, each simulated touch
 taking one calibration touch's own value): the touches' initial-temperature spread (Ts0 SD 0.07 °C,

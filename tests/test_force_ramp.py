@@ -18,6 +18,7 @@ from designkit.calibration.identify import Candidate, identify, nominal_force_pr
 from designkit.calibration.trials import Trial
 from designkit.models import get_model, load_sensor_model, sensor_model, sensor_model_notes
 from designkit.models.ramp import ForceRamp, area_share
+from designkit.rig import rig_scene
 from designkit.sensor import Sensor
 
 SENSOR = Sensor(1000.0, 1.5e-9, depth_m=80e-6, name="synthetic")
@@ -200,6 +201,10 @@ def test_the_real_sensor_file_answers_questions_with_its_model(cli, robot_data_d
     assert isinstance(fm, ForceRamp) and fm.base.name == "layered" and fm.base.smoothing_window == 99
     assert 0.0 < fm.force_fraction < 0.5 and 0.5 < fm.ramp_duration_s < 3.0 and sen.model["contact_area"][
         "n_touches"] == 24
+    # the rig's scene: each of the 24 calibration presses, the residual's correlation, the recorder's onset
+    assert len(fm.touch_ramps) == 24 and np.ptp([d for d, _, _ in fm.touch_ramps]) > 0.3
+    assert 0.2 < sen.conditions["noise_correlation_s"] < 3.0
+    assert rig_scene(sen)["onset_s"] == pytest.approx(-sen.conditions["onset_offset_s"], abs=1e-3)
     ans = json.loads(cli("distinguishable", "--m1", "wood", "--m2", "glass", "--contact", "1", "--sensor", out,
                          "--trials", "20", "--repeats", "1", "--n-mc", "50", "--json").stdout)
     assert ans["model"]["name"] == "force-ramp" and ans["model"]["base"]["name"] == "layered"

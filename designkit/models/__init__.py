@@ -217,14 +217,12 @@ def sensor_model_notes(sensor, model: "ForwardModel | None" = None) -> list[str]
                    f"{sensor.name}" + (f" (calibrated as {cand})" if cand and cand != name else ""))
     if ramp:
         n = (record.get("contact_area") or {}).get("n_touches", "?")
-        out.append(f"contact area: the median force ramp of the {n} calibration touches (a question has no force "
-                   f"trace), area share clip((F/F_p - c)/(1 - c), 0, 1) with c = {fm.force_fraction:.3g}; "
-                   f"the whole area is in contact {fm.ramp_duration_s:.2f} s after the first contact, from which "
-                   "the contact time counts")
-        if fm.touch_ramps:
-            out.append(f"presses: each simulated touch presses as one of the {len(fm.touch_ramps)} calibration "
-                       f"touches (its own force ramp, first contact {min(d for d, _, _ in fm.touch_ramps):+.2f} to "
-                       f"{max(d for d, _, _ in fm.touch_ramps):+.2f} s from the median's)")
+        d = [v for v, _, _ in fm.touch_ramps]
+        how = (f"each simulated touch presses as one of them (its own ramp, first contact {min(d):+.2f} to "
+               f"{max(d):+.2f} s from the median's)" if d else "a question has no force trace")
+        out.append(f"contact area: the median force ramp of the {n} calibration touches ({how}), area share "
+                   f"clip((F/F_p - c)/(1 - c), 0, 1) with c = {fm.force_fraction:.3g}; the whole area is in contact "
+                   f"{fm.ramp_duration_s:.2f} s after the first contact, from which the contact time counts")
     if record.get("drift"):
         out.append("heater drift: fitted per touch in calibration (a nuisance like the touch's initial "
                    "temperature, not a property of the sensor); not played here: a new touch has none")

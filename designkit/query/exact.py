@@ -425,7 +425,6 @@ def exact_min_contact(e1=None, e2=None, *, m1=None, m2=None, objects=None, noise
 
 # ============================================================ max-noise / min-delta-t
 def _exact_ratio(question: str, kw: dict) -> Answer:
-    from ..scene import Scene
     from .crossing import check_coverage, estimate_crossing
 
     contact = check_contact(kw["contact_s"])

@@ -45,8 +45,10 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import sys
 from pathlib import Path
 
+from designkit._validation import InputError
 from designkit_lab.reproduce.prediction import CONTACTS_S, predict_against_real
 from designkit_lab.reproduce.robot import load_real
 
@@ -95,10 +97,14 @@ def main() -> None:
 
         args.data = rotated(args.data, args.first_set, Path(tempfile.mkdtemp()) / "rotated")
         print(f"trial sets renumbered: original set {args.first_set} is set 1 (calibration takes the first fifth)")
-    touches = load_real(args.data, contact_s=max(CONTACTS_S))
-    res = predict_against_real(args.data, touches, candidate=args.candidate, repeats=args.repeats,
-                               trials=args.trials, sim_repeats=args.sim_repeats, parts=not args.no_parts,
-                               min_contact=not args.no_min_contact)
+    try:
+        touches = load_real(args.data, contact_s=max(CONTACTS_S))
+        res = predict_against_real(args.data, touches, candidate=args.candidate, repeats=args.repeats,
+                                   trials=args.trials, sim_repeats=args.sim_repeats, parts=not args.no_parts,
+                                   min_contact=not args.no_min_contact)
+    except InputError as exc:
+        print(f"bench_real_prediction: {exc}", file=sys.stderr)
+        raise SystemExit(2) from None
     print(f"targets: |predicted - real F1| <= 0.05 at every contact 0.25-1.5 s: worst {res['worst_error']:.3f} "
           f"({'met' if res['f1_met'] else 'missed'}); real min-contact inside the interval or within 25 %: "
           f"{res.get('min_contact_met')}; the real F1 inside the predicted F1's interval at {res['inside']} of "

@@ -69,6 +69,7 @@ __all__ = [
     "simulate_class",
     "simulate_interval",
     "simulate_trials",
+    "window_times_s",
 ]
 
 #: Seed-key suffix of the per-trial diffusivity draws (independent of the noise).
@@ -342,6 +343,13 @@ def _class_readings(fm, time_s, e, sensor, diffusivity_m2_s, tol, ramp_index) ->
     return u
 
 
+def window_times_s(sensor: Sensor, scene: Scene) -> np.ndarray:
+    """Model times [s] of the samples a recognizer sees: from the scene's onset (the recorder's; 0: the first
+    heat flow) to its contact, one sample period apart; one sample, at the onset, when contact ends before it."""
+    window = scene.window_s()
+    return scene.onset_s + (sensor.times_s(window) if window > 0 else np.zeros(1))
+
+
 def seed_key(seed) -> list[int]:
     """A seed as a list of integers, so that sub-streams (``key + [k]``) can be derived from it."""
     if isinstance(seed, (list, tuple)):
@@ -375,7 +383,7 @@ def simulate_class(obj: ObjectClass, n_trials: int, sensor: Sensor, scene: Scene
     fm = get_model(model)
     obj.require(fm.object_properties)
     key = seed_key(seed)
-    n_samples = sensor.times_s(scene.window_s()).size
+    n_samples = window_times_s(sensor, scene).size
     draws = draw_trials(*obj.e_range, n_trials, n_samples, key,
                         vary_sensor=scene.sensor_temp_spread_c > 0,
                         vary_ambient=scene.ambient_temp_spread_c > 0)
@@ -401,7 +409,7 @@ def simulate_interval(e_low: float, e_high: float, n_trials: int, sensor: Sensor
     (100, 401)
     """
     lo, hi = check_effusivity_range("class", e_low, e_high)
-    n_samples = sensor.times_s(scene.window_s()).size
+    n_samples = window_times_s(sensor, scene).size
     draws = draw_trials(lo, hi, n_trials, n_samples, seed,
                         vary_sensor=scene.sensor_temp_spread_c > 0,
                         vary_ambient=scene.ambient_temp_spread_c > 0)
@@ -415,7 +423,7 @@ def simulate_trials(e_object: float, sensor: Sensor, scene: Scene, n_trials: int
     ``e_object`` may be 0 (perfect insulator) or ``inf`` (perfect conductor).
     """
     e = check_effusivity("e", e_object, allow_zero=True, allow_inf=True)
-    n_samples = sensor.times_s(scene.window_s()).size
+    n_samples = window_times_s(sensor, scene).size
     draws = draw_trials(0.0, 0.0, n_trials, n_samples, seed,
                         vary_sensor=scene.sensor_temp_spread_c > 0,
                         vary_ambient=scene.ambient_temp_spread_c > 0)

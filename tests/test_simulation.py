@@ -136,3 +136,8 @@ def test_the_recorders_window_starts_at_its_onset(paper_sensor):
     np.testing.assert_allclose(late.temperature_c, full.temperature_c[:, 100:], rtol=0, atol=1e-12)
     before = Scene(contact_s=0.2, onset_s=0.5)        # contact ends before the onset: one sample, at the onset
     assert before.window_s() == 0.0 and "onset_s" in before.to_dict() and "onset_s" not in Scene().to_dict()
+
+
+def test_a_contact_ending_before_the_onset_is_one_sample_at_the_onset(paper_sensor):
+    t = simulate_interval(5000, 5080, 4, paper_sensor, Scene(contact_s=0.3, onset_s=0.5), seed=1)
+    assert t.time_s.tolist() == [0.5] and t.temperature_c.shape == (4, 1)

@@ -34,7 +34,7 @@ from ..models import ForwardModel, get_model
 from ..objects import ObjectClass, ordered_pair
 from ..scene import Scene
 from ..sensor import Sensor
-from ..simulation import response_tolerance, seed_key, simulate_class
+from ..simulation import response_tolerance, seed_key, simulate_class, window_times_s
 from .scores import IdealResult, score_llr
 
 __all__ = ["ideal_pair_mc"]
@@ -194,7 +194,7 @@ def ideal_pair_mc(obj_a: ObjectClass, obj_b: ObjectClass, sensor: Sensor, scene:
     # a noise-free scene is handled as the limit of a tiny noise (as the closed form does)
     sc = scene.replace(noise_c=max(scene.noise_c, 1e-6 * abs(scene.delta_t_c)))
     s_n = sc.noise_ratio
-    t = sc.onset_s + sensor.times_s(sc.window_s())   # the recorder's window
+    t = window_times_s(sensor, sc)   # the recorder's window
     sim_model = fm
     fm, whiten = _whitened(fm, t.size, sensor.sample_rate_hz, sc.noise_correlation_s)
     tol = response_tolerance(s_n, t.size)

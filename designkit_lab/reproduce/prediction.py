@@ -126,6 +126,11 @@ def predict_against_real(data: Path, touches: RealTouches, *, candidate: str | N
 
     t0 = time.perf_counter()
     split, cmp, best = _calibrate(data, candidate)
+    if best.effusivity is None or best.consistent is False:
+        from designkit._validation import InputError
+
+        raise InputError(f"calibration ({split.describe()}) selected {cmp.selected}, whose sensor effusivity is not "
+                         f"identified on these touches (their ranges conflict): nothing to predict; try --candidate")
     sen = best.sensor(name="rig")
     fm = sensor_model(sen)
     start = model_start_s(sen)

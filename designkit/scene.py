@@ -42,6 +42,12 @@ class Scene:
         Where the recorder's window starts [s of model time, >= 0]: a rig's controller detects
         contact after the first heat flow and its recognizer sees the samples from there to
         ``contact_s`` (0: from the first heat flow, the paper's).
+
+    Examples
+    --------
+    >>> s = Scene.from_delta_t(contact_s=1.0, noise_c=0.05, delta_t_c=10.0)
+    >>> s.sensor_temp_c, s.noise_ratio, s.fixed_initial_conditions
+    (35.0, 0.005, True)
     """
 
     contact_s: float = 2.0

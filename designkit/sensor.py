@@ -140,6 +140,11 @@ def sample_times_s(contact_s: float, sample_rate_hz: float) -> np.ndarray:
     -------
     ndarray
         Times [s], float64.
+
+    Examples
+    --------
+    >>> sample_times_s(0.02, 200.0)
+    array([0.   , 0.005, 0.01 , 0.015, 0.02 ])
     """
     contact_s = check_positive("contact time [s]", contact_s)
     fs = check_positive("sample rate [Hz]", sample_rate_hz)
@@ -412,7 +417,14 @@ SENSORS: dict[str, Sensor] = {
 
 
 def load_sensor(name_or_path: "str | Path | Sensor") -> Sensor:
-    """A sensor from a preset name (``"paper"``), a YAML path, or a :class:`Sensor`."""
+    """A sensor from a preset name (``"paper"``), a YAML path, or a :class:`Sensor`.
+
+    Examples
+    --------
+    >>> s = load_sensor("paper")
+    >>> s.effusivity, round(s.tau_s, 4)
+    (892.0, 1.3445)
+    """
     if isinstance(name_or_path, Sensor):
         return name_or_path
     key = str(name_or_path)

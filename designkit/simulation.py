@@ -421,6 +421,13 @@ def simulate_trials(e_object: float, sensor: Sensor, scene: Scene, n_trials: int
     """``n_trials`` touches of one object of effusivity ``e_object``.
 
     ``e_object`` may be 0 (perfect insulator) or ``inf`` (perfect conductor).
+
+    Examples
+    --------
+    >>> from designkit import SENSORS, Scene
+    >>> tr = simulate_trials(20000.0, SENSORS["paper"], Scene(contact_s=1.0), n_trials=3, seed=0)
+    >>> tr.temperature_c.shape  # 3 touches, 1 s at 200 Hz from t = 0
+    (3, 201)
     """
     e = check_effusivity("e", e_object, allow_zero=True, allow_inf=True)
     n_samples = window_times_s(sensor, scene).size

@@ -44,7 +44,7 @@ def test_table_never_cuts_a_name_nor_eats_brackets():
 def test_unknown_format_is_refused():
     from designkit._validation import InputError
 
-    with pytest.raises(InputError, match="table, json, csv, md"):
+    with pytest.raises(InputError, match="text, table, json, csv, ndjson, md"):
         render_rows(ROWS, fmt="xlsx")
 
 
@@ -221,3 +221,88 @@ def test_tables_show_prints_names_from_the_file_as_text(cli, tmp_path):
         first = r.stdout.splitlines()[0]
         assert first.startswith(name if name.isprintable() else repr(name)[1:-1]), first
         assert "\x1b" not in r.stdout
+
+
+# ---------------------------------------------------------------- --format json|csv|ndjson on every command that answers
+# (one shared option and one writer: designkit.cli._format.emit). CSV and ndjson are the records of the JSON.
+ANSWERING = [
+    ("min-contact", "--e1", "35000", "--e2", "20000"),
+    ("max-noise", "--m1", "wood", "--m2", "glass", "--contact", "2"),
+    ("min-delta-t", "--e1", "35000", "--e2", "20000", "--contact", "2"),
+    ("distinguishable", "--m1", "wood", "--m2", "glass", "--contact", "2"),
+    ("delta-e", "--e", "20000", "--contact", "2"),
+    ("validity", "--m", "acrylic", "--thickness", "0.003"),
+    ("tables", "list"),
+]
+
+
+def _same(a, b):
+    """A CSV cell (text) against the JSON value it stands for."""
+    if b is None:
+        return a == ""
+    if isinstance(b, bool):
+        return a == str(b)
+    if isinstance(b, (int, float)):
+        return float(a) == pytest.approx(b, rel=1e-12)
+    return a == str(b)
+
+
+@pytest.mark.parametrize("args", ANSWERING, ids=[" ".join(a[:2]) for a in ANSWERING])
+def test_csv_and_ndjson_are_the_same_records(cli, args):
+    csv_out, nd_out = cli(*args, "--format", "csv"), cli(*args, "-f", "ndjson")
+    assert csv_out.exit_code == 0 and nd_out.exit_code == 0, csv_out.output + nd_out.output
+    rows = list(csv.DictReader(io.StringIO(csv_out.stdout)))
+    records = [json.loads(line) for line in nd_out.stdout.splitlines()]
+    assert rows and len(rows) == len(records)
+    for row, rec in zip(rows, records):
+        assert list(row) == list(rec)
+        bad = {k: (row[k], rec[k]) for k in rec if not _same(row[k], rec[k])}
+        assert not bad
+
+
+@pytest.mark.parametrize("question, args, key", [
+    ("min-contact", ("--e1", "35000", "--e2", "20000"), "value"),
+    ("distinguishable", ("--m1", "wood", "--m2", "glass", "--contact", "1.5"), "value"),
+])
+def test_an_answers_record_has_its_json_values(cli, question, args, key):
+    d = json.loads(cli(question, *args, "--json").stdout)
+    (row,) = list(csv.DictReader(io.StringIO(cli(question, *args, "--format", "csv").stdout)))
+    assert _same(row[key], d[key]) and _same(row["interval_low"], d["interval"]["low"])
+    assert _same(row["ideal_value"], d["ideal"]["value"]) and row["table_name"] == d["table"]["name"]
+    pd = pytest.importorskip("pandas")
+    frame = pd.read_csv(io.StringIO(cli(question, *args, "--format", "csv").stdout))
+    assert frame.shape[0] == 1 and frame["question"][0] == question
+
+
+def test_json_flag_is_format_json_and_they_cannot_disagree(cli):
+    args = ("min-contact", "--e1", "35000", "--e2", "20000")
+    assert cli(*args, "--json").stdout == cli(*args, "--format", "json").stdout
+    r = cli(*args, "--json", "--format", "csv")
+    assert r.exit_code == 2 and "contradict" in r.output
+    r = cli(*args, "--format", "xlsx")  # refused before any work, as JSON when asked with --format json too
+    assert r.exit_code == 2 and "ndjson" in r.output
+
+
+def test_validity_csv_splits_ranges_into_min_and_max(cli):
+    (row,) = list(csv.DictReader(io.StringIO(cli("validity", "--m", "acrylic", "--thickness", "0.003",
+                                                 "-f", "csv").stdout)))
+    d = json.loads(cli("validity", "--m", "acrylic", "--thickness", "0.003", "--json").stdout)
+    assert float(row["valid_up_to_s"]) == pytest.approx(d["valid_up_to_s"])
+    assert float(row["effusivity_min"]) == d["material_ranges"]["effusivity_range"][0]
+    assert float(row["effusivity_max"]) == d["material_ranges"]["effusivity_range"][1]
+
+
+def test_an_answer_written_with_out(cli, tmp_path):
+    out = tmp_path / "a.ndjson"
+    r = cli("min-contact", "--e1", "35000", "--e2", "20000", "-f", "ndjson", "--out", str(out))
+    assert r.exit_code == 0 and r.stdout == ""
+    assert json.loads(out.read_text())["question"] == "min-contact"
+
+
+def test_f1_record_has_its_json_values(cli):
+    args = ("f1", "--e1", "35000", "--e2", "20000", "--trials", "12", "--folds", "2", "--contact", "1")
+    d = json.loads(cli(*args, "--json").stdout)
+    (row,) = list(csv.DictReader(io.StringIO(cli(*args, "--format", "csv").stdout)))
+    assert float(row["svm_f1"]) == pytest.approx(d["svm_f1"]) and float(row["ideal_f1"]) == pytest.approx(d["ideal_f1"])
+    assert float(row["contact_s"]) == d["scene"]["contact_s"] == 1.0
+    assert float(row["effusivity_min_1"]) == d["objects"][0]["effusivity_range"][0]

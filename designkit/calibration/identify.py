@@ -317,7 +317,7 @@ def split_by_trial_set(trials: Sequence[Trial], fit_sets: Sequence[int],
 
 
 #: Share of the trial sets present that :func:`choose_split` fits by default (the first ones, at least one):
-#: 4 of the shared recordings' 20 sets, as every comparison on them was made. A recording without trial
+#: 4 of the shared recordings' 20 sets. A recording without trial
 #: sets (one session, touches in order) fits the first half of each material's touches.
 FIT_SHARE = 0.2
 FIT_SHARE_TOUCH_ORDER = 0.5
@@ -463,9 +463,9 @@ _OBJECT_MODES = ("passive", "passive-end", "free", "passive-affine", "passive-en
 
 
 #: The force is averaged over this window [s] (centred) before it sets the contact area: the force sensor's
-#: white noise, clipped where the area is whole, reads the plateau's area low (errors in variables: granite's
-#: e_o/e_s +0.43 % in pty round trips, +0.21 % after it; :data:`FORCE_NOISE_BAND_SD` removes the rest;
-#: docs/sensor-models.md). A finger presses over 0.3 s or more: 25 ms rounds only the ramp's corners.
+#: white noise, clipped where the area is whole, reads the plateau's area low (errors in variables;
+#: :data:`FORCE_NOISE_BAND_SD` removes the rest; docs/sensor-models.md). A finger presses over 0.3 s or more:
+#: 25 ms rounds only the ramp's corners.
 FORCE_SMOOTHING_S = 0.025
 
 
@@ -1016,8 +1016,10 @@ class IdentifiedParameter:
     note: str = ""
 
     def to_dict(self) -> dict[str, Any]:
-        return {"name": self.name, "value": self.value, "ci95": list(self.ci95), "unit": self.unit,
-                "identified": self.identified, "note": self.note}
+        """The schema's shape (docs/schema.md): the 95 % interval as ``interval: {low, high, coverage}``."""
+        return {"name": self.name, "value": self.value,
+                "interval": {"low": self.ci95[0], "high": self.ci95[1], "coverage": 0.95},
+                "unit": self.unit, "identified": self.identified, "note": self.note}
 
 
 @dataclass(frozen=True)
@@ -1434,10 +1436,8 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
         the pre-contact noise's autocorrelation falls below 0.5, so white
         noise keeps every sample). The model's shapes (and the host
         smoothing) are still computed on the full grid, and the reported
-        RMS, AIC and BIC are of the full grid. On the shared recordings
-        (smoothed by the host over 0.5 s) "auto" gives k = 10 (20 Hz): the
-        estimates move by a small fraction of their standard errors
-        (docs/sensor-models.md) and the fit runs several times faster. The
+        RMS, AIC and BIC are of the full grid. A host-smoothed recording gets
+        a stride of several samples (docs/sensor-models.md). The
         cluster-robust covariance does not depend on the stride.
     touch_conductance : sequence of str
         Materials whose touches each get their own contact conductance
@@ -1477,7 +1477,7 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
         x = np.asarray(x0, dtype=np.float64)[:prob.n_global].copy()
     x = np.concatenate([x[:prob.n_global], np.zeros(prob.lo.size - prob.n_global)])
     x = np.clip(x, prob.lo + 1e-9, prob.hi - 1e-9)
-    with _one_blas_thread():  # tall, thin SVDs: threads only contend (4x slower on a loaded 2-core machine)
+    with _one_blas_thread():  # tall, thin SVDs: threads only contend
         jac = dict(jac=prob.jacobian) if prob.touch_cols else dict(diff_step=1e-6)
         sol = least_squares(prob.residuals, x, bounds=(prob.lo, prob.hi), method="trf", x_scale="jac",
                             xtol=1e-8, ftol=1e-8, gtol=1e-8, max_nfev=max_nfev, **jac)

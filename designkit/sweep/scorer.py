@@ -67,8 +67,7 @@ class PairCell:
 FEATURE_CACHE_MB = 512
 
 #: Working memory of one batched-solver chunk [MiB]: the stacked features of its pairs plus the
-#: solver's own arrays. Together with the feature cache it keeps a worker under 1 GB (measured
-#: at 256 MiB: 0.85 GB peak for 200 intervals at 10 s contact, the cache full; 128 leaves margin).
+#: solver's own arrays. Together with the feature cache it keeps a worker under 1 GB.
 BATCH_MB = 128
 
 #: Most pairs in one batched-solver call (beyond this a batch is no faster per pair).

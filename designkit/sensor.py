@@ -186,7 +186,8 @@ class Sensor:
         "drift"}``. ``contact_area`` (calibrated with a force-driven contact
         area): the threshold ``force_fraction`` c (with ``force_fraction_ci95``),
         the calibration touches' median force over its plateau (``time_s``
-        after the detected onset, ``force_share``) and ``n_touches``;
+        after the detected onset, ``force_share``), each touch's own
+        (``touch_force_share``, rows on ``time_s``) and ``n_touches``;
         ``drift``: how the heater's drift was treated (``"per-touch"``: a
         nuisance fitted per touch like its initial temperature, not a
         property of the sensor). None (old files, presets): the paper's
@@ -338,8 +339,9 @@ class Sensor:
                      "# above; null = infinite), the fitted contact-time offset [s], the per-touch spread of the\n"
                      "# contact conductance (geometric SD), how each material's temperature was taken;\n"
                      "# contact_area: the area grows with the force as clip((F/F_p - c)/(1 - c), 0, 1), c =\n"
-                     "# force_fraction; a question plays the calibration touches' median F/F_p (force_share at\n"
-                     "# time_s after the onset); drift: per-touch = each touch's heater drift was fitted like its\n"
+                     "# force_fraction; the calibration touches' median F/F_p (force_share at time_s after the\n"
+                     "# onset) sets the model's time 0, and a simulated touch presses as one of them\n"
+                     "# (touch_force_share); drift: per-touch = each touch's heater drift was fitted like its\n"
                      "# initial temperature: not a sensor property, a question's touch has none\n")
         text += yaml.safe_dump(self.to_dict(), sort_keys=False)
         return atomic_write_text(Path(path), text)
@@ -361,7 +363,7 @@ class Sensor:
 #: The keys of a sensor file's ``conditions`` record (:class:`designkit.rig.RigConditions`).
 CONDITION_KEYS = ("noise_c", "noise_source", "pre_contact_noise_c", "residual_rms_c", "sensor_temp_c",
                   "object_temp_c", "delta_t_c", "sensor_temp_spread_c", "onset", "onset_offset_s", "contact_ramp",
-                  "n_touches")
+                  "n_touches", "noise_correlation_s")
 
 #: The keys of a sensor's ``model`` record (what calibration writes beside the sensor fields).
 MODEL_KEYS = ("name", "params", "time_offset_s", "contact_spread", "object_temperature", "candidate", "contact_area",

@@ -1614,7 +1614,17 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
                           nominal_force_profile(data) if cand.force_area else None,
                           rig_conditions(trials, pre_contact_noise_c=data.noise_c,
                                          residual_rms_c=float(np.sqrt(np.mean(r ** 2))),
-                                         onset_offset_s=math.nan).to_dict())
+                                         onset_offset_s=math.nan, residuals=_touch_rows(data, r),
+                                         sample_rate_hz=data.sample_rate_hz).to_dict())
+
+
+def _touch_rows(data: "_Data", r: np.ndarray) -> list[np.ndarray]:
+    """The residual ``r`` (groups one after the other, each touch a row) cut into one series per touch."""
+    rows, pos = [], 0
+    for g in data.groups:
+        rows.extend(r[pos:pos + g.y.size].reshape(g.y.shape))
+        pos += g.y.size
+    return rows
 
 
 #: The nominal force ramp a sensor file records: F / F_p from 1 s before the onset to 1.5 s after, every 20 ms.
@@ -1625,7 +1635,8 @@ def nominal_force_profile(data: "_Data | Sequence[Trial]") -> dict[str, Any]:
     """The median over touches of the force over its plateau (:func:`relative_force`), after the onset.
 
     What a question plays for a ``force_area`` model (it has no force trace of its
-    own): ``{"time_s": [...], "force_share": [...], "n_touches": n}`` on
+    own): ``{"time_s": [...], "force_share": [...], "n_touches": n, "touch_force_share": [[...], ...]}`` (the
+    median, and each touch's own, from which a simulated touch draws its press) on
     :data:`FORCE_PROFILE_S`. The median of the area shares is the area share of
     the median force (the share is a non-decreasing function of the force). The share is 0.006, not 0, at the
     onset below: the force is averaged over :data:`FORCE_SMOOTHING_S`, which rounds the foot of the ramp.
@@ -1649,7 +1660,7 @@ def nominal_force_profile(data: "_Data | Sequence[Trial]") -> dict[str, Any]:
         raise InputError("a nominal force profile needs touches with a force channel")
     med = np.median(np.array(rows), axis=0)
     return {"time_s": [float(v) for v in grid], "force_share": [round(float(v), 4) for v in med],
-            "n_touches": len(rows)}
+            "n_touches": len(rows), "touch_force_share": [[round(float(v), 3) for v in r] for r in rows]}
 
 
 def _one_blas_thread():

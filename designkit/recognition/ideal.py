@@ -779,7 +779,10 @@ def ideal_method(range_a, range_b, sensor: Sensor, scene: Scene, *, model=None) 
 
 def _shape_shared_here(fm, a, b, sensor: Sensor, scene: Scene) -> bool:
     """Whether the model's curves share one shape for these classes in this scene (its own, or its extra
-    physics invisible here, :meth:`ForwardModel.equivalent_shared_shape`)."""
+    physics invisible here, :meth:`ForwardModel.equivalent_shared_shape`). A rig's scene (correlated noise,
+    a recorder's window after its onset) takes the Monte Carlo route, which whitens the noise."""
+    if scene.noise_correlation_s > 0 or scene.onset_s > 0:
+        return False
     return fm.shared_shape or fm.equivalent_shared_shape(
         (a, b), sensor, contact_s=scene.contact_s, tolerance=_invisible_tolerance(sensor, scene)) is not None
 

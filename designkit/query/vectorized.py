@@ -25,6 +25,8 @@ Routes
   so element ``i`` equals the scalar call.
 * **exact**, and objects given as material names: one scalar call per
   element (seconds each on the exact route), assembled into the same arrays.
+  The names (``m``, ``m1``, ``m2``) may be lists too, broadcast with the numbers:
+  ``min_contact(m1=["copper", "glass"], m2=["wood", "PVC"])`` answers two pairs.
 
 Bad input names the offending element: ``effusivity e1[2] must be positive, got -5``.
 
@@ -67,6 +69,8 @@ ARRAY_INPUTS: dict[str, tuple[str, ...]] = {
     "distinguishable": ("e1", "e2", "contact_s", "noise_c", "delta_t_c"),
 }
 _DEFAULTS = {"noise_c": 0.05, "delta_t_c": 10.0}
+#: The material-name inputs of each question that may be lists (they broadcast with the numeric ones).
+NAME_INPUTS: dict[str, tuple[str, ...]] = {q: (("m",) if q == "delta-e" else ("m1", "m2")) for q in ARRAY_INPUTS}
 
 FloatArray = NDArray[np.float64]
 
@@ -167,13 +171,28 @@ class ArrayAnswer(QuestionQuantity):
         return out
 
 
+def _is_list(x: Any) -> bool:
+    return x is not None and not isinstance(x, (str, bytes)) and np.ndim(x) >= 1
+
+
 def is_array_call(question: str, arguments: Mapping[str, Any]) -> bool:
-    """Whether any numeric input of ``question`` is an array (ndim >= 1) or a list/tuple."""
-    for name in ARRAY_INPUTS.get(question, ()):
-        x = arguments.get(name)
-        if x is not None and not isinstance(x, (str, bytes)) and np.ndim(x) >= 1:
-            return True
-    return False
+    """Whether any numeric input of ``question`` is an array (ndim >= 1) or a list/tuple, or any material name
+    input (``m``, ``m1``, ``m2``) a list of names."""
+    return any(_is_list(arguments.get(name)) for name in ARRAY_INPUTS.get(question, ()) + NAME_INPUTS.get(question, ()))
+
+
+def _name_arrays(question: str, others: dict[str, Any]) -> dict[str, np.ndarray]:
+    """The material-name inputs given as lists, popped from ``others``, as arrays of str (each element checked)."""
+    out = {}
+    for name in NAME_INPUTS.get(question, ()):
+        if _is_list(others.get(name)):
+            a = np.asarray(others.pop(name), dtype=object)
+            for idx in np.ndindex(a.shape):
+                if not isinstance(a[idx], str):
+                    where = ", ".join(str(int(i)) for i in idx)
+                    raise InputError(f"material names {name}[{where}] must be a name (str), got {a[idx]!r:.60}")
+            out[name] = a
+    return out
 
 
 # ============================================================ input checks, naming the element
@@ -186,6 +205,10 @@ def _as_array(name: str, x: Any) -> np.ndarray:
 
 def _first_bad(name: str, a: np.ndarray, fine: np.ndarray, check: Callable[[str, float], Any]) -> None:
     """Run the scalar check on every element outside ``fine`` (a conservative mask): the first bad raises."""
+    if a.ndim == 0:  # a number beside a list of names
+        if not fine:
+            check(name, float(a))
+        return
     for idx in zip(*np.nonzero(~fine)):
         where = ", ".join(str(int(i)) for i in idx)
         check(f"{name}[{where}]", float(a[idx]))
@@ -820,10 +843,15 @@ def answer_arrays(question: str, scalar: Callable[..., Answer], route: str, argu
     numeric = {n: arguments.get(n, _DEFAULTS.get(n)) for n in names}
     present = {n: v for n, v in numeric.items() if v is not None}
     x = _checked(question, present)
-    shape = next(iter(x.values())).shape if x else ()
-    flat = {n: np.ascontiguousarray(a).ravel() for n, a in x.items()}
     others = {k: v for k, v in arguments.items() if k not in names}
-    by_name = any(others.get(k) is not None for k in ("m", "m1", "m2", "objects"))
+    listed = _name_arrays(question, others)
+    try:
+        shape = np.broadcast_shapes(*(a.shape for a in (*x.values(), *listed.values())))
+    except ValueError:
+        shapes = ", ".join(f"{n} {a.shape}" for n, a in (*x.items(), *listed.items()))
+        raise InputError(f"the array inputs do not broadcast together: {shapes}") from None
+    flat = {n: np.broadcast_to(a, shape).ravel() for n, a in x.items()}
+    by_name = bool(listed) or any(others.get(k) is not None for k in ("m", "m1", "m2", "objects"))
     pair = question != "delta-e"
     if route == "table" and not by_name and all(n in flat for n in names):
         op = _table_route.open_table(others.get("table", _table_route.DEFAULT_TABLE),
@@ -846,7 +874,9 @@ def answer_arrays(question: str, scalar: Callable[..., Answer], route: str, argu
         table = op.tab.name
     else:
         n = int(np.prod(shape)) if shape else 1
-        answers = [scalar(**others, **{k: float(v[i]) for k, v in flat.items()}) for i in range(n)]
+        named = {k: np.broadcast_to(v, shape).ravel() for k, v in listed.items()}
+        answers = [scalar(**others, **{k: float(v[i]) for k, v in flat.items()},
+                          **{k: str(v[i]) for k, v in named.items()}) for i in range(n)]
         res = _from_answers(answers, shape, question)
         table = answers[0].table if answers else None
     details = {k: res.pop(k) for k in ("lower", "upper", "lower_ideal", "upper_ideal", "lower_low", "lower_high",

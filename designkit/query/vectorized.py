@@ -16,7 +16,7 @@ Routes
   scene values, or only the contact time for max-noise / min-delta-t, are
   grouped); the closed-form ideal bound is computed for the distinct
   elements in one vectorized call and kept in the per-process cache of
-  :mod:`designkit.query.ideal_bound` (~7 ms per distinct pair and scene the
+  :mod:`designkit.query.ideal_bound` (a Newton solve per distinct pair the
   first time, a dictionary look-up after). ``ideal_bound=False`` skips it
   (``ideal`` is then NaN, and the intervals are not held to it). The
   rounding-corrected estimates and their intervals at ``coverage`` are the
@@ -105,6 +105,8 @@ class ArrayAnswer(QuestionQuantity):
         Whether every table axis held the element's question (always True on the exact route).
     table : str or None
         Table read (None on the exact route).
+    route_reason : str or None
+        Why ``route`` answered (as :attr:`designkit.query.Answer.route_reason`).
     details : mapping of str to ndarray
         Question-specific arrays: delta-e's ``lower`` / ``upper`` (each
         direction's value), ``lower_ideal`` / ``upper_ideal`` and (table route)
@@ -126,6 +128,7 @@ class ArrayAnswer(QuestionQuantity):
     in_grid: NDArray[np.bool_]
     table: str | None = None
     details: Mapping[str, FloatArray] = field(default_factory=dict)
+    route_reason: str | None = None
 
     @property
     def shape(self) -> tuple[int, ...]:
@@ -156,7 +159,8 @@ class ArrayAnswer(QuestionQuantity):
                 "ideal_value": col(self.ideal)}
         cols.update({k: col(np.broadcast_to(v, self.shape)) for k, v in self.details.items()})
         in_grid = np.broadcast_to(self.in_grid, self.shape).ravel().tolist()
-        fixed = {"question": self.question, "route": self.route, "quantity": self.quantity, "unit": self.unit}
+        fixed = {"question": self.question, "route": self.route, "route_reason": self.route_reason,
+                 "quantity": self.quantity, "unit": self.unit}
         out = []
         for i in range(n):
             rec = dict(fixed)
@@ -276,23 +280,6 @@ def _need(view, kind: str, combos, lo: np.ndarray, hi: np.ndarray) -> np.ndarray
     return np.where(np.isnan(up) | np.isnan(down), np.nan, np.maximum(up, down))
 
 
-def _crossing(xs: np.ndarray, need: np.ndarray, gap: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`designkit.tables.lookup.crossing` per column of ``need`` [contact, n]: the crossing (NaN: none)
-    and the index of the first contact that suffices (-1: none)."""
-    with np.errstate(invalid="ignore"):
-        ok = ~np.isnan(need) & (need <= gap)
-    found = ok.any(axis=0)
-    k = np.argmax(ok, axis=0)
-    cols = np.arange(need.shape[1])
-    cur = need[k, cols]
-    prev = np.where(k > 0, need[np.maximum(k - 1, 0), cols], np.nan)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        w = np.where(prev != cur, (prev - gap) / (prev - cur), 1.0)
-    x0 = xs[np.maximum(k - 1, 0)]
-    x = np.where((k == 0) | np.isnan(prev), xs[k], x0 + w * (xs[k] - x0))
-    return np.where(found, x, np.nan), np.where(found, k, -1)
-
-
 def _at_contact(cw, per_contact: np.ndarray) -> np.ndarray:
     """Contact-weighted sum of ``per_contact`` [contact, n] (NaN if a weighted term is NaN)."""
     total = np.zeros(per_contact.shape[1])
@@ -352,6 +339,26 @@ def _table_pair(question: str, x: dict[str, np.ndarray], op, ideal_bound: bool,
     return res
 
 
+def _mc_contact_bounds(x, op, lo, hi, todo, zc: float, ideal: np.ndarray) -> np.ndarray:
+    """No closed form (varied initial conditions, per-object shapes): the scalar route's Monte Carlo bound of the
+    elements ``todo``, one call per element (remembered per distinct question), written into ``ideal``; returns
+    the floors the intervals are held above (each bound's low end)."""
+    from ..objects import ObjectClass
+    from .ideal_mc_bound import cached_mc_ideal_min_contact
+
+    floor = ideal.copy()
+    spread = _table_route.table_spread(op.tab)
+    for i in np.nonzero(todo)[0]:
+        mcb = cached_mc_ideal_min_contact(
+            ObjectClass("a", (lo[i], lo[i] + op.width)), ObjectClass("b", (hi[i], hi[i] + op.width)),
+            op.tab.sensor, noise_c=float(x["noise_c"][i]), delta_t_c=float(x["delta_t_c"][i]),
+            sensor_temp_spread_c=spread, model=op.model, threshold=op.phi,
+            max_contact_s=_table_route.CLOSED_FORM_MAX_CONTACT_S, coverage=coverage_of_z(zc))
+        ideal[i] = np.nan if mcb.value is None else mcb.value
+        floor[i] = np.nan if mcb.value is None else mcb.floor
+    return floor
+
+
 def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float, outside: bool = True) -> None:
     """min-contact of the elements ``e_in`` marks; with ``outside`` the closed-form bound of the others too
     (a question outside the grid still gets it; ``distinguishable`` needs it only inside)."""
@@ -377,17 +384,17 @@ def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float, outside
         l, h = lo[idx], hi[idx]
         gap = h - l
         need = _need(view, "svm", combos, l, h)
-        value, k = _crossing(grid, need, gap)
-        cols = np.arange(idx.size)
+        value, k, _, _, n0, n1 = _table_route.grid_crossing(grid, need, gap)
         k_cross[idx] = k
-        n_prev[idx] = np.where(k > 0, need[np.maximum(k - 1, 0), cols], np.nan)
-        n_at[idx] = need[np.maximum(k, 0), cols]
-        ilo = _crossing(grid, _need(view, "lo", combos, l, h), gap)[0] if svm else value
-        ihi = _crossing(grid, _need(view, "hi", combos, l, h), gap)[0] if svm else value
+        n_prev[idx] = np.where(k > 0, n0, np.nan)
+        n_at[idx] = n1
+        ilo = _table_route.grid_crossing(grid, _need(view, "lo", combos, l, h), gap)[0] if svm else value
+        ihi = _table_route.grid_crossing(grid, _need(view, "hi", combos, l, h), gap)[0] if svm else value
         if not op.closed and not ideal_bound and op.iview is not None:  # the table's own floor (the scalar's)
             icombos, iflags = op.iview.scene_weights(noise, dt)
             if all(iflags.values()):
-                res["ideal"][idx] = _crossing(op.iview.contacts, _need(op.iview, op.ikind, icombos, l, h), gap)[0]
+                res["ideal"][idx] = _table_route.grid_crossing(op.iview.contacts, _need(op.iview, op.ikind, icombos,
+                                                                                        l, h), gap)[0]
         if efficiency and (has := k >= 0).any():
             r = _table_route.noise_k_min_contact(op, combos, k[has], l[has], h[has], noise / abs(dt), zc=zc)
             for key in eff:
@@ -405,23 +412,9 @@ def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float, outside
         res["ideal"][sel] = exact_ideal_min_contact(
             op.tab.sensor, lo[sel], hi[sel], ratio[sel], width=op.width, threshold=op.phi,
             max_contact_s=_table_route.CLOSED_FORM_MAX_CONTACT_S)
-    # no closed form (varied initial conditions, per-object shapes): the scalar route's Monte Carlo bound, one
-    # call per element (remembered per distinct question); the intervals below are floored at its low end
     ideal_floor = res["ideal"]
     if not op.closed and ideal_bound and todo.any():
-        from ..objects import ObjectClass
-        from .ideal_mc_bound import cached_mc_ideal_min_contact
-
-        ideal_floor = res["ideal"].copy()
-        spread = _table_route.table_spread(op.tab)
-        for i in np.nonzero(todo)[0]:
-            mcb = cached_mc_ideal_min_contact(
-                ObjectClass("a", (lo[i], lo[i] + op.width)), ObjectClass("b", (hi[i], hi[i] + op.width)),
-                op.tab.sensor, noise_c=float(x["noise_c"][i]), delta_t_c=float(x["delta_t_c"][i]),
-                sensor_temp_spread_c=spread, model=op.model, threshold=op.phi,
-                max_contact_s=_table_route.CLOSED_FORM_MAX_CONTACT_S, coverage=coverage_of_z(zc))
-            res["ideal"][i] = np.nan if mcb.value is None else mcb.value
-            ideal_floor[i] = np.nan if mcb.value is None else mcb.floor
+        ideal_floor = _mc_contact_bounds(x, op, lo, hi, todo, zc, res["ideal"])
     # the scalar route's interval: an estimate where the crossing is interpolated between two tabulated needs
     # (table.contact_estimate, the same function), else the grid cell, never below the ideal bound
     raw, ideal = res["value"], ideal_floor
@@ -442,21 +435,32 @@ def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float, outside
         value[j], low[j], high[j] = r["value"][got], r["low"][got], r["high"][got]
         by_estimate[j] = True
     est = (k_cross > 0) & ~np.isnan(n_prev) & ~np.isnan(raw) & ~by_estimate
-    cell = ~np.isnan(raw) & ~est & ~by_estimate
+    _grid_estimates(op, est, ~np.isnan(raw) & ~est & ~by_estimate, k_cross, n_prev, n_at, lo, hi, res, ideal,
+                    value, low, high, varied=varied, zc=zc)
+    if "stated" in res:  # where the interval has a stated coverage, as the scalar answer's
+        res["stated"] = by_estimate | (est & _table_route.states_coverage(op.tab, "min-contact", "table-estimate"))
+
+
+def _grid_estimates(op, est, cell, k_cross, n_prev, n_at, lo, hi, res, ideal, value, low, high, *, varied: bool,
+                    zc: float) -> None:
+    """min-contact's answers read between grid points (the scalar route's ``_rounding_estimate``, through
+    :func:`~designkit.query.table.contact_estimate`) at ``est``, and its grid cells at ``cell``, never below the
+    ideal bound; ``value``, ``low``, ``high`` updated and stored in ``res`` (whose ``low`` / ``high`` hold the
+    Monte Carlo ends' crossings, ``value`` the raw crossing)."""
+    grid, raw = op.view.contacts, res["value"]
     if est.any():
         i = np.nonzero(est)[0]
         r = _table_route.contact_estimate(
             grid[k_cross[i] - 1], grid[k_cross[i]], n_prev[i], n_at[i], hi[i] - lo[i], raw[i], res["low"][i],
-            res["high"][i], ideal[i], width=op.width, svm=svm, z_table=_table_route.table_z(op.tab), zc=zc)
+            res["high"][i], ideal[i], width=op.width, svm=op.tab.fidelity == "svm",
+            z_table=_table_route.table_z(op.tab), zc=zc)
         value[i], low[i], high[i] = r["value"], r["low"], r["high"]
     prev = np.where(k_cross > 0, grid[np.maximum(k_cross - 1, 0)], 0.0)
     if varied:  # the scalar route's rule: F1 need not rise with contact time, the cell starts at the bound
         prev = np.zeros_like(prev)
-    low = np.where(cell, np.where(np.isnan(ideal), prev, np.maximum(prev, ideal)), low)
-    high = np.where(cell, raw, high)
-    res["value"], res["low"], res["high"] = value, low, high
-    if "stated" in res:  # where the interval has a stated coverage, as the scalar answer's
-        res["stated"] = by_estimate | (est & _table_route.states_coverage(op.tab, "min-contact", "table-estimate"))
+    res["value"] = value
+    res["low"] = np.where(cell, np.where(np.isnan(ideal), prev, np.maximum(prev, ideal)), low)
+    res["high"] = np.where(cell, raw, high)
 
 
 _BELOW, _INSIDE, _ABOVE, _CELL = 0, 1, 2, 3  # where a largest separating ratio lies (the scalar route's words)
@@ -502,6 +506,32 @@ def _max_ratio(view, kind: str, cw, lo, hi, *, gcw=None, shift: float = 0.0) -> 
     return r, where
 
 
+def _ratio_interpolants(op, contact: float, cw, j, lo, hi, alt: dict) -> None:
+    """The rounding-corrected estimate's interpolants of the largest separating sigma/dT (the scalar route's:
+    :func:`~designkit.query.table.ratio_estimate` takes them) for pairs ``lo < hi`` at elements ``j``, written
+    into ``alt`` (NaN where one does not cross inside the grid)."""
+    w, view = op.width, op.view
+    gcw = _table_route.axis_weights_flagged(view.contacts, contact, log=True)[0]
+    for key, kw in (("c", dict(gcw=gcw, shift=0.5 * w)), ("lin", dict(shift=0.5 * w)),
+                    ("rnd", dict(gcw=gcw, shift=0.5 * w + w / math.sqrt(12))), ("geo", dict(gcw=gcw))):
+        a_r, a_w = _max_ratio(view, "svm", cw, lo, hi, **kw)
+        alt[key][j] = np.where(a_w == _INSIDE, a_r, np.nan)
+
+
+def _ratio_by_efficiency(op, x, lo, hi, i, r_all, ri, low, high, by_k, ordered, zc: float) -> None:
+    """max-noise / min-delta-t from the SVM's noise efficiency (:func:`~designkit.query.table.noise_k_max_ratio`)
+    at elements ``i``, never beyond the ideal observer's ``ri``: ``r_all``, ``low``, ``high`` and ``by_k``
+    updated where it applies (``ordered``: sigma/dT ends to the answer's interval)."""
+    kr = _table_route.noise_k_max_ratio(op, x["contact_s"][i], r_all[i], ri[i], lo[i], hi[i], zc=zc)
+    got = ~np.isnan(kr["value"])
+    j = i[got]
+    k_low, k_high = _nan(lo.size), _nan(lo.size)
+    k_low[j], k_high[j] = kr["low"][got], np.minimum(kr["high"][got], ri[j])
+    a, b = ordered(k_low, k_high)
+    low[j], high[j], r_all[j] = a[j], b[j], np.minimum(kr["value"][got], ri[j])
+    by_k[j] = True
+
+
 def _ratio(question, x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> None:
     view = op.view
     ratios = view.t.axes["noise_ratio"] if "noise_ratio" in op.tab.axes else None
@@ -539,13 +569,7 @@ def _ratio(question, x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> 
         res["in_grid"][idx] = where != _ABOVE
         est = where == _INSIDE
         if svm and est.any():
-            w = op.width
-            gcw = _table_route.axis_weights_flagged(view.contacts, contact, log=True)[0]
-            j, le, he = idx[est], l[est], h[est]
-            for key, kw in (("c", dict(gcw=gcw, shift=0.5 * w)), ("lin", dict(shift=0.5 * w)),
-                            ("rnd", dict(gcw=gcw, shift=0.5 * w + w / math.sqrt(12))), ("geo", dict(gcw=gcw))):
-                a_r, a_w = _max_ratio(view, "svm", cw, le, he, **kw)
-                alt[key][j] = np.where(a_w == _INSIDE, a_r, np.nan)
+            _ratio_interpolants(op, contact, cw, idx[est], l[est], h[est], alt)
     if op.closed and ideal_bound:  # every element, outside the grid too: the closed form needs no table
         from .ideal_bound import exact_ideal_max_ratio
 
@@ -566,16 +590,7 @@ def _ratio(question, x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> 
     by_k = np.zeros(n, dtype=bool)
     if (svm and op.closed and "delta_up_ideal" in view.t.arrays
             and (cand := ((where_all == _INSIDE) | (where_all == _CELL)) & ~np.isnan(ri)).any()):
-        i = np.nonzero(cand)[0]
-        kr = _table_route.noise_k_max_ratio(op, x["contact_s"][i], r_all[i], ri[i], lo[i], hi[i], zc=zc)
-        got = ~np.isnan(kr["value"])
-        j = i[got]
-        r_k = np.minimum(kr["value"][got], ri[j])
-        k_low, k_high = _nan(n), _nan(n)
-        k_low[j], k_high[j] = kr["low"][got], np.minimum(kr["high"][got], ri[j])
-        a, b = ordered(k_low, k_high)
-        low[j], high[j], r_all[j] = a[j], b[j], r_k
-        by_k[j] = True
+        _ratio_by_efficiency(op, x, lo, hi, np.nonzero(cand)[0], r_all, ri, low, high, by_k, ordered, zc)
     inside = (where_all == _INSIDE) & ~by_k
     if "stated" in res:  # where the interval has a stated coverage, as the scalar answer's
         res["stated"] = by_k | (inside if svm else False)

@@ -1497,6 +1497,7 @@ class _Estimate:
     coverage: float | None
     computation: dict = field(default_factory=dict)
     note: str = ""
+    ratio: float | None = None  # (max-noise / min-delta-t: the sigma/dT answered)
 
 
 def _varied_estimate(rd: _Reading) -> _Estimate | None:
@@ -1670,89 +1671,144 @@ def _ratio_question(question: str, e1, e2, m1, m2, objects, contact_s, noise_c, 
             continue
         out[kind] = _max_ratio(v, op.ikind if kind == "ideal" else kind, contact, lo, hi)
     r, where = out["svm"]
-    note = ""
-    value = to_answer(r)
     ratios = view.t.axes["noise_ratio"]
-    if where == "below":
-        value = None
-        note = f"not separable even at the table's smallest noise ratio sigma/dT = {ratios[0]:g}"
-    elif where == "above":
-        more = "at least" if question == "max-noise" else "at most"  # a larger ratio: more noise, a smaller dT
-        note = (f"separable even at the table's largest noise ratio sigma/dT = {ratios[-1]:g}: "
-                f"the answer is {more} this (the exact route looks further)")
+    if where == "above":
         flags["noise_ratio"] = False
     # the Monte Carlo ends: more noise allowed at the optimistic end ('lo': ratio >= the answer's)
     ends = [to_answer(out[k][0]) if out[k][1] != "below" else None for k in ("hi", "lo")]
     mc = tuple(sorted(ends, key=lambda x: (x is None, x))) if all(e is not None for e in ends) else tuple(ends)
-    ideal = to_answer(out["ideal"][0]) if out["ideal"][1] != "below" else None
-    interval: tuple = (None, None)
-    kind, cov = "none", None
-    computation = {"monte_carlo_interval": list(mc)}
-    kr = None
-    if (where in ("inside", "cell") and op.tab.fidelity == "svm" and op.closed and out["ideal"][1] != "below"
-            and "delta_up_ideal" in view.t.arrays):
-        kr = noise_k_max_ratio(op, contact, r, out["ideal"][0], lo, hi, zc=z_of_coverage(coverage))
-        kr = None if math.isnan(float(kr["value"][0])) else {key: float(v[0]) for key, v in kr.items()}
-    if kr is not None:
-        # the SVM's noise efficiency against the exact ideal observer (noise_k_max_ratio)
-        raw = r
-        r = min(kr["value"], out["ideal"][0])
-        value = to_answer(r)
-        iv = [to_answer(kr["low"]), to_answer(min(kr["high"], out["ideal"][0]))]
-        interval = tuple(iv) if question == "max-noise" else (iv[1], iv[0])
-        kind, cov = "table-efficiency", coverage
-        computation.update(table_crossing_noise_ratio=raw, efficiency=kr["k"], efficiency_se_log=kr["se_log"])
-    elif where == "inside" and op.tab.fidelity == "svm":
-        # as min-contact: the tabulated deltas are rounded up to the grid (on average half a width late),
-        # so the raw crossing tolerates too little noise; the answer subtracts w/2 from the need and
-        # interpolates log-log, the interval carries the interpolants' difference and the rounding's SD
-        w = op.width
-        raw = r
-
-        def inside(v):
-            return v[0] if v[1] == "inside" else math.nan
-
-        r_c = inside(_max_ratio(view, "svm", contact, lo, hi, geometric=True, shift=0.5 * w))
-        r_lin = inside(_max_ratio(view, "svm", contact, lo, hi, shift=0.5 * w))
-        both = not (math.isnan(r_c) or math.isnan(r_lin))
-        r_rnd = inside(_max_ratio(view, "svm", contact, lo, hi, geometric=True,
-                                  shift=0.5 * w + w / math.sqrt(12))) if both else math.nan
-        r_geo = math.nan if both else inside(_max_ratio(view, "svm", contact, lo, hi, geometric=True))
-        ends = [math.nan if out[k][1] == "below" or (k == "lo" and out[k][1] == "above") else out[k][0]
-                for k in ("hi", "lo")]
-        ri = out["ideal"][0] if out["ideal"][1] != "below" else None
-        est = ratio_estimate(raw, r_c, r_lin, r_rnd, r_geo, ends[0], ends[1], _arr(ri), z_table=table_z(op.tab),
-                             zc=z_of_coverage(coverage))
-        r, r_low, r_high = float(est["value"]), _opt(est["low"]), _opt(est["high"])
-        interp, rounding = float(est["interp"]), float(est["rounding"])
-        value = to_answer(r)
-        computation["table_crossing_noise_ratio"] = raw
-        iv = [to_answer(r_low), to_answer(r_high)]
-        interval = tuple(iv) if question == "max-noise" else (iv[1], iv[0])
-        kind, cov = "table-estimate", coverage
-        computation.update(interpolation_error_log=interp, rounding_error_log=rounding)
-    elif where == "cell":  # a neighbour beyond the grid: the crossing lies in the cell, no stated coverage
-        k = int(np.searchsorted(ratios, r))
-        nxt = float(ratios[min(k + 1, ratios.size - 1)])
-        ri = out["ideal"][0] if out["ideal"][1] != "below" else None
-        nxt = min(nxt, ri) if ri is not None else nxt
-        iv = [to_answer(r), to_answer(nxt)]
-        interval, kind = (tuple(iv) if question == "max-noise" else (iv[1], iv[0])), "table-cell"
-        note = (f"sigma/dT {r:g} is the table's last noise ratio where they separate; at the next, {nxt:g}, the "
-                "pair lies beyond its effusivity range: the answer lies between them and the grid cannot support "
-                "an interval of stated coverage there (the exact route estimates it)")
-    elif where == "inside":  # an ideal-observer table: no Monte Carlo ends
-        interval, kind = mc, "table"
-    elif value is not None:  # separable beyond the table's largest ratio: the answer is a one-sided bound
-        note += " (the grid cannot support an interval of stated coverage there)"
-        interval = (value, None) if question == "max-noise" else (None, value)
-        kind = "table-cell"
+    rd = _RatioReading(op, question, contact, lo, hi, r, where, out, mc, coverage, dt if question == "max-noise"
+                       else None, None if question == "max-noise" else noise)
+    est = next((e for e in (estimator(rd) for estimator in RATIO_ESTIMATORS) if e is not None), None)
+    if est is None:  # not separable within the table
+        est = _Estimate(None, (None, None), "none", None,
+                        note=f"not separable even at the table's smallest noise ratio sigma/dT = {ratios[0]:g}")
+    computation = {"monte_carlo_interval": list(mc), **est.computation}
+    r = est.ratio if est.ratio is not None else r
     r_check = r if r is not None else float(ratios[0])
     check_at = (contact, r_check * abs(dt), dt) if question == "max-noise" else (contact, noise, noise / r_check)
-    return _answer(question, op, value=value, interval=interval, ideal=ideal,
+    ideal = to_answer(out["ideal"][0]) if out["ideal"][1] != "below" else None
+    return _answer(question, op, value=est.value, interval=est.interval, ideal=ideal,
                    ideal_method="closed-form" if op.closed else "table", in_grid=flags, details={},
-                   notes=[note], check_at=check_at, interval_kind=kind, interval_coverage=cov,
-                   computation=computation, **common)
+                   notes=[est.note], check_at=check_at,
+                   interval_kind=est.kind, interval_coverage=est.coverage, computation=computation, **common)
+
+
+# ---------------------------------------------------------------- max-noise / min-delta-t's estimators
+@dataclass(frozen=True)
+class _RatioReading:
+    """What max-noise / min-delta-t read from the table for one pair ``lo < hi`` at one contact [s]: the largest
+    separating sigma/dT ``r`` and where it lies (``where``: below / inside / cell / above the table's ratios),
+    each kind's reading (``out``: svm, lo, hi, ideal -> (ratio, where)), the Monte Carlo ends in the answer's
+    units (``mc``), and the scene's dT (max-noise) or noise (min-delta-t) [degC]."""
+
+    op: Any
+    question: str
+    contact: float
+    lo: float
+    hi: float
+    r: float | None
+    where: str
+    out: dict
+    mc: tuple
+    coverage: float
+    dt: float | None
+    noise: float | None
+
+    def answer(self, r: float | None) -> float | None:
+        """A sigma/dT in the answer's units (degC)."""
+        if r is None:
+            return None
+        return r * abs(self.dt) if self.question == "max-noise" else self.noise / r
+
+    def interval(self, r_low, r_high) -> tuple:
+        """The interval of sigma/dT ends in the answer's units, low <= high."""
+        iv = (self.answer(r_low), self.answer(r_high))
+        return iv if self.question == "max-noise" else (iv[1], iv[0])
+
+    @property
+    def ideal_ratio(self) -> float | None:
+        return self.out["ideal"][0] if self.out["ideal"][1] != "below" else None
+
+
+def _ratio_efficiency(rd: _RatioReading) -> _Estimate | None:
+    """The SVM's noise efficiency against the exact ideal observer (:func:`noise_k_max_ratio`)."""
+    op = rd.op
+    if not (rd.where in ("inside", "cell") and op.tab.fidelity == "svm" and op.closed and rd.ideal_ratio is not None
+            and "delta_up_ideal" in op.view.t.arrays):
+        return None
+    kr = noise_k_max_ratio(op, rd.contact, rd.r, rd.ideal_ratio, rd.lo, rd.hi, zc=z_of_coverage(rd.coverage))
+    if math.isnan(float(kr["value"][0])):
+        return None
+    kr = {key: float(v[0]) for key, v in kr.items()}
+    r = min(kr["value"], rd.ideal_ratio)
+    return _Estimate(rd.answer(r), rd.interval(kr["low"], min(kr["high"], rd.ideal_ratio)), "table-efficiency",
+                     rd.coverage, dict(table_crossing_noise_ratio=rd.r, efficiency=kr["k"],
+                                       efficiency_se_log=kr["se_log"]), ratio=r)
+
+
+def _ratio_rounding(rd: _RatioReading) -> _Estimate | None:
+    """As min-contact's: the tabulated deltas are rounded up to the grid (on average half a width late), so the
+    raw crossing tolerates too little noise; the answer subtracts w/2 from the need and interpolates log-log,
+    the interval carries the interpolants' difference and the rounding's SD (:func:`ratio_estimate`)."""
+    op, out = rd.op, rd.out
+    if not (rd.where == "inside" and op.tab.fidelity == "svm"):
+        return None
+    w, view, lo, hi, contact = op.width, op.view, rd.lo, rd.hi, rd.contact
+
+    def inside(v):
+        return v[0] if v[1] == "inside" else math.nan
+
+    r_c = inside(_max_ratio(view, "svm", contact, lo, hi, geometric=True, shift=0.5 * w))
+    r_lin = inside(_max_ratio(view, "svm", contact, lo, hi, shift=0.5 * w))
+    both = not (math.isnan(r_c) or math.isnan(r_lin))
+    r_rnd = inside(_max_ratio(view, "svm", contact, lo, hi, geometric=True,
+                              shift=0.5 * w + w / math.sqrt(12))) if both else math.nan
+    r_geo = math.nan if both else inside(_max_ratio(view, "svm", contact, lo, hi, geometric=True))
+    ends = [math.nan if out[k][1] == "below" or (k == "lo" and out[k][1] == "above") else out[k][0]
+            for k in ("hi", "lo")]
+    est = ratio_estimate(rd.r, r_c, r_lin, r_rnd, r_geo, ends[0], ends[1], _arr(rd.ideal_ratio),
+                         z_table=table_z(op.tab), zc=z_of_coverage(rd.coverage))
+    r = float(est["value"])
+    return _Estimate(rd.answer(r), rd.interval(_opt(est["low"]), _opt(est["high"])), "table-estimate", rd.coverage,
+                     dict(table_crossing_noise_ratio=rd.r, interpolation_error_log=float(est["interp"]),
+                          rounding_error_log=float(est["rounding"])), ratio=r)
+
+
+def _ratio_cell(rd: _RatioReading) -> _Estimate | None:
+    """A neighbour beyond the grid: the crossing lies in the cell up to the next ratio (or the ideal bound), no
+    stated coverage."""
+    if rd.where != "cell":
+        return None
+    ratios = rd.op.view.t.axes["noise_ratio"]
+    k = int(np.searchsorted(ratios, rd.r))
+    nxt = float(ratios[min(k + 1, ratios.size - 1)])
+    nxt = min(nxt, rd.ideal_ratio) if rd.ideal_ratio is not None else nxt
+    return _Estimate(rd.answer(rd.r), rd.interval(rd.r, nxt), "table-cell", None, note=(
+        f"sigma/dT {rd.r:g} is the table's last noise ratio where they separate; at the next, {nxt:g}, the "
+        "pair lies beyond its effusivity range: the answer lies between them and the grid cannot support "
+        "an interval of stated coverage there (the exact route estimates it)"))
+
+
+def _ratio_ideal_table(rd: _RatioReading) -> _Estimate | None:
+    """An ideal-observer table: the answer with its Monte Carlo ends, no stated coverage."""
+    return _Estimate(rd.answer(rd.r), rd.mc, "table", None) if rd.where == "inside" else None
+
+
+def _ratio_beyond(rd: _RatioReading) -> _Estimate | None:
+    """Separable beyond the table's largest ratio: the answer is a one-sided bound."""
+    if rd.where != "above":
+        return None
+    value = rd.answer(rd.r)
+    more = "at least" if rd.question == "max-noise" else "at most"  # a larger ratio: more noise, a smaller dT
+    return _Estimate(value, (value, None) if rd.question == "max-noise" else (None, value), "table-cell", None,
+                     note=(f"separable even at the table's largest noise ratio sigma/dT = {rd.r:g}: the answer is "
+                           f"{more} this (the exact route looks further) (the grid cannot support an interval of "
+                           "stated coverage there)"))
+
+
+#: max-noise / min-delta-t's estimators from a table, in the order tried: the first that applies answers.
+RATIO_ESTIMATORS = (_ratio_efficiency, _ratio_rounding, _ratio_cell, _ratio_ideal_table, _ratio_beyond)
 
 
 def max_noise(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact_s: float, delta_t_c: float = 10.0,

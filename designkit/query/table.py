@@ -1879,24 +1879,8 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
     icw, _ = _contact_weights(iview, contact) if iview is not None else ([], False)
 
     def at(v, cmb, cws, name, geometric=False):
-        if v is None or name not in v.t.arrays:
-            return None
-        total = 0.0
-        for k, w in cws:
-            if w == 0:
-                continue
-            if geometric:  # log delta interpolated (weights in log contact, log sigma/dT)
-                for idx, wi in cmb:
-                    y = _interp_e(v.t.arrays[name][idx + (k,)], v.centres, x) if wi else 1.0
-                    if math.isnan(y) or y <= 0:
-                        return None
-                    total += w * wi * math.log(y)
-                continue
-            y = v.delta_at(name, cmb, k, x)
-            if math.isnan(y):
-                return None
-            total += w * y
-        return math.exp(total) if geometric else total
+        return _delta_read(v, cmb, cws, name, x, geometric)
+
 
     zc, z_t = z_of_coverage(coverage), table_z(op.tab)
     gcw = axis_weights_flagged(view.contacts, contact, log=True)[0]
@@ -1914,15 +1898,8 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
         ideal_side = at(iview, icombos, icw, iname)
         side_floor, extra = ideal_side, {}
         if not op.closed and ideal_bound:  # no closed form: Monte Carlo at query time, the grid's kept beside it
-            from .ideal_mc_bound import cached_mc_ideal_delta
-
-            mcb = cached_mc_ideal_delta(ref, 1 if direction == "up" else -1, op.tab.sensor, contact_s=contact,
-                                        noise_c=noise, delta_t_c=dt, sensor_temp_spread_c=table_spread(op.tab),
-                                        model=op.model, threshold=op.phi, coverage=coverage)
-            extra = {"table_ideal": ideal_side,
-                     "ideal_interval": list(mcb.interval[:2]) if mcb.interval else None}
-            ideal_side = mcb.value
-            side_floor = mcb.floor
+            ideal_side, side_floor, extra = _mc_delta_side(op, ref, direction, contact, noise, dt, coverage,
+                                                           ideal_side)
         stated, cov_side, method = [None, None], None, "none"
         eff = both[direction]
         if eff is not None and val is None and not partner_in_grid(view, x, eff["value"], direction):
@@ -1956,6 +1933,43 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
                    ideal_interval=nearer_side_interval(sides, coverage),
                    in_grid=flags, details=_delta_details(x, sides),
                    check_at=(contact, noise, dt), **common)
+
+
+def _mc_delta_side(op, ref, direction: str, contact: float, noise: float, dt: float, coverage: float,
+                   grid_ideal: float | None) -> tuple:
+    """delta-e's ideal bound of one direction by Monte Carlo at query time (no closed form): its value, the floor
+    the interval is held above (its low end), and the grid's bound and the Monte Carlo interval for ``details``."""
+    from .ideal_mc_bound import cached_mc_ideal_delta
+
+    mcb = cached_mc_ideal_delta(ref, 1 if direction == "up" else -1, op.tab.sensor, contact_s=contact,
+                                noise_c=noise, delta_t_c=dt, sensor_temp_spread_c=table_spread(op.tab),
+                                model=op.model, threshold=op.phi, coverage=coverage)
+    extra = {"table_ideal": grid_ideal, "ideal_interval": list(mcb.interval[:2]) if mcb.interval else None}
+    return mcb.value, mcb.floor, extra
+
+
+def _delta_read(v: "_View | None", cmb, cws, name: str, x: float, geometric: bool = False) -> float | None:
+    """Array ``name`` of view ``v`` at effusivity ``x``, scene weights ``cmb`` and contact weights ``cws`` (None:
+    no such view or array, or a NaN within the weights); ``geometric``: log delta interpolated (weights in log
+    contact, log sigma/dT)."""
+    if v is None or name not in v.t.arrays:
+        return None
+    total = 0.0
+    for k, w in cws:
+        if w == 0:
+            continue
+        if geometric:
+            for idx, wi in cmb:
+                y = _interp_e(v.t.arrays[name][idx + (k,)], v.centres, x) if wi else 1.0
+                if math.isnan(y) or y <= 0:
+                    return None
+                total += w * wi * math.log(y)
+            continue
+        y = v.delta_at(name, cmb, k, x)
+        if math.isnan(y):
+            return None
+        total += w * y
+    return math.exp(total) if geometric else total
 
 
 def partner_in_grid(view: _View, e, delta, direction: str):

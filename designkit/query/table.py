@@ -47,6 +47,7 @@ Examples
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 from typing import Any, Sequence
@@ -1878,9 +1879,7 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
     icombos, _ = iview.scene_weights(noise, dt) if iview is not None else ([], {})
     icw, _ = _contact_weights(iview, contact) if iview is not None else ([], False)
 
-    def at(v, cmb, cws, name, geometric=False):
-        return _delta_read(v, cmb, cws, name, x, geometric)
-
+    at = functools.partial(_delta_read, x)  # (view, scene weights, contact weights, array name[, geometric])
 
     zc, z_t = z_of_coverage(coverage), table_z(op.tab)
     gcw = axis_weights_flagged(view.contacts, contact, log=True)[0]
@@ -1948,7 +1947,7 @@ def _mc_delta_side(op, ref, direction: str, contact: float, noise: float, dt: fl
     return mcb.value, mcb.floor, extra
 
 
-def _delta_read(v: "_View | None", cmb, cws, name: str, x: float, geometric: bool = False) -> float | None:
+def _delta_read(x: float, v: "_View | None", cmb, cws, name: str, geometric: bool = False) -> float | None:
     """Array ``name`` of view ``v`` at effusivity ``x``, scene weights ``cmb`` and contact weights ``cws`` (None:
     no such view or array, or a NaN within the weights); ``geometric``: log delta interpolated (weights in log
     contact, log sigma/dT)."""

@@ -45,6 +45,7 @@ True
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping
@@ -722,6 +723,31 @@ def _mc_delta_bounds(op, e: np.ndarray, direction: int, contact: float, noise: f
     return value, floor
 
 
+def _delta_at(e: np.ndarray, v, cmb, cws, name: str) -> np.ndarray:
+    """Array ``name`` of view ``v`` at effusivities ``e``, scene weights ``cmb``, contact weights ``cws`` (NaN:
+    none, or no such view or array)."""
+    if v is None or name not in v.t.arrays:
+        return _nan(e.size)
+    return _at_contact(cws, _delta(v, name, cmb, e))
+
+
+def _delta_geometric(e: np.ndarray, v, cmb, cws, name: str) -> np.ndarray:
+    """As :func:`_delta_at`, log delta interpolated (the scalar route's alternative interpolant)."""
+    total = np.zeros(e.size)
+    bad = np.zeros(e.size, dtype=bool)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        for k, w in cws:
+            if w == 0:
+                continue
+            for i, wi in cmb:
+                if not wi:
+                    continue
+                y = _table_route.interp_e_rows(v.t.arrays[name][i][k:k + 1], v.centres, e)[0]
+                bad |= np.isnan(y) | (y <= 0)
+                total = total + w * wi * np.log(y)
+        return np.where(bad, np.nan, np.exp(total))
+
+
 def _table_delta_e(x: dict[str, np.ndarray], op, ideal_table, zc: float,
                    ideal_bound: bool = True) -> dict[str, np.ndarray]:
     e = x["e"]
@@ -736,25 +762,7 @@ def _table_delta_e(x: dict[str, np.ndarray], op, ideal_table, zc: float,
     for (contact, noise, dt), combos, cw, idx in _scenes_in_grid(x, view, e_in):
         xe = e[idx]
 
-        def at(v, cmb, cws, name):
-            if v is None or name not in v.t.arrays:
-                return _nan(xe.size)
-            return _at_contact(cws, _delta(v, name, cmb, xe))
-
-        def at_geometric(v, cmb, cws, name):  # log delta interpolated (the scalar route's alternative)
-            total = np.zeros(xe.size)
-            bad = np.zeros(xe.size, dtype=bool)
-            with np.errstate(invalid="ignore", divide="ignore"):
-                for k, w in cws:
-                    if w == 0:
-                        continue
-                    for i, wi in cmb:
-                        if not wi:
-                            continue
-                        y = _table_route.interp_e_rows(v.t.arrays[name][i][k:k + 1], v.centres, xe)[0]
-                        bad |= np.isnan(y) | (y <= 0)
-                        total = total + w * wi * np.log(y)
-                return np.where(bad, np.nan, np.exp(total))
+        at, at_geometric = (functools.partial(f, xe) for f in (_delta_at, _delta_geometric))
 
         icombos = iview.scene_weights(noise, dt)[0] if iview is not None else []
         icw = _table_route.axis_weights_flagged(iview.contacts, contact)[0] if iview is not None else []

@@ -413,7 +413,7 @@ def _explain_lines(con, d):
         con.print(f"method: computed for this pair ({c['repeats']} seeds x {c['trials']} trials per class"
                   f"{varied}, {c['wall_s']:.1f} s)")
     if d.get("route_reason") and d["route_reason"] not in d["notes"]:
-        con.print(f"route: {d['route']}: {d['route_reason']}", markup=False)
+        con.print(f"route ({d['route']}): {d['route_reason']}", markup=False)
     for n in d["notes"]:
         con.print(f"note: {n}", markup=False)
     chk = d["model_check"]

@@ -123,11 +123,7 @@ def _ask_scene(question: str, *, exact: bool, table: Optional[str], ideal_table:
     extra["coverage"] = check_coverage(coverage)  # bad input before any work, on either route
 
     with _hints():
-        from ..query.inputs import table_reroute
-
         if spread is not None and (spread < 0 or spread != spread):
-            from .._validation import InputError
-
             raise InputError(f"sensor temperature spread must be >= 0 degC, got {spread:g}")
         sen, fm, source = sensor_and_model(sensor, model, conductance=conductance, thickness=thickness,
                                            backing=backing)
@@ -141,39 +137,18 @@ def _ask_scene(question: str, *, exact: bool, table: Optional[str], ideal_table:
         asked = scene.get("contact_s")
         rig = resolve_scene(sen, {**scene, "sensor_temp_spread_c": spread})
         scene = {k: rig.values[k] for k in scene}
-        spread = rig.values["sensor_temp_spread_c"]
-        # the shipped tables are for the paper sensor and the semi-infinite model: another sensor or model is
-        # computed unless a table is named (a named table built for another one is refused, never used);
-        # varied initial conditions: no shipped table holds them, computed for the pair
-        reroute = None if exact or table is not None else table_reroute(sen, fm)
-        # varied initial conditions: the shipped table for the paper's spread (2.5 degC) and dT, else computed
-        varied = None
-        if spread > 0 and not exact and table is None and reroute is None:
-            from ..query.table import shipped_spread_table
+        # the library chooses the route (designkit.query.policy): a table built for this sensor, model and
+        # scene, or named, else computed for the pair; the answer's route_reason says why
+        kw = dict(objects, **scene, threshold=threshold, sensor=sen, model=fm, table=table, ideal_table=ideal_table,
+                  diffusivity_m2_s=diffusivity, width=width, trials=trials, repeats=repeats, seed=seed, jobs=jobs,
+                  n_mc=n_mc, sensor_temp_spread_c=rig.values["sensor_temp_spread_c"], **extra)
+        route = "exact" if exact else "auto"
+        from ..query.policy import choose_route
 
-            varied = shipped_spread_table(spread, question, scene.get("delta_t_c"))
-        route = "exact" if exact or reroute or (spread > 0 and table is None and varied is None) else "table"
-        if spread > 0:
-            extra["sensor_temp_spread_c"] = spread
-        if route == "table":
-            if diffusivity is not None:
-                from ..query.inputs import NeedsInput
-
-                raise NeedsInput("a diffusivity was given but tables answer for effusivity alone",
-                                 "diffusivity-unused")
-            from ..query.table import DEFAULT_TABLE
-
-            return query.ask(question, route="table", **objects, **scene, threshold=threshold,
-                             table=table or varied or DEFAULT_TABLE, ideal_table=ideal_table,
-                             sensor=None if sensor == "paper" else sen, model=fm, coverage=extra["coverage"],
-                             sensor_temp_spread_c=spread), rig, asked
-        kw = dict(threshold=threshold, sensor=sen, model=fm, diffusivity_m2_s=diffusivity, width=width,
-                  trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc, **extra)
-        with _exact_display(question, progress) as report:
+        with _exact_display(question, progress and choose_route(question, route, kw)[0] == "exact") as report:
             if report is not None:
                 kw["progress"] = report
-            return _noted(query.ask(question, route="exact", **objects, **scene, **kw), reroute, sen, fm,
-                          source), rig, asked
+            return _noted(query.ask(question, route=route, **kw), sen, fm, source), rig, asked
 
 
 @contextmanager
@@ -201,14 +176,12 @@ def _exact_display(question: str, progress: bool):
         yield report
 
 
-def _noted(ans, reroute: Optional[str], sen, fm, source: str):
-    """The answer with a note saying why it was computed rather than read, and where its model came from."""
+def _noted(ans, sen, fm, source: str):
+    """A computed answer with a note saying where its model came from (a sensor file's own)."""
     import dataclasses
 
     notes = list(ans.notes)
-    if reroute:
-        notes.append(reroute)
-    if source == "sensor file":
+    if source == "sensor file" and ans.route == "exact":
         from ..models import sensor_model_notes
 
         notes.extend(sensor_model_notes(sen, fm))
@@ -456,6 +429,8 @@ def _explain_lines(con, d):
                   if c.get("sensor_temp_spread_c") else "")
         con.print(f"method: computed for this pair ({c['repeats']} seeds x {c['trials']} trials per class"
                   f"{varied}, {c['wall_s']:.1f} s)")
+    if d.get("route_reason") and d["route_reason"] not in d["notes"]:
+        con.print(f"route ({d['route']}): {d['route_reason']}", markup=False)
     for n in d["notes"]:
         con.print(f"note: {n}", markup=False)
     chk = d["model_check"]

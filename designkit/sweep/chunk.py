@@ -104,9 +104,13 @@ def run_chunk(cfg: SweepConfig, point: tuple[int, ...], block: int, contact_inde
     of CPU with the default threads, 3.7 s with one), and one thread everywhere makes the
     floating-point order the same whatever the worker count. (Other CPUs run other
     kernels and round differently; docs/engine.md measures that the tables do not move.)
+    threadpoolctl limits the libraries loaded when the limit is set, so scipy's LAPACK (the
+    solver's, a BLAS of its own) is imported first: loaded later, inside the chunk, it ran
+    on every core (measured: the solve 15x slower per fit at load 7).
     Freed arrays are kept for reuse meanwhile (:func:`~designkit._workers.steady_heap`:
     7 % less CPU over a whole svm-paper build, 12 % on single chunks, measured).
     """
+    import scipy.linalg.lapack  # noqa: F401  (the solver's LAPACK: loaded now, so that the limit below reaches it)
     from joblib import parallel_config
     from threadpoolctl import threadpool_limits
 

@@ -32,11 +32,19 @@ from ..sensor import Sensor
 from ..simulation import draw_trials, render_trials
 from .config import SweepConfig
 
-__all__ = ["BATCH_MB", "CHUNK_PAIRS", "CV_KEY", "FEATURE_CACHE_MB", "PairCell", "PairScorer", "array_namespace",
+__all__ = ["BATCH_MB", "CHUNK_PAIRS", "CV_KEY", "ENGINE_VERSION", "FEATURE_CACHE_MB", "PairCell", "PairScorer", "array_namespace",
            "batch_pairs"]
 
 #: Seed-key suffix of the fold-shuffle streams (distinguishes them from the trial streams).
 CV_KEY = 7919
+
+#: Version of the arithmetic that turns a config into a table (features and solver), recorded in every
+#: table's header (``engine_version``; a table without one is version 1) and in a sweep's working folder.
+#: The same config gives the same bytes on every run, split and backend of one version; another version
+#: rounds differently, so its answers may move within their Monte Carlo intervals (issue 35). Version 2:
+#: the Savitzky-Golay slope in cumulative-sum form (:mod:`designkit.recognition.features`) and the
+#: batched solver's one-gather fold statistics (:func:`~designkit.recognition.batched_svm.batched_cv_f1`).
+ENGINE_VERSION = 2
 
 
 @dataclass

@@ -297,7 +297,9 @@ def _kkt_step(Ka, ya, fr, uu, C, ridge, eye, xp):
             z[k, U] = bu
         else:
             rhs[:, 0] = yk[F]
-        A = Ka[k].take(F, axis=0).take(F, axis=1)  # symmetric: its transpose is the Fortran-order view LAPACK wants
+        # symmetric: its transpose is the Fortran-order view LAPACK wants; every variable free (each fold's
+        # first step): a plain copy instead of two gathers
+        A = Ka[k].copy() if F.size == n else Ka[k].take(F, axis=0).take(F, axis=1)
         A.flat[:: F.size + 1] += ridge[k]
         _, x, info = dposv(A.T, rhs, overwrite_a=1, overwrite_b=1)
         if info != 0:

@@ -62,11 +62,13 @@ from __future__ import annotations
 
 from .chunk import ChunkResult, run_chunk, run_scene
 from .config import FIDELITIES, SOLVERS, SweepConfig
+from .scorer import ENGINE_VERSION
 from .run import SweepInterrupted, iter_sweep, prepare_workdir, run_sweep
 from .search import (assemble, closed_form_model, delta_from_staircase, ideal_staircase, staircase_search,
                      staircase_searches)
 
 __all__ = [
+    "ENGINE_VERSION",
     "FIDELITIES",
     "SOLVERS",
     "ChunkResult",

@@ -98,9 +98,11 @@ def run_chunk(cfg: SweepConfig, point: tuple[int, ...], block: int, contact_inde
     worker, with joblib's local backend (scikit-learn's own joblib calls are not sent back
     to a dask cluster), BLAS and LAPACK on one thread (the same floating-point order
     whatever the worker count) and freed arrays kept for reuse
-    (:func:`~designkit._workers.steady_heap`). Why, with the measurements:
+    (:func:`~designkit._workers.steady_heap`). scipy's LAPACK (the solver's) is imported
+    before the thread limit is set, so that the limit reaches it. Why, with the measurements:
     docs/decisions-log.md.
     """
+    import scipy.linalg.lapack  # noqa: F401  (the solver's LAPACK: loaded now, so that the limit below reaches it)
     from joblib import parallel_config
     from threadpoolctl import threadpool_limits
 

@@ -21,6 +21,7 @@ import numpy as np
 from .._validation import InputError
 from .chunk import ChunkResult, estimated_costs, run_chunk
 from .config import SweepConfig
+from .scorer import ENGINE_VERSION
 from .search import assemble, chunk_wall_s
 
 __all__ = ["BACKENDS", "SweepInterrupted", "check_batches", "check_scheduler", "iter_sweep", "local_cluster",
@@ -88,13 +89,18 @@ def prepare_workdir(cfg: SweepConfig, workdir: Path, *, resume: bool, fresh: boo
             changed = cfg.changes_from(old.get("config")) or ["sensor file"]
             raise InputError(f"{workdir} holds a different sweep ({', '.join(changed)} changed); "
                              "use another --workdir or --fresh")
+        if old.get("engine_version", 1) != ENGINE_VERSION and any(chunks.glob("*.npz")):
+            raise InputError(f"{workdir} holds chunks of engine version {old.get('engine_version', 1)}, this "
+                             f"designkit computes version {ENGINE_VERSION} (it rounds differently); "
+                             "use another --workdir or --fresh")
         if not resume and any(chunks.glob("*.npz")):
             raise InputError(f"{workdir} already has finished chunks; use --resume to continue or --fresh to discard them")
     if fresh and chunks.exists():
         for f in chunks.glob("*.npz"):
             f.unlink()
     chunks.mkdir(parents=True, exist_ok=True)
-    atomic_write_text(meta, json.dumps({"digest": cfg.digest(), "config": cfg.to_dict()}, indent=2))
+    atomic_write_text(meta, json.dumps({"digest": cfg.digest(), "engine_version": ENGINE_VERSION,
+                                        "config": cfg.to_dict()}, indent=2))
 
 
 #: Up to this many chunks per worker, the chunks are ordered by estimated cost (in the parent, before any chunk
@@ -342,5 +348,6 @@ def run_sweep(cfg: SweepConfig, workdir: str | Path, *, out: str | Path | None =
                                             "chunks_total": total, "jobs": jobs, "backend": backend,
                                             "solver": cfg.solver, "compute_s_total": float(wall.sum()),
                                             "chunk_wall_s": wall.tolist()})
+    header["engine_version"] = ENGINE_VERSION  # hashed with the header; tables without it are version 1
     path = Path(out) if out is not None else workdir / f"{cfg.name}.npz"
     return write_table(path, header, arrays, compress=compress)

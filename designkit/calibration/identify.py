@@ -669,7 +669,7 @@ def _reading(model, t: np.ndarray, e_object: float, sensor, interp_points: int |
     Models solved numerically (``solved_numerically``) are evaluated at
     ``interp_points`` log-spaced times and interpolated by a cubic spline in
     ``log t`` (error below 1e-6 of the temperature difference for smooth
-    readings, tested), which makes a residual evaluation about 6x faster.
+    readings, tested), which makes a residual evaluation cheaper.
     The Talbot inversion uses :data:`FIT_TALBOT_NODES` nodes (error below
     1e-8 of the temperature difference against 32 nodes over the fitted
     parameter range, docs/sensor-models.md; the noise is about 1e-3 of it).

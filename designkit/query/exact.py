@@ -61,7 +61,7 @@ __all__ = [
 ]
 
 #: SVM solvers of the exact route: scikit-learn one seed at a time (the reference), or every seed's
-#: cross-validation at once (:mod:`designkit.recognition.batched_svm`, ~3x faster, same classifier).
+#: cross-validation at once (:mod:`designkit.recognition.batched_svm`, the same classifier).
 SOLVERS = ("sklearn", "batched")
 
 #: sigma/dT searched by max-noise and min-delta-t: 10 uK per K up to noise as large as the contrast.

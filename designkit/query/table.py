@@ -16,7 +16,7 @@ reaches both ``delta_up(e1)`` (seen from the lower effusivity) and
 noise, and requiring both is the conservative choice. ``min-contact``'s estimate
 on a table with varied initial conditions averages the two instead, and
 interpolates each scene slice's answer rather than the need
-(:func:`varied_contact_estimate`: requiring both answered a median 18 % late there).
+(:func:`varied_contact_estimate`; why: docs/decisions-log.md, "Question layer").
 
 The ideal bound comes from an ideal-observer table (``ideal_table``) or the
 SVM table's own ideal arrays, interpolated the same way; ``distinguishable``
@@ -506,9 +506,7 @@ def varied_contact_estimate(view: _View, combos, lo, hi, ideal, *, width: float,
     """min-contact [s] on a table with varied initial conditions, elementwise over pairs ``lo < hi``.
 
     Each scene slice the question lies between (``combos``: the noise and dT grid points around it, with their
-    weights) answers on its own: the pair's need with both directions averaged (:func:`_pair_need_both`; the
-    grid rule's maximum of the two answered a median 18 % late on 100 random cases,
-    ``benchmarks/bench_coverage_varied.py``), its crossing estimated between the two contact times around it
+    weights) answers on its own: the pair's need with both directions averaged (:func:`_pair_need_both`), its crossing estimated between the two contact times around it
     as :func:`contact_estimate` does (the Monte Carlo ends from the table's ``delta_lo`` / ``delta_hi``). The
     answers are then interpolated across the slices, ``log t`` linear in the axes' own scale, instead of
     the needs (a need beyond the effusivity range in one slice made the interpolated need unknown, and the

@@ -124,18 +124,6 @@ class _Emulator:
 
 RESULTS: dict[str, int] = {}
 
-#: Examples not run here, and why (each is run by its own command's tests, on smaller settings).
-NOT_RUN = {
-    "designkit reproduce --out report": "minutes: every section of the paper; tests/test_reproduce.py runs them",
-    "designkit reproduce --out report --only multiclass,node-graphs --figure-format svg":
-        "a minute of simulated touches; tests/test_reproduce.py runs these sections",
-    "designkit bench --quick --out bench": "minutes of benchmarks; tests/test_bench.py runs its sections",
-}
-
-
-def test_every_example_not_run_is_still_an_example():
-    assert set(NOT_RUN) <= {c for _, c in EXAMPLES}
-
 
 def _in_process(cmd: str, folder: Path, monkeypatch) -> tuple[int, str]:
     """Run one command (no shell syntax) through typer's runner in ``folder``: (exit status, output)."""
@@ -155,8 +143,6 @@ def _in_process(cmd: str, folder: Path, monkeypatch) -> tuple[int, str]:
 @pytest.mark.slow
 @pytest.mark.parametrize("path,cmd", EXAMPLES, ids=[f"{p}: {c[10:60]}" for p, c in EXAMPLES])
 def test_the_example_runs_as_printed(path, cmd, scratch, monkeypatch):
-    if cmd in NOT_RUN:
-        pytest.skip(NOT_RUN[cmd])
     folder, env = scratch
     if not SHELL.search(cmd) and not NEEDS_PORT.search(cmd):
         RESULTS[cmd] = -1
@@ -183,4 +169,4 @@ def test_the_example_runs_as_printed(path, cmd, scratch, monkeypatch):
 def teardown_module(module):
     if RESULTS:
         failed = sum(rc != 0 for rc in RESULTS.values())
-        print(f"\nhelp examples: {len(EXAMPLES)}, {len(RESULTS)} run, {failed} failing, {len(NOT_RUN)} not run")
+        print(f"\nhelp examples: {len(EXAMPLES)}, {len(RESULTS)} run, {failed} failing")

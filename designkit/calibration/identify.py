@@ -1005,8 +1005,7 @@ class IdentifiedParameter:
 
     ``identifiable`` is False when the Jacobian is rank-deficient along it, its
     interval spans more than a factor of 10 (positive quantities) or it sits
-    on a search bound (``note`` says which). (``identified`` is another concept:
-    a paper12 material's identified effusivity, docs/schema.md.)
+    on a search bound (``note`` says which).
     """
 
     name: str
@@ -1021,8 +1020,7 @@ class IdentifiedParameter:
         return {"low": float(self.ci95[0]), "high": float(self.ci95[1]), "coverage": 0.95}
 
     def to_dict(self) -> dict[str, Any]:
-        """The schema's shape (docs/schema.md): the 95 % interval as ``interval: {low, high, coverage}``, whether
-        the data identify it as ``identifiable`` (a bool)."""
+        """The schema's shape (docs/schema.md): ``interval: {low, high, coverage}``, ``identifiable`` a bool."""
         return {"name": self.name, "value": self.value, "interval": self.interval(),
                 "unit": self.unit, "identifiable": bool(self.identifiable), "note": self.note}
 

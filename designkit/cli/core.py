@@ -45,6 +45,8 @@ def simulate(
 
     Example (the curves as JSON records, one a line): `designkit simulate --e 20000 --contact 0.1 --trials 2 --format ndjson`
     """
+    import numpy as np
+
     from ..models.semi_infinite import contact_temperature
     from ..scene import Scene
     from .._validation import check_temperature
@@ -73,50 +75,30 @@ def simulate(
 
         plot_curves(plot, result.time_s, result.temperature_c,
                     title=f"e = {e:g} J s^-1/2 K^-1 m^-2, sigma = {noise:g} °C, {sen.name} sensor")
-    payload = {
-        "time_s": result.time_s,
-        "temperature_c": result.temperature_c,
-        "effusivity": e,
-        "contact_temperature_c": tc,
-        "scene": scene.to_dict(),
-        "sensor": sen.to_dict(),
-        "model": fm.to_dict(),
-        "model_source": source,
-        "diffusivity_m2_s": diffusivity,
-        "seed": seed,
-        "out": None if out in (None, "-") else str(out),
-        "plot": str(plot) if plot else None,
-    }
-    emit(fmt, out, payload=payload, records=lambda: _curve_records(result.time_s, result.temperature_c),
-         text=lambda: _print_simulation(result, e, trials, contact, sen, fm, source, diffusivity, sensor_temp,
-                                        ambient, tc, plot))
+    payload = {"time_s": result.time_s, "temperature_c": result.temperature_c, "effusivity": e,
+               "contact_temperature_c": tc, "scene": scene.to_dict(), "sensor": sen.to_dict(), "model": fm.to_dict(),
+               "model_source": source, "diffusivity_m2_s": diffusivity, "seed": seed,
+               "out": None if out in (None, "-") else str(out), "plot": str(plot) if plot else None}
+    cols = ["time_s"] + [f"temperature_c_{k + 1}" for k in range(trials)]  # one row per sample time
+    emit(fmt, out, payload=payload, text=lambda: _print_simulation(payload, result, sen, fm),
+         records=lambda: [dict(zip(cols, row)) for row in np.column_stack([result.time_s, result.temperature_c.T]).tolist()])
 
 
-def _curve_records(time_s, temps) -> list[dict]:
-    """The curves as records: one per sample time, ``time_s`` [s] and ``temperature_c_<k>`` [°C] of touch k
-    (1-based), the JSON's ``time_s`` and ``temperature_c[k - 1]``."""
-    cols = ["time_s"] + [f"temperature_c_{k + 1}" for k in range(temps.shape[0])]
-    import numpy as np
-
-    return [dict(zip(cols, row)) for row in np.column_stack([time_s, temps.T]).tolist()]
-
-
-def _print_simulation(result, e, trials, contact, sen, fm, source, diffusivity, sensor_temp, ambient, tc,
-                      plot) -> None:
+def _print_simulation(p: dict, result, sen, fm) -> None:
+    """simulate's text for people, from its JSON document ``p``."""
     from rich.markup import escape
 
-    con = console()
-    final = result.temperature_c[:, -1]
-    con.print(f"[bold]{trials} touch(es)[/] of e = {e:g} J s^-1/2 K^-1 m^-2 for {contact:g} s "
+    con, sc, final = console(), p["scene"], result.temperature_c[:, -1]
+    con.print(f"[bold]{final.size} touch(es)[/] of e = {p['effusivity']:g} J s^-1/2 K^-1 m^-2 for {sc['contact_s']:g} s "
               f"({result.time_s.size} samples at {sen.sample_rate_hz:g} Hz, {sen.name} sensor, tau = {sen.tau_s:.3f} s)")
-    con.print(escape("  " + model_words(sen, fm, source)
-                     + (f", object diffusivity {diffusivity:g} m^2/s" if diffusivity is not None else "")))
-    con.print(f"  sensor {sensor_temp:g} °C, object {ambient:g} °C"
-              + (f", contact surface Tc = {tc:.4f} °C" if tc is not None else ""))
+    con.print(escape("  " + model_words(sen, fm, p["model_source"]) + (
+        f", object diffusivity {p['diffusivity_m2_s']:g} m^2/s" if p["diffusivity_m2_s"] is not None else "")))
+    con.print(f"  sensor {sc['sensor_temp_c']:g} °C, object {sc['ambient_temp_c']:g} °C" + (
+        f", contact surface Tc = {p['contact_temperature_c']:.4f} °C" if p["contact_temperature_c"] is not None else ""))
     con.print(f"  reading at {result.time_s[-1]:g} s: {final.mean():.4f} °C"
-              + (f" (trials {final.min():.4f} to {final.max():.4f})" if trials > 1 else ""))
-    if plot is not None:
-        con.print(f"  wrote {plot}")
+              + (f" (trials {final.min():.4f} to {final.max():.4f})" if final.size > 1 else ""))
+    if p["plot"] is not None:
+        con.print(f"  wrote {p['plot']}")
 
 
 def _check_touch_memory(what: str, touches: int, sensor, contact_s: float, *, copies: int) -> None:

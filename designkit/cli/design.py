@@ -111,8 +111,7 @@ def design(
     targets = targets_from(m or (), set_, identified=identified)
     skins = tuple(get_material(s).name for s in skin) if skin else SKIN_SET
     t0, c0 = time.perf_counter(), time.process_time()
-    with _app.busy(f"design: searching skins x depths with the ideal observer ({len(skins)} skins)",
-                   quiet=fmt != "text"):
+    with _app.busy(f"design: searching skins x depths with the ideal observer ({len(skins)} skins)", quiet=fmt != "text"):
         result = recommend(targets, cons, skins=skins)
     search = {"wall_s": round(time.perf_counter() - t0, 3), "cpu_s": round(time.process_time() - c0, 3),
               "designs": len(result.designs)}
@@ -130,25 +129,18 @@ def design(
          text=lambda: _print_design(payload, result, threshold, plot))
 
 
-#: The recommended design's keys (``Design.to_dict``, flattened): the record's columns when there is none.
-_DESIGN_KEYS = ("skin", "effusivity", "diffusivity_m2_s", "depth_um", "tau_s", "sample_rate_hz", "delta_t_c",
-                "ideal_value", "ideal_method", "limiting_a", "limiting_b")
-#: The SVM's confirmation (``confirm_with_svm``) under ``svm_`` (once), its copy of the ideal bound left out.
-_SVM_KEYS = ("value", "svm_f1", "svm_minus_ideal_s", "grid_step_s", "trials", "seeds", "note")
+#: design's one record (docs/schema.md, "Records"): the JSON's best flattened (empty without one), the reason,
+#: the constraints, the search's figures, the SVM's confirmation as svm_* (its copy of the ideal bound left out)
+_BEST = ("skin", "effusivity", "diffusivity_m2_s", "depth_um", "tau_s", "sample_rate_hz", "delta_t_c", "ideal_value",
+         "ideal_method", "limiting_a", "limiting_b")
+_SVM = ("value", "svm_f1", "svm_minus_ideal_s", "grid_step_s", "trials", "seeds", "note")
 
 
-def _record(payload: dict) -> dict:
-    """design's one record: the recommendation (the JSON's ``best``, flattened; empty where there is none), the
-    reason, the constraints under their own names (the depth range as ``depth_min_um`` / ``depth_max_um``), the
-    search's figures and the SVM's confirmation as ``svm_*``. The JSON's ``pairs`` and trade-off curve are not
-    in it (they are lists: ``--format json``)."""
-    best = flat_record(payload["best"]) if payload["best"] is not None else {}
-    svm = payload["svm"] or {}
-    return {**{k: best.get(k) for k in _DESIGN_KEYS}, "reason": payload["reason"],
-            **flat_record(payload["constraints"]), "designs_searched": payload["designs_searched"],
-            "wall_s": payload["search"]["wall_s"], "cpu_s": payload["search"]["cpu_s"],
-            **{(k if k.startswith("svm_") else f"svm_{k}"): svm.get(k) for k in _SVM_KEYS},
-            "figure": payload.get("figure")}
+def _record(p: dict) -> dict:
+    best, svm = flat_record(p["best"] or {}), p["svm"] or {}
+    return {**{k: best.get(k) for k in _BEST}, "reason": p["reason"], **flat_record(p["constraints"]),
+            "designs_searched": p["designs_searched"], "wall_s": p["search"]["wall_s"], "cpu_s": p["search"]["cpu_s"],
+            **{(k if k.startswith("svm_") else f"svm_{k}"): svm.get(k) for k in _SVM}, "figure": p.get("figure")}
 
 
 def _print_design(payload: dict, result, threshold: float, plot) -> None:

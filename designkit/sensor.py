@@ -184,7 +184,8 @@ class Sensor:
         records it (:data:`MODEL_KEYS`): ``{"name", "params", "time_offset_s",
         "contact_spread", "object_temperature", "candidate", "contact_area",
         "drift"}``. ``contact_area`` (calibrated with a force-driven contact
-        area): the threshold ``force_fraction`` c (with ``force_fraction_ci95``),
+        area): the threshold ``force_fraction`` c (with ``force_fraction_interval``,
+        its 95 % interval ``{low, high, coverage}``),
         the calibration touches' median force over its plateau (``time_s``
         after the detected onset, ``force_share``), each touch's own
         (``touch_force_share``, rows on ``time_s``) and ``n_touches``;

@@ -125,7 +125,11 @@ def test_the_sensor_file_records_c_the_nominal_force_ramp_and_the_drift(syntheti
     sen, fm = load_sensor_model(path)
     area = sen.model["contact_area"]
     c = res.parameter("contact_force_fraction")
-    assert area["force_fraction"] == c.value and area["force_fraction_ci95"] == list(c.ci95)
+    # the interval in the schema's shape (docs/schema.md: {low, high, coverage}), as calibrate fit's parameters
+    assert area["force_fraction"] == c.value and "force_fraction_ci95" not in area
+    assert area["force_fraction_interval"] == {"low": c.ci95[0], "high": c.ci95[1], "coverage": 0.95} \
+        == c.to_dict()["interval"] and c.ci95[0] < c.value < c.ci95[1]
+    assert c.to_dict()["identifiable"] is True and "identified" not in c.to_dict()
     assert area["force_fraction"] == pytest.approx(C_TRUE, rel=0.05) and area["n_touches"] == len(trials)
     # the nominal ramp is the touches' median F / F_p, the force averaged over 25 ms (5 samples at 200 Hz,
     # ends held), computed here without identify

@@ -306,3 +306,50 @@ def test_f1_record_has_its_json_values(cli):
     assert float(row["svm_f1"]) == pytest.approx(d["svm_f1"]) and float(row["ideal_f1"]) == pytest.approx(d["ideal_f1"])
     assert float(row["contact_s"]) == d["scene"]["contact_s"] == 1.0
     assert float(row["effusivity_min_1"]) == d["objects"][0]["effusivity_range"][0]
+
+
+def test_simulate_records_are_its_json_curves_one_row_per_sample_time(cli, tmp_path):
+    """simulate's csv and ndjson: one row per sample time, time_s then temperature_c_K of touch K, the JSON's
+    own numbers (read by the csv module and by pandas); --out FILE alone writes that CSV, stdout empty."""
+    args = ("simulate", "--e", "20000", "--contact", "0.05", "--trials", "2", "--seed", "3")
+    d = json.loads(cli(*args, "--json").stdout)
+    text = cli(*args, "--format", "csv").stdout
+    rows = list(csv.DictReader(io.StringIO(text)))
+    assert list(rows[0]) == ["time_s", "temperature_c_1", "temperature_c_2"] and len(rows) == len(d["time_s"]) == 11
+    for i, row in enumerate(rows):
+        assert _same(row["time_s"], d["time_s"][i])
+        assert all(_same(row[f"temperature_c_{k + 1}"], d["temperature_c"][k][i]) for k in range(2))
+    records = [json.loads(line) for line in cli(*args, "-f", "ndjson").stdout.splitlines()]
+    assert records == [{k: float(v) for k, v in row.items()} for row in rows]
+    pd = pytest.importorskip("pandas")
+    frame = pd.read_csv(io.StringIO(text))
+    assert frame["temperature_c_2"].tolist() == d["temperature_c"][1] and frame["time_s"].tolist() == d["time_s"]
+    out = tmp_path / "curve.csv"
+    r = cli(*args, "--out", out)
+    assert r.exit_code == 0 and r.stdout == "" and out.read_text() == text
+
+
+def test_design_record_is_its_json_recommendation(cli):
+    """design's csv and ndjson: one record, the JSON's recommendation (best, flattened), reason and constraints
+    under their own names; no design (exit 3) is still one record, its design columns empty."""
+    args = ("design", "--m", "a=20000", "--m", "b=35000", "--skin", "Polyetheretherketone (PEEK)",
+            "--depth-um", "100:400", "--no-svm")
+    d = json.loads(cli(*args, "--json").stdout)
+    text = cli(*args, "--format", "csv").stdout
+    (row,) = list(csv.DictReader(io.StringIO(text)))
+    (rec,) = [json.loads(line) for line in cli(*args, "-f", "ndjson").stdout.splitlines()]
+    assert list(row) == list(rec)
+    expect = {**{k: v for k, v in d["best"].items() if k not in ("ideal", "limiting")},
+              "ideal_value": d["best"]["ideal"]["value"], "ideal_method": "closed-form", "limiting_a": "a",
+              "limiting_b": "b", "reason": d["reason"], "max_contact_s": 4.0, "noise_c": 0.05,
+              "depth_min_um": 100.0, "depth_max_um": 400.0, "threshold": 0.9,
+              "designs_searched": d["designs_searched"], "svm_value": None, "svm_f1": None}
+    assert {k: rec[k] for k in expect} == expect
+    assert all(_same(row[k], v) for k, v in expect.items()), row
+    pd = pytest.importorskip("pandas")
+    frame = pd.read_csv(io.StringIO(text))
+    assert frame.shape[0] == 1 and frame["depth_um"][0] == d["best"]["depth_um"] and frame["skin"][0] == d["best"]["skin"]
+    r = cli("design", "--m", "a=400", "--m", "b=450", "--no-svm", "--format", "csv")
+    assert r.exit_code == 3, r.output
+    (none,) = list(csv.DictReader(io.StringIO(r.stdout)))
+    assert list(none) == list(row) and none["skin"] == "" and "overlap" in none["reason"]

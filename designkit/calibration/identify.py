@@ -1003,7 +1003,7 @@ def _initial_ratios(prob: _Problem, x: np.ndarray) -> np.ndarray:
 class IdentifiedParameter:
     """An identified quantity: value, 95 % interval, unit, and whether the data identify it.
 
-    ``identified`` is False when the Jacobian is rank-deficient along it, its
+    ``identifiable`` is False when the Jacobian is rank-deficient along it, its
     interval spans more than a factor of 10 (positive quantities) or it sits
     on a search bound (``note`` says which).
     """
@@ -1012,14 +1012,17 @@ class IdentifiedParameter:
     value: float
     ci95: tuple[float, float]
     unit: str = ""
-    identified: bool = True
+    identifiable: bool = True
     note: str = ""
 
+    def interval(self) -> dict[str, float]:
+        """The 95 % interval in the schema's shape (docs/schema.md, ``interval``): ``{low, high, coverage}``."""
+        return {"low": float(self.ci95[0]), "high": float(self.ci95[1]), "coverage": 0.95}
+
     def to_dict(self) -> dict[str, Any]:
-        """The schema's shape (docs/schema.md): the 95 % interval as ``interval: {low, high, coverage}``."""
-        return {"name": self.name, "value": self.value,
-                "interval": {"low": self.ci95[0], "high": self.ci95[1], "coverage": 0.95},
-                "unit": self.unit, "identified": self.identified, "note": self.note}
+        """The schema's shape (docs/schema.md): ``interval: {low, high, coverage}``, ``identifiable`` a bool."""
+        return {"name": self.name, "value": self.value, "interval": self.interval(),
+                "unit": self.unit, "identifiable": bool(self.identifiable), "note": self.note}
 
 
 @dataclass(frozen=True)
@@ -1233,7 +1236,7 @@ class Identification:
         geometric standard deviation of the touches' h_c,i; ``object_temperature``:
         how each material's temperature was taken (passive, free, a number);
         ``contact_area`` (a ``force_area`` candidate): the threshold c
-        (``force_fraction``, its 95 % interval) and the fitted touches' median
+        (``force_fraction``, its 95 % interval ``force_fraction_interval``) and the fitted touches' median
         force over its plateau (:func:`nominal_force_profile`), which questions
         play as the nominal ramp; ``drift`` (a ``drift`` candidate):
         ``"per-touch"``, a nuisance fitted for each touch, not a sensor property.
@@ -1256,10 +1259,10 @@ class Identification:
             return None
         if "contact_force_fraction" in self.candidate.free:
             p = self.parameter("contact_force_fraction")
-            c, ci = float(p.value), [float(v) for v in p.ci95]
+            c, ci = float(p.value), p.interval()
         else:
             c, ci = 0.0, None
-        return {"force_fraction": c, "force_fraction_ci95": ci, **dict(self.force_profile)}
+        return {"force_fraction": c, "force_fraction_interval": ci, **dict(self.force_profile)}
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -1567,7 +1570,7 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
     for k, n in enumerate(names):
         rp = ratios[n]
         params.append(IdentifiedParameter(f"e_o[{n}]", rp.value * es, (rp.ci95[0] * es_ci[0], rp.ci95[1] * es_ci[1]),
-                                          "J s^-1/2 K^-1 m^-2", rp.identified, rp.note))
+                                          "J s^-1/2 K^-1 m^-2", rp.identifiable, rp.note))
     for gi, j0 in prob.touch_cols.items():
         g = data.groups[gi]
         d = x[j0:j0 + len(g.trials)]

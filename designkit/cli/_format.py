@@ -71,7 +71,7 @@ def check_format(fmt: str) -> str:
 def output_format(format_: Optional[str], json_: bool = False, *, default: str = "text",
                   out: Optional[str] = None) -> str:
     """The format a command prints in: ``--json`` is ``--format json``; none given is ``default``. An ``out``
-    file is checked too (:func:`check_out`), before the command's work.
+    file is checked too (:func:`check_out`, the error naming ``--out``), before the command's work.
 
     >>> output_format(None, True), output_format("CSV"), output_format(None)
     ('json', 'csv', 'text')
@@ -84,7 +84,7 @@ def output_format(format_: Optional[str], json_: bool = False, *, default: str =
         raise InputError(f"--json and --format {format_} contradict each other: --json is --format json; give one")
     fmt = "json" if json_ else (default if format_ is None else check_format(format_))
     if out is not None and str(out) != "-":
-        check_out(out)
+        check_out(out, "--out")  # the refusal names the option
     return fmt
 
 

@@ -596,7 +596,7 @@ def _print_identification(cmp, best, split, names: list[str], out: Optional[Path
         p.add_column(c, justify="left" if c in ("parameter", "unit", "identified") else "right")
     for q in best.parameters:
         p.add_row(escape(q.name), f"{q.value:.4g}", f"[{q.ci95[0]:.4g}, {q.ci95[1]:.4g}]", escape(q.unit),
-                  "yes" if q.identified else f"no: {escape(q.note or 'see notes')}")
+                  "yes" if q.identifiable else f"no: {escape(q.note or 'see notes')}")
     con.print(p)
     con.print(f"noise sigma before contact {best.noise_c:.4g} °C; object temperature: "
               + ", ".join(f"{n} {m}" for n, m in best.object_modes.items()))

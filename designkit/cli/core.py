@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import sys
 import time
 from pathlib import Path
 from typing import Annotated, Optional
@@ -27,35 +26,40 @@ def simulate(
     trials: Annotated[int, typer.Option("--trials", help="Number of touches.")] = 1,
     seed: Seed = 0,
     sensor: SensorOpt = "paper",
-    out: Annotated[Optional[Path], typer.Option("--out", help="Write a CSV: time_s, then one column per trial ('-': standard output, instead of the summary).")] = None,
     plot: Annotated[Optional[Path], typer.Option("--plot", help="Write a PNG of the curves (needs designkit[figures]).")] = None,
     model: ModelOpt = None,
     conductance: Conductance = None,
     thickness: Thickness = None,
     backing: BackingOpt = None,
     diffusivity: Diffusivity = None,
+    format_: FormatOpt = None,
+    out: OutOpt = None,
     json_: Json = False,
 ) -> None:
     """Simulate touches of one object (paper eq. 4): sensor temperature against time, under any forward model.
 
+    csv and ndjson: one row per sample time, time_s then one temperature_c_K column per touch K (the JSON's
+    time_s and temperature_c); --out FILE without --format writes that CSV.
+
     Example: `designkit simulate --e 20000 --contact 2 --conductance 2000 --out curve.csv`
+
+    Example (the curves as JSON records, one a line): `designkit simulate --e 20000 --contact 0.1 --trials 2 --format ndjson`
     """
+    import numpy as np
+
     from ..models.semi_infinite import contact_temperature
     from ..scene import Scene
     from .._validation import check_temperature
 
     if trials < 1:
         raise ValueError(f"trials must be >= 1, got {trials}")
-    to_stdout = out is not None and str(out) == "-"  # it wrote a file named '-'
-    if to_stdout and json_:
-        raise ValueError("--out - and --json would both print on standard output: give --out a file name")
+    # --out alone writes the curves' CSV, as it always has (the other formats when asked)
+    fmt = output_format(format_, json_, default="text" if out is None else "csv", out=out)
     check_temperature("--sensor-temp [°C]", sensor_temp)
     check_temperature("--ambient [°C]", ambient)
     check_temperature("--noise [°C]", noise, nonnegative=True)
     from ._format import check_out
 
-    if out is not None and not to_stdout:
-        check_out(out, "--out")  # before the work; a missing folder is not made
     if plot is not None:
         check_out(plot, "--plot")
     sen, fm, source = sensor_and_model(sensor, model, conductance=conductance, thickness=thickness,
@@ -66,50 +70,35 @@ def simulate(
     # the paper's contact temperature (eq. 1): where the surface jumps at once under a shared-shape
     # model; other models reach it later (a contact's lag) or never (a slab on its backing)
     tc = float(contact_temperature(sensor_temp, ambient, sen.effusivity, e)) if fm.shared_shape else None
-    if to_stdout:
-        sys.stdout.write(_curves_csv(result.time_s, result.temperature_c))
-        sys.stdout.flush()
-    elif out is not None:
-        _write_curves_csv(out, result.time_s, result.temperature_c)
     if plot is not None:
         from ..figures import plot_curves
 
         plot_curves(plot, result.time_s, result.temperature_c,
                     title=f"e = {e:g} J s^-1/2 K^-1 m^-2, sigma = {noise:g} °C, {sen.name} sensor")
-    if json_:
-        emit_json({
-            "time_s": result.time_s,
-            "temperature_c": result.temperature_c,
-            "effusivity": e,
-            "contact_temperature_c": tc,
-            "scene": scene.to_dict(),
-            "sensor": sen.to_dict(),
-            "model": fm.to_dict(),
-            "model_source": source,
-            "diffusivity_m2_s": diffusivity,
-            "seed": seed,
-            "out": str(out) if out else None,
-            "plot": str(plot) if plot else None,
-        })
-        return
-    if to_stdout:  # the CSV is the output
-        return
+    payload = {"time_s": result.time_s, "temperature_c": result.temperature_c, "effusivity": e,
+               "contact_temperature_c": tc, "scene": scene.to_dict(), "sensor": sen.to_dict(), "model": fm.to_dict(),
+               "model_source": source, "diffusivity_m2_s": diffusivity, "seed": seed,
+               "out": None if out in (None, "-") else str(out), "plot": str(plot) if plot else None}
+    cols = ["time_s"] + [f"temperature_c_{k + 1}" for k in range(trials)]  # one row per sample time
+    emit(fmt, out, payload=payload, text=lambda: _print_simulation(payload, result, sen, fm),
+         records=lambda: [dict(zip(cols, row)) for row in np.column_stack([result.time_s, result.temperature_c.T]).tolist()])
+
+
+def _print_simulation(p: dict, result, sen, fm) -> None:
+    """simulate's text for people, from its JSON document ``p``."""
     from rich.markup import escape
 
-    con = console()
-    final = result.temperature_c[:, -1]
-    con.print(f"[bold]{trials} touch(es)[/] of e = {e:g} J s^-1/2 K^-1 m^-2 for {contact:g} s "
+    con, sc, final = console(), p["scene"], result.temperature_c[:, -1]
+    con.print(f"[bold]{final.size} touch(es)[/] of e = {p['effusivity']:g} J s^-1/2 K^-1 m^-2 for {sc['contact_s']:g} s "
               f"({result.time_s.size} samples at {sen.sample_rate_hz:g} Hz, {sen.name} sensor, tau = {sen.tau_s:.3f} s)")
-    con.print(escape("  " + model_words(sen, fm, source)
-                     + (f", object diffusivity {diffusivity:g} m^2/s" if diffusivity is not None else "")))
-    con.print(f"  sensor {sensor_temp:g} °C, object {ambient:g} °C"
-              + (f", contact surface Tc = {tc:.4f} °C" if tc is not None else ""))
+    con.print(escape("  " + model_words(sen, fm, p["model_source"]) + (
+        f", object diffusivity {p['diffusivity_m2_s']:g} m^2/s" if p["diffusivity_m2_s"] is not None else "")))
+    con.print(f"  sensor {sc['sensor_temp_c']:g} °C, object {sc['ambient_temp_c']:g} °C" + (
+        f", contact surface Tc = {p['contact_temperature_c']:.4f} °C" if p["contact_temperature_c"] is not None else ""))
     con.print(f"  reading at {result.time_s[-1]:g} s: {final.mean():.4f} °C"
-              + (f" (trials {final.min():.4f} to {final.max():.4f})" if trials > 1 else ""))
-    if out is not None:
-        con.print(f"  wrote {out}")
-    if plot is not None:
-        con.print(f"  wrote {plot}")
+              + (f" (trials {final.min():.4f} to {final.max():.4f})" if final.size > 1 else ""))
+    if p["plot"] is not None:
+        con.print(f"  wrote {p['plot']}")
 
 
 def _check_touch_memory(what: str, touches: int, sensor, contact_s: float, *, copies: int) -> None:
@@ -146,24 +135,6 @@ def _touches(e: float, sensor, scene, trials: int, seed: int, model, diffusivity
     draws = draw_trials(0.0, 0.0, trials, sensor.times_s(scene.contact_s).size, seed)
     draws = TrialDraws(np.full(trials, e), draws.sensor_offset, draws.ambient_offset, draws.noise)
     return render_trials(draws, sensor, scene, model, alpha)
-
-
-def _curves_csv(time_s, temps) -> str:
-    import io
-
-    import numpy as np
-
-    buf = io.StringIO()
-    header = ["time_s"] + [f"trial_{i + 1}" for i in range(temps.shape[0])]
-    np.savetxt(buf, np.column_stack([time_s, temps.T]), delimiter=",", header=",".join(header),
-               comments="", fmt="%.10g")
-    return buf.getvalue()
-
-
-def _write_curves_csv(path: Path, time_s, temps) -> None:
-    from .._io import atomic_write_text
-
-    atomic_write_text(path, _curves_csv(time_s, temps))
 
 
 @app.command(rich_help_panel=_app.MODEL)

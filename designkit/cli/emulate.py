@@ -62,7 +62,7 @@ def emulate(
 ) -> None:
     """Emulate a sensor rig on a pseudo-terminal: prints its path, streams the profile's wire format.
 
-    Example (a rig playing two objects for 30 s; without --duration until Ctrl-C): `designkit emulate --material wood=400 --material aluminium=20000 --speed 20 --duration 30`
+    Example (a rig playing two objects for 5 s; without --duration until Ctrl-C): `designkit emulate --material wood=400 --material aluminium=20000 --speed 20 --duration 5`
     """
     from .._validation import InputError, check_temperature
     from ..calibration.emulator import Emulator, Faults, TouchPlan

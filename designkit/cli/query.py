@@ -464,12 +464,9 @@ def min_contact_cmd(
     Example (one record, pandas-ready): `designkit min-contact --e1 35000 --e2 20000 --format csv`
     """
     fmt = output_format(format_, json_, out=out)  # before the work: --exact is not computed for nowhere
-    kw = dict(exact=exact, table=table, ideal_table=ideal_table, threshold=threshold, sensor=sensor, model=model,
-              conductance=conductance, thickness=thickness, backing=backing, diffusivity=diffusivity, width=width,
-              trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc, coverage=coverage,
-              spread=sensor_temp_spread, objects=dict(e1=e1, e2=e2, m1=m1, m2=m2),
-              scene=dict(noise_c=noise, delta_t_c=delta_t), exact_extra=dict(max_contact_s=max_contact))
-    _answer("min-contact", kw, batch, fmt, out, explain)
+    opts = _options(locals(), ("e1", "e2", "m1", "m2"), dict(noise_c=noise, delta_t_c=delta_t),
+                    exact_extra=dict(max_contact_s=max_contact))
+    _answer("min-contact", opts, batch, fmt, out, explain)
 
 
 @app.command("max-noise", rich_help_panel=_app.ASK)
@@ -488,12 +485,8 @@ def max_noise_cmd(
     Example: `designkit max-noise --e1 35000 --e2 20000 --contact 2`
     """
     fmt = output_format(format_, json_, out=out)  # before the work: --exact is not computed for nowhere
-    kw = dict(exact=exact, table=table, ideal_table=ideal_table, threshold=threshold, sensor=sensor, model=model,
-              conductance=conductance, thickness=thickness, backing=backing, diffusivity=diffusivity, width=width,
-              trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc, coverage=coverage,
-              spread=sensor_temp_spread, objects=dict(e1=e1, e2=e2, m1=m1, m2=m2),
-              scene=dict(contact_s=contact, delta_t_c=delta_t))
-    _answer("max-noise", kw, batch, fmt, out, explain)
+    opts = _options(locals(), ("e1", "e2", "m1", "m2"), dict(contact_s=contact, delta_t_c=delta_t))
+    _answer("max-noise", opts, batch, fmt, out, explain)
 
 
 @app.command("min-delta-t", rich_help_panel=_app.ASK)
@@ -512,12 +505,8 @@ def min_delta_t_cmd(
     Example: `designkit min-delta-t --e1 35000 --e2 20000 --contact 2 --noise 0.05`
     """
     fmt = output_format(format_, json_, out=out)  # before the work: --exact is not computed for nowhere
-    kw = dict(exact=exact, table=table, ideal_table=ideal_table, threshold=threshold, sensor=sensor, model=model,
-              conductance=conductance, thickness=thickness, backing=backing, diffusivity=diffusivity, width=width,
-              trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc, coverage=coverage,
-              spread=sensor_temp_spread, objects=dict(e1=e1, e2=e2, m1=m1, m2=m2),
-              scene=dict(contact_s=contact, noise_c=noise))
-    _answer("min-delta-t", kw, batch, fmt, out, explain)
+    opts = _options(locals(), ("e1", "e2", "m1", "m2"), dict(contact_s=contact, noise_c=noise))
+    _answer("min-delta-t", opts, batch, fmt, out, explain)
 
 
 @app.command("delta-e", rich_help_panel=_app.ASK)
@@ -542,12 +531,8 @@ def delta_e_cmd(
     Example (one row per direction): `designkit delta-e --e 20000 --contact 2 --format csv`
     """
     fmt = output_format(format_, json_, out=out)  # before the work: --exact is not computed for nowhere
-    kw = dict(exact=exact, table=table, ideal_table=ideal_table, threshold=threshold, sensor=sensor, model=model,
-              conductance=conductance, thickness=thickness, backing=backing, diffusivity=diffusivity, width=width,
-              trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc, coverage=coverage,
-              spread=sensor_temp_spread, objects=dict(e=e, m=m),
-              scene=dict(contact_s=contact, noise_c=noise, delta_t_c=delta_t))
-    _answer("delta-e", kw, batch, fmt, out, explain)
+    opts = _options(locals(), ("e", "m"), dict(contact_s=contact, noise_c=noise, delta_t_c=delta_t))
+    _answer("delta-e", opts, batch, fmt, out, explain)
 
 
 @app.command("distinguishable", rich_help_panel=_app.ASK)
@@ -567,12 +552,20 @@ def distinguishable_cmd(
     Example: `designkit distinguishable --m1 wood --m2 glass --contact 2`
     """
     fmt = output_format(format_, json_, out=out)  # before the work: --exact is not computed for nowhere
-    kw = dict(exact=exact, table=table, ideal_table=ideal_table, threshold=threshold, sensor=sensor, model=model,
-              conductance=conductance, thickness=thickness, backing=backing, diffusivity=diffusivity, width=width,
-              trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc, coverage=coverage,
-              spread=sensor_temp_spread, objects=dict(e1=e1, e2=e2, m1=m1, m2=m2),
-              scene=dict(contact_s=contact, noise_c=noise, delta_t_c=delta_t))
-    _answer("distinguishable", kw, batch, fmt, out, explain)
+    opts = _options(locals(), ("e1", "e2", "m1", "m2"), dict(contact_s=contact, noise_c=noise, delta_t_c=delta_t))
+    _answer("distinguishable", opts, batch, fmt, out, explain)
+
+
+#: The options every question command shares (its arguments of these names), passed on to _ask as they are.
+_SHARED = ("exact", "table", "ideal_table", "threshold", "sensor", "model", "conductance", "thickness", "backing",
+           "diffusivity", "width", "trials", "repeats", "seed", "jobs", "n_mc", "coverage")
+
+
+def _options(args: dict, objects: tuple, scene: dict, **extra) -> dict:
+    """What one question command passes to :func:`_answer`: the shared options read from its arguments
+    (``locals()``), its objects (``objects``: the argument names) and its scene."""
+    return dict({k: args[k] for k in _SHARED}, spread=args["sensor_temp_spread"],
+                objects={k: args[k] for k in objects}, scene=scene, **extra)
 
 
 def _answer(question: str, kw: dict, batch: Optional[str], fmt: str, out: Optional[str], explain: bool) -> None:

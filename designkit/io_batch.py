@@ -6,7 +6,7 @@ A batch file is a CSV with a header; its columns are named as the command line's
 ``delta-t`` are read too). A column left out, or a scene cell left empty, takes the value given
 for the whole call. :func:`read_batch` checks the file (one line naming the row and column of what is
 wrong); :func:`answer_batch` answers every row with one array call of :func:`designkit.query.ask`
-(materials by name: one call per distinct pair, the library's materials rule being per pair).
+(materials by name too: the library takes lists of names).
 
 Examples
 --------
@@ -236,27 +236,18 @@ def answer_batch(batch: Batch, defaults: Mapping[str, Any] | None = None, *, rou
     scene = {a: v for a, v in inputs.items() if a not in _NAMES}
     # arrays everywhere: a file of one row is still an array call (one record out)
     scene = {a: np.broadcast_to(np.asarray(v, dtype=np.float64), (batch.rows,)) for a, v in scene.items()}
-    records: list[dict[str, Any] | None] = [None] * batch.rows
-    if not names:
-        groups = {(): np.arange(batch.rows)}
-    else:  # the materials rule is per pair: one call per distinct pair of names
-        keys = list(zip(*(inputs[a] for a in names)))
-        groups = {}
-        for k, key in enumerate(keys):
-            groups.setdefault(key, []).append(k)
-    for key, rows in groups.items():
-        idx = np.asarray(rows)
-        arguments = {**dict(zip(names, key)), **{a: v[idx] for a, v in scene.items()}}
-        try:
-            answer = ask(batch.question, route=route, **arguments, **options)
-        except InputError as exc:  # the library names an element (noise_c[3]): said as the file's line
-            text = re.sub(r"\b(\w+)\[(\d+)\]", lambda m: f"{m.group(1)} (line {batch.line(int(idx[int(m.group(2))]))})"
-                          if int(m.group(2)) < len(idx) else m.group(0), str(exc))
-            raise InputError(f"batch file {batch.source}: {text}") from None
-        for k, rec in zip(idx, answer.to_dict()):
-            row = {a: (inputs[a][k] if a in _NAMES else _number(scene[a][k])) for a in inputs}
-            records[int(k)] = {**row, **rec}
-    return records  # type: ignore[return-value]
+    arguments = {**{a: list(inputs[a]) for a in names}, **scene}
+    try:
+        answer = ask(batch.question, route=route, **arguments, **options)
+    except InputError as exc:  # the library names an element (noise_c[3]): said as the file's line
+        text = re.sub(r"\b(\w+)\[(\d+)\]", lambda m: f"{m.group(1)} (line {batch.line(int(m.group(2)))})"
+                      if int(m.group(2)) < batch.rows else m.group(0), str(exc))
+        raise InputError(f"batch file {batch.source}: {text}") from None
+    records = []
+    for k, rec in enumerate(answer.to_dict()):
+        row = {a: (inputs[a][k] if a in _NAMES else _number(scene[a][k])) for a in inputs}
+        records.append({**row, **rec})
+    return records
 
 
 def _inputs(batch: Batch, defaults: Mapping[str, Any]) -> dict[str, Any]:

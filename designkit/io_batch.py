@@ -202,7 +202,7 @@ def _column(name: str, arg: str, header: str, cells: list[str], lines: list[int]
     return out
 
 
-def answer_batch(batch: Batch, defaults: Mapping[str, Any] | None = None, *, route: str = "table",
+def answer_batch(batch: Batch, defaults: Mapping[str, Any] | None = None, *, route: str = "auto",
                  **options: Any) -> list[dict[str, Any]]:
     """Answer every row of ``batch``: one record per row, in the file's order.
 
@@ -214,7 +214,8 @@ def answer_batch(batch: Batch, defaults: Mapping[str, Any] | None = None, *, rou
         Library argument -> the value of a column the file leaves out, or of its empty cells (the command's
         options: ``noise_c=0.05`` ...). A scene value neither in the file nor here is the library's default.
     route : str
-        ``"table"`` or ``"exact"`` (:func:`designkit.query.ask`).
+        ``"auto"`` (the library's policy, :func:`designkit.query.policy.choose_route`, decided once for the
+        file), ``"table"`` or ``"exact"`` (:func:`designkit.query.ask`).
     **options
         The route's options (``table=``, ``threshold=``, ``coverage=`` ...).
 
@@ -226,11 +227,16 @@ def answer_batch(batch: Batch, defaults: Mapping[str, Any] | None = None, *, rou
         :meth:`designkit.query.ArrayAnswer.to_dict`).
     """
     from .query import ask
+    from .query.policy import choose_route
 
-    if route == "exact" and batch.rows > MAX_BATCH_ROWS_EXACT:
+    defaults = {k: v for k, v in (defaults or {}).items() if v is not None}
+    # the route the library's policy takes for this file (the scene's dT decides a varied table): the exact
+    # route's row limit applies to it
+    taken = choose_route(batch.question, route, {**options, **{k: v for k, v in defaults.items()
+                                                               if k == "delta_t_c"}})[0]
+    if taken == "exact" and batch.rows > MAX_BATCH_ROWS_EXACT:
         raise InputError(f"batch file {batch.source} has {batch.rows:,} rows: the exact route answers at most "
                          f"{MAX_BATCH_ROWS_EXACT} in one call (each is seconds); split it, or read a table")
-    defaults = {k: v for k, v in (defaults or {}).items() if v is not None}
     inputs = _inputs(batch, defaults)
     names = [a for a in inputs if a in _NAMES]
     scene = {a: v for a, v in inputs.items() if a not in _NAMES}

@@ -246,7 +246,7 @@ def _batch(question: str, path: str, fmt: str, out: Optional[str], *, objects: d
         options.update({k: v for k, v in exact_options.items() if k not in _MODEL_KEYS})
     else:
         options.update(ideal_table=ideal_table, **({"table": table} if table else {}))
-    records = answer_batch(batch, defaults, route="exact" if exact else "table", **options)
+    records = answer_batch(batch, defaults, route="exact" if exact else "auto", **options)
     payload = records  # json: the records (an array answer's to_dict, with each row's inputs)
     emit(fmt, out, payload=payload, records=records, title=f"{question}: {len(records)} rows")
 

@@ -111,10 +111,6 @@ def _ask_scene(question: str, *, exact: bool, table: Optional[str], ideal_table:
     from .. import query
     from ..query.crossing import check_coverage
 
-    from ._options import refuse_together
-
-    refuse_together(("--exact", exact), ("--table", table),
-                    why="--exact computes the answer for the pair, --table reads it from a table")
     from .._validation import MAX_EFFUSIVITY, InputError, check_positive
 
     if check_positive("--width", width) > MAX_EFFUSIVITY:  # on either route (the table's is its own): 1e308 was taken
@@ -229,10 +225,7 @@ def _batch(question: str, path: str, fmt: str, out: Optional[str], *, objects: d
     from ..io_batch import MAX_BATCH_ROWS, MAX_BATCH_ROWS_EXACT, answer_batch, read_batch
     from ..query.crossing import check_coverage
     from ..rig import DEFAULTS
-    from ._options import refuse_together
 
-    refuse_together(("--exact", exact), ("--table", table),
-                    why="--exact computes the answer for the pair, --table reads it from a table")
     if sensor != "paper" or any(v is not None for k, v in exact_options.items() if k in _MODEL_KEYS):
         raise InputError("--batch answers for the paper sensor and model (a sensor file's rig conditions apply to "
                          "one question at a time): ask without --batch, or build a table and name it with --table")
@@ -570,6 +563,10 @@ def _options(args: dict, objects: tuple, scene: dict, **extra) -> dict:
 
 def _answer(question: str, kw: dict, batch: Optional[str], fmt: str, out: Optional[str], explain: bool) -> None:
     """One question command's work: ``--batch`` (every row of a file, one array call) or one answer (_ask)."""
+    from ._options import refuse_together
+
+    refuse_together(("--exact", kw["exact"]), ("--table", kw["table"]),
+                    why="--exact computes the answer for the pair, --table reads it from a table")
     if batch is not None:
         exact_options = {k: kw[k] for k in ("model", "conductance", "thickness", "backing", "diffusivity", "width",
                                             "trials", "repeats", "seed", "jobs", "n_mc")}

@@ -72,7 +72,6 @@ def table_for(question: str, *, sensor=None, model=None, sensor_temp_spread_c: f
     from .table import DEFAULT_TABLE, shipped_spread_table
 
     sen, fm = _sensor_and_model(sensor, model)
-    # tables registered for a sensor of one's own (designkit.tables) are asked here, before the shipped ones
     why = table_reroute(sen, fm)
     if why is not None:
         return TableChoice(None, why, noted=True)
@@ -133,13 +132,9 @@ def choose_route(question: str, route: str, arguments: Mapping[str, Any]) -> tup
         return "exact", {k: v for k, v in args.items() if k not in TABLE_OPTIONS}, choice
     if args.get("diffusivity_m2_s") is not None:
         raise NeedsInput("a diffusivity was given but tables answer for effusivity alone", "diffusivity-unused")
-    args = {k: v for k, v in args.items() if k not in EXACT_OPTIONS}
-    if "table" not in args and choice.table != _default_table():
-        args["table"] = choice.table
-    return "table", args, choice
-
-
-def _default_table() -> str:
     from .table import DEFAULT_TABLE
 
-    return DEFAULT_TABLE
+    args = {k: v for k, v in args.items() if k not in EXACT_OPTIONS}
+    if "table" not in args and choice.table != DEFAULT_TABLE:
+        args["table"] = choice.table
+    return "table", args, choice

@@ -34,6 +34,7 @@ ratio, for every (linear) model.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from dataclasses import dataclass
 
@@ -246,6 +247,7 @@ def noisy_readings(time_s, e_object, sensor_temp_c, ambient_temp_c, sensor: Sens
     return out
 
 
+@functools.lru_cache(maxsize=8)
 def noise_cholesky(n_samples: int, sample_rate_hz: float, correlation_s: float) -> np.ndarray:
     """Lower Cholesky factor ``L`` of the noise's correlation matrix on ``n_samples`` samples.
 
@@ -267,7 +269,9 @@ def noise_cholesky(n_samples: int, sample_rate_hz: float, correlation_s: float) 
     a = math.sqrt(3.0) * np.abs(lag[:, None] - lag[None, :]) / float(correlation_s)
     corr = (1.0 + a) * np.exp(-a)
     corr[np.diag_indices(n)] += 1e-9
-    return np.linalg.cholesky(corr / (1.0 + 1e-9))
+    L = np.linalg.cholesky(corr / (1.0 + 1e-9))
+    L.flags.writeable = False  # one factor per process and size, shared by every class, contact and seed
+    return L
 
 
 def correlate_noise(noise, sample_rate_hz: float, correlation_s: float) -> np.ndarray:

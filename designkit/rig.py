@@ -116,10 +116,8 @@ def residual_correlation_s(residuals: Sequence[np.ndarray], sample_rate_hz: floa
     n_lag = min(int(max_lag_s * sample_rate_hz), min(r.size for r in rows) // 2)
     acf, weight = np.zeros(n_lag + 1), np.zeros(n_lag + 1)
     for r in rows:
-        x = r
-        full = np.correlate(x, x, "full")[x.size - 1:x.size + n_lag]
-        acf += full
-        weight += x.size - np.arange(n_lag + 1)
+        acf += np.correlate(r, r, "full")[r.size - 1:r.size + n_lag]
+        weight += r.size - np.arange(n_lag + 1)
     acf = acf / weight
     if not acf[0] > 0:
         return 0.0

@@ -31,10 +31,6 @@ __all__ = [
     "resolve_ranges",
 ]
 
-#: The paper's sensor (appendix): e_s [J s^-1/2 K^-1 m^-2] and alpha_s [m^2/s].
-PAPER_E_S = 892.0
-PAPER_ALPHA_S = 1.19e-9
-
 
 # ----------------------------------------------------------------- ranges
 @dataclass(frozen=True)

@@ -1593,12 +1593,9 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
                 f"{name}[{names[k]}]", float(x[j]), (x[j] - q[j] * sd[j], x[j] + q[j] * sd[j]), unit, ok,
                 "" if ok else "at a search bound or rank-deficient"))
     # ------------------------------------------------ fit quality
-    res_by: dict[str, list[np.ndarray]] = {n: [] for n in names}
-    pos = 0
-    for g in data.groups:
-        res_by[names[g.material]].append(r[pos:pos + g.y.size])
-        pos += g.y.size
-    rms_by = {n: float(np.sqrt(np.mean(np.concatenate(v) ** 2))) for n, v in res_by.items() if v}
+    rows = _touch_residuals(data, r)
+    rms = _rms([(n, row) for _, n, _, row in rows], total=False)
+    rms_by = {n: rms[n] for n in names if n in rms}
     n_s = r.size
     k_par = x.size + prob.n_linear()
     ssr = float(r @ r)
@@ -1617,17 +1614,30 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
                           nominal_force_profile(data) if cand.force_area else None,
                           rig_conditions(trials, pre_contact_noise_c=data.noise_c,
                                          residual_rms_c=float(np.sqrt(np.mean(r ** 2))),
-                                         onset_offset_s=math.nan, residuals=_touch_rows(data, r),
+                                         onset_offset_s=math.nan, residuals=[row for *_, row in rows],
                                          sample_rate_hz=data.sample_rate_hz).to_dict())
 
 
-def _touch_rows(data: "_Data", r: np.ndarray) -> list[np.ndarray]:
-    """The residual ``r`` (groups one after the other, each touch a row) cut into one series per touch."""
+def _touch_residuals(data: "_Data", r: np.ndarray) -> list[tuple[int, str, np.ndarray, np.ndarray]]:
+    """The residual ``r`` (groups one after the other, each touch a row) cut into one series per touch:
+    ``(trial index, material, time_s, residual)`` in the groups' order."""
     rows, pos = [], 0
     for g in data.groups:
-        rows.extend(r[pos:pos + g.y.size].reshape(g.y.shape))
+        block = r[pos:pos + g.y.size].reshape(g.y.shape)
         pos += g.y.size
+        rows.extend((k, data.names[g.material], g.time_s, row) for k, row in zip(g.trials, block))
     return rows
+
+
+def _rms(rows: Sequence[tuple[str, np.ndarray]], total: bool = True) -> dict[str, float]:
+    """Residual RMS [degC] per material of ``(material, residual)`` rows, and of all (``"all"``, when ``total``)."""
+    per: dict[str, list[np.ndarray]] = {}
+    for name, r in rows:
+        per.setdefault(name, []).append(r)
+    out = {n: float(np.sqrt(np.mean(np.concatenate(v) ** 2))) for n, v in per.items()}
+    if total:
+        out["all"] = float(np.sqrt(np.mean(np.concatenate([r for _, r in rows]) ** 2)))
+    return out
 
 
 #: The nominal force ramp a sensor file records: F / F_p from 1 s before the onset to 1.5 s after, every 20 ms.
@@ -1693,16 +1703,7 @@ def score(result: Identification, trials: Sequence[Trial], *,
     material's object temperature is free). Materials the fit did not see are
     refused (their e_o is unknown).
     """
-    data, r = _held_out(result, trials, object_temps)
-    names = result.names
-    out: dict[str, list[np.ndarray]] = {}
-    pos = 0
-    for g in data.groups:
-        out.setdefault(names[g.material], []).append(r[pos:pos + g.y.size])
-        pos += g.y.size
-    per = {n: float(np.sqrt(np.mean(np.concatenate(v) ** 2))) for n, v in out.items()}
-    per["all"] = float(np.sqrt(np.mean(r ** 2)))
-    return per
+    return _rms([(n, row) for _, n, _, row in _touch_residuals(*_held_out(result, trials, object_temps))])
 
 
 def residual_series(result: Identification, trials: Sequence[Trial], *,
@@ -1713,16 +1714,8 @@ def residual_series(result: Identification, trials: Sequence[Trial], *,
     -------
     list of (material, time_s, residual), in the order of ``trials``.
     """
-    data, r = _held_out(result, trials, object_temps)
-    rows: dict[int, tuple[str, np.ndarray, np.ndarray]] = {}
-    pos = 0
-    for g in data.groups:
-        n, m = g.y.shape
-        block = r[pos:pos + n * m].reshape(n, m)
-        pos += n * m
-        for i, k in enumerate(g.trials):
-            rows[k] = (result.names[g.material], g.time_s, block[i])
-    return [rows[k] for k in range(len(trials))]
+    rows = sorted(_touch_residuals(*_held_out(result, trials, object_temps)), key=lambda row: row[0])
+    return [row[1:] for row in rows]
 
 
 def _held_out(result: Identification, trials: Sequence[Trial],
@@ -1853,12 +1846,7 @@ def compare_models(fit_trials: Sequence[Trial], held_out: Sequence[Trial],
         results.append(res)
         if held_out:
             rows = residual_series(res, held_out, object_temps=kwargs.get("object_temps"))
-            per: dict[str, list[np.ndarray]] = {}
-            for name, _, r in rows:
-                per.setdefault(name, []).append(r)
-            sc = {n: float(np.sqrt(np.mean(np.concatenate(v) ** 2))) for n, v in per.items()}
-            sc["all"] = float(np.sqrt(np.mean(np.concatenate([r for _, _, r in rows]) ** 2)))
-            held.append(sc)
+            held.append(_rms([(name, r) for name, _, r in rows]))
             touch_ms.append(np.array([float(np.mean(r ** 2)) for _, _, r in rows]))
         else:
             held.append({})
@@ -1892,12 +1880,12 @@ def _select(results: Sequence[Identification], held: Sequence[Mapping[str, float
                       f"{len(results)} candidates (no touches held out){conflict}")
     low = min(ok, key=lambda i: (float(np.mean(touch_ms[i])), results[i].bic))
     simple = sorted(ok, key=lambda i: (results[i].n_parameters, i))
-    best, margin = low, 0.0
+    best = low
     for i in simple:
         d = touch_ms[i] - touch_ms[low]
         se = float(np.std(d, ddof=1) / math.sqrt(d.size)) if d.size > 1 else 0.0
         if float(np.mean(d)) <= se:
-            best, margin = i, se
+            best = i
             break
     label = results[best].candidate.label
     per = ", ".join(f"{n} {v:.3f}" for n, v in held[best].items() if n != "all")

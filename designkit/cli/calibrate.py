@@ -222,7 +222,7 @@ class _EmulatorWatch:
 
     def __call__(self, message: str, material: str) -> None:
         from .._validation import InputError
-        from ..calibration.emulator import parse_announcement, parse_greeting
+        from ..calibration.touch_plan import parse_announcement, parse_greeting
 
         advice = ("with the emulator, give its materials in its order, --trials equal to its "
                   "--touches-per-material, and --yes (the command it prints after 'try:')")

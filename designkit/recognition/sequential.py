@@ -64,9 +64,9 @@ Hopeless pairs
 No test that stops by ``T`` (sequential or not) has error rates below those of
 the best fixed test at ``T`` (Neyman-Pearson on all samples up to ``T``), and
 for ordered effusivity classes that test is a threshold on ``v``
-(:mod:`designkit.recognition.ideal`). :func:`fixed_time_errors` gives its best
-error rates from the ideal observer's closed form; where no threshold reaches
-the requested rates for some pair at the longest allowed contact, the test says
+(:mod:`designkit.recognition.ideal`). :func:`min_fixed_contact_s` gives the shortest fixed
+contact at which it reaches the requested rates (the ideal observer's closed form); where none
+does for some pair by the longest allowed contact, the test says
 so before the first sample (:attr:`SequentialTest.plan`), and every
 :meth:`SequentialTest.update` answers ``"no decision possible"``.
 
@@ -108,7 +108,6 @@ __all__ = [
     "CENTRAL",
     "FAR_PIECES",
     "candidate_pieces",
-    "fixed_time_errors",
     "log_marginals",
     "min_fixed_contact_s",
     "run_batch",
@@ -412,50 +411,14 @@ def _survival(t, e_range, e_sensor: float, s: float) -> float:
     return float(class_survival(t, lo, hi, e_sensor, s))
 
 
-def fixed_time_errors(range_low, range_high, error_low: float, error_high: float, sensor: Sensor,
-                      noise_ratio: float, contact_s, *, model=None) -> np.ndarray:
-    """Whether the best fixed test at ``contact_s`` reaches both error rates, vectorized over contact times.
-
-    The best test of two ordered effusivity classes on all samples up to
-    ``contact_s`` is a threshold on the projection ``v`` (Neyman-Pearson with a
-    monotone likelihood ratio, :mod:`designkit.recognition.ideal`); the
-    threshold with ``P(v > t | low) = error_low`` is taken and its error on the
-    high class compared with ``error_high``.
-
-    Parameters
-    ----------
-    range_low, range_high : (float, float)
-        Lower- and higher-effusivity class ranges [J s^-1/2 K^-1 m^-2].
-    error_low, error_high : float
-        Requested error rates on touches of each class.
-    sensor : Sensor
-    noise_ratio : float
-        sigma / |dT|.
-    contact_s : array_like
-        Contact times [s].
-
-    Returns
-    -------
-    ndarray of bool
-
-    Examples
-    --------
-    >>> from designkit import SENSORS
-    >>> fixed_time_errors((20000, 20080), (35000, 35080), 0.05, 0.05, SENSORS["paper"], 0.005, [1.0, 2.0])
-    array([False,  True])
-    """
-    fm = get_model(model)
-    t = np.atleast_1d(np.asarray(contact_s, dtype=np.float64))
-    idx = last_sample_index(t, sensor.sample_rate_hz)
-    g2 = np.cumsum(_shape(sensor, fm, int(idx.max()) + 1) ** 2)
-    with np.errstate(divide="ignore"):
-        s = noise_ratio / np.sqrt(g2[idx])
-    return np.array([_fixed_ok(range_low, range_high, error_low, error_high, sensor.effusivity, s_i) for s_i in s],
-                    dtype=bool)
-
-
 def _fixed_ok(range_low, range_high, error_low: float, error_high: float, e_sensor: float, s: float) -> bool:
-    """Whether the best fixed test with projection noise ``s`` reaches both error rates (see fixed_time_errors)."""
+    """Whether the best fixed test with projection noise ``s`` reaches both error rates.
+
+    The best test of two ordered effusivity classes on all samples up to a contact is a threshold on
+    the projection ``v`` (Neyman-Pearson with a monotone likelihood ratio,
+    :mod:`designkit.recognition.ideal`); the threshold with ``P(v > t | low) = error_low`` is taken
+    and its error on the high class compared with ``error_high``.
+    """
     if not np.isfinite(s):
         return False
     # threshold where the low class's false-positive rate equals error_low (Brent's method on w;
@@ -472,8 +435,8 @@ def min_fixed_contact_s(range_low, range_high, error_low: float, error_high: flo
                         noise_ratio: float, max_contact_s: float, *, model=None) -> float | None:
     """Shortest fixed contact [s] (to one sample) at which the ideal observer reaches both error rates.
 
-    None when not by ``max_contact_s``. Bisection over the sample count on
-    :func:`fixed_time_errors` (monotone: more samples never hurt the ideal observer).
+    None when not by ``max_contact_s``. Bisection over the sample count (monotone: more samples
+    never hurt the ideal observer) of whether the best fixed test reaches both rates.
 
     Examples
     --------

@@ -20,7 +20,7 @@ from .._validation import InputError, check_positive, check_temperature
 from .trials import Trial
 
 if TYPE_CHECKING:  # pragma: no cover
-    from .identify import Identification
+    from .results import Identification
 
 __all__ = [
     "CalibrationProblem",
@@ -30,10 +30,6 @@ __all__ = [
     "parse_ranges",
     "resolve_ranges",
 ]
-
-#: The paper's sensor (appendix): e_s [J s^-1/2 K^-1 m^-2] and alpha_s [m^2/s].
-PAPER_E_S = 892.0
-PAPER_ALPHA_S = 1.19e-9
 
 
 # ----------------------------------------------------------------- ranges
@@ -187,7 +183,7 @@ def check_calibration(result: "Identification | None", trials: Sequence[Trial]) 
       within 2 robust SDs of another material's median and beyond 5 of its own's (touches recorded
       while another sample was under the sensor);
     * **conflict**: no e_s keeps every material inside its effusivity range under ``result``'s model
-      (an :class:`~designkit.calibration.identify.Identification`);
+      (an :class:`~designkit.calibration.results.Identification`);
     * **no-response**: in most touches the sensor's reading moves by less than 5 pre-contact noise SDs
       (and 0.05 °C) over the contact: no heat flowed (the heater off, sensor and object at one
       temperature, a disconnected channel), so the touches hold nothing about e_s, whatever a fit says.

@@ -447,3 +447,17 @@ def test_reproduce_chooses_disjoint_calibration_and_test_touches_from_the_sets_p
     with pytest.raises(InputError) as exc:
         calibration_split(index(["2"]))
     assert str(exc.value) == "the recording has one trial set (9): no touches to hold out"
+
+
+
+def test_one_material_that_does_not_identify_e_s_is_refused_and_nothing_written(robot_data_dir, cli, tmp_path):
+    """Metal alone under the rig's model: its film and contact trade against e_s, so any e_s fits (issue 34).
+
+    One material says which, why and what to record: exit 2, and no sensor file.
+    """
+    path = tmp_path / "metal-only.yaml"
+    res = cli("calibrate", "fit", str(robot_data_dir / "index.csv"), "--only", "metal", "--range", "metal=aluminium",
+              "--model", "layered+lag+smoothing+drift+area", "--fit-sets", "1-2", "--out", str(path))
+    assert res.exit_code == 2, res.output
+    assert "do not identify the sensor's effusivity" in res.output and "one material, metal" in res.output
+    assert "Record a second material" in res.output and not path.exists()

@@ -173,6 +173,10 @@ def _normalized_drop(tr: Trial, at_s: float = 2.0) -> float:
     return drop
 
 
+#: Widest ratio of the e_s the materials allow (largest over smallest) that still counts as identified.
+UNIDENTIFIED_ES_RATIO = 100.0
+
+
 def check_calibration(result: "Identification | None", trials: Sequence[Trial]) -> list[CalibrationProblem]:
     """What makes a calibration unusable or suspect, each with a suggestion.
 
@@ -186,7 +190,9 @@ def check_calibration(result: "Identification | None", trials: Sequence[Trial]) 
       (an :class:`~designkit.calibration.results.Identification`);
     * **no-response**: in most touches the sensor's reading moves by less than 5 pre-contact noise SDs
       (and 0.05 °C) over the contact: no heat flowed (the heater off, sensor and object at one
-      temperature, a disconnected channel), so the touches hold nothing about e_s, whatever a fit says.
+      temperature, a disconnected channel), so the touches hold nothing about e_s, whatever a fit says;
+    * **unidentified**: the e_s every material allows under ``result``'s model spans more than a factor of
+      ``UNIDENTIFIED_ES_RATIO`` (one material under a model with a film and a contact conductance fits any e_s).
 
     Examples
     --------
@@ -270,4 +276,15 @@ def check_calibration(result: "Identification | None", trials: Sequence[Trial]) 
             "Check each material's label, range (--range NAME=MIN:MAX) and object temperature "
             "(--object-temp NAME=free for an object not at room temperature); let calibrate choose among every "
             "sensor model ('calibrate fit --model all', the default); or write the file anyway with --force"))
+    if result is not None and result.es_allowed:
+        lo = max(lo for lo, _ in result.es_allowed.values())
+        hi = min(hi for _, hi in result.es_allowed.values())
+        if not (lo > 0 and math.isfinite(hi) and hi <= UNIDENTIFIED_ES_RATIO * lo):
+            one = len(result.es_allowed) == 1
+            out.append(CalibrationProblem(
+                "unidentified", f"the touches do not identify the sensor's effusivity under the "
+                                f"{result.candidate.label} model (e_s anywhere in [{lo:.4g}, {hi:.4g}]"
+                                + (f", from one material, {next(iter(result.es_allowed))})" if one else ")"),
+                "Record a second material whose effusivity range is known and far from the first (wood beside "
+                "a metal, say) and fit both; or write the file anyway with --force"))
     return out

@@ -1,34 +1,18 @@
-"""The readings of many touches from a few: a scene's response in effusivity, computed once and shared by its classes.
+"""The readings of many touches from a few: a scene's response in effusivity, read once and shared by its classes.
 
-A simulated class is many touches (100 in a sweep) of objects whose effusivity
-is drawn uniformly in the class's range ``[e_low, e_high)``, all read on one
-time grid, and a scene (a sweep's grid) is hundreds of such classes read on the
-same grid. For a model whose reading costs much per object (an inverse Laplace
-transform per time, :class:`~designkit.models.layered.Layered`; a sum over a
-force ramp's shares, :class:`~designkit.models.ramp.ForceRamp`) every touch's
-reading comes from the model's readings at a few effusivities: a polynomial in
-the contact weight ``w = e_o / (e_s + e_o)`` (in which the paper's model is
-exactly linear and every model here nearly so), evaluated by the barycentric
-formula (Berrut & Trefethen 2004).
-
-The weights ``[0, 1]`` are cut into dyadic panels, ``[i / 2^L, (i + 1) / 2^L]``,
-the same for every class of a scene: a panel is read once (5 Chebyshev-Lobatto
-points, one call of the model) and then serves every class and repeat whose
-touches fall in it (:class:`SceneResponse`, kept per model, sensor, time grid and
-tolerance, :func:`scene_response`). The error is measured, not assumed: the
-interpolant through the panel's 3 points of order 2 is compared with the model at
-the 2 points between them; once within the tolerance the interpolant through all
-5 (more accurate still) answers, else the panel's two halves are read instead,
-down to :data:`MAX_LEVEL`, below which touches are read directly. A class's
-touches start at the level whose panels are 8 to 16 times the class's width
-(:func:`start_level`), so a class reads one or two panels (or their halves), each
-shared with its neighbours and repeats. The tolerance is the one a simulation asks of a numerically solved
-model (:func:`designkit.simulation.response_tolerance`: 1 % of the noise over the
-whole curve, at most 1e-5 of the temperature difference).
-
-Every reading is a function of the touches' effusivities and the class's range alone
-(not of which classes were read before): the same draws give the same readings bit
-for bit in any order, split or process.
+A sweep reads hundreds of classes (100 touches each, effusivity uniform in the class's range) on one time
+grid. For a model whose reading costs much per object (:class:`~designkit.models.layered.Layered`'s inverse
+Laplace transform, :class:`~designkit.models.ramp.ForceRamp`'s sum over its shares) every touch's reading is
+a polynomial in the contact weight ``w = e_o / (e_s + e_o)`` (the paper's model is linear in it), evaluated
+by the barycentric formula (Berrut & Trefethen 2004) on dyadic panels ``[i / 2^L, (i + 1) / 2^L]`` of ``w``.
+A panel is read once (5 Chebyshev-Lobatto points, one call of the model) and serves every class and repeat
+whose touches fall in it (:class:`SceneResponse`, one per model, sensor, time grid and tolerance:
+:func:`scene_response`). The error is measured: the panel's 3-point interpolant against the model at the 2
+points between them; within the tolerance (:func:`designkit.simulation.response_tolerance`: 1 % of the noise
+over the curve, at most 1e-5) the 5-point interpolant answers, else the panel's halves are read, down to
+:data:`MAX_LEVEL` (then directly). A class starts at panels 8-16 times its width (:func:`start_level`).
+A reading depends on the touch's effusivity and its class's range alone, never on the classes read before:
+the same draws give the same readings bit for bit in any order, split or process.
 
 Examples
 --------
@@ -47,7 +31,7 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -78,22 +62,9 @@ def _effusivity(w: np.ndarray, e_sensor: float) -> np.ndarray:
         return np.where(w >= 1.0, np.inf, e_sensor * w / np.where(w >= 1.0, 1.0, 1.0 - w))
 
 
-@dataclass(frozen=True, eq=False)  # holds arrays: compared by identity
-class Panel:
-    """The model read at 5 Chebyshev-Lobatto points of the weights ``[i / 2^level, (i + 1) / 2^level]``.
-
-    Attributes
-    ----------
-    level, index : int
-        Where the panel lies.
-    weights : ndarray, shape (5,)
-        The contact weights read.
-    values : ndarray, shape (5, m)
-        The model's readings there.
-    error : float
-        The measured error of the order-2 interpolant at the 2 interlacing points (an upper estimate of the
-        order-4 interpolant's, which answers).
-    """
+class Panel(NamedTuple):
+    """The model read at 5 Chebyshev-Lobatto ``weights`` of ``[index / 2^level, (index + 1) / 2^level]``:
+    ``values`` (5, m); ``error``: the 3-point interpolant's measured error (above the 5-point one's)."""
 
     level: int
     index: int
@@ -171,19 +142,8 @@ class SceneResponse:
         return [p for _, p in sorted(self._panels.items()) if p is not None]
 
 
-class _SensorKey:
-    """A sensor as a cache key: its repr (a sensor holds mappings, so it is not hashable itself)."""
-
-    __slots__ = ("sensor", "key")
-
-    def __init__(self, sensor):
-        self.sensor, self.key = sensor, repr(sensor)
-
-    def __hash__(self) -> int:
-        return hash(self.key)
-
-    def __eq__(self, other) -> bool:
-        return isinstance(other, _SensorKey) and other.key == self.key
+class _SensorKey(str):
+    """A sensor's repr as a cache key, carrying the sensor (which holds mappings: not hashable itself)."""
 
 
 @functools.lru_cache(maxsize=16)
@@ -202,7 +162,9 @@ def scene_response(model: ForwardModel, time_s, sensor, *, tolerance: float) -> 
         hash(model)
     except TypeError:   # a model with unhashable parameters: a response of its own, not shared
         return SceneResponse(model, t, sensor, tolerance)
-    return _cached_scene(model, _SensorKey(sensor), t.tobytes(), float(tolerance))
+    key = _SensorKey(repr(sensor))
+    key.sensor = sensor
+    return _cached_scene(model, key, t.tobytes(), float(tolerance))
 
 
 def start_level(w_low: float, w_high: float) -> int:

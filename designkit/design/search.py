@@ -353,7 +353,8 @@ def recommend(targets: list[Target], constraints: Constraints, *, skins=SKIN_SET
     sep = [e for e in cls if e is not None]
     t_sep = iter(best_sensor_eval(sensor, *(np.array([e[k] for e in sep]) for k in (0, 1)),
                                   np.array([e[2] for e in sep]), ratio).tolist() if sep else [])
-    all_pairs = [(targets[i].name, targets[j].name, next(t_sep) if e is not None else math.nan)
+    all_pairs = [(targets[i].name, targets[j].name, _credited(next(t_sep), best.sample_rate_hz) if e is not None
+                  else math.nan)
                  for (i, j), e in zip(ij, cls)]
     # trade-off: the best design's limiting contact against sigma/dT (noise floor and dT enter only so)
     ratios = ratio * np.geomspace(0.125, 8.0, 13)

@@ -26,7 +26,9 @@ def _plot(result, path: Path, svm: dict | None = None) -> Path:
     from ..figures import log_ticks, pyplot, save_figure
 
     plt = pyplot()
-    fig, (a1, a2) = plt.subplots(1, 2, figsize=(10.0, 4.0), constrained_layout=True)
+    rig = result.contact is not None
+    fig, axes = plt.subplots(1, 3 if rig else 2, figsize=(15.0 if rig else 10.0, 4.2), constrained_layout=True)
+    a1, a2 = axes[0], axes[1]
     r = [x for x, _ in result.pareto]
     t = [y for _, y in result.pareto]
     a1.loglog(r, t, "o-", color="C0")
@@ -42,7 +44,7 @@ def _plot(result, path: Path, svm: dict | None = None) -> Path:
     if (svm or {}).get("value") is not None:
         a1.plot([x0], [svm["value"]], "k^", ms=8, label="SVM confirmed")
     a1.set_xlabel("noise sigma / dT [-]  (noise floor over the heater's dT)")
-    a1.set_ylabel("limiting pair's shortest contact [s]")
+    a1.set_ylabel("limiting pair's shortest contact [s]" + (" (screened)" if rig else ""))
     a1.set_title(f"trade-off of the recommended sensor ({result.best.skin}, {sig(result.best.depth_um)} µm)", fontsize=9)
     a1.legend(fontsize=8)
     by_skin: dict = {}
@@ -63,11 +65,27 @@ def _plot(result, path: Path, svm: dict | None = None) -> Path:
     a2.axhline(c.max_contact_s, color="0.5", ls=":", lw=1)
     log_ticks(a2.xaxis, [d.depth_um for d in result.designs])
     a2.set_xlabel("thermistor depth [µm]")
-    how = "ideal observer" if result.contact is None else "screened under the rig's contact, from its onset"
+    how = "ideal observer" if not rig else f"screened under the contact, from the {result.contact.counted_from}"
     a2.set_ylabel(f"limiting pair's shortest contact [s]\n({how})")
     a2.set_title("each skin material over depth" + ("" if result.contact is None else
                                                       " (best thermistor tau, skin thickness and press)"), fontsize=9)
     a2.legend(fontsize=6, ncol=2)
+    if rig:  # the thermistor's own lag and the press, for the recommended skin at its depth and thickness
+        best, a3 = result.best, axes[2]
+        mine = [d for d in result.designs if (d.skin, d.depth_um, d.skin_thickness_um) ==
+                (best.skin, best.depth_um, best.skin_thickness_um)]
+        for i, pace in enumerate(sorted({d.press_pace for d in mine}, reverse=True)):
+            ds = sorted((d for d in mine if d.press_pace == pace), key=lambda d: d.thermistor_tau_s)
+            a3.plot([max(d.thermistor_tau_s, 1e-3) for d in ds],
+                    [d.min_contact_s if d.min_contact_s < 1e9 else float("nan") for d in ds], "o-", color=f"C{i}",
+                    label="the rig's press" if pace == 1 else f"the press {1 / pace:.3g}x as fast")
+        a3.plot([max(best.thermistor_tau_s, 1e-3)], [best.min_contact_s], "k*", ms=12, label="recommended")
+        a3.set_xscale("log")
+        a3.axhline(c.max_contact_s, color="0.5", ls=":", lw=1)
+        a3.set_xlabel("thermistor's own time constant [s]")
+        a3.set_ylabel("limiting pair's shortest contact [s] (screened)")
+        a3.set_title(f"{best.skin[:30]}, {sig(best.depth_um)} µm: thermistor lag and press", fontsize=9)
+        a3.legend(fontsize=7)
     return save_figure(fig, path)
 
 

@@ -60,8 +60,7 @@ def _plot(result, path: Path, svm: dict | None = None) -> Path:
     if b is not None and b.min_contact_s < 1e9:
         a2.plot([b.depth_um], [b.min_contact_s], "kX", ms=10, label="the rig as built")
     elif b is not None:
-        a2.annotate(f"the rig as built: not within {c.max_contact_s:g} s", (0.02, 0.97), xycoords="axes fraction",
-                    va="top", fontsize=8)
+        a2.plot([], [], "kX", ms=10, label=f"the rig as built: not within {c.max_contact_s:g} s")
     a2.axhline(c.max_contact_s, color="0.5", ls=":", lw=1)
     log_ticks(a2.xaxis, [d.depth_um for d in result.designs])
     a2.set_xlabel("thermistor depth [µm]")

@@ -481,11 +481,12 @@ def confirm_with_svm(result: DesignResult, targets: list[Target], *, trials: int
     """The paper's SVM on the recommended design's limiting pair, under the design's model and scene: its
     shortest contact bracketed.
 
-    The mean F1 over ``seeds`` runs is evaluated at ``low_s`` (default: the credited bound); below the
-    threshold there, at ``high_s`` (default ``low_s + step_s``, the step doubling until the threshold is
-    reached or the longest contact), then the bracket is bisected ``bisections`` times (on sample times).
-    ``value`` is the bracket's high end, ``interval`` the bracket (the SVM's crossing lies in
-    ``(low, high]``; ``low`` None: at or below the first contact evaluated).
+    The mean F1 over ``seeds`` runs is evaluated at ``low_s`` (default: the credited bound). At or above the
+    threshold there, contacts below are evaluated (the step doubling) until it falls short; below it, at
+    ``high_s`` (default ``low_s + step_s``) and above (the step doubling) until it is reached or the longest
+    contact. The bracket is then bisected ``bisections`` times (on sample times). ``value`` is the bracket's
+    high end, ``interval`` the bracket (the SVM's crossing lies in ``(low, high]``; ``low`` None: at the
+    shortest contact credited, :data:`MIN_SAMPLES` samples).
     """
     from ..objects import ObjectClass
 
@@ -500,7 +501,10 @@ def confirm_with_svm(result: DesignResult, targets: list[Target], *, trials: int
     def snap(x, way=round):  # onto sample times (the F1 changes only there), at least MIN_SAMPLES
         return round(max(int(way(x * fs - 1e-9 if way is math.ceil else x * fs + 1e-9)), MIN_SAMPLES) / fs, 6)
 
-    def f1(x):
+    def f1(x):  # each contact once
+        done = [e["svm_f1"] for e in evals if e["contact_s"] == x]
+        if done:
+            return done[0]
         f = svm_f1_at(best, *classes, x, c.noise_c, c.max_delta_t_c, trials=trials,
                       seeds=[[s, 17] for s in range(seeds)])
         evals.append({"contact_s": x, "svm_f1": f})
@@ -510,12 +514,24 @@ def confirm_with_svm(result: DesignResult, targets: list[Target], *, trials: int
            "grid_step_s": step_s}
     top = snap(c.max_contact_s)
     lo = min(snap(best.min_contact_s if low_s is None else low_s, math.floor), top)
+    floor = snap(0.0)
     f_lo = f1(lo)
-    if f_lo >= c.threshold:
-        return {"value": lo, "svm_f1": f_lo, "interval": {"low": None, "high": lo, "coverage": None}, **out,
-                "svm_minus_ideal_s": round(lo - best.min_contact_s, 6), "evaluations": evals}
-    hi = min(snap(lo + step_s if high_s is None else max(high_s, lo + 1 / fs), math.ceil), top)
-    width = hi - lo
+    width = max(step_s, (high_s - lo) if high_s is not None and high_s > lo else step_s)
+    while f_lo >= c.threshold:  # reached already: step down (doubling) until it falls short, or to the floor
+        if lo <= floor:
+            return {"value": lo, "svm_f1": f_lo, "interval": {"low": None, "high": lo, "coverage": None}, **out,
+                    "svm_minus_ideal_s": round(lo - best.min_contact_s, 6), "evaluations": evals}
+        below = max(snap(lo - width, math.floor), floor)
+        f_below = f1(below)
+        if f_below < c.threshold:
+            hi, f_hi, lo = lo, f_lo, below
+            break
+        lo, f_lo, width = below, f_below, 2 * width
+    else:
+        hi = None
+    if hi is None:
+        hi = min(snap(lo + step_s if high_s is None else max(high_s, lo + 1 / fs), math.ceil), top)
+        width = hi - lo
     while True:
         f_hi = f1(hi)
         if f_hi >= c.threshold:
@@ -568,13 +584,14 @@ def predict(result: DesignResult, targets: list[Target], *, trials: int = 100, r
 def predict_and_confirm(result: DesignResult, targets: list[Target], *, trials: int = 100, repeats: int = 4,
                         seeds: int = 3, bisections: int = 3, jobs: int = 1, n_mc: int = 1000) -> dict:
     """:func:`predict`, then :func:`confirm_with_svm` with fresh seeds, bracketing the SVM's crossing from the
-    stated interval's ends: ``holds`` when the SVM falls short of the threshold at the interval's low end and
-    reaches it by its high end (its crossing lies inside the stated interval)."""
+    stated interval's ends: ``holds`` when the bracket lies inside the stated interval (to a sample): the SVM
+    falls short of the threshold at (or above) its low end and reaches it by its high end."""
     pred = predict(result, targets, trials=trials, repeats=repeats, jobs=jobs, n_mc=n_mc)
     low, high = pred["interval"]["low"], pred["interval"]["high"]
     conf = confirm_with_svm(result, targets, trials=trials, seeds=seeds, low_s=low, high_s=high,
                             bisections=bisections)
-    v = conf["value"]
+    v, a, dt = conf["value"], conf["interval"]["low"], 1.0 / result.best.sample_rate_hz
+    # the SVM's crossing lies in (a, v]: inside the stated interval to a sample (the F1 changes only at samples)
     holds = (None if low is None or high is None else
-             bool(v is not None and conf["interval"]["low"] is not None and v <= high + 1e-9))
+             bool(v is not None and a is not None and a >= low - dt - 1e-9 and v <= high + dt + 1e-9))
     return {**conf, "prediction": pred, "holds": holds}

@@ -146,7 +146,9 @@ def design(
 
     Example (the recommendation as one pandas-ready record): `designkit design --m a=20000 --m b=35000 --no-svm --format csv`
 
-    Example (under a slow contact, given explicitly; --sensor FILE takes a calibrated rig's): `designkit design --m a=20000 --m b=35000 --contact-conductance 1600 --contact-ramp-s 2 --thermistor-tau-s 1 --skin peek --skin alumina --no-svm`
+    Under a rig's contact: --sensor FILE (a calibrated rig's), or the contact given explicitly.
+
+    Example (a slow contact, given): `designkit design --m a=20000 --m b=35000 --contact-conductance 1600 --contact-ramp-s 2 --thermistor-tau-s 1 --skin peek --no-svm`
     """
     from ..design.search import SKIN_SET, Constraints, confirm_with_svm, predict_and_confirm, recommend, targets_from
     from ..materials import get_material

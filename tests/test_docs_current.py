@@ -28,6 +28,7 @@ def _generator():
     return runpy.run_path(str(SCRIPT), run_name="docs_generate")
 
 
+@pytest.mark.slow
 @needs_checkout
 def test_generated_examples_are_current(capsys, monkeypatch):
     # docs/tutorial.md is checked whole, its slow blocks too, by tests/test_docs_site.py: not twice

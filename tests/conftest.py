@@ -57,3 +57,20 @@ def ctrl_c_able() -> dict:
     never raises KeyboardInterrupt. The child gets the default disposition back, so that the
     test checks designkit's Ctrl-C handling wherever the suite runs."""
     return {"preexec_fn": _default_sigint}
+
+
+def pytest_collection_modifyitems(config, items):
+    """Files holding a test marked ``slow`` first, the most slow tests first, then the others by their number of
+    tests (most first), each file's tests in their own order.
+
+    pyproject's addopts hand xdist whole files in this order (``--dist loadfile --no-loadscope-reorder``): a slow
+    file started last kept one worker busy while the others had finished (xdist's own order, by number of tests,
+    put the tutorial's calibration, three tests, near the end)."""
+    slow: dict[str, int] = {}
+    count: dict[str, int] = {}
+    for item in items:
+        f = item.nodeid.split("::", 1)[0]
+        count[f] = count.get(f, 0) + 1
+        slow[f] = slow.get(f, 0) + (item.get_closest_marker("slow") is not None)
+    first = {f: i for i, f in enumerate(dict.fromkeys(item.nodeid.split("::", 1)[0] for item in items))}
+    items.sort(key=lambda item: (lambda f: (-slow[f], -count[f], first[f]))(item.nodeid.split("::", 1)[0]))

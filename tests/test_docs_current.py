@@ -28,9 +28,10 @@ def _generator():
     return runpy.run_path(str(SCRIPT), run_name="docs_generate")
 
 
+@pytest.mark.slow
 @needs_checkout
 def test_generated_examples_are_current(capsys, monkeypatch):
-    # docs/tutorial.md is checked whole, its slow blocks too, by tests/test_docs_site.py: not twice
+    # docs/tutorial.md is checked whole, its slow blocks too, by tests/test_docs_tutorial.py: not twice
     files = [str(p) for p in _generator()["FILES"] if p.name != "tutorial.md"]
     monkeypatch.setattr(sys, "argv", [str(SCRIPT), "--check", *files])
     with pytest.raises(SystemExit) as done:

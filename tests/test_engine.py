@@ -146,6 +146,7 @@ def test_noise_ratio_shortcut_equals_sweeping_noise_and_delta_t(paper_sensor):
     np.testing.assert_allclose(by_ratio.cells, by_pair.cells, atol=1e-12)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("solver", ["sklearn", "batched"])
 def test_a_table_is_a_function_of_its_config_whatever_the_split(solver, tmp_path):
     """Same arrays for several --blocks, --jobs and backends, and a contact time swept alone gives

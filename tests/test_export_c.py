@@ -104,6 +104,7 @@ def check_example_answer(exe: Path, tab, want: float) -> None:
 
 
 # ============================================================ random inputs
+@pytest.mark.slow  # a C compile and thousands of queries per case (5-15 s)
 @pytest.mark.parametrize("name", [n for n in CASES if n != "svm-small-full"] + ["svm-small-full"])
 def test_c_header_answers_like_the_query(tmp_path, name):
     tab, opts, exp = case(name)
@@ -127,6 +128,7 @@ def test_c_header_of_the_whole_ideal_table(tmp_path):
     check_example_answer(exe, tab, want)  # the example program on the whole table
 
 
+@pytest.mark.slow  # a C compile and thousands of queries per case (5-15 s)
 def test_c_header_of_the_shipped_svm_paper_table(tmp_path):
     tab = load_table("svm-paper")
     exp = slice_table(tab)
@@ -192,6 +194,7 @@ def _invalid(op: str, args) -> bool:
             or noise < 0 or dt == 0 or (contact is not None and contact <= 0))
 
 
+@pytest.mark.slow  # a C compile and thousands of queries per case (5-15 s)
 @pytest.mark.parametrize("name", ["svm-small-full", "rand-varied-full", "ideal-row", "rand-ratio-e"])
 def test_sanitizer_build_at_and_beyond_every_edge(tmp_path, name):
     tab, opts, exp = case(name)

@@ -21,12 +21,15 @@ mpmath.mp.dps = 30
 
 
 def mp_survival(t, a, b, s):
-    t, a, b, s = (mpmath.mpf(float(v)) for v in (t, a, b, s))
-    w = lambda e: e / (E_S + e)  # noqa: E731
-    et = E_S * t / (1 - t) if t < 1 else b
-    pts = sorted({a, b, *(p for p in (et - 20 * s * (E_S + et) ** 2 / E_S, et,
-                                      et + 20 * s * (E_S + et) ** 2 / E_S) if a < p < b)})
-    return mpmath.quad(lambda e: mpmath.ncdf((w(e) - t) / s), pts) / (b - a)
+    """The class survival by mpmath's quadrature at 20 digits: the 60 cases below round to the same doubles as at 30
+    digits (half the time; they differ from the library's by up to 3e-12)."""
+    with mpmath.workdps(20):
+        t, a, b, s = (mpmath.mpf(float(v)) for v in (t, a, b, s))
+        w = lambda e: e / (E_S + e)  # noqa: E731
+        et = E_S * t / (1 - t) if t < 1 else b
+        pts = sorted({a, b, *(p for p in (et - 20 * s * (E_S + et) ** 2 / E_S, et,
+                                          et + 20 * s * (E_S + et) ** 2 / E_S) if a < p < b)})
+        return mpmath.quad(lambda e: mpmath.ncdf((w(e) - t) / s), pts) / (b - a)
 
 
 def test_class_survival_matches_mpmath():

@@ -98,6 +98,7 @@ def test_array_questions_get_the_same_monte_carlo_bound():
     assert (nan_is_none(arr.low[1]), nan_is_none(arr.high[1])) == one.interval
 
 
+@pytest.mark.slow
 def test_the_cli_prints_the_bounds_interval():
     r = subprocess.run([sys.executable, "-m", "designkit", "min-contact", "--e1", "35000", "--e2", "20000",
                         "--delta-t", "7.5", "--sensor-temp-spread", "2.5"], capture_output=True, text=True,

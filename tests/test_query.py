@@ -199,6 +199,7 @@ def test_materials_rule_answers_for_the_facing_edges(cli):
     assert r.exit_code == 2 and len(r.stderr.strip().splitlines()) == 1
 
 
+@pytest.mark.slow
 def test_materials_edge_pair_against_the_old_nine_by_nine_worst_case():
     """On the shipped svm-paper table, the paper's 12 materials' non-overlapping pairs: the facing-edge answer
     (classes inside the materials) against the worst case over a 9 x 9 grid of effusivity pairs (the rule

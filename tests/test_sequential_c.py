@@ -92,6 +92,7 @@ def _c(exe: Path, temps0, times, temps):
     return out
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("cands,e_true,noise", [
     ((("20000", (20000.0, 20080.0)), ("35000", (35000.0, 35080.0))), [(20000.0, 20080.0), (35000.0, 35080.0)], 0.1),
     ((("wood", (331.0, 506.46)), ("acrylic", (550.0, 650.0)), ("metal", (12767.0, 25972.0))),

@@ -175,7 +175,12 @@ def _ask_scene(question: str, *, exact: bool, table: Optional[str], ideal_table:
         # the shipped tables are for the paper sensor and the semi-infinite model: another sensor or model is
         # computed unless a table is named (a named table built for another one is refused, never used);
         # varied initial conditions: no shipped table holds them, computed for the pair
-        reroute = None if exact or table is not None else table_reroute(sen, fm)
+        own = None  # the table built for this sensor file (designkit tables build), where one is registered
+        if not exact and table is None and source == "sensor file" and not spread > 0:
+            from ..tables.registry import table_for_sensor
+
+            own = table_for_sensor(sen)
+        reroute = None if exact or table is not None or own is not None else table_reroute(sen, fm)
         # varied initial conditions: the shipped table for the paper's spread (2.5 degC) and dT, else computed
         varied = None
         if spread > 0 and not exact and table is None and reroute is None:
@@ -191,6 +196,9 @@ def _ask_scene(question: str, *, exact: bool, table: Optional[str], ideal_table:
 
                 raise NeedsInput("a diffusivity was given but tables answer for effusivity alone",
                                  "diffusivity-unused")
+            if own is not None:
+                return _from_own_table(question, own, objects, scene, threshold, sen, fm, extra["coverage"]), rig, \
+                    asked
             from ..query.table import DEFAULT_TABLE
 
             return query.ask(question, route="table", **objects, **scene, threshold=threshold,
@@ -204,6 +212,32 @@ def _ask_scene(question: str, *, exact: bool, table: Optional[str], ideal_table:
                 kw["progress"] = report
             return _noted(query.ask(question, route="exact", **objects, **scene, **kw), reroute, sen, fm,
                           source), rig, asked
+
+
+#: Questions whose table route would estimate a missing closed-form ideal bound by Monte Carlo (seconds).
+_MC_BOUND = frozenset({"min-contact", "delta-e"})
+
+
+def _from_own_table(question: str, own, objects: dict, scene: dict, threshold, sen, fm, coverage: float):
+    """A question about a sensor file answered from the table built for it (:func:`~designkit.tables.registry.
+    table_for_sensor`). Its model has no closed-form ideal observer: the bound is not tabulated, and not
+    estimated here (seconds; ``--exact`` does). A question outside the table's span is refused (one line,
+    exit 2), never answered by extrapolation nor silently computed instead."""
+    import dataclasses
+
+    from .. import query
+    from .._validation import InputError
+
+    fn = query.QUESTIONS[question].table
+    ans = fn(**objects, **scene, threshold=threshold, table=own, ideal_table=None, sensor=sen, model=fm,
+             coverage=coverage, **({"ideal_bound": False} if question in _MC_BOUND else {}))
+    if not all(ans.in_grid.values()):
+        raise InputError("; ".join(ans.notes) + f" (the table built for sensor {sen.name}): ask with --exact "
+                         "(computed, tens of seconds), or widen the table with 'designkit tables build --sensor "
+                         "FILE --e-range LO HI'")
+    return dataclasses.replace(ans, notes=(*ans.notes, f"from the table built for sensor {sen.name} (designkit "
+                                           "tables build); its model has no closed-form ideal observer: --exact "
+                                           "estimates the bound by Monte Carlo"))
 
 
 @contextmanager

@@ -181,6 +181,8 @@ def _ask_scene(question: str, *, exact: bool, table: Optional[str], ideal_table:
 
             own = table_for_sensor(sen)
         reroute = None if exact or table is not None or own is not None else table_reroute(sen, fm)
+        if reroute and source == "sensor file" and getattr(sen, "conditions", None):
+            reroute += "; 'designkit tables build --sensor FILE' builds this sensor's table (then milliseconds)"
         # varied initial conditions: the shipped table for the paper's spread (2.5 degC) and dT, else computed
         varied = None
         if spread > 0 and not exact and table is None and reroute is None:

@@ -43,9 +43,9 @@ def tables_build(
     data folder (``$DESIGNKIT_DATA_DIR`` when set): later `--sensor FILE` questions read it; an edited or
     recalibrated sensor file has another digest and is computed again until its own table is built.
 
-    Example: `designkit tables build --sensor rig.yaml --materials paper12`
+    The paper's 12 materials at the paper's 100 trials per interval: `--materials paper12` (minutes on 2 cores).
 
-    Example (two materials only, minutes): `designkit tables build --sensor rig.yaml --m wood --m glass`
+    Example (two materials, a quick coarse table): `designkit tables build --sensor my-sensor.yaml --m wood --m glass --trials 20`
     """
     from .._validation import InputError
     from ..sweep import SweepInterrupted

@@ -237,7 +237,18 @@ def _from_own_table(question: str, own, objects: dict, scene: dict, threshold, s
         raise InputError("; ".join(ans.notes) + f" (the table built for sensor {sen.name}): ask with --exact "
                          "(computed, tens of seconds), or widen the table with 'designkit tables build --sensor "
                          "FILE --e-range LO HI'")
-    return dataclasses.replace(ans, notes=(*ans.notes, f"from the table built for sensor {sen.name} (designkit "
+    notes = ans.notes
+    if question == "min-contact" and (ans.value is None or ans.interval_kind == "table-cell"):
+        from ..rig import from_model_contact, model_start_s  # the route's note counts as the model does: from the onset
+
+        start = model_start_s(sen)
+        at = [f"{max(from_model_contact(float(t), start), 0.0):.3g}" for t in
+              ((own.axes["contact_s"][-1],) if ans.value is None else ans.interval)]
+        notes = ((f"no tabulated contact time up to {at[0]} s after the rig's detected onset separates them (--exact "
+                  "examines up to 10 s)",) if ans.value is None else
+                 (f"the shortest contact lies in ({at[0]}, {at[1]}] s after the rig's detected onset, a cell of the "
+                  "table's contact grid: no interval of stated coverage there (--exact estimates one)",))
+    return dataclasses.replace(ans, notes=(*notes, f"from the table built for sensor {sen.name} (designkit "
                                            "tables build); its model has no closed-form ideal observer: --exact "
                                            "estimates the bound by Monte Carlo"))
 

@@ -41,7 +41,9 @@ def tables_build(
     it, contact times counted from the rig's detected onset) over the effusivities of the materials named
     (or a range, or 0 to 40000). It is registered under the digest of the sensor's content in the user's
     data folder (``$DESIGNKIT_DATA_DIR`` when set): later `--sensor FILE` questions read it; an edited or
-    recalibrated sensor file has another digest and is computed again until its own table is built.
+    recalibrated sensor file has another digest and is computed again until its own table is built. A
+    question outside the table's span (another material, noise or contact time) is refused in one line
+    (exit 2) naming the way out: `--exact`, or a table built over a wider span.
 
     The paper's 12 materials at the paper's 100 trials per interval: `--materials paper12` (minutes on 2 cores).
 

@@ -115,6 +115,7 @@ def test_a_question_outside_the_tables_span_is_refused_in_one_line(built, data_d
     assert "\n" not in line and "outside" in line and "--exact" in line and "tables build" in line
     noisy = cli("min-contact", "--sensor", built["sensor_file"], "--m1", "wood", "--m2", "glass", "--noise", "0.5")
     assert noisy.exit_code == 2 and "sigma/dT" in noisy.output and "--exact" in noisy.output
+    assert "{" not in noisy.output and "--e-range" not in noisy.output  # a wider effusivity span would not help
 
 
 def test_a_table_of_another_sensor_is_never_used(built, data_dir, cli, tmp_path):

@@ -235,8 +235,9 @@ def _from_own_table(question: str, own, objects: dict, scene: dict, threshold, s
              coverage=coverage, **({"ideal_bound": False} if question in _MC_BOUND else {}))
     if not all(ans.in_grid.values()):
         raise InputError("; ".join(ans.notes) + f" (the table built for sensor {sen.name}): ask with --exact "
-                         "(computed, tens of seconds){'' if ans.in_grid.get('effusivity', True) else ', or build a table over a "
-                         "wider span with designkit tables build --sensor FILE --e-range LO HI'}")
+                         "(computed, tens of seconds)" + ("" if ans.in_grid.get("effusivity", True) else
+                                                          ", or build a table over a wider span with 'designkit "
+                                                          "tables build --sensor FILE --e-range LO HI'"))
     notes = ans.notes
     if question == "min-contact" and (ans.value is None or ans.interval_kind == "table-cell"):
         from ..rig import from_model_contact, model_start_s  # the route's note counts as the model does: from the onset

@@ -6,6 +6,12 @@ dT in [5, 15] degC, contact in [0.5, 10] s; table svm-fine (the library's defaul
 
     python benchmarks/bench_export.py                 # conformance and timings
     python benchmarks/bench_export.py --reference     # also (re)write tests/data/export_conformance.json
+    python benchmarks/bench_export.py --baseline REV  # also REV's exports, timed in the same run
+
+Per-call times are CPU times (the machines are shared): C's clock(), Python's time.process_time(). With
+``--baseline REV`` the module and header that commit's ``designkit/export`` writes (over this tree's
+library, so the same tables) answer the same questions in the same run: their times are the baseline,
+and the answers are compared with this tree's value by value.
 
 An answer conforms when it is within 1 % of the library's value or inside its 90 % interval (None == None);
 distinguishable's verdicts are compared where the contact lies outside min-contact's interval.
@@ -15,6 +21,8 @@ from __future__ import annotations
 
 import json
 import math
+import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -124,20 +132,20 @@ def estimator_answers(est, q: dict, grid=None):
     times = {"min_contact": 0.0, "delta_e": 0.0}
     for i in range(len(q["e1"])):
         a = (q["e1"][i], q["e2"][i], q["noise"][i], q["dt"][i])
-        t = time.perf_counter()
+        t = time.process_time()
         out["min_contact"].append(est.min_contact_s(*a))
-        times["min_contact"] += time.perf_counter() - t
-        t = time.perf_counter()
+        times["min_contact"] += time.process_time() - t
+        t = time.process_time()
         out["delta_e"].append(est.delta_e(a[0], a[2], a[3], q["contact"][i]))
-        times["delta_e"] += time.perf_counter() - t
+        times["delta_e"] += time.process_time() - t
         out["distinguishable"].append(est.distinguishable(*a, q["contact"][i]))
         if grid is not None:
-            t = time.perf_counter()
+            t = time.process_time()
             grid.min_contact_s(*a)
-            times["grid_min_contact"] = times.get("grid_min_contact", 0.0) + time.perf_counter() - t
-            t = time.perf_counter()
+            times["grid_min_contact"] = times.get("grid_min_contact", 0.0) + time.process_time() - t
+            t = time.process_time()
             grid.delta_e(a[0], a[2], a[3], q["contact"][i])
-            times["grid_delta_e"] = times.get("grid_delta_e", 0.0) + time.perf_counter() - t
+            times["grid_delta_e"] = times.get("grid_delta_e", 0.0) + time.process_time() - t
     return out, {k: v / len(q["e1"]) for k, v in times.items()}
 
 
@@ -157,11 +165,35 @@ def score(ans: dict, ref: dict, q: dict) -> dict:
     return res
 
 
+def baseline_exports(rev: str, workdir: Path) -> tuple[bytes, bytes]:
+    """The Python module and C header of svm-fine that commit ``rev``'s designkit/export writes (over this tree's
+    library and tables, in a subprocess)."""
+    repo = HERE.parent
+    base = workdir / "base"
+    shutil.copytree(repo / "designkit", base / "designkit", ignore=shutil.ignore_patterns("__pycache__"))
+    shutil.rmtree(base / "designkit" / "export")
+    archive = subprocess.run(["git", "-C", str(repo), "archive", rev, "designkit/export"], check=True,
+                             capture_output=True).stdout
+    subprocess.run(["tar", "-x", "-C", str(base)], input=archive, check=True)
+    os.symlink(repo / "tables", base / "tables")
+    code = ("import sys; from designkit.export import render, slice_table; e = slice_table('svm-fine'); "
+            "open(sys.argv[1], 'wb').write(render(e, 'python')); open(sys.argv[2], 'wb').write(render(e, 'c'))")
+    subprocess.run([sys.executable, "-c", code, str(workdir / "dk_base.py"), str(workdir / "base.h")], check=True,
+                   env={**os.environ, "PYTHONPATH": str(base)}, cwd=workdir)
+    return (workdir / "dk_base.py").read_bytes(), (workdir / "base.h").read_bytes()
+
+
+def same_answers(a: dict, b: dict) -> str:
+    """How many answers of two runs are equal, per question."""
+    return ", ".join(f"{k} {sum(x == y for x, y in zip(a[k], b[k]))}/{len(a[k])}" for k in a)
+
+
 def main(argv: list[str]) -> None:
     from designkit.export import export_bytes, read_export, render, slice_table
     from designkit.export.estimator_data import estimator_of
 
     q = questions()
+    baseline = argv[argv.index("--baseline") + 1] if "--baseline" in argv else None
     if "--reference" in argv or not REFERENCE.is_file():
         print("asking the library (array route) ...", flush=True)
         ref = library(q)
@@ -181,8 +213,15 @@ def main(argv: list[str]) -> None:
         (d / "dk.py").write_bytes(render(exp, "python"))
         sys.path.insert(0, str(d))
         import dk  # noqa: E402
+        rows = {}
+        if baseline:
+            base_py, base_h = baseline_exports(baseline, d)
+            (d / "cbase").mkdir()
+            rows[f"C {baseline}"] = c_answers(base_h, q, d / "cbase")
+            import dk_base  # noqa: E402
+            rows[f"python {baseline}"] = estimator_answers(dk_base._EST, q)
         py_ans, py_t = estimator_answers(dk._EST, q, dk.TABLE)
-        rows = {"C": (c_ans, c_t), "python": (py_ans, py_t)}
+        rows.update({"C": (c_ans, c_t), "python": (py_ans, py_t)})
         for fmt in ("json", "csv", "npz"):
             f = d / f"t.{fmt}"
             f.write_bytes(render(exp, fmt))
@@ -192,10 +231,18 @@ def main(argv: list[str]) -> None:
             rows[fmt] = estimator_answers(estimator_of(read_export(f)), q)
     for fmt, (ans, times) in rows.items():
         s = score(ans, ref, q)
-        print(f"{fmt:7s} " + "  ".join(f"{k} {a}/{b} ({100 * a / max(b, 1):.1f} %)" for k, (a, b) in s.items())
+        print(f"{fmt:14s} " + "  ".join(f"{k} {a}/{b} ({100 * a / max(b, 1):.1f} %)" for k, (a, b) in s.items())
               + f"  per call: min-contact {times['min_contact'] * 1e6:.1f} us, delta-e {times['delta_e'] * 1e6:.1f} us"
               + (f" (grid rule in the same run: {times['grid_min_contact'] * 1e6:.2f} us, "
                  f"{times['grid_delta_e'] * 1e6:.2f} us)" if "grid_min_contact" in times else ""))
+    if baseline:
+        for fmt in ("C", "python"):
+            new, old = rows[fmt], rows[f"{fmt} {baseline}"]
+            print(f"{fmt}: answers equal to {baseline}'s: {same_answers(new[0], old[0])}; per call "
+                  f"{baseline} -> now: min-contact {old[1]['min_contact'] * 1e6:.1f} -> "
+                  f"{new[1]['min_contact'] * 1e6:.1f} us ({old[1]['min_contact'] / new[1]['min_contact']:.1f}x), "
+                  f"delta-e {old[1]['delta_e'] * 1e6:.1f} -> {new[1]['delta_e'] * 1e6:.1f} us "
+                  f"({old[1]['delta_e'] / new[1]['delta_e']:.1f}x)")
 
 
 if __name__ == "__main__":

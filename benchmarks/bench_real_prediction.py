@@ -1,25 +1,51 @@
 """designkit's predictions against the real robot (issue 34): calibrate on some trial sets, compare on the others.
 
-Run from the repository root (several minutes on the shared 2 cores; be nice)::
+Run from the repository root (minutes on the shared 2 cores; be nice)::
 
     nice -n 10 python benchmarks/bench_real_prediction.py [--candidate NAME] [--json out.json]
 
-1. Calibration as ``designkit calibrate fit`` does by default: the metal and wood touches split by
-   :func:`~designkit.calibration.identify.choose_split` (the first fifth of the trial sets fitted:
-   sets 1-4 of the shared recordings' 20), every candidate fitted and the one chosen on the held-out
-   touches (``--candidate NAME`` fits that one only), its sensor file with the rig's conditions
-   (:mod:`designkit.rig`: noise, dT, the model's start relative to the detected onset).
-2. Prediction for the rig as calibrated: the paper's SVM F1 of the identified aluminium against the
-   identified wood (their e_o, classes [e, e + 80)) at contact times counted from the detected onset
-   (the exact route, the file's model, noise and dT), and the min-contact with its interval.
-3. Reality: the paper's protocol on the real touches of the *other* trial sets (never used by
-   calibration), each cut after its detected onset (samples 0 .. c): features and SVM as the paper,
-   3 folds x ``--repeats`` shuffles (:func:`designkit_lab.reproduce.robot.real_pair_f1`); the real
-   min-contact is where that F1 first reaches 0.9 on a 0.05 s grid (linear between grid points).
+The steps are :mod:`designkit_lab.reproduce.prediction`'s (the ``real-prediction`` section of
+``designkit reproduce`` runs the same code): calibration as ``designkit calibrate fit`` does by
+default on the first fifth of the trial sets; the exact route's predicted F1 and min-contact for the
+rig as calibrated (contact from the detected onset); the real rig's own SVM F1 on the other trial
+sets, cut after the detected onset; and what each part of the rig's scene changes.
 
-Printed: contact time, predicted F1 with its interval, real F1 with its SD, the error; the
-predicted and real min-contact; the targets (real min-contact inside the predicted 90 % interval or
-within 25 %; predicted F1 within 0.05 of the real one at every contact time from 0.25 to 1.5 s).
+Why the prediction was too optimistic (the model before this benchmark's issue-34 fix predicted
+min-contact 0.148 s against the real 0.59 s): three things the simulated touches did not do as the
+real ones, each measured on the calibration touches and now played by the rig's scene
+(:func:`designkit.rig.rig_scene`):
+
+- the recorder's onset: the simulated SVM saw the samples from the model's first heat flow, 0.643 s
+  (129 samples) before the detected onset, which the real recognizer never sees;
+- the noise: the identified model's residual (0.031 °C RMS) is not white but wanders smoothly
+  (autocorrelation 0.88 at 0.25 s, 0.70 at 0.5 s; a Matern-3/2 length of 0.68 s fitted): it does
+  not average away over a touch's samples as white noise of the same RMS does;
+- the press: real presses vary in pace and in where the onset fires (the 24 calibration touches'
+  first contact from 0.52 s before to 0.36 s after the median's, SD 0.32 s); every simulated touch
+  followed the median ramp.
+
+Alone, the correlated noise does most (worst error 0.127 -> 0.077); the onset window alone changes
+little with white noise (the samples before the onset carry almost no signal) but matters with
+correlated noise (they would let the SVM read the wander's level before the signal); the presses
+alone lower F1 at 0.25 s only. Together: the table this prints. (That table scores each scene with
+:func:`~designkit.recognition.svm.pair_f1` and 2 seeds, the headline with the exact route and 4: they
+differ by Monte Carlo error, about 0.03 at 0.25 s.)
+
+Measured and not adopted (an exploratory simulation from the identified model, each simulated touch
+taking one calibration touch's own value): the touches' initial-temperature spread (Ts0 SD 0.07 °C,
+object SD 0.3 °C) and heater drift (0.11 ± 0.02 °C/s) on top of the correlated residual made the
+prediction too pessimistic at 0.25 s (F1 0.76-0.79 against the real 0.86): the calibration fits
+them per touch, and the residual's slow part already carries touch-to-touch level changes. The
+host's smoothing of the whole recording past the recognizer's cut (the real cut's last 0.25 s have
+seen later samples): F1 0.814 -> 0.820 at 0.25 s, no change from 0.5 s on.
+
+Not yet robust to the calibration touches (``--first-set 9``, results/real_prediction_sets9-12.txt):
+calibrated on the original sets 9-12 instead (their residual 0.022 °C against 0.031, their presses'
+first contact SD 0.21 s against 0.32 s), the same model predicts F1 up to 0.083 above the real one
+and min-contact 0.25 s (0.23-0.28) against the real 0.58 s. Four trial sets (24 touches) estimate
+the rig's touch-to-touch variability loosely, and the predicted interval carries only the
+simulation's uncertainty, not that of the variability. (On that split the default selection among
+all candidates ends with e_s unidentified; the benchmark refuses it in one line.)
 """
 
 from __future__ import annotations
@@ -27,20 +53,12 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import time
+import sys
 from pathlib import Path
 
-import numpy as np
-
-from designkit import query
-from designkit.calibration.fit import resolve_ranges
-from designkit.calibration.identify import CANDIDATES, choose_split, compare_models
-from designkit.calibration.trials import load_index
-from designkit.models import sensor_model
-from designkit.rig import from_model_contact, model_start_s, resolve_scene
-
-RANGES = {"metal": "aluminium"}
-CONTACTS_S = (0.25, 0.5, 0.75, 1.0, 1.25, 1.5)
+from designkit._validation import InputError
+from designkit_lab.reproduce.prediction import CONTACTS_S, predict_against_real
+from designkit_lab.reproduce.robot import load_real
 
 
 def _default_data() -> Path:
@@ -48,32 +66,25 @@ def _default_data() -> Path:
     return Path(env) if env else Path(__file__).resolve().parents[2] / "shared" / "data" / "robot-thermal-recordings"
 
 
-def real_f1_curve(data: Path, test_files: set[str], contacts, repeats: int, seed: int) -> list[dict]:
-    """The real rig's SVM F1 (wood vs metal) on the test touches cut at each contact after the onset."""
-    import dataclasses
+def rotated(data: Path, first: int, out: Path) -> Path:
+    """The recordings with their trial sets renumbered cyclically so that set ``first`` comes first (symbolic
+    links named by the new numbers, and their index): calibration then fits the first fifth from there on."""
+    import csv
 
-    from designkit_lab.reproduce.robot import load_real, real_pair_f1
-
-    touches = load_real(data, contact_s=float(max(contacts)))
-    touches = touches.select(np.array([Path(f).name in test_files for f in touches.files]))
-    fs = 1.0 / float(touches.time_s[1] - touches.time_s[0])
-    out = []
-    for c in contacts:
-        k = int(round(float(c) * fs)) + 1          # samples 0 .. c after the detected onset
-        cut = dataclasses.replace(touches, time_s=touches.time_s[:k], sensor_c=touches.sensor_c[:, :k])
-        out.append({"contact_s": float(c), **real_pair_f1(cut, ("wood", "metal"), repeats=repeats, seed=seed)})
+    with (data / "index.csv").open(newline="") as f:
+        rows = list(csv.DictReader(f))
+    n = max(int(r["trial_set"]) for r in rows)
+    out.mkdir(parents=True, exist_ok=True)
+    with (out / "index.csv").open("w", newline="") as f:
+        w = csv.DictWriter(f, list(rows[0]))
+        w.writeheader()
+        for r in rows:
+            k = (int(r["trial_set"]) - first) % n + 1
+            name = f"set{k:02d}_{r['file'].split('_', 1)[1]}"
+            if not (out / name).exists():
+                (out / name).symlink_to((data / r["file"]).resolve())
+            w.writerow({**r, "trial_set": str(k), "file": name})
     return out
-
-
-def crossing(xs, ys, level: float = 0.9) -> float | None:
-    """First x where y reaches ``level`` (linear between points); None if never."""
-    for i, y in enumerate(ys):
-        if y >= level:
-            if i == 0:
-                return float(xs[0])
-            x0, x1, y0, y1 = xs[i - 1], xs[i], ys[i - 1], ys[i]
-            return float(x0 + (level - y0) * (x1 - x0) / (y1 - y0))
-    return None
 
 
 def main() -> None:
@@ -84,72 +95,30 @@ def main() -> None:
     ap.add_argument("--trials", type=int, default=100, help="predicted F1: simulated touches per class")
     ap.add_argument("--sim-repeats", type=int, default=4, help="predicted F1: seeds per evaluation")
     ap.add_argument("--no-min-contact", action="store_true", help="skip the predicted min-contact (minutes)")
+    ap.add_argument("--no-parts", action="store_true", help="skip what each part of the rig's scene changes")
+    ap.add_argument("--first-set", type=int, default=1, help="calibrate from this trial set on (the sets renumbered "
+                    "cyclically): another honest split of the same recordings")
     ap.add_argument("--json", type=Path, default=None)
     args = ap.parse_args()
-    t0 = time.perf_counter()
-    index = args.data / "index.csv"
-    trials = load_index(index, only=["metal", "wood"])
-    split = choose_split(trials, index)
-    ranges = resolve_ranges(["metal", "wood"], RANGES)
-    cands = CANDIDATES if args.candidate is None else [args.candidate]
-    cmp = compare_models(list(split.fit), list(split.held_out), cands, ranges=ranges)
-    best = next(r for r in cmp.results if r.candidate.label == cmp.selected)
-    sen = best.sensor(name="rig")
-    fm = sensor_model(sen)
-    start = model_start_s(sen)
-    scene = resolve_scene(sen, {"noise_c": None, "delta_t_c": None})
-    noise, dt = scene.values["noise_c"], scene.values["delta_t_c"]
-    es = best.effusivity.value
-    e_wood, e_metal = best.ratios["wood"].value * es, best.ratios["metal"].value * es
-    print(f"calibration: {split.describe()}; selected {cmp.reason} ({time.perf_counter() - t0:.0f} s)")
-    print(f"rig as calibrated: noise {noise:.4f} °C ({scene.sources['noise_c']}), dT {dt:.3f} °C, model start "
-          f"{start:+.3f} s from the detected onset; e_o wood {e_wood:.0f}, metal {e_metal:.0f}, e_s {es:.0f}")
+    if args.first_set != 1:
+        import tempfile
 
-    test_files = {Path(tr.source).name for tr in split.held_out}
-    grid = np.round(np.arange(0.05, 1.5001, 0.05), 3)
-    t1 = time.perf_counter()
-    real = real_f1_curve(args.data, test_files, grid, args.repeats, seed=0)
-    real_min = crossing(grid, [r["f1"] for r in real])
-    print(f"real SVM F1 on {len(test_files)} held-out touches, 3 folds x {args.repeats} ({time.perf_counter() - t1:.0f} s)")
-
-    rows = []
-    for c in CONTACTS_S:
-        t2 = time.perf_counter()
-        ans = query.ask("distinguishable", route="exact", e1=e_wood, e2=e_metal, contact_s=c - start, noise_c=noise,
-                        delta_t_c=dt, sensor=sen, model=fm, trials=args.trials, repeats=args.sim_repeats, seed=0,
-                        jobs=1)
-        f1 = ans.details["svm_f1"]
-        r = next(x for x in real if abs(x["contact_s"] - c) < 1e-9)
-        rows.append({"contact_s": c, "model_contact_s": c - start, "predicted_f1": f1,
-                     "predicted_interval": [ans.interval[0], ans.interval[1]], "ideal_f1": ans.ideal_bound.value,
-                     "real_f1": r["f1"], "real_f1_sd": r["f1_sd"], "error": f1 - r["f1"],
-                     "wall_s": time.perf_counter() - t2})
-        print(f"  contact {c:4.2f} s from onset: predicted F1 {f1:.3f} [{ans.interval[0]:.3f}, {ans.interval[1]:.3f}], "
-              f"real {r['f1']:.3f} ± {r['f1_sd']:.3f}, error {f1 - r['f1']:+.3f}  ({rows[-1]['wall_s']:.0f} s)")
-    pred = None
-    if not args.no_min_contact:
-        t3 = time.perf_counter()
-        mc = query.ask("min-contact", route="exact", e1=e_wood, e2=e_metal, noise_c=noise, delta_t_c=dt, sensor=sen,
-                       model=fm, trials=args.trials, repeats=args.sim_repeats, seed=0, jobs=1, max_contact_s=5.0)
-        pred = {"value": from_model_contact(mc.value, start),
-                "interval": [from_model_contact(v, start) for v in mc.interval],
-                "wall_s": time.perf_counter() - t3}
-        print(f"min-contact from the onset: predicted {pred['value']} (90 % interval {pred['interval']}), real "
-              f"{real_min}  ({pred['wall_s']:.0f} s)")
-    worst = max(abs(r["error"]) for r in rows)
-    inside = None
-    if pred is not None and pred["value"] is not None and real_min is not None:
-        lo, hi = pred["interval"]
-        inside = (lo is not None and hi is not None and lo <= real_min <= hi) or \
-            abs(pred["value"] - real_min) <= 0.25 * real_min
-    print(f"targets: |predicted - real F1| <= 0.05 at every contact 0.25-1.5 s: worst {worst:.3f} "
-          f"({'met' if worst <= 0.05 else 'missed'}); real min-contact inside the interval or within 25 %: "
-          f"{inside}; total {time.perf_counter() - t0:.0f} s, load {os.getloadavg()[0]:.1f}")
+        args.data = rotated(args.data, args.first_set, Path(tempfile.mkdtemp()) / "rotated")
+        print(f"trial sets renumbered: original set {args.first_set} is set 1 (calibration takes the first fifth)")
+    try:
+        touches = load_real(args.data, contact_s=max(CONTACTS_S))
+        res = predict_against_real(args.data, touches, candidate=args.candidate, repeats=args.repeats,
+                                   trials=args.trials, sim_repeats=args.sim_repeats, parts=not args.no_parts,
+                                   min_contact=not args.no_min_contact)
+    except InputError as exc:
+        print(f"bench_real_prediction: {exc}", file=sys.stderr)
+        raise SystemExit(2) from None
+    print(f"targets: |predicted - real F1| <= 0.05 at every contact 0.25-1.5 s: worst {res['worst_error']:.3f} "
+          f"({'met' if res['f1_met'] else 'missed'}); real min-contact inside the interval or within 25 %: "
+          f"{res.get('min_contact_met')}; the real F1 inside the predicted F1's interval at {res['inside']} of "
+          f"{len(res['rows'])} contacts (that interval is the simulation's uncertainty only); total {res['total_s']:.0f} s, load {os.getloadavg()[0]:.1f}")
     if args.json:
-        args.json.write_text(json.dumps({"split": split.to_dict(), "selected": cmp.selected, "reason": cmp.reason,
-                                         "conditions": sen.conditions, "e_o": {"wood": e_wood, "metal": e_metal},
-                                         "rows": rows, "real_curve": real, "real_min_contact_s": real_min,
-                                         "predicted_min_contact": pred}, indent=1, default=float))
+        args.json.write_text(json.dumps(res, indent=1, default=float))
 
 
 if __name__ == "__main__":

@@ -4,7 +4,7 @@ A terminal's Ctrl-C sends SIGINT to every process of the foreground group: the
 program and its joblib (loky) workers alike. A worker that takes it dies printing
 a traceback, and the user sees that under the program's quiet "Interrupted.":
 caught between two tasks (in loky's own loop, seen in CI) or while it starts
-(importing joblib, about a second after the program starts, measured). So:
+(importing joblib). So:
 
 - the workers are started with SIGINT blocked (the signal mask is inherited
   through fork and exec), so a Ctrl-C while they import stays pending in them;
@@ -31,9 +31,8 @@ from contextlib import contextmanager
 from typing import Iterator
 
 
-#: Most local worker processes per core a computation may start: each sweep worker takes up to 1 GB,
-#: and a mistyped ``--jobs 100000`` started processes until the machine stalled (load average 43 on
-#: 2 cores, seen).
+#: Most local worker processes per core a computation may start: each sweep worker takes up to 1 GB, and a
+#: mistyped ``--jobs 100000`` would start processes until the machine stalls.
 MAX_JOBS_PER_CORE = 4
 
 
@@ -120,8 +119,8 @@ def local_processes(n_jobs: int, *, start: bool = True) -> Iterator[None]:
 
     On entry the pool is started (or found running) with SIGINT blocked in this thread, so that workers
     begin life with it blocked; a Ctrl-C during those moments reaches this process when they are over.
-    ``start=False`` skips that (about 11 ms when the pool is already running, measured): for the calls
-    after the first of a computation.
+    ``start=False`` skips that (one round trip to a running pool): for the calls after the first of a
+    computation.
 
     >>> from joblib import Parallel, delayed
     >>> import os, signal
@@ -167,7 +166,7 @@ def _quiet_about_leaks() -> Iterator[None]:
 def _start_pool(n_jobs: int) -> None:
     """Run one trivial task per worker with SIGINT blocked in this thread: loky starts its workers at the
     first submission, from the submitting thread, so they inherit the blocked mask. Where the pool is
-    already running this costs one round trip (about 11 ms, measured)."""
+    already running this costs one round trip."""
     from joblib import Parallel, delayed
 
     can_block = hasattr(signal, "pthread_sigmask") and threading.current_thread() is threading.main_thread()
@@ -210,12 +209,8 @@ def steady_heap() -> Iterator[None]:
     such an array from fresh pages of the kernel (``mmap``, or heap it gave back at the last
     ``free``), and numpy asks the kernel to back every array of 4 MiB or more with 2 MiB
     huge pages (``madvise``): each allocation then pays page faults and the kernel's
-    zeroing of those pages. Measured on 50-reference svm-paper chunks (``benchmarks/profile_chunk.py``,
-    2026-11-24): 4.0 -> 3.6 ms of CPU per SVM fit at 2 s of contact (page faults 333,000 ->
-    56,000), 15.2 -> 13.3 ms at 10 s; the same peak memory; the same arrays (nothing
-    computed changes, only where memory comes from). Either setting alone gains little.
-    A whole svm-paper build: 1,749 -> 1,628 CPU s, the same content hash
-    (``benchmarks/results/svm-paper-rebuild.txt``).
+    zeroing of those pages. Nothing computed changes, only where memory comes from
+    (the gain: docs/decisions-log.md).
 
     Inside: glibc's mmap threshold 32 MiB (arrays below it come from the heap) and its
     trim threshold 1 GiB (freed heap is kept), numpy's huge-page advice off. On exit the

@@ -563,6 +563,11 @@ def material_or_effusivity(spec: str | float, set: str | None = None) -> "Materi
     [J s^-1/2 K^-1 m^-2] and returned as float; anything else is looked up
     with :func:`get_material`. The query layer decides what a material's
     range means for its answer (worst case or mean over the range).
+
+    Examples
+    --------
+    >>> material_or_effusivity("glass").name, material_or_effusivity("1500")
+    ('Glass', 1500.0)
     """
     if isinstance(spec, (int, float)) and not isinstance(spec, bool):
         return check_effusivity("value", spec)

@@ -117,7 +117,13 @@ def object_class(e: float | None = None, material: str | None = None, *, width: 
 
 
 def ordered_pair(a: ObjectClass, b: ObjectClass) -> tuple[ObjectClass, ObjectClass]:
-    """The two classes, lower effusivity first; identical classes are refused."""
+    """The two classes, lower effusivity first; identical classes are refused.
+
+    Examples
+    --------
+    >>> [c.e_range for c in ordered_pair(object_class(35000), object_class(20000))]
+    [(20000.0, 20080.0), (35000.0, 35080.0)]
+    """
     if a.e_range == b.e_range and a.diffusivity_range_m2_s == b.diffusivity_range_m2_s:
         raise InputError(f"the two objects are identical ({a.label}): nothing to separate")
     return (a, b) if a.key <= b.key else (b, a)

@@ -26,7 +26,8 @@ from ._validation import InputError
 from .sensor import CONDITION_KEYS
 
 __all__ = ["CONDITION_KEYS", "DEFAULTS", "RigConditions", "RigScene", "for_rig", "from_model_contact",
-           "model_start_s", "resolve_scene", "rig_conditions", "to_model_contact"]
+           "model_start_s", "residual_correlation_s", "resolve_scene", "rig_conditions", "rig_scene",
+           "to_model_contact"]
 
 #: A question's scene without a sensor file's conditions (and for the paper's sensor): noise [degC], dT [degC].
 DEFAULTS = {"noise_c": 0.05, "delta_t_c": 10.0, "sensor_temp_spread_c": 0.0}
@@ -54,6 +55,11 @@ class RigConditions:
         How the recorder detected contact (its rule), or that the recording's time 0 was taken.
     onset_offset_s : float
         The model's first heat flow relative to the detected onset [s] (negative: before it).
+    noise_correlation_s : float
+        Correlation length [s] of the identified model's residual on the calibration touches (the
+        Matern-3/2 autocorrelation fitted to it, :func:`residual_correlation_s`; 0: not measured, white).
+        A rig's misfit wanders smoothly over a touch, so it does not average away over its samples as
+        white noise would.
     contact_ramp : mapping or None
         ``{"rise_s": s, "to_share": 0.9}``: median time from the detected onset until the force
         reaches 90 % of its plateau (touches with a force channel).
@@ -72,6 +78,7 @@ class RigConditions:
     onset_offset_s: float
     contact_ramp: Mapping[str, float] | None = None
     n_touches: int = 0
+    noise_correlation_s: float = 0.0
 
     def to_dict(self) -> dict[str, Any]:
         def pair(v):
@@ -84,11 +91,51 @@ class RigConditions:
                 "onset": self.onset,
                 "onset_offset_s": round(float(self.onset_offset_s), 4) if math.isfinite(self.onset_offset_s) else None,
                 "contact_ramp": None if self.contact_ramp is None else dict(self.contact_ramp),
-                "n_touches": int(self.n_touches)}
+                "n_touches": int(self.n_touches),
+                "noise_correlation_s": round(float(self.noise_correlation_s), 4)}
+
+
+def residual_correlation_s(residuals: Sequence[np.ndarray], sample_rate_hz: float, *, max_lag_s: float = 2.0) -> float:
+    """Correlation length [s] of residual series: the Matern-3/2 autocorrelation
+    ``(1 + a) exp(-a)``, ``a = sqrt(3) lag / l``, fitted (least squares over lags up to ``max_lag_s``)
+    to their pooled autocorrelation about 0 (residuals of a fit: their mean is part of the wander, not
+    removed). 0 when there is too little to tell.
+
+    Examples
+    --------
+    >>> from designkit.simulation import correlate_noise
+    >>> z = correlate_noise(np.random.default_rng(0).standard_normal((40, 600)), 200.0, 0.5)
+    >>> round(residual_correlation_s(list(z), 200.0), 1)
+    0.5
+    """
+    from scipy.optimize import minimize_scalar
+
+    rows = [np.asarray(r, dtype=np.float64) for r in residuals if np.size(r) >= 8]
+    if not rows:
+        return 0.0
+    n_lag = min(int(max_lag_s * sample_rate_hz), min(r.size for r in rows) // 2)
+    acf, weight = np.zeros(n_lag + 1), np.zeros(n_lag + 1)
+    for r in rows:
+        acf += np.correlate(r, r, "full")[r.size - 1:r.size + n_lag]
+        weight += r.size - np.arange(n_lag + 1)
+    acf = acf / weight
+    if not acf[0] > 0:
+        return 0.0
+    acf /= acf[0]
+    lag = np.arange(n_lag + 1) / float(sample_rate_hz)
+
+    def misfit(log_l):
+        a = math.sqrt(3.0) * lag / math.exp(log_l)
+        return float(np.sum(((1.0 + a) * np.exp(-a) - acf) ** 2))
+
+    lo, hi = math.log(0.5 / sample_rate_hz), math.log(100.0)
+    best = minimize_scalar(misfit, bounds=(lo, hi), method="bounded")
+    return float(math.exp(best.x)) if best.x > lo + 1e-3 else 0.0
 
 
 def rig_conditions(trials: Sequence[Any], *, pre_contact_noise_c: float, residual_rms_c: float,
-                   onset_offset_s: float) -> RigConditions:
+                   onset_offset_s: float, residuals: Sequence[np.ndarray] = (),
+                   sample_rate_hz: float = 200.0) -> RigConditions:
     """The conditions of the touches ``trials`` (:class:`~designkit.calibration.trials.Trial`).
 
     Examples
@@ -136,7 +183,20 @@ def rig_conditions(trials: Sequence[Any], *, pre_contact_noise_c: float, residua
     return RigConditions(float(noise), source, float(pre_contact_noise_c), float(residual_rms_c), mean_sd(ts0_a),
                          mean_sd(to_a), d, math.sqrt(3.0) * d[1], "; ".join(sorted(rules)), float(onset_offset_s),
                          {"rise_s": round(float(np.median(rises)), 4), "to_share": 0.9} if rises else None,
-                         len(ts0))
+                         len(ts0), residual_correlation_s(residuals, sample_rate_hz) if len(residuals) else 0.0)
+
+
+def rig_scene(sensor) -> dict[str, float]:
+    """The Scene fields (:class:`designkit.scene.Scene`) that make a simulated touch the rig's: the noise's
+    correlation length, and the recorder's window from its detected onset (model time, at least 0). Empty
+    for a sensor without recorded conditions (presets, older files: the paper's white noise from the first
+    heat flow)."""
+    cond = getattr(sensor, "conditions", None) or {}
+    if not cond:
+        return {}
+    start = model_start_s(sensor)
+    return {"noise_correlation_s": float(cond.get("noise_correlation_s") or 0.0),
+            "onset_s": max(-start, 0.0) if start is not None else 0.0}
 
 
 def _rule_text(rule: Mapping[str, Any]) -> str:
@@ -268,7 +328,13 @@ def resolve_scene(sensor, given: Mapping[str, float | None]) -> RigScene:
                          f" °C): not played by default; --sensor-temp-spread {spread:.2g} plays it")
     if start is not None:
         notes.append(f"contact time counts from the rig's detected onset ({cond.get('onset') or 'as recorded'}), "
-                     f"as its controller measures it; the model's heat flow starts {start:+.3g} s from it")
+                     f"as its controller measures it; the model's heat flow starts {start:+.3g} s from it"
+                     + ("; simulated touches are read from the onset on, as the rig's recognizer reads them"
+                        if start < 0 else ""))
+    if cond.get("noise_correlation_s"):
+        notes.append(f"the noise is correlated over {float(cond['noise_correlation_s']):.2g} s, as the identified "
+                     "model's residual on the calibration touches (sensor file): it wanders over a touch instead of "
+                     "averaging away")
     return RigScene(values, sources, start, tuple(notes), bool(cond))
 
 

@@ -140,6 +140,11 @@ def sample_times_s(contact_s: float, sample_rate_hz: float) -> np.ndarray:
     -------
     ndarray
         Times [s], float64.
+
+    Examples
+    --------
+    >>> sample_times_s(0.02, 200.0)
+    array([0.   , 0.005, 0.01 , 0.015, 0.02 ])
     """
     contact_s = check_positive("contact time [s]", contact_s)
     fs = check_positive("sample rate [Hz]", sample_rate_hz)
@@ -179,9 +184,11 @@ class Sensor:
         records it (:data:`MODEL_KEYS`): ``{"name", "params", "time_offset_s",
         "contact_spread", "object_temperature", "candidate", "contact_area",
         "drift"}``. ``contact_area`` (calibrated with a force-driven contact
-        area): the threshold ``force_fraction`` c (with ``force_fraction_ci95``),
+        area): the threshold ``force_fraction`` c (with ``force_fraction_interval``,
+        its 95 % interval ``{low, high, coverage}``),
         the calibration touches' median force over its plateau (``time_s``
-        after the detected onset, ``force_share``) and ``n_touches``;
+        after the detected onset, ``force_share``), each touch's own
+        (``touch_force_share``, rows on ``time_s``) and ``n_touches``;
         ``drift``: how the heater's drift was treated (``"per-touch"``: a
         nuisance fitted per touch like its initial temperature, not a
         property of the sensor). None (old files, presets): the paper's
@@ -333,8 +340,9 @@ class Sensor:
                      "# above; null = infinite), the fitted contact-time offset [s], the per-touch spread of the\n"
                      "# contact conductance (geometric SD), how each material's temperature was taken;\n"
                      "# contact_area: the area grows with the force as clip((F/F_p - c)/(1 - c), 0, 1), c =\n"
-                     "# force_fraction; a question plays the calibration touches' median F/F_p (force_share at\n"
-                     "# time_s after the onset); drift: per-touch = each touch's heater drift was fitted like its\n"
+                     "# force_fraction; the calibration touches' median F/F_p (force_share at time_s after the\n"
+                     "# onset) sets the model's time 0, and a simulated touch presses as one of them\n"
+                     "# (touch_force_share); drift: per-touch = each touch's heater drift was fitted like its\n"
                      "# initial temperature: not a sensor property, a question's touch has none\n")
         text += yaml.safe_dump(self.to_dict(), sort_keys=False)
         return atomic_write_text(Path(path), text)
@@ -356,7 +364,7 @@ class Sensor:
 #: The keys of a sensor file's ``conditions`` record (:class:`designkit.rig.RigConditions`).
 CONDITION_KEYS = ("noise_c", "noise_source", "pre_contact_noise_c", "residual_rms_c", "sensor_temp_c",
                   "object_temp_c", "delta_t_c", "sensor_temp_spread_c", "onset", "onset_offset_s", "contact_ramp",
-                  "n_touches")
+                  "n_touches", "noise_correlation_s")
 
 #: The keys of a sensor's ``model`` record (what calibration writes beside the sensor fields).
 MODEL_KEYS = ("name", "params", "time_offset_s", "contact_spread", "object_temperature", "candidate", "contact_area",
@@ -410,7 +418,14 @@ SENSORS: dict[str, Sensor] = {
 
 
 def load_sensor(name_or_path: "str | Path | Sensor") -> Sensor:
-    """A sensor from a preset name (``"paper"``), a YAML path, or a :class:`Sensor`."""
+    """A sensor from a preset name (``"paper"``), a YAML path, or a :class:`Sensor`.
+
+    Examples
+    --------
+    >>> s = load_sensor("paper")
+    >>> s.effusivity, round(s.tau_s, 4)
+    (892.0, 1.3445)
+    """
     if isinstance(name_or_path, Sensor):
         return name_or_path
     key = str(name_or_path)

@@ -14,7 +14,14 @@ the engine's shortcuts are exact:
 
 5. where the forward model needs the object's diffusivity (a slab), one
    uniform draw per trial in the class's diffusivity range, from the
-   independent stream ``seed + [7]``.
+   independent stream ``seed + [7]``;
+6. where the model is a force ramp with calibration touches' own presses,
+   one of them per trial, uniformly, from the stream ``seed + [8]``.
+
+A rig's scene (:func:`designkit.rig.rig_scene`) makes the noise correlated
+(``Scene.noise_correlation_s``: the white draws through a lower-triangular
+factor, so prefixes still hold, to rounding) and starts the samples at the recorder's
+detected onset (``Scene.onset_s``), as the rig's recognizer sees a touch.
 
 The noise-free reading is ``Ts0 + (Ta - Ts0) u(t)`` with ``u`` from the forward
 model (:mod:`designkit.models`; the paper's semi-infinite one by default).
@@ -26,11 +33,12 @@ ratio, for every (linear) model.
 
 from __future__ import annotations
 
+import dataclasses
+import functools
+import math
 from dataclasses import dataclass
 
 import numpy as np
-
-import math
 
 from ._validation import (
     InputError,
@@ -48,9 +56,12 @@ from .sensor import Sensor
 
 __all__ = [
     "DIFFUSIVITY_STREAM",
+    "RAMP_STREAM",
     "TrialDraws",
     "Trials",
     "check_touch_budget",
+    "correlate_noise",
+    "noise_cholesky",
     "draw_trials",
     "noisy_readings",
     "render_trials",
@@ -59,10 +70,13 @@ __all__ = [
     "simulate_class",
     "simulate_interval",
     "simulate_trials",
+    "window_times_s",
 ]
 
 #: Seed-key suffix of the per-trial diffusivity draws (independent of the noise).
 DIFFUSIVITY_STREAM = 7
+#: Seed-key suffix of the per-trial choice of a calibration touch's press (a force ramp with touch ramps).
+RAMP_STREAM = 8
 
 
 @dataclass(frozen=True)
@@ -233,6 +247,42 @@ def noisy_readings(time_s, e_object, sensor_temp_c, ambient_temp_c, sensor: Sens
     return out
 
 
+@functools.lru_cache(maxsize=8)
+def noise_cholesky(n_samples: int, sample_rate_hz: float, correlation_s: float) -> np.ndarray:
+    """Lower Cholesky factor ``L`` of the noise's correlation matrix on ``n_samples`` samples.
+
+    The Matern-3/2 autocorrelation ``(1 + a) exp(-a)``, ``a = sqrt(3) |t_i - t_j| / l`` (a smooth
+    Gaussian process, as a real rig's misfit wanders from touch to touch), plus ``1e-9`` on the
+    diagonal for a stable factor. ``L`` is lower triangular, so the correlated noise of the first
+    ``m`` samples is made from the first ``m`` white draws only: truncating a touch stays the same as
+    simulating the shorter one (to rounding: the products' summation order differs).
+
+    >>> L = noise_cholesky(3, 200.0, 0.5)
+    >>> bool(np.allclose(np.diag(L @ L.T), 1.0)), bool(np.allclose(np.triu(L, 1), 0.0))
+    (True, True)
+    """
+    from ._validation import check_memory
+
+    n = int(n_samples)
+    check_memory(f"noise correlation over {n} samples", float(n) * n * 8 * 2)
+    lag = np.arange(n, dtype=np.float64) / float(sample_rate_hz)
+    a = math.sqrt(3.0) * np.abs(lag[:, None] - lag[None, :]) / float(correlation_s)
+    corr = (1.0 + a) * np.exp(-a)
+    corr[np.diag_indices(n)] += 1e-9
+    L = np.linalg.cholesky(corr / (1.0 + 1e-9))
+    L.flags.writeable = False  # one factor per process and size, shared by every class, contact and seed
+    return L
+
+
+def correlate_noise(noise, sample_rate_hz: float, correlation_s: float) -> np.ndarray:
+    """Standard normal draws (n, m), time along axis 1, made into unit-variance noise correlated over
+    ``correlation_s`` [s] (:func:`noise_cholesky`; 0: returned unchanged, white)."""
+    z = np.asarray(noise, dtype=np.float64)
+    if not correlation_s or z.shape[-1] < 2:
+        return z
+    return z @ noise_cholesky(z.shape[-1], sample_rate_hz, correlation_s).T
+
+
 def response_tolerance(noise_ratio: float, n_samples: int) -> float:
     """Tolerance asked of a numerically solved model: 1 % of the noise over the whole curve, at most 1e-5.
 
@@ -244,7 +294,7 @@ def response_tolerance(noise_ratio: float, n_samples: int) -> float:
 
 
 def render_trials(draws: TrialDraws, sensor: Sensor, scene: Scene, model: "ForwardModel | str | None" = None,
-                  diffusivity_m2_s=None) -> Trials:
+                  diffusivity_m2_s=None, ramp_index=None) -> Trials:
     """Apply a scene to drawn trials: readings of ``draws.n_samples`` samples.
 
     Parameters
@@ -256,9 +306,15 @@ def render_trials(draws: TrialDraws, sensor: Sensor, scene: Scene, model: "Forwa
         Forward model (default: the paper's semi-infinite model).
     diffusivity_m2_s : array_like, shape (n,), optional
         Per-trial object diffusivity, for models that need it.
+    ramp_index : array_like of int, shape (n,), optional
+        Per-trial calibration touch whose press the trial plays (a force ramp with ``touch_ramps``).
     """
     fm = get_model(model)
-    time_s = np.arange(draws.n_samples, dtype=np.float64) / sensor.sample_rate_hz
+    # the recorder's window: from its onset (model time; 0: the first heat flow) on
+    time_s = scene.onset_s + np.arange(draws.n_samples, dtype=np.float64) / sensor.sample_rate_hz
+    if scene.noise_correlation_s > 0 and scene.noise_c > 0:
+        draws = dataclasses.replace(draws, noise=correlate_noise(draws.noise, sensor.sample_rate_hz,
+                                                                 scene.noise_correlation_s))
     ts = scene.sensor_temp_c + scene.sensor_temp_spread_c * draws.sensor_offset
     ta = scene.ambient_temp_c + scene.ambient_temp_spread_c * draws.ambient_offset
     if fm.shared_shape:
@@ -267,13 +323,35 @@ def render_trials(draws: TrialDraws, sensor: Sensor, scene: Scene, model: "Forwa
     else:
         tol = response_tolerance(scene.noise_ratio, draws.n_samples)
         # a costly model is read at a few effusivities of the class and interpolated within tol
-        u = class_readings(fm, time_s, draws.effusivity, sensor, diffusivity_m2_s=diffusivity_m2_s, tolerance=tol)
+        u = _class_readings(fm, time_s, draws.effusivity, sensor, diffusivity_m2_s, tol, ramp_index)
         temps = np.multiply(u, (ta - ts)[:, None], out=u)        # in place: ts + (ta - ts) u, as before
         temps += ts[:, None]
         if scene.noise_c > 0:
             temps += scene.noise_c * draws.noise
     return Trials(time_s, temps, draws.effusivity, ts, ta,
                   None if diffusivity_m2_s is None else np.asarray(diffusivity_m2_s, dtype=np.float64), fm.name)
+
+
+def _class_readings(fm, time_s, e, sensor, diffusivity_m2_s, tol, ramp_index) -> np.ndarray:
+    """A class's normalized readings; with ``ramp_index``, each trial pressing as its calibration touch did
+    (read at its own first contact: ``t - delay``)."""
+    if ramp_index is None:
+        return class_readings(fm, time_s, e, sensor, diffusivity_m2_s=diffusivity_m2_s, tolerance=tol)
+    idx = np.asarray(ramp_index)
+    u = np.empty((e.size, np.size(time_s)))
+    for j in np.unique(idx):
+        rows = idx == j
+        ramp, delay = fm.touch(j)
+        u[rows] = class_readings(ramp, np.asarray(time_s) - delay, e[rows], sensor, tolerance=tol,
+                                 diffusivity_m2_s=None if diffusivity_m2_s is None else diffusivity_m2_s[rows])
+    return u
+
+
+def window_times_s(sensor: Sensor, scene: Scene) -> np.ndarray:
+    """Model times [s] of the samples a recognizer sees: from the scene's onset (the recorder's; 0: the first
+    heat flow) to its contact, one sample period apart; one sample, at the onset, when contact ends before it."""
+    window = scene.window_s()
+    return scene.onset_s + (sensor.times_s(window) if window > 0 else np.zeros(1))
 
 
 def seed_key(seed) -> list[int]:
@@ -309,7 +387,7 @@ def simulate_class(obj: ObjectClass, n_trials: int, sensor: Sensor, scene: Scene
     fm = get_model(model)
     obj.require(fm.object_properties)
     key = seed_key(seed)
-    n_samples = sensor.times_s(scene.contact_s).size
+    n_samples = window_times_s(sensor, scene).size
     draws = draw_trials(*obj.e_range, n_trials, n_samples, key,
                         vary_sensor=scene.sensor_temp_spread_c > 0,
                         vary_ambient=scene.ambient_temp_spread_c > 0)
@@ -318,7 +396,9 @@ def simulate_class(obj: ObjectClass, n_trials: int, sensor: Sensor, scene: Scene
         a_lo, a_hi = obj.diffusivity_range_m2_s
         alpha = (as_generator(key + [DIFFUSIVITY_STREAM]).uniform(a_lo, a_hi, draws.n_trials) if a_hi > a_lo
                  else np.full(draws.n_trials, a_lo))
-    return render_trials(draws, sensor, scene, fm, alpha)
+    ramps = getattr(fm, "touch_ramps", ())
+    pick = as_generator(key + [RAMP_STREAM]).integers(0, len(ramps), draws.n_trials) if ramps else None
+    return render_trials(draws, sensor, scene, fm, alpha, pick)
 
 
 def simulate_interval(e_low: float, e_high: float, n_trials: int, sensor: Sensor,
@@ -333,7 +413,7 @@ def simulate_interval(e_low: float, e_high: float, n_trials: int, sensor: Sensor
     (100, 401)
     """
     lo, hi = check_effusivity_range("class", e_low, e_high)
-    n_samples = sensor.times_s(scene.contact_s).size
+    n_samples = window_times_s(sensor, scene).size
     draws = draw_trials(lo, hi, n_trials, n_samples, seed,
                         vary_sensor=scene.sensor_temp_spread_c > 0,
                         vary_ambient=scene.ambient_temp_spread_c > 0)
@@ -345,9 +425,16 @@ def simulate_trials(e_object: float, sensor: Sensor, scene: Scene, n_trials: int
     """``n_trials`` touches of one object of effusivity ``e_object``.
 
     ``e_object`` may be 0 (perfect insulator) or ``inf`` (perfect conductor).
+
+    Examples
+    --------
+    >>> from designkit import SENSORS, Scene
+    >>> tr = simulate_trials(20000.0, SENSORS["paper"], Scene(contact_s=1.0), n_trials=3, seed=0)
+    >>> tr.temperature_c.shape  # 3 touches, 1 s at 200 Hz from t = 0
+    (3, 201)
     """
     e = check_effusivity("e", e_object, allow_zero=True, allow_inf=True)
-    n_samples = sensor.times_s(scene.contact_s).size
+    n_samples = window_times_s(sensor, scene).size
     draws = draw_trials(0.0, 0.0, n_trials, n_samples, seed,
                         vary_sensor=scene.sensor_temp_spread_c > 0,
                         vary_ambient=scene.ambient_temp_spread_c > 0)

@@ -3,6 +3,8 @@
 The pages are the Markdown files of this folder (MyST); the API reference is generated from the
 numpydoc docstrings of the public modules (``api.md``). tests/test_docs_site.py builds it with
 warnings as errors.
+The examples gallery (``gallery/``, generated) is made by sphinx-gallery from ``examples/gallery/plot_*.py``:
+every build runs every script and shows its output and figure.
 """
 
 import designkit
@@ -17,10 +19,23 @@ extensions = [
     "sphinx.ext.autosummary",
     "numpydoc",
     "sphinx.ext.mathjax",
+    "sphinx_gallery.gen_gallery",
 ]
 source_suffix = {".md": "markdown", ".rst": "restructuredtext"}
 root_doc = "index"
 exclude_patterns = ["_build", "README.md"]
+
+sphinx_gallery_conf = {
+    "examples_dirs": "../examples/gallery",
+    "gallery_dirs": "gallery",          # generated (git-ignored)
+    "filename_pattern": r"/plot_",      # run every script
+    "run_stale_examples": True,         # and run it on every build, changed or not: the docs build is its test
+    "within_subsection_order": "FileNameSortKey",
+    "write_computation_times": False,
+    "download_all_examples": False,
+    "show_signature": False,
+    "remove_config_comments": True,
+}
 myst_heading_anchors = 3
 myst_enable_extensions = ["dollarmath"]
 # Links into the repository (`../designkit/...`, `../tables/...`) are for readers of the files on GitHub.

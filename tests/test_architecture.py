@@ -32,7 +32,7 @@ LAYERS = [
     {"designkit.recognition"},
     {"designkit.tables"},
     {"designkit.sweep"},
-    {"designkit.query"},
+    {"designkit.query", "designkit.io_batch"},
     {"designkit.export", "designkit.calibration", "designkit.design"},
     {"designkit_lab"},
     {"designkit.cli", "designkit.__main__"},

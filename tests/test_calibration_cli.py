@@ -64,7 +64,7 @@ def test_fit_writes_a_sensor_that_other_commands_accept(cli, tmp_path):
     d = json.loads(r.stdout)
     res = d["results"][0]
     assert d["selected"] == "semi-infinite" and res["consistent"]
-    assert res["effusivity"]["ci95"][0] <= res["effusivity"]["value"] <= res["effusivity"]["ci95"][1]
+    assert res["effusivity"]["interval"]["low"] <= res["effusivity"]["value"] <= res["effusivity"]["interval"]["high"]
     assert set(res["ratios"]) == {"metal", "wood"}
     sen = load_sensor(out)
     assert sen.effusivity == pytest.approx(res["effusivity"]["value"])
@@ -153,7 +153,8 @@ def test_guided_run_records_then_fits(cli, tmp_path):
     assert d["record"]["n_trials"] == 3 and d["sensor"] == str(out / "sensor.yaml")
     sen = load_sensor(out / "sensor.yaml")
     # one material: e_s is known only to the width of wood's range (and its ratio's interval)
-    lo, hi = d["fit"]["results"][0]["effusivity"]["ci95"]
+    iv = d["fit"]["results"][0]["effusivity"]["interval"]
+    lo, hi = iv["low"], iv["high"]
     assert lo <= PAPER.effusivity <= hi and sen.tau_s == pytest.approx(PAPER.tau_s, rel=0.05)
 
 
@@ -247,7 +248,7 @@ def test_round_trip_over_a_pty_recovers_the_sensor(cli, tmp_path):
     params = {p["name"]: p for p in res["parameters"]}
     for got, truth in ((res["effusivity"], PAPER.effusivity), (params["diffusivity_m2_s"], PAPER.diffusivity_m2_s),
                        (params["time_offset_s"], offset)):
-        lo, hi = got["ci95"]
+        lo, hi = got["interval"]["low"], got["interval"]["high"]
         assert lo <= truth <= hi, (got, truth)
     assert res["effusivity"]["value"] == pytest.approx(PAPER.effusivity, rel=0.05)
     assert params["diffusivity_m2_s"]["value"] == pytest.approx(PAPER.diffusivity_m2_s, rel=0.05)

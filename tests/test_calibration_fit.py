@@ -198,7 +198,7 @@ def test_guided_run_against_the_emulator_records_its_first_touch_and_labels_ever
         assert name.startswith("wood" if touch < 3 else "metal"), onsets
     res = json.loads(r.stdout)["fit"]["results"][0]
     assert res["consistent"]
-    assert res["effusivity"]["ci95"][0] <= paper.effusivity <= res["effusivity"]["ci95"][1]
+    assert res["effusivity"]["interval"]["low"] <= paper.effusivity <= res["effusivity"]["interval"]["high"]
 
 
 def _write(folder, trials):

@@ -73,12 +73,13 @@ def test_guided_run_refuses_an_emulator_that_alternates(cli, tmp_path):
 
 def test_emulate_and_guided_defaults_agree(cli):
     from designkit.cli import calibrate as cal
+    from designkit.cli import emulate as emu
 
     r = cli("emulate", "--help")
     assert r.exit_code == 0
     import inspect
 
-    emulate_default = inspect.signature(cal.emulate).parameters["touches_per_material"].default
+    emulate_default = inspect.signature(emu.emulate).parameters["touches_per_material"].default
     guided_default = inspect.signature(cal.guided).parameters["trials"].default
     assert emulate_default == guided_default == cal.DEFAULT_TRIALS
 

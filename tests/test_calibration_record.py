@@ -413,7 +413,7 @@ def test_forty_percent_unreadable_lines_give_up_with_the_fraction_and_an_example
                      r"needs 80 % of its samples readable, so none can be kept; check the cable, the baud rate "
                      r"\d+ and the profile '[\w-]+'; 0 trial\(s\) kept.*", msg)
     assert m, msg
-    assert 35.0 < float(m.group(1)) < 45.0 and m.group(2) == emu.port
+    assert 30.0 < float(m.group(1)) < 50.0 and m.group(2) == emu.port  # 40 % drawn, over one 1,601-line window
     assert rec.written == [] and not list(tmp_path.glob("wood_*"))
 
 

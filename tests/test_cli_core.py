@@ -16,8 +16,9 @@ def test_simulate_csv_json_and_plot(cli, tmp_path):
     out, png = tmp_path / "curve.csv", tmp_path / "curve.png"
     r = cli("simulate", "--e", 20000, "--contact", 4, "--trials", 3, "--seed", 1, "--out", out, "--plot", png)
     assert r.exit_code == 0, r.output
+    assert r.stdout == ""  # --out FILE holds the output (the curves' CSV without --format)
     rows = list(csv.reader(out.open()))
-    assert rows[0] == ["time_s", "trial_1", "trial_2", "trial_3"]
+    assert rows[0] == ["time_s", "temperature_c_1", "temperature_c_2", "temperature_c_3"]
     assert len(rows) == 1 + 801
     data = np.array(rows[1:], dtype=float)
     assert data[0, 0] == 0.0 and data[-1, 0] == pytest.approx(4.0)
@@ -153,9 +154,11 @@ def test_simulate_out_dash_prints_the_csv_and_writes_no_file(cli, tmp_path, monk
     r = cli("simulate", "--e", "20000", "--contact", "0.02", "--trials", "2", "--out", "-")
     assert r.exit_code == 0, r.output
     lines = r.stdout.splitlines()
-    assert lines[0] == "time_s,trial_1,trial_2" and len(lines) == 1 + 5 and not (tmp_path / "-").exists()
-    r = cli("simulate", "--e", "20000", "--out", "-", "--json")
-    assert r.exit_code == 2 and "--out - and --json would both print" in r.stderr
+    assert lines[0] == "time_s,temperature_c_1,temperature_c_2" and len(lines) == 1 + 5
+    assert not (tmp_path / "-").exists()
+    # '-' is standard output for every format: --json there is the JSON (it was refused as two outputs)
+    r = cli("simulate", "--e", "20000", "--contact", "0.02", "--out", "-", "--json")
+    assert r.exit_code == 0 and json.loads(r.stdout)["time_s"][-1] == 0.02 and not (tmp_path / "-").exists()
 
 
 def test_calibrate_fit_refuses_out_dash_and_a_missing_folder_before_fitting(cli, tmp_path):

@@ -54,6 +54,17 @@ def test_cli_json_with_svm_confirmation(cli, tmp_path):
     assert out["best"]["skin"] == PEEK and out["svm"]["value"] is not None
     assert out["svm"]["value"] >= out["best"]["ideal"]["value"]  # no classifier beats the bound
     assert (tmp_path / "d.png").stat().st_size > 10_000
+    # its csv record (one row, built from this JSON document): the SVM's confirmation as svm_*, the figure
+    import csv
+    import io
+
+    from designkit.cli._format import render_rows
+    from designkit.cli.design import _record
+
+    (row,) = list(csv.DictReader(io.StringIO(render_rows([_record(out)], fmt="csv"))))
+    assert float(row["svm_value"]) == out["svm"]["value"] and float(row["svm_f1"]) == out["svm"]["svm_f1"]
+    assert float(row["svm_minus_ideal_s"]) == out["svm"]["svm_minus_ideal_s"] and row["svm_note"] == ""
+    assert row["figure"] == out["figure"] and row["skin"] == PEEK and "svm_svm_f1" not in row
 
 
 @pytest.mark.parametrize("args,code,msg", [

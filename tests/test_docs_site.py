@@ -1,5 +1,5 @@
-"""The documentation site: Sphinx builds it with warnings as errors, the tutorial's commands run and print what
-the page shows, and no paragraph of docs/ is a wall of text."""
+"""The documentation site: Sphinx builds it with warnings as errors (running the examples gallery's scripts), the
+tutorial's commands run and print what the page shows, and no paragraph of docs/ is a wall of text."""
 
 from __future__ import annotations
 
@@ -30,6 +30,13 @@ def test_the_site_builds_with_no_warnings(tmp_path):
     api = (tmp_path / "html" / "api" / "query.html").read_text(encoding="utf-8")
     assert "min_contact" in api  # the reference is generated from the docstrings
     assert (tmp_path / "html" / "tutorial.html").is_file()
+    # the gallery: sphinx-gallery ran every script of examples/gallery (a failing one fails the build) and
+    # each page shows the figure it made
+    scripts = sorted(p.stem for p in (REPO / "examples" / "gallery").glob("plot_*.py"))
+    assert len(scripts) >= 5
+    for stem in scripts:
+        page = (tmp_path / "html" / "gallery" / f"{stem}.html").read_text(encoding="utf-8")
+        assert f"sphx_glr_{stem}_001.png" in page, stem
 
 
 def _paragraphs(text: str):

@@ -18,6 +18,7 @@ from designkit.calibration.identify import Candidate, identify, nominal_force_pr
 from designkit.calibration.trials import Trial
 from designkit.models import get_model, load_sensor_model, sensor_model, sensor_model_notes
 from designkit.models.ramp import ForceRamp, area_share
+from designkit.rig import rig_scene
 from designkit.sensor import Sensor
 
 SENSOR = Sensor(1000.0, 1.5e-9, depth_m=80e-6, name="synthetic")
@@ -124,7 +125,11 @@ def test_the_sensor_file_records_c_the_nominal_force_ramp_and_the_drift(syntheti
     sen, fm = load_sensor_model(path)
     area = sen.model["contact_area"]
     c = res.parameter("contact_force_fraction")
-    assert area["force_fraction"] == c.value and area["force_fraction_ci95"] == list(c.ci95)
+    # the interval in the schema's shape (docs/schema.md: {low, high, coverage}), as calibrate fit's parameters
+    assert area["force_fraction"] == c.value and "force_fraction_ci95" not in area
+    assert area["force_fraction_interval"] == {"low": c.ci95[0], "high": c.ci95[1], "coverage": 0.95} \
+        == c.to_dict()["interval"] and c.ci95[0] < c.value < c.ci95[1]
+    assert c.to_dict()["identifiable"] is True and "identified" not in c.to_dict()
     assert area["force_fraction"] == pytest.approx(C_TRUE, rel=0.05) and area["n_touches"] == len(trials)
     # the nominal ramp is the touches' median F / F_p, the force averaged over 25 ms (5 samples at 200 Hz,
     # ends held), computed here without identify
@@ -200,6 +205,10 @@ def test_the_real_sensor_file_answers_questions_with_its_model(cli, robot_data_d
     assert isinstance(fm, ForceRamp) and fm.base.name == "layered" and fm.base.smoothing_window == 99
     assert 0.0 < fm.force_fraction < 0.5 and 0.5 < fm.ramp_duration_s < 3.0 and sen.model["contact_area"][
         "n_touches"] == 24
+    # the rig's scene: each of the 24 calibration presses, the residual's correlation, the recorder's onset
+    assert len(fm.touch_ramps) == 24 and np.ptp([d for d, _, _ in fm.touch_ramps]) > 0.3
+    assert 0.2 < sen.conditions["noise_correlation_s"] < 3.0
+    assert rig_scene(sen)["onset_s"] == pytest.approx(-sen.conditions["onset_offset_s"], abs=1e-3)
     ans = json.loads(cli("distinguishable", "--m1", "wood", "--m2", "glass", "--contact", "1", "--sensor", out,
                          "--trials", "20", "--repeats", "1", "--n-mc", "50", "--json").stdout)
     assert ans["model"]["name"] == "force-ramp" and ans["model"]["base"]["name"] == "layered"
@@ -216,3 +225,24 @@ def test_a_sweep_config_takes_the_ramp_and_its_record_survives_json(synthetic_fi
     cfg = SweepConfig(sensor=str(path), intervals=4, contact_s=(1.0,))
     assert cfg.model == sensor_model(load_sensor_model(path)[0]) and cfg.model.name == "force-ramp"
     assert get_model(json.loads(json.dumps(cfg.model.to_dict()))) == cfg.model   # what a table header keeps
+
+
+def test_touches_press_as_the_calibration_touches_did(paper_sensor):
+    """With touch ramps each simulated touch reads one calibration press (its own pace and first contact):
+    the class's curves spread where the nominal ramp gives one curve."""
+    from designkit import Scene
+    from designkit.models.semi_infinite import SemiInfinite
+    from designkit.objects import object_class
+    from designkit.simulation import simulate_class
+
+    t = np.arange(0, 60) * 0.02
+    med = np.clip(t / 0.6, 0, 1)
+    touches = [np.clip((t - d) / p, 0, 1) for d, p in ((0.0, 0.3), (0.2, 0.6), (-0.0, 1.0))]
+    fm = ForceRamp.from_force_profile(SemiInfinite(), t, med, 0.1, touch_force_rel=touches)
+    assert len(fm.touch_ramps) == 3 and fm.touch_ramps[1][0] == pytest.approx(0.2)
+    assert get_model(fm.to_dict()) == fm and fm.nominal().touch_ramps == ()
+    scene = Scene(contact_s=1.0, noise_c=0.0)
+    pressed = simulate_class(object_class(20000), 30, paper_sensor, scene, seed=3, model=fm).temperature_c
+    nominal = simulate_class(object_class(20000), 30, paper_sensor, scene, seed=3, model=fm.nominal()).temperature_c
+    assert np.ptp(pressed[:, -1]) > 20 * np.ptp(nominal[:, -1])
+    assert len({round(v, 9) for v in pressed[:, 100]}) >= 3

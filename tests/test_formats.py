@@ -44,7 +44,7 @@ def test_table_never_cuts_a_name_nor_eats_brackets():
 def test_unknown_format_is_refused():
     from designkit._validation import InputError
 
-    with pytest.raises(InputError, match="table, json, csv, md"):
+    with pytest.raises(InputError, match="text, table, json, csv, ndjson, md"):
         render_rows(ROWS, fmt="xlsx")
 
 
@@ -221,3 +221,135 @@ def test_tables_show_prints_names_from_the_file_as_text(cli, tmp_path):
         first = r.stdout.splitlines()[0]
         assert first.startswith(name if name.isprintable() else repr(name)[1:-1]), first
         assert "\x1b" not in r.stdout
+
+
+# ---------------------------------------------------------------- --format json|csv|ndjson on every command that answers
+# (one shared option and one writer: designkit.cli._format.emit). CSV and ndjson are the records of the JSON.
+ANSWERING = [
+    ("min-contact", "--e1", "35000", "--e2", "20000"),
+    ("max-noise", "--m1", "wood", "--m2", "glass", "--contact", "2"),
+    ("min-delta-t", "--e1", "35000", "--e2", "20000", "--contact", "2"),
+    ("distinguishable", "--m1", "wood", "--m2", "glass", "--contact", "2"),
+    ("delta-e", "--e", "20000", "--contact", "2"),
+    ("validity", "--m", "acrylic", "--thickness", "0.003"),
+    ("tables", "list"),
+]
+
+
+def _same(a, b):
+    """A CSV cell (text) against the JSON value it stands for."""
+    if b is None:
+        return a == ""
+    if isinstance(b, bool):
+        return a == str(b)
+    if isinstance(b, (int, float)):
+        return float(a) == pytest.approx(b, rel=1e-12)
+    return a == str(b)
+
+
+@pytest.mark.parametrize("args", ANSWERING, ids=[" ".join(a[:2]) for a in ANSWERING])
+def test_csv_and_ndjson_are_the_same_records(cli, args):
+    csv_out, nd_out = cli(*args, "--format", "csv"), cli(*args, "-f", "ndjson")
+    assert csv_out.exit_code == 0 and nd_out.exit_code == 0, csv_out.output + nd_out.output
+    rows = list(csv.DictReader(io.StringIO(csv_out.stdout)))
+    records = [json.loads(line) for line in nd_out.stdout.splitlines()]
+    assert rows and len(rows) == len(records)
+    for row, rec in zip(rows, records):
+        assert list(row) == list(rec)
+        bad = {k: (row[k], rec[k]) for k in rec if not _same(row[k], rec[k])}
+        assert not bad
+
+
+@pytest.mark.parametrize("question, args, key", [
+    ("min-contact", ("--e1", "35000", "--e2", "20000"), "value"),
+    ("distinguishable", ("--m1", "wood", "--m2", "glass", "--contact", "1.5"), "value"),
+])
+def test_an_answers_record_has_its_json_values(cli, question, args, key):
+    d = json.loads(cli(question, *args, "--json").stdout)
+    (row,) = list(csv.DictReader(io.StringIO(cli(question, *args, "--format", "csv").stdout)))
+    assert _same(row[key], d[key]) and _same(row["interval_low"], d["interval"]["low"])
+    assert _same(row["ideal_value"], d["ideal"]["value"]) and row["table_name"] == d["table"]["name"]
+    pd = pytest.importorskip("pandas")
+    frame = pd.read_csv(io.StringIO(cli(question, *args, "--format", "csv").stdout))
+    assert frame.shape[0] == 1 and frame["question"][0] == question
+
+
+def test_json_flag_is_format_json_and_they_cannot_disagree(cli):
+    args = ("min-contact", "--e1", "35000", "--e2", "20000")
+    assert cli(*args, "--json").stdout == cli(*args, "--format", "json").stdout
+    r = cli(*args, "--json", "--format", "csv")
+    assert r.exit_code == 2 and "contradict" in r.output
+    r = cli(*args, "--format", "xlsx")  # refused before any work, as JSON when asked with --format json too
+    assert r.exit_code == 2 and "ndjson" in r.output
+
+
+def test_validity_csv_splits_ranges_into_min_and_max(cli):
+    (row,) = list(csv.DictReader(io.StringIO(cli("validity", "--m", "acrylic", "--thickness", "0.003",
+                                                 "-f", "csv").stdout)))
+    d = json.loads(cli("validity", "--m", "acrylic", "--thickness", "0.003", "--json").stdout)
+    assert float(row["valid_up_to_s"]) == pytest.approx(d["valid_up_to_s"])
+    assert float(row["effusivity_min"]) == d["material_ranges"]["effusivity_range"][0]
+    assert float(row["effusivity_max"]) == d["material_ranges"]["effusivity_range"][1]
+
+
+def test_an_answer_written_with_out(cli, tmp_path):
+    out = tmp_path / "a.ndjson"
+    r = cli("min-contact", "--e1", "35000", "--e2", "20000", "-f", "ndjson", "--out", str(out))
+    assert r.exit_code == 0 and r.stdout == ""
+    assert json.loads(out.read_text())["question"] == "min-contact"
+
+
+def test_f1_record_has_its_json_values(cli):
+    args = ("f1", "--e1", "35000", "--e2", "20000", "--trials", "12", "--folds", "2", "--contact", "1")
+    d = json.loads(cli(*args, "--json").stdout)
+    (row,) = list(csv.DictReader(io.StringIO(cli(*args, "--format", "csv").stdout)))
+    assert float(row["svm_f1"]) == pytest.approx(d["svm_f1"]) and float(row["ideal_f1"]) == pytest.approx(d["ideal_f1"])
+    assert float(row["contact_s"]) == d["scene"]["contact_s"] == 1.0
+    assert float(row["effusivity_min_1"]) == d["objects"][0]["effusivity_range"][0]
+
+
+def test_simulate_records_are_its_json_curves_one_row_per_sample_time(cli, tmp_path):
+    """simulate's csv and ndjson: one row per sample time, time_s then temperature_c_K of touch K, the JSON's
+    own numbers (read by the csv module and by pandas); --out FILE alone writes that CSV, stdout empty."""
+    args = ("simulate", "--e", "20000", "--contact", "0.05", "--trials", "2", "--seed", "3")
+    d = json.loads(cli(*args, "--json").stdout)
+    text = cli(*args, "--format", "csv").stdout
+    rows = list(csv.DictReader(io.StringIO(text)))
+    assert list(rows[0]) == ["time_s", "temperature_c_1", "temperature_c_2"] and len(rows) == len(d["time_s"]) == 11
+    for i, row in enumerate(rows):
+        assert _same(row["time_s"], d["time_s"][i])
+        assert all(_same(row[f"temperature_c_{k + 1}"], d["temperature_c"][k][i]) for k in range(2))
+    records = [json.loads(line) for line in cli(*args, "-f", "ndjson").stdout.splitlines()]
+    assert records == [{k: float(v) for k, v in row.items()} for row in rows]
+    pd = pytest.importorskip("pandas")
+    frame = pd.read_csv(io.StringIO(text))
+    assert frame["temperature_c_2"].tolist() == d["temperature_c"][1] and frame["time_s"].tolist() == d["time_s"]
+    out = tmp_path / "curve.csv"
+    r = cli(*args, "--out", out)
+    assert r.exit_code == 0 and r.stdout == "" and out.read_text() == text
+
+
+def test_design_record_is_its_json_recommendation(cli):
+    """design's csv and ndjson: one record, the JSON's recommendation (best, flattened), reason and constraints
+    under their own names; no design (exit 3) is still one record, its design columns empty."""
+    args = ("design", "--m", "a=20000", "--m", "b=35000", "--skin", "Polyetheretherketone (PEEK)",
+            "--depth-um", "100:400", "--no-svm")
+    d = json.loads(cli(*args, "--json").stdout)
+    text = cli(*args, "--format", "csv").stdout
+    (row,) = list(csv.DictReader(io.StringIO(text)))
+    (rec,) = [json.loads(line) for line in cli(*args, "-f", "ndjson").stdout.splitlines()]
+    assert list(row) == list(rec)
+    expect = {**{k: v for k, v in d["best"].items() if k not in ("ideal", "limiting")},
+              "ideal_value": d["best"]["ideal"]["value"], "ideal_method": "closed-form", "limiting_a": "a",
+              "limiting_b": "b", "reason": d["reason"], "max_contact_s": 4.0, "noise_c": 0.05,
+              "depth_min_um": 100.0, "depth_max_um": 400.0, "threshold": 0.9,
+              "designs_searched": d["designs_searched"], "svm_value": None, "svm_f1": None}
+    assert {k: rec[k] for k in expect} == expect
+    assert all(_same(row[k], v) for k, v in expect.items()), row
+    pd = pytest.importorskip("pandas")
+    frame = pd.read_csv(io.StringIO(text))
+    assert frame.shape[0] == 1 and frame["depth_um"][0] == d["best"]["depth_um"] and frame["skin"][0] == d["best"]["skin"]
+    r = cli("design", "--m", "a=400", "--m", "b=450", "--no-svm", "--format", "csv")
+    assert r.exit_code == 3, r.output
+    (none,) = list(csv.DictReader(io.StringIO(r.stdout)))
+    assert list(none) == list(row) and none["skin"] == "" and "overlap" in none["reason"]

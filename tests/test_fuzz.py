@@ -28,6 +28,7 @@ import pytest
 hypothesis = pytest.importorskip("hypothesis")
 from hypothesis import HealthCheck, given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
+from refusals import REFUSED_IN_ONE_LINE  # noqa: E402
 
 WATCHDOG_S = 60
 EXAMPLES = int(os.environ.get("DESIGNKIT_FUZZ_EXAMPLES", "15"))  # per command; derandomized, so CI sees the same invocations every run
@@ -446,43 +447,9 @@ def _files36(root: Path) -> dict[str, str]:
     return {f"@{p.stem}": str(p) for p in d.iterdir()}
 
 
-ISSUE36_CASES = [
-    (["min-contact", "--m1", "copper", "--m2", "glass", "--exact", "--max-contact", "1e308"], "samples per touch"),
-    (["matrix", "--m", "copper", "--m", "glass", "--m", "granite", "-q", "max-noise", "--contact", "1e308"], None),
-    (["min-contact", "--e1", "35000", "--e2", "20000", "--exact", "--table", "svm-paper"], "contradict"),
-    (["delta-e", "--e", "35000", "--contact", "2", "--exact", "--table", "svm-paper"], "contradict"),
-    (["matrix", "--m", "copper", "--m", "glass", "--set", "paper12"], "contradict"),
-    (["matrix", "--m", "copper", "--m", "glass", "--from", "-"], "contradict"),
-    (["classify", "--m", "wood", "--m", "copper", "--port", "/dev/null", "--export-c", "x.h"], "contradict"),
-    (["f1", "--e1", "35000", "--e2", "20000", "--delta-t", "0"], "--delta-t"),
-    (["min-contact", "--e1", "35000", "--e2", "20000", "--width", "1e308"], "--width"),
-    (["design", "--set", "paper12", "--depth-um", "1:1e308"], "depth"),
-    (["bench", "--jobs", "0"], "jobs"),
-    (["bench", "--out", "@a-file"], "not a folder"),
-    (["export", "--table", "svm-paper", "--contact", "1,,2", "--out", "x.json"], "commas"),
-    (["simulate", "--e", "400", "--sensor", "@noversion"], "designkit_sensor"),
-    (["simulate", "--e", "400", "--sensor", "@dup"], "twice"),
-    (["simulate", "--e", "400", "--sensor", "@e308"], "e_s"),
-    (["simulate", "--e", "400", "--sensor", "@newline"], "sensor name"),
-    (["min-contact", "--m1", "copper", "--m2", "glass", "--sensor", "@fast"], "samples per touch"),
-    (["min-contact", "--e1", "35000", "--e2", "20000", "--table", ""], "empty"),
-    (["simulate", "--e", "400", "--out", ""], "empty"),
-    (["tables", "list", "--folder", ""], "empty"),
-    (["classify", "--m", "wood", "--m", "copper", "--port", ""], "empty"),
-    (["emulate", "--material", "=400", "--duration", "0.1"], "label"),
-    (["emulate", "--material", "a\nb=400", "--duration", "0.1"], "label"),
-    (["simulate", "--e", "400", "--plot", "nowhere/x.png"], "does not exist"),
-    (["simulate", "--e", "400", "--out", "nowhere/x.csv"], "does not exist"),
-    (["validity", "--m", "acrylic", "--thickness", "0.003", "--plot", "nowhere/x.png"], "does not exist"),
-    (["matrix", "--m", "copper", "--m", "glass", "--plot", "nowhere/x.png"], "does not exist"),
-    (["classify", "--m", "wood", "--m", "copper", "--export-c", "nowhere/x.h"], "does not exist"),
-    (["classify", "--m", "wood", "--m", "copper", "--port", "/dev/null", "--profile", "@empty-profile"], "empty"),
-    (["calibrate", "record", "--port", "/dev/null", "--material", "w", "--out", "rec", "--profile", "@post"],
-     "post_s"),
-    (["sweep", "--name", "../../escaped", "--fidelity", "ideal", "--intervals", "4", "--contact", "1"], "name"),
-    (["sweep", "--name", "a\nb", "--fidelity", "ideal", "--intervals", "4", "--contact", "1"], "name"),
-    (["sweep", "--config", "@abs"], "name"),
-]
+#: The cases of issue 36 that read one of the hostile files above; the others run in tests/test_hardening.py
+#: (one list: tests/refusals.py).
+ISSUE36_CASES = [c for c in REFUSED_IN_ONE_LINE if any(a.startswith("@") for a in c[0])]
 
 
 @pytest.mark.parametrize("argv,needle", ISSUE36_CASES,

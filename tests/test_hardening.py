@@ -10,6 +10,7 @@ from pathlib import Path
 import pytest
 
 from designkit._validation import InputError, check_file_name
+from refusals import REFUSED_IN_ONE_LINE
 
 
 def _one_line_refusal(r, *needles: str) -> str:
@@ -141,31 +142,8 @@ def test_csv_cells_of_numpy_scalars_are_plain_numbers():
 
 
 # ------------------------------------------------------------------ class 10: accepted where it should be refused
-@pytest.mark.parametrize("args, needle", [
-    (["min-contact", "--e1", "35000", "--e2", "20000", "--exact", "--table", "svm-paper"], "contradict"),
-    (["max-noise", "--e1", "35000", "--e2", "20000", "--contact", "2", "--exact", "--table", "svm-paper"],
-     "contradict"),
-    (["min-delta-t", "--e1", "35000", "--e2", "20000", "--contact", "2", "--exact", "--table", "svm-paper"],
-     "contradict"),
-    (["delta-e", "--e", "35000", "--contact", "2", "--exact", "--table", "svm-paper"], "contradict"),
-    (["distinguishable", "--e1", "35000", "--e2", "20000", "--contact", "2", "--exact", "--table", "svm-paper"],
-     "contradict"),
-    (["matrix", "--m", "copper", "--m", "glass", "--set", "paper12"], "contradict"),
-    (["matrix", "--m", "copper", "--m", "glass", "--from", "-"], "contradict"),
-    (["classify", "--m", "wood", "--m", "copper", "--port", "/dev/null", "--export-c", "x.h"], "contradict"),
-    (["f1", "--e1", "35000", "--e2", "20000", "--delta-t", "0"], "--delta-t"),
-    (["min-contact", "--e1", "35000", "--e2", "20000", "--width", "1e308"], "--width"),
-    (["design", "--set", "paper12", "--depth-um", "1:1e308"], "depth"),
-    (["bench", "--quick", "--jobs", "0"], "jobs"),
-    (["export", "--table", "svm-paper", "--contact", "1,,2", "--out", "x.json"], "single commas"),
-    (["min-contact", "--e1", "35000", "--e2", "20000", "--table", ""], "empty"),
-    (["simulate", "--e", "400", "--out", ""], "empty"),
-    (["tables", "list", "--folder", ""], "empty"),
-    (["classify", "--m", "wood", "--m", "copper", "--export-c", ""], "empty"),
-    (["classify", "--m", "wood", "--m", "copper", "--port", ""], "empty"),
-    (["emulate", "--material", "=400"], "label"),
-    (["emulate", "--material", "a\nb=400"], "label"),
-])
+@pytest.mark.parametrize("args, needle", [c for c in REFUSED_IN_ONE_LINE if not any(a.startswith("@") for a in c[0])],
+                         ids=lambda v: " ".join(v)[:60] if isinstance(v, list) else None)
 def test_refused_in_one_line(cli, tmp_path, monkeypatch, args, needle):
     monkeypatch.chdir(tmp_path)
     _one_line_refusal(cli(*args), needle)

@@ -50,7 +50,7 @@ def test_synthetic_round_trip_recovers_the_parameters_within_2_percent_and_their
     for name in ("diffusivity_m2_s", "lag_s"):
         p = res.parameter(name)
         assert p.value == pytest.approx(TRUE[name], rel=0.02), name
-        assert p.ci95[0] <= TRUE[name] <= p.ci95[1] and p.identified, name
+        assert p.ci95[0] <= TRUE[name] <= p.ci95[1] and p.identifiable, name
     assert res.parameter("time_offset_s").value == pytest.approx(OFFSET_S, abs=0.01)
     for name, eo in E_O.items():  # the ratios e_o/e_s the data identify
         r = res.ratios[name]

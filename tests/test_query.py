@@ -212,6 +212,7 @@ def test_materials_edge_pair_against_the_old_nine_by_nine_worst_case():
     observer, far-apart pairs no longer share the table's shortest contact, so equality is rare; the edge
     answer is still never the more demanding.)"""
     from designkit.materials import get_material
+    from designkit.query import ask
 
     tab = load_table("svm-paper")
     mats = {n: get_material(f"paper12:{n}").effusivity_range for n in PAPER12}
@@ -222,9 +223,11 @@ def test_materials_edge_pair_against_the_old_nine_by_nine_worst_case():
             if max(a0, b0) < min(a1, b1):
                 continue
             edge = q.min_contact(m1=f"paper12:{a}", m2=f"paper12:{b}", table=tab, ideal_table=None).value
-            grid = [q.min_contact(x, y, table=tab, ideal_table=None).value
-                    for x in np.linspace(a0, a1, 9) for y in np.linspace(b0, b1, 9) if x != y]
-            worst = None if any(g is None for g in grid) else max(grid)
+            x, y = np.meshgrid(np.linspace(a0, a1, 9), np.linspace(b0, b1, 9), indexing="ij")
+            keep = x != y
+            grid = ask("min-contact", route="table", e1=x[keep], e2=y[keep], table=tab, ideal_table=None,
+                       ideal_bound=False).value  # one array call (the scalar route's values), NaN: no answer
+            worst = None if np.isnan(grid).any() else float(grid.max())
             compared += 1
             assert edge is not None, (a, b)
             if worst is None:
@@ -521,3 +524,29 @@ def test_an_effusivity_whose_class_ends_above_the_cap_is_refused_naming_the_clas
     assert r.stderr.startswith("Error: effusivity class 9999999, [9999999, 10000079), ends above the highest")
     assert "give at most 9999920" in r.stderr
     assert cli("min-contact", "--e1", "9999920", "--e2", "20000").exit_code != 2  # the largest value accepted
+
+
+def test_the_library_chooses_the_route_and_says_why():
+    """ask(route="auto") (the default) reads a table built for the sensor, model and scene asked, computes
+    the answer for a sensor or spread no table holds, keeps a named table, and says why (issue 33)."""
+    from designkit import SENSORS, query
+    from designkit.query import NeedsInput
+    from designkit.query.policy import choose_route, table_for
+
+    mine = SENSORS["paper"].replace(effusivity=1982.0, name="mine")
+    route, args, why = choose_route("min-contact", "auto", {"e1": 35000, "e2": 20000, "sensor": mine, "table": None,
+                                                            "ideal_table": "ideal-paper", "trials": 20})
+    assert route == "exact" and "table" not in args and "ideal_table" not in args and args["trials"] == 20
+    assert why.reason.startswith("the shipped tables are for the paper sensor, not mine") and why.noted
+    route, args, why = choose_route("min-contact", "auto", {"e1": 35000, "e2": 20000, "trials": 20, "width": 80.0})
+    assert route == "table" and "trials" not in args and "width" not in args and "svm-fine" in why.reason
+    assert table_for("min-contact", sensor_temp_spread_c=2.5, delta_t_c=7.5).table == "svm-paper-varied"
+    assert table_for("min-contact", sensor_temp_spread_c=2.5, delta_t_c=10.0).table is None
+    assert table_for("max-noise", sensor_temp_spread_c=2.5, delta_t_c=7.5).table is None
+    assert choose_route("min-contact", "auto", {"table": "svm-paper"})[2].reason == "table svm-paper named"
+    with pytest.raises(NeedsInput, match="tables answer for effusivity alone"):
+        choose_route("min-contact", "auto", {"e1": 35000, "e2": 20000, "diffusivity_m2_s": 1e-7})
+    a = query.min_contact(35000, 20000)
+    assert a.route == "table" and a.to_dict()["route_reason"] == a.route_reason and "svm-fine" in a.route_reason
+    arr = query.min_contact([35000, 30000], 20000)
+    assert arr.route_reason == a.route_reason and arr.to_dict()[0]["route_reason"] == a.route_reason

@@ -161,7 +161,7 @@ def small_report(small_tables, tmp_path_factory):
     out = tmp_path_factory.mktemp("report")
     no_data = tmp_path_factory.mktemp("no-robot-data")
     res = reproduce(out, ["f1-matrices", "delta-curves", "effusivity", "node-graphs", "table1", "real-robot",
-                          "sim-to-real"],
+                          "sim-to-real", "real-prediction"],
                     ReproduceSettings(tables_dir=small_tables, robot_data=no_data, quick=True))
     return res
 
@@ -246,7 +246,7 @@ def test_material_pairs_use_the_papers_mean_over_covering_intervals(small_report
 
 @pytest.mark.slow
 def test_real_robot_sections_skip_cleanly_without_data(small_report):
-    for name in ("real-robot", "sim-to-real"):
+    for name in ("real-robot", "sim-to-real", "real-prediction"):
         s = small_report.section(name)
         assert s.skipped and "not available" in s.skipped
         assert s.figures == ()

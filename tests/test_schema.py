@@ -158,6 +158,24 @@ def test_every_key_of_every_command_is_documented_with_one_shape(documents):
     assert not bad, "\n".join(dict.fromkeys(bad))
 
 
+def test_calibration_records_follow_the_schema():
+    """An identified parameter (calibrate fit's results, a sensor file's provenance) and a force-driven contact
+    area's threshold: the interval is {low, high, coverage}, whether the data identify it is ``identifiable``
+    (a bool; ``identified`` is a paper12 material's identified effusivity, a number)."""
+    from designkit.calibration.identify import IdentifiedParameter
+
+    p = IdentifiedParameter("contact_force_fraction", 0.17, (-0.05, 0.38), "", False, "on a search bound")
+    bad: list[str] = []
+    for doc in (p.to_dict(), {"force_fraction": 0.17, "force_fraction_interval": p.interval()}):
+        _check(doc, "calibration", bad, {})
+    assert not bad, bad
+    assert p.to_dict()["identifiable"] is False and p.interval() == {"low": -0.05, "high": 0.38, "coverage": 0.95}
+    assert CONCEPTS["identified"] == ["number"] and CONCEPTS["identifiable"] == ["bool"]
+    assert CONCEPTS["force_fraction_interval"] == ["interval"]
+    _check({"identified": True}, "x", bad, {})
+    assert bad == ["x.identified: true is not number"]
+
+
 def test_retired_names_appear_nowhere(documents):
     """The names issue 33 found for concepts that have one key now."""
     retired = {"e_range", "e1_range", "e2_range", "e_sensor", "ideal_min_contact_s", "limiting_classes",

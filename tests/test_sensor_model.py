@@ -132,6 +132,7 @@ def test_questions_route_a_sensor_file_to_the_exact_route_and_say_why(cli, conta
     assert any("shipped tables are for the paper sensor, not my-sensor and the semi-infinite model, not contact"
                in n for n in ans["notes"])
     assert any("recorded in sensor file my-sensor" in n for n in ans["notes"])
+    assert ans["route_reason"].startswith("the shipped tables are for the paper sensor, not my-sensor")
 
 
 def test_a_table_built_for_another_sensor_never_answers_for_this_one(cli, contact_file):

@@ -107,3 +107,37 @@ def test_draws_reject_bad_input():
     with pytest.raises(InputError):
         d.truncate(11)
     assert render_trials(d.truncate(4), __import__("designkit").SENSORS["paper"], Scene()).temperature_c.shape == (3, 4)
+
+
+# ------------------------------------------------------------------ the rig's scene
+def test_correlated_noise_keeps_prefixes_and_its_correlation_length(paper_sensor):
+    """A rig's noise wanders (Matern-3/2 over the scene's length); truncating a touch is still exact."""
+    from designkit.rig import residual_correlation_s
+
+    scene = Scene(contact_s=3.0, noise_c=0.03, noise_correlation_s=0.5)
+    long = simulate_interval(20000, 20080, 60, paper_sensor, scene, seed=2)
+    short = simulate_interval(20000, 20080, 60, paper_sensor, scene.replace(contact_s=1.0), seed=2)
+    np.testing.assert_allclose(long.temperature_c[:, :short.time_s.size], short.temperature_c, rtol=0, atol=1e-11)
+    white = simulate_interval(20000, 20080, 60, paper_sensor, scene.replace(noise_correlation_s=0.0), seed=2)
+    noise = long.temperature_c - sensor_temperature(long.time_s, long.effusivity[:, None], 35, 25,
+                                                    paper_sensor.effusivity, paper_sensor.tau_s)
+    assert np.std(noise) == pytest.approx(0.03, rel=0.15)
+    assert residual_correlation_s(list(noise), paper_sensor.sample_rate_hz) == pytest.approx(0.5, rel=0.2)
+    lag1 = np.mean(noise[:, 1:] * noise[:, :-1]) / np.mean(noise ** 2)
+    assert lag1 > 0.99 and not np.array_equal(white.temperature_c, long.temperature_c)
+
+
+def test_the_recorders_window_starts_at_its_onset(paper_sensor):
+    """With onset_s the samples are those from the onset to contact_s: the tail of the touch from the first
+    heat flow (the same curve, read later)."""
+    full = simulate_interval(5000, 5080, 5, paper_sensor, Scene(contact_s=1.5, noise_c=0.0), seed=1)
+    late = simulate_interval(5000, 5080, 5, paper_sensor, Scene(contact_s=1.5, noise_c=0.0, onset_s=0.5), seed=1)
+    assert late.time_s[0] == 0.5 and late.time_s.size == full.time_s.size - 100
+    np.testing.assert_allclose(late.temperature_c, full.temperature_c[:, 100:], rtol=0, atol=1e-12)
+    before = Scene(contact_s=0.2, onset_s=0.5)        # contact ends before the onset: one sample, at the onset
+    assert before.window_s() == 0.0 and "onset_s" in before.to_dict() and "onset_s" not in Scene().to_dict()
+
+
+def test_a_contact_ending_before_the_onset_is_one_sample_at_the_onset(paper_sensor):
+    t = simulate_interval(5000, 5080, 4, paper_sensor, Scene(contact_s=0.3, onset_s=0.5), seed=1)
+    assert t.time_s.tolist() == [0.5] and t.temperature_c.shape == (4, 1)

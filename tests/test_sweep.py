@@ -511,3 +511,25 @@ def test_the_gpu_code_path_without_array_api_compat_is_one_line_before_any_work(
     assert r.returncode == 2 and len(err.splitlines()) == 1, err
     assert "needs array-api-compat" in err and "pip install array-api-compat" in err
     assert not (tmp_path / "w").exists() and not (tmp_path / "t.npz").exists()
+
+
+def test_the_table_records_its_engine_version_and_another_engines_chunks_are_not_resumed(tmp_path):
+    """A table says which arithmetic built it (tables without the key are version 1, the shipped ones), and
+    a working folder whose chunks another engine version computed is refused in one line, not mixed in."""
+    from designkit import InputError
+    from designkit.sweep import ENGINE_VERSION, SweepConfig, prepare_workdir, run_sweep
+    from designkit.tables.store import load_table
+
+    cfg = SweepConfig(name="ev", intervals=6, trials=10, noise_ratio=(0.02,), contact_s=(1.0,), fidelity="ideal")
+    table = load_table(run_sweep(cfg, tmp_path / "w", backend="sequential"))
+    assert table.header["engine_version"] == ENGINE_VERSION >= 2
+    assert "engine_version" not in load_table("svm-paper").header  # built by version 1
+    meta = tmp_path / "w" / "sweep.json"
+    old = json.loads(meta.read_text())
+    assert old["engine_version"] == ENGINE_VERSION
+    old.pop("engine_version")  # a folder a version-1 designkit wrote
+    meta.write_text(json.dumps(old))
+    with pytest.raises(InputError, match="engine version 1.*--fresh"):
+        prepare_workdir(cfg, tmp_path / "w", resume=True, fresh=False)
+    prepare_workdir(cfg, tmp_path / "w", resume=True, fresh=True)  # --fresh discards them
+    assert json.loads(meta.read_text())["engine_version"] == ENGINE_VERSION

@@ -112,7 +112,7 @@ def test_varied_table_verdict_follows_its_own_min_contact():
 
 @pytest.mark.parametrize("table, mc_floor", [("svm-paper", 1.0), ("svm-fine", 0.995)])
 def test_grid_answer_what_exports_give_errs_on_the_safe_side_of_the_cli(table, mc_floor):
-    """The exports' documented relation to the CLI (designkit.export._common.CLI_RELATION), on random inputs:
+    """The grid rule's relation to the CLI (docs/decisions-log.md, Exports), on random inputs:
     the grid's min-contact at or above the CLI's estimate (svm-fine's crossings, 0.1 s apart, lie so close to
     it that interpolation can put them 0.3 % below: measured 1 of 139), its distinguishable 'yes' only where
     the CLI says yes, its delta(e) at most 1.5 % below the CLI's (measured: 33 of 723 directions below, by at

@@ -116,21 +116,23 @@ def test_a_varied_estimate_is_never_below_the_ideal_bound():
     assert a.interval_kind == "table-varied-estimate" and a.value == pytest.approx(floor, rel=1e-12)
     assert a.interval[0] == pytest.approx(floor, rel=1e-12) and a.interval[1] > a.value
     rng = np.random.default_rng(5)
-    e1 = rng.uniform(5000, 39000, 40)
-    e2, noise = e1 * rng.uniform(0.2, 0.8, 40), np.exp(rng.uniform(math.log(0.01), math.log(0.1), 40))
+    # the array call estimates each pair's Monte Carlo ideal bound (about 3 s a pair); the scalar calls
+    # after it read them from the memo
+    e1 = rng.uniform(5000, 39000, 10)
+    e2, noise = e1 * rng.uniform(0.2, 0.8, 10), np.exp(rng.uniform(math.log(0.01), math.log(0.1), 10))
     arr = q.min_contact(e1, e2, noise_c=noise, **kw)
     est = ~np.isnan(arr.coverage) & ~np.isnan(arr.value)
-    assert est.sum() >= 10 and (arr.value[est] >= arr.low[est]).all()
-    for i in np.flatnonzero(est)[:10]:
+    assert est.sum() >= 3 and (arr.value[est] >= arr.low[est]).all()
+    for i in np.flatnonzero(est):
         s = q.min_contact(float(e1[i]), float(e2[i]), noise_c=float(noise[i]), **kw)
         assert s.value >= s.ideal_bound.interval[0] and float(arr.value[i]) == pytest.approx(s.value, rel=1e-12)
 
 
 def test_the_array_route_gives_the_scalar_routes_varied_estimates():
     rng = np.random.default_rng(11)
-    e1 = rng.uniform(5000, 39000, 12)
-    e2 = e1 * rng.uniform(0.3, 0.7, 12)
-    noise = np.exp(rng.uniform(math.log(0.01), math.log(0.1), 12)).round(4)
+    e1 = rng.uniform(5000, 39000, 3)  # the array call estimates each pair's Monte Carlo bound (seconds a pair)
+    e2 = e1 * rng.uniform(0.3, 0.7, 3)
+    noise = np.exp(rng.uniform(math.log(0.01), math.log(0.1), 3)).round(4)
     # and a pair separable at the table's first contact: a grid cell, no stated coverage
     e1, e2, noise = np.append(e1, 13190.9), np.append(e2, 1120.5), np.append(noise, 0.03)
     arr = q.min_contact(e1, e2, noise_c=noise, delta_t_c=7.5, sensor_temp_spread_c=2.5)
@@ -147,9 +149,9 @@ def test_the_array_route_gives_the_scalar_routes_varied_estimates():
         # the array says which intervals state a coverage, as each scalar answer does
         assert (None if np.isnan(arr.coverage[i]) else float(arr.coverage[i])) == s.interval_coverage, i
         n_estimates += s.to_dict()["interval"]["method"] == "table-varied-estimate"
-    assert n_estimates >= 4 and np.isnan(arr.coverage).any()  # some stated, some not
-    d = q.delta_e(e1[:4], contact_s=2.0, noise_c=noise[:4], delta_t_c=7.5, sensor_temp_spread_c=2.5)
-    for i in range(4):
+    assert n_estimates >= 1 and np.isnan(arr.coverage).any()  # some stated, some not
+    d = q.delta_e(e1[:2], contact_s=2.0, noise_c=noise[:2], delta_t_c=7.5, sensor_temp_spread_c=2.5)
+    for i in range(2):
         s = q.delta_e(float(e1[i]), contact_s=2.0, noise_c=float(noise[i]), delta_t_c=7.5, sensor_temp_spread_c=2.5)
         assert float(d.value[i]) == pytest.approx(s.value, rel=1e-12) and float(d.coverage[i]) == s.interval_coverage
 

@@ -99,6 +99,24 @@ def test_lists_and_materials_and_exact_route_loop_over_scalar_calls():
         assert _same(float(m.value[i]), _num(max_noise(m1="copper", m2="wood", contact_s=c).value), 1e-12)
 
 
+def test_lists_of_material_names_broadcast_like_numbers():
+    """The README's library call: lists of names answer one element per pair (issue 33), names and numbers
+    broadcast together, element i the single call's answer."""
+    a = min_contact(m1=["copper", "glass"], m2=["wood", "PVC"])
+    assert isinstance(a, ArrayAnswer) and a.shape == (2,)
+    for i, (m1, m2) in enumerate((("copper", "wood"), ("glass", "PVC"))):
+        one = min_contact(m1=m1, m2=m2)
+        assert float(a.value[i]) == one.value and float(a.low[i]) == one.interval[0]
+    b = min_contact(m1=["copper", "glass"], m2="wood", noise_c=[[0.02], [0.05]])
+    assert b.shape == (2, 2) and float(b.value[1, 1]) == min_contact(m1="glass", m2="wood", noise_c=0.05).value
+    d = delta_e(m=["wood", "glass"], contact_s=2.0)
+    assert d.shape == (2,) and float(d.value[1]) == delta_e(m="glass", contact_s=2.0).value
+    with pytest.raises(InputError, match=r"m1\[1\] must be a name"):
+        min_contact(m1=["copper", 3], m2="wood")
+    with pytest.raises(InputError, match="do not broadcast"):
+        min_contact(m1=["copper", "glass", "wood"], m2=["wood", "PVC"])
+
+
 def test_bad_elements_are_named():
     with pytest.raises(InputError, match=r"e1\[2\] must be positive, got -5"):
         min_contact(np.array([35000.0, 30000.0, -5.0]), 20000)

@@ -317,7 +317,7 @@ def split_by_trial_set(trials: Sequence[Trial], fit_sets: Sequence[int],
 
 
 #: Share of the trial sets present that :func:`choose_split` fits by default (the first ones, at least one):
-#: 4 of the shared recordings' 20 sets, as every comparison on them was made. A recording without trial
+#: 4 of the shared recordings' 20 sets. A recording without trial
 #: sets (one session, touches in order) fits the first half of each material's touches.
 FIT_SHARE = 0.2
 FIT_SHARE_TOUCH_ORDER = 0.5
@@ -463,9 +463,9 @@ _OBJECT_MODES = ("passive", "passive-end", "free", "passive-affine", "passive-en
 
 
 #: The force is averaged over this window [s] (centred) before it sets the contact area: the force sensor's
-#: white noise, clipped where the area is whole, reads the plateau's area low (errors in variables: granite's
-#: e_o/e_s +0.43 % in pty round trips, +0.21 % after it; :data:`FORCE_NOISE_BAND_SD` removes the rest;
-#: docs/sensor-models.md). A finger presses over 0.3 s or more: 25 ms rounds only the ramp's corners.
+#: white noise, clipped where the area is whole, reads the plateau's area low (errors in variables;
+#: :data:`FORCE_NOISE_BAND_SD` removes the rest; docs/sensor-models.md). A finger presses over 0.3 s or more:
+#: 25 ms rounds only the ramp's corners.
 FORCE_SMOOTHING_S = 0.025
 
 
@@ -669,7 +669,7 @@ def _reading(model, t: np.ndarray, e_object: float, sensor, interp_points: int |
     Models solved numerically (``solved_numerically``) are evaluated at
     ``interp_points`` log-spaced times and interpolated by a cubic spline in
     ``log t`` (error below 1e-6 of the temperature difference for smooth
-    readings, tested), which makes a residual evaluation about 6x faster.
+    readings, tested), which makes a residual evaluation cheaper.
     The Talbot inversion uses :data:`FIT_TALBOT_NODES` nodes (error below
     1e-8 of the temperature difference against 32 nodes over the fitted
     parameter range, docs/sensor-models.md; the noise is about 1e-3 of it).
@@ -1003,7 +1003,7 @@ def _initial_ratios(prob: _Problem, x: np.ndarray) -> np.ndarray:
 class IdentifiedParameter:
     """An identified quantity: value, 95 % interval, unit, and whether the data identify it.
 
-    ``identified`` is False when the Jacobian is rank-deficient along it, its
+    ``identifiable`` is False when the Jacobian is rank-deficient along it, its
     interval spans more than a factor of 10 (positive quantities) or it sits
     on a search bound (``note`` says which).
     """
@@ -1012,12 +1012,17 @@ class IdentifiedParameter:
     value: float
     ci95: tuple[float, float]
     unit: str = ""
-    identified: bool = True
+    identifiable: bool = True
     note: str = ""
 
+    def interval(self) -> dict[str, float]:
+        """The 95 % interval in the schema's shape (docs/schema.md, ``interval``): ``{low, high, coverage}``."""
+        return {"low": float(self.ci95[0]), "high": float(self.ci95[1]), "coverage": 0.95}
+
     def to_dict(self) -> dict[str, Any]:
-        return {"name": self.name, "value": self.value, "ci95": list(self.ci95), "unit": self.unit,
-                "identified": self.identified, "note": self.note}
+        """The schema's shape (docs/schema.md): ``interval: {low, high, coverage}``, ``identifiable`` a bool."""
+        return {"name": self.name, "value": self.value, "interval": self.interval(),
+                "unit": self.unit, "identifiable": bool(self.identifiable), "note": self.note}
 
 
 @dataclass(frozen=True)
@@ -1231,7 +1236,7 @@ class Identification:
         geometric standard deviation of the touches' h_c,i; ``object_temperature``:
         how each material's temperature was taken (passive, free, a number);
         ``contact_area`` (a ``force_area`` candidate): the threshold c
-        (``force_fraction``, its 95 % interval) and the fitted touches' median
+        (``force_fraction``, its 95 % interval ``force_fraction_interval``) and the fitted touches' median
         force over its plateau (:func:`nominal_force_profile`), which questions
         play as the nominal ramp; ``drift`` (a ``drift`` candidate):
         ``"per-touch"``, a nuisance fitted for each touch, not a sensor property.
@@ -1254,10 +1259,10 @@ class Identification:
             return None
         if "contact_force_fraction" in self.candidate.free:
             p = self.parameter("contact_force_fraction")
-            c, ci = float(p.value), [float(v) for v in p.ci95]
+            c, ci = float(p.value), p.interval()
         else:
             c, ci = 0.0, None
-        return {"force_fraction": c, "force_fraction_ci95": ci, **dict(self.force_profile)}
+        return {"force_fraction": c, "force_fraction_interval": ci, **dict(self.force_profile)}
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -1434,10 +1439,8 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
         the pre-contact noise's autocorrelation falls below 0.5, so white
         noise keeps every sample). The model's shapes (and the host
         smoothing) are still computed on the full grid, and the reported
-        RMS, AIC and BIC are of the full grid. On the shared recordings
-        (smoothed by the host over 0.5 s) "auto" gives k = 10 (20 Hz): the
-        estimates move by a small fraction of their standard errors
-        (docs/sensor-models.md) and the fit runs several times faster. The
+        RMS, AIC and BIC are of the full grid. A host-smoothed recording gets
+        a stride of several samples (docs/sensor-models.md). The
         cluster-robust covariance does not depend on the stride.
     touch_conductance : sequence of str
         Materials whose touches each get their own contact conductance
@@ -1477,7 +1480,7 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
         x = np.asarray(x0, dtype=np.float64)[:prob.n_global].copy()
     x = np.concatenate([x[:prob.n_global], np.zeros(prob.lo.size - prob.n_global)])
     x = np.clip(x, prob.lo + 1e-9, prob.hi - 1e-9)
-    with _one_blas_thread():  # tall, thin SVDs: threads only contend (4x slower on a loaded 2-core machine)
+    with _one_blas_thread():  # tall, thin SVDs: threads only contend
         jac = dict(jac=prob.jacobian) if prob.touch_cols else dict(diff_step=1e-6)
         sol = least_squares(prob.residuals, x, bounds=(prob.lo, prob.hi), method="trf", x_scale="jac",
                             xtol=1e-8, ftol=1e-8, gtol=1e-8, max_nfev=max_nfev, **jac)
@@ -1567,7 +1570,7 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
     for k, n in enumerate(names):
         rp = ratios[n]
         params.append(IdentifiedParameter(f"e_o[{n}]", rp.value * es, (rp.ci95[0] * es_ci[0], rp.ci95[1] * es_ci[1]),
-                                          "J s^-1/2 K^-1 m^-2", rp.identified, rp.note))
+                                          "J s^-1/2 K^-1 m^-2", rp.identifiable, rp.note))
     for gi, j0 in prob.touch_cols.items():
         g = data.groups[gi]
         d = x[j0:j0 + len(g.trials)]
@@ -1614,7 +1617,17 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
                           nominal_force_profile(data) if cand.force_area else None,
                           rig_conditions(trials, pre_contact_noise_c=data.noise_c,
                                          residual_rms_c=float(np.sqrt(np.mean(r ** 2))),
-                                         onset_offset_s=math.nan).to_dict())
+                                         onset_offset_s=math.nan, residuals=_touch_rows(data, r),
+                                         sample_rate_hz=data.sample_rate_hz).to_dict())
+
+
+def _touch_rows(data: "_Data", r: np.ndarray) -> list[np.ndarray]:
+    """The residual ``r`` (groups one after the other, each touch a row) cut into one series per touch."""
+    rows, pos = [], 0
+    for g in data.groups:
+        rows.extend(r[pos:pos + g.y.size].reshape(g.y.shape))
+        pos += g.y.size
+    return rows
 
 
 #: The nominal force ramp a sensor file records: F / F_p from 1 s before the onset to 1.5 s after, every 20 ms.
@@ -1625,7 +1638,8 @@ def nominal_force_profile(data: "_Data | Sequence[Trial]") -> dict[str, Any]:
     """The median over touches of the force over its plateau (:func:`relative_force`), after the onset.
 
     What a question plays for a ``force_area`` model (it has no force trace of its
-    own): ``{"time_s": [...], "force_share": [...], "n_touches": n}`` on
+    own): ``{"time_s": [...], "force_share": [...], "n_touches": n, "touch_force_share": [[...], ...]}`` (the
+    median, and each touch's own, from which a simulated touch draws its press) on
     :data:`FORCE_PROFILE_S`. The median of the area shares is the area share of
     the median force (the share is a non-decreasing function of the force). The share is 0.006, not 0, at the
     onset below: the force is averaged over :data:`FORCE_SMOOTHING_S`, which rounds the foot of the ramp.
@@ -1649,7 +1663,7 @@ def nominal_force_profile(data: "_Data | Sequence[Trial]") -> dict[str, Any]:
         raise InputError("a nominal force profile needs touches with a force channel")
     med = np.median(np.array(rows), axis=0)
     return {"time_s": [float(v) for v in grid], "force_share": [round(float(v), 4) for v in med],
-            "n_touches": len(rows)}
+            "n_touches": len(rows), "touch_force_share": [[round(float(v), 3) for v in r] for r in rows]}
 
 
 def _one_blas_thread():

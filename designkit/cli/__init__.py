@@ -17,8 +17,8 @@ from . import _app  # noqa: E402
 
 #: The modules that register commands on ``app``, in the order of ``designkit --help`` within each panel
 #: (questions first). Each keeps its imports cheap (no numpy work, no scikit-learn) at module level.
-COMMAND_MODULES = ("query", "matrix", "thin", "materials", "tables", "export", "calibrate", "classify", "design",
-                   "core", "sweep", "reproduce", "bench")
+COMMAND_MODULES = ("query", "matrix", "thin", "materials", "tables", "export", "calibrate", "emulate", "classify",
+                   "design", "core", "sweep", "reproduce", "bench")
 
 #: Which module registers each top-level command or command group. The console script imports only the
 #: module of the command it runs; anything else (help, an unknown name, shell completion) imports them all.
@@ -26,7 +26,7 @@ COMMAND_MODULES = ("query", "matrix", "thin", "materials", "tables", "export", "
 COMMAND_MODULE = {
     "min-contact": "query", "max-noise": "query", "min-delta-t": "query", "delta-e": "query",
     "distinguishable": "query", "matrix": "matrix", "validity": "thin", "materials": "materials",
-    "tables": "tables", "export": "export", "calibrate": "calibrate", "emulate": "calibrate",
+    "tables": "tables", "export": "export", "calibrate": "calibrate", "emulate": "emulate",
     "classify": "classify", "design": "design", "simulate": "core", "f1": "core", "sweep": "sweep",
     "reproduce": "reproduce", "bench": "bench",
 }

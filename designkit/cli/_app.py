@@ -41,7 +41,12 @@ _DEBUG_KEY = "designkit.debug"
 
 
 def _wants_json(args: Any) -> bool:
-    return any(a == "--json" for a in (args or ()))
+    """Whether the command line asks for JSON (``--json``, ``--format json``, ``-f json``): errors then come
+    as JSON on stdout too."""
+    args = [str(a) for a in (args or ())]
+    return any(a == "--json" or a.lower() in ("--format=json", "-fjson")
+               or (a in ("--format", "-f") and i + 1 < len(args) and args[i + 1].strip().lower() == "json")
+               for i, a in enumerate(args))
 
 
 def _command_line(ctx: Any, sub_args: list) -> list:

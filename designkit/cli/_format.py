@@ -1,25 +1,32 @@
-"""The one row-output function of the CLI: ``--format table|json|csv|md`` and ``--out FILE|-``.
+"""The one output module of the CLI: ``--format text|table|json|csv|ndjson|md`` and ``--out FILE|-``.
 
-sqlite-utils' convention: every command that prints rows takes the same
-output options and prints through one function, so a new user learns them
-once. A command that prints rows adopts it in three lines::
+sqlite-utils' convention: every command that answers takes the same output
+options (:data:`FormatOpt`, :data:`OutOpt`; ``--json`` is ``--format json``)
+and prints through this module, so a new user learns them once. A command
+adopts them in three lines::
 
-    from ._format import FormatOpt, OutOpt, emit_rows
+    from ._format import FormatOpt, OutOpt, emit, output_format
 
-    def cmd(..., format_: FormatOpt = "table", out: OutOpt = None, json_: Json = False):
-        rows = [...]                                   # list of dicts, plain values
-        emit_rows(rows, ["name", "e_min"], fmt="json" if json_ else format_, out=out,
-                  payload=library_result.to_dict())    # --format json prints the library's data
+    def cmd(..., format_: FormatOpt = None, out: OutOpt = None, json_: Json = False):
+        fmt = output_format(format_, json_)            # before the work: a bad --format is refused first
+        ...
+        emit(fmt, out, payload=result.to_dict(),       # json: the library's data
+             records=[...],                            # csv, ndjson, table, md: one flat row per answer
+             text=lambda: print_for_people(result))    # text: the command's own rendering
 
 ========  ===================================================================
 format    what is printed
 ========  ===================================================================
+text      the command's text for people (its default; a command whose
+          answer is rows prints them as ``table``)
 table     a rich table for people: names and numbers never cut (on a
           terminal a table wider than the window is printed in groups
           of columns under the first one; piped, no wrapping)
 json      ``payload`` (the library's ``to_dict()``) if given, else the rows
 csv       a header line and one line per row: nothing else (no comments), so
           ``pandas.read_csv`` reads it with its defaults; None is empty
+ndjson    one JSON object per row and line (the csv's records, typed:
+          numbers, booleans and null): ``pandas.read_json(f, lines=True)``
 md        a GitHub Markdown table, then ``notes`` as paragraphs
 ========  ===================================================================
 
@@ -41,13 +48,16 @@ import typer
 
 from .._validation import InputError
 
-FORMATS = ("table", "json", "csv", "md")
+from ._options import PANEL_OUTPUT
 
-FormatOpt = Annotated[str, typer.Option(
-    "--format", "-f", help="Output: table (for people), json (the library's data), csv (pandas-ready: header "
-                           "and rows only) or md (Markdown table).")]
+FORMATS = ("text", "table", "json", "csv", "ndjson", "md")
+
+FormatOpt = Annotated[Optional[str], typer.Option(
+    "--format", "-f", help="Output: text (for people, the default), table (rows for people), json (the library's "
+                           "data; as --json), csv (pandas-ready: header and rows only), ndjson (one JSON record "
+                           "a line) or md (Markdown table).", rich_help_panel=PANEL_OUTPUT)]
 OutOpt = Annotated[Optional[str], typer.Option(
-    "--out", "-o", help="Write the output to this file ('-' or none: stdout).")]
+    "--out", "-o", help="Write the output to this file ('-' or none: stdout).", rich_help_panel=PANEL_OUTPUT)]
 
 
 def check_format(fmt: str) -> str:
@@ -56,6 +66,61 @@ def check_format(fmt: str) -> str:
     if f not in FORMATS:
         raise InputError(f"unknown format {fmt!r}; choose one of: {', '.join(FORMATS)}")
     return f
+
+
+def output_format(format_: Optional[str], json_: bool = False, *, default: str = "text",
+                  out: Optional[str] = None) -> str:
+    """The format a command prints in: ``--json`` is ``--format json``; none given is ``default``. An ``out``
+    file is checked too (:func:`check_out`, the error naming ``--out``), before the command's work.
+
+    >>> output_format(None, True), output_format("CSV"), output_format(None)
+    ('json', 'csv', 'text')
+    >>> output_format("csv", True)
+    Traceback (most recent call last):
+    ...
+    designkit._validation.InputError: --json and --format csv contradict each other: --json is --format json; give one
+    """
+    if json_ and format_ is not None and check_format(format_) != "json":
+        raise InputError(f"--json and --format {format_} contradict each other: --json is --format json; give one")
+    fmt = "json" if json_ else (default if format_ is None else check_format(format_))
+    if out is not None and str(out) != "-":
+        check_out(out, "--out")  # the refusal names the option
+    return fmt
+
+
+def flat_record(d: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
+    """A nested document as one flat row: nested keys joined by ``_``, a ``range`` (a pair of numbers under a
+    ``*_range*`` key) as two columns with ``_min`` / ``_max`` in place of ``_range`` (docs/schema.md, "Records"),
+    other lists as JSON text.
+
+    >>> flat_record({"a": 1, "b": {"low": 0.5, "high": None}, "diffusivity_range_m2_s": [1, 2]})
+    {'a': 1, 'b_low': 0.5, 'b_high': None, 'diffusivity_min_m2_s': 1, 'diffusivity_max_m2_s': 2}
+    """
+    out: dict[str, Any] = {}
+    for k, v in d.items():
+        key = f"{prefix}{k}"
+        if isinstance(v, Mapping):
+            out.update(flat_record(v, f"{key}_"))
+        elif isinstance(v, (list, tuple)) and "range" in str(k) and len(v) == 2:
+            out[key.replace("_range", "_min", 1)], out[key.replace("_range", "_max", 1)] = v
+        elif isinstance(v, (list, tuple)):
+            out[key] = json.dumps(_jsonable(v))
+        else:
+            out[key] = v
+    return out
+
+
+def emit(fmt: str, out: str | None, *, payload: Any, records: Sequence[Mapping[str, Any]] | Callable[[], Any],
+         text: Callable[[], None] | None = None, **kw: Any) -> None:
+    """Print (or write to ``out``) one command's answer in ``fmt``: ``payload`` as json, ``records`` (a list of
+    flat rows, or a function giving them) as table, csv, ndjson or md, ``text()`` (the command's own rendering,
+    which prints) as text (without it, text is the table). Keyword arguments are :func:`render_rows`'s."""
+    if fmt == "text" and text is not None:
+        with output_to(out):
+            text()
+        return
+    rows = [] if fmt == "json" else list(records() if callable(records) else records)
+    emit_rows(rows, kw.pop("columns", None), fmt="table" if fmt == "text" else fmt, out=out, payload=payload, **kw)
 
 
 def cell_text(v: Any) -> str:
@@ -107,10 +172,15 @@ def render_rows(rows: Sequence[Mapping[str, Any]], columns: Sequence[str] | None
     column to ``"left"`` or ``"right"`` (default: numbers right).
     """
     fmt = check_format(fmt)
-    cols = list(columns) if columns is not None else (list(rows[0]) if rows else [])
+    if fmt == "text":
+        fmt = "table"
+    # the columns: given, else every key in the order met (rows of one answer may differ in their keys)
+    cols = list(columns) if columns is not None else list(dict.fromkeys(k for r in rows for k in r))
     if fmt == "json":
         data = payload if payload is not None else [dict(r) for r in rows]
         return json.dumps(_jsonable(data), indent=2, allow_nan=False) + "\n"
+    if fmt == "ndjson":
+        return "".join(json.dumps(_jsonable({c: r.get(c) for c in cols}), allow_nan=False) + "\n" for r in rows)
     if fmt == "csv":
         buf = io.StringIO()
         w = csv.writer(buf, lineterminator="\n")

@@ -42,6 +42,53 @@ Width = Annotated[float, typer.Option(
 Trials = Annotated[int, typer.Option("--trials", help="Simulated touches per class.")]
 Folds = Annotated[int, typer.Option("--folds", help="Cross-validation folds.")]
 
+# ---------------------------------------------------------------- the questions' options (cli/query.py)
+Exact = Annotated[bool, typer.Option(
+    "--exact", help="Compute for this pair and scene (seconds) instead of reading a table.",
+    rich_help_panel=PANEL_EXACT)]
+TableOpt = Annotated[Optional[str], typer.Option(
+    "--table", help="Lookup table (name or path) for the SVM answer (default: svm-fine).",
+    rich_help_panel=PANEL_SENSOR)]
+IdealTableOpt = Annotated[str, typer.Option("--ideal-table", help="Lookup table for the ideal-observer bound.",
+    rich_help_panel=PANEL_SENSOR)]
+TrialsQ = Annotated[int, typer.Option("--trials", help="--exact: simulated touches per class.",
+    rich_help_panel=PANEL_EXACT)]
+RepeatsQ = Annotated[int, typer.Option("--repeats", help="--exact: seeds per evaluation (Monte Carlo error).",
+    rich_help_panel=PANEL_EXACT)]
+SeedQ = Annotated[int, typer.Option("--seed", help="--exact: random seed.",
+    rich_help_panel=PANEL_EXACT)]
+WidthQ = Annotated[float, typer.Option(
+    "--width", help="--exact: class width [J s^-1/2 K^-1 m^-2] of each object (and of the materials rule).",
+    rich_help_panel=PANEL_EXACT)]
+JobsQ = Annotated[int, typer.Option("--jobs", "-j", help="--exact: worker processes (-1: all cores).",
+    rich_help_panel=PANEL_EXACT)]
+NmcQ = Annotated[int, typer.Option(
+    "--n-mc", help="--exact: touches per class of the Monte Carlo ideal observer (models without a shared shape).",
+    rich_help_panel=PANEL_EXACT)]
+MaxContact = Annotated[float, typer.Option("--max-contact", help="--exact: longest contact time to consider [s].",
+    rich_help_panel=PANEL_EXACT)]
+NoiseQ = Annotated[Optional[float], typer.Option(
+    "--noise", help="Noise sigma per sample [°C] (default 0.05, or the rig's as calibrated in a --sensor file).",
+    rich_help_panel=PANEL_SCENE)]
+DeltaTQ = Annotated[Optional[float], typer.Option(
+    "--delta-t", help="Sensor minus object temperature before contact [°C] (default 10, or the rig's as "
+                      "calibrated in a --sensor file).", rich_help_panel=PANEL_SCENE)]
+SpreadOpt = Annotated[Optional[float], typer.Option(
+    "--sensor-temp-spread", help="Varied initial conditions: each touch's sensor temperature uniform within "
+    "+-this [°C] of ambient + dT (the paper's robot: --delta-t 7.5 --sensor-temp-spread 2.5, answered from the "
+    "shipped table svm-paper-varied for min-contact, delta-e and distinguishable); any other case is computed "
+    "like --exact. Must stay below |dT|. Default 0, or the rig's touch-to-touch spread of dT as calibrated in a "
+    "--sensor file.", rich_help_panel=PANEL_SCENE)]
+CoverageOpt = Annotated[float, typer.Option(
+    "--coverage", help="Coverage of the answer's interval, in (0, 1) (table and --exact).",
+    rich_help_panel=PANEL_QUESTION)]
+
+BatchOpt = Annotated[Optional[str], typer.Option(
+    "--batch", help="Answer every row of this CSV file ('-': stdin) in one call: columns named as the options "
+                    "(e1,e2 or m1,m2; e or m for delta-e; noise, delta_t, contact); a column left out, or an empty "
+                    "scene cell, takes the option's value. One record per row out (--format csv, ndjson, json, "
+                    "table, md; text is the table).", rich_help_panel=PANEL_QUESTION)]
+
 # ---------------------------------------------------------------- objects and forward models (one vocabulary)
 M1 = Annotated[Optional[str], typer.Option(
     "--m1", help="First material by name (instead of --e1); see 'designkit materials list'.",

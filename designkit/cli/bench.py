@@ -31,7 +31,7 @@ def bench_cmd(
     per answer, speed-up; then the sweep's cost curves with fitted exponents.
     `--quick` takes a few minutes on 2 cores; the full run about half an hour.
 
-    Example: `designkit bench --quick --out bench`
+    Example: `designkit bench --quick --section physics --out bench`
     """
     import time
 

@@ -10,15 +10,14 @@ from __future__ import annotations
 
 import math
 import sys
-import time
 from pathlib import Path
 from typing import Annotated, Any, Optional
 
 import typer
 
-from ._app import EXIT_INTERRUPTED, app, console, emit_json, sub_app
+from ._app import EXIT_INTERRUPTED, console, emit_json, sub_app
 from . import _app
-from ._options import Json, Noise, Seed, SensorOpt, sensor_and_model
+from ._options import PANEL_OUTPUT, Json
 
 #: ``designkit calibrate --help``: the group's and the guided run's (the group's callback) help in one,
 #: since typer shows the group's text, not the callback's docstring.
@@ -232,7 +231,7 @@ class _EmulatorWatch:
             self.labels |= {lab.lower() for lab in plan.labels}
             why = plan.mislabels(self.materials, self.trials)
             if why is not None:
-                fix = _guided_command(self.port, None, list(plan.labels), plan.touches_per_material)
+                fix = guided_command(self.port, None, list(plan.labels), plan.touches_per_material)
                 raise InputError(
                     f"{why}: every trial would get a wrong label, so none is recorded. Record what the emulator "
                     f"plays (e.g. {fix}), or restart it with its --material options in the order of this run's "
@@ -261,7 +260,7 @@ class _EmulatorWatch:
                          f"{self._kept()}. {advice[0].upper()}{advice[1:]}")
 
 
-def _guided_command(port: str, profile: Optional[str], materials: list[str], trials: int,
+def guided_command(port: str, profile: Optional[str], materials: list[str], trials: int,
                     ranges: Optional[list[str]] = None) -> str:
     """A guided ``designkit calibrate`` command line a shell reads back as these arguments."""
     import shlex
@@ -447,59 +446,17 @@ def _run_identify(index: Path, model: Optional[str], fit_sets: Optional[str], ra
     held-out residual wins (BIC where nothing is held out). Prints the report unless ``quiet``;
     returns the JSON payload (None after ``rows_fmt`` rows).
     """
-    from rich.markup import escape
-    from rich.table import Table
-
     from .._validation import InputError
-    from ..calibration.fit import check_calibration, parse_object_temps, parse_ranges, resolve_ranges
     from ..calibration.identify import CANDIDATES, Split, candidate, choose_split, compare_models
-    from ..calibration.trials import load_index
 
     auto = model is None or model.strip().lower() in ("all", "auto")
     cands = list(CANDIDATES) if auto else [candidate(model)]
     if depth_um is not None and not (depth_um > 0 and math.isfinite(depth_um)):
         raise InputError(f"--depth-um must be positive, got {depth_um:g}")
-    trials = load_index(index, only=only)
-    if not trials:
-        raise InputError(f"index {index} lists no trials")
-    trials = _cut(trials, fit_to)
-    short = [tr for tr in trials if tr.time_s[-1] < MIN_CONTACT_S]
-    if short:
-        raise InputError(f"{len(short)} touch(es) end before {MIN_CONTACT_S:g} s after the onset (e.g. "
-                         f"{Path(short[0].source).name}, {max(short[0].time_s[-1], 0.0):.3g} s): the sensor models "
-                         f"need at least {MIN_CONTACT_S:g} s of contact" + (" (raise --fit-to)" if fit_to else
-                                                                           "; record longer touches"))
+    trials = _load_trials(index, only, fit_to)
     names = sorted({tr.material for tr in trials})
-    rng = resolve_ranges(names, parse_ranges(ranges))
-    affine = [spec for spec in object_temps if spec.strip().lower().endswith("-affine")]
-    temps = parse_object_temps([spec for spec in object_temps if spec not in affine])
-    for spec in affine:  # the passive reading through a fitted offset and slope (identification only)
-        mat, _, mode = spec.partition("=")
-        if mode.strip().lower() not in ("passive-affine", "passive-end-affine"):
-            raise InputError(f"--object-temp {spec!r}: the fitted-channel modes are passive-affine and "
-                             "passive-end-affine")
-        temps[mat.strip()] = mode.strip().lower()
-    unknown = sorted(set(temps) - set(names))
-    if unknown:
-        raise InputError(f"--object-temp names material(s) not being fitted: {', '.join(unknown)}")
-    per_touch = [n.strip() for n in (touch_conductance or "").split(",") if n.strip()]
-    unknown = sorted(set(per_touch) - set(names))
-    if unknown:
-        raise InputError(f"--touch-conductance names material(s) not being fitted: {', '.join(unknown)} "
-                         f"(fitted: {', '.join(names)})")
-    if per_touch:
-        cands = [c for c in cands if "conductance_w_m2k" in c.free]
-        if not cands:
-            raise InputError(f"--touch-conductance needs a model that fits the contact conductance "
-                             f"(contact, layered...), not {model}")
-    before = [p for p in check_calibration(None, trials) if p.fatal]  # refuse before minutes of fitting
-    if before and not force:
-        con = console(stderr=True)
-        for p in before:
-            con.print(f"[bold red]error:[/] {escape(p.text())}")
-        raise InputError(f"calibration unusable ({', '.join(sorted({p.kind for p in before}))}): "
-                         + (f"{out} not written; " if out is not None else "")
-                         + "see the messages above; --force fits and writes the sensor file anyway")
+    rng, temps, per_touch, cands = _identify_inputs(names, ranges, object_temps, touch_conductance, cands, model)
+    _refuse_unusable(trials, force, out)
     if fit_sets is not None and fit_sets.strip().lower() == "all":
         split = Split(tuple(trials), (), (), (), "trial set", "--fit-sets all: every touch fitted")
     else:
@@ -523,21 +480,101 @@ def _run_identify(index: Path, model: Optional[str], fit_sets: Optional[str], ra
     if rows_fmt is not None:  # the selected model's parameters (the comparison stays in the report and --json)
         from ._format import emit_rows
 
-        es = best.effusivity
-        head = [] if es is None or not best.consistent else [
-            {"parameter": "e_s", "material": None, "value": es.value, "std_error": None, "low_95": es.ci95[0],
-             "high_95": es.ci95[1], "unit": "J s^-1/2 K^-1 m^-2"}]
-        emit_rows(head + [{"parameter": q.name, "material": None, "value": q.value, "std_error": None,
-                           "low_95": q.ci95[0], "high_95": q.ci95[1], "unit": q.unit} for q in best.parameters],
-                  PARAMETER_COLUMNS, fmt=rows_fmt,
-                  notes=[f"model {selected}, {split.describe()}"])
+        emit_rows(_parameter_rows(best), PARAMETER_COLUMNS, fmt=rows_fmt, notes=[f"model {selected}, {split.describe()}"])
         return None
     payload = {"index": str(index), "n_fit": len(fit), "n_held_out": len(held), "selected": selected,
                "reason": cmp.reason, "split": split.to_dict(),
                "out": str(out) if out is not None else None, "plot": str(plot) if plot is not None else None,
                "results": [dict(r.to_dict(), held_out_rms_c=dict(sc)) for r, sc in zip(results, scores)]}
-    if quiet:
-        return payload
+    if not quiet:
+        _print_identification(cmp, best, split, names, out, plot, len(fit), record)
+    return payload
+
+
+def _load_trials(index: Path, only: Optional[list[str]], fit_to: Optional[float]) -> list:
+    """The index's touches (``only`` these materials), cut at ``fit_to``; refused if any is too short to fit."""
+    from .._validation import InputError
+    from ..calibration.trials import load_index
+
+    trials = load_index(index, only=only)
+    if not trials:
+        raise InputError(f"index {index} lists no trials")
+    trials = _cut(trials, fit_to)
+    short = [tr for tr in trials if tr.time_s[-1] < MIN_CONTACT_S]
+    if short:
+        raise InputError(f"{len(short)} touch(es) end before {MIN_CONTACT_S:g} s after the onset (e.g. "
+                         f"{Path(short[0].source).name}, {max(short[0].time_s[-1], 0.0):.3g} s): the sensor models "
+                         f"need at least {MIN_CONTACT_S:g} s of contact" + (" (raise --fit-to)" if fit_to else
+                                                                           "; record longer touches"))
+    return trials
+
+
+def _identify_inputs(names: list[str], ranges: list[str], object_temps: list[str], touch_conductance: Optional[str],
+                     cands: list, model: Optional[str]) -> tuple:
+    """The options of an identification, checked against the materials fitted: (ranges, object temperatures,
+    materials with a conductance per touch, the candidate models that can fit them)."""
+    from .._validation import InputError
+    from ..calibration.fit import parse_object_temps, parse_ranges, resolve_ranges
+
+    rng = resolve_ranges(names, parse_ranges(ranges))
+    affine = [spec for spec in object_temps if spec.strip().lower().endswith("-affine")]
+    temps = parse_object_temps([spec for spec in object_temps if spec not in affine])
+    for spec in affine:  # the passive reading through a fitted offset and slope (identification only)
+        mat, _, mode = spec.partition("=")
+        if mode.strip().lower() not in ("passive-affine", "passive-end-affine"):
+            raise InputError(f"--object-temp {spec!r}: the fitted-channel modes are passive-affine and "
+                             "passive-end-affine")
+        temps[mat.strip()] = mode.strip().lower()
+    unknown = sorted(set(temps) - set(names))
+    if unknown:
+        raise InputError(f"--object-temp names material(s) not being fitted: {', '.join(unknown)}")
+    per_touch = [n.strip() for n in (touch_conductance or "").split(",") if n.strip()]
+    unknown = sorted(set(per_touch) - set(names))
+    if unknown:
+        raise InputError(f"--touch-conductance names material(s) not being fitted: {', '.join(unknown)} "
+                         f"(fitted: {', '.join(names)})")
+    if per_touch:
+        cands = [c for c in cands if "conductance_w_m2k" in c.free]
+        if not cands:
+            raise InputError(f"--touch-conductance needs a model that fits the contact conductance "
+                             f"(contact, layered...), not {model}")
+    return rng, temps, per_touch, cands
+
+
+def _refuse_unusable(trials: list, force: bool, out: Optional[Path]) -> None:
+    """Refuse, before minutes of fitting, touches that cannot calibrate (unless ``force``), each problem said."""
+    from rich.markup import escape
+
+    from .._validation import InputError
+    from ..calibration.fit import check_calibration
+
+    before = [p for p in check_calibration(None, trials) if p.fatal]
+    if before and not force:
+        con = console(stderr=True)
+        for p in before:
+            con.print(f"[bold red]error:[/] {escape(p.text())}")
+        raise InputError(f"calibration unusable ({', '.join(sorted({p.kind for p in before}))}): "
+                         + (f"{out} not written; " if out is not None else "")
+                         + "see the messages above; --force fits and writes the sensor file anyway")
+
+
+def _parameter_rows(best) -> list[dict]:
+    """The selected model's parameters as rows (:data:`PARAMETER_COLUMNS`): e_s first where it is known."""
+    es = best.effusivity
+    head = [] if es is None or not best.consistent else [
+        {"parameter": "e_s", "material": None, "value": es.value, "std_error": None, "low_95": es.ci95[0],
+         "high_95": es.ci95[1], "unit": "J s^-1/2 K^-1 m^-2"}]
+    return head + [{"parameter": q.name, "material": None, "value": q.value, "std_error": None,
+                    "low_95": q.ci95[0], "high_95": q.ci95[1], "unit": q.unit} for q in best.parameters]
+
+
+def _print_identification(cmp, best, split, names: list[str], out: Optional[Path], plot: Optional[Path],
+                          n_fit: int, record: Optional[dict]) -> None:
+    """The identification's report for people: the models compared, the one selected and its parameters."""
+    from rich.markup import escape
+    from rich.table import Table
+
+    results, scores, selected = cmp.results, cmp.held_out_rms_c, cmp.selected
     con = console()
     if record is not None:
         con.print(f"Recorded {record['n_trials']} trial(s) in {record['out']}")
@@ -559,7 +596,7 @@ def _run_identify(index: Path, model: Optional[str], fit_sets: Optional[str], ra
         p.add_column(c, justify="left" if c in ("parameter", "unit", "identified") else "right")
     for q in best.parameters:
         p.add_row(escape(q.name), f"{q.value:.4g}", f"[{q.ci95[0]:.4g}, {q.ci95[1]:.4g}]", escape(q.unit),
-                  "yes" if q.identified else f"no: {escape(q.note or 'see notes')}")
+                  "yes" if q.identifiable else f"no: {escape(q.note or 'see notes')}")
     con.print(p)
     con.print(f"noise sigma before contact {best.noise_c:.4g} °C; object temperature: "
               + ", ".join(f"{n} {m}" for n, m in best.object_modes.items()))
@@ -568,11 +605,10 @@ def _run_identify(index: Path, model: Optional[str], fit_sets: Optional[str], ra
     for note in best.notes:
         con.print(f"[yellow]note:[/] {escape(note)}")
     if out is not None:
-        con.print(f"wrote {out} with the {selected} model, as fitted on the {len(fit)} fitted touches  "
+        con.print(f"wrote {out} with the {selected} model, as fitted on the {n_fit} fitted touches  "
                   f"(use it with --sensor {out})")
     if plot is not None:
         con.print(f"wrote {plot}")
-    return payload
 
 
 # ------------------------------------------------------------------ record
@@ -653,10 +689,10 @@ def fit(
         "--touch-conductance", help="Give each touch of these materials (comma-separated) its own contact "
                                     "conductance, e.g. metal (contact area differs between touches); only "
                                     "models that fit h_c.")] = None,
-    format_: Annotated[str, typer.Option(
-        "--format", "-f", help="table (the report, default), json (as --json), or csv / md: the identified "
-                               "sensor's parameters as rows (parameter, material, value, std_error, low_95, "
-                               "high_95, unit), pandas-ready.")] = "table",
+    format_: Annotated[Optional[str], typer.Option(
+        "--format", "-f", help="text (the report, default), json (as --json), or table / csv / ndjson / md: the "
+                               "identified sensor's parameters as rows (parameter, material, value, std_error, "
+                               "low_95, high_95, unit), pandas-ready.", rich_help_panel=PANEL_OUTPUT)] = None,
     json_: Json = False,
 ) -> None:
     """Identify your sensor's model from recorded touches: e_s, alpha_s, each e_o, the contact offset.
@@ -665,9 +701,9 @@ def fit(
 
     Example (the paper's model only, parameters as CSV): `designkit calibrate fit trials/index.csv --model semi-infinite --format csv`
     """
-    from ._format import check_format, check_out
+    from ._format import check_out, output_format
 
-    fmt = "json" if json_ else check_format(format_)
+    fmt = output_format(format_, json_)
     if out is not None:
         if str(out) == "-":  # it wrote a file named '-' and advised '--sensor -'
             from .._validation import InputError
@@ -677,8 +713,8 @@ def fit(
     bounds = _offset_bounds(offset_range)
     only_list = [s.strip() for item in only for s in item.split(",") if s.strip()] if only else None
     payload = _run_identify(index, model, fit_sets, range_ or [], only_list, object_temp or [], depth_um, out,
-                            fmt != "table", touch_conductance, name=name, force=force,
-                            rows_fmt=fmt if fmt in ("csv", "md") else None, plot=plot, offset_bounds_s=bounds,
+                            fmt != "text", touch_conductance, name=name, force=force,
+                            rows_fmt=None if fmt in ("text", "json") else fmt, plot=plot, offset_bounds_s=bounds,
                             fit_to=fit_to)
     if fmt == "json":
         emit_json(payload)
@@ -760,164 +796,3 @@ def guided(
                             sensor_path, json_, name=None, force=force, record=record)
     if json_:
         emit_json({"record": record, "fit": payload, "sensor": str(sensor_path)})
-
-
-# ----------------------------------------------------------------- emulate
-def _hint_ranges(mats) -> list[str]:
-    """--range options the guided run needs for emulated materials the materials database does not know.
-
-    The emulator knows their effusivity exactly; the hint gives it +-10 %, as an effusivity meter would.
-    """
-    from .._validation import InputError
-    from ..materials import get_material
-
-    out = []
-    for m in mats:
-        try:
-            get_material(m.label)
-        except InputError:
-            out.append(f"{m.label}={0.9 * m.effusivity:.4g}:{1.1 * m.effusivity:.4g}")
-    return out
-
-
-@app.command(rich_help_panel=_app.SENSOR)
-def emulate(
-    profile: ProfileOpt = "designkit",
-    material: Annotated[Optional[list[str]], typer.Option(
-        "--material", help="Object to touch: a materials database name, or LABEL=E with E the effusivity "
-                           "[J s^-1/2 K^-1 m^-2] (repeatable: touched in turn).")] = None,
-    e: Annotated[Optional[float], typer.Option("--e", help="Effusivity of the object [J s^-1/2 K^-1 m^-2].")] = None,
-    touch_every: Annotated[float, typer.Option("--touch-every", help="Seconds (device time) between touches.")] = 20.0,
-    touches_per_material: Annotated[int, typer.Option(
-        "--touches-per-material", help="Touches of each material before the next one (as the guided "
-                                       "'calibrate --trials' records them).")] = DEFAULT_TRIALS,
-    noise: Noise = 0.05,
-    sensor: SensorOpt = "paper",
-    sensor_temp: Annotated[float, typer.Option("--sensor-temp", help="Heater set point [°C].")] = 35.0,
-    ambient: Annotated[float, typer.Option("--ambient", help="Room temperature [°C].")] = 25.0,
-    object_temp: Annotated[Optional[float], typer.Option(
-        "--object-temp", help="Object temperature [°C] (default: room temperature).")] = None,
-    speed: Annotated[float, typer.Option("--speed", help="Device seconds per real second (20: 20x real time).")] = 1.0,
-    fault: Annotated[Optional[list[str]], typer.Option(
-        "--fault", help="Inject a fault (repeatable): garbled=P, partial=P, non-numeric=P, field-count=P, "
-                        "out-of-range=P, out-of-order=P, duplicate=P, corrupt=P (per-line probabilities, from device time "
-                        "line-faults-after=S on), "
-                        "burst=EVERY_S[:HOLD_S], gap=EVERY_S[:SILENT_S], vanish=AFTER_S, silent.")] = None,
-    duration: Annotated[Optional[float], typer.Option(
-        "--duration", help="Stop after this many real seconds (default: run until Ctrl-C).")] = None,
-    seed: Seed = 0,
-    json_: Json = False,
-) -> None:
-    """Emulate a sensor rig on a pseudo-terminal: prints its path, streams the profile's wire format.
-
-    Example (a rig playing two objects for 30 s; without --duration until Ctrl-C): `designkit emulate --material wood=400 --material aluminium=20000 --speed 20 --duration 30`
-    """
-    from .._validation import InputError
-    from ..calibration.emulator import EmulatedMaterial, Emulator, Faults, TouchPlan
-    from ..calibration.profiles import load_profile
-    from .._validation import check_temperature
-
-    sensor_temp = check_temperature("--sensor-temp [degC]", sensor_temp)
-    ambient = check_temperature("--ambient [degC]", ambient)
-    check_temperature("--noise [degC]", noise, nonnegative=True)  # 1e308 was taken
-    from ..calibration.profiles import MAX_PROFILE_SECONDS
-
-    if not 0 < touch_every <= MAX_PROFILE_SECONDS:
-        raise InputError(f"--touch-every must be a positive number of seconds up to {MAX_PROFILE_SECONDS:g} (a day), "
-                         f"got {touch_every:g}")
-    if duration is not None and not 0 < duration <= MAX_PROFILE_SECONDS:  # inf, 1e308: never stopped
-        raise InputError(f"--duration must be a positive number of seconds up to {MAX_PROFILE_SECONDS:g} (a day; "
-                         f"leave it out to run until Ctrl-C), got {duration:g}")
-    if not 0 < speed <= 1e4:
-        raise InputError(f"--speed must be a positive factor up to 10000, got {speed:g}")
-    if not 1 <= touches_per_material <= 1_000_000:
-        raise InputError(f"--touches-per-material must be 1 to 1000000, got {touches_per_material}")
-
-    mats = []
-    for spec in material or []:
-        label, sep, value = spec.rpartition("=")   # the effusivity follows the last "="
-        if sep:
-            from .._validation import check_label
-
-            check_label(f"--material {spec!r}: the label", label)  # '=400' and a newline were taken
-            try:
-                e_label = float(value)
-            except ValueError:
-                raise InputError(f"--material {spec!r}: use NAME or LABEL=EFFUSIVITY") from None
-            mats.append(EmulatedMaterial(label.strip(" "), e_label, object_temp))  # a newline is refused, not cut
-        else:
-            from ..materials import get_material
-
-            m = get_material(spec)
-            eo = m.identified if m.identified is not None else math.sqrt(m.e_min * m.e_max)
-            mats.append(EmulatedMaterial(m.name, eo, object_temp))
-    if e is not None:
-        mats.append(EmulatedMaterial("object", e, object_temp))
-    if not mats:
-        raise InputError("give --material NAME (or LABEL=E) or --e E: what should the rig touch?")
-    if duration is not None and not duration > 0:
-        raise InputError(f"--duration must be positive, got {duration:g}")
-    prof = load_profile(profile)
-    sen, fm, _ = sensor_and_model(sensor)   # a sensor file's recorded model is what the rig plays
-    emu = Emulator(prof, sen, mats, noise_c=noise, sensor_temp_c=sensor_temp, ambient_c=ambient,
-                   plan=TouchPlan(touch_every_s=touch_every, touches_per_material=touches_per_material),
-                   speed=speed, faults=Faults.parse(fault or []), seed=seed, model=fm)
-    port = emu.start()
-    try_cmd = _guided_command(port, profile, [m.label for m in mats], touches_per_material,
-                              _hint_ranges(mats))
-    # classify's default --time-offset is 0 (a calibrated sensor file carries its own); this emulator's onset
-    # detection lags by expected_time_offset_s, and without it every touch was decided as the same material
-    import shlex
-
-    classify_cmd = None if len(mats) < 2 else (
-        f"designkit classify --port {port}" + ("" if profile is None else f" --profile {shlex.quote(profile)}")
-        + "".join(f" --m {shlex.quote(f'{m.label}={m.effusivity:g}')}" for m in mats)
-        + f" --time-offset {emu.expected_time_offset_s:g}")
-    info = {"port": port, "profile": prof.name, "speed": speed, "touch_every_s": touch_every,
-            "touches_per_material": touches_per_material, "try": try_cmd, "try_classify": classify_cmd,
-            "materials": [{"label": m.label, "effusivity": m.effusivity} for m in mats],
-            "noise_c": noise, "sensor": emu.sensor.to_dict(), "model": fm.to_dict(),
-            "time_offset_s": emu.expected_time_offset_s,
-            "faults": [str(f) for f in fault or []]}
-    if json_:
-        emit_json(info)
-    else:
-        from rich.markup import escape
-
-        con = console()
-        con.print(f"Emulating a '{prof.name}' rig on [bold]{port}[/]  (speed {speed:g}x; Ctrl-C to stop)")
-        con.print("  touching " + ", ".join(f"{m.label} (e = {m.effusivity:g})" for m in mats)
-                  + f" every {touch_every:g} s; noise {noise:g} °C; sensor e_s = {emu.sensor.effusivity:g}, "
-                    f"tau = {emu.sensor.tau_s:.3f} s")
-        if fm.name != "semi-infinite":
-            played = fm.describe() if fm.name != "force-ramp" else (
-                f"{fm.base.describe()} with the contact area following the emulator's force ramp "
-                f"({emu.plan.ramp_s:g} s) at c = {emu.plan.contact_force_fraction:.3g}")
-            con.print(escape(f"  model {played} (recorded in sensor file {emu.sensor.name}; the wire "
-                             "carries the raw reading: any host smoothing is the host's)"))
-        con.print(f"  touches {touches_per_material} of each material in turn, from when a program opens the port")
-        con.print(f"  try: {escape(try_cmd)}", soft_wrap=True)
-        if classify_cmd is not None:
-            con.print(f"  or:  {escape(classify_cmd)}", soft_wrap=True)
-        sys.stdout.flush()
-    start = time.monotonic()
-    announced = -1
-    try:
-        while duration is None or time.monotonic() - start < duration:
-            if emu.wait(0.2):
-                break
-            if not json_:
-                device_t = emu.samples_sent / prof.sample_rate_hz
-                j = int(math.floor((device_t - emu.plan.first_touch_s) / emu.plan.touch_every_s))
-                if j > announced and j >= 0:
-                    tr = emu.touch(j)
-                    console().print(f"[dim]touch {j + 1}: {tr.material} at device time {tr.start_s:g} s[/]")
-                    announced = j
-    except KeyboardInterrupt:
-        pass
-    finally:
-        emu.stop()
-    if emu.error is not None:
-        raise InputError(f"the emulator failed: {emu.error}")
-    if emu.vanished and not json_:
-        console().print("the emulated device vanished (fault injected)")

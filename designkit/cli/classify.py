@@ -18,7 +18,8 @@ from typing import Annotated, Optional
 import typer
 
 from . import _app
-from ._app import EXIT_INTERRUPTED, app, console, emit_json
+from ._app import EXIT_INTERRUPTED, app, console
+from ._format import FormatOpt, emit, flat_record, output_format
 from ._options import Json, SensorOpt
 
 #: Exit status when no decision is possible (as questions with no answer).
@@ -107,6 +108,7 @@ def classify(
         "--export-c", help="Write the test as a C99 header (fixed memory, no allocation, one update call per "
                            "sample) to this file instead of reading a port.")] = None,
     prefix: Annotated[str, typer.Option("--prefix", help="Prefix of the C header's names (with --export-c).")] = "designkit_seq",
+    format_: FormatOpt = None,
     json_: Json = False,
 ) -> None:
     """Decide each touch while it lasts: material, or keep touching, or no contact time will do.
@@ -121,11 +123,64 @@ def classify(
 
     Example: `designkit classify --m wood --m "aluminium alloys" --error-rate 0.001 --export-c robot_seq.h`
     """
-    from .._validation import InputError, check_positive, check_probability, check_temperature
-    from ..calibration.live import LiveClassifier
     from ..calibration.profiles import load_profile
     from ..recognition.sequential import SequentialTest
-    from ..sensor import check_samples_per_touch, load_sensor
+    from ..sensor import load_sensor
+
+    fmt = output_format(format_, json_)
+    _check_options(port, export_c, m, touches, timeout, delta_t, time_offset, object_temp, noise, error_rate)
+    sens = load_sensor(sensor)
+    from .._validation import check_positive
+    from ..sensor import check_samples_per_touch
+
+    check_samples_per_touch(check_positive("--max-contact [s]", max_contact), sens.sample_rate_hz,
+                            "--max-contact", "lower --max-contact")  # a 411 MB header, 3 GB of memory at 1e5 s
+    sigma = noise if noise is not None else (sens.noise_c if sens.noise_c else 0.05)
+    if time_offset is None:  # the calibrated sensor's own offset: its onset detection is what this run uses
+        time_offset = float((sens.model or {}).get("time_offset_s") or 0.0)
+    prof = load_profile(profile)
+    cands = parse_candidates(m)
+
+    def make_test(ts0: float, ta: float, noise_c: Optional[float] = None) -> SequentialTest:
+        return SequentialTest(cands, sens, noise_c=sigma if noise_c is None else noise_c, sensor_temp_c=ts0,
+                              ambient_temp_c=ta, error_rate=error_rate, max_contact_s=max_contact)
+
+    check = make_test(35.0, 35.0 - delta_t)
+    if export_c is not None:
+        _export_c(check, export_c, prefix, fmt)
+    payload = {"port": port, "profile": prof.name, "sensor": sens.name, "noise_c": sigma, "time_offset_s": time_offset,
+               "error_rate": error_rate,
+               "plan": check.plan.to_dict(), "decisions": [], "interrupted": False}
+    if not check.plan.separable:
+        emit(fmt, None, payload=payload, records=[],
+             text=lambda: console().print(f"No decision possible: {check.plan.reason}.", highlight=False))
+        raise typer.Exit(EXIT_NO_DECISION)
+    clf, interrupted, failed = _run_live(port, prof, make_test, sens, time_offset, object_temp, timeout, touches,
+                                         check, quiet=fmt == "json")
+    decisions = clf.decider.written
+    payload["decisions"] = [d.to_dict() for d in decisions]
+    payload["interrupted"] = interrupted
+    if failed is not None:
+        payload["error"] = {"kind": "input", "message": str(failed), "exit_status": 2}
+
+    def text() -> None:
+        out = console(stderr=interrupted and failed is None)  # Ctrl-C: the decisions so far on stderr
+        out.print(f"{check.plan.reason}.", highlight=False)
+        for d in decisions:
+            what = d.material if d.state == "decided" else d.state
+            out.print(_decision_words(d, what, time_offset, sens.sample_rate_hz), highlight=False)
+
+    emit(fmt, None, payload=payload, records=lambda: [flat_record(d) for d in payload["decisions"]], text=text)
+    if failed is not None:
+        typer.echo(f"Error: {failed}", err=True)
+        raise typer.Exit(2)
+    if interrupted:
+        raise typer.Exit(EXIT_INTERRUPTED)
+
+
+def _check_options(port, export_c, m, touches, timeout, delta_t, time_offset, object_temp, noise, error_rate) -> None:
+    """classify's options, each refused in one line before the port is opened."""
+    from .._validation import InputError, check_probability, check_temperature
 
     from ._format import check_out
     from ._options import refuse_together
@@ -152,41 +207,30 @@ def classify(
     if noise is not None:
         check_temperature("--noise [°C]", noise, nonnegative=True)
     check_probability("--error-rate", error_rate, low=0.0, high=0.5)
-    sens = load_sensor(sensor)
-    check_samples_per_touch(check_positive("--max-contact [s]", max_contact), sens.sample_rate_hz,
-                            "--max-contact", "lower --max-contact")  # a 411 MB header, 3 GB of memory at 1e5 s
-    sigma = noise if noise is not None else (sens.noise_c if sens.noise_c else 0.05)
-    if time_offset is None:  # the calibrated sensor's own offset: its onset detection is what this run uses
-        time_offset = float((sens.model or {}).get("time_offset_s") or 0.0)
-    prof = load_profile(profile)
-    cands = parse_candidates(m)
 
-    def make_test(ts0: float, ta: float, noise_c: Optional[float] = None) -> SequentialTest:
-        return SequentialTest(cands, sens, noise_c=sigma if noise_c is None else noise_c, sensor_temp_c=ts0,
-                              ambient_temp_c=ta, error_rate=error_rate, max_contact_s=max_contact)
 
-    check = make_test(35.0, 35.0 - delta_t)
-    if export_c is not None:
-        from .._io import atomic_write_bytes
-        from ..export.sequential_c import write_sequential_c
+def _export_c(check, export_c: Path, prefix: str, fmt: str) -> None:
+    """--export-c: the test as a C99 header; exits (3 when no contact time separates the materials)."""
+    from .._io import atomic_write_bytes
+    from ..export.sequential_c import write_sequential_c
 
-        data = write_sequential_c(check, prefix)
-        atomic_write_bytes(Path(export_c), data)
-        info = {"out": str(export_c), "bytes": len(data), "plan": check.plan.to_dict()}
-        if json_:
-            emit_json(info)
-        else:
-            console().print(f"wrote {export_c} ({len(data):,} bytes): {check.plan.reason}", highlight=False)
-        raise typer.Exit(0 if check.plan.separable else EXIT_NO_DECISION)
-    payload = {"port": port, "profile": prof.name, "sensor": sens.name, "noise_c": sigma, "time_offset_s": time_offset,
-               "error_rate": error_rate,
-               "plan": check.plan.to_dict(), "decisions": [], "interrupted": False}
-    if not check.plan.separable:
-        if json_:
-            emit_json(payload)
-        else:
-            console().print(f"No decision possible: {check.plan.reason}.")
-        raise typer.Exit(EXIT_NO_DECISION)
+    data = write_sequential_c(check, prefix)
+    atomic_write_bytes(Path(export_c), data)
+    info = {"out": str(export_c), "bytes": len(data), "plan": check.plan.to_dict()}
+    emit(fmt, None, payload=info, records=lambda: [flat_record(info)],
+         text=lambda: console().print(f"wrote {export_c} ({len(data):,} bytes): {check.plan.reason}",
+                                      highlight=False))
+    raise typer.Exit(0 if check.plan.separable else EXIT_NO_DECISION)
+
+
+def _run_live(port, prof, make_test, sens, time_offset, object_temp, timeout, touches, check, *, quiet: bool):
+    """Decide ``touches`` touches on the rig, with a live table on a terminal (unless ``quiet``).
+
+    Returns (the classifier, interrupted, the error that ended the session or None): a device that went away
+    or fell silent mid-session keeps the decisions made so far."""
+    from .._validation import InputError
+    from ..calibration.live import LiveClassifier
+
     con = console(stderr=True)
     live_view = None
     clf = None
@@ -198,7 +242,7 @@ def classify(
     def on_event(e) -> None:
         # the decisions are printed once, on stdout at the end (and live in the terminal's table); stderr
         # carries what is not in that summary
-        if not json_ and live_view is None and e.kind in ("skipped", "gap", "bad_line", "noise"):
+        if not quiet and live_view is None and e.kind in ("skipped", "gap", "bad_line", "noise"):
             con.print(e.message, highlight=False)
         refresh()
 
@@ -206,10 +250,10 @@ def classify(
                          ambient_temp_c=object_temp, no_data_timeout_s=timeout, on_event=on_event,
                          on_status=refresh)
     interrupted = False
-    failed = None  # the device went away or fell silent mid-session: the decisions made so far still count
+    failed = None
     try:
         clf.open()  # a port that cannot be opened is refused as it is (nothing decided yet)
-        if not json_ and con.is_terminal:
+        if not quiet and con.is_terminal:
             from rich.live import Live
 
             live_view = Live(console=con, refresh_per_second=8)
@@ -224,21 +268,4 @@ def classify(
         if live_view is not None:
             live_view.__exit__(None, None, None)
         clf.close()
-    decisions = clf.decider.written
-    payload["decisions"] = [d.to_dict() for d in decisions]
-    payload["interrupted"] = interrupted
-    if failed is not None:
-        payload["error"] = {"kind": "input", "message": str(failed), "exit_status": 2}
-    if json_:
-        emit_json(payload)
-    else:
-        out = console(stderr=interrupted and failed is None)  # Ctrl-C: the decisions so far on stderr
-        out.print(f"{check.plan.reason}.", highlight=False)
-        for d in decisions:
-            what = d.material if d.state == "decided" else d.state
-            out.print(_decision_words(d, what, time_offset, sens.sample_rate_hz), highlight=False)
-    if failed is not None:
-        typer.echo(f"Error: {failed}", err=True)
-        raise typer.Exit(2)
-    if interrupted:
-        raise typer.Exit(EXIT_INTERRUPTED)
+    return clf, interrupted, failed

@@ -13,7 +13,8 @@ from typing import Annotated, Optional
 import typer
 
 from . import _app
-from ._app import app, console, emit_json
+from ._app import app, console
+from ._format import FormatOpt, OutOpt, emit, flat_record, output_format
 from ._options import Json
 
 #: Exit status when no design is possible (as questions with no answer).
@@ -73,6 +74,8 @@ def design(
     threshold: Annotated[float, typer.Option("--threshold", help="F1 the limiting pair must reach.")] = 0.9,
     svm: Annotated[bool, typer.Option("--svm/--no-svm", help="Confirm the recommendation with the paper's SVM.")] = True,
     plot: Annotated[Optional[Path], typer.Option("--plot", help="Write the trade-off figure (.png, .svg, .pdf).")] = None,
+    format_: FormatOpt = None,
+    out: OutOpt = None,
     json_: Json = False,
 ) -> None:
     """Recommend the sensor (skin, thermistor depth, sampling rate, dT) for materials to tell apart.
@@ -82,11 +85,14 @@ def design(
     Exit 3 when no allowed design separates the materials.
 
     Example: `designkit design --set paper12 --identified --max-contact 2 --noise 0.05 --max-delta-t 10 --plot design.png`
+
+    Example (the recommendation as one pandas-ready record): `designkit design --m a=20000 --m b=35000 --no-svm --format csv`
     """
     from .._validation import InputError
     from ..design.search import SKIN_SET, Constraints, confirm_with_svm, recommend, targets_from
     from ..materials import get_material
 
+    fmt = output_format(format_, json_, out=out)  # before the search: a bad --format or --out is refused first
     lo, sep, hi = depth_um.partition(":")
     try:
         depths = (float(lo), float(hi)) if sep else (float(lo), float(lo))
@@ -105,25 +111,41 @@ def design(
     targets = targets_from(m or (), set_, identified=identified)
     skins = tuple(get_material(s).name for s in skin) if skin else SKIN_SET
     t0, c0 = time.perf_counter(), time.process_time()
-    with _app.busy(f"design: searching skins x depths with the ideal observer ({len(skins)} skins)", quiet=json_):
+    with _app.busy(f"design: searching skins x depths with the ideal observer ({len(skins)} skins)", quiet=fmt != "text"):
         result = recommend(targets, cons, skins=skins)
     search = {"wall_s": round(time.perf_counter() - t0, 3), "cpu_s": round(time.process_time() - c0, 3),
               "designs": len(result.designs)}
     payload = {**result.to_dict(), "search": search, "svm": None}
     if result.best is None:
-        if json_:
-            emit_json(payload)
-        else:
-            console().print(f"No design possible: {result.reason}.", highlight=False)
+        emit(fmt, out, payload=payload, records=lambda: [_record(payload)],
+             text=lambda: console().print(f"No design possible: {result.reason}.", highlight=False))
         raise typer.Exit(EXIT_NO_DESIGN)
     if svm:
-        with _app.busy("design: confirming the limiting pair with the paper's SVM", quiet=json_):
+        with _app.busy("design: confirming the limiting pair with the paper's SVM", quiet=fmt != "text"):
             payload["svm"] = confirm_with_svm(result, targets)
     if plot is not None:
         payload["figure"] = str(_plot(result, plot))
-    if json_:
-        emit_json(payload)
-        return
+    emit(fmt, out, payload=payload, records=lambda: [_record(payload)],
+         text=lambda: _print_design(payload, result, threshold, plot))
+
+
+#: design's one record (docs/schema.md, "Records"): the JSON's best flattened (empty without one), the reason,
+#: the constraints, the search's figures, the SVM's confirmation as svm_* (its copy of the ideal bound left out)
+_BEST = ("skin", "effusivity", "diffusivity_m2_s", "depth_um", "tau_s", "sample_rate_hz", "delta_t_c", "ideal_value",
+         "ideal_method", "limiting_a", "limiting_b")
+_SVM = ("value", "svm_f1", "svm_minus_ideal_s", "grid_step_s", "trials", "seeds", "note")
+
+
+def _record(p: dict) -> dict:
+    best, svm = flat_record(p["best"] or {}), p["svm"] or {}
+    return {**{k: best.get(k) for k in _BEST}, "reason": p["reason"], **flat_record(p["constraints"]),
+            "designs_searched": p["designs_searched"], "wall_s": p["search"]["wall_s"], "cpu_s": p["search"]["cpu_s"],
+            **{(k if k.startswith("svm_") else f"svm_{k}"): svm.get(k) for k in _SVM}, "figure": p.get("figure")}
+
+
+def _print_design(payload: dict, result, threshold: float, plot) -> None:
+    """The recommendation for people."""
+    search = payload["search"]
     con = console()
     con.print(f"Recommended: {result.reason}.", highlight=False)
     con.print(f"  searched {len(result.designs)} designs (ideal observer) in {search['wall_s']:.2f} s "

@@ -7,8 +7,8 @@ from typing import Annotated, Optional
 import typer
 
 from . import _app
-from ._app import console, emit_json, sub_app
-from ._format import FormatOpt, OutOpt, check_format, emit_rows, output_to
+from ._app import console, sub_app
+from ._format import FormatOpt, OutOpt, emit, emit_rows, output_format
 from ._options import Json
 
 materials_app = sub_app(
@@ -34,7 +34,7 @@ def list_(
     set_: SetOpt = "database",
     sort: Annotated[str, typer.Option(
         "--sort", help="Order: 'file' (grouped by family), 'name' or 'effusivity' (by e_min).")] = "file",
-    format_: FormatOpt = "table",
+    format_: FormatOpt = None,
     out: OutOpt = None,
     json_: Json = False,
 ) -> None:
@@ -47,7 +47,7 @@ def list_(
     from .._validation import InputError
     from ..materials import FAMILY_LABELS, list_materials
 
-    fmt = "json" if json_ else check_format(format_)
+    fmt = output_format(format_, json_, default="table")
     if sort not in _SORTS:
         raise InputError(f"unknown sort {sort!r}; choose one of: {', '.join(_SORTS)}")
     mats = list_materials(family=family, set=set_)
@@ -58,7 +58,7 @@ def list_(
     paper = set_.strip().lower() == "paper12"
     payload = {"set": set_.strip().lower(), "family": family, "count": len(mats),
                "materials": [m.to_dict() for m in mats]}
-    if fmt in ("csv", "json"):  # plain values, full precision; a name column that 'designkit matrix --from' reads
+    if fmt in ("csv", "ndjson", "json"):  # plain values, full precision; a name column that 'designkit matrix --from' reads
         cols = ["name", "family", "set", *(["identified"] if paper else []), "e_min", "e_max",
                 "diffusivity_min_m2_s", "diffusivity_max_m2_s", "flags"]
         rows = [{"name": m.name, "family": m.family, "set": m.set, "identified": m.identified, "e_min": m.e_min,
@@ -93,9 +93,7 @@ def show(
                                              "prefix 'paper12:' for the paper's set.")],
     set_: Annotated[Optional[str], typer.Option(
         "--set", help="Look only in this set (default: database, then paper12).")] = None,
-    format_: Annotated[Optional[str], typer.Option(
-        "--format", "-f", help="Print the properties as rows (property, min, max, unit): table, json, csv or md "
-                               "(default: the description for people; --json: the whole material).")] = None,
+    format_: FormatOpt = None,
     out: OutOpt = None,
     json_: Json = False,
 ) -> None:
@@ -107,29 +105,26 @@ def show(
     """
     from ..materials import get_material
 
+    fmt = output_format(format_, json_, out=out)
     m = get_material(name, set=set_)
-    if json_:
-        with output_to(out):
-            emit_json(m.to_dict())
-        return
-    if format_ is not None:
-        fmt = check_format(format_)
+
+    def rows() -> list[dict]:
+        """One row per property (table, csv, ndjson, md)."""
         props = [("conductivity", m.conductivity_min_w_mk, m.conductivity_max_w_mk, "W m^-1 K^-1"),
                  ("density", m.density_min_kg_m3, m.density_max_kg_m3, "kg m^-3"),
                  ("specific_heat", m.specific_heat_min_j_kgk, m.specific_heat_max_j_kgk, "J kg^-1 K^-1"),
                  ("effusivity", m.e_min, m.e_max, "J s^-1/2 K^-1 m^-2"),
                  ("diffusivity", m.diffusivity_min_m2_s, m.diffusivity_max_m2_s, "m^2 s^-1")]
-        rows = [{"material": m.name, "property": p, "min": lo, "max": hi, "unit": u}
-                for p, lo, hi, u in props if lo is not None or hi is not None]
+        out_rows = [{"material": m.name, "property": p, "min": lo, "max": hi, "unit": u}
+                    for p, lo, hi, u in props if lo is not None or hi is not None]
         if m.identified is not None:
-            rows.append({"material": m.name, "property": "identified_effusivity", "min": m.identified,
-                         "max": m.identified, "unit": "J s^-1/2 K^-1 m^-2"})
-        emit_rows(rows, ["material", "property", "min", "max", "unit"], fmt=fmt, out=out,
-                  title=f"{m.name} ({m.family_label}; {m.set} set)", notes=[f"source: {m.source}"],
-                  payload=m.to_dict())  # json: the library's data, as --json
-        return
-    with output_to(out):
-        _print_material(m)
+            out_rows.append({"material": m.name, "property": "identified_effusivity", "min": m.identified,
+                             "max": m.identified, "unit": "J s^-1/2 K^-1 m^-2"})
+        return out_rows
+
+    emit(fmt, out, payload=m.to_dict(), records=rows, text=lambda: _print_material(m),
+         columns=["material", "property", "min", "max", "unit"], title=f"{m.name} ({m.family_label}; {m.set} set)",
+         notes=[f"source: {m.source}"])
 
 
 def _print_material(m) -> None:

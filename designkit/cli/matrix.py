@@ -14,8 +14,8 @@ import typer
 
 from . import _app
 from ._app import app, console
-from ._format import FormatOpt, OutOpt, check_format, emit_rows
-from ._options import Explain, Json, SensorOpt, sensor_and_model
+from ._format import FormatOpt, OutOpt, emit_rows, output_format
+from ._options import PANEL_OUTPUT, PANEL_QUESTION, PANEL_SCENE, PANEL_SENSOR, Explain, Json, SensorOpt, sensor_and_model
 
 _QUESTIONS = "min-contact, max-noise, min-delta-t or distinguishable"
 
@@ -23,38 +23,38 @@ _QUESTIONS = "min-contact, max-noise, min-delta-t or distinguishable"
 @app.command("matrix", rich_help_panel=_app.ASK)
 def matrix(
     m: Annotated[Optional[List[str]], typer.Option(
-        "--m", help="A material (repeat: --m copper --m glass ...); see 'designkit materials list'.")] = None,
+        "--m", help="A material (repeat: --m copper --m glass ...); see 'designkit materials list'.", rich_help_panel=PANEL_QUESTION)] = None,
     set_: Annotated[Optional[str], typer.Option(
-        "--set", help="Every material of a named set: 'paper12' (the paper's robot materials) or 'database'.")] = None,
+        "--set", help="Every material of a named set: 'paper12' (the paper's robot materials) or 'database'.", rich_help_panel=PANEL_QUESTION)] = None,
     from_: Annotated[Optional[str], typer.Option(
         "--from", help="Read materials from a file ('-': stdin): one name a line, or a CSV with a 'name' column "
-                       "(and 'set'), as 'designkit materials list --format csv' writes it.")] = None,
-    question: Annotated[str, typer.Option("--question", "-q", help=f"What to ask of every pair: {_QUESTIONS}.")]
+                       "(and 'set'), as 'designkit materials list --format csv' writes it.", rich_help_panel=PANEL_QUESTION)] = None,
+    question: Annotated[str, typer.Option("--question", "-q", help=f"What to ask of every pair: {_QUESTIONS}.", rich_help_panel=PANEL_QUESTION)]
     = "min-contact",
     contact: Annotated[Optional[float], typer.Option(
-        "--contact", help="Contact time [s] (max-noise, min-delta-t, distinguishable).")] = None,
+        "--contact", help="Contact time [s] (max-noise, min-delta-t, distinguishable).", rich_help_panel=PANEL_SCENE)] = None,
     noise: Annotated[Optional[float], typer.Option(
         "--noise", help="Noise sigma per sample [°C] (default 0.05; with max-noise only the multi-class curve "
-                        "uses it).")] = None,
+                        "uses it).", rich_help_panel=PANEL_SCENE)] = None,
     delta_t: Annotated[Optional[float], typer.Option(
         "--delta-t", help="Sensor minus object temperature before contact [°C] (default 10; with min-delta-t "
-                          "only the multi-class curve uses it).")]
+                          "only the multi-class curve uses it).", rich_help_panel=PANEL_SCENE)]
     = None,
     threshold: Annotated[Optional[float], typer.Option(
-        "--threshold", help="F1 threshold; must be the table's (0.9 for the shipped tables).")] = None,
-    table: Annotated[Optional[str], typer.Option("--table", help="Lookup table (default: svm-fine).")] = None,
-    ideal_table: Annotated[str, typer.Option("--ideal-table", help="Table for the ideal-observer bound.")]
+        "--threshold", help="F1 threshold; must be the table's (0.9 for the shipped tables).", rich_help_panel=PANEL_QUESTION)] = None,
+    table: Annotated[Optional[str], typer.Option("--table", help="Lookup table (default: svm-fine).", rich_help_panel=PANEL_SENSOR)] = None,
+    ideal_table: Annotated[str, typer.Option("--ideal-table", help="Table for the ideal-observer bound.", rich_help_panel=PANEL_SENSOR)]
     = "ideal-paper",
     multiclass: Annotated[bool, typer.Option(
-        "--multiclass/--no-multiclass", help="Add the accuracy of telling all N apart against contact time.")]
+        "--multiclass/--no-multiclass", help="Add the accuracy of telling all N apart against contact time.", rich_help_panel=PANEL_QUESTION)]
     = True,
     svm_trials: Annotated[Optional[int], typer.Option(
         "--svm-trials", help="Also the SVM's multi-class accuracy, on this many simulated touches per material "
-                             "(seconds; e.g. 60).")] = None,
-    seed: Annotated[int, typer.Option("--seed", help="Seed of the SVM's simulated touches.")] = 0,
+                             "(seconds; e.g. 60).", rich_help_panel=PANEL_QUESTION)] = None,
+    seed: Annotated[int, typer.Option("--seed", help="Seed of the SVM's simulated touches.", rich_help_panel=PANEL_QUESTION)] = 0,
     plot: Annotated[Optional[str], typer.Option(
-        "--plot", help="Save a figure: heatmap + multi-class accuracy (.png, .svg or .pdf).")] = None,
-    format_: FormatOpt = "table",
+        "--plot", help="Save a figure: heatmap + multi-class accuracy (.png, .svg or .pdf).", rich_help_panel=PANEL_OUTPUT)] = None,
+    format_: FormatOpt = None,
     out: OutOpt = None,
     sensor: SensorOpt = "paper",
     json_: Json = False,
@@ -85,7 +85,7 @@ def matrix(
     if plot:
         check_out(plot, "--plot")  # before the work, as export's --out
     names = list(m or ()) + (read_material_names(from_) if from_ else [])
-    fmt = "json" if json_ else check_format(format_)
+    fmt = output_format(format_, json_, default="table")
     from .._validation import check_positive, check_temperature
 
     if noise is not None:  # -inf, nan and 1e400 were answered

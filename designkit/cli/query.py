@@ -18,71 +18,41 @@ from typing import Annotated, Optional
 import typer
 
 from . import _app
-from ._app import app, emit_json
-from ._format import check_format, check_out, emit_rows, output_to
+from ._app import app
+from ._format import FormatOpt, OutOpt, emit, output_format
 from ._options import (
     E1,
     E2,
     M1,
-    Explain,
     M2,
-    BackingOpt,
-    Conductance,
-    Diffusivity,
-    Json,
-    ModelOpt,
-    PANEL_EXACT,
-    PANEL_OUTPUT,
     PANEL_QUESTION,
-    PANEL_SCENE,
-    PANEL_SENSOR,
+    BackingOpt,
+    BatchOpt,
+    Conductance,
+    Contact,
+    CoverageOpt,
+    DeltaTQ,
+    Diffusivity,
+    Exact,
+    Explain,
+    IdealTableOpt,
+    JobsQ,
+    Json,
+    MaxContact,
+    ModelOpt,
+    NmcQ,
+    NoiseQ,
+    RepeatsQ,
+    SeedQ,
     SensorOpt,
+    SpreadOpt,
+    TableOpt,
     Thickness,
     Threshold,
+    TrialsQ,
+    WidthQ,
     sensor_and_model,
 )
-
-Contact = Annotated[float, typer.Option("--contact", help="Contact time [s].",
-    rich_help_panel=PANEL_SCENE)]
-Exact = Annotated[bool, typer.Option(
-    "--exact", help="Compute for this pair and scene (seconds) instead of reading a table.",
-    rich_help_panel=PANEL_EXACT)]
-TableOpt = Annotated[Optional[str], typer.Option(
-    "--table", help="Lookup table (name or path) for the SVM answer (default: svm-fine).",
-    rich_help_panel=PANEL_SENSOR)]
-IdealTableOpt = Annotated[str, typer.Option("--ideal-table", help="Lookup table for the ideal-observer bound.",
-    rich_help_panel=PANEL_SENSOR)]
-TrialsQ = Annotated[int, typer.Option("--trials", help="--exact: simulated touches per class.",
-    rich_help_panel=PANEL_EXACT)]
-RepeatsQ = Annotated[int, typer.Option("--repeats", help="--exact: seeds per evaluation (Monte Carlo error).",
-    rich_help_panel=PANEL_EXACT)]
-SeedQ = Annotated[int, typer.Option("--seed", help="--exact: random seed.",
-    rich_help_panel=PANEL_EXACT)]
-WidthQ = Annotated[float, typer.Option(
-    "--width", help="--exact: class width [J s^-1/2 K^-1 m^-2] of each object (and of the materials rule).",
-    rich_help_panel=PANEL_EXACT)]
-JobsQ = Annotated[int, typer.Option("--jobs", "-j", help="--exact: worker processes (-1: all cores).",
-    rich_help_panel=PANEL_EXACT)]
-NmcQ = Annotated[int, typer.Option(
-    "--n-mc", help="--exact: touches per class of the Monte Carlo ideal observer (models without a shared shape).",
-    rich_help_panel=PANEL_EXACT)]
-MaxContact = Annotated[float, typer.Option("--max-contact", help="--exact: longest contact time to consider [s].",
-    rich_help_panel=PANEL_EXACT)]
-NoiseQ = Annotated[Optional[float], typer.Option(
-    "--noise", help="Noise sigma per sample [°C] (default 0.05, or the rig's as calibrated in a --sensor file).",
-    rich_help_panel=PANEL_SCENE)]
-DeltaTQ = Annotated[Optional[float], typer.Option(
-    "--delta-t", help="Sensor minus object temperature before contact [°C] (default 10, or the rig's as "
-                      "calibrated in a --sensor file).", rich_help_panel=PANEL_SCENE)]
-SpreadOpt = Annotated[Optional[float], typer.Option(
-    "--sensor-temp-spread", help="Varied initial conditions: each touch's sensor temperature uniform within "
-    "+-this [°C] of ambient + dT (the paper's robot: --delta-t 7.5 --sensor-temp-spread 2.5, answered from the "
-    "shipped table svm-paper-varied for min-contact, delta-e and distinguishable); any other case is computed "
-    "like --exact. Must stay below |dT|. Default 0, or the rig's touch-to-touch spread of dT as calibrated in a "
-    "--sensor file.", rich_help_panel=PANEL_SCENE)]
-CoverageOpt = Annotated[float, typer.Option(
-    "--coverage", help="Coverage of the answer's interval, in (0, 1) (table and --exact).",
-    rich_help_panel=PANEL_QUESTION)]
 
 #: Exit status of a question without an answer, on either route: the table cannot answer it (outside
 #: its grid along an axis, or nothing tabulated separates the pair), the materials' effusivity ranges
@@ -105,10 +75,16 @@ _HINTS = {
 @contextmanager
 def _hints():
     """Library errors with the flags that fix them."""
+    from .._validation import InputError
     from ..query.inputs import NeedsInput, TableMismatch
+    from ..query.policy import OutsideSensorTable
 
     try:
         yield
+    except OutsideSensorTable as exc:
+        raise InputError(f"{exc.where}: ask with --exact (computed, tens of seconds)" + (
+            ", or build a table over a wider span with 'designkit tables build --sensor FILE --e-range LO HI'"
+            if exc.wider else "")) from None
     except TableMismatch as exc:
         raise TableMismatch(f"{exc} (use --exact, or a table built for it with designkit sweep)") from None
     except NeedsInput as exc:
@@ -141,10 +117,6 @@ def _ask_scene(question: str, *, exact: bool, table: Optional[str], ideal_table:
     from .. import query
     from ..query.crossing import check_coverage
 
-    from ._options import refuse_together
-
-    refuse_together(("--exact", exact), ("--table", table),
-                    why="--exact computes the answer for the pair, --table reads it from a table")
     from .._validation import MAX_EFFUSIVITY, InputError, check_positive
 
     if check_positive("--width", width) > MAX_EFFUSIVITY:  # on either route (the table's is its own): 1e308 was taken
@@ -153,11 +125,7 @@ def _ask_scene(question: str, *, exact: bool, table: Optional[str], ideal_table:
     extra["coverage"] = check_coverage(coverage)  # bad input before any work, on either route
 
     with _hints():
-        from ..query.inputs import table_reroute
-
         if spread is not None and (spread < 0 or spread != spread):
-            from .._validation import InputError
-
             raise InputError(f"sensor temperature spread must be >= 0 degC, got {spread:g}")
         sen, fm, source = sensor_and_model(sensor, model, conductance=conductance, thickness=thickness,
                                            backing=backing)
@@ -171,87 +139,18 @@ def _ask_scene(question: str, *, exact: bool, table: Optional[str], ideal_table:
         asked = scene.get("contact_s")
         rig = resolve_scene(sen, {**scene, "sensor_temp_spread_c": spread})
         scene = {k: rig.values[k] for k in scene}
-        spread = rig.values["sensor_temp_spread_c"]
-        # the shipped tables are for the paper sensor and the semi-infinite model: another sensor or model is
-        # computed unless a table is named (a named table built for another one is refused, never used);
-        # varied initial conditions: no shipped table holds them, computed for the pair
-        own = None  # the table built for this sensor file (designkit tables build), where one is registered
-        if not exact and table is None and source == "sensor file" and not spread > 0:
-            from ..tables.registry import table_for_sensor
+        # the library chooses the route (designkit.query.policy): a table built for this sensor, model and
+        # scene, or named, else computed for the pair; the answer's route_reason says why
+        kw = dict(objects, **scene, threshold=threshold, sensor=sen, model=fm, table=table, ideal_table=ideal_table,
+                  diffusivity_m2_s=diffusivity, width=width, trials=trials, repeats=repeats, seed=seed, jobs=jobs,
+                  n_mc=n_mc, sensor_temp_spread_c=rig.values["sensor_temp_spread_c"], **extra)
+        route = "exact" if exact else "auto"
+        from ..query.policy import choose_route
 
-            own = table_for_sensor(sen)
-        reroute = None if exact or table is not None or own is not None else table_reroute(sen, fm)
-        if reroute and source == "sensor file" and getattr(sen, "conditions", None):
-            reroute += "; 'designkit tables build --sensor FILE' builds this sensor's table (then milliseconds)"
-        # varied initial conditions: the shipped table for the paper's spread (2.5 degC) and dT, else computed
-        varied = None
-        if spread > 0 and not exact and table is None and reroute is None:
-            from ..query.table import shipped_spread_table
-
-            varied = shipped_spread_table(spread, question, scene.get("delta_t_c"))
-        route = "exact" if exact or reroute or (spread > 0 and table is None and varied is None) else "table"
-        if spread > 0:
-            extra["sensor_temp_spread_c"] = spread
-        if route == "table":
-            if diffusivity is not None:
-                from ..query.inputs import NeedsInput
-
-                raise NeedsInput("a diffusivity was given but tables answer for effusivity alone",
-                                 "diffusivity-unused")
-            if own is not None:
-                return _from_own_table(question, own, objects, scene, threshold, sen, fm, extra["coverage"]), rig, \
-                    asked
-            from ..query.table import DEFAULT_TABLE
-
-            return query.ask(question, route="table", **objects, **scene, threshold=threshold,
-                             table=table or varied or DEFAULT_TABLE, ideal_table=ideal_table,
-                             sensor=None if sensor == "paper" else sen, model=fm, coverage=extra["coverage"],
-                             sensor_temp_spread_c=spread), rig, asked
-        kw = dict(threshold=threshold, sensor=sen, model=fm, diffusivity_m2_s=diffusivity, width=width,
-                  trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc, **extra)
-        with _exact_display(question, progress) as report:
+        with _exact_display(question, progress and choose_route(question, route, kw)[0] == "exact") as report:
             if report is not None:
                 kw["progress"] = report
-            return _noted(query.ask(question, route="exact", **objects, **scene, **kw), reroute, sen, fm,
-                          source), rig, asked
-
-
-#: Questions whose table route would estimate a missing closed-form ideal bound by Monte Carlo (seconds).
-_MC_BOUND = frozenset({"min-contact", "delta-e"})
-
-
-def _from_own_table(question: str, own, objects: dict, scene: dict, threshold, sen, fm, coverage: float):
-    """A question about a sensor file answered from the table built for it (:func:`~designkit.tables.registry.
-    table_for_sensor`). Its model has no closed-form ideal observer: the bound is not tabulated, and not
-    estimated here (seconds; ``--exact`` does). A question outside the table's span is refused (one line,
-    exit 2), never answered by extrapolation nor silently computed instead."""
-    import dataclasses
-
-    from .. import query
-    from .._validation import InputError
-
-    fn = query.QUESTIONS[question].table
-    ans = fn(**objects, **scene, threshold=threshold, table=own, ideal_table=None, sensor=sen, model=fm,
-             coverage=coverage, **({"ideal_bound": False} if question in _MC_BOUND else {}))
-    if not all(ans.in_grid.values()):
-        raise InputError("; ".join(ans.notes) + f" (the table built for sensor {sen.name}): ask with --exact "
-                         "(computed, tens of seconds)" + ("" if ans.in_grid.get("effusivity", True) else
-                                                          ", or build a table over a wider span with 'designkit "
-                                                          "tables build --sensor FILE --e-range LO HI'"))
-    notes = ans.notes
-    if question == "min-contact" and (ans.value is None or ans.interval_kind == "table-cell"):
-        from ..rig import from_model_contact, model_start_s  # the route's note counts as the model does: from the onset
-
-        start = model_start_s(sen)
-        at = [f"{max(from_model_contact(float(t), start), 0.0):.3g}" for t in
-              ((own.axes["contact_s"][-1],) if ans.value is None else ans.interval)]
-        notes = ((f"no tabulated contact time up to {at[0]} s after the rig's detected onset separates them (--exact "
-                  "examines up to 10 s)",) if ans.value is None else
-                 (f"the shortest contact lies in ({at[0]}, {at[1]}] s after the rig's detected onset, a cell of the "
-                  "table's contact grid: no interval of stated coverage there (--exact estimates one)",))
-    return dataclasses.replace(ans, notes=(*notes, f"from the table built for sensor {sen.name} (designkit "
-                                           "tables build); its model has no closed-form ideal observer: --exact "
-                                           "estimates the bound by Monte Carlo"))
+            return _noted(query.ask(question, route=route, **kw), sen, fm, source), rig, asked
 
 
 @contextmanager
@@ -279,14 +178,12 @@ def _exact_display(question: str, progress: bool):
         yield report
 
 
-def _noted(ans, reroute: Optional[str], sen, fm, source: str):
-    """The answer with a note saying why it was computed rather than read, and where its model came from."""
+def _noted(ans, sen, fm, source: str):
+    """A computed answer with a note saying where its model came from (a sensor file's own)."""
     import dataclasses
 
     notes = list(ans.notes)
-    if reroute:
-        notes.append(reroute)
-    if source == "sensor file":
+    if source == "sensor file" and ans.route == "exact":
         from ..models import sensor_model_notes
 
         notes.extend(sensor_model_notes(sen, fm))
@@ -303,14 +200,58 @@ def _fmt(x, unit="") -> str:
     return sig(x, unit.strip())
 
 
-def _render(ans, json_: bool, explain: bool = False) -> None:
+def _render(ans, fmt: str = "text", out: Optional[str] = None, explain: bool = False) -> None:
+    """Print the answer in ``fmt``: the text for people, ``to_dict()`` (json), or its record (csv, ndjson,
+    table, md: one row, docs/schema.md "Records"; delta-e: one row per direction). Exit 3 if there is none."""
     d = ans.to_dict()
-    if json_:
-        emit_json(d)
-    else:
-        _render_text(d, explain)
+    emit(fmt, out, payload=d, records=lambda: _records(d), text=lambda: _render_text(d, explain),
+         title=f"{d['question']}")
     if d["value"] is None and (d["question"] != "delta-e" or not all(d["in_grid"].values())):
         raise typer.Exit(EXIT_NO_ANSWER)
+
+
+def _records(d: dict) -> list[dict]:
+    """An answer's rows: its record (:func:`designkit.query.answer.to_record`); delta-e's, one per direction."""
+    if d["question"] != "delta-e":
+        from ..query.answer import to_record
+
+        return [to_record(d)]
+    x = d["details"]
+    return [{"direction": side, "effusivity": x["effusivity"], "delta_e": x[side]["value"],
+             "interval_low": x[side]["interval"]["low"], "interval_high": x[side]["interval"]["high"],
+             "ideal_value": x[side]["ideal"]["value"], "unit": d["unit"], "route": d["route"],
+             "table_name": (d["table"] or {}).get("name")} for side in ("lower", "upper")]
+
+
+def _batch(question: str, path: str, fmt: str, out: Optional[str], *, objects: dict, scene: dict, exact: bool,
+           table, ideal_table, threshold, coverage, sensor, spread, exact_options: dict) -> None:
+    """``--batch FILE``: every row answered by one array call of the library (:mod:`designkit.io_batch`), one
+    record per row out; the options give the columns the file leaves out."""
+    from .._validation import InputError
+    from ..io_batch import MAX_BATCH_ROWS, MAX_BATCH_ROWS_EXACT, answer_batch, read_batch
+    from ..query.crossing import check_coverage
+    from ..rig import DEFAULTS
+
+    if sensor != "paper" or any(v is not None for k, v in exact_options.items() if k in _MODEL_KEYS):
+        raise InputError("--batch answers for the paper sensor and model (a sensor file's rig conditions apply to "
+                         "one question at a time): ask without --batch, or build a table and name it with --table")
+    batch = read_batch(path, question, max_rows=MAX_BATCH_ROWS_EXACT if exact else MAX_BATCH_ROWS)
+    defaults = {**{k: v for k, v in objects.items() if v is not None},
+                **{k: (DEFAULTS[k] if v is None and k in DEFAULTS else v) for k, v in scene.items()}}
+    options = dict(threshold=threshold, coverage=check_coverage(coverage))
+    if spread:
+        options["sensor_temp_spread_c"] = spread
+    if exact:
+        options.update({k: v for k, v in exact_options.items() if k not in _MODEL_KEYS})
+    else:
+        options.update(ideal_table=ideal_table, **({"table": table} if table else {}))
+    records = answer_batch(batch, defaults, route="exact" if exact else "auto", **options)
+    payload = records  # json: the records (an array answer's to_dict, with each row's inputs)
+    emit(fmt, out, payload=payload, records=records, title=f"{question}: {len(records)} rows")
+
+
+#: Options of the sensor's forward model (the --batch route answers for the paper's).
+_MODEL_KEYS = ("model", "conductance", "thickness", "backing", "diffusivity")
 
 
 def _render_text(d, explain: bool = False) -> None:
@@ -487,6 +428,8 @@ def _explain_lines(con, d):
                   if c.get("sensor_temp_spread_c") else "")
         con.print(f"method: computed for this pair ({c['repeats']} seeds x {c['trials']} trials per class"
                   f"{varied}, {c['wall_s']:.1f} s)")
+    if d.get("route_reason") and d["route_reason"] not in d["notes"]:
+        con.print(f"route ({d['route']}): {d['route_reason']}", markup=False)
     for n in d["notes"]:
         con.print(f"note: {n}", markup=False)
     chk = d["model_check"]
@@ -497,6 +440,8 @@ def _explain_lines(con, d):
 
 
 # ============================================================ the commands
+# Each command: its options, one library call (_ask, or --batch: one array call), the answer rendered in
+# --format (text for people by default; --json is --format json).
 @app.command("min-contact", rich_help_panel=_app.ASK)
 def min_contact_cmd(
     e1: E1 = None, e2: E2 = None, m1: M1 = None, m2: M2 = None,
@@ -506,22 +451,21 @@ def min_contact_cmd(
     exact: Exact = False, table: TableOpt = None, ideal_table: IdealTableOpt = "ideal-paper",
     trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
     n_mc: NmcQ = 1000, max_contact: MaxContact = 10.0, coverage: CoverageOpt = 0.9,
-    sensor_temp_spread: SpreadOpt = None, json_: Json = False,
-    explain: Explain = False,
+    sensor_temp_spread: SpreadOpt = None, batch: BatchOpt = None, format_: FormatOpt = None, out: OutOpt = None,
+    json_: Json = False, explain: Explain = False,
 ) -> None:
     """Shortest contact time that separates two materials.
 
     Example: `designkit min-contact --e1 35000 --e2 20000`
 
     Example (materials by name, the method too): `designkit min-contact --m1 wood --m2 glass --explain`
+
+    Example (one record, pandas-ready): `designkit min-contact --e1 35000 --e2 20000 --format csv`
     """
-    ans = _ask("min-contact", exact=exact, table=table, ideal_table=ideal_table, threshold=threshold, sensor=sensor,
-               model=model, conductance=conductance, thickness=thickness, backing=backing, diffusivity=diffusivity,
-               width=width, trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc,
-               objects=dict(e1=e1, e2=e2, m1=m1, m2=m2), scene=dict(noise_c=noise, delta_t_c=delta_t),
-               exact_extra=dict(max_contact_s=max_contact), coverage=coverage, progress=not json_,
-               spread=sensor_temp_spread)
-    _render(ans, json_, explain)
+    fmt = output_format(format_, json_, out=out)  # before the work: --exact is not computed for nowhere
+    opts = _options(locals(), ("e1", "e2", "m1", "m2"), dict(noise_c=noise, delta_t_c=delta_t),
+                    exact_extra=dict(max_contact_s=max_contact))
+    _answer("min-contact", opts, batch, fmt, out, explain)
 
 
 @app.command("max-noise", rich_help_panel=_app.ASK)
@@ -532,20 +476,16 @@ def max_noise_cmd(
     backing: BackingOpt = None, diffusivity: Diffusivity = None,
     exact: Exact = False, table: TableOpt = None, ideal_table: IdealTableOpt = "ideal-paper",
     trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
-    n_mc: NmcQ = 1000, coverage: CoverageOpt = 0.9, sensor_temp_spread: SpreadOpt = None, json_: Json = False,
-    explain: Explain = False,
+    n_mc: NmcQ = 1000, coverage: CoverageOpt = 0.9, sensor_temp_spread: SpreadOpt = None, batch: BatchOpt = None,
+    format_: FormatOpt = None, out: OutOpt = None, json_: Json = False, explain: Explain = False,
 ) -> None:
     """Largest sensor noise at which a contact time still separates two materials.
 
     Example: `designkit max-noise --e1 35000 --e2 20000 --contact 2`
     """
-    ans = _ask("max-noise", exact=exact, table=table, ideal_table=ideal_table, threshold=threshold, sensor=sensor,
-               model=model, conductance=conductance, thickness=thickness, backing=backing, diffusivity=diffusivity,
-               width=width, trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc,
-               objects=dict(e1=e1, e2=e2, m1=m1, m2=m2),
-               scene=dict(contact_s=contact, delta_t_c=delta_t), coverage=coverage, progress=not json_,
-               spread=sensor_temp_spread)
-    _render(ans, json_, explain)
+    fmt = output_format(format_, json_, out=out)  # before the work: --exact is not computed for nowhere
+    opts = _options(locals(), ("e1", "e2", "m1", "m2"), dict(contact_s=contact, delta_t_c=delta_t))
+    _answer("max-noise", opts, batch, fmt, out, explain)
 
 
 @app.command("min-delta-t", rich_help_panel=_app.ASK)
@@ -556,20 +496,16 @@ def min_delta_t_cmd(
     backing: BackingOpt = None, diffusivity: Diffusivity = None,
     exact: Exact = False, table: TableOpt = None, ideal_table: IdealTableOpt = "ideal-paper",
     trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
-    n_mc: NmcQ = 1000, coverage: CoverageOpt = 0.9, sensor_temp_spread: SpreadOpt = None, json_: Json = False,
-    explain: Explain = False,
+    n_mc: NmcQ = 1000, coverage: CoverageOpt = 0.9, sensor_temp_spread: SpreadOpt = None, batch: BatchOpt = None,
+    format_: FormatOpt = None, out: OutOpt = None, json_: Json = False, explain: Explain = False,
 ) -> None:
     """Smallest sensor-object temperature difference that separates two materials.
 
     Example: `designkit min-delta-t --e1 35000 --e2 20000 --contact 2 --noise 0.05`
     """
-    ans = _ask("min-delta-t", exact=exact, table=table, ideal_table=ideal_table, threshold=threshold, sensor=sensor,
-               model=model, conductance=conductance, thickness=thickness, backing=backing, diffusivity=diffusivity,
-               width=width, trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc,
-               objects=dict(e1=e1, e2=e2, m1=m1, m2=m2),
-               scene=dict(contact_s=contact, noise_c=noise), coverage=coverage, progress=not json_,
-               spread=sensor_temp_spread)
-    _render(ans, json_, explain)
+    fmt = output_format(format_, json_, out=out)  # before the work: --exact is not computed for nowhere
+    opts = _options(locals(), ("e1", "e2", "m1", "m2"), dict(contact_s=contact, noise_c=noise))
+    _answer("min-delta-t", opts, batch, fmt, out, explain)
 
 
 @app.command("delta-e", rich_help_panel=_app.ASK)
@@ -584,13 +520,8 @@ def delta_e_cmd(
     backing: BackingOpt = None, diffusivity: Diffusivity = None,
     exact: Exact = False, table: TableOpt = None, ideal_table: IdealTableOpt = "ideal-paper",
     trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
-    n_mc: NmcQ = 1000, coverage: CoverageOpt = 0.9, sensor_temp_spread: SpreadOpt = None,
-    format_: Annotated[Optional[str], typer.Option(
-        "--format", "-f", help="Print the two directions as rows: table, json, csv or md (default: the answer "
-                               "for people; --json: the whole answer).", rich_help_panel=PANEL_OUTPUT)] = None,
-    out: Annotated[Optional[str], typer.Option("--out", "-o", help="Write the output to this file ('-' or none: "
-                                               "stdout).", rich_help_panel=PANEL_OUTPUT)] = None,
-    json_: Json = False, explain: Explain = False,
+    n_mc: NmcQ = 1000, coverage: CoverageOpt = 0.9, sensor_temp_spread: SpreadOpt = None, batch: BatchOpt = None,
+    format_: FormatOpt = None, out: OutOpt = None, json_: Json = False, explain: Explain = False,
 ) -> None:
     """Smallest distinguishable effusivity difference delta(e), towards lower and higher effusivity.
 
@@ -598,26 +529,9 @@ def delta_e_cmd(
 
     Example (one row per direction): `designkit delta-e --e 20000 --contact 2 --format csv`
     """
-    fmt = None if json_ or format_ is None else check_format(format_)
-    if out not in (None, "-"):
-        check_out(out)  # before the work: an --exact answer is not computed for a folder that does not exist
-    ans = _ask("delta-e", exact=exact, table=table, ideal_table=ideal_table, threshold=threshold, sensor=sensor,
-               model=model, conductance=conductance, thickness=thickness, backing=backing, diffusivity=diffusivity,
-               width=width, trials=trials, repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc,
-               objects=dict(e=e, m=m), scene=dict(contact_s=contact, noise_c=noise, delta_t_c=delta_t),
-               coverage=coverage, progress=not json_, spread=sensor_temp_spread)
-    if fmt is not None:
-        d = ans.to_dict()  # rows: each direction as a record (docs/schema.md); json: the answer, as --json
-        x = d["details"]
-        rows = [{"direction": side, "effusivity": x["effusivity"], "delta_e": x[side]["value"],
-                 "interval_low": x[side]["interval"]["low"], "interval_high": x[side]["interval"]["high"],
-                 "ideal_value": x[side]["ideal"]["value"], "unit": d["unit"], "route": d["route"],
-                 "table_name": (d["table"] or {}).get("name")}
-                for side in ("lower", "upper")]
-        emit_rows(rows, list(rows[0]), fmt=fmt, out=out, title=f"delta(e) at {x['effusivity']:g}", payload=d)
-        return
-    with output_to(out):
-        _render(ans, json_, explain)
+    fmt = output_format(format_, json_, out=out)  # before the work: --exact is not computed for nowhere
+    opts = _options(locals(), ("e", "m"), dict(contact_s=contact, noise_c=noise, delta_t_c=delta_t))
+    _answer("delta-e", opts, batch, fmt, out, explain)
 
 
 @app.command("distinguishable", rich_help_panel=_app.ASK)
@@ -629,17 +543,42 @@ def distinguishable_cmd(
     backing: BackingOpt = None, diffusivity: Diffusivity = None,
     exact: Exact = False, table: TableOpt = None, ideal_table: IdealTableOpt = "ideal-paper",
     trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
-    n_mc: NmcQ = 1000, coverage: CoverageOpt = 0.9, sensor_temp_spread: SpreadOpt = None, json_: Json = False,
-    explain: Explain = False,
+    n_mc: NmcQ = 1000, coverage: CoverageOpt = 0.9, sensor_temp_spread: SpreadOpt = None, batch: BatchOpt = None,
+    format_: FormatOpt = None, out: OutOpt = None, json_: Json = False, explain: Explain = False,
 ) -> None:
     """Whether a scene separates two materials, with the SVM's and the ideal observer's F1.
 
     Example: `designkit distinguishable --m1 wood --m2 glass --contact 2`
     """
-    ans = _ask("distinguishable", exact=exact, table=table, ideal_table=ideal_table, threshold=threshold,
-               sensor=sensor, model=model, conductance=conductance, thickness=thickness, backing=backing,
-               diffusivity=diffusivity, width=width, trials=trials, repeats=repeats, seed=seed, jobs=jobs,
-               n_mc=n_mc, objects=dict(e1=e1, e2=e2, m1=m1, m2=m2),
-               scene=dict(contact_s=contact, noise_c=noise, delta_t_c=delta_t), coverage=coverage,
-               progress=not json_, spread=sensor_temp_spread)
-    _render(ans, json_, explain)
+    fmt = output_format(format_, json_, out=out)  # before the work: --exact is not computed for nowhere
+    opts = _options(locals(), ("e1", "e2", "m1", "m2"), dict(contact_s=contact, noise_c=noise, delta_t_c=delta_t))
+    _answer("distinguishable", opts, batch, fmt, out, explain)
+
+
+#: The options every question command shares (its arguments of these names), passed on to _ask as they are.
+_SHARED = ("exact", "table", "ideal_table", "threshold", "sensor", "model", "conductance", "thickness", "backing",
+           "diffusivity", "width", "trials", "repeats", "seed", "jobs", "n_mc", "coverage")
+
+
+def _options(args: dict, objects: tuple, scene: dict, **extra) -> dict:
+    """What one question command passes to :func:`_answer`: the shared options read from its arguments
+    (``locals()``), its objects (``objects``: the argument names) and its scene."""
+    return dict({k: args[k] for k in _SHARED}, spread=args["sensor_temp_spread"],
+                objects={k: args[k] for k in objects}, scene=scene, **extra)
+
+
+def _answer(question: str, kw: dict, batch: Optional[str], fmt: str, out: Optional[str], explain: bool) -> None:
+    """One question command's work: ``--batch`` (every row of a file, one array call) or one answer (_ask)."""
+    from ._options import refuse_together
+
+    refuse_together(("--exact", kw["exact"]), ("--table", kw["table"]),
+                    why="--exact computes the answer for the pair, --table reads it from a table")
+    if batch is not None:
+        exact_options = {k: kw[k] for k in ("model", "conductance", "thickness", "backing", "diffusivity", "width",
+                                            "trials", "repeats", "seed", "jobs", "n_mc")}
+        exact_options.update(kw.get("exact_extra") or {})
+        _batch(question, batch, fmt, out, objects=kw["objects"], scene=kw["scene"], exact=kw["exact"],
+               table=kw["table"], ideal_table=kw["ideal_table"], threshold=kw["threshold"], coverage=kw["coverage"],
+               sensor=kw["sensor"], spread=kw["spread"], exact_options=exact_options)
+        return
+    _render(_ask(question, **kw, progress=fmt != "json"), fmt, out, explain)

@@ -37,9 +37,11 @@ def reproduce(
     """Reproduce the paper's figures and tables (F1 matrices, δ(e) curves, node graphs, Table I, guideline,
     real robot, sim-to-real, multi-class) into a markdown report with figures, beside the paper's numbers.
 
-    Example: `designkit reproduce --out report`
+    The whole report, every section: `designkit reproduce --out report` (minutes).
 
-    Example: `designkit reproduce --out report --only multiclass,node-graphs --figure-format svg`
+    Example: `designkit reproduce --out report --only f1-matrices,guideline`
+
+    Example: `designkit reproduce --out report --only f1-matrices --figure-format svg`
     """
     lab = import_lab("reproduce", "reproduce")
     ReproduceSettings, parse_only, run = lab.ReproduceSettings, lab.parse_only, lab.reproduce

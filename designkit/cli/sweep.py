@@ -77,7 +77,7 @@ def sweep(
     import time
 
     from .._validation import InputError
-    from ..sweep import SweepConfig, SweepInterrupted, run_sweep
+    from ..sweep import SweepInterrupted, run_sweep
 
     if resume and fresh:
         raise InputError("--resume and --fresh contradict each other: give one")
@@ -98,54 +98,13 @@ def sweep(
                      ambient_temp_spread_c=ambient_temp_spread, contact_s=_floats(contact, "--contact"),
                      sample_rate_hz=sample_rate, blocks=blocks, full_matrix=full_matrix, model=fm,
                      diffusivity_m2_s=diffusivity, solver=solver)
-    if overrides["noise_c"] is not None or overrides["delta_t_c"] is not None:
-        overrides.setdefault("noise_ratio", None)
-    if config is not None:
-        cfg = SweepConfig.from_yaml(config, **overrides)
-    else:
-        given = {k: v for k, v in overrides.items() if v is not None}
-        if "noise_c" in given:
-            given.setdefault("noise_ratio", None)
-        cfg = SweepConfig.from_mapping(given, source="options")
-    from ._format import check_out, check_out_dir
-
-    if workdir is not None:
-        check_out_dir(workdir, "--workdir")  # before any work: as every command's output folder
-    wd = workdir if workdir is not None else Path("sweeps") / cfg.name
-    target = out
-    if target is not None and (target.is_dir() or target.suffix == ""):
-        target = check_out_dir(target, "--out") / f"{cfg.name}.npz"
-    elif target is not None:
-        check_out(target, "--out")
+    cfg = _config(config, overrides)
+    wd, target = _outputs(cfg, workdir, out)
     con = console(stderr=True)
     total = len(cfg.scene_points()) * len(cfg.blocks_of()) * len(cfg.contact_s)
     started = time.perf_counter()
     stats = {"fits": 0, "computed": 0}
-
-    if con.is_terminal and not json_:
-        from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn,
-                                   TimeRemainingColumn)
-
-        progress = Progress(TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
-                            TextColumn("chunks"), TimeElapsedColumn(), TextColumn("ETA"), TimeRemainingColumn(),
-                            TextColumn("{task.fields[fits]} SVM fits"), console=con, transient=False)
-        task = progress.add_task(f"sweep {cfg.name}", total=total, fits=0)
-        progress.start()
-
-        def on_chunk(res, computed, done, total_):
-            stats["fits"] += res.fits
-            stats["computed"] += computed
-            progress.update(task, completed=done, fits=stats["fits"])
-    else:
-        progress = None
-
-        def on_chunk(res, computed, done, total_):
-            stats["fits"] += res.fits
-            stats["computed"] += computed
-            if computed:
-                con.print(f"[{time.perf_counter() - started:8.1f} s] chunk {done}/{total_}: scene {res.point} "
-                          f"contact {cfg.contact_s[res.contact_index]:g} s, {res.fits} fits, {res.wall_s:.1f} s",
-                          highlight=False)
+    progress, on_chunk = _progress(con, cfg, total, stats, started, quiet=json_)
     try:
         path = run_sweep(cfg, wd, out=target, jobs=jobs, backend=backend, scheduler=scheduler, resume=resume,
                          fresh=fresh, on_chunk=on_chunk, compress=not uncompressed)
@@ -165,12 +124,79 @@ def sweep(
     if json_:
         emit_json(summary)
         return
-    from rich.markup import escape
-
     out_con = console()
     out_con.print(f"[bold green]Wrote[/] {path} (+ .json): {total} chunks "
                   f"({stats['computed']} computed now), {stats['fits']} SVM fits, {elapsed:.1f} s; "
-                  f"model {escape(cfg.model.describe())}"
-                  + (f" (recorded in sensor file {escape(cfg.sensor)})" if fm is None and cfg.model.name !=
+                  f"model {_markup_escape(cfg.model.describe())}"
+                  + (f" (recorded in sensor file {_markup_escape(cfg.sensor)})" if fm is None and cfg.model.name !=
                      "semi-infinite" else ""))
     sys.stdout.flush()
+
+
+def _markup_escape(text: str) -> str:
+    from rich.markup import escape
+
+    return escape(text)
+
+
+def _config(config: Optional[Path], overrides: dict):
+    """The sweep's configuration: the YAML file with the options over it, or the options alone."""
+    from ..sweep import SweepConfig
+
+    if overrides["noise_c"] is not None or overrides["delta_t_c"] is not None:
+        overrides.setdefault("noise_ratio", None)
+    if config is not None:
+        return SweepConfig.from_yaml(config, **overrides)
+    given = {k: v for k, v in overrides.items() if v is not None}
+    if "noise_c" in given:
+        given.setdefault("noise_ratio", None)
+    return SweepConfig.from_mapping(given, source="options")
+
+
+def _outputs(cfg, workdir: Optional[Path], out: Optional[Path]) -> tuple[Path, Optional[Path]]:
+    """The work folder and the table file, checked before any work (as every command's outputs)."""
+    from ._format import check_out, check_out_dir
+
+    if workdir is not None:
+        check_out_dir(workdir, "--workdir")
+    wd = workdir if workdir is not None else Path("sweeps") / cfg.name
+    target = out
+    if target is not None and (target.is_dir() or target.suffix == ""):
+        target = check_out_dir(target, "--out") / f"{cfg.name}.npz"
+    elif target is not None:
+        check_out(target, "--out")
+    return wd, target
+
+
+def _progress(con, cfg, total: int, stats: dict, started: float, *, quiet: bool):
+    """What the sweep shows while it runs: a bar on a terminal, else a line per chunk computed on stderr.
+
+    Returns (the rich Progress to stop, or None; the per-chunk callback, which counts into ``stats``)."""
+    import time
+
+    if con.is_terminal and not quiet:
+        from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn,
+                                   TimeRemainingColumn)
+
+        progress = Progress(TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
+                            TextColumn("chunks"), TimeElapsedColumn(), TextColumn("ETA"), TimeRemainingColumn(),
+                            TextColumn("{task.fields[fits]} SVM fits"), console=con, transient=False)
+        task = progress.add_task(f"sweep {cfg.name}", total=total, fits=0)
+        progress.start()
+
+        def on_bar(res, computed, done, total_):
+            stats["fits"] += res.fits
+            stats["computed"] += computed
+            progress.update(task, completed=done, fits=stats["fits"])
+
+        return progress, on_bar
+
+    def on_chunk(res, computed, done, total_):
+        stats["fits"] += res.fits
+        stats["computed"] += computed
+        if computed:
+            con.print(f"[{time.perf_counter() - started:8.1f} s] chunk {done}/{total_}: scene {res.point} "
+                      f"contact {cfg.contact_s[res.contact_index]:g} s, {res.fits} fits, {res.wall_s:.1f} s",
+                      highlight=False)
+
+    return None, on_chunk

@@ -8,8 +8,8 @@ from typing import Annotated, Optional
 import typer
 
 from . import _app
-from ._app import console, emit_json, sub_app
-from ._format import FormatOpt, OutOpt, check_format, emit_rows, output_to, write_output
+from ._app import console, sub_app
+from ._format import FormatOpt, OutOpt, emit, emit_rows, output_format, write_output
 from ._options import Json
 
 tables_app = sub_app("tables", "Shipped lookup tables: list them, or show one's grid and provenance.",
@@ -19,7 +19,7 @@ tables_app = sub_app("tables", "Shipped lookup tables: list them, or show one's 
 @tables_app.command("list")
 def tables_list(
     folder: Annotated[Optional[Path], typer.Option("--folder", help="List tables in this folder instead.")] = None,
-    format_: FormatOpt = "table",
+    format_: FormatOpt = None,
     out: OutOpt = None,
     json_: Json = False,
 ) -> None:
@@ -31,7 +31,7 @@ def tables_list(
 
     from .._validation import InputError
 
-    fmt = "json" if json_ else check_format(format_)
+    fmt = output_format(format_, json_, default="table")
     rows = []
     for name in list_tables(folder):
         try:
@@ -59,8 +59,8 @@ def tables_list(
                      "noise_axis": noise_axis, "noise_min": noise[0], "noise_max": noise[1], "noise_points": noise[2],
                      "contact_min_s": contact[0], "contact_max_s": contact[1], "contact_points": contact[2],
                      "intervals": ax["e_ref"][2], "size_bytes": r["size_bytes"], "path": r["path"]})
-    if fmt == "csv":
-        emit_rows(flat, fmt="csv", out=out)
+    if fmt in ("csv", "ndjson"):
+        emit_rows(flat, fmt=fmt, out=out)
         return
     if not flat and fmt == "table":
         write_output(f"no designkit tables in {folder if folder is not None else 'the shipped folder'}\n", out)
@@ -78,9 +78,7 @@ def tables_list(
 @tables_app.command("show")
 def tables_show(
     name: Annotated[str, typer.Argument(help="Table name (see 'designkit tables list') or path.")],
-    format_: Annotated[Optional[str], typer.Option(
-        "--format", "-f", help="Print the table's axes as rows: table, json, csv or md (default: the description "
-                               "for people; --json: the whole summary).")] = None,
+    format_: FormatOpt = None,
     out: OutOpt = None,
     json_: Json = False,
 ) -> None:
@@ -93,22 +91,14 @@ def tables_show(
     """
     from ..tables.store import load_table
 
+    fmt = output_format(format_, json_, out=out)
     table = load_table(name, thorough=True)
     s = table.summary()
-    if json_:
-        with output_to(out):
-            emit_json(s)
-        return
-    if format_ is not None:
-        fmt = check_format(format_)
-        rows = [{"axis": a["name"], "unit": a.get("unit"), "scale": a.get("scale"), "points": a.get("points"),
-                 "min": a.get("min"), "max": a.get("max"),
-                 "values": " ".join(f"{v:g}" for v in a.get("values", []))} for a in s["axes"]]
-        emit_rows(rows, ["axis", "unit", "scale", "points", "min", "max", "values"], fmt=fmt, out=out,
-                  title=f"{s['name']}: axes", payload=s)  # json: the --json document
-        return
-    with output_to(out):
-        _print_table(table, s)
+    rows = [{"axis": a["name"], "unit": a.get("unit"), "scale": a.get("scale"), "points": a.get("points"),
+             "min": a.get("min"), "max": a.get("max"),
+             "values": " ".join(f"{v:g}" for v in a.get("values", []))} for a in s["axes"]]
+    emit(fmt, out, payload=s, records=rows, text=lambda: _print_table(table, s), title=f"{s['name']}: axes",
+         columns=["axis", "unit", "scale", "points", "min", "max", "values"])
 
 
 def _visible(x) -> str:

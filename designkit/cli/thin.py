@@ -8,9 +8,10 @@ from typing import Annotated, Optional
 
 import typer
 
-from ._app import app, console, emit_json
+from ._app import app, console
+from ._format import FormatOpt, OutOpt, check_out, emit, flat_record, output_format
 from . import _app
-from ._options import BackingOpt, DeltaT, Json, SensorOpt
+from ._options import PANEL_OUTPUT, PANEL_QUESTION, BackingOpt, DeltaT, Json, SensorOpt
 
 #: Contact times [s] at which the deviation is reported (the paper's 1-4 s, and longer).
 REPORT_TIMES_S = (1.0, 2.0, 3.0, 4.0, 10.0, 30.0, 60.0)
@@ -18,23 +19,25 @@ REPORT_TIMES_S = (1.0, 2.0, 3.0, 4.0, 10.0, 30.0, 60.0)
 
 @app.command(rich_help_panel=_app.ASK)
 def validity(
-    thickness: Annotated[float, typer.Option("--thickness", help="Object thickness \\[m] (e.g. 0.003 for 3 mm).")],
+    thickness: Annotated[float, typer.Option("--thickness", help="Object thickness \\[m] (e.g. 0.003 for 3 mm).", rich_help_panel=PANEL_QUESTION)],
     material: Annotated[Optional[str], typer.Option(
         "--m", "--material", help="Object material (see 'designkit materials list'); its ranges give a worst "
-                                  "case.")] = None,
+                                  "case.", rich_help_panel=PANEL_QUESTION)] = None,
     e: Annotated[Optional[float], typer.Option(
-        "--e", help="Object effusivity [J s^-1/2 K^-1 m^-2] (instead of --m; needs --diffusivity).")] = None,
+        "--e", help="Object effusivity [J s^-1/2 K^-1 m^-2] (instead of --m; needs --diffusivity).", rich_help_panel=PANEL_QUESTION)] = None,
     alpha: Annotated[Optional[float], typer.Option(
-        "--diffusivity", "--alpha", help="Object diffusivity \\[m^2/s] (instead of --m; needs --e).")] = None,
+        "--diffusivity", "--alpha", help="Object diffusivity \\[m^2/s] (instead of --m; needs --e).", rich_help_panel=PANEL_QUESTION)] = None,
     backing: BackingOpt = None,
     tolerance: Annotated[float, typer.Option(
         "--tolerance", help="Acceptable deviation from the semi-infinite reading [°C] "
-                            "(default 0.01: the paper's smallest noise level).")] = 0.01,
+                            "(default 0.01: the paper's smallest noise level).", rich_help_panel=PANEL_QUESTION)] = 0.01,
     delta_t: DeltaT = 10.0,
     sensor: SensorOpt = "paper",
-    horizon: Annotated[float, typer.Option("--horizon", help="Longest contact time examined \\[s].")] = 3600.0,
+    horizon: Annotated[float, typer.Option("--horizon", help="Longest contact time examined \\[s].", rich_help_panel=PANEL_QUESTION)] = 3600.0,
     plot: Annotated[Optional[Path], typer.Option(
-        "--plot", help="Write a figure of the deviation against contact time (.png, or vector .svg / .pdf).")] = None,
+        "--plot", help="Write a figure of the deviation against contact time (.png, or vector .svg / .pdf).", rich_help_panel=PANEL_OUTPUT)] = None,
+    format_: FormatOpt = None,
+    out: OutOpt = None,
     json_: Json = False,
 ) -> None:
     """Contact time up to which the semi-infinite model (paper eq. 2) holds for a slab of this thickness.
@@ -44,6 +47,8 @@ def validity(
     Prints the first contact time at which that difference exceeds --tolerance.
 
     Example: `designkit validity --m acrylic --thickness 0.003 --backing table`
+
+    Example (one flat record, pandas-ready): `designkit validity --m acrylic --thickness 0.003 --format csv`
     """
     import numpy as np
 
@@ -51,13 +56,12 @@ def validity(
     from ..sensor import load_sensor
     from ..models.slab import material_validity, resolve_backing, semi_infinite_deviation, semi_infinite_validity
 
+    fmt = output_format(format_, json_, out=out)
     L = check_positive("thickness [m]", thickness)
     from .._validation import check_temperature
 
     check_temperature("--tolerance [°C]", tolerance, nonnegative=True)  # 1e308 was answered
     if plot is not None:
-        from ._format import check_out
-
         check_out(plot, "--plot")  # before the work; a missing folder is not made
     if delta_t == 0:
         raise InputError("--delta-t must be non-zero: an unheated sensor sees no difference to hold a tolerance to")
@@ -101,9 +105,15 @@ def validity(
         "deviation_c": {f"{t:g}": float(d) for t, d in zip(REPORT_TIMES_S, dev_c)},
         "plot": str(plot) if plot else None,
     }
-    if json_:
-        emit_json(payload)
-        return
+    emit(fmt, out, payload=payload, records=lambda: [flat_record({**{k: v for k, v in payload.items() if k not in ("sensor", "material_ranges")},
+                                        **(payload["material_ranges"] or {}), "sensor": payload["sensor"]["name"]})],
+         text=lambda: _print_validity(payload, nominal, worst, name, back, sen, L, plot))
+
+
+def _print_validity(payload: dict, nominal, worst, name, back, sen, L: float, plot) -> None:
+    """validity's text for people: the headline is the answer --json gives (the worst case over the ranges)."""
+    tolerance, delta_t, horizon = payload["tolerance_c"], payload["delta_t_c"], payload["horizon_s"]
+    dev_c = list(payload["deviation_c"].values())
     con = console()
     what = name if name else f"object (e {nominal.e_object:.4g}, alpha {nominal.alpha_object_m2_s:.3g} m²/s)"
     con.print(f"[bold]{L * 1e3:g} mm {what}[/] on {back.name}")

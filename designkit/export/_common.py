@@ -264,26 +264,6 @@ def regenerate_command(exp: "Exported", fmt: str, prefix: str | None) -> str:
     return " ".join(cmd) + " --out FILE"
 
 
-#: What an export's lookup functions answer against the CLI (the C header's opening comment and the Python
-#: module's docstring carry these lines): the table's grid interpolation, checked in tests/test_export.py against
-#: :func:`designkit.query.table.grid_answer`; the relation to the CLI's refined estimate measured in
-#: tests/test_table_agreement.py (3 x 150 random inputs on svm-paper: min-contact 420 answers, delta-e 723
-#: directions, distinguishable 319 contacts within a factor 1.5 of the pair's min-contact; 150 on svm-fine:
-#: min-contact 139 answers, 1 of them 0.25 % below, delta-e 199 directions, 24 below by at most 0.74 %).
-CLI_RELATION = (
-    "These are the table's answers on its grid (designkit.query.table.grid_answer; the",
-    "tests compare them on random inputs), not the estimates designkit min-contact /",
-    "delta-e / distinguishable print from an SVM table whose ideal observer has a closed",
-    "form: between grid points those apply the SVM's tabulated efficiency to the exact",
-    "ideal observer, which this lookup cannot run. Measured on the shipped svm-paper",
-    "table (random inputs): min_contact_s at or above the CLI's estimate (median +19 %,",
-    "at most +85 %: touching that long errs long); distinguishable yes only where the",
-    "CLI says yes; delta_e a median 10 % above the CLI's, at most 1.5 % below it. On",
-    "svm-fine (contact every 0.1 s) the grid lies closer: min_contact_s a median +6 %,",
-    "at most 0.3 % below; delta_e a median +2 %, at most 0.8 % below.",
-)
-
-
 def slice_lines(exp: "Exported") -> list[str]:
     """Human description of the slice taken, one line per axis."""
     s = exp.provenance["slice"]

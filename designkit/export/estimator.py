@@ -62,11 +62,6 @@ def _finite(x):
     return not (x != x) and x not in (math.inf, -math.inf)
 
 
-def _cr(p0, p1, p2, p3, t):
-    """Catmull-Rom cubic through p1 (t = 0) and p2 (t = 1)."""
-    return p1 + 0.5 * t * (p2 - p0 + t * (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3 + t * (3.0 * (p1 - p2) + p3 - p0)))
-
-
 class Estimator:
     """The library's answers from one table's arrays (see the module docstring).
 
@@ -103,6 +98,15 @@ class Estimator:
         # per sample n: log(n / fs) and log |g| (n = 0: no signal)
         self._log_t = [-math.inf] + [math.log(n / self.fs) for n in range(1, len(self.cum))]
         self._log_norm = [0.5 * math.log(c) if c > 0 else -math.inf for c in self.cum]
+        # the critical-noise grid's constants as attributes (read on every critical noise)
+        self._es, self._e_hi = float(p["e_s"]), float(p["e_hi"])
+        nu, nv, f = int(p["s_nu"]), int(p["s_nv"]), p["s_f"]
+        self._grid = (float(p["s_a0"]), float(p["s_dmin"]), float(p["s_u0"]), float(p["s_du"]), nu,
+                      float(p["s_v0"]), float(p["s_dv"]), nv)
+        # each grid cell's 4 x 4 neighbourhood of nodes in one tuple ([i - 1][j - 1]: nodes i-1..i+2, j-1..j+2)
+        rows = [list(f[i * nv:(i + 1) * nv]) for i in range(nu)]
+        self._cells = [[tuple(rows[i - 1][j - 1:j + 3] + rows[i][j - 1:j + 3] + rows[i + 1][j - 1:j + 3]
+                              + rows[i + 2][j - 1:j + 3]) for j in range(1, nv - 2)] for i in range(1, nu - 2)]
 
     # ---------------------------------------------------------------- the ideal observer
     def shape_norm(self, t):
@@ -111,62 +115,117 @@ class Estimator:
         n = min(max(n, 0), len(self.cum) - 1)
         return math.sqrt(self.cum[n])
 
-    def weight(self, e):
-        """``w(e) = e / (e_s + e)``, the object's weight in the response (0 for e <= 0)."""
-        return 1.0 / (1.0 + self.p["e_s"] / e) if e > 0 else 0.0
-
     def sstar(self, a, b):
         """The ideal observer's critical projection noise of classes [a, a+w), [b, b+w) (0: not separable)."""
-        p = self.p
-        d = b - a
-        if not (d >= p["s_dmin"]) or a < 0:
+        g = self._log_shape(a, b)
+        if g is None:
             return 0.0
-        u = (math.log(a + p["s_a0"]) - p["s_u0"]) / p["s_du"]
-        v = (math.log(d) - p["s_v0"]) / p["s_dv"]
-        nv, f = p["s_nv"], p["s_f"]
-        i = min(max(int(u), 1), p["s_nu"] - 3)
-        j = min(max(int(v), 1), nv - 3)
-        # Catmull-Rom in both directions: its four basis weights at the fractions (the nested form of _cr)
-        t = u - i
-        t2, t3 = t * t, t * t * t
-        wu = (0.5 * (-t + 2.0 * t2 - t3), 0.5 * (2.0 - 5.0 * t2 + 3.0 * t3), 0.5 * (t + 4.0 * t2 - 3.0 * t3),
-              0.5 * (t3 - t2))
-        t = v - j
-        t2, t3 = t * t, t * t * t
-        w0, w1, w2, w3 = (0.5 * (-t + 2.0 * t2 - t3), 0.5 * (2.0 - 5.0 * t2 + 3.0 * t3),
-                          0.5 * (t + 4.0 * t2 - 3.0 * t3), 0.5 * (t3 - t2))
-        g = 0.0
-        base = (i - 1) * nv + j - 1
-        for wi in wu:
-            g += wi * (w0 * f[base] + w1 * f[base + 1] + w2 * f[base + 2] + w3 * f[base + 3])
-            base += nv
-        e_s = p["e_s"]
+        e_s = self._es
         return math.exp(g) * (1.0 / (1.0 + e_s / b) - (1.0 / (1.0 + e_s / a) if a > 0 else 0.0))
 
-    def ideal_delta(self, e, t, ratio, direction):
+    def _log_shape(self, a, b):
+        """``log(s*(a, b) / (w(b) - w(a)))`` read bicubically (Catmull-Rom) off the grid; None: not separable."""
+        a0, dmin, u0, du, nu, v0, dv, nv = self._grid
+        d = b - a
+        if not (d >= dmin) or a < 0:
+            return None
+        u = (math.log(a + a0) - u0) / du
+        v = (math.log(d) - v0) / dv
+        i = int(u)
+        i = 1 if i < 1 else (nu - 3 if i > nu - 3 else i)
+        j = int(v)
+        j = 1 if j < 1 else (nv - 3 if j > nv - 3 else j)
+        p0, p1, p2, p3, q0, q1, q2, q3, r0, r1, r2, r3, s0, s1, s2, s3 = self._cells[i - 1][j - 1]
+        # Catmull-Rom in both directions: its four basis weights at the fractions
+        t = v - j
+        t2 = t * t
+        t3 = t2 * t
+        w0, w1, w2, w3 = (0.5 * (-t + 2.0 * t2 - t3), 0.5 * (2.0 - 5.0 * t2 + 3.0 * t3),
+                          0.5 * (t + 4.0 * t2 - 3.0 * t3), 0.5 * (t3 - t2))
+        t = u - i
+        t2 = t * t
+        t3 = t2 * t
+        return (0.5 * (-t + 2.0 * t2 - t3) * (w0 * p0 + w1 * p1 + w2 * p2 + w3 * p3)
+                + 0.5 * (2.0 - 5.0 * t2 + 3.0 * t3) * (w0 * q0 + w1 * q1 + w2 * q2 + w3 * q3)
+                + 0.5 * (t + 4.0 * t2 - 3.0 * t3) * (w0 * r0 + w1 * r1 + w2 * r2 + w3 * r3)
+                + 0.5 * (t3 - t2) * (w0 * s0 + w1 * s1 + w2 * s2 + w3 * s3))
+
+    def ideal_delta(self, e, t, ratio, direction, guess=None):
         """Ideal observer's delta(e) [J s^-1/2 K^-1 m^-2] towards ``direction`` (+1 / -1) at contact ``t`` [s]
-        (designkit.query.ideal_bound.exact_ideal_delta: bisection on the distance to 0.5); NaN: none."""
+        (designkit.query.ideal_bound.exact_ideal_delta: bisection on the distance to 0.5); NaN: none.
+
+        ``guess`` (a distance near the answer, optional) only makes it faster: see :meth:`_delta_root`."""
         norm = self.shape_norm(t)
-        s = ratio / norm if norm > 0 else math.inf
+        return self._delta_root(e, ratio / norm if norm > 0 else math.inf, direction, guess)[0]
+
+    def _delta_root(self, e, s, direction, guess=None, slope=math.nan):
+        """``(delta, slope)``: the library's bisection on the distance ``d`` to 0.5 for ``s <= s*(e, e +- d)``,
+        at projection noise ``s``; ``slope`` is d log s* / d log d near the answer (NaN: unknown).
+
+        The bisection's last step is a cell ``((k - 1) h, k h]`` of the grid ``h = limit / 2^n`` (n the
+        bisection's steps) that holds the crossing; where s* grows with ``d`` (the ideal observer's does), the
+        answer is that cell's upper end. The cell is found by probing grid nodes: each probe's end nearest the
+        estimate of a secant in ``(log d, log s*)`` that starts at ``guess`` (a distance near the answer;
+        ``slope`` where known), until a node that separates lies next to one that does not: 2 to 4 probes
+        instead of the bisection's 17, and the same answer (the bisection's steps are then replayed on the two
+        nodes, so that it is the same float: its nodes may lie an ulp from ``k h``)."""
         w = self.w
-        limit = (self.p["e_hi"] - e - w) if direction > 0 else (e - w)
-        if not limit >= w:
-            return math.nan
-
-        def ok(d):
+        limit = (self._e_hi - e - w) if direction > 0 else (e - w)
+        if not (limit >= w and s < math.inf):  # s infinite (no signal yet): nothing separates
+            return math.nan, math.nan
+        es, log_shape, log, exp, inf = self._es, self._log_shape, math.log, math.exp, math.inf
+        ls = log(s) if s > 0.0 else None
+        m, n = math.frexp(2.0 * limit)  # the bisection's steps: limit / 2^n <= 0.5
+        n = max(n if m > 0.5 else n - 1, 0)
+        h, top = math.ldexp(limit, -n), 1 << n
+        # grid nodes: lo does not separate (closer than the grid's least distance never does), hi separates
+        # (top + 1: none yet)
+        lo, hi = (min(max(math.ceil(self._grid[1] / h) - 1, 0), top) if s > 0.0 else 0), top + 1
+        if lo * h >= self._grid[1]:
+            lo -= 1
+        r = guess if ls is not None and guess and guess < limit else 0.5 * limit
+        x0 = f0 = None
+        probes = 0
+        while hi - lo > 1:
+            k = math.ceil(r / h) if r < limit else top
+            k = lo + 1 if k <= lo else (hi - 1 if k >= hi else k)  # r's cell: ((k - 1) h, k h]
+            if probes >= 7 and hi - lo > 2:  # the secant stalls: halve the bracket
+                k = (lo + min(hi, top)) // 2
+            elif k - 1 > lo and (k >= hi or r - (k - 1) * h < k * h - r):
+                k -= 1  # its end nearer the estimate
+            d = k * h
             q = e + direction * d
-            return s <= self.sstar(min(e, q), max(e, q))
-
-        if not ok(limit):
-            return math.nan
-        a, b = 0.0, limit
+            a, b = (e, q) if q > e else (q, e)
+            g = log_shape(a, b)
+            probes += 1
+            if g is None:
+                ok, f = s <= 0.0, -inf
+            else:
+                dw = 1.0 / (1.0 + es / b) - (1.0 / (1.0 + es / a) if a > 0 else 0.0)
+                ok, f = s <= exp(g) * dw, (g + log(dw) - ls if ls is not None and dw > 0.0 else math.nan)
+            if ok:
+                hi = k
+            else:
+                lo = k
+            if not -inf < f < inf:
+                r = 0.5 * (lo + min(hi, top)) * h
+                continue
+            x = log(d)
+            if x0 is not None and x != x0 and f != f0 and -inf < f0 < inf:
+                slope = (f - f0) / (x - x0)
+            r = exp(x - f / (slope if -inf < slope < inf and slope > 0.0 else 1.0))
+            x0, f0 = x, f
+        if hi > top:
+            return math.nan, slope
+        lo_d, hi_d = lo * h, hi * h
+        a, b = 0.0, limit  # the bisection's steps, to return its very float
         while b - a > 0.5:
             mid = 0.5 * (a + b)
-            if ok(mid):
+            if mid >= hi_d or (mid > lo_d and hi_d - mid < mid - lo_d):
                 b = mid
             else:
                 a = mid
-        return b
+        return b, slope
 
     def k_contact(self, ratio, s_star, t_a, t_b, ka, kb):
         """First sample time [s] where k(t) ratio / |g(t)| <= s_star, log k linear in log t (floored at 0)
@@ -224,10 +283,6 @@ class Estimator:
         if a != a or b != b:
             return math.nan
         return a + w * (b - a)
-
-    def _at(self, direction, suffix, row, k, e):
-        t = self.t
-        return self._val(self.arr[(direction, suffix)], (row * t._nc + k) * t._ne, self._ew(e))
 
     def _k_readings(self, slices, ka, kb, lo, hi):
         """log k and its standard error at contacts ka (0) and kb (1) (designkit.query.table._k_readings_computed)."""
@@ -466,10 +521,12 @@ class Estimator:
         ratio = noise / abs(dt)
         ends = (cw[0][0], cw[-1][0])
         slices = [(row, wt) for row, wt in combos if wt]
+        ew = self._ew(x)
         out = {}
         for direction, side, sign in (("down", "lower", -1), ("up", "upper", 1)):
-            val = self._at_contacts(direction, "", combos, cw, x)
-            eff = self._delta_efficiency(x, contact, ratio, sign, ends, slices, direction) if self.efficiency else None
+            val = self._at_contacts(direction, "", combos, cw, ew)
+            eff = self._delta_efficiency(x, contact, ratio, sign, ends, slices, direction, ew) \
+                if self.efficiency else None
             if eff is not None and val is None:
                 d = eff[0]
                 inside = x + d <= self.p["e_hi"] if sign > 0 else x - d > self.p["e_lo"]
@@ -478,72 +535,79 @@ class Estimator:
             if eff is not None:
                 out[side] = eff
             elif val is not None:
-                out[side] = self._delta_estimate(direction, combos, cw, contact, x, val, ratio, sign)
+                out[side] = self._delta_estimate(direction, combos, cw, contact, x, val, ratio, sign, ew)
             else:
                 out[side] = (None, None, None)
         return out
 
-    def _at_contacts(self, direction, suffix, combos, cw, x):
+    def _at_contacts(self, direction, suffix, combos, cw, ew):
         total = 0.0
         for k, wk in cw:
             if wk == 0:
                 continue
-            y = self._delta_at(self.arr[(direction, suffix)], combos, k, self._ew(x))
+            y = self._delta_at(self.arr[(direction, suffix)], combos, k, ew)
             if _isnan(y):
                 return None
             total += wk * y
         return total
 
-    def _delta_efficiency(self, x, contact, ratio, sign, ends, slices, direction):
+    def _delta_efficiency(self, x, contact, ratio, sign, ends, slices, direction, ew):
         """designkit.query.table.delta_efficiency_estimate for one direction: (value, low, high) or None."""
-        p, w, h, C = self.p, self.w, self.h, self.contacts
+        p, w, h, C, inf = self.p, self.w, self.h, self.contacts, math.inf
         z = p["z_table"]
         t_a, t_b = C[ends[0]], C[ends[1]]
         u = math.log(contact / t_a) / math.log(t_b / t_a) if t_a != t_b else 0.0
         wc = (1.0 - u, u)
         wsum = sum(ws for _, ws in slices)
-        ent = {}
+        S_, L_, H_ = self.arr[(direction, "")], self.arr[(direction, "_lo")], self.arr[(direction, "_hi")]
+        nc, ne, val = self.t._nc, self.t._ne, self._val
+        ent = []  # (c, slice, (log efficiency, its Monte Carlo sd, rounding) or None), in reading order
+        ok_c = [wc[0] > 0, wc[1] > 0]
+        solved = []  # (log s, log delta, slope) of the ideal observer's answers so far: the next one's guess
         for c in (0, 1):
+            if not wc[c] > 0:
+                continue
+            k = ends[c]
+            norm = self.shape_norm(C[k])
             for s_i, (row, ws) in enumerate(slices):
-                if not (wc[c] > 0 and ws > 0):
+                if not ws > 0:
                     continue
-                S = self._at(direction, "", row, ends[c], x)
-                live = _finite(S) and S > 0
-                if not live:
-                    ent[(c, s_i)] = None
+                start = (row * nc + k) * ne
+                S = val(S_, start, ew)
+                if not 0 < S < inf:
+                    ent.append((c, s_i, None))
+                    ok_c[c] = False
                     continue
-                i_e = self.ideal_delta(x, C[ends[c]], self.ratios[row], sign)
-                if not (_finite(i_e) and i_e > 0):
-                    ent[(c, s_i)] = None
+                i_e = self._ideal_of(x, self.ratios[row] / norm if norm > 0 else inf, sign, solved, S)
+                if not 0 < i_e < inf:
+                    ent.append((c, s_i, None))
+                    ok_c[c] = False
                     continue
-                L = self._at(direction, "_lo", row, ends[c], x)
-                H = self._at(direction, "_hi", row, ends[c], x)
+                L = val(L_, start, ew)
+                H = val(H_, start, ew)
                 lower = min(max(i_e, S - w), S)
                 mid = 0.5 * (lower + S)
                 rnd = (S - lower) / _SQRT12 / mid
                 le = math.log(mid / i_e)
-                if _finite(H) and L > h:
+                if -inf < H < inf and L > h:
                     mc = math.log((H - h) / (L - h)) / (2.0 * z)
                 elif L > h:
                     mc = math.log((S - h) / (L - h)) / z
                 else:
                     mc = 0.0
-                if not _finite(mc):
-                    mc = 0.0
-                ent[(c, s_i)] = (le, mc, rnd)
-        ok_c = [wc[c] > 0 and all(ent.get((c, s_i)) is not None for s_i, (_, ws) in enumerate(slices) if ws > 0)
-                for c in (0, 1)]
-        if not any(ok_c):
+                ent.append((c, s_i, (le, mc if -inf < mc < inf else 0.0, rnd)))
+        if not (ok_c[0] or ok_c[1]):
             return None
-        ideal = self.ideal_delta(x, contact, ratio, sign)
-        if not _finite(ideal):
+        norm = self.shape_norm(contact)
+        ideal = self._ideal_of(x, ratio / norm if norm > 0 else inf, sign, solved, None)
+        if not -inf < ideal < inf:
             return None
         wcn = [wc[c] if ok_c[c] else 0.0 for c in (0, 1)]
         tot = wcn[0] + wcn[1]
         wcn = [v / tot for v in wcn]
         log_eff = var_mc = rounding = 0.0
         per_c = [0.0, 0.0]
-        for (c, s_i), v in ent.items():
+        for c, s_i, v in ent:
             if v is None:
                 continue
             ws = slices[s_i][1] / wsum
@@ -554,16 +618,24 @@ class Estimator:
             per_c[c] += ws * v[0]
         interp = u * (1.0 - u) * abs(per_c[1] - per_c[0]) / 2.0 if ok_c[0] and ok_c[1] else 0.0
         se = math.sqrt(p["mc_factor"] ** 2 * var_mc + rounding ** 2 + interp ** 2)
-        if not (_finite(log_eff) and _finite(se)):
+        if not (-inf < log_eff < inf and -inf < se < inf):
             return None
         value = max(math.exp(log_eff), 1.0) * ideal
         return value, max(value * math.exp(-p["zc"] * se), ideal), value * math.exp(p["zc"] * se)
 
-    def _delta_estimate(self, direction, combos, cw, contact, x, val, ratio, sign):
+    def _ideal_of(self, x, s, sign, solved, default):
+        """The ideal observer's delta at projection noise ``s`` (:meth:`_delta_root`), guessed from ``solved``
+        (the answers for the same effusivity and direction so far, which it extends) or ``default``."""
+        d, slope = self._delta_root(x, s, sign, *_guess(solved, s, default))
+        if 0.0 < d < math.inf and 0.0 < s < math.inf:
+            solved.append((math.log(s), math.log(d), slope))
+        return d
+
+    def _delta_estimate(self, direction, combos, cw, contact, x, val, ratio, sign, ew):
         """designkit.query.table.delta_estimate (no efficiency reading): the grid's value, its interval."""
         p, t = self.p, self.t
-        lo_end = self._at_contacts(direction, "_lo", combos, cw, x)
-        hi_end = self._at_contacts(direction, "_hi", combos, cw, x)
+        lo_end = self._at_contacts(direction, "_lo", combos, cw, ew)
+        hi_end = self._at_contacts(direction, "_hi", combos, cw, ew)
         gcw = axis_weights(self.contacts, contact, True, [math.log(c) for c in self.contacts])
         geo = 0.0
         for k, wk in gcw:
@@ -601,6 +673,29 @@ class Estimator:
         """Smallest distinguishable effusivity difference from ``e`` [J s^-1/2 K^-1 m^-2] (designkit delta-e's
         value); None: none within the grid in either direction."""
         return self.delta_e_interval(e, noise_c, delta_t_c, contact_s)[0]
+
+
+def _guess(solved, s, default):
+    """``(distance, slope)`` near the ideal observer's answer at projection noise ``s`` from its answers at other
+    noises for the same effusivity and direction (``solved``: (log s, log delta, slope)): log delta is smooth
+    in log s, read linearly between (or beyond) the two nearest; ``default`` where none is known."""
+    if not solved or not 0.0 < s < math.inf:
+        return default, math.nan
+    ls = math.log(s)
+    a, da = None, math.inf
+    for p in solved:  # the nearest (the first of equals)
+        d = abs(p[0] - ls)
+        if d < da:
+            a, da = p, d
+    b, db = None, math.inf
+    for p in solved:  # the nearest at another noise
+        d = abs(p[0] - ls)
+        if d < db and abs(p[0] - a[0]) > 1e-9:
+            b, db = p, d
+    if b is not None:
+        return math.exp(a[1] + (ls - a[0]) * (b[1] - a[1]) / (b[0] - a[0])), a[2]
+    gamma = a[2] if _finite(a[2]) and a[2] > 0.1 else 1.0
+    return math.exp(a[1] + (ls - a[0]) / gamma), a[2]
 
 
 def _log(x):

@@ -34,8 +34,7 @@ COVERAGE = 0.9
 #: The arrays an estimator export carries besides delta_up / delta_down (the ends of the Monte Carlo interval).
 MORE_ARRAYS = ("delta_up_lo", "delta_down_lo", "delta_up_hi", "delta_down_hi")
 #: The critical-noise grid: u = log(a + A0) for lower edges a in [0, 40,100], v = log(b - a) for distances in
-#: [D_MIN, 40,200]; 60 x 60 points, bicubic in the estimator (within 2e-4 of the library's, measured on 2,000
-#: random pairs).
+#: [D_MIN, 40,200]; 60 x 60 points, bicubic in the estimator (within 2e-4 of the library's: docs/decisions-log.md).
 _A0, _D_MIN, _N = 100.0, 60.0, 60
 
 
@@ -59,7 +58,7 @@ def estimator_reason(tab, kind: str, contact_sliced: bool) -> str | None:
 def _sstar_grid(e_s: float, width: float, threshold: float, e_top: float):
     """The critical-noise grid (a function of the sensor's effusivity, the class width and the threshold only:
     the scene enters through the projection noise alone). Computed once per process and key (3,600 critical
-    noises, ~10 s)."""
+    noises)."""
     from ..query.ideal_bound import critical_noise
 
     sensor = _SensorLike(e_s)
@@ -72,8 +71,7 @@ def _sstar_grid(e_s: float, width: float, threshold: float, e_top: float):
     f = np.log(star) - np.log(dw)
     # Classes that overlap too much never separate (the library's critical noise is NaN there): the bicubic
     # reading still needs a value at such nodes next to separable ones; extend each row linearly in log
-    # distance from its first two finite nodes (the 60 nodes at the grid's smallest distance, 60, for a
-    # class width of 80; measured with benchmarks/bench_export.py against the library)
+    # distance from its first two finite nodes (docs/decisions-log.md, Exports)
     for row in f:
         ok = np.flatnonzero(np.isfinite(row))
         if 2 <= ok.size < row.size and ok[0] > 0 and np.all(np.diff(ok) == 1):

@@ -318,6 +318,161 @@ def _plain_json(tab: Table, provenance: dict) -> None:
                          f"({printable(exc)})") from None
 
 
+def _units(meta: dict[str, dict], name: str) -> str:
+    return str(meta[name].get("units", ""))
+
+
+def _scene_cut(tab: Table, names: list[str], meta: dict[str, dict], values: dict[str, np.ndarray], noise_c, delta_t_c,
+               arrays: dict[str, np.ndarray], keep_rows: bool):
+    """One scene of ``arrays`` (name -> array, scene axes first): the rows combined with the query's weights, or
+    (``keep_rows``, an estimator export) the one or two rows around it kept apart, each with its own ratio.
+
+    Returns ``(arrays, scene axes, the slice's scene record)``; every scene and None when neither
+    ``noise_c`` nor ``delta_t_c`` is given."""
+    if (noise_c is None) != (delta_t_c is None):
+        raise InputError("give --noise and --delta-t together (one scene), or neither (all scenes)")
+    if noise_c is None:
+        return arrays, [Axis(n, _units(meta, n), meta[n]["scale"], tuple(values[n].tolist())) for n in names], None
+    noise = check_nonnegative("noise sigma [degC]", noise_c)
+    dt = check_finite("temperature difference [degC]", delta_t_c)
+    if dt == 0:
+        raise InputError("temperature difference is 0: an unheated sensor sees no contrast between materials")
+    point = {"noise_ratio": noise / abs(dt)} if names == ["noise_ratio"] else {"noise_c": noise, "delta_t_c": dt}
+    combos: list[tuple[tuple[int, ...], float]] = [((), 1.0)]
+    bad = []
+    for name in names:
+        vals = values[name]
+        log = meta[name]["scale"] == "log"
+        pts = axis_weights(vals, point[name], log, np.log(vals) if log and vals[0] > 0 else None)
+        if pts is None:
+            bad.append(name)
+            continue
+        combos = [(idx + (k,), w * wk) for idx, w in combos for k, wk in pts]
+    if bad:
+        ranges = ", ".join(f"{k} [{values[k].min():g}, {values[k].max():g}]" for k in bad)
+        raise InputError(f"noise {noise:g} degC, dT {dt:g} degC lies outside table {tab.name}'s grid "
+                         f"along {ranges} (no extrapolation)")
+    if keep_rows:  # noise_ratio layout: the rows themselves (the estimator reads each row's ratio)
+        rows = sorted({idx[0] for idx, w in combos if w != 0})
+        arrays = {k: a[rows] for k, a in arrays.items()}
+        ratios = values["noise_ratio"][rows]
+        axes = [Axis("noise_ratio", _units(meta, "noise_ratio"), meta["noise_ratio"]["scale"],
+                     tuple(float(r) for r in ratios))]
+    else:
+        arrays = {k: _combine(a, combos, len(names)) for k, a in arrays.items()}
+        axes = [Axis(n, _units(meta, n), meta[n]["scale"], (float(point[n]),)) for n in names]
+    info = {"noise_c": noise, "delta_t_c": dt, **point,
+            "rows": [{"index": list(idx), "weight": w} for idx, w in combos if w != 0]}
+    return arrays, axes, info
+
+
+def _combine(arr: np.ndarray, combos, n_scene: int) -> np.ndarray:
+    """The scene rows of ``arr`` summed with their weights, as one row (NaN in a weighted row stays NaN, as in
+    the query)."""
+    total = np.zeros(arr.shape[n_scene:])
+    for idx, w in combos:
+        if w == 0:
+            continue
+        total = total + w * arr[idx]
+    return total[(None,) * n_scene]
+
+
+def _contact_cut(contacts: np.ndarray, contact, arrays: dict[str, np.ndarray]):
+    """The contact columns a deployment uses: ``(arrays, kept columns, neighbours in the source, record)``."""
+    request = parse_contact(contact)
+    info = None
+    if request is not None:
+        cols = _kept_contacts(contacts, request)
+        info = {"requested": [list(r) if isinstance(r, tuple) else r for r in request], "source_columns": cols}
+    else:
+        cols = list(range(contacts.size))
+    arrays = {k: a[..., cols, :] for k, a in arrays.items()}
+    return arrays, cols, tuple(bool(cols[k + 1] == cols[k] + 1) for k in range(len(cols) - 1)), info
+
+
+def _effusivity_cut(tab: Table, centres: np.ndarray, e_min, e_max):
+    """The effusivities answered: ``(e_lo, e_hi, e_lo inclusive, first and last interval kept, record)``."""
+    try:
+        grid_lo = check_finite(f"table {tab.name}'s effusivity min", tab.header["effusivity"]["min"])
+        grid_hi = check_finite(f"table {tab.name}'s effusivity max", tab.header["effusivity"]["max"])
+    except (KeyError, TypeError):
+        raise InputError(f"table {tab.name}: its header has no effusivity min and max") from None
+    if e_min is None and e_max is None:
+        return grid_lo, grid_hi, False, 0, centres.size - 1, None
+    e_lo, e_hi, inclusive = grid_lo, grid_hi, False
+    a = check_finite("--e-min", e_min) if e_min is not None else None
+    b = check_finite("--e-max", e_max) if e_max is not None else None
+    grid = f"({grid_lo:g}, {grid_hi:g}]"
+    if a is not None:
+        if not (grid_lo <= a <= grid_hi):
+            raise InputError(f"--e-min {a:g} is outside table {tab.name}'s effusivity grid {grid}")
+        if a > grid_lo:
+            e_lo, inclusive = a, True
+    if b is not None:
+        if not (grid_lo < b <= grid_hi):
+            raise InputError(f"--e-max {b:g} is outside table {tab.name}'s effusivity grid {grid}")
+        e_hi = b
+    if not e_hi > e_lo:
+        raise InputError(f"--e-min must be below --e-max, got {e_lo:g} and {e_hi:g}")
+    i0, i1 = _kept_centres(centres, e_lo, e_hi)
+    return e_lo, e_hi, inclusive, i0, i1, {"e_min": a, "e_max": b, "source_intervals": [i0, i1]}
+
+
+def _check_deltas(tab: Table, arrays: dict[str, np.ndarray]) -> None:
+    for name in ("delta_up", "delta_down"):
+        arr = arrays[name]
+        finite = arr[~np.isnan(arr)]
+        if np.isinf(arr).any() or (finite < 0).any():
+            raise InputError(f"table {tab.name}: {name} holds negative or infinite values; not a delta table")
+
+
+def _provenance(tab: Table, kind: str, names: tuple[str, str], sensor: dict, axes, shape, answered: tuple,
+                slice_info: dict, export_hash: str, params: dict | None, why_not: str | None) -> dict:
+    """What an export records about itself (plain JSON)."""
+    from .. import __version__
+    from .estimator import ESTIMATOR, ESTIMATOR_VERSION
+
+    hdr = tab.header
+    fidelity = hdr.get("fidelity")
+    answers = ("grid rule only" if params is None else "library" if params["efficiency"] else
+               "library's value; interval low ends without its simulated ideal bound")
+    e_lo, e_hi, inclusive = answered
+    return {
+        "format": EXPORT_FORMAT,
+        "schema_version": EXPORT_SCHEMA,
+        "source_table": tab.name,
+        "source_content_hash": hdr.get("content_hash"),
+        "source_created": hdr.get("created"),
+        "source_designkit_version": hdr.get("designkit_version"),
+        "designkit_version": __version__,
+        "model": tab.model.to_dict(),
+        "fidelity": fidelity,
+        "threshold": check_finite(f"table {tab.name}'s threshold", hdr.get("threshold")),
+        "trials": hdr.get("trials"),
+        "sensor": sensor,
+        "kind": kind,
+        "kind_meaning": (KIND_MEANING[kind] if fidelity == "svm" or names[0] != "delta_up"
+                         else "delta of the ideal observer (an ideal-fidelity table holds only that)"),
+        "source_arrays": {"delta_up": names[0], "delta_down": names[1]},
+        "units": {"delta": E_UNITS, "effusivity": E_UNITS, "contact_s": "s", "noise_c": "degC",
+                  "delta_t_c": "degC", "noise_ratio": "1 (sigma / dT)"},
+        "axes": [{"name": a.name, "units": a.units, "scale": a.scale, "points": len(a.values),
+                  "min": min(a.values), "max": max(a.values)} for a in axes],
+        "effusivity_answered": {"min": e_lo, "min_inclusive": inclusive, "max": e_hi, "max_inclusive": True,
+                                "units": E_UNITS},
+        "slice": slice_info,
+        "shape": list(shape),
+        "nan_means": "no distinguishable partner within the table's effusivity grid (not separable)",
+        "decision_rule": "lo < hi are distinguishable when hi - lo >= max(delta_up(lo), delta_down(hi))",
+        "interpolation": ("linear in e_ref between interval centres (a NaN neighbour gives NaN), linear in "
+                          "contact_s and delta_t_c, log-linear in noise_ratio and noise_c; no extrapolation"),
+        "export_hash": export_hash,
+        "estimator": {"name": ESTIMATOR, "version": ESTIMATOR_VERSION,
+                      "answers": answers,
+                      "coverage": 0.9 if why_not is None else None, "unavailable": why_not},
+    }
+
+
 # ============================================================ slicing
 def slice_table(table: "Table | str", *, noise_c: float | None = None, delta_t_c: float | None = None,
                 contact=None, e_min: float | None = None, e_max: float | None = None,
@@ -359,174 +514,44 @@ def slice_table(table: "Table | str", *, noise_c: float | None = None, delta_t_c
     >>> exp.provenance["model"]
     {'name': 'semi-infinite'}
     """
-    from .. import __version__
-
     tab = table if isinstance(table, Table) else load_table(table)
     check_name("table name", tab.name)
-    up_name, down_name = _array_names(tab, kind)
-    up = np.asarray(tab.arrays[up_name], dtype=np.float64)
-    down = np.asarray(tab.arrays[down_name], dtype=np.float64)
+    names = _array_names(tab, kind)
+    up = np.asarray(tab.arrays[names[0]], dtype=np.float64)
+    down = np.asarray(tab.arrays[names[1]], dtype=np.float64)
     if up.shape != down.shape:
-        raise InputError(f"table {tab.name}: {up_name} and {down_name} differ in shape")
+        raise InputError(f"table {tab.name}: {names[0]} and {names[1]} differ in shape")
     scene_names, ax_meta, ax_values = _axes_of(tab, up.shape)
     sensor = _sensor_of(tab)
-    model = tab.model.to_dict()
-    hdr = tab.header
-    slice_info: dict[str, Any] = {"scene": None, "contact_s": None, "effusivity": None}
 
-    def units(name: str) -> str:
-        return str(ax_meta[name].get("units", ""))
-
-    from .estimator import ESTIMATOR, ESTIMATOR_VERSION
     from .estimator_data import MORE_ARRAYS, estimator_params, estimator_reason
 
     why_not = estimator_reason(tab, kind, contact is not None)
-    more = {n: np.asarray(tab.arrays[n], dtype=np.float64) for n in MORE_ARRAYS} if why_not is None else {}
-
-    # ---- scene: one combined row (an estimator export: the one or two rows around it, kept apart)
-    if (noise_c is None) != (delta_t_c is None):
-        raise InputError("give --noise and --delta-t together (one scene), or neither (all scenes)")
-    if noise_c is not None:
-        noise = check_nonnegative("noise sigma [degC]", noise_c)
-        dt = check_finite("temperature difference [degC]", delta_t_c)
-        if dt == 0:
-            raise InputError("temperature difference is 0: an unheated sensor sees no contrast between materials")
-        point = {"noise_ratio": noise / abs(dt)} if scene_names == ["noise_ratio"] else \
-            {"noise_c": noise, "delta_t_c": dt}
-        combos: list[tuple[tuple[int, ...], float]] = [((), 1.0)]
-        bad = []
-        for name in scene_names:
-            vals = ax_values[name]
-            log = ax_meta[name]["scale"] == "log"
-            pts = axis_weights(vals, point[name], log, np.log(vals) if log and vals[0] > 0 else None)
-            if pts is None:
-                bad.append(name)
-                continue
-            combos = [(idx + (k,), w * wk) for idx, w in combos for k, wk in pts]
-        if bad:
-            ranges = ", ".join(f"{k} [{ax_values[k].min():g}, {ax_values[k].max():g}]" for k in bad)
-            raise InputError(f"noise {noise:g} degC, dT {dt:g} degC lies outside table {tab.name}'s grid "
-                             f"along {ranges} (no extrapolation)")
-
-        def combine(arr: np.ndarray) -> np.ndarray:
-            total = np.zeros(arr.shape[len(scene_names):])
-            for idx, w in combos:
-                if w == 0:
-                    continue
-                total = total + w * arr[idx]  # NaN in any weighted row stays NaN, as in the query
-            return total[(None,) * len(scene_names)]
-
-        if why_not is None:  # noise_ratio layout: the rows themselves (the estimator reads each row's ratio)
-            rows = sorted({idx[0] for idx, w in combos if w != 0})
-            up, down = up[rows], down[rows]
-            more = {n: a[rows] for n, a in more.items()}
-            ratios = ax_values["noise_ratio"][rows]
-            scene_axes = [Axis("noise_ratio", units("noise_ratio"), ax_meta["noise_ratio"]["scale"],
-                               tuple(float(r) for r in ratios))]
-        else:
-            up, down = combine(up), combine(down)
-            scene_axes = [Axis(n, units(n), ax_meta[n]["scale"], (float(point[n]),)) for n in scene_names]
-        slice_info["scene"] = {"noise_c": noise, "delta_t_c": dt, **point,
-                               "rows": [{"index": list(idx), "weight": w} for idx, w in combos if w != 0]}
-    else:
-        scene_axes = [Axis(n, units(n), ax_meta[n]["scale"], tuple(ax_values[n].tolist())) for n in scene_names]
-
-    # ---- contact columns
+    arrays = {"delta_up": up, "delta_down": down,
+              **({n: np.asarray(tab.arrays[n], dtype=np.float64) for n in MORE_ARRAYS} if why_not is None else {})}
+    arrays, scene_axes, scene_info = _scene_cut(tab, scene_names, ax_meta, ax_values, noise_c, delta_t_c, arrays,
+                                                why_not is None)
     contacts = ax_values["contact_s"]
-    request = parse_contact(contact)
-    if request is not None:
-        cols = _kept_contacts(contacts, request)
-        slice_info["contact_s"] = {"requested": [list(r) if isinstance(r, tuple) else r for r in request],
-                                   "source_columns": cols}
-    else:
-        cols = list(range(contacts.size))
-    up, down = up[..., cols, :], down[..., cols, :]
-    more = {n: a[..., cols, :] for n, a in more.items()}
-    adjacent = tuple(bool(cols[k + 1] == cols[k] + 1) for k in range(len(cols) - 1))
-
-    # ---- effusivity
+    arrays, cols, adjacent, contact_info = _contact_cut(contacts, contact, arrays)
     centres = ax_values["e_ref"]
-    try:
-        grid_lo = check_finite(f"table {tab.name}'s effusivity min", hdr["effusivity"]["min"])
-        grid_hi = check_finite(f"table {tab.name}'s effusivity max", hdr["effusivity"]["max"])
-    except (KeyError, TypeError):
-        raise InputError(f"table {tab.name}: its header has no effusivity min and max") from None
-    e_lo, e_hi, inclusive = grid_lo, grid_hi, False
-    if e_min is not None or e_max is not None:
-        a = check_finite("--e-min", e_min) if e_min is not None else None
-        b = check_finite("--e-max", e_max) if e_max is not None else None
-        grid = f"({grid_lo:g}, {grid_hi:g}]"
-        if a is not None:
-            if not (grid_lo <= a <= grid_hi):
-                raise InputError(f"--e-min {a:g} is outside table {tab.name}'s effusivity grid {grid}")
-            if a > grid_lo:
-                e_lo, inclusive = a, True
-        if b is not None:
-            if not (grid_lo < b <= grid_hi):
-                raise InputError(f"--e-max {b:g} is outside table {tab.name}'s effusivity grid {grid}")
-            e_hi = b
-        if not e_hi > e_lo:
-            raise InputError(f"--e-min must be below --e-max, got {e_lo:g} and {e_hi:g}")
-        i0, i1 = _kept_centres(centres, e_lo, e_hi)
-        slice_info["effusivity"] = {"e_min": a, "e_max": b, "source_intervals": [i0, i1]}
-    else:
-        i0, i1 = 0, centres.size - 1
-    up, down = up[..., i0:i1 + 1], down[..., i0:i1 + 1]
-    up, down = np.ascontiguousarray(up), np.ascontiguousarray(down)
-    more = {n: np.ascontiguousarray(a[..., i0:i1 + 1]) for n, a in more.items()}
-
-    for name, arr in (("delta_up", up), ("delta_down", down)):
-        finite = arr[~np.isnan(arr)]
-        if np.isinf(arr).any() or (finite < 0).any():
-            raise InputError(f"table {tab.name}: {name} holds negative or infinite values; not a delta table")
+    e_lo, e_hi, inclusive, i0, i1, e_info = _effusivity_cut(tab, centres, e_min, e_max)
+    arrays = {k: np.ascontiguousarray(a[..., i0:i1 + 1]) for k, a in arrays.items()}
+    _check_deltas(tab, arrays)
 
     axes = tuple(scene_axes) + (
-        Axis("contact_s", units("contact_s"), "linear", tuple(float(contacts[k]) for k in cols)),
+        Axis("contact_s", _units(ax_meta, "contact_s"), "linear", tuple(float(contacts[k]) for k in cols)),
         Axis("e_ref", E_UNITS, "linear", tuple(float(c) for c in centres[i0:i1 + 1])),
     )
-    export_hash = content_hash({"delta_up": up, "delta_down": down, **more,
-                                **{f"axis_{a.name}": np.asarray(a.values) for a in axes}})
-    fidelity = hdr.get("fidelity")
+    export_hash = content_hash({**arrays, **{f"axis_{a.name}": np.asarray(a.values) for a in axes}})
     params = estimator_params(tab) if why_not is None else None
-    answers = ("grid rule only" if params is None else "library" if params["efficiency"] else
-               "library's value; interval low ends without its simulated ideal bound")
-    provenance = {
-        "format": EXPORT_FORMAT,
-        "schema_version": EXPORT_SCHEMA,
-        "source_table": tab.name,
-        "source_content_hash": hdr.get("content_hash"),
-        "source_created": hdr.get("created"),
-        "source_designkit_version": hdr.get("designkit_version"),
-        "designkit_version": __version__,
-        "model": model,
-        "fidelity": fidelity,
-        "threshold": check_finite(f"table {tab.name}'s threshold", hdr.get("threshold")),
-        "trials": hdr.get("trials"),
-        "sensor": sensor,
-        "kind": kind,
-        "kind_meaning": (KIND_MEANING[kind] if fidelity == "svm" or up_name != "delta_up"
-                         else "delta of the ideal observer (an ideal-fidelity table holds only that)"),
-        "source_arrays": {"delta_up": up_name, "delta_down": down_name},
-        "units": {"delta": E_UNITS, "effusivity": E_UNITS, "contact_s": "s", "noise_c": "degC",
-                  "delta_t_c": "degC", "noise_ratio": "1 (sigma / dT)"},
-        "axes": [{"name": a.name, "units": a.units, "scale": a.scale, "points": len(a.values),
-                  "min": min(a.values), "max": max(a.values)} for a in axes],
-        "effusivity_answered": {"min": e_lo, "min_inclusive": inclusive, "max": e_hi, "max_inclusive": True,
-                                "units": E_UNITS},
-        "slice": slice_info,
-        "shape": list(up.shape),
-        "nan_means": "no distinguishable partner within the table's effusivity grid (not separable)",
-        "decision_rule": "lo < hi are distinguishable when hi - lo >= max(delta_up(lo), delta_down(hi))",
-        "interpolation": ("linear in e_ref between interval centres (a NaN neighbour gives NaN), linear in "
-                          "contact_s and delta_t_c, log-linear in noise_ratio and noise_c; no extrapolation"),
-        "export_hash": export_hash,
-        "estimator": {"name": ESTIMATOR, "version": ESTIMATOR_VERSION,
-                      "answers": answers,
-                      "coverage": 0.9 if why_not is None else None, "unavailable": why_not},
-    }
+    slice_info = {"scene": scene_info, "contact_s": contact_info, "effusivity": e_info}
+    provenance = _provenance(tab, kind, names, sensor, axes, arrays["delta_up"].shape, (e_lo, e_hi, inclusive),
+                             slice_info, export_hash, params, why_not)
     _plain_json(tab, provenance)
     # a table another with its name could shadow (a user's svm-paper) is named by its path in "Regenerate:" lines
+    hdr = tab.header
     ref = tab.name if SHIPPED_TABLES.get(tab.name, (None,))[0] == hdr.get("content_hash") else str(tab.path)
-    return Exported(axes=axes, delta_up=up, delta_down=down, contact_adjacent=adjacent, e_lo=float(e_lo),
-                    e_hi=float(e_hi), e_lo_inclusive=inclusive, provenance=provenance, source_ref=ref, more=more,
-                    estimator=params)
+    more = {n: a for n, a in arrays.items() if n not in ("delta_up", "delta_down")}
+    return Exported(axes=axes, delta_up=arrays["delta_up"], delta_down=arrays["delta_down"],
+                    contact_adjacent=adjacent, e_lo=float(e_lo), e_hi=float(e_hi), e_lo_inclusive=inclusive,
+                    provenance=provenance, source_ref=ref, more=more, estimator=params)

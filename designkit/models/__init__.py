@@ -172,7 +172,8 @@ def sensor_model(sensor) -> ForwardModel:
             raise InputError(f"contact_area needs {', '.join(missing)}")
         return ForceRamp.from_force_profile(
             base, area["time_s"], area["force_share"], float(area["force_fraction"]),
-            source=f"the median force ramp of {area.get('n_touches', 'the')} calibration touches")
+            source=f"the median force ramp of {area.get('n_touches', 'the')} calibration touches",
+            touch_force_rel=area.get("touch_force_share") or ())
     except InputError as exc:
         raise InputError(f"sensor {sensor.name!r}: its recorded model: {exc}") from None
 
@@ -216,10 +217,12 @@ def sensor_model_notes(sensor, model: "ForwardModel | None" = None) -> list[str]
                    f"{sensor.name}" + (f" (calibrated as {cand})" if cand and cand != name else ""))
     if ramp:
         n = (record.get("contact_area") or {}).get("n_touches", "?")
-        out.append(f"contact area: the median force ramp of the {n} calibration touches (a question has no force "
-                   f"trace), area share clip((F/F_p - c)/(1 - c), 0, 1) with c = {fm.force_fraction:.3g}; "
-                   f"the whole area is in contact {fm.ramp_duration_s:.2f} s after the first contact, from which "
-                   "the contact time counts")
+        d = [v for v, _, _ in fm.touch_ramps]
+        how = (f"each simulated touch presses as one of them (its own ramp, first contact {min(d):+.2f} to "
+               f"{max(d):+.2f} s from the median's)" if d else "a question has no force trace")
+        out.append(f"contact area: the median force ramp of the {n} calibration touches ({how}), area share "
+                   f"clip((F/F_p - c)/(1 - c), 0, 1) with c = {fm.force_fraction:.3g}; the whole area is in contact "
+                   f"{fm.ramp_duration_s:.2f} s after the first contact, from which the contact time counts")
     if record.get("drift"):
         out.append("heater drift: fitted per touch in calibration (a nuisance like the touch's initial "
                    "temperature, not a property of the sensor); not played here: a new touch has none")

@@ -201,6 +201,11 @@ def truncation_depth_m(diffusivity_m2_s: float, time_max_s: float,
     -------
     float
         D [m].
+
+    Examples
+    --------
+    >>> round(truncation_depth_m(1.19e-9, 4.0) * 1e6)  # the paper's sensor after 4 s [um]
+    315
     """
     return math.sqrt(diffusivity_m2_s * time_max_s) * float(special.erfcinv(tolerance))
 

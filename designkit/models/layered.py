@@ -203,9 +203,8 @@ def savgol_smooth(values, window: int, order: int, *, pad_before: int | None = N
         raise InputError(f"smoothing window {window} is longer than the series ({v.shape[-1]} samples)")
     # scipy.signal.savgol_filter(v, window, order, mode="interp") as two linear operators: the filter's
     # coefficients by FFT convolution inside, and at each end the projection onto the polynomial fitted to
-    # the first / last window (what savgol_filter's polyfit does per row). Same values to 1e-14 relative;
-    # 3x faster on the calibration's (120, 1601) arrays (correlate1d and one polyfit per row and end took
-    # a third of a model-selection fit: docs/sensor-models.md, "Fit time").
+    # the first / last window (what savgol_filter's polyfit does per row). Same values to 1e-14 relative
+    # (why: docs/decisions-log.md).
     coeffs, head, tail = _savgol_operators(int(window), int(order))
     half = window // 2
     out = np.empty(v.shape)

@@ -88,6 +88,11 @@ class ForceRamp(ForwardModel):
         ramp already contains it).
     source : str
         Where the ramp came from (for people).
+    touch_ramps : tuple of (float, tuple, tuple)
+        The calibration touches' own ramps, ``(delay_s, ramp_time_s, ramp_area)`` each, the delay of
+        its first contact after the nominal ramp's (negative: before it). A simulated touch presses as
+        one of them, drawn at random (:func:`designkit.simulation.simulate_class`): real presses vary in
+        pace and in where the recorder's onset fires. Empty: every touch follows the nominal ramp.
 
     Examples
     --------
@@ -106,11 +111,13 @@ class ForceRamp(ForwardModel):
     ramp_area: tuple[float, ...] = (1.0,)
     force_fraction: float = 0.0
     source: str = ""
+    touch_ramps: tuple = ()
 
     name = "force-ramp"
     shared_shape = False
     shared_response = True
-    units = {"ramp_time_s": "s", "ramp_area": "share of the final contact area", "force_fraction": "of F_p"}
+    units = {"ramp_time_s": "s", "ramp_area": "share of the final contact area", "force_fraction": "of F_p",
+             "touch_ramps": "delay s, times s, area shares"}
 
     def __post_init__(self) -> None:
         base = self.base
@@ -140,9 +147,27 @@ class ForceRamp(ForwardModel):
         object.__setattr__(self, "force_fraction", float(self.force_fraction))
         object.__setattr__(self, "source", str(self.source))
         object.__setattr__(self, "object_properties", base.object_properties)
+        touches = []
+        for item in self.touch_ramps:
+            delay, times, areas = (item["delay_s"], item["ramp_time_s"], item["ramp_area"]) \
+                if isinstance(item, Mapping) else item
+            one = ForceRamp(base, tuple(times), tuple(areas), self.force_fraction)   # validates the ramp
+            touches.append((float(delay), one.ramp_time_s, one.ramp_area))
+        object.__setattr__(self, "touch_ramps", tuple(touches))
+
+    def touch(self, j: int) -> tuple["ForceRamp", float]:
+        """Touch ``j``'s own ramp (a ramp without touch ramps) and its first contact's delay [s] after the
+        nominal one's: its reading at model time ``t`` is ``ramp.response(t - delay)``."""
+        delay, times, areas = self.touch_ramps[int(j)]
+        return ForceRamp(self.base, times, areas, self.force_fraction, self.source), delay
+
+    def nominal(self) -> "ForceRamp":
+        """This ramp without the touch ramps (every touch pressing as the nominal one)."""
+        return dataclasses.replace(self, touch_ramps=()) if self.touch_ramps else self
 
     @classmethod
-    def from_force_profile(cls, base, time_s, force_rel, fraction: float, *, source: str = "") -> "ForceRamp":
+    def from_force_profile(cls, base, time_s, force_rel, fraction: float, *, source: str = "",
+                           touch_force_rel=()) -> "ForceRamp":
         """The ramp of a nominal force profile ``F / F_p`` at ``time_s`` after the detected onset.
 
         The area ``A = clip((F/F_p - c) / (1 - c), 0, 1)`` (made non-decreasing:
@@ -151,15 +176,27 @@ class ForceRamp(ForwardModel):
         result is the first share's contact (a calibrated time offset of the
         heat flow relative to the detected onset moves every share alike, so it
         does not enter). After the profile's last time the whole area is in
-        contact.
+        contact. ``touch_force_rel``: each calibration touch's own ``F / F_p`` on ``time_s`` (rows), kept as
+        :attr:`touch_ramps` with the delay of its first contact after the nominal one's.
 
         Examples
         --------
         >>> from designkit.models.semi_infinite import SemiInfinite
-        >>> r = ForceRamp.from_force_profile(SemiInfinite(), [0.0, 0.1, 0.2, 0.3], [0.1, 0.5, 0.9, 1.0], 0.3)
-        >>> r.ramp_time_s, [round(a, 3) for a in r.ramp_area]
-        ((0.0, 0.1, 0.2), [0.286, 0.857, 1.0])
+        >>> r = ForceRamp.from_force_profile(SemiInfinite(), [0.0, 0.1, 0.2, 0.3], [0.1, 0.5, 0.9, 1.0], 0.3,
+        ...                                  touch_force_rel=[[0.5, 1.0, 1.0, 1.0]])
+        >>> r.ramp_time_s, [round(a, 3) for a in r.ramp_area], r.touch_ramps[0][0]
+        ((0.0, 0.1, 0.2), [0.286, 0.857, 1.0], -0.1)
         """
+        nominal = cls._profile_ramp(time_s, force_rel, fraction)
+        touches = []
+        for row in touch_force_rel:
+            first, times, shares = cls._profile_ramp(time_s, row, fraction)
+            touches.append((round(first - nominal[0], 9), times, shares))
+        return cls(base, nominal[1], nominal[2], float(fraction), source, tuple(touches))
+
+    @staticmethod
+    def _profile_ramp(time_s, force_rel, fraction: float) -> tuple[float, tuple, tuple]:
+        """(time of the first contact, ramp times from it, area shares) of one force profile."""
         t = np.asarray(time_s, dtype=np.float64).ravel()
         area = np.maximum.accumulate(area_share(force_rel, fraction))
         if t.size != area.size or t.size == 0:
@@ -177,7 +214,7 @@ class ForceRamp(ForwardModel):
             step = float(t[1] - t[0]) if t.size > 1 else 0.0
             times = np.append(times, times[-1] + step)
             shares = np.append(shares, 1.0)
-        return cls(base, tuple(times), tuple(shares), float(fraction), source)
+        return float(t[first]), tuple(float(v) for v in times), tuple(float(v) for v in shares)
 
     # ------------------------------------------------------------ the physics
     def _step_model(self):
@@ -276,11 +313,17 @@ class ForceRamp(ForwardModel):
         return float(self.ramp_time_s[-1])
 
     def parameters(self) -> dict[str, Any]:
-        return {"base": self.base.to_dict(), "ramp_time_s": list(self.ramp_time_s),
-                "ramp_area": list(self.ramp_area), "force_fraction": self.force_fraction, "source": self.source}
+        out = {"base": self.base.to_dict(), "ramp_time_s": list(self.ramp_time_s),
+               "ramp_area": list(self.ramp_area), "force_fraction": self.force_fraction, "source": self.source}
+        if self.touch_ramps:
+            out["touch_ramps"] = [{"delay_s": d, "ramp_time_s": list(t), "ramp_area": list(a)}
+                                  for d, t, a in self.touch_ramps]
+        return out
 
     def describe(self) -> str:
         """The base model, and the ramp in one phrase."""
         how = f", {self.source}" if self.source else ""
+        touches = f"; each touch pressing as one of {len(self.touch_ramps)} calibration touches" \
+            if self.touch_ramps else ""
         return (f"{self.base.describe()} with a contact area growing over {self.ramp_duration_s:.2f} s "
-                f"(c = {self.force_fraction:.3g}{how})")
+                f"(c = {self.force_fraction:.3g}{how}{touches})")

@@ -70,6 +70,11 @@ def object_weight(e_sensor, e_object):
     -------
     ndarray
         w, dimensionless.
+
+    Examples
+    --------
+    >>> object_weight(892.0, np.array([0.0, 892.0, np.inf]))
+    array([0. , 0.5, 1. ])
     """
     es = np.asarray(e_sensor, dtype=np.float64)
     eo = np.asarray(e_object, dtype=np.float64)
@@ -98,6 +103,11 @@ def contact_temperature(sensor_temp_c, object_temp_c, e_sensor, e_object):
     -------
     ndarray
         Tc [degC].
+
+    Examples
+    --------
+    >>> float(contact_temperature(35.0, 25.0, 892.0, 892.0))  # equal effusivities meet half way [degC]
+    30.0
     """
     ts = np.asarray(sensor_temp_c, dtype=np.float64)
     to = np.asarray(object_temp_c, dtype=np.float64)
@@ -138,6 +148,11 @@ def response_shape(time_s, tau_s):
         with ``tau = 0`` (thermistor at the surface), ``g = 1`` for all t >= 0.
         Underflows to 0 for ``tau / t`` above about 740; use
         :func:`log_response_shape` there.
+
+    Examples
+    --------
+    >>> response_shape(np.array([0.0, 1.3445, 100.0]), 1.3445).round(4)  # the paper's sensor, tau = 1.3445 s
+    array([0.    , 0.1573, 0.8697])
     """
     from scipy import special  # imported here: a table query never needs it (~150 ms)
 
@@ -188,6 +203,11 @@ def temperature_change(time_s, e_object, sensor_temp_c, object_temp_c, e_sensor,
     -------
     ndarray
         [K], broadcast over all inputs.
+
+    Examples
+    --------
+    >>> temperature_change(np.array([1.0]), 20000.0, 35.0, 25.0, 892.0, 1.3445).round(3)  # after 1 s [degC]
+    array([-0.967])
     """
     ts = np.asarray(sensor_temp_c, dtype=np.float64)
     to = np.asarray(object_temp_c, dtype=np.float64)

@@ -95,7 +95,7 @@ INTERVAL_MEANING = {
 
 #: The keys of every answer's dictionary (the ``--json`` schema), whatever the question and route.
 ANSWER_KEYS = frozenset({
-    "question", "route", "quantity", "unit", "value", "interval", "bound", "ideal", "objects", "limiting_pair",
+    "question", "route", "route_reason", "quantity", "unit", "value", "interval", "bound", "ideal", "objects", "limiting_pair",
     "materials_rule", "scene", "sensor", "model", "model_check", "threshold", "table", "ideal_table",
     "in_grid", "details", "computation", "notes",
 })
@@ -243,6 +243,9 @@ class Answer(QuestionQuantity):
         Nominal coverage of ``interval`` (None: not stated).
     interval_kind : str or None
         Key of :data:`INTERVAL_MEANING` for ``interval`` (None: by route).
+    route_reason : str or None
+        Why ``route`` answered (:func:`designkit.query.ask`'s policy, :mod:`designkit.query.policy`);
+        None where a route function was called directly.
     """
 
     question: str
@@ -268,6 +271,7 @@ class Answer(QuestionQuantity):
     notes: tuple[str, ...] = ()
     interval_coverage: float | None = None
     interval_kind: str | None = None
+    route_reason: str | None = None
 
     # ------------------------------------------------------------ schema
     @property
@@ -298,6 +302,7 @@ class Answer(QuestionQuantity):
         return {
             "question": self.question,
             "route": self.route,
+            "route_reason": self.route_reason,
             "quantity": self.quantity,
             "unit": self.unit,
             "value": value,

@@ -61,7 +61,7 @@ __all__ = [
 ]
 
 #: SVM solvers of the exact route: scikit-learn one seed at a time (the reference), or every seed's
-#: cross-validation at once (:mod:`designkit.recognition.batched_svm`, ~3x faster, same classifier).
+#: cross-validation at once (:mod:`designkit.recognition.batched_svm`, the same classifier).
 SOLVERS = ("sklearn", "batched")
 
 #: sigma/dT searched by max-noise and min-delta-t: 10 uK per K up to noise as large as the contrast.
@@ -201,16 +201,21 @@ class _Run:
     # ---------------------------------------------------------------- the ideal observer
     def scene(self, contact_s: float, noise_c: float, delta_t_c: float):
         """The scene of one evaluation: Ts0 = Ta + dT (Ta 25 degC), drawn per touch uniformly within
-        +-``spread`` degC of it when the question has a sensor temperature spread (varied initial conditions)."""
+        +-``spread`` degC of it when the question has a sensor temperature spread (varied initial conditions);
+        for a calibrated rig, its correlated noise and its recorder's window from the detected onset
+        (:func:`designkit.rig.rig_scene`)."""
+        from ..rig import rig_scene
         from ..scene import Scene
 
         return Scene.from_delta_t(contact_s=contact_s, noise_c=noise_c, delta_t_c=delta_t_c,
-                                  sensor_temp_spread_c=self.spread)
+                                  sensor_temp_spread_c=self.spread).replace(**rig_scene(self.sensor))
 
     def closed_form(self, *classes: ObjectClass) -> bool:
         """Whether the vectorized closed form answers (shared shape, fixed initial conditions, every class
         ``width`` wide); varied initial conditions take the Monte Carlo ideal observer."""
-        return self.spread == 0 and self.model.shared_shape and all(
+        from ..rig import rig_scene
+
+        return self.spread == 0 and self.model.shared_shape and not any(rig_scene(self.sensor).values()) and all(
             math.isclose(c.e_range[1] - c.e_range[0], self.width, rel_tol=1e-9) for c in classes)
 
     def ideal_f1(self, classes, scene) -> float:
@@ -420,7 +425,6 @@ def exact_min_contact(e1=None, e2=None, *, m1=None, m2=None, objects=None, noise
 
 # ============================================================ max-noise / min-delta-t
 def _exact_ratio(question: str, kw: dict) -> Answer:
-    from ..scene import Scene
     from .crossing import check_coverage, estimate_crossing
 
     contact = check_contact(kw["contact_s"])
@@ -442,7 +446,7 @@ def _exact_ratio(question: str, kw: dict) -> Answer:
     lo_r, hi_r = RATIO_BRACKET
     if run.spread == 0:
         def scene(r):  # readings depend on sigma and dT only through r
-            return Scene.from_delta_t(contact_s=contact, noise_c=r, delta_t_c=1.0)
+            return run.scene(contact, r, 1.0)
     elif question == "max-noise":  # varied Ts0: the ratio invariance is gone, sigma moves at the asked dT
         _check_spread(run.spread, dt)
 

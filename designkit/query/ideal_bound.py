@@ -198,7 +198,7 @@ def _ideal_delta(sensor, e, contact, ratio, direction, width, threshold, e_max, 
 
 # ============================================================ per-process cache of the closed-form bounds
 #: Closed-form bounds kept per process (least recently used out): a table question asked again (a loop,
-#: a matrix over scenes) costs a dict look-up instead of ~30 ms of quadrature. Entries are pure
+#: a matrix over scenes) costs a dict look-up instead of a quadrature. Entries are pure
 #: functions of their key (sensor, class width, threshold, the pair and the scene), so a hit returns
 #: exactly what a computation would (each element's bisection is independent of the others).
 BOUND_CACHE_SIZE = 262144  # a 10,000-query array call reads ~120,000 critical noises: they must fit

@@ -449,7 +449,7 @@ def _multiclass(mats, tab, *, noise_c: float, delta_t_c: float, svm_trials: int 
 def _prefill_bounds(question: str, mats, tab, itab, given: dict) -> None:
     """The closed-form ideal bounds (and min-contact's efficiency estimates) of all pairs in one vectorized
     call, kept in the cache of :mod:`designkit.query.ideal_bound` where the per-pair table questions find
-    them: one bisection per pair (numpy's per-call overhead, ~16 ms each) was most of a 12-material matrix.
+    them (one solve per pair was most of a 12-material matrix: docs/decisions-log.md).
     Anything odd is left to the per-pair questions, which say what is wrong."""
     if question not in ("min-contact", "max-noise", "min-delta-t"):
         return

@@ -26,6 +26,8 @@ Examples
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 from dataclasses import dataclass
 from typing import Any, Callable, overload
 
@@ -35,12 +37,12 @@ from .._validation import InputError
 from . import exact as _exact_route
 from . import table as _table_route
 from .answer import Answer, QuestionQuantity
+from .policy import MC_BOUND, choose_route, sensor_table_answer
 from .vectorized import ArrayAnswer, answer_arrays, is_array_call
 
-__all__ = ["QUESTIONS", "ROUTES", "Question", "ask", "delta_e", "distinguishable", "max_noise", "min_contact",
+__all__ = ["QUESTIONS", "Question", "ask", "delta_e", "distinguishable", "max_noise", "min_contact",
            "min_delta_t"]
 
-ROUTES = ("table", "exact")
 
 
 @dataclass(frozen=True)
@@ -71,9 +73,9 @@ class Question(QuestionQuantity):
         return self.name
 
     def route(self, name: str) -> Callable[..., Answer]:
-        """The function answering this question by route ``name``."""
-        if name not in ROUTES:
-            raise InputError(f"unknown route {name!r}; known: {', '.join(ROUTES)}")
+        """The function answering this question by route ``name`` (``"table"`` or ``"exact"``)."""
+        if name not in ("table", "exact"):
+            raise InputError(f"unknown route {name!r}; known: table, exact")
         return self.table if name == "table" else self.exact
 
 
@@ -93,30 +95,43 @@ QUESTIONS: dict[str, Question] = {q.name: q for q in (
 )}
 
 
-def ask(question: str, *, route: str = "table", ideal_bound: bool = True,
+def ask(question: str, *, route: str = "auto", ideal_bound: bool = True,
         **arguments: Any) -> "Answer | ArrayAnswer":
-    """Answer ``question`` by ``route`` (``"table"`` or ``"exact"``).
+    """Answer ``question`` by ``route``: ``"auto"`` (default), ``"table"`` or ``"exact"``.
 
     ``arguments`` are the route function's (objects, scene, and the route's
     options: ``table=`` ... for the table route, ``trials=`` ... for the exact one).
-    Numeric inputs given as arrays (or lists) broadcast like numpy and give an
+    ``"auto"`` reads a table where one is built for the sensor, model and scene
+    asked (or one is named), and computes the answer otherwise; the options of the
+    route not taken are left out (:func:`designkit.query.policy.choose_route`). The
+    answer's ``route_reason`` says why its route answered.
+    Numeric inputs given as arrays (or lists), and material names given as lists,
+    broadcast like numpy and give an
     :class:`~designkit.query.vectorized.ArrayAnswer` (:mod:`designkit.query.vectorized`);
     ``ideal_bound=False`` there skips the closed-form ideal bound (the slow part of a first call).
     """
     if question not in QUESTIONS:
         raise InputError(f"unknown question {question!r}; known: {', '.join(QUESTIONS)}")
+    route, arguments, why = choose_route(question, route, arguments)
     fn = QUESTIONS[question].route(route)
+    own = route == "table" and why.sensor_table and question in MC_BOUND  # no Monte Carlo bound from it
     if is_array_call(question, arguments):
-        return answer_arrays(question, fn, route, arguments, ideal_bound=ideal_bound)
-    if not ideal_bound:
+        ans = answer_arrays(question, functools.partial(fn, ideal_bound=False) if own else fn, route, arguments,
+                            ideal_bound=ideal_bound and not own)
+    elif not ideal_bound:
         raise InputError("ideal_bound=False is for array inputs (a single answer always carries its bound)")
-    return fn(**arguments)
+    else:
+        ans = fn(**arguments, **({"ideal_bound": False} if own else {}))
+    if route == "table" and why.sensor_table:
+        ans = sensor_table_answer(question, ans, why, arguments.get("sensor"))
+    notes = (*ans.notes, why.reason) if why.noted and isinstance(ans, Answer) else None
+    return dataclasses.replace(ans, route_reason=why.reason, **({"notes": notes} if notes else {}))
 
 
 def _route(exact: bool, route: str | None) -> str:
     if route is not None and exact and route != "exact":
         raise InputError(f"exact=True contradicts route={route!r}")
-    return route or ("exact" if exact else "table")
+    return route or ("exact" if exact else "auto")
 
 
 # Each question answers one Answer for numbers and one ArrayAnswer when a numeric input is an array

@@ -16,7 +16,7 @@ reaches both ``delta_up(e1)`` (seen from the lower effusivity) and
 noise, and requiring both is the conservative choice. ``min-contact``'s estimate
 on a table with varied initial conditions averages the two instead, and
 interpolates each scene slice's answer rather than the need
-(:func:`varied_contact_estimate`: requiring both answered a median 18 % late there).
+(:func:`varied_contact_estimate`; why: docs/decisions-log.md, "Question layer").
 
 The ideal bound comes from an ideal-observer table (``ideal_table``) or the
 SVM table's own ideal arrays, interpolated the same way; ``distinguishable``
@@ -47,8 +47,9 @@ Examples
 
 from __future__ import annotations
 
+import functools
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Sequence
 
 import numpy as np
@@ -91,6 +92,7 @@ __all__ = [
     "delta_e_ideal_view",
     "GRID_KINDS",
     "grid_answer",
+    "grid_crossing",
     "delta_estimate",
     "distinguishable",
     "max_noise",
@@ -118,7 +120,7 @@ DEFAULT_IDEAL_TABLE = "ideal-paper"
 
 
 #: Tables loaded (and verified) by this process, keyed by their files' identity: a name or path is
-#: read and hashed once, not on every question (12 ms -> 0.6 ms a call). Least recently used out.
+#: read and hashed once, not on every question. Least recently used out.
 _LOADED: "LRUCache[tuple, Table]" = LRUCache(16)
 
 
@@ -302,8 +304,8 @@ class _View:
 
 
 def _median(x: np.ndarray) -> float:
-    """The median of a non-empty 1-D array. Not ``np.median``: its first call imports ``numpy.ma`` (11 ms,
-    measured), a tenth of a fresh ``designkit min-contact``'s budget above ``import numpy``.
+    """The median of a non-empty 1-D array (not ``np.median``, whose first call imports ``numpy.ma``:
+    docs/decisions-log.md).
 
     >>> _median(np.array([3.0, 1.0, 10.0, 2.0])), _median(np.array([5.0, 1.0, 4.0]))
     (2.5, 4.0)
@@ -479,17 +481,24 @@ def _pair_need_both(view: _View, kind: str, idx: tuple[int, ...], lo: np.ndarray
     return np.where(both_out, np.nan, np.sqrt(up * down))
 
 
-def _crossing_rows(grid: np.ndarray, need: np.ndarray, gap: np.ndarray) -> tuple[np.ndarray, ...]:
-    """Per column of ``need`` [contact, n]: the first contact whose need is at most ``gap``, interpolated
-    linearly from the contact before (:func:`cross2`; NaN where that is the first contact, or none suffices),
-    and the two contacts and needs it lies between: ``(crossing, x0, x1, n0, n1)``."""
+def grid_crossing(grid: np.ndarray, need: np.ndarray, gap) -> tuple[np.ndarray, ...]:
+    """Per column of ``need`` [grid point, n]: the first grid point whose need is at most ``gap``, interpolated
+    linearly from the point before (:func:`cross2`; that point itself where it is the first, or follows a NaN
+    need; NaN where none suffices): the one grid crossing of the table route, over arrays
+    (:func:`designkit.tables.lookup.crossing`'s rule). Returns ``(crossing, k, x0, x1, n0, n1)``: the index
+    of the first point that suffices (-1: none), and the two points and needs the crossing lies between.
+
+    >>> [float(v[0]) for v in grid_crossing(np.array([1.0, 2.0, 3.0]), np.array([[300.0], [150.0], [50.0]]), 100.0)]
+    [2.5, 2.0, 2.0, 3.0, 150.0, 50.0]
+    """
     with np.errstate(invalid="ignore"):
         ok = ~np.isnan(need) & (need <= gap)
     k = np.where(ok.any(axis=0), ok.argmax(axis=0), -1)
     cols, k0, k1 = np.arange(need.shape[1]), np.maximum(k - 1, 0), np.maximum(k, 0)
     x0, x1, n0, n1 = grid[k0], grid[k1], need[k0, cols], need[k1, cols]
     with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(k > 0, cross2(x0, x1, n0, n1, gap), np.nan), x0, x1, n0, n1
+        x = np.where(k > 0, cross2(x0, x1, n0, n1, gap), np.where(k == 0, grid[0], np.nan))
+    return x, k, x0, x1, n0, n1
 
 
 def varied_contact_estimate(view: _View, combos, lo, hi, ideal, *, width: float, z_table: float,
@@ -497,9 +506,7 @@ def varied_contact_estimate(view: _View, combos, lo, hi, ideal, *, width: float,
     """min-contact [s] on a table with varied initial conditions, elementwise over pairs ``lo < hi``.
 
     Each scene slice the question lies between (``combos``: the noise and dT grid points around it, with their
-    weights) answers on its own: the pair's need with both directions averaged (:func:`_pair_need_both`; the
-    grid rule's maximum of the two answered a median 18 % late on 100 random cases,
-    ``benchmarks/bench_coverage_varied.py``), its crossing estimated between the two contact times around it
+    weights) answers on its own: the pair's need with both directions averaged (:func:`_pair_need_both`), its crossing estimated between the two contact times around it
     as :func:`contact_estimate` does (the Monte Carlo ends from the table's ``delta_lo`` / ``delta_hi``). The
     answers are then interpolated across the slices, ``log t`` linear in the axes' own scale, instead of
     the needs (a need beyond the effusivity range in one slice made the interpolated need unknown, and the
@@ -525,8 +532,11 @@ def varied_contact_estimate(view: _View, combos, lo, hi, ideal, *, width: float,
     slices = [(idx, w) for idx, w in combos if w != 0]
     per_slice = []
     for idx, w in slices:
-        raw, x0, x1, n0, n1 = _crossing_rows(grid, _pair_need_both(view, "svm", idx, lo, hi), gap)
-        ends = [_crossing_rows(grid, _pair_need_both(view, kind, idx, lo, hi), gap)[0] for kind in ("lo", "hi")]
+        # (a crossing at the first contact is not interpolated: the caller's grid reading stands there)
+        raw, k, x0, x1, n0, n1 = grid_crossing(grid, _pair_need_both(view, "svm", idx, lo, hi), gap)
+        raw = np.where(k > 0, raw, np.nan)
+        ends = [np.where(kk > 0, x, np.nan) for x, kk in (
+            grid_crossing(grid, _pair_need_both(view, kind, idx, lo, hi), gap)[:2] for kind in ("lo", "hi"))]
         with np.errstate(invalid="ignore", divide="ignore"):
             r = contact_estimate(x0, x1, n0, n1, gap, raw, ends[0], ends[1], np.nan, width=width, svm=True,
                                  z_table=z_table, zc=zc)
@@ -562,7 +572,7 @@ def _interp_at(arr3d: np.ndarray, centres: np.ndarray, si: np.ndarray, j: np.nda
 
 #: The noise-efficiency readings of small calls (a single question's), kept per process (least recently used
 #: out): a question asked again reads them from here instead of re-reading 12 table entries and their critical
-#: noises (1.5 ms of numpy overhead a call). Pure functions of the key: the table's content and the arguments.
+#: noises. Pure functions of the key: the table's content and the arguments.
 _K_READINGS_PAIRS = 16
 _K_READINGS: "LRUCache[tuple, tuple]" = LRUCache(4096)
 
@@ -694,12 +704,8 @@ def _slices(combos, n):
             np.tile(np.array([w for _, w in live], dtype=np.float64), (n, 1)))
 
 
-#: The shortest span in contact time [ratio] over which min-contact reads the slope of ``log k`` in ``log t``.
-#: Each reading of ``k`` carries the table's Monte Carlo error (about 3 % on svm-fine), so two readings 0.1 s
-#: apart give a slope that is mostly noise (measured on svm-fine: 1.70 at 2.4 s, 1.80 at 2.5 s, a slope of
-#: 1.4 against the signal's 0.3-0.5, which put 33,906 vs 22,141 at 0.1 degC at 1.83 s with an interval to
-#: 666 s, where 16 seeds give 2.28 s). 1.14 is just under the closest step of svm-paper's axis (8/7), so its
-#: answers are unchanged.
+#: The shortest span in contact time [ratio] over which min-contact reads the slope of ``log k`` in ``log t``:
+#: closer readings give a slope that is mostly the table's Monte Carlo noise (docs/decisions-log.md).
 K_SLOPE_SPAN = 1.14
 
 
@@ -1411,6 +1417,12 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
     monte_carlo = {"monte_carlo_interval": list(mc_interval)}  # the table's delta_lo / delta_hi answers alone
     if "delta_up_ideal" in view.t.arrays:  # the grid's own bound, beside the exact one (its interpolation error)
         monte_carlo["table_ideal_s"] = contact_for(view, "ideal", combos)
+    efficiency = None
+    if value is not None and op.closed and op.tab.fidelity == "svm" and "delta_up_ideal" in view.t.arrays:
+        # the efficiency estimate's critical noises first, the pair's own among them, in one solve: the
+        # closed-form bound below then reads the pair's from the per-process memo (one Newton solve a new pair)
+        r = noise_k_min_contact(op, combos, [k_cross], [lo], [hi], [noise / abs(dt)], zc=z_of_coverage(coverage))
+        efficiency = {key: float(v[0]) for key, v in r.items()}
     ideal_interval = None
     if op.closed:
         ideal, ideal_method = _closed_ideal_contact(op, lo, hi, noise, dt), "closed-form"
@@ -1427,83 +1439,145 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
                                           coverage=coverage)
         ideal, ideal_method, ideal_interval = mcb.value, "monte-carlo", mcb.interval
         monte_carlo["ideal_monte_carlo"] = {"n_mc": mcb.n_mc, "evaluations": len(mcb.evaluations)}
-    varied = None
-    if op.tab.fidelity == "svm" and table_spread(op.tab) > 0 and "delta_up_lo" in view.t.arrays:
-        r = varied_contact_estimate(view, combos, lo, hi, _arr(ideal_floor(ideal, ideal_interval)), width=op.width,
-                                    z_table=table_z(op.tab), zc=z_of_coverage(coverage))
-        if not math.isnan(float(r["value"][0])):
-            varied = {key: float(v[0]) for key, v in r.items()}
-    note = "" if value is not None or varied is not None else (
-        f"no tabulated contact time up to {view.contacts[-1]:g} s separates them "
-        "(the exact route examines longer contacts)")
-    grid = [float(c) for c in view.contacts]
-    interval: tuple = (None, None)
-    kind, cov = "none", None
-    eff = None
-    if value is not None and op.tab.fidelity == "svm" and op.closed and "delta_up_ideal" in view.t.arrays:
-        r = noise_k_min_contact(op, combos, [k_cross], [lo], [hi], [noise / abs(dt)], zc=z_of_coverage(coverage))
-        if not math.isnan(float(r["value"][0])):
-            eff = {key: float(v[0]) for key, v in r.items()}
-    if varied is not None:
-        # varied initial conditions: each scene slice's estimate, both directions averaged, interpolated across
-        # the slices (varied_contact_estimate)
-        raw = value
-        value, interval = varied["value"], (_opt(varied["low"]), _opt(varied["high"]))
-        kind, cov = "table-varied-estimate", coverage
-        monte_carlo.update(interpolation_error_log=varied["interp"], rounding_error_log=varied["rounding"],
-                           table_crossing_s=raw)
-    elif eff is not None:
-        # the SVM's noise efficiency against the exact ideal observer (noise_k_min_contact): no interpolation
-        # of the steep need between grid points
-        raw = value
-        low = eff["low"] if ideal is None else min(max(eff["low"], ideal), eff["value"])
-        value, interval, kind, cov = eff["value"], (low, eff["high"]), "table-efficiency", coverage
-        monte_carlo.update(efficiency=eff["k"], efficiency_se_log=eff["se_log"], table_crossing_s=raw,
-                           noise_efficiency_at_s={f"{eff['t_a']:g}": eff["k_a"], f"{eff['t_b']:g}": eff["k_b"]})
-        if value < grid[0]:  # the efficiency at the first contact times, applied below them: said, not hidden
-            monte_carlo["below_grid"] = True
-            note = (f"{value:.3g} s lies below the table's first contact time, {grid[0]:g} s: the SVM's noise "
-                    "efficiency read there is applied to the exact ideal observer (an extrapolation in contact "
-                    "time; docs/accuracy.md measures it)")
-    elif value is not None:
-        prev_need = needs[k_cross - 1] if k_cross > 0 else math.nan
-        if k_cross > 0 and not math.isnan(prev_need):
-            # interpolated between two tabulated needs: the Monte Carlo interval of the table (its deltas'
-            # z-SE ends, rescaled to the coverage) and the interpolation error, estimated as the distance to
-            # the crossing of a log-log interpolation (the need falls roughly as a power of the contact time)
-            raw = value
-            est = contact_estimate(grid[k_cross - 1], grid[k_cross], needs[k_cross - 1], needs[k_cross], hi - lo,
-                                   raw, _arr(mc_interval[0]), _arr(mc_interval[1]),
-                                   _arr(ideal_floor(ideal, ideal_interval)), width=op.width,
-                                   svm=op.tab.fidelity == "svm", z_table=table_z(op.tab),
-                                   zc=z_of_coverage(coverage))
-            value, low, high = float(est["value"]), _opt(est["low"]), _opt(est["high"])
-            interp, rounding = float(est["interp"]), float(est["rounding"])
-            interval, kind, cov = (low, high), "table-estimate", coverage
-            monte_carlo.update(interpolation_error_log=interp, rounding_error_log=rounding, table_crossing_s=raw)
-        else:
-            prev = grid[k_cross - 1] if k_cross > 0 else 0.0
-            # with the initial temperature varied per touch, F1 need not rise with contact time (an F1 of 0.9 at
-            # 0.44 s, and not at the table's 0.5 s, was measured): not separable at the previous contact does
-            # not bound the shortest time from below, so the cell starts at the ideal bound
-            start = 0.0 if table_spread(op.tab) > 0 else prev
-            floor = ideal_floor(ideal, ideal_interval)
-            low = max(start, floor) if floor is not None else start
-            interval, kind = (low, value), "table-cell"
-            why = ("the table's first contact time" if k_cross == 0 else
-                   f"the table's next contact time after {prev:g} s, where they are not separable within its "
-                   "effusivity range")
-            note = (f"{value:g} s is {why}: the shortest time lies in ({low:g}, {value:g}] s and the grid cannot "
-                    "support an interval of stated coverage there (the exact route estimates it)")
-            if not states_coverage(op.tab, "min-contact", "table-cell"):  # VARIED_COVERAGE_NOTE: no claim
-                note = f"{value:g} s is {why}: the grid cell is ({low:g}, {value:g}] s"
-                if start < prev:
-                    note += (" (from the ideal bound: with the initial temperature varied, F1 need not rise "
-                             "with contact time)")
-    needed = value if value is not None else float(view.contacts[-1])
-    return _answer("min-contact", op, value=value, interval=interval, ideal=ideal, ideal_method=ideal_method,
-                   ideal_interval=ideal_interval, in_grid=flags, details={}, notes=[note], check_at=(needed, noise, dt),
-                   interval_kind=kind, interval_coverage=cov, computation=monte_carlo, **common)
+    rd = _Reading(op, lo, hi, noise, dt, combos, needs, k_cross, value, mc_interval, ideal, ideal_interval,
+                  coverage, efficiency)
+    est = next((e for e in (estimator(rd) for estimator in CONTACT_ESTIMATORS) if e is not None), None)
+    if est is None:
+        est = _Estimate(None, (None, None), "none", None, note=(
+            f"no tabulated contact time up to {view.contacts[-1]:g} s separates them "
+            "(the exact route examines longer contacts)"))
+    monte_carlo.update(est.computation)
+    needed = est.value if est.value is not None else float(view.contacts[-1])
+    return _answer("min-contact", op, value=est.value, interval=est.interval, ideal=ideal, ideal_method=ideal_method,
+                   ideal_interval=ideal_interval, in_grid=flags, details={}, notes=[est.note],
+                   check_at=(needed, noise, dt), interval_kind=est.kind, interval_coverage=est.coverage,
+                   computation=monte_carlo, **common)
+
+
+# ---------------------------------------------------------------- min-contact's estimators
+@dataclass(frozen=True)
+class _Reading:
+    """What min-contact read from the table for one pair ``lo < hi`` at one scene: the tabulated SVM needs up to
+    the crossing (``needs``), the crossing's contact index ``k_cross`` and value ``raw`` [s] (None: none
+    within the table), the Monte Carlo ends' crossings, the ideal bound (and its Monte Carlo interval, or None),
+    the noise-efficiency reading (:func:`noise_k_min_contact`'s element, or None where it does not apply)."""
+
+    op: Any
+    lo: float
+    hi: float
+    noise: float
+    dt: float
+    combos: Any
+    needs: list
+    k_cross: int
+    raw: float
+    mc_interval: tuple
+    ideal: float | None
+    ideal_interval: tuple | None
+    coverage: float
+    efficiency: dict | None
+
+    @property
+    def floor(self) -> float | None:
+        return ideal_floor(self.ideal, self.ideal_interval)
+
+    @property
+    def svm(self) -> bool:
+        return self.op.tab.fidelity == "svm"
+
+
+@dataclass(frozen=True)
+class _Estimate:
+    """One estimator's answer: value [s], interval, its kind and coverage, what goes to ``computation``, a note."""
+
+    value: float | None
+    interval: tuple
+    kind: str
+    coverage: float | None
+    computation: dict = field(default_factory=dict)
+    note: str = ""
+    ratio: float | None = None  # (max-noise / min-delta-t: the sigma/dT answered)
+
+
+def _varied_estimate(rd: _Reading) -> _Estimate | None:
+    """Varied initial conditions: each scene slice's estimate, both directions averaged, interpolated across the
+    slices (:func:`varied_contact_estimate`)."""
+    op = rd.op
+    if not (rd.svm and table_spread(op.tab) > 0 and "delta_up_lo" in op.view.t.arrays):
+        return None
+    r = varied_contact_estimate(op.view, rd.combos, rd.lo, rd.hi, _arr(rd.floor), width=op.width,
+                                z_table=table_z(op.tab), zc=z_of_coverage(rd.coverage))
+    v = {key: float(x[0]) for key, x in r.items()}
+    if math.isnan(v["value"]):
+        return None
+    return _Estimate(v["value"], (_opt(v["low"]), _opt(v["high"])), "table-varied-estimate", rd.coverage,
+                     dict(interpolation_error_log=v["interp"], rounding_error_log=v["rounding"],
+                          table_crossing_s=rd.raw))
+
+
+def _efficiency_estimate(rd: _Reading) -> _Estimate | None:
+    """The SVM's noise efficiency against the exact ideal observer (:func:`noise_k_min_contact`): no
+    interpolation of the steep need between grid points (an SVM table of a model with a closed form)."""
+    op, eff = rd.op, rd.efficiency
+    if eff is None or math.isnan(eff["value"]):
+        return None
+    low = eff["low"] if rd.ideal is None else min(max(eff["low"], rd.ideal), eff["value"])
+    comp = dict(efficiency=eff["k"], efficiency_se_log=eff["se_log"], table_crossing_s=rd.raw,
+                noise_efficiency_at_s={f"{eff['t_a']:g}": eff["k_a"], f"{eff['t_b']:g}": eff["k_b"]})
+    note = ""
+    first = float(op.view.contacts[0])
+    if eff["value"] < first:  # the efficiency at the first contact times, applied below them: said, not hidden
+        comp["below_grid"] = True
+        note = (f"{eff['value']:.3g} s lies below the table's first contact time, {first:g} s: the SVM's noise "
+                "efficiency read there is applied to the exact ideal observer (an extrapolation in contact "
+                "time; docs/accuracy.md measures it)")
+    return _Estimate(eff["value"], (low, eff["high"]), "table-efficiency", rd.coverage, comp, note)
+
+
+def _rounding_estimate(rd: _Reading) -> _Estimate | None:
+    """Interpolated between two tabulated needs (:func:`contact_estimate`): the table's Monte Carlo interval
+    (its deltas' z-SE ends, rescaled to the coverage) and the interpolation error (the distance to a log-log
+    interpolation's crossing: the need falls roughly as a power of the contact time), the grid's rounding
+    corrected on an SVM table."""
+    k = rd.k_cross
+    if rd.raw is None or not (k > 0 and not math.isnan(rd.needs[k - 1])):
+        return None
+    grid, op = rd.op.view.contacts, rd.op
+    est = contact_estimate(float(grid[k - 1]), float(grid[k]), rd.needs[k - 1], rd.needs[k], rd.hi - rd.lo, rd.raw,
+                           _arr(rd.mc_interval[0]), _arr(rd.mc_interval[1]), _arr(rd.floor), width=op.width,
+                           svm=rd.svm, z_table=table_z(op.tab), zc=z_of_coverage(rd.coverage))
+    return _Estimate(float(est["value"]), (_opt(est["low"]), _opt(est["high"])), "table-estimate", rd.coverage,
+                     dict(interpolation_error_log=float(est["interp"]), rounding_error_log=float(est["rounding"]),
+                          table_crossing_s=rd.raw))
+
+
+def _cell_estimate(rd: _Reading) -> _Estimate | None:
+    """The grid cell the crossing lies in, no stated coverage: where the crossing is the table's first contact,
+    or follows a contact where the pair is beyond the grid."""
+    k, op, value = rd.k_cross, rd.op, rd.raw
+    if value is None:
+        return None
+    prev = float(op.view.contacts[k - 1]) if k > 0 else 0.0
+    # with the initial temperature varied per touch, F1 need not rise with contact time (an F1 of 0.9 at
+    # 0.44 s, and not at the table's 0.5 s, was measured): not separable at the previous contact does
+    # not bound the shortest time from below, so the cell starts at the ideal bound
+    start = 0.0 if table_spread(op.tab) > 0 else prev
+    low = max(start, rd.floor) if rd.floor is not None else start
+    why = ("the table's first contact time" if k == 0 else
+           f"the table's next contact time after {prev:g} s, where they are not separable within its "
+           "effusivity range")
+    note = (f"{value:g} s is {why}: the shortest time lies in ({low:g}, {value:g}] s and the grid cannot "
+            "support an interval of stated coverage there (the exact route estimates it)")
+    if not states_coverage(op.tab, "min-contact", "table-cell"):  # VARIED_COVERAGE_NOTE: no claim
+        note = f"{value:g} s is {why}: the grid cell is ({low:g}, {value:g}] s"
+        if start < prev:
+            note += (" (from the ideal bound: with the initial temperature varied, F1 need not rise "
+                     "with contact time)")
+    return _Estimate(value, (low, value), "table-cell", None, note=note)
+
+
+#: min-contact's estimators from a table, in the order tried: the first that applies answers.
+CONTACT_ESTIMATORS = (_varied_estimate, _efficiency_estimate, _rounding_estimate, _cell_estimate)
 
 
 # ============================================================ max-noise / min-delta-t
@@ -1596,89 +1670,144 @@ def _ratio_question(question: str, e1, e2, m1, m2, objects, contact_s, noise_c, 
             continue
         out[kind] = _max_ratio(v, op.ikind if kind == "ideal" else kind, contact, lo, hi)
     r, where = out["svm"]
-    note = ""
-    value = to_answer(r)
     ratios = view.t.axes["noise_ratio"]
-    if where == "below":
-        value = None
-        note = f"not separable even at the table's smallest noise ratio sigma/dT = {ratios[0]:g}"
-    elif where == "above":
-        more = "at least" if question == "max-noise" else "at most"  # a larger ratio: more noise, a smaller dT
-        note = (f"separable even at the table's largest noise ratio sigma/dT = {ratios[-1]:g}: "
-                f"the answer is {more} this (the exact route looks further)")
+    if where == "above":
         flags["noise_ratio"] = False
     # the Monte Carlo ends: more noise allowed at the optimistic end ('lo': ratio >= the answer's)
     ends = [to_answer(out[k][0]) if out[k][1] != "below" else None for k in ("hi", "lo")]
     mc = tuple(sorted(ends, key=lambda x: (x is None, x))) if all(e is not None for e in ends) else tuple(ends)
-    ideal = to_answer(out["ideal"][0]) if out["ideal"][1] != "below" else None
-    interval: tuple = (None, None)
-    kind, cov = "none", None
-    computation = {"monte_carlo_interval": list(mc)}
-    kr = None
-    if (where in ("inside", "cell") and op.tab.fidelity == "svm" and op.closed and out["ideal"][1] != "below"
-            and "delta_up_ideal" in view.t.arrays):
-        kr = noise_k_max_ratio(op, contact, r, out["ideal"][0], lo, hi, zc=z_of_coverage(coverage))
-        kr = None if math.isnan(float(kr["value"][0])) else {key: float(v[0]) for key, v in kr.items()}
-    if kr is not None:
-        # the SVM's noise efficiency against the exact ideal observer (noise_k_max_ratio)
-        raw = r
-        r = min(kr["value"], out["ideal"][0])
-        value = to_answer(r)
-        iv = [to_answer(kr["low"]), to_answer(min(kr["high"], out["ideal"][0]))]
-        interval = tuple(iv) if question == "max-noise" else (iv[1], iv[0])
-        kind, cov = "table-efficiency", coverage
-        computation.update(table_crossing_noise_ratio=raw, efficiency=kr["k"], efficiency_se_log=kr["se_log"])
-    elif where == "inside" and op.tab.fidelity == "svm":
-        # as min-contact: the tabulated deltas are rounded up to the grid (on average half a width late),
-        # so the raw crossing tolerates too little noise; the answer subtracts w/2 from the need and
-        # interpolates log-log, the interval carries the interpolants' difference and the rounding's SD
-        w = op.width
-        raw = r
-
-        def inside(v):
-            return v[0] if v[1] == "inside" else math.nan
-
-        r_c = inside(_max_ratio(view, "svm", contact, lo, hi, geometric=True, shift=0.5 * w))
-        r_lin = inside(_max_ratio(view, "svm", contact, lo, hi, shift=0.5 * w))
-        both = not (math.isnan(r_c) or math.isnan(r_lin))
-        r_rnd = inside(_max_ratio(view, "svm", contact, lo, hi, geometric=True,
-                                  shift=0.5 * w + w / math.sqrt(12))) if both else math.nan
-        r_geo = math.nan if both else inside(_max_ratio(view, "svm", contact, lo, hi, geometric=True))
-        ends = [math.nan if out[k][1] == "below" or (k == "lo" and out[k][1] == "above") else out[k][0]
-                for k in ("hi", "lo")]
-        ri = out["ideal"][0] if out["ideal"][1] != "below" else None
-        est = ratio_estimate(raw, r_c, r_lin, r_rnd, r_geo, ends[0], ends[1], _arr(ri), z_table=table_z(op.tab),
-                             zc=z_of_coverage(coverage))
-        r, r_low, r_high = float(est["value"]), _opt(est["low"]), _opt(est["high"])
-        interp, rounding = float(est["interp"]), float(est["rounding"])
-        value = to_answer(r)
-        computation["table_crossing_noise_ratio"] = raw
-        iv = [to_answer(r_low), to_answer(r_high)]
-        interval = tuple(iv) if question == "max-noise" else (iv[1], iv[0])
-        kind, cov = "table-estimate", coverage
-        computation.update(interpolation_error_log=interp, rounding_error_log=rounding)
-    elif where == "cell":  # a neighbour beyond the grid: the crossing lies in the cell, no stated coverage
-        k = int(np.searchsorted(ratios, r))
-        nxt = float(ratios[min(k + 1, ratios.size - 1)])
-        ri = out["ideal"][0] if out["ideal"][1] != "below" else None
-        nxt = min(nxt, ri) if ri is not None else nxt
-        iv = [to_answer(r), to_answer(nxt)]
-        interval, kind = (tuple(iv) if question == "max-noise" else (iv[1], iv[0])), "table-cell"
-        note = (f"sigma/dT {r:g} is the table's last noise ratio where they separate; at the next, {nxt:g}, the "
-                "pair lies beyond its effusivity range: the answer lies between them and the grid cannot support "
-                "an interval of stated coverage there (the exact route estimates it)")
-    elif where == "inside":  # an ideal-observer table: no Monte Carlo ends
-        interval, kind = mc, "table"
-    elif value is not None:  # separable beyond the table's largest ratio: the answer is a one-sided bound
-        note += " (the grid cannot support an interval of stated coverage there)"
-        interval = (value, None) if question == "max-noise" else (None, value)
-        kind = "table-cell"
+    rd = _RatioReading(op, question, contact, lo, hi, r, where, out, mc, coverage, dt if question == "max-noise"
+                       else None, None if question == "max-noise" else noise)
+    est = next((e for e in (estimator(rd) for estimator in RATIO_ESTIMATORS) if e is not None), None)
+    if est is None:  # not separable within the table
+        est = _Estimate(None, (None, None), "none", None,
+                        note=f"not separable even at the table's smallest noise ratio sigma/dT = {ratios[0]:g}")
+    computation = {"monte_carlo_interval": list(mc), **est.computation}
+    r = est.ratio if est.ratio is not None else r
     r_check = r if r is not None else float(ratios[0])
     check_at = (contact, r_check * abs(dt), dt) if question == "max-noise" else (contact, noise, noise / r_check)
-    return _answer(question, op, value=value, interval=interval, ideal=ideal,
+    ideal = to_answer(out["ideal"][0]) if out["ideal"][1] != "below" else None
+    return _answer(question, op, value=est.value, interval=est.interval, ideal=ideal,
                    ideal_method="closed-form" if op.closed else "table", in_grid=flags, details={},
-                   notes=[note], check_at=check_at, interval_kind=kind, interval_coverage=cov,
-                   computation=computation, **common)
+                   notes=[est.note], check_at=check_at,
+                   interval_kind=est.kind, interval_coverage=est.coverage, computation=computation, **common)
+
+
+# ---------------------------------------------------------------- max-noise / min-delta-t's estimators
+@dataclass(frozen=True)
+class _RatioReading:
+    """What max-noise / min-delta-t read from the table for one pair ``lo < hi`` at one contact [s]: the largest
+    separating sigma/dT ``r`` and where it lies (``where``: below / inside / cell / above the table's ratios),
+    each kind's reading (``out``: svm, lo, hi, ideal -> (ratio, where)), the Monte Carlo ends in the answer's
+    units (``mc``), and the scene's dT (max-noise) or noise (min-delta-t) [degC]."""
+
+    op: Any
+    question: str
+    contact: float
+    lo: float
+    hi: float
+    r: float | None
+    where: str
+    out: dict
+    mc: tuple
+    coverage: float
+    dt: float | None
+    noise: float | None
+
+    def answer(self, r: float | None) -> float | None:
+        """A sigma/dT in the answer's units (degC)."""
+        if r is None:
+            return None
+        return r * abs(self.dt) if self.question == "max-noise" else self.noise / r
+
+    def interval(self, r_low, r_high) -> tuple:
+        """The interval of sigma/dT ends in the answer's units, low <= high."""
+        iv = (self.answer(r_low), self.answer(r_high))
+        return iv if self.question == "max-noise" else (iv[1], iv[0])
+
+    @property
+    def ideal_ratio(self) -> float | None:
+        return self.out["ideal"][0] if self.out["ideal"][1] != "below" else None
+
+
+def _ratio_efficiency(rd: _RatioReading) -> _Estimate | None:
+    """The SVM's noise efficiency against the exact ideal observer (:func:`noise_k_max_ratio`)."""
+    op = rd.op
+    if not (rd.where in ("inside", "cell") and op.tab.fidelity == "svm" and op.closed and rd.ideal_ratio is not None
+            and "delta_up_ideal" in op.view.t.arrays):
+        return None
+    kr = noise_k_max_ratio(op, rd.contact, rd.r, rd.ideal_ratio, rd.lo, rd.hi, zc=z_of_coverage(rd.coverage))
+    if math.isnan(float(kr["value"][0])):
+        return None
+    kr = {key: float(v[0]) for key, v in kr.items()}
+    r = min(kr["value"], rd.ideal_ratio)
+    return _Estimate(rd.answer(r), rd.interval(kr["low"], min(kr["high"], rd.ideal_ratio)), "table-efficiency",
+                     rd.coverage, dict(table_crossing_noise_ratio=rd.r, efficiency=kr["k"],
+                                       efficiency_se_log=kr["se_log"]), ratio=r)
+
+
+def _ratio_rounding(rd: _RatioReading) -> _Estimate | None:
+    """As min-contact's: the tabulated deltas are rounded up to the grid (on average half a width late), so the
+    raw crossing tolerates too little noise; the answer subtracts w/2 from the need and interpolates log-log,
+    the interval carries the interpolants' difference and the rounding's SD (:func:`ratio_estimate`)."""
+    op, out = rd.op, rd.out
+    if not (rd.where == "inside" and op.tab.fidelity == "svm"):
+        return None
+    w, view, lo, hi, contact = op.width, op.view, rd.lo, rd.hi, rd.contact
+
+    def inside(v):
+        return v[0] if v[1] == "inside" else math.nan
+
+    r_c = inside(_max_ratio(view, "svm", contact, lo, hi, geometric=True, shift=0.5 * w))
+    r_lin = inside(_max_ratio(view, "svm", contact, lo, hi, shift=0.5 * w))
+    both = not (math.isnan(r_c) or math.isnan(r_lin))
+    r_rnd = inside(_max_ratio(view, "svm", contact, lo, hi, geometric=True,
+                              shift=0.5 * w + w / math.sqrt(12))) if both else math.nan
+    r_geo = math.nan if both else inside(_max_ratio(view, "svm", contact, lo, hi, geometric=True))
+    ends = [math.nan if out[k][1] == "below" or (k == "lo" and out[k][1] == "above") else out[k][0]
+            for k in ("hi", "lo")]
+    est = ratio_estimate(rd.r, r_c, r_lin, r_rnd, r_geo, ends[0], ends[1], _arr(rd.ideal_ratio),
+                         z_table=table_z(op.tab), zc=z_of_coverage(rd.coverage))
+    r = float(est["value"])
+    return _Estimate(rd.answer(r), rd.interval(_opt(est["low"]), _opt(est["high"])), "table-estimate", rd.coverage,
+                     dict(table_crossing_noise_ratio=rd.r, interpolation_error_log=float(est["interp"]),
+                          rounding_error_log=float(est["rounding"])), ratio=r)
+
+
+def _ratio_cell(rd: _RatioReading) -> _Estimate | None:
+    """A neighbour beyond the grid: the crossing lies in the cell up to the next ratio (or the ideal bound), no
+    stated coverage."""
+    if rd.where != "cell":
+        return None
+    ratios = rd.op.view.t.axes["noise_ratio"]
+    k = int(np.searchsorted(ratios, rd.r))
+    nxt = float(ratios[min(k + 1, ratios.size - 1)])
+    nxt = min(nxt, rd.ideal_ratio) if rd.ideal_ratio is not None else nxt
+    return _Estimate(rd.answer(rd.r), rd.interval(rd.r, nxt), "table-cell", None, note=(
+        f"sigma/dT {rd.r:g} is the table's last noise ratio where they separate; at the next, {nxt:g}, the "
+        "pair lies beyond its effusivity range: the answer lies between them and the grid cannot support "
+        "an interval of stated coverage there (the exact route estimates it)"))
+
+
+def _ratio_ideal_table(rd: _RatioReading) -> _Estimate | None:
+    """An ideal-observer table: the answer with its Monte Carlo ends, no stated coverage."""
+    return _Estimate(rd.answer(rd.r), rd.mc, "table", None) if rd.where == "inside" else None
+
+
+def _ratio_beyond(rd: _RatioReading) -> _Estimate | None:
+    """Separable beyond the table's largest ratio: the answer is a one-sided bound."""
+    if rd.where != "above":
+        return None
+    value = rd.answer(rd.r)
+    more = "at least" if rd.question == "max-noise" else "at most"  # a larger ratio: more noise, a smaller dT
+    return _Estimate(value, (value, None) if rd.question == "max-noise" else (None, value), "table-cell", None,
+                     note=(f"separable even at the table's largest noise ratio sigma/dT = {rd.r:g}: the answer is "
+                           f"{more} this (the exact route looks further) (the grid cannot support an interval of "
+                           "stated coverage there)"))
+
+
+#: max-noise / min-delta-t's estimators from a table, in the order tried: the first that applies answers.
+RATIO_ESTIMATORS = (_ratio_efficiency, _ratio_rounding, _ratio_cell, _ratio_ideal_table, _ratio_beyond)
 
 
 def max_noise(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact_s: float, delta_t_c: float = 10.0,
@@ -1748,25 +1877,7 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
     icombos, _ = iview.scene_weights(noise, dt) if iview is not None else ([], {})
     icw, _ = _contact_weights(iview, contact) if iview is not None else ([], False)
 
-    def at(v, cmb, cws, name, geometric=False):
-        if v is None or name not in v.t.arrays:
-            return None
-        total = 0.0
-        for k, w in cws:
-            if w == 0:
-                continue
-            if geometric:  # log delta interpolated (weights in log contact, log sigma/dT)
-                for idx, wi in cmb:
-                    y = _interp_e(v.t.arrays[name][idx + (k,)], v.centres, x) if wi else 1.0
-                    if math.isnan(y) or y <= 0:
-                        return None
-                    total += w * wi * math.log(y)
-                continue
-            y = v.delta_at(name, cmb, k, x)
-            if math.isnan(y):
-                return None
-            total += w * y
-        return math.exp(total) if geometric else total
+    at = functools.partial(_delta_read, x)  # (view, scene weights, contact weights, array name[, geometric])
 
     zc, z_t = z_of_coverage(coverage), table_z(op.tab)
     gcw = axis_weights_flagged(view.contacts, contact, log=True)[0]
@@ -1784,15 +1895,8 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
         ideal_side = at(iview, icombos, icw, iname)
         side_floor, extra = ideal_side, {}
         if not op.closed and ideal_bound:  # no closed form: Monte Carlo at query time, the grid's kept beside it
-            from .ideal_mc_bound import cached_mc_ideal_delta
-
-            mcb = cached_mc_ideal_delta(ref, 1 if direction == "up" else -1, op.tab.sensor, contact_s=contact,
-                                        noise_c=noise, delta_t_c=dt, sensor_temp_spread_c=table_spread(op.tab),
-                                        model=op.model, threshold=op.phi, coverage=coverage)
-            extra = {"table_ideal": ideal_side,
-                     "ideal_interval": list(mcb.interval[:2]) if mcb.interval else None}
-            ideal_side = mcb.value
-            side_floor = mcb.floor
+            ideal_side, side_floor, extra = _mc_delta_side(op, ref, direction, contact, noise, dt, coverage,
+                                                           ideal_side)
         stated, cov_side, method = [None, None], None, "none"
         eff = both[direction]
         if eff is not None and val is None and not partner_in_grid(view, x, eff["value"], direction):
@@ -1826,6 +1930,43 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
                    ideal_interval=nearer_side_interval(sides, coverage),
                    in_grid=flags, details=_delta_details(x, sides),
                    check_at=(contact, noise, dt), **common)
+
+
+def _mc_delta_side(op, ref, direction: str, contact: float, noise: float, dt: float, coverage: float,
+                   grid_ideal: float | None) -> tuple:
+    """delta-e's ideal bound of one direction by Monte Carlo at query time (no closed form): its value, the floor
+    the interval is held above (its low end), and the grid's bound and the Monte Carlo interval for ``details``."""
+    from .ideal_mc_bound import cached_mc_ideal_delta
+
+    mcb = cached_mc_ideal_delta(ref, 1 if direction == "up" else -1, op.tab.sensor, contact_s=contact,
+                                noise_c=noise, delta_t_c=dt, sensor_temp_spread_c=table_spread(op.tab),
+                                model=op.model, threshold=op.phi, coverage=coverage)
+    extra = {"table_ideal": grid_ideal, "ideal_interval": list(mcb.interval[:2]) if mcb.interval else None}
+    return mcb.value, mcb.floor, extra
+
+
+def _delta_read(x: float, v: "_View | None", cmb, cws, name: str, geometric: bool = False) -> float | None:
+    """Array ``name`` of view ``v`` at effusivity ``x``, scene weights ``cmb`` and contact weights ``cws`` (None:
+    no such view or array, or a NaN within the weights); ``geometric``: log delta interpolated (weights in log
+    contact, log sigma/dT)."""
+    if v is None or name not in v.t.arrays:
+        return None
+    total = 0.0
+    for k, w in cws:
+        if w == 0:
+            continue
+        if geometric:
+            for idx, wi in cmb:
+                y = _interp_e(v.t.arrays[name][idx + (k,)], v.centres, x) if wi else 1.0
+                if math.isnan(y) or y <= 0:
+                    return None
+                total += w * wi * math.log(y)
+            continue
+        y = v.delta_at(name, cmb, k, x)
+        if math.isnan(y):
+            return None
+        total += w * y
+    return math.exp(total) if geometric else total
 
 
 def partner_in_grid(view: _View, e, delta, direction: str):

@@ -16,7 +16,7 @@ Routes
   scene values, or only the contact time for max-noise / min-delta-t, are
   grouped); the closed-form ideal bound is computed for the distinct
   elements in one vectorized call and kept in the per-process cache of
-  :mod:`designkit.query.ideal_bound` (~7 ms per distinct pair and scene the
+  :mod:`designkit.query.ideal_bound` (a Newton solve per distinct pair the
   first time, a dictionary look-up after). ``ideal_bound=False`` skips it
   (``ideal`` is then NaN, and the intervals are not held to it). The
   rounding-corrected estimates and their intervals at ``coverage`` are the
@@ -25,6 +25,8 @@ Routes
   so element ``i`` equals the scalar call.
 * **exact**, and objects given as material names: one scalar call per
   element (seconds each on the exact route), assembled into the same arrays.
+  The names (``m``, ``m1``, ``m2``) may be lists too, broadcast with the numbers:
+  ``min_contact(m1=["copper", "glass"], m2=["wood", "PVC"])`` answers two pairs.
 
 Bad input names the offending element: ``effusivity e1[2] must be positive, got -5``.
 
@@ -43,6 +45,7 @@ True
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping
@@ -67,6 +70,8 @@ ARRAY_INPUTS: dict[str, tuple[str, ...]] = {
     "distinguishable": ("e1", "e2", "contact_s", "noise_c", "delta_t_c"),
 }
 _DEFAULTS = {"noise_c": 0.05, "delta_t_c": 10.0}
+#: The material-name inputs of each question that may be lists (they broadcast with the numeric ones).
+NAME_INPUTS: dict[str, tuple[str, ...]] = {q: (("m",) if q == "delta-e" else ("m1", "m2")) for q in ARRAY_INPUTS}
 
 FloatArray = NDArray[np.float64]
 
@@ -101,6 +106,8 @@ class ArrayAnswer(QuestionQuantity):
         Whether every table axis held the element's question (always True on the exact route).
     table : str or None
         Table read (None on the exact route).
+    route_reason : str or None
+        Why ``route`` answered (as :attr:`designkit.query.Answer.route_reason`).
     details : mapping of str to ndarray
         Question-specific arrays: delta-e's ``lower`` / ``upper`` (each
         direction's value), ``lower_ideal`` / ``upper_ideal`` and (table route)
@@ -122,6 +129,7 @@ class ArrayAnswer(QuestionQuantity):
     in_grid: NDArray[np.bool_]
     table: str | None = None
     details: Mapping[str, FloatArray] = field(default_factory=dict)
+    route_reason: str | None = None
 
     @property
     def shape(self) -> tuple[int, ...]:
@@ -152,7 +160,8 @@ class ArrayAnswer(QuestionQuantity):
                 "ideal_value": col(self.ideal)}
         cols.update({k: col(np.broadcast_to(v, self.shape)) for k, v in self.details.items()})
         in_grid = np.broadcast_to(self.in_grid, self.shape).ravel().tolist()
-        fixed = {"question": self.question, "route": self.route, "quantity": self.quantity, "unit": self.unit}
+        fixed = {"question": self.question, "route": self.route, "route_reason": self.route_reason,
+                 "quantity": self.quantity, "unit": self.unit}
         out = []
         for i in range(n):
             rec = dict(fixed)
@@ -167,13 +176,28 @@ class ArrayAnswer(QuestionQuantity):
         return out
 
 
+def _is_list(x: Any) -> bool:
+    return x is not None and not isinstance(x, (str, bytes)) and np.ndim(x) >= 1
+
+
 def is_array_call(question: str, arguments: Mapping[str, Any]) -> bool:
-    """Whether any numeric input of ``question`` is an array (ndim >= 1) or a list/tuple."""
-    for name in ARRAY_INPUTS.get(question, ()):
-        x = arguments.get(name)
-        if x is not None and not isinstance(x, (str, bytes)) and np.ndim(x) >= 1:
-            return True
-    return False
+    """Whether any numeric input of ``question`` is an array (ndim >= 1) or a list/tuple, or any material name
+    input (``m``, ``m1``, ``m2``) a list of names."""
+    return any(_is_list(arguments.get(name)) for name in ARRAY_INPUTS.get(question, ()) + NAME_INPUTS.get(question, ()))
+
+
+def _name_arrays(question: str, others: dict[str, Any]) -> dict[str, np.ndarray]:
+    """The material-name inputs given as lists, popped from ``others``, as arrays of str (each element checked)."""
+    out = {}
+    for name in NAME_INPUTS.get(question, ()):
+        if _is_list(others.get(name)):
+            a = np.asarray(others.pop(name), dtype=object)
+            for idx in np.ndindex(a.shape):
+                if not isinstance(a[idx], str):
+                    where = ", ".join(str(int(i)) for i in idx)
+                    raise InputError(f"material names {name}[{where}] must be a name (str), got {a[idx]!r:.60}")
+            out[name] = a
+    return out
 
 
 # ============================================================ input checks, naming the element
@@ -186,6 +210,10 @@ def _as_array(name: str, x: Any) -> np.ndarray:
 
 def _first_bad(name: str, a: np.ndarray, fine: np.ndarray, check: Callable[[str, float], Any]) -> None:
     """Run the scalar check on every element outside ``fine`` (a conservative mask): the first bad raises."""
+    if a.ndim == 0:  # a number beside a list of names
+        if not fine:
+            check(name, float(a))
+        return
     for idx in zip(*np.nonzero(~fine)):
         where = ", ".join(str(int(i)) for i in idx)
         check(f"{name}[{where}]", float(a[idx]))
@@ -253,23 +281,6 @@ def _need(view, kind: str, combos, lo: np.ndarray, hi: np.ndarray) -> np.ndarray
     return np.where(np.isnan(up) | np.isnan(down), np.nan, np.maximum(up, down))
 
 
-def _crossing(xs: np.ndarray, need: np.ndarray, gap: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`designkit.tables.lookup.crossing` per column of ``need`` [contact, n]: the crossing (NaN: none)
-    and the index of the first contact that suffices (-1: none)."""
-    with np.errstate(invalid="ignore"):
-        ok = ~np.isnan(need) & (need <= gap)
-    found = ok.any(axis=0)
-    k = np.argmax(ok, axis=0)
-    cols = np.arange(need.shape[1])
-    cur = need[k, cols]
-    prev = np.where(k > 0, need[np.maximum(k - 1, 0), cols], np.nan)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        w = np.where(prev != cur, (prev - gap) / (prev - cur), 1.0)
-    x0 = xs[np.maximum(k - 1, 0)]
-    x = np.where((k == 0) | np.isnan(prev), xs[k], x0 + w * (xs[k] - x0))
-    return np.where(found, x, np.nan), np.where(found, k, -1)
-
-
 def _at_contact(cw, per_contact: np.ndarray) -> np.ndarray:
     """Contact-weighted sum of ``per_contact`` [contact, n] (NaN if a weighted term is NaN)."""
     total = np.zeros(per_contact.shape[1])
@@ -329,6 +340,26 @@ def _table_pair(question: str, x: dict[str, np.ndarray], op, ideal_bound: bool,
     return res
 
 
+def _mc_contact_bounds(x, op, lo, hi, todo, zc: float, ideal: np.ndarray) -> np.ndarray:
+    """No closed form (varied initial conditions, per-object shapes): the scalar route's Monte Carlo bound of the
+    elements ``todo``, one call per element (remembered per distinct question), written into ``ideal``; returns
+    the floors the intervals are held above (each bound's low end)."""
+    from ..objects import ObjectClass
+    from .ideal_mc_bound import cached_mc_ideal_min_contact
+
+    floor = ideal.copy()
+    spread = _table_route.table_spread(op.tab)
+    for i in np.nonzero(todo)[0]:
+        mcb = cached_mc_ideal_min_contact(
+            ObjectClass("a", (lo[i], lo[i] + op.width)), ObjectClass("b", (hi[i], hi[i] + op.width)),
+            op.tab.sensor, noise_c=float(x["noise_c"][i]), delta_t_c=float(x["delta_t_c"][i]),
+            sensor_temp_spread_c=spread, model=op.model, threshold=op.phi,
+            max_contact_s=_table_route.CLOSED_FORM_MAX_CONTACT_S, coverage=coverage_of_z(zc))
+        ideal[i] = np.nan if mcb.value is None else mcb.value
+        floor[i] = np.nan if mcb.value is None else mcb.floor
+    return floor
+
+
 def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float, outside: bool = True) -> None:
     """min-contact of the elements ``e_in`` marks; with ``outside`` the closed-form bound of the others too
     (a question outside the grid still gets it; ``distinguishable`` needs it only inside)."""
@@ -354,17 +385,17 @@ def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float, outside
         l, h = lo[idx], hi[idx]
         gap = h - l
         need = _need(view, "svm", combos, l, h)
-        value, k = _crossing(grid, need, gap)
-        cols = np.arange(idx.size)
+        value, k, _, _, n0, n1 = _table_route.grid_crossing(grid, need, gap)
         k_cross[idx] = k
-        n_prev[idx] = np.where(k > 0, need[np.maximum(k - 1, 0), cols], np.nan)
-        n_at[idx] = need[np.maximum(k, 0), cols]
-        ilo = _crossing(grid, _need(view, "lo", combos, l, h), gap)[0] if svm else value
-        ihi = _crossing(grid, _need(view, "hi", combos, l, h), gap)[0] if svm else value
+        n_prev[idx] = np.where(k > 0, n0, np.nan)
+        n_at[idx] = n1
+        ilo = _table_route.grid_crossing(grid, _need(view, "lo", combos, l, h), gap)[0] if svm else value
+        ihi = _table_route.grid_crossing(grid, _need(view, "hi", combos, l, h), gap)[0] if svm else value
         if not op.closed and not ideal_bound and op.iview is not None:  # the table's own floor (the scalar's)
             icombos, iflags = op.iview.scene_weights(noise, dt)
             if all(iflags.values()):
-                res["ideal"][idx] = _crossing(op.iview.contacts, _need(op.iview, op.ikind, icombos, l, h), gap)[0]
+                res["ideal"][idx] = _table_route.grid_crossing(op.iview.contacts, _need(op.iview, op.ikind, icombos,
+                                                                                        l, h), gap)[0]
         if efficiency and (has := k >= 0).any():
             r = _table_route.noise_k_min_contact(op, combos, k[has], l[has], h[has], noise / abs(dt), zc=zc)
             for key in eff:
@@ -382,23 +413,9 @@ def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float, outside
         res["ideal"][sel] = exact_ideal_min_contact(
             op.tab.sensor, lo[sel], hi[sel], ratio[sel], width=op.width, threshold=op.phi,
             max_contact_s=_table_route.CLOSED_FORM_MAX_CONTACT_S)
-    # no closed form (varied initial conditions, per-object shapes): the scalar route's Monte Carlo bound, one
-    # call per element (remembered per distinct question); the intervals below are floored at its low end
     ideal_floor = res["ideal"]
     if not op.closed and ideal_bound and todo.any():
-        from ..objects import ObjectClass
-        from .ideal_mc_bound import cached_mc_ideal_min_contact
-
-        ideal_floor = res["ideal"].copy()
-        spread = _table_route.table_spread(op.tab)
-        for i in np.nonzero(todo)[0]:
-            mcb = cached_mc_ideal_min_contact(
-                ObjectClass("a", (lo[i], lo[i] + op.width)), ObjectClass("b", (hi[i], hi[i] + op.width)),
-                op.tab.sensor, noise_c=float(x["noise_c"][i]), delta_t_c=float(x["delta_t_c"][i]),
-                sensor_temp_spread_c=spread, model=op.model, threshold=op.phi,
-                max_contact_s=_table_route.CLOSED_FORM_MAX_CONTACT_S, coverage=coverage_of_z(zc))
-            res["ideal"][i] = np.nan if mcb.value is None else mcb.value
-            ideal_floor[i] = np.nan if mcb.value is None else mcb.floor
+        ideal_floor = _mc_contact_bounds(x, op, lo, hi, todo, zc, res["ideal"])
     # the scalar route's interval: an estimate where the crossing is interpolated between two tabulated needs
     # (table.contact_estimate, the same function), else the grid cell, never below the ideal bound
     raw, ideal = res["value"], ideal_floor
@@ -419,21 +436,32 @@ def _min_contact(x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float, outside
         value[j], low[j], high[j] = r["value"][got], r["low"][got], r["high"][got]
         by_estimate[j] = True
     est = (k_cross > 0) & ~np.isnan(n_prev) & ~np.isnan(raw) & ~by_estimate
-    cell = ~np.isnan(raw) & ~est & ~by_estimate
+    _grid_estimates(op, est, ~np.isnan(raw) & ~est & ~by_estimate, k_cross, n_prev, n_at, lo, hi, res, ideal,
+                    value, low, high, varied=varied, zc=zc)
+    if "stated" in res:  # where the interval has a stated coverage, as the scalar answer's
+        res["stated"] = by_estimate | (est & _table_route.states_coverage(op.tab, "min-contact", "table-estimate"))
+
+
+def _grid_estimates(op, est, cell, k_cross, n_prev, n_at, lo, hi, res, ideal, value, low, high, *, varied: bool,
+                    zc: float) -> None:
+    """min-contact's answers read between grid points (the scalar route's ``_rounding_estimate``, through
+    :func:`~designkit.query.table.contact_estimate`) at ``est``, and its grid cells at ``cell``, never below the
+    ideal bound; ``value``, ``low``, ``high`` updated and stored in ``res`` (whose ``low`` / ``high`` hold the
+    Monte Carlo ends' crossings, ``value`` the raw crossing)."""
+    grid, raw = op.view.contacts, res["value"]
     if est.any():
         i = np.nonzero(est)[0]
         r = _table_route.contact_estimate(
             grid[k_cross[i] - 1], grid[k_cross[i]], n_prev[i], n_at[i], hi[i] - lo[i], raw[i], res["low"][i],
-            res["high"][i], ideal[i], width=op.width, svm=svm, z_table=_table_route.table_z(op.tab), zc=zc)
+            res["high"][i], ideal[i], width=op.width, svm=op.tab.fidelity == "svm",
+            z_table=_table_route.table_z(op.tab), zc=zc)
         value[i], low[i], high[i] = r["value"], r["low"], r["high"]
     prev = np.where(k_cross > 0, grid[np.maximum(k_cross - 1, 0)], 0.0)
     if varied:  # the scalar route's rule: F1 need not rise with contact time, the cell starts at the bound
         prev = np.zeros_like(prev)
-    low = np.where(cell, np.where(np.isnan(ideal), prev, np.maximum(prev, ideal)), low)
-    high = np.where(cell, raw, high)
-    res["value"], res["low"], res["high"] = value, low, high
-    if "stated" in res:  # where the interval has a stated coverage, as the scalar answer's
-        res["stated"] = by_estimate | (est & _table_route.states_coverage(op.tab, "min-contact", "table-estimate"))
+    res["value"] = value
+    res["low"] = np.where(cell, np.where(np.isnan(ideal), prev, np.maximum(prev, ideal)), low)
+    res["high"] = np.where(cell, raw, high)
 
 
 _BELOW, _INSIDE, _ABOVE, _CELL = 0, 1, 2, 3  # where a largest separating ratio lies (the scalar route's words)
@@ -479,6 +507,32 @@ def _max_ratio(view, kind: str, cw, lo, hi, *, gcw=None, shift: float = 0.0) -> 
     return r, where
 
 
+def _ratio_interpolants(op, contact: float, cw, j, lo, hi, alt: dict) -> None:
+    """The rounding-corrected estimate's interpolants of the largest separating sigma/dT (the scalar route's:
+    :func:`~designkit.query.table.ratio_estimate` takes them) for pairs ``lo < hi`` at elements ``j``, written
+    into ``alt`` (NaN where one does not cross inside the grid)."""
+    w, view = op.width, op.view
+    gcw = _table_route.axis_weights_flagged(view.contacts, contact, log=True)[0]
+    for key, kw in (("c", dict(gcw=gcw, shift=0.5 * w)), ("lin", dict(shift=0.5 * w)),
+                    ("rnd", dict(gcw=gcw, shift=0.5 * w + w / math.sqrt(12))), ("geo", dict(gcw=gcw))):
+        a_r, a_w = _max_ratio(view, "svm", cw, lo, hi, **kw)
+        alt[key][j] = np.where(a_w == _INSIDE, a_r, np.nan)
+
+
+def _ratio_by_efficiency(op, x, lo, hi, i, r_all, ri, low, high, by_k, ordered, zc: float) -> None:
+    """max-noise / min-delta-t from the SVM's noise efficiency (:func:`~designkit.query.table.noise_k_max_ratio`)
+    at elements ``i``, never beyond the ideal observer's ``ri``: ``r_all``, ``low``, ``high`` and ``by_k``
+    updated where it applies (``ordered``: sigma/dT ends to the answer's interval)."""
+    kr = _table_route.noise_k_max_ratio(op, x["contact_s"][i], r_all[i], ri[i], lo[i], hi[i], zc=zc)
+    got = ~np.isnan(kr["value"])
+    j = i[got]
+    k_low, k_high = _nan(lo.size), _nan(lo.size)
+    k_low[j], k_high[j] = kr["low"][got], np.minimum(kr["high"][got], ri[j])
+    a, b = ordered(k_low, k_high)
+    low[j], high[j], r_all[j] = a[j], b[j], np.minimum(kr["value"][got], ri[j])
+    by_k[j] = True
+
+
 def _ratio(question, x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> None:
     view = op.view
     ratios = view.t.axes["noise_ratio"] if "noise_ratio" in op.tab.axes else None
@@ -516,13 +570,7 @@ def _ratio(question, x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> 
         res["in_grid"][idx] = where != _ABOVE
         est = where == _INSIDE
         if svm and est.any():
-            w = op.width
-            gcw = _table_route.axis_weights_flagged(view.contacts, contact, log=True)[0]
-            j, le, he = idx[est], l[est], h[est]
-            for key, kw in (("c", dict(gcw=gcw, shift=0.5 * w)), ("lin", dict(shift=0.5 * w)),
-                            ("rnd", dict(gcw=gcw, shift=0.5 * w + w / math.sqrt(12))), ("geo", dict(gcw=gcw))):
-                a_r, a_w = _max_ratio(view, "svm", cw, le, he, **kw)
-                alt[key][j] = np.where(a_w == _INSIDE, a_r, np.nan)
+            _ratio_interpolants(op, contact, cw, idx[est], l[est], h[est], alt)
     if op.closed and ideal_bound:  # every element, outside the grid too: the closed form needs no table
         from .ideal_bound import exact_ideal_max_ratio
 
@@ -543,16 +591,7 @@ def _ratio(question, x, op, lo, hi, e_in, res, ideal_bound: bool, zc: float) -> 
     by_k = np.zeros(n, dtype=bool)
     if (svm and op.closed and "delta_up_ideal" in view.t.arrays
             and (cand := ((where_all == _INSIDE) | (where_all == _CELL)) & ~np.isnan(ri)).any()):
-        i = np.nonzero(cand)[0]
-        kr = _table_route.noise_k_max_ratio(op, x["contact_s"][i], r_all[i], ri[i], lo[i], hi[i], zc=zc)
-        got = ~np.isnan(kr["value"])
-        j = i[got]
-        r_k = np.minimum(kr["value"][got], ri[j])
-        k_low, k_high = _nan(n), _nan(n)
-        k_low[j], k_high[j] = kr["low"][got], np.minimum(kr["high"][got], ri[j])
-        a, b = ordered(k_low, k_high)
-        low[j], high[j], r_all[j] = a[j], b[j], r_k
-        by_k[j] = True
+        _ratio_by_efficiency(op, x, lo, hi, np.nonzero(cand)[0], r_all, ri, low, high, by_k, ordered, zc)
     inside = (where_all == _INSIDE) & ~by_k
     if "stated" in res:  # where the interval has a stated coverage, as the scalar answer's
         res["stated"] = by_k | (inside if svm else False)
@@ -684,6 +723,31 @@ def _mc_delta_bounds(op, e: np.ndarray, direction: int, contact: float, noise: f
     return value, floor
 
 
+def _delta_at(e: np.ndarray, v, cmb, cws, name: str) -> np.ndarray:
+    """Array ``name`` of view ``v`` at effusivities ``e``, scene weights ``cmb``, contact weights ``cws`` (NaN:
+    none, or no such view or array)."""
+    if v is None or name not in v.t.arrays:
+        return _nan(e.size)
+    return _at_contact(cws, _delta(v, name, cmb, e))
+
+
+def _delta_geometric(e: np.ndarray, v, cmb, cws, name: str) -> np.ndarray:
+    """As :func:`_delta_at`, log delta interpolated (the scalar route's alternative interpolant)."""
+    total = np.zeros(e.size)
+    bad = np.zeros(e.size, dtype=bool)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        for k, w in cws:
+            if w == 0:
+                continue
+            for i, wi in cmb:
+                if not wi:
+                    continue
+                y = _table_route.interp_e_rows(v.t.arrays[name][i][k:k + 1], v.centres, e)[0]
+                bad |= np.isnan(y) | (y <= 0)
+                total = total + w * wi * np.log(y)
+        return np.where(bad, np.nan, np.exp(total))
+
+
 def _table_delta_e(x: dict[str, np.ndarray], op, ideal_table, zc: float,
                    ideal_bound: bool = True) -> dict[str, np.ndarray]:
     e = x["e"]
@@ -698,25 +762,7 @@ def _table_delta_e(x: dict[str, np.ndarray], op, ideal_table, zc: float,
     for (contact, noise, dt), combos, cw, idx in _scenes_in_grid(x, view, e_in):
         xe = e[idx]
 
-        def at(v, cmb, cws, name):
-            if v is None or name not in v.t.arrays:
-                return _nan(xe.size)
-            return _at_contact(cws, _delta(v, name, cmb, xe))
-
-        def at_geometric(v, cmb, cws, name):  # log delta interpolated (the scalar route's alternative)
-            total = np.zeros(xe.size)
-            bad = np.zeros(xe.size, dtype=bool)
-            with np.errstate(invalid="ignore", divide="ignore"):
-                for k, w in cws:
-                    if w == 0:
-                        continue
-                    for i, wi in cmb:
-                        if not wi:
-                            continue
-                        y = _table_route.interp_e_rows(v.t.arrays[name][i][k:k + 1], v.centres, xe)[0]
-                        bad |= np.isnan(y) | (y <= 0)
-                        total = total + w * wi * np.log(y)
-                return np.where(bad, np.nan, np.exp(total))
+        at, at_geometric = (functools.partial(f, xe) for f in (_delta_at, _delta_geometric))
 
         icombos = iview.scene_weights(noise, dt)[0] if iview is not None else []
         icw = _table_route.axis_weights_flagged(iview.contacts, contact)[0] if iview is not None else []
@@ -820,10 +866,15 @@ def answer_arrays(question: str, scalar: Callable[..., Answer], route: str, argu
     numeric = {n: arguments.get(n, _DEFAULTS.get(n)) for n in names}
     present = {n: v for n, v in numeric.items() if v is not None}
     x = _checked(question, present)
-    shape = next(iter(x.values())).shape if x else ()
-    flat = {n: np.ascontiguousarray(a).ravel() for n, a in x.items()}
     others = {k: v for k, v in arguments.items() if k not in names}
-    by_name = any(others.get(k) is not None for k in ("m", "m1", "m2", "objects"))
+    listed = _name_arrays(question, others)
+    try:
+        shape = np.broadcast_shapes(*(a.shape for a in (*x.values(), *listed.values())))
+    except ValueError:
+        shapes = ", ".join(f"{n} {a.shape}" for n, a in (*x.items(), *listed.items()))
+        raise InputError(f"the array inputs do not broadcast together: {shapes}") from None
+    flat = {n: np.broadcast_to(a, shape).ravel() for n, a in x.items()}
+    by_name = bool(listed) or any(others.get(k) is not None for k in ("m", "m1", "m2", "objects"))
     pair = question != "delta-e"
     if route == "table" and not by_name and all(n in flat for n in names):
         op = _table_route.open_table(others.get("table", _table_route.DEFAULT_TABLE),
@@ -846,7 +897,9 @@ def answer_arrays(question: str, scalar: Callable[..., Answer], route: str, argu
         table = op.tab.name
     else:
         n = int(np.prod(shape)) if shape else 1
-        answers = [scalar(**others, **{k: float(v[i]) for k, v in flat.items()}) for i in range(n)]
+        named = {k: np.broadcast_to(v, shape).ravel() for k, v in listed.items()}
+        answers = [scalar(**others, **{k: float(v[i]) for k, v in flat.items()},
+                          **{k: str(v[i]) for k, v in named.items()}) for i in range(n)]
         res = _from_answers(answers, shape, question)
         table = answers[0].table if answers else None
     details = {k: res.pop(k) for k in ("lower", "upper", "lower_ideal", "upper_ideal", "lower_low", "lower_high",

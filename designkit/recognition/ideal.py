@@ -32,12 +32,9 @@ every closed-form bound of :mod:`designkit.query.ideal_bound` follows.
 
 The normal CDF is numpy's own here (:func:`ndtr`, cubic Hermite pieces of a
 table of :func:`math.erfc`, within 5e-14, tested against mpmath), not
-:mod:`scipy.special`: this module is the one closed form for the table
-builder and for a table question asked from a fresh shell, and importing
-``scipy.special`` costs that question about 0.35 s of a 0.2 s budget (measured
-with ``python -X importtime``, issue 16; ``tests/test_startup.py`` keeps the
-question scipy-free). The Monte Carlo observer below, which needs
-``scipy.special``'s ``log_ndtr`` and ``logsumexp``, imports them when it runs.
+:mod:`scipy.special`, so that a table question from a fresh shell never imports
+scipy (``tests/test_startup.py``; docs/decisions-log.md). The Monte Carlo
+observer below imports ``scipy.special`` when it runs.
 
 Varied initial conditions (Monte Carlo on the exact likelihood)
 ---------------------------------------------------------------
@@ -96,8 +93,7 @@ def _gauss_legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
     of the Legendre recurrence, and twice the squared first components of its eigenvectors).
 
     The same rule as ``numpy.polynomial.legendre.leggauss(n)`` (to 4e-16 in the nodes and 4e-15 in the
-    weights at n = 40, tested), without importing ``numpy.polynomial``: its classes cost a fresh table query
-    2.3 ms of a start-up that issue 16 counts (this takes 0.2 ms).
+    weights at n = 40, tested), without importing ``numpy.polynomial`` (start-up: docs/decisions-log.md).
     """
     k = np.arange(1.0, n)
     off = k / np.sqrt(4.0 * k * k - 1.0)
@@ -117,7 +113,7 @@ _PHI_Z = 9.0  # beyond +-9 the CDF is 0 or 1 to 1e-19
 
 @functools.lru_cache(maxsize=1)
 def _phi_table() -> tuple[np.ndarray, np.ndarray]:
-    """The standard normal CDF and density on [-9, 9] every 1/512, from :func:`math.erfc` (~2 ms, once)."""
+    """The standard normal CDF and density on [-9, 9] every 1/512, from :func:`math.erfc` (once per process)."""
     z = np.arange(-_PHI_Z, _PHI_Z + _PHI_H / 2, _PHI_H)
     cdf = np.array([0.5 * math.erfc(-_SQRT1_2 * x) for x in z.tolist()])
     return cdf, np.exp(-0.5 * z * z) / math.sqrt(2.0 * math.pi)
@@ -136,10 +132,13 @@ def ndtr(z) -> np.ndarray:
     """Standard normal CDF, elementwise (a new array; float64): cubic Hermite interpolation of :func:`_phi_table`.
 
     Interpolation error at most h^4 max|d4 Phi| / 384 = 5e-14 (h = 1/512), tested against
-    :func:`math.erfc`; a Python call of math.erfc per element costs 5x more, scipy's import 0.35 s.
-    Evaluated in Horner form from per-interval coefficients, in place, with 1-D ``take`` gathers:
-    8x faster than the textbook basis form on (3000, 40) arrays (9.1 -> 1.1 ms, same values to
-    7e-16), which was a fifth of a 12-material ``designkit matrix``.
+    :func:`math.erfc`. Evaluated in Horner form from per-interval coefficients, in place, with 1-D
+    ``take`` gathers.
+
+    Examples
+    --------
+    >>> float(ndtr(np.array([0.0]))[0])
+    0.5
     """
     c0, c1, c2, c3 = _phi_horner()
     u = np.clip(z, -_PHI_Z, _PHI_Z)
@@ -333,14 +332,20 @@ def _bisect_noise(sensor, lo, hi, per_ratio, width, threshold, bracket, rel_tol)
     def ok(log_r):
         return separates(sensor, lo, hi, width, np.exp(log_r) * per_ratio, threshold)
 
-    la = np.full(lo.shape, math.log(bracket[0]))
-    lb = np.full(lo.shape, math.log(bracket[1]))
-    ok_lo, ok_hi = ok(la), ok(lb)
+    ok_lo, ok_hi = ok(np.full(lo.shape, math.log(bracket[0]))), ok(np.full(lo.shape, math.log(bracket[1])))
+    out = np.where(ok_lo, np.where(ok_hi, bracket[1], np.nan), np.nan)
+    # only the elements decided inside the bracket are bisected (classes that never separate, NaN, are most
+    # of a coarse export grid's fallbacks: bisecting them too cost an export of f1-matrix-paper about 60 s)
+    r = np.flatnonzero(ok_lo & ~ok_hi)
+    lo, hi, per_ratio, width = lo[r], hi[r], per_ratio[r], width[r]
+    la = np.full(r.shape, math.log(bracket[0]))
+    lb = np.full(r.shape, math.log(bracket[1]))
     while np.any(active := lb - la > rel_tol):  # an element stops when it converges: its answer does not
         mid = 0.5 * (la + lb)                    # depend on the other elements of the call (nor on a cache)
         good = ok(mid)
         la, lb = np.where(active & good, mid, la), np.where(active & ~good, mid, lb)
-    return np.where(ok_lo, np.where(ok_hi, bracket[1], np.exp(la)), np.nan)
+    out[r] = np.exp(la)
+    return out
 
 
 @functools.lru_cache(maxsize=8)
@@ -496,6 +501,12 @@ def projection_noise(sensor: Sensor, scene: Scene) -> float:
     ``s = (sigma / |Ts0 - Ta|) / |g|`` with ``|g|`` the Euclidean norm of the
     response shape over the touch's samples (:func:`shape_norm`). ``inf`` when there is no signal
     (no temperature difference, or no sample after contact); 0 when noise-free.
+
+    Examples
+    --------
+    >>> from designkit import SENSORS, Scene
+    >>> round(projection_noise(SENSORS["paper"], Scene(contact_s=1.0, noise_c=0.05)), 5)  # sigma/dT 0.005
+    0.00776
     """
     ratio = scene.noise_ratio
     norm = float(shape_norm(sensor, scene.contact_s))
@@ -552,6 +563,12 @@ def ideal_scores(low_a, low_b, high_a, high_b, e_sensor: float, s, *, accuracy: 
     -------
     f1, accuracy : ndarray (accuracy None when not asked for)
         Broadcast over the inputs.
+
+    Examples
+    --------
+    >>> f1, accuracy = ideal_scores(20000, 20080, 35000, 35080, 892.0, 0.01)
+    >>> round(float(f1), 3), round(float(accuracy), 3)
+    (0.818, 0.813)
     """
     la, lb, ha, hb, s = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64)
                                              for x in (low_a, low_b, high_a, high_b, s)))
@@ -762,7 +779,10 @@ def ideal_method(range_a, range_b, sensor: Sensor, scene: Scene, *, model=None) 
 
 def _shape_shared_here(fm, a, b, sensor: Sensor, scene: Scene) -> bool:
     """Whether the model's curves share one shape for these classes in this scene (its own, or its extra
-    physics invisible here, :meth:`ForwardModel.equivalent_shared_shape`)."""
+    physics invisible here, :meth:`ForwardModel.equivalent_shared_shape`). A rig's scene (correlated noise,
+    a recorder's window after its onset) takes the Monte Carlo route, which whitens the noise."""
+    if scene.noise_correlation_s > 0 or scene.onset_s > 0:
+        return False
     return fm.shared_shape or fm.equivalent_shared_shape(
         (a, b), sensor, contact_s=scene.contact_s, tolerance=_invisible_tolerance(sensor, scene)) is not None
 

@@ -34,7 +34,7 @@ from ..models import ForwardModel, get_model
 from ..objects import ObjectClass, ordered_pair
 from ..scene import Scene
 from ..sensor import Sensor
-from ..simulation import response_tolerance, seed_key, simulate_class
+from ..simulation import response_tolerance, seed_key, simulate_class, window_times_s
 from .scores import IdealResult, score_llr
 
 __all__ = ["ideal_pair_mc"]
@@ -179,6 +179,9 @@ def ideal_pair_mc(obj_a: ObjectClass, obj_b: ObjectClass, sensor: Sensor, scene:
     'monte-carlo'
     """
     fm = get_model(model)
+    if getattr(fm, "touch_ramps", ()):
+        # every touch pressing as the nominal one: a nuisance less, so still a bound on any classifier
+        fm = fm.nominal()
     n_mc = int(n_mc)
     if n_mc < 10:
         raise InputError(f"the Monte Carlo ideal observer needs at least 10 touches per class, got {n_mc}")
@@ -191,7 +194,9 @@ def ideal_pair_mc(obj_a: ObjectClass, obj_b: ObjectClass, sensor: Sensor, scene:
     # a noise-free scene is handled as the limit of a tiny noise (as the closed form does)
     sc = scene.replace(noise_c=max(scene.noise_c, 1e-6 * abs(scene.delta_t_c)))
     s_n = sc.noise_ratio
-    t = sensor.times_s(sc.contact_s)
+    t = window_times_s(sensor, sc)   # the recorder's window
+    sim_model = fm
+    fm, whiten = _whitened(fm, t.size, sensor.sample_rate_hz, sc.noise_correlation_s)
     tol = response_tolerance(s_n, t.size)
     pilot: list[np.ndarray] = []
     grids = [_class_grid(fm, obj, t, sensor, s_n, tol, pilot) for obj in (low, high)]
@@ -208,17 +213,49 @@ def ideal_pair_mc(obj_a: ObjectClass, obj_b: ObjectClass, sensor: Sensor, scene:
     dt = sc.ambient_temp_c - sc.sensor_temp_c
     obs = []
     for obj, k in zip((low, high), _TEST_STREAMS):
-        tr = simulate_class(obj, n_mc, sensor, sc, key + [k], fm)
-        obs.append(((tr.temperature_c - sc.sensor_temp_c) / dt) @ basis.T)
+        tr = simulate_class(obj, n_mc, sensor, sc, key + [k], sim_model)
+        obs.append(whiten((tr.temperature_c - sc.sensor_temp_c) / dt) @ basis.T)
     labels = np.r_[np.zeros(n_mc, dtype=int), np.ones(n_mc, dtype=int)]
     llr = _log_likelihood_ratio(np.vstack(obs), coefs, s_n)
     f1, se, acc, acc_se = score_llr(llr, labels, n_mc)
     details = {"grid": [[g.e_nodes.size, len(g.d_nodes)] for g in grids],
                "arc_length_noise_units": [[g.arc_e, g.arc_d] for g in grids],
                "grid_capped": any(g.capped for g in grids), "basis_rank": int(basis.shape[0]),
-               "basis_residual_noise_units": worst / s_n, "model": fm.name}
+               "basis_residual_noise_units": worst / s_n, "model": sim_model.name}
     return IdealResult(f1=f1, accuracy=acc, method="monte-carlo", standard_error=se,
                        accuracy_standard_error=acc_se, projection_noise=None, n_mc=n_mc, details=details)
+
+
+@dataclass(frozen=True)
+class _Whitened:
+    """A model whose curves are read through the whitening ``L^-1`` of correlated noise (a rig's scene):
+    in whitened coordinates the noise is white again and the likelihood below holds as it is."""
+
+    base: ForwardModel
+    chol: np.ndarray
+
+    def __getattr__(self, name):
+        return getattr(self.base, name)
+
+    def whiten(self, curves) -> np.ndarray:
+        from scipy.linalg import solve_triangular
+
+        y = np.atleast_2d(np.asarray(curves, dtype=np.float64))
+        return solve_triangular(self.chol, y.T, lower=True).T
+
+    def response(self, *args, **kwargs) -> np.ndarray:
+        return self.whiten(self.base.response(*args, **kwargs))
+
+
+def _whitened(fm: ForwardModel, n_samples: int, sample_rate_hz: float, correlation_s: float):
+    """(model, whiten): the model and observations read in whitened coordinates when the noise is correlated
+    (:func:`designkit.simulation.noise_cholesky`), else unchanged."""
+    if not correlation_s or n_samples < 2:
+        return fm, lambda y: y
+    from ..simulation import noise_cholesky
+
+    w = _Whitened(fm, noise_cholesky(n_samples, sample_rate_hz, correlation_s))
+    return w, w.whiten
 
 
 def _log_likelihood_ratio(y: np.ndarray, coefs: list[np.ndarray], s_n: float) -> np.ndarray:

@@ -68,6 +68,12 @@ def score_llr(llr: np.ndarray, labels: np.ndarray, n_mc: int) -> tuple[float, fl
     2/3 of calling everything positive); the accuracy is the Bayes rule's
     (threshold 0, equal priors). Returns ``(f1, f1 standard error, accuracy,
     accuracy standard error)``.
+
+    Examples
+    --------
+    >>> f1, _, acc, _ = score_llr(np.array([-2.0, -1.0, 1.0, 2.0]), np.array([0, 0, 1, 1]), 2)
+    >>> f1, acc
+    (1.0, 1.0)
     """
     from sklearn.metrics import precision_recall_curve
 

@@ -34,9 +34,9 @@ This engine scores a few per reference, and each shortcut is exact or tested:
   it. The closed form exists for shared-shape models (and models that cannot
   be told from one at the scene's noise); for others the search runs without
   the floor (correct, slower) and the table has no ideal arrays.
-* **No warm starts.** The previous row's or contact time's answer as a first
-  guess saved fits but changed answers on noisy (not exactly monotone) F1
-  (37 of 500 references of a scene differed with another split): dropped.
+* **No warm starts.** A row starts from its own floor, never from the previous
+  row's or contact time's answer, which would change answers on noisy (not
+  exactly monotone) F1.
 * **Trials generated once.** Noise is drawn time-major
   (:mod:`designkit.simulation`), so the trials of a shorter contact are exact
   prefixes of a longer one: drawing the shorter trials directly *is* truncating
@@ -62,11 +62,13 @@ from __future__ import annotations
 
 from .chunk import ChunkResult, run_chunk, run_scene
 from .config import FIDELITIES, SOLVERS, SweepConfig
+from .scorer import ENGINE_VERSION
 from .run import SweepInterrupted, iter_sweep, prepare_workdir, run_sweep
 from .search import (assemble, closed_form_model, delta_from_staircase, ideal_staircase, staircase_search,
                      staircase_searches)
 
 __all__ = [
+    "ENGINE_VERSION",
     "FIDELITIES",
     "SOLVERS",
     "ChunkResult",

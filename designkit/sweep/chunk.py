@@ -95,18 +95,14 @@ def run_chunk(cfg: SweepConfig, point: tuple[int, ...], block: int, contact_inde
     """Compute one chunk (a picklable top-level function for joblib/dask workers).
 
     A chunk is the unit of parallelism: everything inside it runs sequentially in its
-    worker. (Where joblib's active backend is dask, as on the workers of joblib's dask
-    backend, scikit-learn's own joblib calls, such as the folds of cross-validation, would
-    otherwise be sent back to the cluster one by one: measured 5x slower per chunk.) BLAS
-    and LAPACK run on one thread for the same reason: the batched solver's small
-    factorizations (133 x 133) spent most of their time in idle threads of a
-    multithreaded BLAS on a loaded machine (measured: one 60-interval chunk at 4 s, 43 s
-    of CPU with the default threads, 3.7 s with one), and one thread everywhere makes the
-    floating-point order the same whatever the worker count. (Other CPUs run other
-    kernels and round differently; docs/engine.md measures that the tables do not move.)
-    Freed arrays are kept for reuse meanwhile (:func:`~designkit._workers.steady_heap`:
-    7 % less CPU over a whole svm-paper build, 12 % on single chunks, measured).
+    worker, with joblib's local backend (scikit-learn's own joblib calls are not sent back
+    to a dask cluster), BLAS and LAPACK on one thread (the same floating-point order
+    whatever the worker count) and freed arrays kept for reuse
+    (:func:`~designkit._workers.steady_heap`). scipy's LAPACK (the solver's) is imported
+    before the thread limit is set, so that the limit reaches it. Why, with the measurements:
+    docs/decisions-log.md.
     """
+    import scipy.linalg.lapack  # noqa: F401  (the solver's LAPACK: loaded now, so that the limit below reaches it)
     from joblib import parallel_config
     from threadpoolctl import threadpool_limits
 
@@ -151,8 +147,7 @@ def ideal_floor(cfg: SweepConfig, sensor: Sensor, scene: Scene, rows) -> np.ndar
     elsewhere); None where the model and scene have no closed form.
 
     The anchors get it too, inside the block or not: an anchor searched from another floor than in its own
-    block may find another crossing of noisy decisions, and the rows guessed from it follow (``--blocks 3``
-    moved ``J_lo`` / ``J_hi`` of a 500-interval scene, measured).
+    block may find another crossing of noisy decisions, and the rows guessed from it would follow.
     """
     if closed_form_model(cfg, sensor, scene) is None:
         return None
@@ -168,10 +163,8 @@ def _svm_staircases(cfg: SweepConfig, scorer: PairScorer, rows, floor):
     Every search step's probes go to the scorer as one batch (the batched solver
     scores them together; the reference solver one by one). Rows are searched in
     windows of consecutive references (:func:`search_window`) so that the features a
-    window's probes need stay in the scorer's bounded cache (searching all rows of a
-    large block in lockstep rebuilt every interval's features at every step at long
-    contacts: measured 3,672 feature builds for 250 rows at 10 s, 48 % of the CPU);
-    a row's answer does not depend on the window it is searched in
+    window's probes need stay in the scorer's bounded cache; a row's answer does not
+    depend on the window it is searched in
     (:func:`~designkit.sweep.search.staircase_searches`).
     """
     n, phi, z = cfg.intervals, cfg.threshold, cfg.z
@@ -197,8 +190,8 @@ def _svm_staircases(cfg: SweepConfig, scorer: PairScorer, rows, floor):
     return out["J"], out["J_lo"], out["J_hi"]
 
 
-#: The SVM's need over the ideal observer's, for :func:`estimated_costs` only (an ordering, not a result): the
-#: noise efficiency measured on svm-paper is 1.3 at 0.5 s, 1.7 at 2 s, 2.1 at 4 s of contact.
+#: The SVM's need over the ideal observer's, for :func:`estimated_costs` only (an ordering, not a result):
+#: svm-paper's noise efficiency at 2 s of contact.
 _SVM_OVER_IDEAL = 1.7
 
 
@@ -209,10 +202,7 @@ def estimated_costs(cfg: SweepConfig, point: tuple[int, ...], contact_index: int
     probes for a reference whose partner is ``g`` intervals away, next to nothing where the partner lies
     beyond the grid; each probe a fit over ``contact_s`` seconds of samples. ``g`` is guessed as
     ``1.7`` times the closed-form ideal observer's (at every :data:`ANCHOR_EVERY`-th reference, one
-    vectorized call for all blocks, about 0.2 s); where no closed form holds, every reference counts 1.
-
-    Measured on one 500-interval scene (2 s, sigma/dT 0.005) in 4 blocks: 6.2, 14.3, 20.0 and 0.6 s of CPU
-    (the highest effusivities mostly have no partner in the grid); estimated 52, 95, 119 and 0.
+    vectorized call for all blocks); where no closed form holds, every reference counts 1.
     """
     blocks = cfg.blocks_of()
     contact = float(cfg.contact_s[contact_index])

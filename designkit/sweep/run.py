@@ -21,6 +21,7 @@ import numpy as np
 from .._validation import InputError
 from .chunk import ChunkResult, estimated_costs, run_chunk
 from .config import SweepConfig
+from .scorer import ENGINE_VERSION
 from .search import assemble, chunk_wall_s
 
 __all__ = ["BACKENDS", "SweepInterrupted", "check_batches", "check_scheduler", "iter_sweep", "local_cluster",
@@ -88,17 +89,22 @@ def prepare_workdir(cfg: SweepConfig, workdir: Path, *, resume: bool, fresh: boo
             changed = cfg.changes_from(old.get("config")) or ["sensor file"]
             raise InputError(f"{workdir} holds a different sweep ({', '.join(changed)} changed); "
                              "use another --workdir or --fresh")
+        if old.get("engine_version", 1) != ENGINE_VERSION and any(chunks.glob("*.npz")):
+            raise InputError(f"{workdir} holds chunks of engine version {old.get('engine_version', 1)}, this "
+                             f"designkit computes version {ENGINE_VERSION} (it rounds differently); "
+                             "use another --workdir or --fresh")
         if not resume and any(chunks.glob("*.npz")):
             raise InputError(f"{workdir} already has finished chunks; use --resume to continue or --fresh to discard them")
     if fresh and chunks.exists():
         for f in chunks.glob("*.npz"):
             f.unlink()
     chunks.mkdir(parents=True, exist_ok=True)
-    atomic_write_text(meta, json.dumps({"digest": cfg.digest(), "config": cfg.to_dict()}, indent=2))
+    atomic_write_text(meta, json.dumps({"digest": cfg.digest(), "engine_version": ENGINE_VERSION,
+                                        "config": cfg.to_dict()}, indent=2))
 
 
-#: Up to this many chunks per worker, the chunks are ordered by estimated cost (about 0.2 s per scene point and
-#: contact, in the parent before any chunk starts); with more, handing them out as workers free up balances
+#: Up to this many chunks per worker, the chunks are ordered by estimated cost (in the parent, before any chunk
+#: starts); with more, handing them out as workers free up balances
 #: them well enough.
 _FEW_CHUNKS_PER_WORKER = 8
 
@@ -171,9 +177,8 @@ def _on_dask(cfg: SweepConfig, todo, jobs: int, scheduler: str | None) -> Iterat
     """The chunks ``todo`` on a dask cluster, as they finish, each handed out when a worker thread frees up.
 
     dask assigns a submitted task to a worker at once and a worker runs its own in turn, so with more chunks
-    submitted than threads a worker that finished early ran a small chunk while a costlier one waited behind
-    a busy worker (joblib's dask backend keeps 2 per thread in flight: a 500-interval scene in 4 blocks on 2
-    workers took 18.3-19.7 s, against 17.4-18.7 s with one per thread, measured in alternation). The number
+    submitted than threads a worker that finished early would run a small chunk while a costlier one waited
+    behind a busy worker: one chunk per thread is in flight (docs/decisions-log.md). The number
     of threads is asked again at each hand-out, so the chunks follow a cluster that grows (an adaptive one
     sees the work of its running chunks; with no worker yet, one chunk waits for it).
     """
@@ -206,11 +211,8 @@ def local_cluster(jobs: int):
     import dask
     from dask.distributed import Client
 
-    # dask's nanny spawns workers with MALLOC_TRIM_THRESHOLD_=65536 (to hand freed memory back sooner), and
-    # the solver's per-fold arrays are then handed back and faulted in afresh: one chunk of a 500-interval
-    # scene took 3.1 million minor page faults and 3.6 s of system CPU instead of 1.0 million and 1.4 s
-    # (14.3 s of wall against 12.0 s), and the whole scene on two workers 22.7-26.0 s against 19.7-20.1 s
-    # with it unset (measured; benchmarks/bench_engine.py --dask). The cluster designkit starts leaves it
+    # dask's nanny spawns workers with MALLOC_TRIM_THRESHOLD_=65536, and the solver's per-fold arrays are
+    # then handed back and faulted in afresh (docs/decisions-log.md). The cluster designkit starts leaves it
     # unset; a worker's memory stays bounded by the chunk's own limits (scorer.BATCH_MB, the feature cache).
     with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
         return Client(processes=True, n_workers=max(jobs, 1), threads_per_worker=1)
@@ -346,5 +348,6 @@ def run_sweep(cfg: SweepConfig, workdir: str | Path, *, out: str | Path | None =
                                             "chunks_total": total, "jobs": jobs, "backend": backend,
                                             "solver": cfg.solver, "compute_s_total": float(wall.sum()),
                                             "chunk_wall_s": wall.tolist()})
+    header["engine_version"] = ENGINE_VERSION  # hashed with the header; tables without it are version 1
     path = Path(out) if out is not None else workdir / f"{cfg.name}.npz"
     return write_table(path, header, arrays, compress=compress)

@@ -32,11 +32,19 @@ from ..sensor import Sensor
 from ..simulation import draw_trials, render_trials
 from .config import SweepConfig
 
-__all__ = ["BATCH_MB", "CHUNK_PAIRS", "CV_KEY", "FEATURE_CACHE_MB", "PairCell", "PairScorer", "array_namespace",
+__all__ = ["BATCH_MB", "CHUNK_PAIRS", "CV_KEY", "ENGINE_VERSION", "FEATURE_CACHE_MB", "PairCell", "PairScorer", "array_namespace",
            "batch_pairs"]
 
 #: Seed-key suffix of the fold-shuffle streams (distinguishes them from the trial streams).
 CV_KEY = 7919
+
+#: Version of the arithmetic that turns a config into a table (features and solver), recorded in every
+#: table's header (``engine_version``; a table without one is version 1) and in a sweep's working folder.
+#: The same config gives the same bytes on every run, split and backend of one version; another version
+#: rounds differently, so its answers may move within their Monte Carlo intervals (issue 35). Version 2:
+#: the Savitzky-Golay slope in cumulative-sum form (:mod:`designkit.recognition.features`) and the
+#: batched solver's one-gather fold statistics (:func:`~designkit.recognition.batched_svm.batched_cv_f1`).
+ENGINE_VERSION = 2
 
 
 @dataclass
@@ -67,8 +75,7 @@ class PairCell:
 FEATURE_CACHE_MB = 512
 
 #: Working memory of one batched-solver chunk [MiB]: the stacked features of its pairs plus the
-#: solver's own arrays. Together with the feature cache it keeps a worker under 1 GB (measured
-#: at 256 MiB: 0.85 GB peak for 200 intervals at 10 s contact, the cache full; 128 leaves margin).
+#: solver's own arrays. Together with the feature cache it keeps a worker under 1 GB.
 BATCH_MB = 128
 
 #: Most pairs in one batched-solver call (beyond this a batch is no faster per pair).
@@ -144,10 +151,11 @@ class PairScorer:
         self.edges = cfg.edges
         # features of (interval, seed), least recently used first; they are a deterministic function
         # of their key, so evicting one only costs its regeneration, never changes a result
-        per_entry = cfg.trials * 2 * self.n_samples * 8  # raw samples + slope, float64
+        self._prepare = cfg.solver == "batched"  # numpy's batched path: cache PreparedFeatures
+        # raw samples + slope: float64, or float32 deviations as the batched solver's numpy path keeps them
+        per_entry = cfg.trials * 2 * self.n_samples * (4 if self._prepare else 8)
         self.max_features = max(8, int(FEATURE_CACHE_MB * 2**20 // max(per_entry, 1)))  # cache entries
         self._features: LRUCache[tuple[int, int], Any] = LRUCache(self.max_features)
-        self._prepare = cfg.solver == "batched"  # numpy's batched path: cache PreparedFeatures
         self.scored: dict[tuple[int, int], PairCell] = {}  # every pair scored so far
         self.fits = 0
         self.calls = 0  # batched-solver calls (fits / calls: pairs per call)
@@ -155,7 +163,7 @@ class PairScorer:
     def features(self, k: int, rep: int):
         """Features of interval ``k`` with seed ``rep``: the ``(trials, 2 n_samples)`` matrix, or with the
         ``batched`` solver its :class:`~designkit.recognition.batched_svm.PreparedFeatures` (what that
-        solver reads; as many bytes as the float64 matrix, prepared once per cache entry)."""
+        solver reads; half the float64 matrix's bytes, prepared once per cache entry)."""
         key = (k, rep)
         feats = self._features.get(key)
         if feats is None:
@@ -166,7 +174,7 @@ class PairScorer:
                                 vary_ambient=cfg.ambient_temp_spread_c > 0)
             temps = render_trials(draws, self.sensor, self.scene, cfg.model, cfg.trial_diffusivity()).temperature_c
             feats = feature_matrix(temps, self.sensor.sample_rate_hz, cfg.slope_window_s)
-            if self._prepare:  # the batched solver's numpy path reads these (as many bytes as the float64 matrix)
+            if self._prepare:  # the batched solver's numpy path reads these (half the float64 matrix's bytes)
                 from ..recognition.batched_svm import prepare_features
 
                 feats = prepare_features(feats)

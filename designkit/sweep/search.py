@@ -102,8 +102,8 @@ def staircase_search(decide: Callable[[int, int], bool] | None, rows: Sequence[i
 
 #: Spacing of the anchor rows of a guided search (:func:`staircase_searches`): every row ``i`` with
 #: ``i % ANCHOR_EVERY == 0`` is searched from its floor alone; every other row starts from a guess
-#: interpolated between the answers of its two anchors. Measured on svm-paper scenes (2 s and 10 s of
-#: contact): 8 gives about 40 % fewer pairs per reference than searching every row from its floor.
+#: interpolated between the answers of its two anchors (fewer pairs per reference than searching every
+#: row from its floor).
 ANCHOR_EVERY = 8
 
 

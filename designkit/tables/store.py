@@ -371,8 +371,7 @@ class _NpzArrays(Mapping):
     A question reads a few slices of a few arrays (min-contact: the noise slices around its own, of
     ``delta_*`` and their intervals). Members stored uncompressed (the fine shipped table,
     :func:`write_table` with ``compress=False``) are mapped from the file, so only those pages are
-    read: decompressing all of svm-fine's 22 MB cost a fresh ``designkit min-contact`` 27 ms, more than
-    its question. Each member's bytes, mapped or decompressed, are checked against the shipped table's
+    read (decompressing the whole table would cost a fresh question more than its answer). Each member's bytes, mapped or decompressed, are checked against the shipped table's
     :data:`SHIPPED_MEMBER_DIGESTS` when it is first read (once per process and file), and its npy header
     against the JSON header. Plain data: picklable.
     """
@@ -584,7 +583,7 @@ SHIPPED_CONTENT_HASHES = frozenset(content for content, _ in SHIPPED_TABLES.valu
 #: Digests of the shipped tables' files (:func:`file_digest`: the .json header and the .npz's directory).
 #: Files with one of these digests are a shipped content, checked in full when it was shipped
 #: (tests/test_startup.py checks every shipped table again, the long way), so loading them checks the
-#: digest (well under a millisecond) instead of hashing every decompressed array (35 ms on svm-fine), and
+#: digest instead of hashing every decompressed array, and
 #: reads an array only when a question asks for it, hashing that array's bytes then against its shipped
 #: digest (:mod:`designkit.tables._shipped_members`). Files that differ (a rebuilt table, an edited one, a
 #: header rewritten with other line endings) take the long way: hash, schema, consistency.

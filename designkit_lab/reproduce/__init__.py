@@ -50,6 +50,7 @@ def _registry() -> dict[str, tuple[Callable[[Context], SectionResult], float]]:
     from .matrices import section_f1_matrices, section_node_graphs
     from .table1 import section_table1
     from .multiclass import section_multiclass
+    from .prediction import section_real_prediction
     from .robot import section_real_robot, section_sim_to_real
 
     return {
@@ -61,13 +62,14 @@ def _registry() -> dict[str, tuple[Callable[[Context], SectionResult], float]]:
         "guideline": (section_guideline, 15.0),
         "real-robot": (section_real_robot, 10.0),
         "sim-to-real": (section_sim_to_real, 12.0),
+        "real-prediction": (section_real_prediction, 12.0),
         "multiclass": (section_multiclass, 30.0),
     }
 
 
 #: Section names in report order.
 SECTIONS: tuple[str, ...] = ("f1-matrices", "delta-curves", "effusivity", "node-graphs", "table1", "guideline",
-                             "real-robot", "sim-to-real", "multiclass")
+                             "real-robot", "sim-to-real", "real-prediction", "multiclass")
 
 
 def parse_only(only: "str | Sequence[str] | None") -> tuple[str, ...]:

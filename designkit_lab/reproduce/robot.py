@@ -43,6 +43,7 @@ __all__ = [
     "load_real",
     "passive_object_temp",
     "real_pair_f1",
+    "robot_section",
     "section_real_robot",
     "section_sim_to_real",
     "sim_to_real",
@@ -579,16 +580,30 @@ def _calibration_text(setup: "SimToRealSetup") -> str:
     return text
 
 
-def _data_or_skip(ctx: Context, name: str, title: str, t0: float):
-    d = ctx.settings.robot_data_dir
-    if not (d / "index.csv").is_file():
-        why = (f"the real robot recordings are not available at {d} (set DESIGNKIT_ROBOT_DATA or pass "
-               f"--robot-data to their folder)")
-        return None, SectionResult(name, title, f"*Skipped: {why}.*", {"data_dir": str(d)}, skipped=why,
-                                   wall_s=time.perf_counter() - t0)
-    if "real_touches" not in ctx.cache:
-        ctx.cache["real_touches"] = load_real(d)
-    return ctx.cache["real_touches"], None
+def robot_section(name: str, title: str):
+    """A report section on the real recordings: ``fn(ctx, touches) -> SectionResult`` (its compute time
+    filled in here); skipped with one line saying where to put them when the recordings are absent."""
+    import dataclasses
+    import functools
+
+    def wrap(fn):
+        @functools.wraps(fn)
+        def section(ctx: Context) -> SectionResult:
+            t0 = time.perf_counter()
+            d = ctx.settings.robot_data_dir
+            if not (d / "index.csv").is_file():
+                why = (f"the real robot recordings are not available at {d} (set DESIGNKIT_ROBOT_DATA or pass "
+                       f"--robot-data to their folder)")
+                return SectionResult(name, title, f"*Skipped: {why}.*", {"data_dir": str(d)}, skipped=why,
+                                     wall_s=time.perf_counter() - t0)
+            if "real_touches" not in ctx.cache:
+                ctx.cache["real_touches"] = load_real(d)
+            res = fn(ctx, ctx.cache["real_touches"])
+            return dataclasses.replace(res, wall_s=time.perf_counter() - t0)
+
+        return section
+
+    return wrap
 
 
 def _confusion_figure(ctx: Context, mats: list[tuple[str, np.ndarray]], labels, name: str) -> str:
@@ -616,13 +631,9 @@ def _cm_table(cm, labels) -> str:
     return md_table(["true \\ predicted"] + list(labels), [[lab] + list(row) for lab, row in zip(labels, cm)])
 
 
-def section_real_robot(ctx: Context) -> SectionResult:
+@robot_section("real-robot", "Real robot: train on real touches, test on real touches")
+def section_real_robot(ctx: Context, touches: RealTouches) -> SectionResult:
     """Train real, test real: metal vs wood, metal vs cold wood, wood vs cold wood; three classes at once."""
-    t0 = time.perf_counter()
-    title = "Real robot: train on real touches, test on real touches"
-    touches, skip = _data_or_skip(ctx, "real-robot", title, t0)
-    if skip is not None:
-        return skip
     repeats = 2 if ctx.settings.quick else 10
     pairs = []
     for k, p in enumerate(PAIRS):
@@ -666,17 +677,13 @@ def section_real_robot(ctx: Context) -> SectionResult:
                         REAL_ROBOT["real_fixed_f1"], 0.03,
                         "" if abs(mean_f1 - REAL_ROBOT["real_fixed_f1"]) <= 0.03 else
                         "different materials (three classes here, the paper's 12); see the section."),)
-    return SectionResult("real-robot", title, "\n".join(lines), numbers, (fig,), comps,
-                         wall_s=time.perf_counter() - t0)
+    return SectionResult("real-robot", "Real robot: train on real touches, test on real touches", "\n".join(lines),
+                         numbers, (fig,), comps)
 
 
-def section_sim_to_real(ctx: Context) -> SectionResult:
+@robot_section("sim-to-real", "Sim-to-real: train on simulated touches, test on the real ones")
+def section_sim_to_real(ctx: Context, touches: RealTouches) -> SectionResult:
     """Sim-to-real: train on simulated touches (calibrated sensor, the trials' own temperatures), test on real."""
-    t0 = time.perf_counter()
-    title = "Sim-to-real: train on simulated touches, test on the real ones"
-    touches, skip = _data_or_skip(ctx, "sim-to-real", title, t0)
-    if skip is not None:
-        return skip
     seed = ctx.settings.seed
     setup = ctx.cache.get("sim_setup")
     if setup is None:
@@ -778,5 +785,5 @@ def section_sim_to_real(ctx: Context) -> SectionResult:
     comps = (Comparison("sim-to-real mean F1", main["mean_f1"], REAL_ROBOT["sim_to_real_f1"], 0.03,
                         "three classes here (one hard pair, wood vs cold wood, that the simulator cannot tell "
                         "apart from the pre-contact passive reading), the paper's 12 materials and 66 pairs."),)
-    return SectionResult("sim-to-real", title, "\n".join(lines), numbers, (fig,), comps,
-                         wall_s=time.perf_counter() - t0)
+    return SectionResult("sim-to-real", "Sim-to-real: train on simulated touches, test on the real ones",
+                         "\n".join(lines), numbers, (fig,), comps)

@@ -10,10 +10,8 @@ import typer
 
 from ._app import EXIT_INTERRUPTED, console, emit_json
 from ._options import Json
-from .tables import tables_app
 
 
-@tables_app.command("build")
 def tables_build(
     sensor: Annotated[str, typer.Option("--sensor", help="Sensor file written by 'designkit calibrate fit' (with "
                                         "the rig's conditions).")],
@@ -50,8 +48,7 @@ def tables_build(
     Example (two materials, a quick coarse table): `designkit tables build --sensor my-sensor.yaml --m wood --m glass --trials 20`
     """
     from ..sweep import SweepInterrupted
-    from ..sweep.for_sensor import effusivity_span, sensor_sweep_config
-    from ..tables.registry import build_sensor_table
+    from ..sweep.for_sensor import build_sensor_table, effusivity_span, sensor_sweep_config
     from ._format import check_out, check_out_dir
 
     span = effusivity_span(material_set=materials, materials=tuple(m or ()), e_range=e_range)

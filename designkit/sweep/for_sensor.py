@@ -28,8 +28,10 @@ Units: effusivity [J s^-1/2 K^-1 m^-2], times [s], noise [degC].
 from __future__ import annotations
 
 import math
+import json
 from dataclasses import dataclass
-from typing import Sequence
+from pathlib import Path
+from typing import Any, Sequence
 
 import numpy as np
 
@@ -37,7 +39,7 @@ from .._validation import InputError
 from ..objects import DEFAULT_CLASS_WIDTH
 from .config import SweepConfig
 
-__all__ = ["FIRST_CONTACT_S", "LONGEST_CONTACT_SCALES", "NOISE_FACTORS", "SensorSpan", "contact_grid",
+__all__ = ["BuiltTable", "FIRST_CONTACT_S", "LONGEST_CONTACT_SCALES", "NOISE_FACTORS", "SensorSpan", "build_sensor_table", "contact_grid",
            "effusivity_span", "rig_noise_ratio", "sensor_sweep_config"]
 
 #: sigma/dT of the table's noise axis, as multiples of the rig's own (the middle one *is* the rig's: a
@@ -216,3 +218,58 @@ def _slug(text: str) -> str:
 
     s = re.sub(r"[^A-Za-z0-9._-]+", "-", str(text)).strip("-.")
     return s[:60] or "sensor"
+
+
+@dataclass(frozen=True)
+class BuiltTable:
+    """What :func:`build_sensor_table` made: the table's path, its registry entry and what it holds.
+
+    Attributes
+    ----------
+    table, entry : Path
+        The table's .npz (its .json beside it) and its registry entry.
+    sensor_name, sensor_digest, content_hash : str
+    contacts_from_onset_s : tuple of float
+        The tabulated contact times, counted from the rig's detected onset [s].
+    config : SweepConfig
+    """
+
+    table: Path
+    entry: Path
+    sensor_name: str
+    sensor_digest: str
+    content_hash: str
+    contacts_from_onset_s: tuple[float, ...]
+    config: Any
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"table": str(self.table), "header": str(self.table.with_suffix(".json")),
+                "registry_entry": str(self.entry), "sensor": {"name": self.sensor_name, "digest": self.sensor_digest},
+                "content_hash": self.content_hash, "contacts_from_onset_s": list(self.contacts_from_onset_s),
+                "config": self.config.to_dict()}
+
+
+def build_sensor_table(cfg, *, out: str | Path | None = None, jobs: int = -1, on_chunk=None) -> BuiltTable:
+    """Sweep ``cfg`` (:func:`designkit.sweep.for_sensor.sensor_sweep_config`) and register its table for the sensor.
+
+    The chunks are kept in a working folder named by the config's digest beside the registry entry, so an
+    interrupted build continues where it stopped when run again; it is removed once the table is registered.
+    ``out``: the table's .npz (default: in the registry folder, :func:`default_table_dir`).
+    """
+    import shutil
+
+    from ..rig import from_model_contact, model_start_s
+    from ..tables.registry import default_table_dir, register_table, sensor_digest
+    from .run import run_sweep
+
+    sensor = cfg.resolved_sensor()
+    home = default_table_dir(sensor)
+    work = home / f"work-{cfg.digest()[:16]}"
+    path = Path(out) if out is not None else home / f"{cfg.name}.npz"
+    table = run_sweep(cfg, work, out=path, jobs=jobs, resume=True, on_chunk=on_chunk)
+    entry = register_table(sensor, table, sensor_file=cfg.sensor)
+    shutil.rmtree(work, ignore_errors=True)
+    start = model_start_s(sensor)
+    return BuiltTable(Path(table), entry, sensor.name, sensor_digest(sensor),
+                      json.loads(entry.read_text())["content_hash"],
+                      tuple(round(float(from_model_contact(c, start)), 6) for c in cfg.contact_s), cfg)

@@ -1,7 +1,7 @@
 """Tables for your sensor: build the table a calibrated sensor's questions need, register it, find it.
 
 ``designkit tables build --sensor rig.yaml`` sweeps the config :func:`designkit.sweep.for_sensor.sensor_sweep_config`
-derives from the sensor file and registers the table for that sensor; later questions about the sensor
+derives from the sensor file (:func:`designkit.sweep.for_sensor.build_sensor_table`) and registers the table for that sensor; later questions about the sensor
 (``designkit min-contact --sensor rig.yaml ...``) call :func:`table_for_sensor` and answer from it in
 milliseconds instead of computing each answer (tens of seconds).
 
@@ -26,14 +26,13 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Mapping
 
 from .._validation import InputError
 
-__all__ = ["DATA_DIR_VARIABLE", "BuiltTable", "build_sensor_table", "default_table_dir", "entry_path", "register_table", "registry_dir",
-           "sensor_digest", "table_for_sensor"]
+__all__ = ["DATA_DIR_VARIABLE", "default_table_dir", "entry_path", "register_table", "registry_dir", "sensor_digest",
+           "table_for_sensor"]
 
 #: Environment variable naming designkit's data folder instead of the user's (tests, shared machines).
 DATA_DIR_VARIABLE = "DESIGNKIT_DATA_DIR"
@@ -175,57 +174,3 @@ def _check_built_for(table, digest: str, name: str) -> None:
         raise InputError(f"table {table.name} was built for sensor {table.sensor.name!r} as it was then "
                          f"(another content), not for sensor {name!r} as it is now: rebuild it with "
                          "'designkit tables build --sensor FILE'")
-
-
-@dataclass(frozen=True)
-class BuiltTable:
-    """What :func:`build_sensor_table` made: the table's path, its registry entry and what it holds.
-
-    Attributes
-    ----------
-    table, entry : Path
-        The table's .npz (its .json beside it) and its registry entry.
-    sensor_name, sensor_digest, content_hash : str
-    contacts_from_onset_s : tuple of float
-        The tabulated contact times, counted from the rig's detected onset [s].
-    config : SweepConfig
-    """
-
-    table: Path
-    entry: Path
-    sensor_name: str
-    sensor_digest: str
-    content_hash: str
-    contacts_from_onset_s: tuple[float, ...]
-    config: Any
-
-    def to_dict(self) -> dict[str, Any]:
-        return {"table": str(self.table), "header": str(self.table.with_suffix(".json")),
-                "registry_entry": str(self.entry), "sensor": {"name": self.sensor_name, "digest": self.sensor_digest},
-                "content_hash": self.content_hash, "contacts_from_onset_s": list(self.contacts_from_onset_s),
-                "config": self.config.to_dict()}
-
-
-def build_sensor_table(cfg, *, out: str | Path | None = None, jobs: int = -1, on_chunk=None) -> BuiltTable:
-    """Sweep ``cfg`` (:func:`designkit.sweep.for_sensor.sensor_sweep_config`) and register its table for the sensor.
-
-    The chunks are kept in a working folder named by the config's digest beside the registry entry, so an
-    interrupted build continues where it stopped when run again; it is removed once the table is registered.
-    ``out``: the table's .npz (default: in the registry folder, :func:`default_table_dir`).
-    """
-    import shutil
-
-    from ..rig import from_model_contact, model_start_s
-    from ..sweep import run_sweep
-
-    sensor = cfg.resolved_sensor()
-    home = default_table_dir(sensor)
-    work = home / f"work-{cfg.digest()[:16]}"
-    path = Path(out) if out is not None else home / f"{cfg.name}.npz"
-    table = run_sweep(cfg, work, out=path, jobs=jobs, resume=True, on_chunk=on_chunk)
-    entry = register_table(sensor, table, sensor_file=cfg.sensor)
-    shutil.rmtree(work, ignore_errors=True)
-    start = model_start_s(sensor)
-    return BuiltTable(Path(table), entry, sensor.name, sensor_digest(sensor),
-                      json.loads(entry.read_text())["content_hash"],
-                      tuple(round(float(from_model_contact(c, start)), 6) for c in cfg.contact_s), cfg)

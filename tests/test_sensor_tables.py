@@ -149,3 +149,32 @@ def test_the_build_refuses_a_sensor_without_the_rigs_conditions(cli, tmp_path, m
     both = cli("tables", "build", "--sensor", old, "--materials", "paper12", "--m", "wood")
     assert both.exit_code == 2 and "give one of" in both.output
     assert not (tmp_path / "data").exists()  # refused before any work
+
+
+def test_one_question_has_one_answer_on_every_surface(built, data_dir, cli, tmp_path):
+    """A rig sensor file's scene is resolved once, in the library: the library's scalar and array answers, the
+    CLI's --json and its --batch give the same number, interval and conditions (each value with its source)."""
+    from designkit.query import min_contact
+
+    f = str(built["sensor_file"])
+    batch = tmp_path / "pairs.csv"
+    batch.write_text("m1,m2\nwood,glass\nwood,glass\n")
+    for given, cli_given in (({}, ()), ({"noise_c": 0.01}, ("--noise", "0.01"))):
+        lib = min_contact(m1="wood", m2="glass", sensor=f, **given)
+        arr = min_contact(m1=["wood", "glass"], m2=["glass", "wood"], sensor=f, **given)
+        res = cli("min-contact", "--sensor", f, "--m1", "wood", "--m2", "glass", "--json", *cli_given)
+        rows = cli("min-contact", "--sensor", f, "--batch", batch, "--json", *cli_given)
+        assert res.exit_code == 0 and rows.exit_code == 0, res.output + rows.output
+        d, rec = json.loads(res.stdout), json.loads(rows.stdout)[0]
+        one = json.loads(json.dumps(lib.to_dict()))
+        assert lib.route == d["route"] == rec["route"] == "table" and lib.value is not None
+        assert d["value"] == one["value"] == float(arr.value[0]) == rec["value"]
+        assert d["interval"] == one["interval"]
+        assert (rec["interval_low"], rec["interval_high"]) == (d["interval"]["low"], d["interval"]["high"])
+        conditions = one["scene"]["conditions"]
+        assert d["scene"]["conditions"] == conditions == arr.to_dict()[0]["conditions"] == rec["conditions"]
+        assert conditions["noise_c"] == ({"value": 0.02, "source": "sensor file"} if not given
+                                         else {"value": 0.01, "source": "user"})
+        assert conditions["delta_t_c"] == {"value": 7.0, "source": "sensor file"}
+        assert conditions["onset_offset_s"] == {"value": -0.3, "source": "sensor file"}
+        assert d["route_reason"] == one["route_reason"] and "built for sensor rig" in d["route_reason"]

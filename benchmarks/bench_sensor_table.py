@@ -62,7 +62,7 @@ def _scene(sensor):
     return resolve_scene(sensor, {"noise_c": None, "delta_t_c": None}).values
 
 
-def exact_case(sensor_file: str, case: dict) -> dict:
+def exact_case(sensor_file: str, case: dict, repeats: int = 4) -> dict:
     from designkit.models import sensor_model
     from designkit.query.exact import exact_min_contact
     from designkit.sensor import load_sensor
@@ -71,11 +71,11 @@ def exact_case(sensor_file: str, case: dict) -> dict:
     sc = _scene(sen)
     t0, c0 = time.perf_counter(), time.process_time()
     a = exact_min_contact(case["e1"], case["e2"], noise_c=sc["noise_c"], delta_t_c=sc["delta_t_c"], sensor=sen,
-                          model=sensor_model(sen), seed=1000 + case["index"], repeats=4, jobs=1)
+                          model=sensor_model(sen), seed=1000 + case["index"], repeats=repeats, jobs=1)
     d = a.to_dict()
     return {**case, "exact": {"value": d["value"], "low": d["interval"]["low"], "high": d["interval"]["high"],
                               "coverage": d["interval"]["coverage"], "ideal": d["ideal"]["value"]},
-            "wall_s": time.perf_counter() - t0, "cpu_s": time.process_time() - c0}
+            "repeats": repeats, "wall_s": time.perf_counter() - t0, "cpu_s": time.process_time() - c0}
 
 
 def phase_exact(args) -> None:
@@ -90,7 +90,7 @@ def phase_exact(args) -> None:
     todo = [c for c in cases if c["index"] not in done]
     print(f"{len(todo)} of {len(cases)} pairs to compute by the exact route, {args.jobs} processes", flush=True)
     with ProcessPoolExecutor(args.jobs) as pool, path.open("a") as fh:
-        futs = [pool.submit(exact_case, args.sensor, c) for c in todo]
+        futs = [pool.submit(exact_case, args.sensor, c, args.repeats) for c in todo]
         for f in as_completed(futs):
             r = f.result()
             fh.write(json.dumps(r) + "\n")
@@ -224,6 +224,7 @@ def main() -> None:
     p.add_argument("--pairs", type=int, default=60)
     p.add_argument("--seed", type=int, default=34)
     p.add_argument("--jobs", type=int, default=2)
+    p.add_argument("--repeats", type=int, default=4, help="the exact route's seeds of 100 trials per class")
     p.add_argument("--build-cpu-s", type=float, default=None, help="CPU seconds the build printed (projection)")
     args = p.parse_args()
     Path(args.out).mkdir(parents=True, exist_ok=True)

@@ -67,11 +67,11 @@ def test_the_build_sweeps_the_rigs_conditions_and_registers_the_table(built, dat
     s = built["summary"]
     cfg = s["config"]
     sensor = load_sensor(built["sensor_file"])
-    # sigma/dT: the rig's own (noise 0.02 over dT 7), half and twice it; the model: the file's
-    assert cfg["noise_ratio"] == pytest.approx([0.01 / 7, 0.02 / 7, 0.04 / 7], rel=1e-12)
+    # sigma/dT: the rig's own (noise 0.02 over dT 7); the model: the file's; the touches: the rig's (as --exact's)
+    assert cfg["noise_ratio"] == pytest.approx([0.02 / 7], rel=1e-12) and cfg["rig_scene"] is True
     assert cfg["model"] == {"name": "contact", "conductance_w_m2k": 1800.0}
-    # contact counted from the detected onset (0.05 s to 4 settling times of 0.75 s), stored as the model counts
-    assert s["contacts_from_onset_s"] == pytest.approx([0.05, 0.387, 3.0], abs=1e-3)
+    # contact counted from the detected onset (0.1 s to 4 settling times of 0.75 s), stored as the model counts
+    assert s["contacts_from_onset_s"] == pytest.approx([0.1, 0.548, 3.0], abs=1e-3)
     assert cfg["contact_s"] == pytest.approx([c - model_start_s(sensor) for c in s["contacts_from_onset_s"]])
     assert s["effusivity_span"] == {"min": 240.0, "max": 1680.0, "source": "materials Wood, Glass"}
     assert cfg["e_max"] - cfg["e_min"] == 80.0 * cfg["intervals"]  # the class width of --exact and svm-fine
@@ -159,7 +159,7 @@ def test_one_question_has_one_answer_on_every_surface(built, data_dir, cli, tmp_
     f = str(built["sensor_file"])
     batch = tmp_path / "pairs.csv"
     batch.write_text("m1,m2\nwood,glass\nwood,glass\n")
-    for given, cli_given in (({}, ()), ({"noise_c": 0.01}, ("--noise", "0.01"))):
+    for given, cli_given in (({}, ()), ({"noise_c": 0.04, "delta_t_c": 14.0}, ("--noise", "0.04", "--delta-t", "14"))):
         lib = min_contact(m1="wood", m2="glass", sensor=f, **given)
         arr = min_contact(m1=["wood", "glass"], m2=["glass", "wood"], sensor=f, **given)
         res = cli("min-contact", "--sensor", f, "--m1", "wood", "--m2", "glass", "--json", *cli_given)
@@ -174,7 +174,8 @@ def test_one_question_has_one_answer_on_every_surface(built, data_dir, cli, tmp_
         conditions = one["scene"]["conditions"]
         assert d["scene"]["conditions"] == conditions == arr.to_dict()[0]["conditions"] == rec["conditions"]
         assert conditions["noise_c"] == ({"value": 0.02, "source": "sensor file"} if not given
-                                         else {"value": 0.01, "source": "user"})
-        assert conditions["delta_t_c"] == {"value": 7.0, "source": "sensor file"}
+                                         else {"value": 0.04, "source": "user"})
+        assert conditions["delta_t_c"] == ({"value": 7.0, "source": "sensor file"} if not given
+                                           else {"value": 14.0, "source": "user"})
         assert conditions["onset_offset_s"] == {"value": -0.3, "source": "sensor file"}
         assert d["route_reason"] == one["route_reason"] and "built for sensor rig" in d["route_reason"]

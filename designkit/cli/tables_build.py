@@ -26,7 +26,10 @@ def tables_build(
         "--out", help="Folder (or .npz) for the table's files (default: the sensor-table registry in the user's "
                       "data folder; 'designkit tables build --help' says where).")] = None,
     contact_points: Annotated[int, typer.Option("--contact-points", help="Contact times tabulated, from the rig's "
-                                                "detected onset to 4 settling times.")] = 9,
+                                                "detected onset to 4 settling times.")] = 13,
+    noise_factors: Annotated[Optional[str], typer.Option(
+        "--noise-factors", help="sigma/dT tabulated, as multiples of the rig's own, comma-separated, 1 among them "
+                                "(default 1: the rig's alone; each factor costs as much as the first).")] = None,
     trials: Annotated[int, typer.Option("--trials", help="Touches per effusivity interval (the paper: 100).")] = 100,
     seed: Annotated[int, typer.Option("--seed", help="Random seed.")] = 0,
     jobs: Annotated[int, typer.Option("--jobs", "-j", help="Worker processes (-1: all cores).")] = -1,
@@ -35,8 +38,8 @@ def tables_build(
     """Build the lookup table of a calibrated sensor and register it, so that its questions answer in
     milliseconds.
 
-    The table is swept at the rig's conditions as calibrated (its model, its sigma/dT and half and twice
-    it, contact times counted from the rig's detected onset) over the effusivities of the materials named
+    The table is swept at the rig's conditions as calibrated (its model, its sigma/dT, its correlated
+    noise, touches read and contact times counted from the rig's detected onset) over the effusivities of the materials named
     (or a range, or 0 to 40000). It is registered under the digest of the sensor's content in the user's
     data folder (``$DESIGNKIT_DATA_DIR`` when set): later `--sensor FILE` questions read it; an edited or
     recalibrated sensor file has another digest and is computed again until its own table is built. A
@@ -52,7 +55,8 @@ def tables_build(
     from ._format import check_out, check_out_dir
 
     span = effusivity_span(material_set=materials, materials=tuple(m or ()), e_range=e_range)
-    cfg = sensor_sweep_config(sensor, span=span, contact_points=contact_points, trials=trials, seed=seed)
+    cfg = sensor_sweep_config(sensor, span=span, contact_points=contact_points, trials=trials, seed=seed,
+                              noise_factors=_factors(noise_factors))
     if out is not None:
         if out.suffix == ".npz":
             check_out(out, "--out")
@@ -123,3 +127,16 @@ def _cpu_s() -> float:
         except psutil.Error:  # gone meanwhile: counted in children_* once waited for
             pass
     return t.user + t.system + t.children_user + t.children_system + alive
+
+
+def _factors(text: Optional[str]) -> tuple[float, ...]:
+    """``--noise-factors`` read (one line naming what is wrong otherwise)."""
+    from .._validation import InputError
+    from ..sweep.for_sensor import NOISE_FACTORS
+
+    if text is None:
+        return NOISE_FACTORS
+    try:
+        return tuple(float(x) for x in text.split(",") if x.strip())
+    except ValueError:
+        raise InputError(f"--noise-factors must be numbers separated by commas, got {text!r}") from None

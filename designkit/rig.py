@@ -376,7 +376,7 @@ def rig_arguments(scene_keys: Sequence[str], arguments: Mapping[str, Any]) -> tu
     if sen is None or not getattr(sen, "conditions", None):
         return {k: v for k, v in arguments.items() if not (k in keys and v is None)}, None
     rig = resolve_scene(sen, {k: arguments.get(k) for k in keys})
-    return {**arguments, **{k: rig.values[k] for k in keys}}, rig
+    return {**arguments, "sensor": sen, **{k: rig.values[k] for k in keys}}, rig  # (the file read once)
 
 
 def for_rig(answer, scene: RigScene, asked_contact_s: float | None = None):

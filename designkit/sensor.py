@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any, Mapping
 
 import numpy as np
+from cachetools import LRUCache
 
 from ._validation import InputError, check_effusivity, check_label, check_nonnegative, check_positive
 from .properties import time_constant
@@ -433,5 +434,16 @@ def load_sensor(name_or_path: "str | Path | Sensor") -> Sensor:
         return SENSORS[key]
     p = Path(key)
     if p.suffix.lower() in (".yaml", ".yml") or p.exists():
-        return Sensor.from_yaml(p)
+        try:  # read once per process while the file is unchanged (a calibrated file is thousands of lines)
+            st = p.stat()
+            stamp = (str(p.resolve()), st.st_mtime_ns, st.st_size)
+        except OSError:  # from_yaml says what is missing
+            return Sensor.from_yaml(p)
+        if stamp not in _READ:
+            _READ[stamp] = Sensor.from_yaml(p)
+        return _READ[stamp]
     raise InputError(f"unknown sensor {key!r}: use a preset ({', '.join(SENSORS)}) or a sensor YAML file")
+
+
+#: Sensor files read by this process, keyed by (path, modification time, size): the frozen Sensor is shared.
+_READ: "LRUCache[tuple, Sensor]" = LRUCache(16)

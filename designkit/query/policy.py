@@ -18,7 +18,7 @@ Examples
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, Mapping
 
 from .._validation import InputError
@@ -40,13 +40,15 @@ EXACT_OPTIONS = frozenset({"diffusivity_m2_s", "width", "trials", "folds", "seed
 class TableChoice:
     """The table that answers a question (``table``: a name or path; None: none does) and why (``reason``);
     ``noted``: the reason belongs in the answer's notes too (it answers for another sensor or model than the
-    tables are built for); ``sensor_table``: the table was built for this sensor file (``designkit tables build``,
-    :func:`designkit.tables.registry.table_for_sensor`): read without the paper's ideal table (:func:`sensor_table_answer`)."""
+    tables are built for); ``sensor_table``: the table was built for this sensor file (``designkit tables
+    build``, :func:`designkit.tables.registry.table_for_sensor`): read without the paper's ideal table
+    (:func:`sensor_table_answer`); ``loaded``: that table, loaded and checked (the route does not read it again)."""
 
     table: str | None
     reason: str
     noted: bool = False
     sensor_table: bool = False
+    loaded: Any = field(default=None, compare=False, repr=False)
 
 
 def table_for(question: str, *, sensor=None, model=None, sensor_temp_spread_c: float = 0.0,
@@ -111,7 +113,7 @@ def _registered_table(sen, fm, spread: float) -> TableChoice | None:
     if tab is None or (fm is not None and get_model(fm) != tab.model):
         return None
     return TableChoice(str(tab.path), f"table {tab.name} is built for sensor {sen.name} as calibrated (designkit "
-                                      "tables build)", sensor_table=True)
+                                      "tables build)", sensor_table=True, loaded=tab)
 
 
 def _sensor_and_model(sensor, model):
@@ -165,6 +167,7 @@ def choose_route(question: str, route: str, arguments: Mapping[str, Any]) -> tup
         args["table"] = choice.table
     if choice.sensor_table:  # its model has no closed-form ideal observer: no paper's ideal table either
         args["ideal_table"] = None
+        args["table"] = choice.loaded  # (found and checked once: not read again by the route)
     return "table", args, choice
 
 
@@ -211,9 +214,7 @@ def sensor_table_answer(question: str, ans, choice: TableChoice, sensor):
         from ..rig import from_model_contact, model_start_s  # counted as the rig counts: from the onset
 
         start = model_start_s(sen)
-        from ..tables.store import load_table
-
-        own = load_table(choice.table)
+        own = choice.loaded
         at = [f"{max(from_model_contact(float(t), start), 0.0):.3g}" for t in
               ((own.axes["contact_s"][-1],) if ans.value is None else ans.interval)]
         notes = ((f"no tabulated contact time up to {at[0]} s after the rig's detected onset separates them (--exact "

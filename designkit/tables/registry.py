@@ -29,6 +29,8 @@ import os
 from pathlib import Path
 from typing import Any, Mapping
 
+from cachetools import LRUCache
+
 from .._validation import InputError
 
 __all__ = ["DATA_DIR_VARIABLE", "default_table_dir", "entry_path", "register_table", "registry_dir", "sensor_digest",
@@ -122,8 +124,9 @@ def table_for_sensor(sensor):
     damaged, edited or built for another sensor is refused (:class:`~designkit._validation.InputError`,
     one line saying what to do), never used and never silently skipped.
 
-    The question route calls it for a ``--sensor`` question (the CLI's ``_ask_scene``); a table found
-    answers the question (:mod:`designkit.query.table`), else the question is computed (``--exact``).
+    The library's route policy calls it for a question about a sensor file (:func:`designkit.query.policy.
+    table_for`); a table found answers the question (:mod:`designkit.query.table`), else it is computed (the
+    exact route). Found once per process while its files are unchanged.
     """
     from ..sensor import load_sensor
 
@@ -144,9 +147,13 @@ def table_for_sensor(sensor):
         raise InputError(f"sensor table registry entry {path} is for another sensor: delete it, or rebuild with "
                          "'designkit tables build --sensor FILE'")
     npz = Path(entry["table"])
-    if not (npz.is_file() and npz.with_suffix(".json").is_file()):
+    try:
+        key = (digest, raw, *((st.st_mtime_ns, st.st_size) for st in (npz.stat(), npz.with_suffix(".json").stat())))
+    except OSError:
         raise InputError(f"the table registered for sensor {sensor.name} ({npz}) is missing: rebuild it with "
-                         "'designkit tables build --sensor FILE', or ask with --exact")
+                         "'designkit tables build --sensor FILE', or ask with --exact") from None
+    if key in _FOUND:  # found and checked by this process, its files unchanged since
+        return _FOUND[key]
     from .store import load_table
 
     table = load_table(npz)
@@ -154,7 +161,13 @@ def table_for_sensor(sensor):
         raise InputError(f"the table registered for sensor {sensor.name} ({npz}) was replaced since it was "
                          "registered: rebuild it with 'designkit tables build --sensor FILE', or ask with --exact")
     _check_built_for(table, digest, sensor.name)
+    _FOUND[key] = table
     return table
+
+
+#: Tables found by :func:`table_for_sensor` in this process, keyed by the sensor's digest, its registry entry and
+#: the table's files' modification times and sizes (a question reads and hashes the table once, not every time).
+_FOUND: "LRUCache[tuple, Any]" = LRUCache(8)
 
 
 def _entry(raw: str, path: Path) -> Mapping[str, Any]:

@@ -434,9 +434,10 @@ def load_sensor(name_or_path: "str | Path | Sensor") -> Sensor:
         return SENSORS[key]
     p = Path(key)
     if p.suffix.lower() in (".yaml", ".yml") or p.exists():
-        try:  # read once per process while the file is unchanged (a calibrated file is thousands of lines)
-            st = p.stat()
-            stamp = (str(p.resolve()), st.st_mtime_ns, st.st_size)
+        try:  # parsed once per process while its content is the same (a calibrated file is thousands of lines)
+            import hashlib
+
+            stamp = (str(p.resolve()), hashlib.sha256(p.read_bytes()).hexdigest())
         except OSError:  # from_yaml says what is missing
             return Sensor.from_yaml(p)
         if stamp not in _READ:
@@ -445,5 +446,5 @@ def load_sensor(name_or_path: "str | Path | Sensor") -> Sensor:
     raise InputError(f"unknown sensor {key!r}: use a preset ({', '.join(SENSORS)}) or a sensor YAML file")
 
 
-#: Sensor files read by this process, keyed by (path, modification time, size): the frozen Sensor is shared.
+#: Sensor files parsed by this process, keyed by (path, SHA-256 of the content): the frozen Sensor is shared.
 _READ: "LRUCache[tuple, Sensor]" = LRUCache(16)

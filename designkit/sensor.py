@@ -374,6 +374,8 @@ MODEL_KEYS = ("name", "params", "time_offset_s", "contact_spread", "object_tempe
 
 def _plain(value: Any) -> Any:
     """JSON/YAML-ready copy: mappings to dicts, tuples to lists, numpy scalars to Python numbers."""
+    if type(value) in (int, str, bool) or (type(value) is float and not math.isinf(value)):
+        return value  # (most of a calibrated file's thousands of values: no slower Mapping check first)
     if isinstance(value, Mapping):
         return {str(k): _plain(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):

@@ -78,11 +78,13 @@ def table_for(question: str, *, sensor=None, model=None, sensor_temp_spread_c: f
     """
     from .table import DEFAULT_TABLE, shipped_spread_table
 
-    sen, fm = _sensor_and_model(sensor, model)
+    from ..sensor import load_sensor
+
     spread = float(sensor_temp_spread_c or 0.0)
-    own = _registered_table(sen, fm, spread)
+    own = _registered_table(load_sensor(sensor if sensor is not None else "paper"), model, spread)
     if own is not None:
         return own
+    sen, fm = _sensor_and_model(sensor, model)
     why = table_reroute(sen, fm)
     if why is not None:
         if getattr(sen, "conditions", None):
@@ -102,8 +104,9 @@ def table_for(question: str, *, sensor=None, model=None, sensor_temp_spread_c: f
 
 def _registered_table(sen, fm, spread: float) -> TableChoice | None:
     """The table registered for sensor file ``sen`` (:func:`~designkit.tables.registry.table_for_sensor`) when it
-    answers under model ``fm`` at fixed initial conditions; None otherwise (a registered table that is damaged or
-    built for another sensor is refused there, in one line)."""
+    answers under model ``fm`` (None: the file's own, the one the table was built with) at fixed initial
+    conditions; None otherwise (a registered table that is damaged or built for another sensor is refused there,
+    in one line)."""
     if not getattr(sen, "conditions", None) or spread > 0:
         return None
     from ..models import get_model
@@ -168,6 +171,7 @@ def choose_route(question: str, route: str, arguments: Mapping[str, Any]) -> tup
     if choice.sensor_table:  # its model has no closed-form ideal observer: no paper's ideal table either
         args["ideal_table"] = None
         args["table"] = choice.loaded  # (found and checked once: not read again by the route)
+        args["model"] = choice.loaded.model  # (the file's own, or the same asked: not rebuilt from the file)
     return "table", args, choice
 
 

@@ -54,7 +54,9 @@ __all__ = ["BuiltTable", "FIRST_CONTACT_S", "LONGEST_CONTACT_SCALES", "NOISE_FAC
 NOISE_FACTORS = (1.0,)
 #: The first tabulated contact after the rig's detected onset [s].
 FIRST_CONTACT_S = 0.1
-#: The longest tabulated contact after the onset, in units of the sensor's settling time.
+#: The longest tabulated contact after the onset, in units of the sensor's settling time. With the real rig's
+#: correlated noise some of the paper's pairs need longer (up to ~9 s; benchmarks/results/sensor_table_rig_scene.txt):
+#: the table says none up to its last contact separates them, ``--exact`` searches up to 10 s.
 LONGEST_CONTACT_SCALES = 4.0
 #: Contact times tabulated (geometric between the two ends, counted from the onset): ratio 1.33 between
 #: neighbours for the rig (0.1 to 3 s), 1.1-1.2 in the model's time where the paper's materials separate

@@ -63,9 +63,21 @@ def sensor_digest(sensor) -> str:
     >>> a == sensor_digest(SENSORS["paper"].replace(noise_c=0.01))
     False
     """
+    import weakref
+
     from ..sensor import load_sensor
 
-    return _content_digest(load_sensor(sensor).to_dict())
+    sen = load_sensor(sensor)
+    hit = _DIGESTS.get(id(sen))
+    if hit is not None and hit[0]() is sen:  # the same (frozen) sensor: a calibrated file's is thousands of values
+        return hit[1]
+    digest = _content_digest(sen.to_dict())
+    _DIGESTS[id(sen)] = (weakref.ref(sen), digest)
+    return digest
+
+
+#: :func:`sensor_digest` per sensor object alive in this process (load_sensor gives one object per file content).
+_DIGESTS: "LRUCache[int, tuple]" = LRUCache(16)
 
 
 def _content_digest(record: Mapping[str, Any]) -> str:

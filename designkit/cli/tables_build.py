@@ -48,7 +48,7 @@ def tables_build(
 
     The paper's 12 materials at the paper's 100 trials per interval: `--materials paper12` (minutes on 2 cores).
 
-    Example (two materials, a quick coarse table): `designkit tables build --sensor my-sensor.yaml --m wood --m glass --trials 20`
+    Example (two materials, a quick coarse table): `designkit tables build --sensor my-sensor.yaml --m wood --m glass --trials 10 --contact-points 4`
     """
     from ..sweep import SweepInterrupted
     from ..sweep.for_sensor import build_sensor_table, effusivity_span, sensor_sweep_config

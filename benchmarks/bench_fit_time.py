@@ -23,7 +23,9 @@ from pathlib import Path
 
 import numpy as np
 
+from designkit.calibration import compare as cmpm
 from designkit.calibration import identify as idm
+from designkit.calibration.candidates import CANDIDATES, PARAMS
 from designkit.calibration.fit import parse_ranges, resolve_ranges
 from designkit.calibration.trials import load_index
 from designkit.models import layered
@@ -70,25 +72,25 @@ def _warm_start_baseline(cand, done):
             continue
         n_prev = len(prev.candidate.free)
         x = [prev.x[prev.candidate.free.index(p)] if p in prev.candidate.free
-             else idm._PARAMS[p].to_x(idm._PARAMS[p].start) for p in cand.free]
+             else PARAMS[p].to_x(PARAMS[p].start) for p in cand.free]
         return np.concatenate([x, prev.x[n_prev:]])
     return None
 
 
 @contextmanager
 def _baseline():
-    saved = layered.savgol_smooth, idm._area_weighted, idm._warm_start
-    layered.savgol_smooth, idm._area_weighted, idm._warm_start = (_savgol_baseline, _area_weighted_baseline,
+    saved = layered.savgol_smooth, idm.area_weighted, cmpm._warm_start
+    layered.savgol_smooth, idm.area_weighted, cmpm._warm_start = (_savgol_baseline, _area_weighted_baseline,
                                                                   _warm_start_baseline)
     try:
         yield
     finally:
-        layered.savgol_smooth, idm._area_weighted, idm._warm_start = saved
+        layered.savgol_smooth, idm.area_weighted, cmpm._warm_start = saved
 
 
 def _run(trials, ranges):
     c0, t0 = time.process_time(), time.perf_counter()
-    cmp = idm.compare_models(trials, [], idm.CANDIDATES, ranges=ranges)
+    cmp = cmpm.compare_models(trials, [], CANDIDATES, ranges=ranges)
     return time.process_time() - c0, time.perf_counter() - t0, cmp
 
 
@@ -98,7 +100,7 @@ def main() -> None:
     args = ap.parse_args()
     trials = load_index(args.data / "index.csv", only=["metal", "wood"])
     ranges = resolve_ranges(["metal", "wood"], parse_ranges(["metal=aluminium"]))
-    print(f"{len(trials)} touches, {len(idm.CANDIDATES)} candidates; load average {os.getloadavg()[0]:.2f} "
+    print(f"{len(trials)} touches, {len(CANDIDATES)} candidates; load average {os.getloadavg()[0]:.2f} "
           f"(on {os.cpu_count()} cores)")
     cpu, wall, cmp = _run(trials, ranges)
     print(f"current : {cpu:6.1f} s CPU, {wall:6.1f} s wall; selected {cmp.selected} "

@@ -5,8 +5,8 @@ Run from the repository root (a few minutes on the shared 2 cores; be nice)::
     nice -n 10 python benchmarks/bench_sensor_residuals.py                  # all candidates, figure
     nice -n 10 python benchmarks/bench_sensor_residuals.py --json res.json --figure docs/sensor_residuals.png
 
-Every candidate of :data:`designkit.calibration.identify.CANDIDATES` is fitted on the metal and wood
-touches of trial sets 1-4 (:func:`~designkit.calibration.identify.compare_models`; object temperatures
+Every candidate of :data:`designkit.calibration.candidates.CANDIDATES` is fitted on the metal and wood
+touches of trial sets 1-4 (:func:`~designkit.calibration.compare.compare_models`; object temperatures
 from the passive channel before contact) and scored on sets 5-20, each held-out touch with its own
 initial state (Ts0, and the drift where the candidate has it). Printed: the residual RMS per material,
 AIC/BIC on the fitted touches, e_s with its 95 % interval, fit time and the load average; then, for the
@@ -25,7 +25,10 @@ from pathlib import Path
 
 import numpy as np
 
-from designkit.calibration.identify import CANDIDATES, compare_models, residual_series, split_by_trial_set
+from designkit.calibration.candidates import CANDIDATES
+from designkit.calibration.compare import compare_models
+from designkit.calibration.identify import residual_series
+from designkit.calibration.split import split_by_trial_set
 from designkit.calibration.trials import load_index
 
 RANGES = {"metal": (12767.0, 25972.0), "wood": (331.0, 506.46)}   # the paper's aluminium and wood

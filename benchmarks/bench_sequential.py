@@ -20,7 +20,7 @@ conditions). For each requested error rate eps (the same on both classes):
   300 touches per class, is at least 1 - eps: what a robot using designkit's
   tables waits);
 - the ratios fixed / mean time to decision;
-- the optimal sequential test (:func:`designkit.recognition.sequential.optimal_test`,
+- the optimal sequential test (:func:`designkit_lab.sequential_bound.optimal_test`,
   backward induction, longest contact 3 s, each class at its centre: 3 points per class
   gave the same figures to 4 decimals at eps 0.01, 2.5x slower):
   the bound no test reaches the same mean error rate under (Lagrangian dual), and the
@@ -43,7 +43,8 @@ from scipy import stats
 
 from designkit import SENSORS, Scene
 from designkit.objects import ObjectClass
-from designkit.recognition.sequential import SequentialTest, optimal_test, run_batch, run_boundaries
+from designkit.recognition.sequential import SequentialTest, run_batch
+from designkit_lab.sequential_bound import optimal_test, run_boundaries
 from designkit.recognition.svm import pair_f1
 from designkit.simulation import simulate_class
 

@@ -10,7 +10,7 @@ noise 0.05 degC, dT 10 degC, 200 Hz, fixed initial conditions) on the paper's se
 with the thermistor moved closer to the surface: ``tau = x^2 / (4 alpha_s)`` scaled by
 1, 0.3, 0.1 and 0.03. For each error rate eps (the same on both classes): the shortest
 fixed contact at which the ideal observer reaches it (closed form), the bound no
-sequential test beats (:func:`designkit.recognition.sequential.optimal_test`:
+sequential test beats (:func:`designkit_lab.sequential_bound.optimal_test`:
 backward induction, each class at its centre), Wald's SPRT's mean time under the same
 recursion, and the ratio fixed / bound: the most any live decision can save.
 
@@ -31,7 +31,8 @@ import time
 import numpy as np
 
 from designkit import SENSORS
-from designkit.recognition.sequential import SequentialTest, optimal_test
+from designkit.recognition.sequential import SequentialTest
+from designkit_lab.sequential_bound import optimal_test
 
 
 def main(argv=None):

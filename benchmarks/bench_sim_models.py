@@ -12,6 +12,13 @@ subprocess in the same run; the new code is this tree's. Also printed: the large
 the new readings from the old on the same draws (normalized, i.e. in units of ``|Ts0 - Ta|``) and
 the tolerance the simulation asks (1 % of the noise over the curve).
 
+A sweep reads many classes of one scene: ``SCENE`` renders every class of a 60-interval grid (0-24,000
+J s^-1/2 K^-1 m^-2, the rig's materials' span) and 100 intervals of the paper's (width 80), 2 repeats
+each (seeds as a sweep's), and prints each model's CPU per touch over the whole scene against the
+semi-infinite touch's (issue 35's target: at most 2x), old code and new, with the largest difference of
+the new readings from the old and from the model read directly at every touch's effusivity (the
+independent reference: no interpolation), on every 10th touch of 6 classes, every sample.
+
 Run: ``PYTHONPATH=. python benchmarks/bench_sim_models.py [--repeats 5] [--baseline c8fe4cc]``.
 """
 
@@ -89,6 +96,52 @@ print(json.dumps(out))
 '''
 
 
+SCENE = r'''
+import json, sys, time
+import numpy as np
+import scipy.interpolate, scipy.signal, scipy.special  # imports outside the timings
+from designkit import Scene
+from designkit.sensor import Sensor
+from designkit.models import get_model
+from designkit.models.ramp import ForceRamp
+from designkit.simulation import draw_trials, render_trials
+
+sensor = Sensor(1980.74, 8.798e-09, depth_m=8e-5, name="rig")
+layered = get_model("layered", film_thickness_m=0.000221, backing_effusivity_ws05_m2k=1980742.7,
+                    conductance_w_m2k=18496.5, lag_s=2.618, smoothing_window=99, smoothing_order=3)
+tp = np.arange(-50, 76) * 0.02
+ramp = ForceRamp.from_force_profile(layered, tp, np.clip(0.05 + 0.95 * (tp + 0.5) / 2.5, 0, 1), 0.168)
+models = {"semi-infinite": get_model(), "contact": get_model("contact", conductance_w_m2k=2500.0),
+          "layered": layered, "force-ramp": ramp}
+grids = {"rig-60": np.linspace(0.0, 24000.0, 61), "paper-100": 80.0 * np.arange(101)}
+sample = (1, 7, 19, 33, 48, 59)
+out = {}
+for gname, edges in grids.items():
+    for contact in (2.0, 10.0):
+        scene = Scene(contact_s=contact, noise_c=0.05)
+        m = sensor.times_s(contact).size
+        render_trials(draw_trials(331.0, 506.0, 2, m, [0]), sensor, scene, get_model())   # imports
+        for name, fm in models.items():
+            us = {}
+            t0 = time.process_time()
+            for k in range(edges.size - 1):
+                for rep in (0, 1):
+                    d = draw_trials(edges[k], edges[k + 1], 100, m, [0, k, rep])
+                    temps = render_trials(d, sensor, scene, fm).temperature_c
+                    if rep == 0 and k in sample:
+                        us[k] = ((temps - scene.sensor_temp_c - scene.noise_c * d.noise)
+                                 / (scene.ambient_temp_c - scene.sensor_temp_c), d.effusivity)
+            cpu = time.process_time() - t0
+            direct = 0.0
+            if name in ("layered", "force-ramp"):
+                t = np.arange(m) / sensor.sample_rate_hz
+                direct = max(float(np.max(np.abs(u - fm.response(t, e, sensor)))) for u, e in us.values())
+            out[f"{name}@{contact:g}@{gname}"] = {"touch_s": cpu / (2 * 100 * (edges.size - 1)), "direct": direct,
+                                                  "u": [u[::10].tolist() for u, _ in us.values()]}
+print(json.dumps(out))
+'''
+
+
 def run(pythonpath: str, repeats: int, code: str = CASE) -> dict:
     env = dict(os.environ, PYTHONPATH=pythonpath, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1",
                MKL_NUM_THREADS="1")  # one core per process, as a sweep worker has
@@ -115,8 +168,10 @@ def main() -> None:
         subprocess.run(["tar", "-x", "-C", tmp], input=tar, check=True)
         old = run(tmp, args.repeats)
         old_direct = run(tmp, 0, DIRECT)
+        old_scene = run(tmp, 0, SCENE)
     new = run(str(root), args.repeats)
     new_direct = run(str(root), 0, DIRECT)
+    new_scene = run(str(root), 0, SCENE)
     print(f"per-touch simulation cost (draw + render, 100 touches of wood, 200 Hz), old = {args.baseline}, "
           "new = this tree; ratio to the semi-infinite touch of the same code")
     print(f"{'model':<14}{'contact':>8}{'old warm':>11}{'ratio':>7}{'new warm':>11}{'ratio':>7}"
@@ -131,6 +186,21 @@ def main() -> None:
         print(f"{name:<14}{contact + ' s':>8}{o['warm_s'] * 1e3:>9.3f}ms{o['warm_s'] / base_o['warm_s']:>7.1f}"
               f"{n['warm_s'] * 1e3:>9.3f}ms{n['warm_s'] / base_n['warm_s']:>7.1f}"
               f"{n['cold_s'] * 1e3:>9.3f}ms{n['cold_s'] / base_n['warm_s']:>7.1f}{du:>11.2e}{tol:>10.1e}")
+    print("a whole scene (every class of the grid, 2 repeats, 100 touches each), CPU per touch and its ratio to the "
+          "semi-infinite touch of the same code; max|du|: new against old readings; direct: new against the model "
+          "read at every touch's effusivity")
+    print(f"{'model':<14}{'grid':>10}{'contact':>8}{'old':>11}{'ratio':>7}{'new':>11}{'ratio':>7}{'max|du|':>11}"
+          f"{'direct':>10}{'tol':>10}")
+    for key in new_scene:
+        name, contact, grid = key.split("@")
+        base_o, base_n = old_scene[f"semi-infinite@{contact}@{grid}"], new_scene[f"semi-infinite@{contact}@{grid}"]
+        o, n = old_scene[key], new_scene[key]
+        du = max(float(np.max(np.abs(np.array(a) - np.array(b)))) for a, b in zip(o["u"], n["u"]))
+        m = int(float(contact) * 200) + 1
+        tol = response_tolerance(Scene(contact_s=float(contact), noise_c=0.05).noise_ratio, m)
+        print(f"{name:<14}{grid:>10}{contact + ' s':>8}{o['touch_s'] * 1e3:>9.4f}ms"
+              f"{o['touch_s'] / base_o['touch_s']:>7.2f}{n['touch_s'] * 1e3:>9.4f}ms"
+              f"{n['touch_s'] / base_n['touch_s']:>7.2f}{du:>11.2e}{n['direct']:>10.2e}{tol:>10.1e}")
     o = np.concatenate([np.ravel(a) for a in old_direct])
     n = np.concatenate([np.ravel(a) for a in new_direct])
     big = np.abs(o) > 1e-6

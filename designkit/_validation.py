@@ -22,6 +22,7 @@ __all__ = [
     "check_file_name",
     "check_finite",
     "check_label",
+    "error_line",
     "check_memory",
     "check_temperature",
     "check_nonnegative",
@@ -176,6 +177,12 @@ def check_file_name(what: str, name: Any) -> str:
 
 def _short(text: str, n: int = 60) -> str:
     return repr(text if len(text) <= n else text[:n] + "...")
+
+
+def error_line(exc: BaseException) -> str:
+    """The first line of an exception's message (its type's name when it has none): one line for a user."""
+    text = str(exc).strip()
+    return text.splitlines()[0] if text else type(exc).__name__
 
 
 #: Seeds averaged per pair (a sweep's ``max_repeats``, an exact question's ``repeats``): the Monte

@@ -1,11 +1,12 @@
 """designkit's lab: what measures and reports designkit, outside the installed core.
 
 :mod:`designkit_lab.accuracy` (``designkit bench``: every answering route against a reference),
-:mod:`designkit_lab.reproduce` (``designkit reproduce``: the paper's figures and tables) and
-:mod:`designkit_lab.roundtrip` (synthetic calibration round trips, ``benchmarks/bench_roundtrip.py``).
+:mod:`designkit_lab.reproduce` (``designkit reproduce``: the paper's figures and tables),
+:mod:`designkit_lab.roundtrip` (synthetic calibration round trips, ``benchmarks/bench_roundtrip.py``) and
+:mod:`designkit_lab.sequential_bound` (the optimal sequential test: the bound on the core's live decisions).
 The lab imports the core (:mod:`designkit`); the core never imports the lab, except the two CLI
 commands above, which load it when they run. Installed by the same distribution; its figures need
 ``pip install 'designkit[lab]'`` (matplotlib, networkx).
 """
 
-__all__ = ["accuracy", "reproduce", "roundtrip"]
+__all__ = ["accuracy", "reproduce", "roundtrip", "sequential_bound"]

@@ -83,7 +83,7 @@ class RoundTripCase:
     force_area: bool = False
 
     def candidate(self):
-        from designkit.calibration.identify import Candidate
+        from designkit.calibration.candidates import Candidate
 
         free = self.free + (("contact_force_fraction",) if self.force_area else ())
         return Candidate(self.label, str(self.model["name"]), free, dict(self.fixed), self.smoothing,
@@ -210,7 +210,7 @@ def _record(case: RoundTripCase, seed: int, noise_c: float, touches: int, speed:
 
 def _host_smoothed(trials):
     from designkit.models.layered import savgol_smooth
-    from designkit.calibration.identify import HOST_SMOOTHING
+    from designkit.calibration.candidates import HOST_SMOOTHING
     from designkit.calibration.trials import Trial
 
     return [Trial(t.time_s, savgol_smooth(t.sensor_c, *HOST_SMOOTHING), t.object_c, t.force_n, t.material,

@@ -24,7 +24,10 @@ from pathlib import Path
 from designkit import SENSORS
 from designkit.calibration.emulator import EmulatedMaterial, Emulator, TouchPlan
 from designkit.calibration.fit import parse_ranges, resolve_ranges
-from designkit.calibration.identify import CANDIDATES, choose_split, compare_models, identify
+from designkit.calibration.candidates import CANDIDATES
+from designkit.calibration.compare import compare_models
+from designkit.calibration.identify import identify
+from designkit.calibration.split import choose_split
 from designkit.calibration.profiles import load_profile
 from designkit.calibration.recorder import SerialRecorder
 from designkit.calibration.trials import load_index

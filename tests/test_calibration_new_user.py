@@ -150,7 +150,7 @@ def test_a_run_out_of_step_with_the_emulator_stops_before_a_wrong_label(cli, tmp
 def test_an_announcement_names_the_emulators_materials(tmp_path):
     """A run that missed the first line still knows the emulator's labels from any touch's announcement."""
     from designkit._validation import InputError
-    from designkit.calibration.emulator import parse_announcement
+    from designkit.calibration.touch_plan import parse_announcement
     from designkit.cli.calibrate import _EmulatorWatch
 
     emu = _two_materials(2)

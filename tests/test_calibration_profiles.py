@@ -14,15 +14,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from designkit._validation import InputError
-from designkit.calibration.profiles import (
-    ROLES,
-    Identity,
-    Linear,
-    Thermistor,
-    list_profiles,
-    load_profile,
-    profile_from_dict,
-)
+from designkit.calibration.conversions import Identity, Linear, Thermistor
+from designkit.calibration.profiles import ROLES, list_profiles, load_profile, profile_from_dict
 
 # ----------------------------------------------------------------- strategies
 bits = st.integers(min_value=8, max_value=16)

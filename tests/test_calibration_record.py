@@ -22,7 +22,8 @@ from designkit import SENSORS
 from designkit._validation import InputError
 from designkit.calibration.emulator import EmulatedMaterial, Emulator, Faults, TouchPlan
 from designkit.calibration.profiles import list_profiles, load_profile, profile_from_dict
-from designkit.calibration.recorder import DeviceGone, NoData, SerialRecorder, TooManyBadLines, TrialCutter
+from designkit.calibration.cutter import TrialCutter
+from designkit.calibration.recorder import DeviceGone, NoData, SerialRecorder, TooManyBadLines
 from designkit.calibration.trials import load_index, read_trial_csv, recorded_trials, write_trial
 from designkit.models.semi_infinite import sensor_temperature
 

@@ -14,7 +14,9 @@ import pytest
 from scipy import integrate
 
 from designkit import SENSORS, InputError
-from designkit.calibration.identify import Candidate, identify, nominal_force_profile, relative_force
+from designkit.calibration.candidates import Candidate
+from designkit.calibration.force import nominal_force_profile, relative_force
+from designkit.calibration.identify import identify
 from designkit.calibration.trials import Trial
 from designkit.models import get_model, load_sensor_model, sensor_model, sensor_model_notes
 from designkit.models.ramp import ForceRamp, area_share

@@ -8,7 +8,10 @@ import numpy as np
 import pytest
 
 from designkit import InputError
-from designkit.calibration.identify import Candidate, compare_models, identify, score, split_by_trial_set
+from designkit.calibration.candidates import Candidate
+from designkit.calibration.compare import compare_models
+from designkit.calibration.identify import identify, score
+from designkit.calibration.split import split_by_trial_set
 from designkit.calibration.trials import Trial, load_index
 from designkit.models import get_model
 from designkit.sensor import Sensor
@@ -217,7 +220,7 @@ def _chain_touches(seed: int, n_per: int = 6, noise_c: float = 0.01) -> list[Tri
     Written independently of identify's convolution: each touch's reading is the area-weighted sum of
     step responses, summed sample by sample in a loop.
     """
-    from designkit.calibration.identify import contact_area
+    from designkit.calibration.force import contact_area
 
     rng = np.random.default_rng(seed)
     sensor = Sensor(TRUE_ES, CHAIN_TRUE["diffusivity_m2_s"], depth_m=80e-6)
@@ -253,7 +256,7 @@ def test_drift_and_force_area_round_trip_recovers_the_parameters_and_the_shape()
     assert hc == pytest.approx(CHAIN_TRUE["conductance_w_m2k"] / TRUE_ES, rel=0.02)
     # the identified reading, given a touch's own force, is the shape the touch was made from
     tr = trials[0]
-    from designkit.calibration.identify import relative_force
+    from designkit.calibration.force import relative_force
 
     v, b = res.reading(tr.time_s, tr.material, force=relative_force(tr), force_time_s=tr.time_s, drift=True)
     coef = np.linalg.lstsq(np.stack([1 - v, b, v], axis=1), tr.sensor_c, rcond=None)[0]
@@ -309,11 +312,11 @@ def test_passive_object_temp_reads_the_object_through_the_passive_response():
 
 
 def test_cr2_covariance_and_bell_mccaffrey_degrees_of_freedom_match_the_dense_formulas():
-    """_sandwich against the textbook formulas written with dense N x N matrices (Imbens & Kolesar 2016,
+    """cluster_sandwich against the textbook formulas written with dense N x N matrices (Imbens & Kolesar 2016,
     eqs. for V_CR2 and K_BM): unequal touches, one of which carries most of a parameter."""
     from scipy.linalg import sqrtm
 
-    from designkit.calibration.identify import _sandwich
+    from designkit.calibration.robust import cluster_sandwich
 
     rng = np.random.default_rng(5)
     sizes = [30, 8, 12, 25, 5, 20]
@@ -323,7 +326,7 @@ def test_cr2_covariance_and_bell_mccaffrey_degrees_of_freedom_match_the_dense_fo
     J = np.column_stack([np.ones(n), rng.normal(size=n), carried])
     r = rng.normal(size=n) * (1 + cl)
     r -= J @ np.linalg.lstsq(J, r, rcond=None)[0]      # residuals orthogonal to J, as at a least-squares optimum
-    cov, df = _sandwich(J, r, cl)
+    cov, df = cluster_sandwich(J, r, cl)
     B = np.linalg.inv(J.T @ J)
     H = J @ B @ J.T
     meat = np.zeros((3, 3))
@@ -359,7 +362,7 @@ def _plateau_trials(n: int, sigma_n: float, plateau_n: float, seed: int) -> list
 
 @pytest.mark.parametrize("sigma_n, plateau_n", [(0.02, 10.0), (0.05, 4.5), (0.002, 4.5)])
 def test_force_noise_reads_the_white_noise_of_the_averaged_relative_force(sigma_n, plateau_n):
-    from designkit.calibration.identify import force_noise
+    from designkit.calibration.force import force_noise
 
     width = 5   # the 25 ms average at 200 Hz
     got = [force_noise(tr) for tr in _plateau_trials(20, sigma_n, plateau_n, seed=1)]
@@ -371,7 +374,7 @@ def test_force_noise_reads_the_white_noise_of_the_averaged_relative_force(sigma_
 
 def test_the_noise_band_keeps_the_plateau_area_whole_on_average():
     """The capped map reads a noisy plateau's area low by sigma E[max(Z, 0)] / (1 - c); the band does not."""
-    from designkit.calibration.identify import FORCE_NOISE_BAND_SD, contact_area, force_noise, relative_force
+    from designkit.calibration.force import FORCE_NOISE_BAND_SD, contact_area, force_noise, relative_force
 
     c, sigma_n, plateau_n = 0.3, 0.02, 10.0
     trials = _plateau_trials(200, sigma_n, plateau_n, seed=2)
@@ -402,7 +405,7 @@ def test_force_noise_does_not_bias_the_identified_ratios(monkeypatch):
     ref = fit.ratios["granite"].value
     assert abs(identify(noisy, CHAIN, ranges=RANGES).ratios["granite"].value / ref - 1) < 0.0006
     # a reading simulated from a measured (noisy) force: with its band it is the clean force's on the plateau
-    from designkit.calibration.identify import FORCE_NOISE_BAND_SD, force_noise, relative_force
+    from designkit.calibration.force import FORCE_NOISE_BAND_SD, force_noise, relative_force
 
     tr, tn = clean[-1], noisy[-1]
     late = tr.time_s >= 3.0
@@ -444,3 +447,17 @@ def test_reproduce_chooses_disjoint_calibration_and_test_touches_from_the_sets_p
     with pytest.raises(InputError) as exc:
         calibration_split(index(["2"]))
     assert str(exc.value) == "the recording has one trial set (9): no touches to hold out"
+
+
+
+def test_one_material_that_does_not_identify_e_s_is_refused_and_nothing_written(robot_data_dir, cli, tmp_path):
+    """Metal alone under the rig's model: its film and contact trade against e_s, so any e_s fits (issue 34).
+
+    One material says which, why and what to record: exit 2, and no sensor file.
+    """
+    path = tmp_path / "metal-only.yaml"
+    res = cli("calibrate", "fit", str(robot_data_dir / "index.csv"), "--only", "metal", "--range", "metal=aluminium",
+              "--model", "layered+lag+smoothing+drift+area", "--fit-sets", "1-2", "--out", str(path))
+    assert res.exit_code == 2, res.output
+    assert "do not identify the sensor's effusivity" in res.output and "one material, metal" in res.output
+    assert "Record a second material" in res.output and not path.exists()

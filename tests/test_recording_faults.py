@@ -29,8 +29,8 @@ from designkit import SENSORS
 from designkit._validation import InputError
 from designkit.calibration.emulator import EmulatedMaterial, Emulator, Faults, TouchPlan
 from designkit.calibration.profiles import list_profiles, load_profile, profile_from_dict
-from designkit.calibration.recorder import (SPIKE_SIGMAS, NoProgress, SerialRecorder, TrialCutter,
-                                            TrialNotWritten)
+from designkit.calibration.cutter import TrialCutter, TrialNotWritten
+from designkit.calibration.recorder import SPIKE_SIGMAS, NoProgress, SerialRecorder
 from designkit.calibration.trials import (MAX_STEM_CHARS, FolderBusy, FolderLock, check_material_label,
                                           load_index, recorded_trials, trial_stem, write_trial)
 

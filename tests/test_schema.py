@@ -162,7 +162,7 @@ def test_calibration_records_follow_the_schema():
     """An identified parameter (calibrate fit's results, a sensor file's provenance) and a force-driven contact
     area's threshold: the interval is {low, high, coverage}, whether the data identify it is ``identifiable``
     (a bool; ``identified`` is a paper12 material's identified effusivity, a number)."""
-    from designkit.calibration.identify import IdentifiedParameter
+    from designkit.calibration.results import IdentifiedParameter
 
     p = IdentifiedParameter("contact_force_fraction", 0.17, (-0.05, 0.38), "", False, "on a search bound")
     bad: list[str] = []

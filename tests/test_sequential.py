@@ -14,7 +14,7 @@ from designkit._validation import InputError
 from designkit.objects import ObjectClass
 from designkit.recognition.ideal import ideal_pair
 from designkit.recognition.sequential import (
-    KEEP_TOUCHING, NO_DECISION, NOT_SEPARABLE, SequentialTest, candidate_pieces, fixed_time_errors,
+    KEEP_TOUCHING, NO_DECISION, NOT_SEPARABLE, SequentialTest, candidate_pieces,
     log_marginals, min_fixed_contact_s, run_batch,
 )
 from designkit.scene import Scene
@@ -95,7 +95,7 @@ def test_fixed_time_reference_matches_the_ideal_observer():
     acc = ideal_pair(LOW[1], HIGH[1], PAPER, Scene(contact_s=t)).accuracy
     before = ideal_pair(LOW[1], HIGH[1], PAPER, Scene(contact_s=t - 0.02)).accuracy
     assert acc >= 0.95 - 1e-9 and before < 0.95 + 0.01
-    assert not fixed_time_errors(LOW[1], HIGH[1], 0.05, 0.05, PAPER, 0.005, [t - 0.005])[0]
+    assert min_fixed_contact_s(LOW[1], HIGH[1], 0.05, 0.05, PAPER, 0.005, t - 0.005) is None  # the shortest
 
 
 def test_hopeless_pair_says_so_before_the_first_sample():

@@ -12,9 +12,8 @@ from scipy import stats
 from designkit import SENSORS
 from designkit._validation import InputError
 from designkit.objects import ObjectClass
-from designkit.recognition.sequential import (
-    SequentialTest, optimal_stopping, optimal_test, run_batch, run_boundaries,
-)
+from designkit.recognition.sequential import SequentialTest, run_batch
+from designkit_lab.sequential_bound import optimal_stopping, optimal_test, run_boundaries
 from designkit.scene import Scene
 from designkit.simulation import simulate_class
 

@@ -1,4 +1,4 @@
-"""A class's touches read from a few effusivities (designkit.models.shared) and the ramp's sum as a convolution.
+"""Touches read from a scene's panels of a few effusivities (designkit.models.shared) and the ramp's sum as a convolution.
 
 The interpolated readings are checked against the model read directly at every touch's effusivity
 (the independent reference: no interpolation), within the tolerance the simulation asks; the draws
@@ -13,7 +13,7 @@ import pytest
 from designkit import Scene
 from designkit.models import get_model
 from designkit.models.ramp import ForceRamp
-from designkit.models.shared import SharedResponse, class_readings
+from designkit.models.shared import SceneResponse, class_readings, start_level
 from designkit.sensor import Sensor
 from designkit.simulation import draw_trials, render_trials, response_tolerance
 
@@ -33,20 +33,34 @@ def test_interpolated_class_readings_agree_with_direct_evaluation(model, e_range
     got = class_readings(model, t, e, SENSOR, tolerance=tol)
     want = model.response(t, e, SENSOR)
     assert np.max(np.abs(got - want)) <= tol
-    table = SharedResponse.build(model, t, e.min(), e.max(), SENSOR, tolerance=tol)
-    if e_range[1] / e_range[0] < 2:   # a class of the sweep's grid: a few readings; a very wide range may read directly
-        assert not table.direct and table.error <= tol and table.weights.size <= 9
+    scene = SceneResponse(model, t, SENSOR, tol)
+    w = e / (SENSOR.effusivity + e)
+    again = np.clip(scene.readings(e, start_level(w.min(), w.max())), 0.0, 1.0)
+    np.testing.assert_array_equal(again, got)   # the cached scene's panels and a fresh one's: the same bits
+    assert all(p.error <= tol for p in scene.panels)
+    if e_range[1] / e_range[0] < 2:   # a class of the sweep's grid: one or two panels of 5 readings, maybe halved once
+        assert scene.model_readings <= 20
 
 
-def test_one_class_table_serves_every_draw_of_the_class():
+def test_a_scene_reads_each_panel_once_and_a_class_reads_the_same_whatever_came_before():
+    """Classes of one scene (neighbouring intervals, repeats) share panels; a class's readings do not depend on
+    which classes were read first (a sweep's split or order changes no bit)."""
     t = np.arange(301) / 200.0
-    table = SharedResponse.build(RAMP, t, 331.0, 506.0, SENSOR, tolerance=1e-6)
-    assert table.weights.size <= 9 and np.all(np.diff(table.nodes) > 0)
-    for seed in (1, 2):
-        e = np.random.default_rng(seed).uniform(331.0, 506.0, 40)
-        assert np.max(np.abs(table.readings(e) - RAMP.response(t, e, SENSOR))) <= 1e-6
-    with pytest.raises(Exception, match="outside the class response's range"):
-        table.readings([600.0])
+    edges = np.linspace(331.0, 506.0, 11)
+    scene = SceneResponse(RAMP, t, SENSOR, 1e-6)
+    first = {}
+    for k in range(10):
+        for seed in (1, 2):
+            e = np.random.default_rng([seed, k]).uniform(edges[k], edges[k + 1], 40)
+            w = e / (SENSOR.effusivity + e)
+            first[k, seed] = scene.readings(e, start_level(w.min(), w.max()))
+            assert np.max(np.abs(first[k, seed] - RAMP.response(t, e, SENSOR))) <= 1e-6
+    assert scene.model_readings < 20 * 5 / 2        # fewer than one panel per class and repeat
+    fresh = SceneResponse(RAMP, t, SENSOR, 1e-6)
+    for k in (7, 2):                                # another order, another process's cache
+        e = np.random.default_rng([2, k]).uniform(edges[k], edges[k + 1], 40)
+        w = e / (SENSOR.effusivity + e)
+        np.testing.assert_array_equal(fresh.readings(e, start_level(w.min(), w.max())), first[k, 2])
 
 
 def test_render_trials_is_within_the_asked_tolerance_and_keeps_the_draws():
@@ -71,7 +85,6 @@ def test_few_distinct_objects_or_a_per_touch_diffusivity_are_read_directly():
                                   LAYERED.response(t, np.unique(e), SENSOR)[[0, 0, 1, 0]])
     semi = get_model()
     np.testing.assert_array_equal(class_readings(semi, t, e, SENSOR, tolerance=1e-6), semi.response(t, e, SENSOR))
-    assert SharedResponse.build(LAYERED, t, 400.0, 400.0, SENSOR, tolerance=1e-6).direct
 
 
 def test_a_ramp_off_the_sample_grid_is_the_sum_of_shifted_step_responses():

@@ -33,11 +33,8 @@ the line is silent), a device that vanishes, and one that never speaks.
 from __future__ import annotations
 
 import fcntl
-import itertools
-import json
 import math
 import os
-import re
 import select
 import termios
 import threading
@@ -48,42 +45,18 @@ from typing import Sequence
 
 import numpy as np
 
-from .._validation import InputError, as_generator, check_effusivity, check_nonnegative, check_positive
+from .._validation import InputError, as_generator, check_nonnegative, check_positive
 from ..models.semi_infinite import object_weight, response_shape
 from ..sensor import Sensor
-from .profiles import DeviceProfile, Linear, Thermistor
-from .trials import check_material_label
+from .conversions import Linear, Thermistor
+from .profiles import DeviceProfile
+from .touch_plan import EmulatedMaterial, TouchPlan, TouchRecord, announcement_text, greeting_text
 
-__all__ = ["AnnouncedPlan", "EmulatedMaterial", "Emulator", "Faults", "TouchPlan", "TouchRecord", "parse_announcement",
-           "parse_greeting"]
+__all__ = ["EmulatedMaterial", "Emulator", "Faults", "TouchPlan", "TouchRecord"]
 
 _MAX_PENDING = 1 << 16
 #: Real seconds between a client opening the port and the first sample (a rig's reset on open).
 CLIENT_SETTLE_S = 0.05
-
-
-@dataclass(frozen=True)
-class EmulatedMaterial:
-    """An object the emulated rig touches.
-
-    Parameters
-    ----------
-    label : str
-        Name shown and logged.
-    effusivity : float
-        e_o [J s^-1/2 K^-1 m^-2].
-    object_temp_c : float or None
-        Object temperature [degC]; None: room temperature (the emulator's
-        ambient).
-    """
-
-    label: str
-    effusivity: float
-    object_temp_c: float | None = None
-
-    def __post_init__(self) -> None:
-        check_material_label(self.label, "the emulated material's label")   # it labels the recorded trials
-        object.__setattr__(self, "effusivity", check_effusivity(self.label, self.effusivity))
 
 
 @dataclass(frozen=True)
@@ -180,154 +153,6 @@ class Faults:
                 raise InputError(f"fault {spec!r} needs a number, e.g. garbled=0.01, gap=30:0.5, "
                                  "vanish=45") from None
         return cls(**kw)  # type: ignore[arg-type]
-
-
-@dataclass(frozen=True)
-class TouchPlan:
-    """When and how the emulated rig touches.
-
-    ``contact_s`` defaults to the profile's trial window plus half a second,
-    ``press_force_n`` to twice the contact threshold.
-
-    What real touches do beyond the paper's model (all off by default):
-
-    ``ramp_spread``: touch ``j``'s force ramp lasts ``ramp_s (1 + ramp_spread
-    v_j)``, ``v_j`` uniform in [-1, 1] (the pace differs from touch to touch).
-    ``contact_force_fraction`` (c): the contact area grows with the force,
-    ``A = clip((F / F_p - c) / (1 - c), 0, 1)``, each share starting its heat
-    flow as it comes into contact (:class:`~designkit.models.ramp.ForceRamp`);
-    None: the whole area at once when the force leaves zero.
-    ``drift_c_per_s`` and ``drift_sd_c_per_s``: the heater still warms at a
-    rate ``s_j`` (normal, per touch) from ``drift_lead_s`` before contact until
-    release, on the sensor's side of the contact: ``T = (Ts + s_j t)(1 - u) +
-    To u``; after release it settles back to its set point.
-    """
-
-    touch_every_s: float = 20.0
-    first_touch_s: float = 2.0
-    contact_s: float | None = None
-    press_force_n: float | None = None
-    ramp_s: float = 0.5
-    recover_s: float = 0.4
-    touches_per_material: int = 1
-    ramp_spread: float = 0.0
-    contact_force_fraction: float | None = None
-    drift_c_per_s: float = 0.0
-    drift_sd_c_per_s: float = 0.0
-    drift_lead_s: float = 1.5
-
-
-_GREETING = re.compile(r"designkit emulator, profile .*?; touches \d+ of each of \[.*\] in turn")
-_PLAN = re.compile(r"touches (?P<n>\d+) of each of (?P<labels>\[.*\]) in turn")
-
-
-@dataclass(frozen=True)
-class AnnouncedPlan:
-    """The touch sequence an emulator announces in its first line (a device message).
-
-    Parameters
-    ----------
-    labels : tuple of str
-        Materials, touched in this order.
-    touches_per_material : int
-        Touches of each before the next one (then the first again).
-
-    Examples
-    --------
-    >>> plan = parse_greeting('# designkit emulator, profile designkit; touches 2 of each of ["wood", "metal"] in turn')
-    >>> plan.sequence(5)
-    ['wood', 'wood', 'metal', 'metal', 'wood']
-    >>> plan.mislabels(["metal", "wood"], 2)   # doctest: +ELLIPSIS
-    'the emulator touches wood, wood, metal, metal in turn, but this run labels its first 4 touches metal, ...'
-    >>> plan.mislabels(["block", "slab"], 2) is None   # any names, as long as each stands for one material
-    True
-    """
-
-    labels: tuple[str, ...]
-    touches_per_material: int
-
-    def sequence(self, n: int) -> list[str]:
-        """Labels of the first ``n`` touches."""
-        k = self.touches_per_material
-        return [self.labels[(j // k) % len(self.labels)] for j in range(n)]
-
-    def mislabels(self, materials: Sequence[str], trials: int) -> str | None:
-        """Why a recording of ``trials`` touches of each of ``materials`` in turn would mislabel them (None: it
-        would not).
-
-        A recording may name the materials as it likes, but each of its names must stand for one of the
-        emulator's materials and no two for the same; a name that is one of the emulator's labels (any case)
-        must stand for that one.
-        """
-        ours = [m for m in materials for _ in range(trials)]
-        theirs = self.sequence(len(ours))
-        pairs = set(zip(ours, theirs))
-        known = {lab.lower() for lab in self.labels}
-        ok = (len(pairs) == len({a for a, _ in pairs}) == len({b for _, b in pairs})
-              and all(a.lower() == b.lower() for a, b in pairs if a.lower() in known))
-        if ok:
-            return None
-
-        def runs(seq: list[str]) -> str:
-            return ", ".join(seq) if len(seq) <= 6 else ", ".join(
-                f"{sum(1 for _ in g)} x {lab}" for lab, g in itertools.groupby(seq))
-        return (f"the emulator touches {runs(theirs)} in turn, but this run labels its first {len(ours)} touches "
-                f"{runs(ours)}")
-
-
-_ANNOUNCEMENT = re.compile(r'designkit emulator: touch (?P<j>\d+) of (?P<label>"(?:[^"\\]|\\.)*") starts')
-
-
-def parse_announcement(message: str) -> tuple[int, str, AnnouncedPlan | None] | None:
-    """(touch number from 1, material label, the plan it repeats) of an emulator's touch announcement;
-    None for other messages.
-
-    >>> j, label, plan = parse_announcement(
-    ...     '# designkit emulator: touch 3 of "Aluminium alloys" starts; touches 2 of each of ["Aluminium alloys", '
-    ...     '"wood"] in turn')
-    >>> j, label, plan.labels
-    (3, 'Aluminium alloys', ('Aluminium alloys', 'wood'))
-    """
-    m = _ANNOUNCEMENT.search(message)
-    if not m:
-        return None
-    try:
-        label = json.loads(m.group("label"))
-    except ValueError:
-        return None
-    if not isinstance(label, str):
-        return None
-    plan = _plan(message[m.end():])
-    return int(m.group("j")), label, plan
-
-
-def parse_greeting(message: str) -> AnnouncedPlan | None:
-    """The plan an emulator's first line announces (None: ``message`` is no such line)."""
-    return _plan(message) if _GREETING.search(message) else None
-
-
-def _plan(text: str) -> AnnouncedPlan | None:
-    m = _PLAN.search(text)
-    if not m:
-        return None
-    try:
-        labels = json.loads(m.group("labels"))
-    except ValueError:
-        return None
-    if not labels or not all(isinstance(x, str) for x in labels) or int(m.group("n")) < 1:
-        return None
-    return AnnouncedPlan(tuple(labels), int(m.group("n")))
-
-
-@dataclass(frozen=True)
-class TouchRecord:
-    """Ground truth of one emulated touch (device time)."""
-
-    index: int
-    material: str
-    effusivity: float
-    start_s: float
-    expected_onset_s: float
 
 
 class Emulator:
@@ -458,12 +283,11 @@ class Emulator:
     def greeting(self) -> str:
         """The first line sent (a device message, with the profile's comment prefix): the touch plan.
 
-        A recorder reads it back with :func:`parse_greeting` and can refuse a run that would label
-        the touches wrongly.
+        A recorder reads it back with :func:`~designkit.calibration.touch_plan.parse_greeting` and can
+        refuse a run that would label the touches wrongly.
         """
-        labels = json.dumps([m.label for m in self.materials], ensure_ascii=False)
-        return (f"{self.profile.comment or '#'} designkit emulator, profile {self.profile.name}; touches "
-                f"{self.plan.touches_per_material} of each of {labels} in turn, every {self.plan.touch_every_s:g} s")
+        return greeting_text(self.profile.comment or "#", self.profile.name, [m.label for m in self.materials],
+                             self.plan)
 
     # ----------------------------------------------------------------- truth
     def _touch_draws(self, j: int) -> tuple[float, float]:
@@ -762,12 +586,9 @@ class Emulator:
         return out
 
     def announcement(self, j: int) -> str:
-        """The device message sent as touch ``j`` (0-based) starts, with the plan; :func:`parse_announcement`
-        reads it."""
-        label = json.dumps(self.material_of_touch(j).label, ensure_ascii=False)
-        labels = json.dumps([m.label for m in self.materials], ensure_ascii=False)
-        return (f"{self.profile.comment or '#'} designkit emulator: touch {j + 1} of {label} starts; touches "
-                f"{self.plan.touches_per_material} of each of {labels} in turn")
+        """The device message sent as touch ``j`` (0-based) starts, with the plan
+        (:func:`~designkit.calibration.touch_plan.parse_announcement` reads it)."""
+        return announcement_text(self.profile.comment or "#", j, [m.label for m in self.materials], self.plan)
 
     # ---------------------------------------------------------------- pty
     @property

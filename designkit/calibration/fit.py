@@ -20,7 +20,7 @@ from .._validation import InputError, check_positive, check_temperature
 from .trials import Trial
 
 if TYPE_CHECKING:  # pragma: no cover
-    from .identify import Identification
+    from .results import Identification
 
 __all__ = [
     "CalibrationProblem",
@@ -30,10 +30,6 @@ __all__ = [
     "parse_ranges",
     "resolve_ranges",
 ]
-
-#: The paper's sensor (appendix): e_s [J s^-1/2 K^-1 m^-2] and alpha_s [m^2/s].
-PAPER_E_S = 892.0
-PAPER_ALPHA_S = 1.19e-9
 
 
 # ----------------------------------------------------------------- ranges
@@ -177,6 +173,10 @@ def _normalized_drop(tr: Trial, at_s: float = 2.0) -> float:
     return drop
 
 
+#: Widest ratio of the e_s the materials allow (largest over smallest) that still counts as identified.
+UNIDENTIFIED_ES_RATIO = 100.0
+
+
 def check_calibration(result: "Identification | None", trials: Sequence[Trial]) -> list[CalibrationProblem]:
     """What makes a calibration unusable or suspect, each with a suggestion.
 
@@ -187,10 +187,12 @@ def check_calibration(result: "Identification | None", trials: Sequence[Trial]) 
       within 2 robust SDs of another material's median and beyond 5 of its own's (touches recorded
       while another sample was under the sensor);
     * **conflict**: no e_s keeps every material inside its effusivity range under ``result``'s model
-      (an :class:`~designkit.calibration.identify.Identification`);
+      (an :class:`~designkit.calibration.results.Identification`);
     * **no-response**: in most touches the sensor's reading moves by less than 5 pre-contact noise SDs
       (and 0.05 °C) over the contact: no heat flowed (the heater off, sensor and object at one
-      temperature, a disconnected channel), so the touches hold nothing about e_s, whatever a fit says.
+      temperature, a disconnected channel), so the touches hold nothing about e_s, whatever a fit says;
+    * **unidentified**: the e_s every material allows under ``result``'s model spans more than a factor of
+      ``UNIDENTIFIED_ES_RATIO`` (one material under a model with a film and a contact conductance fits any e_s).
 
     Examples
     --------
@@ -274,4 +276,15 @@ def check_calibration(result: "Identification | None", trials: Sequence[Trial]) 
             "Check each material's label, range (--range NAME=MIN:MAX) and object temperature "
             "(--object-temp NAME=free for an object not at room temperature); let calibrate choose among every "
             "sensor model ('calibrate fit --model all', the default); or write the file anyway with --force"))
+    if result is not None and result.es_allowed:
+        lo = max(lo for lo, _ in result.es_allowed.values())
+        hi = min(hi for _, hi in result.es_allowed.values())
+        if not (lo > 0 and math.isfinite(hi) and hi <= UNIDENTIFIED_ES_RATIO * lo):
+            one = len(result.es_allowed) == 1
+            out.append(CalibrationProblem(
+                "unidentified", f"the touches do not identify the sensor's effusivity under the "
+                                f"{result.candidate.label} model (e_s anywhere in [{lo:.4g}, {hi:.4g}]"
+                                + (f", from one material, {next(iter(result.es_allowed))})" if one else ")"),
+                "Record a second material whose effusivity range is known and far from the first (wood beside "
+                "a metal, say) and fit both; or write the file anyway with --force"))
     return out

@@ -1,7 +1,7 @@
 """Live material decisions from a serial device: each touch decided while it lasts.
 
 :class:`TouchDecider` is pure logic, fed samples like the recorder's
-:class:`~designkit.calibration.recorder.TrialCutter` (time [s], sensor [degC],
+:class:`~designkit.calibration.cutter.TrialCutter` (time [s], sensor [degC],
 object [degC], force [N]): it detects the contact onset with the profile's
 force rule, takes the sensor's temperature before contact (Ts0, the mean over
 the profile's ``pre_s``) and the object's (Ta: the object channel's mean over
@@ -35,7 +35,8 @@ import numpy as np
 from .._validation import InputError
 from ..recognition.sequential import SequentialTest
 from .profiles import DeviceProfile
-from .recorder import RecordEvent, SerialRecorder
+from .cutter import RecordEvent
+from .recorder import SerialRecorder
 
 __all__ = ["LiveClassifier", "NOISE_MISMATCH", "TouchDecider", "TouchDecision", "pre_contact_noise_c"]
 

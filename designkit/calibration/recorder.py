@@ -1,40 +1,16 @@
 """Recording touches from a serial device: detect each contact, cut the trial, write it at once.
 
-Two layers:
-
-- :class:`TrialCutter` is pure logic. It is fed samples (time [s], sensor
-  [degC], object [degC], force [N]), detects contact with the profile's rule
-  (force threshold, 5 N by default as in the paper, or a temperature-slope
-  rule), cuts ``pre_s`` before to ``post_s`` after the onset and writes the
-  trial (CSV + JSON sidecar, atomically, then the folder index) as soon as
-  the window is complete. A discontinuity (samples lost, device reset,
-  reconnect) discards the trial in progress and waits for a full clean
-  ``pre_s`` before the next onset.
-- :class:`SerialRecorder` reads a serial port with pyserial, splits the byte
-  stream into lines, parses them with the profile and feeds the cutter. It
-  survives garbled, partial or non-numeric lines, wrong field counts,
-  out-of-range readings (each reported once per kind with an example, then
-  counted), bursts, gaps (from the device clock, or from silences longer than
-  the profile's ``stall_s`` when there is no timestamp), a device that
-  disappears (it tries to reopen the port for ``reconnect_s``) and a device
-  that never speaks (``no_data_timeout_s``). Trials already written are never
-  touched again; Ctrl-C (KeyboardInterrupt) leaves them all in place.
-
-A reopened port is a new device until its stream shows otherwise: a pty path
-(or a USB port) the device left may now belong to another program's device.
-After a reconnect the recorder holds the samples back until it has seen
-``VERIFY_S`` of them out of contact and compares them with what the session
-saw before the disconnect: the device clock must restart near zero (a reset,
-``RESTART_MAX_S``) or continue (``CLOCK_SLACK_S`` plus twice the real time
-away), one sample must come every session's sample interval (within
-``RATE_TOLERANCE``) with at least ``MIN_ARRIVING_FRACTION`` of them arriving
-(two programs reading one port split its lines), and the pre-contact sensor
-and object temperatures must stay within ``SENSOR_TOLERANCE_C`` and
-``OBJECT_TOLERANCE_C`` of the session's (the median of its last 20 s out of
-contact). A stream that matches is recorded from, its held samples first; one
-that does not stops the recording (:class:`DeviceChanged`, naming what
-differs; trials already written stay), so that no touch of another device is
-labelled with this session's material.
+:class:`SerialRecorder` reads a serial port with pyserial, splits the byte
+stream into lines, parses them with the profile and feeds a
+:class:`~designkit.calibration.cutter.TrialCutter` (which detects each contact,
+cuts the trial and writes it). It survives garbled, partial or non-numeric
+lines, wrong field counts, out-of-range readings (each reported once per kind
+with an example, then counted), bursts, gaps (from the device clock, or from
+silences longer than the profile's ``stall_s`` when there is no timestamp), a
+device that disappears (it tries to reopen the port for ``reconnect_s``) and a
+device that never speaks (``no_data_timeout_s``). Trials already written are
+never touched again; Ctrl-C (KeyboardInterrupt) leaves them all in place. A reopened port
+records only once it shows the session's device (:mod:`~designkit.calibration.reconnect`).
 
 Without a timestamp channel, time is the count of lines received divided by
 the sample rate; a line that cannot be read still counts (its sample is
@@ -76,32 +52,27 @@ rate).
 
 from __future__ import annotations
 
-import datetime as _dt
 import errno
 import math
 import os
 import stat
-import tempfile
 import time
 import uuid
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable
+from typing import Callable
 
 import numpy as np
 
-from .._validation import InputError, check_positive
+from .._validation import InputError, check_positive, error_line
 from .profiles import ROLES, DeviceProfile
-from .trials import FolderLock, check_material_label, check_trial_folder, write_trial
+from .reconnect import Probation
+from .cutter import COL_FORCE, MIN_READABLE_FRACTION, RecordEvent, TrialCutter
+from .trials import FolderLock, check_material_label, check_trial_folder
 
-__all__ = ["CLOCK_SLACK_S", "CONFIRM_SAMPLES", "DeviceChanged", "GIVE_UP_TOUCHES", "GIVE_UP_WINDOWS",
-           "NoProgress", "SPIKE_SIGMAS", "MIN_ARRIVING_FRACTION", "MIN_READABLE_FRACTION", "OBJECT_TOLERANCE_C",
-           "RATE_TOLERANCE", "RESTART_MAX_S", "RecordEvent", "RecorderStatus", "SENSOR_TOLERANCE_C",
-           "SerialRecorder", "TrialCutter", "TrialNotWritten", "VERIFY_S"]
-
-#: Fewest samples of a trial's window that must be readable for the trial to be kept.
-MIN_READABLE_FRACTION = 0.8
+__all__ = ["CONFIRM_SAMPLES", "DeviceChanged", "GIVE_UP_TOUCHES", "GIVE_UP_WINDOWS", "NoProgress", "SPIKE_SIGMAS",
+           "RecorderStatus", "SerialRecorder"]
 
 # Lines that parse but cannot be right (module docstring, "Lines that lie")
 #: Samples in a row, each within ``stall_s`` of the one before, that make a jump of the device clock real.
@@ -116,25 +87,9 @@ GIVE_UP_TOUCHES = 3
 #: Trial windows (pre_s + post_s) of stream without a touch kept, at the least, before giving up.
 GIVE_UP_WINDOWS = 5
 
-# After a reconnect (module docstring): is it still the session's device?
-#: Device seconds of samples out of contact read (and held back) before trusting a reopened port.
-VERIFY_S = 1.0
-#: Largest change of the pre-contact sensor temperature [degC] (a regulated heater holds its set point).
-SENSOR_TOLERANCE_C = 1.0
-#: Largest change of the pre-contact object (passive) temperature [degC] (the room drifts slowly).
-OBJECT_TOLERANCE_C = 2.0
-#: Largest first device time [s] after reopening that counts as a clock restarted by a reset.
-RESTART_MAX_S = 5.0
-#: Largest advance [s] of a continuing device clock beyond twice the real seconds the device was away.
-CLOCK_SLACK_S = 10.0
-#: Largest relative change of the median sample interval.
-RATE_TOLERANCE = 0.2
-#: Fewest of the samples (by device time) that must arrive: two readers of one port split its lines.
-MIN_ARRIVING_FRACTION = 0.8
 #: Device seconds of samples out of contact the session's reference temperatures are the median of.
 _REFERENCE_S = 20.0
 
-_S, _O, _F = 0, 1, 2  # columns of the cutter's value buffer
 _BAD_KIND_TEXT = {
     "garbled": "garbled bytes (not text in the profile's encoding)",
     "field_count": "wrong number of fields",
@@ -149,20 +104,6 @@ _BAD_KIND_TEXT = {
                    f"{SPIKE_SIGMAS:g} times the stream's noise)",
 }
 _EXAMPLES_PER_KIND = 3
-
-
-@dataclass(frozen=True)
-class RecordEvent:
-    """Something worth telling the user.
-
-    ``kind``: ``trial`` (written; ``path`` set), ``skipped`` (a touch not
-    recorded, with the reason), ``bad_line``, ``gap``, ``reconnect``,
-    ``device`` (a device message line), ``info``.
-    """
-
-    kind: str
-    message: str
-    path: Path | None = None
 
 
 @dataclass
@@ -186,256 +127,6 @@ class RecorderStatus:
     last_message: str = ""
 
 
-class TrialCutter:
-    """Detect touches in a sample stream and write each trial as soon as it is complete.
-
-    Parameters
-    ----------
-    profile : DeviceProfile
-        Contact rule, trial window, sample rate.
-    out_dir : Path
-        Folder for the trials (created).
-    material : str
-        Label written with each trial.
-    meta : dict
-        Extra sidecar fields (port, profile name...).
-    lock : FolderLock, optional
-        The caller's held lock of ``out_dir`` (without one, each write locks the folder itself).
-    """
-
-    WAIT_RELEASE, ARMED, COLLECT, WAIT_STEADY = "waiting for release", "armed", "in contact", "waiting for steady"
-
-    def __init__(self, profile: DeviceProfile, out_dir: Path, material: str,
-                 meta: dict[str, Any] | None = None, lock: FolderLock | None = None) -> None:
-        self.profile = profile
-        self.out_dir = Path(out_dir)
-        self.material = check_material_label(material)
-        self.lock = lock
-        self.meta = dict(meta or {})
-        self.fs = profile.sample_rate_hz
-        self.pre = profile.trial.pre_s
-        self.post = profile.trial.post_s
-        self.rule = profile.contact
-        self.written: list[Path] = []
-        self.events: list[RecordEvent] = []
-        self._dropped: list[tuple[float, str]] = []   # (device time [s], why) of samples dropped upstream
-        self._t = np.zeros(0)
-        self._v = np.zeros((0, 3))
-        self._scan = 0
-        self._clean_since = -np.inf
-        self._onset = np.nan
-        self._state = self.WAIT_RELEASE if self.rule.rule == "force" else self.WAIT_STEADY
-
-    @property
-    def state(self) -> str:
-        return self._state
-
-    @property
-    def in_trial(self) -> bool:
-        return self._state == self.COLLECT
-
-    # ------------------------------------------------------------- input
-    def feed(self, time_s: np.ndarray, values: np.ndarray) -> list[RecordEvent]:
-        """Add samples (times increasing, continuing the stream) and act on them.
-
-        ``values`` has columns sensor [degC], object [degC], force [N] (NaN
-        where the rig has no such channel). Returns the events raised.
-        """
-        t = np.asarray(time_s, dtype=np.float64)
-        if t.size == 0:
-            return []
-        if not np.isfinite(self._clean_since):
-            self._clean_since = float(t[0])
-        self._t = np.concatenate([self._t, t])
-        self._v = np.concatenate([self._v, np.asarray(values, dtype=np.float64).reshape(-1, 3)])
-        events: list[RecordEvent] = []
-        self._advance(events)
-        self._trim()
-        self.events.extend(events)
-        return events
-
-    def note_dropped(self, time_s: float, why: str) -> None:
-        """A sample at device time ``time_s`` [s] was dropped before reaching here (the trial's sidecar says so)."""
-        self._dropped.append((float(time_s), why))
-
-    def discontinuity(self, reason: str) -> list[RecordEvent]:
-        """Samples were lost or the clock restarted: drop the buffer and any trial in progress."""
-        events = []
-        if self._state == self.COLLECT:
-            events.append(RecordEvent("skipped", f"trial in progress discarded: {reason}"))
-        self._state = self.WAIT_RELEASE if self.rule.rule == "force" else self.WAIT_STEADY
-        self._t = np.zeros(0)
-        self._v = np.zeros((0, 3))
-        self._dropped = []
-        self._scan = 0
-        self._clean_since = -np.inf
-        self.events.extend(events)
-        return events
-
-    # ------------------------------------------------------------- logic
-    def _slope(self) -> np.ndarray:
-        """Smoothed temperature slope [degC/s] at each buffered sample (NaN where too early)."""
-        h = max(2, int(round(self.rule.slope_window_s * self.fs / 2)))
-        s = self._v[:, _S]
-        out = np.full(s.size, np.nan)
-        if s.size >= 2 * h:
-            c = np.concatenate([[0.0], np.cumsum(s)])
-            mean_new = (c[2 * h:] - c[h:-h]) / h
-            mean_old = (c[h:-h] - c[:-2 * h]) / h
-            out[2 * h - 1:] = (mean_new - mean_old) / (h / self.fs)
-        return out
-
-    def _advance(self, events: list[RecordEvent]) -> None:
-        t, v = self._t, self._v
-        eps = 0.5 / self.fs
-        while True:
-            if self._state == self.COLLECT:
-                if t[-1] >= self._onset + self.post - eps:
-                    self._finish(events)
-                    self._state = self.WAIT_RELEASE if self.rule.rule == "force" else self.WAIT_STEADY
-                    continue
-                return
-            if self._scan >= t.size:
-                return
-            if self._state == self.WAIT_RELEASE:
-                below = np.flatnonzero(v[self._scan:, _F] < self.rule.release_n)
-                if below.size == 0:
-                    self._scan = t.size
-                    return
-                self._scan += int(below[0])
-                self._state = self.ARMED
-                continue
-            if self._state == self.WAIT_STEADY:
-                slope = self._slope()[self._scan:]
-                steady = np.abs(slope) < self.rule.slope_c_per_s / 2  # NaN -> False
-                need = max(1, int(round(self.pre * self.fs)))
-                run = np.convolve(steady.astype(np.int64), np.ones(need, dtype=np.int64), "valid")
-                hit = np.flatnonzero(run == need)
-                if hit.size == 0:
-                    self._scan = max(self._scan, t.size - need + 1)
-                    return
-                self._scan += int(hit[0]) + need - 1
-                self._state = self.ARMED
-                continue
-            # ARMED
-            if self.rule.rule == "force":
-                cross = np.flatnonzero(v[self._scan:, _F] >= self.rule.force_threshold_n)
-            else:
-                cross = np.flatnonzero(self._slope()[self._scan:] <= -self.rule.slope_c_per_s)
-            if cross.size == 0:
-                self._scan = t.size
-                return
-            i = self._scan + int(cross[0])
-            onset = float(t[i])
-            self._scan = i + 1
-            if onset - self.pre < self._clean_since - eps:
-                have = max(0.0, onset - self._clean_since)
-                events.append(RecordEvent(
-                    "skipped", f"touch at device time {onset:.2f} s skipped: only {have:.2f} s of clean data "
-                               f"before contact (need {self.pre:g} s)"))
-                self._state = self.WAIT_RELEASE if self.rule.rule == "force" else self.WAIT_STEADY
-                continue
-            self._onset = onset
-            self._state = self.COLLECT
-
-    def _finish(self, events: list[RecordEvent]) -> None:
-        t, v = self._t, self._v
-        eps = 0.5 / self.fs
-        onset = self._onset
-        sel = (t >= onset - self.pre - eps) & (t <= onset + self.post + eps)
-        tt = t[sel] - onset
-        vv = v[sel]
-        expected = int(round((self.pre + self.post) * self.fs)) + 1
-        if tt.size < MIN_READABLE_FRACTION * expected:
-            events.append(RecordEvent(
-                "skipped", f"touch at device time {onset:.2f} s skipped: only {tt.size} of {expected} samples "
-                           "readable"))
-            return
-        pre = tt < 0
-        release_s = None
-        if self.rule.rule == "force":
-            after = np.flatnonzero((tt > 0) & (vv[:, _F] < self.rule.release_n))
-            if after.size:
-                release_s = float(tt[after[0]])
-        ts0 = float(np.mean(vv[pre, _S]))
-        to0 = float(np.mean(vv[pre, _O])) if np.isfinite(vv[pre, _O]).any() else None
-        meta = {
-            **self.meta,
-            "recorded_at": _dt.datetime.now().astimezone().isoformat(timespec="seconds"),
-            "sensor_temp_before_c": ts0,
-            "object_temp_before_c": to0,
-            "onset_device_time_s": onset,
-            "contact_rule": self.rule.to_dict(),
-            "pre_s": self.pre,
-            "post_s": self.post,
-            "release_s": release_s,
-            "sample_rate_hz": self.fs,
-            "n_samples": int(tt.size),
-            "n_missing": int(expected - tt.size),
-        }
-        dropped = [{"time_s": d - onset, "why": why} for d, why in self._dropped
-                   if onset - self.pre - eps <= d <= onset + self.post + eps]
-        if dropped:
-            meta["dropped_samples"] = dropped
-        path = self._write(tt, vv, meta, events)
-        self.written.append(path)
-        note = f", released at {release_s:.2f} s" if release_s is not None else ""
-        if dropped:
-            note += f"; {len(dropped)} implausible sample(s) dropped, listed in its sidecar"
-        obj = f", object {to0:.2f} °C" if to0 is not None else ""
-        events.append(RecordEvent("trial", f"trial {len(self.written)}: {path.name} (sensor {ts0:.2f} °C{obj}"
-                                           f" before contact{note})", path))
-
-    def _write(self, tt: np.ndarray, vv: np.ndarray, meta: dict, events: list[RecordEvent]) -> Path:
-        """Write the trial; whatever fails, the touch is kept somewhere and the user is told where.
-
-        First under the label's name; then under the plain name ``trial_NNN``
-        in the same folder (a name the file system refused); then, when the
-        folder cannot take it at all (disk full, gone, read-only), in a new
-        folder under the system's temporary folder, after which recording
-        stops (:class:`TrialNotWritten`, naming both).
-        """
-        cols = (tt, vv[:, _S], vv[:, _O], vv[:, _F])
-        try:
-            return write_trial(self.out_dir, self.material, *cols, meta, lock=self.lock)
-        except (OSError, InputError) as exc:
-            first = exc
-        try:
-            path = write_trial(self.out_dir, self.material, *cols, meta, lock=self.lock, stem="trial")
-            events.append(RecordEvent("info", f"could not write the trial under its label's name "
-                                              f"({_short(first)}): written as {path.name} instead (its sidecar and "
-                                              "the index keep the label)"))
-            return path
-        except (OSError, InputError):
-            pass
-        n = len(self.written)
-        kept = f"{n} trial(s) kept in {self.out_dir}"
-        try:
-            rescue = Path(tempfile.mkdtemp(prefix="designkit-rescued-trial-"))
-            path = write_trial(rescue, self.material, *cols, meta)
-        except (OSError, InputError) as exc:
-            raise TrialNotWritten(f"cannot write the trial just recorded into {self.out_dir} ({_short(first)}), nor "
-                                  f"into a temporary folder ({_short(exc)}): that touch is lost; {kept}") from None
-        raise TrialNotWritten(f"cannot write into {self.out_dir} ({_short(first)}): the trial just recorded was kept "
-                              f"as {path} (move it and its .json into the folder once it can be written); {kept}")
-
-    def _trim(self) -> None:
-        if self._state == self.COLLECT or self._t.size == 0:
-            return
-        keep_from = self._t[-1] - self.pre - max(1.0, 2 * self.rule.slope_window_s)
-        cut = int(np.searchsorted(self._t, keep_from))
-        if self._state == self.WAIT_STEADY:
-            need = max(1, int(round(self.pre * self.fs))) + int(round(self.rule.slope_window_s * self.fs)) + 2
-            cut = min(cut, max(0, self._scan - need))
-        cut = min(cut, self._scan)
-        if self._dropped and cut < self._t.size:
-            self._dropped = [d for d in self._dropped if d[0] >= self._t[cut]]
-        if cut > 0:
-            self._t = self._t[cut:]
-            self._v = self._v[cut:]
-            self._scan -= cut
-
-
 class DeviceGone(InputError):
     """The port disappeared and could not be reopened."""
 
@@ -448,29 +139,12 @@ class NoProgress(InputError):
     """Touch after touch was skipped and none kept for a long stretch of stream (module docstring)."""
 
 
-class TrialNotWritten(InputError):
-    """The trial folder cannot be written; the touch was kept elsewhere when possible (message says where)."""
-
-
 class TooManyBadLines(InputError):
     """So many lines are unreadable that no trial can be kept (see the module docstring)."""
 
 
 class DeviceChanged(InputError):
     """After a reconnect the port streams data unlike the session's device (see the module docstring)."""
-
-
-@dataclass
-class _Verification:
-    """A reopened port on probation: samples held back until they show the same device."""
-
-    sensor_c: float          # the session's pre-contact medians [degC] (NaN: none seen)
-    object_c: float
-    last_t: float | None     # the session's last device time [s]
-    dt_s: float              # the session's median sample interval [s]
-    away_s: float            # real seconds between the disconnect and the reopening
-    t: list = field(default_factory=list)
-    v: list = field(default_factory=list)
 
 
 class SerialRecorder:
@@ -532,7 +206,7 @@ class SerialRecorder:
         self._pre_contact: list[tuple[float, float]] = []   # the trials' (sensor, object) before contact
         self._idle_t = np.zeros(0)        # recent samples out of contact: the session's reference
         self._idle_v = np.zeros((0, 3))
-        self._verify: _Verification | None = None
+        self._verify: Probation | None = None
         self._pend: list[tuple[float, np.ndarray]] = []   # samples after a clock jump, until confirmed
         self._held: tuple[np.ndarray, np.ndarray] | None = None   # the last sample, until its successor comes
         self._prev_row: np.ndarray | None = None   # the last sample fed: the left neighbour of the next
@@ -582,7 +256,7 @@ class SerialRecorder:
         except (serial.SerialException, OSError, ValueError) as exc:
             if _is_enotty(exc):
                 raise InputError(f"{self.port} is not a serial device (not a terminal)") from None
-            raise InputError(f"cannot open serial port {self.port}: {_short(exc)}") from None
+            raise InputError(f"cannot open serial port {self.port}: {error_line(exc)}") from None
         self._restart_stream()
 
     def close(self) -> None:
@@ -657,7 +331,6 @@ class SerialRecorder:
         if self._ser is None:
             self.open()
         cutter = self._new_cutter(material)
-        self._cutter = cutter
         st = self.status
         st.material, st.target, st.trials, st.state = material, trials, 0, cutter.state
         start_written = len(self.written)
@@ -754,7 +427,8 @@ class SerialRecorder:
         while True:
             try:
                 self.open()
-                self._verify = self._probation(last_t, time.monotonic() - lost_at)
+                self._verify = Probation.start(self._idle_t, self._idle_v, self._pre_contact, last_t,
+                                               time.monotonic() - lost_at, self.profile.sample_rate_hz)
                 self._emit(RecordEvent("reconnect", f"reopened {self.port}; checking that it streams this "
                                                     "session's device before recording from it"))
                 return
@@ -764,7 +438,7 @@ class SerialRecorder:
                 time.sleep(0.1)
         self._sync(cutter)
         lost = "; the trial in progress was discarded" if in_trial else ""
-        raise DeviceGone(f"the device on {self.port} disappeared ({_short(exc)}) and did not come back within "
+        raise DeviceGone(f"the device on {self.port} disappeared ({error_line(exc)}) and did not come back within "
                          f"{self.profile.serial.reconnect_s:g} s; {self._kept_words()}{lost}")
 
     def _consume(self, chunk: bytes, cutter: TrialCutter) -> None:
@@ -924,7 +598,7 @@ class SerialRecorder:
     # ------------------------------------------------------- same device?
     def _out_of_contact(self, vals: np.ndarray) -> np.ndarray:
         """Rows of ``vals`` taken with nothing touching: force below release (without force: every row)."""
-        f = vals[:, _F]
+        f = vals[:, COL_FORCE]
         if self.profile.contact.rule != "force" or not np.isfinite(f).any():
             return np.ones(f.size, dtype=bool)
         return np.isfinite(f) & (f < self.profile.contact.release_n)
@@ -951,70 +625,18 @@ class SerialRecorder:
         except (OSError, ValueError, KeyError, TypeError):
             pass   # the idle samples remain the reference
 
-    def _probation(self, last_t: float | None, away_s: float) -> _Verification:
-        v, t = self._idle_v, self._idle_t
-        if self._pre_contact:   # the recorded trials' own pre-contact means: steady by construction
-            v = np.array([[s, o, np.nan] for s, o in self._pre_contact[-10:]], dtype=np.float64)
-        with np.errstate(all="ignore"):
-            sensor = float(np.nanmedian(v[:, _S])) if np.isfinite(v[:, _S]).any() else float("nan")
-            obj = float(np.nanmedian(v[:, _O])) if np.isfinite(v[:, _O]).any() else float("nan")
-        d = np.diff(t)
-        d = d[(d > 0) & (d < 3.0 / self.profile.sample_rate_hz)]
-        dt = float(np.median(d)) if d.size >= 10 else 1.0 / self.profile.sample_rate_hz
-        return _Verification(sensor, obj, last_t, dt, away_s)
-
     def _check_device(self, cutter: TrialCutter) -> None:
-        """Judge a reopened port once ``VERIFY_S`` of samples out of contact arrived (module docstring).
+        """Judge a reopened port once it showed enough samples (:mod:`~designkit.calibration.reconnect`).
 
         Raises
         ------
         DeviceChanged
             The stream differs from the session's device; nothing of it was fed to the cutter.
         """
-        ver = self._verify
-        t, vals = np.concatenate(ver.t), np.concatenate(ver.v)
-        need = max(2, int(round(VERIFY_S * self.profile.sample_rate_hz)))
-        idle = np.flatnonzero(self._out_of_contact(vals))[-need:]   # the latest VERIFY_S out of contact
-        if t.size < 10 * need:
-            if idle.size < need:
-                return                                  # not enough seen yet
-            s = vals[idle, _S]
-            if abs(np.median(s[need // 2:]) - np.median(s[:need // 2])) > SENSOR_TOLERANCE_C / 4:
-                return                                  # still settling (a heater recovering from a touch)
-        if idle.size == 0:
-            idle = np.arange(t.size)
-        reasons, same = [], []
-        sensor = float(np.nanmedian(vals[idle, _S]))
-        if math.isfinite(ver.sensor_c):
-            (reasons if abs(sensor - ver.sensor_c) > SENSOR_TOLERANCE_C else same).append(
-                f"sensor {sensor:.2f} °C out of contact, the session's {ver.sensor_c:.2f} °C")
-        if math.isfinite(ver.object_c) and np.isfinite(vals[idle, _O]).any():
-            obj = float(np.nanmedian(vals[idle, _O]))
-            (reasons if abs(obj - ver.object_c) > OBJECT_TOLERANCE_C else same).append(
-                f"object {obj:.2f} °C, the session's {ver.object_c:.2f} °C")
-        if self.profile.has_timestamp:
-            t0 = float(t[0])
-            if ver.last_t is not None:
-                if t0 < ver.last_t and t0 > RESTART_MAX_S:
-                    reasons.append(f"the device clock went back from {ver.last_t:.2f} s to {t0:.2f} s, where a "
-                                   "reset restarts it near 0")
-                elif t0 >= ver.last_t and t0 - ver.last_t > CLOCK_SLACK_S + 2 * ver.away_s:
-                    reasons.append(f"the device clock jumped ahead by {t0 - ver.last_t:.1f} s while the device was "
-                                   f"away {ver.away_s:.1f} s")
-                else:
-                    same.append("clock restarted" if t0 < ver.last_t else "clock continued")
-            d = np.diff(t)
-            d = d[d > 0]
-            if d.size >= 10:
-                dt = float(np.median(d))
-                if abs(dt / ver.dt_s - 1.0) > RATE_TOLERANCE:
-                    reasons.append(f"a sample every {1e3 * dt:.3g} ms, the session's {1e3 * ver.dt_s:.3g} ms")
-                span = float(t[-1] - t[0])
-                if span > 0:
-                    frac = t.size / (span / ver.dt_s + 1.0)
-                    if frac < MIN_ARRIVING_FRACTION:
-                        reasons.append(f"only {100 * frac:.0f} % of the samples arrive (another program reading "
-                                       "the same port splits its lines)")
+        verdict = self._verify.judge(self._out_of_contact, self.profile.has_timestamp, self.profile.sample_rate_hz)
+        if verdict is None:
+            return                                      # not enough seen yet, or still settling
+        reasons, same, t, vals = verdict
         if reasons:
             self._verify = None
             raise DeviceChanged(
@@ -1172,8 +794,3 @@ def _is_enotty(exc: BaseException | None) -> bool:
             return True
         exc = exc.__cause__ or exc.__context__
     return False
-
-
-def _short(exc: BaseException) -> str:
-    text = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-    return text

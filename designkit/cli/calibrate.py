@@ -222,7 +222,7 @@ class _EmulatorWatch:
 
     def __call__(self, message: str, material: str) -> None:
         from .._validation import InputError
-        from ..calibration.emulator import parse_announcement, parse_greeting
+        from ..calibration.touch_plan import parse_announcement, parse_greeting
 
         advice = ("with the emulator, give its materials in its order, --trials equal to its "
                   "--touches-per-material, and --yes (the command it prints after 'try:')")
@@ -441,13 +441,15 @@ def _run_identify(index: Path, model: Optional[str], fit_sets: Optional[str], ra
                   record: Optional[dict] = None) -> Optional[dict]:
     """Identify one model, or choose among them all (``model`` None or 'all'), and write the sensor file.
 
-    The touches are split by :func:`~designkit.calibration.identify.choose_split` (``fit_sets``
+    The touches are split by :func:`~designkit.calibration.split.choose_split` (``fit_sets``
     None: from the trial sets present; 'all': nothing held out) and the candidate with the smallest
     held-out residual wins (BIC where nothing is held out). Prints the report unless ``quiet``;
     returns the JSON payload (None after ``rows_fmt`` rows).
     """
     from .._validation import InputError
-    from ..calibration.identify import CANDIDATES, Split, candidate, choose_split, compare_models
+    from ..calibration.candidates import CANDIDATES, candidate
+    from ..calibration.compare import compare_models
+    from ..calibration.split import Split, choose_split
 
     auto = model is None or model.strip().lower() in ("all", "auto")
     cands = list(CANDIDATES) if auto else [candidate(model)]
@@ -470,7 +472,7 @@ def _run_identify(index: Path, model: Optional[str], fit_sets: Optional[str], ra
     best = next(r for r in results if r.candidate.label == selected)
     best_score = scores[results.index(best)]
     if plot is not None:  # before the sensor file: a refused fit is worth seeing too
-        from ..calibration.identify import plot_identification
+        from ..calibration.compare import plot_identification
 
         plot_identification(results, selected, fit, held, plot, held_out_rms_c=scores, object_temps=temps)
     selection = {"selected": selected, "reason": cmp.reason, "split": split.to_dict(),
@@ -775,7 +777,7 @@ def guided(
         raise InputError(f"--object-temp names {', '.join(map(repr, unknown))}, not a material of this run "
                          f"({', '.join(materials)})")
     if model is not None and model.strip().lower() not in ("all", "auto"):
-        from ..calibration.identify import candidate
+        from ..calibration.candidates import candidate
 
         candidate(model)
     if sensor_out is not None:

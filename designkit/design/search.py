@@ -21,7 +21,8 @@ neighbouring pairs are searched, and every pair is scored for the recommended de
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 
@@ -30,14 +31,18 @@ from ..materials import get_material, list_materials
 from ..query.ideal_bound import exact_ideal_min_contact
 from ..sensor import Sensor, check_samples_per_touch
 
-__all__ = ["SKIN_SET", "Constraints", "Design", "DesignResult", "Target", "confirm_with_svm", "recommend",
-           "targets_from"]
+__all__ = ["MIN_SAMPLES", "SKIN_SET", "Constraints", "Design", "DesignResult", "Target", "confirm_with_svm", "predict",
+           "predict_and_confirm", "recommend", "svm_f1_at", "targets_from"]
 
 #: Common skin materials of a heated tactile sensor (materials database names): polymers, ceramics, metals.
 SKIN_SET = ("Polyetheretherketone (PEEK)", "Silicone elastomers", "Polytetrafluoroethylene (Teflon, PTFE)",
             "Epoxies", "Polyethylene terephthalate (PET)", "Silica glass", "Alumina", "Zirconia",
             "Stainless steel", "Titanium alloys")
 WIDTH = 80.0
+#: A recommendation never rests on the first samples after contact: a design is credited with at least this
+#: many samples of contact (a separation sooner is scored as this many; ties go to the sooner one). The
+#: SVM's slope feature needs neighbours, and a real onset moves by a few samples from touch to touch.
+MIN_SAMPLES = 10
 #: Width of the class of a material given by its identified effusivity (a point, to the J).
 POINT_WIDTH = 1.0
 
@@ -74,6 +79,13 @@ class Constraints:
         Thermistor depths that can be built [um].
     threshold : float
         F1 the limiting pair must reach (the paper's 0.9).
+    min_thermistor_tau_s : float
+        Fastest thermistor (own time constant) that can be built [s]; under a rig's contact the search
+        goes from it to the rig's (:mod:`designkit.design.contact`).
+    skin_thickness_um : (float, float)
+        Skin thicknesses that can be built [um] (under a rig whose model has a film of finite thickness).
+    max_press_speedup : float
+        How much faster than the rig's the press may be (its force ramp's pace; 1: the rig's only).
     """
 
     max_contact_s: float = 4.0
@@ -82,6 +94,9 @@ class Constraints:
     max_rate_hz: float = 200.0
     depth_um: tuple[float, float] = (20.0, 500.0)
     threshold: float = 0.9
+    min_thermistor_tau_s: float = 0.05
+    skin_thickness_um: tuple[float, float] = (50.0, 500.0)
+    max_press_speedup: float = 2.0
 
     def __post_init__(self) -> None:
         for name, v in (("longest contact [s]", self.max_contact_s), ("noise floor [degC]", self.noise_c),
@@ -96,6 +111,14 @@ class Constraints:
         if hi > MAX_DEPTH_UM:  # 1e308 um was searched
             raise InputError(f"thermistor depth must be at most {MAX_DEPTH_UM:g} um (1 cm: a time constant of minutes "
                              f"under any skin), got {hi:g} um")
+        if not (math.isfinite(self.min_thermistor_tau_s) and self.min_thermistor_tau_s >= 0):
+            raise InputError(f"fastest thermistor time constant must be >= 0 s, got {self.min_thermistor_tau_s:g}")
+        lo, hi = self.skin_thickness_um
+        if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo <= hi <= MAX_DEPTH_UM):
+            raise InputError(f"skin thicknesses contradict each other: MIN must be positive and <= MAX <= "
+                             f"{MAX_DEPTH_UM:g} um, got {lo:g}:{hi:g} um")
+        if not (math.isfinite(self.max_press_speedup) and 1.0 <= self.max_press_speedup <= 100.0):
+            raise InputError(f"press speed-up must be between 1 (the rig's) and 100, got {self.max_press_speedup:g}")
         if not 0.5 < self.threshold < 1.0:
             raise InputError(f"F1 threshold must lie in (0.5, 1), got {self.threshold:g}")
         if self.max_contact_s * self.max_rate_hz < 1.0:
@@ -118,16 +141,33 @@ class Design:
     delta_t_c: float
     min_contact_s: float
     limiting_pair: tuple[str, str]
+    thermistor_tau_s: float | None = None
+    skin_thickness_um: float | None = None
+    press_pace: float | None = None
+    ideal_time_s: float | None = None
+    method: str = "closed-form"
+    contact: Any = field(default=None, compare=False, repr=False)
 
     def sensor(self) -> Sensor:
-        return Sensor(self.e_sensor, self.diffusivity_m2_s, self.depth_um * 1e-6, self.sample_rate_hz,
-                      name=f"design: {self.skin}, {self.depth_um:.3g} um")
+        """The design's sensor (under a rig's contact: the rig's with this design's changes, its model record
+        and conditions)."""
+        name = f"design: {self.skin}, {self.depth_um:.3g} um"
+        if self.contact is None:
+            return Sensor(self.e_sensor, self.diffusivity_m2_s, self.depth_um * 1e-6, self.sample_rate_hz, name=name)
+        return self.contact.sensor(effusivity=self.e_sensor, diffusivity_m2_s=self.diffusivity_m2_s,
+                                   depth_m=self.depth_um * 1e-6, sample_rate_hz=self.sample_rate_hz,
+                                   thermistor_tau_s=self.thermistor_tau_s,
+                                   skin_thickness_m=None if self.skin_thickness_um is None else self.skin_thickness_um * 1e-6,
+                                   pace=self.press_pace or 1.0, name=name)
 
     def to_dict(self) -> dict:
         # the sensor's effusivity as Sensor.to_dict names it; the bound as every answer's ideal (docs/schema.md)
         return {"skin": self.skin, "effusivity": self.e_sensor, "diffusivity_m2_s": self.diffusivity_m2_s,
                 "depth_um": self.depth_um, "tau_s": self.tau_s, "sample_rate_hz": self.sample_rate_hz,
-                "delta_t_c": self.delta_t_c, "ideal": _ideal(self.min_contact_s),
+                "delta_t_c": self.delta_t_c, "thermistor_tau_s": self.thermistor_tau_s,
+                "skin_thickness_um": self.skin_thickness_um, "press_pace": self.press_pace,
+                "ideal": {"value": _num(self.min_contact_s), "method": self.method},
+                "ideal_time_s": _num(self.ideal_time_s),
                 "limiting": {"a": self.limiting_pair[0], "b": self.limiting_pair[1]} if self.limiting_pair else None}
 
 
@@ -141,13 +181,21 @@ class DesignResult:
     pareto: tuple[tuple[float, float], ...]
     constraints: Constraints
     reason: str
+    contact: Any = None
+    baseline: Design | None = None
 
     def to_dict(self) -> dict:
         c = self.constraints
         return {"best": None if self.best is None else self.best.to_dict(), "reason": self.reason,
                 "constraints": {"max_contact_s": c.max_contact_s, "noise_c": c.noise_c,
                                 "max_delta_t_c": c.max_delta_t_c, "max_rate_hz": c.max_rate_hz,
-                                "depth_range_um": list(c.depth_um), "threshold": c.threshold},
+                                "depth_range_um": list(c.depth_um), "threshold": c.threshold,
+                                "min_thermistor_tau_s": c.min_thermistor_tau_s,
+                                "skin_thickness_range_um": list(c.skin_thickness_um),
+                                "max_press_speedup": c.max_press_speedup},
+                "rig_contact": None if self.contact is None else self.contact.to_dict(),
+                "baseline": None if self.baseline is None else self.baseline.to_dict(),
+                "min_samples": MIN_SAMPLES,
                 "pairs": [{"a": a, "b": b, "ideal": _ideal(t)} for a, b, t in self.pairs],
                 "pareto_noise_ratio_vs_contact": [{"noise_ratio": r, "ideal": _ideal(t)} for r, t in self.pareto],
                 "designs_searched": len(self.designs)}
@@ -220,16 +268,34 @@ def _grid(c: Constraints, n_depth: int) -> np.ndarray:
     return np.unique(np.geomspace(lo, hi, n_depth)) if hi > lo else np.array([lo])
 
 
+def _skin(name: str) -> tuple[str, float, float]:
+    """(database name, effusivity, diffusivity): the geometric means of the material's ranges."""
+    m = get_material(name)
+    return m.name, math.sqrt(m.e_min * m.e_max), math.sqrt(m.diffusivity_min_m2_s * m.diffusivity_max_m2_s)
+
+
+def _credited(t: float, rate_hz: float) -> float:
+    """A separation's contact as the search credits it: at least :data:`MIN_SAMPLES` samples."""
+    return max(t, MIN_SAMPLES / rate_hz) if math.isfinite(t) else t
+
+
 def recommend(targets: list[Target], constraints: Constraints, *, skins=SKIN_SET, n_depth: int = 8,
-              progress=None) -> DesignResult:
-    """Search skin x depth with the ideal observer; the design with the shortest limiting contact wins.
+              progress=None, contact=None) -> DesignResult:
+    """Search the designs; the one with the shortest limiting contact wins.
+
+    Without ``contact``: skin x depth under the paper's instantaneous perfect contact, with the ideal
+    observer's closed form. With a :class:`~designkit.design.contact.RigContact`: skin (and the rig's own
+    as calibrated) x depth x thermistor time constant x skin thickness x press pace under the rig's contact
+    model and scene, screened by :func:`~designkit.design.contact.screen_contact`. Either way a design is
+    credited with at least :data:`MIN_SAMPLES` samples of contact (ties: the sooner separation, then the
+    smaller tau).
 
     Examples
     --------
     >>> t = targets_from(["a=20000", "b=35000"])
     >>> r = recommend(t, Constraints(max_contact_s=4.0), skins=("Polyetheretherketone (PEEK)",), n_depth=3)
-    >>> r.best.depth_um, r.best.limiting_pair
-    (20.0, ('a', 'b'))
+    >>> r.best.depth_um, r.best.limiting_pair, r.best.min_contact_s
+    (20.0, ('a', 'b'), 0.05)
     """
     c = constraints
     ratio = c.noise_c / c.max_delta_t_c
@@ -244,78 +310,288 @@ def recommend(targets: list[Target], constraints: Constraints, *, skins=SKIN_SET
                                                  f"overlap in effusivity (each material is judged as a class {w:g} "
                                                  "J s^-1/2 K^-1 m^-2 wide; NAME=E is the class [E, E + "
                                                  f"{w:g})): no sensor separates every object of one from every "
-                                                 "object of the other")
+                                                 "object of the other", contact)
     lo = np.array([e[0] for e in edges])
     hi = np.array([e[1] for e in edges])
     wd = np.array([e[2] for e in edges])
     depths = _grid(c, n_depth)
-    designs = []
-    for skin in skins:
-        m = get_material(skin)
-        e_s = math.sqrt(m.e_min * m.e_max)
-        alpha = math.sqrt(m.diffusivity_min_m2_s * m.diffusivity_max_m2_s)
-        for d in depths:
-            sensor = Sensor(e_s, alpha, d * 1e-6, c.max_rate_hz)
-            t = exact_ideal_min_contact(sensor, lo, hi, ratio, width=wd, threshold=c.threshold,
-                                        max_contact_s=c.max_contact_s)
-            worst = np.where(np.isnan(t), np.inf, t)
-            k = int(np.argmax(worst))
-            designs.append(Design(m.name, e_s, alpha, float(d), sensor.tau_s, c.max_rate_hz, c.max_delta_t_c,
-                                  float(worst[k]), (pairs[k][0].name, pairs[k][1].name)))
-            if progress is not None:
-                progress()
-    best = min(designs, key=lambda x: (x.min_contact_s, x.tau_s))
+    if contact is not None:
+        designs, baseline, best_sensor_eval = _search_contact(contact, c, pairs, lo, hi, wd, depths, skins,
+                                                             progress=progress)
+    else:
+        baseline = None
+        designs = []
+        for skin in skins:
+            name, e_s, alpha = _skin(skin)
+            for d in depths:
+                sensor = Sensor(e_s, alpha, d * 1e-6, c.max_rate_hz)
+                t = exact_ideal_min_contact(sensor, lo, hi, ratio, width=wd, threshold=c.threshold,
+                                            max_contact_s=c.max_contact_s)
+                worst = np.where(np.isnan(t), np.inf, t)
+                k = int(np.argmax(worst))
+                designs.append(Design(name, e_s, alpha, float(d), sensor.tau_s, c.max_rate_hz, c.max_delta_t_c,
+                                      _credited(float(worst[k]), c.max_rate_hz), (pairs[k][0].name, pairs[k][1].name),
+                                      ideal_time_s=float(worst[k])))
+                if progress is not None:
+                    progress()
+
+        def best_sensor_eval(sensor, e_lo, e_hi, widths, ratios):
+            return exact_ideal_min_contact(sensor, e_lo, e_hi, ratios, width=widths, threshold=c.threshold,
+                                           max_contact_s=c.max_contact_s)
+    best = min(designs, key=lambda x: (x.min_contact_s, x.ideal_time_s, x.tau_s))
     if not math.isfinite(best.min_contact_s):
         hard = best.limiting_pair
         return DesignResult(None, tuple(designs), (), (), c,
                             f"no allowed design separates {hard[0]} from {hard[1]} within {c.max_contact_s:g} s "
-                            f"(noise {c.noise_c:g} degC, dT {c.max_delta_t_c:g} degC, {c.max_rate_hz:g} Hz)")
+                            f"(noise {c.noise_c:g} degC, dT {c.max_delta_t_c:g} degC, {c.max_rate_hz:g} Hz"
+                            + (f", under the contact of {contact.source}" if contact is not None else "") + ")",
+                            contact, baseline)
     sensor = best.sensor()
     # every pair of targets, one vectorized call for the separable ones (overlapping ones have no answer)
     ij = [(i, j) for i in range(len(targets)) for j in range(i + 1, len(targets))]
     cls = [_pair_classes(targets[i], targets[j]) for i, j in ij]
     sep = [e for e in cls if e is not None]
-    t_sep = iter(exact_ideal_min_contact(sensor, *(np.array([e[k] for e in sep]) for k in (0, 1)), ratio,
-                                         width=np.array([e[2] for e in sep]), threshold=c.threshold,
-                                         max_contact_s=c.max_contact_s).tolist() if sep else [])
-    all_pairs = [(targets[i].name, targets[j].name, next(t_sep) if e is not None else math.nan)
+    t_sep = iter(best_sensor_eval(sensor, *(np.array([e[k] for e in sep]) for k in (0, 1)),
+                                  np.array([e[2] for e in sep]), ratio).tolist() if sep else [])
+    all_pairs = [(targets[i].name, targets[j].name, _credited(next(t_sep), best.sample_rate_hz) if e is not None
+                  else math.nan)
                  for (i, j), e in zip(ij, cls)]
     # trade-off: the best design's limiting contact against sigma/dT (noise floor and dT enter only so)
     ratios = ratio * np.geomspace(0.125, 8.0, 13)
-    t = exact_ideal_min_contact(sensor, lo[None, :], hi[None, :], ratios[:, None], width=wd[None, :],
-                                threshold=c.threshold, max_contact_s=c.max_contact_s)
+    t = np.asarray(best_sensor_eval(sensor, lo[None, :], hi[None, :], wd[None, :], ratios[:, None]))
     worst = np.max(np.where(np.isnan(t), np.inf, t), axis=1)
-    front = [(float(r), float(x)) for r, x in zip(ratios, worst)]
-    reason = (f"{best.skin} skin (e_s {best.e_sensor:.0f}), thermistor {best.depth_um:.3g} um deep (tau "
-              f"{best.tau_s:.3g} s), {best.sample_rate_hz:g} Hz, dT {best.delta_t_c:g} degC: the limiting pair "
-              f"{best.limiting_pair[0]} / {best.limiting_pair[1]} separates (ideal F1 >= {c.threshold:g}) after "
-              f"{best.min_contact_s:.3g} s")
-    return DesignResult(best, tuple(designs), tuple(all_pairs), tuple(front), c, reason)
+    front = [(float(r), _credited(float(x), best.sample_rate_hz)) for r, x in zip(ratios, worst)]
+    return DesignResult(best, tuple(designs), tuple(all_pairs), tuple(front), c, _reason(best, c, contact), contact,
+                        baseline)
+
+
+def _lags(contact, fastest_s: float) -> list[float]:
+    """Thermistor time constants searched [s]: from the fastest that can be built to the rig's, 3 points."""
+    own = contact.thermistor_tau_s
+    if own <= 0:
+        return [0.0]
+    lo = min(fastest_s, own)
+    if lo <= 0:
+        return [0.0, own]
+    return sorted({lo, math.sqrt(lo * own), own})
+
+
+def _search_contact(contact, c, pairs, lo, hi, wd, depths, skins, *, progress=None):
+    """Every design under the contact, screened; returns (designs, the rig as built or None, evaluator).
+
+    ``c``: :class:`~designkit.design.search.Constraints`; ``pairs`` the neighbouring target pairs with their
+    classes' lower edges ``lo``, ``hi`` and widths ``wd``; ``depths`` [um]; ``skins`` database names. The
+    evaluator ``(sensor, e_lo, e_hi, widths, ratios)`` screens any pairs for one design's sensor.
+    """
+    from .contact import screen_contact
+
+    ratio = c.noise_c / c.max_delta_t_c
+    centre_lo, centre_hi = lo + 0.5 * wd, hi + 0.5 * wd
+    calibrated = contact.source.startswith("sensor file")
+    candidates = ([("rig as calibrated", contact.rig.effusivity, contact.rig.diffusivity_m2_s)] if calibrated else [])
+    candidates += [_skin(s) for s in skins]
+    lags = _lags(contact, c.min_thermistor_tau_s)
+    film = math.isfinite(contact.skin_thickness_m)
+    a, b = c.skin_thickness_um
+    thick = sorted({a, math.sqrt(a * b), b}) if film else [None]
+    paces = [1.0, 1.0 / c.max_press_speedup] if contact.ramp_s > 0 and c.max_press_speedup > 1 else [1.0]
+
+    def design(name, e_s, alpha, depth_um, lag, thickness_um, pace, rate):
+        d = Design(name, e_s, alpha, float(depth_um), float((depth_um * 1e-6) ** 2 / (4 * alpha)), rate, c.max_delta_t_c,
+                   math.inf, (), thermistor_tau_s=lag, skin_thickness_um=thickness_um, press_pace=pace,
+                   method="screen", contact=contact)
+        t = screen_contact(d.sensor(), centre_lo, centre_hi, ratio, max_contact_s=c.max_contact_s,
+                           threshold=c.threshold)
+        k = int(np.argmax(t))
+        return replace(d, min_contact_s=_credited(float(t[k]), rate), ideal_time_s=float(t[k]),
+                                   limiting_pair=(pairs[k][0].name, pairs[k][1].name))
+
+    designs = []
+    for name, e_s, alpha in candidates:
+        for d_um in depths:
+            for L in thick:
+                if L is not None and d_um > L:  # the thermistor lies in the skin
+                    continue
+                for lag in lags:
+                    for pace in paces:
+                        designs.append(design(name, e_s, alpha, d_um, lag, L, pace, c.max_rate_hz))
+                        if progress is not None:
+                            progress()
+    if not designs:
+        raise InputError(f"no thermistor depth in {c.depth_um[0]:g}-{c.depth_um[1]:g} um fits in a skin of "
+                         f"{c.skin_thickness_um[0]:g}-{c.skin_thickness_um[1]:g} um: allow thicker skins or "
+                         "shallower depths")
+    baseline = None
+    if calibrated:
+        r = contact.rig
+        baseline = design("rig as built", r.effusivity, r.diffusivity_m2_s, r.depth_m * 1e6, contact.thermistor_tau_s,
+                          contact.skin_thickness_m * 1e6 if film else None, 1.0, r.sample_rate_hz)
+
+    def evaluate(sensor, e_lo, e_hi, widths, ratios):
+        e_lo, e_hi, widths = (np.asarray(x, dtype=np.float64) for x in (e_lo, e_hi, widths))
+        r = np.asarray(ratios, dtype=np.float64)
+        if r.size == 1:
+            return screen_contact(sensor, (e_lo + 0.5 * widths).ravel(), (e_hi + 0.5 * widths).ravel(), float(r),
+                                  max_contact_s=c.max_contact_s, threshold=c.threshold)
+        return screen_contact(sensor, (e_lo + 0.5 * widths).ravel(), (e_hi + 0.5 * widths).ravel(), ratio,
+                              max_contact_s=c.max_contact_s, threshold=c.threshold, ratios=r.ravel())
+
+    return designs, baseline, evaluate
+
+
+def _reason(best: Design, c: Constraints, contact) -> str:
+    parts = [f"{best.skin} skin (e_s {best.e_sensor:.0f})"]
+    if best.skin_thickness_um is not None:
+        parts.append(f"{best.skin_thickness_um:.3g} um thick")
+    parts.append(f"thermistor {best.depth_um:.3g} um deep (tau {best.tau_s:.3g} s)")
+    if best.thermistor_tau_s is not None:
+        parts.append(f"a thermistor of own time constant {best.thermistor_tau_s:.3g} s")
+    if best.press_pace is not None and best.press_pace != 1.0:
+        parts.append(f"the press {1 / best.press_pace:.3g}x as fast")
+    parts.append(f"{best.sample_rate_hz:g} Hz, dT {best.delta_t_c:g} degC")
+    how = ("(ideal F1" if contact is None else "(screened: d' of the class centres through the noise, F1")
+    floor = (f"; it separates after {best.ideal_time_s:.3g} s, credited {MIN_SAMPLES} samples"
+             if best.ideal_time_s is not None and best.ideal_time_s < best.min_contact_s else "")
+    under = "" if contact is None else f", under the contact of {contact.source}, counted from the {contact.counted_from}"
+    return (", ".join(parts) + f": the limiting pair {best.limiting_pair[0]} / {best.limiting_pair[1]} separates "
+            f"{how} >= {c.threshold:g}) after {best.min_contact_s:.3g} s{floor}{under}")
+
+
+def svm_f1_at(design: Design, lo_class, hi_class, contact_s: float, noise_c: float, delta_t_c: float, *,
+              trials: int, seeds, jobs: int = 1) -> float:
+    """Mean F1 of the paper's SVM for two classes under the design's sensor, model and scene, over ``seeds``
+    (contact counted from the rig's detected onset where the design is under a rig's contact)."""
+    from ..models import sensor_model
+    from ..recognition.svm import pair_f1
+    from ..rig import model_start_s, rig_scene, to_model_contact
+    from ..scene import Scene
+
+    sensor = design.sensor()
+    model = sensor_model(sensor)
+    start = model_start_s(sensor)
+    scene = Scene.from_delta_t(contact_s=to_model_contact(contact_s, start), noise_c=noise_c,
+                               delta_t_c=delta_t_c).replace(**rig_scene(sensor))
+    return float(np.mean([pair_f1(lo_class, hi_class, sensor, scene, model=model, trials=trials, seed=s).f1
+                          for s in seeds]))
 
 
 def confirm_with_svm(result: DesignResult, targets: list[Target], *, trials: int = 100, seeds: int = 3,
-                     step_s: float = 0.05) -> dict:
-    """The paper's SVM on the recommended design's limiting pair: the shortest contact (on a ``step_s`` grid,
-    from the ideal bound up) whose mean F1 over ``seeds`` runs reaches the threshold."""
+                     step_s: float = 0.05, low_s: float | None = None, high_s: float | None = None,
+                     bisections: int = 3) -> dict:
+    """The paper's SVM on the recommended design's limiting pair, under the design's model and scene: its
+    shortest contact bracketed.
+
+    The mean F1 over ``seeds`` runs is evaluated at ``low_s`` (default: the credited bound). At or above the
+    threshold there, contacts below are evaluated (the step doubling) until it falls short; below it, at
+    ``high_s`` (default ``low_s + step_s``) and above (the step doubling) until it is reached or the longest
+    contact. The bracket is then bisected ``bisections`` times (on sample times). ``value`` is the bracket's
+    high end, ``interval`` the bracket (the SVM's crossing lies in ``(low, high]``; ``low`` None: at the
+    shortest contact credited, :data:`MIN_SAMPLES` samples).
+    """
     from ..objects import ObjectClass
-    from ..recognition.svm import pair_f1
-    from ..scene import Scene
+
+    best, c = result.best, result.constraints
+    fs = best.sample_rate_hz
+    by_name = {t.name: t for t in targets}
+    a, b = (by_name[n] for n in best.limiting_pair)
+    lo_e, hi_e, w = _pair_classes(a, b)
+    classes = ObjectClass("lo", (lo_e, lo_e + w)), ObjectClass("hi", (hi_e, hi_e + w))
+    evals: list[dict] = []
+
+    def snap(x, way=round):  # onto sample times (the F1 changes only there), at least MIN_SAMPLES
+        return round(max(int(way(x * fs - 1e-9 if way is math.ceil else x * fs + 1e-9)), MIN_SAMPLES) / fs, 6)
+
+    def f1(x):  # each contact once
+        done = [e["svm_f1"] for e in evals if e["contact_s"] == x]
+        if done:
+            return done[0]
+        f = svm_f1_at(best, *classes, x, c.noise_c, c.max_delta_t_c, trials=trials,
+                      seeds=[[s, 17] for s in range(seeds)])
+        evals.append({"contact_s": x, "svm_f1": f})
+        return f
+
+    out = {"ideal": {"value": _num(best.min_contact_s), "method": best.method}, "trials": trials, "seeds": seeds,
+           "grid_step_s": step_s}
+    top = snap(c.max_contact_s)
+    lo = min(snap(best.min_contact_s if low_s is None else low_s, math.floor), top)
+    floor = snap(0.0)
+    f_lo = f1(lo)
+    width = max(step_s, (high_s - lo) if high_s is not None and high_s > lo else step_s)
+    while f_lo >= c.threshold:  # reached already: step down (doubling) until it falls short, or to the floor
+        if lo <= floor:
+            return {"value": lo, "svm_f1": f_lo, "interval": {"low": None, "high": lo, "coverage": None}, **out,
+                    "svm_minus_ideal_s": round(lo - best.min_contact_s, 6), "evaluations": evals}
+        below = max(snap(lo - width, math.floor), floor)
+        f_below = f1(below)
+        if f_below < c.threshold:
+            hi, f_hi, lo = lo, f_lo, below
+            break
+        lo, f_lo, width = below, f_below, 2 * width
+    else:
+        hi = None
+    if hi is None:
+        hi = min(snap(lo + step_s if high_s is None else max(high_s, lo + 1 / fs), math.ceil), top)
+        width = hi - lo
+    while True:
+        f_hi = f1(hi)
+        if f_hi >= c.threshold:
+            break
+        if hi >= top:
+            return {"value": None, "interval": {"low": hi, "high": None, "coverage": None}, **out,
+                    "svm_minus_ideal_s": None, "evaluations": evals,
+                    "note": f"the SVM does not reach F1 {c.threshold:g} by {c.max_contact_s:g} s"}
+        width *= 2
+        lo, hi = hi, min(snap(hi + width), top)
+    for _ in range(bisections):
+        mid = snap(0.5 * (lo + hi))
+        if not lo < mid < hi:
+            break
+        f_mid = f1(mid)
+        if f_mid >= c.threshold:
+            hi, f_hi = mid, f_mid
+        else:
+            lo = mid
+    return {"value": hi, "svm_f1": f_hi, "interval": {"low": lo, "high": hi, "coverage": None}, **out,
+            "svm_minus_ideal_s": round(hi - best.min_contact_s, 6), "evaluations": evals}
+
+
+def predict(result: DesignResult, targets: list[Target], *, trials: int = 100, repeats: int = 4, seed: int = 0,
+            jobs: int = 1, coverage: float = 0.9, n_mc: int = 1000) -> dict:
+    """The recommendation's contact as designkit states it for a computed question: the exact route's
+    estimate of where the SVM's mean F1 crosses the threshold for the limiting pair, with its interval
+    (:func:`designkit.query.exact.exact_min_contact`, the design's sensor, model and scene), counted from
+    the rig's detected onset under a rig's contact."""
+    from ..objects import ObjectClass
+    from ..query.exact import exact_min_contact
+    from ..rig import from_model_contact, model_start_s
 
     best, c = result.best, result.constraints
     by_name = {t.name: t for t in targets}
-    a, b = (by_name[n] for n in best.limiting_pair)
-    lo, hi, w = _pair_classes(a, b)
+    lo, hi, w = _pair_classes(*(by_name[n] for n in best.limiting_pair))
     sensor = best.sensor()
-    t = best.min_contact_s
-    while t <= c.max_contact_s + 1e-9:
-        scene = Scene.from_delta_t(contact_s=t, noise_c=c.noise_c, delta_t_c=c.max_delta_t_c)
-        f1 = [pair_f1(ObjectClass("lo", (lo, lo + w)), ObjectClass("hi", (hi, hi + w)), sensor, scene,
-                      trials=trials, seed=[s, 17]).f1 for s in range(seeds)]
-        if float(np.mean(f1)) >= c.threshold:
-            return {"value": round(t, 6), "svm_f1": float(np.mean(f1)), "ideal": _ideal(best.min_contact_s),
-                    "svm_minus_ideal_s": round(t - best.min_contact_s, 6), "grid_step_s": step_s,
-                    "trials": trials, "seeds": seeds}
-        t = round(t + step_s, 9)
-    return {"value": None, "ideal": _ideal(best.min_contact_s), "svm_minus_ideal_s": None,
-            "grid_step_s": step_s, "trials": trials, "seeds": seeds,
-            "note": f"the SVM does not reach F1 {c.threshold:g} by {c.max_contact_s:g} s"}
+    start = model_start_s(sensor)
+    ans = exact_min_contact(objects=(ObjectClass("lo", (lo, lo + w)), ObjectClass("hi", (hi, hi + w))),
+                            noise_c=c.noise_c, delta_t_c=c.max_delta_t_c, threshold=c.threshold, sensor=sensor,
+                            width=w, trials=trials, repeats=repeats, seed=seed, jobs=jobs, coverage=coverage,
+                            max_contact_s=c.max_contact_s - (start or 0.0), solver="batched", n_mc=n_mc)
+    low, high = (None if v is None else round(float(from_model_contact(v, start)), 6) for v in ans.interval)
+    value = None if ans.value is None else round(float(from_model_contact(ans.value, start)), 6)
+    return {"value": value, "interval": {"low": low, "high": high, "coverage": ans.interval_coverage},
+            "trials": trials, "repeats": repeats, "seed": seed,
+            "counted_from": "detected onset" if start is not None else "first contact"}
+
+
+def predict_and_confirm(result: DesignResult, targets: list[Target], *, trials: int = 100, repeats: int = 4,
+                        seeds: int = 3, bisections: int = 3, jobs: int = 1, n_mc: int = 1000) -> dict:
+    """:func:`predict`, then :func:`confirm_with_svm` with fresh seeds, bracketing the SVM's crossing from the
+    stated interval's ends: ``holds`` when the bracket lies inside the stated interval (to a sample): the SVM
+    falls short of the threshold at (or above) its low end and reaches it by its high end."""
+    pred = predict(result, targets, trials=trials, repeats=repeats, jobs=jobs, n_mc=n_mc)
+    low, high = pred["interval"]["low"], pred["interval"]["high"]
+    conf = confirm_with_svm(result, targets, trials=trials, seeds=seeds, low_s=low, high_s=high,
+                            bisections=bisections)
+    v, a, dt = conf["value"], conf["interval"]["low"], 1.0 / result.best.sample_rate_hz
+    # the SVM's crossing lies in (a, v]: inside the stated interval to a sample (the F1 changes only at samples)
+    holds = (None if low is None or high is None else
+             bool(v is not None and a is not None and a >= low - dt - 1e-9 and v <= high + dt + 1e-9))
+    return {**conf, "prediction": pred, "holds": holds}

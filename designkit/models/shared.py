@@ -1,27 +1,18 @@
-"""The readings of a class of objects from a few: interpolation in effusivity, computed once per class.
+"""The readings of many touches from a few: a scene's response in effusivity, read once and shared by its classes.
 
-A simulated class is many touches (100 in a sweep) of objects whose effusivity
-is drawn uniformly in the class's range ``[e_low, e_high)``, all read on one
-time grid. For a model whose reading costs much per object (an inverse Laplace
-transform per time, :class:`~designkit.models.layered.Layered`; a sum over a
-force ramp's shares, :class:`~designkit.models.ramp.ForceRamp`) the readings of
-the whole class come from the model's readings at a few effusivities of the
-range: a polynomial in the contact weight ``w = e_o / (e_s + e_o)`` (in which
-the paper's model is exactly linear and every model here nearly so), through
-Chebyshev points, evaluated by the barycentric formula
-(:class:`scipy.interpolate.BarycentricInterpolator`).
-
-The error is measured, not assumed: the interpolant through ``n + 1``
-Chebyshev-Lobatto points is compared with the model at the ``n`` points that
-interlace them (the next level's new points, ``n = 2, 4, 8, 16, 32``); once the
-largest difference over every time is within the tolerance, the next level's
-interpolant (through all ``2n + 1`` points, more accurate still) answers. A
-class whose readings do not converge by 33 points, or whose touches have no
-more distinct effusivities than the points it would need, is read directly
-(the model at every distinct effusivity). The tolerance is the one a
-simulation asks of a numerically solved model
-(:func:`designkit.simulation.response_tolerance`: 1 % of the noise over the
-whole curve, at most 1e-5 of the temperature difference).
+A sweep reads hundreds of classes (100 touches each, effusivity uniform in the class's range) on one time
+grid. For a model whose reading costs much per object (:class:`~designkit.models.layered.Layered`'s inverse
+Laplace transform, :class:`~designkit.models.ramp.ForceRamp`'s sum over its shares) every touch's reading is
+a polynomial in the contact weight ``w = e_o / (e_s + e_o)`` (the paper's model is linear in it), evaluated
+by the barycentric formula (Berrut & Trefethen 2004) on dyadic panels ``[i / 2^L, (i + 1) / 2^L]`` of ``w``.
+A panel is read once (5 Chebyshev-Lobatto points, one call of the model) and serves every class and repeat
+whose touches fall in it (:class:`SceneResponse`, one per model, sensor, time grid and tolerance:
+:func:`scene_response`). The error is measured: the panel's 3-point interpolant against the model at the 2
+points between them; within the tolerance (:func:`designkit.simulation.response_tolerance`: 1 % of the noise
+over the curve, at most 1e-5) the 5-point interpolant answers, else the panel's halves are read, down to
+:data:`MAX_LEVEL` (then directly). A class starts at panels 8-16 times its width (:func:`start_level`).
+A reading depends on the touch's effusivity and its class's range alone, never on the classes read before:
+the same draws give the same readings bit for bit in any order, split or process.
 
 Examples
 --------
@@ -30,17 +21,17 @@ Examples
 >>> from designkit.models import get_model
 >>> m = get_model("layered", film_thickness_m=2e-4, backing_effusivity_ws05_m2k=600.0, conductance_w_m2k=3000.0)
 >>> t = np.arange(1, 401) / 200.0
->>> table = SharedResponse.build(m, t, 331.0, 506.0, SENSORS["paper"], tolerance=1e-7)
 >>> e = np.random.default_rng(0).uniform(331.0, 506.0, 50)
->>> bool(np.max(np.abs(table.readings(e) - m.response(t, e, SENSORS["paper"]))) < 1e-7), table.nodes.size <= 9
-(True, True)
+>>> u = class_readings(m, t, e, SENSORS["paper"], tolerance=1e-7)
+>>> bool(np.max(np.abs(u - m.response(t, e, SENSORS["paper"]))) < 1e-7)
+True
 """
 
 from __future__ import annotations
 
+import functools
 import math
-from dataclasses import dataclass
-from typing import Any
+from typing import NamedTuple
 
 import numpy as np
 
@@ -48,10 +39,12 @@ from .._validation import InputError
 from .base import ForwardModel
 from .semi_infinite import object_weight
 
-__all__ = ["MAX_LEVEL", "SharedResponse", "class_readings"]
+__all__ = ["MAX_LEVEL", "Panel", "SceneResponse", "class_readings", "scene_response", "start_level"]
 
-#: Most interpolation intervals (33 Chebyshev-Lobatto points); beyond, the class is read directly.
-MAX_LEVEL = 32
+#: Deepest panel level (width ``2^-MAX_LEVEL`` in w); touches in a panel that fails there are read directly.
+MAX_LEVEL = 40
+#: Fewest distinct effusivities worth a panel (5 readings); a class with fewer is read directly.
+MIN_DISTINCT = 6
 
 
 def _lobatto(n: int, lo: float, hi: float) -> np.ndarray:
@@ -69,124 +62,123 @@ def _effusivity(w: np.ndarray, e_sensor: float) -> np.ndarray:
         return np.where(w >= 1.0, np.inf, e_sensor * w / np.where(w >= 1.0, 1.0, 1.0 - w))
 
 
-@dataclass(frozen=True, eq=False)  # holds arrays: compared by identity
-class SharedResponse:
-    """A class's readings on one time grid: the model at a few effusivities, interpolated between them.
+class Panel(NamedTuple):
+    """The model read at 5 Chebyshev-Lobatto ``weights`` of ``[index / 2^level, (index + 1) / 2^level]``:
+    ``values`` (5, m); ``error``: the 3-point interpolant's measured error (above the 5-point one's)."""
 
-    Build it once per (model, sensor, time grid, class range, tolerance) with
-    :meth:`build`; :meth:`readings` gives any touches' readings of the range at
-    the cost of a ``(K, n) @ (n, m)`` product.
-
-    Attributes
-    ----------
-    model : ForwardModel
-        The model read.
-    time_s : ndarray, shape (m,)
-        The time grid [s].
-    e_low, e_high : float
-        The effusivity range covered [J s^-1/2 K^-1 m^-2].
-    weights : ndarray, shape (n,)
-        The contact weights ``w = e_o / (e_s + e_o)`` read (Chebyshev-Lobatto
-        points of the range's weights); empty when ``direct``.
-    values : ndarray, shape (n, m)
-        The model's readings there.
-    tolerance : float
-        The largest interpolation error allowed (normalized reading).
-    error : float
-        The measured interpolation error of the level below the one used (an
-        upper estimate of this one's); 0 when ``direct``.
-    direct : bool
-        True when no interpolant met the tolerance: the touches are to be read
-        directly (:func:`class_readings` does).
-    e_sensor : float
-        The sensor's effusivity [J s^-1/2 K^-1 m^-2] (the weights' scale).
-    """
-
-    model: ForwardModel
-    time_s: np.ndarray
-    e_low: float
-    e_high: float
+    level: int
+    index: int
     weights: np.ndarray
     values: np.ndarray
-    tolerance: float
     error: float
-    direct: bool
-    e_sensor: float
 
-    @classmethod
-    def build(cls, model: ForwardModel, time_s, e_low: float, e_high: float, sensor, *, tolerance: float,
-              distinct: int | None = None) -> "SharedResponse":
-        """Read ``model`` at Chebyshev points of ``[e_low, e_high]`` until the interpolation is within ``tolerance``.
 
-        Parameters
-        ----------
-        model : ForwardModel
-            A model whose reading depends on the object through its effusivity only.
-        time_s : array_like, shape (m,)
-            Times after contact [s] (what :meth:`ForwardModel.response` takes).
-        e_low, e_high : float
-            The class range [J s^-1/2 K^-1 m^-2], ``0 <= e_low <= e_high <= inf``.
-        sensor : designkit.Sensor
-        tolerance : float
-            Largest interpolation error (normalized reading), > 0.
-        distinct : int, optional
-            How many distinct effusivities the touches have: a level that would
-            need as many model readings is not worth it (the caller reads them
-            directly instead; :func:`class_readings`).
+class SceneResponse:
+    """A model's readings on one time grid at any effusivity: dyadic panels in w, each read when first needed.
 
-        Returns
-        -------
-        SharedResponse
-            ``direct`` is False when an interpolant met the tolerance; True (with
-            no nodes) when none did within :data:`MAX_LEVEL` or ``distinct`` points.
-        """
+    Parameters
+    ----------
+    model : ForwardModel
+        A model whose reading depends on the object through its effusivity only.
+    time_s : array_like, shape (m,)
+        Times after contact [s] (what :meth:`ForwardModel.response` takes).
+    sensor : designkit.Sensor
+    tolerance : float
+        Largest interpolation error (normalized reading), > 0.
+    """
+
+    def __init__(self, model: ForwardModel, time_s, sensor, tolerance: float):
         if not (tolerance > 0):
             raise InputError(f"interpolation tolerance must be > 0, got {tolerance!r}")
-        lo, hi = float(e_low), float(e_high)
-        if not (0.0 <= lo <= hi):
-            raise InputError(f"effusivity range must have 0 <= low <= high, got [{lo:g}, {hi:g}]")
-        t = np.atleast_1d(np.asarray(time_s, dtype=np.float64))
-        es = float(sensor.effusivity)
-        w_lo, w_hi = float(object_weight(es, lo)), float(object_weight(es, hi))
-        limit = MAX_LEVEL if distinct is None else min(MAX_LEVEL, int(distinct) - 2)
-        n = 2
-        if w_hi <= w_lo or n > limit // 2:
-            return cls(model, t, lo, hi, np.empty(0), np.empty((0, t.size)), float(tolerance), 0.0, True, es)
-        # the first level and its check points in one reading (one pass of the model's fixed costs)
-        w_all = _lobatto(2 * n, w_lo, w_hi)
-        v_all = model.response(t, _effusivity(w_all, es), sensor, tolerance=0.1 * tolerance)
-        w, values, w_new, u_new = w_all[0::2], v_all[0::2], w_all[1::2], v_all[1::2]
-        while True:
-            error = float(np.max(np.abs(_interpolate(w, values, w_new) - u_new)))
-            if error <= tolerance:
-                return cls(model, t, lo, hi, w_all, v_all, float(tolerance), error, False, es)
-            n *= 2
-            if 2 * n > limit:
-                break
-            w, values = w_all, v_all
-            w_new = _lobatto(2 * n, w_lo, w_hi)[1::2]      # the points interlacing the current ones
-            u_new = model.response(t, _effusivity(w_new, es), sensor, tolerance=0.1 * tolerance)
-            w_all = np.empty(2 * n + 1)
-            w_all[0::2], w_all[1::2] = w, w_new
-            v_all = np.empty((2 * n + 1, t.size))
-            v_all[0::2], v_all[1::2] = values, u_new
-        return cls(model, t, lo, hi, np.empty(0), np.empty((0, t.size)), float(tolerance), 0.0, True, es)
+        self.model = model
+        self.time_s = np.atleast_1d(np.asarray(time_s, dtype=np.float64))
+        self.sensor = sensor
+        self.tolerance = float(tolerance)
+        self.e_sensor = float(sensor.effusivity)
+        self._panels: dict[tuple[int, int], Panel | None] = {}   # None: failed, read its halves
+        self.model_readings = 0   # effusivities the model was read at (for benchmarks)
 
-    def readings(self, e_object) -> np.ndarray:
-        """Normalized readings (K, m) of objects of effusivities ``e_object`` in ``[e_low, e_high]``."""
+    def panel(self, level: int, index: int) -> Panel | None:
+        """Panel ``index`` of ``level`` (read on first use), or None where it misses the tolerance."""
+        key = (int(level), int(index))
+        if key not in self._panels:
+            a, b = math.ldexp(index, -level), math.ldexp(index + 1, -level)
+            w = _lobatto(4, a, b)
+            v = self.model.response(self.time_s, _effusivity(w, self.e_sensor), self.sensor,
+                                    tolerance=0.1 * self.tolerance)
+            self.model_readings += w.size
+            error = float(np.max(np.abs(_interpolate(w[0::2], v[0::2], w[1::2]) - v[1::2])))
+            self._panels[key] = Panel(key[0], key[1], w, v, error) if error <= self.tolerance else None
+        return self._panels[key]
+
+    def readings(self, e_object, level: int = 0) -> np.ndarray:
+        """Normalized readings (K, m) of objects of effusivities ``e_object`` (>= 0, finite or inf), each
+        from the first panel that meets the tolerance on its way down from ``level``."""
         e = np.atleast_1d(np.asarray(e_object, dtype=np.float64))
-        if self.direct:
-            raise InputError("this class response reads its touches directly (no interpolant): use class_readings")
-        if e.size and (np.min(e) < self.e_low or np.max(e) > self.e_high):
-            raise InputError(f"effusivities [{np.min(e):g}, {np.max(e):g}] outside the class response's range "
-                             f"[{self.e_low:g}, {self.e_high:g}]")
-        out = _interpolate(self.weights, self.values, object_weight(self.e_sensor, e))
-        return np.clip(out, 0.0, 1.0, out=out)
+        w = object_weight(self.e_sensor, e)
+        out = np.empty((e.size, self.time_s.size))
+        pending = np.arange(e.size)
+        for lev in range(int(level), MAX_LEVEL + 1):
+            if pending.size == 0:
+                return out
+            idx = np.minimum(np.floor(np.ldexp(w[pending], lev)), 2.0 ** lev - 1).astype(np.int64)
+            keep = np.ones(pending.size, dtype=bool)
+            for i in np.unique(idx).tolist():
+                p = self.panel(lev, i)
+                if p is not None:
+                    sel = idx == i
+                    out[pending[sel]] = _interpolate(p.weights, p.values, w[pending[sel]])
+                    keep &= ~sel
+            pending = pending[keep]
+        if pending.size:   # no panel met the tolerance: read directly
+            uniq, inverse = np.unique(e[pending], return_inverse=True)
+            out[pending] = self.model.response(self.time_s, uniq, self.sensor, tolerance=self.tolerance)[inverse.ravel()]
+            self.model_readings += uniq.size
+        return out
 
     @property
-    def nodes(self) -> np.ndarray:
-        """The effusivities read by the model [J s^-1/2 K^-1 m^-2]."""
-        return _effusivity(self.weights, self.e_sensor)
+    def panels(self) -> list[Panel]:
+        """The panels read so far that met the tolerance, by level and index."""
+        return [p for _, p in sorted(self._panels.items()) if p is not None]
+
+
+class _SensorKey(str):
+    """A sensor's repr as a cache key, carrying the sensor (which holds mappings: not hashable itself)."""
+
+
+@functools.lru_cache(maxsize=16)
+def _cached_scene(model: ForwardModel, sensor: _SensorKey, time_bytes: bytes, tolerance: float) -> SceneResponse:
+    return SceneResponse(model, np.frombuffer(time_bytes, dtype=np.float64).copy(), sensor.sensor, tolerance)
+
+
+def scene_response(model: ForwardModel, time_s, sensor, *, tolerance: float) -> SceneResponse:
+    """The :class:`SceneResponse` of a model, sensor, time grid and tolerance, one per process (the last 16 kept).
+
+    Its panels are a pure function of those four, so sharing them changes no reading: it only saves reading
+    the model again for the next class or repeat of the same scene.
+    """
+    t = np.ascontiguousarray(np.atleast_1d(np.asarray(time_s, dtype=np.float64)))
+    try:
+        hash(model)
+    except TypeError:   # a model with unhashable parameters: a response of its own, not shared
+        return SceneResponse(model, t, sensor, tolerance)
+    key = _SensorKey(repr(sensor))
+    key.sensor = sensor
+    return _cached_scene(model, key, t.tobytes(), float(tolerance))
+
+
+def start_level(w_low: float, w_high: float) -> int:
+    """The panel level a class of weights ``[w_low, w_high]`` starts from: panels 8 to 16 times its width
+    (0 for a class wider than 1/16 of the weights; :data:`MAX_LEVEL` for one of no width). Wider panels are
+    shared by more classes; a panel that misses the tolerance costs its 5 readings and is read in halves.
+
+    >>> start_level(0.14, 0.2), start_level(0.0, 1.0), start_level(0.5, 0.5 + 2 ** -10)
+    (1, 0, 7)
+    """
+    width = float(w_high) - float(w_low)
+    if not width > 0:
+        return MAX_LEVEL
+    return int(min(max(math.floor(-math.log2(width)) - 3, 0), MAX_LEVEL))
 
 
 def _interpolate(x_nodes: np.ndarray, values: np.ndarray, x: np.ndarray) -> np.ndarray:
@@ -214,19 +206,22 @@ def _interpolate(x_nodes: np.ndarray, values: np.ndarray, x: np.ndarray) -> np.n
     if exact.any():                                          # x on a node: that node's value
         basis[exact] = hit[exact].astype(np.float64)
     out = basis[:, :1] * values[0]
+    term = np.empty_like(out)
     for j in range(1, n):
-        out += basis[:, j:j + 1] * values[j]
+        out += np.multiply(basis[:, j:j + 1], values[j], out=term)
     return out
 
 
 def class_readings(model: ForwardModel, time_s, e_object, sensor, *, tolerance: float,
-                   diffusivity_m2_s=None, **build: Any) -> np.ndarray:
+                   diffusivity_m2_s=None) -> np.ndarray:
     """Normalized readings (K, m) of touches of one class: interpolated where the model is costly, else direct.
 
     Models with ``shared_response`` (the layered model, a force ramp) whose
-    reading depends on the effusivity alone are read at a few effusivities of
-    the touches' range (:class:`SharedResponse`); others, and touches with a
-    per-touch diffusivity, are read directly by :meth:`ForwardModel.response`.
+    reading depends on the effusivity alone are read from the scene's panels
+    (:func:`scene_response`), starting at the class's :func:`start_level`;
+    others, touches with a per-touch diffusivity, and classes of fewer than
+    :data:`MIN_DISTINCT` distinct effusivities are read directly by
+    :meth:`ForwardModel.response`.
 
     Parameters
     ----------
@@ -247,8 +242,9 @@ def class_readings(model: ForwardModel, time_s, e_object, sensor, *, tolerance: 
             or not np.all(np.isfinite(e)) or np.any(e < 0):
         return model.response(t, e, sensor, diffusivity_m2_s=diffusivity_m2_s, tolerance=tolerance)
     uniq, inverse = np.unique(e, return_inverse=True)
-    table = SharedResponse.build(model, t, float(uniq[0]), float(uniq[-1]), sensor, tolerance=tolerance,
-                                 distinct=uniq.size, **build)
-    if table.direct:
+    if uniq.size < MIN_DISTINCT:
         return model.response(t, uniq, sensor, tolerance=tolerance)[inverse.ravel()]
-    return table.readings(e)
+    es = float(sensor.effusivity)
+    level = start_level(float(object_weight(es, uniq[0])), float(object_weight(es, uniq[-1])))
+    out = scene_response(model, t, sensor, tolerance=tolerance).readings(e, level)
+    return np.clip(out, 0.0, 1.0, out=out)

@@ -791,8 +791,3 @@ def check_table(header: Mapping[str, Any], arrays: Mapping[str, np.ndarray], wha
         get_model(header.get("model"))
     except InputError as exc:
         raise bad(f"model: {exc}") from None
-
-
-def finite_or_none(x: float) -> float | None:
-    """JSON-friendly float."""
-    return None if x is None or not math.isfinite(x) else float(x)

@@ -1,7 +1,7 @@
 """designkit's predictions against the real robot (issue 34): calibrate on some trial sets, predict, compare.
 
 1. Calibration as ``designkit calibrate fit`` does by default on the metal and wood touches, split by
-   :func:`~designkit.calibration.identify.choose_split` (the first fifth of the trial sets present
+   :func:`~designkit.calibration.split.choose_split` (the first fifth of the trial sets present
    fitted: sets 1-4 of the shared recordings' 20); every candidate fitted and one chosen on the
    held-out touches (``candidate``: that one only); its sensor file with the rig's conditions
    (:mod:`designkit.rig`).
@@ -74,7 +74,9 @@ def scene_parts(sensor) -> dict[str, dict]:
 
 def _calibrate(data: Path, candidate: str | None):
     from designkit.calibration.fit import resolve_ranges
-    from designkit.calibration.identify import CANDIDATES, choose_split, compare_models
+    from designkit.calibration.candidates import CANDIDATES
+    from designkit.calibration.compare import compare_models
+    from designkit.calibration.split import choose_split
     from designkit.calibration.trials import load_index
 
     index = data / "index.csv"

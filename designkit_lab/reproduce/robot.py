@@ -199,7 +199,7 @@ class SimToRealSetup:
     rms_c: float | None
     noise_c: float | None
     details: dict
-    #: an :class:`~designkit.calibration.identify.Identification` (None: the paper's semi-infinite sensor)
+    #: an :class:`~designkit.calibration.results.Identification` (None: the paper's semi-infinite sensor)
     identification: object = None
     #: per class, (mean, sd) of ln(h_c,i / h_c) of its touches' own contact (drawn per simulated touch)
     contact: dict | None = None
@@ -214,11 +214,11 @@ class SimToRealSetup:
 def calibration_split(touches: RealTouches) -> tuple[np.ndarray, str]:
     """Which touches calibrate (True) and which test, chosen from the trial sets present, and how.
 
-    :func:`designkit.calibration.identify.choose_split`: the first fifth of the trial sets (at least
+    :func:`designkit.calibration.split.choose_split`: the first fifth of the trial sets (at least
     one) calibrate, the others test; every class on both sides. A recording where that is
     impossible (one trial set, one material) is refused in one line (InputError).
     """
-    from designkit.calibration.identify import choose_split, trial_sets
+    from designkit.calibration.split import choose_split, trial_sets
 
     sets = [int(v) if v > 0 else None for v in touches.trial_set]
     if any(v is None for v in sets):
@@ -290,7 +290,7 @@ def _touch_curves(ident, material: str, trial, time_s: np.ndarray, pressed=None)
 
     ``pressed``: touches (Trial) whose forces to use instead, one reading each.
     """
-    from designkit.calibration.identify import relative_force
+    from designkit.calibration.force import relative_force
 
     if not ident.candidate.force_area:
         return ident.reading(time_s, material, drift=True)
@@ -418,7 +418,7 @@ def _simulate_model(test: RealTouches, setup: SimToRealSetup, noise_c: float, pe
         for k in idx:
             tr = test.trials[k]
             if cls in contact:
-                from designkit.calibration.identify import relative_force
+                from designkit.calibration.force import relative_force
 
                 mu, sd = contact[cls]
                 v, b = ident.reading(test.time_s, mat, conductance_factor=np.exp(rng.normal(mu, sd, per_trial)),

@@ -26,8 +26,8 @@ from ._validation import InputError
 from .sensor import CONDITION_KEYS
 
 __all__ = ["CONDITION_KEYS", "DEFAULTS", "RigConditions", "RigScene", "for_rig", "from_model_contact",
-           "model_start_s", "residual_correlation_s", "resolve_scene", "rig_conditions", "rig_scene",
-           "to_model_contact"]
+           "model_start_s", "residual_correlation_s", "resolve_scene", "rig_arguments", "rig_conditions",
+           "rig_scene", "to_model_contact"]
 
 #: A question's scene without a sensor file's conditions (and for the paper's sensor): noise [degC], dT [degC].
 DEFAULTS = {"noise_c": 0.05, "delta_t_c": 10.0, "sensor_temp_spread_c": 0.0}
@@ -307,19 +307,22 @@ def resolve_scene(sensor, given: Mapping[str, float | None]) -> RigScene:
         if key == "contact_s":
             continue
         if v is not None:
-            values[key], sources[key] = float(v), "user"
+            values[key], sources[key] = _number(v), "user"
         elif from_file.get(key) is not None and math.isfinite(float(from_file[key])):
             values[key], sources[key] = float(from_file[key]), "sensor file"
         else:
             values[key], sources[key] = float(DEFAULTS[key]), "default"
     start = model_start_s(sensor)
     if "contact_s" in given and given["contact_s"] is not None:
-        values["contact_s"] = to_model_contact(float(given["contact_s"]), start)
+        asked = _number(given["contact_s"])
+        values["contact_s"] = to_model_contact(asked, start)
         sources["contact_s"] = "user"
-        if start is not None and values["contact_s"] <= 0 < float(given["contact_s"]):
-            raise InputError(f"contact {given['contact_s']:g} s after the rig's detected onset ends before the "
+        early = np.ravel((np.asarray(values["contact_s"]) <= 0) & (np.asarray(asked) > 0))
+        if start is not None and early.any():
+            bad = float(np.ravel(asked)[np.flatnonzero(early)[0]])
+            raise InputError(f"contact {bad:g} s after the rig's detected onset ends before the "
                              f"model's first heat flow ({start:+.3g} s from the onset): give a longer contact")
-    used = [f"{k} {values[k]:g} ({sources[k]})" for k in values if k != "contact_s"]
+    used = [f"{k} {_words(values[k])} ({sources[k]})" for k in values if k != "contact_s"]
     if cond:
         notes.append(f"the rig as calibrated (sensor file {sensor.name}): " + ", ".join(used))
         spread = cond.get("sensor_temp_spread_c")
@@ -338,6 +341,44 @@ def resolve_scene(sensor, given: Mapping[str, float | None]) -> RigScene:
     return RigScene(values, sources, start, tuple(notes), bool(cond))
 
 
+def _number(v):
+    """A scene value as given: a float, or a float64 array (array questions)."""
+    return float(v) if np.ndim(v) == 0 else np.asarray(v, dtype=np.float64)
+
+
+def _words(v) -> str:
+    return f"{v:g}" if np.ndim(v) == 0 else "as given per element"
+
+
+def rig_arguments(scene_keys: Sequence[str], arguments: Mapping[str, Any]) -> tuple[dict[str, Any], RigScene | None]:
+    """A question's arguments with its scene resolved for the sensor asked about (:func:`resolve_scene`).
+
+    ``scene_keys``: the scene quantities the question takes (:attr:`designkit.query.Question.scene`); with
+    ``sensor_temp_spread_c`` they may be None or absent, meaning "the sensor file's recorded conditions, else
+    the paper's defaults". For a sensor file with the rig's conditions each is resolved (a contact time, asked
+    from the rig's detected onset, becomes the model's), and the :class:`RigScene` comes back for
+    :func:`for_rig`; otherwise the values not given are left to the route's defaults (None back). The one
+    place a question's scene is resolved: :func:`designkit.query.ask` calls it.
+
+    Examples
+    --------
+    >>> args, rig = rig_arguments(("noise_c", "delta_t_c"), {"e1": 35000.0, "e2": 20000.0, "noise_c": None})
+    >>> args, rig
+    ({'e1': 35000.0, 'e2': 20000.0}, None)
+    """
+    keys = (*scene_keys, "sensor_temp_spread_c")
+    sensor = arguments.get("sensor")
+    sen = None
+    if sensor is not None:
+        from .sensor import load_sensor
+
+        sen = load_sensor(sensor)
+    if sen is None or not getattr(sen, "conditions", None):
+        return {k: v for k, v in arguments.items() if not (k in keys and v is None)}, None
+    rig = resolve_scene(sen, {k: arguments.get(k) for k in keys})
+    return {**arguments, "sensor": sen, **{k: rig.values[k] for k in keys}}, rig  # (the file read once)
+
+
 def for_rig(answer, scene: RigScene, asked_contact_s: float | None = None):
     """An answer (:class:`~designkit.query.answer.Answer`) as the rig sees it.
 
@@ -350,6 +391,8 @@ def for_rig(answer, scene: RigScene, asked_contact_s: float | None = None):
 
     if not scene.calibrated:
         return answer
+    if not hasattr(answer, "scene"):  # an array answer (designkit.query.ArrayAnswer)
+        return _arrays_for_rig(answer, scene, asked_contact_s)
     changes: dict[str, Any] = {}
     if answer.question == "min-contact" and scene.start_s is not None:
         def shift(v):
@@ -371,4 +414,15 @@ def for_rig(answer, scene: RigScene, asked_contact_s: float | None = None):
         notes = tuple(n.replace(", from which the contact time counts", "") for n in notes)
     notes += tuple(n for n in scene.notes if n not in notes)
     changes["notes"] = notes
+    return dataclasses.replace(answer, **changes)
+
+
+def _arrays_for_rig(answer, scene: RigScene, asked_contact_s):
+    """:func:`for_rig` of an array answer: min-contact's arrays counted from the onset, the conditions stated."""
+    import dataclasses
+
+    changes: dict[str, Any] = {"conditions": scene.conditions(asked_contact_s)}
+    if answer.question == "min-contact" and scene.start_s is not None:
+        for k in ("value", "low", "high", "ideal"):
+            changes[k] = np.maximum(np.asarray(getattr(answer, k)) + scene.start_s, 0.0)  # (NaN stays NaN)
     return dataclasses.replace(answer, **changes)

@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any, Mapping
 
 import numpy as np
+from cachetools import LRUCache
 
 from ._validation import InputError, check_effusivity, check_label, check_nonnegative, check_positive
 from .properties import time_constant
@@ -373,6 +374,8 @@ MODEL_KEYS = ("name", "params", "time_offset_s", "contact_spread", "object_tempe
 
 def _plain(value: Any) -> Any:
     """JSON/YAML-ready copy: mappings to dicts, tuples to lists, numpy scalars to Python numbers."""
+    if type(value) in (int, str, bool) or (type(value) is float and not math.isinf(value)):
+        return value  # (most of a calibrated file's thousands of values: no slower Mapping check first)
     if isinstance(value, Mapping):
         return {str(k): _plain(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
@@ -433,5 +436,17 @@ def load_sensor(name_or_path: "str | Path | Sensor") -> Sensor:
         return SENSORS[key]
     p = Path(key)
     if p.suffix.lower() in (".yaml", ".yml") or p.exists():
-        return Sensor.from_yaml(p)
+        try:  # parsed once per process while its content is the same (a calibrated file is thousands of lines)
+            import hashlib
+
+            stamp = (str(p.resolve()), hashlib.sha256(p.read_bytes()).hexdigest())
+        except OSError:  # from_yaml says what is missing
+            return Sensor.from_yaml(p)
+        if stamp not in _READ:
+            _READ[stamp] = Sensor.from_yaml(p)
+        return _READ[stamp]
     raise InputError(f"unknown sensor {key!r}: use a preset ({', '.join(SENSORS)}) or a sensor YAML file")
+
+
+#: Sensor files parsed by this process, keyed by (path, SHA-256 of the content): the frozen Sensor is shared.
+_READ: "LRUCache[tuple, Sensor]" = LRUCache(16)

@@ -87,6 +87,7 @@ def scratch(tmp_path_factory):
     shim.write_text(f"#!/bin/sh\nexec {shlex.quote(sys.executable)} -m designkit \"$@\"\n")
     shim.chmod(0o755)
     env = {**os.environ, "PATH": f"{bindir}{os.pathsep}{os.environ.get('PATH', '')}", "COLUMNS": "100",
+           "DESIGNKIT_DATA_DIR": str(folder / "data"),  # 'tables build' registers there, not in the user's folder
            "PYTHONPATH": os.pathsep.join(p for p in (str(REPO), os.environ.get("PYTHONPATH", "")) if p)}
     return folder, env
 

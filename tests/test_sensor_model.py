@@ -241,3 +241,9 @@ def test_the_cli_answers_for_the_rig_as_calibrated(cli, rig_file):
     assert c["delta_t_c"] == {"value": 7.0, "source": "sensor file"}
     assert c["contact_s"]["value"] == 1.0 and c["contact_s"]["model_contact_s"] == pytest.approx(1.3)
     assert c["contact_s"]["counted_from"] == "detected onset" and d["scene"]["contact_s"] == 1.0
+    # the library, asked the same question, answers the same: the scene is resolved there, once
+    from designkit.query import distinguishable
+
+    lib = json.loads(json.dumps(distinguishable(e1=400.0, e2=1500.0, contact_s=1.0, sensor=str(rig_file), trials=30,
+                                                repeats=1).to_dict()))
+    assert lib["scene"] == d["scene"] and lib["value"] == d["value"] and lib["details"] == d["details"]

@@ -75,10 +75,16 @@ _HINTS = {
 @contextmanager
 def _hints():
     """Library errors with the flags that fix them."""
+    from .._validation import InputError
     from ..query.inputs import NeedsInput, TableMismatch
+    from ..query.policy import OutsideSensorTable
 
     try:
         yield
+    except OutsideSensorTable as exc:
+        raise InputError(f"{exc.where}: ask with --exact (computed, tens of seconds)" + (
+            ", or build a table over a wider span with 'designkit tables build --sensor FILE --e-range LO HI'"
+            if exc.wider else "")) from None
     except TableMismatch as exc:
         raise TableMismatch(f"{exc} (use --exact, or a table built for it with designkit sweep)") from None
     except NeedsInput as exc:
@@ -90,24 +96,8 @@ def _ask(question: str, *, exact: bool, table: Optional[str], ideal_table: str, 
          model, conductance, thickness, backing, diffusivity, width: float, trials: int, repeats: int, seed: int,
          jobs: int, n_mc: int, objects: dict, scene: dict, exact_extra: Optional[dict] = None,
          progress: bool = False, coverage: float = 0.9, spread: Optional[float] = None):
-    """The one library call of a command: the table route, or the exact one.
-
-    The scene's values not given (None) come from the sensor file's rig conditions, else the defaults
-    (:func:`designkit.rig.resolve_scene`); the answer says which and where each came from."""
-    ans, rig, asked = _ask_scene(question, exact=exact, table=table, ideal_table=ideal_table, threshold=threshold,
-                                 sensor=sensor, model=model, conductance=conductance, thickness=thickness,
-                                 backing=backing, diffusivity=diffusivity, width=width, trials=trials,
-                                 repeats=repeats, seed=seed, jobs=jobs, n_mc=n_mc, objects=objects, scene=scene,
-                                 exact_extra=exact_extra, progress=progress, coverage=coverage, spread=spread)
-    from ..rig import for_rig
-
-    return for_rig(ans, rig, asked)
-
-
-def _ask_scene(question: str, *, exact: bool, table: Optional[str], ideal_table: str, threshold: float, sensor: str,
-               model, conductance, thickness, backing, diffusivity, width: float, trials: int, repeats: int,
-               seed: int, jobs: int, n_mc: int, objects: dict, scene: dict, exact_extra: Optional[dict] = None,
-               progress: bool = False, coverage: float = 0.9, spread: Optional[float] = None):
+    """The one library call of a command: the options parsed, passed as given (a scene value not given is None:
+    the library takes the sensor file's rig conditions, else the defaults, and says where each came from)."""
     from .. import query
     from ..query.crossing import check_coverage
 
@@ -128,23 +118,18 @@ def _ask_scene(question: str, *, exact: bool, table: Optional[str], ideal_table:
 
             check_samples_per_touch(check_positive("--contact [s]", scene["contact_s"]), sen.sample_rate_hz,
                                     "--contact", "give a contact time a touch can last")
-        from ..rig import resolve_scene
-
-        asked = scene.get("contact_s")
-        rig = resolve_scene(sen, {**scene, "sensor_temp_spread_c": spread})
-        scene = {k: rig.values[k] for k in scene}
         # the library chooses the route (designkit.query.policy): a table built for this sensor, model and
         # scene, or named, else computed for the pair; the answer's route_reason says why
         kw = dict(objects, **scene, threshold=threshold, sensor=sen, model=fm, table=table, ideal_table=ideal_table,
                   diffusivity_m2_s=diffusivity, width=width, trials=trials, repeats=repeats, seed=seed, jobs=jobs,
-                  n_mc=n_mc, sensor_temp_spread_c=rig.values["sensor_temp_spread_c"], **extra)
+                  n_mc=n_mc, sensor_temp_spread_c=spread, **extra)
         route = "exact" if exact else "auto"
         from ..query.policy import choose_route
 
         with _exact_display(question, progress and choose_route(question, route, kw)[0] == "exact") as report:
             if report is not None:
                 kw["progress"] = report
-            return _noted(query.ask(question, route=route, **kw), sen, fm, source), rig, asked
+            return _noted(query.ask(question, route=route, **kw), sen, fm, source)
 
 
 @contextmanager
@@ -221,30 +206,37 @@ def _batch(question: str, path: str, fmt: str, out: Optional[str], *, objects: d
            table, ideal_table, threshold, coverage, sensor, spread, exact_options: dict) -> None:
     """``--batch FILE``: every row answered by one array call of the library (:mod:`designkit.io_batch`), one
     record per row out; the options give the columns the file leaves out."""
-    from .._validation import InputError
     from ..io_batch import MAX_BATCH_ROWS, MAX_BATCH_ROWS_EXACT, answer_batch, read_batch
     from ..query.crossing import check_coverage
-    from ..rig import DEFAULTS
 
-    if sensor != "paper" or any(v is not None for k, v in exact_options.items() if k in _MODEL_KEYS):
-        raise InputError("--batch answers for the paper sensor and model (a sensor file's rig conditions apply to "
-                         "one question at a time): ask without --batch, or build a table and name it with --table")
+    with _hints():
+        sen, fm, _ = sensor_and_model(sensor, exact_options["model"], conductance=exact_options["conductance"],
+                                      thickness=exact_options["thickness"], backing=exact_options["backing"])
     batch = read_batch(path, question, max_rows=MAX_BATCH_ROWS_EXACT if exact else MAX_BATCH_ROWS)
-    defaults = {**{k: v for k, v in objects.items() if v is not None},
-                **{k: (DEFAULTS[k] if v is None and k in DEFAULTS else v) for k, v in scene.items()}}
-    options = dict(threshold=threshold, coverage=check_coverage(coverage))
+    # a scene value neither in the file nor given: the library's (the sensor file's rig conditions, else the
+    # defaults, each with its source); an empty cell of a column the file has: the same value
+    from ..query import QUESTIONS
+    from ..rig import DEFAULTS, rig_arguments
+
+    empty = [k for k, v in scene.items() if v is None and k in batch.columns]
+    resolved = rig_arguments(QUESTIONS[question].scene, {**scene, "sensor": sen})[0] if empty else {}
+    defaults = {**{k: v for k, v in objects.items() if v is not None}, **scene,
+                **{k: resolved.get(k, DEFAULTS.get(k)) for k in empty}}
+    options = dict(threshold=threshold, coverage=check_coverage(coverage), sensor=sen, model=fm,
+                   **{k: v for k, v in exact_options.items() if k not in _MODEL_KEYS})
     if spread:
         options["sensor_temp_spread_c"] = spread
-    if exact:
-        options.update({k: v for k, v in exact_options.items() if k not in _MODEL_KEYS})
-    else:
+    if exact_options["diffusivity"] is not None:
+        options["diffusivity_m2_s"] = exact_options["diffusivity"]
+    if not exact:
         options.update(ideal_table=ideal_table, **({"table": table} if table else {}))
-    records = answer_batch(batch, defaults, route="exact" if exact else "auto", **options)
+    with _hints():
+        records = answer_batch(batch, defaults, route="exact" if exact else "auto", **options)
     payload = records  # json: the records (an array answer's to_dict, with each row's inputs)
     emit(fmt, out, payload=payload, records=records, title=f"{question}: {len(records)} rows")
 
 
-#: Options of the sensor's forward model (the --batch route answers for the paper's).
+#: Options of the sensor's forward model (--batch: sensor_and_model reads them).
 _MODEL_KEYS = ("model", "conductance", "thickness", "backing", "diffusivity")
 
 

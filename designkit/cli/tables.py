@@ -141,3 +141,8 @@ def _print_table(table, s: dict) -> None:
     con.print(f"  designkit {v(s['designkit_version'])}, created {v(s['created'])}")
     con.print(f"  arrays: {v(', '.join(s['arrays']))}")
     con.print(f"  {v(s['content_hash'])}  ({s['size_bytes'] / 1024:.0f} KiB)")
+
+
+from .tables_build import tables_build  # noqa: E402  (its own module: the command is long)
+
+tables_app.command("build")(tables_build)

@@ -27,16 +27,18 @@ Examples
 from __future__ import annotations
 
 import dataclasses
+import functools
 from dataclasses import dataclass
 from typing import Any, Callable, overload
 
 from numpy.typing import ArrayLike
 
 from .._validation import InputError
+from ..rig import for_rig, rig_arguments
 from . import exact as _exact_route
 from . import table as _table_route
 from .answer import Answer, QuestionQuantity
-from .policy import choose_route
+from .policy import MC_BOUND, choose_route, sensor_table_answer
 from .vectorized import ArrayAnswer, answer_arrays, is_array_call
 
 __all__ = ["QUESTIONS", "Question", "ask", "delta_e", "distinguishable", "max_noise", "min_contact",
@@ -108,19 +110,29 @@ def ask(question: str, *, route: str = "auto", ideal_bound: bool = True,
     broadcast like numpy and give an
     :class:`~designkit.query.vectorized.ArrayAnswer` (:mod:`designkit.query.vectorized`);
     ``ideal_bound=False`` there skips the closed-form ideal bound (the slow part of a first call).
+    Scene values not given (or None) are the sensor's: a sensor file's recorded rig conditions, with contact
+    counted from the rig's detected onset, else the paper's defaults; the answer's ``scene["conditions"]``
+    (an array answer's ``conditions``) says each value and where it came from (:func:`designkit.rig.rig_arguments`).
     """
     if question not in QUESTIONS:
         raise InputError(f"unknown question {question!r}; known: {', '.join(QUESTIONS)}")
+    asked = arguments.get("contact_s")
+    arguments, rig = rig_arguments(QUESTIONS[question].scene, arguments)
     route, arguments, why = choose_route(question, route, arguments)
     fn = QUESTIONS[question].route(route)
+    own = route == "table" and why.sensor_table and question in MC_BOUND  # no Monte Carlo bound from it
     if is_array_call(question, arguments):
-        ans = answer_arrays(question, fn, route, arguments, ideal_bound=ideal_bound)
+        ans = answer_arrays(question, functools.partial(fn, ideal_bound=False) if own else fn, route, arguments,
+                            ideal_bound=ideal_bound and not own)
     elif not ideal_bound:
         raise InputError("ideal_bound=False is for array inputs (a single answer always carries its bound)")
     else:
-        ans = fn(**arguments)
+        ans = fn(**arguments, **({"ideal_bound": False} if own else {}))
+    if route == "table" and why.sensor_table:
+        ans = sensor_table_answer(question, ans, why, arguments.get("sensor"))
     notes = (*ans.notes, why.reason) if why.noted and isinstance(ans, Answer) else None
-    return dataclasses.replace(ans, route_reason=why.reason, **({"notes": notes} if notes else {}))
+    ans = dataclasses.replace(ans, route_reason=why.reason, **({"notes": notes} if notes else {}))
+    return ans if rig is None else for_rig(ans, rig, asked)
 
 
 def _route(exact: bool, route: str | None) -> str:

@@ -108,6 +108,9 @@ class ArrayAnswer(QuestionQuantity):
         Table read (None on the exact route).
     route_reason : str or None
         Why ``route`` answered (as :attr:`designkit.query.Answer.route_reason`).
+    conditions : mapping or None
+        A calibrated sensor's scene, each value with its source (as a single answer's ``scene["conditions"]``;
+        a value given per element is an array): :func:`designkit.rig.for_rig`.
     details : mapping of str to ndarray
         Question-specific arrays: delta-e's ``lower`` / ``upper`` (each
         direction's value), ``lower_ideal`` / ``upper_ideal`` and (table route)
@@ -130,6 +133,7 @@ class ArrayAnswer(QuestionQuantity):
     table: str | None = None
     details: Mapping[str, FloatArray] = field(default_factory=dict)
     route_reason: str | None = None
+    conditions: Mapping[str, Any] | None = None
 
     @property
     def shape(self) -> tuple[int, ...]:
@@ -172,8 +176,19 @@ class ArrayAnswer(QuestionQuantity):
             rec["bound"] = (bound_of(rec["interval_low"], rec["interval_high"]) or None) if numeric else None
             rec["in_grid"] = bool(in_grid[i])
             rec["table_name"] = self.table
+            if self.conditions is not None:
+                rec["conditions"] = {k: {**c, **{f: _element(c[f], self.shape, i) for f in ("value", "model_contact_s")
+                                                 if f in c}} for k, c in self.conditions.items()}
             out.append(rec)
         return out
+
+
+def _element(v: Any, shape: tuple[int, ...], i: int) -> Any:
+    """Element ``i`` (C order) of a value given per element, as JSON (a scalar value is every element's)."""
+    if v is None or np.ndim(v) == 0:
+        return v
+    x = float(np.broadcast_to(np.asarray(v, dtype=np.float64), shape).ravel()[i])
+    return x if math.isfinite(x) else None
 
 
 def _is_list(x: Any) -> bool:

@@ -103,6 +103,9 @@ class SweepConfig:
     model: Any = None
     diffusivity_m2_s: float | None = None
     solver: str = "batched"
+    #: Play the sensor file's rig as a question about it does (:func:`designkit.rig.rig_scene`: its correlated
+    #: noise, touches read from the detected onset): what ``tables build --sensor FILE`` sets.
+    rig_scene: bool = False
 
     def __post_init__(self) -> None:
         for name in ("noise_ratio", "noise_c", "delta_t_c", "contact_s"):
@@ -273,15 +276,22 @@ class SweepConfig:
         return [tuple(int(x) for x in idx) for idx in np.ndindex(*self.scene_shape)]
 
     def scene(self, point: Sequence[int], contact_s: float) -> Scene:
-        """The scene at a scene-axis point (for noise_ratio: dT = 1, sigma = ratio)."""
+        """The scene at a scene-axis point (for noise_ratio: dT = 1, sigma = ratio); with ``rig_scene`` the
+        sensor file's rig (the scene the exact route plays for a question about it)."""
         if self.noise_ratio is not None:
-            return Scene(contact_s=contact_s, noise_c=self.noise_ratio[point[0]],
-                         sensor_temp_c=self.ambient_temp_c + 1.0, ambient_temp_c=self.ambient_temp_c)
-        return Scene(contact_s=contact_s, noise_c=self.noise_c[point[0]],
-                     sensor_temp_c=self.ambient_temp_c + self.delta_t_c[point[1]],
-                     ambient_temp_c=self.ambient_temp_c,
-                     sensor_temp_spread_c=self.sensor_temp_spread_c,
-                     ambient_temp_spread_c=self.ambient_temp_spread_c)
+            sc = Scene(contact_s=contact_s, noise_c=self.noise_ratio[point[0]],
+                       sensor_temp_c=self.ambient_temp_c + 1.0, ambient_temp_c=self.ambient_temp_c)
+        else:
+            sc = Scene(contact_s=contact_s, noise_c=self.noise_c[point[0]],
+                       sensor_temp_c=self.ambient_temp_c + self.delta_t_c[point[1]],
+                       ambient_temp_c=self.ambient_temp_c,
+                       sensor_temp_spread_c=self.sensor_temp_spread_c,
+                       ambient_temp_spread_c=self.ambient_temp_spread_c)
+        if not self.rig_scene:
+            return sc
+        from ..rig import rig_scene
+
+        return sc.replace(**rig_scene(self.resolved_sensor()))
 
     def resolved_sensor(self) -> Sensor:
         sensor = load_sensor(self.sensor)
@@ -413,7 +423,7 @@ def _axis(name: str, values: Any) -> tuple[float, ...] | None:
 
 #: Config keys newer than the first tables, with the default that keeps an older digest.
 _DIGEST_DEFAULTS: dict[str, Any] = {"model": {"name": "semi-infinite"}, "diffusivity_m2_s": None,
-                                    "solver": "sklearn"}
+                                    "solver": "sklearn", "rig_scene": False}
 
 
 def _flatten(data: Mapping[str, Any], source: str) -> dict[str, Any]:

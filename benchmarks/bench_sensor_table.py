@@ -1,0 +1,248 @@
+"""A calibrated sensor's own table (issues 34 and 35): coverage of its 90 % intervals against the exact route,
+and the time of a question answered from it.
+
+Usage::
+
+    # once: a sensor file of the real rig, and its table for the paper's 12 materials
+    designkit calibrate fit ../shared/data/robot-thermal-recordings/index.csv --range metal=aluminium \
+        --only metal,wood --out /tmp/rig.yaml
+    designkit tables build --sensor /tmp/rig.yaml --materials paper12 -j 2
+    # the exact route on random pairs (minutes each on a loaded machine; resumable, appends as it goes)
+    nice -n 10 python benchmarks/bench_sensor_table.py --sensor /tmp/rig.yaml --out /tmp/bst --phase exact
+    # the table's answers against them, and the time of a question from a fresh shell
+    python benchmarks/bench_sensor_table.py --sensor /tmp/rig.yaml --out /tmp/bst --phase table
+
+Pairs: effusivities log-uniform in the table's span (the lower one in [200, 30000]), the ratio of the two
+log-uniform in [1.05, 3]; min-contact at the rig's conditions as calibrated (its noise and dT, its correlated
+noise, read from the detected onset). The exact route is the one ``--exact`` takes (``--repeats`` seeds of 100
+trials per class, default 4 as ``--exact``; the Monte Carlo ideal bound), with seeds ``1000 + i`` (the table's
+are 0), stored as the model counts contact; the table's answers are the library's whole question
+(``designkit.query.min_contact(e1, e2, sensor=FILE)``: the route policy finds the table), counted from the
+rig's detected onset, and the exact values are moved by the same offset.
+
+Coverage: the fraction of the table's stated 90 % intervals holding the exact route's value. The exact value
+has its own Monte Carlo error, which dilutes that fraction below the intervals' own coverage; the z-scores
+``(table - exact) / sqrt(sd_table^2 + sd_exact^2)`` (each sd from its stated interval) are given beside it:
+their spread is 1 for calibrated intervals.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import statistics
+import subprocess
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from pathlib import Path
+
+import numpy as np
+
+E_LO = (200.0, 30000.0)
+RATIO = (1.05, 3.0)
+Z90 = 1.6448536269514722
+
+
+def draw_pairs(n: int, seed: int, e_max: float) -> list[dict]:
+    rng = np.random.default_rng(seed)
+    out = []
+    while len(out) < n:
+        lo = float(np.exp(rng.uniform(*np.log(E_LO))))
+        hi = lo * float(np.exp(rng.uniform(*np.log(RATIO))))
+        if hi <= e_max - 80.0:
+            out.append({"index": len(out), "e1": round(lo, 1), "e2": round(hi, 1)})
+    return out
+
+
+def _scene(sensor):
+    from designkit.rig import resolve_scene
+
+    return resolve_scene(sensor, {"noise_c": None, "delta_t_c": None}).values
+
+
+def exact_case(sensor_file: str, case: dict, repeats: int = 4) -> dict:
+    from designkit.models import sensor_model
+    from designkit.query.exact import exact_min_contact
+    from designkit.sensor import load_sensor
+
+    sen = load_sensor(sensor_file)
+    sc = _scene(sen)
+    t0, c0 = time.perf_counter(), time.process_time()
+    a = exact_min_contact(case["e1"], case["e2"], noise_c=sc["noise_c"], delta_t_c=sc["delta_t_c"], sensor=sen,
+                          model=sensor_model(sen), seed=1000 + case["index"], repeats=repeats, jobs=1)
+    d = a.to_dict()
+    return {**case, "exact": {"value": d["value"], "low": d["interval"]["low"], "high": d["interval"]["high"],
+                              "coverage": d["interval"]["coverage"], "ideal": d["ideal"]["value"]},
+            "repeats": repeats, "wall_s": time.perf_counter() - t0, "cpu_s": time.process_time() - c0}
+
+
+def phase_exact(args) -> None:
+    from designkit.sensor import load_sensor
+    from designkit.sweep.for_sensor import effusivity_span
+
+    span = effusivity_span(material_set=args.materials)
+    load_sensor(args.sensor)
+    cases = draw_pairs(args.pairs, args.seed, span.e_max)
+    path = Path(args.out) / "exact.jsonl"
+    done = {json.loads(line)["index"] for line in path.read_text().splitlines()} if path.exists() else set()
+    todo = [c for c in cases if c["index"] not in done]
+    print(f"{len(todo)} of {len(cases)} pairs to compute by the exact route, {args.jobs} processes", flush=True)
+    with ProcessPoolExecutor(args.jobs) as pool, path.open("a") as fh:
+        futs = [pool.submit(exact_case, args.sensor, c, args.repeats) for c in todo]
+        for f in as_completed(futs):
+            r = f.result()
+            fh.write(json.dumps(r) + "\n")
+            fh.flush()
+            print(f"pair {r['index']}: {r['e1']:g} vs {r['e2']:g}: exact {r['exact']['value']} "
+                  f"({r['cpu_s']:.1f} CPU s, {os.getloadavg()[0]:.1f} load)", flush=True)
+
+
+def _sd(low, high) -> float | None:
+    if low is None or high is None:
+        return None
+    return (high - low) / (2 * Z90)
+
+
+def phase_table(args) -> None:
+    from designkit._validation import InputError
+    from designkit.query import min_contact
+    from designkit.rig import model_start_s
+    from designkit.sensor import load_sensor
+    from designkit.tables.registry import table_for_sensor
+
+    t0 = time.perf_counter()
+    sen = load_sensor(args.sensor)
+    table = table_for_sensor(sen)
+    load_ms = 1e3 * (time.perf_counter() - t0)
+    if table is None:
+        sys.exit(f"no table registered for {args.sensor}: build it with 'designkit tables build --sensor ...'")
+    start = model_start_s(sen) or 0.0
+
+    def onset(v):  # the exact route's model time as the library gives it: from the rig's detected onset
+        return None if v is None else max(v + start, 0.0)
+
+    rows = [json.loads(line) for line in (Path(args.out) / "exact.jsonl").read_text().splitlines()]
+    stated, hits, zs, cells, none, outside, times = [], 0, [], 0, 0, 0, []
+    for r in sorted(rows, key=lambda r: r["index"]):
+        c0 = time.perf_counter()  # the library's whole question: scene, route policy, the table's answer
+        try:
+            a = min_contact(r["e1"], r["e2"], sensor=args.sensor)
+        except InputError as exc:  # outside the table's span: refused in one line
+            times.append(time.perf_counter() - c0)
+            r["table"] = {"refused": str(exc)}
+            outside += 1
+            continue
+        times.append(time.perf_counter() - c0)
+        d = a.to_dict()
+        ex = r["exact_from_onset"] = {k: (onset(v) if k in ("value", "low", "high") else v)
+                                      for k, v in r["exact"].items()}
+        r["table"] = {"value": d["value"], "low": d["interval"]["low"], "high": d["interval"]["high"],
+                      "coverage": d["interval"]["coverage"], "method": d["interval"]["method"]}
+        if not all(d["in_grid"].values()):
+            outside += 1
+            continue
+        if d["value"] is None or ex["value"] is None:
+            none += 1
+            continue
+        if not d["interval"]["coverage"]:
+            cells += 1
+            r["held"] = d["interval"]["low"] <= ex["value"] <= d["interval"]["high"]
+            continue
+        held = d["interval"]["low"] <= ex["value"] <= d["interval"]["high"]
+        r["held"] = held
+        stated.append(r)
+        hits += held
+        st, se = _sd(d["interval"]["low"], d["interval"]["high"]), _sd(ex["low"], ex["high"])
+        if st is not None and se is not None and st + se > 0:
+            zs.append((d["value"] - ex["value"]) / math.hypot(st, se))
+    n = len(stated)
+    rel = [abs(r["table"]["value"] - r["exact_from_onset"]["value"]) / r["exact_from_onset"]["value"] for r in stated
+           if r["exact_from_onset"]["value"]]
+    summary = {
+        "sensor": str(args.sensor), "table": table.name, "content_hash": table.header["content_hash"],
+        "pairs": len(rows), "stated": n, "covered": hits, "coverage": hits / n if n else None,
+        "grid_cells": cells, "grid_cells_held": sum(1 for r in rows if "held" in r and r not in stated and r["held"]),
+        "no_answer": none, "outside_span": outside,
+        "z_sd": statistics.pstdev(zs) if len(zs) > 1 else None,
+        "z_within_1.645": (sum(abs(z) <= Z90 for z in zs) / len(zs)) if zs else None,
+        "median_rel_error": statistics.median(rel) if rel else None,
+        "p95_rel_error": float(np.percentile(rel, 95)) if rel else None,
+        "table_load_ms": load_ms, "question_ms_median": 1e3 * statistics.median(times),
+        "build": table.header.get("stats", {}),
+    }
+    summary.update(projection(table, args.build_cpu_s))
+    summary.update(fresh_shell(args))
+    (Path(args.out) / "cases_scored.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rows))
+    (Path(args.out) / "summary.json").write_text(json.dumps(summary, indent=1) + "\n")
+    print(json.dumps({k: v for k, v in summary.items() if k != "build"}, indent=1))
+
+
+def projection(table, build_cpu_s: float | None, workers: int = 2) -> dict:
+    """The build's time on an idle machine with ``workers`` cores, projected from its CPU seconds.
+
+    The build ran on a shared machine, so its wall clock says little. Each chunk's cost is its wall time in its
+    worker scaled to the build's CPU seconds (``build_cpu_s``: the process tree's, as ``tables build`` prints
+    them); the chunks are handed to ``workers`` idle workers in the engine's order (longest contact first) and
+    the projected wall time is when the last one finishes. Parallel efficiency: CPU over workers x that time.
+    """
+    run = (table.header.get("stats") or {}).get("run") or {}
+    wall = np.asarray(run.get("chunk_wall_s") or [], dtype=np.float64)
+    if not wall.size or not build_cpu_s:
+        return {"projection": None}
+    cost = wall * (build_cpu_s / wall.sum())  # [point, contact]
+    order = [cost[p, k] for k in reversed(range(cost.shape[1])) for p in range(cost.shape[0])]
+    free = [0.0] * workers
+    for c in order:
+        i = int(np.argmin(free))
+        free[i] += c
+    span = max(free)
+    return {"projection": {"build_cpu_s": build_cpu_s, "build_wall_s_shared": run.get("elapsed_s"),
+                           "workers": workers, "idle_wall_s": span,
+                           "parallel_efficiency": build_cpu_s / (workers * span),
+                           "longest_chunk_cpu_s": float(cost.max())}}
+
+
+def fresh_shell(args, runs: int = 7) -> dict:
+    """Wall time of the whole command from a fresh shell, and of ``import numpy`` in the same run (baseline)."""
+    env = dict(os.environ)
+
+    def wall(cmd) -> float:
+        ts = []
+        for _ in range(runs):
+            t0 = time.perf_counter()
+            subprocess.run(cmd, env=env, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            ts.append(time.perf_counter() - t0)
+        return statistics.median(ts)
+
+    py = sys.executable
+    question = [py, "-m", "designkit", "min-contact", "--sensor", str(args.sensor), "--m1", "wood", "--m2", "glass"]
+    wall(question)  # the first run writes the byte code
+    out = {"fresh_shell_question_s": wall(question), "fresh_shell_import_numpy_s": wall([py, "-c", "import numpy"]),
+           "fresh_shell_paper_question_s": wall([py, "-m", "designkit", "min-contact", "--m1", "wood", "--m2",
+                                                 "glass"]),
+           "load_average": os.getloadavg()[0]}
+    out["question_over_numpy"] = out["fresh_shell_question_s"] / out["fresh_shell_import_numpy_s"]
+    return out
+
+
+def main() -> None:
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--sensor", required=True)
+    p.add_argument("--out", required=True)
+    p.add_argument("--phase", choices=("exact", "table"), required=True)
+    p.add_argument("--materials", default="paper12")
+    p.add_argument("--pairs", type=int, default=60)
+    p.add_argument("--seed", type=int, default=34)
+    p.add_argument("--jobs", type=int, default=2)
+    p.add_argument("--repeats", type=int, default=4, help="the exact route's seeds of 100 trials per class")
+    p.add_argument("--build-cpu-s", type=float, default=None, help="CPU seconds the build printed (projection)")
+    args = p.parse_args()
+    Path(args.out).mkdir(parents=True, exist_ok=True)
+    (phase_exact if args.phase == "exact" else phase_table)(args)
+
+
+if __name__ == "__main__":
+    main()

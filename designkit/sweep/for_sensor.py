@@ -1,0 +1,286 @@
+"""The sweep a calibrated sensor's questions need: its config, derived from the sensor file.
+
+A sensor file written by calibration (version 2) records the rig's conditions
+(:mod:`designkit.rig`): its noise, its temperature difference dT, the contact
+ramp and where the model's first heat flow lies relative to the rig's detected
+onset. :func:`sensor_sweep_config` turns them into a :class:`~designkit.sweep.SweepConfig`
+whose table answers that sensor's questions as the rig sees them:
+
+* **the model** is the one the file records (its forward model, force ramp included);
+* **the effusivity span** is that of the materials named (a named set such as
+  ``paper12``, or materials by name), or a range given, or the shipped tables'
+  whole range (0, 40000]; cut into intervals of the class width (80
+  J s^-1/2 K^-1 m^-2, what ``--exact`` and the shipped tables use), on the
+  shipped grid's multiples, one class beyond each end so that every material's
+  hardest class lies inside;
+* **the noise axis** is sigma/dT at the rig's own noise and dT (:data:`NOISE_FACTORS`;
+  more factors tabulate other noises, each as costly as the first): every forward model
+  here is linear in the temperatures, so sigma/dT alone decides (``designkit.sweep``'s
+  invariance);
+* **the touches** are the rig's, as the exact route plays them for a question about the
+  sensor (``SweepConfig.rig_scene``, :func:`designkit.rig.rig_scene`): the noise
+  correlated over the calibration residual's length, each touch read from the detected
+  onset on, pressed as the calibration touches were;
+* **the contact axis** counts, as the rig's controller does, from the detected
+  onset: from :data:`FIRST_CONTACT_S` after it to :data:`LONGEST_CONTACT_SCALES` times
+  the sensor's own settling time (the contact ramp's rise to 90 % of the force,
+  else the thermistor's tau), geometric (:data:`CONTACT_POINTS`: dense enough that
+  the need, convex in contact time, is not read late between two points), and stored as
+  the model counts it (the onset's offset subtracted, :func:`designkit.rig.to_model_contact`).
+
+Units: effusivity [J s^-1/2 K^-1 m^-2], times [s], noise [degC].
+"""
+
+from __future__ import annotations
+
+import math
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Sequence
+
+import numpy as np
+
+from .._validation import InputError
+from ..objects import DEFAULT_CLASS_WIDTH
+from .config import SweepConfig
+
+__all__ = ["BuiltTable", "FIRST_CONTACT_S", "LONGEST_CONTACT_SCALES", "NOISE_FACTORS", "SensorSpan", "build_sensor_table", "contact_grid",
+           "effusivity_span", "rig_noise_ratio", "sensor_sweep_config"]
+
+#: sigma/dT of the table's noise axis, as multiples of the rig's own (1 *is* the rig's: a question at the rig's
+#: conditions lands on a grid point, not between two). The rig's alone by default: each factor costs a whole
+#: build again, and a question at another noise is refused in one line (``--exact`` answers it).
+NOISE_FACTORS = (1.0,)
+#: The first tabulated contact after the rig's detected onset [s].
+FIRST_CONTACT_S = 0.1
+#: The longest tabulated contact after the onset, in units of the sensor's settling time. With the real rig's
+#: correlated noise some of the paper's pairs need longer (up to ~9 s; benchmarks/results/sensor_table_rig_scene.txt):
+#: the table says none up to its last contact separates them, ``--exact`` searches up to 10 s.
+LONGEST_CONTACT_SCALES = 4.0
+#: Contact times tabulated (geometric between the two ends, counted from the onset): ratio 1.33 between
+#: neighbours for the rig (0.1 to 3 s), 1.1-1.2 in the model's time where the paper's materials separate
+#: (9 points, ratio 1.3-1.4 there, answered later than the exact route in 23 of 24 pairs).
+CONTACT_POINTS = 13
+#: The whole range (the shipped tables'): a table for no materials in particular [J s^-1/2 K^-1 m^-2].
+WHOLE_RANGE = (0.0, 40000.0)
+
+
+@dataclass(frozen=True)
+class SensorSpan:
+    """The effusivity span a sensor table answers, and what it was taken from.
+
+    Attributes
+    ----------
+    e_min, e_max : float
+        The grid's ends [J s^-1/2 K^-1 m^-2] (multiples of ``width``).
+    width : float
+        Class width [J s^-1/2 K^-1 m^-2].
+    source : str
+        ``"set paper12"``, ``"materials wood, glass"``, ``"range 300-2000"`` or ``"whole range"``.
+    """
+
+    e_min: float
+    e_max: float
+    width: float
+    source: str
+
+    @property
+    def intervals(self) -> int:
+        return int(round((self.e_max - self.e_min) / self.width))
+
+
+def effusivity_span(*, material_set: str | None = None, materials: Sequence[str] = (),
+                    e_range: tuple[float, float] | None = None,
+                    width: float = DEFAULT_CLASS_WIDTH) -> SensorSpan:
+    """The span of the materials named, a range, or the whole range, on the grid of ``width``.
+
+    The ends are rounded outwards to multiples of ``width`` and widened by one class, so that each
+    material's hardest class (one class width at the edge of its range) lies inside.
+
+    Examples
+    --------
+    >>> s = effusivity_span(materials=["wood", "glass"])
+    >>> s.e_min, s.e_max, s.intervals, s.source
+    (240.0, 1680.0, 18, 'materials Wood, Glass')
+    >>> effusivity_span().intervals
+    500
+    """
+    from ..materials import get_material, list_materials
+
+    given = [x for x in (material_set, materials or None, e_range) if x is not None]
+    if len(given) > 1:
+        raise InputError("give one of a material set, materials by name, or an effusivity range")
+    if not (width > 0 and math.isfinite(width)):
+        raise InputError(f"class width must be positive and finite, got {width!r}")
+    if material_set is not None:
+        try:
+            mats = list_materials(set=material_set)
+        except (InputError, KeyError, ValueError):
+            from ..materials import SETS
+
+            raise InputError(f"unknown material set {material_set!r}; known: {', '.join(SETS)}") from None
+        lo, hi, source = min(m.e_min for m in mats), max(m.e_max for m in mats), f"set {material_set}"
+    elif materials:
+        mats = [get_material(m) for m in materials]
+        lo, hi = min(m.e_min for m in mats), max(m.e_max for m in mats)
+        source = "materials " + ", ".join(dict.fromkeys(m.name for m in mats))
+    elif e_range is not None:
+        lo, hi = (float(x) for x in e_range)
+        if not (0 <= lo < hi and math.isfinite(hi)):
+            raise InputError(f"effusivity range must satisfy 0 <= LO < HI (finite), got {lo:g} {hi:g}")
+        source = f"range {lo:g}-{hi:g}"
+    else:
+        return SensorSpan(*WHOLE_RANGE, float(width), "whole range")
+    e_min = max(0.0, (math.floor(lo / width) - 1) * width)
+    e_max = (math.ceil(hi / width) + 1) * width
+    return SensorSpan(float(e_min), float(e_max), float(width), source)
+
+
+def rig_noise_ratio(sensor) -> float:
+    """sigma/dT of the rig as calibrated: the sensor file's noise over its mean dT [1].
+
+    The same arithmetic as a question's scene (:func:`designkit.rig.resolve_scene` takes the same two
+    values), so that a question at the rig's conditions lands on the grid point exactly.
+    """
+    cond = getattr(sensor, "conditions", None) or {}
+    noise = cond.get("noise_c")
+    dt = (cond.get("delta_t_c") or {}).get("mean")
+    if noise is None or dt is None or not (math.isfinite(float(noise)) and math.isfinite(float(dt))) \
+            or float(dt) == 0 or float(noise) <= 0:
+        raise InputError(f"sensor {sensor.name}: the file records no usable noise and dT of the rig "
+                         f"(noise {noise!r}, dT {dt!r}); recalibrate it with 'designkit calibrate fit'")
+    return float(noise) / abs(float(dt))
+
+
+def contact_grid(sensor, points: int = CONTACT_POINTS) -> tuple[np.ndarray, np.ndarray]:
+    """Contact times from the rig's detected onset, and the same as the model counts them [s].
+
+    Geometric from :data:`FIRST_CONTACT_S` to :data:`LONGEST_CONTACT_SCALES` settling times, the settling
+    time being the contact ramp's rise (the median time from the onset until the force reaches 90 % of
+    its plateau) or, without a force channel, the thermistor's tau. Rounded to 1 ms (onset times).
+    """
+    from ..rig import model_start_s, to_model_contact
+
+    cond = getattr(sensor, "conditions", None) or {}
+    ramp = cond.get("contact_ramp") or {}
+    scale = float(ramp.get("rise_s") or 0.0) or float(sensor.tau_s)
+    start = model_start_s(sensor)
+    first = FIRST_CONTACT_S
+    if start is not None and start > 0:  # the model's heat flow begins after the onset: tabulate from there on
+        first = max(first, start + FIRST_CONTACT_S)
+    last = max(LONGEST_CONTACT_SCALES * scale, 4 * first)
+    onset = np.round(np.geomspace(first, last, points), 3)
+    model = np.array([to_model_contact(float(c), start) for c in onset])
+    return onset, model
+
+
+def sensor_sweep_config(sensor_file: str, *, span: SensorSpan | None = None, name: str | None = None,
+                        noise_factors: Sequence[float] = NOISE_FACTORS, contact_points: int = CONTACT_POINTS,
+                        trials: int = 100, seed: int = 0, max_repeats: int = 4) -> SweepConfig:
+    """The sweep config of the table that answers a calibrated sensor's questions (module docstring).
+
+    Parameters
+    ----------
+    sensor_file : str
+        A sensor YAML file written by calibration, with the rig's conditions (version 2).
+    span : SensorSpan, optional
+        Effusivity span (default: the whole range, :func:`effusivity_span`).
+    name : str, optional
+        Table name (default ``sensor-NAME``).
+    noise_factors : sequence of float
+        sigma/dT of the noise axis as multiples of the rig's own (1 must be one of them).
+    contact_points : int
+        Contact times tabulated.
+    trials, seed, max_repeats : int
+        The classifier protocol (the paper's: 100 trials per interval, 3 folds) and its Monte Carlo.
+
+    Raises
+    ------
+    InputError
+        A sensor without the rig's conditions (a preset, or a file from an older designkit).
+    """
+    from ..sensor import SENSORS, load_sensor
+
+    if str(sensor_file) in SENSORS:
+        raise InputError(f"sensor {sensor_file!r} is a preset: the shipped tables answer for it; a sensor "
+                         "table is for a sensor file written by 'designkit calibrate fit'")
+    sensor = load_sensor(str(sensor_file))
+    if not getattr(sensor, "conditions", None):
+        raise InputError(f"sensor file {sensor_file} records no rig conditions (written by an older designkit, or "
+                         "by hand): recalibrate it with 'designkit calibrate fit' to record them, or build a table "
+                         "at conditions of your choice with 'designkit sweep --sensor FILE ...'")
+    factors = tuple(sorted(float(f) for f in noise_factors))
+    if 1.0 not in factors or any(not (f > 0 and math.isfinite(f)) for f in factors):
+        raise InputError(f"noise factors must be positive and include 1 (the rig's own), got {list(noise_factors)}")
+    span = span or effusivity_span()
+    r0 = rig_noise_ratio(sensor)
+    _, model_contacts = contact_grid(sensor, contact_points)
+    if np.any(model_contacts <= 0):
+        raise InputError(f"sensor {sensor.name}: its contact grid starts before the model's first heat flow")
+    return SweepConfig(name=name or f"sensor-{_slug(sensor.name)}", sensor=str(sensor_file), e_min=span.e_min,
+                       e_max=span.e_max, intervals=span.intervals, trials=trials, seed=seed,
+                       max_repeats=max_repeats, noise_ratio=tuple(r0 * f for f in factors),
+                       contact_s=tuple(float(c) for c in model_contacts), rig_scene=True)
+
+
+def _slug(text: str) -> str:
+    import re
+
+    s = re.sub(r"[^A-Za-z0-9._-]+", "-", str(text)).strip("-.")
+    return s[:60] or "sensor"
+
+
+@dataclass(frozen=True)
+class BuiltTable:
+    """What :func:`build_sensor_table` made: the table's path, its registry entry and what it holds.
+
+    Attributes
+    ----------
+    table, entry : Path
+        The table's .npz (its .json beside it) and its registry entry.
+    sensor_name, sensor_digest, content_hash : str
+    contacts_from_onset_s : tuple of float
+        The tabulated contact times, counted from the rig's detected onset [s].
+    config : SweepConfig
+    """
+
+    table: Path
+    entry: Path
+    sensor_name: str
+    sensor_digest: str
+    content_hash: str
+    contacts_from_onset_s: tuple[float, ...]
+    config: Any
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"table": str(self.table), "header": str(self.table.with_suffix(".json")),
+                "registry_entry": str(self.entry), "sensor": {"name": self.sensor_name, "digest": self.sensor_digest},
+                "content_hash": self.content_hash, "contacts_from_onset_s": list(self.contacts_from_onset_s),
+                "config": self.config.to_dict()}
+
+
+def build_sensor_table(cfg, *, out: str | Path | None = None, jobs: int = -1, on_chunk=None) -> BuiltTable:
+    """Sweep ``cfg`` (:func:`designkit.sweep.for_sensor.sensor_sweep_config`) and register its table for the sensor.
+
+    The chunks are kept in a working folder named by the config's digest beside the registry entry, so an
+    interrupted build continues where it stopped when run again; it is removed once the table is registered.
+    ``out``: the table's .npz (default: in the registry folder, :func:`default_table_dir`).
+    """
+    import shutil
+
+    from ..rig import from_model_contact, model_start_s
+    from ..tables.registry import default_table_dir, register_table, sensor_digest
+    from .run import run_sweep
+
+    sensor = cfg.resolved_sensor()
+    home = default_table_dir(sensor)
+    work = home / f"work-{cfg.digest()[:16]}"
+    path = Path(out) if out is not None else home / f"{cfg.name}.npz"
+    table = run_sweep(cfg, work, out=path, jobs=jobs, resume=True, on_chunk=on_chunk)
+    entry = register_table(sensor, table, sensor_file=cfg.sensor)
+    shutil.rmtree(work, ignore_errors=True)
+    start = model_start_s(sensor)
+    return BuiltTable(Path(table), entry, sensor.name, sensor_digest(sensor),
+                      json.loads(entry.read_text())["content_hash"],
+                      tuple(round(float(from_model_contact(c, start)), 6) for c in cfg.contact_s), cfg)

@@ -247,3 +247,22 @@ def test_the_cli_answers_for_the_rig_as_calibrated(cli, rig_file):
     lib = json.loads(json.dumps(distinguishable(e1=400.0, e2=1500.0, contact_s=1.0, sensor=str(rig_file), trials=30,
                                                 repeats=1).to_dict()))
     assert lib["scene"] == d["scene"] and lib["value"] == d["value"] and lib["details"] == d["details"]
+
+
+@pytest.mark.slow
+def test_the_monte_carlo_ideal_bound_plays_the_rigs_scene(rig_file):
+    """The bound is the ideal observer of the touches the SVM sees: a rig's correlated noise averages away
+    less than white noise over a touch, so its bound comes later (before, the bound was always taken under
+    white noise from the first heat flow, 0.22 s where the rig's SVM needed 1.09 s)."""
+    from designkit.objects import ObjectClass
+    from designkit.query.ideal_mc_bound import mc_ideal_min_contact
+
+    rig = load_sensor(rig_file)
+    correlated = rig.replace(conditions={**rig.conditions, "noise_correlation_s": 0.68})
+    white = rig.replace(conditions=None)
+    a, b = ObjectClass("a", (400.0, 480.0)), ObjectClass("b", (1500.0, 1580.0))
+    kw = dict(noise_c=0.2, delta_t_c=7.0, max_contact_s=4.0, n_mc=300, seed=2)
+    got_white = mc_ideal_min_contact(a, b, white, **kw)
+    got_rig = mc_ideal_min_contact(a, b, correlated, **kw)
+    assert got_white.value is not None and got_rig.value is not None
+    assert got_rig.low > got_white.high

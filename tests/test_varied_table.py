@@ -157,7 +157,9 @@ def test_the_array_route_gives_the_scalar_routes_varied_estimates():
 
 
 def test_a_direction_beyond_the_range_enters_the_pair_need_at_its_least_possible_value():
-    from designkit.query.table import _View, _as_table, _pair_need_both
+    from designkit.query.estimates import pair_need_both as _pair_need_both
+    from designkit.query.table import _as_table
+    from designkit.query.table_arrays import TableView as _View
 
     view = _View(_as_table(VARIED_TABLE))
     t = view.t

@@ -1,5 +1,8 @@
 """The table route's estimates over numpy arrays: the grid crossing, the rounding-corrected estimates of
-min-contact, max-noise / min-delta-t and delta-e and their stated intervals (NaN for "none" throughout).
+min-contact, max-noise / min-delta-t and delta-e and their stated intervals (NaN for "none" throughout), and
+min-contact's and max-noise / min-delta-t's estimators as small named strategies (:data:`CONTACT_ESTIMATORS`,
+:data:`RATIO_ESTIMATORS`): each says where it applies, and per element the first that applies answers
+(:func:`first_applicable`).
 
 Every function is elementwise over arrays: a single question is one element of an array question
 (:mod:`designkit.query.table_arrays`).
@@ -8,6 +11,8 @@ Every function is elementwise over arrays: a single question is one element of a
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass, field
+from typing import Any, Callable
 
 import numpy as np
 
@@ -15,9 +20,13 @@ from ..tables import lookup
 from ..tables.store import Table
 
 __all__ = [
-    "K_SLOPE_SPAN", "axis_weights_flagged", "contact_estimate", "cross2", "delta_estimate", "grid_crossing",
-    "interp_e_by", "interp_e_rows", "k_baseline", "median", "pair_need_both", "partner_in_grid",
-    "ratio_estimate", "span_neighbours", "stated_log", "table_z", "varied_contact_estimate"
+    "ABOVE", "BELOW", "CELL", "CONTACT_ESTIMATORS", "ContactReading", "Estimates", "INSIDE",
+    "RATIO_ESTIMATORS", "RatioReading", "axis_weights_flagged", "cell_estimate", "contact_estimate", "cross2",
+    "delta_estimate", "efficiency_estimate", "first_applicable", "grid_crossing", "interp_e_by",
+    "interp_e_rows", "k_baseline", "median", "pair_need_both", "partner_in_grid", "ratio_beyond",
+    "ratio_cell", "ratio_efficiency", "ratio_estimate", "ratio_ideal_table", "ratio_rounding",
+    "rounding_estimate", "span_neighbours", "stated_log", "states_coverage", "table_spread", "table_z",
+    "varied_contact_estimate", "varied_estimate"
 ]
 
 
@@ -376,3 +385,280 @@ def partner_in_grid(view, e, delta, direction: str):
 
 #: The scalar route's efficiency estimates (:func:`delta_efficiency_estimate`, both directions), per process (least
 #: recently used out): a question asked again reads them from here (the estimate re-reads 24 table entries and 10
+
+
+# ============================================================ the estimators: named strategies over arrays
+def _nan(n: int) -> np.ndarray:
+    return np.full(n, np.nan)
+
+
+#: The (question, interval kind) pairs a table with varied initial conditions shows as ``table-varied``, with
+#: no coverage (:data:`designkit.query.table.VARIED_COVERAGE_NOTE`): min-contact's grid-rule estimate and grid
+#: cell. Its min-contact estimates (``table-varied-estimate``) and delta-e's (``table-estimate``) state theirs,
+#: measured to hold there (``bench_coverage_varied.py``, 200 random cases each against 16-seed exact references).
+VARIED_UNMEASURED = frozenset({("min-contact", "table-estimate"), ("min-contact", "table-cell")})
+
+
+def table_spread(tab: Table) -> float:
+    """Half-width [degC] of the per-touch sensor temperature a table was built with (0: fixed conditions)."""
+    return float(tab.header.get("config", {}).get("sensor_temp_spread_c") or 0.0)
+
+
+def states_coverage(tab: Table, question: str, interval_kind: str | None) -> bool:
+    """Whether an answer of ``question`` from ``tab`` may state the coverage of an interval of this kind:
+    everywhere but on a varied table's :data:`VARIED_UNMEASURED` kinds."""
+    return not (table_spread(tab) > 0 and (question, interval_kind) in VARIED_UNMEASURED)
+
+
+@dataclass(frozen=True)
+class Estimates:
+    """One estimator's answers over the elements it ``applies`` to (elsewhere ignored): value and interval in the
+    answer's units, the interval's kind, whether it states the asked coverage, further arrays (``extra``)."""
+
+    applies: np.ndarray
+    value: np.ndarray
+    low: np.ndarray
+    high: np.ndarray
+    kind: str
+    stated: bool
+    extra: dict = field(default_factory=dict)
+
+
+def first_applicable(estimators, rd, n: int) -> dict[str, np.ndarray]:
+    """Per element, the answer of the first estimator (in order) that applies to it (``kind`` "none" where none
+    does)."""
+    out = {k: _nan(n) for k in ("value", "low", "high")}
+    out["kind"], out["stated"] = np.full(n, "none", dtype=object), np.zeros(n, dtype=bool)
+    taken = np.zeros(n, dtype=bool)
+    for estimator in estimators:
+        r = estimator(rd)
+        if r is None:
+            continue
+        m = r.applies & ~taken
+        if not m.any():
+            continue
+        for k in ("value", "low", "high"):
+            out[k][m] = np.broadcast_to(getattr(r, k), (n,))[m]
+        out["kind"][m], out["stated"][m] = r.kind, r.stated
+        for k, v in r.extra.items():
+            out.setdefault(k, _nan(n))[m] = np.broadcast_to(v, (n,))[m]
+        taken |= m
+    return out
+
+
+# ---------------------------------------------------------------- min-contact's
+@dataclass(frozen=True)
+class ContactReading:
+    """What min-contact read from the table for pairs ``lo < hi``: the crossing ``raw`` [s] of the tabulated need
+    (NaN: none within the table), its contact index ``k_cross`` (-1: none) and the needs around it, the Monte
+    Carlo ends' crossings, the ideal bound and the floor the intervals are held above, the noise-efficiency
+    readings (None: the route does not apply), the scene slices of each scene's elements."""
+
+    op: Any
+    lo: np.ndarray
+    hi: np.ndarray
+    raw: np.ndarray
+    k_cross: np.ndarray
+    n_prev: np.ndarray
+    n_at: np.ndarray
+    mc_lo: np.ndarray
+    mc_hi: np.ndarray
+    ideal: np.ndarray
+    floor: np.ndarray
+    eff: dict | None
+    slices: list
+    zc: float
+
+    @property
+    def svm(self) -> bool:
+        return self.op.tab.fidelity == "svm"
+
+
+def varied_estimate(rd: ContactReading) -> Estimates | None:
+    """Varied initial conditions: each scene slice's estimate, both directions averaged, interpolated across the
+    slices (:func:`~designkit.query.estimates.varied_contact_estimate`)."""
+    op, n = rd.op, rd.lo.size
+    if not (rd.svm and table_spread(op.tab) > 0 and "delta_up_lo" in op.view.t.arrays):
+        return None
+    out = {k: _nan(n) for k in ("value", "low", "high", "interp", "rounding")}
+    for combos, idx in rd.slices:
+        r = varied_contact_estimate(op.view, combos, rd.lo[idx], rd.hi[idx], rd.floor[idx], width=op.width,
+                                    z_table=table_z(op.tab), zc=rd.zc)
+        for k in out:
+            out[k][idx] = r[k]
+    return Estimates(~np.isnan(out["value"]), out["value"], out["low"], out["high"], "table-varied-estimate", True,
+                     {"interp": out["interp"], "rounding": out["rounding"]})
+
+
+def efficiency_estimate(rd: ContactReading) -> Estimates | None:
+    """The SVM's noise efficiency against the exact ideal observer
+    (:func:`~designkit.query.efficiency.noise_k_min_contact`): no interpolation of the steep need between grid
+    points (an SVM table of a model with a closed form)."""
+    eff = rd.eff
+    if eff is None:
+        return None
+    with np.errstate(invalid="ignore"):
+        low = np.where(np.isnan(rd.ideal), eff["low"], np.minimum(np.maximum(eff["low"], rd.ideal), eff["value"]))
+    return Estimates(~np.isnan(rd.raw) & ~np.isnan(eff["value"]), eff["value"], low, eff["high"],
+                     "table-efficiency", True, {f"eff_{k}": eff[k] for k in ("k", "se_log", "k_a", "k_b", "t_a", "t_b")})
+
+
+def rounding_estimate(rd: ContactReading) -> Estimates | None:
+    """Interpolated between two tabulated needs (:func:`~designkit.query.estimates.contact_estimate`): the table's
+    Monte Carlo interval (its deltas' z-SE ends, rescaled to the coverage) and the interpolation error (the
+    distance to a log-log interpolation's crossing), the grid's rounding corrected on an SVM table."""
+    op, k = rd.op, rd.k_cross
+    applies = (k > 0) & ~np.isnan(rd.n_prev) & ~np.isnan(rd.raw)
+    if not applies.any():
+        return None
+    grid = op.view.contacts
+    with np.errstate(invalid="ignore", divide="ignore"):
+        r = contact_estimate(grid[np.maximum(k - 1, 0)], grid[np.maximum(k, 0)], rd.n_prev, rd.n_at, rd.hi - rd.lo,
+                             rd.raw, rd.mc_lo, rd.mc_hi, rd.floor, width=op.width, svm=rd.svm,
+                             z_table=table_z(op.tab), zc=rd.zc)
+    return Estimates(applies, r["value"], r["low"], r["high"], "table-estimate",
+                     states_coverage(op.tab, "min-contact", "table-estimate"),
+                     {"interp": r["interp"], "rounding": r["rounding"]})
+
+
+def cell_estimate(rd: ContactReading) -> Estimates | None:
+    """The grid cell the crossing lies in, no stated coverage: where the crossing is the table's first contact,
+    or follows a contact where the pair is beyond the grid. With the initial temperature varied per touch F1
+    need not rise with contact time: the cell then starts at the ideal bound."""
+    grid, k = rd.op.view.contacts, rd.k_cross
+    start = np.where(k > 0, grid[np.maximum(k - 1, 0)], 0.0)
+    if table_spread(rd.op.tab) > 0:
+        start = np.zeros_like(start)
+    low = np.where(np.isnan(rd.floor), start, np.maximum(start, rd.floor))
+    return Estimates(~np.isnan(rd.raw), rd.raw, low, rd.raw, "table-cell", False)
+
+
+#: min-contact's estimators from a table, in the order tried: per element the first that applies answers.
+CONTACT_ESTIMATORS: tuple[Callable[[ContactReading], Estimates | None], ...] = (
+    varied_estimate, efficiency_estimate, rounding_estimate, cell_estimate)
+
+
+# ---------------------------------------------------------------- max-noise / min-delta-t's
+BELOW, INSIDE, ABOVE, CELL = 0, 1, 2, 3  # where a largest separating ratio lies
+
+
+
+
+@dataclass(frozen=True)
+class RatioReading:
+    """What max-noise / min-delta-t read for pairs ``lo < hi`` at contacts ``contact`` [s]: the largest separating
+    sigma/dT ``r`` and where it lies (``where``, -1: not read), the Monte Carlo ends ``end_hi`` / ``end_lo``
+    (sigma/dT), the ideal observer's ``ri`` (NaN: none), the rounding estimate's interpolants ``alt``, and the
+    conversion of sigma/dT to the answer (``scale``: dT for max-noise, noise for min-delta-t)."""
+
+    op: Any
+    question: str
+    contact: np.ndarray
+    lo: np.ndarray
+    hi: np.ndarray
+    r: np.ndarray
+    where: np.ndarray
+    end_hi: np.ndarray
+    end_lo: np.ndarray
+    ri: np.ndarray
+    alt: dict
+    scale: np.ndarray
+    zc: float
+
+    def answer(self, r):
+        """sigma/dT in the answer's units [degC]."""
+        return r * self.scale if self.question == "max-noise" else self.scale / r
+
+    def interval(self, r_low, r_high):
+        """An interval of sigma/dT ends in the answer's units, low <= high."""
+        a, b = self.answer(r_low), self.answer(r_high)
+        return (a, b) if self.question == "max-noise" else (b, a)
+
+    @property
+    def svm(self) -> bool:
+        return self.op.tab.fidelity == "svm"
+
+
+def ratio_efficiency(rd: RatioReading) -> Estimates | None:
+    """The SVM's noise efficiency against the exact ideal observer
+    (:func:`~designkit.query.efficiency.noise_k_max_ratio`), never beyond the ideal observer's."""
+    op = rd.op
+    cand = ((rd.where == INSIDE) | (rd.where == CELL)) & ~np.isnan(rd.ri)
+    if not (rd.svm and op.closed and "delta_up_ideal" in op.view.t.arrays and cand.any()):
+        return None
+    i = np.nonzero(cand)[0]
+    from .efficiency import noise_k_max_ratio
+
+    kr = noise_k_max_ratio(op, rd.contact[i], rd.r[i], rd.ri[i], rd.lo[i], rd.hi[i], zc=rd.zc)
+    out = {k: _nan(rd.lo.size) for k in ("r", "low", "high", "k", "se_log")}
+    out["r"][i], out["low"][i] = np.minimum(kr["value"], rd.ri[i]), kr["low"]
+    out["high"][i], out["k"][i], out["se_log"][i] = np.minimum(kr["high"], rd.ri[i]), kr["k"], kr["se_log"]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        low, high = rd.interval(out["low"], out["high"])
+        value = rd.answer(out["r"])
+    return Estimates(~np.isnan(out["r"]), value, low, high, "table-efficiency", True,
+                     {"ratio": out["r"], "eff_k": out["k"], "eff_se_log": out["se_log"]})
+
+
+def ratio_rounding(rd: RatioReading) -> Estimates | None:
+    """As min-contact's: the tabulated deltas are rounded up to the grid (on average half a width late), so the
+    raw crossing tolerates too little noise; the answer subtracts w/2 from the need and interpolates log-log,
+    the interval carries the interpolants' difference and the rounding's SD
+    (:func:`~designkit.query.estimates.ratio_estimate`)."""
+    applies = rd.where == INSIDE
+    if not (rd.svm and applies.any()):
+        return None
+    a = rd.alt
+    est = ratio_estimate(rd.r, a["c"], a["lin"], a["rnd"], a["geo"], rd.end_hi, rd.end_lo, rd.ri,
+                         z_table=table_z(rd.op.tab), zc=rd.zc)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        low, high = rd.interval(est["low"], est["high"])
+        value = rd.answer(est["value"])
+    return Estimates(applies, value, low, high, "table-estimate", True,
+                     {"ratio": est["value"], "interp": est["interp"], "rounding": est["rounding"]})
+
+
+def ratio_cell(rd: RatioReading) -> Estimates | None:
+    """A neighbour beyond the grid: the crossing lies in the cell up to the next ratio (or the ideal bound), no
+    stated coverage."""
+    applies = rd.where == CELL
+    if not applies.any():
+        return None
+    ratios = rd.op.view.t.axes["noise_ratio"]
+    k = np.searchsorted(ratios, np.where(applies, rd.r, ratios[0]))
+    nxt = ratios[np.minimum(k + 1, ratios.size - 1)]
+    nxt = np.where(np.isnan(rd.ri), nxt, np.minimum(nxt, rd.ri))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        low, high = rd.interval(rd.r, nxt)
+        value = rd.answer(rd.r)
+    return Estimates(applies, value, low, high, "table-cell", False, {"next_ratio": nxt})
+
+
+def ratio_ideal_table(rd: RatioReading) -> Estimates | None:
+    """An ideal-observer table: the answer with its Monte Carlo ends, no stated coverage."""
+    applies = rd.where == INSIDE
+    if not applies.any():
+        return None
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mc = [rd.answer(rd.end_hi), rd.answer(rd.end_lo)]
+        both = ~np.isnan(mc[0]) & ~np.isnan(mc[1])
+        return Estimates(applies, rd.answer(rd.r), np.where(both, np.fmin(*mc), mc[0]),
+                         np.where(both, np.fmax(*mc), mc[1]), "table", False)
+
+
+def ratio_beyond(rd: RatioReading) -> Estimates | None:
+    """Separable beyond the table's largest ratio: the answer is a one-sided bound."""
+    applies = rd.where == ABOVE
+    if not applies.any():
+        return None
+    with np.errstate(invalid="ignore", divide="ignore"):
+        v = rd.answer(rd.r)
+    nan = _nan(v.size)
+    return Estimates(applies, v, *((v, nan) if rd.question == "max-noise" else (nan, v)), "table-cell", False)
+
+
+#: max-noise / min-delta-t's estimators from a table, in the order tried: per element the first that applies.
+RATIO_ESTIMATORS: tuple[Callable[[RatioReading], Estimates | None], ...] = (
+    ratio_efficiency, ratio_rounding, ratio_cell, ratio_ideal_table, ratio_beyond)
+
+

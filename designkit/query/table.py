@@ -48,231 +48,34 @@ Examples
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import Any, Sequence
 
 import numpy as np
-from cachetools import LRUCache
 
-from .._validation import InputError, check_nonnegative
+from .._validation import InputError
 from ..tables.lookup import GRID_RTOL
-from ..tables.store import Table, load_table, resolve_table
+from ..tables.store import Table
 from .answer import Answer, IdealBound, number
 from .crossing import check_coverage, z_of_coverage
-from .efficiency import (CLOSED_FORM_MAX_CONTACT_S, clear_efficiency_cache, delta_efficiency_estimate, delta_entries,
-                         noise_k_max_ratio, noise_k_min_contact)
-from .estimates import (K_SLOPE_SPAN, axis_weights_flagged, contact_estimate, cross2, delta_estimate, grid_crossing,
-                        k_baseline, partner_in_grid, ratio_estimate, stated_log, table_z)
-from .inputs import (
-    REFERENCE_RULE,
-    PairQuestion,
-    TableMismatch,
-    check_contact,
-    check_threshold,
-    pair_question,
-    reference_class,
-    scene_inputs,
-)
-from .table_arrays import (ABOVE, BELOW, CELL, CLOSED_FORM_RATIO_BRACKET, CONTACT_ESTIMATORS, RATIO_ESTIMATORS,
-                           TableView, contact_arrays, delta_e_arrays, distinguishable_arrays,
-                           ratio_arrays, states_coverage, table_spread)
+from .efficiency import CLOSED_FORM_MAX_CONTACT_S, noise_k_max_ratio, noise_k_min_contact
+from .estimates import (ABOVE, BELOW, CELL, CONTACT_ESTIMATORS, K_SLOPE_SPAN, RATIO_ESTIMATORS,
+                        axis_weights_flagged, k_baseline, states_coverage, table_spread, table_z)
+from .inputs import REFERENCE_RULE, PairQuestion, TableMismatch, check_contact, pair_question, reference_class, \
+    scene_inputs
+from .table_arrays import (CLOSED_FORM_RATIO_BRACKET, TableView, contact_arrays, delta_e_arrays,
+                           distinguishable_arrays, ratio_arrays)
+from .table_open import (DEFAULT_IDEAL_TABLE, DEFAULT_TABLE, SPREAD_TABLE_QUESTIONS, VARIED_TABLE, OpenedTable,
+                         as_table, clear_table_cache, open_table, shipped_spread_table)
 
 __all__ = [
-    "CLOSED_FORM_MAX_CONTACT_S",
-    "CLOSED_FORM_RATIO_BRACKET",
-    "CONTACT_ESTIMATORS",
-    "DEFAULT_IDEAL_TABLE",
-    "DEFAULT_TABLE",
-    "GRID_KINDS",
-    "GRID_RTOL",
-    "K_SLOPE_SPAN",
-    "RATIO_ESTIMATORS",
-    "SPREAD_TABLE_QUESTIONS",
-    "VARIED_TABLE",
-    "axis_weights_flagged",
-    "clear_table_cache",
-    "contact_estimate",
-    "cross2",
-    "delta_e",
-    "delta_efficiency_estimate",
-    "delta_entries",
-    "delta_estimate",
-    "distinguishable",
-    "grid_answer",
-    "grid_crossing",
-    "k_baseline",
-    "max_noise",
-    "min_contact",
-    "min_delta_t",
-    "noise_k_max_ratio",
-    "noise_k_min_contact",
-    "open_table",
-    "partner_in_grid",
-    "ratio_estimate",
-    "shipped_spread_table",
-    "stated_log",
-    "table_spread",
-    "table_z",
+    "CLOSED_FORM_MAX_CONTACT_S", "CLOSED_FORM_RATIO_BRACKET", "CONTACT_ESTIMATORS", "DEFAULT_IDEAL_TABLE",
+    "DEFAULT_TABLE", "GRID_KINDS", "GRID_RTOL", "K_SLOPE_SPAN", "RATIO_ESTIMATORS", "SPREAD_TABLE_QUESTIONS",
+    "VARIED_TABLE", "clear_table_cache", "delta_e", "distinguishable", "grid_answer", "k_baseline", "max_noise",
+    "min_contact", "min_delta_t", "noise_k_max_ratio", "noise_k_min_contact", "open_table", "shipped_spread_table",
+    "table_spread", "table_z",
 ]
 
-DEFAULT_TABLE = "svm-fine"
-#: The shipped table for the paper's second setting (the sensor's temperature drawn per touch, uniform in
-#: 30-35 degC with the object at 25 degC: dT 7.5 degC, spread 2.5 degC): a question with that spread reads it.
-VARIED_TABLE = "svm-paper-varied"
-DEFAULT_IDEAL_TABLE = "ideal-paper"
-
-
-#: Tables loaded (and verified) by this process, keyed by their files' identity: a name or path is
-#: read and hashed once, not on every question. Least recently used out.
-_LOADED: "LRUCache[tuple, Table]" = LRUCache(16)
-
-
-def _as_table(table: "Table | str") -> Table:
-    """A Table object, or the table a name or path names, loaded once per process while its files
-    are unchanged (same path, size and modification time of the .npz and the .json header)."""
-    if isinstance(table, Table):
-        return table
-    npz = resolve_table(table)
-    try:
-        key = tuple((str(p), st.st_mtime_ns, st.st_size) for p in (npz, npz.with_suffix(".json"))
-                    for st in (p.stat(),))
-    except OSError:  # let load_table say what is missing
-        return load_table(npz)
-    t = _LOADED.get(key)
-    if t is None:
-        t = _LOADED[key] = load_table(npz)
-    return t
-
-
-def clear_table_cache() -> None:
-    """Forget the tables this process has loaded (they are re-read and re-verified on next use), and the
-    noise-efficiency readings taken from them."""
-    _LOADED.clear()
-    clear_efficiency_cache()
-
-
-# ============================================================ opening a table for a question
-@dataclass(frozen=True)
-class _Opened:
-    """A table checked against the question (threshold, sensor, model), and its ideal-bound view."""
-
-    tab: Table
-    view: TableView
-    phi: float
-    model: Any
-    iview: TableView | None
-    ikind: str
-    iname: str | None
-    ihash: str | None
-
-    @property
-    def width(self) -> float:
-        return float(self.tab.header["effusivity"]["width"])
-
-    @property
-    def closed(self) -> bool:
-        """The ideal bound is computed in closed form at query time (never read from a grid)."""
-        return _closed_form(self.tab, self.model)
-
-
-def ideal_view(svm: TableView, ideal_table: "Table | str | None") -> tuple[TableView, str, Table | None]:
-    """The view answering the ideal bound: a dedicated ideal table built for the same sensor, model and
-    threshold, else the SVM table's own ideal arrays, else none (``(None, "", None)``: no bound from
-    tables; never the SVM's own answer passed off as the bound). An ideal table that cannot be read is
-    an error, not a silent fallback."""
-    if ideal_table is not None:
-        t = _as_table(ideal_table)
-        if (t.sensor == svm.t.sensor and t.fidelity == "ideal" and t.threshold == svm.t.threshold
-                and t.model == svm.t.model):
-            return TableView(t), "svm", t
-    if "delta_up_ideal" in svm.t.arrays:
-        return svm, "ideal", svm.t
-    if svm.t.fidelity == "ideal":
-        return svm, "svm", svm.t
-    return None, "", None
-
-
-#: The questions a table with varied initial conditions answers (its noise and dT are separate axes, not
-#: sigma/dT: max-noise and min-delta-t are refused by it and need the exact route).
-SPREAD_TABLE_QUESTIONS = ("min-contact", "delta-e", "distinguishable")
-
-
-def shipped_spread_table(spread: float, question: str = "min-contact", delta_t_c: float | None = None) -> str | None:
-    """The shipped table that answers ``question`` with sensor temperature spread ``spread`` [degC], or None.
-
-    With ``delta_t_c`` [degC], also None where the table holds no such temperature difference: its dT is an
-    axis of its own (the spread is about the sensor's temperature, so sigma/dT is no invariance there), and
-    a question at another dT is computed for the pair instead of refused as outside the grid.
-
-    >>> shipped_spread_table(2.5)
-    'svm-paper-varied'
-    >>> shipped_spread_table(1.0) is None, shipped_spread_table(2.5, "max-noise") is None
-    (True, True)
-    >>> shipped_spread_table(2.5, delta_t_c=7.5), shipped_spread_table(2.5, delta_t_c=10.0)
-    ('svm-paper-varied', None)
-    """
-    if question not in SPREAD_TABLE_QUESTIONS or not spread > 0:
-        return None
-    tab = _as_table(VARIED_TABLE)
-    if not math.isclose(table_spread(tab), spread, rel_tol=1e-9):
-        return None
-    if delta_t_c is not None:
-        held = tab.axes.get("delta_t_c")
-        if held is not None and not np.any(np.isclose(held, abs(float(delta_t_c)), rtol=1e-9)):
-            return None
-    return VARIED_TABLE
-
-
-def _spread_words(spread: float) -> str:
-    return (f"the sensor temperature drawn per touch within +-{spread:g} degC" if spread > 0
-            else "fixed initial conditions")
-
-
-def _open(table, ideal_table, *, threshold, sensor, model, spread: float = 0.0) -> _Opened:
-    """Load ``table`` and refuse it when it was built for another threshold, sensor, model or sensor
-    temperature spread (``spread`` [degC]: the question's; a spread reads :data:`VARIED_TABLE` by default)."""
-    from ..models import get_model
-
-    spread = check_nonnegative("sensor temperature spread [degC]", spread)
-    if spread > 0 and isinstance(table, str) and table == DEFAULT_TABLE:
-        table = VARIED_TABLE
-    tab = _as_table(table)
-    held = table_spread(tab)
-    if not math.isclose(spread, held, rel_tol=1e-9, abs_tol=1e-12) or tab.header.get("config", {}).get(
-            "ambient_temp_spread_c"):
-        raise TableMismatch(f"table {tab.name} was built with {_spread_words(held)}, not with "
-                            f"{_spread_words(spread)}")
-    if threshold is not None and not math.isclose(check_threshold(threshold), tab.threshold, rel_tol=1e-9):
-        raise TableMismatch(f"table {tab.name} was built for threshold {tab.threshold:g}, not {threshold:g}")
-    if sensor is not None:
-        from ..sensor import load_sensor
-
-        s = load_sensor(sensor)
-        if s != tab.sensor:
-            raise TableMismatch(f"table {tab.name} was built for sensor {tab.sensor.name!r}, not {s.name!r}")
-        if model is None and s.model is not None:  # a sensor file's own model must be the table's too
-            from ..models import sensor_model
-
-            model = sensor_model(s)
-    fm = tab.model
-    if model is not None:
-        asked = get_model(model)
-        if asked != fm:
-            raise TableMismatch(f"table {tab.name} was built for the {fm.describe()} model, "
-                                f"not the {asked.describe()} model")
-    view = TableView(tab)
-    if _closed_form(tab, fm):  # the bound is computed at query time: the default ideal table is not read
-        if ideal_table is not None and ideal_table != DEFAULT_IDEAL_TABLE:
-            _as_table(ideal_table)  # a table the caller named must exist: an error, not a silent fallback
-        return _Opened(tab, view, tab.threshold, fm, None, "", None, None)
-    iview, ikind, it = ideal_view(view, ideal_table)
-    return _Opened(tab, view, tab.threshold, fm, iview, ikind, None if it is None else it.name,
-                   None if it is None else it.header.get("content_hash"))
-
-
-def _closed_form(tab: Table, fm) -> bool:
-    """Whether the ideal bound is computed in closed form (shared-shape model, fixed initial conditions)."""
-    return bool(fm.shared_shape) and "noise_ratio" in tab.axes
+_as_table = as_table  # (the name tests and the lab know)
 
 
 # ============================================================ in-grid flags, in the user's units
@@ -318,7 +121,7 @@ def _scene_wanted(view: TableView, noise, dt) -> dict[str, Any]:
 
 
 # ============================================================ one answer builder for the route
-def _answer(question: str, op: _Opened, *, objects, limiting, rule: str, scene: dict, value, interval,
+def _answer(question: str, op: OpenedTable, *, objects, limiting, rule: str, scene: dict, value, interval,
             ideal, ideal_method: str = "table", in_grid: dict, details: dict, notes: Sequence[str] = (),
             check_at: tuple[float, float, float] | None = None, classes=(), interval_kind=None,
             interval_coverage=None, computation: dict | None = None, ideal_interval=None) -> Answer:
@@ -360,7 +163,7 @@ def _scene(contact_s=None, noise_c=None, delta_t_c=None) -> dict[str, Any]:
     return {"contact_s": contact_s, "noise_c": noise_c, "delta_t_c": delta_t_c, "noise_ratio": ratio}
 
 
-def _no_pair(question: str, op: _Opened, pq: PairQuestion, scene: dict, details: dict) -> Answer:
+def _no_pair(question: str, op: OpenedTable, pq: PairQuestion, scene: dict, details: dict) -> Answer:
     """The materials overlap: no answer, said so."""
     return _answer(question, op, objects=pq.objects_dicts(), limiting=(), rule=pq.rule, scene=scene,
                    value=None, interval=(None, None), ideal=None, in_grid={}, details=details, notes=[pq.note])
@@ -432,8 +235,8 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
     """
     noise, dt = scene_inputs(noise_c, delta_t_c)
     coverage = check_coverage(coverage)
-    op = _open(table, ideal_table, threshold=threshold, sensor=sensor, model=model,
-               spread=sensor_temp_spread_c)
+    op = open_table(table, ideal_table, threshold=threshold, sensor=sensor, model=model,
+                    sensor_temp_spread_c=sensor_temp_spread_c)
     pq = pair_question(e1, e2, m1, m2, objects=objects, width=op.width, model=op.model)
     scene = _scene(None, noise, dt)
     if pq.classes is None:
@@ -516,8 +319,8 @@ def _ratio_question(question: str, e1, e2, m1, m2, objects, contact_s, noise_c, 
         if noise == 0:
             raise InputError("noise sigma is 0: any temperature difference separates them (no smallest one)")
         scene, scale = _scene(contact, noise, None), noise
-    op = _open(table, ideal_table, threshold=threshold, sensor=sensor, model=model,
-               spread=sensor_temp_spread_c)
+    op = open_table(table, ideal_table, threshold=threshold, sensor=sensor, model=model,
+                    sensor_temp_spread_c=sensor_temp_spread_c)
     if "noise_ratio" not in op.tab.axes:
         raise TableMismatch(f"table {op.tab.name} has separate noise and temperature axes (varied initial "
                             f"conditions): it cannot answer {question}; the exact route can")
@@ -623,8 +426,8 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
     contact = check_contact(contact_s)
     coverage = check_coverage(coverage)
     noise, dt = scene_inputs(noise_c, delta_t_c)
-    op = _open(table, ideal_table, threshold=threshold, sensor=sensor, model=model,
-               spread=sensor_temp_spread_c)
+    op = open_table(table, ideal_table, threshold=threshold, sensor=sensor, model=model,
+                    sensor_temp_spread_c=sensor_temp_spread_c)
     ref = reference_class(e, m, width=op.width, model=op.model)
     x = ref.e_range[0]
     view = op.view
@@ -719,8 +522,8 @@ def distinguishable(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact
     coverage = check_coverage(coverage)
     contact = check_contact(contact_s)
     noise, dt = scene_inputs(noise_c, delta_t_c)
-    op = _open(table, ideal_table, threshold=threshold, sensor=sensor, model=model,
-               spread=sensor_temp_spread_c)
+    op = open_table(table, ideal_table, threshold=threshold, sensor=sensor, model=model,
+                    sensor_temp_spread_c=sensor_temp_spread_c)
     pq = pair_question(e1, e2, m1, m2, objects=objects, width=op.width, model=op.model)
     scene = _scene(contact, noise, dt)
     empty = {"distinguishable": None, "svm_f1": None, "svm_standard_error": None, "verdict": None,
@@ -890,17 +693,3 @@ def grid_answer(answer: Answer, kind: str = "svm", part: str | None = None):
 
 def _fmt_or_open(x) -> str:
     return "(open)" if x is None else f"{x:.3g}"
-
-
-# ============================================================ for the array route (designkit.query.vectorized)
-def open_table(table: "Table | str" = DEFAULT_TABLE, ideal_table: "Table | str | None" = DEFAULT_IDEAL_TABLE, *,
-               threshold=None, sensor=None, model=None, sensor_temp_spread_c: float = 0.0):
-    """The table checked against the question, as this route opens it (for the array route).
-
-    Returns an object with ``tab`` (the :class:`~designkit.tables.store.Table`), ``view`` (its
-    interpolation view: ``scene_weights``, ``delta_at``, ``need``, ``contacts``, ``centres``, ``e_lo``,
-    ``e_hi``), ``phi``, ``model``, ``width``, ``closed`` (the ideal bound is computed in closed form),
-    ``iview`` / ``ikind`` (the ideal bound's view and array kind when read from a grid).
-    """
-    return _open(table, ideal_table, threshold=threshold, sensor=sensor, model=model,
-                 spread=sensor_temp_spread_c)

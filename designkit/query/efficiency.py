@@ -11,11 +11,13 @@ import math
 import numpy as np
 from cachetools import LRUCache
 
-from .estimates import interp_e_by, k_baseline, median, span_neighbours, table_z
+from ..tables.store import Table
+
 
 __all__ = [
-    "CLOSED_FORM_MAX_CONTACT_S", "clear_efficiency_cache", "delta_efficiency_estimate", "delta_entries",
-    "mc_calibration", "noise_k_max_ratio", "noise_k_min_contact"
+    "CLOSED_FORM_MAX_CONTACT_S", "K_SLOPE_SPAN", "clear_efficiency_cache", "delta_efficiency_estimate",
+    "delta_entries", "interp_e_by", "k_baseline", "mc_calibration", "median", "noise_k_max_ratio",
+    "noise_k_min_contact", "span_neighbours", "table_z"
 ]
 
 
@@ -30,6 +32,71 @@ def clear_efficiency_cache() -> None:
     """Forget the noise-efficiency readings and Monte Carlo calibrations taken from tables."""
     _K_READINGS.clear()
     _MC_CALIBRATION.clear()
+
+
+def median(x: np.ndarray) -> float:
+    """The median of a non-empty 1-D array (not ``np.median``, whose first call imports ``numpy.ma``:
+    docs/decisions-log.md).
+
+    >>> median(np.array([3.0, 1.0, 10.0, 2.0])), median(np.array([5.0, 1.0, 4.0]))
+    (2.5, 4.0)
+    """
+    k = x.size // 2
+    p = np.partition(x, [k - 1, k] if x.size > 1 else [0])
+    return float(p[k]) if x.size % 2 else 0.5 * float(p[k - 1] + p[k])
+
+
+def table_z(tab: Table) -> float:
+    """The z (standard errors) of the table's Monte Carlo interval of delta(e) (its header; 2 if absent)."""
+    return float(tab.header.get("z") or 2.0)
+
+
+def interp_e_by(at, centres: np.ndarray, e: np.ndarray) -> np.ndarray:
+    """:func:`designkit.tables.lookup.interp_e`'s rule over arrays: ``at(c)`` gives the tabulated values at
+    centre indices ``c`` (an array shaped as ``e``), and the result is shaped as what ``at`` returns."""
+    n = centres.size
+    c = np.clip(np.searchsorted(centres, e, side="right") - 1, 0, n - 2)
+    a, b = at(c), at(c + 1)
+    w = (e - centres[c]) / (centres[c + 1] - centres[c])
+    with np.errstate(invalid="ignore"):
+        out = np.where(w == 0.0, a, np.where(np.isnan(a) | np.isnan(b), np.nan, a + w * (b - a)))
+    out = np.where(e >= centres[-1], at(np.full_like(c, n - 1)), out)
+    return np.where(e <= centres[0], at(np.zeros_like(c)), out)
+
+
+#: The shortest span in contact time [ratio] over which min-contact reads the slope of ``log k`` in ``log t``:
+#: closer readings give a slope that is mostly the table's Monte Carlo noise (docs/decisions-log.md).
+K_SLOPE_SPAN = 1.14
+
+
+def span_neighbours(contacts_s, k):
+    """The contacts at least :data:`K_SLOPE_SPAN` away from ``contacts_s[k]`` on each side: the index of the latest
+    at or below ``contacts_s[k] / K_SLOPE_SPAN`` and of the first at or above ``contacts_s[k] * K_SLOPE_SPAN``
+    (-1 where none), elementwise over the indices ``k``.
+
+    >>> c = np.array([0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.5, 2.0])
+    >>> [a.tolist() for a in span_neighbours(c, np.array([0, 1, 5, 7]))]
+    [[-1, 0, 3, 6], [1, 2, 6, -1]]
+    """
+    c, k = np.asarray(contacts_s, dtype=np.float64), np.asarray(k, dtype=np.int64)
+    back = np.searchsorted(c, c[k] / K_SLOPE_SPAN * (1 + 1e-12), side="right") - 1
+    ahead = np.searchsorted(c, c[k] * K_SLOPE_SPAN * (1 - 1e-12), side="left")
+    return back, np.where(ahead < c.size, ahead, -1)
+
+
+def k_baseline(contacts_s, k_cross):
+    """Index of the contact where min-contact reads ``k`` beside the crossing's contact ``k_cross``: the
+    latest at or below ``contacts_s[k_cross] / K_SLOPE_SPAN`` (at least one step back, and the first contact
+    where none lies that far back), or, where ``k_cross`` is the first, the first at or above
+    ``contacts_s[0] * K_SLOPE_SPAN``; -1 where none.
+
+    >>> c = np.array([0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.5, 2.0])
+    >>> k_baseline(c, np.array([5, 6, 7, 0, 1])).tolist()
+    [3, 5, 6, 1, 0]
+    """
+    kb = np.asarray(k_cross, dtype=np.int64)
+    back, ahead = span_neighbours(contacts_s, kb)  # (where kb is the first contact, ahead is read from it)
+    return np.where(kb > 0, np.maximum(back, 0), ahead)
 
 
 def mc_calibration(table) -> float:

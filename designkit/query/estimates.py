@@ -18,28 +18,16 @@ import numpy as np
 
 from ..tables import lookup
 from ..tables.store import Table
+from .efficiency import interp_e_by, noise_k_max_ratio, table_z
 
 __all__ = [
     "ABOVE", "BELOW", "CELL", "CONTACT_ESTIMATORS", "ContactReading", "Estimates", "INSIDE",
     "RATIO_ESTIMATORS", "RatioReading", "axis_weights_flagged", "cell_estimate", "contact_estimate", "cross2",
-    "delta_estimate", "efficiency_estimate", "first_applicable", "grid_crossing", "interp_e_by",
-    "interp_e_rows", "k_baseline", "median", "pair_need_both", "partner_in_grid", "ratio_beyond",
-    "ratio_cell", "ratio_efficiency", "ratio_estimate", "ratio_ideal_table", "ratio_rounding",
-    "rounding_estimate", "span_neighbours", "stated_log", "states_coverage", "table_spread", "table_z",
-    "varied_contact_estimate", "varied_estimate"
+    "delta_estimate", "efficiency_estimate", "first_applicable", "grid_crossing", "interp_e_rows",
+    "pair_need_both", "partner_in_grid", "ratio_beyond", "ratio_cell", "ratio_efficiency", "ratio_estimate",
+    "ratio_ideal_table", "ratio_rounding", "rounding_estimate", "stated_log", "states_coverage",
+    "table_spread", "varied_contact_estimate", "varied_estimate"
 ]
-
-
-def median(x: np.ndarray) -> float:
-    """The median of a non-empty 1-D array (not ``np.median``, whose first call imports ``numpy.ma``:
-    docs/decisions-log.md).
-
-    >>> median(np.array([3.0, 1.0, 10.0, 2.0])), median(np.array([5.0, 1.0, 4.0]))
-    (2.5, 4.0)
-    """
-    k = x.size // 2
-    p = np.partition(x, [k - 1, k] if x.size > 1 else [0])
-    return float(p[k]) if x.size % 2 else 0.5 * float(p[k - 1] + p[k])
 
 
 def axis_weights_flagged(vals: np.ndarray, x: float, *,
@@ -50,12 +38,6 @@ def axis_weights_flagged(vals: np.ndarray, x: float, *,
     if pts is not None:
         return pts, True
     return [(0 if (x < vals[0] or (log and x <= 0)) else vals.size - 1, 1.0)], False
-
-
-
-def table_z(tab: Table) -> float:
-    """The z (standard errors) of the table's Monte Carlo interval of delta(e) (its header; 2 if absent)."""
-    return float(tab.header.get("z") or 2.0)
 
 
 
@@ -146,19 +128,6 @@ def contact_estimate(x0, x1, n0, n1, gap, raw, mc_lo, mc_hi, ideal, *, width: fl
     ideal = np.asarray(ideal, dtype=np.float64)
     low = np.where(np.isnan(low) | np.isnan(ideal), low, np.minimum(np.maximum(low, ideal), value))
     return {"value": value, "low": low, "high": high, "interp": interp, "rounding": rounding}
-
-
-def interp_e_by(at, centres: np.ndarray, e: np.ndarray) -> np.ndarray:
-    """:func:`designkit.tables.lookup.interp_e`'s rule over arrays: ``at(c)`` gives the tabulated values at
-    centre indices ``c`` (an array shaped as ``e``), and the result is shaped as what ``at`` returns."""
-    n = centres.size
-    c = np.clip(np.searchsorted(centres, e, side="right") - 1, 0, n - 2)
-    a, b = at(c), at(c + 1)
-    w = (e - centres[c]) / (centres[c + 1] - centres[c])
-    with np.errstate(invalid="ignore"):
-        out = np.where(w == 0.0, a, np.where(np.isnan(a) | np.isnan(b), np.nan, a + w * (b - a)))
-    out = np.where(e >= centres[-1], at(np.full_like(c, n - 1)), out)
-    return np.where(e <= centres[0], at(np.zeros_like(c)), out)
 
 
 def interp_e_rows(rows: np.ndarray, centres: np.ndarray, e: np.ndarray) -> np.ndarray:
@@ -267,44 +236,6 @@ def varied_contact_estimate(view, combos, lo, hi, ideal, *, width: float, z_tabl
         low = np.where(np.isnan(ideal), low, np.minimum(np.where(np.isnan(low), ideal, np.maximum(low, ideal)),
                                                         value))
     return {"value": value, "low": low, "high": high, "interp": interp, "rounding": rounding}
-
-
-
-
-#: The shortest span in contact time [ratio] over which min-contact reads the slope of ``log k`` in ``log t``:
-#: closer readings give a slope that is mostly the table's Monte Carlo noise (docs/decisions-log.md).
-K_SLOPE_SPAN = 1.14
-
-
-def span_neighbours(contacts_s, k):
-    """The contacts at least :data:`K_SLOPE_SPAN` away from ``contacts_s[k]`` on each side: the index of the latest
-    at or below ``contacts_s[k] / K_SLOPE_SPAN`` and of the first at or above ``contacts_s[k] * K_SLOPE_SPAN``
-    (-1 where none), elementwise over the indices ``k``.
-
-    >>> c = np.array([0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.5, 2.0])
-    >>> [a.tolist() for a in span_neighbours(c, np.array([0, 1, 5, 7]))]
-    [[-1, 0, 3, 6], [1, 2, 6, -1]]
-    """
-    c, k = np.asarray(contacts_s, dtype=np.float64), np.asarray(k, dtype=np.int64)
-    back = np.searchsorted(c, c[k] / K_SLOPE_SPAN * (1 + 1e-12), side="right") - 1
-    ahead = np.searchsorted(c, c[k] * K_SLOPE_SPAN * (1 - 1e-12), side="left")
-    return back, np.where(ahead < c.size, ahead, -1)
-
-
-def k_baseline(contacts_s, k_cross):
-    """Index of the contact where min-contact reads ``k`` beside the crossing's contact ``k_cross``: the
-    latest at or below ``contacts_s[k_cross] / K_SLOPE_SPAN`` (at least one step back, and the first contact
-    where none lies that far back), or, where ``k_cross`` is the first, the first at or above
-    ``contacts_s[0] * K_SLOPE_SPAN``; -1 where none.
-
-    >>> c = np.array([0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.5, 2.0])
-    >>> k_baseline(c, np.array([5, 6, 7, 0, 1])).tolist()
-    [3, 5, 6, 1, 0]
-    """
-    kb = np.asarray(k_cross, dtype=np.int64)
-    back, ahead = span_neighbours(contacts_s, kb)  # (where kb is the first contact, ahead is read from it)
-    return np.where(kb > 0, np.maximum(back, 0), ahead)
-
 
 
 def ratio_estimate(raw, r_c, r_lin, r_rnd, r_geo, end_lo, end_hi, ideal, *, z_table: float,
@@ -587,8 +518,6 @@ def ratio_efficiency(rd: RatioReading) -> Estimates | None:
     if not (rd.svm and op.closed and "delta_up_ideal" in op.view.t.arrays and cand.any()):
         return None
     i = np.nonzero(cand)[0]
-    from .efficiency import noise_k_max_ratio
-
     kr = noise_k_max_ratio(op, rd.contact[i], rd.r[i], rd.ri[i], rd.lo[i], rd.hi[i], zc=rd.zc)
     out = {k: _nan(rd.lo.size) for k in ("r", "low", "high", "k", "se_log")}
     out["r"][i], out["low"][i] = np.minimum(kr["value"], rd.ri[i]), kr["low"]

@@ -57,15 +57,16 @@ from ..tables.lookup import GRID_RTOL
 from ..tables.store import Table
 from .answer import Answer, IdealBound, number
 from .crossing import check_coverage, z_of_coverage
-from .efficiency import CLOSED_FORM_MAX_CONTACT_S, noise_k_max_ratio, noise_k_min_contact
-from .estimates import (ABOVE, BELOW, CELL, CONTACT_ESTIMATORS, K_SLOPE_SPAN, RATIO_ESTIMATORS,
-                        axis_weights_flagged, k_baseline, states_coverage, table_spread, table_z)
+from .efficiency import CLOSED_FORM_MAX_CONTACT_S, K_SLOPE_SPAN, k_baseline, noise_k_max_ratio, noise_k_min_contact, \
+    table_z
+from .estimates import (ABOVE, BELOW, CELL, CONTACT_ESTIMATORS, RATIO_ESTIMATORS, axis_weights_flagged,
+                        states_coverage, table_spread)
 from .inputs import REFERENCE_RULE, PairQuestion, TableMismatch, check_contact, pair_question, reference_class, \
     scene_inputs
 from .table_arrays import (CLOSED_FORM_RATIO_BRACKET, TableView, contact_arrays, delta_e_arrays,
                            distinguishable_arrays, ratio_arrays)
 from .table_open import (DEFAULT_IDEAL_TABLE, DEFAULT_TABLE, SPREAD_TABLE_QUESTIONS, VARIED_TABLE, OpenedTable,
-                         as_table, clear_table_cache, open_table, shipped_spread_table)
+                         as_table, clear_table_cache, delta_e_ideal_view, open_table, shipped_spread_table)
 
 __all__ = [
     "CLOSED_FORM_MAX_CONTACT_S", "CLOSED_FORM_RATIO_BRACKET", "CONTACT_ESTIMATORS", "DEFAULT_IDEAL_TABLE",
@@ -436,7 +437,7 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
     flags["effusivity"] = view.e_in_grid(x)
     common = dict(objects=(ref.to_dict(),), limiting=(ref.to_dict(),), rule=REFERENCE_RULE,
                   scene=_scene(contact, noise, dt), classes=(ref,))
-    r = delta_e_arrays(op, _one(x), _one(contact), _one(noise), _one(dt), ideal_table=ideal_table,
+    r = delta_e_arrays(op, _one(x), _one(contact), _one(noise), _one(dt), ideal_view=delta_e_ideal_view(op, ideal_table),
                        zc=z_of_coverage(coverage), ideal_bound=ideal_bound, classes=[ref])
     if not all(flags.values()):
         wanted = {**_scene_wanted(view, noise, dt), "contact_s": contact, "effusivity": (x,)}
@@ -539,7 +540,7 @@ def distinguishable(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact
                   classes=pq.classes)
     zc = z_of_coverage(coverage)
     r = distinguishable_arrays(op, _one(lo), _one(hi), _one(contact), _one(noise), _one(dt), ideal_bound=True,
-                               zc=zc, ideal_table=ideal_table, classes=[pq.classes])
+                               zc=zc, ideal_view=delta_e_ideal_view(op, ideal_table), classes=[pq.classes])
     ideal_f1, ideal_method = _at0(r, "ideal"), r["ideal_method"][0]
     ideal_details = {} if ideal_f1 is None else {"ideal_f1": ideal_f1, "ideal_distinguishable": ideal_f1 >= op.phi}
     if not all(flags.values()):

@@ -25,10 +25,10 @@ from ..sensor import within_sample_limit
 from ..tables.store import Table
 from .crossing import coverage_of_z
 from .efficiency import (CLOSED_FORM_MAX_CONTACT_S, delta_efficiency_estimate, delta_entries, mc_calibration,
-                         noise_k_min_contact)
+                         noise_k_min_contact, table_z)
 from .estimates import (ABOVE, BELOW, CELL, CONTACT_ESTIMATORS, INSIDE, RATIO_ESTIMATORS,
                         ContactReading, RatioReading, axis_weights_flagged, delta_estimate, first_applicable,
-                        grid_crossing, interp_e_rows, partner_in_grid, states_coverage, table_spread, table_z)
+                        grid_crossing, interp_e_rows, partner_in_grid, states_coverage, table_spread)
 
 __all__ = ["CLOSED_FORM_RATIO_BRACKET", "TableView", "at_contact", "contact_arrays", "delta_e_arrays",
            "distinguishable_arrays", "groups", "max_ratio", "ratio_arrays"]
@@ -347,20 +347,11 @@ def delta_geometric(e: np.ndarray, v, cmb, cws, name: str) -> np.ndarray:
         return np.where(bad, np.nan, np.exp(total))
 
 
-def delta_e_ideal_view(op, ideal_table):
-    """The view and kind delta-e reads its grid ideal bound from (a grid even where a closed form exists)."""
-    if not op.closed:
-        return op.iview, op.ikind
-    from .table_open import ideal_view
-
-    iview, ikind, _ = ideal_view(op.view, ideal_table)
-    return iview, ikind
-
-
-def delta_e_arrays(op, e, contact, noise, dt, *, ideal_table, zc: float, ideal_bound: bool = True,
+def delta_e_arrays(op, e, contact, noise, dt, *, ideal_view, zc: float, ideal_bound: bool = True,
                    classes=None) -> dict[str, Any]:
     """delta(e) [J s^-1/2 K^-1 m^-2] towards lower and higher effusivity from references ``e`` at the scenes
-    ``contact`` [s], ``noise``, ``dt`` [degC] (1-D arrays).
+    ``contact`` [s], ``noise``, ``dt`` [degC] (1-D arrays); ``ideal_view``: the (view, kind) its grid ideal bound
+    is read from (:func:`designkit.query.table_open.delta_e_ideal_view`).
 
     Per side (``lower``, ``upper``): the value, ``{side}_ideal``, its interval ``{side}_low`` / ``{side}_high``,
     ``{side}_method`` (table-efficiency, table-estimate, none), the table's own reading ``{side}_table`` and its
@@ -377,7 +368,7 @@ def delta_e_arrays(op, e, contact, noise, dt, *, ideal_table, zc: float, ideal_b
         res[f"{side}_method"], res[f"{side}_mc_bounds"] = np.full(n, "none", dtype=object), {}
     res["in_grid"] = np.zeros(n, dtype=bool)
     e_in = view.e_in(e)
-    iview, ikind = delta_e_ideal_view(op, ideal_table)
+    iview, ikind = ideal_view
     efficiency = svm and op.closed and "delta_up_ideal" in view.t.arrays
     for (c, nz, d), idx in groups(contact, noise, dt):
         combos, flags = view.scene_weights(nz, d)
@@ -467,7 +458,7 @@ def _mc_delta_bounds(op, e, classes, idx, direction: str, contact: float, noise:
 
 
 # ============================================================ distinguishable
-def distinguishable_arrays(op, lo, hi, contact, noise, dt, *, ideal_bound: bool, zc: float, ideal_table,
+def distinguishable_arrays(op, lo, hi, contact, noise, dt, *, ideal_bound: bool, zc: float, ideal_view,
                            classes=None) -> dict[str, Any]:
     """Whether ``contact`` [s] separates pairs ``lo < hi`` at ``noise``, ``dt`` [degC] (1-D arrays): 1.0 / 0.0 /
     NaN (outside the grid).
@@ -509,7 +500,7 @@ def distinguishable_arrays(op, lo, hi, contact, noise, dt, *, ideal_bound: bool,
                                                                                           "confident", None)))
     res["decided"] = np.zeros(n, dtype=bool)
     if unsure.any():
-        yes, decided = _others_decide(op, lo, hi, contact, noise, dt, np.nonzero(unsure)[0], yes, zc, ideal_table, res)
+        yes, decided = _others_decide(op, lo, hi, contact, noise, dt, np.nonzero(unsure)[0], yes, zc, ideal_view, res)
         res["decided"] = decided
         verdict = np.where(decided, "confident", verdict)
     res["value"] = np.where(todo, yes.astype(np.float64), np.nan)
@@ -548,7 +539,7 @@ def _ideal_f1(op, lo, hi, contact, noise, dt, classes, res) -> None:
         res["ideal"][i], res["ideal_method"][i] = r.f1, r.method
 
 
-def _others_decide(op, lo, hi, contact, noise, dt, i: np.ndarray, yes: np.ndarray, zc: float, ideal_table, res):
+def _others_decide(op, lo, hi, contact, noise, dt, i: np.ndarray, yes: np.ndarray, zc: float, ideal_view, res):
     """``yes`` where max-noise (the asked noise outside its stated interval) or delta-e (the pair's distance
     outside the interval of the need ``max(delta_up(lo), delta_down(hi))``) is sure, for elements ``i`` whose
     contact lies inside min-contact's interval; both sure and disagreeing: unchanged. Their readings are kept in
@@ -567,7 +558,7 @@ def _others_decide(op, lo, hi, contact, noise, dt, i: np.ndarray, yes: np.ndarra
         with np.errstate(invalid="ignore"):
             sure["max-noise"] = (mn_stated & ~((mn["low"] <= nz) & (nz <= mn["high"])), nz <= mn["value"])
     de = delta_e_arrays(op, np.concatenate([l, h]), np.tile(c, 2), np.tile(nz, 2), np.tile(d, 2),
-                        ideal_table=ideal_table, zc=zc, ideal_bound=False)
+                        ideal_view=ideal_view, zc=zc, ideal_bound=False)
     parts = []
     for side, sl in (("upper", slice(0, n)), ("lower", slice(n, 2 * n))):
         stated = de[f"{side}_method"][sl] != "none"

@@ -21,7 +21,7 @@ from .inputs import TableMismatch, check_threshold
 from .table_arrays import TableView
 
 __all__ = ["DEFAULT_IDEAL_TABLE", "DEFAULT_TABLE", "SPREAD_TABLE_QUESTIONS", "VARIED_TABLE", "OpenedTable",
-           "as_table", "clear_table_cache", "ideal_view", "open_table", "shipped_spread_table"]
+           "as_table", "clear_table_cache", "delta_e_ideal_view", "ideal_view", "open_table", "shipped_spread_table"]
 
 DEFAULT_TABLE = "svm-fine"
 #: The shipped table for the paper's second setting (the sensor's temperature drawn per touch, uniform in
@@ -185,3 +185,11 @@ def open_table(table: "Table | str" = DEFAULT_TABLE, ideal_table: "Table | str |
 def _closed_form(tab: Table, fm) -> bool:
     """Whether the ideal bound is computed in closed form (shared-shape model, fixed initial conditions)."""
     return bool(fm.shared_shape) and "noise_ratio" in tab.axes
+
+
+def delta_e_ideal_view(op: OpenedTable, ideal_table: "Table | str | None" = DEFAULT_IDEAL_TABLE):
+    """The view and kind delta-e reads its grid ideal bound from (a grid even where a closed form exists)."""
+    if not op.closed:
+        return op.iview, op.ikind
+    iview, ikind, _ = ideal_view(op.view, ideal_table)
+    return iview, ikind

@@ -54,6 +54,7 @@ from numpy.typing import NDArray
 from .._validation import InputError, check_effusivity, check_positive, check_temperature
 from . import table as _table_route
 from . import table_arrays
+from .table_open import delta_e_ideal_view
 from .answer import Answer, QuestionQuantity
 from .crossing import check_coverage, z_of_coverage
 
@@ -261,7 +262,8 @@ def _table_arrays(question: str, x: dict[str, np.ndarray], op, ideal_bound: bool
     in_grid, stated, and the question's details."""
     if question == "delta-e":
         r = table_arrays.delta_e_arrays(op, x["e"], x["contact_s"], x["noise_c"], x["delta_t_c"],
-                                        ideal_table=ideal_table, zc=zc, ideal_bound=ideal_bound)
+                                        ideal_view=delta_e_ideal_view(op, ideal_table), zc=zc,
+                                        ideal_bound=ideal_bound)
         keep = ("lower", "upper", "lower_ideal", "upper_ideal", "lower_low", "lower_high", "upper_low", "upper_high")
     else:
         lo, hi = np.minimum(x["e1"], x["e2"]), np.maximum(x["e1"], x["e2"])
@@ -269,7 +271,8 @@ def _table_arrays(question: str, x: dict[str, np.ndarray], op, ideal_bound: bool
             r = table_arrays.contact_arrays(op, lo, hi, x["noise_c"], x["delta_t_c"], ideal_bound=ideal_bound, zc=zc)
         elif question == "distinguishable":
             r = table_arrays.distinguishable_arrays(op, lo, hi, x["contact_s"], x["noise_c"], x["delta_t_c"],
-                                                    ideal_bound=ideal_bound, zc=zc, ideal_table=ideal_table)
+                                                    ideal_bound=ideal_bound, zc=zc,
+                                                    ideal_view=delta_e_ideal_view(op, ideal_table))
             r.update(min_contact_s=r["mc_value"], min_contact_low=r["mc_low"], min_contact_high=r["mc_high"])
         else:
             scale = np.abs(x["delta_t_c"]) if question == "max-noise" else x["noise_c"]

@@ -362,6 +362,8 @@ def first_applicable(estimators, rd, n: int) -> dict[str, np.ndarray]:
     out["kind"], out["stated"] = np.full(n, "none", dtype=object), np.zeros(n, dtype=bool)
     taken = np.zeros(n, dtype=bool)
     for estimator in estimators:
+        if taken.all():  # (the later ones would answer nothing)
+            break
         r = estimator(rd)
         if r is None:
             continue

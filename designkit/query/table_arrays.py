@@ -118,6 +118,9 @@ def at_contact(cw, per_contact: np.ndarray) -> np.ndarray:
 
 def groups(*columns: np.ndarray):
     """Indices of the elements sharing each distinct combination of ``columns`` (1-D, equal length)."""
+    if columns[0].size == 1:  # a single question: one group
+        yield tuple(float(c[0]) for c in columns), np.zeros(1, dtype=np.int64)
+        return
     stacked = np.stack(columns, axis=1)
     uniq, inverse = np.unique(stacked, axis=0, return_inverse=True)
     inverse = inverse.ravel()

@@ -10,6 +10,7 @@ import pytest
 
 from designkit.query import min_contact
 from designkit.query import table as q
+from designkit.query.efficiency import mc_calibration
 from designkit.query.ideal_bound import exact_ideal_min_contact
 from designkit.sensor import load_sensor
 from designkit.sweep import SweepConfig
@@ -92,7 +93,7 @@ def test_monte_carlo_calibration_is_measured_on_the_table_and_follows_its_interv
                 a = t.arrays[f"delta_{d}_{end}"]
                 arrays[f"delta_{d}_{end}"] = np.where(a > h, h + (s - h) * ((a - h) / (s - h)) ** 2, a)
     wide = dataclasses.replace(t, header={**t.header, "content_hash": None}, arrays=arrays)
-    f_wide = q._View(wide).mc_calibration()
+    f_wide = mc_calibration(wide)
     assert 0.4 * f < f_wide < 0.7 * f
 
 
@@ -182,7 +183,7 @@ def test_max_noise_of_a_classifier_as_good_as_the_ideal_observer_is_the_exact_id
 
 def test_the_shipped_tables_noise_efficiency_does_not_depend_on_the_noise_ratio():
     # the property the route rests on: the same pair read in two noise-ratio slices gives the same k
-    from designkit.query.table import _k_readings
+    from designkit.query.efficiency import _k_readings
 
     op = q.open_table("svm-paper")
     lo, hi = np.array([8000.0, 15000.0, 20000.0]), np.array([16000.0, 25000.0, 35000.0])
@@ -227,7 +228,7 @@ def test_monte_carlo_calibration_does_not_depend_on_how_densely_the_table_sample
     header["content_hash"] = None  # not cached under the full table's hash
     next(a for a in header["axes"] if a["name"] == "contact_s")["values"] = c[keep].tolist()
     arrays = {k: (np.asarray(v)[:, keep] if np.ndim(v) >= 2 else v) for k, v in t.arrays.items()}
-    thinned = q._View(dataclasses.replace(t, header=header, arrays=arrays)).mc_calibration()
+    thinned = mc_calibration(dataclasses.replace(t, header=header, arrays=arrays))
     assert op.view.mc_calibration() == pytest.approx(thinned, rel=0.1)
 
 

@@ -66,25 +66,19 @@ def test_distinguishable_outside_states_the_ideal_f1():
     assert d.details["ideal_distinguishable"] is True
 
 
-def test_the_array_route_states_the_scalar_bounds_outside_the_grid():
+def test_the_array_route_states_the_bounds_outside_the_grid():
     e2 = np.array([20000.0, 25000.0, 20000.0])
     noise = np.array([1.0, 0.05, 2.0])  # outside, inside, outside the noise axis
     arr = query.min_contact(35000, e2, noise_c=noise)
-    assert arr.in_grid.tolist() == [False, True, False]
-    for i in range(3):
-        s = query.min_contact(35000, float(e2[i]), noise_c=float(noise[i]))
-        assert (np.nan if s.ideal_bound.value is None else s.ideal_bound.value) == pytest.approx(
-            arr.ideal[i], nan_ok=True)
+    assert arr.in_grid.tolist() == [False, True, False] and np.isnan(arr.value[[0, 2]]).all()
+    # the closed form needs no table: 7.22 s at 1 degC; none within its 10 s at 2 degC
+    assert arr.ideal[0] == pytest.approx(7.22, rel=0.01) and np.isnan(arr.ideal[2])
     contact = np.array([20.0, 2.0, 15.0])
     for ask, kw in ((query.max_noise, {}), (query.min_delta_t, {"noise_c": 0.05}), (query.distinguishable, {})):
         arr = ask(35000, e2, contact_s=contact, **kw)
-        scalar = [ask(35000, float(e2[i]), contact_s=float(contact[i]), **kw).ideal_bound.value for i in range(3)]
-        # distinguishable's F1: ideal_pair on the scalar route, the vectorized ideal_f1 on the array one
-        np.testing.assert_allclose(arr.ideal, np.array(scalar, dtype=float),
-                                   rtol=1e-6 if ask is query.distinguishable else 1e-12)
+        assert arr.in_grid.tolist() == [False, True, False] and np.isfinite(arr.ideal).all()
     arr = query.delta_e(np.array([20000.0, 20000.0]), contact_s=np.array([20.0, 2.0]), noise_c=np.array([0.05, 1.0]))
-    scalar = [query.delta_e(20000.0, contact_s=c, noise_c=n).ideal_bound.value for c, n in ((20.0, 0.05), (2.0, 1.0))]
-    np.testing.assert_allclose(arr.ideal, np.array(scalar, dtype=float), rtol=1e-12)
+    assert not arr.in_grid.any() and np.isfinite(arr.ideal).all()
 
 
 def test_without_a_closed_form_the_bound_is_left_out_as_the_answer_is():

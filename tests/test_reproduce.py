@@ -335,17 +335,17 @@ def test_table1_section_labels_each_resolution_and_names_missing_tables():
     def pct(x):
         return "—" if x is None else f"{x:.4g} %"
 
-    assert "Not built: `f1-matrix-500-r0.005`" in "\n".join(_paper_grid_lines([row(0.005, None)], pct))
-    grid = {"table": "f1-matrix-500-r0.005", "grid": {"e_min": 0.0, "width": 80.0, "intervals": 500},
+    assert "Not built: `f1-matrix-500-r0p005`" in "\n".join(_paper_grid_lines([row(0.005, None)], pct))
+    grid = {"table": "f1-matrix-500-r0p005", "grid": {"e_min": 0.0, "width": 80.0, "intervals": 500},
             "intervals": {"mean_f1": 0.9123, "percent_indistinguishable": 17.25, "pairs": 124750},
             "materials": {"mean_f1": 0.9456, "percent_indistinguishable": 12.5, "pairs": 2346},
             "build": {"compute_s": 412.0, "fits": 130000, "elapsed_s": 900.0, "jobs": 2, "whole_build": True}}
     text = "\n".join(_paper_grid_lines([row(0.005, grid), row(0.01, None)], pct))
-    assert "124,750 interval pairs" in text and "Not built: `f1-matrix-500-r0.01`" in text
+    assert "124,750 interval pairs" in text and "Not built: `f1-matrix-500-r0p01`" in text
     assert "% indist. 500 (every pair)" in text and "mean F1 100" in text and "% indist. 500 (staircase)" in text
     line = next(ln for ln in text.splitlines() if ln.startswith("| 0.05 | 10 |"))
     assert "17.25 %" in line and "0.912" in line and "0.931" in line and "19.8 %" in line
-    assert "412 worker-s" in text and "15.0 min wall on 2 worker(s)" in text
+    assert "412 worker-s of chunk wall" in text and "one run of 15.0 min wall on 2 worker(s)" in text
 
 
 def test_paper_grid_row_counts_every_pair_of_the_shipped_500_interval_matrices(tmp_path):

@@ -34,6 +34,18 @@ SHIPPED_MEMBER_DIGESTS: dict[str, dict[str, str]] = {
         'f1_matrix': 'sha256:9a6876c3f98b3b48936c7b38b19bd1de7debca44510e23168e12648267dadc90',
         'fits': 'sha256:e2f4920e3bffa82e8b586e73be85d683e5dbf2f4bcafca4b6b0ea782f7dcf229',
     },
+    'f1-matrix-500-r0p01': {
+        'delta_down': 'sha256:fb0bafdc51145f8d1d8ea9ce6b0366957a92af1451637cf3811ade14ce9aa4c0',
+        'delta_down_hi': 'sha256:cc469dc9e91f4b52adae198992e7acb4fb7d56cbc04c26f97640e34568a91d45',
+        'delta_down_ideal': 'sha256:bfc4ab9f946ed2e7af0af0f51d54994218f3bad0bec016dd7aa1efbf304b4c40',
+        'delta_down_lo': 'sha256:32428586d5025166a3dca15b9d597cdfccce10cf5306cd7791782b516d77ae24',
+        'delta_up': 'sha256:f1cbb437293036dd4f1bd45ced6c3cd4106b1bb78ca58a8784e341f22f6cebbf',
+        'delta_up_hi': 'sha256:edbc62e29825015f74fb84f93a6c4c28093b5bec913d244d31574585d5798d6f',
+        'delta_up_ideal': 'sha256:c44e19ab9bae485229b18ba2fa683a263de697c081a255a530824b8562320213',
+        'delta_up_lo': 'sha256:7d44d3465a10f0f39d122e6e4cc25c8a71af091b16112a8090e320bfbfe1b386',
+        'f1_matrix': 'sha256:6bc31a71e2cc9004cf77213986b42dd4b4a846bfadbe03986da445e74fe91a6f',
+        'fits': 'sha256:fa2deb74c3e9454f9412f58125fa70f9e48c8c871cf723399477b7f895b39a9a',
+    },
     'f1-matrix-fine-low': {
         'chunk_wall_s': 'sha256:2d9c7ab36e347e58c20a1ffbe7265d5fe5ad5a48cadb15b8abcdc4986e7b958e',
         'delta_down': 'sha256:c8f90a7a20c8ce83c721970510c378c0b5bf85064c2e812798ea4d2bdf62308b',

@@ -554,6 +554,9 @@ SHIPPED_TABLES: dict[str, tuple[str, str]] = {
     "f1-matrix-2s": (
         "sha256:60fa880ce4e50749e3aad5c48d061e41f743d89a6ca512f840793d16ade75c37",
         "sha256:d39c9fbf935896606db255017df138f92fce5fcbcc0ff680b2ddeda2458f0ae8"),
+    "f1-matrix-500-r0p01": (
+        "sha256:fb4b48404a6ee109f1f24fe1f63935839f10f7097e87944ee9dac187f3fc5b65",
+        "sha256:cf47f950d062a611aa463f133dbd858f40cb78b0236c4791b90aa90e3bb9face"),
     "f1-matrix-fine-low": (
         "sha256:f4ecf487aec590490a63ec41215c6511218f038794ad33b52d5077bc1e5cf7ca",
         "sha256:1f7cc68036078992caf4c20e0d201193b83d37dc3f3868688edb6a90e6cf7eb0"),

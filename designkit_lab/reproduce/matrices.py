@@ -19,7 +19,7 @@ Which grid each number comes from
   itself; their F1 is the SVM's chance F1, measured at run time
   (:func:`chance_f1`).
 * **The paper's resolution** (issue 35): where the 500-interval full matrices
-  ``f1-matrix-500-r<sigma/dT>`` (one table per sigma/dT, all 124,750 pairs of
+  ``f1-matrix-500-r0p005`` etc. (one table per sigma/dT, all 124,750 pairs of
   the paper's grid) exist, Table I also reports % indistinguishable and mean F1
   over every pair, and the material pairs by the same rule on width-80
   intervals everywhere, beside the 100-interval figures (:func:`paper_grid_row`).
@@ -287,24 +287,25 @@ def material_f1(ctx: Context, noise_ratio: float) -> MaterialF1 | None:
 
 # ============================================================ the paper's resolution
 def paper_grid_table(noise_ratio: float) -> str:
-    """Name of the 500-interval full-matrix table of one sigma/dT (``f1-matrix-500-r0.005``).
+    """Name of the 500-interval full-matrix table of one sigma/dT (``f1-matrix-500-r0p005``: ``p`` for the
+    decimal point, since a table name with a dot would read as a file suffix).
 
     >>> paper_grid_table(0.05 / 10), paper_grid_table(0.1 / 5)
-    ('f1-matrix-500-r0.005', 'f1-matrix-500-r0.02')
+    ('f1-matrix-500-r0p005', 'f1-matrix-500-r0p02')
     """
-    return f"{PAPER_GRID_PREFIX}{round(noise_ratio, 12):g}"
+    return f"{PAPER_GRID_PREFIX}{round(noise_ratio, 12):g}".replace(".", "p")
 
 
 def build_time(table) -> dict:
-    """What building ``table`` cost, from its header's ``stats``: worker compute seconds summed over its
-    chunks (``compute_s``: CPU-bound chunks, so about their CPU seconds), SVM fits, and the wall time of
-    the run that assembled it (``elapsed_s``; the whole build only when that run computed every chunk,
-    ``whole_build``)."""
+    """What building ``table`` cost, from its header's ``stats``: the workers' busy wall seconds summed over
+    its chunks (``compute_s``: CPU seconds on idle cores, more where the cores are shared), SVM fits, and
+    the wall time of the run that assembled it (``elapsed_s``; the whole build only when that run computed
+    every chunk, ``whole_build``)."""
     st = table.header.get("stats") or {}
     run = st.get("run") or {}
     done, total = run.get("chunks_computed"), run.get("chunks_total")
     return {"compute_s": st.get("compute_s_total"), "fits": st.get("svm_fits_total"),
-            "elapsed_s": run.get("elapsed_s"), "jobs": run.get("jobs"),
+            "elapsed_s": run.get("elapsed_s"), "jobs": run.get("jobs"), "chunks_computed": done,
             "whole_build": done is not None and done == total, "created": table.header.get("created")}
 
 

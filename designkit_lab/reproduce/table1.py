@@ -111,15 +111,22 @@ def _paper_grid_lines(rows: list[dict], pct) -> list[str]:
     for ratio, g in sorted(built.items()):
         b = g["build"]
         wall = b.get("elapsed_s")
-        run = ("" if wall is None else f", assembled by a run of {wall / 60:.1f} min wall on {b.get('jobs')} "
-               f"worker(s)" + ("" if b.get("whole_build") else " (a resumed build: that run's wall only)"))
+        if wall is None:
+            run = ""
+        elif b.get("whole_build"):
+            run = f", built in one run of {wall / 60:.1f} min wall on {b.get('jobs')} worker(s)"
+        elif not b.get("chunks_computed"):
+            run = ", assembled from finished chunks (the build's wall and CPU: `docs/engine.md`)"
+        else:
+            run = f", finished by a resumed run of {wall / 60:.1f} min wall (that run's only)"
         cpu = b.get("compute_s")
         cost.append(f"`{g['table']}` (σ/dT {ratio:g}): {fmt(b.get('fits'))} SVM fits, "
-                    f"{'—' if cpu is None else f'{cpu:,.0f}'} worker-s of chunk compute{run}.")
+                    f"{'—' if cpu is None else f'{cpu:,.0f}'} worker-s of chunk wall (busy workers; CPU s on idle "
+                    f"cores){run}.")
     g0 = next(iter(built.values()))["grid"]
     n, w = g0["intervals"], g0["width"]
     return head + [
-        f"The full F1 matrices `f1-matrix-500-r<σ/dT>` score every one of the {n * (n - 1) // 2:,} interval "
+        f"The full F1 matrices `f1-matrix-500-r<σ/dT, p for the point>` score every one of the {n * (n - 1) // 2:,} interval "
         f"pairs of their grid ({n} intervals of {w:g}; the paper's: 500 of 80; one table per σ/dT, the "
         f"batched solver, the same trials, folds, repeats and seed as `f1-matrix-2s`). Columns marked "
         f"**{n} (every pair)** come from them; **500 (staircase)** is `svm-paper`'s count above; **100** is "

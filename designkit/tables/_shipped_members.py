@@ -46,6 +46,18 @@ SHIPPED_MEMBER_DIGESTS: dict[str, dict[str, str]] = {
         'f1_matrix': 'sha256:6bc31a71e2cc9004cf77213986b42dd4b4a846bfadbe03986da445e74fe91a6f',
         'fits': 'sha256:fa2deb74c3e9454f9412f58125fa70f9e48c8c871cf723399477b7f895b39a9a',
     },
+    'f1-matrix-500-r0p02': {
+        'delta_down': 'sha256:9667b812a6322232d1e208fb1491ebb65c575b0297c4f34f6930b54bbdf96af1',
+        'delta_down_hi': 'sha256:7351345b071049900987fd71e5555b2013aaeff616c0d92239355dec50c27504',
+        'delta_down_ideal': 'sha256:e23d6cfc1347b0541633a4de7a51e8511e5b24de3e276f06fc4e246184074e39',
+        'delta_down_lo': 'sha256:920a79070af1ad818f2c878d612d62b001d7ddfb82b9db9ab4c2af89bda2c8bc',
+        'delta_up': 'sha256:e8d2edfd461a83ab722b70503b01bfccb9a52a6154ba36b5ee162939d062d051',
+        'delta_up_hi': 'sha256:c3f7994709b330833f359c0cf73c8a5a0894bdb909dd4ef5c329c0bf21e51906',
+        'delta_up_ideal': 'sha256:f94a34e617b64e21916082b6bef9a30b6d0c00d3831b6048e1a048f2c2c6efa5',
+        'delta_up_lo': 'sha256:6a1744cdfb7ab643a55bd993d373241e28f90fefa575f7730f9b39fa5b5a34d0',
+        'f1_matrix': 'sha256:c806ffb53320acc404742b1dbb247d84e66a90e060aa4141f4c738e4b367f338',
+        'fits': 'sha256:c74a25a2f7e6ffebca37183ebbed67c3fe515a61c9f9e150b4214e334912321f',
+    },
     'f1-matrix-fine-low': {
         'chunk_wall_s': 'sha256:2d9c7ab36e347e58c20a1ffbe7265d5fe5ad5a48cadb15b8abcdc4986e7b958e',
         'delta_down': 'sha256:c8f90a7a20c8ce83c721970510c378c0b5bf85064c2e812798ea4d2bdf62308b',

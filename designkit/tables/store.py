@@ -557,6 +557,9 @@ SHIPPED_TABLES: dict[str, tuple[str, str]] = {
     "f1-matrix-500-r0p01": (
         "sha256:fb4b48404a6ee109f1f24fe1f63935839f10f7097e87944ee9dac187f3fc5b65",
         "sha256:cf47f950d062a611aa463f133dbd858f40cb78b0236c4791b90aa90e3bb9face"),
+    "f1-matrix-500-r0p02": (
+        "sha256:a490cabcf1d28fda41f89a1e757325911544b7bf4fe31b36d66f8076d931ee5f",
+        "sha256:3304aec59926d0bb74749c6a2f3fde89503b46f49c60eeea03e3617ada742398"),
     "f1-matrix-fine-low": (
         "sha256:f4ecf487aec590490a63ec41215c6511218f038794ad33b52d5077bc1e5cf7ca",
         "sha256:1f7cc68036078992caf4c20e0d201193b83d37dc3f3868688edb6a90e6cf7eb0"),

@@ -58,6 +58,18 @@ SHIPPED_MEMBER_DIGESTS: dict[str, dict[str, str]] = {
         'f1_matrix': 'sha256:c806ffb53320acc404742b1dbb247d84e66a90e060aa4141f4c738e4b367f338',
         'fits': 'sha256:c74a25a2f7e6ffebca37183ebbed67c3fe515a61c9f9e150b4214e334912321f',
     },
+    'f1-matrix-500-r0p005': {
+        'delta_down': 'sha256:164dc87305ac2ff0c83c8c1d3bfade0de4a0bc5eb21b73b8a44f3af3f100856e',
+        'delta_down_hi': 'sha256:06df8c3e664694fc08b0d2f5d6f0892e983388ec75b46f8766216e9507635a80',
+        'delta_down_ideal': 'sha256:b3312b3238fd45c97a4bb3f669d4acac6fe68cb6855a682eedea810072047301',
+        'delta_down_lo': 'sha256:f6c997c64164b41d313c24945f5d10330aa36ebae5249c817e4753cc2ab12163',
+        'delta_up': 'sha256:f3244d8e8872048e5c7dbd0d6653b257a407331a9eb8161f060b2940d5923d56',
+        'delta_up_hi': 'sha256:54819d8c2d90dd0ab382aac1037e6ab4bfa34e76efe274544f25311faf2b8a41',
+        'delta_up_ideal': 'sha256:a11a9b8e92afd7fa356612344576de677881a6d9c07f394391f4262771632a0b',
+        'delta_up_lo': 'sha256:68134ea3a716d0451707827053edfc0189a39f78c477aab5359f1100519806de',
+        'f1_matrix': 'sha256:0ae43a1994019b747ebe550a13b4e6b4ad5bdba345fca327f9ade79bdbbd692d',
+        'fits': 'sha256:d9b3cbdb53a878526f10559cb5f66d7610bdb5c2f794454335d72b8273b52788',
+    },
     'f1-matrix-fine-low': {
         'chunk_wall_s': 'sha256:2d9c7ab36e347e58c20a1ffbe7265d5fe5ad5a48cadb15b8abcdc4986e7b958e',
         'delta_down': 'sha256:c8f90a7a20c8ce83c721970510c378c0b5bf85064c2e812798ea4d2bdf62308b',

@@ -560,6 +560,9 @@ SHIPPED_TABLES: dict[str, tuple[str, str]] = {
     "f1-matrix-500-r0p02": (
         "sha256:a490cabcf1d28fda41f89a1e757325911544b7bf4fe31b36d66f8076d931ee5f",
         "sha256:3304aec59926d0bb74749c6a2f3fde89503b46f49c60eeea03e3617ada742398"),
+    "f1-matrix-500-r0p005": (
+        "sha256:e7e0cf174687bab40a6b3249fe771dc2701661744ce2d76263bc061e7a6ea708",
+        "sha256:e48b7145d0873852e752fb24582bf95a795890485b7c9be0320bb138bcd1b4f1"),
     "f1-matrix-fine-low": (
         "sha256:f4ecf487aec590490a63ec41215c6511218f038794ad33b52d5077bc1e5cf7ca",
         "sha256:1f7cc68036078992caf4c20e0d201193b83d37dc3f3868688edb6a90e6cf7eb0"),

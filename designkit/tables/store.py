@@ -554,14 +554,11 @@ SHIPPED_TABLES: dict[str, tuple[str, str]] = {
     "f1-matrix-2s": (
         "sha256:60fa880ce4e50749e3aad5c48d061e41f743d89a6ca512f840793d16ade75c37",
         "sha256:d39c9fbf935896606db255017df138f92fce5fcbcc0ff680b2ddeda2458f0ae8"),
-    "f1-matrix-500-r0p01": (
-        "sha256:fb4b48404a6ee109f1f24fe1f63935839f10f7097e87944ee9dac187f3fc5b65",
+    "f1-matrix-500-r0p01": ("sha256:fb4b48404a6ee109f1f24fe1f63935839f10f7097e87944ee9dac187f3fc5b65",
         "sha256:cf47f950d062a611aa463f133dbd858f40cb78b0236c4791b90aa90e3bb9face"),
-    "f1-matrix-500-r0p02": (
-        "sha256:a490cabcf1d28fda41f89a1e757325911544b7bf4fe31b36d66f8076d931ee5f",
+    "f1-matrix-500-r0p02": ("sha256:a490cabcf1d28fda41f89a1e757325911544b7bf4fe31b36d66f8076d931ee5f",
         "sha256:3304aec59926d0bb74749c6a2f3fde89503b46f49c60eeea03e3617ada742398"),
-    "f1-matrix-500-r0p005": (
-        "sha256:e7e0cf174687bab40a6b3249fe771dc2701661744ce2d76263bc061e7a6ea708",
+    "f1-matrix-500-r0p005": ("sha256:e7e0cf174687bab40a6b3249fe771dc2701661744ce2d76263bc061e7a6ea708",
         "sha256:e48b7145d0873852e752fb24582bf95a795890485b7c9be0320bb138bcd1b4f1"),
     "f1-matrix-fine-low": (
         "sha256:f4ecf487aec590490a63ec41215c6511218f038794ad33b52d5077bc1e5cf7ca",

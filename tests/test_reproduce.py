@@ -297,3 +297,75 @@ def test_console_script_runs(tmp_path):
                          capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr
     assert "Wrote" in out.stdout and (tmp_path / "rep" / "report.md").is_file()
+
+
+# ------------------------------------------------------------------ Table I at the paper's resolution (issue 35)
+TABLES_DIR = Path(__file__).resolve().parents[1] / "tables"
+
+
+def test_every_table1_setting_has_a_500_interval_full_matrix_config():
+    """Each sigma/dT of Table I names its own 500-interval full-matrix config, the 100-interval
+    matrices' sweep on the paper's grid (same trials, folds, repeats, seed, threshold, contact)."""
+    import yaml
+
+    from designkit_lab.reproduce.matrices import paper_grid_table
+    from designkit_lab.reproduce.paper import TABLE1
+
+    base = yaml.safe_load((TABLES_DIR / "f1-matrix-2s.yaml").read_text())
+    for row in TABLE1:
+        name = paper_grid_table(row.noise_ratio)
+        cfg = yaml.safe_load((TABLES_DIR / f"{name}.yaml").read_text())
+        assert cfg["name"] == name and cfg["full_matrix"] is True
+        assert cfg["effusivity"] == {"min": 0, "max": 40000, "intervals": 500}
+        assert cfg["noise_ratio"] == [pytest.approx(row.noise_ratio)]
+        for key in ("trials", "folds", "seed", "max_repeats", "threshold", "z", "contact_s", "sensor", "fidelity"):
+            assert cfg[key] == base[key], key
+
+
+def test_table1_section_labels_each_resolution_and_names_missing_tables():
+    from designkit_lab.reproduce.table1 import _paper_grid_lines
+
+    def row(ratio, grid):
+        return {"noise_c": 0.05, "delta_t_c": 0.05 / ratio, "noise_ratio": ratio,
+                "paper": {"intervals_percent": 15.0, "intervals_f1": 0.93, "materials_percent": 18.0,
+                          "materials_f1": 0.95},
+                "intervals": {"percent": 19.8, "coarse": {"mean_f1": 0.931, "percent_indistinguishable": 19.5}},
+                "materials": {"mean_f1": 0.978, "percent_indistinguishable": 8.9}, "paper_grid": grid}
+
+    def pct(x):
+        return "—" if x is None else f"{x:.4g} %"
+
+    assert "Not built: `f1-matrix-500-r0p005`" in "\n".join(_paper_grid_lines([row(0.005, None)], pct))
+    grid = {"table": "f1-matrix-500-r0p005", "grid": {"e_min": 0.0, "width": 80.0, "intervals": 500},
+            "intervals": {"mean_f1": 0.9123, "percent_indistinguishable": 17.25, "pairs": 124750},
+            "materials": {"mean_f1": 0.9456, "percent_indistinguishable": 12.5, "pairs": 2346},
+            "build": {"compute_s": 412.0, "fits": 130000, "elapsed_s": 900.0, "jobs": 2, "whole_build": True}}
+    text = "\n".join(_paper_grid_lines([row(0.005, grid), row(0.01, None)], pct))
+    assert "124,750 interval pairs" in text and "Not built: `f1-matrix-500-r0p01`" in text
+    assert "% indist. 500 (every pair)" in text and "mean F1 100" in text and "% indist. 500 (staircase)" in text
+    line = next(ln for ln in text.splitlines() if ln.startswith("| 0.05 | 10 |"))
+    assert "17.25 %" in line and "0.912" in line and "0.931" in line and "19.8 %" in line
+    assert "412 worker-s of chunk wall" in text and "one run of 15.0 min wall on 2 worker(s)" in text
+
+
+def test_paper_grid_row_counts_every_pair_of_the_shipped_500_interval_matrices(tmp_path):
+    from designkit.tables.store import load_table
+    from designkit_lab.reproduce._report import Context
+    from designkit_lab.reproduce.matrices import paper_grid_row, paper_grid_table
+    from designkit_lab.reproduce.paper import TABLE1
+
+    shipped = [r.noise_ratio for r in TABLE1 if (TABLES_DIR / f"{paper_grid_table(r.noise_ratio)}.npz").is_file()]
+    if not shipped:
+        pytest.skip("no 500-interval full matrix is shipped in tables/ (build: tables/f1-matrix-500-r*.yaml)")
+    ctx = Context(ReproduceSettings(tables_dir=TABLES_DIR), tmp_path)
+    for ratio in sorted(set(shipped)):
+        got = paper_grid_row(ctx, ratio, material_cover=False)
+        m = np.asarray(load_table(TABLES_DIR / f"{paper_grid_table(ratio)}.npz").arrays["f1_matrix"][0, 0],
+                       dtype=np.float64)
+        upper = m[np.triu(np.ones(m.shape, dtype=bool), 1)]
+        assert m.shape == (500, 500) and got["intervals"]["pairs"] == 124_750 == upper.size
+        assert np.isfinite(upper).all()
+        assert got["intervals"]["mean_f1"] == pytest.approx(upper.sum() / upper.size, rel=1e-12)
+        assert got["intervals"]["percent_indistinguishable"] == pytest.approx(100.0 * np.count_nonzero(upper < 0.9)
+                                                                              / upper.size)
+        assert got["build"]["fits"] >= 124_750

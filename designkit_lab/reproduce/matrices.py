@@ -18,6 +18,11 @@ Which grid each number comes from
   that cover the same interval (overlapping ranges) compare a class with
   itself; their F1 is the SVM's chance F1, measured at run time
   (:func:`chance_f1`).
+* **The paper's resolution** (issue 35): where the 500-interval full matrices
+  ``f1-matrix-500-r0p005`` etc. (one table per sigma/dT, all 124,750 pairs of
+  the paper's grid) exist, Table I also reports % indistinguishable and mean F1
+  over every pair, and the material pairs by the same rule on width-80
+  intervals everywhere, beside the 100-interval figures (:func:`paper_grid_row`).
 """
 
 from __future__ import annotations
@@ -42,6 +47,8 @@ __all__ = [
     "material_f1",
     "matrix_delta_up",
     "matrix_stats",
+    "paper_grid_row",
+    "paper_grid_table",
     "section_f1_matrices",
     "section_node_graphs",
     "graph_layout",
@@ -54,6 +61,7 @@ COARSE_TABLE = "f1-matrix-2s"
 FINE_TABLE = "f1-matrix-fine-low"
 STAIRCASE_TABLE = "svm-paper"
 IDEAL_TABLE = "ideal-paper"
+PAPER_GRID_PREFIX = "f1-matrix-500-r"  # + sigma/dT: the 500-interval full matrix of one Table I setting
 TABLE1_CONTACT_S = 2.0
 GRAPH_SETTINGS = ((30.0, 0.05), (35.0, 0.05))  # (Ts0 [degC], sigma [degC]) of Fig. 6, Ta = 25
 AMBIENT_C = 25.0
@@ -277,6 +285,57 @@ def material_f1(ctx: Context, noise_ratio: float) -> MaterialF1 | None:
     return out
 
 
+# ============================================================ the paper's resolution
+def paper_grid_table(noise_ratio: float) -> str:
+    """Name of the 500-interval full-matrix table of one sigma/dT (``f1-matrix-500-r0p005``: ``p`` for the
+    decimal point, since a table name with a dot would read as a file suffix).
+
+    >>> paper_grid_table(0.05 / 10), paper_grid_table(0.1 / 5)
+    ('f1-matrix-500-r0p005', 'f1-matrix-500-r0p02')
+    """
+    return f"{PAPER_GRID_PREFIX}{round(noise_ratio, 12):g}".replace(".", "p")
+
+
+def build_time(table) -> dict:
+    """What building ``table`` cost, from its header's ``stats``: the workers' busy wall seconds summed over
+    its chunks (``compute_s``: CPU seconds on idle cores, more where the cores are shared), SVM fits, and
+    the wall time of the run that assembled it (``elapsed_s``; the whole build only when that run computed
+    every chunk, ``whole_build``)."""
+    st = table.header.get("stats") or {}
+    run = st.get("run") or {}
+    done, total = run.get("chunks_computed"), run.get("chunks_total")
+    return {"compute_s": st.get("compute_s_total"), "fits": st.get("svm_fits_total"),
+            "elapsed_s": run.get("elapsed_s"), "jobs": run.get("jobs"), "chunks_computed": done,
+            "whole_build": done is not None and done == total, "created": table.header.get("created")}
+
+
+def paper_grid_row(ctx: Context, noise_ratio: float, material_cover: bool = True) -> dict | None:
+    """Table I's numbers at the paper's own resolution, from ``f1-matrix-500-r<sigma/dT>``; None when
+    that table is not available.
+
+    ``intervals``: mean F1 and % indistinguishable over every interval pair ``i < j`` of its grid (124,750
+    pairs at 500 intervals; no monotonicity assumed). ``materials`` (with ``material_cover``): the paper's
+    rule (a pair's F1 is the mean over the interval pairs covering the two ranges) on this one grid,
+    same-interval cells at the SVM's chance F1 (:func:`chance_f1`).
+    """
+    name = paper_grid_table(noise_ratio)
+    tab = ctx.table(name)
+    m = f1_matrix(tab, noise_ratio, TABLE1_CONTACT_S)
+    if m is None:
+        return None
+    e_min, width, n = _grid(tab)
+    phi = tab.threshold
+    out = {"table": name, "grid": {"e_min": e_min, "width": width, "intervals": n},
+           "intervals": matrix_stats(m, phi).to_dict(), "build": build_time(tab)}
+    if material_cover:
+        from designkit.materials import list_materials
+
+        ranges = np.array([mat.effusivity_range for mat in list_materials()], dtype=np.float64)
+        cover = [covering_intervals(lo, hi, e_min, width, n) for lo, hi in ranges]
+        out["materials"] = matrix_stats(_pair_means(m, cover, chance_f1(ctx)["mean"]), phi).to_dict()
+    return out
+
+
 # ============================================================ Fig. 3
 def section_f1_matrices(ctx: Context) -> SectionResult:
     """Fig. 3: F1 matrices at contact 4 s and 1 s (Ts0 35, sigma 0.05: sigma/dT 0.005)."""
@@ -397,7 +456,8 @@ def table1_numbers(ctx: Context) -> list[dict]:
         rows.append({"noise_c": p.noise_c, "delta_t_c": p.delta_t_c, "noise_ratio": r,
                      "paper": {"intervals_percent": p.intervals_percent, "intervals_f1": p.intervals_f1,
                                "materials_percent": p.materials_percent, "materials_f1": p.materials_f1},
-                     "intervals": _interval_row(ctx, r), "materials": _material_row(ctx, r)})
+                     "intervals": _interval_row(ctx, r), "materials": _material_row(ctx, r),
+                     "paper_grid": paper_grid_row(ctx, r)})
         ctx.step(k + 1, len(TABLE1))
     return rows
 

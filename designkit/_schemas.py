@@ -336,6 +336,7 @@ def schemas() -> dict[str, type]:
         model: Any = None  # a name, a mapping or a ForwardModel: checked by designkit.models
         diffusivity_m2_s: Optional[Number] = None
         solver: Optional[StrictStr] = None
+        rig_scene: Optional[StrictBool] = None
 
     # JSON formats (table header, trial sidecar): numbers are numbers, never strings
     Number = Annotated[Any, PlainValidator(_json_number)]

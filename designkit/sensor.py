@@ -436,9 +436,14 @@ def load_sensor(name_or_path: "str | Path | Sensor") -> Sensor:
         return SENSORS[key]
     p = Path(key)
     if p.suffix.lower() in (".yaml", ".yml") or p.exists():
-        try:  # parsed once per process while its content is the same (a calibrated file is thousands of lines)
-            import hashlib
+        import hashlib
 
+        from ._schemas import check_regular_file
+
+        # parsed once per process while its content is the same (a calibrated file is thousands of lines); a
+        # FIFO, folder or oversized file is refused here, before its bytes are read for the memo's key
+        check_regular_file(p, "sensor file")
+        try:
             stamp = (str(p.resolve()), hashlib.sha256(p.read_bytes()).hexdigest())
         except OSError:  # from_yaml says what is missing
             return Sensor.from_yaml(p)

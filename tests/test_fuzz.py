@@ -199,6 +199,7 @@ BASE = {
     "materials show": ["copper"],
     "tables list": [],
     "tables show": ["ideal-paper"],
+    "tables build": ["--sensor", "@MISSING", "--out", "built"],
     "calibrate record": ["--port", "@PORT", "--material", "wood", "--trials", "1", "--timeout", "0.5"],
     "calibrate fit": ["@MISSING"],
     "calibrate": ["--port", "@PORT", "--material", "wood", "--yes", "--timeout", "0.5"],

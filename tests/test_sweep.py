@@ -227,15 +227,26 @@ def _mmapped_bytes() -> int:
 def test_a_chunk_takes_its_arrays_from_a_kept_heap_and_sets_everything_back_after():
     """Inside steady_heap (what run_chunk runs in) a 16 MB array comes from the heap, not fresh mmap'd pages,
     and numpy's huge-page advice is off, also after another chunk of the process has ended; after the last,
-    glibc's default threshold and numpy's advice are back."""
+    glibc's default threshold and numpy's advice are back.
+
+    Checked in a fresh process: the allocator's state is the process's, and an earlier test's chunk still
+    running in a thread of this worker (a dask thread, a timed-out in-process command) would hold it."""
     import ctypes
     import platform
-
-    from designkit._workers import _numpy_hugepage_setter, steady_heap
 
     if platform.system() != "Linux" or platform.libc_ver()[0] != "glibc" or not hasattr(ctypes.CDLL(None),
                                                                                        "mallinfo2"):
         pytest.skip("needs glibc 2.33 or later (mallopt, mallinfo2)")
+    code = "import test_sweep; test_sweep.kept_heap_check(); print('ok')"
+    r = subprocess.run([sys.executable, "-c", code], cwd=Path(__file__).parent, capture_output=True, text=True,
+                       timeout=120)
+    assert r.returncode == 0 and r.stdout.strip() == "ok", r.stderr
+
+
+def kept_heap_check() -> None:
+    """The body of the test above, run in a fresh process."""
+    from designkit._workers import _numpy_hugepage_setter, steady_heap
+
     advise = _numpy_hugepage_setter()
 
     def advice():

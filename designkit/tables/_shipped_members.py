@@ -70,6 +70,18 @@ SHIPPED_MEMBER_DIGESTS: dict[str, dict[str, str]] = {
         'f1_matrix': 'sha256:0ae43a1994019b747ebe550a13b4e6b4ad5bdba345fca327f9ade79bdbbd692d',
         'fits': 'sha256:d9b3cbdb53a878526f10559cb5f66d7610bdb5c2f794454335d72b8273b52788',
     },
+    'f1-matrix-500-r0p002': {
+        'delta_down': 'sha256:2e5b861ab6c9426e418fd25981835a0f3cdd1bd76a20a511519bf07c2c8f44cc',
+        'delta_down_hi': 'sha256:ec84948b7b5bc02e7252157963237a495a36ddcbd6561af9d685a6d20acfa285',
+        'delta_down_ideal': 'sha256:41e745629e298bc4bcfe50f672f37cbf83775c61531348f39daaae2a61ad94a1',
+        'delta_down_lo': 'sha256:1796419fca170e939d777f099d891b0d5dcee9290748771aae78f339bc690731',
+        'delta_up': 'sha256:033489f08b6c948bbeaee2649b7819febf4d344689a6fdb94118c44cf33df4b7',
+        'delta_up_hi': 'sha256:bc874fdd69e0cd05a8d42b129e524295df3109ad0ffb79126544d648c36e8f40',
+        'delta_up_ideal': 'sha256:04cbf1313ded6ac6a30a13f998c8c9ab218bbee81d78fbd0dc8401b0104a4e01',
+        'delta_up_lo': 'sha256:9e22dbbc3fc35c3761296e9c872238083e1920d396e2266277d5d3418236a519',
+        'f1_matrix': 'sha256:ea48f78c3aca60fc154a5c1868094922d54c1d2b5f82ae4b42f3b35429369e80',
+        'fits': 'sha256:ab0f0308b15068cb3a5bbcd63a6de70b5d59ae02ed748e72db24d82ab7c67920',
+    },
     'f1-matrix-fine-low': {
         'chunk_wall_s': 'sha256:2d9c7ab36e347e58c20a1ffbe7265d5fe5ad5a48cadb15b8abcdc4986e7b958e',
         'delta_down': 'sha256:c8f90a7a20c8ce83c721970510c378c0b5bf85064c2e812798ea4d2bdf62308b',

@@ -82,6 +82,18 @@ SHIPPED_MEMBER_DIGESTS: dict[str, dict[str, str]] = {
         'f1_matrix': 'sha256:ea48f78c3aca60fc154a5c1868094922d54c1d2b5f82ae4b42f3b35429369e80',
         'fits': 'sha256:ab0f0308b15068cb3a5bbcd63a6de70b5d59ae02ed748e72db24d82ab7c67920',
     },
+    'f1-matrix-500-r0p001': {
+        'delta_down': 'sha256:33f64736cce315eb77633b1a1c0c5c6950c8891fb82737ee00ee37096b69109f',
+        'delta_down_hi': 'sha256:07dcd9835ddffbf7c467c24296bf2ba272344ba635a3804cd08775caa7c29873',
+        'delta_down_ideal': 'sha256:b0c70b2edc12b6f7687ac7b89d570f90746713e4e235af2a26e5098e0c347b99',
+        'delta_down_lo': 'sha256:f88660d5b20115ed0d2be32b221c3d3b975b21637e2c4581814f28711b8c8f8b',
+        'delta_up': 'sha256:00e36916087db44a66e3d8aa10dd5e5cb3642c1a0e67a2b207aa795aa16813bd',
+        'delta_up_hi': 'sha256:2df2e6599ddab265e474024df7f5573ac6ada5347cf1a3e09b2cbd5786ab8418',
+        'delta_up_ideal': 'sha256:615a2dccdfcca5ab0487fd69759224c0e5f81d5bdefac6d246d124e410350c37',
+        'delta_up_lo': 'sha256:a006571c653ae54821615031291e597bfec20217fcb07f7ae45a1d9feadeb8bf',
+        'f1_matrix': 'sha256:6f1e8d51f1a4af8c03e9f0fdacd8563cc39bb440ee19167315e0ae441da01e62',
+        'fits': 'sha256:2d8e9915f8a4746d074239ec81b27c89095fa97c54fc6577d2eb5d27bcc28063',
+    },
     'f1-matrix-fine-low': {
         'chunk_wall_s': 'sha256:2d9c7ab36e347e58c20a1ffbe7265d5fe5ad5a48cadb15b8abcdc4986e7b958e',
         'delta_down': 'sha256:c8f90a7a20c8ce83c721970510c378c0b5bf85064c2e812798ea4d2bdf62308b',

@@ -199,6 +199,16 @@ def rig_scene(sensor) -> dict[str, float]:
             "onset_s": max(-start, 0.0) if start is not None else 0.0}
 
 
+def question_scene(sensor, **scene):
+    """The scene a question about ``sensor`` plays (:meth:`designkit.scene.Scene.from_delta_t` of ``scene``),
+    with a calibrated rig's correlated noise and its recorder's window from the detected onset
+    (:func:`rig_scene`; nothing added for a sensor without recorded conditions). The SVM and the Monte Carlo
+    ideal observer of the exact route both read their touches from it."""
+    from .scene import Scene
+
+    return Scene.from_delta_t(**scene).replace(**rig_scene(sensor))
+
+
 def _rule_text(rule: Mapping[str, Any]) -> str:
     kind = rule.get("rule", "?")
     if kind == "force":

@@ -204,11 +204,10 @@ class _Run:
         +-``spread`` degC of it when the question has a sensor temperature spread (varied initial conditions);
         for a calibrated rig, its correlated noise and its recorder's window from the detected onset
         (:func:`designkit.rig.rig_scene`)."""
-        from ..rig import rig_scene
-        from ..scene import Scene
+        from ..rig import question_scene
 
-        return Scene.from_delta_t(contact_s=contact_s, noise_c=noise_c, delta_t_c=delta_t_c,
-                                  sensor_temp_spread_c=self.spread).replace(**rig_scene(self.sensor))
+        return question_scene(self.sensor, contact_s=contact_s, noise_c=noise_c, delta_t_c=delta_t_c,
+                              sensor_temp_spread_c=self.spread)
 
     def closed_form(self, *classes: ObjectClass) -> bool:
         """Whether the vectorized closed form answers (shared shape, fixed initial conditions, every class

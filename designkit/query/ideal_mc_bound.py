@@ -122,15 +122,6 @@ def _estimate(score, name: str, x_lo: float, x_hi: float, threshold: float, *, s
     return est, tuple(sorted(evals, key=lambda e: e[name]))
 
 
-def _scene(sensor: Sensor, **scene) -> Scene:
-    """The scene the SVM of the same question plays: a calibrated rig's correlated noise and its recorder's
-    window from the detected onset (:func:`designkit.rig.rig_scene`; nothing for the paper's sensor), so the
-    bound is the ideal observer of the same touches, not of white noise from the first heat flow."""
-    from ..rig import rig_scene
-
-    return Scene.from_delta_t(**scene).replace(**rig_scene(sensor))
-
-
 def mc_ideal_min_contact(a: ObjectClass, b: ObjectClass, sensor: Sensor, *, noise_c: float, delta_t_c: float,
                          sensor_temp_spread_c: float = 0.0, model=None, threshold: float = 0.9,
                          max_contact_s: float = 10.0, n_mc: int = MC_BOUND_TOUCHES, seed: int = 0,
@@ -178,12 +169,13 @@ def mc_ideal_min_contact(a: ObjectClass, b: ObjectClass, sensor: Sensor, *, nois
     (True, True, 0.9)
     """
     from ..recognition.ideal import ideal_pair
+    from ..rig import question_scene
 
     cov = check_coverage(coverage)
     fs = float(sensor.sample_rate_hz)
 
     def score(c, point_seed):
-        scene = _scene(sensor, contact_s=c, noise_c=noise_c, delta_t_c=delta_t_c,
+        scene = question_scene(sensor, contact_s=c, noise_c=noise_c, delta_t_c=delta_t_c,
                        sensor_temp_spread_c=sensor_temp_spread_c)
         return ideal_pair(a, b, sensor, scene, model=model, n_mc=n_mc, seed=point_seed)
 
@@ -240,6 +232,7 @@ def mc_ideal_delta(ref: ObjectClass, direction: int, sensor: Sensor, *, contact_
     (True, True)
     """
     from ..recognition.ideal import ideal_pair
+    from ..rig import question_scene
 
     cov = check_coverage(coverage)
     x, w = ref.e_range[0], ref.e_range[1] - ref.e_range[0]
@@ -248,7 +241,7 @@ def mc_ideal_delta(ref: ObjectClass, direction: int, sensor: Sensor, *, contact_
     limit = (e_max - x - w) if sign > 0 else (x - w)
     if limit < w:
         return MonteCarloBound(None, None, None, None, int(n_mc), ())
-    scene = _scene(sensor, contact_s=contact_s, noise_c=noise_c, delta_t_c=delta_t_c,
+    scene = question_scene(sensor, contact_s=contact_s, noise_c=noise_c, delta_t_c=delta_t_c,
                    sensor_temp_spread_c=sensor_temp_spread_c)
 
     def score(d, point_seed):

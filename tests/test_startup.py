@@ -49,13 +49,42 @@ def test_a_copied_table_is_schema_checked_and_an_edited_one_refused(tmp_path):
     assert "sha256:" + "0" * 64 not in SHIPPED_CONTENT_HASHES
 
 
-def test_a_table_question_from_the_cli_imports_no_pydantic():
-    r = _py("-X", "importtime", "-m", "designkit", "min-contact", "--e1", "35000", "--e2", "20000")
+def _imported(r: subprocess.CompletedProcess) -> set[str]:
+    """The modules a ``python -X importtime`` run imported."""
     assert r.returncode == 0, r.stderr
-    imported = {line.split("|")[-1].strip() for line in r.stderr.splitlines() if line.startswith("import time")}
-    assert "designkit.query" in imported and "numpy" in imported
-    assert not {"pydantic", "typer._adapters", "sklearn", "scipy", "matplotlib", "numpy.ma"} \
-        & imported
+    return {line.split("|")[-1].strip() for line in r.stderr.splitlines() if line.startswith("import time")}
+
+
+#: What a table question never needs: the exact route (simulation, SVM, its Monte Carlo bound), pydantic (the
+#: schemas of files it does not read, typer's adapters), scipy, scikit-learn, joblib, matplotlib.
+_NOT_FOR_A_TABLE_QUESTION = {"pydantic", "typer._adapters", "sklearn", "scipy", "scipy.optimize", "joblib",
+                             "matplotlib", "numpy.ma", "designkit.query.exact", "designkit.query.ideal_mc_bound",
+                             "designkit.simulation", "designkit.recognition.svm", "designkit.recognition.features"}
+
+
+def test_a_table_question_from_the_cli_imports_no_pydantic_and_not_the_exact_route():
+    imported = _imported(_py("-X", "importtime", "-m", "designkit", "min-contact", "--e1", "35000", "--e2", "20000"))
+    assert "designkit.query" in imported and "numpy" in imported and "designkit.query.table" in imported
+    assert not _NOT_FOR_A_TABLE_QUESTION & imported
+
+
+def test_the_library_loads_a_question_route_on_first_use():
+    code = ("import sys, designkit.query as q\n"
+            "assert 'numpy' not in sys.modules, 'import designkit.query loaded numpy'\n"
+            "a = q.min_contact(35000, 20000)\n"
+            "print(a.route, a.value)")
+    r = _py("-X", "importtime", "-c", code)
+    imported = _imported(r)
+    assert r.stdout.split()[0] == "table" and float(r.stdout.split()[1]) > 0
+    assert not _NOT_FOR_A_TABLE_QUESTION & imported
+    # the exact route is there when asked for, by name or through the registry
+    from designkit import query
+    from designkit.query import exact
+
+    assert query.QUESTIONS["min-contact"].route("exact") is exact.exact_min_contact is query.exact_min_contact
+    assert set(query.__all__) <= set(dir(query))
+    with pytest.raises(AttributeError, match="no_such_name"):
+        query.no_such_name  # noqa: B018
 
 
 def test_the_lean_app_answers_as_the_whole_app(cli):

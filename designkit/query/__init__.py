@@ -20,11 +20,33 @@ Examples
 ('min-contact', 's')
 """
 
-from .answer import ANSWER_KEYS, Answer, IdealBound
-from .exact import exact_delta_e, exact_distinguishable, exact_max_noise, exact_min_contact, exact_min_delta_t
-from .inputs import MATERIALS_RULE, NeedsInput, PairQuestion, TableMismatch, pair_question, reference_class
-from .vectorized import ArrayAnswer
-from .questions import QUESTIONS, Question, ask, delta_e, distinguishable, max_noise, min_contact, min_delta_t
+import importlib
+
+#: Where each public name lives. PEP 562: a name is imported on first use, so a table question does not pay
+#: for the exact route (simulation, SVM) or the array route it does not take (``python -X importtime``).
+_LAZY = {
+    **dict.fromkeys(("ANSWER_KEYS", "Answer", "IdealBound"), ".answer"),
+    **dict.fromkeys(("exact_delta_e", "exact_distinguishable", "exact_max_noise", "exact_min_contact",
+                     "exact_min_delta_t"), ".exact"),
+    **dict.fromkeys(("MATERIALS_RULE", "NeedsInput", "PairQuestion", "TableMismatch", "pair_question",
+                     "reference_class"), ".inputs"),
+    "ArrayAnswer": ".vectorized",
+    **dict.fromkeys(("QUESTIONS", "Question", "ask", "delta_e", "distinguishable", "max_noise", "min_contact",
+                     "min_delta_t"), ".questions"),
+}
+
+
+def __getattr__(name: str):
+    if name in _LAZY:
+        value = getattr(importlib.import_module(_LAZY[name], __name__), name)
+        globals()[name] = value  # once: later lookups are plain attribute reads
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *_LAZY})
+
 
 __all__ = [
     "ANSWER_KEYS",

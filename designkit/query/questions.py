@@ -35,7 +35,6 @@ from numpy.typing import ArrayLike
 
 from .._validation import InputError
 from ..rig import for_rig, rig_arguments
-from . import exact as _exact_route
 from . import table as _table_route
 from .answer import Answer, QuestionQuantity
 from .policy import MC_BOUND, choose_route, sensor_table_answer
@@ -58,15 +57,26 @@ class Question(QuestionQuantity):
         One line for people.
     scene : tuple of str
         The scene quantities the question takes (the others are what it asks for).
-    table, exact : callable
-        The route functions (same objects and scene arguments; route options differ).
+    table : callable
+        The table route's function.
+    exact_name : str
+        The name of the exact route's function in :mod:`designkit.query.exact` (same objects and scene
+        arguments; route options differ); :attr:`exact` is the function, imported on first use so that a
+        table question does not load the exact route.
     """
 
     name: str
     summary: str
     scene: tuple[str, ...]
     table: Callable[..., Answer]
-    exact: Callable[..., Answer]
+    exact_name: str
+
+    @property
+    def exact(self) -> Callable[..., Answer]:
+        """The exact route's function."""
+        from . import exact
+
+        return getattr(exact, self.exact_name)
 
     @property
     def question(self) -> str:
@@ -83,16 +93,16 @@ class Question(QuestionQuantity):
 #: The registry: question name -> :class:`Question`.
 QUESTIONS: dict[str, Question] = {q.name: q for q in (
     Question("min-contact", "shortest contact time that separates two objects", ("noise_c", "delta_t_c"),
-             _table_route.min_contact, _exact_route.exact_min_contact),
+             _table_route.min_contact, "exact_min_contact"),
     Question("max-noise", "largest noise sigma at which a contact time still separates two objects",
-             ("contact_s", "delta_t_c"), _table_route.max_noise, _exact_route.exact_max_noise),
+             ("contact_s", "delta_t_c"), _table_route.max_noise, "exact_max_noise"),
     Question("min-delta-t", "smallest sensor-object temperature difference that separates two objects",
-             ("contact_s", "noise_c"), _table_route.min_delta_t, _exact_route.exact_min_delta_t),
+             ("contact_s", "noise_c"), _table_route.min_delta_t, "exact_min_delta_t"),
     Question("delta-e", "smallest distinguishable effusivity difference from a reference, both directions",
-             ("contact_s", "noise_c", "delta_t_c"), _table_route.delta_e, _exact_route.exact_delta_e),
+             ("contact_s", "noise_c", "delta_t_c"), _table_route.delta_e, "exact_delta_e"),
     Question("distinguishable", "whether a scene separates two objects, with the SVM's and ideal F1",
              ("contact_s", "noise_c", "delta_t_c"), _table_route.distinguishable,
-             _exact_route.exact_distinguishable),
+             "exact_distinguishable"),
 )}
 
 

@@ -189,3 +189,17 @@ def test_an_uncompressed_table_is_mapped_and_reads_the_same_arrays(tmp_path, mon
 
     again = pickle.loads(pickle.dumps(t))  # a worker maps its own copy
     np.testing.assert_array_equal(again.arrays["delta_up"], src.arrays["delta_up"])
+
+
+def test_reading_a_sensor_file_builds_the_sensor_files_schema_only():
+    code = ("from designkit import _schemas\n"
+            "from designkit.sensor import load_sensor\n"
+            f"s = load_sensor({str(REPO / 'tests' / 'data' / 'rig_sensor.yaml')!r})\n"
+            "print(s.name, _schemas._schema.cache_info().currsize)")
+    r = _py("-c", code)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.split() == ["rig", "1"]  # the sweep, table and sidecar schemas not built
+    assert list(schemas()) == ["sensor", "sweep", "table", "sidecar"] and len(schemas()) == 4
+    assert schemas()["sensor"] is schemas()["sensor"]  # built once per process
+    with pytest.raises(KeyError):
+        schemas()["nope"]

@@ -16,7 +16,16 @@ Byte-compile the tree first (``python -m compileall -q designkit``): an installe
 every run (it doubled designkit's own import time here).
 
 Targets: ``designkit min-contact --e1 35000 --e2 20000`` at most 2x ``import
-numpy``; ``designkit --version`` at most 1.5x.
+numpy``; ``designkit --version`` at most 1.5x (issue 33).
+
+``--sensor FILE`` (e.g. ``tests/data/rig_sensor.yaml``) adds a calibrated sensor's question (issue 34: answered
+from its table in at most 50 ms from a fresh shell; python with numpy alone takes longer, so the figure is
+reported as is and above ``import numpy``): a tiny table for the sensor is built first (2 materials, 3 contact
+times, 6 touches: seconds) and registered in a scratch data folder, then ``designkit min-contact --sensor FILE
+--m1 wood --m2 glass`` answers from it; beside it, the sensor file read alone, and the sensor file read plus
+the registry looked up where no table is registered (what every ``--sensor`` question pays first)::
+
+    python benchmarks/bench_startup.py --runs 11 --sensor tests/data/rig_sensor.yaml
 """
 
 from __future__ import annotations
@@ -27,6 +36,7 @@ import os
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -61,8 +71,15 @@ def main(argv=None) -> dict:
     ap.add_argument("--baseline", type=Path,
                     help="another designkit tree (e.g. /work/main): its min-contact runs in the same round robin, "
                          "with that tree first on PYTHONPATH (a before/after in one run)")
+    ap.add_argument("--sensor", type=Path, help="a calibrated sensor file: also time its question from a fresh shell")
     args = ap.parse_args(argv)
     commands = {name: (cmd, None) for name, cmd in COMMANDS.items()}
+    scratch = tempfile.TemporaryDirectory(prefix="bench-startup-")
+    if args.sensor is not None:
+        commands.update(_sensor_commands(args.sensor.resolve(), Path(scratch.name)))
+        if args.baseline is not None:
+            cmd, env = commands["sensor question (its table)"]
+            commands["baseline sensor question"] = (cmd, {**env, "PYTHONPATH": str(args.baseline)})
     if args.baseline is not None:
         env = {**os.environ, "PYTHONPATH": str(args.baseline)}
         commands["baseline min-contact"] = (COMMANDS["designkit min-contact"], env)
@@ -90,7 +107,34 @@ def main(argv=None) -> dict:
               f"{cpu / base_cpu:5.2f}x  (x: of import numpy){target}")
     if args.json:
         args.json.write_text(json.dumps(out, indent=2))
+    if args.sensor is not None:
+        above = {k: out["median_s"][k] - base for k in out["median_s"] if "sensor" in k}
+        print("  above import numpy (wall): " + ", ".join(f"{k} +{v * 1e3:.0f} ms" for k, v in above.items()))
+        out["sensor_above_import_numpy_s"] = above
+    scratch.cleanup()
     return out
+
+
+def _sensor_commands(sensor: Path, scratch: Path) -> dict[str, tuple[list[str], dict]]:
+    """The sensor question's commands, each with its data folder (a tiny table registered in one, none in the
+    other), after building that table."""
+    with_table, without = {**os.environ, "DESIGNKIT_DATA_DIR": str(scratch / "with")}, \
+        {**os.environ, "DESIGNKIT_DATA_DIR": str(scratch / "without")}
+    t0 = time.perf_counter()
+    r = subprocess.run([PY, "-m", "designkit", "tables", "build", "--sensor", str(sensor), "--m", "wood", "--m",
+                        "glass", "--contact-points", "3", "--trials", "6", "--jobs", "1"], env=with_table,
+                       capture_output=True, text=True)
+    if r.returncode != 0:
+        raise SystemExit(f"building a table for {sensor} failed:\n{r.stderr}")
+    print(f"(a tiny table for {sensor.name} built in {time.perf_counter() - t0:.1f} s)")
+    read = f"from designkit.sensor import load_sensor; s = load_sensor({str(sensor)!r})"
+    return {
+        "sensor question (its table)": ([PY, "-m", "designkit", "min-contact", "--sensor", str(sensor), "--m1", "wood",
+                                         "--m2", "glass"], with_table),
+        "sensor file read": ([PY, "-c", read], without),
+        "sensor file + registry (none)": ([PY, "-c", read + "; from designkit.tables.registry import "
+                                           "table_for_sensor; assert table_for_sensor(s) is None"], without),
+    }
 
 
 if __name__ == "__main__":

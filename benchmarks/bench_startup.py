@@ -52,10 +52,11 @@ COMMANDS = {
 TARGETS = {"designkit --version": 1.5, "designkit min-contact": 2.0}
 
 
-def _run(cmd: list[str], env: dict | None = None) -> tuple[float, float]:
+def _run(cmd: list[str], env: dict | None = None, cwd: Path | None = None) -> tuple[float, float]:
     """Wall seconds and CPU seconds (user + system, from the child's rusage) of one run."""
     t0 = time.perf_counter()
-    p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env or os.environ.copy())
+    p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env or os.environ.copy(),
+                         cwd=cwd)
     _, status, usage = os.wait4(p.pid, 0)
     wall = time.perf_counter() - t0
     p.returncode = os.waitstatus_to_exitcode(status)
@@ -73,23 +74,27 @@ def main(argv=None) -> dict:
                          "with that tree first on PYTHONPATH (a before/after in one run)")
     ap.add_argument("--sensor", type=Path, help="a calibrated sensor file: also time its question from a fresh shell")
     args = ap.parse_args(argv)
-    commands = {name: (cmd, None) for name, cmd in COMMANDS.items()}
+    if args.baseline is not None:
+        args.baseline = args.baseline.resolve()
+    commands = {name: (cmd, None, None) for name, cmd in COMMANDS.items()}
     scratch = tempfile.TemporaryDirectory(prefix="bench-startup-")
     if args.sensor is not None:
         commands.update(_sensor_commands(args.sensor.resolve(), Path(scratch.name)))
         if args.baseline is not None:
-            cmd, env = commands["sensor question (its table)"]
-            commands["baseline sensor question"] = (cmd, {**env, "PYTHONPATH": str(args.baseline)})
+            for name in ("sensor question (its table)", "sensor file read"):
+                cmd, env, _ = commands[name]
+                commands[f"baseline {name}"] = (cmd, {**env, "PYTHONPATH": str(args.baseline)}, args.baseline)
     if args.baseline is not None:
         env = {**os.environ, "PYTHONPATH": str(args.baseline)}
-        commands["baseline min-contact"] = (COMMANDS["designkit min-contact"], env)
-    for cmd, env in commands.values():  # warm-up: page cache, .pyc files
-        _run(cmd, env)
+        # run from that tree too: ``python -m`` puts the working folder first on sys.path, before PYTHONPATH
+        commands["baseline min-contact"] = (COMMANDS["designkit min-contact"], env, args.baseline)
+    for cmd, env, cwd in commands.values():  # warm-up: page cache, .pyc files
+        _run(cmd, env, cwd)
     times: dict[str, list[float]] = {k: [] for k in commands}
     cpus: dict[str, list[float]] = {k: [] for k in commands}
     for _ in range(args.runs):
-        for name, (cmd, env) in commands.items():
-            wall, cpu = _run(cmd, env)
+        for name, (cmd, env, cwd) in commands.items():
+            wall, cpu = _run(cmd, env, cwd)
             times[name].append(wall)
             cpus[name].append(cpu)
     base = statistics.median(times["import numpy"])
@@ -103,7 +108,7 @@ def main(argv=None) -> dict:
         out["median_s"][name], out["ratio_to_import_numpy"][name] = med, med / base
         out["median_cpu_s"][name], out["cpu_ratio_to_import_numpy"][name] = cpu, cpu / base_cpu
         target = f"   target <= {TARGETS[name]:g}x" if name in TARGETS else ""
-        print(f"  {name:<30} wall {med * 1e3:7.1f} ms {med / base:5.2f}x   CPU {cpu * 1e3:7.1f} ms "
+        print(f"  {name:<38} wall {med * 1e3:7.1f} ms {med / base:5.2f}x   CPU {cpu * 1e3:7.1f} ms "
               f"{cpu / base_cpu:5.2f}x  (x: of import numpy){target}")
     if args.json:
         args.json.write_text(json.dumps(out, indent=2))
@@ -115,7 +120,7 @@ def main(argv=None) -> dict:
     return out
 
 
-def _sensor_commands(sensor: Path, scratch: Path) -> dict[str, tuple[list[str], dict]]:
+def _sensor_commands(sensor: Path, scratch: Path) -> dict[str, tuple[list[str], dict, None]]:
     """The sensor question's commands, each with its data folder (a tiny table registered in one, none in the
     other), after building that table."""
     with_table, without = {**os.environ, "DESIGNKIT_DATA_DIR": str(scratch / "with")}, \
@@ -130,10 +135,10 @@ def _sensor_commands(sensor: Path, scratch: Path) -> dict[str, tuple[list[str], 
     read = f"from designkit.sensor import load_sensor; s = load_sensor({str(sensor)!r})"
     return {
         "sensor question (its table)": ([PY, "-m", "designkit", "min-contact", "--sensor", str(sensor), "--m1", "wood",
-                                         "--m2", "glass"], with_table),
-        "sensor file read": ([PY, "-c", read], without),
+                                         "--m2", "glass"], with_table, None),
+        "sensor file read": ([PY, "-c", read], without, None),
         "sensor file + registry (none)": ([PY, "-c", read + "; from designkit.tables.registry import "
-                                           "table_for_sensor; assert table_for_sensor(s) is None"], without),
+                                           "table_for_sensor; assert table_for_sensor(s) is None"], without, None),
     }
 
 

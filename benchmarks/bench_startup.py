@@ -13,7 +13,11 @@ the console script plus runpy's few milliseconds.
 
 Byte-compile the tree first (``python -m compileall -q designkit``): an installed package has its
 ``.pyc`` files, and where ``PYTHONDONTWRITEBYTECODE`` is set a source tree compiles every module on
-every run (it doubled designkit's own import time here).
+every run (it doubled designkit's own import time here). The same for a ``--baseline`` tree: a checkout of
+the commit to compare (``git archive COMMIT designkit designkit_lab tables | tar -x -C /tmp/base``), byte-compiled::
+
+    python -m compileall -q designkit /tmp/base/designkit
+    python benchmarks/bench_startup.py --runs 11 --baseline /tmp/base --sensor tests/data/rig_sensor.yaml
 
 Targets: ``designkit min-contact --e1 35000 --e2 20000`` at most 2x ``import
 numpy``; ``designkit --version`` at most 1.5x (issue 33).

@@ -454,12 +454,8 @@ def load_sensor(name_or_path: "str | Path | Sensor") -> Sensor:
 
 
 #: Sensor files parsed by this process, keyed by (path, SHA-256 of the content): the frozen Sensor is shared.
-#: Process-wide on purpose, the one exception to "no global state" here: it memoizes a pure function of the
-#: file's bytes (an edited file has another key and is read again), holds only frozen Sensors, is bounded, and
-#: changes no answer, only how often a file is parsed. A caller that reads a sensor once passes the Sensor down
-#: (the command line does: one parse per command); the memo serves the library's users who name the same file
-#: in question after question (a calibrated file is thousands of values: tens of ms to parse and check each
-#: time), and keeps one Sensor object per content, which :func:`designkit.tables.registry.sensor_digest`'s
-#: memo relies on. Owning it by an object passed down would make every question of the library take that
-#: object too.
+#: Process-wide on purpose (the exception to "no global state" here): it memoizes a pure function of the file's
+#: bytes, holds frozen Sensors, is bounded and changes no answer. The command line parses a file once and passes
+#: the Sensor down; the memo serves library users who name the same file question after question, and gives one
+#: Sensor per content, which registry.sensor_digest's memo relies on.
 _READ: "LRUCache[tuple, Sensor]" = LRUCache(16)

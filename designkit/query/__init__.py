@@ -22,8 +22,8 @@ Examples
 
 import importlib
 
-#: Where each public name lives. PEP 562: a name is imported on first use, so a table question does not pay
-#: for the exact route (simulation, SVM) or the array route it does not take (``python -X importtime``).
+#: Where each public name lives. PEP 562: a name is imported on first use, so ``import designkit.query`` loads
+#: nothing and a table question does not load the exact route (simulation, SVM; ``python -X importtime``).
 _LAZY = {
     **dict.fromkeys(("ANSWER_KEYS", "Answer", "IdealBound"), ".answer"),
     **dict.fromkeys(("exact_delta_e", "exact_distinguishable", "exact_max_noise", "exact_min_contact",
@@ -48,28 +48,4 @@ def __dir__() -> list[str]:
     return sorted({*globals(), *_LAZY})
 
 
-__all__ = [
-    "ANSWER_KEYS",
-    "MATERIALS_RULE",
-    "QUESTIONS",
-    "Answer",
-    "ArrayAnswer",
-    "IdealBound",
-    "NeedsInput",
-    "PairQuestion",
-    "Question",
-    "TableMismatch",
-    "ask",
-    "delta_e",
-    "distinguishable",
-    "exact_delta_e",
-    "exact_distinguishable",
-    "exact_max_noise",
-    "exact_min_contact",
-    "exact_min_delta_t",
-    "max_noise",
-    "min_contact",
-    "min_delta_t",
-    "pair_question",
-    "reference_class",
-]
+__all__ = sorted(_LAZY)

@@ -11,8 +11,8 @@ Each chunk runs as a sweep worker runs it (``run_chunk``: one BLAS thread, the s
 process, alternately with the old tree's code and this tree's (``PYTHONPATH``), so that both see the
 same load on a shared machine. Printed per contact time and in total: CPU seconds of the chunk
 (``time.process_time``, imports not counted), SVM fits, CPU ms per fit, the worker's peak resident
-memory (``ru_maxrss``, imports included), and the new/old ratio of CPU per fit. From that ratio and a
-full build's figures (``--full-wall-s``, ``--full-cpu-s``: the last from-scratch build of svm-paper,
+memory (``ru_maxrss``, imports included), and the new/old ratio of CPU per fit. From the slice's CPU ratio
+(fewer fits count too) and a full build's figures (``--full-wall-s``, ``--full-cpu-s``: the last from-scratch build of svm-paper,
 benchmarks/results/svm-paper-rebuild.txt) it projects the full build's 2-core wall time. Each engine's
 chunks are written to ``OUT/old`` and ``OUT/new`` as a sweep's working folder, for
 ``compare_svm_paper.py --workdir``. No figure here is asserted anywhere.
@@ -73,6 +73,9 @@ def main(argv=None) -> int:
     p.add_argument("--contacts", type=int, nargs="*", help="contact indices (default: all)")
     p.add_argument("--full-wall-s", type=float, default=820.0, help="the last full build's wall [s] (13 min 40 s)")
     p.add_argument("--full-cpu-s", type=float, default=1628.0, help="the last full build's CPU [s]")
+    p.add_argument("--old-vs-full", type=float, default=1.0,
+                   help="the old tree's CPU relative to the engine of that build (e.g. 0.904 for engine version 2 "
+                        "against the version-1 build of 1,628 CPU s, engine-v2-slice.txt)")
     a = p.parse_args(argv)
     from designkit.sweep.config import SweepConfig
 
@@ -104,10 +107,13 @@ def main(argv=None) -> int:
     ratio = per_new / per_old
     print(f"total: old {o[0]:.1f} CPU s, {o[1]} fits, {1e3 * per_old:.2f} ms/fit, peak RSS {o[2]:.0f} MB; "
           f"new {n[0]:.1f} CPU s, {n[1]} fits, {1e3 * per_new:.2f} ms/fit, peak RSS {n[2]:.0f} MB")
+    # the slice's CPU, not CPU per fit: a search that makes fewer fits (engine version 3) counts too
+    slice_ratio = n[0] / max(o[0], 1e-9) * a.old_vs_full
     print(f"CPU per fit new/old: {ratio:.3f}; slice CPU new/old: {n[0] / max(o[0], 1e-9):.3f}")
-    print(f"projected full build on 2 idle cores: {a.full_wall_s * ratio / 60:.1f} min wall "
-          f"({a.full_cpu_s * ratio:.0f} CPU s), from the last build's {a.full_wall_s / 60:.1f} min / "
-          f"{a.full_cpu_s:.0f} CPU s times the ratio")
+    print(f"projected full build on 2 idle cores: {a.full_wall_s * slice_ratio / 60:.1f} min wall "
+          f"({a.full_cpu_s * slice_ratio:.0f} CPU s), from the last build's {a.full_wall_s / 60:.1f} min / "
+          f"{a.full_cpu_s:.0f} CPU s times the slice's CPU ratio" + (f" and {a.old_vs_full:g} (the old tree's own "
+          "ratio to that build)" if a.old_vs_full != 1.0 else ""))
     print(f"load average at end: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
     return 0
 

@@ -44,7 +44,9 @@ CV_KEY = 7919
 #: rounds differently, so its answers may move within their Monte Carlo intervals (issue 35). Version 2:
 #: the Savitzky-Golay slope in cumulative-sum form (:mod:`designkit.recognition.features`) and the
 #: batched solver's one-gather fold statistics (:func:`~designkit.recognition.batched_svm.batched_cv_f1`).
-ENGINE_VERSION = 2
+#: Version 3: a guided row's search gallops to ``g -+ 1, 2, 4, ...`` from its guess instead of ``g -+ 1, 3, 7, ...``
+#: (:func:`~designkit.sweep.search.staircase_searches`): fewer fits; on noisy decisions another crossing.
+ENGINE_VERSION = 3
 
 
 @dataclass

@@ -268,3 +268,16 @@ def test_critical_noise_grid_reads_the_exact_solve_and_does_not_depend_on_what_w
     assert alone[0] == got[-1]  # bitwise: its 16 nodes are the same solves
     near = np.array([20000.0, 20100.0])  # 100 apart: outside the grid, solved exactly
     assert grid(near[:1], near[1:])[0] == critical_noise(PAPER, near[:1], near[1:], width=80.0, threshold=0.9)[0]
+
+
+def test_the_tables_memo_is_kept_with_the_loaded_table():
+    """What no question changes (the critical-noise grid, the Monte Carlo calibration, the sensor's dict) is
+    computed once per loaded table: every question opening the table gets the same view; clearing the loaded
+    tables forgets it."""
+    from designkit.query.table_open import clear_table_cache
+
+    first = q.open_table("svm-paper").view
+    assert q.open_table("svm-paper").view is first
+    assert first.mc_calibration() == first.mc_calibration() == mc_calibration(first.t)
+    clear_table_cache()
+    assert q.open_table("svm-paper").view is not first

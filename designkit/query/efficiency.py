@@ -14,8 +14,8 @@ from ..tables.store import Table
 
 
 __all__ = [
-    "CLOSED_FORM_MAX_CONTACT_S", "K_SLOPE_SPAN", "NOISE_GRID_NODES", "CriticalNoiseGrid", "clear_efficiency_cache", "delta_efficiency_estimate",
-    "delta_entries", "interp_e_by", "k_baseline", "mc_calibration", "median", "noise_k_max_ratio",
+    "CLOSED_FORM_MAX_CONTACT_S", "K_SLOPE_SPAN", "NOISE_GRID_NODES", "CriticalNoiseGrid",
+    "delta_efficiency_estimate", "delta_entries", "interp_e_by", "k_baseline", "mc_calibration", "median", "noise_k_max_ratio",
     "noise_k_min_contact", "span_neighbours", "table_z"
 ]
 
@@ -23,13 +23,6 @@ __all__ = [
 #: Longest contact [s] the closed-form ideal bound examines (the exact route's default).
 CLOSED_FORM_MAX_CONTACT_S = 10.0
 
-#: :func:`mc_calibration` per table content (computed once per process, not on every question).
-_MC_CALIBRATION: dict[str, float] = {}
-
-
-def clear_efficiency_cache() -> None:
-    """Forget the Monte Carlo calibrations taken from tables."""
-    _MC_CALIBRATION.clear()
 
 
 def median(x: np.ndarray) -> float:
@@ -120,12 +113,8 @@ def mc_calibration(table) -> float:
     (on svm-paper 0.78: its Monte Carlo intervals are a quarter wider than its entries scatter; on
     svm-fine 0.72).
     1 where the table has no ideal needs or no Monte Carlo interval to calibrate (fewer than 20
-    residuals).
+    residuals). Computed once per table by its view (:meth:`~designkit.query.table_arrays.TableView.mc_calibration`).
     """
-    key = table.header.get("content_hash")
-    hit = _MC_CALIBRATION.get(key) if key is not None else None  # a table without a hash: not cached
-    if hit is not None:
-        return hit
     arrays, h = table.arrays, 0.5 * float(table.header["effusivity"]["width"])
     rnd_sd, z = 2.0 * h / math.sqrt(12.0), table_z(table)
     lt = np.log(table.axes["contact_s"])
@@ -169,8 +158,6 @@ def mc_calibration(table) -> float:
             else:
                 b = math.log(f)
         value = math.exp(0.5 * (a + b))
-    if key is not None:
-        _MC_CALIBRATION[key] = value
     return value
 
 

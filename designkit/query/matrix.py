@@ -448,8 +448,10 @@ def _multiclass(mats, tab, *, noise_c: float, delta_t_c: float, svm_trials: int 
 # ============================================================ the matrix
 def _prefill_bounds(question: str, mats, tab, itab, given: dict) -> None:
     """The closed-form ideal bounds (and min-contact's efficiency estimates) of all pairs in one vectorized
-    call, kept in the cache of :mod:`designkit.query.ideal_bound` where the per-pair table questions find
-    them (one solve per pair was most of a 12-material matrix: docs/decisions-log.md).
+    call: the critical noises they read are solved together, into the table's critical-noise grid
+    (min-contact) or the cache of :mod:`designkit.query.ideal_bound` (max-noise, min-delta-t), where the
+    per-pair table questions find them (one solve per pair was most of a 12-material matrix:
+    docs/decisions-log.md).
     Anything odd is left to the per-pair questions, which say what is wrong."""
     if question not in ("min-contact", "max-noise", "min-delta-t"):
         return
@@ -473,8 +475,8 @@ def _prefill_bounds(question: str, mats, tab, itab, given: dict) -> None:
         if not los:
             return
         if question == "min-contact":
-            # the array route: its closed-form bounds and efficiency estimates land in the same cache, under
-            # the same keys, as the per-pair questions' (the one vectorized computation for every pair)
+            # the array route: the grid nodes its closed-form bounds and efficiency estimates read are those
+            # the per-pair questions read (one vectorized solve for every pair)
             ask("min-contact", route="table", e1=np.array(los), e2=np.array(his), table=tab, ideal_table=itab,
                 **given)
         else:

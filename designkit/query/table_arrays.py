@@ -25,14 +25,13 @@ from ..sensor import within_sample_limit
 from ..tables.store import Table
 from .crossing import coverage_of_z
 from .efficiency import (CLOSED_FORM_MAX_CONTACT_S, CriticalNoiseGrid, delta_efficiency_estimate, delta_entries,
-                         interp_e_by, mc_calibration,
-                         noise_k_min_contact, table_z)
+                         interp_e_by, mc_calibration, noise_k_min_contact, table_z)
 from .estimates import (ABOVE, BELOW, CELL, CONTACT_ESTIMATORS, INSIDE, RATIO_ESTIMATORS,
                         ContactReading, RatioReading, axis_weights_flagged, delta_estimate, first_applicable,
                         grid_crossing, interp_e_rows, partner_in_grid, states_coverage, table_spread)
 
 __all__ = ["CLOSED_FORM_RATIO_BRACKET", "TableView", "at_contact", "contact_arrays", "delta_e_arrays",
-           "distinguishable_arrays", "groups", "max_ratio", "ratio_arrays"]
+           "distinguishable_arrays", "groups", "max_ratio", "ratio_arrays", "scene_groups"]
 
 #: sigma/dT the closed-form ideal bound searches (the exact route's bracket).
 CLOSED_FORM_RATIO_BRACKET = (1e-5, 1.0)
@@ -53,6 +52,7 @@ class TableView:
         self.e_hi = float(table.header["effusivity"]["max"])
         self._noise_grid: CriticalNoiseGrid | None = None
         self._sensor_dict: dict | None = None
+        self._mc_factor: float | None = None
 
     def critical_noise(self, lo, hi) -> np.ndarray:
         """The ideal observer's critical noise of the table's classes ``[lo, lo + w)``, ``[hi, hi + w)`` (its
@@ -89,8 +89,10 @@ class TableView:
         return combos, flags
 
     def mc_calibration(self) -> float:
-        """:func:`designkit.query.efficiency.mc_calibration` of this table."""
-        return mc_calibration(self.t)
+        """:func:`designkit.query.efficiency.mc_calibration` of this table (computed once)."""
+        if self._mc_factor is None:
+            self._mc_factor = mc_calibration(self.t)
+        return self._mc_factor
 
     def e_in_grid(self, *es: float) -> bool:
         return all(self.e_lo < e <= self.e_hi for e in es)
@@ -237,7 +239,8 @@ def contact_arrays(op, lo, hi, noise, dt, *, ideal_bound: bool, zc: float, class
             if all(iflags.values()):
                 res["ideal"][idx] = grid_crossing(op.iview.contacts, op.iview.need(op.ikind, icombos, l, h), gap)[0]
         if efficiency and (has := k >= 0).any():
-            r = noise_k_min_contact(op, combos, k[has], l[has], h[has], nz / abs(d), zc=zc, s_pair=star[idx[has]])
+            r = noise_k_min_contact(op, combos, k[has], l[has], h[has], nz / abs(d), zc=zc,
+                                    s_pair=star[idx[has]])
             for key in eff:
                 eff[key][idx[has]] = r[key]
         res["in_grid"][idx] = True

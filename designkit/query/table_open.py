@@ -15,7 +15,6 @@ from cachetools import LRUCache
 
 from .._validation import check_nonnegative
 from ..tables.store import Table, load_table, resolve_table
-from .efficiency import clear_efficiency_cache
 from .estimates import table_spread
 from .inputs import TableMismatch, check_threshold
 from .table_arrays import TableView
@@ -65,10 +64,9 @@ def table_view(tab: Table) -> TableView:
 
 
 def clear_table_cache() -> None:
-    """Forget the tables this process has loaded (they are re-read and re-verified on next use), and the
-    noise-efficiency readings taken from them."""
+    """Forget the tables this process has loaded (they are re-read and re-verified on next use), and what
+    their views computed of them."""
     _LOADED.clear()
-    clear_efficiency_cache()
 
 
 # ============================================================ opening a table for a question

@@ -55,12 +55,15 @@ def as_table(table: "Table | str") -> Table:
 
 
 def table_view(tab: Table) -> TableView:
-    """The view of ``tab`` kept with it where this process loaded it by name or path (its memo: the critical
-    noises, computed once per table), else a new one."""
+    """The view of ``tab`` kept with it (its memo: the critical noises, computed once per table): the one made
+    when this process loaded it, or when a question first read this Table object (kept beside the loaded
+    tables, least recently used out)."""
     for t, view in list(_LOADED.values()):
         if t is tab:
             return view
-    return TableView(tab)
+    view = TableView(tab)
+    _LOADED[("object", id(tab))] = (tab, view)  # (the entry holds the table: its id is not reused meanwhile)
+    return view
 
 
 def clear_table_cache() -> None:

@@ -167,6 +167,10 @@ def mc_calibration(table) -> float:
 #: 8,000 random pairs of the paper sensor (lo in [0, 40,080], distances 160 to 40,160, width 80): relative error
 #: at most 4.5e-7 (99th percentile 1.9e-7, median 2.9e-10).
 NOISE_GRID_NODES, NOISE_GRID_A0, NOISE_GRID_MIN_WIDTHS = 128, 100.0, 2.0
+#: The grid is solved in aligned blocks of this many nodes a side, each the first time a pair reads one of
+#: its nodes (a solve's fixed cost is several node's: a process's first questions then fill the blocks later
+#: ones read).
+NOISE_GRID_BLOCK = 8
 
 
 class CriticalNoiseGrid:
@@ -228,8 +232,15 @@ class CriticalNoiseGrid:
             four = np.arange(4)
             flat = (su[:, None, None] + four[None, :, None]) * n + (sv[:, None, None] + four[None, None, :])
             missing = flat[~self.known[flat]]
-            if missing.size:
-                self._fill(np.unique(missing))
+            if missing.size:  # the whole blocks of NOISE_GRID_BLOCK x NOISE_GRID_BLOCK nodes around them
+                b = NOISE_GRID_BLOCK
+                wanted = np.zeros((n // b) ** 2, dtype=bool)  # (not np.unique: its first call imports numpy.ma)
+                wanted[(missing // n) // b * (n // b) + (missing % n) // b] = True
+                blocks = np.flatnonzero(wanted)
+                rows = (blocks // (n // b))[:, None, None] * b + np.arange(b)[None, :, None]
+                cols = (blocks % (n // b))[:, None, None] * b + np.arange(b)[None, None, :]
+                nodes = (rows * n + cols).ravel()
+                self._fill(nodes[~self.known[nodes]])
             g = np.einsum("pi,pj,pij->p", _lagrange4(pu - su), _lagrange4(pv - sv), self.values[flat])
             out[i] = np.exp(g) * (self._weight(hi[i]) - self._weight(lo[i]))
         rest = np.flatnonzero(np.isnan(out) & np.isfinite(lo) & np.isfinite(hi))
@@ -266,12 +277,13 @@ def _entries(view, slices, ka, kb, lo, hi):
     return list(out), jj
 
 
-def _k_readings(op, slices, sw, ka, kb, lo, hi):
+def _k_readings(op, slices, sw, ka, kb, lo, hi, extra=None):
     """The noise efficiency ``log k`` and its standard error at the tabulated contacts ``ka`` and ``kb`` (rows
     0 and 1 of the (2, n) arrays; NaN: no usable entry), per pair, from the pair's own entries (upwards at
     ``lo``, downwards at ``hi``) in the noise-ratio slices ``slices`` (n, m) weighted ``sw`` (n, m); see
     :func:`noise_k_min_contact`. The entries' critical noises are read off the table's
-    :class:`CriticalNoiseGrid`."""
+    :class:`CriticalNoiseGrid`; ``extra``: (lo, hi) of further pairs read in the same call, whose critical
+    noises are returned third (None: not asked)."""
     from ..recognition.ideal import shape_norm
 
     view, tab = op.view, op.tab
@@ -306,8 +318,9 @@ def _k_readings(op, slices, sw, ka, kb, lo, hi):
     a2 = np.maximum(a2, 0.0)
     k = P.size
     # one reading: every entry at its need and one width further
-    star = op.view.critical_noise(np.concatenate([a1, a2]), np.concatenate([b1, b2]))
-    s1, s2 = star[:k], star[k:]
+    xa, xb = extra if extra is not None else (np.zeros(0),) * 2
+    star = op.view.critical_noise(np.concatenate([a1, a2, xa]), np.concatenate([b1, b2, xb]))
+    s1, s2 = star[:k], star[k:2 * k]
     with np.errstate(divide="ignore", invalid="ignore"):
         log_k = np.log(s1 / s_t)
         gamma = np.log(s2 / s1) / np.log((D - h + width) / (D - h))
@@ -333,7 +346,7 @@ def _k_readings(op, slices, sw, ka, kb, lo, hi):
         with np.errstate(divide="ignore", invalid="ignore"):
             lk[c] = np.where(den > 0, num / den, np.nan)
             se[c] = np.where(den > 0, np.hypot(np.sqrt(var) / den, rnd_mean / den), np.nan)
-    return lk, se
+    return (lk, se) if extra is None else (lk, se, star[2 * k:])
 
 
 def _k_line(lk, se, t_a, t_b):
@@ -423,8 +436,11 @@ def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
     n = lo.size
     ka = k_baseline(view.contacts, kb)
     slices, sw = _slices(combos, n)
-    lk, se = _k_readings(op, slices, sw, ka, kb, lo, hi)
-    s_pair = op.view.critical_noise(lo, hi) if s_pair is None else np.atleast_1d(s_pair)
+    if s_pair is None:  # the pair's own critical noise read with its entries'
+        lk, se, s_pair = _k_readings(op, slices, sw, ka, kb, lo, hi, extra=(lo, hi))
+    else:
+        lk, se = _k_readings(op, slices, sw, ka, kb, lo, hi)
+        s_pair = np.atleast_1d(s_pair)
     t_a, t_b = view.contacts[np.where(ka >= 0, ka, kb)], view.contacts[kb]
     la_, lb_, have_a, have_b, falls, wa, wb, disagree = _k_line(lk, se, t_a, t_b)
     ok = have_a | have_b
@@ -446,7 +462,7 @@ def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
     return {"value": np.where(nan, np.nan, value), "low": np.where(nan, np.nan, low),
             "high": np.where(nan, np.nan, high), "k_a": np.where(have_a & ok, np.exp(lk[0]), np.nan),
             "k_b": np.where(have_b & ok, np.exp(lk[1]), np.nan), "t_a": t_a, "t_b": t_b,
-            "k": np.where(nan, np.nan, k_at), "se_log": np.where(nan, np.nan, se_t)}
+            "k": np.where(nan, np.nan, k_at), "se_log": np.where(nan, np.nan, se_t), "s_pair": s_pair}
 
 
 def noise_k_max_ratio(op, contact_s, r_table, r_ideal, lo, hi, *, zc: float) -> dict[str, np.ndarray]:

@@ -210,8 +210,9 @@ def contact_arrays(op, lo, hi, noise, dt, *, ideal_bound: bool, zc: float, class
     efficiency = svm and op.closed and "delta_up_ideal" in view.t.arrays
     eff = {k: _nan(n) for k in ("value", "low", "high", "k", "se_log", "k_a", "k_b", "t_a", "t_b")} if efficiency else None
     e_in = view.e_in(lo) & view.e_in(hi)
-    # the pairs' own critical noises, read once: the closed-form bound and the efficiency route's target
-    star = view.critical_noise(lo, hi) if op.closed and (efficiency or ideal_bound) else None
+    # the pairs' own critical noises (the efficiency route's target, the closed-form bound): read with the
+    # efficiency route's entries where it reads them (one call of the grid), the others' after the loop
+    star, have_star = _nan(n), np.zeros(n, dtype=bool)
     slices = []
     for (nz, d), idx in groups(noise, dt):
         combos, flags = view.scene_weights(nz, d)
@@ -239,16 +240,18 @@ def contact_arrays(op, lo, hi, noise, dt, *, ideal_bound: bool, zc: float, class
             if all(iflags.values()):
                 res["ideal"][idx] = grid_crossing(op.iview.contacts, op.iview.need(op.ikind, icombos, l, h), gap)[0]
         if efficiency and (has := k >= 0).any():
-            r = noise_k_min_contact(op, combos, k[has], l[has], h[has], nz / abs(d), zc=zc,
-                                    s_pair=star[idx[has]])
+            r = noise_k_min_contact(op, combos, k[has], l[has], h[has], nz / abs(d), zc=zc)
             for key in eff:
                 eff[key][idx[has]] = r[key]
+            star[idx[has]], have_star[idx[has]] = r["s_pair"], True
         res["in_grid"][idx] = True
         slices.append((combos, idx))
     sel = np.ones(n, dtype=bool) if outside else res["in_grid"]
     if op.closed and ideal_bound and sel.any():  # outside the grid too: the closed form needs no table
         from .ideal_bound import contact_at_noise
 
+        if (rest := sel & ~have_star).any():
+            star[rest] = view.critical_noise(lo[rest], hi[rest])
         res["ideal"][sel] = contact_at_noise(op.tab.sensor, (noise / np.abs(dt))[sel], star[sel],
                                              CLOSED_FORM_MAX_CONTACT_S)
     res["floor"] = res["ideal"].copy()

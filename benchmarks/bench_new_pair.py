@@ -17,8 +17,11 @@ load is printed beside them)::
 3. **10,000 new pairs as one array call** (target at most 2 s): ``min_contact(e1, e2)`` with arrays of
    ``--array`` random pairs inside the grid (seeded), in a fresh process per tree (the tables opened first).
 4. **``designkit matrix --set paper12``**: its compute in-process (``material_matrix(set="paper12")``, the
-   tables opened first: what this helper's area owns) and its wall from a fresh shell (target at most 1 s;
-   start-up is another part of issue 33).
+   tables opened first) and its wall from a fresh shell (target at most 1 s; start-up is another part of
+   issue 33).
+5. **The answers**: ``min_contact`` (at two noises) and ``max_noise`` (at 2 s) of ``--answers`` seeded random
+   pairs in each tree: how many values changed, whether each lies inside the baseline's interval, how far
+   the interval ends and the ideal bounds moved.
 
 The baseline is ``git archive`` of ``--rev`` into a temporary folder, imported through ``PYTHONPATH``
 (the tables are read from each tree's own ``tables/``).
@@ -37,6 +40,8 @@ import tarfile
 import tempfile
 import time
 from pathlib import Path
+
+import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -90,6 +95,40 @@ print(json.dumps(time.process_time() - t0))
 """
 
 
+ANSWERS = r"""
+import json, sys
+import numpy as np
+from designkit.query import max_noise, min_contact
+rng = np.random.default_rng(33)
+n = int(sys.argv[1])
+a, b = rng.uniform(2000.0, 39000.0, n), rng.uniform(2000.0, 39000.0, n)
+b = np.where(np.abs(a - b) < 500.0, a + 500.0, b)
+out = {}
+for tag, ans in (("min-contact", min_contact(a, b)), ("min-contact at 0.02 degC", min_contact(a, b, noise_c=0.02)),
+                 ("max-noise at 2 s", max_noise(a, b, contact_s=2.0))):
+    out[tag] = [np.asarray(getattr(ans, k), dtype=float).tolist() for k in ("value", "low", "high", "ideal")]
+print(json.dumps(out))
+"""
+
+
+def answers_changed(trees: dict[str, Path], n: int) -> None:
+    """Count the answers of ``n`` seeded random pairs that differ between the trees, and whether each lies
+    inside the baseline's interval."""
+    new, old = (_child(tree, ANSWERS, n) for tree in trees.values())
+    for tag in new:
+        (v1, lo1, hi1, i1), (v0, lo0, hi0, i0) = (np.array(x, dtype=float) for x in new[tag]), \
+            (np.array(x, dtype=float) for x in old[tag])
+        same = (v0 == v1) | (np.isnan(v0) & np.isnan(v1))
+        inside = ~same & (lo0 <= v1) & (v1 <= hi0)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            ends = np.nanmax(np.abs(np.r_[lo1 / lo0, hi1 / hi0] - 1.0), initial=0.0)
+            moved = np.nanmax(np.abs(v1[~same] / v0[~same] - 1.0), initial=0.0)
+        ideal = int(np.sum(~((i0 == i1) | (np.isnan(i0) & np.isnan(i1)))))
+        print(f"{tag}: {int((~same).sum())} of {n} values changed (at most {moved:.1e} relative), "
+              f"{int(inside.sum())} of them inside the baseline's interval; interval ends moved at most "
+              f"{ends:.1e} relative; {ideal} ideal bounds changed")
+
+
 def _tree(rev: str, into: Path) -> Path:
     data = subprocess.run(["git", "-C", str(ROOT), "archive", rev], check=True, capture_output=True).stdout
     with tarfile.open(fileobj=io.BytesIO(data)) as tar:
@@ -120,6 +159,7 @@ def main(argv=None) -> None:
     p.add_argument("--array", type=int, default=10000, help="new pairs in the array call")
     p.add_argument("--pairs", type=int, default=40, help="new pairs per process")
     p.add_argument("--runs", type=int, default=3, help="runs of each measurement per tree")
+    p.add_argument("--answers", type=int, default=3000, help="random pairs whose answers are compared (0: none)")
     a = p.parse_args(argv)
     loads = [os.getloadavg()[0]]
     with tempfile.TemporaryDirectory(prefix="dk-bench-") as tmp:
@@ -150,7 +190,9 @@ def main(argv=None) -> None:
             v = [scale * statistics.median(figs[k][key]) for k in names]
             print(f"| {label} | " + " | ".join(f"{x:.3g}" for x in v) + f" | {v[1] / v[0]:.2f}x | {target} |")
         print(f"\n{len(figs['this tree']['cold'])} new pairs and {a.runs} runs per tree; load (1 min) "
-              f"{min(loads):.1f}-{max(loads):.1f} over the run; ratio = baseline / this tree")
+              f"{min(loads):.1f}-{max(loads):.1f} over the run; ratio = baseline / this tree\n")
+        if a.answers:
+            answers_changed(trees, a.answers)
 
 
 if __name__ == "__main__":

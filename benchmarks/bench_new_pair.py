@@ -1,17 +1,27 @@
 """Issue 33's speed targets of the question layer, this tree against a baseline revision in the same run.
 
-Run from the repository root::
+Run from the repository root (one command; the figures are CPU seconds of each child process, the machine's
+load is printed beside them)::
 
-    python benchmarks/bench_new_pair.py                  # against 2bf154e (before the array-native table route)
-    python benchmarks/bench_new_pair.py --rev HEAD~3 --pairs 60 --runs 5
+    python benchmarks/bench_new_pair.py                  # against e9a377f (before the critical-noise grid)
+    python benchmarks/bench_new_pair.py --rev HEAD~3 --pairs 60 --runs 3
 
-1. **A single new pair in-process** (target at most 1 ms): ``min_contact(e1, e2)`` on the default table,
-   the tables already opened, each pair asked once (nothing in the per-process memos): the median over
-   ``--pairs`` random pairs inside the grid (seeded), in a fresh process per tree, the trees interleaved.
-2. **10,000 new pairs as one array call** (target at most 2 s): ``min_contact(e1, e2)`` with arrays of
+1. **A single new pair in-process** (target at most 1 ms): ``min_contact(e1, e2)`` on the default table, each
+   pair asked once (no per-pair memo holds it), the median over ``--pairs`` random pairs inside the grid
+   (seeded), in a fresh process per tree, the trees interleaved. Two figures: *cold*, the tables opened by one
+   question first (the table's critical-noise grid, :class:`designkit.query.efficiency.CriticalNoiseGrid`,
+   still mostly unsolved: the first questions of a process solve the nodes they read), and *warm*, after one
+   array call of ``--array`` other pairs (the grid then holds the nodes a question reads; the baseline's
+   per-process memos hold nothing of the new pairs either way).
+2. **A repeated pair**: the same pair asked again (the median of ``--pairs`` asks of one pair).
+3. **10,000 new pairs as one array call** (target at most 2 s): ``min_contact(e1, e2)`` with arrays of
    ``--array`` random pairs inside the grid (seeded), in a fresh process per tree (the tables opened first).
-3. **``designkit matrix --set paper12``** from a fresh shell (target at most 1 s wall): median wall over
-   ``--runs`` runs of ``python -m designkit matrix --set paper12``, trees interleaved.
+4. **``designkit matrix --set paper12``**: its compute in-process (``material_matrix(set="paper12")``, the
+   tables opened first) and its wall from a fresh shell (target at most 1 s; start-up is another part of
+   issue 33).
+5. **The answers**: ``min_contact`` (at two noises) and ``max_noise`` (at 2 s) of ``--answers`` seeded random
+   pairs in each tree: how many values changed, whether each lies inside the baseline's interval, how far
+   the interval ends and the ideal bounds moved.
 
 The baseline is ``git archive`` of ``--rev`` into a temporary folder, imported through ``PYTHONPATH``
 (the tables are read from each tree's own ``tables/``).
@@ -31,25 +41,35 @@ import tempfile
 import time
 from pathlib import Path
 
+import numpy as np
+
 ROOT = Path(__file__).resolve().parent.parent
 
 SINGLE = r"""
 import json, sys, time
 import numpy as np
 from designkit.query import min_contact
+seed, count, n_warm = int(sys.argv[1]), int(sys.argv[2]), int(sys.argv[3])
 min_contact(35000.0, 20000.0)  # the tables opened, the caches of the sensor filled
-rng = np.random.default_rng(int(sys.argv[1]))
-pairs = rng.uniform(2000.0, 39000.0, size=(int(sys.argv[2]), 2))
+rng = np.random.default_rng(seed)
+if n_warm:  # other pairs, one array call: what a table's per-table memo holds after it
+    w = rng.uniform(2000.0, 39000.0, size=(n_warm, 2))
+    min_contact(w[:, 0], w[:, 1])
+pairs = rng.uniform(2000.0, 39000.0, size=(count, 2))
 times = []
 for a, b in pairs.tolist():
     if abs(a - b) < 500.0:
         continue
-    t0 = time.perf_counter()
+    t0 = time.process_time()
     min_contact(a, b)
-    times.append(time.perf_counter() - t0)
-print(json.dumps(times))
+    times.append(time.process_time() - t0)
+rep = []
+for _ in range(count):
+    t0 = time.process_time()
+    min_contact(pairs[0, 0], pairs[0, 1])
+    rep.append(time.process_time() - t0)
+print(json.dumps([times, rep]))
 """
-
 
 ARRAY = r"""
 import json, sys, time
@@ -59,10 +79,54 @@ min_contact(35000.0, 20000.0)  # the tables opened
 rng = np.random.default_rng(int(sys.argv[1]))
 pairs = rng.uniform(2000.0, 39000.0, size=(int(sys.argv[2]), 2))
 pairs[:, 1] = np.where(np.abs(pairs[:, 0] - pairs[:, 1]) < 500.0, pairs[:, 0] + 500.0, pairs[:, 1])
-t0 = time.perf_counter()
+t0 = time.process_time()
 min_contact(pairs[:, 0], pairs[:, 1])
-print(json.dumps(time.perf_counter() - t0))
+print(json.dumps(time.process_time() - t0))
 """
+
+MATRIX = r"""
+import json, time
+from designkit.query import min_contact
+from designkit.query.matrix import material_matrix
+min_contact(35000.0, 20000.0)  # the tables opened
+t0 = time.process_time()
+material_matrix(set="paper12")
+print(json.dumps(time.process_time() - t0))
+"""
+
+
+ANSWERS = r"""
+import json, sys
+import numpy as np
+from designkit.query import max_noise, min_contact
+rng = np.random.default_rng(33)
+n = int(sys.argv[1])
+a, b = rng.uniform(2000.0, 39000.0, n), rng.uniform(2000.0, 39000.0, n)
+b = np.where(np.abs(a - b) < 500.0, a + 500.0, b)
+out = {}
+for tag, ans in (("min-contact", min_contact(a, b)), ("min-contact at 0.02 degC", min_contact(a, b, noise_c=0.02)),
+                 ("max-noise at 2 s", max_noise(a, b, contact_s=2.0))):
+    out[tag] = [np.asarray(getattr(ans, k), dtype=float).tolist() for k in ("value", "low", "high", "ideal")]
+print(json.dumps(out))
+"""
+
+
+def answers_changed(trees: dict[str, Path], n: int) -> None:
+    """Count the answers of ``n`` seeded random pairs that differ between the trees, and whether each lies
+    inside the baseline's interval."""
+    new, old = (_child(tree, ANSWERS, n) for tree in trees.values())
+    for tag in new:
+        (v1, lo1, hi1, i1), (v0, lo0, hi0, i0) = (np.array(x, dtype=float) for x in new[tag]), \
+            (np.array(x, dtype=float) for x in old[tag])
+        same = (v0 == v1) | (np.isnan(v0) & np.isnan(v1))
+        inside = ~same & (lo0 <= v1) & (v1 <= hi0)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            ends = np.nanmax(np.abs(np.r_[lo1 / lo0, hi1 / hi0] - 1.0), initial=0.0)
+            moved = np.nanmax(np.abs(v1[~same] / v0[~same] - 1.0), initial=0.0)
+        ideal = int(np.sum(~((i0 == i1) | (np.isnan(i0) & np.isnan(i1)))))
+        print(f"{tag}: {int((~same).sum())} of {n} values changed (at most {moved:.1e} relative), "
+              f"{int(inside.sum())} of them inside the baseline's interval; interval ends moved at most "
+              f"{ends:.1e} relative; {ideal} ideal bounds changed")
 
 
 def _tree(rev: str, into: Path) -> Path:
@@ -76,15 +140,9 @@ def _env(tree: Path) -> dict:
     return {**os.environ, "PYTHONPATH": str(tree)}
 
 
-def single_pair(tree: Path, seed: int, pairs: int) -> list[float]:
-    out = subprocess.run([sys.executable, "-c", SINGLE, str(seed), str(pairs)], cwd=tree, env=_env(tree),
-                         check=True, capture_output=True, text=True).stdout
-    return json.loads(out.strip().splitlines()[-1])
-
-
-def array_call(tree: Path, seed: int, pairs: int) -> float:
-    out = subprocess.run([sys.executable, "-c", ARRAY, str(seed), str(pairs)], cwd=tree, env=_env(tree),
-                         check=True, capture_output=True, text=True).stdout
+def _child(tree: Path, script: str, *args) -> object:
+    out = subprocess.run([sys.executable, "-c", script, *map(str, args)], cwd=tree, env=_env(tree), check=True,
+                         capture_output=True, text=True).stdout
     return json.loads(out.strip().splitlines()[-1])
 
 
@@ -97,37 +155,44 @@ def matrix_wall(tree: Path) -> float:
 
 def main(argv=None) -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--rev", default="2bf154e", help="baseline revision (git archive)")
+    p.add_argument("--rev", default="e9a377f", help="baseline revision (git archive)")
     p.add_argument("--array", type=int, default=10000, help="new pairs in the array call")
     p.add_argument("--pairs", type=int, default=40, help="new pairs per process")
-    p.add_argument("--runs", type=int, default=5, help="runs of each measurement per tree")
+    p.add_argument("--runs", type=int, default=3, help="runs of each measurement per tree")
+    p.add_argument("--answers", type=int, default=3000, help="random pairs whose answers are compared (0: none)")
     a = p.parse_args(argv)
+    loads = [os.getloadavg()[0]]
     with tempfile.TemporaryDirectory(prefix="dk-bench-") as tmp:
         trees = {"this tree": ROOT, f"baseline {a.rev}": _tree(a.rev, Path(tmp))}
-        single: dict[str, list[float]] = {k: [] for k in trees}
-        matrix: dict[str, list[float]] = {k: [] for k in trees}
-        arrays: dict[str, list[float]] = {k: [] for k in trees}
+        figs: dict[str, dict[str, list[float]]] = {k: {f: [] for f in ("cold", "warm", "repeat", "array", "mx",
+                                                                         "mxwall")} for k in trees}
         for run in range(a.runs):
             for name, tree in trees.items():  # interleaved: the machine's load falls on both alike
-                single[name] += single_pair(tree, 100 + run, a.pairs)
-                matrix[name].append(matrix_wall(tree))
-                if run < 2:  # (seconds each)
-                    arrays[name].append(array_call(tree, 200 + run, a.array))
-        print(f"| figure | {' | '.join(trees)} | target |")
-        print("|---|" + "---|" * (len(trees) + 1))
-        med = {k: 1e3 * statistics.median(v) for k, v in single.items()}
-        print("| single new pair, median [ms] | " + " | ".join(f"{v:.2f}" for v in med.values()) + " | <= 1 |")
-        aw = {k: statistics.median(v) for k, v in arrays.items()}
-        print(f"| {a.array:,} new pairs, one array call, median [s] | " + " | ".join(f"{v:.2f}" for v in aw.values())
-              + " | <= 2 |")
-        mw = {k: statistics.median(v) for k, v in matrix.items()}
-        print("| matrix --set paper12, median wall [s] | " + " | ".join(f"{v:.2f}" for v in mw.values())
-              + " | <= 1 |")
-        base = list(trees)[1]
-        print(f"\nratios (baseline / this tree): single pair {med[base] / med['this tree']:.2f}x, "
-              f"array {aw[base] / aw['this tree']:.2f}x, matrix {mw[base] / mw['this tree']:.2f}x; "
-              f"{len(single['this tree'])} pairs and {a.runs} matrix runs per tree; load "
-              f"{os.getloadavg()[0]:.1f}")
+                f = figs[name]
+                cold, rep = _child(tree, SINGLE, 100 + run, a.pairs, 0)
+                f["cold"] += cold
+                f["repeat"] += rep
+                f["warm"] += _child(tree, SINGLE, 100 + run, a.pairs, a.array)[0]
+                f["array"].append(_child(tree, ARRAY, 200 + run, a.array))
+                f["mx"].append(_child(tree, MATRIX))
+                f["mxwall"].append(matrix_wall(tree))
+                loads.append(os.getloadavg()[0])
+        rows = [("single new pair, cold grid, median CPU [ms]", "cold", 1e3, "<= 1"),
+                ("single new pair, warm grid, median CPU [ms]", "warm", 1e3, "<= 1"),
+                ("repeated pair, median CPU [ms]", "repeat", 1e3, ""),
+                (f"{a.array:,} new pairs, one array call, median CPU [s]", "array", 1.0, "<= 2"),
+                ("matrix --set paper12 compute in-process, median CPU [s]", "mx", 1.0, ""),
+                ("matrix --set paper12 from a fresh shell, median wall [s]", "mxwall", 1.0, "<= 1")]
+        names = list(trees)
+        print(f"| figure | {' | '.join(names)} | ratio | target |")
+        print("|---|" + "---|" * (len(names) + 2))
+        for label, key, scale, target in rows:
+            v = [scale * statistics.median(figs[k][key]) for k in names]
+            print(f"| {label} | " + " | ".join(f"{x:.3g}" for x in v) + f" | {v[1] / v[0]:.2f}x | {target} |")
+        print(f"\n{len(figs['this tree']['cold'])} new pairs and {a.runs} runs per tree; load (1 min) "
+              f"{min(loads):.1f}-{max(loads):.1f} over the run; ratio = baseline / this tree\n")
+        if a.answers:
+            answers_changed(trees, a.answers)
 
 
 if __name__ == "__main__":

@@ -119,6 +119,7 @@ def test_twelve_materials_load_each_table_once():
     here); what makes it fast is checked: each table is loaded once for all 66 pairs."""
     import designkit.query.matrix as qm
     from designkit.query import table as qt
+    from designkit.query import table_open as qo
     from designkit.tables import store
 
     calls = []
@@ -128,7 +129,7 @@ def test_twelve_materials_load_each_table_once():
         calls.append(str(a[0]) if a else str(k))
         return real(*a, **k)
 
-    patched = [(mod, "load_table") for mod in (store, qt, qm) if hasattr(mod, "load_table")]
+    patched = [(mod, "load_table") for mod in (store, qt, qo, qm) if hasattr(mod, "load_table")]
     saved = [getattr(mod, name) for mod, name in patched]
     for mod, name in patched:
         setattr(mod, name, counting)

@@ -23,7 +23,7 @@ from .efficiency import interp_e_by, noise_k_max_ratio, table_z
 __all__ = [
     "ABOVE", "BELOW", "CELL", "CONTACT_ESTIMATORS", "ContactReading", "Estimates", "INSIDE",
     "RATIO_ESTIMATORS", "RatioReading", "axis_weights_flagged", "cell_estimate", "contact_estimate", "cross2",
-    "delta_estimate", "efficiency_estimate", "first_applicable", "grid_crossing", "interp_e_rows",
+    "delta_estimate", "efficiency_estimate", "first_applicable", "grid_crossing", "held_interval", "interp_e_rows",
     "pair_need_both", "partner_in_grid", "ratio_beyond", "ratio_cell", "ratio_efficiency", "ratio_estimate",
     "ratio_ideal_table", "ratio_rounding", "rounding_estimate", "stated_log", "states_coverage",
     "table_spread", "varied_contact_estimate", "varied_estimate"
@@ -76,6 +76,28 @@ def stated_log(value, lo_end, hi_end, interp, z_table: float, zc: float) -> tupl
     return out[0], out[1]
 
 
+def held_interval(value, mc_lo, mc_hi, interp, ideal, side: str, *, raw=None, z_table: float,
+                  zc: float) -> tuple[np.ndarray, np.ndarray]:
+    """An estimate's stated interval, elementwise: the table's Monte Carlo ends ``mc_lo`` / ``mc_hi`` of the
+    raw crossing ``raw`` carried to ``value`` (shifted by ``log(value) - log(raw)``; None: they are the
+    value's own), :func:`stated_log` with the interpolation error ``interp`` (log), and the end on ``side``
+    ("low" for a contact time or a distance, "high" for a sigma/dT) held at the ideal bound ``ideal`` (NaN:
+    none), which no classifier beats, unless the value itself is beyond it.
+
+    >>> [float(x) for x in held_interval(2.0, 1.0, 4.0, 0.0, 1.5, "low", z_table=2.0, zc=2.0)]
+    [1.5, 4.0]
+    """
+    if raw is not None:
+        with np.errstate(invalid="ignore", divide="ignore"):
+            shift = np.log(value) - np.log(raw)
+            mc_lo, mc_hi = (np.exp(np.log(np.asarray(m, dtype=np.float64)) + shift) for m in (mc_lo, mc_hi))
+    low, high = stated_log(value, mc_lo, mc_hi, interp, z_table, zc)
+    ideal = np.asarray(ideal, dtype=np.float64)
+    if side == "low":
+        return np.where(np.isnan(low) | np.isnan(ideal), low, np.minimum(np.maximum(low, ideal), value)), high
+    return low, np.where(np.isnan(high) | np.isnan(ideal), high, np.maximum(np.minimum(high, ideal), value))
+
+
 def contact_estimate(x0, x1, n0, n1, gap, raw, mc_lo, mc_hi, ideal, *, width: float, svm: bool,
                      z_table: float, zc: float) -> dict[str, np.ndarray]:
     """min-contact's estimate where the crossing ``raw`` [s] is interpolated between tabulated contact times
@@ -122,18 +144,15 @@ def contact_estimate(x0, x1, n0, n1, gap, raw, mc_lo, mc_hi, ideal, *, width: fl
             rounding = np.where(use, slope * (width / math.sqrt(12.0)) / gap, 0.0)
         else:
             value, interp, rounding = raw, raw_interp, np.zeros_like(raw)
-        shift = np.log(value) - np.log(raw)
-        ends = [np.exp(np.log(np.asarray(m, dtype=np.float64)) + shift) for m in (mc_lo, mc_hi)]
-    low, high = stated_log(value, ends[0], ends[1], np.hypot(interp, rounding), z_table, zc)
-    ideal = np.asarray(ideal, dtype=np.float64)
-    low = np.where(np.isnan(low) | np.isnan(ideal), low, np.minimum(np.maximum(low, ideal), value))
+    low, high = held_interval(value, mc_lo, mc_hi, np.hypot(interp, rounding), ideal, "low", raw=raw,
+                              z_table=z_table, zc=zc)
     return {"value": value, "low": low, "high": high, "interp": interp, "rounding": rounding}
 
 
 def interp_e_rows(rows: np.ndarray, centres: np.ndarray, e: np.ndarray) -> np.ndarray:
-    """:func:`designkit.tables.lookup.interp_e` for every row of ``rows`` [contact, centre] at every ``e``:
-    shape [contact, len(e)]."""
-    return interp_e_by(lambda c: rows[:, c], centres, e)
+    """:func:`designkit.tables.lookup.interp_e` for every row of ``rows`` [..., centre] at every ``e``:
+    shape [..., len(e)]."""
+    return interp_e_by(lambda c: rows[..., c], centres, e)
 
 
 def pair_need_both(view, kind: str, idx: tuple[int, ...], lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
@@ -265,11 +284,8 @@ def ratio_estimate(raw, r_c, r_lin, r_rnd, r_geo, end_lo, end_hi, ideal, *, z_ta
         interp = np.where(use, np.abs(np.log(r_c) - np.log(r_lin)),
                           np.where(np.isnan(r_geo), 0.0, np.abs(np.log(raw) - np.log(r_geo))))
         rounding = np.where(use & ~np.isnan(r_rnd), np.abs(np.log(r_rnd) - np.log(r_c)), 0.0)
-        shift = np.log(r) - np.log(raw)
-        ends = [np.exp(np.log(np.asarray(m, dtype=np.float64)) + shift) for m in (end_lo, end_hi)]
-    low, high = stated_log(r, ends[0], ends[1], np.hypot(interp, rounding), z_table, zc)
-    ideal = np.asarray(ideal, dtype=np.float64)
-    high = np.where(np.isnan(high) | np.isnan(ideal), high, np.maximum(np.minimum(high, ideal), r))
+    low, high = held_interval(r, end_lo, end_hi, np.hypot(interp, rounding), ideal, "high", raw=raw,
+                              z_table=z_table, zc=zc)
     return {"value": r, "low": low, "high": high, "interp": interp, "rounding": rounding}
 
 
@@ -290,10 +306,7 @@ def delta_estimate(value, mc_lo, mc_hi, geometric, ideal, *, width: float, z_tab
     with np.errstate(invalid="ignore", divide="ignore"):
         interp = np.where(np.isnan(geometric), 0.0, np.abs(np.log(value) - np.log(geometric)))
         rounding = (width / math.sqrt(12.0)) / value
-    low, high = stated_log(value, mc_lo, mc_hi, np.hypot(interp, rounding), z_table, zc)
-    ideal = np.asarray(ideal, dtype=np.float64)
-    low = np.where(np.isnan(low) | np.isnan(ideal), low, np.minimum(np.maximum(low, ideal), value))
-    return low, high
+    return held_interval(value, mc_lo, mc_hi, np.hypot(interp, rounding), ideal, "low", z_table=z_table, zc=zc)
 
 
 
@@ -313,9 +326,6 @@ def partner_in_grid(view, e, delta, direction: str):
         out = e + delta <= view.e_hi if direction == "up" else e - delta > view.e_lo
     return bool(out) if np.ndim(out) == 0 else out
 
-
-#: The scalar route's efficiency estimates (:func:`delta_efficiency_estimate`, both directions), per process (least
-#: recently used out): a question asked again reads them from here (the estimate re-reads 24 table entries and 10
 
 
 # ============================================================ the estimators: named strategies over arrays

@@ -32,6 +32,7 @@ from ..sensor import last_sample_index
 __all__ = [
     "BOUND_CACHE_SIZE",
     "clear_bound_cache",
+    "contact_at_noise",
     "exact_ideal_delta",
     "exact_ideal_max_ratio",
     "exact_ideal_min_contact",
@@ -94,14 +95,20 @@ def exact_ideal_min_contact(sensor, lo, hi, ratio, *, width: float = 80.0, thres
     >>> round(float(exact_ideal_min_contact(load_sensor("paper"), 20000.0, 35000.0, 0.005)), 3)
     1.05
     """
-    fs = float(sensor.sample_rate_hz)
-    n_max = max(int(last_sample_index(max_contact_s, fs)), 1)
-
     def compute(a, b, r, w):
-        star = pair_critical_noise(sensor, a, b, width=w, threshold=threshold)
-        return first_sample_at(cumulative_g2(float(sensor.tau_s), fs, n_max), r, star) / fs
+        return contact_at_noise(sensor, r, pair_critical_noise(sensor, a, b, width=w, threshold=threshold),
+                                max_contact_s)
     return _cached("min-contact", sensor, (lo, hi, ratio, width), (float(threshold), float(max_contact_s)),
                    compute)
+
+
+def contact_at_noise(sensor, ratio, s_star, max_contact_s: float = 10.0) -> np.ndarray:
+    """The ideal observer's shortest contact [s] of a pair whose critical noise is ``s_star`` at sigma/dT
+    ``ratio``: the first sample time where ``ratio / |g|`` falls to ``s_star`` (:func:`first_sample_at`),
+    elementwise; NaN where none up to ``max_contact_s`` [s] is."""
+    fs = float(sensor.sample_rate_hz)
+    n_max = max(int(last_sample_index(max_contact_s, fs)), 1)
+    return first_sample_at(cumulative_g2(float(sensor.tau_s), fs, n_max), ratio, s_star) / fs
 
 
 def first_sample_at(cum: np.ndarray, ratio, s_star) -> np.ndarray:

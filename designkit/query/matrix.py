@@ -356,15 +356,23 @@ def multiclass_ideal_accuracy(ranges, sensor, scene, *, max_bins: int = _MAX_BIN
     step = max(s / 8.0, (hi - lo) / max_bins)
     edges = np.arange(lo, hi + step, step)
     best = np.zeros(edges.size - 1)
+    segs = []
     for (a, b), (wa, wb) in zip(r, w):
         # outside [w(a) - 8.5 s, w(b) + 8.5 s] the class's survival is exactly 1 or 0: its bin mass is 0
         i0 = max(int(np.searchsorted(edges, wa - _CUT * s - step)) - 1, 0)
         i1 = min(int(np.searchsorted(edges, wb + _CUT * s + step)) + 1, edges.size)
-        if i1 - i0 < 2:
-            continue
-        surv = class_survival(edges[i0:i1], a, b, sensor.effusivity, s)
+        if i1 - i0 >= 2:
+            segs.append((i0, i1, a, b))
+    if not segs:
+        return float(np.sum(best) / K)
+    # every class's survivals in one call (elementwise: each value is the one a call per class gives)
+    size = [i1 - i0 for i0, i1, _, _ in segs]
+    surv = class_survival(np.concatenate([edges[i0:i1] for i0, i1, _, _ in segs]),
+                          np.repeat([a for *_, a, _ in segs], size), np.repeat([b for *_, b in segs], size),
+                          sensor.effusivity, s)
+    for (i0, i1, _, _), part in zip(segs, np.split(surv, np.cumsum(size)[:-1])):
         seg = best[i0:i1 - 1]
-        np.maximum(seg, surv[:-1] - surv[1:], out=seg)
+        np.maximum(seg, part[:-1] - part[1:], out=seg)
     return float(np.sum(best) / K)
 
 
@@ -448,8 +456,10 @@ def _multiclass(mats, tab, *, noise_c: float, delta_t_c: float, svm_trials: int 
 # ============================================================ the matrix
 def _prefill_bounds(question: str, mats, tab, itab, given: dict) -> None:
     """The closed-form ideal bounds (and min-contact's efficiency estimates) of all pairs in one vectorized
-    call, kept in the cache of :mod:`designkit.query.ideal_bound` where the per-pair table questions find
-    them (one solve per pair was most of a 12-material matrix: docs/decisions-log.md).
+    call: the critical noises they read are solved together, into the table's critical-noise grid
+    (min-contact) or the cache of :mod:`designkit.query.ideal_bound` (max-noise, min-delta-t), where the
+    per-pair table questions find them (one solve per pair was most of a 12-material matrix:
+    docs/decisions-log.md).
     Anything odd is left to the per-pair questions, which say what is wrong."""
     if question not in ("min-contact", "max-noise", "min-delta-t"):
         return
@@ -473,8 +483,8 @@ def _prefill_bounds(question: str, mats, tab, itab, given: dict) -> None:
         if not los:
             return
         if question == "min-contact":
-            # the array route: its closed-form bounds and efficiency estimates land in the same cache, under
-            # the same keys, as the per-pair questions' (the one vectorized computation for every pair)
+            # the array route: the grid nodes its closed-form bounds and efficiency estimates read are those
+            # the per-pair questions read (one vectorized solve for every pair)
             ask("min-contact", route="table", e1=np.array(los), e2=np.array(his), table=tab, ideal_table=itab,
                 **given)
         else:
@@ -566,15 +576,15 @@ def material_matrix(materials: Sequence[str | Material] = (), question: str = "m
     -------
     MaterialMatrix
     """
-    from ..tables.store import Table, load_table
-    from .table import DEFAULT_TABLE
+    from .table_open import DEFAULT_TABLE, as_table
 
     t0 = time.perf_counter()
     if question not in MATRIX_QUESTIONS:
         raise InputError(f"a matrix asks one of: {', '.join(MATRIX_QUESTIONS)}; got {question!r}")
     mats = resolve_materials(materials, set=set)
-    tab = table if isinstance(table, Table) else load_table(DEFAULT_TABLE if table is None else table)
-    itab = ideal_table if ideal_table is None or isinstance(ideal_table, Table) else load_table(ideal_table)
+    # (loaded once per process, with the table's memo: as every table question loads it)
+    tab = as_table(DEFAULT_TABLE if table is None else table)
+    itab = None if ideal_table is None else as_table(ideal_table)
     allowed = frozenset({"contact_s", "noise_c", "delta_t_c", "threshold", "sensor", "model"})
     unknown = sorted(k for k in scene if k not in allowed)
     if unknown:

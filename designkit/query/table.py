@@ -141,7 +141,7 @@ def _answer(question: str, op: OpenedTable, *, objects, limiting, rule: str, sce
                                ideal_method if ideal is not None else "none",
                                ideal_interval if ideal is not None else None),
         objects=tuple(objects), limiting_pair=tuple(limiting), materials_rule=rule, scene=scene,
-        sensor=op.tab.sensor.to_dict(), model=op.model.to_dict(), model_check=check, threshold=op.phi,
+        sensor=op.view.sensor_dict(), model=op.model.to_dict(), model_check=check, threshold=op.phi,
         table=op.tab.name, table_hash=op.tab.header.get("content_hash"), ideal_table=ideal_table,
         ideal_table_hash=op.ihash if ideal_table else None, in_grid=dict(in_grid), details=details,
         computation={"fidelity": op.tab.fidelity, "table_contacts_s": op.view.contacts.tolist(),

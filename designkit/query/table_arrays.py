@@ -24,21 +24,23 @@ import numpy as np
 from ..sensor import within_sample_limit
 from ..tables.store import Table
 from .crossing import coverage_of_z
-from .efficiency import (CLOSED_FORM_MAX_CONTACT_S, delta_efficiency_estimate, delta_entries, mc_calibration,
-                         noise_k_min_contact, table_z)
+from .efficiency import (CLOSED_FORM_MAX_CONTACT_S, CriticalNoiseGrid, delta_efficiency_estimate, delta_entries,
+                         interp_e_by, mc_calibration, noise_k_min_contact, table_z)
 from .estimates import (ABOVE, BELOW, CELL, CONTACT_ESTIMATORS, INSIDE, RATIO_ESTIMATORS,
                         ContactReading, RatioReading, axis_weights_flagged, delta_estimate, first_applicable,
                         grid_crossing, interp_e_rows, partner_in_grid, states_coverage, table_spread)
 
 __all__ = ["CLOSED_FORM_RATIO_BRACKET", "TableView", "at_contact", "contact_arrays", "delta_e_arrays",
-           "distinguishable_arrays", "groups", "max_ratio", "ratio_arrays"]
+           "distinguishable_arrays", "groups", "max_ratio", "ratio_arrays", "scene_groups"]
 
 #: sigma/dT the closed-form ideal bound searches (the exact route's bracket).
 CLOSED_FORM_RATIO_BRACKET = (1e-5, 1.0)
 
 # ============================================================ the table, read over arrays
 class TableView:
-    """One table's axes and its interpolation (:mod:`designkit.tables.lookup`'s rule) over arrays."""
+    """One table's axes and its interpolation (:mod:`designkit.tables.lookup`'s rule) over arrays, and the
+    table's memo of what no question changes: kept with the loaded table
+    (:func:`~designkit.query.table_open.open_table`), so it is computed once per process and table."""
 
     def __init__(self, table: Table):
         self.t = table
@@ -48,6 +50,24 @@ class TableView:
         self.scene_axes = [n for n in table.axis_names if n not in ("contact_s", "e_ref")]
         self.e_lo = float(table.header["effusivity"]["min"])
         self.e_hi = float(table.header["effusivity"]["max"])
+        self._noise_grid: CriticalNoiseGrid | None = None
+        self._sensor_dict: dict | None = None
+        self._mc_factor: float | None = None
+
+    def critical_noise(self, lo, hi) -> np.ndarray:
+        """The ideal observer's critical noise of the table's classes ``[lo, lo + w)``, ``[hi, hi + w)`` (its
+        sensor, width and threshold), elementwise, read off the table's
+        :class:`~designkit.query.efficiency.CriticalNoiseGrid` (filled on demand, kept with the table)."""
+        if self._noise_grid is None:
+            self._noise_grid = CriticalNoiseGrid(self.t.sensor, float(self.t.header["effusivity"]["width"]),
+                                                 self.t.threshold, self.e_hi)
+        return self._noise_grid(lo, hi)
+
+    def sensor_dict(self) -> dict:
+        """The table's ``sensor.to_dict()``, computed once (each caller gets its own top-level dict)."""
+        if self._sensor_dict is None:
+            self._sensor_dict = self.t.sensor.to_dict()
+        return dict(self._sensor_dict)
 
     def scene_weights(self, noise_c: float, delta_t_c: float) -> tuple[list[tuple[tuple[int, ...], float]], dict[str, bool]]:
         """Multilinear weights over the scene axes; in-grid flags per axis."""
@@ -69,8 +89,10 @@ class TableView:
         return combos, flags
 
     def mc_calibration(self) -> float:
-        """:func:`designkit.query.efficiency.mc_calibration` of this table."""
-        return mc_calibration(self.t)
+        """:func:`designkit.query.efficiency.mc_calibration` of this table (computed once)."""
+        if self._mc_factor is None:
+            self._mc_factor = mc_calibration(self.t)
+        return self._mc_factor
 
     def e_in_grid(self, *es: float) -> bool:
         return all(self.e_lo < e <= self.e_hi for e in es)
@@ -79,29 +101,36 @@ class TableView:
         """:meth:`e_in_grid` elementwise."""
         return (self.e_lo < e) & (e <= self.e_hi)
 
-    def delta(self, name: str, combos, e: np.ndarray) -> np.ndarray:
-        """Array ``name`` at scene weights ``combos``, every contact and every ``e``: [contact, len(e)] (NaN:
-        none)."""
-        arr = self.t.arrays[name]
-        total = np.zeros((self.contacts.size, e.size))
-        bad = np.zeros(total.shape, dtype=bool)
-        for idx, w in combos:
-            if w == 0:
-                continue
-            v = interp_e_rows(arr[idx], self.centres, e)
-            bad |= np.isnan(v)
-            total = total + w * v
-        return np.where(bad, np.nan, total)
+    def delta(self, names, combos, e: np.ndarray) -> np.ndarray:
+        """The arrays ``names`` (one name, or a sequence) at scene weights ``combos``, every contact and every
+        ``e``: [contact, len(e)], or [len(names), contact, len(e)] for a sequence (NaN: none), all the weighted
+        scene slices of all the arrays in one reading."""
+        live = [(idx, w) for idx, w in combos if w != 0]
+        at = tuple(np.array(k)[:, None, None] for k in zip(*(idx for idx, _ in live)))  # each [slice, 1, 1]
+        at += (np.arange(self.contacts.size)[:, None],)
+        many = not isinstance(names, str)
+        arrays = [self.t.arrays[n] for n in (names if many else [names])]
+        # [name, slice, contact, e]: only the entries read (the arrays may be mapped from the file)
+        v = interp_e_by(lambda c: np.stack([a[at + (c,)] for a in arrays]), self.centres, e)
+        # (NaN where any weighted slice is NaN; summed in the slices' order)
+        out = np.sum(np.array([w for _, w in live])[:, None, None] * v, axis=1)
+        return out if many else out[0]
 
-    def need(self, kind: str, combos, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    def need(self, kind, combos, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
         """Distance needed to separate ``lo < hi``, ``max(delta_up(lo), delta_down(hi))``, at every contact and
-        pair: [contact, n] (NaN: not within the grid). ``kind``: svm, lo, hi (the Monte Carlo ends), ideal."""
-        suffix = {"svm": "", "lo": "_lo", "hi": "_hi", "ideal": "_ideal"}[kind]
-        up_name, down_name = f"delta_up{suffix}", f"delta_down{suffix}"
-        if up_name not in self.t.arrays:  # ideal tables carry only delta_up / delta_down
-            up_name, down_name = "delta_up", "delta_down"
-        up, down = self.delta(up_name, combos, lo), self.delta(down_name, combos, hi)
-        return np.where(np.isnan(up) | np.isnan(down), np.nan, np.maximum(up, down))
+        pair: [contact, n] (NaN: not within the grid). ``kind``: svm, lo, hi (the Monte Carlo ends), ideal; or a
+        sequence of them: [kind, contact, n], in one reading."""
+        many = not isinstance(kind, str)
+        names = []
+        for k in (kind if many else [kind]):
+            suffix = {"svm": "", "lo": "_lo", "hi": "_hi", "ideal": "_ideal"}[k]
+            if f"delta_up{suffix}" not in self.t.arrays:  # ideal tables carry only delta_up / delta_down
+                suffix = ""
+            names.append(suffix)
+        up = self.delta([f"delta_up{x}" for x in names], combos, lo)
+        down = self.delta([f"delta_down{x}" for x in names], combos, hi)
+        out = np.where(np.isnan(up) | np.isnan(down), np.nan, np.maximum(up, down))
+        return out if many else out[0]
 
 
 def at_contact(cw, per_contact: np.ndarray) -> np.ndarray:
@@ -128,6 +157,20 @@ def groups(*columns: np.ndarray):
     bounds = np.searchsorted(inverse[order], np.arange(len(uniq) + 1))
     for g, row in enumerate(uniq):
         yield tuple(float(v) for v in row), order[bounds[g]:bounds[g + 1]]
+
+
+def scene_groups(view, contact, noise, dt, e_in):
+    """The in-grid groups of elements sharing a scene (contact [s], noise, dT [degC]): per group its scene, the
+    indices of its elements whose effusivities lie inside the grid (``e_in``), its scene weights and its contact
+    weights; groups outside the grid on a scene axis or the contact axis, or with no element inside it, left
+    out."""
+    for scene, idx in groups(contact, noise, dt):
+        c, nz, d = scene
+        combos, flags = view.scene_weights(nz, d)
+        cw, c_ok = axis_weights_flagged(view.contacts, c)
+        idx = idx[e_in[idx]]
+        if all(flags.values()) and c_ok and idx.size:
+            yield scene, idx, combos, cw
 
 
 def _nan(n: int) -> np.ndarray:
@@ -167,6 +210,9 @@ def contact_arrays(op, lo, hi, noise, dt, *, ideal_bound: bool, zc: float, class
     efficiency = svm and op.closed and "delta_up_ideal" in view.t.arrays
     eff = {k: _nan(n) for k in ("value", "low", "high", "k", "se_log", "k_a", "k_b", "t_a", "t_b")} if efficiency else None
     e_in = view.e_in(lo) & view.e_in(hi)
+    # the pairs' own critical noises (the efficiency route's target, the closed-form bound): read with the
+    # efficiency route's entries where it reads them (one call of the grid), the others' after the loop
+    star, have_star = _nan(n), np.zeros(n, dtype=bool)
     slices = []
     for (nz, d), idx in groups(noise, dt):
         combos, flags = view.scene_weights(nz, d)
@@ -175,13 +221,20 @@ def contact_arrays(op, lo, hi, noise, dt, *, ideal_bound: bool, zc: float, class
             continue
         l, h = lo[idx], hi[idx]
         gap = h - l
-        value, k, _, _, n0, n1 = grid_crossing(grid, view.need("svm", combos, l, h), gap)
-        res["raw"][idx], res["k_cross"][idx] = value, k
+        # every need in one reading, every crossing in one: svm, its Monte Carlo ends, the grid's own bound
+        kinds = ["svm"] + (["lo", "hi"] if svm else []) + (["ideal"] if "delta_up_ideal" in view.t.arrays else [])
+        need = view.need(kinds, combos, l, h)  # [kind, contact, pair]
+        m = l.size
+        value, k, _, _, n0, n1 = grid_crossing(grid, need.transpose(1, 0, 2).reshape(grid.size, -1),
+                                               np.tile(gap, len(kinds)))
+        cross = dict(zip(kinds, value.reshape(len(kinds), m)))
+        k, n0, n1 = k[:m], n0[:m], n1[:m]
+        res["raw"][idx], res["k_cross"][idx] = cross["svm"], k
         res["n_prev"][idx], res["n_at"][idx] = np.where(k > 0, n0, np.nan), n1
         for end in ("lo", "hi"):
-            res[f"mc_{end}"][idx] = grid_crossing(grid, view.need(end, combos, l, h), gap)[0] if svm else value
-        if "delta_up_ideal" in view.t.arrays:  # the grid's own bound, beside the exact one
-            res["table_ideal"][idx] = grid_crossing(grid, view.need("ideal", combos, l, h), gap)[0]
+            res[f"mc_{end}"][idx] = cross.get(end, cross["svm"])
+        if "ideal" in cross:  # the grid's own bound, beside the exact one
+            res["table_ideal"][idx] = cross["ideal"]
         if not op.closed and not ideal_bound and op.iview is not None:  # the table's own floor (no Monte Carlo)
             icombos, iflags = op.iview.scene_weights(nz, d)
             if all(iflags.values()):
@@ -190,15 +243,17 @@ def contact_arrays(op, lo, hi, noise, dt, *, ideal_bound: bool, zc: float, class
             r = noise_k_min_contact(op, combos, k[has], l[has], h[has], nz / abs(d), zc=zc)
             for key in eff:
                 eff[key][idx[has]] = r[key]
+            star[idx[has]], have_star[idx[has]] = r["s_pair"], True
         res["in_grid"][idx] = True
         slices.append((combos, idx))
     sel = np.ones(n, dtype=bool) if outside else res["in_grid"]
     if op.closed and ideal_bound and sel.any():  # outside the grid too: the closed form needs no table
-        from .ideal_bound import exact_ideal_min_contact
+        from .ideal_bound import contact_at_noise
 
-        res["ideal"][sel] = exact_ideal_min_contact(op.tab.sensor, lo[sel], hi[sel], (noise / np.abs(dt))[sel],
-                                                    width=op.width, threshold=op.phi,
-                                                    max_contact_s=CLOSED_FORM_MAX_CONTACT_S)
+        if (rest := sel & ~have_star).any():
+            star[rest] = view.critical_noise(lo[rest], hi[rest])
+        res["ideal"][sel] = contact_at_noise(op.tab.sensor, (noise / np.abs(dt))[sel], star[sel],
+                                             CLOSED_FORM_MAX_CONTACT_S)
     res["floor"] = res["ideal"].copy()
     if not op.closed and ideal_bound:  # no closed form: Monte Carlo at query time, one per element
         from .ideal_mc_bound import cached_mc_ideal_min_contact
@@ -373,12 +428,7 @@ def delta_e_arrays(op, e, contact, noise, dt, *, ideal_view, zc: float, ideal_bo
     e_in = view.e_in(e)
     iview, ikind = ideal_view
     efficiency = svm and op.closed and "delta_up_ideal" in view.t.arrays
-    for (c, nz, d), idx in groups(contact, noise, dt):
-        combos, flags = view.scene_weights(nz, d)
-        cw, c_ok = axis_weights_flagged(view.contacts, c)
-        idx = idx[e_in[idx]]
-        if not (all(flags.values()) and c_ok and idx.size):
-            continue
+    for (c, nz, d), idx, combos, cw in scene_groups(view, contact, noise, dt, e_in):
         xe = e[idx]
         icombos = iview.scene_weights(nz, d)[0] if iview is not None else []
         icw = axis_weights_flagged(iview.contacts, c)[0] if iview is not None else []
@@ -479,12 +529,7 @@ def distinguishable_arrays(op, lo, hi, contact, noise, dt, *, ideal_bound: bool,
     res: dict[str, Any] = {k: _nan(n) for k in ("grid_svm", "grid_lo", "grid_hi", "ideal")}
     res["in_grid"], res["ideal_method"] = np.zeros(n, dtype=bool), np.full(n, "none", dtype=object)
     e_in = view.e_in(lo) & view.e_in(hi)
-    for (c, nz, d), idx in groups(contact, noise, dt):
-        combos, flags = view.scene_weights(nz, d)
-        cw, c_ok = axis_weights_flagged(view.contacts, c)
-        idx = idx[e_in[idx]]
-        if not (all(flags.values()) and c_ok and idx.size):
-            continue
+    for _, idx, combos, cw in scene_groups(view, contact, noise, dt, e_in):
         res["in_grid"][idx] = True
         l, h = lo[idx], hi[idx]
         for kind in (("svm", "lo", "hi") if svm else ("svm",)):

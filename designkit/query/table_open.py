@@ -15,13 +15,13 @@ from cachetools import LRUCache
 
 from .._validation import check_nonnegative
 from ..tables.store import Table, load_table, resolve_table
-from .efficiency import clear_efficiency_cache
 from .estimates import table_spread
 from .inputs import TableMismatch, check_threshold
 from .table_arrays import TableView
 
 __all__ = ["DEFAULT_IDEAL_TABLE", "DEFAULT_TABLE", "SPREAD_TABLE_QUESTIONS", "VARIED_TABLE", "OpenedTable",
-           "as_table", "clear_table_cache", "delta_e_ideal_view", "ideal_view", "open_table", "shipped_spread_table"]
+           "as_table", "clear_table_cache", "delta_e_ideal_view", "ideal_view", "open_table", "shipped_spread_table",
+           "table_view"]
 
 DEFAULT_TABLE = "svm-fine"
 #: The shipped table for the paper's second setting (the sensor's temperature drawn per touch, uniform in
@@ -30,9 +30,10 @@ VARIED_TABLE = "svm-paper-varied"
 DEFAULT_IDEAL_TABLE = "ideal-paper"
 
 
-#: Tables loaded (and verified) by this process, keyed by their files' identity: a name or path is
-#: read and hashed once, not on every question. Least recently used out.
-_LOADED: "LRUCache[tuple, Table]" = LRUCache(16)
+#: Tables loaded (and verified) by this process, keyed by their files' identity, each with its
+#: :class:`~designkit.query.table_arrays.TableView` (the table's memo): a name or path is read and hashed
+#: once, not on every question. Least recently used out.
+_LOADED: "LRUCache[tuple, tuple[Table, TableView]]" = LRUCache(16)
 
 
 def as_table(table: "Table | str") -> Table:
@@ -46,17 +47,29 @@ def as_table(table: "Table | str") -> Table:
                     for st in (p.stat(),))
     except OSError:  # let load_table say what is missing
         return load_table(npz)
-    t = _LOADED.get(key)
-    if t is None:
-        t = _LOADED[key] = load_table(npz)
-    return t
+    hit = _LOADED.get(key)
+    if hit is None:
+        t = load_table(npz)
+        hit = _LOADED[key] = (t, TableView(t))
+    return hit[0]
+
+
+def table_view(tab: Table) -> TableView:
+    """The view of ``tab`` kept with it (its memo: the critical noises, computed once per table): the one made
+    when this process loaded it, or when a question first read this Table object (kept beside the loaded
+    tables, least recently used out)."""
+    for t, view in list(_LOADED.values()):
+        if t is tab:
+            return view
+    view = TableView(tab)
+    _LOADED[("object", id(tab))] = (tab, view)  # (the entry holds the table: its id is not reused meanwhile)
+    return view
 
 
 def clear_table_cache() -> None:
-    """Forget the tables this process has loaded (they are re-read and re-verified on next use), and the
-    noise-efficiency readings taken from them."""
+    """Forget the tables this process has loaded (they are re-read and re-verified on next use), and what
+    their views computed of them."""
     _LOADED.clear()
-    clear_efficiency_cache()
 
 
 # ============================================================ opening a table for a question
@@ -92,7 +105,7 @@ def ideal_view(svm: TableView, ideal_table: "Table | str | None") -> tuple[Table
         t = as_table(ideal_table)
         if (t.sensor == svm.t.sensor and t.fidelity == "ideal" and t.threshold == svm.t.threshold
                 and t.model == svm.t.model):
-            return TableView(t), "svm", t
+            return table_view(t), "svm", t
     if "delta_up_ideal" in svm.t.arrays:
         return svm, "ideal", svm.t
     if svm.t.fidelity == "ideal":
@@ -172,7 +185,7 @@ def open_table(table: "Table | str" = DEFAULT_TABLE, ideal_table: "Table | str |
         if asked != fm:
             raise TableMismatch(f"table {tab.name} was built for the {fm.describe()} model, "
                                 f"not the {asked.describe()} model")
-    view = TableView(tab)
+    view = table_view(tab)
     if _closed_form(tab, fm):  # the bound is computed at query time: the default ideal table is not read
         if ideal_table is not None and ideal_table != DEFAULT_IDEAL_TABLE:
             as_table(ideal_table)  # a table the caller named must exist: an error, not a silent fallback

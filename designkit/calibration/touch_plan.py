@@ -1,7 +1,7 @@
 """What an emulated rig touches and when, and how it announces it on the wire.
 
 :class:`EmulatedMaterial` and :class:`TouchPlan` set up an
-:class:`~designkit.calibration.emulator.Emulator`; :class:`TouchRecord` is the ground truth of
+:class:`~designkit_lab.emulator.Emulator`; :class:`TouchRecord` is the ground truth of
 one of its touches. The emulator's first line (:func:`greeting_text`) and a device message at
 each touch (:func:`announcement_text`) name the plan; a recorder reads them back
 (:func:`parse_greeting`, :func:`parse_announcement`) to refuse a run that would label the

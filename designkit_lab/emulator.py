@@ -45,12 +45,12 @@ from typing import Sequence
 
 import numpy as np
 
-from .._validation import InputError, as_generator, check_nonnegative, check_positive
-from ..models.semi_infinite import object_weight, response_shape
-from ..sensor import Sensor
-from .conversions import Linear, Thermistor
-from .profiles import DeviceProfile
-from .touch_plan import EmulatedMaterial, TouchPlan, TouchRecord, announcement_text, greeting_text
+from designkit._validation import InputError, as_generator, check_nonnegative, check_positive
+from designkit.models.semi_infinite import object_weight, response_shape
+from designkit.sensor import Sensor
+from designkit.calibration.conversions import Linear, Thermistor
+from designkit.calibration.profiles import DeviceProfile
+from designkit.calibration.touch_plan import EmulatedMaterial, TouchPlan, TouchRecord, announcement_text, greeting_text
 
 __all__ = ["EmulatedMaterial", "Emulator", "Faults", "TouchPlan", "TouchRecord"]
 
@@ -205,7 +205,7 @@ class Emulator:
         self.profile = profile
         self.sensor = sensor
         if model is not None:
-            from ..models import get_model
+            from designkit.models import get_model
 
             model = get_model(model)
             if "diffusivity_m2_s" in model.object_properties:
@@ -438,8 +438,8 @@ class Emulator:
 
         from scipy.signal import fftconvolve
 
-        from ..models import get_model
-        from ..models.ramp import area_share
+        from designkit.models import get_model
+        from designkit.models.ramp import area_share
 
         key = (j, e)
         if key in self._curves:

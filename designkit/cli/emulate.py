@@ -143,7 +143,8 @@ def _check_emulation(touch_every: float, duration: Optional[float], speed: float
 def _emulated_materials(material: Optional[list[str]], e: Optional[float], object_temp: Optional[float]) -> list:
     """The objects the emulated rig touches: ``--material`` NAME or LABEL=E (in turn), then ``--e``."""
     from .._validation import InputError
-    from ..calibration.touch_plan import EmulatedMaterial
+
+    EmulatedMaterial = import_lab("emulator", "emulate").EmulatedMaterial
 
     mats = []
     for spec in material or []:

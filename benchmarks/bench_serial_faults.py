@@ -5,7 +5,7 @@ Run from the repository root::
     python benchmarks/bench_serial_faults.py                          # this tree
     python benchmarks/bench_serial_faults.py --baseline /path/to/old   # and an older tree, same scenarios
 
-The rig is this tree's emulator (:class:`designkit.calibration.emulator.Emulator`, in this
+The rig is this tree's emulator (:class:`designkit_lab.emulator.Emulator`, in this
 process, on a real pseudo-terminal); the recorder is ``designkit calibrate record`` (or
 ``designkit classify``) run as a process from the tree under test (``PYTHONPATH``), exactly
 as a user runs it. An older tree records from the same emulator, so its figures are those of
@@ -54,7 +54,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from designkit import SENSORS  # noqa: E402
-from designkit.calibration.emulator import EmulatedMaterial, Emulator, Faults, TouchPlan  # noqa: E402
+from designkit_lab.emulator import EmulatedMaterial, Emulator, Faults, TouchPlan  # noqa: E402
 from designkit.calibration.profiles import list_profiles, load_profile  # noqa: E402
 
 PLAN = TouchPlan(touch_every_s=13.0)

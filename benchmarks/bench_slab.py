@@ -41,6 +41,7 @@ import numpy as np
 
 from designkit import SENSORS
 from designkit.models import fv, slab
+from designkit_lab import explicit_euler
 
 SENSOR = SENSORS["paper"]
 DT_C = 10.0  # sensor - object temperature difference [degC]
@@ -175,14 +176,14 @@ def stability():
     rows = []
     for label, (e, a), L, back, contact in cases:
         grid = _grid(e, a, L, back, contact, slab.FV_DEFAULTS["cells_per_layer"])
-        limit = float(fv.explicit_step_limit_s(grid)[0])
+        limit = float(explicit_euler.explicit_step_limit_s(grid)[0])
         t = SENSOR.times_s(contact)
         levels = fv.time_levels_s(t, slab.FV_DEFAULTS["step_ratio"])
         cn = fv.integrate_crank_nicolson(grid, t, slab.FV_DEFAULTS["step_ratio"])[0]
         ref = slab.slab_response(t, e, a, L, back, tolerance=1e-12, method="image-series").response[0]
         dt_try = 1.0 / SENSOR.sample_rate_hz
-        bad = fv.integrate_explicit(grid, min(dt_try, 2.0 * limit), 2000)
-        good = fv.integrate_explicit(grid, 0.9 * limit, 2000)
+        bad = explicit_euler.integrate_explicit(grid, min(dt_try, 2.0 * limit), 2000)
+        good = explicit_euler.integrate_explicit(grid, 0.9 * limit, 2000)
         rows.append({
             "case": label,
             "cells": grid.n_cells,

@@ -1,6 +1,6 @@
 """Synthetic calibration round trips over a real pseudo-terminal, for every identifiable sensor model.
 
-One run: an :class:`~designkit.calibration.emulator.Emulator` plays a rig whose
+One run: an :class:`~designkit_lab.emulator.Emulator` plays a rig whose
 sensor follows a known forward model (:data:`CASES`), one pty per material;
 :class:`~designkit.calibration.recorder.SerialRecorder` records its touches
 from that pty exactly as from a USB rig; :func:`~designkit.calibration.identify.identify`
@@ -90,7 +90,7 @@ class RoundTripCase:
                          drift=self.drift, force_area=self.force_area)
 
     def plan(self, touches: int, press: "tuple[float, float] | None" = None) -> dict[str, Any]:
-        """The emulator's :class:`~designkit.calibration.emulator.TouchPlan` settings for this case.
+        """The emulator's :class:`~designkit_lab.emulator.TouchPlan` settings for this case.
 
         ``press``: the force ramps' mean duration [s] and spread (a share of it) of the ``+area`` cases,
         default :data:`CHAIN_PLAN`'s (0.6 s +- 50 %, about as on the shared recordings);
@@ -190,7 +190,7 @@ def _record(case: RoundTripCase, seed: int, noise_c: float, touches: int, speed:
     """Emulate and record every material over its own pty; returns the emulated time offset [s]."""
     from designkit.models import get_model
     from designkit.sensor import Sensor
-    from designkit.calibration.emulator import EmulatedMaterial, Emulator, TouchPlan
+    from designkit_lab.emulator import EmulatedMaterial, Emulator, TouchPlan
     from designkit.calibration.profiles import load_profile
     from designkit.calibration.recorder import SerialRecorder
 

@@ -22,7 +22,7 @@ import time
 from pathlib import Path
 
 from designkit import SENSORS
-from designkit.calibration.emulator import EmulatedMaterial, Emulator, TouchPlan
+from designkit_lab.emulator import EmulatedMaterial, Emulator, TouchPlan
 from designkit.calibration.fit import parse_ranges, resolve_ranges
 from designkit.calibration.candidates import CANDIDATES
 from designkit.calibration.compare import compare_models

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from designkit import SENSORS
-from designkit.calibration.emulator import EmulatedMaterial, Emulator, Faults, TouchPlan
+from designkit_lab.emulator import EmulatedMaterial, Emulator, Faults, TouchPlan
 from designkit.calibration.profiles import load_profile
 from designkit.calibration.trials import write_trial
 from designkit.sensor import load_sensor

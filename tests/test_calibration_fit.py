@@ -176,7 +176,7 @@ def test_guided_run_against_the_emulator_records_its_first_touch_and_labels_ever
     import json
 
     from designkit import SENSORS
-    from designkit.calibration.emulator import EmulatedMaterial, Emulator, TouchPlan
+    from designkit_lab.emulator import EmulatedMaterial, Emulator, TouchPlan
     from designkit.calibration.profiles import load_profile
 
     paper = SENSORS["paper"]
@@ -282,7 +282,7 @@ def test_touches_in_which_no_heat_flows_are_refused_not_fitted(cli, tmp_path, ho
 def test_touches_below_the_contact_threshold_get_a_hint_with_their_peak_force(cli, tmp_path):
     """The emulated rig presses with 4.2 N; the profile's threshold is 5 N: no touch would ever be recorded."""
     from designkit import SENSORS
-    from designkit.calibration.emulator import EmulatedMaterial, Emulator, TouchPlan
+    from designkit_lab.emulator import EmulatedMaterial, Emulator, TouchPlan
     from designkit.calibration.profiles import load_profile
 
     prof = load_profile("designkit")

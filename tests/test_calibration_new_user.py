@@ -50,7 +50,7 @@ def test_a_refused_model_fit_still_writes_its_plot(cli, tmp_path):
 # ------------------------------------ emulate and the guided run agree on the protocol
 def _two_materials(per_material: int, seed: int = 0, speed: float = 100.0):
     from designkit import SENSORS
-    from designkit.calibration.emulator import EmulatedMaterial, Emulator, TouchPlan
+    from designkit_lab.emulator import EmulatedMaterial, Emulator, TouchPlan
     from designkit.calibration.profiles import load_profile
 
     return Emulator(load_profile("designkit"), SENSORS["paper"],
@@ -212,7 +212,7 @@ def _replay_rig(robot_data_dir, per_material: int, profile):
     import numpy as np
 
     from designkit import SENSORS
-    from designkit.calibration.emulator import EmulatedMaterial, Emulator, TouchPlan
+    from designkit_lab.emulator import EmulatedMaterial, Emulator, TouchPlan
     from designkit.calibration.trials import load_index
 
     trials = load_index(robot_data_dir / "index.csv", only=["metal", "wood"])

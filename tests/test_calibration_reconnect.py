@@ -17,7 +17,7 @@ import pytest
 import yaml
 
 from designkit import SENSORS
-from designkit.calibration.emulator import EmulatedMaterial, Emulator, Faults, TouchPlan
+from designkit_lab.emulator import EmulatedMaterial, Emulator, Faults, TouchPlan
 from designkit.calibration.profiles import list_profiles, profile_from_dict
 from designkit.calibration.recorder import DeviceChanged, SerialRecorder
 from designkit.calibration.trials import load_index

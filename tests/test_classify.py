@@ -9,7 +9,7 @@ import json
 import pytest
 
 from designkit import SENSORS
-from designkit.calibration.emulator import EmulatedMaterial, Emulator, TouchPlan
+from designkit_lab.emulator import EmulatedMaterial, Emulator, TouchPlan
 from designkit.calibration.profiles import load_profile
 
 PAPER = SENSORS["paper"]
@@ -148,7 +148,7 @@ def test_a_device_that_vanishes_mid_session_keeps_the_decisions_made(cli):
     """The pty closes after two touches: the two decisions are in --json's document beside the error (only the
     error was there, saying "trial(s) kept in None"), exit 2, and the text route prints them before its one
     error line."""
-    from designkit.calibration.emulator import Faults
+    from designkit_lab.emulator import Faults
 
     mats = [EmulatedMaterial("metal", 20000.0), EmulatedMaterial("wood", 420.0)]
     for json_ in (True, False):

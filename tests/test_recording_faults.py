@@ -27,7 +27,7 @@ from hypothesis import strategies as st
 
 from designkit import SENSORS
 from designkit._validation import InputError
-from designkit.calibration.emulator import EmulatedMaterial, Emulator, Faults, TouchPlan
+from designkit_lab.emulator import EmulatedMaterial, Emulator, Faults, TouchPlan
 from designkit.calibration.profiles import list_profiles, load_profile, profile_from_dict
 from designkit.calibration.cutter import TrialCutter, TrialNotWritten
 from designkit.calibration.recorder import SPIKE_SIGMAS, NoProgress, SerialRecorder

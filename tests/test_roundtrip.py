@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from designkit import InputError
-from designkit.calibration.emulator import EmulatedMaterial, Emulator, TouchPlan
+from designkit_lab.emulator import EmulatedMaterial, Emulator, TouchPlan
 from designkit.calibration.profiles import load_profile
 from designkit_lab.roundtrip import CASES, round_trip, summarize
 from designkit.models import get_model

@@ -13,6 +13,7 @@ from designkit import SENSORS, InputError
 from designkit.models import fv
 from designkit.models.semi_infinite import object_weight, response_shape
 from designkit.models.slab import FV_DEFAULTS, Backing, slab_response
+from designkit_lab import explicit_euler
 
 SENSOR = SENSORS["paper"]
 COPPER = (36800.0, 1.17e-4)
@@ -132,7 +133,7 @@ def test_explicit_step_limit_matches_dense_eigenvalues():
         a[i, i + 1] -= g[i]
         a[i + 1, i] -= g[i]
     lam = np.max(np.linalg.eigvals(a / m[:, None]).real)
-    assert fv.explicit_step_limit_s(grid)[0] == pytest.approx(2.0 / lam, rel=1e-9)
+    assert explicit_euler.explicit_step_limit_s(grid)[0] == pytest.approx(2.0 / lam, rel=1e-9)
 
 
 def test_explicit_stepping_is_unstable_where_implicit_is_not():
@@ -143,12 +144,12 @@ def test_explicit_stepping_is_unstable_where_implicit_is_not():
     and accurate."""
     grid = fv.build_grid(sensor_layer(), stack(*COPPER, 1e-4, FOAM_BACK), SENSOR.depth_m, 4.0,
                          FV_DEFAULTS["cells_per_layer"])
-    limit = float(fv.explicit_step_limit_s(grid)[0])
+    limit = float(explicit_euler.explicit_step_limit_s(grid)[0])
     assert grid.widths_m.min() < 1e-6
     assert limit < 1e-7
-    bad = fv.integrate_explicit(grid, 1.1 * limit, 3000)
+    bad = explicit_euler.integrate_explicit(grid, 1.1 * limit, 3000)
     assert bad.diverged and bad.steps_taken < 3000
-    good = fv.integrate_explicit(grid, 0.9 * limit, 3000)
+    good = explicit_euler.integrate_explicit(grid, 0.9 * limit, 3000)
     assert not good.diverged
     assert np.nanmax(good.max_abs) <= 1.0 + 1e-12  # the maximum principle holds
     t = SENSOR.times_s(4.0)

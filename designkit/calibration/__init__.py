@@ -4,9 +4,8 @@
   line format, channels, contact rule, trial window).
 - :mod:`~designkit.calibration.conversions`: a channel's raw numbers to engineering values
   (linear, thermistors) and back.
-- :mod:`~designkit.calibration.emulator`: a simulated rig on a pseudo-terminal.
-- :mod:`~designkit.calibration.touch_plan`: what the emulated rig touches and when, and how it
-  announces it on the wire.
+- :mod:`~designkit.calibration.touch_plan`: what an emulated rig (``designkit emulate``, the lab's
+  :mod:`designkit_lab.emulator`) touches and when, and how it announces it on the wire.
 - :mod:`~designkit.calibration.recorder`: recording touches over serial; :mod:`~designkit.calibration.cutter`
   cuts the stream into trials, :mod:`~designkit.calibration.reconnect` checks a reopened port.
 - :mod:`~designkit.calibration.trials`: trials on disk (CSV + JSON sidecar + index).
@@ -22,5 +21,5 @@
 Submodules are imported on use; this package imports nothing heavy.
 """
 
-__all__ = ["candidates", "compare", "conversions", "cutter", "emulator", "fit", "force", "identify", "profiles", "reconnect",
+__all__ = ["candidates", "compare", "conversions", "cutter", "fit", "force", "identify", "profiles", "reconnect",
            "recorder", "results", "robust", "split", "touch_plan", "trials"]

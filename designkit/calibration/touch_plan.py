@@ -1,11 +1,9 @@
-"""What an emulated rig touches and when, and how it announces it on the wire.
+"""How an emulated rig announces what it touches and when, on the wire.
 
-:class:`EmulatedMaterial` and :class:`TouchPlan` set up an
-:class:`~designkit.calibration.emulator.Emulator`; :class:`TouchRecord` is the ground truth of
-one of its touches. The emulator's first line (:func:`greeting_text`) and a device message at
-each touch (:func:`announcement_text`) name the plan; a recorder reads them back
-(:func:`parse_greeting`, :func:`parse_announcement`) to refuse a run that would label the
-touches wrongly.
+The emulator's (:class:`designkit_lab.emulator.Emulator`, ``designkit emulate``) first line
+(:func:`greeting_text`) and a device message at each touch (:func:`announcement_text`) name its touch
+plan; a recorder reads them back (:func:`parse_greeting`, :func:`parse_announcement`) to refuse a run that
+would label the touches wrongly. Writer and reader live here together, so that the two agree.
 """
 
 from __future__ import annotations
@@ -16,70 +14,8 @@ import re
 from dataclasses import dataclass
 from typing import Sequence
 
-from .._validation import check_effusivity
-from .trials import check_material_label
 
-__all__ = ["AnnouncedPlan", "EmulatedMaterial", "TouchPlan", "TouchRecord", "announcement_text", "greeting_text",
-           "parse_announcement", "parse_greeting"]
-
-
-@dataclass(frozen=True)
-class EmulatedMaterial:
-    """An object the emulated rig touches.
-
-    Parameters
-    ----------
-    label : str
-        Name shown and logged.
-    effusivity : float
-        e_o [J s^-1/2 K^-1 m^-2].
-    object_temp_c : float or None
-        Object temperature [degC]; None: room temperature (the emulator's
-        ambient).
-    """
-
-    label: str
-    effusivity: float
-    object_temp_c: float | None = None
-
-    def __post_init__(self) -> None:
-        check_material_label(self.label, "the emulated material's label")   # it labels the recorded trials
-        object.__setattr__(self, "effusivity", check_effusivity(self.label, self.effusivity))
-
-
-@dataclass(frozen=True)
-class TouchPlan:
-    """When and how the emulated rig touches.
-
-    ``contact_s`` defaults to the profile's trial window plus half a second,
-    ``press_force_n`` to twice the contact threshold.
-
-    What real touches do beyond the paper's model (all off by default):
-
-    ``ramp_spread``: touch ``j``'s force ramp lasts ``ramp_s (1 + ramp_spread
-    v_j)``, ``v_j`` uniform in [-1, 1] (the pace differs from touch to touch).
-    ``contact_force_fraction`` (c): the contact area grows with the force,
-    ``A = clip((F / F_p - c) / (1 - c), 0, 1)``, each share starting its heat
-    flow as it comes into contact (:class:`~designkit.models.ramp.ForceRamp`);
-    None: the whole area at once when the force leaves zero.
-    ``drift_c_per_s`` and ``drift_sd_c_per_s``: the heater still warms at a
-    rate ``s_j`` (normal, per touch) from ``drift_lead_s`` before contact until
-    release, on the sensor's side of the contact: ``T = (Ts + s_j t)(1 - u) +
-    To u``; after release it settles back to its set point.
-    """
-
-    touch_every_s: float = 20.0
-    first_touch_s: float = 2.0
-    contact_s: float | None = None
-    press_force_n: float | None = None
-    ramp_s: float = 0.5
-    recover_s: float = 0.4
-    touches_per_material: int = 1
-    ramp_spread: float = 0.0
-    contact_force_fraction: float | None = None
-    drift_c_per_s: float = 0.0
-    drift_sd_c_per_s: float = 0.0
-    drift_lead_s: float = 1.5
+__all__ = ["AnnouncedPlan", "announcement_text", "greeting_text", "parse_announcement", "parse_greeting"]
 
 
 _GREETING = re.compile(r"designkit emulator, profile .*?; touches \d+ of each of \[.*\] in turn")
@@ -184,25 +120,15 @@ def _plan(text: str) -> AnnouncedPlan | None:
     return AnnouncedPlan(tuple(labels), int(m.group("n")))
 
 
-@dataclass(frozen=True)
-class TouchRecord:
-    """Ground truth of one emulated touch (device time)."""
-
-    index: int
-    material: str
-    effusivity: float
-    start_s: float
-    expected_onset_s: float
-
-
-def greeting_text(prefix: str, profile_name: str, labels: Sequence[str], plan: TouchPlan) -> str:
-    """The emulator's first line (a device message after ``prefix``): the touch plan."""
+def greeting_text(prefix: str, profile_name: str, labels: Sequence[str], plan) -> str:
+    """The emulator's first line (a device message after ``prefix``): the touch plan (its
+    ``touches_per_material`` and ``touch_every_s`` [s])."""
     names = json.dumps(list(labels), ensure_ascii=False)
     return (f"{prefix} designkit emulator, profile {profile_name}; touches "
             f"{plan.touches_per_material} of each of {names} in turn, every {plan.touch_every_s:g} s")
 
 
-def announcement_text(prefix: str, j: int, labels: Sequence[str], plan: TouchPlan) -> str:
+def announcement_text(prefix: str, j: int, labels: Sequence[str], plan) -> str:
     """The device message sent as touch ``j`` (0-based) starts, with the plan."""
     k = plan.touches_per_material
     label = json.dumps(labels[(j // k) % len(labels)], ensure_ascii=False)

@@ -288,13 +288,14 @@ def sub_app(name: str, help: str, panel: str) -> typer.Typer:
     return group
 
 
-def _jsonable(obj: Any) -> Any:
+def jsonable(obj: Any) -> Any:
+    """``obj`` as plain JSON types: numpy arrays and scalars as lists and numbers, NaN and inf as None."""
     if isinstance(obj, dict):
-        return {str(k): _jsonable(v) for k, v in obj.items()}
+        return {str(k): jsonable(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
-        return [_jsonable(v) for v in obj]
+        return [jsonable(v) for v in obj]
     if hasattr(obj, "tolist"):  # numpy arrays and scalars
-        return _jsonable(obj.tolist())
+        return jsonable(obj.tolist())
     if isinstance(obj, float) and not math.isfinite(obj):
         return None
     return obj
@@ -318,7 +319,7 @@ def import_lab(module: str, command: str) -> Any:
 
 def emit_json(payload: Any) -> None:
     """Print ``payload`` as JSON on stdout (NaN and inf become null)."""
-    sys.stdout.write(json.dumps(_jsonable(payload), indent=2, allow_nan=False) + "\n")
+    sys.stdout.write(json.dumps(jsonable(payload), indent=2, allow_nan=False) + "\n")
     sys.stdout.flush()
 
 

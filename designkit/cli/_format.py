@@ -48,6 +48,7 @@ import typer
 
 from .._validation import InputError
 
+from ._app import jsonable
 from ._options import PANEL_OUTPUT
 
 FORMATS = ("text", "table", "json", "csv", "ndjson", "md")
@@ -104,7 +105,7 @@ def flat_record(d: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
         elif isinstance(v, (list, tuple)) and "range" in str(k) and len(v) == 2:
             out[key.replace("_range", "_min", 1)], out[key.replace("_range", "_max", 1)] = v
         elif isinstance(v, (list, tuple)):
-            out[key] = json.dumps(_jsonable(v))
+            out[key] = json.dumps(jsonable(v))
         else:
             out[key] = v
     return out
@@ -146,20 +147,8 @@ def _csv_text(v: Any) -> str:
     if isinstance(v, float):
         return "" if not math.isfinite(v) else repr(float(v))
     if isinstance(v, (list, tuple, dict)):
-        return json.dumps(_jsonable(v))
+        return json.dumps(jsonable(v))
     return str(v)
-
-
-def _jsonable(obj: Any) -> Any:
-    if isinstance(obj, dict):
-        return {str(k): _jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_jsonable(v) for v in obj]
-    if hasattr(obj, "tolist"):
-        return _jsonable(obj.tolist())
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    return obj
 
 
 def render_rows(rows: Sequence[Mapping[str, Any]], columns: Sequence[str] | None = None, *, fmt: str = "table",
@@ -178,9 +167,9 @@ def render_rows(rows: Sequence[Mapping[str, Any]], columns: Sequence[str] | None
     cols = list(columns) if columns is not None else list(dict.fromkeys(k for r in rows for k in r))
     if fmt == "json":
         data = payload if payload is not None else [dict(r) for r in rows]
-        return json.dumps(_jsonable(data), indent=2, allow_nan=False) + "\n"
+        return json.dumps(jsonable(data), indent=2, allow_nan=False) + "\n"
     if fmt == "ndjson":
-        return "".join(json.dumps(_jsonable({c: r.get(c) for c in cols}), allow_nan=False) + "\n" for r in rows)
+        return "".join(json.dumps(jsonable({c: r.get(c) for c in cols}), allow_nan=False) + "\n" for r in rows)
     if fmt == "csv":
         buf = io.StringIO()
         w = csv.writer(buf, lineterminator="\n")

@@ -76,53 +76,7 @@ def bench_cmd(
         payload["written"] = {k: str(v) for k, v in written.items()}
         emit_json(payload)
         return
-    _print_report(report, written)
-
-
-def _print_report(report, written) -> None:
-    from rich.table import Table
-
-    lab = import_lab("accuracy", "bench")
-    format_time, format_value = lab.format_time, lab.format_value
-
     con = console()
     if not con.is_terminal:
         con.width = max(con.width, 160)  # piped into a file: do not squeeze the table to 80 columns
-    con.print(f"[bold]designkit bench{' --quick' if report.quick else ''}: error against run time[/] "
-              f"(seed {report.seed}; time per answer; speed-up = reference time / method time)")
-    groups: dict = {}
-    for r in report.rows:
-        groups.setdefault(r.question, []).append(r)
-    for question, rows in groups.items():
-        refs: dict = {}
-        for r in rows:
-            refs.setdefault(r.reference, r.reference_wall_s)
-        ref_text = "; ".join(f"{name} ({format_time(t)})" for name, t in refs.items())
-        t = Table(title=f"{question} — reference: {ref_text}", title_justify="left", title_style="bold")
-        for col, kw in (("method", {}), ("setting", {"max_width": 44}), ("metric", {"max_width": 30}),
-                        ("p95/value", {"justify": "right"}), ("worst", {"justify": "right"}),
-                        ("time/answer", {"justify": "right"}), ("speed-up", {"justify": "right"}),
-                        ("n", {"justify": "right"})):
-            t.add_column(col, **kw)
-        for r in rows:
-            t.add_row(r.method, r.setting, r.metric, format_value(r.error, 3), format_value(r.worst, 3),
-                      format_time(r.wall_s), format_value(r.speedup, 3), str(r.n))
-        con.print(t)
-    if report.curves:
-        c = Table(title="Sweep cost curves (one scene point; exponent p of cost ~ size^p)", title_justify="left",
-                  title_style="bold")
-        for col in ("curve", "x", "wall time [s]", "SVM fits", "peak MB above start", "p time", "p fits", "p memory"):
-            c.add_column(col)
-        for cur in report.curves:
-            c.add_row(cur.name, ", ".join(f"{x:g}" for x in cur.x), ", ".join(f"{w:.3g}" for w in cur.wall_s),
-                      ", ".join(str(f) for f in cur.fits), ", ".join(f"{m:.1f}" for m in cur.peak_mb),
-                      format_value(cur.time_exponent, 3),
-                      "—" if cur.fits_exponent is None else format_value(cur.fits_exponent, 3),
-                      "—" if cur.memory_exponent is None else format_value(cur.memory_exponent, 3))
-        con.print(c)
-    for s in report.skipped:
-        con.print(f"[yellow]skipped:[/] {s}")
-    con.print(f"total {report.wall_s:.0f} s (" + ", ".join(f"{k} {v:.0f} s" for k, v in report.section_wall_s.items())
-              + ")")
-    for v in written.values():
-        con.print(f"[bold green]wrote[/] {v}")
+    accuracy.print_report(report, written, con)

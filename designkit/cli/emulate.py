@@ -10,7 +10,7 @@ from typing import Annotated, Optional
 import typer
 
 from . import _app
-from ._app import app, console, emit_json
+from ._app import app, console, emit_json, import_lab
 from ._options import Json, Noise, Seed, SensorOpt, sensor_and_model
 from .calibrate import DEFAULT_TRIALS, ProfileOpt, guided_command
 
@@ -65,8 +65,9 @@ def emulate(
     Example (a rig playing two objects for 5 s; without --duration until Ctrl-C): `designkit emulate --material wood=400 --material aluminium=20000 --speed 20 --duration 5`
     """
     from .._validation import InputError, check_temperature
-    from ..calibration.emulator import Emulator, Faults, TouchPlan
     from ..calibration.profiles import load_profile
+
+    lab = import_lab("emulator", "emulate")
 
     sensor_temp = check_temperature("--sensor-temp [degC]", sensor_temp)
     ambient = check_temperature("--ambient [degC]", ambient)
@@ -75,9 +76,9 @@ def emulate(
     mats = _emulated_materials(material, e, object_temp)
     prof = load_profile(profile)
     sen, fm, _ = sensor_and_model(sensor)   # a sensor file's recorded model is what the rig plays
-    emu = Emulator(prof, sen, mats, noise_c=noise, sensor_temp_c=sensor_temp, ambient_c=ambient,
-                   plan=TouchPlan(touch_every_s=touch_every, touches_per_material=touches_per_material),
-                   speed=speed, faults=Faults.parse(fault or []), seed=seed, model=fm)
+    emu = lab.Emulator(prof, sen, mats, noise_c=noise, sensor_temp_c=sensor_temp, ambient_c=ambient,
+                       plan=lab.TouchPlan(touch_every_s=touch_every, touches_per_material=touches_per_material),
+                       speed=speed, faults=lab.Faults.parse(fault or []), seed=seed, model=fm)
     port = emu.start()
     try_cmd = guided_command(port, profile, [m.label for m in mats], touches_per_material,
                               _hint_ranges(mats))
@@ -142,7 +143,8 @@ def _check_emulation(touch_every: float, duration: Optional[float], speed: float
 def _emulated_materials(material: Optional[list[str]], e: Optional[float], object_temp: Optional[float]) -> list:
     """The objects the emulated rig touches: ``--material`` NAME or LABEL=E (in turn), then ``--e``."""
     from .._validation import InputError
-    from ..calibration.emulator import EmulatedMaterial
+
+    EmulatedMaterial = import_lab("emulator", "emulate").EmulatedMaterial
 
     mats = []
     for spec in material or []:

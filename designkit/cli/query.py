@@ -426,131 +426,91 @@ def _explain_lines(con, d):
 
 
 # ============================================================ the commands
-# Each command: its options, one library call (_ask, or --batch: one array call), the answer rendered in
+# One command per question, built from one list of options: the objects and scene of its question (the
+# library's registry, designkit.query.QUESTIONS, names the same scene), then the options every question
+# shares. Each command: one library call (_ask, or --batch: one array call), the answer rendered in
 # --format (text for people by default; --json is --format json).
-@app.command("min-contact", rich_help_panel=_app.ASK)
-def min_contact_cmd(
-    e1: E1 = None, e2: E2 = None, m1: M1 = None, m2: M2 = None,
-    noise: NoiseQ = None, delta_t: DeltaTQ = None, threshold: Threshold = 0.9, sensor: SensorOpt = "paper",
-    model: ModelOpt = None, conductance: Conductance = None, thickness: Thickness = None,
-    backing: BackingOpt = None, diffusivity: Diffusivity = None,
-    exact: Exact = False, table: TableOpt = None, ideal_table: IdealTableOpt = "ideal-paper",
-    trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
-    n_mc: NmcQ = 1000, max_contact: MaxContact = 10.0, coverage: CoverageOpt = 0.9,
-    sensor_temp_spread: SpreadOpt = None, batch: BatchOpt = None, format_: FormatOpt = None, out: OutOpt = None,
-    json_: Json = False, explain: Explain = False,
-) -> None:
-    """Shortest contact time that separates two materials.
+E = Annotated[Optional[float], typer.Option("--e", help="Reference effusivity [J s^-1/2 K^-1 m^-2].",
+                                            rich_help_panel=PANEL_QUESTION)]
+M = Annotated[Optional[str], typer.Option("--m", help="Reference material (its range's middle).",
+                                          rich_help_panel=PANEL_QUESTION)]
+#: A question's objects and scene quantities as (argument, option type, default); the scene is keyed by
+#: the library's name (QUESTIONS[q].scene) of the quantity.
+_OBJECT_OPTIONS = {"e1": (E1, None), "e2": (E2, None), "m1": (M1, None), "m2": (M2, None), "e": (E, None),
+                   "m": (M, None)}
+_SCENE_OPTIONS = {"contact_s": ("contact", Contact, 2.0), "noise_c": ("noise", NoiseQ, None),
+                  "delta_t_c": ("delta_t", DeltaTQ, None)}
+_SHARED_OPTIONS = (
+    ("threshold", Threshold, 0.9), ("sensor", SensorOpt, "paper"), ("model", ModelOpt, None),
+    ("conductance", Conductance, None), ("thickness", Thickness, None), ("backing", BackingOpt, None),
+    ("diffusivity", Diffusivity, None), ("exact", Exact, False), ("table", TableOpt, None),
+    ("ideal_table", IdealTableOpt, "ideal-paper"), ("trials", TrialsQ, 100), ("repeats", RepeatsQ, 4),
+    ("seed", SeedQ, 0), ("width", WidthQ, 80.0), ("jobs", JobsQ, -1), ("n_mc", NmcQ, 1000))
+_OUTPUT_OPTIONS = (
+    ("coverage", CoverageOpt, 0.9), ("sensor_temp_spread", SpreadOpt, None), ("batch", BatchOpt, None),
+    ("format_", FormatOpt, None), ("out", OutOpt, None), ("json_", Json, False), ("explain", Explain, False))
+#: question -> (its objects, its scene: as QUESTIONS[question].scene, its --exact-only options, its help).
+_COMMANDS = {
+    "min-contact": (("e1", "e2", "m1", "m2"), ("noise_c", "delta_t_c"), (("max_contact", MaxContact, 10.0),),
+                    """Shortest contact time that separates two materials.
 
     Example: `designkit min-contact --e1 35000 --e2 20000`
 
     Example (materials by name, the method too): `designkit min-contact --m1 wood --m2 glass --explain`
 
     Example (one record, pandas-ready): `designkit min-contact --e1 35000 --e2 20000 --format csv`
-    """
-    fmt = output_format(format_, json_, out=out)  # before the work: --exact is not computed for nowhere
-    opts = _options(locals(), ("e1", "e2", "m1", "m2"), dict(noise_c=noise, delta_t_c=delta_t),
-                    exact_extra=dict(max_contact_s=max_contact))
-    _answer("min-contact", opts, batch, fmt, out, explain)
-
-
-@app.command("max-noise", rich_help_panel=_app.ASK)
-def max_noise_cmd(
-    e1: E1 = None, e2: E2 = None, m1: M1 = None, m2: M2 = None,
-    contact: Contact = 2.0, delta_t: DeltaTQ = None, threshold: Threshold = 0.9, sensor: SensorOpt = "paper",
-    model: ModelOpt = None, conductance: Conductance = None, thickness: Thickness = None,
-    backing: BackingOpt = None, diffusivity: Diffusivity = None,
-    exact: Exact = False, table: TableOpt = None, ideal_table: IdealTableOpt = "ideal-paper",
-    trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
-    n_mc: NmcQ = 1000, coverage: CoverageOpt = 0.9, sensor_temp_spread: SpreadOpt = None, batch: BatchOpt = None,
-    format_: FormatOpt = None, out: OutOpt = None, json_: Json = False, explain: Explain = False,
-) -> None:
-    """Largest sensor noise at which a contact time still separates two materials.
+    """),
+    "max-noise": (("e1", "e2", "m1", "m2"), ("contact_s", "delta_t_c"), (),
+                  """Largest sensor noise at which a contact time still separates two materials.
 
     Example: `designkit max-noise --e1 35000 --e2 20000 --contact 2`
-    """
-    fmt = output_format(format_, json_, out=out)  # before the work: --exact is not computed for nowhere
-    opts = _options(locals(), ("e1", "e2", "m1", "m2"), dict(contact_s=contact, delta_t_c=delta_t))
-    _answer("max-noise", opts, batch, fmt, out, explain)
-
-
-@app.command("min-delta-t", rich_help_panel=_app.ASK)
-def min_delta_t_cmd(
-    e1: E1 = None, e2: E2 = None, m1: M1 = None, m2: M2 = None,
-    contact: Contact = 2.0, noise: NoiseQ = None, threshold: Threshold = 0.9, sensor: SensorOpt = "paper",
-    model: ModelOpt = None, conductance: Conductance = None, thickness: Thickness = None,
-    backing: BackingOpt = None, diffusivity: Diffusivity = None,
-    exact: Exact = False, table: TableOpt = None, ideal_table: IdealTableOpt = "ideal-paper",
-    trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
-    n_mc: NmcQ = 1000, coverage: CoverageOpt = 0.9, sensor_temp_spread: SpreadOpt = None, batch: BatchOpt = None,
-    format_: FormatOpt = None, out: OutOpt = None, json_: Json = False, explain: Explain = False,
-) -> None:
-    """Smallest sensor-object temperature difference that separates two materials.
+    """),
+    "min-delta-t": (("e1", "e2", "m1", "m2"), ("contact_s", "noise_c"), (),
+                    """Smallest sensor-object temperature difference that separates two materials.
 
     Example: `designkit min-delta-t --e1 35000 --e2 20000 --contact 2 --noise 0.05`
-    """
-    fmt = output_format(format_, json_, out=out)  # before the work: --exact is not computed for nowhere
-    opts = _options(locals(), ("e1", "e2", "m1", "m2"), dict(contact_s=contact, noise_c=noise))
-    _answer("min-delta-t", opts, batch, fmt, out, explain)
-
-
-@app.command("delta-e", rich_help_panel=_app.ASK)
-def delta_e_cmd(
-    e: Annotated[Optional[float], typer.Option("--e", help="Reference effusivity [J s^-1/2 K^-1 m^-2].",
-                                               rich_help_panel=PANEL_QUESTION)] = None,
-    m: Annotated[Optional[str], typer.Option("--m", help="Reference material (its range's middle).",
-                                             rich_help_panel=PANEL_QUESTION)] = None,
-    contact: Contact = 2.0, noise: NoiseQ = None, delta_t: DeltaTQ = None, threshold: Threshold = 0.9,
-    sensor: SensorOpt = "paper",
-    model: ModelOpt = None, conductance: Conductance = None, thickness: Thickness = None,
-    backing: BackingOpt = None, diffusivity: Diffusivity = None,
-    exact: Exact = False, table: TableOpt = None, ideal_table: IdealTableOpt = "ideal-paper",
-    trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
-    n_mc: NmcQ = 1000, coverage: CoverageOpt = 0.9, sensor_temp_spread: SpreadOpt = None, batch: BatchOpt = None,
-    format_: FormatOpt = None, out: OutOpt = None, json_: Json = False, explain: Explain = False,
-) -> None:
-    """Smallest distinguishable effusivity difference delta(e), towards lower and higher effusivity.
+    """),
+    "delta-e": (("e", "m"), ("contact_s", "noise_c", "delta_t_c"), (),
+                """Smallest distinguishable effusivity difference delta(e), towards lower and higher effusivity.
 
     Example: `designkit delta-e --e 20000 --contact 2`
 
     Example (one row per direction): `designkit delta-e --e 20000 --contact 2 --format csv`
-    """
-    fmt = output_format(format_, json_, out=out)  # before the work: --exact is not computed for nowhere
-    opts = _options(locals(), ("e", "m"), dict(contact_s=contact, noise_c=noise, delta_t_c=delta_t))
-    _answer("delta-e", opts, batch, fmt, out, explain)
-
-
-@app.command("distinguishable", rich_help_panel=_app.ASK)
-def distinguishable_cmd(
-    e1: E1 = None, e2: E2 = None, m1: M1 = None, m2: M2 = None,
-    contact: Contact = 2.0, noise: NoiseQ = None, delta_t: DeltaTQ = None, threshold: Threshold = 0.9,
-    sensor: SensorOpt = "paper",
-    model: ModelOpt = None, conductance: Conductance = None, thickness: Thickness = None,
-    backing: BackingOpt = None, diffusivity: Diffusivity = None,
-    exact: Exact = False, table: TableOpt = None, ideal_table: IdealTableOpt = "ideal-paper",
-    trials: TrialsQ = 100, repeats: RepeatsQ = 4, seed: SeedQ = 0, width: WidthQ = 80.0, jobs: JobsQ = -1,
-    n_mc: NmcQ = 1000, coverage: CoverageOpt = 0.9, sensor_temp_spread: SpreadOpt = None, batch: BatchOpt = None,
-    format_: FormatOpt = None, out: OutOpt = None, json_: Json = False, explain: Explain = False,
-) -> None:
-    """Whether a scene separates two materials, with the SVM's and the ideal observer's F1.
+    """),
+    "distinguishable": (("e1", "e2", "m1", "m2"), ("contact_s", "noise_c", "delta_t_c"), (),
+                        """Whether a scene separates two materials, with the SVM's and the ideal observer's F1.
 
     Example: `designkit distinguishable --m1 wood --m2 glass --contact 2`
-    """
-    fmt = output_format(format_, json_, out=out)  # before the work: --exact is not computed for nowhere
-    opts = _options(locals(), ("e1", "e2", "m1", "m2"), dict(contact_s=contact, noise_c=noise, delta_t_c=delta_t))
-    _answer("distinguishable", opts, batch, fmt, out, explain)
+    """),
+}
 
 
-#: The options every question command shares (its arguments of these names), passed on to _ask as they are.
-_SHARED = ("exact", "table", "ideal_table", "threshold", "sensor", "model", "conductance", "thickness", "backing",
-           "diffusivity", "width", "trials", "repeats", "seed", "jobs", "n_mc", "coverage")
+def _question_command(question: str, objects: tuple, scene: tuple, exact_only: tuple, doc: str) -> None:
+    """Register ``designkit QUESTION``: its options in help order (objects, scene, shared, its own --exact
+    ones, output), its one call."""
+    import inspect
+
+    options = ([(name, *_OBJECT_OPTIONS[name]) for name in objects] + [_SCENE_OPTIONS[k] for k in scene]
+               + list(_SHARED_OPTIONS) + list(exact_only) + list(_OUTPUT_OPTIONS))
+
+    def command(**args) -> None:
+        fmt = output_format(args["format_"], args["json_"], out=args["out"])  # before the work: --exact is
+        opts = dict({k: args[k] for k, _, _ in _SHARED_OPTIONS}, coverage=args["coverage"],  # not computed
+                    spread=args["sensor_temp_spread"], objects={k: args[k] for k in objects},  # for nowhere
+                    scene={k: args[_SCENE_OPTIONS[k][0]] for k in scene},
+                    exact_extra={"max_contact_s": args["max_contact"]} if exact_only else None)
+        _answer(question, opts, args["batch"], fmt, args["out"], args["explain"])
+
+    command.__name__ = command.__qualname__ = f"{question.replace('-', '_')}_cmd"
+    command.__doc__ = doc
+    command.__signature__ = inspect.Signature(
+        [inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, default=default, annotation=kind)
+         for name, kind, default in options], return_annotation=None)
+    app.command(question, rich_help_panel=_app.ASK)(command)
 
 
-def _options(args: dict, objects: tuple, scene: dict, **extra) -> dict:
-    """What one question command passes to :func:`_answer`: the shared options read from its arguments
-    (``locals()``), its objects (``objects``: the argument names) and its scene."""
-    return dict({k: args[k] for k in _SHARED}, spread=args["sensor_temp_spread"],
-                objects={k: args[k] for k in objects}, scene=scene, **extra)
+for _question, _spec in _COMMANDS.items():
+    _question_command(_question, *_spec)
 
 
 def _answer(question: str, kw: dict, batch: Optional[str], fmt: str, out: Optional[str], explain: bool) -> None:

@@ -29,7 +29,7 @@ where the early reading is decided. Refining ``cells_per_layer`` refines all
 of them together, which keeps the scheme's formal second order in space
 (observed: 2.00, ``benchmarks/bench_slab.py``).
 
-Three time integrators for the semi-discrete system ``M du/dt = -A u``
+Two time integrators for the semi-discrete system ``M du/dt = -A u``
 (``M`` diagonal heat capacities, ``A`` symmetric tridiagonal conductances):
 
 * :func:`integrate_crank_nicolson`: trapezoidal rule on a geometric time
@@ -39,11 +39,12 @@ Three time integrators for the semi-discrete system ``M du/dt = -A u``
 * :func:`integrate_bdf`: :func:`scipy.integrate.solve_ivp` with the BDF method
   (variable order 1-5, adaptive) and the constant sparse Jacobian; several
   times slower here for the same accuracy.
-* :func:`integrate_explicit`: forward Euler, only to show why it cannot be used
-  here: it is stable only for ``dt < 2 / lambda_max`` (:func:`explicit_step_limit_s`),
-  nanoseconds for micrometre cells in copper.
 
-All integrators take a stack of ``K`` property sets that share one geometry
+Forward Euler cannot be used here: it is stable only for ``dt < 2 / lambda_max``,
+nanoseconds for micrometre cells in copper (the demonstration is the lab's
+:mod:`designkit_lab.explicit_euler`).
+
+Both integrators take a stack of ``K`` property sets that share one geometry
 (the same diffusivities, different effusivities: the effusivity classes of a
 recognition task) and advance them together as one block-diagonal system.
 """
@@ -57,17 +58,16 @@ from typing import Sequence
 import numpy as np
 from scipy import linalg, sparse, special
 
-from .._validation import InputError, check_nonnegative, check_positive
+from .._validation import InputError, check_positive
 
 __all__ = [
     "Grid",
     "Layer",
+    "apply_conductances",
     "build_grid",
-    "explicit_step_limit_s",
     "heat_content",
     "integrate_bdf",
     "integrate_crank_nicolson",
-    "integrate_explicit",
     "probe_reading",
     "time_levels_s",
     "truncation_depth_m",
@@ -337,8 +337,9 @@ def build_grid(sensor: Layer, body: Sequence[Layer], probe_depth_m: float, time_
 
 
 # ------------------------------------------------------------------ semi-discrete system
-def _apply_a(g: np.ndarray, u: np.ndarray) -> np.ndarray:
-    """A u for the conductance matrix A (insulated ends), row-wise over (K, N)."""
+def apply_conductances(g: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """``A u`` for the conductance matrix ``A`` (insulated ends), row-wise over (K, N): ``g`` the face
+    conductances (:meth:`Grid.conductances`), ``u`` the cell temperatures."""
     flux = g * (u[:, :-1] - u[:, 1:])  # heat flow left -> right through each interior face
     out = np.zeros_like(u)
     out[:, :-1] += flux
@@ -467,11 +468,11 @@ def integrate_crank_nicolson(grid: Grid, times_s, step_ratio: float = 0.05, *,
             sub = dt / n_be
             ab = m_band + sub * a_band
             for _ in range(n_be):  # backward Euler quarter steps
-                u = u + linalg.solve_banded((1, 1), ab, -sub * _apply_a(g, u.reshape(shape)).ravel(),
+                u = u + linalg.solve_banded((1, 1), ab, -sub * apply_conductances(g, u.reshape(shape)).ravel(),
                                             check_finite=False)
         else:
             ab = m_band + (0.5 * dt) * a_band
-            u = u + linalg.solve_banded((1, 1), ab, -dt * _apply_a(g, u.reshape(shape)).ravel(),
+            u = u + linalg.solve_banded((1, 1), ab, -dt * apply_conductances(g, u.reshape(shape)).ravel(),
                                         overwrite_ab=True, overwrite_b=True, check_finite=False)
         readings[:, j] = probe(u)
     u = u.reshape(shape)
@@ -520,7 +521,7 @@ def integrate_bdf(grid: Grid, times_s, rtol: float = 1e-6, atol: float = 1e-9, *
     inv_m = 1.0 / m
 
     def rhs(_t, y):
-        return (-_apply_a(g, y.reshape(k, n)) * inv_m).ravel()
+        return (-apply_conductances(g, y.reshape(k, n)) * inv_m).ravel()
 
     gl = np.zeros((k, n))
     gr = np.zeros((k, n))
@@ -545,76 +546,3 @@ def integrate_bdf(grid: Grid, times_s, rtol: float = 1e-6, atol: float = 1e-9, *
     if return_state:
         return out, ys[:, :, -1], int(sol.nfev)
     return out
-
-
-def explicit_step_limit_s(grid: Grid) -> np.ndarray:
-    """Largest stable forward-Euler step ``2 / lambda_max(M^-1 A)`` [s], per property set.
-
-    ``M^-1 A`` is similar to the symmetric tridiagonal ``M^-1/2 A M^-1/2``,
-    whose largest eigenvalue :func:`scipy.linalg.eigvalsh_tridiagonal` returns.
-    Of order ``h^2 / (2 alpha)`` of the worst cell: nanoseconds for micrometre
-    cells in copper (alpha ~ 1e-4 m^2/s).
-    """
-    m = grid.heat_capacities()
-    g = grid.conductances()
-    out = np.empty(m.shape[0])
-    for j in range(m.shape[0]):
-        gl = np.concatenate([[0.0], g[j]])
-        gr = np.concatenate([g[j], [0.0]])
-        d = (gl + gr) / m[j]
-        e = -g[j] / np.sqrt(m[j, :-1] * m[j, 1:])
-        n = d.size
-        lam = linalg.eigvalsh_tridiagonal(d, e, select="i", select_range=(n - 1, n - 1))[0]
-        out[j] = 2.0 / lam
-    return out
-
-
-@dataclass(frozen=True)
-class ExplicitRun:
-    """Outcome of :func:`integrate_explicit`.
-
-    Attributes
-    ----------
-    readings : ndarray, shape (K, n_steps + 1)
-        Thermistor reading after each step (NaN after divergence).
-    max_abs : ndarray, shape (n_steps + 1,)
-        Largest ``|u|`` over all cells after each step (the maximum principle
-        bounds the exact solution by the initial extremes, here [0, 1]).
-    diverged : bool
-        Whether ``|u|`` exceeded 1e6 or became non-finite.
-    steps_taken : int
-    """
-
-    readings: np.ndarray
-    max_abs: np.ndarray
-    diverged: bool
-    steps_taken: int
-
-
-def integrate_explicit(grid: Grid, step_s: float, n_steps: int) -> ExplicitRun:
-    """Forward Euler ``u_{n+1} = u_n - dt M^-1 A u_n`` (for the stability demonstration).
-
-    Stops early once the solution leaves any physical bound (``|u| > 1e6``).
-    """
-    dt = check_positive("time step [s]", step_s)
-    steps = int(check_nonnegative("number of steps", n_steps))
-    m = grid.heat_capacities()
-    g = grid.conductances()
-    u = np.broadcast_to(grid.initial, m.shape).astype(np.float64)
-    readings = np.full((m.shape[0], steps + 1), np.nan)
-    max_abs = np.full(steps + 1, np.nan)
-    readings[:, 0] = probe_reading(grid, u)
-    max_abs[0] = float(np.max(np.abs(u)))
-    diverged = False
-    taken = 0
-    with np.errstate(over="ignore", invalid="ignore"):
-        for j in range(1, steps + 1):
-            u = u - dt * _apply_a(g, u) / m
-            taken = j
-            big = float(np.max(np.abs(u)))
-            max_abs[j] = big
-            if not math.isfinite(big) or big > 1e6:
-                diverged = True
-                break
-            readings[:, j] = probe_reading(grid, u)
-    return ExplicitRun(readings, max_abs, diverged, taken)

@@ -93,7 +93,6 @@ __all__ = [
     "semi_infinite_error_bound",
     "semi_infinite_validity",
     "slab_response",
-    "slab_temperature",
 ]
 
 #: Methods :func:`slab_response` can use.
@@ -579,16 +578,6 @@ def _finite_volume(t, e, alpha, L, back, sen, base, cells, ratio, integrator) ->
     details = {"integrator": integ, "cells_per_layer": n, "step_ratio" if integ != "bdf" else "rtol": r}
     details.update(info)
     return SlabResponse(response=fine, method="finite-volume", error_bound=err, details=details, **base)
-
-
-def slab_temperature(time_s, e_object, alpha_object_m2_s, thickness_m, sensor_temp_c, ambient_temp_c,
-                     backing="insulated", sensor: Sensor | None = None, **kwargs) -> np.ndarray:
-    """Noise-free thermistor readings [degC] for a slab scene, shape (K, m).
-
-    Shorthand for ``slab_response(...).temperature_c(sensor_temp_c, ambient_temp_c)``.
-    """
-    r = slab_response(time_s, e_object, alpha_object_m2_s, thickness_m, backing, sensor, **kwargs)
-    return r.temperature_c(sensor_temp_c, ambient_temp_c)
 
 
 # ----------------------------------------------------------------------------- validity

@@ -41,7 +41,7 @@ from .recognition import RECOGNITION_PAIRS, ideal_mc_rows, recognition_rows
 from .render import (COVERAGE_FILES, FIGURES_HINT, VARIED_COVERAGE_FIGURE, VARIED_COVERAGE_FILE, coverage_markdown,
                      curves_markdown,
                      format_time, format_value, insert_coverage, insert_varied_coverage, markdown_cell, pareto_figure,
-                     plot_costs, plot_pareto, render_markdown, require_figures, rows_markdown,
+                     plot_costs, plot_pareto, print_report, render_markdown, require_figures, rows_markdown,
                      varied_coverage_cases, varied_coverage_figure, varied_coverage_markdown, write_coverage,
                      write_report, write_varied_coverage)
 from .results import PAPER_RATIO, CostCurve, Row, p95, paper_sensor, worst
@@ -58,7 +58,7 @@ __all__ = [
     "cost_curve", "cost_curve_specs", "cost_curves", "curves_markdown", "delta_rows",
     "density_rows", "environment", "fit_exponent", "format_time", "format_value", "grid_rows", "ideal_mc_rows",
     "markdown_cell", "measure", "p95", "paper_sensor", "pareto_figure", "physics_rows", "plot_costs",
-    "plot_pareto", "process_cost", "query_rows", "recognition_rows", "render_markdown", "require_figures",
+    "plot_pareto", "print_report", "process_cost", "query_rows", "recognition_rows", "render_markdown", "require_figures",
     "reset_peak_memory", "resident_mb", "rows_markdown", "run_bench", "slab_rows", "staircase_vs_full",
     "subsample_table", "svm_query_rows", "timed", "worst", "write_report",
 ]

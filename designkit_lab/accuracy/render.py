@@ -22,7 +22,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from .run import BenchReport
 
 __all__ = ["COVERAGE_FILES", "FIGURES_HINT", "VARIED_COVERAGE_FIGURE", "VARIED_COVERAGE_FILE", "coverage_markdown", "curves_markdown", "format_time", "format_value",
-           "insert_coverage", "insert_varied_coverage", "markdown_cell", "pareto_figure", "plot_costs", "plot_pareto", "render_markdown",
+           "insert_coverage", "insert_varied_coverage", "markdown_cell", "pareto_figure", "plot_costs", "print_report", "plot_pareto", "render_markdown",
            "require_figures", "rows_markdown", "varied_coverage_cases", "varied_coverage_figure",
            "varied_coverage_markdown", "write_coverage", "write_report", "write_varied_coverage"]
 
@@ -565,6 +565,51 @@ def plot_costs(report: BenchReport, path) -> Path | None:
 
 
 # ============================================================ files
+def print_report(report: BenchReport, written: Mapping[str, Path], con: Any) -> None:
+    """``designkit bench``'s text: one table per question (error against run time), the sweep's cost curves,
+    what was skipped, the sections' wall times and the files written, on the rich console ``con``."""
+    from rich.table import Table
+
+    con.print(f"[bold]designkit bench{' --quick' if report.quick else ''}: error against run time[/] "
+              f"(seed {report.seed}; time per answer; speed-up = reference time / method time)")
+    groups: dict = {}
+    for r in report.rows:
+        groups.setdefault(r.question, []).append(r)
+    for question, rows in groups.items():
+        refs: dict = {}
+        for r in rows:
+            refs.setdefault(r.reference, r.reference_wall_s)
+        ref_text = "; ".join(f"{name} ({format_time(t)})" for name, t in refs.items())
+        t = Table(title=f"{question} — reference: {ref_text}", title_justify="left", title_style="bold")
+        for col, kw in (("method", {}), ("setting", {"max_width": 44}), ("metric", {"max_width": 30}),
+                        ("p95/value", {"justify": "right"}), ("worst", {"justify": "right"}),
+                        ("time/answer", {"justify": "right"}), ("speed-up", {"justify": "right"}),
+                        ("n", {"justify": "right"})):
+            t.add_column(col, **kw)
+        for r in rows:
+            t.add_row(r.method, r.setting, r.metric, format_value(r.error, 3), format_value(r.worst, 3),
+                      format_time(r.wall_s), format_value(r.speedup, 3), str(r.n))
+        con.print(t)
+    if report.curves:
+        c = Table(title="Sweep cost curves (one scene point; exponent p of cost ~ size^p)", title_justify="left",
+                  title_style="bold")
+        for col in ("curve", "x", "wall time [s]", "SVM fits", "peak MB above start", "p time", "p fits", "p memory"):
+            c.add_column(col)
+        for cur in report.curves:
+            c.add_row(cur.name, ", ".join(f"{x:g}" for x in cur.x), ", ".join(f"{w:.3g}" for w in cur.wall_s),
+                      ", ".join(str(f) for f in cur.fits), ", ".join(f"{m:.1f}" for m in cur.peak_mb),
+                      format_value(cur.time_exponent, 3),
+                      "—" if cur.fits_exponent is None else format_value(cur.fits_exponent, 3),
+                      "—" if cur.memory_exponent is None else format_value(cur.memory_exponent, 3))
+        con.print(c)
+    for s in report.skipped:
+        con.print(f"[yellow]skipped:[/] {s}")
+    con.print(f"total {report.wall_s:.0f} s (" + ", ".join(f"{k} {v:.0f} s" for k, v in report.section_wall_s.items())
+              + ")")
+    for v in written.values():
+        con.print(f"[bold green]wrote[/] {v}")
+
+
 def _jsonable(obj):
     if isinstance(obj, dict):
         return {str(k): _jsonable(v) for k, v in obj.items()}

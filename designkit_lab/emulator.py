@@ -45,18 +45,89 @@ from typing import Sequence
 
 import numpy as np
 
-from .._validation import InputError, as_generator, check_nonnegative, check_positive
-from ..models.semi_infinite import object_weight, response_shape
-from ..sensor import Sensor
-from .conversions import Linear, Thermistor
-from .profiles import DeviceProfile
-from .touch_plan import EmulatedMaterial, TouchPlan, TouchRecord, announcement_text, greeting_text
+from designkit._validation import InputError, as_generator, check_effusivity, check_nonnegative, check_positive
+from designkit.models.semi_infinite import object_weight, response_shape
+from designkit.sensor import Sensor
+from designkit.calibration.conversions import Linear, Thermistor
+from designkit.calibration.profiles import DeviceProfile
+from designkit.calibration.touch_plan import announcement_text, greeting_text
+from designkit.calibration.trials import check_material_label
 
 __all__ = ["EmulatedMaterial", "Emulator", "Faults", "TouchPlan", "TouchRecord"]
 
 _MAX_PENDING = 1 << 16
 #: Real seconds between a client opening the port and the first sample (a rig's reset on open).
 CLIENT_SETTLE_S = 0.05
+
+
+@dataclass(frozen=True)
+class EmulatedMaterial:
+    """An object the emulated rig touches.
+
+    Parameters
+    ----------
+    label : str
+        Name shown and logged.
+    effusivity : float
+        e_o [J s^-1/2 K^-1 m^-2].
+    object_temp_c : float or None
+        Object temperature [degC]; None: room temperature (the emulator's
+        ambient).
+    """
+
+    label: str
+    effusivity: float
+    object_temp_c: float | None = None
+
+    def __post_init__(self) -> None:
+        check_material_label(self.label, "the emulated material's label")   # it labels the recorded trials
+        object.__setattr__(self, "effusivity", check_effusivity(self.label, self.effusivity))
+
+
+@dataclass(frozen=True)
+class TouchPlan:
+    """When and how the emulated rig touches.
+
+    ``contact_s`` defaults to the profile's trial window plus half a second,
+    ``press_force_n`` to twice the contact threshold.
+
+    What real touches do beyond the paper's model (all off by default):
+
+    ``ramp_spread``: touch ``j``'s force ramp lasts ``ramp_s (1 + ramp_spread
+    v_j)``, ``v_j`` uniform in [-1, 1] (the pace differs from touch to touch).
+    ``contact_force_fraction`` (c): the contact area grows with the force,
+    ``A = clip((F / F_p - c) / (1 - c), 0, 1)``, each share starting its heat
+    flow as it comes into contact (:class:`~designkit.models.ramp.ForceRamp`);
+    None: the whole area at once when the force leaves zero.
+    ``drift_c_per_s`` and ``drift_sd_c_per_s``: the heater still warms at a
+    rate ``s_j`` (normal, per touch) from ``drift_lead_s`` before contact until
+    release, on the sensor's side of the contact: ``T = (Ts + s_j t)(1 - u) +
+    To u``; after release it settles back to its set point.
+    """
+
+    touch_every_s: float = 20.0
+    first_touch_s: float = 2.0
+    contact_s: float | None = None
+    press_force_n: float | None = None
+    ramp_s: float = 0.5
+    recover_s: float = 0.4
+    touches_per_material: int = 1
+    ramp_spread: float = 0.0
+    contact_force_fraction: float | None = None
+    drift_c_per_s: float = 0.0
+    drift_sd_c_per_s: float = 0.0
+    drift_lead_s: float = 1.5
+
+
+@dataclass(frozen=True)
+class TouchRecord:
+    """Ground truth of one emulated touch (device time)."""
+
+    index: int
+    material: str
+    effusivity: float
+    start_s: float
+    expected_onset_s: float
 
 
 @dataclass(frozen=True)
@@ -205,7 +276,7 @@ class Emulator:
         self.profile = profile
         self.sensor = sensor
         if model is not None:
-            from ..models import get_model
+            from designkit.models import get_model
 
             model = get_model(model)
             if "diffusivity_m2_s" in model.object_properties:
@@ -438,8 +509,8 @@ class Emulator:
 
         from scipy.signal import fftconvolve
 
-        from ..models import get_model
-        from ..models.ramp import area_share
+        from designkit.models import get_model
+        from designkit.models.ramp import area_share
 
         key = (j, e)
         if key in self._curves:

@@ -573,10 +573,10 @@ def predict(result: DesignResult, targets: list[Target], *, trials: int = 100, r
 
     What the interval covers: the crossing of the SVM's *mean* F1 over seeds (``trials`` touches per class,
     the paper's 3-fold protocol), at ``coverage``; not where one training run of the SVM crosses (its F1
-    scatters from seed to seed: by 0.03 for the rig's paper12 design, 0.7 s of contact where the mean F1
+    scatters from seed to seed: by 0.03 for the rig's paper12 design, 0.6 s of contact where the mean F1
     rises 0.05 per second). Every end is credited at least :data:`MIN_SAMPLES` samples. ``solver``: the
-    exact route's (:data:`designkit.query.exact.SOLVERS`; the same F1 for the same seeds, scikit-learn seed by
-    seed measured 3x faster here than the batched one at the rig's 800-sample touches).
+    exact route's (:data:`designkit.query.exact.SOLVERS`): scikit-learn gives the batched solver's F1 for the same
+    seeds and took 47 s of CPU for paper12's statement against the batched one's 112 s.
     """
     from ..objects import ObjectClass
     from ..query.exact import exact_min_contact

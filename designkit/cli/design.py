@@ -300,7 +300,8 @@ def _print_design(payload: dict, result, threshold: float, plot) -> None:
                   f"touches per class and contact, {len(s['evaluations'])} contacts): {_estimate(s)}", highlight=False)
         if s.get("holds") is not None:
             con.print(f"  the SVM-confirmed contact {'lies' if s['holds'] else 'does NOT lie'} inside the stated "
-                      "interval", highlight=False)
+                      "interval" + ("" if s["holds"] else " (about one confirmation in seven lands outside a right "
+                                    "90 % interval: its own error is about half the statement's)"), highlight=False)
     elif s is not None:
         runs = f"{s['seeds']} fresh seeds x {s['trials']} touches per class, contacts evaluated: {len(s['evaluations'])}"
         iv = s["interval"]

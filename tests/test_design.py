@@ -4,6 +4,7 @@ independent closed form of designkit.recognition.ideal; no design is exit 3, con
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import pytest
 
@@ -74,6 +75,11 @@ def test_cli_json_with_svm_confirmation(cli, tmp_path):
                                           "judged as a class 80"),
     (["--m", "a=20000", "--m", "b=20100", "--max-contact", "0.5", "--skin", PEEK, "--depth-um", "400:400"], 3,
      "no allowed design"),
+    # a set whose handbook ranges overlap but which gives identified effusivities: the reason says what to do
+    (["--set", "paper12"], 3, "overlap in effusivity"),
+    (["--set", "paper12", "--sensor", str(Path(__file__).parent / "data" / "rig_sensor.yaml")], 3,
+     "the paper12 set's handbook ranges overlap, so judge its materials at their identified effusivities with "
+     "--identified"),
     (["--m", "a=1000", "--m", "b=2000", "--depth-um", "500:20"], 2, "contradict"),
     (["--m", "a=1000", "--m", "b=2000", "--max-rate", "10", "--max-contact", "0.05"], 2, "contradict"),
     (["--m", "a=1000"], 2, "at least two"),

@@ -92,6 +92,17 @@ def test_a_steep_curve_is_bracketed_around_its_crossing_not_answered_by_the_coar
     if est.method == "bracket":
         assert est.high / est.low <= 1.05 + 1e-12
 
+
+def test_a_nearly_flat_noisy_curve_gives_an_interval_clipped_to_the_range_not_an_overflow():
+    """F1 creeps through 0.9 with standard errors of 0.2 (a few seeds on a flat curve): the fit's interval
+    spans hundreds of e-folds of x; exp() of its ends overflowed (OverflowError) instead of answering."""
+    import math
+
+    est = estimate_crossing(lambda x: (0.9 + 1e-4 * math.log(x), 0.2), 1e-3, 1e3, 0.9)
+    assert est.method == "wls-logit-log"
+    assert 1e-3 <= est.low <= est.value <= est.high <= 1e3
+    assert (est.low, est.high) == (1e-3, 1e3)  # the data say nothing: the whole range examined
+
 def test_ideal_bound_never_above_the_exact_ideal_observer():
     # the query-time bound (math.erfc closed form) against an independent bisection on the scipy closed form
     sensor = load_sensor("paper")

@@ -239,7 +239,10 @@ def estimate_crossing(f: Callable[[float], tuple[float, float]], x_lo: float, x_
     u_star = (target - alpha) / beta
     grad = np.array([-1.0 / beta, -(target - alpha) / beta ** 2])
     sd = math.sqrt(max(float(grad @ cov @ grad), 0.0))
-    lo_u, hi_u = u_star - z * sd, u_star + z * sd
-    value = min(max(math.exp(u_star), x_lo), x_hi)
-    return CrossingEstimate(value, max(math.exp(lo_u), x_lo), min(math.exp(hi_u), x_hi), coverage,
+    # clipped to the range examined in log space, before exp: a nearly flat fit has u_star +- z sd far
+    # outside it (exp overflowed on a flat, noisy curve)
+    def x_of(u: float) -> float:
+        return x_lo if u <= math.log(x_lo) else x_hi if u >= math.log(x_hi) else min(max(math.exp(u), x_lo), x_hi)
+
+    return CrossingEstimate(x_of(u_star), x_of(u_star - z * sd), x_of(u_star + z * sd), coverage,
                             "wls-logit-log", log_of(evals))

@@ -100,7 +100,7 @@ def design(
         "--set", help="Every material of a named set, by its range as in 'matrix --set' ('paper12': the paper's 12).")] = None,
     identified: Annotated[bool, typer.Option(
         "--identified", help="Judge the --set's materials at their identified effusivities (paper12: the paper's "
-                             "calibration), 80-wide classes, instead of their ranges.")] = False,
+                             "calibration), each a point (a class 1 wide), instead of their ranges.")] = False,
     max_contact: Annotated[float, typer.Option(
         "--max-contact", help="Longest acceptable contact [s] (under a rig's contact: from its detected onset).")] = 4.0,
     noise: Annotated[Optional[float], typer.Option(

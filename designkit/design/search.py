@@ -11,8 +11,8 @@ costs); the search is over skin material x depth, exhaustive on a grid (vectoriz
 Materials rule: each material is judged by the hardest 80-wide classes of its range (the nearest
 ends of two ranges: ranges that overlap cannot be separated by any design), as everywhere in
 designkit (``matrix``, ``min-contact --m1``); ``identified=True`` judges a set's materials instead as
-an 80-wide class (the paper's) at the identified effusivity the set gives (``paper12``, the paper's
-calibration). For
+a class 1 J s^-1/2 K^-1 m^-2 wide (``POINT_WIDTH``: a point) at the identified effusivity the set gives
+(``paper12``, the paper's calibration). For
 "all at once" the limiting pair is the hardest one; for ordered classes it is always between
 neighbours in effusivity (the ideal observer separates farther classes sooner), so only
 neighbouring pairs are searched, and every pair is scored for the recommended design.
@@ -49,7 +49,7 @@ POINT_WIDTH = 1.0
 
 @dataclass(frozen=True)
 class Target:
-    """One material to recognize, as the 80-wide class the design is judged on."""
+    """One material to recognize, as the class the design is judged on (80 wide, or ``POINT_WIDTH`` for an identified effusivity)."""
 
     name: str
     e_low: float

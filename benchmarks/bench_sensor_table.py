@@ -63,7 +63,7 @@ def _scene(sensor):
     return resolve_scene(sensor, {"noise_c": None, "delta_t_c": None}).values
 
 
-def exact_case(sensor_file: str, case: dict, repeats: int = 4) -> dict:
+def exact_case(sensor_file: str, case: dict, repeats: int = 4, solver: str = "batched") -> dict:
     from designkit.models import sensor_model
     from designkit.query.exact import exact_min_contact
     from designkit.sensor import load_sensor
@@ -72,11 +72,12 @@ def exact_case(sensor_file: str, case: dict, repeats: int = 4) -> dict:
     sc = _scene(sen)
     t0, c0 = time.perf_counter(), time.process_time()
     a = exact_min_contact(case["e1"], case["e2"], noise_c=sc["noise_c"], delta_t_c=sc["delta_t_c"], sensor=sen,
-                          model=sensor_model(sen), seed=1000 + case["index"], repeats=repeats, jobs=1)
+                          model=sensor_model(sen), seed=1000 + case["index"], repeats=repeats, jobs=1,
+                          solver=solver)
     d = a.to_dict()
     return {**case, "exact": {"value": d["value"], "low": d["interval"]["low"], "high": d["interval"]["high"],
                               "coverage": d["interval"]["coverage"], "ideal": d["ideal"]["value"]},
-            "repeats": repeats, "wall_s": time.perf_counter() - t0, "cpu_s": time.process_time() - c0}
+            "repeats": repeats, "solver": solver, "load": os.getloadavg()[0], "wall_s": time.perf_counter() - t0, "cpu_s": time.process_time() - c0}
 
 
 def phase_exact(args) -> None:
@@ -91,7 +92,7 @@ def phase_exact(args) -> None:
     todo = [c for c in cases if c["index"] not in done]
     print(f"{len(todo)} of {len(cases)} pairs to compute by the exact route, {args.jobs} processes", flush=True)
     with ProcessPoolExecutor(args.jobs) as pool, path.open("a") as fh:
-        futs = [pool.submit(exact_case, args.sensor, c, args.repeats) for c in todo]
+        futs = [pool.submit(exact_case, args.sensor, c, args.repeats, args.solver) for c in todo]
         for f in as_completed(futs):
             r = f.result()
             fh.write(json.dumps(r) + "\n")
@@ -238,6 +239,8 @@ def main() -> None:
     p.add_argument("--seed", type=int, default=34)
     p.add_argument("--jobs", type=int, default=2)
     p.add_argument("--repeats", type=int, default=4, help="the exact route's seeds of 100 trials per class")
+    p.add_argument("--solver", default="batched", help="the exact route's SVM solver (batched: the same classifier "
+                   "as sklearn's, all seeds at once)")
     p.add_argument("--build-cpu-s", type=float, default=None, help="CPU seconds the build printed (projection)")
     args = p.parse_args()
     Path(args.out).mkdir(parents=True, exist_ok=True)

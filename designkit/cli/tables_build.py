@@ -25,8 +25,10 @@ def tables_build(
     out: Annotated[Optional[Path], typer.Option(
         "--out", help="Folder (or .npz) for the table's files (default: the sensor-table registry in the user's "
                       "data folder; 'designkit tables build --help' says where).")] = None,
-    contact_points: Annotated[int, typer.Option("--contact-points", help="Contact times tabulated, from the rig's "
-                                                "detected onset to 4 settling times.")] = 13,
+    contact_points: Annotated[Optional[int], typer.Option(
+        "--contact-points", help="Contact times tabulated, geometric from one of the sensor's time scales after the "
+                                 "rig's detected onset to 8 of them (default: a ratio of at most 1.35 between "
+                                 "neighbours; 8 for the real rig, 0.75 to 6 s).")] = None,
     noise_factors: Annotated[Optional[str], typer.Option(
         "--noise-factors", help="sigma/dT tabulated, as multiples of the rig's own, comma-separated, 1 among them "
                                 "(default 1: the rig's alone; each factor costs as much as the first).")] = None,

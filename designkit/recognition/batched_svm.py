@@ -409,6 +409,9 @@ def _libsvm_smo(K, y, C, eps, max_iter, xp):
     class that is +1 here listed first), so the same path and optimum as the reference's fit; ``a`` is
     ``|dual_coef_|`` at the support vectors.
     """
+    import warnings
+
+    from sklearn.exceptions import ConvergenceWarning
     from sklearn.svm import SVC
 
     host = lambda v: v.get() if hasattr(v, "get") else np.asarray(v)  # noqa: E731  (CuPy: an explicit copy)
@@ -416,10 +419,12 @@ def _libsvm_smo(K, y, C, eps, max_iter, xp):
     a = np.zeros(yh.shape, dtype=np.float64)
     iters = np.zeros(yh.shape[0], dtype=np.int64)
     for p in range(yh.shape[0]):
-        m = SVC(kernel="precomputed", C=C, tol=eps, max_iter=max_iter).fit(Kh[p], (yh[p] < 0).astype(np.int64))
+        with warnings.catch_warnings():  # at max_iter as the batched SMO stopped: silently (``done`` says so)
+            warnings.simplefilter("ignore", ConvergenceWarning)
+            m = SVC(kernel="precomputed", C=C, tol=eps, max_iter=max_iter).fit(Kh[p], (yh[p] < 0).astype(np.int64))
         a[p, m.support_] = np.abs(m.dual_coef_[0])
         iters[p] = int(np.sum(m.n_iter_))
-    return xp.asarray(a, dtype=K.dtype), xp.ones(yh.shape[0], dtype=xp.bool), xp.asarray(iters)
+    return xp.asarray(a, dtype=K.dtype), xp.asarray(iters < max_iter), xp.asarray(iters)
 
 
 def solve_svc_duals(K, y, *, C: float = 1.0, xp=None, max_active_set_iter: int = 25,

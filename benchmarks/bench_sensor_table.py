@@ -11,6 +11,8 @@ Usage::
     nice -n 10 python benchmarks/bench_sensor_table.py --sensor /tmp/rig.yaml --out /tmp/bst --phase exact
     # the table's answers against them, and the time of a question from a fresh shell
     python benchmarks/bench_sensor_table.py --sensor /tmp/rig.yaml --out /tmp/bst --phase table
+    # where a build's CPU goes (one block of 20 references at each contact; no table needed)
+    python benchmarks/bench_sensor_table.py --sensor tests/data/rig_sensor.yaml --out /tmp/bst --phase profile
 
 Pairs: effusivities log-uniform in the table's span (the lower one in [200, 30000]), the ratio of the two
 log-uniform in [1.05, 3]; min-contact at the rig's conditions as calibrated (its noise and dT, its correlated
@@ -239,11 +241,59 @@ def fresh_shell(args, runs: int = 7) -> dict:
     return out
 
 
+def phase_profile(args) -> None:
+    """Where a build's CPU goes: one block of references (``--rows``) at each tabulated contact, run as a sweep worker
+    runs it; per contact the fits per reference, CPU per fit, and the shares of simulation + features, libsvm's SMO
+    (classes that overlap) and the rest of the solver. A projection of the whole build is printed beside it."""
+    import dataclasses
+
+    from designkit.recognition import batched_svm
+    from designkit.sweep import scorer as scorer_mod
+    from designkit.sweep.chunk import run_chunk
+    from designkit.sweep.for_sensor import effusivity_span, sensor_sweep_config
+
+    cfg = sensor_sweep_config(args.sensor, span=effusivity_span(material_set=args.materials))
+    blocks = max(1, cfg.intervals // args.rows)
+    cfg = dataclasses.replace(cfg, blocks=blocks)
+    T: dict[str, float] = {}
+
+    def timed(name, fn):
+        def wrapper(*a, **k):
+            t = time.process_time()
+            try:
+                return fn(*a, **k)
+            finally:
+                T[name] = T.get(name, 0.0) + time.process_time() - t
+        return wrapper
+
+    batched_svm._libsvm_smo = timed("libsvm", batched_svm._libsvm_smo)
+    scorer_mod.PairScorer.features = timed("features", scorer_mod.PairScorer.features)
+    block = blocks // 2
+    total = 0.0
+    print(f"{cfg.intervals} intervals, sigma/dT {cfg.noise_ratio[0]:.5f}, contacts (model) "
+          f"{[round(c, 3) for c in cfg.contact_s]}, max_repeats {cfg.max_repeats}; block {block} of {blocks}; "
+          f"load {os.getloadavg()[0]:.1f}", flush=True)
+    for k in ([int(x) for x in args.contacts.split(",")] if args.contacts else range(len(cfg.contact_s))):
+        T.clear()
+        t0 = time.process_time()
+        r = run_chunk(cfg, (0,), block, k)
+        cpu = time.process_time() - t0
+        total += cpu * cfg.intervals / r.rows.size
+        print(f"contact {cfg.contact_s[k]:.3f} s (model): {r.rows.size} refs, {r.fits / r.rows.size:.1f} fits/ref, "
+              f"{cpu / max(r.fits, 1):.3f} CPU s/fit, {cpu / r.rows.size:.2f} CPU s/ref; libsvm "
+              f"{T.get('libsvm', 0) / cpu:.0%}, simulation+features {T.get('features', 0) / cpu:.0%}; "
+              f"J - i {np.median(r.J - r.rows):.0f} (median); load {os.getloadavg()[0]:.1f}", flush=True)
+    print(f"projected build CPU for the contacts profiled: {total:.0f} s ({total / 2 / 60:.1f} min on 2 idle cores "
+          "at this CPU per reference)", flush=True)
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--sensor", required=True)
     p.add_argument("--out", required=True)
-    p.add_argument("--phase", choices=("exact", "table"), required=True)
+    p.add_argument("--phase", choices=("exact", "table", "profile"), required=True)
+    p.add_argument("--rows", type=int, default=20, help="profile: references per profiled block")
+    p.add_argument("--contacts", default=None, help="profile: contact indices, comma-separated (default all)")
     p.add_argument("--materials", default="paper12")
     p.add_argument("--pairs", type=int, default=60)
     p.add_argument("--seed", type=int, default=34)
@@ -254,7 +304,7 @@ def main() -> None:
     p.add_argument("--build-cpu-s", type=float, default=None, help="CPU seconds the build printed (projection)")
     args = p.parse_args()
     Path(args.out).mkdir(parents=True, exist_ok=True)
-    (phase_exact if args.phase == "exact" else phase_table)(args)
+    {"exact": phase_exact, "table": phase_table, "profile": phase_profile}[args.phase](args)
 
 
 if __name__ == "__main__":

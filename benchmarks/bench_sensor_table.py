@@ -268,7 +268,7 @@ def phase_profile(args) -> None:
 
     batched_svm._libsvm_smo = timed("libsvm", batched_svm._libsvm_smo)
     scorer_mod.PairScorer.features = timed("features", scorer_mod.PairScorer.features)
-    block = blocks // 2
+    block = blocks // 2 if args.block is None else args.block
     total = 0.0
     print(f"{cfg.intervals} intervals, sigma/dT {cfg.noise_ratio[0]:.5f}, contacts (model) "
           f"{[round(c, 3) for c in cfg.contact_s]}, max_repeats {cfg.max_repeats}; block {block} of {blocks}; "
@@ -293,6 +293,8 @@ def main() -> None:
     p.add_argument("--out", required=True)
     p.add_argument("--phase", choices=("exact", "table", "profile"), required=True)
     p.add_argument("--rows", type=int, default=20, help="profile: references per profiled block")
+    p.add_argument("--block", type=int, default=None, help="profile: which block of --rows references (default: the "
+                   "middle one)")
     p.add_argument("--contacts", default=None, help="profile: contact indices, comma-separated (default all)")
     p.add_argument("--materials", default="paper12")
     p.add_argument("--pairs", type=int, default=60)

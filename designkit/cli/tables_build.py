@@ -48,7 +48,8 @@ def tables_build(
     question outside the table's span (another material, noise or contact time) is refused in one line
     (exit 2) naming the way out: `--exact`, or a table built over a wider span.
 
-    The paper's 12 materials at the paper's 100 trials per interval: `--materials paper12` (minutes on 2 cores).
+    The paper's 12 materials at the paper's 100 trials per interval: `--materials paper12` (for the real rig about
+    7,000 CPU s measured on a loaded machine: an hour on 2 cores; benchmarks/results/sensor_table_rig_scene.txt).
 
     Example (two materials, a quick coarse table): `designkit tables build --sensor my-sensor.yaml --m wood --m glass --trials 10 --contact-points 4`
     """

@@ -92,6 +92,9 @@ def phase_exact(args) -> None:
     path = Path(args.out) / "exact.jsonl"
     done = {json.loads(line)["index"] for line in path.read_text().splitlines()} if path.exists() else set()
     todo = [c for c in cases if c["index"] not in done]
+    if args.first_within:  # the pairs a table over this effusivity range answers first
+        lo, hi = args.first_within
+        todo.sort(key=lambda c: (not (lo <= c["e1"] and c["e2"] <= hi), c["index"]))
     print(f"{len(todo)} of {len(cases)} pairs to compute by the exact route, {args.jobs} processes", flush=True)
     with ProcessPoolExecutor(args.jobs) as pool, path.open("a") as fh:
         futs = [pool.submit(exact_case, args.sensor, c, args.repeats, args.solver) for c in todo]
@@ -293,6 +296,8 @@ def main() -> None:
     p.add_argument("--out", required=True)
     p.add_argument("--phase", choices=("exact", "table", "profile"), required=True)
     p.add_argument("--rows", type=int, default=20, help="profile: references per profiled block")
+    p.add_argument("--first-within", type=float, nargs=2, default=None, metavar=("LO", "HI"),
+                   help="exact: compute the pairs inside this effusivity range first")
     p.add_argument("--block", type=int, default=None, help="profile: which block of --rows references (default: the "
                    "middle one)")
     p.add_argument("--contacts", default=None, help="profile: contact indices, comma-separated (default all)")

@@ -66,3 +66,19 @@ def test_overlapping_classes_are_solved_by_libsvm_itself():
     ref = np.zeros(n)
     ref[s.support_] = np.abs(s.dual_coef_[0])
     np.testing.assert_allclose(a[0], ref, rtol=0, atol=1e-12)
+
+
+def test_the_tables_touches_are_read_in_the_recorders_window_as_the_exact_routes():
+    """A sensor table's touch at model contact c is read from the rig's onset to c, the window the exact route's
+    touches have (simulate_class), not c seconds from the onset on (0.64 s more for the rig: answers that early)."""
+    from designkit.simulation import window_times_s
+    from designkit.sweep.for_sensor import effusivity_span, sensor_sweep_config
+    from designkit.sweep.scorer import PairScorer
+
+    cfg = sensor_sweep_config("tests/data/rig_sensor.yaml", span=effusivity_span(e_range=(240.0, 400.0)))
+    sensor = cfg.resolved_sensor()
+    scene = cfg.scene((0,), cfg.contact_s[0])
+    assert scene.onset_s == pytest.approx(0.6427, abs=1e-4)
+    n = PairScorer(cfg, sensor, scene).n_samples
+    assert n == window_times_s(sensor, scene).size == round((cfg.contact_s[0] - scene.onset_s) * 200) + 1
+    assert PairScorer(cfg, sensor, scene).features(0, 0).shape == (cfg.trials, 2 * n)

@@ -29,7 +29,7 @@ from .._validation import InputError
 from ..recognition.features import feature_matrix
 from ..scene import Scene
 from ..sensor import Sensor
-from ..simulation import draw_trials, render_trials
+from ..simulation import draw_trials, render_trials, window_times_s
 from .config import SweepConfig
 
 __all__ = ["BATCH_MB", "CHUNK_PAIRS", "CV_KEY", "ENGINE_VERSION", "FEATURE_CACHE_MB", "PairCell", "PairScorer", "array_namespace",
@@ -147,7 +147,9 @@ class PairScorer:
         self.cfg = cfg
         self.sensor = sensor
         self.scene = scene
-        self.n_samples = sensor.times_s(scene.contact_s).size
+        # the recorder's window, from the scene's onset to its contact, as simulate_class reads a touch (the whole
+        # contact from the onset on read a rig's touches 0.64 s longer than the exact route: answers that early)
+        self.n_samples = window_times_s(sensor, scene).size
         self.edges = cfg.edges
         # features of (interval, seed), least recently used first; they are a deterministic function
         # of their key, so evicting one only costs its regeneration, never changes a result

@@ -4,6 +4,8 @@ builds one and measures its coverage)."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -82,3 +84,24 @@ def test_the_tables_touches_are_read_in_the_recorders_window_as_the_exact_routes
     n = PairScorer(cfg, sensor, scene).n_samples
     assert n == window_times_s(sensor, scene).size == round((cfg.contact_s[0] - scene.onset_s) * 200) + 1
     assert PairScorer(cfg, sensor, scene).features(0, 0).shape == (cfg.trials, 2 * n)
+
+
+def test_the_tables_touches_press_as_the_calibration_touches_did_as_the_exact_routes():
+    """Each of a sensor table's touches plays one calibration touch's press (a force ramp's ``touch_ramps``), from
+    the stream simulate_class picks from: the same touches as the exact route's for the same seed."""
+    from designkit.objects import ObjectClass
+    from designkit.recognition.features import feature_matrix
+    from designkit.simulation import simulate_class
+    from designkit.sweep.for_sensor import effusivity_span, sensor_sweep_config
+    from designkit.sweep.scorer import PairScorer
+
+    cfg = sensor_sweep_config("tests/data/rig_sensor.yaml", span=effusivity_span(e_range=(240.0, 400.0)),
+                              trials=12)
+    sensor = cfg.resolved_sensor()
+    assert len(cfg.model.touch_ramps) == 24
+    scene = cfg.scene((0,), cfg.contact_s[0])
+    k = 1
+    ref = simulate_class(ObjectClass("k", (cfg.edges[k], cfg.edges[k + 1])), cfg.trials, sensor, scene,
+                         [cfg.seed, k, 0], cfg.model)
+    ours = PairScorer(dataclasses.replace(cfg, solver="sklearn"), sensor, scene).features(k, 0)
+    np.testing.assert_allclose(ours, feature_matrix(ref.temperature_c, sensor.sample_rate_hz), rtol=1e-12, atol=1e-12)

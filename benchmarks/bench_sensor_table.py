@@ -6,11 +6,13 @@ Usage::
     # once: a sensor file of the real rig, and its table for the paper's 12 materials
     designkit calibrate fit ../shared/data/robot-thermal-recordings/index.csv --range metal=aluminium \
         --only metal,wood --out /tmp/rig.yaml
-    designkit tables build --sensor /tmp/rig.yaml --materials paper12 -j 2
+    designkit tables build --sensor /tmp/rig.yaml --materials paper12 -j 2   # or tests/data/rig_sensor.yaml
     # the exact route on random pairs (minutes each on a loaded machine; resumable, appends as it goes)
     nice -n 10 python benchmarks/bench_sensor_table.py --sensor /tmp/rig.yaml --out /tmp/bst --phase exact
     # the table's answers against them, and the time of a question from a fresh shell
     python benchmarks/bench_sensor_table.py --sensor /tmp/rig.yaml --out /tmp/bst --phase table
+    # where a build's CPU goes (one block of 20 references at each contact; no table needed)
+    python benchmarks/bench_sensor_table.py --sensor tests/data/rig_sensor.yaml --out /tmp/bst --phase profile
 
 Pairs: effusivities log-uniform in the table's span (the lower one in [200, 30000]), the ratio of the two
 log-uniform in [1.05, 3]; min-contact at the rig's conditions as calibrated (its noise and dT, its correlated
@@ -63,7 +65,7 @@ def _scene(sensor):
     return resolve_scene(sensor, {"noise_c": None, "delta_t_c": None}).values
 
 
-def exact_case(sensor_file: str, case: dict, repeats: int = 4) -> dict:
+def exact_case(sensor_file: str, case: dict, repeats: int = 4, solver: str = "batched") -> dict:
     from designkit.models import sensor_model
     from designkit.query.exact import exact_min_contact
     from designkit.sensor import load_sensor
@@ -72,11 +74,12 @@ def exact_case(sensor_file: str, case: dict, repeats: int = 4) -> dict:
     sc = _scene(sen)
     t0, c0 = time.perf_counter(), time.process_time()
     a = exact_min_contact(case["e1"], case["e2"], noise_c=sc["noise_c"], delta_t_c=sc["delta_t_c"], sensor=sen,
-                          model=sensor_model(sen), seed=1000 + case["index"], repeats=repeats, jobs=1)
+                          model=sensor_model(sen), seed=1000 + case["index"], repeats=repeats, jobs=1,
+                          solver=solver)
     d = a.to_dict()
     return {**case, "exact": {"value": d["value"], "low": d["interval"]["low"], "high": d["interval"]["high"],
                               "coverage": d["interval"]["coverage"], "ideal": d["ideal"]["value"]},
-            "repeats": repeats, "wall_s": time.perf_counter() - t0, "cpu_s": time.process_time() - c0}
+            "repeats": repeats, "solver": solver, "load": os.getloadavg()[0], "wall_s": time.perf_counter() - t0, "cpu_s": time.process_time() - c0}
 
 
 def phase_exact(args) -> None:
@@ -89,9 +92,12 @@ def phase_exact(args) -> None:
     path = Path(args.out) / "exact.jsonl"
     done = {json.loads(line)["index"] for line in path.read_text().splitlines()} if path.exists() else set()
     todo = [c for c in cases if c["index"] not in done]
+    if args.first_within:  # the pairs a table over this effusivity range answers first
+        lo, hi = args.first_within
+        todo.sort(key=lambda c: (not (lo <= c["e1"] and c["e2"] <= hi), c["index"]))
     print(f"{len(todo)} of {len(cases)} pairs to compute by the exact route, {args.jobs} processes", flush=True)
     with ProcessPoolExecutor(args.jobs) as pool, path.open("a") as fh:
-        futs = [pool.submit(exact_case, args.sensor, c, args.repeats) for c in todo]
+        futs = [pool.submit(exact_case, args.sensor, c, args.repeats, args.solver) for c in todo]
         for f in as_completed(futs):
             r = f.result()
             fh.write(json.dumps(r) + "\n")
@@ -144,8 +150,15 @@ def phase_table(args) -> None:
         if not all(d["in_grid"].values()):
             outside += 1
             continue
-        if d["value"] is None or ex["value"] is None:
+        last = float(table.axes["contact_s"][-1]) + start  # the table's last contact, from the onset
+        if d["value"] is None:  # beyond the table's contact cap: a bound ("none up to LAST s"), held if the exact
+            none += 1           # route finds none up to 10 s or one beyond LAST
+            r["held"] = ex["value"] is None or ex["value"] > last
+            r["reason"] = "bound: none up to the table's last contact"
+            continue
+        if ex["value"] is None:  # the table separates them, the exact route does not up to 10 s
             none += 1
+            r["held"], r["reason"] = False, "the exact route finds none up to 10 s"
             continue
         if not d["interval"]["coverage"]:
             cells += 1
@@ -165,7 +178,10 @@ def phase_table(args) -> None:
         "sensor": str(args.sensor), "table": table.name, "content_hash": table.header["content_hash"],
         "pairs": len(rows), "stated": n, "covered": hits, "coverage": hits / n if n else None,
         "grid_cells": cells, "grid_cells_held": sum(1 for r in rows if "held" in r and r not in stated and r["held"]),
-        "no_answer": none, "outside_span": outside,
+        "no_answer": none, "no_answer_held": sum(1 for r in rows if r.get("reason") and r["held"]),
+        "outside_span": outside, "missed": [{k: r.get(k) for k in ("index", "e1", "e2", "reason")}
+                                             | {"table": r.get("table"), "exact": r.get("exact_from_onset")}
+                                             for r in rows if r.get("held") is False],
         "z_sd": statistics.pstdev(zs) if len(zs) > 1 else None,
         "z_within_1.645": (sum(abs(z) <= Z90 for z in zs) / len(zs)) if zs else None,
         "median_rel_error": statistics.median(rel) if rel else None,
@@ -228,20 +244,74 @@ def fresh_shell(args, runs: int = 7) -> dict:
     return out
 
 
+def phase_profile(args) -> None:
+    """Where a build's CPU goes: one block of references (``--rows``) at each tabulated contact, run as a sweep worker
+    runs it; per contact the fits per reference, CPU per fit, and the shares of simulation + features, libsvm's SMO
+    (classes that overlap) and the rest of the solver. A projection of the whole build is printed beside it."""
+    import dataclasses
+
+    from designkit.recognition import batched_svm
+    from designkit.sweep import scorer as scorer_mod
+    from designkit.sweep.chunk import run_chunk
+    from designkit.sweep.for_sensor import effusivity_span, sensor_sweep_config
+
+    cfg = sensor_sweep_config(args.sensor, span=effusivity_span(material_set=args.materials))
+    blocks = max(1, cfg.intervals // args.rows)
+    cfg = dataclasses.replace(cfg, blocks=blocks)
+    T: dict[str, float] = {}
+
+    def timed(name, fn):
+        def wrapper(*a, **k):
+            t = time.process_time()
+            try:
+                return fn(*a, **k)
+            finally:
+                T[name] = T.get(name, 0.0) + time.process_time() - t
+        return wrapper
+
+    batched_svm._libsvm_smo = timed("libsvm", batched_svm._libsvm_smo)
+    scorer_mod.PairScorer.features = timed("features", scorer_mod.PairScorer.features)
+    block = blocks // 2 if args.block is None else args.block
+    total = 0.0
+    print(f"{cfg.intervals} intervals, sigma/dT {cfg.noise_ratio[0]:.5f}, contacts (model) "
+          f"{[round(c, 3) for c in cfg.contact_s]}, max_repeats {cfg.max_repeats}; block {block} of {blocks}; "
+          f"load {os.getloadavg()[0]:.1f}", flush=True)
+    for k in ([int(x) for x in args.contacts.split(",")] if args.contacts else range(len(cfg.contact_s))):
+        T.clear()
+        t0 = time.process_time()
+        r = run_chunk(cfg, (0,), block, k)
+        cpu = time.process_time() - t0
+        total += cpu * cfg.intervals / r.rows.size
+        print(f"contact {cfg.contact_s[k]:.3f} s (model): {r.rows.size} refs, {r.fits / r.rows.size:.1f} fits/ref, "
+              f"{cpu / max(r.fits, 1):.3f} CPU s/fit, {cpu / r.rows.size:.2f} CPU s/ref; libsvm "
+              f"{T.get('libsvm', 0) / cpu:.0%}, simulation+features {T.get('features', 0) / cpu:.0%}; "
+              f"J - i {np.median(r.J - r.rows):.0f} (median); load {os.getloadavg()[0]:.1f}", flush=True)
+    print(f"projected build CPU for the contacts profiled: {total:.0f} s ({total / 2 / 60:.1f} min on 2 idle cores "
+          "at this CPU per reference)", flush=True)
+
+
 def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--sensor", required=True)
     p.add_argument("--out", required=True)
-    p.add_argument("--phase", choices=("exact", "table"), required=True)
+    p.add_argument("--phase", choices=("exact", "table", "profile"), required=True)
+    p.add_argument("--rows", type=int, default=20, help="profile: references per profiled block")
+    p.add_argument("--first-within", type=float, nargs=2, default=None, metavar=("LO", "HI"),
+                   help="exact: compute the pairs inside this effusivity range first")
+    p.add_argument("--block", type=int, default=None, help="profile: which block of --rows references (default: the "
+                   "middle one)")
+    p.add_argument("--contacts", default=None, help="profile: contact indices, comma-separated (default all)")
     p.add_argument("--materials", default="paper12")
     p.add_argument("--pairs", type=int, default=60)
     p.add_argument("--seed", type=int, default=34)
     p.add_argument("--jobs", type=int, default=2)
     p.add_argument("--repeats", type=int, default=4, help="the exact route's seeds of 100 trials per class")
+    p.add_argument("--solver", default="batched", help="the exact route's SVM solver (batched: the same classifier "
+                   "as sklearn's, all seeds at once)")
     p.add_argument("--build-cpu-s", type=float, default=None, help="CPU seconds the build printed (projection)")
     args = p.parse_args()
     Path(args.out).mkdir(parents=True, exist_ok=True)
-    (phase_exact if args.phase == "exact" else phase_table)(args)
+    {"exact": phase_exact, "table": phase_table, "profile": phase_profile}[args.phase](args)
 
 
 if __name__ == "__main__":

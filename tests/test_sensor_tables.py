@@ -70,8 +70,11 @@ def test_the_build_sweeps_the_rigs_conditions_and_registers_the_table(built, dat
     # sigma/dT: the rig's own (noise 0.02 over dT 7); the model: the file's; the touches: the rig's (as --exact's)
     assert cfg["noise_ratio"] == pytest.approx([0.02 / 7], rel=1e-12) and cfg["rig_scene"] is True
     assert cfg["model"] == {"name": "contact", "conductance_w_m2k": 1800.0}
-    # contact counted from the detected onset (0.1 s to 4 settling times of 0.75 s), stored as the model counts
-    assert s["contacts_from_onset_s"] == pytest.approx([0.1, 0.548, 3.0], abs=1e-3)
+    # contact counted from the detected onset, on the sensor's time scale (here the thermistor's tau, 1.345 s,
+    # longer than the ramp's 0.75 s: one to eight of them, capped at the exact route's 10 s of model time),
+    # stored as the model counts; the rig's repeats
+    assert s["contacts_from_onset_s"] == pytest.approx([1.345, 3.611, 9.7], abs=1e-3)
+    assert cfg["max_repeats"] == 2
     assert cfg["contact_s"] == pytest.approx([c - model_start_s(sensor) for c in s["contacts_from_onset_s"]])
     assert s["effusivity_span"] == {"min": 240.0, "max": 1680.0, "source": "materials Wood, Glass"}
     assert cfg["e_max"] - cfg["e_min"] == 80.0 * cfg["intervals"]  # the class width of --exact and svm-fine

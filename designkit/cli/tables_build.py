@@ -25,8 +25,10 @@ def tables_build(
     out: Annotated[Optional[Path], typer.Option(
         "--out", help="Folder (or .npz) for the table's files (default: the sensor-table registry in the user's "
                       "data folder; 'designkit tables build --help' says where).")] = None,
-    contact_points: Annotated[int, typer.Option("--contact-points", help="Contact times tabulated, from the rig's "
-                                                "detected onset to 4 settling times.")] = 13,
+    contact_points: Annotated[Optional[int], typer.Option(
+        "--contact-points", help="Contact times tabulated, geometric from one of the sensor's time scales after the "
+                                 "rig's detected onset to 8 of them (default: a ratio of at most 1.35 between "
+                                 "neighbours; 8 for the real rig, 0.75 to 6 s).")] = None,
     noise_factors: Annotated[Optional[str], typer.Option(
         "--noise-factors", help="sigma/dT tabulated, as multiples of the rig's own, comma-separated, 1 among them "
                                 "(default 1: the rig's alone; each factor costs as much as the first).")] = None,
@@ -46,7 +48,8 @@ def tables_build(
     question outside the table's span (another material, noise or contact time) is refused in one line
     (exit 2) naming the way out: `--exact`, or a table built over a wider span.
 
-    The paper's 12 materials at the paper's 100 trials per interval: `--materials paper12` (minutes on 2 cores).
+    The paper's 12 materials at the paper's 100 trials per interval: `--materials paper12` (for the real rig about
+    7,000 CPU s measured on a loaded machine: an hour on 2 cores; benchmarks/results/sensor_table_rig_scene.txt).
 
     Example (two materials, a quick coarse table): `designkit tables build --sensor my-sensor.yaml --m wood --m glass --trials 10 --contact-points 4`
     """

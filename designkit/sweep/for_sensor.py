@@ -22,11 +22,17 @@ whose table answers that sensor's questions as the rig sees them:
   correlated over the calibration residual's length, each touch read from the detected
   onset on, pressed as the calibration touches were;
 * **the contact axis** counts, as the rig's controller does, from the detected
-  onset: from :data:`FIRST_CONTACT_S` after it to :data:`LONGEST_CONTACT_SCALES` times
-  the sensor's own settling time (the contact ramp's rise to 90 % of the force,
-  else the thermistor's tau), geometric (:data:`CONTACT_POINTS`: dense enough that
-  the need, convex in contact time, is not read late between two points), and stored as
-  the model counts it (the onset's offset subtracted, :func:`designkit.rig.to_model_contact`).
+  onset, on the sensor's own time scale (:func:`time_scale_s`: the longest of the contact
+  ramp's rise to 90 % of the force, the noise's correlation length and the thermistor's tau):
+  from one time scale (before the touch has settled and while the noise is one correlated
+  draw, nothing separates at the rig's noise: measured, F1 0.5 at 0.55 s for pairs 100 classes
+  apart) to :data:`LONGEST_CONTACT_SCALES` of them, capped at :data:`MAX_CONTACT_S` (the exact
+  route's longest contact, in the model's time), geometric at a ratio of at most
+  :data:`CONTACT_RATIO` (the need, convex in contact time, is not read late between two points),
+  and stored as the model counts it (the onset's offset subtracted,
+  :func:`designkit.rig.to_model_contact`). A pair no tabulated contact separates is answered with
+  that bound (none up to the last contact; ``--exact`` looks up to 10 s), a pair the first
+  contact already separates with the first contact (at most that).
 
 Units: effusivity [J s^-1/2 K^-1 m^-2], times [s], noise [degC].
 """
@@ -45,23 +51,27 @@ from .._validation import InputError
 from ..objects import DEFAULT_CLASS_WIDTH
 from .config import SweepConfig
 
-__all__ = ["BuiltTable", "FIRST_CONTACT_S", "LONGEST_CONTACT_SCALES", "NOISE_FACTORS", "SensorSpan", "build_sensor_table", "contact_grid",
-           "effusivity_span", "rig_noise_ratio", "sensor_sweep_config"]
+__all__ = ["BuiltTable", "CONTACT_RATIO", "LONGEST_CONTACT_SCALES", "MAX_CONTACT_S", "NOISE_FACTORS", "SensorSpan",
+           "build_sensor_table", "contact_grid", "effusivity_span", "rig_noise_ratio", "sensor_sweep_config",
+           "time_scale_s"]
 
 #: sigma/dT of the table's noise axis, as multiples of the rig's own (1 *is* the rig's: a question at the rig's
 #: conditions lands on a grid point, not between two). The rig's alone by default: each factor costs a whole
 #: build again, and a question at another noise is refused in one line (``--exact`` answers it).
 NOISE_FACTORS = (1.0,)
-#: The first tabulated contact after the rig's detected onset [s].
-FIRST_CONTACT_S = 0.1
-#: The longest tabulated contact after the onset, in units of the sensor's settling time. With the real rig's
-#: correlated noise some of the paper's pairs need longer (up to ~9 s; benchmarks/results/sensor_table_rig_scene.txt):
-#: the table says none up to its last contact separates them, ``--exact`` searches up to 10 s.
-LONGEST_CONTACT_SCALES = 4.0
-#: Contact times tabulated (geometric between the two ends, counted from the onset): ratio 1.33 between
-#: neighbours for the rig (0.1 to 3 s), 1.1-1.2 in the model's time where the paper's materials separate
-#: (9 points, ratio 1.3-1.4 there, answered later than the exact route in 23 of 24 pairs).
-CONTACT_POINTS = 13
+#: The longest tabulated contact after the onset, in units of the sensor's time scale (:func:`time_scale_s`): 6 s for
+#: the real rig (0.75 s), where the exact route found the paper's pairs separating at 1.2-3.1 s from the onset and
+#: a few of the hardest (effusivities within 25 % above 9000) beyond (benchmarks/results/sensor_table_rig_scene.txt).
+LONGEST_CONTACT_SCALES = 8.0
+#: Cap of the contact axis in the model's time [s]: the exact route's longest contact (``max_contact_s``).
+MAX_CONTACT_S = 10.0
+#: Largest ratio between neighbouring contact times (0.75-6 s: 8 points for the rig).
+CONTACT_RATIO = 1.35
+#: Samples a touch has at least at the first tabulated contact (a time scale shorter than a few sample periods).
+MIN_SAMPLES = 10
+#: Seeds per pair at most (the search re-scores only pairs within z standard errors of Phi): 2, not the
+#: paper tables' 4; each seed near the threshold is a fit where the rig's classes overlap, its costliest kind.
+MAX_REPEATS = 2
 #: The whole range (the shipped tables'): a table for no materials in particular [J s^-1/2 K^-1 m^-2].
 WHOLE_RANGE = (0.0, 40000.0)
 
@@ -153,31 +163,50 @@ def rig_noise_ratio(sensor) -> float:
     return float(noise) / abs(float(dt))
 
 
-def contact_grid(sensor, points: int = CONTACT_POINTS) -> tuple[np.ndarray, np.ndarray]:
+def time_scale_s(sensor) -> float:
+    """The sensor's own time scale [s]: the longest of the contact ramp's rise (from the onset until the force
+    reaches 90 % of its plateau), the correlation length of the rig's noise and the thermistor's tau.
+
+    Examples
+    --------
+    >>> from designkit.sensor import load_sensor
+    >>> round(time_scale_s(load_sensor("tests/data/rig_sensor.yaml")), 4)   # the real rig's ramp
+    0.7525
+    """
+    cond = getattr(sensor, "conditions", None) or {}
+    ramp = cond.get("contact_ramp") or {}
+    return max(float(ramp.get("rise_s") or 0.0), float(cond.get("noise_correlation_s") or 0.0), float(sensor.tau_s))
+
+
+def contact_grid(sensor, points: int | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Contact times from the rig's detected onset, and the same as the model counts them [s].
 
-    Geometric from :data:`FIRST_CONTACT_S` to :data:`LONGEST_CONTACT_SCALES` settling times, the settling
-    time being the contact ramp's rise (the median time from the onset until the force reaches 90 % of
-    its plateau) or, without a force channel, the thermistor's tau. Rounded to 1 ms (onset times).
+    Geometric from one time scale (:func:`time_scale_s`, at least :data:`MIN_SAMPLES` sample periods, and after
+    the model's first heat flow) to :data:`LONGEST_CONTACT_SCALES` of them, capped at :data:`MAX_CONTACT_S` in
+    the model's time; ``points`` (default: the fewest at a ratio of at most :data:`CONTACT_RATIO`). Rounded to
+    1 ms (onset times).
     """
     from ..rig import model_start_s, to_model_contact
 
-    cond = getattr(sensor, "conditions", None) or {}
-    ramp = cond.get("contact_ramp") or {}
-    scale = float(ramp.get("rise_s") or 0.0) or float(sensor.tau_s)
+    scale = time_scale_s(sensor)
     start = model_start_s(sensor)
-    first = FIRST_CONTACT_S
+    first = max(scale, MIN_SAMPLES / float(sensor.sample_rate_hz))
     if start is not None and start > 0:  # the model's heat flow begins after the onset: tabulate from there on
-        first = max(first, start + FIRST_CONTACT_S)
-    last = max(LONGEST_CONTACT_SCALES * scale, 4 * first)
-    onset = np.round(np.geomspace(first, last, points), 3)
+        first = max(first, start + MIN_SAMPLES / float(sensor.sample_rate_hz))
+    cap = MAX_CONTACT_S - max(-(start or 0.0), 0.0) if start is not None and start < 0 else MAX_CONTACT_S
+    last = max(min(LONGEST_CONTACT_SCALES * scale, cap), 2 * first)
+    if points is None:
+        points = int(math.ceil(math.log(last / first) / math.log(CONTACT_RATIO) - 1e-9)) + 1
+    if int(points) != points or points < 2:
+        raise InputError(f"contact points must be an integer >= 2, got {points!r}")
+    onset = np.round(np.geomspace(first, last, int(points)), 3)
     model = np.array([to_model_contact(float(c), start) for c in onset])
     return onset, model
 
 
 def sensor_sweep_config(sensor_file: str, *, span: SensorSpan | None = None, name: str | None = None,
-                        noise_factors: Sequence[float] = NOISE_FACTORS, contact_points: int = CONTACT_POINTS,
-                        trials: int = 100, seed: int = 0, max_repeats: int = 4) -> SweepConfig:
+                        noise_factors: Sequence[float] = NOISE_FACTORS, contact_points: int | None = None,
+                        trials: int = 100, seed: int = 0, max_repeats: int = MAX_REPEATS) -> SweepConfig:
     """The sweep config of the table that answers a calibrated sensor's questions (module docstring).
 
     Parameters
@@ -190,8 +219,8 @@ def sensor_sweep_config(sensor_file: str, *, span: SensorSpan | None = None, nam
         Table name (default ``sensor-NAME``).
     noise_factors : sequence of float
         sigma/dT of the noise axis as multiples of the rig's own (1 must be one of them).
-    contact_points : int
-        Contact times tabulated.
+    contact_points : int, optional
+        Contact times tabulated (default: :func:`contact_grid`'s, from the sensor's time scale).
     trials, seed, max_repeats : int
         The classifier protocol (the paper's: 100 trials per interval, 3 folds) and its Monte Carlo.
 

@@ -25,11 +25,11 @@ from typing import Any
 import numpy as np
 from cachetools import LRUCache
 
-from .._validation import InputError
+from .._validation import InputError, as_generator
 from ..recognition.features import feature_matrix
 from ..scene import Scene
 from ..sensor import Sensor
-from ..simulation import draw_trials, render_trials
+from ..simulation import RAMP_STREAM, draw_trials, render_trials, window_times_s
 from .config import SweepConfig
 
 __all__ = ["BATCH_MB", "CHUNK_PAIRS", "CV_KEY", "ENGINE_VERSION", "FEATURE_CACHE_MB", "PairCell", "PairScorer", "array_namespace",
@@ -149,7 +149,9 @@ class PairScorer:
         self.cfg = cfg
         self.sensor = sensor
         self.scene = scene
-        self.n_samples = sensor.times_s(scene.contact_s).size
+        # the recorder's window, from the scene's onset to its contact, as simulate_class reads a touch (the whole
+        # contact from the onset on read a rig's touches 0.64 s longer than the exact route: answers that early)
+        self.n_samples = window_times_s(sensor, scene).size
         self.edges = cfg.edges
         # features of (interval, seed), least recently used first; they are a deterministic function
         # of their key, so evicting one only costs its regeneration, never changes a result
@@ -174,7 +176,14 @@ class PairScorer:
                                 seed=[cfg.seed, k, rep],
                                 vary_sensor=cfg.sensor_temp_spread_c > 0,
                                 vary_ambient=cfg.ambient_temp_spread_c > 0)
-            temps = render_trials(draws, self.sensor, self.scene, cfg.model, cfg.trial_diffusivity()).temperature_c
+            # a force ramp with the calibration touches' presses: each trial presses as one of them, picked from
+            # the stream simulate_class picks from (the exact route's touches); the nominal press for all was
+            # less varied than the rig, and its table answered earlier than --exact
+            ramps = getattr(cfg.model, "touch_ramps", ())
+            pick = (as_generator([cfg.seed, k, rep, RAMP_STREAM]).integers(0, len(ramps), cfg.trials) if ramps
+                    else None)
+            temps = render_trials(draws, self.sensor, self.scene, cfg.model, cfg.trial_diffusivity(),
+                                  pick).temperature_c
             feats = feature_matrix(temps, self.sensor.sample_rate_hz, cfg.slope_window_s)
             if self._prepare:  # the batched solver's numpy path reads these (half the float64 matrix's bytes)
                 from ..recognition.batched_svm import prepare_features

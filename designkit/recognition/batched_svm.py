@@ -28,8 +28,8 @@ mean(diag K) * a_i``, far below libsvm's tolerance); where the Gram matrix is ra
 deficient (short contacts, fewer samples than training touches) the active set can
 jump, and those problems are re-solved by continuation (ridge ``1e-3`` then ``1e-9``
 times ``mean(diag K)``); whatever still fails (classes that overlap, many bounded
-support vectors) is solved by a batched SMO with libsvm's working-set selection and
-stopping rule (eps = 1e-3).
+support vectors) is solved by libsvm itself (scikit-learn's ``SVC`` on the precomputed
+kernel, on the host, eps = 1e-3).
 
 Cost. The Gram products dominate (``n_train^2 d / 2`` multiply-adds per fold); by
 default they are formed in float32 from features centered in float64 (relative error
@@ -72,7 +72,6 @@ __all__ = [
 
 #: libsvm's default stopping tolerance on the KKT gap (scikit-learn's ``SVC(tol=1e-3)``).
 LIBSVM_EPS = 1e-3
-_TAU = 1e-12  # libsvm's floor on a non-positive curvature
 _RIDGE = 1e-9  # relative ridge of the active-set solves (times mean(diag K))
 _CONTINUATION = (1e-3, 1e-9)
 _SOLVER_NAMES = ("active-set", "active-set continuation", "smo")
@@ -352,58 +351,8 @@ def _active_set(K, y, C, ridge, free, up, max_iter, xp):
     return a_out, done, iters
 
 
-def _smo(K, y, C, eps, max_iter, xp):
-    """Batched SMO with libsvm's second-order working-set selection (WSS3) and stopping rule."""
-    P, n = y.shape
-    dt = K.dtype
-    a = xp.zeros((P, n), dtype=dt)
-    G = -xp.ones((P, n), dtype=dt)
-    QD = xp.linalg.diagonal(K) if hasattr(xp, "linalg") and hasattr(xp.linalg, "diagonal") else xp.diagonal(K, axis1=-2, axis2=-1)
-    rows = xp.arange(P)
-    inf = float("inf")
-    iters = xp.zeros(P, dtype=xp.int64)
-    done = xp.zeros(P, dtype=xp.bool)
-    for it in range(max_iter):
-        v = -y * G
-        i_up = ((y > 0) & (a < C)) | ((y < 0) & (a > 0))
-        i_low = ((y > 0) & (a > 0)) | ((y < 0) & (a < C))
-        vu = xp.where(i_up, v, -inf)
-        i = xp.argmax(vu, axis=-1)
-        m = vu[rows, i]
-        vl = xp.where(i_low, v, inf)
-        done = (m - xp.min(vl, axis=-1) < eps) | ~xp.any(i_up, axis=-1)
-        if bool(xp.all(done)):
-            break
-        Ki = K[rows, i, :]
-        bdiff = m[:, None] - v
-        quad = QD[rows, i][:, None] + QD - 2.0 * Ki
-        quad = xp.where(quad > 0, quad, _TAU)
-        obj = xp.where(i_low & (bdiff > 0), -(bdiff * bdiff) / quad, inf)
-        j = xp.argmin(obj, axis=-1)
-        none = ~xp.isfinite(obj[rows, j])
-        stop = done | none
-        yi, yj = y[rows, i], y[rows, j]
-        ai, aj = a[rows, i], a[rows, j]
-        t = bdiff[rows, j] / quad[rows, j]
-        tmax_i = xp.where(yi > 0, C - ai, ai)
-        tmax_j = xp.where(yj > 0, aj, C - aj)
-        t = xp.minimum(xp.minimum(t, tmax_i), tmax_j)
-        t = xp.where(stop, 0.0, t)
-        ai_new = xp.where(t >= tmax_i, xp.where(yi > 0, C, 0.0), ai + yi * t)
-        aj_new = xp.where(t >= tmax_j, xp.where(yj > 0, 0.0, C), aj - yj * t)
-        ai_new = xp.where(stop, ai, ai_new)
-        aj_new = xp.where(stop, aj, aj_new)
-        dai, daj = ai_new - ai, aj_new - aj
-        a[rows, i] = ai_new
-        a[rows, j] = aj_new
-        Kj = K[rows, j, :]
-        G = G + y * ((yi * dai)[:, None] * Ki + (yj * daj)[:, None] * Kj)
-        iters = iters + xp.astype(~stop, xp.int64)
-    return a, done, iters
-
-
 def _libsvm_smo(K, y, C, eps, max_iter, xp):
-    """:func:`_smo` by libsvm itself, problem by problem on the host: ``(a, done, iterations)``.
+    """libsvm's own SMO, problem by problem on the host: ``(a, done, iterations)``.
 
     scikit-learn's ``SVC`` on the precomputed kernel with the labels as the reference fits them (the
     class that is +1 here listed first), so the same path and optimum as the reference's fit; ``a`` is
@@ -419,7 +368,7 @@ def _libsvm_smo(K, y, C, eps, max_iter, xp):
     a = np.zeros(yh.shape, dtype=np.float64)
     iters = np.zeros(yh.shape[0], dtype=np.int64)
     for p in range(yh.shape[0]):
-        with warnings.catch_warnings():  # at max_iter as the batched SMO stopped: silently (``done`` says so)
+        with warnings.catch_warnings():  # at max_iter: silently (``done`` says so)
             warnings.simplefilter("ignore", ConvergenceWarning)
             m = SVC(kernel="precomputed", C=C, tol=eps, max_iter=max_iter).fit(Kh[p], (yh[p] < 0).astype(np.int64))
         a[p, m.support_] = np.abs(m.dual_coef_[0])
@@ -521,8 +470,8 @@ def solve_svc_duals(K, y, *, C: float = 1.0, xp=None, max_active_set_iter: int =
         solver[todo] = 1
         rest = todo[~ok_t]
         if rest.shape[0]:
-            # libsvm's own SMO (the reference's solver, in C): the batched one (:func:`_smo`) steps in Python,
-            # 100,000+ steps a fold where classes overlap (a rig's correlated noise: 86 s a fit, 1.2 s by libsvm)
+            # libsvm's own SMO (the reference's solver, in C): a batched SMO stepped in Python, 100,000+ steps
+            # a fold where classes overlap (a rig's correlated noise: 86 s a fit, 1.2 s by libsvm)
             a_s, _, it_s = _libsvm_smo(K[rest], y[rest], C, LIBSVM_EPS, smo_max_iter, xp)
             a[rest] = a_s
             solver[rest] = 2

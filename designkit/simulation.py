@@ -70,6 +70,7 @@ __all__ = [
     "simulate_class",
     "simulate_interval",
     "simulate_trials",
+    "touch_picks",
     "window_times_s",
 ]
 
@@ -396,9 +397,15 @@ def simulate_class(obj: ObjectClass, n_trials: int, sensor: Sensor, scene: Scene
         a_lo, a_hi = obj.diffusivity_range_m2_s
         alpha = (as_generator(key + [DIFFUSIVITY_STREAM]).uniform(a_lo, a_hi, draws.n_trials) if a_hi > a_lo
                  else np.full(draws.n_trials, a_lo))
-    ramps = getattr(fm, "touch_ramps", ())
-    pick = as_generator(key + [RAMP_STREAM]).integers(0, len(ramps), draws.n_trials) if ramps else None
-    return render_trials(draws, sensor, scene, fm, alpha, pick)
+    return render_trials(draws, sensor, scene, fm, alpha, touch_picks(fm, key, draws.n_trials))
+
+
+def touch_picks(model, key, n_trials: int) -> np.ndarray | None:
+    """Which calibration touch's press each of ``n_trials`` trials plays (indices into ``model.touch_ramps``),
+    drawn from the ``key + [RAMP_STREAM]`` stream; None for a model without touch ramps (every trial presses
+    alike). The one rule for the exact route's touches and a sweep's."""
+    ramps = getattr(model, "touch_ramps", ())
+    return as_generator(list(key) + [RAMP_STREAM]).integers(0, len(ramps), n_trials) if ramps else None
 
 
 def simulate_interval(e_low: float, e_high: float, n_trials: int, sensor: Sensor,

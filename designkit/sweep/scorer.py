@@ -25,11 +25,11 @@ from typing import Any
 import numpy as np
 from cachetools import LRUCache
 
-from .._validation import InputError, as_generator
+from .._validation import InputError
 from ..recognition.features import feature_matrix
 from ..scene import Scene
 from ..sensor import Sensor
-from ..simulation import RAMP_STREAM, draw_trials, render_trials, window_times_s
+from ..simulation import draw_trials, render_trials, touch_picks, window_times_s
 from .config import SweepConfig
 
 __all__ = ["BATCH_MB", "CHUNK_PAIRS", "CV_KEY", "ENGINE_VERSION", "FEATURE_CACHE_MB", "PairCell", "PairScorer", "array_namespace",
@@ -179,11 +179,8 @@ class PairScorer:
             # a force ramp with the calibration touches' presses: each trial presses as one of them, picked from
             # the stream simulate_class picks from (the exact route's touches); the nominal press for all was
             # less varied than the rig, and its table answered earlier than --exact
-            ramps = getattr(cfg.model, "touch_ramps", ())
-            pick = (as_generator([cfg.seed, k, rep, RAMP_STREAM]).integers(0, len(ramps), cfg.trials) if ramps
-                    else None)
             temps = render_trials(draws, self.sensor, self.scene, cfg.model, cfg.trial_diffusivity(),
-                                  pick).temperature_c
+                                  touch_picks(cfg.model, [cfg.seed, k, rep], cfg.trials)).temperature_c
             feats = feature_matrix(temps, self.sensor.sample_rate_hz, cfg.slope_window_s)
             if self._prepare:  # the batched solver's numpy path reads these (half the float64 matrix's bytes)
                 from ..recognition.batched_svm import prepare_features

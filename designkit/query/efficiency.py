@@ -200,7 +200,9 @@ class CriticalNoiseGrid:
         self.known = np.zeros(n * n, dtype=bool)
 
     def _weight(self, e):
-        return e / (self.e_s + e)
+        from ..models.semi_infinite import object_weight
+
+        return object_weight(self.e_s, e)
 
     def _fill(self, nodes: np.ndarray) -> None:
         """Solve the nodes ``nodes`` (flat indices) exactly, in one vectorized call."""

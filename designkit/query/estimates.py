@@ -365,6 +365,11 @@ class Estimates:
     extra: dict = field(default_factory=dict)
 
 
+def _at(v, m: np.ndarray):
+    """``v`` (an array of the elements, or one value for all) at the elements ``m``."""
+    return v[m] if np.ndim(v) else v
+
+
 def first_applicable(estimators, rd, n: int) -> dict[str, np.ndarray]:
     """Per element, the answer of the first estimator (in order) that applies to it (``kind`` "none" where none
     does)."""
@@ -381,10 +386,10 @@ def first_applicable(estimators, rd, n: int) -> dict[str, np.ndarray]:
         if not m.any():
             continue
         for k in ("value", "low", "high"):
-            out[k][m] = np.broadcast_to(getattr(r, k), (n,))[m]
+            out[k][m] = _at(getattr(r, k), m)
         out["kind"][m], out["stated"][m] = r.kind, r.stated
         for k, v in r.extra.items():
-            out.setdefault(k, _nan(n))[m] = np.broadcast_to(v, (n,))[m]
+            out.setdefault(k, _nan(n))[m] = _at(v, m)
         taken |= m
     return out
 

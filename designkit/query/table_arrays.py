@@ -53,6 +53,7 @@ class TableView:
         self._noise_grid: CriticalNoiseGrid | None = None
         self._sensor_dict: dict | None = None
         self._mc_factor: float | None = None
+        self._contact_norms: np.ndarray | None = None
 
     def critical_noise(self, lo, hi) -> np.ndarray:
         """The ideal observer's critical noise of the table's classes ``[lo, lo + w)``, ``[hi, hi + w)`` (its
@@ -62,6 +63,15 @@ class TableView:
             self._noise_grid = CriticalNoiseGrid(self.t.sensor, float(self.t.header["effusivity"]["width"]),
                                                  self.t.threshold, self.e_hi)
         return self._noise_grid(lo, hi)
+
+    def contact_norms(self) -> np.ndarray:
+        """``|g|`` (:func:`~designkit.recognition.ideal.shape_norm`) of the table's sensor at each tabulated
+        contact time, computed once."""
+        if self._contact_norms is None:
+            from ..recognition.ideal import shape_norm
+
+            self._contact_norms = shape_norm(self.t.sensor, self.contacts)
+        return self._contact_norms
 
     def sensor_dict(self) -> dict:
         """The table's ``sensor.to_dict()``, computed once (each caller gets its own top-level dict)."""
@@ -105,32 +115,49 @@ class TableView:
         """The arrays ``names`` (one name, or a sequence) at scene weights ``combos``, every contact and every
         ``e``: [contact, len(e)], or [len(names), contact, len(e)] for a sequence (NaN: none), all the weighted
         scene slices of all the arrays in one reading."""
-        live = [(idx, w) for idx, w in combos if w != 0]
-        at = tuple(np.array(k)[:, None, None] for k in zip(*(idx for idx, _ in live)))  # each [slice, 1, 1]
-        at += (np.arange(self.contacts.size)[:, None],)
         many = not isinstance(names, str)
-        arrays = [self.t.arrays[n] for n in (names if many else [names])]
-        # [name, slice, contact, e]: only the entries read (the arrays may be mapped from the file)
-        v = interp_e_by(lambda c: np.stack([a[at + (c,)] for a in arrays]), self.centres, e)
-        # (NaN where any weighted slice is NaN; summed in the slices' order)
-        out = np.sum(np.array([w for _, w in live])[:, None, None] * v, axis=1)
+        out = _weighted(combos, self.slices(names if many else [names], combos, e))
         return out if many else out[0]
 
-    def need(self, kind, combos, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-        """Distance needed to separate ``lo < hi``, ``max(delta_up(lo), delta_down(hi))``, at every contact and
-        pair: [contact, n] (NaN: not within the grid). ``kind``: svm, lo, hi (the Monte Carlo ends), ideal; or a
-        sequence of them: [kind, contact, n], in one reading."""
-        many = not isinstance(kind, str)
+    def slices(self, names, combos, e: np.ndarray) -> np.ndarray:
+        """The arrays ``names`` (a sequence) in each weighted scene slice of ``combos`` (in their order), at every
+        contact and every ``e``: [name, slice, contact, len(e)] (NaN: none), in one reading."""
+        live = [idx for idx, w in combos if w != 0]
+        at = tuple(np.array(k)[:, None, None] for k in zip(*live))  # each [slice, 1, 1]
+        at += (np.arange(self.contacts.size)[:, None],)
+        arrays = [self.t.arrays[n] for n in names]
+        # only the entries read (the arrays may be mapped from the file)
+        return interp_e_by(lambda c: np.stack([a[at + (c,)] for a in arrays]), self.centres, e)
+
+    def readings(self, kinds, combos, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """What :meth:`need` of the sequence ``kinds`` is made of: ``delta_up`` at ``lo`` and ``delta_down`` at
+        ``hi`` of each kind in each weighted scene slice, [kind, slice, contact, n] each."""
         names = []
-        for k in (kind if many else [kind]):
+        for k in kinds:
             suffix = {"svm": "", "lo": "_lo", "hi": "_hi", "ideal": "_ideal"}[k]
             if f"delta_up{suffix}" not in self.t.arrays:  # ideal tables carry only delta_up / delta_down
                 suffix = ""
             names.append(suffix)
-        up = self.delta([f"delta_up{x}" for x in names], combos, lo)
-        down = self.delta([f"delta_down{x}" for x in names], combos, hi)
+        return (self.slices([f"delta_up{x}" for x in names], combos, lo),
+                self.slices([f"delta_down{x}" for x in names], combos, hi))
+
+    def need(self, kind, combos, lo: np.ndarray, hi: np.ndarray, readings=None) -> np.ndarray:
+        """Distance needed to separate ``lo < hi``, ``max(delta_up(lo), delta_down(hi))``, at every contact and
+        pair: [contact, n] (NaN: not within the grid). ``kind``: svm, lo, hi (the Monte Carlo ends), ideal; or a
+        sequence of them: [kind, contact, n], in one reading (``readings``: :meth:`readings` of them, read
+        already)."""
+        many = not isinstance(kind, str)
+        up, down = (_weighted(combos, r) for r in (
+            readings if readings is not None else self.readings(kind if many else [kind], combos, lo, hi)))
         out = np.where(np.isnan(up) | np.isnan(down), np.nan, np.maximum(up, down))
         return out if many else out[0]
+
+
+def _weighted(combos, per_slice: np.ndarray) -> np.ndarray:
+    """The weighted sum over the scene slices (axis 1) of ``per_slice`` (NaN where any weighted slice is NaN;
+    summed in the slices' order)."""
+    w = np.array([w for _, w in combos if w != 0])
+    return np.sum(w[:, None, None] * per_slice, axis=1)
 
 
 def at_contact(cw, per_contact: np.ndarray) -> np.ndarray:
@@ -223,7 +250,8 @@ def contact_arrays(op, lo, hi, noise, dt, *, ideal_bound: bool, zc: float, class
         gap = h - l
         # every need in one reading, every crossing in one: svm, its Monte Carlo ends, the grid's own bound
         kinds = ["svm"] + (["lo", "hi"] if svm else []) + (["ideal"] if "delta_up_ideal" in view.t.arrays else [])
-        need = view.need(kinds, combos, l, h)  # [kind, contact, pair]
+        readings = view.readings(kinds, combos, l, h)  # the efficiency route reads its entries from them
+        need = view.need(kinds, combos, l, h, readings)  # [kind, contact, pair]
         m = l.size
         value, k, _, _, n0, n1 = grid_crossing(grid, need.transpose(1, 0, 2).reshape(grid.size, -1),
                                                np.tile(gap, len(kinds)))
@@ -240,7 +268,8 @@ def contact_arrays(op, lo, hi, noise, dt, *, ideal_bound: bool, zc: float, class
             if all(iflags.values()):
                 res["ideal"][idx] = grid_crossing(op.iview.contacts, op.iview.need(op.ikind, icombos, l, h), gap)[0]
         if efficiency and (has := k >= 0).any():
-            r = noise_k_min_contact(op, combos, k[has], l[has], h[has], nz / abs(d), zc=zc)
+            r = noise_k_min_contact(op, combos, k[has], l[has], h[has], nz / abs(d), zc=zc,
+                                    readings=[x[:3][..., has] for x in readings])
             for key in eff:
                 eff[key][idx[has]] = r[key]
             star[idx[has]], have_star[idx[has]] = r["s_pair"], True

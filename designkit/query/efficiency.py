@@ -246,7 +246,8 @@ class CriticalNoiseGrid:
                 nodes = (rows * n + cols).ravel()
                 self._fill(nodes[~self.known[nodes]])
             g = np.einsum("pi,pj,pij->p", _lagrange4(pu - su), _lagrange4(pv - sv), self.values[flat])
-            out[i] = np.exp(g) * (self._weight(hi[i]) - self._weight(lo[i]))
+            w = self._weight(np.concatenate([hi[i], lo[i]]))
+            out[i] = np.exp(g) * (w[:i.size] - w[i.size:])
         rest = np.flatnonzero(np.isnan(out) & np.isfinite(lo) & np.isfinite(hi))
         if rest.size:  # outside the grid (or next to a node that does not separate): the exact solve
             from .ideal_bound import pair_critical_noise
@@ -259,7 +260,9 @@ class CriticalNoiseGrid:
 def _lagrange4(x: np.ndarray) -> np.ndarray:
     """Cubic Lagrange weights of the nodes 0, 1, 2, 3 at positions ``x`` (in [0, 3]): shape ``x.shape + (4,)``."""
     a, b, c, d = x, x - 1.0, x - 2.0, x - 3.0
-    return np.stack([-b * c * d / 6.0, a * c * d / 2.0, -a * b * d / 2.0, a * b * c / 6.0], axis=-1)
+    out = np.empty(x.shape + (4,))
+    out[..., 0], out[..., 1], out[..., 2], out[..., 3] = -b * c * d / 6.0, a * c * d / 2.0, -a * b * d / 2.0, a * b * c / 6.0
+    return out
 
 
 # ============================================================ the noise efficiency (min-contact)

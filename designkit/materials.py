@@ -478,9 +478,12 @@ def _shipped_table() -> MaterialTable:
 
     content = _SHIPPED.read_bytes()
     data = recorded("materials", content)  # parsed once by designkit tables build: no YAML (its import and parse)
-    if data is None:
-        data = _yaml_data(content.decode("utf-8"), _SHIPPED_SOURCE)
-    return _parse_table(data, _SHIPPED_SOURCE)  # every rule checked either way
+    if data is not None:
+        try:
+            return _parse_table(data, _SHIPPED_SOURCE)  # every rule checked either way
+        except Exception:  # (not what designkit recorded): the file itself, the long way
+            pass
+    return _parse_table(_yaml_data(content.decode("utf-8"), _SHIPPED_SOURCE), _SHIPPED_SOURCE)
 
 
 def remember_shipped_table() -> None:

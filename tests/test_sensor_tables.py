@@ -226,3 +226,18 @@ def test_a_registered_tables_content_other_than_checked_gets_the_schemas_verdict
     ok = load_table(npz, checked_hash=entry["content_hash"])
     assert ok.checked and not ok.shipped
     assert not load_table(npz).checked and not load_table(npz, checked_hash="sha256:other").checked
+
+
+def test_a_damaged_record_is_passed_over_for_the_file_itself(built, tmp_path, monkeypatch):
+    from designkit.sensor import Sensor, remember_checked_file
+
+    monkeypatch.setenv("DESIGNKIT_DATA_DIR", str(tmp_path / "data"))
+    f = tmp_path / "copy.yaml"
+    f.write_bytes(built["sensor_file"].read_bytes())
+    s = Sensor.from_yaml(f)
+    remember_checked_file(f, s)
+    [rec] = (tmp_path / "data" / "checked-files").glob("sensor-*.json")
+    d = json.loads(rec.read_text())
+    d["data"]["effusivity"] = "not a number"
+    rec.write_text(json.dumps(d))
+    assert load_sensor(f) == s and load_sensor(f).to_dict() == s.to_dict()

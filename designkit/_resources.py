@@ -9,7 +9,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-__all__ = ["profiles_dir", "shipped_tables_dir"]
+__all__ = ["DATA_DIR_VARIABLE", "data_dir", "profiles_dir", "shipped_tables_dir"]
+
+#: Environment variable naming designkit's data folder instead of the user's (tests, shared machines).
+DATA_DIR_VARIABLE = "DESIGNKIT_DATA_DIR"
 
 _PKG = Path(__file__).resolve().parent
 _REPO = _PKG.parent
@@ -30,3 +33,16 @@ def shipped_tables_dir() -> Path:
 def profiles_dir() -> Path:
     """Folder of the shipped device profiles."""
     return _first_dir(_PKG / "profiles", _REPO / "calibration" / "profiles")
+
+
+def data_dir() -> Path:
+    """designkit's data folder (what it records for later runs: the sensor-table registry, the sensor files it
+    checked): ``$DESIGNKIT_DATA_DIR`` or the user's data folder (``platformdirs.user_data_dir("designkit")``)."""
+    import os
+
+    base = os.environ.get(DATA_DIR_VARIABLE)
+    if not base:
+        import platformdirs
+
+        base = platformdirs.user_data_dir("designkit", appauthor=False)
+    return Path(base)

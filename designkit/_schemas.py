@@ -33,7 +33,8 @@ from typing import Any, Mapping
 
 from ._validation import InputError
 
-__all__ = ["MAX_FILE_BYTES", "check_regular_file", "load_json", "load_yaml", "read_text", "schemas", "validate"]
+__all__ = ["MAX_FILE_BYTES", "check_regular_file", "load_json", "load_yaml", "read_text", "recorded", "record_checked",
+           "schemas", "validate"]
 
 #: The largest text file designkit parses (headers, configs, profiles, sidecars are kilobytes).
 MAX_FILE_BYTES = 64 * 1024 * 1024
@@ -99,6 +100,64 @@ def load_yaml(path: str | Path, what: str, *, empty_ok: bool = False) -> Any:
     if data is None and not empty_ok:
         raise InputError(f"{what} {path} is empty")
     return data
+
+
+# ------------------------------------------------------------------- checked files, recorded
+#: The format of a record :func:`record_checked` writes.
+_RECORD_FORMAT = "designkit-checked-file"
+
+
+def _record_path(kind: str, sha256: str) -> Path:
+    from ._resources import data_dir
+
+    return data_dir() / "checked-files" / f"{kind}-{sha256[:32]}.json"
+
+
+def record_checked(kind: str, content: bytes, data: Any) -> None:
+    """Record in designkit's data folder that a file of ``kind`` with exactly ``content`` reads, checked, as the
+    plain data ``data`` (JSON: numbers, strings, lists, mappings), so that a later process reads the record
+    (:func:`recorded`) instead of parsing the file through YAML and its schema: what a question from a fresh
+    shell about a registered sensor pays otherwise (pydantic's import and first model build, the YAML of a
+    calibrated file's thousands of numbers: about 0.3 s). ``designkit tables build --sensor FILE`` records
+    the sensor file and the shipped materials when it registers the table. A record that cannot be written
+    (a read-only data folder) is left out: the files are then read the long way."""
+    import hashlib
+    import json
+
+    from . import __version__
+    from ._io import atomic_write_text
+
+    sha = hashlib.sha256(content).hexdigest()
+    try:
+        text = json.dumps({"format": _RECORD_FORMAT, "kind": kind, "designkit_version": __version__, "sha256": sha,
+                           "data": data}, allow_nan=False)
+        if json.loads(text)["data"] != data:  # (a type JSON does not keep: not recorded)
+            return
+        out = _record_path(kind, sha)
+        out.parent.mkdir(parents=True, exist_ok=True)
+        atomic_write_text(out, text + "\n")
+    except (OSError, ValueError, TypeError):
+        return
+
+
+def recorded(kind: str, content: bytes) -> Any | None:
+    """The data :func:`record_checked` recorded for a file of ``kind`` with exactly ``content``, by this designkit
+    (another version's record is not read); None where there is none (the file is then read the long way,
+    which says what is wrong with it, if anything)."""
+    import hashlib
+    import json
+
+    from . import __version__
+
+    sha = hashlib.sha256(content).hexdigest()
+    try:
+        rec = json.loads(_record_path(kind, sha).read_text())
+    except (OSError, ValueError):
+        return None
+    if not isinstance(rec, dict) or (rec.get("format"), rec.get("kind"), rec.get("designkit_version"),
+                                     rec.get("sha256")) != (_RECORD_FORMAT, kind, __version__, sha):
+        return None
+    return rec.get("data")
 
 
 class _DuplicateKey(ValueError):

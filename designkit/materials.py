@@ -62,6 +62,7 @@ __all__ = [
     "list_materials",
     "load_material_table",
     "material_or_effusivity",
+    "remember_shipped_table",
 ]
 
 MATERIALS_FILE_VERSION = 1
@@ -447,12 +448,16 @@ def _parse_table(data: Any, source: str) -> MaterialTable:
 
 
 def _read_table(text: str, source: str) -> MaterialTable:
+    return _parse_table(_yaml_data(text, source), source)
+
+
+def _yaml_data(text: str, source: str) -> Any:
     import yaml
 
     from ._schemas import _DuplicateKey, _unique_key_loader
 
     try:
-        data = yaml.load(text, Loader=_unique_key_loader())  # noqa: S506 - a safe loader (libyaml's when present)
+        return yaml.load(text, Loader=_unique_key_loader())  # noqa: S506 - a safe loader (libyaml's when present)
     except _DuplicateKey as exc:
         raise InputError(f"{source}: the key {exc.key!r} is given twice (line {exc.line}): the last would win "
                          f"unnoticed; keep one") from None
@@ -461,15 +466,36 @@ def _read_table(text: str, source: str) -> MaterialTable:
         mark = getattr(exc, "problem_mark", None)
         at = f" (line {mark.line + 1})" if mark is not None else ""
         raise InputError(f"{source}: not valid YAML{at}: {first}") from None
-    return _parse_table(data, source)
+
+
+_SHIPPED = Path(__file__).resolve().parent / "data" / "materials.yaml"
+_SHIPPED_SOURCE = "designkit/data/materials.yaml"
 
 
 @functools.lru_cache(maxsize=1)
 def _shipped_table() -> MaterialTable:
-    from importlib import resources
+    from ._schemas import recorded
 
-    res = resources.files("designkit").joinpath("data").joinpath("materials.yaml")
-    return _read_table(res.read_text(encoding="utf-8"), "designkit/data/materials.yaml")
+    content = _SHIPPED.read_bytes()
+    data = recorded("materials", content)  # parsed once by designkit tables build: no YAML (its import and parse)
+    if data is not None:
+        try:
+            return _parse_table(data, _SHIPPED_SOURCE)  # every rule checked either way
+        except Exception:  # (not what designkit recorded): the file itself, the long way
+            pass
+    return _parse_table(_yaml_data(content.decode("utf-8"), _SHIPPED_SOURCE), _SHIPPED_SOURCE)
+
+
+def remember_shipped_table() -> None:
+    """Record the shipped materials file's parsed content (:func:`designkit._schemas.record_checked`), so that a
+    later process reads it without YAML (``designkit tables build --sensor FILE`` does, for the questions about
+    the sensor that follow)."""
+    from ._schemas import record_checked
+
+    content = _SHIPPED.read_bytes()
+    data = _yaml_data(content.decode("utf-8"), _SHIPPED_SOURCE)
+    _parse_table(data, _SHIPPED_SOURCE)
+    record_checked("materials", content, data)
 
 
 def load_material_table(path: str | Path | None = None) -> MaterialTable:

@@ -10,6 +10,7 @@ presets live in :data:`SENSORS`; calibration writes sensor YAML files that
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -22,7 +23,7 @@ from ._validation import InputError, check_effusivity, check_label, check_nonneg
 from .properties import time_constant
 
 __all__ = ["MAX_SAMPLES_PER_TOUCH", "MODEL_KEYS", "SENSORS", "Sensor", "last_sample_index", "load_sensor",
-           "sample_times_s", "within_sample_limit"]
+           "remember_checked_file", "sample_times_s", "within_sample_limit"]
 
 #: Version of the sensor files this designkit writes. 2: a calibrated file records the rig's operating
 #: conditions (``conditions``, :mod:`designkit.rig`). Version 1 files (no conditions) still load.
@@ -71,9 +72,13 @@ def last_sample_index(contact_s, sample_rate_hz: float) -> np.ndarray:
     >>> int(last_sample_index(2.0, 200.0)), last_sample_index([0.0, 0.004, 0.005], 200.0).tolist()
     (400, [0, 0, 1])
     """
+    if type(contact_s) is float:  # one number (the common call): no array round trip, the same rule
+        k1 = contact_s * float(sample_rate_hz) + _SAMPLE_TOLERANCE
+        if 0.0 <= k1 < MAX_SAMPLES_PER_TOUCH:
+            return np.int64(math.floor(k1))
     k = _last_index_float(contact_s, sample_rate_hz)
     ok = (k >= 0) & (k < MAX_SAMPLES_PER_TOUCH)
-    if not np.all(ok):
+    if not ok.all():
         bad = float(np.broadcast_to(np.asarray(contact_s, dtype=np.float64), k.shape)[~ok].flat[0])
         if bad < 0:
             raise InputError(f"contact time must be >= 0 s, got {bad:g}")
@@ -240,9 +245,10 @@ class Sensor:
                                  f"(known: {', '.join(CONDITION_KEYS)})")
             object.__setattr__(self, "conditions", _plain(self.conditions))
 
-    @property
+    @functools.cached_property
     def tau_s(self) -> float:
-        """Time constant ``tau = x^2 / (4 alpha_s)`` [s] (1.3445 s for the paper's sensor)."""
+        """Time constant ``tau = x^2 / (4 alpha_s)`` [s] (1.3445 s for the paper's sensor; computed once per
+        Sensor, which is frozen)."""
         return float(time_constant(self.depth_m, self.diffusivity_m2_s))
 
     def times_s(self, contact_s: float) -> np.ndarray:
@@ -444,13 +450,43 @@ def load_sensor(name_or_path: "str | Path | Sensor") -> Sensor:
         # FIFO, folder or oversized file is refused here, before its bytes are read for the memo's key
         check_regular_file(p, "sensor file")
         try:
-            stamp = (str(p.resolve()), hashlib.sha256(p.read_bytes()).hexdigest())
+            content = p.read_bytes()
+            stamp = (str(p.resolve()), hashlib.sha256(content).hexdigest())
         except OSError:  # from_yaml says what is missing
             return Sensor.from_yaml(p)
-        if stamp not in _READ:
-            _READ[stamp] = Sensor.from_yaml(p)
+        if stamp not in _READ:  # a file recorded as checked by designkit tables build: no YAML, no schema
+            _READ[stamp] = _checked_sensor(content, p) or Sensor.from_yaml(p)
         return _READ[stamp]
     raise InputError(f"unknown sensor {key!r}: use a preset ({', '.join(SENSORS)}) or a sensor YAML file")
+
+
+def remember_checked_file(path: "str | Path", sensor: Sensor) -> None:
+    """Record (:func:`designkit._schemas.record_checked`) that the sensor file ``path``, its bytes as they are now,
+    reads as ``sensor``: :func:`load_sensor` then builds the Sensor from the record instead of parsing the YAML
+    through the schema (``designkit tables build --sensor FILE`` records it when it registers the sensor's
+    table). A file that does not read as ``sensor`` is not recorded."""
+    from ._schemas import record_checked
+
+    p = Path(path)
+    try:
+        content = p.read_bytes()
+    except OSError:  # (a preset's name, a file gone meanwhile): nothing to record
+        return
+    if load_sensor(p).to_dict() == sensor.to_dict():
+        record_checked("sensor", content, sensor.to_dict())
+
+
+def _checked_sensor(content: bytes, p: Path) -> "Sensor | None":
+    """The Sensor recorded for a sensor file of exactly ``content`` (:func:`remember_checked_file`), or None."""
+    from ._schemas import recorded
+
+    data = recorded("sensor", content)
+    if not isinstance(data, dict):
+        return None
+    try:
+        return Sensor.from_dict(data, source=f"sensor file {p}", schema=False)
+    except Exception:  # (not what designkit recorded): the long way says what is wrong, if anything
+        return None
 
 
 #: Sensor files parsed by this process, keyed by (path, SHA-256 of the content): the frozen Sensor is shared.

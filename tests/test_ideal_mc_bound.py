@@ -14,7 +14,7 @@ import pytest
 import designkit.query as q
 from designkit.objects import ObjectClass
 from designkit.query.ideal_bound import exact_ideal_delta, exact_ideal_min_contact
-from designkit.query.ideal_mc_bound import cached_mc_ideal_min_contact, mc_ideal_delta, mc_ideal_min_contact
+from designkit.query.ideal_mc_bound import mc_ideal_delta, mc_ideal_min_contact, remembered
 from designkit.query.table import VARIED_TABLE
 from designkit.sensor import SENSORS
 
@@ -74,8 +74,8 @@ def test_the_varied_table_computes_its_bound_at_query_time_not_from_its_grid():
     assert a.table == VARIED_TABLE and a.ideal_bound.method == "monte-carlo"
     low, high, cov = a.ideal_bound.interval
     assert cov == 0.9 and low <= a.ideal <= high
-    mc = cached_mc_ideal_min_contact(ObjectClass("a", (20000.0, 20080.0)), ObjectClass("b", (35000.0, 35080.0)),
-                                     PAPER, noise_c=0.05, delta_t_c=7.5, sensor_temp_spread_c=2.5)
+    mc = remembered(mc_ideal_min_contact, ObjectClass("a", (20000.0, 20080.0)), ObjectClass("b", (35000.0, 35080.0)),
+                    PAPER, noise_c=0.05, delta_t_c=7.5, sensor_temp_spread_c=2.5)
     assert a.ideal == mc.value
     # the grid's own bound is kept beside it, and it is not the answer (the grid put it 0.2 s early)
     assert a.computation["table_ideal_s"] != a.ideal

@@ -182,3 +182,62 @@ def test_one_question_has_one_answer_on_every_surface(built, data_dir, cli, tmp_
                                            else {"value": 14.0, "source": "user"})
         assert conditions["onset_offset_s"] == {"value": -0.3, "source": "sensor file"}
         assert d["route_reason"] == one["route_reason"] and "built for sensor rig" in d["route_reason"]
+
+
+def test_a_registered_sensors_question_from_a_fresh_shell_reads_no_yaml_and_no_schema(built, data_dir):
+    """What the build checked (the sensor file's bytes, the shipped materials, the table's content) a later
+    process trusts by its hash: neither pydantic nor yaml is imported for the question (issue 34's start-up)."""
+    import subprocess
+    import sys
+
+    code = ("import sys; from designkit.query import min_contact; "
+            f"a = min_contact(m1='wood', m2='glass', sensor={str(built['sensor_file'])!r}); "
+            "print(a.route, a.value is not None, sorted(m for m in ('pydantic', 'yaml') if m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
+    assert out == ["table", "True", "[]"]
+
+
+def test_a_checked_record_answers_only_for_the_same_bytes(built, data_dir, tmp_path):
+    """The record of a checked sensor file holds for exactly its bytes: the same sensor read either way; an edited
+    file is read the long way, and its bad input refused in the same one line as without any record."""
+    from designkit.sensor import Sensor
+    from designkit.tables.registry import sensor_digest
+
+    recorded = load_sensor(built["sensor_file"])
+    long_way = Sensor.from_yaml(built["sensor_file"])
+    assert recorded == long_way and sensor_digest(recorded) == sensor_digest(long_way)
+    assert recorded.conditions == long_way.conditions and recorded.provenance == long_way.provenance
+    bad = tmp_path / "rig.yaml"
+    bad.write_text(built["sensor_file"].read_text().replace("effusivity: 892.0", "effusivity: [892.0]"))
+    with pytest.raises(InputError) as exc:
+        load_sensor(bad)
+    with pytest.raises(InputError) as plain:
+        Sensor.from_yaml(bad)
+    assert str(exc.value) == str(plain.value) and "effusivity" in str(exc.value)
+
+
+def test_a_registered_tables_content_other_than_checked_gets_the_schemas_verdict(built, data_dir):
+    """``checked_hash`` skips the header's schema only for the content it names."""
+    from designkit.tables.registry import entry_path
+    from designkit.tables.store import load_table
+
+    npz = built["summary"]["table"]
+    entry = json.loads(entry_path(load_sensor(built["sensor_file"])).read_text())
+    ok = load_table(npz, checked_hash=entry["content_hash"])
+    assert ok.checked and not ok.shipped
+    assert not load_table(npz).checked and not load_table(npz, checked_hash="sha256:other").checked
+
+
+def test_a_damaged_record_is_passed_over_for_the_file_itself(built, tmp_path, monkeypatch):
+    from designkit.sensor import Sensor, remember_checked_file
+
+    monkeypatch.setenv("DESIGNKIT_DATA_DIR", str(tmp_path / "data"))
+    f = tmp_path / "copy.yaml"
+    f.write_bytes(built["sensor_file"].read_bytes())
+    s = Sensor.from_yaml(f)
+    remember_checked_file(f, s)
+    [rec] = (tmp_path / "data" / "checked-files").glob("sensor-*.json")
+    d = json.loads(rec.read_text())
+    d["data"]["effusivity"] = "not a number"
+    rec.write_text(json.dumps(d))
+    assert load_sensor(f) == s and load_sensor(f).to_dict() == s.to_dict()

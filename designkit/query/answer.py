@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 from typing import Any, Mapping, Sequence
 
 __all__ = ["ANSWER_KEYS", "INTERVAL_MEANING", "QUANTITIES", "Answer", "IdealBound", "QuestionQuantity", "bound_of",
-           "interval_dict", "number", "to_record"]
+           "interval_dict", "number", "scene_record", "to_record"]
 
 #: question -> (quantity name of ``value``, its unit).
 QUANTITIES: dict[str, tuple[str, str]] = {
@@ -164,6 +164,16 @@ def number(x: Any) -> float | None:
         return None
     v = float(x)
     return v if math.isfinite(v) else None
+
+
+def scene_record(contact_s=None, noise_c=None, delta_t_c=None) -> dict[str, Any]:
+    """An answer's ``scene``: the asked contact [s], noise and dT [degC], and sigma/dT (None: not asked).
+
+    >>> scene_record(noise_c=0.05, delta_t_c=-10.0)["noise_ratio"]
+    0.005
+    """
+    ratio = None if noise_c is None or delta_t_c is None else noise_c / abs(delta_t_c)
+    return {"contact_s": contact_s, "noise_c": noise_c, "delta_t_c": delta_t_c, "noise_ratio": ratio}
 
 
 @dataclass(frozen=True)

@@ -218,7 +218,9 @@ class CriticalNoiseGrid:
 
     def __call__(self, lo, hi) -> np.ndarray:
         """``s*`` of the classes ``[lo, lo + w)``, ``[hi, hi + w)``, elementwise (NaN: not separable)."""
-        lo, hi = np.broadcast_arrays(np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64))
+        lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
+        if lo.shape != hi.shape or lo.ndim != 1:
+            lo, hi = np.broadcast_arrays(lo, hi)
         shape, lo, hi = lo.shape, lo.ravel(), hi.ravel()
         n = NOISE_GRID_NODES
         out = np.full(lo.size, np.nan)
@@ -229,12 +231,12 @@ class CriticalNoiseGrid:
         i = np.flatnonzero(inside)
         if i.size:
             pu, pv = pu[i], pv[i]
-            su = np.clip(np.floor(pu).astype(np.int64) - 1, 0, n - 4)
-            sv = np.clip(np.floor(pv).astype(np.int64) - 1, 0, n - 4)
+            su = np.minimum(np.maximum(np.floor(pu).astype(np.int64) - 1, 0), n - 4)
+            sv = np.minimum(np.maximum(np.floor(pv).astype(np.int64) - 1, 0), n - 4)
             four = np.arange(4)
             flat = (su[:, None, None] + four[None, :, None]) * n + (sv[:, None, None] + four[None, None, :])
-            missing = flat[~self.known[flat]]
-            if missing.size:  # the whole blocks of NOISE_GRID_BLOCK x NOISE_GRID_BLOCK nodes around them
+            if not self.known[flat].all():
+                missing = flat[~self.known[flat]]  # the whole blocks of NOISE_GRID_BLOCK x NOISE_GRID_BLOCK nodes around them
                 b = NOISE_GRID_BLOCK
                 wanted = np.zeros((n // b) ** 2, dtype=bool)  # (not np.unique: its first call imports numpy.ma)
                 wanted[(missing // n) // b * (n // b) + (missing % n) // b] = True
@@ -244,7 +246,8 @@ class CriticalNoiseGrid:
                 nodes = (rows * n + cols).ravel()
                 self._fill(nodes[~self.known[nodes]])
             g = np.einsum("pi,pj,pij->p", _lagrange4(pu - su), _lagrange4(pv - sv), self.values[flat])
-            out[i] = np.exp(g) * (self._weight(hi[i]) - self._weight(lo[i]))
+            w = self._weight(np.concatenate([hi[i], lo[i]]))
+            out[i] = np.exp(g) * (w[:i.size] - w[i.size:])
         rest = np.flatnonzero(np.isnan(out) & np.isfinite(lo) & np.isfinite(hi))
         if rest.size:  # outside the grid (or next to a node that does not separate): the exact solve
             from .ideal_bound import pair_critical_noise
@@ -257,60 +260,64 @@ class CriticalNoiseGrid:
 def _lagrange4(x: np.ndarray) -> np.ndarray:
     """Cubic Lagrange weights of the nodes 0, 1, 2, 3 at positions ``x`` (in [0, 3]): shape ``x.shape + (4,)``."""
     a, b, c, d = x, x - 1.0, x - 2.0, x - 3.0
-    return np.stack([-b * c * d / 6.0, a * c * d / 2.0, -a * b * d / 2.0, a * b * c / 6.0], axis=-1)
+    out = np.empty(x.shape + (4,))
+    out[..., 0], out[..., 1], out[..., 2], out[..., 3] = -b * c * d / 6.0, a * c * d / 2.0, -a * b * d / 2.0, a * b * c / 6.0
+    return out
 
 
 # ============================================================ the noise efficiency (min-contact)
-def _entries(view, slices, ka, kb, lo, hi):
+def _entries(view, slices, ka, kb, lo, hi, readings=None):
     """The table's entries a pair's noise efficiency is read from, in one gather per array: the SVM need and its
     Monte Carlo ends (``delta_{up,down}{,_lo,_hi}``, interpolated in effusivity as
     :func:`designkit.tables.lookup.interp_e`) upwards at ``lo`` and downwards at ``hi``, at the contacts ``ka``
     (row 0) and ``kb`` (row 1), in each of the pair's slices ``slices`` (n, m): three arrays shaped
-    (contact 2, slice m, direction 2, pair n), and the (clipped) contact indices (2, n)."""
-    jj = np.clip(np.stack([ka, kb]), 0, view.contacts.size - 1)  # (2, n)
-    si = slices.T[None]  # (1, m, n)
-    j = jj[:, None, :]  # (2, 1, n)
-    sides = []
-    for d, e in (("up", lo), ("down", hi)):  # the need and its two ends in one reading per direction
-        arrays = [view.t.arrays[f"delta_{d}{suffix}"] for suffix in ("", "_lo", "_hi")]
-        sides.append(interp_e_by(lambda c: np.stack([a[si, j, c] for a in arrays]), view.centres,
-                                 np.broadcast_to(e, (2, si.shape[1], e.size))))
+    (contact 2, slice m, direction 2, pair n), and the (clipped) contact indices (2, n). ``readings``: these
+    arrays upwards and downwards at every contact in the slices (the first three kinds of
+    :meth:`~designkit.query.table_arrays.TableView.readings`), read already."""
+    jj = np.minimum(np.maximum(np.array([ka, kb]), 0), view.contacts.size - 1)  # (2, n)
+    if readings is not None:  # [kind, slice, contact, pair] -> [kind, contact, slice, pair] at jj
+        pair = np.arange(lo.size)
+        sides = [r[:, :, jj, pair].transpose(0, 2, 1, 3) for r in readings]
+    else:
+        si = slices.T[None]  # (1, m, n)
+        j = jj[:, None, :]  # (2, 1, n)
+        sides = []
+        for d, e in (("up", lo), ("down", hi)):  # the need and its two ends in one reading per direction
+            arrays = [view.t.arrays[f"delta_{d}{suffix}"] for suffix in ("", "_lo", "_hi")]
+            sides.append(interp_e_by(lambda c: np.stack([a[si, j, c] for a in arrays]), view.centres,
+                                     np.broadcast_to(e, (2, si.shape[1], e.size))))
     out = np.stack(sides, axis=3)  # [need / lo / hi, contact, slice, direction, pair]
     return list(out), jj
 
 
-def _k_readings(op, slices, sw, ka, kb, lo, hi, extra=None):
+def _k_readings(op, slices, sw, ka, kb, lo, hi, extra=None, readings=None):
     """The noise efficiency ``log k`` and its standard error at the tabulated contacts ``ka`` and ``kb`` (rows
     0 and 1 of the (2, n) arrays; NaN: no usable entry), per pair, from the pair's own entries (upwards at
     ``lo``, downwards at ``hi``) in the noise-ratio slices ``slices`` (n, m) weighted ``sw`` (n, m); see
     :func:`noise_k_min_contact`. The entries' critical noises are read off the table's
     :class:`CriticalNoiseGrid`; ``extra``: (lo, hi) of further pairs read in the same call, whose critical
     noises are returned third (None: not asked)."""
-    from ..recognition.ideal import shape_norm
-
     view, tab = op.view, op.tab
     width = op.width
     z_table = table_z(tab)
     n = lo.size
     h, rnd_sd = 0.5 * width, width / math.sqrt(12.0)
-    (d, dl, dh), jj = _entries(view, slices, ka, kb, lo, hi)  # (2, m, 2, n)
+    (d, dl, dh), jj = _entries(view, slices, ka, kb, lo, hi, readings)  # (2, m, 2, n)
     shape = d.shape
     m = shape[1]
-    sign = np.array([1.0, -1.0])[None, None, :, None]
-    e = np.stack([lo, hi])[None, None, :, :]
-    ok_j = ((np.stack([ka, kb]) >= 0) & (np.stack([ka, kb]) < view.contacts.size))[:, None, None, :]
+    kk = np.array([ka, kb])
+    ok_j = ((kk >= 0) & (kk < view.contacts.size))[:, None, None, :]
     with np.errstate(invalid="ignore"):
         ok = np.isfinite(d) & (d > width) & ok_j & (sw.T[None, :, None, :] > 0)
-        ok &= (sign > 0) | (e - (d - h) > 0)
+        ok[:, :, 1] &= hi - (d[:, :, 1] - h) > 0  # downwards: the partner stays above 0
     # the entries in (contact, slice, direction, pair) order
     C4, M4, S4, P4 = np.unravel_index(np.flatnonzero(ok), shape)
     D, DL, DH = d[ok], dl[ok], dh[ok]
     P, Cc, SIGN = P4, C4, np.where(S4 == 0, 1.0, -1.0)
     W = sw[P, M4]
     RS = view.t.axes["noise_ratio"][slices[P, M4]]
-    T = view.contacts[jj[C4, P]]
     e_ref = np.where(SIGN > 0, lo[P], hi[P])
-    s_t = RS / shape_norm(tab.sensor, T) if T.size else np.zeros(0)
+    s_t = RS / view.contact_norms()[jj[C4, P]]
 
     def pair_of(dist):  # the entry's pair of lower edges at distance dist from its reference
         return np.where(SIGN > 0, e_ref, e_ref - dist), np.where(SIGN > 0, e_ref + dist, e_ref)
@@ -338,16 +345,17 @@ def _k_readings(op, slices, sw, ka, kb, lo, hi, extra=None):
     # similar needs of neighbouring entries the same way (at needs under 5 widths neighbouring readings of
     # log k are identical), so the rounding term is the entries' weighted mean, not reduced by averaging
     om = np.where(good, W / sd ** 2, 0.0)
-    lk, se = np.full((2, n), np.nan), np.full((2, n), np.nan)
-    for c in (0, 1):
-        sel = Cc == c
-        num = np.bincount(P[sel], om[sel] * np.where(good[sel], log_k[sel], 0.0), minlength=n)
-        den = np.bincount(P[sel], om[sel], minlength=n)
-        var = np.bincount(P[sel], om[sel] ** 2 * np.where(good[sel], mck[sel] ** 2, 0.0), minlength=n)
-        rnd_mean = np.bincount(P[sel], om[sel] * np.where(good[sel], rnd[sel], 0.0), minlength=n)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            lk[c] = np.where(den > 0, num / den, np.nan)
-            se[c] = np.where(den > 0, np.hypot(np.sqrt(var) / den, rnd_mean / den), np.nan)
+    # per (contact, pair): bin c * n + p, each bin's entries summed in their order
+    at = Cc * n + P
+
+    def total(x):
+        return np.bincount(at, x, minlength=2 * n).reshape(2, n)
+
+    num, den = total(om * np.where(good, log_k, 0.0)), total(om)
+    var, rnd_mean = total(om ** 2 * np.where(good, mck ** 2, 0.0)), total(om * np.where(good, rnd, 0.0))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lk = np.where(den > 0, num / den, np.nan)
+        se = np.where(den > 0, np.hypot(np.sqrt(var) / den, rnd_mean / den), np.nan)
     return (lk, se) if extra is None else (lk, se, star[2 * k:])
 
 
@@ -360,7 +368,8 @@ def _k_line(lk, se, t_a, t_b):
     with np.errstate(invalid="ignore", divide="ignore"):
         wa, wb = np.where(have_a, 1.0 / se[0] ** 2, 0.0), np.where(have_b, 1.0 / se[1] ** 2, 0.0)
         falls = have_a & have_b & ((lb_ - la_) * np.sign(np.log(t_b / t_a)) < 0)
-        pooled = (np.nan_to_num(la_) * wa + np.nan_to_num(lb_) * wb) / (wa + wb)
+        # (la_, lb_ are finite or NaN: a reading is a weighted mean of finite log k)
+        pooled = (np.where(have_a, la_, 0.0) * wa + np.where(have_b, lb_, 0.0) * wb) / (wa + wb)
         disagree = np.where(falls, np.abs(lb_ - la_), 0.0)
     la_, lb_ = np.where(falls, pooled, la_), np.where(falls, pooled, lb_)
     return la_, lb_, have_a, have_b, falls, wa, wb, disagree
@@ -384,7 +393,8 @@ def _slices(combos, n):
 
 
 def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
-                        max_contact_s: float = CLOSED_FORM_MAX_CONTACT_S, s_pair=None) -> dict[str, np.ndarray]:
+                        max_contact_s: float = CLOSED_FORM_MAX_CONTACT_S, s_pair=None,
+                        readings=None) -> dict[str, np.ndarray]:
     """min-contact from the SVM's *noise efficiency* against the exact ideal observer, for pairs of one scene.
 
     The SVM separates a pair when the ideal observer would at a larger noise: ``k(t)`` times the projection
@@ -421,6 +431,10 @@ def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
         Pairs [J s^-1/2 K^-1 m^-2] and the asked sigma/dT.
     zc : float
         z of the asked coverage.
+    readings : (ndarray, ndarray), optional
+        The pairs' entries read already: ``delta_up{,_lo,_hi}`` at ``lo`` and ``delta_down{,_lo,_hi}`` at
+        ``hi`` in each weighted slice of ``combos`` at every contact, [kind, slice, contact, pair] each
+        (:meth:`~designkit.query.table_arrays.TableView.readings`); None: read here.
 
     Returns
     -------
@@ -439,9 +453,9 @@ def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
     ka = k_baseline(view.contacts, kb)
     slices, sw = _slices(combos, n)
     if s_pair is None:  # the pair's own critical noise read with its entries'
-        lk, se, s_pair = _k_readings(op, slices, sw, ka, kb, lo, hi, extra=(lo, hi))
+        lk, se, s_pair = _k_readings(op, slices, sw, ka, kb, lo, hi, extra=(lo, hi), readings=readings)
     else:
-        lk, se = _k_readings(op, slices, sw, ka, kb, lo, hi)
+        lk, se = _k_readings(op, slices, sw, ka, kb, lo, hi, readings=readings)
         s_pair = np.atleast_1d(s_pair)
     t_a, t_b = view.contacts[np.where(ka >= 0, ka, kb)], view.contacts[kb]
     la_, lb_, have_a, have_b, falls, wa, wb, disagree = _k_line(lk, se, t_a, t_b)
@@ -456,7 +470,8 @@ def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
                        np.log(value / np.where(have_a, t_a, t_b)))
         slope_k = np.where(have_a & have_b & (t_a != t_b), (lb_ - la_) / np.log(t_b / t_a), 0.0)
         v_ok = np.where(ok, value, 1.0)  # (shape_norm takes finite contact times only)
-        beta_g = np.log(shape_norm(sensor, v_ok * 1.05) / shape_norm(sensor, v_ok / 1.05)) / (2 * math.log(1.05))
+        g = shape_norm(sensor, np.concatenate([v_ok * 1.05, v_ok / 1.05]))
+        beta_g = np.log(g[:n] / g[n:]) / (2 * math.log(1.05))
         se_t = np.sqrt(var_k) / np.maximum(beta_g - slope_k, 0.05)
         low, high = value * np.exp(-zc * se_t), value * np.exp(zc * se_t)
         k_at = np.exp(np.maximum(la_ + slope_k * np.log(value / t_a), 0.0))

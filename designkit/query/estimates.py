@@ -24,7 +24,7 @@ __all__ = [
     "ABOVE", "BELOW", "CELL", "CONTACT_ESTIMATORS", "ContactReading", "Estimates", "INSIDE",
     "RATIO_ESTIMATORS", "RatioReading", "axis_weights_flagged", "cell_estimate", "contact_estimate", "cross2",
     "delta_estimate", "efficiency_estimate", "first_applicable", "grid_crossing", "held_interval", "interp_e_rows",
-    "pair_need_both", "partner_in_grid", "ratio_beyond", "ratio_cell", "ratio_efficiency", "ratio_estimate",
+    "nans", "pair_need_both", "partner_in_grid", "ratio_beyond", "ratio_cell", "ratio_efficiency", "ratio_estimate",
     "ratio_ideal_table", "ratio_rounding", "rounding_estimate", "stated_log", "states_coverage",
     "table_spread", "varied_contact_estimate", "varied_estimate"
 ]
@@ -329,7 +329,8 @@ def partner_in_grid(view, e, delta, direction: str):
 
 
 # ============================================================ the estimators: named strategies over arrays
-def _nan(n: int) -> np.ndarray:
+def nans(n: int) -> np.ndarray:
+    """``n`` NaNs: an answer array before its elements are answered ("none" until then)."""
     return np.full(n, np.nan)
 
 
@@ -365,10 +366,15 @@ class Estimates:
     extra: dict = field(default_factory=dict)
 
 
+def _at(v, m: np.ndarray):
+    """``v`` (an array of the elements, or one value for all) at the elements ``m``."""
+    return v[m] if np.ndim(v) else v
+
+
 def first_applicable(estimators, rd, n: int) -> dict[str, np.ndarray]:
     """Per element, the answer of the first estimator (in order) that applies to it (``kind`` "none" where none
     does)."""
-    out = {k: _nan(n) for k in ("value", "low", "high")}
+    out = {k: nans(n) for k in ("value", "low", "high")}
     out["kind"], out["stated"] = np.full(n, "none", dtype=object), np.zeros(n, dtype=bool)
     taken = np.zeros(n, dtype=bool)
     for estimator in estimators:
@@ -381,10 +387,10 @@ def first_applicable(estimators, rd, n: int) -> dict[str, np.ndarray]:
         if not m.any():
             continue
         for k in ("value", "low", "high"):
-            out[k][m] = np.broadcast_to(getattr(r, k), (n,))[m]
+            out[k][m] = _at(getattr(r, k), m)
         out["kind"][m], out["stated"][m] = r.kind, r.stated
         for k, v in r.extra.items():
-            out.setdefault(k, _nan(n))[m] = np.broadcast_to(v, (n,))[m]
+            out.setdefault(k, nans(n))[m] = _at(v, m)
         taken |= m
     return out
 
@@ -423,7 +429,7 @@ def varied_estimate(rd: ContactReading) -> Estimates | None:
     op, n = rd.op, rd.lo.size
     if not (rd.svm and table_spread(op.tab) > 0 and "delta_up_lo" in op.view.t.arrays):
         return None
-    out = {k: _nan(n) for k in ("value", "low", "high", "interp", "rounding")}
+    out = {k: nans(n) for k in ("value", "low", "high", "interp", "rounding")}
     for combos, idx in rd.slices:
         r = varied_contact_estimate(op.view, combos, rd.lo[idx], rd.hi[idx], rd.floor[idx], width=op.width,
                                     z_table=table_z(op.tab), zc=rd.zc)
@@ -531,7 +537,7 @@ def ratio_efficiency(rd: RatioReading) -> Estimates | None:
         return None
     i = np.nonzero(cand)[0]
     kr = noise_k_max_ratio(op, rd.contact[i], rd.r[i], rd.ri[i], rd.lo[i], rd.hi[i], zc=rd.zc)
-    out = {k: _nan(rd.lo.size) for k in ("r", "low", "high", "k", "se_log")}
+    out = {k: nans(rd.lo.size) for k in ("r", "low", "high", "k", "se_log")}
     out["r"][i], out["low"][i] = np.minimum(kr["value"], rd.ri[i]), kr["low"]
     out["high"][i], out["k"][i], out["se_log"][i] = np.minimum(kr["high"], rd.ri[i]), kr["k"], kr["se_log"]
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -594,7 +600,7 @@ def ratio_beyond(rd: RatioReading) -> Estimates | None:
         return None
     with np.errstate(invalid="ignore", divide="ignore"):
         v = rd.answer(rd.r)
-    nan = _nan(v.size)
+    nan = nans(v.size)
     return Estimates(applies, v, *((v, nan) if rd.question == "max-noise" else (nan, v)), "table-cell", False)
 
 

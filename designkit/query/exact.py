@@ -39,7 +39,7 @@ import numpy as np
 
 from .._validation import InputError, check_positive, check_repeats
 from ..objects import DEFAULT_CLASS_WIDTH, ObjectClass
-from .answer import Answer, IdealBound, ideal_floor, number
+from .answer import Answer, IdealBound, ideal_floor, number, scene_record
 from .inputs import (
     REFERENCE_RULE,
     check_contact,
@@ -264,11 +264,6 @@ class _Run:
             interval_coverage=interval_coverage, interval_kind=interval_kind)
 
 
-def _scene(contact_s=None, noise_c=None, delta_t_c=None) -> dict[str, Any]:
-    ratio = None if noise_c is None or delta_t_c is None else noise_c / abs(delta_t_c)
-    return {"contact_s": contact_s, "noise_c": noise_c, "delta_t_c": delta_t_c, "noise_ratio": ratio}
-
-
 def _make(kw: dict) -> _Run:
     return _Run.make(**{k: kw[k] for k in ("sensor", "model", "threshold", "width", "trials", "folds", "seed",
                                            "repeats", "z", "jobs", "n_mc")}, solver=kw.get("solver", "sklearn"),
@@ -345,7 +340,7 @@ def exact_min_contact(e1=None, e2=None, *, m1=None, m2=None, objects=None, noise
     tmax = check_positive("maximum contact time [s]", max_contact_s)
     pq = pair_question(e1, e2, m1, m2, objects=objects, width=run.width, diffusivity_m2_s=diffusivity_m2_s,
                        model=run.model)
-    scene_d = _scene(None, noise, dt)
+    scene_d = scene_record(None, noise, dt)
     if pq.classes is None:
         return _no_pair("min-contact", run, pq, scene_d, {})
     cls = pq.classes
@@ -429,12 +424,12 @@ def _exact_ratio(question: str, kw: dict) -> Answer:
     contact = check_contact(kw["contact_s"])
     if question == "max-noise":
         _, dt = scene_inputs(0.0, kw["delta_t_c"])
-        scene_d = _scene(contact, None, dt)
+        scene_d = scene_record(contact, None, dt)
     else:
         noise, _ = scene_inputs(kw["noise_c"], 1.0)
         if noise == 0:
             raise InputError("noise sigma is 0: any temperature difference separates them (no smallest one)")
-        scene_d = _scene(contact, noise, None)
+        scene_d = scene_record(contact, noise, None)
     cov = check_coverage(kw["coverage"])
     run = _make(kw)
     pq = pair_question(kw["e1"], kw["e2"], kw["m1"], kw["m2"], objects=kw["objects"], width=run.width,
@@ -574,7 +569,7 @@ def exact_distinguishable(e1=None, e2=None, *, m1=None, m2=None, objects=None, c
     run = _make(kw)
     pq = pair_question(e1, e2, m1, m2, objects=objects, width=run.width, diffusivity_m2_s=diffusivity_m2_s,
                        model=run.model)
-    scene_d = _scene(contact, noise, dt)
+    scene_d = scene_record(contact, noise, dt)
     if pq.classes is None:
         return _no_pair("distinguishable", run, pq, scene_d,
                         {"distinguishable": None, "svm_f1": None, "svm_standard_error": None, "verdict": None,
@@ -697,5 +692,5 @@ def exact_delta_e(e: float | None = None, *, m: str | None = None, contact_s: fl
                       interval_kind="exact-estimate" if stated else "exact",
                       ideal=min(ifinite) if ifinite else None, ideal_method=run.ideal_method(closed),
                       objects=(ref.to_dict(),), limiting=(ref.to_dict(),), rule=REFERENCE_RULE,
-                      scene=_scene(contact, noise, dt), details=details, check_classes=checked,
+                      scene=scene_record(contact, noise, dt), details=details, check_classes=checked,
                       check_at=(contact, noise, dt), e_max=e_max)

@@ -40,8 +40,8 @@ from ..sensor import Sensor
 from .answer import ideal_floor
 from .crossing import check_coverage, estimate_crossing
 
-__all__ = ["MC_BOUND_TOUCHES", "MonteCarloBound", "cached_mc_ideal_delta", "cached_mc_ideal_min_contact",
-           "mc_ideal_delta", "mc_ideal_max_ratio", "mc_ideal_min_contact", "nearer_side_interval"]
+__all__ = ["MC_BOUND_TOUCHES", "MonteCarloBound", "mc_ideal_delta", "mc_ideal_max_ratio", "mc_ideal_min_contact",
+           "nearer_side_interval", "remembered"]
 
 #: Bisection stops at a bracket this wide (ratio) before the fit: the ideal F1's logit bends in log time, and a
 #: fit across the SVM route's 1.6 put its crossing about 1 % early (several SEs at these touch counts).
@@ -255,23 +255,6 @@ def mc_ideal_delta(ref: ObjectClass, direction: int, sensor: Sensor, *, contact_
     return MonteCarloBound(est.value, est.low, est.high, cov if est.stated else None, int(n_mc), evs)
 
 
-def cached_mc_ideal_delta(ref: ObjectClass, direction: int, sensor: Sensor, *, contact_s: float, noise_c: float,
-                          delta_t_c: float, sensor_temp_spread_c: float = 0.0, model=None, threshold: float = 0.9,
-                          e_max: float = 40000.0, n_mc: int = MC_BOUND_TOUCHES, seed: int = 0,
-                          coverage: float = 0.9) -> MonteCarloBound:
-    """:func:`mc_ideal_delta`, remembered per process like :func:`cached_mc_ideal_min_contact`."""
-    from ..models import get_model
-
-    fm = get_model(model)
-    key = ("delta", ref.e_range, ref.diffusivity_range_m2_s, 1 if direction > 0 else -1, repr(sensor.to_dict()),
-           repr(fm.to_dict()), float(contact_s), float(noise_c), float(delta_t_c), float(sensor_temp_spread_c),
-           float(threshold), float(e_max), int(n_mc), int(seed), float(coverage))
-    return _remember(key, lambda: mc_ideal_delta(
-        ref, direction, sensor, contact_s=contact_s, noise_c=noise_c, delta_t_c=delta_t_c,
-        sensor_temp_spread_c=sensor_temp_spread_c, model=fm, threshold=threshold, e_max=e_max, n_mc=n_mc,
-        seed=seed, coverage=coverage))
-
-
 def mc_ideal_max_ratio(a: ObjectClass, b: ObjectClass, sensor: Sensor, scene_of, ratio_lo: float, ratio_hi: float,
                        *, model=None, threshold: float = 0.9, n_mc: int = MC_BOUND_TOUCHES, seed: int = 0,
                        coverage: float = 0.9, progress=None) -> MonteCarloBound:
@@ -318,32 +301,36 @@ def nearer_side_interval(sides: dict, coverage: float):
     return (*best["ideal_interval"], coverage)
 
 
-#: Most distinct questions :func:`cached_mc_ideal_min_contact` remembers per process.
+#: Most distinct questions :func:`remembered` keeps per process.
 _CACHE_SIZE = 64
 _CACHE: "LRUCache[tuple, MonteCarloBound]" = LRUCache(_CACHE_SIZE)
 
 
-def cached_mc_ideal_min_contact(a: ObjectClass, b: ObjectClass, sensor: Sensor, *, noise_c: float,
-                                delta_t_c: float, sensor_temp_spread_c: float = 0.0, model=None,
-                                threshold: float = 0.9, max_contact_s: float = 10.0,
-                                n_mc: int = MC_BOUND_TOUCHES, seed: int = 0,
-                                coverage: float = 0.9) -> MonteCarloBound:
-    """:func:`mc_ideal_min_contact`, remembered per process for the last 64 distinct questions (a repeated
-    question, as a table route asks it, costs nothing the second time; the answer is a function of the
-    question and the seed, so remembering changes nothing)."""
-    from ..models import get_model
+def remembered(fn, *args, **kwargs) -> MonteCarloBound:
+    """``fn(*args, **kwargs)`` (:func:`mc_ideal_min_contact`, :func:`mc_ideal_delta`), remembered per process for
+    the last :data:`_CACHE_SIZE` distinct questions: a repeated question, as a table route asks it, costs
+    nothing the second time (the answer is a function of the question and the seed, so remembering changes
+    nothing). The question is its arguments with the defaults filled in, the classes by their ranges, the
+    sensor and the forward model by their content."""
+    import inspect
 
-    fm = get_model(model)
-    key = ("min-contact", a.e_range, a.diffusivity_range_m2_s, b.e_range, b.diffusivity_range_m2_s, repr(sensor.to_dict()),
-           repr(fm.to_dict()), float(noise_c), float(delta_t_c), float(sensor_temp_spread_c), float(threshold),
-           float(max_contact_s), int(n_mc), int(seed), float(coverage))
-    return _remember(key, lambda: mc_ideal_min_contact(
-        a, b, sensor, noise_c=noise_c, delta_t_c=delta_t_c, sensor_temp_spread_c=sensor_temp_spread_c, model=fm,
-        threshold=threshold, max_contact_s=max_contact_s, n_mc=n_mc, seed=seed, coverage=coverage))
-
-
-def _remember(key: tuple, compute) -> MonteCarloBound:
+    bound = inspect.signature(fn).bind(*args, **kwargs)
+    bound.apply_defaults()
+    key = (fn.__name__, *((k, _content(k, v)) for k, v in bound.arguments.items()))
     r = _CACHE.get(key)
     if r is None:
-        r = _CACHE[key] = compute()
+        r = _CACHE[key] = fn(*args, **kwargs)
     return r
+
+
+def _content(name: str, value):
+    """What identifies an argument of a Monte Carlo bound's question in :func:`remembered`'s key."""
+    if name == "model":
+        from ..models import get_model
+
+        return repr(get_model(value).to_dict())
+    if isinstance(value, ObjectClass):
+        return value.e_range, value.diffusivity_range_m2_s
+    if isinstance(value, Sensor):
+        return repr(value.to_dict())
+    return value

@@ -280,6 +280,8 @@ def table_reroute(sensor, model, table_sensor=None, table_model=None) -> str | N
     from ..sensor import SENSORS, load_sensor
 
     sen = load_sensor(sensor)
+    if sen is SENSORS["paper"] and model is None and table_sensor is None:  # (the shipped tables' own: at once)
+        return None
     fm = get_model(model) if model is not None else None
     ts = table_sensor if table_sensor is not None else SENSORS["paper"]
     tm = get_model(table_model)

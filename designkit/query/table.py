@@ -55,7 +55,7 @@ import numpy as np
 from .._validation import InputError
 from ..tables.lookup import GRID_RTOL
 from ..tables.store import Table
-from .answer import Answer, IdealBound, number
+from .answer import Answer, IdealBound, number, scene_record
 from .crossing import check_coverage, z_of_coverage
 from .efficiency import CLOSED_FORM_MAX_CONTACT_S, K_SLOPE_SPAN, k_baseline, noise_k_max_ratio, noise_k_min_contact, \
     table_z
@@ -159,11 +159,6 @@ VARIED_COVERAGE_NOTE = (
     "the pair)")
 
 
-def _scene(contact_s=None, noise_c=None, delta_t_c=None) -> dict[str, Any]:
-    ratio = None if noise_c is None or delta_t_c is None else noise_c / abs(delta_t_c)
-    return {"contact_s": contact_s, "noise_c": noise_c, "delta_t_c": delta_t_c, "noise_ratio": ratio}
-
-
 def _no_pair(question: str, op: OpenedTable, pq: PairQuestion, scene: dict, details: dict) -> Answer:
     """The materials overlap: no answer, said so."""
     return _answer(question, op, objects=pq.objects_dicts(), limiting=(), rule=pq.rule, scene=scene,
@@ -239,7 +234,7 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
     op = open_table(table, ideal_table, threshold=threshold, sensor=sensor, model=model,
                     sensor_temp_spread_c=sensor_temp_spread_c)
     pq = pair_question(e1, e2, m1, m2, objects=objects, width=op.width, model=op.model)
-    scene = _scene(None, noise, dt)
+    scene = scene_record(None, noise, dt)
     if pq.classes is None:
         return _no_pair("min-contact", op, pq, scene, {})
     lo, hi = pq.points
@@ -314,12 +309,12 @@ def _ratio_question(question: str, e1, e2, m1, m2, objects, contact_s, noise_c, 
     coverage = check_coverage(coverage)
     if question == "max-noise":
         _, dt = scene_inputs(0.0, delta_t_c)
-        scene, scale = _scene(contact, None, dt), abs(dt)
+        scene, scale = scene_record(contact, None, dt), abs(dt)
     else:
         noise, _ = scene_inputs(noise_c, 1.0)
         if noise == 0:
             raise InputError("noise sigma is 0: any temperature difference separates them (no smallest one)")
-        scene, scale = _scene(contact, noise, None), noise
+        scene, scale = scene_record(contact, noise, None), noise
     op = open_table(table, ideal_table, threshold=threshold, sensor=sensor, model=model,
                     sensor_temp_spread_c=sensor_temp_spread_c)
     if "noise_ratio" not in op.tab.axes:
@@ -436,7 +431,7 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
     flags["contact_s"] = axis_weights_flagged(view.contacts, contact)[1]
     flags["effusivity"] = view.e_in_grid(x)
     common = dict(objects=(ref.to_dict(),), limiting=(ref.to_dict(),), rule=REFERENCE_RULE,
-                  scene=_scene(contact, noise, dt), classes=(ref,))
+                  scene=scene_record(contact, noise, dt), classes=(ref,))
     r = delta_e_arrays(op, _one(x), _one(contact), _one(noise), _one(dt), ideal_view=delta_e_ideal_view(op, ideal_table),
                        zc=z_of_coverage(coverage), ideal_bound=ideal_bound, classes=[ref])
     if not all(flags.values()):
@@ -526,7 +521,7 @@ def distinguishable(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact
     op = open_table(table, ideal_table, threshold=threshold, sensor=sensor, model=model,
                     sensor_temp_spread_c=sensor_temp_spread_c)
     pq = pair_question(e1, e2, m1, m2, objects=objects, width=op.width, model=op.model)
-    scene = _scene(contact, noise, dt)
+    scene = scene_record(contact, noise, dt)
     empty = {"distinguishable": None, "svm_f1": None, "svm_standard_error": None, "verdict": None,
              "ideal_f1": None, "ideal_distinguishable": None}
     if pq.classes is None:

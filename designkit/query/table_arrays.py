@@ -28,7 +28,7 @@ from .efficiency import (CLOSED_FORM_MAX_CONTACT_S, CriticalNoiseGrid, delta_eff
                          interp_e_by, mc_calibration, noise_k_min_contact, table_z)
 from .estimates import (ABOVE, BELOW, CELL, CONTACT_ESTIMATORS, INSIDE, RATIO_ESTIMATORS,
                         ContactReading, RatioReading, axis_weights_flagged, delta_estimate, first_applicable,
-                        grid_crossing, interp_e_rows, partner_in_grid, states_coverage, table_spread)
+                        grid_crossing, interp_e_rows, nans, partner_in_grid, states_coverage, table_spread)
 
 __all__ = ["CLOSED_FORM_RATIO_BRACKET", "TableView", "at_contact", "contact_arrays", "delta_e_arrays",
            "distinguishable_arrays", "groups", "max_ratio", "ratio_arrays", "scene_groups"]
@@ -53,6 +53,7 @@ class TableView:
         self._noise_grid: CriticalNoiseGrid | None = None
         self._sensor_dict: dict | None = None
         self._mc_factor: float | None = None
+        self._contact_norms: np.ndarray | None = None
 
     def critical_noise(self, lo, hi) -> np.ndarray:
         """The ideal observer's critical noise of the table's classes ``[lo, lo + w)``, ``[hi, hi + w)`` (its
@@ -62,6 +63,15 @@ class TableView:
             self._noise_grid = CriticalNoiseGrid(self.t.sensor, float(self.t.header["effusivity"]["width"]),
                                                  self.t.threshold, self.e_hi)
         return self._noise_grid(lo, hi)
+
+    def contact_norms(self) -> np.ndarray:
+        """``|g|`` (:func:`~designkit.recognition.ideal.shape_norm`) of the table's sensor at each tabulated
+        contact time, computed once."""
+        if self._contact_norms is None:
+            from ..recognition.ideal import shape_norm
+
+            self._contact_norms = shape_norm(self.t.sensor, self.contacts)
+        return self._contact_norms
 
     def sensor_dict(self) -> dict:
         """The table's ``sensor.to_dict()``, computed once (each caller gets its own top-level dict)."""
@@ -105,32 +115,49 @@ class TableView:
         """The arrays ``names`` (one name, or a sequence) at scene weights ``combos``, every contact and every
         ``e``: [contact, len(e)], or [len(names), contact, len(e)] for a sequence (NaN: none), all the weighted
         scene slices of all the arrays in one reading."""
-        live = [(idx, w) for idx, w in combos if w != 0]
-        at = tuple(np.array(k)[:, None, None] for k in zip(*(idx for idx, _ in live)))  # each [slice, 1, 1]
-        at += (np.arange(self.contacts.size)[:, None],)
         many = not isinstance(names, str)
-        arrays = [self.t.arrays[n] for n in (names if many else [names])]
-        # [name, slice, contact, e]: only the entries read (the arrays may be mapped from the file)
-        v = interp_e_by(lambda c: np.stack([a[at + (c,)] for a in arrays]), self.centres, e)
-        # (NaN where any weighted slice is NaN; summed in the slices' order)
-        out = np.sum(np.array([w for _, w in live])[:, None, None] * v, axis=1)
+        out = _weighted(combos, self.slices(names if many else [names], combos, e))
         return out if many else out[0]
 
-    def need(self, kind, combos, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-        """Distance needed to separate ``lo < hi``, ``max(delta_up(lo), delta_down(hi))``, at every contact and
-        pair: [contact, n] (NaN: not within the grid). ``kind``: svm, lo, hi (the Monte Carlo ends), ideal; or a
-        sequence of them: [kind, contact, n], in one reading."""
-        many = not isinstance(kind, str)
+    def slices(self, names, combos, e: np.ndarray) -> np.ndarray:
+        """The arrays ``names`` (a sequence) in each weighted scene slice of ``combos`` (in their order), at every
+        contact and every ``e``: [name, slice, contact, len(e)] (NaN: none), in one reading."""
+        live = [idx for idx, w in combos if w != 0]
+        at = tuple(np.array(k)[:, None, None] for k in zip(*live))  # each [slice, 1, 1]
+        at += (np.arange(self.contacts.size)[:, None],)
+        arrays = [self.t.arrays[n] for n in names]
+        # only the entries read (the arrays may be mapped from the file)
+        return interp_e_by(lambda c: np.stack([a[at + (c,)] for a in arrays]), self.centres, e)
+
+    def readings(self, kinds, combos, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """What :meth:`need` of the sequence ``kinds`` is made of: ``delta_up`` at ``lo`` and ``delta_down`` at
+        ``hi`` of each kind in each weighted scene slice, [kind, slice, contact, n] each."""
         names = []
-        for k in (kind if many else [kind]):
+        for k in kinds:
             suffix = {"svm": "", "lo": "_lo", "hi": "_hi", "ideal": "_ideal"}[k]
             if f"delta_up{suffix}" not in self.t.arrays:  # ideal tables carry only delta_up / delta_down
                 suffix = ""
             names.append(suffix)
-        up = self.delta([f"delta_up{x}" for x in names], combos, lo)
-        down = self.delta([f"delta_down{x}" for x in names], combos, hi)
+        return (self.slices([f"delta_up{x}" for x in names], combos, lo),
+                self.slices([f"delta_down{x}" for x in names], combos, hi))
+
+    def need(self, kind, combos, lo: np.ndarray, hi: np.ndarray, readings=None) -> np.ndarray:
+        """Distance needed to separate ``lo < hi``, ``max(delta_up(lo), delta_down(hi))``, at every contact and
+        pair: [contact, n] (NaN: not within the grid). ``kind``: svm, lo, hi (the Monte Carlo ends), ideal; or a
+        sequence of them: [kind, contact, n], in one reading (``readings``: :meth:`readings` of them, read
+        already)."""
+        many = not isinstance(kind, str)
+        up, down = (_weighted(combos, r) for r in (
+            readings if readings is not None else self.readings(kind if many else [kind], combos, lo, hi)))
         out = np.where(np.isnan(up) | np.isnan(down), np.nan, np.maximum(up, down))
         return out if many else out[0]
+
+
+def _weighted(combos, per_slice: np.ndarray) -> np.ndarray:
+    """The weighted sum over the scene slices (axis 1) of ``per_slice`` (NaN where any weighted slice is NaN;
+    summed in the slices' order)."""
+    w = np.array([w for _, w in combos if w != 0])
+    return np.sum(w[:, None, None] * per_slice, axis=1)
 
 
 def at_contact(cw, per_contact: np.ndarray) -> np.ndarray:
@@ -173,10 +200,6 @@ def scene_groups(view, contact, noise, dt, e_in):
             yield scene, idx, combos, cw
 
 
-def _nan(n: int) -> np.ndarray:
-    return np.full(n, np.nan)
-
-
 def _boxes(op, lo, hi, classes, i):
     """The classes of element ``i``: those given, or ``[lo, lo + w)``, ``[hi, hi + w)``."""
     from ..objects import ObjectClass
@@ -205,14 +228,14 @@ def contact_arrays(op, lo, hi, noise, dt, *, ideal_bound: bool, zc: float, class
     """
     view, n = op.view, lo.size
     grid, svm = view.contacts, op.tab.fidelity == "svm"
-    res: dict[str, Any] = {k: _nan(n) for k in ("raw", "n_prev", "n_at", "mc_lo", "mc_hi", "ideal", "table_ideal")}
+    res: dict[str, Any] = {k: nans(n) for k in ("raw", "n_prev", "n_at", "mc_lo", "mc_hi", "ideal", "table_ideal")}
     res["k_cross"], res["in_grid"], res["mc_bounds"] = np.full(n, -1), np.zeros(n, dtype=bool), {}
     efficiency = svm and op.closed and "delta_up_ideal" in view.t.arrays
-    eff = {k: _nan(n) for k in ("value", "low", "high", "k", "se_log", "k_a", "k_b", "t_a", "t_b")} if efficiency else None
+    eff = {k: nans(n) for k in ("value", "low", "high", "k", "se_log", "k_a", "k_b", "t_a", "t_b")} if efficiency else None
     e_in = view.e_in(lo) & view.e_in(hi)
     # the pairs' own critical noises (the efficiency route's target, the closed-form bound): read with the
     # efficiency route's entries where it reads them (one call of the grid), the others' after the loop
-    star, have_star = _nan(n), np.zeros(n, dtype=bool)
+    star, have_star = nans(n), np.zeros(n, dtype=bool)
     slices = []
     for (nz, d), idx in groups(noise, dt):
         combos, flags = view.scene_weights(nz, d)
@@ -223,7 +246,8 @@ def contact_arrays(op, lo, hi, noise, dt, *, ideal_bound: bool, zc: float, class
         gap = h - l
         # every need in one reading, every crossing in one: svm, its Monte Carlo ends, the grid's own bound
         kinds = ["svm"] + (["lo", "hi"] if svm else []) + (["ideal"] if "delta_up_ideal" in view.t.arrays else [])
-        need = view.need(kinds, combos, l, h)  # [kind, contact, pair]
+        readings = view.readings(kinds, combos, l, h)  # the efficiency route reads its entries from them
+        need = view.need(kinds, combos, l, h, readings)  # [kind, contact, pair]
         m = l.size
         value, k, _, _, n0, n1 = grid_crossing(grid, need.transpose(1, 0, 2).reshape(grid.size, -1),
                                                np.tile(gap, len(kinds)))
@@ -240,7 +264,9 @@ def contact_arrays(op, lo, hi, noise, dt, *, ideal_bound: bool, zc: float, class
             if all(iflags.values()):
                 res["ideal"][idx] = grid_crossing(op.iview.contacts, op.iview.need(op.ikind, icombos, l, h), gap)[0]
         if efficiency and (has := k >= 0).any():
-            r = noise_k_min_contact(op, combos, k[has], l[has], h[has], nz / abs(d), zc=zc)
+            sel = slice(None) if has.all() else has  # (every pair: the readings themselves, no copy)
+            r = noise_k_min_contact(op, combos, k[sel], l[sel], h[sel], nz / abs(d), zc=zc,
+                                    readings=[x[:3][..., sel] for x in readings])
             for key in eff:
                 eff[key][idx[has]] = r[key]
             star[idx[has]], have_star[idx[has]] = r["s_pair"], True
@@ -256,11 +282,11 @@ def contact_arrays(op, lo, hi, noise, dt, *, ideal_bound: bool, zc: float, class
                                              CLOSED_FORM_MAX_CONTACT_S)
     res["floor"] = res["ideal"].copy()
     if not op.closed and ideal_bound:  # no closed form: Monte Carlo at query time, one per element
-        from .ideal_mc_bound import cached_mc_ideal_min_contact
+        from .ideal_mc_bound import mc_ideal_min_contact, remembered
 
         for i in np.nonzero(res["in_grid"])[0].tolist():
-            mcb = cached_mc_ideal_min_contact(
-                *_boxes(op, lo, hi, classes, i), op.tab.sensor, noise_c=float(noise[i]), delta_t_c=float(dt[i]),
+            mcb = remembered(
+                mc_ideal_min_contact, *_boxes(op, lo, hi, classes, i), op.tab.sensor, noise_c=float(noise[i]), delta_t_c=float(dt[i]),
                 sensor_temp_spread_c=table_spread(op.tab), model=op.model, threshold=op.phi,
                 max_contact_s=CLOSED_FORM_MAX_CONTACT_S, coverage=coverage_of_z(zc))
             res["mc_bounds"][i] = mcb
@@ -331,9 +357,9 @@ def ratio_arrays(question: str, op, lo, hi, contact, scale, *, ideal_bound: bool
         raise TableMismatch(f"table {op.tab.name} has separate noise and temperature axes (varied initial "
                             f"conditions): it cannot answer {question}; the exact route can")
     svm = op.tab.fidelity == "svm"
-    r_all, where_all, ri = _nan(n), np.full(n, -1), _nan(n)
-    ends = {k: _nan(n) for k in ("hi", "lo", "lo_any")}
-    alt = {k: _nan(n) for k in ("c", "lin", "rnd", "geo")}  # the rounding estimate's interpolants
+    r_all, where_all, ri = nans(n), np.full(n, -1), nans(n)
+    ends = {k: nans(n) for k in ("hi", "lo", "lo_any")}
+    alt = {k: nans(n) for k in ("c", "lin", "rnd", "geo")}  # the rounding estimate's interpolants
     e_in = view.e_in(lo) & view.e_in(hi)
     for (c,), idx in groups(contact):
         cw, c_ok = axis_weights_flagged(view.contacts, c)
@@ -384,7 +410,7 @@ def delta_at(e: np.ndarray, v, cmb, cws, name: str) -> np.ndarray:
     """Array ``name`` of view ``v`` at effusivities ``e``, scene weights ``cmb``, contact weights ``cws`` (NaN:
     none, or no such view or array)."""
     if v is None or name not in v.t.arrays:
-        return _nan(e.size)
+        return nans(e.size)
     return at_contact(cws, v.delta(name, cmb, e))
 
 
@@ -422,7 +448,7 @@ def delta_e_arrays(op, e, contact, noise, dt, *, ideal_view, zc: float, ideal_bo
     res: dict[str, Any] = {}
     for side in ("lower", "upper"):
         for k in ("", "_ideal", "_low", "_high", "_table", "_mc_lo", "_mc_hi", "_table_ideal", "_efficiency"):
-            res[side + k] = _nan(n)
+            res[side + k] = nans(n)
         res[f"{side}_method"], res[f"{side}_mc_bounds"] = np.full(n, "none", dtype=object), {}
     res["in_grid"] = np.zeros(n, dtype=bool)
     e_in = view.e_in(e)
@@ -444,12 +470,12 @@ def delta_e_arrays(op, e, contact, noise, dt, *, ideal_view, zc: float, ideal_bo
                 ideal, floor = _mc_delta_bounds(op, e, classes, idx, direction, c, nz, d, zc,
                                                 res[f"{side}_mc_bounds"])
             method = np.full(idx.size, "table-estimate" if svm else "none", dtype=object)
-            low = high = _nan(idx.size)
+            low = high = nans(idx.size)
             if svm:
                 low, high = delta_estimate(val, mc_lo, mc_hi, delta_geometric(xe, view, combos, gcw,
                                                                               f"delta_{direction}"),
                                            floor, width=op.width, z_table=table_z(op.tab), zc=zc)
-            value, eff = val, _nan(idx.size)
+            value, eff = val, nans(idx.size)
             if efficiency:  # the SVM's efficiency against the exact ideal observer, where it applies
                 r = delta_efficiency_estimate(
                     op.tab.sensor, xe, c, nz / abs(d), -1.0 if direction == "down" else 1.0, view.contacts[ends[0]],
@@ -496,14 +522,14 @@ def _mc_delta_bounds(op, e, classes, idx, direction: str, contact: float, noise:
     """Per reference ``e[idx]``: the Monte Carlo ideal delta(e) of one direction and the low end of its
     interval (NaN: none), each bound kept in ``store`` (element -> bound)."""
     from ..objects import ObjectClass
-    from .ideal_mc_bound import cached_mc_ideal_delta
+    from .ideal_mc_bound import mc_ideal_delta, remembered
 
-    value, floor = _nan(idx.size), _nan(idx.size)
+    value, floor = nans(idx.size), nans(idx.size)
     for j, i in enumerate(idx.tolist()):
         ref = classes[i] if classes is not None else ObjectClass("r", (e[i], e[i] + op.width))
-        mcb = cached_mc_ideal_delta(ref, 1 if direction == "up" else -1, op.tab.sensor, contact_s=contact,
-                                    noise_c=noise, delta_t_c=dt, sensor_temp_spread_c=table_spread(op.tab),
-                                    model=op.model, threshold=op.phi, coverage=coverage_of_z(zc))
+        mcb = remembered(mc_ideal_delta, ref, 1 if direction == "up" else -1, op.tab.sensor, contact_s=contact,
+                         noise_c=noise, delta_t_c=dt, sensor_temp_spread_c=table_spread(op.tab), model=op.model,
+                         threshold=op.phi, coverage=coverage_of_z(zc))
         store[i] = mcb
         if mcb.value is not None:
             value[j], floor[j] = mcb.value, mcb.floor
@@ -526,7 +552,7 @@ def distinguishable_arrays(op, lo, hi, contact, noise, dt, *, ideal_bound: bool,
     """
     n, view = lo.size, op.view
     svm = op.tab.fidelity == "svm"
-    res: dict[str, Any] = {k: _nan(n) for k in ("grid_svm", "grid_lo", "grid_hi", "ideal")}
+    res: dict[str, Any] = {k: nans(n) for k in ("grid_svm", "grid_lo", "grid_hi", "ideal")}
     res["in_grid"], res["ideal_method"] = np.zeros(n, dtype=bool), np.full(n, "none", dtype=object)
     e_in = view.e_in(lo) & view.e_in(hi)
     for _, idx, combos, cw in scene_groups(view, contact, noise, dt, e_in):
@@ -556,7 +582,7 @@ def distinguishable_arrays(op, lo, hi, contact, noise, dt, *, ideal_bound: bool,
     for key in ("value", "low", "high", "kind", "stated"):
         res[f"mc_{key}"] = np.where(todo, mc[key], np.nan if key in ("value", "low", "high") else mc[key])
     res["kind"], res["stated"] = np.full(n, "none", dtype=object), np.zeros(n, dtype=bool)
-    res["low"] = res["high"] = _nan(n)
+    res["low"] = res["high"] = nans(n)
     if ideal_bound:
         _ideal_f1(op, lo, hi, contact, noise, dt, classes, res)
     return res
@@ -597,7 +623,7 @@ def _others_decide(op, lo, hi, contact, noise, dt, i: np.ndarray, yes: np.ndarra
     sure = {"max-noise": (np.zeros(n, dtype=bool), np.zeros(n, dtype=bool))}
     for k in ("mn_value", "mn_low", "mn_high", "de_upper_value", "de_upper_low", "de_upper_high", "de_lower_value",
               "de_lower_low", "de_lower_high"):
-        res[k] = _nan(size)
+        res[k] = nans(size)
     if "noise_ratio" in op.tab.axes:
         mn = ratio_arrays("max-noise", op, l, h, c, np.abs(d), ideal_bound=True, zc=zc)
         mn_stated = mn["stated"] & ~np.isnan(mn["low"]) & ~np.isnan(mn["high"])

@@ -7,7 +7,9 @@ is read from (:class:`OpenedTable`). A table built for another one is refused
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -34,6 +36,9 @@ DEFAULT_IDEAL_TABLE = "ideal-paper"
 #: :class:`~designkit.query.table_arrays.TableView` (the table's memo): a name or path is read and hashed
 #: once, not on every question. Least recently used out.
 _LOADED: "LRUCache[tuple, tuple[Table, TableView]]" = LRUCache(16)
+#: The files each table name given as a string resolved to (:func:`~designkit.tables.store.resolve_table`), so
+#: that a question stats two files instead of searching for them; resolved again when they are gone.
+_RESOLVED: "LRUCache[tuple, tuple[str, str]]" = LRUCache(64)
 
 
 def as_table(table: "Table | str") -> Table:
@@ -41,15 +46,21 @@ def as_table(table: "Table | str") -> Table:
     are unchanged (same path, size and modification time of the .npz and the .json header)."""
     if isinstance(table, Table):
         return table
-    npz = resolve_table(table)
+    named = ("name", table) if isinstance(table, str) else None
+    files = _RESOLVED.get(named) if named else None
+    if files is None:
+        npz = resolve_table(table)
+        files = (str(npz), str(npz.with_suffix(".json")))
     try:
-        key = tuple((str(p), st.st_mtime_ns, st.st_size) for p in (npz, npz.with_suffix(".json"))
-                    for st in (p.stat(),))
+        key = tuple((p, st.st_mtime_ns, st.st_size) for p in files for st in (os.stat(p),))
     except OSError:  # let load_table say what is missing
-        return load_table(npz)
+        _RESOLVED.pop(named, None)
+        return load_table(resolve_table(table))
+    if named:
+        _RESOLVED[named] = files
     hit = _LOADED.get(key)
     if hit is None:
-        t = load_table(npz)
+        t = load_table(Path(files[0]))
         hit = _LOADED[key] = (t, TableView(t))
     return hit[0]
 
@@ -70,6 +81,7 @@ def clear_table_cache() -> None:
     """Forget the tables this process has loaded (they are re-read and re-verified on next use), and what
     their views computed of them."""
     _LOADED.clear()
+    _RESOLVED.clear()
 
 
 # ============================================================ opening a table for a question

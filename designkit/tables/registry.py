@@ -25,30 +25,26 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
 from pathlib import Path
 from typing import Any, Mapping
 
 from cachetools import LRUCache
 
+from .. import __version__
+from .._resources import DATA_DIR_VARIABLE, data_dir
 from .._validation import InputError
+from ..materials import remember_shipped_table
+from ..sensor import remember_checked_file
 
 __all__ = ["DATA_DIR_VARIABLE", "default_table_dir", "entry_path", "register_table", "registry_dir", "sensor_digest",
            "table_for_sensor"]
 
-#: Environment variable naming designkit's data folder instead of the user's (tests, shared machines).
-DATA_DIR_VARIABLE = "DESIGNKIT_DATA_DIR"
 _ENTRY_FORMAT = "designkit-sensor-table"
 
 
 def registry_dir() -> Path:
     """The folder of the sensor-table registry: ``$DESIGNKIT_DATA_DIR/sensor-tables`` or the user's data folder's."""
-    base = os.environ.get(DATA_DIR_VARIABLE)
-    if not base:
-        import platformdirs
-
-        base = platformdirs.user_data_dir("designkit", appauthor=False)
-    return Path(base) / "sensor-tables"
+    return data_dir() / "sensor-tables"
 
 
 def sensor_digest(sensor) -> str:
@@ -121,10 +117,14 @@ def register_table(sensor, table_path: str | Path, *, sensor_file: str | None = 
     entry = {"format": _ENTRY_FORMAT, "sensor_digest": digest, "sensor_name": getattr(sensor, "name", None),
              "sensor_file": None if sensor_file is None else str(Path(sensor_file).resolve()),
              "table": str(Path(table.path).resolve()), "content_hash": table.header["content_hash"],
+             "checked_by": __version__,
              "registered": _dt.datetime.now(_dt.timezone.utc).replace(microsecond=0).isoformat()}
     path = registry_dir() / f"{_key(digest)}.json"
     path.parent.mkdir(parents=True, exist_ok=True)
     atomic_write_text(path, json.dumps(entry, indent=1) + "\n")
+    if sensor_file is not None:  # later questions about it read the sensor file and the materials without YAML
+        remember_checked_file(sensor_file, sensor)  # or the schema (their import and parse: about 0.3 s)
+        remember_shipped_table()
     return path
 
 
@@ -168,7 +168,8 @@ def table_for_sensor(sensor):
         return _FOUND[key]
     from .store import load_table
 
-    table = load_table(npz)
+    # its content was checked in full when this designkit registered it: that content skips the schema's check
+    table = load_table(npz, checked_hash=entry.get("content_hash") if entry.get("checked_by") == __version__ else None)
     if table.header.get("content_hash") != entry.get("content_hash"):
         raise InputError(f"the table registered for sensor {sensor.name} ({npz}) was replaced since it was "
                          "registered: rebuild it with 'designkit tables build --sensor FILE', or ask with --exact")

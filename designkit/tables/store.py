@@ -425,6 +425,9 @@ class Table:
     arrays: Mapping[str, np.ndarray]
     #: Loaded content is a shipped table's (its hash is in :data:`SHIPPED_CONTENT_HASHES`): schema-checked already.
     shipped: bool = field(default=False, compare=False)
+    #: Loaded content was schema-checked already: a shipped table's, or one whose content hash this designkit
+    #: recorded when it checked it (a registered sensor table: :func:`load_table`'s ``checked_hash``).
+    checked: bool = field(default=False, compare=False)
 
     @property
     def fidelity(self) -> str:
@@ -451,7 +454,8 @@ class Table:
     def sensor(self):
         from ..sensor import Sensor
 
-        return Sensor.from_dict(self.header["sensor"], source=f"table {self.name}", schema=not self.shipped)
+        return Sensor.from_dict(self.header["sensor"], source=f"table {self.name}",
+                                schema=not (self.shipped or self.checked))
 
     @property
     def fixed_initial_conditions(self) -> bool:
@@ -646,13 +650,17 @@ def _check_schema(header: dict, path: Path) -> None:
     validate(schemas()["table"], header, f"table header {path.with_suffix('.json')}")
 
 
-def load_table(name_or_path: str | Path, *, verify: bool = True, thorough: bool = False) -> Table:
+def load_table(name_or_path: str | Path, *, verify: bool = True, thorough: bool = False,
+               checked_hash: str | None = None) -> Table:
     """Load and verify a table (shipped name or path): its content hash (header and arrays) and its
     header's schema and consistency with the arrays.
 
     Files of a shipped table as shipped (:data:`SHIPPED_FILE_DIGESTS`) are checked by their digest
     instead, and each array is read when a question first asks for it; ``thorough=True`` takes the
-    long way for them too (``designkit tables show`` does)."""
+    long way for them too (``designkit tables show`` does). ``checked_hash``: the content hash of a table
+    this designkit checked in full before (a registered sensor table's, recorded when it was registered):
+    content with that hash skips the schema check as a shipped table's does (the content hash itself is
+    still verified, so any other content gets the schema's verdict)."""
     path = resolve_table(name_or_path)
     header = _read_header(path, schema=False)
     from .._schemas import check_regular_file
@@ -672,7 +680,8 @@ def load_table(name_or_path: str | Path, *, verify: bool = True, thorough: bool 
             return Table(name=header["name"], path=path, header=header,
                          arrays=_NpzArrays(path, members, specs, shipped_members), shipped=True)
     # a shipped table's content is checked by its hash instead of the schema (see SHIPPED_CONTENT_HASHES)
-    known = verify and isinstance(header.get("content_hash"), str) and header["content_hash"] in SHIPPED_CONTENT_HASHES
+    known = verify and isinstance(header.get("content_hash"), str) and (
+        header["content_hash"] in SHIPPED_CONTENT_HASHES or header["content_hash"] == checked_hash)
     if not known:
         _check_schema(header, path)
         specs = header["arrays"]
@@ -691,7 +700,8 @@ def load_table(name_or_path: str | Path, *, verify: bool = True, thorough: bool 
             raise InputError(f"table {path.name} failed its content check (hash of header and arrays mismatch): "
                              f"corrupted or edited; rebuild it with designkit sweep")
     check_table(header, arrays, path.name, schema=not known)
-    return Table(name=header["name"], path=path, header=header, arrays=arrays, shipped=known)
+    return Table(name=header["name"], path=path, header=header, arrays=arrays,
+                 shipped=known and header["content_hash"] in SHIPPED_CONTENT_HASHES, checked=known)
 
 
 def _shipped_members(files_digest: str | None) -> dict[str, str] | None:

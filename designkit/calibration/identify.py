@@ -305,20 +305,15 @@ class _Problem:
                                        x[self.touch_cols[gi]:self.touch_cols[gi] + len(g.trials)], x)
                 out.append(self._chain(g.time_s, u))
                 continue
+            def step(tt, rho_m=rho[g.material]):
+                return _reading(model, tt, rho_m, sensor, self.interp_points)
+
             if g.force is not None:  # one shape per touch: its contact area grows with its own force
-                area = self.contact_area(g, x)
-                out.append(self._chain(g.time_s, area_weighted(
-                    lambda tt: _reading(model, tt, rho[g.material], sensor, self.interp_points),
-                    g.time_s, area, off)))
+                out.append(self._chain(g.time_s, area_weighted(step, g.time_s, self.contact_area(g, x), off)))
                 continue
             key = (g.material, g.time_s.tobytes())
             if key not in cache:
-                tt = g.time_s - off
-                u = np.zeros(tt.size)
-                pos = tt > 0
-                if pos.any():
-                    u[pos] = _reading(model, tt[pos], rho[g.material], sensor, self.interp_points)
-                cache[key] = self._chain(g.time_s, u)
+                cache[key] = self._chain(g.time_s, area_weighted(step, g.time_s, None, off))
             out.append(cache[key])
         return out
 
@@ -352,17 +347,12 @@ class _Problem:
         """Unsmoothed readings (n, m) of a group whose touches each have their own h_c."""
         import dataclasses
 
-        tt = g.time_s - off
-        pos = tt > 0
         out = np.zeros((log_dev.size, g.time_s.size))
         area = self.contact_area(g, x)
         for i, d in enumerate(log_dev):
             m = dataclasses.replace(model, conductance_w_m2k=model.conductance_w_m2k * math.exp(float(d)))
-            if area is not None:
-                out[i] = area_weighted(lambda t: _reading(m, t, rho, sensor, self.interp_points), g.time_s,
-                                        area[i:i + 1], off)[0]
-            elif pos.any():
-                out[i, pos] = _reading(m, tt[pos], rho, sensor, self.interp_points)
+            out[i] = area_weighted(lambda t: _reading(m, t, rho, sensor, self.interp_points), g.time_s,
+                                   None if area is None else area[i:i + 1], off)
         return out
 
     def jacobian(self, x: np.ndarray, touch_only: bool = False) -> np.ndarray:

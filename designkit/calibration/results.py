@@ -188,8 +188,6 @@ class Identification:
         sensor = self.sensor()
         eo = self.ratios[material].value * es
         off = self.parameter("time_offset_s").value
-        tt = grid - off
-        pos = tt > 0
         factors = [None] if conductance_factor is None else list(np.atleast_1d(conductance_factor))
         areas = [None]
         if force is not None and self.candidate.force_area:
@@ -212,10 +210,7 @@ class Identification:
             def step(tp, m=m):
                 return m.conduction(tp, [eo], sensor)[0]
 
-            if area is not None:
-                out[i] = area_weighted(step, grid, area[None, :], off)[0]
-            elif pos.any():
-                out[i, pos] = step(tt[pos])
+            out[i] = area_weighted(step, grid, None if area is None else area[None, :], off)
         b = grid * (1.0 - out)
         if self.candidate.smoothing:
             out = savgol_smooth(out, *HOST_SMOOTHING)

@@ -161,7 +161,7 @@ def _normalized_drop(tr: Trial, at_s: float = 2.0) -> float:
     late = np.abs(tr.time_s - at_s) <= 0.25
     if (tr.time_s < 0).sum() < 3 or not late.any():
         return math.nan
-    ts0, to = _before(tr)
+    ts0, to = tr.before_contact()
     drop = ts0 - float(np.mean(tr.sensor_c[late]))
     if math.isfinite(to):
         diff = ts0 - to
@@ -206,19 +206,12 @@ def check_calibration(result: "Identification | None", trials: Sequence[Trial]) 
     return [p for p in checks if p is not None]
 
 
-def _before(tr: Trial) -> tuple[float, float]:
-    """Mean sensor and object temperatures before contact [degC] (object NaN without a passive reading)."""
-    pre = tr.time_s < 0
-    obj = tr.object_c[pre]
-    return float(np.mean(tr.sensor_c[pre])), float(np.nanmean(obj)) if np.isfinite(obj).any() else math.nan
-
-
 def _no_response(trials: Sequence[Trial]) -> CalibrationProblem | None:
     moved = []  # (largest move over the contact, pre-contact noise SD, sensor - object before contact) [degC]
     for tr in trials:
         pre, post = tr.time_s < 0, tr.time_s >= 0
         if pre.sum() >= 3 and post.sum() >= 3:
-            ts0, to = _before(tr)
+            ts0, to = tr.before_contact()
             moved.append((float(np.max(np.abs(tr.sensor_c[post] - ts0))), float(np.std(tr.sensor_c[pre])), ts0 - to))
     still = [m for m in moved if m[0] < max(5.0 * m[1], 0.05)]
     if not (moved and len(still) > len(moved) / 2):
@@ -235,7 +228,7 @@ def _no_response(trials: Sequence[Trial]) -> CalibrationProblem | None:
 
 
 def _wiring(trials: Sequence[Trial]) -> CalibrationProblem | None:
-    cold = [_before(tr) for tr in trials if (tr.time_s < 0).any()]
+    cold = [tr.before_contact() for tr in trials if (tr.time_s < 0).any()]
     cold = [(s, o) for s, o in cold if math.isfinite(o)]
     below = [(s, o) for s, o in cold if s < o - 0.2]
     if not (cold and len(below) > len(cold) / 2):

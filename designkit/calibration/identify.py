@@ -55,7 +55,7 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from .._validation import InputError
-from .candidates import CHAIN_PARAMS, PARAMS, Candidate, HOST_SMOOTHING, candidate
+from .candidates import CHAIN_PARAMS, PARAMS, Candidate, candidate
 from .force import FORCE_NOISE_BAND_SD, area_weighted, contact_area, force_noise, nominal_force_profile, relative_force
 from .results import IdentifiedParameter, Identification
 from .robust import cluster_sandwich, t_critical
@@ -298,17 +298,17 @@ class _Problem:
             if gi in self.touch_cols:  # one shape per touch, each with its own h_c
                 u = self._touch_shapes(g, model, sensor, off, rho[g.material],
                                        x[self.touch_cols[gi]:self.touch_cols[gi] + len(g.trials)], x)
-                out.append(self._chain(g.time_s, u))
+                out.append(self.cand.chain(g.time_s, u))
                 continue
             def step(tt, rho_m=rho[g.material]):
                 return _reading(model, tt, rho_m, sensor, self.interp_points)
 
             if g.force is not None:  # one shape per touch: its contact area grows with its own force
-                out.append(self._chain(g.time_s, area_weighted(step, g.time_s, self.contact_area(g, x), off)))
+                out.append(self.cand.chain(g.time_s, area_weighted(step, g.time_s, self.contact_area(g, x), off)))
                 continue
             key = (g.material, g.time_s.tobytes())
             if key not in cache:
-                cache[key] = self._chain(g.time_s, area_weighted(step, g.time_s, None, off))
+                cache[key] = self.cand.chain(g.time_s, area_weighted(step, g.time_s, None, off))
             out.append(cache[key])
         return out
 
@@ -321,17 +321,6 @@ class _Problem:
         c = PARAMS["contact_force_fraction"].from_x(x[free.index("contact_force_fraction")]) \
             if "contact_force_fraction" in free else 0.0
         return contact_area(g.force, c, band)
-
-    def _chain(self, time_s: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
-        """The measurement chain on unsmoothed readings ``u``: (v, drift basis or None)."""
-        b = time_s * (1.0 - u) if self.cand.drift else None
-        if self.cand.smoothing:
-            from ..models.layered import savgol_smooth
-
-            u = savgol_smooth(u, *HOST_SMOOTHING)
-            if b is not None:
-                b = savgol_smooth(b, *HOST_SMOOTHING)
-        return u, b
 
     def _touch_shapes(self, g: _Group, model, sensor, off: float, rho: float, log_dev: np.ndarray,
                       x: np.ndarray) -> np.ndarray:

@@ -172,8 +172,6 @@ class Identification:
         """
         import dataclasses
 
-        from ..models.layered import savgol_smooth
-
         if material not in self.ratios:
             raise InputError(f"no identified material {material!r} (fitted: {', '.join(self.ratios)})")
         t = np.asarray(time_s, dtype=np.float64)
@@ -211,10 +209,7 @@ class Identification:
                 return m.conduction(tp, [eo], sensor)[0]
 
             out[i] = area_weighted(step, grid, None if area is None else area[None, :], off)
-        b = grid * (1.0 - out)
-        if self.candidate.smoothing:
-            out = savgol_smooth(out, *HOST_SMOOTHING)
-            b = savgol_smooth(b, *HOST_SMOOTHING)
+        out, b = self.candidate.chain(grid, out, drift=drift)
         single = conductance_factor is None and (force is None or np.ndim(force) == 1)
         res = np.array([np.interp(t, grid, row) for row in out])
         res = res[0] if single else res

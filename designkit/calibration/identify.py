@@ -113,20 +113,9 @@ def _prepare(trials: Sequence[Trial], names: Sequence[str], object_temps: Mappin
     idx = {n: k for k, n in enumerate(names)}
     modes: dict[str, str] = {}
     info = []
-    ssr, dof, rates = 0.0, 0, []
-    acf = np.zeros(41)
+    rates = []
+    noise, lag = _pre_contact_noise(trials)
     for tr in trials:
-        pre = tr.time_s < 0
-        if pre.sum() < 3:
-            raise InputError(f"trial {tr.source}: fewer than 3 samples before contact (time_s < 0)")
-        t, s = tr.time_s[pre], tr.sensor_c[pre]
-        early = t < t[0] + 0.5 * (t[-1] - t[0]) if t.size >= 20 else np.ones(t.size, bool)
-        coef = np.polyfit(t[early], s[early], 1)
-        e = s[early] - np.polyval(coef, t[early])
-        ssr += float(e @ e)
-        lags = min(acf.size, e.size)
-        acf[:lags] += [float(e[:e.size - k] @ e[k:]) for k in range(lags)]
-        dof += int(early.sum()) - 2
         to = tr.before_contact()[1]
         post = tr.object_c[tr.time_s >= 0]
         moved = float(np.nanmax(np.abs(post - to))) if math.isfinite(to) and np.isfinite(post).any() else math.nan
@@ -182,14 +171,33 @@ def _prepare(trials: Sequence[Trial], names: Sequence[str], object_temps: Mappin
                           np.array([relative_force(trials[i]) for i in members]) if force_area else None,
                           np.array([FORCE_NOISE_BAND_SD * force_noise(trials[i]) for i in members])
                           if force_area else None))
-    noise = math.sqrt(ssr / dof) if dof > 0 else math.nan
     ref = dict(refs or {})
     for n in names:  # the reference reading of an affine channel: the fitted touches' mean (kept for scoring)
         if isinstance(modes[n], str) and modes[n].endswith("-affine") and n not in ref:
             ref[n] = float(np.mean(np.concatenate([g.to for g in out if names[g.material] == n])))
+    return _Data(tuple(out), tuple(names), modes, noise, float(np.median(rates)), ref, lag)
+
+
+def _pre_contact_noise(trials: Sequence[Trial]) -> tuple[float, int]:
+    """The pre-contact noise [degC] (pooled scatter about each touch's straight line over the first half of its
+    samples before contact) and the first lag [samples] at which its autocorrelation falls below 0.5."""
+    ssr, dof = 0.0, 0
+    acf = np.zeros(41)
+    for tr in trials:
+        pre = tr.time_s < 0
+        if pre.sum() < 3:
+            raise InputError(f"trial {tr.source}: fewer than 3 samples before contact (time_s < 0)")
+        t, s = tr.time_s[pre], tr.sensor_c[pre]
+        early = t < t[0] + 0.5 * (t[-1] - t[0]) if t.size >= 20 else np.ones(t.size, bool)
+        coef = np.polyfit(t[early], s[early], 1)
+        e = s[early] - np.polyval(coef, t[early])
+        ssr += float(e @ e)
+        lags = min(acf.size, e.size)
+        acf[:lags] += [float(e[:e.size - k] @ e[k:]) for k in range(lags)]
+        dof += int(early.sum()) - 2
     below = np.flatnonzero(acf < 0.5 * acf[0]) if acf[0] > 0 else np.array([1])
     lag = int(below[0]) if below.size else acf.size
-    return _Data(tuple(out), tuple(names), modes, noise, float(np.median(rates)), ref, max(lag, 1))
+    return (math.sqrt(ssr / dof) if dof > 0 else math.nan), max(lag, 1)
 
 
 # ------------------------------------------------------------ the problem

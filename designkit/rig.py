@@ -155,10 +155,9 @@ def rig_conditions(trials: Sequence[Any], *, pre_contact_noise_c: float, residua
         pre = tr.time_s < 0
         if pre.sum() < 1:
             continue
-        s = float(np.mean(tr.sensor_c[pre]))
+        s, o = tr.before_contact()
         ts0.append(s)
-        obj = tr.object_c[pre]
-        to.append(float(np.mean(obj[np.isfinite(obj)])) if np.isfinite(obj).any() else math.nan)
+        to.append(o)
         f = np.asarray(tr.force_n, dtype=np.float64)
         late = tr.time_s >= 1.0
         if np.isfinite(f).all() and late.any():

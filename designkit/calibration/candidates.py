@@ -116,6 +116,20 @@ class Candidate:
             raise InputError(f"candidate {self.label}: no fittable parameter {', '.join(unknown)} "
                              f"(fittable: {', '.join(PARAMS)})")
 
+    def chain(self, time_s, u, *, drift: bool | None = None):
+        """The measurement chain on unsmoothed readings ``u`` (..., m) at ``time_s``: ``(v, b)``, the reading
+        and the drift basis ``b = t (1 - u)`` (None unless ``drift``, by default the candidate's), both
+        smoothed by the host's filter when ``smoothing`` (it is linear: ``Ts0 (1 - v) + s b + To v`` is the
+        smoothed ``(Ts0 + s t)(1 - u) + To u``)."""
+        b = time_s * (1.0 - u) if (self.drift if drift is None else drift) else None
+        if self.smoothing:
+            from ..models.layered import savgol_smooth
+
+            u = savgol_smooth(u, *HOST_SMOOTHING)
+            if b is not None:
+                b = savgol_smooth(b, *HOST_SMOOTHING)
+        return u, b
+
 
 #: The candidates :func:`~designkit.calibration.compare.compare_models` tries by default, simplest first.
 CANDIDATES: tuple[Candidate, ...] = (

@@ -63,6 +63,14 @@ def parse_ranges(specs: Sequence[str]) -> dict[str, str]:
     return out
 
 
+def _database_range(name: str, database_name: str) -> MaterialRange:
+    """The range of ``database_name`` in the materials database, for material ``name`` (InputError if unknown)."""
+    from ..materials import get_material
+
+    m = get_material(database_name)
+    return MaterialRange(name, m.e_min, m.e_max, f"materials database: {m.name}")
+
+
 def _range_from_spec(name: str, spec: str) -> MaterialRange:
     lo_text, sep, hi_text = spec.partition(":")
     if sep:
@@ -71,13 +79,10 @@ def _range_from_spec(name: str, spec: str) -> MaterialRange:
         except ValueError:
             raise InputError(f"--range {name}={spec}: MIN and MAX must be numbers") from None
         return MaterialRange(name, lo, hi, "--range")
-    from ..materials import get_material
-
     try:
-        m = get_material(spec)
+        return _database_range(name, spec)
     except InputError as exc:
         raise InputError(f"--range {name}={spec}: not MIN:MAX and {exc}") from None
-    return MaterialRange(name, m.e_min, m.e_max, f"materials database: {m.name}")
 
 
 def resolve_ranges(materials: Sequence[str], overrides: Mapping[str, str]) -> dict[str, MaterialRange]:
@@ -96,16 +101,9 @@ def resolve_ranges(materials: Sequence[str], overrides: Mapping[str, str]) -> di
             out[name] = _range_from_spec(name, overrides[name])
             continue
         try:
-            from ..materials import get_material
-        except ImportError:  # pragma: no cover - the materials layer is part of designkit
-            missing.append(name)
-            continue
-        try:
-            m = get_material(name)
+            out[name] = _database_range(name, name)
         except InputError:
             missing.append(name)
-            continue
-        out[name] = MaterialRange(name, m.e_min, m.e_max, f"materials database: {m.name}")
     if missing:
         raise InputError(f"no effusivity range for {', '.join(missing)} (not a materials database name): "
                          f"give --range NAME=MIN:MAX or NAME=DATABASE_NAME, or leave them out with --only")
@@ -160,15 +158,13 @@ class CalibrationProblem:
 
 def _normalized_drop(tr: Trial, at_s: float = 2.0) -> float:
     """(Ts0 - T(at_s)) / (Ts0 - To) of one touch (raw drop [degC] without a passive channel); NaN if too short."""
-    pre = tr.time_s < 0
     late = np.abs(tr.time_s - at_s) <= 0.25
-    if pre.sum() < 3 or not late.any():
+    if (tr.time_s < 0).sum() < 3 or not late.any():
         return math.nan
-    ts0 = float(np.mean(tr.sensor_c[pre]))
+    ts0, to = tr.before_contact()
     drop = ts0 - float(np.mean(tr.sensor_c[late]))
-    obj = tr.object_c[pre]
-    if np.isfinite(obj).any():
-        diff = ts0 - float(np.nanmean(obj))
+    if math.isfinite(to):
+        diff = ts0 - to
         return drop / diff if abs(diff) > 0.5 else math.nan
     return drop
 
@@ -206,41 +202,47 @@ def check_calibration(result: "Identification | None", trials: Sequence[Trial]) 
     >>> [p.kind for p in check_calibration(None, [flat, flat])]
     ['no-response']
     """
-    out: list[CalibrationProblem] = []
+    checks = (_no_response(trials), _wiring(trials), _mislabelled(trials), _conflict(result), _unidentified(result))
+    return [p for p in checks if p is not None]
+
+
+def _no_response(trials: Sequence[Trial]) -> CalibrationProblem | None:
     moved = []  # (largest move over the contact, pre-contact noise SD, sensor - object before contact) [degC]
     for tr in trials:
         pre, post = tr.time_s < 0, tr.time_s >= 0
         if pre.sum() >= 3 and post.sum() >= 3:
-            ts0 = float(np.mean(tr.sensor_c[pre]))
-            obj = tr.object_c[pre]
-            diff = ts0 - float(np.nanmean(obj)) if np.isfinite(obj).any() else math.nan
-            moved.append((float(np.max(np.abs(tr.sensor_c[post] - ts0))), float(np.std(tr.sensor_c[pre])), diff))
+            ts0, to = tr.before_contact()
+            moved.append((float(np.max(np.abs(tr.sensor_c[post] - ts0))), float(np.std(tr.sensor_c[pre])), ts0 - to))
     still = [m for m in moved if m[0] < max(5.0 * m[1], 0.05)]
-    if moved and len(still) > len(moved) / 2:
-        diffs = [m[2] for m in still if math.isfinite(m[2])]
-        why = (f"; sensor minus object before contact {np.mean(diffs):+.2f} °C on average" if diffs else "")
-        out.append(CalibrationProblem(
-            "no-response", f"the sensor's reading does not respond to contact in {len(still)} of {len(moved)} "
-                           f"touches (it moves by at most {max(m[0] for m in still):.3g} °C, against a pre-contact "
-                           f"noise of {np.mean([m[1] for m in still]):.2g} °C{why}): no heat flowed, so these "
-                           "touches say nothing about the sensor",
-            "Heat the sensor above the object (its set point), check that the thermistor channel is "
-            "connected and that the object is under the sensor when a touch is recorded, then record again"))
-    cold = []
-    for tr in trials:
-        pre = tr.time_s < 0
-        obj = tr.object_c[pre]
-        if pre.any() and np.isfinite(obj).any():
-            cold.append((float(np.mean(tr.sensor_c[pre])), float(np.nanmean(obj))))
+    if not (moved and len(still) > len(moved) / 2):
+        return None
+    diffs = [m[2] for m in still if math.isfinite(m[2])]
+    why = (f"; sensor minus object before contact {np.mean(diffs):+.2f} °C on average" if diffs else "")
+    return CalibrationProblem(
+        "no-response", f"the sensor's reading does not respond to contact in {len(still)} of {len(moved)} "
+                       f"touches (it moves by at most {max(m[0] for m in still):.3g} °C, against a pre-contact "
+                       f"noise of {np.mean([m[1] for m in still]):.2g} °C{why}): no heat flowed, so these "
+                       "touches say nothing about the sensor",
+        "Heat the sensor above the object (its set point), check that the thermistor channel is "
+        "connected and that the object is under the sensor when a touch is recorded, then record again")
+
+
+def _wiring(trials: Sequence[Trial]) -> CalibrationProblem | None:
+    cold = [tr.before_contact() for tr in trials if (tr.time_s < 0).any()]
+    cold = [(s, o) for s, o in cold if math.isfinite(o)]
     below = [(s, o) for s, o in cold if s < o - 0.2]
-    if cold and len(below) > len(cold) / 2:
-        s, o = np.mean([b[0] for b in below]), np.mean([b[1] for b in below])
-        out.append(CalibrationProblem(
-            "wiring", f"the heated sensor reads colder than the object before contact in {len(below)} of "
-                      f"{len(cold)} touches (sensor {s:.2f} °C, object {o:.2f} °C on average)",
-            "A heated sensor should be the warmer one: check that each thermistor sits on the side of its "
-            "divider that the profile's channel says (wired the other way, a thermistor reads a plausible "
-            "but wrong temperature), and the heater's set point"))
+    if not (cold and len(below) > len(cold) / 2):
+        return None
+    s, o = np.mean([b[0] for b in below]), np.mean([b[1] for b in below])
+    return CalibrationProblem(
+        "wiring", f"the heated sensor reads colder than the object before contact in {len(below)} of "
+                  f"{len(cold)} touches (sensor {s:.2f} °C, object {o:.2f} °C on average)",
+        "A heated sensor should be the warmer one: check that each thermistor sits on the side of its "
+        "divider that the profile's channel says (wired the other way, a thermistor reads a plausible "
+        "but wrong temperature), and the heater's set point")
+
+
+def _mislabelled(trials: Sequence[Trial]) -> CalibrationProblem | None:
     names = sorted({tr.material for tr in trials})
     drops = {n: [(i, _normalized_drop(tr)) for i, tr in enumerate(trials) if tr.material == n] for n in names}
     med = {n: float(np.nanmedian([d for _, d in v])) for n, v in drops.items()
@@ -248,43 +250,53 @@ def check_calibration(result: "Identification | None", trials: Sequence[Trial]) 
     # robust spread of each material's responses (1.4826 MAD, at least 0.005): materials made to look
     # alike (cold wood and metal) are not "mislabelled" just because their medians are close
     spread = {n: max(0.005, 1.4826 * float(np.nanmedian([abs(d - med[n]) for _, d in drops[n]]))) for n in med}
-    if len(med) >= 2:
-        odd = []
-        for n, v in drops.items():
-            if n not in med:
+    if len(med) < 2:
+        return None
+    odd = []
+    for n, v in drops.items():
+        if n not in med:
+            continue
+        for i, d in v:
+            if not math.isfinite(d):
                 continue
-            for i, d in v:
-                if not math.isfinite(d):
-                    continue
-                near = min(med, key=lambda m: abs(d - med[m]))
-                if near != n and abs(d - med[near]) < 2.0 * spread[near] and abs(d - med[n]) > 5.0 * spread[n]:
-                    odd.append(f"{Path(trials[i].source).name or f'touch {i + 1}'} ({n}, looks like {near}: "
-                               f"response {d:.3g} against {med[n]:.3g} for {n} and {med[near]:.3g} for {near})")
-        if odd:
-            out.append(CalibrationProblem(
-                "mislabelled", f"{len(odd)} touch(es) look like another material: " + "; ".join(odd[:6])
-                + (" ..." if len(odd) > 6 else ""),
-                "Touches recorded while another sample was under the sensor get the wrong label; record "
-                "those materials again (press Enter only once the sample is in place), or delete the odd "
-                "trials from the index and run 'calibrate fit' on it"))
-    if result is not None and result.consistent is False:
-        allowed = "; ".join(f"{n} allows e_s in [{lo:.4g}, {hi:.4g}]" for n, (lo, hi) in result.es_allowed.items())
-        noise = f", at {result.rms_c / result.noise_c:.0f}x the pre-contact noise" if result.noise_c > 0 else ""
-        out.append(CalibrationProblem(
-            "conflict", f"the materials' effusivity ranges conflict under the {result.candidate.label} model "
-                        f"({allowed}): no e_s keeps every material in range; residual {result.rms_c:.3g} °C{noise}",
-            "Check each material's label, range (--range NAME=MIN:MAX) and object temperature "
-            "(--object-temp NAME=free for an object not at room temperature); let calibrate choose among every "
-            "sensor model ('calibrate fit --model all', the default); or write the file anyway with --force"))
-    if result is not None and result.es_allowed:
-        lo = max(lo for lo, _ in result.es_allowed.values())
-        hi = min(hi for _, hi in result.es_allowed.values())
-        if not (lo > 0 and math.isfinite(hi) and hi <= UNIDENTIFIED_ES_RATIO * lo):
-            one = len(result.es_allowed) == 1
-            out.append(CalibrationProblem(
-                "unidentified", f"the touches do not identify the sensor's effusivity under the "
-                                f"{result.candidate.label} model (e_s anywhere in [{lo:.4g}, {hi:.4g}]"
-                                + (f", from one material, {next(iter(result.es_allowed))})" if one else ")"),
-                "Record a second material whose effusivity range is known and far from the first (wood beside "
-                "a metal, say) and fit both; or write the file anyway with --force"))
-    return out
+            near = min(med, key=lambda m: abs(d - med[m]))
+            if near != n and abs(d - med[near]) < 2.0 * spread[near] and abs(d - med[n]) > 5.0 * spread[n]:
+                odd.append(f"{Path(trials[i].source).name or f'touch {i + 1}'} ({n}, looks like {near}: "
+                           f"response {d:.3g} against {med[n]:.3g} for {n} and {med[near]:.3g} for {near})")
+    if not odd:
+        return None
+    return CalibrationProblem(
+        "mislabelled", f"{len(odd)} touch(es) look like another material: " + "; ".join(odd[:6])
+        + (" ..." if len(odd) > 6 else ""),
+        "Touches recorded while another sample was under the sensor get the wrong label; record "
+        "those materials again (press Enter only once the sample is in place), or delete the odd "
+        "trials from the index and run 'calibrate fit' on it")
+
+
+def _conflict(result: "Identification | None") -> CalibrationProblem | None:
+    if result is None or result.consistent is not False:
+        return None
+    allowed = "; ".join(f"{n} allows e_s in [{lo:.4g}, {hi:.4g}]" for n, (lo, hi) in result.es_allowed.items())
+    noise = f", at {result.rms_c / result.noise_c:.0f}x the pre-contact noise" if result.noise_c > 0 else ""
+    return CalibrationProblem(
+        "conflict", f"the materials' effusivity ranges conflict under the {result.candidate.label} model "
+                    f"({allowed}): no e_s keeps every material in range; residual {result.rms_c:.3g} °C{noise}",
+        "Check each material's label, range (--range NAME=MIN:MAX) and object temperature "
+        "(--object-temp NAME=free for an object not at room temperature); let calibrate choose among every "
+        "sensor model ('calibrate fit --model all', the default); or write the file anyway with --force")
+
+
+def _unidentified(result: "Identification | None") -> CalibrationProblem | None:
+    if result is None or not result.es_allowed:
+        return None
+    lo = max(lo for lo, _ in result.es_allowed.values())
+    hi = min(hi for _, hi in result.es_allowed.values())
+    if lo > 0 and math.isfinite(hi) and hi <= UNIDENTIFIED_ES_RATIO * lo:
+        return None
+    one = len(result.es_allowed) == 1
+    return CalibrationProblem(
+        "unidentified", f"the touches do not identify the sensor's effusivity under the "
+                        f"{result.candidate.label} model (e_s anywhere in [{lo:.4g}, {hi:.4g}]"
+                        + (f", from one material, {next(iter(result.es_allowed))})" if one else ")"),
+        "Record a second material whose effusivity range is known and far from the first (wood beside "
+        "a metal, say) and fit both; or write the file anyway with --force")

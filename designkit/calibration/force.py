@@ -135,14 +135,16 @@ def contact_area(force_rel, fraction: float, band=0.0) -> np.ndarray:
     return np.clip((np.asarray(force_rel, dtype=np.float64) - c) / (1.0 - c), 0.0, (1.0 + b - c) / (1.0 - c))
 
 
-def area_weighted(step, time_s: np.ndarray, area: np.ndarray, offset_s: float) -> np.ndarray:
+def area_weighted(step, time_s: np.ndarray, area: "np.ndarray | None", offset_s: float) -> np.ndarray:
     """Readings of touches whose contact area grows: ``u_i(t_k) = sum_j dA_ij u(t_k - t_j - offset)``.
 
     ``step(t)`` is the full-contact reading at times ``t > 0``; ``area`` (n, m)
     the share of the final area in contact at each sample of the uniform grid
     ``time_s`` (what is in contact at the first sample counts from there). A
     discrete convolution (:func:`scipy.signal.fftconvolve`) of the area's
-    increments with the step response on the lags of the grid.
+    increments with the step response on the lags of the grid. ``area`` None:
+    full contact from the offset on, ``step(t - offset)`` where positive and 0
+    before, shape (m,) (any grid).
 
     Examples
     --------
@@ -152,6 +154,13 @@ def area_weighted(step, time_s: np.ndarray, area: np.ndarray, offset_s: float) -
     >>> bool(np.allclose(full[0], np.where(t > 0, 1.0 - np.exp(-np.maximum(t, 0.0)), 0.0)))
     True
     """
+    if area is None:
+        tt = time_s - offset_s
+        u = np.zeros(tt.size)
+        pos = tt > 0
+        if pos.any():
+            u[pos] = step(tt[pos])
+        return u
     from scipy.signal import fftconvolve
 
     m = time_s.size

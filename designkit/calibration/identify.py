@@ -55,7 +55,7 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from .._validation import InputError
-from .candidates import CHAIN_PARAMS, PARAMS, Candidate, HOST_SMOOTHING, candidate
+from .candidates import CHAIN_PARAMS, PARAMS, Candidate, candidate
 from .force import FORCE_NOISE_BAND_SD, area_weighted, contact_area, force_noise, nominal_force_profile, relative_force
 from .results import IdentifiedParameter, Identification
 from .robust import cluster_sandwich, t_critical
@@ -113,22 +113,10 @@ def _prepare(trials: Sequence[Trial], names: Sequence[str], object_temps: Mappin
     idx = {n: k for k, n in enumerate(names)}
     modes: dict[str, str] = {}
     info = []
-    ssr, dof, rates = 0.0, 0, []
-    acf = np.zeros(41)
+    rates = []
+    noise, lag = _pre_contact_noise(trials)
     for tr in trials:
-        pre = tr.time_s < 0
-        if pre.sum() < 3:
-            raise InputError(f"trial {tr.source}: fewer than 3 samples before contact (time_s < 0)")
-        t, s = tr.time_s[pre], tr.sensor_c[pre]
-        early = t < t[0] + 0.5 * (t[-1] - t[0]) if t.size >= 20 else np.ones(t.size, bool)
-        coef = np.polyfit(t[early], s[early], 1)
-        e = s[early] - np.polyval(coef, t[early])
-        ssr += float(e @ e)
-        lags = min(acf.size, e.size)
-        acf[:lags] += [float(e[:e.size - k] @ e[k:]) for k in range(lags)]
-        dof += int(early.sum()) - 2
-        obj = tr.object_c[pre]
-        to = float(np.mean(obj[np.isfinite(obj)])) if np.isfinite(obj).any() else math.nan
+        to = tr.before_contact()[1]
         post = tr.object_c[tr.time_s >= 0]
         moved = float(np.nanmax(np.abs(post - to))) if math.isfinite(to) and np.isfinite(post).any() else math.nan
         info.append((to, moved))
@@ -183,14 +171,33 @@ def _prepare(trials: Sequence[Trial], names: Sequence[str], object_temps: Mappin
                           np.array([relative_force(trials[i]) for i in members]) if force_area else None,
                           np.array([FORCE_NOISE_BAND_SD * force_noise(trials[i]) for i in members])
                           if force_area else None))
-    noise = math.sqrt(ssr / dof) if dof > 0 else math.nan
     ref = dict(refs or {})
     for n in names:  # the reference reading of an affine channel: the fitted touches' mean (kept for scoring)
         if isinstance(modes[n], str) and modes[n].endswith("-affine") and n not in ref:
             ref[n] = float(np.mean(np.concatenate([g.to for g in out if names[g.material] == n])))
+    return _Data(tuple(out), tuple(names), modes, noise, float(np.median(rates)), ref, lag)
+
+
+def _pre_contact_noise(trials: Sequence[Trial]) -> tuple[float, int]:
+    """The pre-contact noise [degC] (pooled scatter about each touch's straight line over the first half of its
+    samples before contact) and the first lag [samples] at which its autocorrelation falls below 0.5."""
+    ssr, dof = 0.0, 0
+    acf = np.zeros(41)
+    for tr in trials:
+        pre = tr.time_s < 0
+        if pre.sum() < 3:
+            raise InputError(f"trial {tr.source}: fewer than 3 samples before contact (time_s < 0)")
+        t, s = tr.time_s[pre], tr.sensor_c[pre]
+        early = t < t[0] + 0.5 * (t[-1] - t[0]) if t.size >= 20 else np.ones(t.size, bool)
+        coef = np.polyfit(t[early], s[early], 1)
+        e = s[early] - np.polyval(coef, t[early])
+        ssr += float(e @ e)
+        lags = min(acf.size, e.size)
+        acf[:lags] += [float(e[:e.size - k] @ e[k:]) for k in range(lags)]
+        dof += int(early.sum()) - 2
     below = np.flatnonzero(acf < 0.5 * acf[0]) if acf[0] > 0 else np.array([1])
     lag = int(below[0]) if below.size else acf.size
-    return _Data(tuple(out), tuple(names), modes, noise, float(np.median(rates)), ref, max(lag, 1))
+    return (math.sqrt(ssr / dof) if dof > 0 else math.nan), max(lag, 1)
 
 
 # ------------------------------------------------------------ the problem
@@ -228,7 +235,7 @@ class _Problem:
     """Projected residuals of one candidate on prepared data; x = [model params, t_off, log rho_m]."""
 
     def __init__(self, cand: Candidate, data: _Data, depth_m: float, offset_bounds_s: tuple[float, float],
-                 constrained: np.ndarray, stride: int = 1, touch_conductance: Sequence[str] = ()):
+                 stride: int = 1, touch_conductance: Sequence[str] = ()):
         from ..models import get_model
 
         self.stride = max(int(stride), 1)   # residual rows: every stride-th sample (shapes on the full grid)
@@ -239,7 +246,6 @@ class _Problem:
         self.params = [PARAMS[p] for p in cand.free]
         self.n_model = len(self.params)
         self.n_mat = len(data.names)
-        self.constrained = constrained
         self._get_model = get_model
         self.interp_points: int | None = 80
         #: materials whose To is the passive reading through a fitted offset and slope: x gets both
@@ -282,10 +288,7 @@ class _Problem:
         alpha = vals.pop("diffusivity_m2_s", PARAMS["diffusivity_m2_s"].start)
         sensor = Sensor(effusivity=1.0, diffusivity_m2_s=alpha, depth_m=self.depth_m,
                         sample_rate_hz=self.data.sample_rate_hz, name="identify")
-        kw = {k: v for k, v in self.cand.fixed.items()}
-        kw.update(vals)
-        model = self._get_model(self.cand.model, **kw)
-        return model, sensor
+        return self._get_model(self.cand.model, **{**self.cand.fixed, **vals}), sensor
 
     def shapes_and_drift(self, x: np.ndarray) -> list[tuple[np.ndarray, np.ndarray | None]]:
         """Per group (v, b): the normalized reading and, with ``drift``, the drift's basis ``t (1 - u)``.
@@ -303,22 +306,17 @@ class _Problem:
             if gi in self.touch_cols:  # one shape per touch, each with its own h_c
                 u = self._touch_shapes(g, model, sensor, off, rho[g.material],
                                        x[self.touch_cols[gi]:self.touch_cols[gi] + len(g.trials)], x)
-                out.append(self._chain(g.time_s, u))
+                out.append(self.cand.chain(g.time_s, u))
                 continue
+            def step(tt, rho_m=rho[g.material]):
+                return _reading(model, tt, rho_m, sensor, self.interp_points)
+
             if g.force is not None:  # one shape per touch: its contact area grows with its own force
-                area = self.contact_area(g, x)
-                out.append(self._chain(g.time_s, area_weighted(
-                    lambda tt: _reading(model, tt, rho[g.material], sensor, self.interp_points),
-                    g.time_s, area, off)))
+                out.append(self.cand.chain(g.time_s, area_weighted(step, g.time_s, self.contact_area(g, x), off)))
                 continue
             key = (g.material, g.time_s.tobytes())
             if key not in cache:
-                tt = g.time_s - off
-                u = np.zeros(tt.size)
-                pos = tt > 0
-                if pos.any():
-                    u[pos] = _reading(model, tt[pos], rho[g.material], sensor, self.interp_points)
-                cache[key] = self._chain(g.time_s, u)
+                cache[key] = self.cand.chain(g.time_s, area_weighted(step, g.time_s, None, off))
             out.append(cache[key])
         return out
 
@@ -327,42 +325,22 @@ class _Problem:
         if g.force is None:
             return None
         band = 0.0 if g.force_band is None else g.force_band[:, None]
-        return contact_area(g.force, self.params_value(x, "contact_force_fraction", 0.0), band)
-
-    def params_value(self, x: np.ndarray, name: str, default: float) -> float:
-        """A free parameter's natural value in ``x`` (``default`` when the candidate does not fit it)."""
-        for i, p in enumerate(self.params):
-            if p.name == name:
-                return p.from_x(x[i])
-        return default
-
-    def _chain(self, time_s: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
-        """The measurement chain on unsmoothed readings ``u``: (v, drift basis or None)."""
-        b = time_s * (1.0 - u) if self.cand.drift else None
-        if self.cand.smoothing:
-            from ..models.layered import savgol_smooth
-
-            u = savgol_smooth(u, *HOST_SMOOTHING)
-            if b is not None:
-                b = savgol_smooth(b, *HOST_SMOOTHING)
-        return u, b
+        free = self.cand.free
+        c = PARAMS["contact_force_fraction"].from_x(x[free.index("contact_force_fraction")]) \
+            if "contact_force_fraction" in free else 0.0
+        return contact_area(g.force, c, band)
 
     def _touch_shapes(self, g: _Group, model, sensor, off: float, rho: float, log_dev: np.ndarray,
                       x: np.ndarray) -> np.ndarray:
         """Unsmoothed readings (n, m) of a group whose touches each have their own h_c."""
         import dataclasses
 
-        tt = g.time_s - off
-        pos = tt > 0
         out = np.zeros((log_dev.size, g.time_s.size))
         area = self.contact_area(g, x)
         for i, d in enumerate(log_dev):
             m = dataclasses.replace(model, conductance_w_m2k=model.conductance_w_m2k * math.exp(float(d)))
-            if area is not None:
-                out[i] = area_weighted(lambda t: _reading(m, t, rho, sensor, self.interp_points), g.time_s,
-                                        area[i:i + 1], off)[0]
-            elif pos.any():
-                out[i, pos] = _reading(m, tt[pos], rho, sensor, self.interp_points)
+            out[i] = area_weighted(lambda t: _reading(m, t, rho, sensor, self.interp_points), g.time_s,
+                                   None if area is None else area[i:i + 1], off)
         return out
 
     def jacobian(self, x: np.ndarray, touch_only: bool = False) -> np.ndarray:
@@ -456,6 +434,10 @@ class _Problem:
         x = [p.to_x(p.start) for p in self.params] + [0.3]
         return np.array(x + [0.0] * self.n_mat + [0.0, 0.0] * len(self.affine) + [0.0] * (self.lo.size - self.n_global))
 
+    def row_touches(self) -> np.ndarray:
+        """The touch (trial index) of each residual row: the clusters of the sandwich."""
+        return np.concatenate([np.repeat(np.asarray(g.trials), self.fitted_y(g).shape[1]) for g in self.data.groups])
+
     def rows_of(self, k: int) -> np.ndarray:
         """Residual rows of material ``k``."""
         mask = [np.full(self.fitted_y(g).size, g.material == k) for g in self.data.groups]
@@ -484,14 +466,6 @@ def _initial_ratios(prob: _Problem, x: np.ndarray) -> np.ndarray:
 def _exp(v: float) -> float:
     """exp that saturates at the float range instead of raising."""
     return math.exp(min(max(float(v), -700.0), 700.0)) if math.isfinite(v) else (math.inf if v > 0 else 0.0)
-
-
-def _clusters(data: _Data, stride: int = 1) -> np.ndarray:
-    out = []
-    for g in data.groups:
-        m = g.y[:, ::stride].shape[1]
-        out.append(np.repeat(np.asarray(g.trials), m))
-    return np.concatenate(out)
 
 
 def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+smoothing", *,
@@ -553,12 +527,11 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
     names = tuple(sorted({tr.material for tr in trials}))
     data = _prepare(trials, names, dict(object_temps or {}), force_area=cand.force_area)
     rng = {n: _as_range(ranges[n]) for n in names if ranges and n in ranges}
-    constrained = np.array([n in rng and data.modes[n] != "free" for n in names])
     if fit_rate_hz == "auto":
         stride = data.noise_lag
     else:
         stride = 1 if not fit_rate_hz else max(1, int(round(data.sample_rate_hz / float(fit_rate_hz))))
-    prob = _Problem(cand, data, depth_m, offset_bounds_s, constrained, stride=stride,
+    prob = _Problem(cand, data, depth_m, offset_bounds_s, stride=stride,
                     touch_conductance=tuple(touch_conductance))
     if x0 is None:
         x = prob.start()
@@ -576,114 +549,14 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
         jac = dict(jac=prob.jacobian) if prob.touch_cols else dict(diff_step=1e-6)
         sol = least_squares(prob.residuals, x, bounds=(prob.lo, prob.hi), method="trf", x_scale="jac",
                             xtol=1e-8, ftol=1e-8, gtol=1e-8, max_nfev=max_nfev, **jac)
-    x = sol.x
+    est = _Estimate.of(prob, sol)
     r = sol.fun
-    J = sol.jac
-    # ------------------------------------------------ identifiability
-    norms = np.linalg.norm(J, axis=0)
-    Js = J / np.where(norms > 0, norms, 1.0)
-    sv = np.linalg.svd(Js, compute_uv=False)
-    rank = int(np.sum(sv > sv[0] * 1e-6)) if sv.size else 0
-    _, _, vt = np.linalg.svd(Js, full_matrices=False)
-    weak = set()
-    for j in range(rank, len(sv)):
-        weak |= {int(i) for i in np.flatnonzero(np.abs(vt[j]) > 0.3)}
-    weak |= {int(i) for i in np.flatnonzero(norms == 0)}
-    clusters = _clusters(data, prob.stride)
-    cov, dof = cluster_sandwich(J, r, clusters, df_columns=prob.n_global)
-    q = t_critical(dof)   # per parameter, the 95 % intervals' half-width in standard errors
     if prob.stride > 1:  # fit quality on every sample
         prob.stride = 1
-        r = prob.residuals(x)
-    sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
-    at_bound = (np.abs(x - prob.lo) < 1e-6) | (np.abs(x - prob.hi) < 1e-6)
-    # ------------------------------------------------ e_s from the ranges
-    ratios: dict[str, IdentifiedParameter] = {}
-    allowed: dict[str, tuple[float, float]] = {}
-    point_lo, point_hi, wide_lo, wide_hi = [], [], [], []
-    for k, n in enumerate(names):
-        j = prob.n_model + 1 + k
-        lr, s = x[j], sd[j]
-        qm = q[j]   # mostly its own touches inform it: its degrees of freedom say how many
-        ident = j not in weak and not at_bound[j] and 2 * qm * s < math.log(10.0)
-        why = ("at the search limit: the touches ask for the full temperature difference (e_o/e_s -> inf)"
-               if lr > 0 and at_bound[j] else "at the search limit (e_o/e_s -> 0)" if at_bound[j]
-               else "95 % interval wider than a factor of 10" if not ident else "")
-        ratios[n] = IdentifiedParameter(f"e_o/e_s[{n}]", _exp(lr), (_exp(lr - qm * s), _exp(lr + qm * s)),
-                                        "", ident, why)
-        if constrained[k]:
-            e_lo, e_hi = rng[n]
-            allowed[n] = (e_lo / _exp(lr + qm * s), e_hi / _exp(lr - qm * s))
-            point_lo.append(math.log(e_lo) - lr)
-            point_hi.append(math.log(e_hi) - lr)
-            wide_lo.append(math.log(min(max(allowed[n][0], 1e-300), 1e300)))
-            wide_hi.append(math.log(min(max(allowed[n][1], 1e-300), 1e300)))
-    notes: list[str] = []
-    es_p: IdentifiedParameter | None = None
-    consistent: bool | None = None
-    if point_lo:
-        a, b = max(point_lo), min(point_hi)
-        wa, wb = max(wide_lo), min(wide_hi)
-        consistent = bool(wa <= wb)
-        if a <= b:
-            les = 0.5 * (a + b)
-            note = "set-identified: every e_s in the interval keeps all materials in range"
-        elif consistent:
-            les = 0.5 * (wa + wb)
-            note = "the ranges touch only within the ratios' uncertainty"
-        else:
-            les = 0.5 * (a + b)
-            note = "conflict: no e_s keeps every material in its range"
-        ci = (_exp(wa), _exp(wb)) if consistent else (math.nan, math.nan)
-        es_p = IdentifiedParameter("effusivity", _exp(les), ci, "J s^-1/2 K^-1 m^-2", consistent, note)
-        if not consistent:
-            notes.append("the materials' ranges conflict under this model: " + "; ".join(
-                f"{n} allows e_s in [{lo:.4g}, {hi:.4g}]" for n, (lo, hi) in allowed.items()))
-    es = es_p.value if es_p is not None else 1.0
-    es_ci = es_p.ci95 if es_p is not None and consistent else (es, es)
-    # ------------------------------------------------ parameters in physical units
-    params: list[IdentifiedParameter] = []
-    for i, p in enumerate(prob.params):
-        v = p.from_x(x[i])
-        lo, hi = p.from_x(x[i] - q[i] * sd[i]), p.from_x(x[i] + q[i] * sd[i])
-        if p.scale_with_es:
-            v, lo, hi = v * es, lo * es_ci[0], hi * es_ci[1]
-        why = []
-        if i in weak:
-            why.append("Jacobian rank-deficient along it")
-        if at_bound[i]:
-            why.append("at a search bound")
-        if p.log and 2 * q[i] * sd[i] > math.log(10.0):
-            why.append("95 % interval wider than a factor of 10")
-        params.append(IdentifiedParameter(p.name, v, (lo, hi), p.unit, not why, "; ".join(why)))
-    j = prob.n_model
-    params.append(IdentifiedParameter("time_offset_s", float(x[j]), (x[j] - q[j] * sd[j], x[j] + q[j] * sd[j]),
-                                      "s", j not in weak and not at_bound[j]))
-    for k, n in enumerate(names):
-        rp = ratios[n]
-        params.append(IdentifiedParameter(f"e_o[{n}]", rp.value * es, (rp.ci95[0] * es_ci[0], rp.ci95[1] * es_ci[1]),
-                                          "J s^-1/2 K^-1 m^-2", rp.identifiable, rp.note))
-    for gi, j0 in prob.touch_cols.items():
-        g = data.groups[gi]
-        d = x[j0:j0 + len(g.trials)]
-        n = names[g.material]
-        sdl = float(np.std(d, ddof=1)) if d.size > 1 else math.nan
-        hc = PARAMS["conductance_w_m2k"].from_x(x[prob.params.index(PARAMS["conductance_w_m2k"])]) * es
-        inside = bool(np.all(~at_bound[j0:j0 + d.size]))
-        params.append(IdentifiedParameter(
-            f"conductance_w_m2k[{n} touches]", hc * _exp(float(np.mean(d))),
-            (hc * _exp(float(np.min(d))), hc * _exp(float(np.max(d)))), "W m^-2 K^-1", inside,
-            "geometric mean of the touches' own h_c,i; interval: their smallest and largest (not a CI)"))
-        params.append(IdentifiedParameter(
-            f"conductance_spread[{n}]", _exp(sdl) if math.isfinite(sdl) else math.nan,
-            (math.nan, math.nan), "factor", inside, "geometric standard deviation of the touches' h_c,i"))
-    for i, k in enumerate(prob.affine):
-        for j, name, unit in ((prob.n_model + 1 + prob.n_mat + 2 * i, "passive_offset_c", "degC"),
-                              (prob.n_model + 2 + prob.n_mat + 2 * i, "passive_slope", "")):
-            ok = j not in weak and not at_bound[j]
-            params.append(IdentifiedParameter(
-                f"{name}[{names[k]}]", float(x[j]), (x[j] - q[j] * sd[j], x[j] + q[j] * sd[j]), unit, ok,
-                "" if ok else "at a search bound or rank-deficient"))
+        r = prob.residuals(est.x)
+    x, rank, weak = est.x, est.rank, est.weak
+    ratios, allowed, es_p, consistent, notes = _effusivity(est, prob, rng)
+    params = _physical_parameters(est, prob, ratios, es_p, consistent)
     # ------------------------------------------------ fit quality
     rows = _touch_residuals(data, r)
     rms = rms_by_material([(n, row) for _, n, _, row in rows], total=False)
@@ -700,7 +573,7 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
         notes.append(f"alpha_s is identified at the fixed thermistor depth x = {depth_m * 1e6:g} um "
                      "(only x^2/alpha_s matters)")
     return Identification(cand, tuple(params), ratios, es_p, consistent, allowed, float(np.sqrt(np.mean(r ** 2))),
-                          rms_by, n_s, k_par, aic, bic, rank, x.size, sv, time.perf_counter() - t0,
+                          rms_by, n_s, k_par, aic, bic, rank, x.size, est.singular_values, time.perf_counter() - t0,
                           data.noise_c, x, names, depth_m, data.sample_rate_hz, dict(data.modes), tuple(notes),
                           dict(data.refs), tuple(touch_conductance),
                           nominal_force_profile(data) if cand.force_area else None,
@@ -708,6 +581,137 @@ def identify(trials: Sequence[Trial], model: "str | Candidate" = "layered+lag+sm
                                          residual_rms_c=float(np.sqrt(np.mean(r ** 2))),
                                          onset_offset_s=math.nan, residuals=[row for *_, row in rows],
                                          sample_rate_hz=data.sample_rate_hz).to_dict())
+
+
+@dataclass(frozen=True)
+class _Estimate:
+    """The fitted transformed parameters with their 95 % half-widths and what the data leave unidentified."""
+
+    x: np.ndarray
+    sd: np.ndarray               # standard errors (cluster-robust sandwich)
+    q: np.ndarray                # each parameter's t quantile (its Bell-McCaffrey degrees of freedom)
+    weak: frozenset              # columns along which the scaled Jacobian is rank-deficient (or zero)
+    at_bound: np.ndarray
+    rank: int
+    singular_values: np.ndarray
+
+    @classmethod
+    def of(cls, prob: "_Problem", sol) -> "_Estimate":
+        """Identifiability (singular values of the column-scaled Jacobian) and the covariance of a solution."""
+        x, J = sol.x, sol.jac
+        norms = np.linalg.norm(J, axis=0)
+        Js = J / np.where(norms > 0, norms, 1.0)
+        sv = np.linalg.svd(Js, compute_uv=False)
+        rank = int(np.sum(sv > sv[0] * 1e-6)) if sv.size else 0
+        _, _, vt = np.linalg.svd(Js, full_matrices=False)
+        weak = set()
+        for j in range(rank, len(sv)):
+            weak |= {int(i) for i in np.flatnonzero(np.abs(vt[j]) > 0.3)}
+        weak |= {int(i) for i in np.flatnonzero(norms == 0)}
+        cov, dof = cluster_sandwich(J, sol.fun, prob.row_touches(), df_columns=prob.n_global)
+        at_bound = (np.abs(x - prob.lo) < 1e-6) | (np.abs(x - prob.hi) < 1e-6)
+        return cls(x, np.sqrt(np.clip(np.diag(cov), 0.0, None)), t_critical(dof), frozenset(weak), at_bound, rank, sv)
+
+    def interval(self, j: int) -> tuple[float, float]:
+        """95 % interval of ``x[j]`` (transformed)."""
+        h = self.q[j] * self.sd[j]
+        return self.x[j] - h, self.x[j] + h
+
+    def identified(self, j: int) -> bool:
+        return j not in self.weak and not self.at_bound[j]
+
+
+def _effusivity(est: _Estimate, prob: "_Problem", rng: Mapping[str, tuple[float, float]]):
+    """e_s from the ranges of materials with a known object temperature: ``(ratios, allowed, e_s, consistent, notes)``."""
+    x, names = est.x, prob.data.names
+    ratios: dict[str, IdentifiedParameter] = {}
+    allowed: dict[str, tuple[float, float]] = {}
+    point_lo, point_hi, wide_lo, wide_hi = [], [], [], []
+    for k, n in enumerate(names):
+        j = prob.n_model + 1 + k
+        lr, (r_lo, r_hi) = x[j], est.interval(j)   # its own touches inform it: its degrees of freedom say how many
+        ident = est.identified(j) and 2 * est.q[j] * est.sd[j] < math.log(10.0)
+        why = ("at the search limit: the touches ask for the full temperature difference (e_o/e_s -> inf)"
+               if lr > 0 and est.at_bound[j] else "at the search limit (e_o/e_s -> 0)" if est.at_bound[j]
+               else "95 % interval wider than a factor of 10" if not ident else "")
+        ratios[n] = IdentifiedParameter(f"e_o/e_s[{n}]", _exp(lr), (_exp(r_lo), _exp(r_hi)), "", ident, why)
+        if n in rng and prob.data.modes[n] != "free":
+            e_lo, e_hi = rng[n]
+            allowed[n] = (e_lo / _exp(r_hi), e_hi / _exp(r_lo))
+            point_lo.append(math.log(e_lo) - lr)
+            point_hi.append(math.log(e_hi) - lr)
+            wide_lo.append(math.log(min(max(allowed[n][0], 1e-300), 1e300)))
+            wide_hi.append(math.log(min(max(allowed[n][1], 1e-300), 1e300)))
+    notes: list[str] = []
+    if not point_lo:
+        return ratios, allowed, None, None, notes
+    a, b = max(point_lo), min(point_hi)
+    wa, wb = max(wide_lo), min(wide_hi)
+    consistent = bool(wa <= wb)
+    if a <= b:
+        les = 0.5 * (a + b)
+        note = "set-identified: every e_s in the interval keeps all materials in range"
+    elif consistent:
+        les = 0.5 * (wa + wb)
+        note = "the ranges touch only within the ratios' uncertainty"
+    else:
+        les = 0.5 * (a + b)
+        note = "conflict: no e_s keeps every material in its range"
+    ci = (_exp(wa), _exp(wb)) if consistent else (math.nan, math.nan)
+    es_p = IdentifiedParameter("effusivity", _exp(les), ci, "J s^-1/2 K^-1 m^-2", consistent, note)
+    if not consistent:
+        notes.append("the materials' ranges conflict under this model: " + "; ".join(
+            f"{n} allows e_s in [{lo:.4g}, {hi:.4g}]" for n, (lo, hi) in allowed.items()))
+    return ratios, allowed, es_p, consistent, notes
+
+
+def _physical_parameters(est: _Estimate, prob: "_Problem", ratios: Mapping[str, IdentifiedParameter],
+                         es_p: IdentifiedParameter | None, consistent: bool | None) -> list[IdentifiedParameter]:
+    """Every fitted parameter in physical units (effusivities and h_c scaled by e_s), with its 95 % interval."""
+    x, data, names = est.x, prob.data, prob.data.names
+    es = es_p.value if es_p is not None else 1.0
+    es_ci = es_p.ci95 if es_p is not None and consistent else (es, es)
+    params: list[IdentifiedParameter] = []
+    for i, p in enumerate(prob.params):
+        v = p.from_x(x[i])
+        lo, hi = (p.from_x(e) for e in est.interval(i))
+        if p.scale_with_es:
+            v, lo, hi = v * es, lo * es_ci[0], hi * es_ci[1]
+        why = []
+        if i in est.weak:
+            why.append("Jacobian rank-deficient along it")
+        if est.at_bound[i]:
+            why.append("at a search bound")
+        if p.log and 2 * est.q[i] * est.sd[i] > math.log(10.0):
+            why.append("95 % interval wider than a factor of 10")
+        params.append(IdentifiedParameter(p.name, v, (lo, hi), p.unit, not why, "; ".join(why)))
+    j = prob.n_model
+    params.append(IdentifiedParameter("time_offset_s", float(x[j]), est.interval(j), "s", est.identified(j)))
+    for n in names:
+        rp = ratios[n]
+        params.append(IdentifiedParameter(f"e_o[{n}]", rp.value * es, (rp.ci95[0] * es_ci[0], rp.ci95[1] * es_ci[1]),
+                                          "J s^-1/2 K^-1 m^-2", rp.identifiable, rp.note))
+    for gi, j0 in prob.touch_cols.items():
+        g = data.groups[gi]
+        d = x[j0:j0 + len(g.trials)]
+        n = names[g.material]
+        sdl = float(np.std(d, ddof=1)) if d.size > 1 else math.nan
+        hc = PARAMS["conductance_w_m2k"].from_x(x[prob.params.index(PARAMS["conductance_w_m2k"])]) * es
+        inside = bool(np.all(~est.at_bound[j0:j0 + d.size]))
+        params.append(IdentifiedParameter(
+            f"conductance_w_m2k[{n} touches]", hc * _exp(float(np.mean(d))),
+            (hc * _exp(float(np.min(d))), hc * _exp(float(np.max(d)))), "W m^-2 K^-1", inside,
+            "geometric mean of the touches' own h_c,i; interval: their smallest and largest (not a CI)"))
+        params.append(IdentifiedParameter(
+            f"conductance_spread[{n}]", _exp(sdl) if math.isfinite(sdl) else math.nan,
+            (math.nan, math.nan), "factor", inside, "geometric standard deviation of the touches' h_c,i"))
+    for i, k in enumerate(prob.affine):
+        for j, name, unit in ((prob.n_model + 1 + prob.n_mat + 2 * i, "passive_offset_c", "degC"),
+                              (prob.n_model + 2 + prob.n_mat + 2 * i, "passive_slope", "")):
+            ok = est.identified(j)
+            params.append(IdentifiedParameter(f"{name}[{names[k]}]", float(x[j]), est.interval(j), unit, ok,
+                                              "" if ok else "at a search bound or rank-deficient"))
+    return params
 
 
 def _touch_residuals(data: "_Data", r: np.ndarray) -> list[tuple[int, str, np.ndarray, np.ndarray]]:
@@ -773,8 +777,8 @@ def _held_out(result: Identification, trials: Sequence[Trial],
     modes = dict(result.object_modes)
     modes.update(dict(object_temps or {}))
     data = _prepare(trials, names, modes, refs=result.object_refs, force_area=result.candidate.force_area)
-    prob = _Problem(result.candidate, data, result.depth_m, (-math.inf, math.inf),
-                    np.zeros(len(names), dtype=bool), stride=1, touch_conductance=result.touch_conductance)
+    prob = _Problem(result.candidate, data, result.depth_m, (-math.inf, math.inf), stride=1,
+                    touch_conductance=result.touch_conductance)
     x = np.concatenate([result.x[:prob.n_global], np.zeros(prob.lo.size - prob.n_global)])
     if prob.touch_cols:  # each held-out touch's own h_c (the sensor's parameters stay as fitted)
         from scipy.optimize import least_squares

@@ -504,49 +504,9 @@ def _parse_profile(data: Any, source: str) -> DeviceProfile:
     name = rd.text("name")
     description = rd.text("description", "")
 
-    ser = rd.sub("serial") or _Reader(source, {}, "serial")
-    parity_text = ser.text("parity", "none").strip().lower()
-    if parity_text not in _PARITY:
-        raise ser.err("parity", f"must be one of none, even, odd, mark, space; got {parity_text!r}")
-    stopbits = ser.number("stopbits", 1)
-    if stopbits not in (1, 1.5, 2):
-        raise ser.err("stopbits", f"must be 1, 1.5 or 2, got {stopbits:g}")
-    serial = SerialSettings(
-        baudrate=ser.integer("baudrate", 115200, low=50, high=20_000_000),
-        bytesize=ser.integer("bytesize", 8, low=5, high=8),
-        parity=_PARITY[parity_text],
-        stopbits=stopbits,
-        read_timeout_s=ser.number("read_timeout_s", 0.05, positive=True),
-        no_data_timeout_s=ser.number("no_data_timeout_s", 5.0, positive=True),
-        stall_s=ser.number("stall_s", 0.25, positive=True),
-        reconnect_s=ser.number("reconnect_s", 2.0, nonnegative=True),
-    )
-    ser.done()
-
-    line = rd.sub("line", required=True)
-    delim_text = line.text("delimiter", ",")
-    delimiter = None if delim_text == "whitespace" else delim_text
-    if delimiter is not None and (delimiter == "" or "\n" in delimiter or "\r" in delimiter):
-        raise line.err("delimiter", f"must be a non-empty string without newlines or 'whitespace', got {delim_text!r}")
-    comment = line.text("comment") if line.has("comment") else None
-    line.used.add("comment")
-    encoding = line.text("encoding", "ascii")
-    try:
-        "x".encode(encoding)
-    except LookupError:
-        raise line.err("encoding", f"is not a known text encoding: {encoding!r}") from None
-    checksum = line.text("checksum", "none", choices=tuple(CHECKSUMS))
-    if checksum != "none" and delimiter is not None and "*" in delimiter:
-        raise line.err("checksum", "needs a delimiter without '*' (the checksum follows the last '*')")
-    fields_raw = line.raw("fields", required=True)
-    if not isinstance(fields_raw, list) or not fields_raw:
-        raise line.err("fields", f"must be a non-empty list of field names, got {fields_raw!r}")
-    fields = tuple("_" if f is None else str(f) for f in fields_raw)
+    serial = _serial(rd.sub("serial") or _Reader(source, {}, "serial"))
+    delimiter, comment, encoding, checksum, fields = _line(rd.sub("line", required=True))
     named = [f for f in fields if f != "_"]
-    dupes = sorted({f for f in named if named.count(f) > 1})
-    if dupes:
-        raise line.err("fields", f"has duplicate name(s) {', '.join(dupes)}")
-    line.done()
 
     ch_rd = rd.sub("channels", required=True)
     channels: dict[str, Channel] = {}
@@ -605,6 +565,56 @@ def _parse_profile(data: Any, source: str) -> DeviceProfile:
     return DeviceProfile(name=str(name), description=description, serial=serial, delimiter=delimiter,
                          comment=comment, encoding=encoding, fields=fields, channels=channels,
                          sample_rate_hz=sample_rate, contact=contact, trial=trial, source=source, checksum=checksum)
+
+
+def _serial(ser: _Reader) -> SerialSettings:
+    """The ``serial`` section."""
+    parity_text = ser.text("parity", "none").strip().lower()
+    if parity_text not in _PARITY:
+        raise ser.err("parity", f"must be one of none, even, odd, mark, space; got {parity_text!r}")
+    stopbits = ser.number("stopbits", 1)
+    if stopbits not in (1, 1.5, 2):
+        raise ser.err("stopbits", f"must be 1, 1.5 or 2, got {stopbits:g}")
+    serial = SerialSettings(
+        baudrate=ser.integer("baudrate", 115200, low=50, high=20_000_000),
+        bytesize=ser.integer("bytesize", 8, low=5, high=8),
+        parity=_PARITY[parity_text],
+        stopbits=stopbits,
+        read_timeout_s=ser.number("read_timeout_s", 0.05, positive=True),
+        no_data_timeout_s=ser.number("no_data_timeout_s", 5.0, positive=True),
+        stall_s=ser.number("stall_s", 0.25, positive=True),
+        reconnect_s=ser.number("reconnect_s", 2.0, nonnegative=True),
+    )
+    ser.done()
+    return serial
+
+
+def _line(line: _Reader) -> tuple[str | None, str | None, str, str, tuple[str, ...]]:
+    """The ``line`` section: ``(delimiter, comment, encoding, checksum, fields)``."""
+    delim_text = line.text("delimiter", ",")
+    delimiter = None if delim_text == "whitespace" else delim_text
+    if delimiter is not None and (delimiter == "" or "\n" in delimiter or "\r" in delimiter):
+        raise line.err("delimiter", f"must be a non-empty string without newlines or 'whitespace', got {delim_text!r}")
+    comment = line.text("comment") if line.has("comment") else None
+    line.used.add("comment")
+    encoding = line.text("encoding", "ascii")
+    try:
+        "x".encode(encoding)
+    except LookupError:
+        raise line.err("encoding", f"is not a known text encoding: {encoding!r}") from None
+    checksum = line.text("checksum", "none", choices=tuple(CHECKSUMS))
+    if checksum != "none" and delimiter is not None and "*" in delimiter:
+        raise line.err("checksum", "needs a delimiter without '*' (the checksum follows the last '*')")
+    fields_raw = line.raw("fields", required=True)
+    if not isinstance(fields_raw, list) or not fields_raw:
+        raise line.err("fields", f"must be a non-empty list of field names, got {fields_raw!r}")
+    fields = tuple("_" if f is None else str(f) for f in fields_raw)
+    named = [f for f in fields if f != "_"]
+    dupes = sorted({f for f in named if named.count(f) > 1})
+    if dupes:
+        raise line.err("fields", f"has duplicate name(s) {', '.join(dupes)}")
+    line.done()
+    return delimiter, comment, encoding, checksum, fields
 
 
 def list_profiles() -> dict[str, Path]:

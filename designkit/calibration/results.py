@@ -172,8 +172,6 @@ class Identification:
         """
         import dataclasses
 
-        from ..models.layered import savgol_smooth
-
         if material not in self.ratios:
             raise InputError(f"no identified material {material!r} (fitted: {', '.join(self.ratios)})")
         t = np.asarray(time_s, dtype=np.float64)
@@ -188,8 +186,6 @@ class Identification:
         sensor = self.sensor()
         eo = self.ratios[material].value * es
         off = self.parameter("time_offset_s").value
-        tt = grid - off
-        pos = tt > 0
         factors = [None] if conductance_factor is None else list(np.atleast_1d(conductance_factor))
         areas = [None]
         if force is not None and self.candidate.force_area:
@@ -212,14 +208,8 @@ class Identification:
             def step(tp, m=m):
                 return m.conduction(tp, [eo], sensor)[0]
 
-            if area is not None:
-                out[i] = area_weighted(step, grid, area[None, :], off)[0]
-            elif pos.any():
-                out[i, pos] = step(tt[pos])
-        b = grid * (1.0 - out)
-        if self.candidate.smoothing:
-            out = savgol_smooth(out, *HOST_SMOOTHING)
-            b = savgol_smooth(b, *HOST_SMOOTHING)
+            out[i] = area_weighted(step, grid, None if area is None else area[None, :], off)
+        out, b = self.candidate.chain(grid, out, drift=drift)
         single = conductance_factor is None and (force is None or np.ndim(force) == 1)
         res = np.array([np.interp(t, grid, row) for row in out])
         res = res[0] if single else res

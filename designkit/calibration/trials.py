@@ -110,6 +110,14 @@ class Trial:
     def n_samples(self) -> int:
         return int(self.time_s.size)
 
+    def before_contact(self) -> tuple[float, float]:
+        """Mean sensor and object temperatures before contact (``time_s < 0``) [degC]; the object's NaN
+        without a finite passive reading there (the caller checks that there are samples before contact)."""
+        pre = self.time_s < 0
+        obj = self.object_c[pre]
+        ok = np.isfinite(obj)
+        return float(np.mean(self.sensor_c[pre])), float(np.mean(obj[ok])) if ok.any() else math.nan
+
 
 #: Longest material label [characters]: it is written into every trial's sidecar, the index and messages.
 MAX_LABEL_CHARS = 100

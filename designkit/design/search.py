@@ -430,11 +430,9 @@ def _search_contact(contact, c, pairs, lo, hi, wd, depths, skins, *, progress=No
     def evaluate(sensor, e_lo, e_hi, widths, ratios):
         e_lo, e_hi, widths = (np.asarray(x, dtype=np.float64) for x in (e_lo, e_hi, widths))
         r = np.asarray(ratios, dtype=np.float64)
-        if r.size == 1:
-            return screen_contact(sensor, (e_lo + 0.5 * widths).ravel(), (e_hi + 0.5 * widths).ravel(), float(r),
-                                  max_contact_s=c.max_contact_s, threshold=c.threshold)
-        return screen_contact(sensor, (e_lo + 0.5 * widths).ravel(), (e_hi + 0.5 * widths).ravel(), ratio,
-                              max_contact_s=c.max_contact_s, threshold=c.threshold, ratios=r.ravel())
+        many = {} if r.size == 1 else {"ratios": r.ravel()}   # one ratio, or the design's with several more
+        return screen_contact(sensor, (e_lo + 0.5 * widths).ravel(), (e_hi + 0.5 * widths).ravel(),
+                              ratio if many else float(r), max_contact_s=c.max_contact_s, threshold=c.threshold, **many)
 
     return designs, baseline, evaluate
 

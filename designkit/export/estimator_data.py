@@ -96,8 +96,6 @@ def estimator_params(tab) -> dict:
     from ..query.table import CLOSED_FORM_MAX_CONTACT_S, open_table, table_spread, table_z
     from ..sensor import last_sample_index
 
-    from ..query.table import open_table, table_spread
-
     sensor = tab.sensor
     op = open_table(tab, None, sensor_temp_spread_c=table_spread(tab))
     width = float(tab.header["effusivity"]["width"])

@@ -450,11 +450,9 @@ def integrate_crank_nicolson(grid: Grid, times_s, step_ratio: float = 0.05, *,
     m_band = _banded(m, g, 0.0)  # M in banded storage
     a_band = _banded(np.zeros_like(m), g, 1.0)  # A in banded storage
     u = np.broadcast_to(grid.initial, shape).astype(np.float64).ravel()
-    i_p, w_p = grid.probe_weights()
 
     def probe(v):
-        v2 = v.reshape(shape)
-        return (1.0 - w_p) * v2[:, i_p] + w_p * v2[:, i_p + 1]
+        return probe_reading(grid, v.reshape(shape))
 
     readings = np.empty((shape[0], levels.size))
     readings[:, 0] = probe(u)
@@ -523,17 +521,9 @@ def integrate_bdf(grid: Grid, times_s, rtol: float = 1e-6, atol: float = 1e-9, *
     def rhs(_t, y):
         return (-apply_conductances(g, y.reshape(k, n)) * inv_m).ravel()
 
-    gl = np.zeros((k, n))
-    gr = np.zeros((k, n))
-    gl[:, 1:] = g
-    gr[:, :-1] = g
-    diag = (-(gl + gr) * inv_m).ravel()
-    # off-diagonals of -M^-1 A: row i, column i+1 is +g_i / m_i; row i+1, column i is +g_i / m_{i+1}
-    up = np.zeros((k, n))
-    up[:, :-1] = g * inv_m[:, :-1]
-    lo = np.zeros((k, n))
-    lo[:, 1:] = g * inv_m[:, 1:]
-    jac = sparse.diags([lo.ravel()[1:], diag, up.ravel()[:-1]], [-1, 0, 1], format="csc")
+    # -M^-1 A: A from its banded storage (ab[0, j] = a[j - 1, j], ab[1, j] = a[j, j], ab[2, j] = a[j + 1, j])
+    a = sparse.dia_matrix((_banded(np.zeros_like(m), g, 1.0), [1, 0, -1]), shape=(k * n, k * n))
+    jac = (sparse.diags(-inv_m.ravel()) @ a).tocsc()
     t_eval = np.unique(np.clip(t_out, 0.0, t_end))
     sol = solve_ivp(rhs, (0.0, t_end), u0, method="BDF", t_eval=t_eval, jac=jac,
                     rtol=rtol, atol=atol, first_step=min(t_end, float(t_eval[t_eval > 0].min())) * 1e-6)

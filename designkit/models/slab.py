@@ -258,40 +258,44 @@ def reflection_coefficients(e_object, e_backing, e_sensor):
     return w, 2.0 * w - 1.0, 2.0 * wb - 1.0
 
 
-def _series_terms(w, rs, rb, sqrt_tau, flight, t_max, tolerance, max_terms):
-    """Terms needed so that the tail bound is below ``tolerance``, and that bound.
+def _reflected_bound(w, rs, rb, sqrt_tau, flight, time_s: float, n_terms):
+    """Bound on the image terms after the first ``n_terms``, per object (K,), at times up to ``time_s``.
 
     Term n has magnitude ``A |r|^(n-1) erfc(a_n)`` with ``A = 2 w (1 - w) |R_b|``,
     ``r = R_b R_s``, ``a_n = (sqrt(tau) + n * flight) / sqrt(t)``; erfc(a_n)
-    falls with n, so the tail after N terms is at most
-    ``A |r|^N erfc(a_{N+1}) / (1 - |r|)``.
+    falls with n (and grows with t), so the tail after N terms is at most
+    ``A |r|^N erfc(a_{N+1}) / (1 - |r|)``. ``n_terms = 0``: all reflected heat.
     """
     amp = 2.0 * w * (1.0 - w) * np.abs(rb)  # (K,)
     r = np.abs(rb * rs)
     # |r| < 1 whenever amp > 0 (finite, positive e_o); e_o = 0 or inf carry no reflections
     geo_tail = np.where(amp == 0.0, 0.0, amp / np.where(r < 1.0, 1.0 - r, 1.0))
+    with np.errstate(under="ignore"):
+        erfc_next = special.erfc((sqrt_tau + (n_terms + 1.0) * flight) / math.sqrt(time_s))
+        return np.where(amp == 0.0, 0.0, geo_tail * r ** n_terms * erfc_next)
+
+
+def _series_terms(w, rs, rb, sqrt_tau, flight, t_max, tolerance, max_terms):
+    """Terms needed so that the tail bound (:func:`_reflected_bound`) is below ``tolerance``, and that bound."""
     if t_max <= 0:
         return 0, 0.0
-    st = math.sqrt(t_max)
 
     def tail(n_terms):  # bound after n_terms terms, per object (K,)
-        with np.errstate(under="ignore"):
-            erfc_next = special.erfc((sqrt_tau + (n_terms + 1.0) * flight) / st)
-            return np.where(amp == 0.0, 0.0, geo_tail * r ** n_terms * erfc_next)
+        return _reflected_bound(w, rs, rb, sqrt_tau, flight, t_max, n_terms)
 
-    b_max = tail(np.full(amp.shape, float(max_terms)))
+    b_max = tail(np.full(w.shape, float(max_terms)))
     if np.any(b_max > tolerance):
         return None, float(b_max.max())
     # tail(N) falls with N: bisection for the smallest N meeting the tolerance, per object
-    lo = np.full(amp.shape, -1.0)  # tail(lo) > tol (or lo = -1)
-    hi = np.full(amp.shape, float(max_terms))  # tail(hi) <= tol
+    lo = np.full(w.shape, -1.0)  # tail(lo) > tol (or lo = -1)
+    hi = np.full(w.shape, float(max_terms))  # tail(hi) <= tol
     while np.any(hi - lo > 1):
         mid = np.floor(0.5 * (lo + hi))
         good = tail(mid) <= tolerance
         hi = np.where(good, mid, hi)
         lo = np.where(good, lo, mid)
     n_terms = int(hi.max())
-    return n_terms, float(tail(np.full(amp.shape, float(n_terms))).max())
+    return n_terms, float(tail(np.full(w.shape, float(n_terms))).max())
 
 
 def image_series(time_s, e_object, alpha_object_m2_s, thickness_m, e_backing, e_sensor, tau_s, *,
@@ -432,6 +436,13 @@ def _check_objects(e_object, alpha_object_m2_s):
     return e, a
 
 
+def _scene(e_object, alpha_object_m2_s, thickness_m, backing, sensor):
+    """Checked objects, thickness, backing and sensor of a slab scene: ``(e, alpha, L, backing, sensor)``."""
+    e, alpha = _check_objects(e_object, alpha_object_m2_s)
+    L = check_positive("object thickness [m]", thickness_m, allow_inf=True)
+    return e, alpha, L, resolve_backing(backing), SENSORS["paper"] if sensor is None else sensor
+
+
 def slab_response(time_s, e_object, alpha_object_m2_s, thickness_m, backing="insulated",
                   sensor: Sensor | None = None, *, tolerance: float = 1e-5, method: str = "auto",
                   max_terms: int = 20000, cells_per_layer: int | None = None,
@@ -489,10 +500,7 @@ def slab_response(time_s, e_object, alpha_object_m2_s, thickness_m, backing="ins
     ('image-series', 2, (1, 2))
     """
     t = _check_times(time_s)
-    e, alpha = _check_objects(e_object, alpha_object_m2_s)
-    L = check_positive("object thickness [m]", thickness_m, allow_inf=True)
-    back = resolve_backing(backing)
-    sen = SENSORS["paper"] if sensor is None else sensor
+    e, alpha, L, back, sen = _scene(e_object, alpha_object_m2_s, thickness_m, backing, sensor)
     tol = check_positive("tolerance", tolerance)
     if method not in METHODS:
         raise InputError(f"unknown method {method!r}: use one of {', '.join(METHODS)}")
@@ -589,10 +597,7 @@ def semi_infinite_deviation(time_s, e_object, alpha_object_m2_s, thickness_m, ba
     reflected image terms.
     """
     t = _check_times(time_s)
-    e, alpha = _check_objects(e_object, alpha_object_m2_s)
-    L = check_positive("object thickness [m]", thickness_m, allow_inf=True)
-    back = resolve_backing(backing)
-    sen = SENSORS["paper"] if sensor is None else sensor
+    e, alpha, L, back, sen = _scene(e_object, alpha_object_m2_s, thickness_m, backing, sensor)
     if not math.isfinite(L):
         return np.zeros((e.size, t.size))
     w, rs, rb = reflection_coefficients(e, back.effusivity, sen.effusivity)
@@ -620,17 +625,11 @@ def semi_infinite_error_bound(contact_s, e_object, alpha_object_m2_s, thickness_
         Normalized bound; 0 for ``L = inf``.
     """
     t = check_positive("contact time [s]", contact_s)
-    e, alpha = _check_objects(e_object, alpha_object_m2_s)
-    L = check_positive("object thickness [m]", thickness_m, allow_inf=True)
-    back = resolve_backing(backing)
-    sen = SENSORS["paper"] if sensor is None else sensor
+    e, alpha, L, back, sen = _scene(e_object, alpha_object_m2_s, thickness_m, backing, sensor)
     if not math.isfinite(L):
         return np.zeros(e.shape)
     w, rs, rb = reflection_coefficients(e, back.effusivity, sen.effusivity)
-    amp = 2.0 * w * (1.0 - w) * np.abs(rb)
-    r = np.abs(rb * rs)
-    a1 = (math.sqrt(sen.tau_s) + L / np.sqrt(alpha)) / math.sqrt(t)
-    return np.where(amp == 0.0, 0.0, amp * special.erfc(a1) / np.where(r < 1.0, 1.0 - r, 1.0))
+    return _reflected_bound(w, rs, rb, math.sqrt(sen.tau_s), L / np.sqrt(alpha), t, 0)
 
 
 @dataclass(frozen=True)

@@ -158,7 +158,7 @@ def _how_lines(exp: Exported, prefix: str, grid_is_library: bool) -> list[str]:
 def _example_lines(exp: Exported, prefix: str) -> list[str]:
     """The opening comment's runnable example: the README's main job, and what it prints."""
     q, ans = example_answer(exp)
-    return [f"    #include <stdio.h>", f'    #include "{prefix}_table.h"',
+    return ["    #include <stdio.h>", f'    #include "{prefix}_table.h"',
             "    int main(void) {", "        double iv[3];",
             f"        if ({prefix}_min_contact_interval({q[0]!r}, {q[1]!r}, {q[2]!r}, {q[3]!r}, iv) == 0)",
             '            printf("%.3f s (%.3f to %.3f)\\n", iv[0], iv[1], iv[2]);',

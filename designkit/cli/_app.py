@@ -271,6 +271,23 @@ def console(stderr: bool = False):
     return Console(stderr=stderr, highlight=False, soft_wrap=True, width=100_000)
 
 
+def escape(text: str) -> str:
+    r"""``rich.markup.escape(text)``: ``text`` inside a line of markup, printed as it is.
+
+    Text without ``[`` and without a trailing backslash is returned as it is, without importing rich
+    (``rich.markup.escape`` returns it unchanged; importing rich.markup is about 20 ms of a fresh
+    question's start-up).
+
+    >>> escape("svm-fine"), escape("[bold] table")
+    ('svm-fine', '\\[bold] table')
+    """
+    if "[" not in text and not text.endswith("\\"):
+        return text
+    from rich.markup import escape as rich_escape
+
+    return rich_escape(text)
+
+
 # rich's markup grammar (rich.markup.RE_TAGS): a tag is "[" + a letter, "#", "/" or "@" + text up to "]",
 # and an odd run of backslashes before "[" makes it literal.
 _MARKUP_TAG = re.compile(r"((\\*)\[([a-z#/@][^[]*?)])")

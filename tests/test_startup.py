@@ -56,8 +56,9 @@ def _imported(r: subprocess.CompletedProcess) -> set[str]:
 
 
 #: What a table question never needs: the exact route (simulation, SVM, its Monte Carlo bound), pydantic (the
-#: schemas of files it does not read, typer's adapters), scipy, scikit-learn, joblib, matplotlib.
-_NOT_FOR_A_TABLE_QUESTION = {"pydantic", "typer._adapters", "sklearn", "scipy", "scipy.optimize", "joblib",
+#: schemas of files it does not read, typer's adapters), scipy, scikit-learn, joblib, matplotlib, and rich when
+#: its answer is piped (plain lines: designkit.cli._app.text_console).
+_NOT_FOR_A_TABLE_QUESTION = {"pydantic", "typer._adapters", "rich", "sklearn", "scipy", "scipy.optimize", "joblib",
                              "matplotlib", "numpy.ma", "designkit.query.exact", "designkit.query.ideal_mc_bound",
                              "designkit.simulation", "designkit.recognition.svm", "designkit.recognition.features"}
 
@@ -216,3 +217,13 @@ def test_the_cli_uses_typer_through_its_public_names_only():
             names = ([node.module or ""] if isinstance(node, ast.ImportFrom)
                      else [a.name for a in node.names] if isinstance(node, ast.Import) else [])
             assert not any(n.startswith(("typer._", "click")) for n in names), f"{path}: imports {names}"
+
+
+@pytest.mark.parametrize("text", ["svm-fine", "", "a [b] c", "[bold]x[/]", "x\\", "x\\\\", "\\[red]", "e [J s^-1/2]",
+                                  "50% [", "]", "C:\\tables\\"])
+def test_the_clis_escape_is_richs(text):
+    from rich.markup import escape as rich_escape
+
+    from designkit.cli._app import escape
+
+    assert escape(text) == rich_escape(text)

@@ -84,16 +84,6 @@ def test_the_first_sample_is_the_first_count_whose_projection_noise_reaches_the_
     assert ib.first_sample_at(cum, 0.0, 1e-3) == 1 and np.isnan(ib.first_sample_at(cum, 0.01, np.nan))
 
 
-@pytest.mark.parametrize("n", [5, 20, 40, 64])
-def test_the_quadrature_rule_is_numpys_gauss_legendre(n):
-    x, w = np.polynomial.legendre.leggauss(n)
-    gx, gw = cf._gauss_legendre(n)
-    assert np.max(np.abs(gx - x)) < 1e-15
-    assert np.max(np.abs(gw - w)) < 1e-14
-    # and it integrates polynomials up to degree 2n - 1 exactly
-    assert abs(np.sum(gw * gx ** (2 * n - 2)) - 2.0 / (2 * n - 1)) < 1e-13
-
-
 def test_noise_k_contact_is_the_first_sample_where_the_classifier_separates():
     """The bisection (monotone k, many pairs) and the dense scan (steep k, or few pairs) give the definition's first sample."""
     rng = np.random.default_rng(5)

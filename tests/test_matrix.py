@@ -90,6 +90,38 @@ def test_separated_classes_are_told_apart_perfectly(paper_sensor):
                                      Scene.from_delta_t(contact_s=2.0)) == pytest.approx(0.5, abs=1e-6)
 
 
+def test_multiclass_accuracy_matches_scipys_quadrature(paper_sensor):
+    # an independent reference: (1/K) * integral of the highest class density, each density itself a quadrature
+    # over the class's effusivities, by scipy's adaptive quad; three overlapping classes (wood, rubber,
+    # acrylic), a short contact where the highest class changes three times
+    from scipy import integrate
+
+    from designkit.recognition.ideal import projection_noise
+    from designkit.scene import Scene
+
+    ranges = [(331.0, 506.46), (407.0, 570.81), (380.35, 702.15)]
+    scene = Scene.from_delta_t(contact_s=0.6, noise_c=0.05, delta_t_c=10.0)
+    s, e_s = projection_noise(paper_sensor, scene), paper_sensor.effusivity
+
+    def density(v, a, b):
+        f = lambda e: math.exp(-0.5 * ((v - e / (e_s + e)) / s) ** 2)  # noqa: E731
+        return integrate.quad(f, a, b, epsabs=1e-14, epsrel=1e-12)[0] / ((b - a) * s * math.sqrt(2 * math.pi))
+
+    lo, hi = 331.0 / (e_s + 331.0) - 9 * s, 702.15 / (e_s + 702.15) + 9 * s
+    top = integrate.quad(lambda v: max(density(v, a, b) for a, b in ranges), lo, hi, limit=200,
+                         epsabs=1e-11, epsrel=1e-10)[0]
+    assert multiclass_ideal_accuracy(ranges, paper_sensor, scene) == pytest.approx(top / 3, abs=1e-8)
+
+
+def test_noise_free_multiclass_accuracy_is_the_narrowest_class_wherever_classes_overlap(paper_sensor):
+    from designkit.scene import Scene
+
+    # [400, 450): the first class alone; [450, 500): both, the narrower (first) wins; [500, 600): the second
+    acc = multiclass_ideal_accuracy([(400, 500), (450, 600)], paper_sensor,
+                                    Scene.from_delta_t(contact_s=2.0, noise_c=0.0))
+    assert acc == pytest.approx(0.5 * (50 / 100 + 50 / 100 + 100 / 150), abs=1e-15)
+
+
 def test_to_dict_is_json_and_symmetric(paper12):
     d = json.loads(json.dumps(paper12.to_dict(), allow_nan=False))
     n = len(d["materials"])

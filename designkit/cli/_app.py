@@ -18,20 +18,10 @@ import json
 import math
 import re
 import sys
-from pathlib import Path
 from typing import Any
 
 import typer
-from typer.core import TyperGroup
-
-try:  # recent typer vendors click; older typer uses click itself
-    from typer._click.exceptions import ClickException as _ClickException
-    from typer._click.exceptions import BadParameter as _BadParameter
-    from typer._click.exceptions import NoArgsIsHelpError as _NoArgsIsHelp
-except ImportError:  # pragma: no cover - depends on the installed typer
-    from click.exceptions import BadParameter as _BadParameter
-    from click.exceptions import ClickException as _ClickException
-    from click.exceptions import NoArgsIsHelpError as _NoArgsIsHelp
+from typer.core import TyperCommand, TyperGroup
 
 EXIT_BAD_INPUT = 2
 EXIT_BUG = 1
@@ -66,109 +56,53 @@ def _report_error(kind: str, message: str, status: int, as_json: bool) -> None:
         sys.stdout.flush()
 
 
-_FLOAT_TEXT = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
-_INT_TEXT = re.compile(r"[+-]?\d+")
-_MISSING = object()
+def _empty_text(ctx: Any) -> None:
+    """One rule for every text option: empty is no value (``--table ''`` fell back to svm-fine, ``--out ''``
+    meant the current folder, ``--port ''`` was looked for as a device).
 
-
-class _PlainCoercion:
-    """Typer's coercion of one option, with a fast path for plain numbers and text.
-
-    A float, int or str option whose value is already of its type, or is plain decimal text, is
-    converted here to the value pydantic gives, without building typer's pydantic adapter (why:
-    docs/decisions-log.md); anything else (other types, ranges, lists, odd text, bad input) goes
-    to typer's own coercion, so its conversions and its error messages stay typer's.
+    Click leaves a text or path option's value as the text given until typer's callback converts it, so an
+    empty one is still ``""`` here, after parsing and before the command runs.
     """
-
-    def __init__(self, kind: type):
-        self.kind = kind
-        self._typer: Any = None
-
-    def _fast(self, value: Any) -> Any:
-        kind = self.kind
-        if type(value) is kind:
-            return value
-        if kind is float:
-            if type(value) is int:
-                return float(value)
-            if isinstance(value, str) and _FLOAT_TEXT.fullmatch(value):
-                return float(value)
-        elif kind is int and isinstance(value, str) and _INT_TEXT.fullmatch(value):
-            return int(value)
-        return _MISSING
-
-    def coerce(self, value: Any, param: Any, ctx: Any) -> Any:
-        if value is None:
-            return None
-        if isinstance(value, str) and self.kind in (str, Path) and not value.strip():
-            # one rule for every text option: empty is no value (--table '' fell back to svm-fine, --out ''
-            # meant the current folder, --port '' was looked for as a device)
-            raise _BadParameter("it is empty; give a value (or leave the option out)", ctx=ctx, param=param)
-        fast = self._fast(value)
-        if fast is not _MISSING:
-            return fast
-        if self._typer is None:
-            from typer._coercion import build_runtime_param
-
-            self._typer = build_runtime_param(param.type_descriptor)
-        return self._typer.coerce(value, param=param, ctx=ctx)
+    for param in ctx.command.params:
+        value = ctx.params.get(param.name)
+        if isinstance(value, str) and not value.strip():
+            raise typer.BadParameter("it is empty; give a value (or leave the option out)", ctx=ctx, param=param)
 
 
-def _plain_kind(param: Any) -> type | None:
-    """float, int, str or bool when the option is a single plain value of that type (or None of it)."""
-    desc = getattr(param, "type_descriptor", None)
-    if desc is None or not hasattr(param, "_runtime_param") or param._runtime_param is not None:
-        return None
-    if getattr(param, "multiple", False) or getattr(param, "nargs", 1) != 1:
-        return None
-    info = desc.parameter_info
-    if any(getattr(info, k, None) is not None for k in ("min", "max", "click_type", "parser")):
-        return None
-    ann = desc.annotation
-    args = [a for a in getattr(ann, "__args__", ()) if a is not type(None)]
-    if getattr(ann, "__origin__", None) is not None or args:  # Optional[X] (typing.Union[X, None])
-        ann = args[0] if len(args) == 1 and len(getattr(ann, "__args__", ())) == 2 else None
-    if ann is Path and any(getattr(info, k, None) not in (None, False, True) for k in ("path_type",)):
-        return None
-    return ann if ann in (float, int, str, bool, Path) else None
+class _Command(TyperCommand):
+    """Typer command that refuses empty text options (:func:`_empty_text`)."""
+
+    def parse_args(self, ctx: Any, args: Any) -> Any:
+        rest = super().parse_args(ctx, args)
+        _empty_text(ctx)
+        return rest
 
 
-def _fast_coercion(command: Any, ctx: Any) -> None:
-    """Give ``command``'s plain options the fast coercion (once; typer versions without it: untouched)."""
-    try:
-        params = command.get_params(ctx)  # with the help option click adds
-    except Exception:  # pragma: no cover - another click/typer: leave typer's coercion alone
-        return
-    for param in params:
-        kind = _plain_kind(param)
-        if kind is not None and param.name in ("install_completion", "show_completion"):
-            kind = type(None)  # absent: None, fast; given: typer's own coercion (it reads the shell from it)
-        if kind is not None:
-            param._runtime_param = _PlainCoercion(kind)
+class _Typer(typer.Typer):
+    """Typer application whose commands are :class:`_Command` unless a command names its own class."""
+
+    def command(self, *args: Any, cls: Any = None, **kwargs: Any) -> Any:
+        return super().command(*args, cls=cls or _Command, **kwargs)
 
 
 class _Group(TyperGroup):
     """Typer group that turns bad input into a one-line error and exit status 2."""
 
     def parse_args(self, ctx: Any, args: Any) -> Any:
-        _fast_coercion(self, ctx)  # the group's own options (--version, --help, completion)
-        return super().parse_args(ctx, args)
-
-    def resolve_command(self, ctx: Any, args: Any) -> Any:
-        name, cmd, rest = super().resolve_command(ctx, args)
-        if cmd is not None:
-            _fast_coercion(cmd, ctx)
-        return name, cmd, rest
+        if not args and self.no_args_is_help and not ctx.resilient_parsing:
+            # the help (typer prints it while rendering), then exit status 2, as click's NoArgsIsHelpError
+            typer.echo(ctx.get_help(), err=True)
+            raise typer.Exit(EXIT_BAD_INPUT)
+        rest = super().parse_args(ctx, args)
+        _empty_text(ctx)  # the group's own options
+        return rest
 
     def main(self, *args: Any, standalone_mode: bool = True, **kwargs: Any) -> Any:
         if not standalone_mode:
             return super().main(*args, standalone_mode=False, **kwargs)
         try:
             rv = super().main(*args, standalone_mode=False, **kwargs)
-        except _NoArgsIsHelp as exc:
-            exc.show()
-            sys.exit(exc.exit_code)
-        except _ClickException as exc:  # usage errors: one line, not a box
+        except typer.TyperException as exc:  # click's usage errors (typer 0.28's): one line, not a box
             hint = ""
             ctx = getattr(exc, "ctx", None)
             if ctx is not None:
@@ -211,7 +145,7 @@ class _Group(TyperGroup):
         except BrokenPipeError:  # the reader had what it wanted (``| head -1``): not bad input, not a failure
             _quiet_stdout()
             raise typer.Exit(EXIT_BROKEN_PIPE) from None
-        except (typer.Exit, typer.Abort, _ClickException, KeyboardInterrupt, SystemExit):
+        except (typer.Exit, typer.Abort, typer.TyperException, KeyboardInterrupt, SystemExit):
             raise
         except (ValueError, OSError) as exc:
             message = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
@@ -237,7 +171,7 @@ class _Group(TyperGroup):
             raise typer.Exit(EXIT_BUG) from None
 
 
-app = typer.Typer(
+app = _Typer(
     cls=_Group,
     name="designkit",
     help="Design guidelines for active thermal tactile sensors: which contact time, noise and "
@@ -282,7 +216,7 @@ REPORTS = "The paper and accuracy"
 
 def sub_app(name: str, help: str, panel: str) -> typer.Typer:
     """A command group (``designkit NAME ...``) registered on the main app in help ``panel``."""
-    group = typer.Typer(cls=_Group, help=help, no_args_is_help=True, add_completion=False,
+    group = _Typer(cls=_Group, help=help, no_args_is_help=True, add_completion=False,
                         pretty_exceptions_enable=False, rich_markup_mode="markdown")
     app.add_typer(group, name=name, rich_help_panel=panel)
     return group
@@ -335,6 +269,23 @@ def console(stderr: bool = False):
     if hasattr(stream, "isatty") and stream.isatty():
         return Console(stderr=stderr, highlight=False)
     return Console(stderr=stderr, highlight=False, soft_wrap=True, width=100_000)
+
+
+def escape(text: str) -> str:
+    r"""``rich.markup.escape(text)``: ``text`` inside a line of markup, printed as it is.
+
+    Text without ``[`` and without a trailing backslash is returned as it is, without importing rich
+    (``rich.markup.escape`` returns it unchanged; importing rich.markup is about 20 ms of a fresh
+    question's start-up).
+
+    >>> escape("svm-fine"), escape("[bold] table")
+    ('svm-fine', '\\[bold] table')
+    """
+    if "[" not in text and not text.endswith("\\"):
+        return text
+    from rich.markup import escape as rich_escape
+
+    return rich_escape(text)
 
 
 # rich's markup grammar (rich.markup.RE_TAGS): a tag is "[" + a letter, "#", "/" or "@" + text up to "]",

@@ -195,7 +195,7 @@ def sensor_and_model(sensor, model: Optional[str] = None, *, conductance: Option
     else:
         fm, source = sensor_model(sen), ("sensor file" if sen.model is not None else "default")
     if warn and sen.problems:
-        from rich.markup import escape
+        from ._app import escape
 
         from ._app import console
 

@@ -408,7 +408,7 @@ def _write_identified(best, trials, out: Path, name: Optional[str], index: Path,
 
     Returns the problems written into the file's provenance (so that ``--sensor`` can warn).
     """
-    from rich.markup import escape
+    from ._app import escape
 
     from .._validation import InputError
     from ..calibration.fit import check_calibration
@@ -545,7 +545,7 @@ def _identify_inputs(names: list[str], ranges: list[str], object_temps: list[str
 
 def _refuse_unusable(trials: list, force: bool, out: Optional[Path]) -> None:
     """Refuse, before minutes of fitting, touches that cannot calibrate (unless ``force``), each problem said."""
-    from rich.markup import escape
+    from ._app import escape
 
     from .._validation import InputError
     from ..calibration.fit import check_calibration
@@ -573,7 +573,7 @@ def _parameter_rows(best) -> list[dict]:
 def _print_identification(cmp, best, split, names: list[str], out: Optional[Path], plot: Optional[Path],
                           n_fit: int, record: Optional[dict]) -> None:
     """The identification's report for people: the models compared, the one selected and its parameters."""
-    from rich.markup import escape
+    from ._app import escape
     from rich.table import Table
 
     results, scores, selected = cmp.results, cmp.held_out_rms_c, cmp.selected

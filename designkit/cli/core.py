@@ -86,7 +86,7 @@ def simulate(
 
 def _print_simulation(p: dict, result, sen, fm) -> None:
     """simulate's text for people, from its JSON document ``p``."""
-    from rich.markup import escape
+    from ._app import escape
 
     con, sc, final = console(), p["scene"], result.temperature_c[:, -1]
     con.print(f"[bold]{final.size} touch(es)[/] of e = {p['effusivity']:g} J s^-1/2 K^-1 m^-2 for {sc['contact_s']:g} s "
@@ -274,7 +274,7 @@ def _check_f1(e1, e2, threshold, noise, delta_t, two_sensor, width, ambient, fol
 
 def _print_f1(payload: dict, svm, ideal, sen, fm, source: str, width: float) -> None:
     """f1's answer for people: the pair and scene, the model, the SVM's F1 and verdict, the ideal bound."""
-    from rich.markup import escape
+    from ._app import escape
 
     sc, threshold = payload["scene"], payload["threshold"]
     (o1, o2), diffusivity = payload["objects"], payload["diffusivity_m2_s"]
@@ -311,7 +311,7 @@ def _f1_two_sensor(obj1, obj2, temp1, temp2, sen, fm, source, scene, trials, fol
     if json_:
         emit_json(payload)
         return
-    from rich.markup import escape
+    from ._app import escape
 
     con = console()
     con.print(f"[bold]{escape(a.label)}[/] vs [bold]{escape(b.label)}[/] (classes {obj1.e_range[1] - obj1.e_range[0]:g} "

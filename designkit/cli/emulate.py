@@ -173,7 +173,7 @@ def _emulated_materials(material: Optional[list[str]], e: Optional[float], objec
 
 def _print_emulation(emu, prof, fm, mats: list, info: dict) -> None:
     """emulate's banner for people: the port, what the rig touches, and the commands to try on it."""
-    from rich.markup import escape
+    from ._app import escape
 
     con = console()
     con.print(f"Emulating a '{prof.name}' rig on [bold]{info['port']}[/]  (speed {info['speed']:g}x; Ctrl-C to stop)")

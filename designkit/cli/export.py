@@ -66,7 +66,7 @@ def export_cmd(
     if json_:
         emit_json(res.to_dict())
         return
-    from rich.markup import escape
+    from ._app import escape
 
     p = res.provenance
     con = console()

@@ -15,7 +15,8 @@ import typer
 from . import _app
 from ._app import app, console
 from ._format import FormatOpt, OutOpt, emit_rows, output_format
-from ._options import PANEL_OUTPUT, PANEL_QUESTION, PANEL_SCENE, PANEL_SENSOR, Explain, Json, SensorOpt, sensor_and_model
+from ._options import (PANEL_OUTPUT, PANEL_QUESTION, PANEL_SCENE, Explain, IdealTableOpt, Json, SensorOpt, TableOpt,
+                       sensor_and_model)
 
 _QUESTIONS = "min-contact, max-noise, min-delta-t or distinguishable"
 
@@ -42,9 +43,8 @@ def matrix(
     = None,
     threshold: Annotated[Optional[float], typer.Option(
         "--threshold", help="F1 threshold; must be the table's (0.9 for the shipped tables).", rich_help_panel=PANEL_QUESTION)] = None,
-    table: Annotated[Optional[str], typer.Option("--table", help="Lookup table (default: svm-fine).", rich_help_panel=PANEL_SENSOR)] = None,
-    ideal_table: Annotated[str, typer.Option("--ideal-table", help="Table for the ideal-observer bound.", rich_help_panel=PANEL_SENSOR)]
-    = "ideal-paper",
+    table: TableOpt = None,
+    ideal_table: IdealTableOpt = "ideal-paper",
     multiclass: Annotated[bool, typer.Option(
         "--multiclass/--no-multiclass", help="Add the accuracy of telling all N apart against contact time.", rich_help_panel=PANEL_QUESTION)]
     = True,

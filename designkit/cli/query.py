@@ -253,7 +253,7 @@ def _render_text(d, explain: bool = False) -> None:
 
 def _scene_line(d) -> str:
     """Line 3: the objects, the scene, the sensor (and model) and where the answer came from."""
-    from rich.markup import escape
+    from ._app import escape
 
     sc = d["scene"]
     scene = [f"{w} {_fmt(sc[k], u)}" for k, w, u in (("noise_c", "noise", "°C"), ("delta_t_c", "dT", "°C"),
@@ -270,7 +270,7 @@ def _scene_line(d) -> str:
 
 def _warning(d) -> str | None:
     """Line 4, when the answer needs a caveat: why there is none, or where the table was left."""
-    from rich.markup import escape
+    from ._app import escape
 
     if d["value"] is None and d["notes"]:
         return escape(d["notes"][0])
@@ -311,7 +311,7 @@ def _interval(d, unit):
 def _answerer(d) -> str:
     """Whose answer line 1 gives: the paper's SVM, or the ideal observer where the table holds that."""
     if (d.get("computation") or {}).get("fidelity") == "ideal":
-        from rich.markup import escape
+        from ._app import escape
 
         return f"ideal observer on table {escape(d['table']['name'])}'s grid"
     return "SVM"
@@ -376,7 +376,7 @@ def _explain_lines(con, d):
     """--explain: the objects with their units, the hardest pair, the paper's remark, the method, every note."""
     con.print("objects [J s^-1/2 K^-1 m^-2]: " + " vs ".join(f"[bold]{o['label']}[/]" for o in d["objects"]))
     if d["model"]["name"] != "semi-infinite":
-        from rich.markup import escape
+        from ._app import escape
 
         con.print(f"model: {escape(_model_words(d))}")
     if d["limiting_pair"] and any(o["material"] for o in d["objects"]) and d["question"] != "delta-e":

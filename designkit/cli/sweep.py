@@ -134,7 +134,7 @@ def sweep(
 
 
 def _markup_escape(text: str) -> str:
-    from rich.markup import escape
+    from ._app import escape
 
     return escape(text)
 

@@ -103,7 +103,7 @@ def tables_show(
 
 def _visible(x) -> str:
     """``str(x)`` with rich markup escaped and control characters (escape sequences, newlines) shown as escapes."""
-    from rich.markup import escape
+    from ._app import escape
 
     return escape("".join(ch if ch.isprintable() else repr(ch)[1:-1] for ch in str(x)))
 

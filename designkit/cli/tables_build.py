@@ -104,7 +104,7 @@ def tables_build(
     if json_:
         emit_json(summary)
         return
-    from rich.markup import escape
+    from ._app import escape
 
     console().print(
         f"[bold green]Built[/] {escape(str(built.table))} for sensor {escape(built.sensor_name)} "

@@ -69,6 +69,7 @@ from ..sensor import Sensor, last_sample_index
 
 __all__ = [
     "IdealResult",
+    "class_density",
     "class_survival",
     "critical_noise",
     "cumulative_g2",
@@ -87,23 +88,8 @@ __all__ = [
 
 
 # ----------------------------------------------------------------- closed form
-def _gauss_legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
-    """Gauss-Legendre nodes and weights on [-1, 1] (Golub & Welsch 1969: the eigenvalues of the Jacobi matrix
-    of the Legendre recurrence, and twice the squared first components of its eigenvectors).
-
-    The same rule as ``numpy.polynomial.legendre.leggauss(n)`` (to 4e-16 in the nodes and 4e-15 in the
-    weights at n = 40, tested), without importing ``numpy.polynomial`` (start-up: docs/decisions-log.md).
-    """
-    k = np.arange(1.0, n)
-    off = k / np.sqrt(4.0 * k * k - 1.0)
-    nodes, vectors = np.linalg.eigh(np.diag(off, 1) + np.diag(off, -1))
-    weights = 2.0 * vectors[0] ** 2
-    nodes = 0.5 * (nodes - nodes[::-1])  # exactly symmetric, as leggauss makes them
-    weights = 0.5 * (weights + weights[::-1])
-    return nodes, weights
-
-
-_GL_X, _GL_W = _gauss_legendre(40)
+#: Gauss-Legendre nodes of :func:`class_survival` and :func:`class_density` (accurate to about 1e-11).
+_NODES = 40
 _CUT = 8.5  # Phi(-8.5) = 9.5e-18: the integrand is 0 or 1 to double precision outside +-8.5 s
 _SQRT1_2 = math.sqrt(0.5)
 _PHI_H = 1.0 / 512.0  # grid step of the tabulated normal CDF (a power of two: exact node positions)
@@ -215,12 +201,13 @@ def _survival(t, a, b, wa, wb, e_s, s):
     """
     e_lo, e_hi = _window(t - _CUT * s, a, b, wa, wb, e_s), _window(t + _CUT * s, a, b, wa, wb, e_s)
     half, mid = 0.5 * (e_hi - e_lo), 0.5 * (e_hi + e_lo)
-    nodes = mid[..., None] + half[..., None] * _GL_X
+    gx, gw = _rule(_NODES)
+    nodes = mid[..., None] + half[..., None] * gx
     with np.errstate(divide="ignore", invalid="ignore"):
         z = (_weight(e_s, nodes) - t[..., None]) / s[..., None]
     z[np.isnan(z)] = 0.0
     middle = ndtr(z)
-    middle *= _GL_W  # a row's sum alone (a matrix-vector product's blocking depends on the row count)
+    middle *= gw  # a row's sum alone (a matrix-vector product's blocking depends on the row count)
     middle = half * middle.sum(axis=-1)
     return np.minimum(np.maximum(((b - e_hi) + middle) / (b - a), 0.0), 1.0)
 
@@ -237,6 +224,23 @@ def class_survival(t, e_low, e_high, e_sensor: float, s) -> np.ndarray:
     """
     t, a, b, s = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64) for x in (t, e_low, e_high, s)))
     return _survival(t, a, b, _weight(e_sensor, a), _weight(e_sensor, b), e_sensor, s)
+
+
+def class_density(t, e_low, e_high, e_sensor: float, s) -> np.ndarray:
+    """Density of ``w(e) + s N(0,1)`` at ``t`` for ``e ~ U[e_low, e_high)``, elementwise (all arguments but
+    ``e_sensor`` broadcast, as 1-D; ``s`` > 0 and finite): minus :func:`class_survival`'s derivative in
+    ``t``, by the same quadrature.
+
+    >>> round(float(class_density([0.5], 892.0, 892.0 * 1.0001, 892.0, 0.01)[0]), 4)  # nearly N(0.5, 0.01)
+    39.8942
+    """
+    t, a, b, s = (np.ravel(x) for x in np.broadcast_arrays(*(np.asarray(x, dtype=np.float64)
+                                                             for x in (t, e_low, e_high, s))))
+    gx, gw = _rule(_NODES)
+    _, half, z = _window_z(t, s, a, b, _weight(e_sensor, a), _weight(e_sensor, b), e_sensor, gx)
+    pdf = np.exp(-0.5 * z * z)
+    pdf *= gw  # a row's sum alone, as in _survival
+    return (_INV_SQRT_2PI * half / ((b - a) * s)) * pdf.sum(axis=1)
 
 
 def _zoom_max(f, a, b, *, points: int, passes: int, stop_at: float | None = None) -> np.ndarray:
@@ -362,7 +366,23 @@ _COARSE_NODES = 12
 
 @functools.lru_cache(maxsize=4)
 def _rule(n: int) -> tuple[np.ndarray, np.ndarray]:
-    return (_GL_X, _GL_W) if n == _GL_X.size else _gauss_legendre(n)
+    """Gauss-Legendre nodes and weights of ``n`` points on [-1, 1] (numpy's, once per process)."""
+    from numpy.polynomial.legendre import leggauss
+
+    x, w = leggauss(n)
+    x.flags.writeable = w.flags.writeable = False  # shared by every caller
+    return x, w
+
+
+def _window_z(t, s, a, b, wa, wb, e_s, gx):
+    """The upper end ``e_hi`` [J s^-1/2 K^-1 m^-2] of a survival integral's window at threshold ``t`` (1-D),
+    its half width, and ``z = (w(e) - t) / s`` at the window's quadrature nodes ``gx`` (on [-1, 1])."""
+    e_lo, e_hi = _window(t - _CUT * s, a, b, wa, wb, e_s), _window(t + _CUT * s, a, b, wa, wb, e_s)
+    half, mid = 0.5 * (e_hi - e_lo), 0.5 * (e_hi + e_lo)
+    z = _weight(e_s, mid[:, None] + half[:, None] * gx)
+    z -= t[:, None]
+    z /= s[:, None]
+    return e_hi, half, z
 
 
 def _survival_derivatives(t, s, a, b, wa, wb, e_s, nodes: int):
@@ -371,12 +391,7 @@ def _survival_derivatives(t, s, a, b, wa, wb, e_s, nodes: int):
     nodes). The window cut at +-8.5 s moves with ``t`` and ``s``, but the integrand is 0 or 1 to double
     precision at its ends, so the derivatives are the integrals of the integrand's."""
     gx, gw = _rule(nodes)
-
-    e_lo, e_hi = _window(t - _CUT * s, a, b, wa, wb, e_s), _window(t + _CUT * s, a, b, wa, wb, e_s)
-    half, mid = 0.5 * (e_hi - e_lo), 0.5 * (e_hi + e_lo)
-    z = _weight(e_s, mid[:, None] + half[:, None] * gx)
-    z -= t[:, None]
-    z /= s[:, None]
+    e_hi, half, z = _window_z(t, s, a, b, wa, wb, e_s, gx)
     pdf = np.exp(-0.5 * z * z)
     pdf *= _INV_SQRT_2PI
     c = half / (b - a)
@@ -441,7 +456,7 @@ def critical_noise(sensor, lo, hi, *, width=80.0, threshold: float = 0.9, iterat
         if not live.size:
             break
         coarse = nodes[live] == _COARSE_NODES
-        for n_q, r in ((_COARSE_NODES, live[coarse]), (_GL_X.size, live[~coarse])):
+        for n_q, r in ((_COARSE_NODES, live[coarse]), (_NODES, live[~coarse])):
             if not r.size:
                 continue
             tr, xr = t[r], x[r]
@@ -465,7 +480,7 @@ def critical_noise(sensor, lo, hi, *, width=80.0, threshold: float = 0.9, iterat
             t[r], x[r] = tr + dt, xr + dx
             small = (np.abs(dx) < 1e-4) & (np.abs(dt) < 1e-4 * s)
             fine = n_q != _COARSE_NODES
-            nodes[r[small]] = _GL_X.size
+            nodes[r[small]] = _NODES
             # quadratic convergence: after a step below 1e-7 the error is below ~1e-14
             done = fine & (np.abs(dx) < 1e-7) & (np.abs(dt) < 1e-7 * s) & ~bad
             out[r[done]] = np.exp(x[r[done]])
@@ -621,7 +636,7 @@ def _class_loglik(stats, e_range, sensor, scene, g, sigma, n_grid):
     w = object_weight(sensor.effusivity, e)[None, :]
     m, S1, S2 = float(g.size), float(g.sum()), float(np.dot(g, g))
     if scene.ambient_temp_spread_c > 0:
-        xs, ws = np.polynomial.legendre.leggauss(16)
+        xs, ws = _rule(16)
         ta_nodes = scene.ambient_temp_c + scene.ambient_temp_spread_c * xs
         log_wts = np.log(ws / 2.0)
     else:

@@ -10,11 +10,10 @@ The ideal observer's multi-class accuracy is exact here: with fixed initial
 conditions every class's touches reduce to one number ``v ~ w(e) + N(0, s^2)``
 (:mod:`designkit.recognition.ideal`), so the Bayes classifier picks the class of highest
 density of ``v``. Its accuracy is computed from the classes' laws of ``v``
-(:func:`designkit.recognition.ideal.class_survival`, closed form) on bins of width
-``s / 8`` (at most 100,000 bins: for nearly noise-free scenes the bins are
-wider and the result is a lower bound accurate to the bin width): the bin-wise
-Bayes rule, which converges to the Bayes accuracy from below as the bins
-shrink.
+(:func:`designkit.recognition.ideal.class_density` and ``class_survival``, closed
+form): each class's probability over the runs of ``v`` where its density is the
+highest, between the crossings of the densities
+(:func:`designkit.query.matrix.multiclass_ideal_accuracy`).
 """
 
 from __future__ import annotations

@@ -153,7 +153,9 @@ def staircase_searches(searches: Sequence[tuple[Sequence[int], np.ndarray | None
     top anchors' efficiency ``(J - a) / (floor[a] - a)`` interpolated between them (engine version 4;
     version 3 searched every anchor from its floor: a gallop ``f, f + 2, f + 6, ...`` from the ideal
     observer's staircase, which lies at about 0.6 of the SVM's distance, cost an anchor row about
-    twice a guided row's fits; 0.92-0.97x the fits on seven svm-paper slices, measured), without one
+    twice a guided row's fits; on svm-paper 0.977x the fits of two 250-reference blocks at four contacts each,
+    0.94-1.03x on ten 62-reference slices; where the model has no closed-form floor each anchor galloped
+    from ``i + 1``: 0.56x on a slice of the rig's table, benchmarks/results/engine-search-slice.txt), without one
     ``J`` interpolated between them. Every other row ``i`` between anchors ``a0 < i < a1 = a0 + A``
     then starts from the guess ``g = J(a0) + (J(a1) - J(a0)) (i - a0) / A`` (``J(a0)``
     above the last anchor), raised to its floor: one probe at ``g``, then galloping down

@@ -155,8 +155,8 @@ def staircase_searches(searches: Sequence[tuple[Sequence[int], np.ndarray | None
     observer's staircase, which lies at about 0.6 of the SVM's distance, cost an anchor row about
     twice a guided row's fits; on svm-paper 0.977x the fits of two 250-reference blocks at four contacts each,
     0.94-1.03x on ten 62-reference slices; where the model has no closed-form floor each anchor galloped
-    from ``i + 1``: 0.56x on a slice of the rig's table, benchmarks/results/engine-search-slice.txt), without one
-    ``J`` interpolated between them. Every other row ``i`` between anchors ``a0 < i < a1 = a0 + A``
+    from ``i + 1``: 0.91x on two slices of the rig's table, benchmarks/results/engine-search-slice.txt), without one
+    the distance ``J - a`` interpolated geometrically between them. Every other row ``i`` between anchors ``a0 < i < a1 = a0 + A``
     then starts from the guess ``g = J(a0) + (J(a1) - J(a0)) (i - a0) / A`` (``J(a0)``
     above the last anchor), raised to its floor: one probe at ``g``, then galloping down
     (if true) or up (if false) to ``g -+ 1, 2, 4, ...`` and bisecting (engine version 3; version 2
@@ -219,8 +219,9 @@ def _efficiency_guesses(rows: list[int], top: dict[int, int], floor: np.ndarray 
 
     With a floor, the floor's distance ``floor[i] - i`` times the efficiency ``(J - a) / (floor[a] - a)`` of the
     top anchors ``a`` either side, interpolated linearly in ``i`` (the SVM needs about a constant multiple of
-    the ideal observer's distance, a multiple that changes slowly along the references); without one, ``J``
-    interpolated. The top anchor below alone where the one above has no partner in the grid; ``n - 1`` where
+    the ideal observer's distance, a multiple that changes slowly along the references); without one, their
+    distances ``J - a`` interpolated geometrically (linearly, a rig's need growing about as a power of ``e`` made
+    1.12x version 3's fits on a slice). The top anchor below alone where the one above has no partner in the grid; ``n - 1`` where
     the one below has none.
     """
     out = {}
@@ -231,8 +232,9 @@ def _efficiency_guesses(rows: list[int], top: dict[int, int], floor: np.ndarray 
             out[i] = n - 1
             continue
         w = (i - a0) / S if a1 != a0 else 0.0
-        if floor is None:
-            g = top[a0] + (top[a1] - top[a0]) * w
+        if floor is None:  # the distance interpolated geometrically (a need grows about as a power of e)
+            d0, d1 = top[a0] - a0, top[a1] - a1
+            g = i + d0 * (d1 / d0) ** w
         else:
             e0, e1 = ((top[a] - a) / max(int(floor[a]) - a, 1) for a in (a0, a1))
             g = i + (e0 + (e1 - e0) * w) * max(int(floor[i]) - i, 1)

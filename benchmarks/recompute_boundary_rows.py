@@ -43,8 +43,10 @@ def recompute(workdir: str, name: str) -> tuple[str, int, bool]:
     check_chunk(arrays, cfg, res.point, res.block, res.contact_index, path)  # its identity: this sweep's chunk
     t0 = time.process_time()
     n, rows = cfg.intervals, res.rows
-    in_block = set(rows.tolist())  # the rows whose guided search needs an anchor outside the block
-    aff = np.array([i for i in rows.tolist() if not set(with_anchors([i], n, ANCHOR_EVERY).tolist()) <= in_block],
+    in_block = set(rows.tolist())  # the rows whose guided search needs an anchor outside the block: the anchors
+    # every ANCHOR_EVERY of the builds this script fixes (engine version 4's top anchors came after the fix)
+    aff = np.array([i for i in rows.tolist()
+                    if not set(with_anchors([i], n, ANCHOR_EVERY, super_every=None).tolist()) <= in_block],
                    dtype=np.int64)
     if aff.size == 0 or cfg.fidelity != "svm" or cfg.full_matrix or not cfg.ideal_bound:
         return name, 0, False

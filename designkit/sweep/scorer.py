@@ -46,7 +46,9 @@ CV_KEY = 7919
 #: batched solver's one-gather fold statistics (:func:`~designkit.recognition.batched_svm.batched_cv_f1`).
 #: Version 3: a guided row's search gallops to ``g -+ 1, 2, 4, ...`` from its guess instead of ``g -+ 1, 3, 7, ...``
 #: (:func:`~designkit.sweep.search.staircase_searches`): fewer fits; on noisy decisions another crossing.
-ENGINE_VERSION = 3
+#: Version 4: only every :data:`~designkit.sweep.search.SUPER_EVERY`-th reference is searched from its floor; the
+#: other anchors start from a guess scaled from those (the same gallop; fewer fits, another crossing where noisy).
+ENGINE_VERSION = 4
 
 
 @dataclass

@@ -28,6 +28,7 @@ from .config import SweepConfig
 __all__ = [
     "ANCHOR_EVERY",
     "IDEAL_UNKNOWN",
+    "SUPER_EVERY",
     "assemble",
     "chunk_wall_s",
     "closed_form_model",
@@ -107,18 +108,32 @@ def staircase_search(decide: Callable[[int, int], bool] | None, rows: Sequence[i
 ANCHOR_EVERY = 8
 
 
-def with_anchors(rows: Sequence[int], n: int, every: int = ANCHOR_EVERY) -> np.ndarray:
-    """``rows`` and the anchor rows their guided search needs (sorted, unique).
+#: Spacing of the top-level anchors of a guided search (engine version 4): every row ``i`` with
+#: ``i % SUPER_EVERY == 0`` is searched from its floor alone; the other anchors start from their floor's distance
+#: times the efficiency (``(J - i) / (floor - i)``) of these, interpolated (:func:`staircase_searches`).
+SUPER_EVERY = 64
+
+
+def with_anchors(rows: Sequence[int], n: int, every: int = ANCHOR_EVERY, super_every: int | None = SUPER_EVERY) -> np.ndarray:
+    """``rows`` and the anchor rows their guided search needs (sorted, unique): the anchors of ``every``
+    spacing around each row and the top-level anchors (``super_every``) around each anchor.
 
     Examples
     --------
     >>> with_anchors([3, 9, 16], 20, every=8).tolist()
     [0, 3, 8, 9, 16]
+    >>> with_anchors([70, 130], 200, every=8, super_every=64).tolist()
+    [64, 70, 72, 128, 130, 136, 192]
     """
     rows = np.asarray(rows, dtype=np.int64).reshape(-1)
     a0 = (rows // every) * every
     a1 = (a0 + every)[(rows % every != 0) & (a0 + every < n)]  # an anchor needs no other anchor
-    return np.unique(np.concatenate([rows, a0, a1]))
+    anchors = np.unique(np.concatenate([a0, a1]))
+    if super_every:
+        s0 = (anchors // super_every) * super_every
+        s1 = (s0 + super_every)[(anchors % super_every != 0) & (s0 + super_every < n)]
+        anchors = np.concatenate([anchors, s0, s1])
+    return np.unique(np.concatenate([rows, anchors]))
 
 
 def staircase_searches(searches: Sequence[tuple[Sequence[int], np.ndarray | None]], n: int,
@@ -132,15 +147,23 @@ def staircase_searches(searches: Sequence[tuple[Sequence[int], np.ndarray | None
     are fewer and larger (what a batched scorer needs).
 
     With ``anchor_every = A`` the search is *guided*: the anchor rows (``i % A == 0``; the
-    ones the given rows need are added, see :func:`with_anchors`) are searched first, each
-    from its floor alone; every other row ``i`` between anchors ``a0 < i < a1 = a0 + A``
+    ones the given rows need are added, see :func:`with_anchors`) are searched first. The
+    top-level ones (``i % SUPER_EVERY == 0``) each from its floor alone, then the others from a
+    guess (below, the same gallop): with a floor, the floor's distance ``floor[i] - i`` times the
+    top anchors' efficiency ``(J - a) / (floor[a] - a)`` interpolated between them (engine version 4;
+    version 3 searched every anchor from its floor: a gallop ``f, f + 2, f + 6, ...`` from the ideal
+    observer's staircase, which lies at about 0.6 of the SVM's distance, cost an anchor row about
+    twice a guided row's fits; on svm-paper 0.977x the fits of two 250-reference blocks at four contacts each,
+    0.94-1.03x on ten 62-reference slices; where the model has no closed-form floor each anchor galloped
+    from ``i + 1``: 0.91x on two slices of the rig's table, benchmarks/results/engine-search-slice.txt), without one
+    the distance ``J - a`` interpolated geometrically between them. Every other row ``i`` between anchors ``a0 < i < a1 = a0 + A``
     then starts from the guess ``g = J(a0) + (J(a1) - J(a0)) (i - a0) / A`` (``J(a0)``
     above the last anchor), raised to its floor: one probe at ``g``, then galloping down
     (if true) or up (if false) to ``g -+ 1, 2, 4, ...`` and bisecting (engine version 3; version 2
     galloped to ``g -+ 1, 3, 7, ...``: the answers lie within 1-3 of the guess at short contact
     times, where this costs 0.95x the fits, measured). A row's path depends
-    on its own decisions and its anchors', which depend on theirs alone, so the answer
-    is still the same whatever other rows are searched with it. On exactly monotone
+    on its own decisions and its anchors', which depend on theirs and their top anchors'
+    alone, so the answer is still the same whatever other rows are searched with it. On exactly monotone
     decisions it is ``min{j > i : decide(i, j)}`` as before; on noisy ones the crossing
     nearest the guess. Where ``J`` follows the staircase of its neighbours it costs
     2-4 probes per row instead of ``2 log2(J - f + 1) + 1``.
@@ -163,9 +186,18 @@ def staircase_searches(searches: Sequence[tuple[Sequence[int], np.ndarray | None
         found = _lockstep([(rows_of[s], floors[s], None) for s in range(len(searches))], n, decide_many)
         return [np.array([found[s][i] for i in rows_of[s]], dtype=np.int64) for s in range(len(searches))]
     A = int(anchor_every)
-    ext = [with_anchors(r, n, A).tolist() if r else [] for r in rows_of]
-    anchors = [[i for i in e if i % A == 0] for e in ext]
-    found = _lockstep([(anchors[s], floors[s], None) for s in range(len(searches))], n, decide_many)
+    S = SUPER_EVERY if SUPER_EVERY % A == 0 else None
+    ext = [with_anchors(r, n, A, S).tolist() if r else [] for r in rows_of]
+    if S is None:
+        anchors = [[i for i in e if i % A == 0] for e in ext]
+        found = _lockstep([(anchors[s], floors[s], None) for s in range(len(searches))], n, decide_many)
+    else:
+        tops = [[i for i in e if i % S == 0] for e in ext]
+        found = _lockstep([(tops[s], floors[s], None) for s in range(len(searches))], n, decide_many)
+        mids = [[i for i in e if i % A == 0 and i % S] for e in ext]
+        more = _lockstep([(mids[s], floors[s], _efficiency_guesses(mids[s], found[s], floors[s], S, n))
+                          for s in range(len(searches))], n, decide_many)
+        found = [{**found[s], **more[s]} for s in range(len(searches))]
     guesses = []
     for s in range(len(searches)):
         g = {}
@@ -180,6 +212,34 @@ def staircase_searches(searches: Sequence[tuple[Sequence[int], np.ndarray | None
                      n, decide_many)
     return [np.array([rest[s].get(i, found[s].get(i)) for i in rows_of[s]], dtype=np.int64)
             for s in range(len(searches))]
+
+
+def _efficiency_guesses(rows: list[int], top: dict[int, int], floor: np.ndarray | None, S: int, n: int) -> dict[int, int]:
+    """Guesses of the anchors ``rows`` from the top-level anchors' answers ``top`` (spacing ``S``).
+
+    With a floor, the floor's distance ``floor[i] - i`` times the efficiency ``(J - a) / (floor[a] - a)`` of the
+    top anchors ``a`` either side, interpolated linearly in ``i`` (the SVM needs about a constant multiple of
+    the ideal observer's distance, a multiple that changes slowly along the references); without one, their
+    distances ``J - a`` interpolated geometrically (linearly, a rig's need growing about as a power of ``e`` made
+    1.12x version 3's fits on a slice). The top anchor below alone where the one above has no partner in the grid; ``n - 1`` where
+    the one below has none.
+    """
+    out = {}
+    for i in rows:
+        a0 = (i // S) * S
+        a1 = a0 + S if a0 + S in top and top[a0 + S] < n else a0
+        if top[a0] >= n:  # no partner in the grid below: most likely none here either (one probe at n - 1)
+            out[i] = n - 1
+            continue
+        w = (i - a0) / S if a1 != a0 else 0.0
+        if floor is None:  # the distance interpolated geometrically (a need grows about as a power of e)
+            d0, d1 = top[a0] - a0, top[a1] - a1
+            g = i + d0 * (d1 / d0) ** w
+        else:
+            e0, e1 = ((top[a] - a) / max(int(floor[a]) - a, 1) for a in (a0, a1))
+            g = i + (e0 + (e1 - e0) * w) * max(int(floor[i]) - i, 1)
+        out[i] = int(np.floor(g + 0.5))
+    return out
 
 
 def _lockstep(searches, n, decide_many) -> list[dict[int, int]]:

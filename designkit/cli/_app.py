@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import json
 import math
-import re
 import sys
 from typing import Any
 
@@ -288,55 +287,37 @@ def escape(text: str) -> str:
     return rich_escape(text)
 
 
-# rich's markup grammar (rich.markup.RE_TAGS): a tag is "[" + a letter, "#", "/" or "@" + text up to "]",
-# and an odd run of backslashes before "[" makes it literal.
-_MARKUP_TAG = re.compile(r"((\\*)\[([a-z#/@][^[]*?)])")
+class Lines:
+    """Lines of text with styled parts, for the answer a question prints.
 
+    A part is plain text or a ``(text, style)`` pair (a rich style such as ``"bold green"``); text is
+    never read as markup, so a material, table or sensor name needs no escaping. On a terminal a line
+    is ``rich.text.Text.assemble(*parts)`` printed by rich's console; piped or logged, the parts' text
+    is written as it is, and rich is not imported (start-up: docs/decisions-log.md). Both print the
+    same characters: rich drops only the styles.
 
-def strip_markup(text: str) -> str:
-    """``text`` as rich prints it without a terminal: markup tags dropped, escaped brackets kept.
-
-    >>> strip_markup(r"[bold]1.5 s[/] in (1, 1.5] s, \\[not a tag]")
-    '1.5 s in (1, 1.5] s, [not a tag]'
-    """
-    out, pos = [], 0
-    for m in _MARKUP_TAG.finditer(text):
-        out.append(text[pos:m.start()])
-        pos = m.end()
-        slashes, escaped = divmod(len(m.group(2)), 2)
-        out.append("\\" * slashes)
-        if escaped:
-            out.append(f"[{m.group(3)}]")
-    out.append(text[pos:])
-    return "".join(out)
-
-
-class _PlainConsole:
-    """What :func:`text_console` gives when the stream is not a terminal: rich's output without rich.
-
-    Piped or logged, rich prints a line of markup as the line without its tags (no colour, no
-    wrap); this writes the same text without importing rich (start-up: docs/decisions-log.md).
-    Anything but plain strings goes to a real rich console.
+    >>> Lines(stream=sys.stdout).print("answer: ", ("1.2 s", "bold green"), " (SVM)")
+    answer: 1.2 s (SVM)
     """
 
-    def __init__(self, stderr: bool):
-        self._stderr = stderr
+    def __init__(self, stderr: bool = False, *, stream: Any = None, rich_console: Any = None):
+        self._stream = stream if stream is not None else (sys.stderr if stderr else sys.stdout)
+        terminal = stream is None and hasattr(self._stream, "isatty") and self._stream.isatty()
+        self._rich = rich_console if rich_console is not None else (console(stderr) if terminal else None)
 
-    def print(self, *objects, markup: bool = True, **kwargs) -> None:
-        if kwargs or not all(isinstance(o, str) for o in objects):
-            console(self._stderr).print(*objects, markup=markup, **kwargs)
+    def print(self, *parts: "str | tuple[str, str]") -> None:
+        """Print one line made of ``parts`` (plain text, or ``(text, style)``)."""
+        if self._rich is None:
+            self._stream.write("".join(p if isinstance(p, str) else p[0] for p in parts) + "\n")
             return
-        text = " ".join(objects)
-        stream = sys.stderr if self._stderr else sys.stdout
-        stream.write((strip_markup(text) if markup else text) + "\n")
+        from rich.text import Text
+
+        self._rich.print(Text.assemble(*parts))
 
 
-def text_console(stderr: bool = False):
-    """A console for lines of rich markup: rich's on a terminal, :class:`_PlainConsole` otherwise."""
-    stream = sys.stderr if stderr else sys.stdout
-    if hasattr(stream, "isatty") and stream.isatty():
-        return console(stderr)
-    return _PlainConsole(stderr)
+def text_console(stderr: bool = False) -> Lines:
+    """The lines a question's answer is printed on (stdout, or stderr): :class:`Lines`."""
+    return Lines(stderr)
 
 
 def _app_for(argv: list[str]) -> typer.Typer:

@@ -243,18 +243,16 @@ _MODEL_KEYS = ("model", "conductance", "thickness", "backing", "diffusivity")
 def _render_text(d, explain: bool = False) -> None:
     con = _app.text_console()
     _VALUE_LINES[d["question"]](con, d)
-    con.print(f"[dim]{_scene_line(d)}[/]")
+    con.print((_scene_line(d), "dim"))
     warning = _warning(d)
     if explain:
         _explain_lines(con, d)
     elif warning:
-        con.print(f"[yellow]{warning}[/]")
+        con.print((warning, "yellow"))
 
 
 def _scene_line(d) -> str:
     """Line 3: the objects, the scene, the sensor (and model) and where the answer came from."""
-    from ._app import escape
-
     sc = d["scene"]
     scene = [f"{w} {_fmt(sc[k], u)}" for k, w, u in (("noise_c", "noise", "°C"), ("delta_t_c", "dT", "°C"),
                                                    ("contact_s", "contact", "s")) if sc.get(k) is not None]
@@ -264,16 +262,13 @@ def _scene_line(d) -> str:
     model = "" if d["model"]["name"] == "semi-infinite" else f", model {d['model']['name']}"  # --explain: its parameters
     source = (f"table {d['table']['name']}" if d["route"] == "table"
               else f"computed in {d['computation']['wall_s']:.1f} s")
-    return escape(f"{names}, {', '.join(scene)}, F1 ≥ {d['threshold']:g}, {d['sensor']['name']} sensor{model}; "
-                  f"{source}")
+    return f"{names}, {', '.join(scene)}, F1 ≥ {d['threshold']:g}, {d['sensor']['name']} sensor{model}; {source}"
 
 
 def _warning(d) -> str | None:
     """Line 4, when the answer needs a caveat: why there is none, or where the table was left."""
-    from ._app import escape
-
     if d["value"] is None and d["notes"]:
-        return escape(d["notes"][0])
+        return d["notes"][0]
     if d["question"] == "delta-e" and any(d["details"][k][w] is None for k in ("lower", "upper")
                                           for w in ("value", "ideal")):
         return "— : no distinguishable effusivity in that direction within the range examined"
@@ -287,7 +282,7 @@ def _warning(d) -> str | None:
             return "below the table's shortest contact time: extrapolated (--explain says more)"
     chk = d["model_check"]
     if chk and chk.get("message") and not chk.get("holds"):
-        return escape(chk["message"])
+        return chk["message"]
     return None
 
 
@@ -311,20 +306,18 @@ def _interval(d, unit):
 def _answerer(d) -> str:
     """Whose answer line 1 gives: the paper's SVM, or the ideal observer where the table holds that."""
     if (d.get("computation") or {}).get("fidelity") == "ideal":
-        from ._app import escape
-
-        return f"ideal observer on table {escape(d['table']['name'])}'s grid"
+        return f"ideal observer on table {d['table']['name']}'s grid"
     return "SVM"
 
 
 def _scalar(words: str, unit: str):
     def line(con, d):
         if d["value"] is None:
-            con.print(f"{words}: [red]no answer[/] ({_answerer(d)})")
+            con.print(f"{words}: ", ("no answer", "red"), f" ({_answerer(d)})")
         else:
             qual = {"at-most": "at most ", "at-least": "at least "}.get(d.get("bound") or "", "")  # Answer.bound
             iv = "(a bound: the table's grid ends there)" if qual else _interval(d, unit)
-            con.print(f"{words}: {qual}[bold green]{_fmt(d['value'], unit)}[/] {iv}, {_answerer(d)}")
+            con.print(f"{words}: {qual}", (_fmt(d["value"], unit), "bold green"), f" {iv}, {_answerer(d)}")
         ideal = d["ideal"]
         iv = ideal.get("interval")
         ends = f", {iv['coverage']:.0%} interval {_fmt(iv['low'])} to {_fmt(iv['high'], unit)}" if iv else ""
@@ -342,20 +335,20 @@ def _delta_lines(con, d):
         cov = f"{iv['coverage']:.0%} interval" if iv.get("coverage") else "interval, coverage not stated"
         shown = s["value"] is not None and (iv["low"], iv["high"]) != (None, None)  # an ideal table's has no ends
         ivs = f" ({cov} {_fmt(iv['low'])} to {_fmt(iv['high'])})" if shown else ""
-        con.print(f"{words}: [bold green]{_fmt(s['value'])}[/]{ivs} {who}, ideal bound {_fmt(s['ideal']['value'])}")
+        con.print(f"{words}: ", (_fmt(s["value"]), "bold green"), f"{ivs} {who}, ideal bound {_fmt(s['ideal']['value'])}")
 
 
 def _distinguishable_lines(con, d):
     x = d["details"]
     if x["distinguishable"] is None:
-        con.print("distinguishable: [yellow]no answer[/]")
+        con.print("distinguishable: ", ("no answer", "yellow"))
     else:
-        yes = "[bold green]yes[/]" if x["distinguishable"] else "[bold red]no[/]"
+        yes = ("yes", "bold green") if x["distinguishable"] else ("no", "bold red")
         iv = d["interval"]
         f1 = (f", F1 {x['svm_f1']:.3f} ({iv['coverage']:.0%} interval {iv['low']:.3f} to {iv['high']:.3f})"
               if x["svm_f1"] is not None else "")
         verdict = f"; {x['verdict']}" if x.get("verdict") else ""
-        con.print(f"distinguishable: {yes}{f1} ({_answerer(d)}{verdict})")
+        con.print("distinguishable: ", yes, f"{f1} ({_answerer(d)}{verdict})")
     if x["ideal_f1"] is not None:  # also where the table has no answer: the closed form needs no table
         con.print(f"ideal observer bound: F1 {x['ideal_f1']:.3f} ({d['ideal']['method']})"
                   + (", distinguishable" if x["ideal_distinguishable"] else ", not even in principle"))
@@ -374,11 +367,10 @@ _VALUE_LINES = {
 
 def _explain_lines(con, d):
     """--explain: the objects with their units, the hardest pair, the paper's remark, the method, every note."""
-    con.print("objects [J s^-1/2 K^-1 m^-2]: " + " vs ".join(f"[bold]{o['label']}[/]" for o in d["objects"]))
+    labels = [part for o in d["objects"] for part in (" vs ", (o["label"], "bold"))][1:]
+    con.print("objects [J s^-1/2 K^-1 m^-2]: ", *labels)
     if d["model"]["name"] != "semi-infinite":
-        from ._app import escape
-
-        con.print(f"model: {escape(_model_words(d))}")
+        con.print(f"model: {_model_words(d)}")
     if d["limiting_pair"] and any(o["material"] for o in d["objects"]) and d["question"] != "delta-e":
         con.print("answered for the hardest pair: " + " vs ".join(o["label"] for o in d["limiting_pair"]))
     if d["question"] == "delta-e":
@@ -415,14 +407,14 @@ def _explain_lines(con, d):
         con.print(f"method: computed for this pair ({c['repeats']} seeds x {c['trials']} trials per class"
                   f"{varied}, {c['wall_s']:.1f} s)")
     if d.get("route_reason") and d["route_reason"] not in d["notes"]:
-        con.print(f"route ({d['route']}): {d['route_reason']}", markup=False)
+        con.print(f"route ({d['route']}): {d['route_reason']}")
     for n in d["notes"]:
-        con.print(f"note: {n}", markup=False)
+        con.print(f"note: {n}")
     chk = d["model_check"]
     if chk and chk.get("message"):
-        con.print(f"{'' if chk['holds'] else '[yellow]'}model check: {chk['message']}{'' if chk['holds'] else '[/]'}")
+        con.print((f"model check: {chk['message']}", "" if chk["holds"] else "yellow"))
     if any(o["material"] for o in d["objects"]):
-        con.print(d["materials_rule"], markup=False)
+        con.print(d["materials_rule"])
 
 
 # ============================================================ the commands

@@ -32,11 +32,9 @@ support vectors) is solved by libsvm itself (scikit-learn's ``SVC`` on the preco
 kernel, on the host, eps = 1e-3, at most 200,000 steps), and from libsvm's free and
 bounded sets the active-set method then finds the exact optimum in a few solves
 (``solver`` 2; libsvm's own answer where that does not converge, ``solver`` 3). On the
-calibrated rig's overlapping classes libsvm stops at its step cap short of eps on most
-fold problems; against libsvm without a cap (what the reference runs), per-fit F1 moves
-by sd 0.005 with the exact optimum, 0.008 with libsvm's capped answer and 0.03 with the
-``1e-3`` ridge's optimum (a different classifier), at about the capped cost
-(``benchmarks/bench_rig_duals.py``, ``benchmarks/results/rig-duals.txt``).
+calibrated rig's overlapping classes, against libsvm without a cap (the reference), per-fit
+F1 moves by sd 0.005 so, 0.008 with libsvm's capped answer, 0.03 with the ``1e-3`` ridge's
+optimum (a different classifier): ``benchmarks/results/rig-duals.txt``.
 
 Cost. The Gram products dominate (``n_train^2 d / 2`` multiply-adds per fold); by
 default they are formed in float32 from features centered in float64 (relative error
@@ -82,7 +80,6 @@ LIBSVM_EPS = 1e-3
 _RIDGE = 1e-9  # relative ridge of the active-set solves (times mean(diag K))
 _CONTINUATION = (1e-3, 1e-9)
 _POLISH_SMO = True  # SMO's answers polished to the exact optimum (benchmarks/bench_rig_duals.py compares without)
-_SOLVER_NAMES = ("active-set", "active-set continuation", "smo + active set", "smo")
 
 
 def _namespace(xp, *arrays):
@@ -360,13 +357,8 @@ def _active_set(K, y, C, ridge, free, up, max_iter, xp):
 
 
 def _restore_equality(a, y, ok, C, xp):
-    """``y.a = 0`` restored on the free variables of active-set solutions: ``(a, ok)``.
-
-    Near-degenerate optima (more free variables than the Gram matrix's rank) leave the
-    numpy path's block elimination a residual of up to about 1e-8 (the bordered LU of the
-    array-API path does not); it is spread evenly over the free variables (each moves by
-    ``|residual| / |F|``). A problem where that would leave the box keeps ``ok`` false.
-    """
+    """``(a, ok)`` with ``y.a = 0`` restored: numpy's block elimination leaves up to 1e-8 on near-degenerate
+    optima (the bordered LU does not), spread evenly over the free ``a``; ``ok`` false where that leaves the box."""
     free = (a > 0.0) & (a < C)
     n_free = xp.sum(xp.astype(free, a.dtype), axis=-1)
     r = xp.sum(y * a, axis=-1) / xp.where(n_free > 0, n_free, 1.0)
@@ -497,13 +489,10 @@ def solve_svc_duals(K, y, *, C: float = 1.0, xp=None, max_active_set_iter: int =
         solver[todo] = 1
         rest = todo[~ok_t]
         if rest.shape[0]:
-            # libsvm's own SMO (the reference's solver, in C): a batched SMO stepped in Python, 100,000+ steps
-            # a fold where classes overlap (a rig's correlated noise: 86 s a fit, 1.2 s by libsvm)
+            # libsvm's own SMO (the reference's solver, in C), then the exact optimum from its active set: 1-10
+            # solves on the calibrated rig's duals, where SMO stops at its cap short of eps (solver 3: SMO's answer)
             Kr, yr = K[rest], y[rest]
             a_s, _, it_s = _libsvm_smo(Kr, yr, C, LIBSVM_EPS, smo_max_iter, xp)
-            # then the exact optimum from SMO's active set: a few active-set solves (1-10 on the calibrated rig's
-            # duals, where SMO stops at its step cap short of eps; from all-free they diverge). Where they do not
-            # converge, SMO's own answer stays (solver 3).
             if _POLISH_SMO:
                 a_p, ok_p, _ = _active_set(Kr, yr, C, _RIDGE * scale[rest], (a_s > 0.0) & (a_s < C), a_s >= C,
                                            max_active_set_iter, xp)

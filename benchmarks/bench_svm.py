@@ -96,7 +96,7 @@ def agreement(n_pairs: int, seed: int, group: int = 16) -> dict:
     n_pred = n_f1_diff = 0
     diffs = []  # (|dec ref|, |dec ours|, contact, ratio, gap)
     max_abs = 0.0
-    stages = np.zeros(3, dtype=int)
+    stages = np.zeros(4, dtype=int)  # active set, continuation, libsvm + exact polish, libsvm alone
     max_gap = 0.0
     t_ref = t_new = 0.0
     for contact, group_specs in sorted(by_contact.items()):
@@ -107,7 +107,7 @@ def agreement(n_pairs: int, seed: int, group: int = 16) -> dict:
             t = time.process_time()
             ours = batched_cv_f1([f[0] for f in feats], [f[1] for f in feats], seeds=seeds)
             t_new += time.process_time() - t
-            stages += np.bincount(ours.solver.ravel(), minlength=3)
+            stages += np.bincount(ours.solver.ravel(), minlength=4)
             max_gap = max(max_gap, float(ours.kkt_gap.max()))
             for i, ((lo, hi), spec) in enumerate(zip(feats, chunk)):
                 t = time.process_time()

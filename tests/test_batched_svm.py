@@ -90,6 +90,33 @@ def test_dual_solution_meets_libsvms_optimum(case):
     np.testing.assert_allclose(dec_ours, dec_ref, atol=0.05 * max(1.0, np.abs(dec_ref).max()))
 
 
+def test_problems_libsvm_solves_end_at_the_exact_optimum_even_where_it_stops_at_its_cap():
+    """Overlapping, rank-deficient classes: the active set cannot solve them from all-free,
+    libsvm can (to eps 1e-3, or stopped by its step cap, as on the calibrated rig); its free
+    and bounded sets then give the exact optimum (``solver`` 2), whatever libsvm's step cap."""
+    rng = np.random.default_rng(3)
+    n, d = 40, 10
+    y01 = np.r_[np.zeros(n // 2, dtype=int), np.ones(n // 2, dtype=int)]
+    X = rng.normal(size=(n, d)) + 0.5 * y01[:, None]
+    K = X @ X.T
+    y_lib = np.where(y01 == 0, 1.0, -1.0)
+    a_ref, _ = _libsvm(K, y01)  # libsvm without a cap: 386 steps, KKT gap just under 1e-3
+    _, _, info_ref = solve_svc_duals(K[None], y_lib, smo_max_iter=10**6)
+    a, rho, info = solve_svc_duals(K[None], y_lib)
+    a_cap, rho_cap, info_cap = solve_svc_duals(K[None], y_lib, smo_max_iter=150)
+    assert info_cap["iterations"][0] == 150 < info_ref["iterations"][0]  # stopped by the cap
+    assert info["solver"][0] == info_cap["solver"][0] == 2
+    assert info["kkt_gap"][0] < 1e-6 and info_cap["kkt_gap"][0] < 1e-6  # libsvm stops at 1e-3
+
+    def dual(v):
+        q = v * y_lib
+        return 0.5 * q @ K @ q - v.sum()
+
+    assert dual(a[0]) < dual(a_ref)
+    np.testing.assert_allclose(a_cap, a, atol=1e-9)
+    np.testing.assert_allclose(rho_cap, rho, atol=1e-9)
+
+
 def test_batched_f1_equals_the_reference_except_on_near_ties(paper_sensor):
     rng = np.random.default_rng(12)
     specs = []

@@ -47,7 +47,9 @@ CV_KEY = 7919
 #: Version 3: a guided row's search gallops to ``g -+ 1, 2, 4, ...`` from its guess instead of ``g -+ 1, 3, 7, ...``
 #: (:func:`~designkit.sweep.search.staircase_searches`): fewer fits; on noisy decisions another crossing.
 #: Version 4: only every :data:`~designkit.sweep.search.SUPER_EVERY`-th reference is searched from its floor; the
-#: other anchors start from a guess scaled from those (the same gallop; fewer fits, another crossing where noisy).
+#: other anchors start from a guess scaled from those (the same gallop; fewer fits, another crossing where noisy);
+#: and a fold problem the batched solver hands to libsvm ends at the exact optimum reached from libsvm's active
+#: set, not libsvm's answer at its step cap (overlapping classes, e.g. a calibrated rig's table).
 ENGINE_VERSION = 4
 
 

@@ -312,21 +312,39 @@ def _object_reading(parts, e_object) -> np.ndarray:
     return C / (A + B * inv_eo)
 
 
-@functools.lru_cache(maxsize=4)
-def _scene_parts(kwargs: tuple, time_bytes: bytes, nodes: int):
-    """Talbot weights and the object-independent transform on a time grid, once per scene (read-only).
+class _SceneGrid:
+    """Talbot weights and the object-independent transform (``C / B``, ``A / B``) on the longest time grid asked
+    so far of one scene whose grids start at one time: a grid that is a prefix of it reads a slice.
 
-    A pure function of its (hashable) arguments, so the cache changes no result: a simulation reading
-    class after class of one scene pays the contour's exponentials once.
+    Every factor is a function of its own time alone (elementwise), so a slice is bit for bit the parts computed
+    on the shorter grid: a force ramp's shares and touches (lag grids of one phase, each a prefix of the longest)
+    and a sweep's contacts share one evaluation of the contour's exponentials instead of one per grid.
     """
-    t = np.frombuffer(time_bytes, dtype=np.float64)
-    p, weights = talbot_points(t, nodes)
-    A, B, C = laplace_parts(p, **dict(kwargs))
-    # U = C / (A + B / e_o) = (C / B) / (A / B + 1 / e_o): per object one real addition and one division
-    out = (weights, C / B, A / B)
-    for a in out:
-        a.setflags(write=False)
-    return out
+
+    def __init__(self, kwargs: tuple, nodes: int):
+        self.kwargs, self.nodes = dict(kwargs), int(nodes)
+        self.time = np.empty(0)
+        self.parts: tuple = ()
+
+    def parts_for(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(weights, C / B, A / B)`` at times ``t`` (m,), each (m, nodes), read-only."""
+        n = t.size
+        if n > self.time.size or not np.array_equal(self.time[:n], t):
+            p, weights = talbot_points(t, self.nodes)
+            A, B, C = laplace_parts(p, **self.kwargs)
+            # U = C / (A + B / e_o) = (C / B) / (A / B + 1 / e_o): per object one real addition and one division
+            self.parts = (weights, C / B, A / B)
+            for a in self.parts:
+                a.setflags(write=False)
+            self.time = t.copy()
+        return tuple(a[:n] for a in self.parts)
+
+
+@functools.lru_cache(maxsize=8)
+def _scene_grid(kwargs: tuple, start_bytes: bytes, nodes: int) -> _SceneGrid:
+    """The :class:`_SceneGrid` of a scene (the model's Laplace parameters) and a grid's first time, one per process
+    (the last 8 kept). A pure function's memo: it changes no result, it only saves the exponentials."""
+    return _SceneGrid(kwargs, nodes)
 
 
 @dataclass(frozen=True)
@@ -461,7 +479,8 @@ class Layered(ForwardModel):
         live = eo > 0
         if pos.any() and live.any():
             kw = tuple(sorted(self._laplace_kwargs(sensor).items()))
-            weights, num, den = _scene_parts(kw, np.ascontiguousarray(t[pos]).tobytes(), int(nodes))
+            tp = np.ascontiguousarray(t[pos])
+            weights, num, den = _scene_grid(kw, tp[:1].tobytes(), int(nodes)).parts_for(tp)
             x = eo[live]
             inv = np.where(np.isinf(x), 0.0, 1.0 / np.where(np.isinf(x), 1.0, x))
             out[np.ix_(live, pos)] = _talbot_sum(num / (den + inv[:, None, None]), weights)

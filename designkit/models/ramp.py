@@ -37,6 +37,7 @@ True
 from __future__ import annotations
 
 import dataclasses
+import functools
 from dataclasses import dataclass
 from typing import Any, Mapping
 
@@ -158,8 +159,13 @@ class ForceRamp(ForwardModel):
     def touch(self, j: int) -> tuple["ForceRamp", float]:
         """Touch ``j``'s own ramp (a ramp without touch ramps) and its first contact's delay [s] after the
         nominal one's: its reading at model time ``t`` is ``ramp.response(t - delay)``."""
-        delay, times, areas = self.touch_ramps[int(j)]
-        return ForceRamp(self.base, times, areas, self.force_fraction, self.source), delay
+        return self._touches[int(j)]
+
+    @functools.cached_property
+    def _touches(self) -> tuple:
+        """Every touch's ``(ramp, delay)``, made once (a simulated class asks for them class after class)."""
+        return tuple((ForceRamp(self.base, times, areas, self.force_fraction, self.source), delay)
+                     for delay, times, areas in self.touch_ramps)
 
     def nominal(self) -> "ForceRamp":
         """This ramp without the touch ramps (every touch pressing as the nominal one)."""
@@ -275,14 +281,18 @@ class ForceRamp(ForwardModel):
             if live.any():
                 S[:, live] = step.response(lag[live], e_object, sensor, diffusivity_m2_s=diffusivity_m2_s,
                                            tolerance=tolerance)
-            buf = np.empty(out.shape)
-            for n_j, d_j in zip(whole[group].tolist(), da[group].tolist()):
-                lo = -n_j if n_j < 0 else 0                               # first sample with n_j + i >= 0
-                if lo >= m:
-                    continue
-                part = buf[:, lo:]
-                np.multiply(S[:, n_j + lo:n_j + m], d_j, out=part)
-                out[:, lo:] += part
+            # every share's window of S at once (S padded with the zeros before contact where n_j < 0; a share
+            # whose contact comes after the last time adds nothing), weighted by its dA and summed share by share
+            # in order (a reduction over a middle axis: elementwise additions, no BLAS: the same bits on every
+            # run), a few objects at a time (the windows' copy: objects x shares x m)
+            group = group[whole[group] > -m]
+            pad = max(0, -int(whole[group].min())) if group.size else 0
+            S = np.concatenate([np.zeros((out.shape[0], pad)), S], axis=1) if pad else S
+            windows = np.lib.stride_tricks.sliding_window_view(S, m, axis=1)
+            for k in range(0, out.shape[0], 16):
+                part = windows[k:k + 16, whole[group] + pad]                  # (K, J, m)
+                part *= da[group][None, :, None]
+                out[k:k + 16] += part.sum(axis=1)
         return out
 
     def response(self, time_s, e_object, sensor, *, diffusivity_m2_s=None, tolerance: float = 1e-9) -> np.ndarray:

@@ -554,6 +554,14 @@ def smoothed_reading(reading, time_s, sample_rate_hz: float, window: int, order:
     True
     """
     t = np.atleast_1d(np.asarray(time_s, dtype=np.float64))
+    u = reading(smoothing_grid(t, sample_rate_hz, window, what=what))
+    return smooth_cut(u, t.size, window, order)
+
+
+def smoothing_grid(time_s, sample_rate_hz: float, window: int, *, what: str = "a smoothed model") -> np.ndarray:
+    """The times :func:`smoothed_reading` reads the model at: ``window // 2`` samples before the first of the
+    uniformly spaced ``time_s``, the times, and past the last where the series is shorter than the window."""
+    t = np.atleast_1d(np.asarray(time_s, dtype=np.float64))
     if t.size > 1:
         dt = np.diff(t)
         if np.any(np.abs(dt - dt[0]) > 1e-6 * dt[0]) or dt[0] <= 0:
@@ -562,11 +570,14 @@ def smoothed_reading(reading, time_s, sample_rate_hz: float, window: int, order:
     else:
         step = 1.0 / float(sample_rate_hz)
     half = window // 2
-    before = t[0] - step * np.arange(half, 0, -1)
-    u = reading(np.concatenate([before, t]))
-    if u.shape[1] < window:  # short series: extend past the end, smooth, cut
-        extra = window - u.shape[1]
-        after = t[-1] + step * np.arange(1, extra + 1)
-        u = reading(np.concatenate([before, t, after]))
-        return np.clip(savgol_smooth(u, window, order)[:, half:half + t.size], 0.0, 1.0)
-    return np.clip(savgol_smooth(u, window, order)[:, half:], 0.0, 1.0)
+    grid = [t[0] - step * np.arange(half, 0, -1), t]
+    if half + t.size < window:  # short series: extend past the end, smooth, cut
+        grid.append(t[-1] + step * np.arange(1, window - half - t.size + 1))
+    return np.concatenate(grid)
+
+
+def smooth_cut(u, n_times: int, window: int, order: int) -> np.ndarray:
+    """Readings (K, len(grid)) on a :func:`smoothing_grid` smoothed, cut back to its ``n_times`` times and
+    clipped to [0, 1]."""
+    half = window // 2
+    return np.clip(savgol_smooth(u, window, order)[:, half:half + n_times], 0.0, 1.0)

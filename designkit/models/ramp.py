@@ -312,6 +312,31 @@ class ForceRamp(ForwardModel):
                                 t, sensor.sample_rate_hz, window, int(self.base.smoothing_order),
                                 what="a smoothed model with a force ramp")
 
+    def touch_readings(self, time_s, e_object, touch, sensor, *, tolerance: float = 1e-9) -> np.ndarray:
+        """Normalized readings (K, m) of objects ``e_object`` (K,), object ``k`` pressing as touch ramp ``touch[k]``
+        (:meth:`touch`: its reading at ``time_s - delay``): each touch's Duhamel sum on its own times, and with a
+        base model that smooths, one smoothing of them all: what :meth:`response` of each touch's ramp gives.
+        """
+        t = np.atleast_1d(np.asarray(time_s, dtype=np.float64))
+        e = np.atleast_1d(np.asarray(e_object, dtype=np.float64))
+        touch = np.asarray(touch)
+        window = int(getattr(self.base, "smoothing_window", 0) or 0)
+        if window > 1:
+            from .layered import smooth_cut, smoothing_grid
+        raw = None
+        for j in np.unique(touch).tolist():
+            ramp, delay = self.touch(j)
+            rows = touch == j
+            times = t - delay if window <= 1 else smoothing_grid(t - delay, sensor.sample_rate_hz, window,
+                                                                  what="a smoothed model with a force ramp")
+            u = ramp._unsmoothed(times, e[rows], sensor, None, tolerance)
+            if raw is None:
+                raw = np.empty((e.size, u.shape[1]))
+            raw[rows] = u
+        if raw is None:
+            return np.zeros((0, t.size))
+        return raw if window <= 1 else smooth_cut(raw, t.size, window, int(self.base.smoothing_order))
+
     def check(self, objects, sensor, *, contact_s: float, noise_c: float, delta_t_c: float):
         """The base model's check (the ramp adds no validity limit of its own)."""
         return self.base.check(objects, sensor, contact_s=contact_s, noise_c=noise_c, delta_t_c=delta_t_c)

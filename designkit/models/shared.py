@@ -148,13 +148,13 @@ class _SensorKey(bytes):
     repr cost 5 ms for a calibrated rig's, per class and touch ramp)."""
 
 
-@functools.lru_cache(maxsize=16)
+@functools.lru_cache(maxsize=64)   # a calibrated rig's 24 touch ramps at a contact or two
 def _cached_scene(model: ForwardModel, sensor: _SensorKey, time_bytes: bytes, tolerance: float) -> SceneResponse:
     return SceneResponse(model, np.frombuffer(time_bytes, dtype=np.float64).copy(), sensor.sensor, tolerance)
 
 
 def scene_response(model: ForwardModel, time_s, sensor, *, tolerance: float) -> SceneResponse:
-    """The :class:`SceneResponse` of a model, sensor, time grid and tolerance, one per process (the last 16 kept).
+    """The :class:`SceneResponse` of a model, sensor, time grid and tolerance, one per process (the last 64 kept).
 
     Its panels are a pure function of those four, so sharing them changes no reading: it only saves reading
     the model again for the next class or repeat of the same scene.

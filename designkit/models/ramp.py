@@ -288,9 +288,9 @@ class ForceRamp(ForwardModel):
             group = group[whole[group] > -m]
             pad = max(0, -int(whole[group].min())) if group.size else 0
             S = np.concatenate([np.zeros((out.shape[0], pad)), S], axis=1) if pad else S
-            windows = np.lib.stride_tricks.sliding_window_view(S, m, axis=1)
+            at = (whole[group] + pad)[:, None] + np.arange(m)                  # (J, m): share j's window
             for k in range(0, out.shape[0], 16):
-                part = windows[k:k + 16, whole[group] + pad]                  # (K, J, m)
+                part = S[k:k + 16, at]                                        # (K, J, m)
                 part *= da[group][None, :, None]
                 out[k:k + 16] += part.sum(axis=1)
         return out

@@ -76,8 +76,8 @@ import numpy as np
 from .._validation import InputError, check_nonnegative, check_positive
 from .base import ForwardModel
 
-__all__ = ["Layered", "laplace_parts", "laplace_reading", "savgol_smooth", "smoothed_reading", "talbot_invert",
-           "talbot_points"]
+__all__ = ["Layered", "laplace_parts", "laplace_reading", "savgol_smooth", "smooth_cut", "smoothing_grid",
+           "talbot_invert", "talbot_points"]
 
 #: Fixed-Talbot nodes: 24 gives about 1e-11 absolute error in double precision.
 TALBOT_NODES = 24
@@ -257,7 +257,9 @@ def laplace_reading(p, e_object, *, e_film: float, diffusivity_film_m2_s: float,
                           thickness_m=thickness_m, e_backing=e_backing,
                           diffusivity_backing_m2_s=diffusivity_backing_m2_s, conductance_w_m2k=conductance_w_m2k,
                           lag_s=lag_s, backing_thickness_m=backing_thickness_m)
-    return _object_reading(parts, e_object)
+    A, B, C = parts
+    eo = np.asarray(e_object, dtype=np.float64)[:, None, None]
+    return C / (A + B * np.where(np.isinf(eo), 0.0, 1.0 / np.where(np.isinf(eo), 1.0, eo)))   # e_o = inf: C / A
 
 
 def laplace_parts(p, *, e_film: float, diffusivity_film_m2_s: float, depth_m: float, thickness_m: float,
@@ -304,22 +306,10 @@ def laplace_parts(p, *, e_film: float, diffusivity_film_m2_s: float, depth_m: fl
     return np.broadcast_to(A, p.shape), B, C
 
 
-def _object_reading(parts, e_object) -> np.ndarray:
-    """``U = C / (A + B / e_o)`` for objects ``e_object`` (K,): shape (K, m, n); ``e_o = inf`` reads ``C / A``."""
-    A, B, C = parts
-    eo = np.asarray(e_object, dtype=np.float64)[:, None, None]
-    inv_eo = np.where(np.isinf(eo), 0.0, 1.0 / np.where(np.isinf(eo), 1.0, eo))
-    return C / (A + B * inv_eo)
-
-
 class _SceneGrid:
-    """Talbot weights and the object-independent transform (``A / B``, ``C / B``) on the longest time grid asked
-    so far of one scene whose grids start at one time: a grid that is a prefix of it reads a slice.
-
-    Every factor is a function of its own time alone (elementwise), so a slice is bit for bit the parts computed
-    on the shorter grid: a force ramp's shares and touches (lag grids of one phase, each a prefix of the longest)
-    and a sweep's contacts share one evaluation of the contour's exponentials instead of one per grid.
-    """
+    """The object-independent transform on the longest time grid of a scene asked so far, starting at one time:
+    a grid that is its prefix reads a slice (elementwise factors: the same bits), so a ramp's shares and touches
+    and a sweep's contacts pay the contour's exponentials once."""
 
     def __init__(self, kwargs: tuple, nodes: int):
         self.kwargs, self.nodes = dict(kwargs), int(nodes)
@@ -341,13 +331,9 @@ class _SceneGrid:
         return tuple(a[:, :n] for a in self.parts)
 
     def reading(self, t: np.ndarray, inv_e: np.ndarray) -> np.ndarray:
-        """The inverse transform at times ``t`` (m,) of objects of ``1 / e_o`` ``inv_e`` (K,): shape (K, m).
-
-        ``U = C / (A + B / e_o) = (C / B) / (d + v)``, ``v = 1 / e_o``, and the Talbot sum's terms
-        ``Re(g / (d + v)) = (g_re x + g_im d_im) / (x^2 + d_im^2)``, ``x = d_re + v``: real arithmetic, all
-        objects, times and nodes at once, summed node by node in a fixed order (elementwise operations only: the
-        same bits on every run).
-        """
+        """The inverse at times ``t`` (m,) of objects of ``1 / e_o`` = ``inv_e`` (K,), shape (K, m): the Talbot
+        terms ``Re(g / (d + v)) = (g_re x + g_im d_im) / (x^2 + d_im^2)``, ``x = d_re + v``, in real arithmetic,
+        summed node by node in a fixed order (elementwise only: the same bits on every run)."""
         d_re, d_im2, g_re, g_dim = self.parts_for(t)
         x = d_re + inv_e[:, None, None]                      # (K, nodes, m)
         terms = g_re * x
@@ -363,8 +349,7 @@ class _SceneGrid:
 
 @functools.lru_cache(maxsize=8)
 def _scene_grid(kwargs: tuple, start_bytes: bytes, nodes: int) -> _SceneGrid:
-    """The :class:`_SceneGrid` of a scene (the model's Laplace parameters) and a grid's first time, one per process
-    (the last 8 kept). A pure function's memo: it changes no result, it only saves the exponentials."""
+    """One :class:`_SceneGrid` per scene and first time per process (a memo: it changes no result)."""
     return _SceneGrid(kwargs, nodes)
 
 
@@ -520,47 +505,21 @@ class Layered(ForwardModel):
         t = np.atleast_1d(np.asarray(time_s, dtype=np.float64))
         if self.smoothing_window <= 1:
             return self.conduction(t, e_object, sensor)
-        return smoothed_reading(lambda tt: self.conduction(tt, e_object, sensor), t, sensor.sample_rate_hz,
-                                self.smoothing_window, self.smoothing_order, what="the smoothed layered model")
-
-
-def smoothed_reading(reading, time_s, sample_rate_hz: float, window: int, order: int, *,
-                     what: str = "a smoothed model") -> np.ndarray:
-    """A reading smoothed as the host smoothed a recording (Savitzky-Golay, ``mode="interp"``).
-
-    ``reading(t)`` gives the unsmoothed reading (K, len(t)), 0 before contact.
-    It is evaluated from ``window // 2`` samples before the first time (zeros
-    before contact, as the host saw them) to the last (extended past the end
-    when the series is shorter than the window), smoothed, and cut back to
-    ``time_s``; the last ``window // 2`` samples use the filter's polynomial
-    fit at the end. The result is clipped to [0, 1].
-
-    Parameters
-    ----------
-    reading : callable
-        ``t -> ndarray (K, len(t))``.
-    time_s : array_like, shape (m,)
-        Uniformly spaced times [s] (one time: the sample period ``1/fs``).
-    sample_rate_hz : float
-        Used for the spacing when ``time_s`` has one time.
-    window, order : int
-        Savitzky-Golay window (odd, samples) and order.
-
-    Examples
-    --------
-    >>> t = np.arange(300) / 200.0
-    >>> u = smoothed_reading(lambda tt: np.clip(tt, 0.0, None)[None, :] * 0.1, t, 200.0, 99, 3)
-    >>> bool(np.allclose(u[0, 60:240], 0.1 * t[60:240]))   # a line away from the kink at 0 passes unchanged
-    True
-    """
-    t = np.atleast_1d(np.asarray(time_s, dtype=np.float64))
-    u = reading(smoothing_grid(t, sample_rate_hz, window, what=what))
-    return smooth_cut(u, t.size, window, order)
+        grid = smoothing_grid(t, sensor.sample_rate_hz, self.smoothing_window, what="the smoothed layered model")
+        return smooth_cut(self.conduction(grid, e_object, sensor), t.size, self.smoothing_window, self.smoothing_order)
 
 
 def smoothing_grid(time_s, sample_rate_hz: float, window: int, *, what: str = "a smoothed model") -> np.ndarray:
-    """The times :func:`smoothed_reading` reads the model at: ``window // 2`` samples before the first of the
-    uniformly spaced ``time_s``, the times, and past the last where the series is shorter than the window."""
+    """Where a reading smoothed as the host smoothed a recording (Savitzky-Golay, ``mode="interp"``) reads the
+    model: ``window // 2`` samples before the first of the uniformly spaced ``time_s`` (zeros before contact, as
+    the host saw them; one time: ``1 / sample_rate_hz`` apart), the times, and past the last where the series is
+    shorter than the window; :func:`smooth_cut` smooths the reading and cuts it back.
+
+    >>> t = np.arange(300) / 200.0
+    >>> u = smooth_cut(np.clip(smoothing_grid(t, 200.0, 99), 0.0, None)[None, :] * 0.1, t.size, 99, 3)
+    >>> bool(np.allclose(u[0, 60:240], 0.1 * t[60:240]))   # a line away from the kink at 0 passes unchanged
+    True
+    """
     t = np.atleast_1d(np.asarray(time_s, dtype=np.float64))
     if t.size > 1:
         dt = np.diff(t)

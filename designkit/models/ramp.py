@@ -302,40 +302,31 @@ class ForceRamp(ForwardModel):
         sum is smoothed once, as the host smoothed the recorded touch; then the
         times must be uniform.
         """
-        t = np.atleast_1d(np.asarray(time_s, dtype=np.float64))
-        window = int(getattr(self.base, "smoothing_window", 0) or 0)
-        if window <= 1:
-            return self._unsmoothed(t, e_object, sensor, diffusivity_m2_s, tolerance)
-        from .layered import smoothed_reading
-
-        return smoothed_reading(lambda tt: self._unsmoothed(tt, e_object, sensor, diffusivity_m2_s, tolerance),
-                                t, sensor.sample_rate_hz, window, int(self.base.smoothing_order),
-                                what="a smoothed model with a force ramp")
+        return self._read(time_s, e_object, [(self, 0.0, slice(None))], sensor, diffusivity_m2_s, tolerance)
 
     def touch_readings(self, time_s, e_object, touch, sensor, *, tolerance: float = 1e-9) -> np.ndarray:
         """Normalized readings (K, m) of objects ``e_object`` (K,), object ``k`` pressing as touch ramp ``touch[k]``
-        (:meth:`touch`: its reading at ``time_s - delay``): each touch's Duhamel sum on its own times, and with a
-        base model that smooths, one smoothing of them all: what :meth:`response` of each touch's ramp gives.
-        """
+        (:meth:`touch`: its reading at ``time_s - delay``): each touch ramp's :meth:`response`, smoothed at once."""
+        touch = np.asarray(touch)
+        groups = [(*self.touch(j), touch == j) for j in np.unique(touch).tolist()]
+        return self._read(time_s, e_object, groups, sensor, None, tolerance)
+
+    def _read(self, time_s, e_object, groups, sensor, diffusivity_m2_s, tolerance: float) -> np.ndarray:
+        """Objects ``e_object[rows]`` read as ``ramp`` at ``time_s - delay``, for each ``(ramp, delay, rows)``;
+        with a base model that smooths, every row's sum smoothed in one call."""
+        from .layered import smooth_cut, smoothing_grid
+
         t = np.atleast_1d(np.asarray(time_s, dtype=np.float64))
         e = np.atleast_1d(np.asarray(e_object, dtype=np.float64))
-        touch = np.asarray(touch)
         window = int(getattr(self.base, "smoothing_window", 0) or 0)
-        if window > 1:
-            from .layered import smooth_cut, smoothing_grid
-        raw = None
-        for j in np.unique(touch).tolist():
-            ramp, delay = self.touch(j)
-            rows = touch == j
+        raw = np.zeros((e.size, t.size)) if not groups else None
+        for ramp, delay, rows in groups:
             times = t - delay if window <= 1 else smoothing_grid(t - delay, sensor.sample_rate_hz, window,
                                                                   what="a smoothed model with a force ramp")
-            u = ramp._unsmoothed(times, e[rows], sensor, None, tolerance)
-            if raw is None:
-                raw = np.empty((e.size, u.shape[1]))
+            u = ramp._unsmoothed(times, e[rows], sensor, diffusivity_m2_s, tolerance)
+            raw = np.empty((e.size, u.shape[1])) if raw is None else raw
             raw[rows] = u
-        if raw is None:
-            return np.zeros((0, t.size))
-        return raw if window <= 1 else smooth_cut(raw, t.size, window, int(self.base.smoothing_order))
+        return raw if window <= 1 or not groups else smooth_cut(raw, t.size, window, int(self.base.smoothing_order))
 
     def check(self, objects, sensor, *, contact_s: float, noise_c: float, delta_t_c: float):
         """The base model's check (the ramp adds no validity limit of its own)."""

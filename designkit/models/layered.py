@@ -306,51 +306,39 @@ def laplace_parts(p, *, e_film: float, diffusivity_film_m2_s: float, depth_m: fl
     return np.broadcast_to(A, p.shape), B, C
 
 
-class _SceneGrid:
-    """The object-independent transform on the longest time grid of a scene asked so far, starting at one time:
-    a grid that is its prefix reads a slice (elementwise factors: the same bits), so a ramp's shares and touches
-    and a sweep's contacts pay the contour's exponentials once."""
-
-    def __init__(self, kwargs: tuple, nodes: int):
-        self.kwargs, self.nodes = dict(kwargs), int(nodes)
-        self.time = np.empty(0)
-        self.parts: tuple = ()
-
-    def parts_for(self, t: np.ndarray) -> tuple[np.ndarray, ...]:
-        """``(d_re, d_im^2, g_re, g_im d_im)`` at times ``t`` (m,), each (nodes, m), read-only: ``d = A / B`` and
-        ``g = W C / B`` (``W`` the Talbot weights)."""
-        n = t.size
-        if n > self.time.size or not np.array_equal(self.time[:n], t):
-            p, weights = talbot_points(t, self.nodes)
-            A, B, C = laplace_parts(p, **self.kwargs)
-            d, g = A / B, weights * (C / B)
-            self.parts = tuple(np.ascontiguousarray(a.T) for a in (d.real, d.imag ** 2, g.real, g.imag * d.imag))
-            for a in self.parts:
-                a.setflags(write=False)
-            self.time = t.copy()
-        return tuple(a[:, :n] for a in self.parts)
-
-    def reading(self, t: np.ndarray, inv_e: np.ndarray) -> np.ndarray:
-        """The inverse at times ``t`` (m,) of objects of ``1 / e_o`` = ``inv_e`` (K,), shape (K, m): the Talbot
-        terms ``Re(g / (d + v)) = (g_re x + g_im d_im) / (x^2 + d_im^2)``, ``x = d_re + v``, in real arithmetic,
-        summed node by node in a fixed order (elementwise only: the same bits on every run)."""
-        d_re, d_im2, g_re, g_dim = self.parts_for(t)
-        x = d_re + inv_e[:, None, None]                      # (K, nodes, m)
-        terms = g_re * x
-        terms += g_dim
-        x *= x
-        x += d_im2
-        terms /= x
-        out = terms[:, 0].copy()
-        for k in range(1, terms.shape[1]):
-            out += terms[:, k]
-        return out
+@functools.lru_cache(maxsize=64)
+def _scene_parts(kwargs: tuple, time_bytes: bytes, nodes: int) -> tuple[np.ndarray, ...]:
+    """``(d_re, d_im^2, g_re, g_im d_im)`` on a time grid (m,), each (nodes, m), read-only: ``d = A / B`` and
+    ``g = W C / B`` (``W`` the Talbot weights), once per scene and grid (a memo of a pure function; the last 64
+    kept: a calibrated rig's 24 touch ramps read lag grids of their own). Never sliced from a longer grid: numpy's
+    complex products round an element by where it lies in the array, and a reading must not depend on what was
+    read before."""
+    t = np.frombuffer(time_bytes, dtype=np.float64)
+    p, weights = talbot_points(t, nodes)
+    A, B, C = laplace_parts(p, **dict(kwargs))
+    d, g = A / B, weights * (C / B)
+    parts = tuple(np.ascontiguousarray(a.T) for a in (d.real, d.imag ** 2, g.real, g.imag * d.imag))
+    for a in parts:
+        a.setflags(write=False)
+    return parts
 
 
-@functools.lru_cache(maxsize=8)
-def _scene_grid(kwargs: tuple, start_bytes: bytes, nodes: int) -> _SceneGrid:
-    """One :class:`_SceneGrid` per scene and first time per process (a memo: it changes no result)."""
-    return _SceneGrid(kwargs, nodes)
+def _talbot_readings(parts, inv_e: np.ndarray) -> np.ndarray:
+    """The inverse at a grid's times of objects of ``1 / e_o`` = ``inv_e`` (K,), shape (K, m), from
+    :func:`_scene_parts`: the Talbot terms ``Re(g / (d + v)) = (g_re x + g_im d_im) / (x^2 + d_im^2)``,
+    ``x = d_re + v``, in real arithmetic, summed node by node in a fixed order (elementwise only: the same bits
+    on every run)."""
+    d_re, d_im2, g_re, g_dim = parts
+    x = d_re + inv_e[:, None, None]                      # (K, nodes, m)
+    terms = g_re * x
+    terms += g_dim
+    x *= x
+    x += d_im2
+    terms /= x
+    out = terms[:, 0].copy()
+    for k in range(1, terms.shape[1]):
+        out += terms[:, k]
+    return out
 
 
 @dataclass(frozen=True)
@@ -488,7 +476,7 @@ class Layered(ForwardModel):
             tp = np.ascontiguousarray(t[pos])
             x = eo[live]
             inv = np.where(np.isinf(x), 0.0, 1.0 / np.where(np.isinf(x), 1.0, x))
-            out[np.ix_(live, pos)] = _scene_grid(kw, tp[:1].tobytes(), int(nodes)).reading(tp, inv)
+            out[np.ix_(live, pos)] = _talbot_readings(_scene_parts(kw, tp.tobytes(), int(nodes)), inv)
         zero = t == 0
         if zero.any():
             out[:, zero] = self.initial_value(eo, sensor)[:, None]

@@ -19,7 +19,12 @@ semi-infinite touch's (issue 35's target: at most 2x), old code and new, with th
 the new readings from the old and from the model read directly at every touch's effusivity (the
 independent reference: no interpolation), on every 10th touch of 6 classes, every sample.
 
-Run: ``PYTHONPATH=. python benchmarks/bench_sim_models.py [--repeats 5] [--baseline c8fe4cc]``.
+``RIG`` renders the calibrated rig's table touches (``--rig``, default tests/data/rig_sensor.yaml): 40 classes at
+three of its table's contacts, as the sweep's scorer renders them (each touch pressing as one of the calibration
+touches, ``simulation.touch_picks``; the rig's correlated noise, from its onset), against the semi-infinite model in
+the same scene, old code and new.
+
+Run: ``PYTHONPATH=. python benchmarks/bench_sim_models.py [--repeats 5] [--baseline c8fe4cc] [--only-rig]``.
 """
 
 from __future__ import annotations
@@ -141,12 +146,37 @@ for gname, edges in grids.items():
 print(json.dumps(out))
 '''
 
+RIG = r'''
+import json, sys, time
+import numpy as np
+import scipy.interpolate, scipy.signal, scipy.special  # imports outside the timings
+from designkit.models import get_model
+from designkit.sweep.for_sensor import effusivity_span, sensor_sweep_config
+from designkit.simulation import draw_trials, render_trials, touch_picks, window_times_s
 
-def run(pythonpath: str, repeats: int, code: str = CASE) -> dict:
+cfg = sensor_sweep_config(sys.argv[2], span=effusivity_span(material_set="paper12"))
+sensor = cfg.resolved_sensor()
+out = {}
+for ci in (0, 4, 7):
+    scene = cfg.scene((0,), cfg.contact_s[ci])
+    m = window_times_s(sensor, scene).size
+    for name, fm in (("semi-infinite", get_model()), ("rig", cfg.model)):
+        render_trials(draw_trials(331.0, 506.0, 2, m, [0]), sensor, scene, fm, None, touch_picks(fm, [0], 2))   # cold
+        us, t0 = [], time.process_time()
+        for k in range(200, 240):
+            d = draw_trials(cfg.edges[k], cfg.edges[k + 1], cfg.trials, m, [cfg.seed, k, 0])
+            us.append(render_trials(d, sensor, scene, fm, None, touch_picks(fm, [cfg.seed, k, 0], cfg.trials)).temperature_c)
+        out[f"{name}@{cfg.contact_s[ci]:.3f}"] = {"touch_s": (time.process_time() - t0) / (40 * cfg.trials),
+                                                   "u": [u[::9, ::5].tolist() for u in us[::4]]}
+print(json.dumps(out))
+'''
+
+
+def run(pythonpath: str, repeats: int, code: str = CASE, *extra: str) -> dict:
     env = dict(os.environ, PYTHONPATH=pythonpath, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1",
                MKL_NUM_THREADS="1")  # one core per process, as a sweep worker has
     with tempfile.TemporaryDirectory() as cwd:  # python -c puts its working directory first on sys.path
-        res = subprocess.run([sys.executable, "-c", code, str(repeats)], env=env, capture_output=True, text=True,
+        res = subprocess.run([sys.executable, "-c", code, str(repeats), *extra], env=env, capture_output=True, text=True,
                              check=True, cwd=cwd)
     return json.loads(res.stdout.strip().splitlines()[-1])
 
@@ -155,6 +185,9 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=5, help="warm renders per model and contact time")
     ap.add_argument("--baseline", default="c8fe4cc", help="the old code's commit")
+    ap.add_argument("--rig", default=str(Path(__file__).resolve().parents[1] / "tests/data/rig_sensor.yaml"),
+                    help="the calibrated rig's sensor file (its table's touches: 24 touch ramps, correlated noise)")
+    ap.add_argument("--only-rig", action="store_true", help="only the rig's table touches")
     args = ap.parse_args()
     import numpy as np
 
@@ -166,9 +199,28 @@ def main() -> None:
         tar = subprocess.run(["git", "-C", str(root), "archive", args.baseline, "designkit"], capture_output=True,
                              check=True).stdout
         subprocess.run(["tar", "-x", "-C", tmp], input=tar, check=True)
-        old = run(tmp, args.repeats)
-        old_direct = run(tmp, 0, DIRECT)
-        old_scene = run(tmp, 0, SCENE)
+        old_rig = run(tmp, 0, RIG, args.rig)
+        if not args.only_rig:
+            old = run(tmp, args.repeats)
+            old_direct = run(tmp, 0, DIRECT)
+            old_scene = run(tmp, 0, SCENE)
+    new_rig = run(str(root), 0, RIG, args.rig)
+    print("the calibrated rig's table touches (sensor_sweep_config of --rig, paper12; 40 classes of 100 touches as the "
+          "sweep renders them: each touch pressing as one of the 24 calibration touches, the rig's correlated noise, "
+          "from its onset), CPU per touch and its ratio to the semi-infinite touch in the same scene; max|du|: new "
+          "against old readings [degC at the sweep's dT = 1 degC]")
+    print(f"{'contact':>9}{'old':>11}{'ratio':>7}{'new':>11}{'ratio':>7}{'new/old':>9}{'max|du|':>11}")
+    for key in new_rig:
+        name, contact = key.split("@")
+        if name != "rig":
+            continue
+        o, n = old_rig[key], new_rig[key]
+        so, sn = old_rig[f"semi-infinite@{contact}"], new_rig[f"semi-infinite@{contact}"]
+        du = max(float(np.max(np.abs(np.array(a) - np.array(b)))) for a, b in zip(o["u"], n["u"]))
+        print(f"{contact + ' s':>9}{o['touch_s'] * 1e3:>9.4f}ms{o['touch_s'] / so['touch_s']:>7.1f}"
+              f"{n['touch_s'] * 1e3:>9.4f}ms{n['touch_s'] / sn['touch_s']:>7.1f}{n['touch_s'] / o['touch_s']:>9.2f}{du:>11.2e}")
+    if args.only_rig:
+        return
     new = run(str(root), args.repeats)
     new_direct = run(str(root), 0, DIRECT)
     new_scene = run(str(root), 0, SCENE)

@@ -338,13 +338,21 @@ def _class_readings(fm, time_s, e, sensor, diffusivity_m2_s, tol, ramp_index) ->
     (read at its own first contact: ``t - delay``)."""
     if ramp_index is None:
         return class_readings(fm, time_s, e, sensor, diffusivity_m2_s=diffusivity_m2_s, tolerance=tol)
+    from .models.shared import MIN_DISTINCT
+
     idx = np.asarray(ramp_index)
     u = np.empty((e.size, np.size(time_s)))
+    direct = np.zeros(e.size, dtype=bool)
     for j in np.unique(idx):
         rows = idx == j
+        if diffusivity_m2_s is None and (np.unique(e[rows]).size < MIN_DISTINCT or not np.all(np.isfinite(e[rows]))):
+            direct |= rows    # read directly (as class_readings would), every such touch in one call below
+            continue
         ramp, delay = fm.touch(j)
         u[rows] = class_readings(ramp, np.asarray(time_s) - delay, e[rows], sensor, tolerance=tol,
                                  diffusivity_m2_s=None if diffusivity_m2_s is None else diffusivity_m2_s[rows])
+    if direct.any():
+        u[direct] = fm.touch_readings(time_s, e[direct], idx[direct], sensor, tolerance=tol)
     return u
 
 

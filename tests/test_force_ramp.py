@@ -248,3 +248,30 @@ def test_touches_press_as_the_calibration_touches_did(paper_sensor):
     nominal = simulate_class(object_class(20000), 30, paper_sensor, scene, seed=3, model=fm.nominal()).temperature_c
     assert np.ptp(pressed[:, -1]) > 20 * np.ptp(nominal[:, -1])
     assert len({round(v, 9) for v in pressed[:, 100]}) >= 3
+
+
+def test_a_class_s_touches_read_at_once_are_each_touch_ramp_s_response():
+    """ForceRamp.touch_readings (a class's touches, each pressing as its calibration touch, smoothed in one call)
+    gives what each touch's own ramp reads at its own first contact, to rounding; and the layered model's cached
+    Laplace parts do not depend on which grids were read before (a longer grid of the same start first)."""
+    from designkit.models import layered
+
+    lay = get_model("layered", film_thickness_m=2.2e-4, backing_effusivity_ws05_m2k=2000.0, conductance_w_m2k=1800.0,
+                    lag_s=1.1, smoothing_window=99, smoothing_order=3)
+    tp = np.arange(0, 60) * 0.02
+    ramp = ForceRamp.from_force_profile(lay, tp, np.clip(tp / 0.9, 0, 1), 0.16,
+                                        touch_force_rel=[np.clip((tp - d) / w, 0, 1) for d, w in
+                                                         ((0.1, 0.5), (0.0, 0.9), (0.3, 0.7))])
+    t = 0.4 + np.arange(120) / SENSOR.sample_rate_hz
+    e = np.array([300.0, 450.0, 2500.0, 800.0, 20000.0])
+    touch = np.array([2, 0, 1, 2, 0])
+    layered._scene_parts.cache_clear()
+    got = ramp.touch_readings(t, e, touch, SENSOR)
+    for k in range(e.size):
+        one, delay = ramp.touch(touch[k])
+        np.testing.assert_allclose(got[k], one.response(t - delay, e[k:k + 1], SENSOR)[0], rtol=0, atol=1e-13)
+    short = np.arange(1, 150) / 200.0
+    layered._scene_parts.cache_clear()
+    cold = lay.conduction(short, e, SENSOR)
+    lay.conduction(np.arange(1, 900) / 200.0, e, SENSOR)   # a longer grid of the same start read in between
+    np.testing.assert_array_equal(lay.conduction(short, e, SENSOR), cold)

@@ -76,8 +76,8 @@ import numpy as np
 from .._validation import InputError, check_nonnegative, check_positive
 from .base import ForwardModel
 
-__all__ = ["Layered", "laplace_parts", "laplace_reading", "savgol_smooth", "smoothed_reading", "talbot_invert",
-           "talbot_points"]
+__all__ = ["Layered", "laplace_parts", "laplace_reading", "savgol_smooth", "smooth_cut", "smoothing_grid",
+           "talbot_invert", "talbot_points"]
 
 #: Fixed-Talbot nodes: 24 gives about 1e-11 absolute error in double precision.
 TALBOT_NODES = 24
@@ -257,7 +257,9 @@ def laplace_reading(p, e_object, *, e_film: float, diffusivity_film_m2_s: float,
                           thickness_m=thickness_m, e_backing=e_backing,
                           diffusivity_backing_m2_s=diffusivity_backing_m2_s, conductance_w_m2k=conductance_w_m2k,
                           lag_s=lag_s, backing_thickness_m=backing_thickness_m)
-    return _object_reading(parts, e_object)
+    A, B, C = parts
+    eo = np.asarray(e_object, dtype=np.float64)[:, None, None]
+    return C / (A + B * np.where(np.isinf(eo), 0.0, 1.0 / np.where(np.isinf(eo), 1.0, eo)))   # e_o = inf: C / A
 
 
 def laplace_parts(p, *, e_film: float, diffusivity_film_m2_s: float, depth_m: float, thickness_m: float,
@@ -304,28 +306,38 @@ def laplace_parts(p, *, e_film: float, diffusivity_film_m2_s: float, depth_m: fl
     return np.broadcast_to(A, p.shape), B, C
 
 
-def _object_reading(parts, e_object) -> np.ndarray:
-    """``U = C / (A + B / e_o)`` for objects ``e_object`` (K,): shape (K, m, n); ``e_o = inf`` reads ``C / A``."""
-    A, B, C = parts
-    eo = np.asarray(e_object, dtype=np.float64)[:, None, None]
-    inv_eo = np.where(np.isinf(eo), 0.0, 1.0 / np.where(np.isinf(eo), 1.0, eo))
-    return C / (A + B * inv_eo)
-
-
-@functools.lru_cache(maxsize=4)
-def _scene_parts(kwargs: tuple, time_bytes: bytes, nodes: int):
-    """Talbot weights and the object-independent transform on a time grid, once per scene (read-only).
-
-    A pure function of its (hashable) arguments, so the cache changes no result: a simulation reading
-    class after class of one scene pays the contour's exponentials once.
-    """
+@functools.lru_cache(maxsize=64)
+def _scene_parts(kwargs: tuple, time_bytes: bytes, nodes: int) -> tuple[np.ndarray, ...]:
+    """``(d_re, d_im^2, g_re, g_im d_im)`` on a time grid (m,), each (nodes, m), read-only: ``d = A / B`` and
+    ``g = W C / B`` (``W`` the Talbot weights), once per scene and grid (a memo of a pure function; the last 64
+    kept: a calibrated rig's 24 touch ramps read lag grids of their own). Never sliced from a longer grid: numpy's
+    complex products round an element by where it lies in the array, and a reading must not depend on what was
+    read before."""
     t = np.frombuffer(time_bytes, dtype=np.float64)
     p, weights = talbot_points(t, nodes)
     A, B, C = laplace_parts(p, **dict(kwargs))
-    # U = C / (A + B / e_o) = (C / B) / (A / B + 1 / e_o): per object one real addition and one division
-    out = (weights, C / B, A / B)
-    for a in out:
+    d, g = A / B, weights * (C / B)
+    parts = tuple(np.ascontiguousarray(a.T) for a in (d.real, d.imag ** 2, g.real, g.imag * d.imag))
+    for a in parts:
         a.setflags(write=False)
+    return parts
+
+
+def _talbot_readings(parts, inv_e: np.ndarray) -> np.ndarray:
+    """The inverse at a grid's times of objects of ``1 / e_o`` = ``inv_e`` (K,), shape (K, m), from
+    :func:`_scene_parts`: the Talbot terms ``Re(g / (d + v)) = (g_re x + g_im d_im) / (x^2 + d_im^2)``,
+    ``x = d_re + v``, in real arithmetic, summed node by node in a fixed order (elementwise only: the same bits
+    on every run)."""
+    d_re, d_im2, g_re, g_dim = parts
+    x = d_re + inv_e[:, None, None]                      # (K, nodes, m)
+    terms = g_re * x
+    terms += g_dim
+    x *= x
+    x += d_im2
+    terms /= x
+    out = terms[:, 0].copy()
+    for k in range(1, terms.shape[1]):
+        out += terms[:, k]
     return out
 
 
@@ -461,10 +473,10 @@ class Layered(ForwardModel):
         live = eo > 0
         if pos.any() and live.any():
             kw = tuple(sorted(self._laplace_kwargs(sensor).items()))
-            weights, num, den = _scene_parts(kw, np.ascontiguousarray(t[pos]).tobytes(), int(nodes))
+            tp = np.ascontiguousarray(t[pos])
             x = eo[live]
             inv = np.where(np.isinf(x), 0.0, 1.0 / np.where(np.isinf(x), 1.0, x))
-            out[np.ix_(live, pos)] = _talbot_sum(num / (den + inv[:, None, None]), weights)
+            out[np.ix_(live, pos)] = _talbot_readings(_scene_parts(kw, tp.tobytes(), int(nodes)), inv)
         zero = t == 0
         if zero.any():
             out[:, zero] = self.initial_value(eo, sensor)[:, None]
@@ -481,36 +493,18 @@ class Layered(ForwardModel):
         t = np.atleast_1d(np.asarray(time_s, dtype=np.float64))
         if self.smoothing_window <= 1:
             return self.conduction(t, e_object, sensor)
-        return smoothed_reading(lambda tt: self.conduction(tt, e_object, sensor), t, sensor.sample_rate_hz,
-                                self.smoothing_window, self.smoothing_order, what="the smoothed layered model")
+        grid = smoothing_grid(t, sensor.sample_rate_hz, self.smoothing_window, what="the smoothed layered model")
+        return smooth_cut(self.conduction(grid, e_object, sensor), t.size, self.smoothing_window, self.smoothing_order)
 
 
-def smoothed_reading(reading, time_s, sample_rate_hz: float, window: int, order: int, *,
-                     what: str = "a smoothed model") -> np.ndarray:
-    """A reading smoothed as the host smoothed a recording (Savitzky-Golay, ``mode="interp"``).
+def smoothing_grid(time_s, sample_rate_hz: float, window: int, *, what: str = "a smoothed model") -> np.ndarray:
+    """Where a reading smoothed as the host smoothed a recording (Savitzky-Golay, ``mode="interp"``) reads the
+    model: ``window // 2`` samples before the first of the uniformly spaced ``time_s`` (zeros before contact, as
+    the host saw them; one time: ``1 / sample_rate_hz`` apart), the times, and past the last where the series is
+    shorter than the window; :func:`smooth_cut` smooths the reading and cuts it back.
 
-    ``reading(t)`` gives the unsmoothed reading (K, len(t)), 0 before contact.
-    It is evaluated from ``window // 2`` samples before the first time (zeros
-    before contact, as the host saw them) to the last (extended past the end
-    when the series is shorter than the window), smoothed, and cut back to
-    ``time_s``; the last ``window // 2`` samples use the filter's polynomial
-    fit at the end. The result is clipped to [0, 1].
-
-    Parameters
-    ----------
-    reading : callable
-        ``t -> ndarray (K, len(t))``.
-    time_s : array_like, shape (m,)
-        Uniformly spaced times [s] (one time: the sample period ``1/fs``).
-    sample_rate_hz : float
-        Used for the spacing when ``time_s`` has one time.
-    window, order : int
-        Savitzky-Golay window (odd, samples) and order.
-
-    Examples
-    --------
     >>> t = np.arange(300) / 200.0
-    >>> u = smoothed_reading(lambda tt: np.clip(tt, 0.0, None)[None, :] * 0.1, t, 200.0, 99, 3)
+    >>> u = smooth_cut(np.clip(smoothing_grid(t, 200.0, 99), 0.0, None)[None, :] * 0.1, t.size, 99, 3)
     >>> bool(np.allclose(u[0, 60:240], 0.1 * t[60:240]))   # a line away from the kink at 0 passes unchanged
     True
     """
@@ -523,11 +517,14 @@ def smoothed_reading(reading, time_s, sample_rate_hz: float, window: int, order:
     else:
         step = 1.0 / float(sample_rate_hz)
     half = window // 2
-    before = t[0] - step * np.arange(half, 0, -1)
-    u = reading(np.concatenate([before, t]))
-    if u.shape[1] < window:  # short series: extend past the end, smooth, cut
-        extra = window - u.shape[1]
-        after = t[-1] + step * np.arange(1, extra + 1)
-        u = reading(np.concatenate([before, t, after]))
-        return np.clip(savgol_smooth(u, window, order)[:, half:half + t.size], 0.0, 1.0)
-    return np.clip(savgol_smooth(u, window, order)[:, half:], 0.0, 1.0)
+    grid = [t[0] - step * np.arange(half, 0, -1), t]
+    if half + t.size < window:  # short series: extend past the end, smooth, cut
+        grid.append(t[-1] + step * np.arange(1, window - half - t.size + 1))
+    return np.concatenate(grid)
+
+
+def smooth_cut(u, n_times: int, window: int, order: int) -> np.ndarray:
+    """Readings (K, len(grid)) on a :func:`smoothing_grid` smoothed, cut back to its ``n_times`` times and
+    clipped to [0, 1]."""
+    half = window // 2
+    return np.clip(savgol_smooth(u, window, order)[:, half:half + n_times], 0.0, 1.0)

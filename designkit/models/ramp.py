@@ -37,6 +37,7 @@ True
 from __future__ import annotations
 
 import dataclasses
+import functools
 from dataclasses import dataclass
 from typing import Any, Mapping
 
@@ -158,8 +159,13 @@ class ForceRamp(ForwardModel):
     def touch(self, j: int) -> tuple["ForceRamp", float]:
         """Touch ``j``'s own ramp (a ramp without touch ramps) and its first contact's delay [s] after the
         nominal one's: its reading at model time ``t`` is ``ramp.response(t - delay)``."""
-        delay, times, areas = self.touch_ramps[int(j)]
-        return ForceRamp(self.base, times, areas, self.force_fraction, self.source), delay
+        return self._touches[int(j)]
+
+    @functools.cached_property
+    def _touches(self) -> tuple:
+        """Every touch's ``(ramp, delay)``, made once (a simulated class asks for them class after class)."""
+        return tuple((ForceRamp(self.base, times, areas, self.force_fraction, self.source), delay)
+                     for delay, times, areas in self.touch_ramps)
 
     def nominal(self) -> "ForceRamp":
         """This ramp without the touch ramps (every touch pressing as the nominal one)."""
@@ -275,14 +281,18 @@ class ForceRamp(ForwardModel):
             if live.any():
                 S[:, live] = step.response(lag[live], e_object, sensor, diffusivity_m2_s=diffusivity_m2_s,
                                            tolerance=tolerance)
-            buf = np.empty(out.shape)
-            for n_j, d_j in zip(whole[group].tolist(), da[group].tolist()):
-                lo = -n_j if n_j < 0 else 0                               # first sample with n_j + i >= 0
-                if lo >= m:
-                    continue
-                part = buf[:, lo:]
-                np.multiply(S[:, n_j + lo:n_j + m], d_j, out=part)
-                out[:, lo:] += part
+            # every share's window of S at once (S padded with the zeros before contact where n_j < 0; a share
+            # whose contact comes after the last time adds nothing), weighted by its dA and summed share by share
+            # in order (a reduction over a middle axis: elementwise additions, no BLAS: the same bits on every
+            # run), a few objects at a time (the windows' copy: objects x shares x m)
+            group = group[whole[group] > -m]
+            pad = max(0, -int(whole[group].min())) if group.size else 0
+            S = np.concatenate([np.zeros((out.shape[0], pad)), S], axis=1) if pad else S
+            at = (whole[group] + pad)[:, None] + np.arange(m)                  # (J, m): share j's window
+            for k in range(0, out.shape[0], 16):
+                part = S[k:k + 16, at]                                        # (K, J, m)
+                part *= da[group][None, :, None]
+                out[k:k + 16] += part.sum(axis=1)
         return out
 
     def response(self, time_s, e_object, sensor, *, diffusivity_m2_s=None, tolerance: float = 1e-9) -> np.ndarray:
@@ -292,15 +302,31 @@ class ForceRamp(ForwardModel):
         sum is smoothed once, as the host smoothed the recorded touch; then the
         times must be uniform.
         """
-        t = np.atleast_1d(np.asarray(time_s, dtype=np.float64))
-        window = int(getattr(self.base, "smoothing_window", 0) or 0)
-        if window <= 1:
-            return self._unsmoothed(t, e_object, sensor, diffusivity_m2_s, tolerance)
-        from .layered import smoothed_reading
+        return self._read(time_s, e_object, [(self, 0.0, slice(None))], sensor, diffusivity_m2_s, tolerance)
 
-        return smoothed_reading(lambda tt: self._unsmoothed(tt, e_object, sensor, diffusivity_m2_s, tolerance),
-                                t, sensor.sample_rate_hz, window, int(self.base.smoothing_order),
-                                what="a smoothed model with a force ramp")
+    def touch_readings(self, time_s, e_object, touch, sensor, *, tolerance: float = 1e-9) -> np.ndarray:
+        """Normalized readings (K, m) of objects ``e_object`` (K,), object ``k`` pressing as touch ramp ``touch[k]``
+        (:meth:`touch`: its reading at ``time_s - delay``): each touch ramp's :meth:`response`, smoothed at once."""
+        touch = np.asarray(touch)
+        groups = [(*self.touch(j), touch == j) for j in np.unique(touch).tolist()]
+        return self._read(time_s, e_object, groups, sensor, None, tolerance)
+
+    def _read(self, time_s, e_object, groups, sensor, diffusivity_m2_s, tolerance: float) -> np.ndarray:
+        """Objects ``e_object[rows]`` read as ``ramp`` at ``time_s - delay``, for each ``(ramp, delay, rows)``;
+        with a base model that smooths, every row's sum smoothed in one call."""
+        from .layered import smooth_cut, smoothing_grid
+
+        t = np.atleast_1d(np.asarray(time_s, dtype=np.float64))
+        e = np.atleast_1d(np.asarray(e_object, dtype=np.float64))
+        window = int(getattr(self.base, "smoothing_window", 0) or 0)
+        raw = np.zeros((e.size, t.size)) if not groups else None
+        for ramp, delay, rows in groups:
+            times = t - delay if window <= 1 else smoothing_grid(t - delay, sensor.sample_rate_hz, window,
+                                                                  what="a smoothed model with a force ramp")
+            u = ramp._unsmoothed(times, e[rows], sensor, diffusivity_m2_s, tolerance)
+            raw = np.empty((e.size, u.shape[1])) if raw is None else raw
+            raw[rows] = u
+        return raw if window <= 1 or not groups else smooth_cut(raw, t.size, window, int(self.base.smoothing_order))
 
     def check(self, objects, sensor, *, contact_s: float, noise_c: float, delta_t_c: float):
         """The base model's check (the ramp adds no validity limit of its own)."""

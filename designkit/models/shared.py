@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import functools
 import math
+import pickle
 from typing import NamedTuple
 
 import numpy as np
@@ -142,17 +143,18 @@ class SceneResponse:
         return [p for _, p in sorted(self._panels.items()) if p is not None]
 
 
-class _SensorKey(str):
-    """A sensor's repr as a cache key, carrying the sensor (which holds mappings: not hashable itself)."""
+class _SensorKey(bytes):
+    """A sensor's pickle as a cache key, carrying the sensor (which holds mappings: not hashable itself; its
+    repr cost 5 ms for a calibrated rig's, per class and touch ramp)."""
 
 
-@functools.lru_cache(maxsize=16)
+@functools.lru_cache(maxsize=64)   # a calibrated rig's 24 touch ramps at a contact or two
 def _cached_scene(model: ForwardModel, sensor: _SensorKey, time_bytes: bytes, tolerance: float) -> SceneResponse:
     return SceneResponse(model, np.frombuffer(time_bytes, dtype=np.float64).copy(), sensor.sensor, tolerance)
 
 
 def scene_response(model: ForwardModel, time_s, sensor, *, tolerance: float) -> SceneResponse:
-    """The :class:`SceneResponse` of a model, sensor, time grid and tolerance, one per process (the last 16 kept).
+    """The :class:`SceneResponse` of a model, sensor, time grid and tolerance, one per process (the last 64 kept).
 
     Its panels are a pure function of those four, so sharing them changes no reading: it only saves reading
     the model again for the next class or repeat of the same scene.
@@ -162,7 +164,7 @@ def scene_response(model: ForwardModel, time_s, sensor, *, tolerance: float) -> 
         hash(model)
     except TypeError:   # a model with unhashable parameters: a response of its own, not shared
         return SceneResponse(model, t, sensor, tolerance)
-    key = _SensorKey(repr(sensor))
+    key = _SensorKey(pickle.dumps(sensor, protocol=5))
     key.sensor = sensor
     return _cached_scene(model, key, t.tobytes(), float(tolerance))
 

@@ -261,16 +261,24 @@ class ForceRamp(ForwardModel):
         """The Duhamel sum on a uniform grid as a (sparse) convolution: ``out[i] += dA_j S[n_j + i]``.
 
         Share ``j``'s lags are ``t_0 + i dt - t_j = (n_j + f_j + i) dt`` with ``n_j`` whole and the phase
-        ``f_j`` in [0, 1): the shares of one phase read one step response ``S_l = u_step((f + l) dt)``
+        ``f_j`` in [0, 1) (phases within 1e-6 of each other taken as the smallest of them): the shares of one
+        phase read one step response ``S_l = u_step((f + l) dt)``
         (a ramp on the grid's own step: one phase, about ``m`` times), each shifted by its ``n_j``.
         """
         shift = (t[0] - tj) / dt
         whole = np.floor(shift + 1e-9)
-        frac = np.round(np.maximum(shift - whole, 0.0), 9)
+        frac = np.maximum(shift - whole, 0.0)
         whole = whole.astype(np.int64)
+        # one phase per set of shares whose fractional shifts agree to 1e-6 of a step (ramp times on the grid's
+        # own step differ there only by the rounding of t - t_j and dt): read at the set's smallest phase, a
+        # shift of ~1e-9 dt, far below the readings' tolerance; one step response instead of two
+        order = np.argsort(frac, kind="stable")
+        new = np.diff(frac[order], prepend=-1.0) > 1e-6
+        label = np.empty(frac.size, dtype=np.int64)
+        label[order] = np.cumsum(new) - 1
         m = t.size
-        for f in np.unique(frac):
-            group = np.flatnonzero(frac == f)
+        for g, f in enumerate(frac[order][new].tolist()):
+            group = np.flatnonzero(label == g)
             n_hi = int(whole[group].max())
             length = n_hi + m                                             # l = 0 .. n_j + m - 1
             if length <= 0:

@@ -237,12 +237,8 @@ class ForceRamp(ForwardModel):
 
     @staticmethod
     def _duhamel(step, parts, e, sensor, diffusivity_m2_s, tolerance: float) -> list:
-        """Unsmoothed readings of each part ``(t, tj, dA, rows)``: objects ``e[rows]`` read at times ``t`` as the
-        area-weighted sum of ``step``'s responses to shares of contact times ``tj``, one array (K_p, m_p) a part.
-
-        On uniform grids of one step the parts' shares of one phase read one step response (:meth:`_on_grid`);
-        at any other times each part reads the step response at its distinct lags and sums share by share.
-        """
+        """Unsmoothed readings (K_p, m_p) of each part ``(t, tj, dA, rows)``: objects ``e[rows]`` at times ``t``, the
+        dA-weighted sum of ``step``'s responses to shares in contact from ``tj`` (uniform grids: :meth:`_on_grid`)."""
         outs, grid = [], []
         for p, (t, tj, da, rows) in enumerate(parts):
             idx = np.arange(e.size)[rows]
@@ -282,20 +278,17 @@ class ForceRamp(ForwardModel):
         long enough for the latest share, each shifted by its ``n_j``.
         """
         dt = grid[0][1]
-        shift = [(parts[p][0][0] - parts[p][1]) / dt for p, _, _ in grid]
-        whole = np.concatenate([np.floor(v + 1e-9) for v in shift])
-        frac = np.maximum(np.concatenate(shift) - whole, 0.0)
-        whole = whole.astype(np.int64)
-        owner = np.repeat(np.arange(len(grid)), [v.size for v in shift])
-        start = np.cumsum([0] + [v.size for v in shift])
+        shift = np.concatenate([(parts[p][0][0] - parts[p][1]) / dt for p, _, _ in grid])
+        whole = np.floor(shift + 1e-9)
+        frac, whole = np.maximum(shift - whole, 0.0), whole.astype(np.int64)
+        start = np.cumsum([0] + [parts[p][1].size for p, _, _ in grid])
         order = np.argsort(frac, kind="stable")
         new = np.diff(frac[order], prepend=-1.0) > 1e-6
         label = np.empty(frac.size, dtype=np.int64)
         label[order] = np.cumsum(new) - 1
         for g, f in enumerate(frac[order][new].tolist()):
             members = []
-            for q in np.unique(owner[label == g]).tolist():
-                p, _, idx = grid[q]
+            for q, (p, _, idx) in enumerate(grid):
                 m = parts[p][0].size
                 js = np.flatnonzero(label[start[q]:start[q + 1]] == g)
                 js = js[whole[start[q] + js] > -m]     # a share whose contact comes after the last time adds nothing
@@ -303,9 +296,7 @@ class ForceRamp(ForwardModel):
                     members.append((p, idx, m, whole[start[q] + js], parts[p][2][js]))
             if not members:
                 continue
-            length = max(int(n.max()) + m for _, _, m, n, _ in members)    # l = 0 .. n_j + m - 1
-            if length <= 0:
-                continue
+            length = max(int(n.max()) + m for _, _, m, n, _ in members)    # l = 0 .. n_j + m - 1 (> 0)
             objects = np.unique(np.concatenate([idx for _, idx, _, _, _ in members]))
             lag = (f + np.arange(length)) * dt
             live = lag > 0
@@ -315,9 +306,8 @@ class ForceRamp(ForwardModel):
                                            diffusivity_m2_s=None if diffusivity_m2_s is None
                                            else diffusivity_m2_s[objects])
             for p, idx, m, n, da in members:
-                # share by share, in order, each share's window of S (padded with the zeros before contact where
-                # n_j < 0) weighted by its dA: elementwise products and additions into one buffer, no BLAS, no
-                # copy of every window (the same bits on every run)
+                # share by share, in order, each share's window of S (zeros before contact padded where n_j < 0)
+                # times its dA, into one buffer: elementwise, no BLAS (the same bits on every run)
                 pad = max(0, -int(n.min()))
                 Sp = S[np.searchsorted(objects, idx)]
                 Sp = np.concatenate([np.zeros((idx.size, pad)), Sp], axis=1) if pad else Sp

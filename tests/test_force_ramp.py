@@ -275,3 +275,53 @@ def test_a_class_s_touches_read_at_once_are_each_touch_ramp_s_response():
     cold = lay.conduction(short, e, SENSOR)
     lay.conduction(np.arange(1, 900) / 200.0, e, SENSOR)   # a longer grid of the same start read in between
     np.testing.assert_array_equal(lay.conduction(short, e, SENSOR), cold)
+
+
+def test_a_ramp_on_the_grid_s_own_step_reads_one_step_response():
+    """A ramp sampled on the grid's own step (a calibrated rig's touch ramp, 20 ms, on 200 Hz readings from its
+    onset) reads its base model once on one lag grid, although the shares' fractional shifts differ in their last
+    bits (they used to straddle a 9-digit rounding: two step responses, twice the work); the reading is the
+    Duhamel sum read share by share at any times, to rounding."""
+    from designkit.models.semi_infinite import SemiInfinite
+
+    grids = []
+
+    class Counting(SemiInfinite):
+        def response(self, time_s, e_object, sensor, **kw):
+            grids.append(np.size(time_s))
+            return super().response(time_s, e_object, sensor, **kw)
+
+    tj = np.round(np.arange(127) * 0.02, 9)
+    ramp = ForceRamp(Counting(), tuple(tj), tuple(np.linspace(0.05, 1.0, tj.size)))
+    t = 0.9177346451224817 + np.arange(400) * 0.004999999999999893
+    got = ramp.response(t, [450.0], SENSOR)
+    assert len(grids) == 1
+    jitter = t + np.r_[0.0, 1e-7, np.zeros(398)]   # not uniform: every share read at its own lags
+    np.testing.assert_allclose(got[:, 2:], ramp.response(jitter, [450.0], SENSOR)[:, 2:], rtol=1e-11, atol=1e-14)
+
+
+def test_a_class_s_touch_ramps_share_one_step_response():
+    """The touches of a class, each pressing as its calibration touch (ramps on the grid's step, delays of whole
+    samples), read the base model once, on the lag grid of the latest share, for all objects; each touch as its
+    own ramp reads it alone, to rounding."""
+    from designkit.models.semi_infinite import SemiInfinite
+
+    grids = []
+
+    class Counting(SemiInfinite):
+        def response(self, time_s, e_object, sensor, **kw):
+            grids.append((np.size(time_s), np.size(e_object)))
+            return super().response(time_s, e_object, sensor, **kw)
+
+    tp = np.arange(0, 60) * 0.02
+    ramp = ForceRamp.from_force_profile(Counting(), tp, np.clip(tp / 0.9, 0, 1), 0.16,
+                                        touch_force_rel=[np.clip((tp - d) / w, 0, 1) for d, w in
+                                                         ((0.1, 0.5), (0.0, 0.9), (0.3, 0.7))])
+    t = 0.4 + np.arange(120) / SENSOR.sample_rate_hz
+    e = np.array([300.0, 450.0, 2500.0, 800.0, 20000.0])
+    touch = np.array([2, 0, 1, 2, 0])
+    got = ramp.touch_readings(t, e, touch, SENSOR)
+    assert len(grids) == 1 and grids[0][1] == e.size
+    for k in range(e.size):
+        one, delay = ramp.touch(touch[k])
+        np.testing.assert_allclose(got[k], one.response(t - delay, e[k:k + 1], SENSOR)[0], rtol=0, atol=1e-13)

@@ -229,71 +229,94 @@ class ForceRamp(ForwardModel):
             return dataclasses.replace(self.base, smoothing_window=0)
         return self.base
 
-    def _unsmoothed(self, t: np.ndarray, e_object, sensor, diffusivity_m2_s, tolerance: float) -> np.ndarray:
-        step = self._step_model()
+    def _shares(self) -> tuple[np.ndarray, np.ndarray]:
+        """The ramp's contact times [s] and area increments ``dA_j`` (those > 0)."""
         tj = np.asarray(self.ramp_time_s)
         da = np.diff(np.asarray(self.ramp_area), prepend=0.0)
-        keep = da > 0
-        tj, da = tj[keep], da[keep]
-        lags = t[None, :] - tj[:, None]                                 # (J, m)
-        pos = lags > 0
-        k = np.atleast_1d(np.asarray(e_object)).size
-        out = np.zeros((k, t.size))
-        if not pos.any():
-            return out
-        dt = float(t[1] - t[0]) if t.size > 1 else 0.0
-        if dt > 0 and np.all(np.abs(np.diff(t) - dt) <= 1e-9 * dt):
-            return self._on_grid(out, t, dt, tj, da, step, e_object, sensor, diffusivity_m2_s, tolerance)
-        # any times: one evaluation of the step response at the distinct lags, then the sum share by share
-        key = np.round(lags[pos] * 1e9).astype(np.int64)
-        uniq, first, inverse = np.unique(key, return_index=True, return_inverse=True)
-        u = step.response(lags[pos][first], e_object, sensor, diffusivity_m2_s=diffusivity_m2_s,
-                          tolerance=tolerance)                           # (K, U)
-        where = np.zeros(lags.shape, dtype=np.int64)
-        where[pos] = inverse.ravel()
-        for j in range(tj.size):
-            cols = np.flatnonzero(pos[j])
-            out[:, cols] += da[j] * u[:, where[j, cols]]
-        return out
+        return tj[da > 0], da[da > 0]
 
     @staticmethod
-    def _on_grid(out, t, dt, tj, da, step, e_object, sensor, diffusivity_m2_s, tolerance) -> np.ndarray:
-        """The Duhamel sum on a uniform grid as a (sparse) convolution: ``out[i] += dA_j S[n_j + i]``.
+    def _duhamel(step, parts, e, sensor, diffusivity_m2_s, tolerance: float) -> list:
+        """Unsmoothed readings (K_p, m_p) of each part ``(t, tj, dA, rows)``: objects ``e[rows]`` at times ``t``, the
+        dA-weighted sum of ``step``'s responses to shares in contact from ``tj`` (uniform grids: :meth:`_on_grid`)."""
+        outs, grid = [], []
+        for p, (t, tj, da, rows) in enumerate(parts):
+            idx = np.arange(e.size)[rows]
+            outs.append(np.zeros((idx.size, t.size)))
+            lags = t[None, :] - tj[:, None]                             # (J, m)
+            pos = lags > 0
+            if not pos.any():
+                continue
+            dt = float(t[1] - t[0]) if t.size > 1 else 0.0
+            if dt > 0 and np.all(np.abs(np.diff(t) - dt) <= 1e-9 * dt) \
+                    and (not grid or abs(dt - grid[0][1]) <= 1e-9 * dt):
+                grid.append((p, dt, idx))
+                continue
+            # any times: one evaluation of the step response at the distinct lags, then the sum share by share
+            key = np.round(lags[pos] * 1e9).astype(np.int64)
+            uniq, first, inverse = np.unique(key, return_index=True, return_inverse=True)
+            u = step.response(lags[pos][first], e[idx], sensor, tolerance=tolerance,
+                              diffusivity_m2_s=None if diffusivity_m2_s is None else diffusivity_m2_s[idx])
+            where = np.zeros(lags.shape, dtype=np.int64)
+            where[pos] = inverse.ravel()
+            for j in range(tj.size):
+                cols = np.flatnonzero(pos[j])
+                outs[p][:, cols] += da[j] * u[:, where[j, cols]]
+        if grid:
+            ForceRamp._on_grid(outs, grid, parts, step, e, sensor, diffusivity_m2_s, tolerance)
+        return outs
+
+    @staticmethod
+    def _on_grid(outs, grid, parts, step, e, sensor, diffusivity_m2_s, tolerance) -> None:
+        """The Duhamel sums on uniform grids of step ``dt`` as (sparse) convolutions: ``out[i] += dA_j S[n_j + i]``.
 
         Share ``j``'s lags are ``t_0 + i dt - t_j = (n_j + f_j + i) dt`` with ``n_j`` whole and the phase
-        ``f_j`` in [0, 1): the shares of one phase read one step response ``S_l = u_step((f + l) dt)``
-        (a ramp on the grid's own step: one phase, about ``m`` times), each shifted by its ``n_j``.
+        ``f_j`` in [0, 1) (phases within 1e-6 of a step of each other taken as the smallest of them: ramp times
+        on the grid's own step differ there only by the rounding of ``t - t_j`` and ``dt``, a shift of ~1e-9
+        ``dt``, far below the readings' tolerance): the shares of one phase, of every part (a class's touch ramps,
+        read at their own delays), read one step response ``S_l = u_step((f + l) dt)`` of all their objects,
+        long enough for the latest share, each shifted by its ``n_j``.
         """
-        shift = (t[0] - tj) / dt
+        dt = grid[0][1]
+        shift = np.concatenate([(parts[p][0][0] - parts[p][1]) / dt for p, _, _ in grid])
         whole = np.floor(shift + 1e-9)
-        frac = np.round(np.maximum(shift - whole, 0.0), 9)
-        whole = whole.astype(np.int64)
-        m = t.size
-        for f in np.unique(frac):
-            group = np.flatnonzero(frac == f)
-            n_hi = int(whole[group].max())
-            length = n_hi + m                                             # l = 0 .. n_j + m - 1
-            if length <= 0:
+        frac, whole = np.maximum(shift - whole, 0.0), whole.astype(np.int64)
+        start = np.cumsum([0] + [parts[p][1].size for p, _, _ in grid])
+        order = np.argsort(frac, kind="stable")
+        new = np.diff(frac[order], prepend=-1.0) > 1e-6
+        label = np.empty(frac.size, dtype=np.int64)
+        label[order] = np.cumsum(new) - 1
+        for g, f in enumerate(frac[order][new].tolist()):
+            members = []
+            for q, (p, _, idx) in enumerate(grid):
+                m = parts[p][0].size
+                js = np.flatnonzero(label[start[q]:start[q + 1]] == g)
+                js = js[whole[start[q] + js] > -m]     # a share whose contact comes after the last time adds nothing
+                if js.size:
+                    members.append((p, idx, m, whole[start[q] + js], parts[p][2][js]))
+            if not members:
                 continue
+            length = max(int(n.max()) + m for _, _, m, n, _ in members)    # l = 0 .. n_j + m - 1 (> 0)
+            objects = np.unique(np.concatenate([idx for _, idx, _, _, _ in members]))
             lag = (f + np.arange(length)) * dt
             live = lag > 0
-            S = np.zeros((out.shape[0], length))
+            S = np.zeros((objects.size, length))
             if live.any():
-                S[:, live] = step.response(lag[live], e_object, sensor, diffusivity_m2_s=diffusivity_m2_s,
-                                           tolerance=tolerance)
-            # every share's window of S at once (S padded with the zeros before contact where n_j < 0; a share
-            # whose contact comes after the last time adds nothing), weighted by its dA and summed share by share
-            # in order (a reduction over a middle axis: elementwise additions, no BLAS: the same bits on every
-            # run), a few objects at a time (the windows' copy: objects x shares x m)
-            group = group[whole[group] > -m]
-            pad = max(0, -int(whole[group].min())) if group.size else 0
-            S = np.concatenate([np.zeros((out.shape[0], pad)), S], axis=1) if pad else S
-            at = (whole[group] + pad)[:, None] + np.arange(m)                  # (J, m): share j's window
-            for k in range(0, out.shape[0], 16):
-                part = S[k:k + 16, at]                                        # (K, J, m)
-                part *= da[group][None, :, None]
-                out[k:k + 16] += part.sum(axis=1)
-        return out
+                S[:, live] = step.response(lag[live], e[objects], sensor, tolerance=tolerance,
+                                           diffusivity_m2_s=None if diffusivity_m2_s is None
+                                           else diffusivity_m2_s[objects])
+            for p, idx, m, n, da in members:
+                # share by share, in order, each share's window of S (zeros before contact padded where n_j < 0)
+                # times its dA, into one buffer: elementwise, no BLAS (the same bits on every run)
+                pad = max(0, -int(n.min()))
+                Sp = S[np.searchsorted(objects, idx)]
+                Sp = np.concatenate([np.zeros((idx.size, pad)), Sp], axis=1) if pad else Sp
+                at, weight = (n + pad).tolist(), da.tolist()
+                total = np.multiply(Sp[:, at[0]:at[0] + m], weight[0])
+                term = np.empty_like(total)
+                for a, w in zip(at[1:], weight[1:]):
+                    total += np.multiply(Sp[:, a:a + m], w, out=term)
+                outs[p] += total
 
     def response(self, time_s, e_object, sensor, *, diffusivity_m2_s=None, tolerance: float = 1e-9) -> np.ndarray:
         """Normalized reading (K, m): the area-weighted sum of the base model's step responses.
@@ -319,11 +342,13 @@ class ForceRamp(ForwardModel):
         t = np.atleast_1d(np.asarray(time_s, dtype=np.float64))
         e = np.atleast_1d(np.asarray(e_object, dtype=np.float64))
         window = int(getattr(self.base, "smoothing_window", 0) or 0)
+        parts = [(t - delay if window <= 1 else smoothing_grid(t - delay, sensor.sample_rate_hz, window,
+                                                              what="a smoothed model with a force ramp"),
+                  *ramp._shares(), rows) for ramp, delay, rows in groups]
+        d = None if diffusivity_m2_s is None else np.broadcast_to(np.asarray(diffusivity_m2_s, dtype=np.float64),
+                                                                    e.shape)
         raw = np.zeros((e.size, t.size)) if not groups else None
-        for ramp, delay, rows in groups:
-            times = t - delay if window <= 1 else smoothing_grid(t - delay, sensor.sample_rate_hz, window,
-                                                                  what="a smoothed model with a force ramp")
-            u = ramp._unsmoothed(times, e[rows], sensor, diffusivity_m2_s, tolerance)
+        for (_, _, _, rows), u in zip(parts, self._duhamel(self._step_model(), parts, e, sensor, d, tolerance)):
             raw = np.empty((e.size, u.shape[1])) if raw is None else raw
             raw[rows] = u
         return raw if window <= 1 or not groups else smooth_cut(raw, t.size, window, int(self.base.smoothing_order))

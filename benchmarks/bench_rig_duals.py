@@ -12,7 +12,8 @@ worker runs it; every fit (a pair's three folds) with a fold problem that reache
 matrices and fold seed, ``fits.npz`` in ``--out``), up to ``--max-fits`` per contact.
 
 Replay: the kept fits through :func:`designkit.recognition.batched_svm.batched_cv_f1` once per way of ending the
-problems, in one process, CPU measured per way (the whole call: standardization, Gram, solve, predict):
+problems, in one process with one BLAS thread (as a sweep worker), CPU measured per way (the whole call:
+standardization, Gram, solve, predict):
 
 - ``reference``: libsvm (scikit-learn's ``SVC``, eps 1e-3) without a step cap;
 - ``libsvm-cap``: libsvm capped at 200,000 steps (designkit before this benchmark);
@@ -138,10 +139,13 @@ def replay(kept, way: str):
         bs._libsvm_smo = ridge_polish
     elif way != "designkit":
         raise SystemExit(f"unknown way {way!r}")
-    try:
+    from threadpoolctl import threadpool_limits
+
+    try:  # one BLAS thread, as a sweep worker runs (designkit.sweep.chunk): idle BLAS threads would count as CPU
         t = time.process_time()
-        parts = [bs.batched_cv_f1([f["lo"] for f in group], [f["hi"] for f in group], seeds=[f["seed"] for f in group])
-                 for group in _by_contact(kept)]
+        with threadpool_limits(limits=1):
+            parts = [bs.batched_cv_f1([f["lo"] for f in group], [f["hi"] for f in group], seeds=[f["seed"] for f in group])
+                     for group in _by_contact(kept)]
         cpu = time.process_time() - t
         out = {k: np.concatenate([getattr(r, k) for r in parts]) for k in ("f1", "predictions", "solver", "kkt_gap")}
         return {**out, "to_libsvm": to_libsvm[0]}, cpu

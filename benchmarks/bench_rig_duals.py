@@ -12,14 +12,20 @@ worker runs it; every fit (a pair's three folds) with a fold problem that reache
 matrices and fold seed, ``fits.npz`` in ``--out``), up to ``--max-fits`` per contact.
 
 Replay: the kept fits through :func:`designkit.recognition.batched_svm.batched_cv_f1` once per way of ending the
-problems, in one process, CPU measured per way (the whole call: standardization, Gram, solve, predict):
+problems, in one process with one BLAS thread (as a sweep worker), CPU measured per way (the whole call:
+standardization, Gram, solve, predict):
 
 - ``reference``: libsvm (scikit-learn's ``SVC``, eps 1e-3) without a step cap;
 - ``libsvm-cap``: libsvm capped at 200,000 steps (designkit before this benchmark);
 - ``ridge-1e-3``: the exact optimum of the dual ridged by ``1e-3 * mean(diag K)`` (the active set's first
   continuation level, which converges on these problems);
-- ``designkit``: what the code under test does (the rule it ships: libsvm at its cap, then the exact optimum
-  by the active set from libsvm's free and bounded sets).
+- ``designkit``: what the code under test does (the rule it ships: libsvm at eps 1e-2 and its cap, then the
+  exact optimum by the active set from libsvm's free and bounded sets; where that fails, the same from libsvm at
+  eps 1e-3);
+- ``polish-1e-3``: the same polish from libsvm at eps 1e-3 only (the rule before);
+- ``ridge-polish`` (experiment): before libsvm, the same exact polish (active set, ridge 1e-9, 25 solves) from
+  the ``1e-3`` ridge optimum's free and bounded sets; only the problems where it does not converge go to libsvm
+  (the ridge optimum is recomputed here, a few solves per problem that the shipped code already has).
 
 Per way against the reference: per-fit F1 difference (mean, sd, largest), touches whose cross-validated
 prediction differs, and CPU. Output: a table on stdout (``benchmarks/results/rig-duals.txt`` is this output).
@@ -104,24 +110,51 @@ def replay(kept, way: str):
     """batched_cv_f1 on the kept fits with one way of ending the problems the active set cannot; (result, CPU s)."""
     from designkit.recognition import batched_svm as bs
 
-    saved = (bs._libsvm_smo, bs._CONTINUATION, bs._POLISH_SMO)
-    orig_smo = bs._libsvm_smo
+    saved = (bs._libsvm_smo, bs._CONTINUATION, bs._POLISH_SMO, bs._SMO_EPS_START)
+    libsvm = bs._libsvm_smo
+    to_libsvm = [0]
+
+    def orig_smo(K, y, C, eps, max_iter, xp):  # libsvm, counting the problems it runs
+        to_libsvm[0] += int(K.shape[0])
+        return libsvm(K, y, C, eps, max_iter, xp)
+
+    bs._libsvm_smo = orig_smo
     if way in ("reference", "libsvm-cap"):  # libsvm's own answer, without (reference) or with its step cap
         cap = -1 if way == "reference" else 200_000
         bs._libsvm_smo = lambda K, y, C, eps, max_iter, xp: orig_smo(K, y, C, eps, cap, xp)
         bs._POLISH_SMO = False
     elif way == "ridge-1e-3":  # the continuation ends at the 1e-3 ridge: every problem here stops there
         bs._CONTINUATION = (1e-3,)
+    elif way == "polish-1e-3":  # the polish from libsvm at its own eps 1e-3 only (the rule before eps 1e-2 first)
+        bs._SMO_EPS_START = bs.LIBSVM_EPS
+    elif way == "ridge-polish":
+        def ridge_polish(K, y, C, eps, max_iter, xp):
+            P, n = y.shape
+            scale = np.mean(np.diagonal(K, axis1=1, axis2=2), axis=1)
+            a_r, _, _ = bs._active_set(K, y, C, 1e-3 * scale, np.ones((P, n), bool), np.zeros((P, n), bool), 25, xp)
+            a_p, ok, _ = bs._active_set(K, y, C, bs._RIDGE * scale, (a_r > 0) & (a_r < C), a_r >= C, 25, xp)
+            a_p, ok = bs._restore_equality(a_p, y, ok, C, xp)
+            a = np.array(a_p)
+            iters = np.zeros(P, dtype=np.int64)
+            if not ok.all():
+                a[~ok], _, iters[~ok] = orig_smo(K[~ok], y[~ok], C, eps, max_iter, xp)
+            return a, iters < max_iter, iters
+
+        bs._libsvm_smo = ridge_polish
     elif way != "designkit":
         raise SystemExit(f"unknown way {way!r}")
-    try:
+    from threadpoolctl import threadpool_limits
+
+    try:  # one BLAS thread, as a sweep worker runs (designkit.sweep.chunk): idle BLAS threads would count as CPU
         t = time.process_time()
-        parts = [bs.batched_cv_f1([f["lo"] for f in group], [f["hi"] for f in group], seeds=[f["seed"] for f in group])
-                 for group in _by_contact(kept)]
+        with threadpool_limits(limits=1):
+            parts = [bs.batched_cv_f1([f["lo"] for f in group], [f["hi"] for f in group], seeds=[f["seed"] for f in group])
+                     for group in _by_contact(kept)]
         cpu = time.process_time() - t
-        return {k: np.concatenate([getattr(r, k) for r in parts]) for k in ("f1", "predictions", "solver", "kkt_gap")}, cpu
+        out = {k: np.concatenate([getattr(r, k) for r in parts]) for k in ("f1", "predictions", "solver", "kkt_gap")}
+        return {**out, "to_libsvm": to_libsvm[0]}, cpu
     finally:
-        bs._libsvm_smo, bs._CONTINUATION, bs._POLISH_SMO = saved
+        bs._libsvm_smo, bs._CONTINUATION, bs._POLISH_SMO, bs._SMO_EPS_START = saved
 
 
 def main() -> None:
@@ -133,7 +166,7 @@ def main() -> None:
     p.add_argument("--contacts", default="4,6", help="contact indices of the rig table, comma-separated")
     p.add_argument("--max-fits", type=int, default=15, help="fits kept per contact")
     p.add_argument("--replay-only", action="store_true")
-    p.add_argument("--ways", default="reference,libsvm-cap,ridge-1e-3,designkit")
+    p.add_argument("--ways", default="reference,libsvm-cap,ridge-1e-3,polish-1e-3,designkit,ridge-polish")
     args = p.parse_args()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -154,6 +187,7 @@ def main() -> None:
         res[way] = (r, cpu)
         print(f"#   {way}: {cpu:.1f} CPU s, solver stages {np.bincount(r['solver'].ravel(), minlength=4).tolist()}, "
               f"KKT gap of the exact dual: median {np.median(r['kkt_gap']):.2g}, largest {np.max(r['kkt_gap']):.2g}; "
+              f"{r['to_libsvm']} problems ran libsvm; "
               f"load {os.getloadavg()[0]:.1f}", flush=True)
     ref, ref_cpu = res["reference"]
     print(f"{'way':<12} {'CPU [s]':>8} {'x ref':>6}   F1 - reference F1: {'mean':>7} {'sd':>6} {'max|d|':>6}"

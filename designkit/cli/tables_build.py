@@ -48,8 +48,8 @@ def tables_build(
     question outside the table's span (another material, noise or contact time) is refused in one line
     (exit 2) naming the way out: `--exact`, or a table built over a wider span.
 
-    The paper's 12 materials at the paper's 100 trials per interval: `--materials paper12` (for the real rig about
-    7,000 CPU s measured on a loaded machine: an hour on 2 cores; benchmarks/results/sensor_table_rig_scene.txt).
+    The paper's 12 materials at the paper's 100 trials per interval: `--materials paper12` (for the real rig 1,337
+    CPU s, 11 min 22 s on 2 idle cores with engine version 4; benchmarks/results/sensor_table_build.txt).
 
     Example (two materials, a quick coarse table): `designkit tables build --sensor my-sensor.yaml --m wood --m glass --trials 10 --contact-points 4`
     """

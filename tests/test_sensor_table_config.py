@@ -50,35 +50,6 @@ def test_the_table_config_is_the_rigs_one_noise_its_span_and_two_repeats(rig):
     assert (cfg.e_min, cfg.intervals, cfg.max_repeats, len(cfg.contact_s), cfg.rig_scene) == (80.0, 460, 2, 8, True)
 
 
-def test_overlapping_classes_are_solved_through_libsvm_to_the_optimum():
-    """Classes that overlap leave the active-set method to libsvm (the reference's solver; a Python SMO took
-    100,000+ steps a fold on the rig's touches, 86 CPU s one fit), and the answer ends at least as near the dual's
-    optimum as libsvm's own (engine version 4 restarts the active set from libsvm's sets)."""
-    from sklearn.svm import SVC
-
-    from designkit.recognition.batched_svm import solve_svc_duals
-
-    rng = np.random.default_rng(3)
-    n, d = 40, 10
-    y01 = np.r_[np.zeros(n // 2, dtype=int), np.ones(n // 2, dtype=int)]
-    X = rng.normal(size=(n, d)) + 0.5 * y01[:, None]
-    K = X @ X.T
-    y = np.where(y01 == 0, 1.0, -1.0)
-    a, rho, info = solve_svc_duals(K[None], y)
-    assert info["solver"][0] in (2, 3)  # libsvm, then (2) the exact optimum from its sets, or (3) libsvm's own
-    s = SVC(kernel="precomputed", C=1.0).fit(K, y01)
-    ref = np.zeros(n)
-    ref[s.support_] = np.abs(s.dual_coef_[0])
-    Q = np.outer(y, y) * K
-
-    def objective(alpha):
-        return 0.5 * alpha @ Q @ alpha - alpha.sum()
-
-    assert a[0].min() >= 0 and a[0].max() <= 1 + 1e-12 and abs(a[0] @ y) < 1e-9
-    assert objective(a[0]) <= objective(ref) + 1e-9
-    np.testing.assert_allclose(a[0], ref, rtol=0, atol=2e-2)  # libsvm stops at its own tolerance (eps 1e-3)
-
-
 def test_the_tables_touches_are_read_in_the_recorders_window_as_the_exact_routes():
     """A sensor table's touch at model contact c is read from the rig's onset to c, the window the exact route's
     touches have (simulate_class), not c seconds from the onset on (0.64 s more for the rig: answers that early)."""

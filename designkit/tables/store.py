@@ -423,11 +423,14 @@ class Table:
     header: dict
     #: name -> array (a shipped table's: each read on first use, :class:`_NpzArrays`)
     arrays: Mapping[str, np.ndarray]
-    #: Loaded content is a shipped table's (its hash is in :data:`SHIPPED_CONTENT_HASHES`): schema-checked already.
-    shipped: bool = field(default=False, compare=False)
     #: Loaded content was schema-checked already: a shipped table's, or one whose content hash this designkit
     #: recorded when it checked it (a registered sensor table: :func:`load_table`'s ``checked_hash``).
     checked: bool = field(default=False, compare=False)
+
+    @property
+    def shipped(self) -> bool:
+        """Loaded content is a shipped table's, verified (its hash is in :data:`SHIPPED_CONTENT_HASHES`)."""
+        return self.checked and self.header.get("content_hash") in SHIPPED_CONTENT_HASHES
 
     @property
     def fidelity(self) -> str:
@@ -455,7 +458,7 @@ class Table:
         from ..sensor import Sensor
 
         return Sensor.from_dict(self.header["sensor"], source=f"table {self.name}",
-                                schema=not (self.shipped or self.checked))
+                                schema=not self.checked)
 
     @property
     def fixed_initial_conditions(self) -> bool:
@@ -678,7 +681,7 @@ def load_table(name_or_path: str | Path, *, verify: bool = True, thorough: bool 
         if (not thorough and shipped_members is not None
                 and header.get("content_hash") in SHIPPED_CONTENT_HASHES):
             return Table(name=header["name"], path=path, header=header,
-                         arrays=_NpzArrays(path, members, specs, shipped_members), shipped=True)
+                         arrays=_NpzArrays(path, members, specs, shipped_members), checked=True)
     # a shipped table's content is checked by its hash instead of the schema (see SHIPPED_CONTENT_HASHES)
     known = verify and isinstance(header.get("content_hash"), str) and (
         header["content_hash"] in SHIPPED_CONTENT_HASHES or header["content_hash"] == checked_hash)
@@ -700,8 +703,7 @@ def load_table(name_or_path: str | Path, *, verify: bool = True, thorough: bool 
             raise InputError(f"table {path.name} failed its content check (hash of header and arrays mismatch): "
                              f"corrupted or edited; rebuild it with designkit sweep")
     check_table(header, arrays, path.name, schema=not known)
-    return Table(name=header["name"], path=path, header=header, arrays=arrays,
-                 shipped=known and header["content_hash"] in SHIPPED_CONTENT_HASHES, checked=known)
+    return Table(name=header["name"], path=path, header=header, arrays=arrays, checked=known)
 
 
 def _shipped_members(files_digest: str | None) -> dict[str, str] | None:

@@ -110,7 +110,7 @@ def replay(kept, way: str):
     """batched_cv_f1 on the kept fits with one way of ending the problems the active set cannot; (result, CPU s)."""
     from designkit.recognition import batched_svm as bs
 
-    saved = (bs._libsvm_smo, bs._CONTINUATION, bs._POLISH_SMO, bs._SMO_EPS_START)
+    saved = (bs._libsvm_smo, bs._CONTINUATION, bs._smo_polished, bs._SMO_EPS_START)
     libsvm = bs._libsvm_smo
     to_libsvm = [0]
 
@@ -122,7 +122,10 @@ def replay(kept, way: str):
     if way in ("reference", "libsvm-cap"):  # libsvm's own answer, without (reference) or with its step cap
         cap = -1 if way == "reference" else 200_000
         bs._libsvm_smo = lambda K, y, C, eps, max_iter, xp: orig_smo(K, y, C, eps, cap, xp)
-        bs._POLISH_SMO = False
+        # libsvm at its own eps 1e-3, not polished (solver 3 everywhere)
+        bs._SMO_EPS_START = bs.LIBSVM_EPS
+        bs._smo_polished = lambda K, y, C, eps, max_iter, scale, max_as, xp: (
+            lambda a, _, it: (a, np.zeros(K.shape[0], dtype=bool), it))(*bs._libsvm_smo(K, y, C, eps, max_iter, xp))
     elif way == "ridge-1e-3":  # the continuation ends at the 1e-3 ridge: every problem here stops there
         bs._CONTINUATION = (1e-3,)
     elif way == "polish-1e-3":  # the polish from libsvm at its own eps 1e-3 only (the rule before eps 1e-2 first)
@@ -154,7 +157,7 @@ def replay(kept, way: str):
         out = {k: np.concatenate([getattr(r, k) for r in parts]) for k in ("f1", "predictions", "solver", "kkt_gap")}
         return {**out, "to_libsvm": to_libsvm[0]}, cpu
     finally:
-        bs._libsvm_smo, bs._CONTINUATION, bs._POLISH_SMO, bs._SMO_EPS_START = saved
+        bs._libsvm_smo, bs._CONTINUATION, bs._smo_polished, bs._SMO_EPS_START = saved
 
 
 def main() -> None:

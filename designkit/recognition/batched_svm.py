@@ -82,7 +82,6 @@ __all__ = [
 LIBSVM_EPS = 1e-3
 _RIDGE = 1e-9  # relative ridge of the active-set solves (times mean(diag K))
 _CONTINUATION = (1e-3, 1e-9)
-_POLISH_SMO = True  # SMO's answers polished to the exact optimum (benchmarks/bench_rig_duals.py compares without)
 _SMO_EPS_START = 1e-2  # libsvm's eps before the polish (rig duals: exact after it on 90 of 90, after 1e-3 on 83)
 
 
@@ -506,17 +505,13 @@ def solve_svc_duals(K, y, *, C: float = 1.0, xp=None, max_active_set_iter: int =
             # set (1-10 solves); where that does not converge, the same from libsvm at its own eps 1e-3; solver 3:
             # libsvm's own answer (benchmarks/results/rig-duals.txt)
             Kr, yr = K[rest], y[rest]
-            if _POLISH_SMO:
-                a_r, ok_r, it_r = _smo_polished(Kr, yr, C, _SMO_EPS_START, smo_max_iter, scale[rest],
-                                                max_active_set_iter, xp)
-                again = xp.nonzero(~ok_r)[0]
-                if again.shape[0] and _SMO_EPS_START != LIBSVM_EPS:
-                    a_g, ok_g, it_g = _smo_polished(Kr[again], yr[again], C, LIBSVM_EPS, smo_max_iter,
-                                                    scale[rest][again], max_active_set_iter, xp)
-                    a_r[again], ok_r[again], it_r[again] = a_g, ok_g, it_r[again] + it_g
-            else:
-                a_r, _, it_r = _libsvm_smo(Kr, yr, C, LIBSVM_EPS, smo_max_iter, xp)
-                ok_r = xp.zeros(rest.shape[0], dtype=xp.bool)
+            a_r, ok_r, it_r = _smo_polished(Kr, yr, C, _SMO_EPS_START, smo_max_iter, scale[rest],
+                                            max_active_set_iter, xp)
+            again = xp.nonzero(~ok_r)[0]
+            if again.shape[0] and _SMO_EPS_START != LIBSVM_EPS:
+                a_g, ok_g, it_g = _smo_polished(Kr[again], yr[again], C, LIBSVM_EPS, smo_max_iter,
+                                                scale[rest][again], max_active_set_iter, xp)
+                a_r[again], ok_r[again], it_r[again] = a_g, ok_g, it_r[again] + it_g
             a[rest] = a_r
             solver[rest] = 3 - xp.astype(ok_r, xp.int64)
             iters[rest] = it_r

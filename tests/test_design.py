@@ -52,8 +52,15 @@ def test_cli_json_with_svm_confirmation(cli, tmp_path):
             "--plot", str(tmp_path / "d.png"))
     assert r.exit_code == 0, r.output
     out = json.loads(r.stdout)
-    assert out["best"]["skin"] == PEEK and out["svm"]["value"] is not None
-    assert out["svm"]["value"] >= out["best"]["ideal"]["value"]  # no classifier beats the bound
+    svm, pred = out["svm"], out["svm"]["prediction"]
+    assert out["best"]["skin"] == PEEK and svm["value"] is not None and pred["value"] is not None
+    # the statement and its confirmation: the same quantity (the crossing of the SVM's mean F1), each with an
+    # interval, the confirmation from fresh seeds; neither beats the ideal observer's bound
+    assert min(svm["value"], pred["value"]) >= out["best"]["ideal"]["value"]
+    assert svm["seed"] != pred["seed"] and svm["seeds"] == 4 * pred["repeats"]
+    assert pred["interval"]["low"] <= pred["value"] <= pred["interval"]["high"]
+    assert svm["holds"] == (pred["interval"]["low"] - 0.005 - 1e-9 <= svm["value"] <= pred["interval"]["high"] + 0.005 + 1e-9)
+    assert pred["counted_from"] == "first contact"  # the paper's sensor: no rig onset
     assert (tmp_path / "d.png").stat().st_size > 10_000
     # its csv record (one row, built from this JSON document): the SVM's confirmation as svm_*, the figure
     import csv
@@ -63,9 +70,10 @@ def test_cli_json_with_svm_confirmation(cli, tmp_path):
     from designkit.cli.design import _record
 
     (row,) = list(csv.DictReader(io.StringIO(render_rows([_record(out)], fmt="csv"))))
-    assert float(row["svm_value"]) == out["svm"]["value"] and float(row["svm_f1"]) == out["svm"]["svm_f1"]
-    assert float(row["svm_minus_ideal_s"]) == out["svm"]["svm_minus_ideal_s"] and row["svm_note"] == ""
-    assert row["figure"] == out["figure"] and row["skin"] == PEEK and "svm_svm_f1" not in row
+    assert float(row["svm_value"]) == svm["value"] and float(row["svm_high"]) == svm["interval"]["high"]
+    assert float(row["svm_prediction_value"]) == pred["value"] and row["svm_holds"] == str(svm["holds"])
+    assert float(row["svm_minus_ideal_s"]) == svm["svm_minus_ideal_s"] and row["svm_note"] == ""
+    assert row["figure"] == out["figure"] and row["skin"] == PEEK and "svm_svm_value" not in row
 
 
 @pytest.mark.parametrize("args,code,msg", [

@@ -343,7 +343,7 @@ def test_design_record_is_its_json_recommendation(cli):
               "ideal_value": d["best"]["ideal"]["value"], "ideal_method": "closed-form", "limiting_a": "a",
               "limiting_b": "b", "reason": d["reason"], "max_contact_s": 4.0, "noise_c": 0.05,
               "depth_min_um": 100.0, "depth_max_um": 400.0, "threshold": 0.9,
-              "designs_searched": d["designs_searched"], "svm_value": None, "svm_f1": None}
+              "designs_searched": d["designs_searched"], "svm_value": None, "svm_low": None, "svm_high": None}
     assert {k: rec[k] for k in expect} == expect
     assert all(_same(row[k], v) for k, v in expect.items()), row
     pd = pytest.importorskip("pandas")

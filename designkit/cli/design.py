@@ -154,7 +154,7 @@ def design(
 
     Example (a slow contact, given): `designkit design --m a=20000 --m b=35000 --contact-conductance 1600 --contact-ramp-s 2 --thermistor-tau-s 1 --skin peek --no-svm`
     """
-    from ..design.search import SKIN_SET, Constraints, confirm_with_svm, predict_and_confirm, recommend, targets_from
+    from ..design.search import SKIN_SET, Constraints, predict_and_confirm, recommend, targets_from
     from ..materials import get_material
 
     fmt = output_format(format_, json_, out=out)  # before the search: a bad --format or --out is refused first
@@ -194,8 +194,7 @@ def design(
         raise typer.Exit(EXIT_NO_DESIGN)
     if svm:
         with _app.busy("design: confirming the limiting pair with the paper's SVM", quiet=fmt != "text"):
-            payload["svm"] = (confirm_with_svm(result, targets) if contact is None
-                              else predict_and_confirm(result, targets))
+            payload["svm"] = predict_and_confirm(result, targets)
     if plot is not None:
         payload["figure"] = str(_plot(result, plot, payload["svm"]))
     emit(fmt, out, payload=payload, records=lambda: [_record(payload)],
@@ -245,7 +244,7 @@ def _contact(sensor, conductance, ramp_s, tau_s, rate):
 _BEST = ("skin", "effusivity", "diffusivity_m2_s", "depth_um", "tau_s", "sample_rate_hz", "delta_t_c",
          "thermistor_tau_s", "skin_thickness_um", "press_pace", "ideal_value", "ideal_method", "ideal_time_s",
          "limiting_a", "limiting_b")
-_SVM = ("value", "svm_f1", "svm_minus_ideal_s", "trials", "seeds", "holds", "note")
+_SVM = ("value", "svm_minus_ideal_s", "trials", "seeds", "holds", "note")
 
 
 def _record(p: dict) -> dict:
@@ -254,7 +253,7 @@ def _record(p: dict) -> dict:
     return {**{k: best.get(k) for k in _BEST}, "reason": p["reason"], **flat_record(p["constraints"]),
             "designs_searched": p["designs_searched"], "wall_s": p["search"]["wall_s"], "cpu_s": p["search"]["cpu_s"],
             **{(k if k.startswith("svm_") else f"svm_{k}"): svm.get(k) for k in _SVM},
-            "svm_low": (svm.get("interval") or {}).get("low"),
+            "svm_low": (svm.get("interval") or {}).get("low"), "svm_high": (svm.get("interval") or {}).get("high"),
             **{f"svm_prediction_{k}": pred.get(k) for k in ("value", "interval_low", "interval_high")},
             "figure": p.get("figure")}
 
@@ -262,6 +261,8 @@ def _record(p: dict) -> dict:
 def _estimate(e: dict) -> str:
     """An estimate of the mean-F1 crossing with its interval, for people."""
     iv = e["interval"]
+    if e["value"] is not None and iv["low"] is None and iv["high"] is not None:  # reached where it was first evaluated
+        return f"at most {iv['high']:.3g} s (the mean F1 reaches it at the shortest contact evaluated)"
     rng = (f"{iv['low']:.3g}-{iv['high']:.3g} s ({100 * iv['coverage']:.0f} % interval of the mean-F1 crossing)"
            if iv["low"] is not None and iv["high"] is not None and iv.get("coverage") else "no stated interval")
     return f"{'none' if e['value'] is None else format(e['value'], '.3g') + ' s'}, {rng}"
@@ -292,7 +293,7 @@ def _print_design(payload: dict, result, threshold: float, plot) -> None:
               "recommendation rests on the first samples)", highlight=False)
     s = payload["svm"]
     pred = (s or {}).get("prediction")
-    if pred is not None:  # under a rig's contact: the statement, then its confirmation (the same quantity)
+    if pred is not None:  # the statement, then its confirmation (the same quantity)
         con.print(f"  predicted (the exact route's estimate of where the SVM's mean F1 over seeds crosses {threshold:g} "
                   f"for the limiting pair, {pred['repeats']} seeds x {pred['trials']} touches per class and contact, "
                   f"from the {pred['counted_from']}): {_estimate(pred)}", highlight=False)
@@ -302,18 +303,6 @@ def _print_design(payload: dict, result, threshold: float, plot) -> None:
             con.print(f"  the SVM-confirmed contact {'lies' if s['holds'] else 'does NOT lie'} inside the stated "
                       "interval" + ("" if s["holds"] else " (about one confirmation in seven lands outside a right "
                                     "90 % interval: its own error is about half the statement's)"), highlight=False)
-    elif s is not None:
-        runs = f"{s['seeds']} fresh seeds x {s['trials']} touches per class, contacts evaluated: {len(s['evaluations'])}"
-        iv = s["interval"]
-        if s["value"] is None:
-            con.print(f"  SVM: {s['note']} ({runs})", highlight=False)
-        elif iv["low"] is None:
-            con.print(f"  SVM (the paper's classifier) on the limiting pair: F1 >= {threshold:g} already at the first "
-                      f"contact evaluated, {s['value']:.3g} s ({runs})", highlight=False)
-        else:
-            con.print(f"  SVM (the paper's classifier) on the limiting pair: F1 >= {threshold:g} at {s['value']:.3g} s, "
-                      f"not yet at {iv['low']:.3g} s ({runs}): its shortest contact lies in ({iv['low']:.3g}, "
-                      f"{s['value']:.3g}] s", highlight=False)
     worst = sorted((p for p in result.pairs), key=lambda p: -(p[2] if p[2] == p[2] else 1e9))[:3]
     con.print("  hardest pairs: " + "; ".join(f"{a} / {b} {t:.3g} s" if t == t else f"{a} / {b} none"
                                              for a, b, t in worst), highlight=False)

@@ -31,7 +31,7 @@ from ..materials import get_material, list_materials
 from ..query.ideal_bound import exact_ideal_min_contact
 from ..sensor import Sensor, check_samples_per_touch
 
-__all__ = ["CONFIRM_REPEATS", "CONFIRM_SEED", "MIN_SAMPLES", "SKIN_SET", "Constraints", "Design", "DesignResult", "Target", "confirm_with_svm", "predict",
+__all__ = ["CONFIRM_REPEATS", "CONFIRM_SEED", "MIN_SAMPLES", "SKIN_SET", "Constraints", "Design", "DesignResult", "Target", "predict",
            "predict_and_confirm", "recommend", "svm_f1_at", "targets_from"]
 
 #: Common skin materials of a heated tactile sensor (materials database names): polymers, ceramics, metals.
@@ -473,87 +473,7 @@ def svm_f1_at(design: Design, lo_class, hi_class, contact_s: float, noise_c: flo
                           for s in seeds]))
 
 
-def confirm_with_svm(result: DesignResult, targets: list[Target], *, trials: int = 100, seeds: int = 3,
-                     step_s: float = 0.05, low_s: float | None = None, high_s: float | None = None,
-                     bisections: int = 3) -> dict:
-    """The paper's SVM on the recommended design's limiting pair, under the design's model and scene: its
-    shortest contact bracketed.
-
-    The mean F1 over ``seeds`` runs is evaluated at ``low_s`` (default: the credited bound). At or above the
-    threshold there, contacts below are evaluated (the step doubling) until it falls short; below it, at
-    ``high_s`` (default ``low_s + step_s``) and above (the step doubling) until it is reached or the longest
-    contact. The bracket is then bisected ``bisections`` times (on sample times). ``value`` is the bracket's
-    high end, ``interval`` the bracket (the SVM's crossing lies in ``(low, high]``; ``low`` None: at the
-    shortest contact credited, :data:`MIN_SAMPLES` samples).
-    """
-    from ..objects import ObjectClass
-
-    best, c = result.best, result.constraints
-    fs = best.sample_rate_hz
-    by_name = {t.name: t for t in targets}
-    a, b = (by_name[n] for n in best.limiting_pair)
-    lo_e, hi_e, w = _pair_classes(a, b)
-    classes = ObjectClass("lo", (lo_e, lo_e + w)), ObjectClass("hi", (hi_e, hi_e + w))
-    evals: list[dict] = []
-
-    def snap(x, way=round):  # onto sample times (the F1 changes only there), at least MIN_SAMPLES
-        return round(max(int(way(x * fs - 1e-9 if way is math.ceil else x * fs + 1e-9)), MIN_SAMPLES) / fs, 6)
-
-    def f1(x):  # each contact once
-        done = [e["svm_f1"] for e in evals if e["contact_s"] == x]
-        if done:
-            return done[0]
-        f = svm_f1_at(best, *classes, x, c.noise_c, c.max_delta_t_c, trials=trials,
-                      seeds=[[s, 17] for s in range(seeds)])
-        evals.append({"contact_s": x, "svm_f1": f})
-        return f
-
-    out = {"ideal": {"value": _num(best.min_contact_s), "method": best.method}, "trials": trials, "seeds": seeds,
-           "grid_step_s": step_s}
-    top = snap(c.max_contact_s)
-    lo = min(snap(best.min_contact_s if low_s is None else low_s, math.floor), top)
-    floor = snap(0.0)
-    f_lo = f1(lo)
-    width = max(step_s, (high_s - lo) if high_s is not None and high_s > lo else step_s)
-    while f_lo >= c.threshold:  # reached already: step down (doubling) until it falls short, or to the floor
-        if lo <= floor:
-            return {"value": lo, "svm_f1": f_lo, "interval": {"low": None, "high": lo, "coverage": None}, **out,
-                    "svm_minus_ideal_s": round(lo - best.min_contact_s, 6), "evaluations": evals}
-        below = max(snap(lo - width, math.floor), floor)
-        f_below = f1(below)
-        if f_below < c.threshold:
-            hi, f_hi, lo = lo, f_lo, below
-            break
-        lo, f_lo, width = below, f_below, 2 * width
-    else:
-        hi = None
-    if hi is None:
-        hi = min(snap(lo + step_s if high_s is None else max(high_s, lo + 1 / fs), math.ceil), top)
-        width = hi - lo
-    while True:
-        f_hi = f1(hi)
-        if f_hi >= c.threshold:
-            break
-        if hi >= top:
-            return {"value": None, "interval": {"low": hi, "high": None, "coverage": None}, **out,
-                    "svm_minus_ideal_s": None, "evaluations": evals,
-                    "note": f"the SVM does not reach F1 {c.threshold:g} by {c.max_contact_s:g} s"}
-        width *= 2
-        lo, hi = hi, min(snap(hi + width), top)
-    for _ in range(bisections):
-        mid = snap(0.5 * (lo + hi))
-        if not lo < mid < hi:
-            break
-        f_mid = f1(mid)
-        if f_mid >= c.threshold:
-            hi, f_hi = mid, f_mid
-        else:
-            lo = mid
-    return {"value": hi, "svm_f1": f_hi, "interval": {"low": lo, "high": hi, "coverage": None}, **out,
-            "svm_minus_ideal_s": round(hi - best.min_contact_s, 6), "evaluations": evals}
-
-
-#: Seeds per contact of the SVM confirmation under a rig's contact: 4x the statement's, so the confirmation's own
+#: Seeds per contact of the SVM confirmation: 4x the statement's, so the confirmation's own
 #: error is about half the statement's (its estimate of the mean-F1 crossing scatters by sd/2 around the true one)
 #: and a confirmation of a right 90 % interval lands inside it about 86 % of the time (P(|Z| < 1.645 / sqrt(1.25))).
 CONFIRM_REPEATS = 16

@@ -289,21 +289,38 @@ def member_digest(npy_bytes) -> str:
     return "xxh3_128:" + xxhash.xxh3_128_hexdigest(npy_bytes)
 
 
-def member_digests(path: str | Path) -> dict[str, str]:
-    """:func:`member_digest` of every array of the .npz at ``path``, by array name (to list a shipped table)."""
+def member_digests(path: str | Path) -> dict[str, str | tuple[str, ...]]:
+    """The shipped digests of every array of the .npz at ``path``, by array name (to list a shipped table).
+
+    A member stored uncompressed with two or more axes (mapped from the file: a question reads a few rows of
+    it) gets one :func:`member_digest` for its npy header's bytes, then one for each row (first axis), so
+    that a question hashes the rows it reads and no other (:class:`_CheckedRows`); any other member gets one
+    :func:`member_digest` of its whole ``.npy``."""
+    out: dict[str, str | tuple[str, ...]] = {}
     with zipfile.ZipFile(path) as z:
-        return {n: member_digest(z.read(i)) for n, i in sorted(_zip_members(z).items())}
+        for name, info in sorted(_zip_members(z).items()):
+            raw = z.read(info)
+            out[name] = member_digest(raw)
+            if info.compress_type == zipfile.ZIP_STORED:
+                buf = io.BytesIO(raw)
+                shape, fortran, dtype = _npy_header(buf, np.lib.format.read_magic(buf))
+                if len(shape) >= 2 and not fortran:
+                    a = np.frombuffer(raw, dtype=dtype, count=math.prod(shape), offset=buf.tell()).reshape(shape)
+                    out[name] = (member_digest(raw[:buf.tell()]), *(member_digest(row) for row in a))
+    return out
 
 
 def _read_member(path: Path, info: zipfile.ZipInfo, spec: Mapping[str, Any] | None = None,
-                 digest: str | None = None) -> np.ndarray:
+                 digest: str | tuple[str, ...] | None = None) -> "np.ndarray | _CheckedRows":
     """One array of an .npz, read-only, its npy header checked against ``spec`` (the JSON header's entry).
 
     A member stored uncompressed is mapped from the file, so that only the pages a question touches are
     read; a compressed one is decompressed (its CRC checked). With ``digest`` (a shipped table's
     :func:`member_digest`) the member's bytes as read or mapped are hashed and compared first: the zip
     directory is not trusted for them. A member checked once in this process is not hashed again while its
-    file keeps its identity (device, inode, size, mtime, ctime).
+    file keeps its identity (device, inode, size, mtime, ctime). A mapped member listed row by row (``digest``
+    a tuple: :func:`member_digests`) has its npy header's bytes checked here and each row when it is first
+    read (:class:`_CheckedRows`).
     """
     import mmap
     import os
@@ -315,6 +332,8 @@ def _read_member(path: Path, info: zipfile.ZipInfo, spec: Mapping[str, Any] | No
         if info.compress_type != zipfile.ZIP_STORED:
             with zipfile.ZipFile(fh) as z:
                 raw = z.read(info)  # decompressed, CRC-checked
+            if isinstance(digest, tuple):  # listed row by row: a member stored uncompressed, as shipped
+                raise _EditedArray(f"array {name} is compressed; the shipped table's is stored")
             if digest is not None and not _verified(key, digest):
                 if member_digest(raw) != digest:
                     raise _EditedArray(f"array {name} differs from the shipped table's (digest mismatch)")
@@ -348,6 +367,16 @@ def _read_member(path: Path, info: zipfile.ZipInfo, spec: Mapping[str, Any] | No
         if info.file_size == 0 or st.st_size == 0:
             raise ValueError(f"{info.filename} is empty")
         mm = mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ)
+    if isinstance(digest, tuple):
+        if len(digest) != 1 + (shape[0] if shape else 0) or size == 0:
+            raise _EditedArray(f"array {name} has not the shipped table's rows")
+        head = key + ("npy header",)
+        if not _verified(head, digest[0]):
+            if member_digest(memoryview(mm)[start:offset]) != digest[0]:
+                raise _EditedArray(f"array {name} differs from the shipped table's (digest mismatch)")
+            _remember(head, digest[0])
+        return _CheckedRows(path, name, np.ndarray(shape, dtype=dtype, buffer=mm, offset=offset, order="C"),
+                            digest[1:], key)
     if digest is not None and not _verified(key, digest):
         if member_digest(memoryview(mm)[start:start + info.file_size]) != digest:
             raise _EditedArray(f"array {name} differs from the shipped table's (digest mismatch)")
@@ -377,19 +406,99 @@ _READ_ERRORS = (zipfile.BadZipFile, ValueError, OSError, EOFError, zlib.error, K
                 struct.error)
 
 
+class _CheckedRows(np.lib.mixins.NDArrayOperatorsMixin):
+    """A shipped array mapped from its file whose rows (first axis) are each checked against their shipped
+    digest (:func:`member_digests`) when first read: a fresh ``min-contact`` reads one noise row of svm-fine's
+    17, so it hashes (and pages in) that row only, not the table's 22 MB.
+
+    Indexing checks the rows its first index names (an integer, a slice, integer arrays; anything else:
+    every row) and returns numpy's result; ``np.asarray``, ufuncs, operators and every other ndarray
+    attribute check every row first. No byte of an unchecked row leaves it. A row checked once in this
+    process is not hashed again while the file keeps its identity.
+    """
+
+    def __init__(self, path: Path, name: str, array: np.ndarray, digests: tuple[str, ...], key: tuple):
+        self._path, self._name, self._a, self._digests, self._key = path, name, array, digests, key
+        self._checked: set[int] = set()
+
+    shape = property(lambda self: self._a.shape)
+    dtype = property(lambda self: self._a.dtype)
+    ndim = property(lambda self: self._a.ndim)
+    size = property(lambda self: self._a.size)
+
+    def __len__(self) -> int:
+        return len(self._a)
+
+    def _check(self, rows) -> None:
+        for r in rows:
+            if r in self._checked:
+                continue
+            key, digest = self._key + (r,), self._digests[r]
+            if not _verified(key, digest):
+                if member_digest(self._a[r]) != digest:
+                    raise _read_error(self._path, self._name, _EditedArray(
+                        f"array {self._name} differs from the shipped table's (digest mismatch in row {r})"))
+                _remember(key, digest)
+            self._checked.add(r)
+
+    def _rows(self, index):
+        """The rows (first axis) ``self._a[index]`` reads: those its first index names, else every row."""
+        n = len(self._a)
+        if isinstance(index, tuple):
+            if not index:
+                return range(n)
+            index = index[0]
+        if isinstance(index, (int, np.integer)) and not isinstance(index, (bool, np.bool_)):
+            return (int(index) % n,) if -n <= index < n else ()  # out of range: numpy says so
+        if isinstance(index, slice):
+            return range(*index.indices(n))
+        if isinstance(index, (list, np.ndarray)):
+            idx = np.asarray(index)
+            if idx.dtype.kind in "iu":
+                idx = idx.astype(np.int64).ravel()
+                return sorted(set((idx[(idx >= -n) & (idx < n)] % n).tolist()))  # (np.unique imports numpy.ma)
+        return range(n)  # Ellipsis, a new axis, a mask, anything else: every row
+
+    def __getitem__(self, index):
+        self._check(self._rows(index))
+        return self._a[index]
+
+    def __array__(self, dtype=None, copy=None):
+        self._check(range(len(self._a)))
+        a = self._a if dtype is None else self._a.astype(dtype, copy=False)
+        return a.copy() if copy else a
+
+    def __array_ufunc__(self, ufunc, method, *inputs, **kwargs):
+        inputs = tuple(np.asarray(x) if isinstance(x, _CheckedRows) else x for x in inputs)
+        return getattr(ufunc, method)(*inputs, **kwargs)
+
+    def __iter__(self):
+        return iter(np.asarray(self))
+
+    def __getattr__(self, attr):  # every other ndarray attribute: every row checked first
+        if attr.startswith("_"):
+            raise AttributeError(attr)
+        return getattr(np.asarray(self), attr)
+
+    def __repr__(self) -> str:
+        return f"<{self._name} {self.dtype}{list(self.shape)} mapped from {self._path.name}, checked row by row>"
+
+
 class _NpzArrays(Mapping):
     """A shipped table's arrays, each read when a question first asks for it.
 
     A question reads a few slices of a few arrays (min-contact: the noise slices around its own, of
     ``delta_*`` and their intervals). Members stored uncompressed (the fine shipped table,
     :func:`write_table` with ``compress=False``) are mapped from the file, so only those pages are
-    read (decompressing the whole table would cost a fresh question more than its answer). Each member's bytes, mapped or decompressed, are checked against the shipped table's
-    :data:`SHIPPED_MEMBER_DIGESTS` when it is first read (once per process and file), and its npy header
-    against the JSON header. Plain data: picklable.
+    read (decompressing the whole table would cost a fresh question more than its answer). Each member's
+    bytes, mapped or decompressed, are checked against the shipped table's :data:`SHIPPED_MEMBER_DIGESTS`
+    when first read (once per process and file; a mapped member's row by row, :class:`_CheckedRows`), and
+    its npy header against the JSON header. Plain data: picklable.
     """
 
     def __init__(self, path: Path, members: Mapping[str, zipfile.ZipInfo],
-                 specs: Mapping[str, Any] | None = None, digests: Mapping[str, str] | None = None):
+                 specs: Mapping[str, Any] | None = None,
+                 digests: Mapping[str, str | tuple[str, ...]] | None = None):
         self._path = Path(path)
         self._members = dict(members)
         self._specs = dict(specs or {})
@@ -719,7 +828,7 @@ def load_table(name_or_path: str | Path, *, verify: bool = True, thorough: bool 
     return Table(name=header["name"], path=path, header=header, arrays=arrays, checked=known)
 
 
-def _shipped_members(files_digest: str | None) -> dict[str, str] | None:
+def _shipped_members(files_digest: str | None) -> dict[str, str | tuple[str, ...]] | None:
     """The member digests of the shipped table whose files have ``files_digest``, or None (not shipped)."""
     if files_digest is None or files_digest not in SHIPPED_FILE_DIGESTS:
         return None

@@ -442,22 +442,26 @@ class _CheckedRows(np.lib.mixins.NDArrayOperatorsMixin):
             self._checked.add(r)
 
     def _rows(self, index):
-        """The rows (first axis) ``self._a[index]`` reads: those its first index names, else every row."""
+        """The rows (first axis) ``self._a[index]`` reads: those its first index names, else every row. (Cheap:
+        a question indexes each array it reads a few times, with small integer arrays.)"""
         n = len(self._a)
-        if isinstance(index, tuple):
+        if type(index) is tuple:
             if not index:
                 return range(n)
             index = index[0]
+        if isinstance(index, (np.ndarray, list)):
+            flat = np.asarray(index)
+            if flat.dtype.kind not in "iu":
+                return range(n)  # a mask, or anything else: every row
+            flat = flat.astype(np.int64, copy=False).ravel()
+            if flat.size > 64:  # one entry per row named (np.unique imports numpy.ma)
+                flat = np.flatnonzero(np.bincount(flat[(flat >= -n) & (flat < n)] % n, minlength=n))
+            return {r % n for r in flat.tolist() if -n <= r < n}  # out of range: numpy says so
         if isinstance(index, (int, np.integer)) and not isinstance(index, (bool, np.bool_)):
-            return (int(index) % n,) if -n <= index < n else ()  # out of range: numpy says so
+            return (int(index) % n,) if -n <= index < n else ()
         if isinstance(index, slice):
             return range(*index.indices(n))
-        if isinstance(index, (list, np.ndarray)):
-            idx = np.asarray(index)
-            if idx.dtype.kind in "iu":
-                idx = idx.astype(np.int64).ravel()
-                return sorted(set((idx[(idx >= -n) & (idx < n)] % n).tolist()))  # (np.unique imports numpy.ma)
-        return range(n)  # Ellipsis, a new axis, a mask, anything else: every row
+        return range(n)  # Ellipsis, a new axis, anything else: every row
 
     def __getitem__(self, index):
         self._check(self._rows(index))

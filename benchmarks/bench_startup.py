@@ -9,7 +9,8 @@ Like hyperfine: each command runs ``--runs`` times as a new process, round robin
 (so a neighbour's load spreads over all of them), after one warm-up run each;
 the figure is the median wall time. The CLI runs as ``python -m designkit`` with
 this interpreter (the tree on ``PYTHONPATH`` if set), which costs the same as
-the console script plus runpy's few milliseconds.
+the console script plus runpy's few milliseconds. Its output goes to the null device, except for
+``(terminal)`` rows: those run on a pseudo-terminal, as in a user's shell, where the answer is styled.
 
 The script byte-compiles this tree's packages and a ``--baseline`` tree's first (what ``python -m
 compileall -q designkit`` does; only stale or missing ``.pyc`` files are written): an installed package has
@@ -62,8 +63,11 @@ ARGS = {
     "designkit min-contact": ["-m", "designkit", "min-contact", "--e1", "35000", "--e2", "20000"],
     "designkit min-contact --json": ["-m", "designkit", "min-contact", "--e1", "35000", "--e2", "20000", "--json"],
 }
+#: A command's first item when it runs on a pseudo-terminal (:func:`_run`).
+TERMINAL = "<terminal>"
+ARGS["designkit min-contact (terminal)"] = [TERMINAL, *ARGS["designkit min-contact"]]
 COMMANDS = {name: [PY, *args] for name, args in ARGS.items()}
-TARGETS = {"designkit --version": 1.5, "designkit min-contact": 2.0}
+TARGETS = {"designkit --version": 1.5, "designkit min-contact": 2.0, "designkit min-contact (terminal)": 2.0}
 
 
 def _compile(trees: list[Path]) -> None:
@@ -77,10 +81,29 @@ def _compile(trees: list[Path]) -> None:
 
 
 def _run(cmd: list[str], env: dict | None = None, cwd: Path | None = None) -> tuple[float, float]:
-    """Wall seconds and CPU seconds (user + system, from the child's rusage) of one run."""
+    """Wall seconds and CPU seconds (user + system, from the child's rusage) of one run. A command whose first
+    item is :data:`TERMINAL` runs the rest with stdout and stderr on a pseudo-terminal (a user's shell:
+    styled output), its output read as it comes; any other's output goes to the null device."""
+    terminal = cmd[0] == TERMINAL
+    if terminal:
+        import pty
+
+        cmd = cmd[1:]
+        main, sub = pty.openpty()
+        out = err = sub
+    else:
+        out = err = subprocess.DEVNULL
     t0 = time.perf_counter()
-    p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env or os.environ.copy(),
-                         cwd=cwd)
+    p = subprocess.Popen(cmd, stdout=out, stderr=err, env=env or os.environ.copy(), cwd=cwd)
+    if terminal:
+        os.close(sub)
+        while True:
+            try:
+                if not os.read(main, 65536):
+                    break
+            except OSError:  # the child closed the terminal
+                break
+        os.close(main)
     _, status, usage = os.wait4(p.pid, 0)
     wall = time.perf_counter() - t0
     p.returncode = os.waitstatus_to_exitcode(status)
@@ -113,7 +136,8 @@ def main(argv=None) -> dict:
     where = subprocess.run([str(args.python), "-c", "import designkit; print(designkit.__file__)"], cwd=home,
                            env=own, capture_output=True, text=True)
     print(f"{args.python}: designkit from {where.stdout.strip() or where.stderr.strip()}")
-    commands = {name: ([str(args.python), *a], own, home) for name, a in ARGS.items()}
+    commands = {name: ([TERMINAL, str(args.python), *a[1:]] if a[0] == TERMINAL else [str(args.python), *a], own, home)
+                for name, a in ARGS.items()}
     if args.sensor is not None:
         commands.update(_sensor_commands(args.sensor.resolve(), Path(scratch.name), str(args.python)))
         if args.baseline is not None:
@@ -124,6 +148,8 @@ def main(argv=None) -> dict:
         env = {**os.environ, "PYTHONPATH": str(args.baseline)}
         # run from that tree too: ``python -m`` puts the working folder first on sys.path, before PYTHONPATH
         commands["baseline min-contact"] = (commands["designkit min-contact"][0], env, args.baseline)
+        commands["baseline min-contact (terminal)"] = (commands["designkit min-contact (terminal)"][0], env,
+                                                       args.baseline)
     for cmd, env, cwd in commands.values():  # warm-up: page cache, .pyc files
         _run(cmd, env, cwd)
     times: dict[str, list[float]] = {k: [] for k in commands}

@@ -50,8 +50,9 @@ def members_module() -> str:
     for name in SHIPPED_TABLES:
         lines.append(f"    {name!r}: {{")
         for k, v in member_digests(root / f"{name}.npz").items():
-            if isinstance(v, tuple):  # a mapped member: its npy header, then each row
-                lines += [f"        {k!r}: ("] + [f"            {d!r}," for d in v] + ["        ),"]
+            if isinstance(v, tuple):  # a mapped member: its npy header, then each row (two a line)
+                lines += [f"        {k!r}: ("] + [
+                    "            " + " ".join(f"{d!r}," for d in v[i:i + 2]) for i in range(0, len(v), 2)] + ["        ),"]
             else:
                 lines.append(f"        {k!r}: {v!r},")
         lines.append("    },")

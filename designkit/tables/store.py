@@ -55,7 +55,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-
 import xxhash
 
 from .._validation import InputError
@@ -304,7 +303,7 @@ def member_digests(path: str | Path) -> dict[str, str | tuple[str, ...]]:
             if info.compress_type == zipfile.ZIP_STORED:
                 buf = io.BytesIO(raw)
                 shape, fortran, dtype = _npy_header(buf, np.lib.format.read_magic(buf))
-                if len(shape) >= 2 and not fortran:
+                if len(shape) >= 2 and not fortran and math.prod(shape):
                     a = np.frombuffer(raw, dtype=dtype, count=math.prod(shape), offset=buf.tell()).reshape(shape)
                     out[name] = (member_digest(raw[:buf.tell()]), *(member_digest(row) for row in a))
     return out

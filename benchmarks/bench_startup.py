@@ -9,15 +9,25 @@ Like hyperfine: each command runs ``--runs`` times as a new process, round robin
 (so a neighbour's load spreads over all of them), after one warm-up run each;
 the figure is the median wall time. The CLI runs as ``python -m designkit`` with
 this interpreter (the tree on ``PYTHONPATH`` if set), which costs the same as
-the console script plus runpy's few milliseconds.
+the console script plus runpy's few milliseconds. Its output goes to the null device, except for
+``(terminal)`` rows: those run on a pseudo-terminal, as in a user's shell, where the answer is styled.
 
-Byte-compile the tree first (``python -m compileall -q designkit``): an installed package has its
-``.pyc`` files, and where ``PYTHONDONTWRITEBYTECODE`` is set a source tree compiles every module on
-every run (it doubled designkit's own import time here). The same for a ``--baseline`` tree: a checkout of
-the commit to compare (``git archive COMMIT designkit designkit_lab tables | tar -x -C /tmp/base``), byte-compiled::
+The script byte-compiles this tree's packages and a ``--baseline`` tree's first (what ``python -m
+compileall -q designkit`` does; only stale or missing ``.pyc`` files are written): an installed package has
+its ``.pyc`` files, and where ``PYTHONDONTWRITEBYTECODE`` is set a source tree edited since its last
+compile compiles that module on every run (a stale ``store.pyc`` showed as 15 ms of "self" import time).
+A ``--baseline`` tree is a checkout of the commit to compare (``git archive COMMIT designkit designkit_lab
+tables | tar -x -C /tmp/base``)::
 
-    python -m compileall -q designkit /tmp/base/designkit
     python benchmarks/bench_startup.py --runs 11 --baseline /tmp/base --sensor tests/data/rig_sensor.yaml
+
+``--python PY`` runs every command (``import numpy`` too) with another interpreter, e.g. a virtual
+environment where designkit is installed as the README installs it (``pip install .``, not editable: an
+editable install's import hook loads pathlib into every process, ``import numpy`` included, which flatters
+the ratio by about 10 ms)::
+
+    python -m venv /tmp/ne && /tmp/ne/bin/pip install .
+    python benchmarks/bench_startup.py --python /tmp/ne/bin/python --baseline /tmp/base
 
 Targets: ``designkit min-contact --e1 35000 --e2 20000`` at most 2x ``import
 numpy``; ``designkit --version`` at most 1.5x (issue 33).
@@ -45,22 +55,55 @@ import time
 from pathlib import Path
 
 PY = sys.executable
-COMMANDS = {
-    "python -c pass": [PY, "-c", "pass"],
-    "import numpy": [PY, "-c", "import numpy"],
-    "designkit --version": [PY, "-m", "designkit", "--version"],
-    "designkit min-contact": [PY, "-m", "designkit", "min-contact", "--e1", "35000", "--e2", "20000"],
-    "designkit min-contact --json": [PY, "-m", "designkit", "min-contact", "--e1", "35000", "--e2", "20000",
-                                     "--json"],
+REPO = Path(__file__).resolve().parents[1]
+ARGS = {
+    "python -c pass": ["-c", "pass"],
+    "import numpy": ["-c", "import numpy"],
+    "designkit --version": ["-m", "designkit", "--version"],
+    "designkit min-contact": ["-m", "designkit", "min-contact", "--e1", "35000", "--e2", "20000"],
+    "designkit min-contact --json": ["-m", "designkit", "min-contact", "--e1", "35000", "--e2", "20000", "--json"],
 }
-TARGETS = {"designkit --version": 1.5, "designkit min-contact": 2.0}
+#: A command's first item when it runs on a pseudo-terminal (:func:`_run`).
+TERMINAL = "<terminal>"
+ARGS["designkit min-contact (terminal)"] = [TERMINAL, *ARGS["designkit min-contact"]]
+COMMANDS = {name: [PY, *args] for name, args in ARGS.items()}
+TARGETS = {"designkit --version": 1.5, "designkit min-contact": 2.0, "designkit min-contact (terminal)": 2.0}
+
+
+def _compile(trees: list[Path]) -> None:
+    """Byte-compile the designkit packages of ``trees`` where their ``.pyc`` files are missing or stale."""
+    import compileall
+
+    for tree in trees:
+        for package in ("designkit", "designkit_lab"):
+            if (tree / package).is_dir():
+                compileall.compile_dir(tree / package, quiet=1)
 
 
 def _run(cmd: list[str], env: dict | None = None, cwd: Path | None = None) -> tuple[float, float]:
-    """Wall seconds and CPU seconds (user + system, from the child's rusage) of one run."""
+    """Wall seconds and CPU seconds (user + system, from the child's rusage) of one run. A command whose first
+    item is :data:`TERMINAL` runs the rest with stdout and stderr on a pseudo-terminal (a user's shell:
+    styled output), its output read as it comes; any other's output goes to the null device."""
+    terminal = cmd[0] == TERMINAL
+    if terminal:
+        import pty
+
+        cmd = cmd[1:]
+        main, sub = pty.openpty()
+        out = err = sub
+    else:
+        out = err = subprocess.DEVNULL
     t0 = time.perf_counter()
-    p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env or os.environ.copy(),
-                         cwd=cwd)
+    p = subprocess.Popen(cmd, stdout=out, stderr=err, env=env or os.environ.copy(), cwd=cwd)
+    if terminal:
+        os.close(sub)
+        while True:
+            try:
+                if not os.read(main, 65536):
+                    break
+            except OSError:  # the child closed the terminal
+                break
+        os.close(main)
     _, status, usage = os.wait4(p.pid, 0)
     wall = time.perf_counter() - t0
     p.returncode = os.waitstatus_to_exitcode(status)
@@ -77,13 +120,26 @@ def main(argv=None) -> dict:
                     help="another designkit tree (e.g. /work/main): its min-contact runs in the same round robin, "
                          "with that tree first on PYTHONPATH (a before/after in one run)")
     ap.add_argument("--sensor", type=Path, help="a calibrated sensor file: also time its question from a fresh shell")
+    ap.add_argument("--python", type=Path, default=Path(PY),
+                    help="the interpreter every command runs with (default: this one), e.g. a virtual environment "
+                         "with designkit installed non-editable")
     args = ap.parse_args(argv)
     if args.baseline is not None:
         args.baseline = args.baseline.resolve()
-    commands = {name: (cmd, None, None) for name, cmd in COMMANDS.items()}
+    _compile([REPO] + ([args.baseline] if args.baseline is not None else []))
     scratch = tempfile.TemporaryDirectory(prefix="bench-startup-")
+    # another interpreter runs from an empty folder: ``python -m`` puts the working folder first on sys.path,
+    # which would put this tree before the installed package
+    # (and without PYTHONPATH): its own installed designkit is measured
+    home = None if args.python == Path(PY) else Path(scratch.name)
+    own = None if home is None else {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    where = subprocess.run([str(args.python), "-c", "import designkit; print(designkit.__file__)"], cwd=home,
+                           env=own, capture_output=True, text=True)
+    print(f"{args.python}: designkit from {where.stdout.strip() or where.stderr.strip()}")
+    commands = {name: ([TERMINAL, str(args.python), *a[1:]] if a[0] == TERMINAL else [str(args.python), *a], own, home)
+                for name, a in ARGS.items()}
     if args.sensor is not None:
-        commands.update(_sensor_commands(args.sensor.resolve(), Path(scratch.name)))
+        commands.update(_sensor_commands(args.sensor.resolve(), Path(scratch.name), str(args.python)))
         if args.baseline is not None:
             for name in ("sensor question (its table)", "sensor file read"):
                 cmd, env, _ = commands[name]
@@ -91,7 +147,9 @@ def main(argv=None) -> dict:
     if args.baseline is not None:
         env = {**os.environ, "PYTHONPATH": str(args.baseline)}
         # run from that tree too: ``python -m`` puts the working folder first on sys.path, before PYTHONPATH
-        commands["baseline min-contact"] = (COMMANDS["designkit min-contact"], env, args.baseline)
+        commands["baseline min-contact"] = (commands["designkit min-contact"][0], env, args.baseline)
+        commands["baseline min-contact (terminal)"] = (commands["designkit min-contact (terminal)"][0], env,
+                                                       args.baseline)
     for cmd, env, cwd in commands.values():  # warm-up: page cache, .pyc files
         _run(cmd, env, cwd)
     times: dict[str, list[float]] = {k: [] for k in commands}
@@ -124,13 +182,13 @@ def main(argv=None) -> dict:
     return out
 
 
-def _sensor_commands(sensor: Path, scratch: Path) -> dict[str, tuple[list[str], dict, None]]:
+def _sensor_commands(sensor: Path, scratch: Path, py: str = PY) -> dict[str, tuple[list[str], dict, None]]:
     """The sensor question's commands, each with its data folder (a tiny table registered in one, none in the
     other), after building that table."""
     with_table, without = {**os.environ, "DESIGNKIT_DATA_DIR": str(scratch / "with")}, \
         {**os.environ, "DESIGNKIT_DATA_DIR": str(scratch / "without")}
     t0 = time.perf_counter()
-    r = subprocess.run([PY, "-m", "designkit", "tables", "build", "--sensor", str(sensor), "--m", "wood", "--m",
+    r = subprocess.run([py, "-m", "designkit", "tables", "build", "--sensor", str(sensor), "--m", "wood", "--m",
                         "glass", "--contact-points", "3", "--trials", "6", "--jobs", "1"], env=with_table,
                        capture_output=True, text=True)
     if r.returncode != 0:
@@ -138,10 +196,10 @@ def _sensor_commands(sensor: Path, scratch: Path) -> dict[str, tuple[list[str], 
     print(f"(a tiny table for {sensor.name} built in {time.perf_counter() - t0:.1f} s)")
     read = f"from designkit.sensor import load_sensor; s = load_sensor({str(sensor)!r})"
     return {
-        "sensor question (its table)": ([PY, "-m", "designkit", "min-contact", "--sensor", str(sensor), "--m1", "wood",
+        "sensor question (its table)": ([py, "-m", "designkit", "min-contact", "--sensor", str(sensor), "--m1", "wood",
                                          "--m2", "glass"], with_table, None),
-        "sensor file read": ([PY, "-c", read], without, None),
-        "sensor file + registry (none)": ([PY, "-c", read + "; from designkit.tables.registry import "
+        "sensor file read": ([py, "-c", read], without, None),
+        "sensor file + registry (none)": ([py, "-c", read + "; from designkit.tables.registry import "
                                            "table_for_sensor; assert table_for_sensor(s) is None"], without, None),
     }
 

@@ -46,10 +46,15 @@ def members_module() -> str:
 
     root = Path(__file__).resolve().parents[1] / "tables"
     doc = _shipped_members.__doc__
-    lines = [f'"""{doc}"""', "", "SHIPPED_MEMBER_DIGESTS: dict[str, dict[str, str]] = {"]
+    lines = [f'"""{doc}"""', "", "SHIPPED_MEMBER_DIGESTS: dict[str, dict[str, str | tuple[str, ...]]] = {"]
     for name in SHIPPED_TABLES:
         lines.append(f"    {name!r}: {{")
-        lines += [f"        {k!r}: {v!r}," for k, v in member_digests(root / f"{name}.npz").items()]
+        for k, v in member_digests(root / f"{name}.npz").items():
+            if isinstance(v, tuple):  # a mapped member: its npy header, then each row (two a line)
+                lines += [f"        {k!r}: ("] + [
+                    "            " + " ".join(f"{d!r}," for d in v[i:i + 2]) for i in range(0, len(v), 2)] + ["        ),"]
+            else:
+                lines.append(f"        {k!r}: {v!r},")
         lines.append("    },")
     return "\n".join(lines + ["}", ""])
 

@@ -1,9 +1,10 @@
-"""Piped answers are printed without rich (start-up, issue 16): the same characters rich prints, styles dropped."""
+"""An answer is printed without rich (start-up, issues 16 and 33): on a terminal its styled parts get typer's ANSI
+styles, piped the same characters without them."""
 
 import io
+import re
 
 import pytest
-from rich.console import Console
 
 from designkit import query
 from designkit.cli import _app
@@ -20,30 +21,31 @@ ANSWERS = [
 ]
 
 
-def _rich_lines(buf):
-    return _app.Lines(rich_console=Console(file=buf, highlight=False, soft_wrap=True, width=100_000))
+_ANSI = re.compile("\x1b\\[[0-9;]*m")
 
 
 @pytest.mark.parametrize("make", ANSWERS)
 @pytest.mark.parametrize("explain", [False, True])
-def test_piped_lines_are_what_rich_prints(make, explain, capsys, monkeypatch):
+def test_piped_lines_are_the_terminals_without_its_styles(make, explain, capsys, monkeypatch):
     d = make().to_dict()
     cli_query._render_text(d, explain)
     plain = capsys.readouterr().out
     buf = io.StringIO()
-    monkeypatch.setattr(_app, "text_console", lambda stderr=False: _rich_lines(buf))
+    monkeypatch.setattr(_app, "text_console", lambda stderr=False: _app.Lines(stream=buf, color=True))
     cli_query._render_text(d, explain)
-    assert plain == buf.getvalue()
+    styled = buf.getvalue()
+    assert "\x1b[" in styled and "\x1b[" not in plain  # the answer (or the refusal) and the scene line styled
+    assert _ANSI.sub("", styled) == plain
     assert "[/" not in plain and "[bold" not in plain
 
 
 @pytest.mark.parametrize("text", ["[bold]a[/] b", r"\[x] and [dim]y[/dim]", "(1, 1.5] s", "e [J s^-1/2] ok"])
 def test_text_is_never_read_as_markup(text):
-    """A name with brackets (a user's material or sensor) is printed as it is, piped or on a console."""
-    buf, plain = io.StringIO(), io.StringIO()
-    for lines in (_rich_lines(buf), _app.Lines(stream=plain)):
+    """A name with brackets (a user's material or sensor) is printed as it is, piped or on a terminal."""
+    styled, plain = io.StringIO(), io.StringIO()
+    for lines in (_app.Lines(stream=styled, color=True), _app.Lines(stream=plain)):
         lines.print(text, " ", (text, "bold green"))
-    assert buf.getvalue() == plain.getvalue() == f"{text} {text}\n"
+    assert _ANSI.sub("", styled.getvalue()) == plain.getvalue() == f"{text} {text}\n"
 
 
 @pytest.mark.parametrize("make", ANSWERS)

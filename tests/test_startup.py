@@ -69,6 +69,43 @@ def test_a_table_question_from_the_cli_imports_no_pydantic_and_not_the_exact_rou
     assert not _NOT_FOR_A_TABLE_QUESTION & imported
 
 
+def _on_a_terminal(*args: str, env: dict | None = None) -> str:
+    """What ``python ARGS`` prints with stdin, stdout and stderr on a pseudo-terminal (NO_COLOR unset unless
+    ``env`` sets it)."""
+    import pty
+
+    env = {**{k: v for k, v in os.environ.items() if k != "NO_COLOR"},
+           "PYTHONPATH": str(REPO) + os.pathsep + os.environ.get("PYTHONPATH", ""), **(env or {})}
+    main, sub = pty.openpty()
+    p = subprocess.Popen([sys.executable, *args], stdin=sub, stdout=sub, stderr=sub, env=env)
+    os.close(sub)
+    out = b""
+    while True:
+        try:
+            chunk = os.read(main, 65536)
+        except OSError:  # the child closed the terminal
+            break
+        if not chunk:
+            break
+        out += chunk
+    p.wait(timeout=120)
+    os.close(main)
+    assert p.returncode == 0, out
+    return out.decode("utf-8", "replace")
+
+
+def test_a_question_on_a_terminal_is_styled_without_rich():
+    """On a terminal the answer's parts get typer's ANSI styles (rich's console cost a fresh question about
+    25 ms); NO_COLOR prints the plain text."""
+    code = ("import sys, runpy; sys.argv = ['designkit', 'min-contact', '--e1', '35000', '--e2', '20000']\n"
+            "try:\n    runpy.run_module('designkit', run_name='__main__')\nexcept SystemExit:\n    pass\n"
+            "print('rich imported:', 'rich' in sys.modules)")
+    out = _on_a_terminal("-c", code)
+    assert "shortest contact: \x1b[" in out and "rich imported: False" in out, out
+    plain = _on_a_terminal("-c", code, env={"NO_COLOR": "1"})
+    assert "\x1b[" not in plain and "shortest contact: 1.23 s" in plain, plain
+
+
 def test_the_library_loads_a_question_route_on_first_use():
     code = ("import sys, designkit.query as q\n"
             "assert 'numpy' not in sys.modules, 'import designkit.query loaded numpy'\n"

@@ -193,14 +193,42 @@ def test_a_compressed_shipped_table_edited_with_a_matching_crc_is_refused(tmp_pa
 
 def test_an_array_checked_once_is_not_hashed_again_in_this_process(fine, monkeypatch):
     t = load_table(fine)
-    t.arrays["fits"]
+    np.asarray(t.arrays["fits"])  # every row read: every row checked
     calls = []
     real = store.member_digest
     monkeypatch.setattr(store, "member_digest", lambda b: calls.append(1) or real(b))
     again = load_table(fine)
-    again.arrays["fits"]
+    np.asarray(again.arrays["fits"])
     assert not calls
     with _Edit(fine, _members(fine)["fits"][0] + 200, b"\x07"):  # a new identity: hashed again, refused
         with pytest.raises(ValueError, match="fits differs"):
-            load_table(fine).arrays["fits"]
+            np.asarray(load_table(fine).arrays["fits"])
     assert calls
+
+
+def test_a_question_hashes_only_the_rows_it_reads_and_an_edit_in_them_is_refused(fine):
+    """A mapped array is checked row by row (first axis) as rows are read: min-contact at noise 0.05 °C and
+    dT 10 °C reads one noise row of svm-fine's 17; an edit in another row is refused when that row is read."""
+    from designkit.query import min_contact
+    from designkit.query.table import clear_table_cache
+
+    clear_table_cache()
+    t = load_table(fine)
+    assert min_contact(35000, 20000, noise_c=0.05, delta_t_c=10, table=t).value > 0
+    read = {name: sorted(a._checked) for name, a in t.arrays._loaded.items()}
+    assert read and all(rows == [8] for rows in read.values()), read
+    offset, size = _members(fine)["delta_up"]
+    row_bytes, data_at = 40 * 500 * 8, offset + size - 17 * 40 * 500 * 8
+    with _Edit(fine, data_at + 3 * row_bytes + 16, b"\x07"):  # row 3: not read by the question
+        clear_table_cache()
+        t = load_table(fine)
+        assert min_contact(35000, 20000, noise_c=0.05, delta_t_c=10, table=t).value > 0
+        with pytest.raises(ValueError, match=r"delta_up differs from the shipped table's .*row 3"):
+            t.arrays["delta_up"][2:4, 0]
+        with pytest.raises(ValueError, match="delta_up differs"):
+            np.asarray(t.arrays["delta_up"]) + 1
+    with _Edit(fine, data_at + 8 * row_bytes + 16, b"\x07"):  # row 8: the question's own
+        clear_table_cache()
+        with pytest.raises(ValueError, match="delta_up differs"):
+            min_contact(35000, 20000, noise_c=0.05, delta_t_c=10, table=load_table(fine))
+    clear_table_cache()

@@ -287,32 +287,39 @@ def escape(text: str) -> str:
     return rich_escape(text)
 
 
+#: The styles of an answer's parts (:class:`Lines`), as typer.style's keywords (click's ANSI styles).
+STYLES = {"": {}, "bold": {"bold": True}, "dim": {"dim": True}, "bold green": {"fg": "green", "bold": True},
+          "bold red": {"fg": "red", "bold": True}, "red": {"fg": "red"}, "yellow": {"fg": "yellow"}}
+
+
 class Lines:
     """Lines of text with styled parts, for the answer a question prints.
 
-    A part is plain text or a ``(text, style)`` pair (a rich style such as ``"bold green"``); text is
-    never read as markup, so a material, table or sensor name needs no escaping. On a terminal a line
-    is ``rich.text.Text.assemble(*parts)`` printed by rich's console; piped or logged, the parts' text
-    is written as it is, and rich is not imported (start-up: docs/decisions-log.md). Both print the
-    same characters: rich drops only the styles.
+    A part is plain text or a ``(text, style)`` pair (``style`` one of :data:`STYLES`, e.g. ``"bold green"``);
+    text is never read as markup, so a material, table or sensor name needs no escaping. On a terminal the
+    styled parts get typer's (click's) ANSI styles, unless ``NO_COLOR`` is set or ``TERM`` is ``dumb``;
+    piped or logged, the parts' text is written as it is. Both print the same characters. Not rich: its
+    console cost a fresh question on a terminal about 25 ms of start-up, and typer is loaded already
+    (docs/decisions-log.md).
 
     >>> Lines(stream=sys.stdout).print("answer: ", ("1.2 s", "bold green"), " (SVM)")
     answer: 1.2 s (SVM)
     """
 
-    def __init__(self, stderr: bool = False, *, stream: Any = None, rich_console: Any = None):
+    def __init__(self, stderr: bool = False, *, stream: Any = None, color: bool | None = None):
+        import os
+
         self._stream = stream if stream is not None else (sys.stderr if stderr else sys.stdout)
-        terminal = stream is None and hasattr(self._stream, "isatty") and self._stream.isatty()
-        self._rich = rich_console if rich_console is not None else (console(stderr) if terminal else None)
+        if color is None:
+            color = (stream is None and hasattr(self._stream, "isatty") and self._stream.isatty()
+                     and "NO_COLOR" not in os.environ and os.environ.get("TERM") != "dumb")
+        self._color = color
 
     def print(self, *parts: "str | tuple[str, str]") -> None:
         """Print one line made of ``parts`` (plain text, or ``(text, style)``)."""
-        if self._rich is None:
-            self._stream.write("".join(p if isinstance(p, str) else p[0] for p in parts) + "\n")
-            return
-        from rich.text import Text
-
-        self._rich.print(Text.assemble(*parts))
+        text = "".join(p if isinstance(p, str) else typer.style(p[0], **STYLES[p[1]]) if self._color else p[0]
+                       for p in parts)
+        typer.echo(text, file=self._stream, color=self._color)
 
 
 def text_console(stderr: bool = False) -> Lines:

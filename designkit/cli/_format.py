@@ -35,7 +35,6 @@ md        a GitHub Markdown table, then ``notes`` as paragraphs
 
 from __future__ import annotations
 
-import csv
 import io
 import json
 import math
@@ -171,6 +170,8 @@ def render_rows(rows: Sequence[Mapping[str, Any]], columns: Sequence[str] | None
     if fmt == "ndjson":
         return "".join(json.dumps(jsonable({c: r.get(c) for c in cols}), allow_nan=False) + "\n" for r in rows)
     if fmt == "csv":
+        import csv  # here: a question answered in text (the usual case) never loads it
+
         buf = io.StringIO()
         w = csv.writer(buf, lineterminator="\n")
         w.writerow(cols)

@@ -43,7 +43,6 @@ from __future__ import annotations
 
 import datetime as _dt
 import functools
-import hashlib
 import io
 import json
 import math
@@ -56,6 +55,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import xxhash
 
 from .._validation import InputError
 
@@ -109,6 +109,8 @@ _AXIS_DOCS = {
 def content_hash(arrays: Mapping[str, np.ndarray], header: Mapping[str, Any] | None = None) -> str:
     """SHA-256 over a table's identity: ``header`` (if given; canonical JSON without
     :data:`UNHASHED_FIELDS`), then every array's name, dtype, shape and C-order bytes, in name order."""
+    import hashlib  # here, not at the top: a shipped table's question never computes it
+
     h = hashlib.sha256()
     if header is not None:
         ident = {k: v for k, v in header.items() if k not in UNHASHED_FIELDS}
@@ -270,28 +272,54 @@ def _remember(key: tuple, digest: str) -> None:
 
 
 def member_digest(npy_bytes) -> str:
-    """SHA-256 of one member of a table's .npz: its whole ``.npy`` (header and data), decompressed.
+    """XXH3-128 of one member of a table's .npz: its whole ``.npy`` (header and data), decompressed.
 
     What :data:`SHIPPED_MEMBER_DIGESTS` lists, and what a shipped table's array is checked against when it is
-    first read (the npy header included: dtype, shape and order as well as every byte)."""
-    return "sha256:" + hashlib.sha256(npy_bytes).hexdigest()
+    first read (the npy header included: dtype, shape and order as well as every byte). XXH3 (the xxhash
+    library) rather than SHA-256: a fresh question hashes every byte of the arrays it reads (about 22 MB of
+    the fine table: SHA-256 took 12-18 ms of a 375 ms start, XXH3 about 1 ms), and a cryptographic digest
+    buys nothing here: it detects a changed byte no better, and a deliberately crafted table given by path
+    passes the long way's checks anyway (its content hash is its own), so a shipped digest is a shortcut
+    to trust, never a signature. The content hash (:func:`content_hash`) stays SHA-256.
+
+    >>> member_digest(b"")
+    'xxh3_128:99aa06d3014798d86001c324468d497f'
+    """
+    return "xxh3_128:" + xxhash.xxh3_128_hexdigest(npy_bytes)
 
 
-def member_digests(path: str | Path) -> dict[str, str]:
-    """:func:`member_digest` of every array of the .npz at ``path``, by array name (to list a shipped table)."""
+def member_digests(path: str | Path) -> dict[str, str | tuple[str, ...]]:
+    """The shipped digests of every array of the .npz at ``path``, by array name (to list a shipped table).
+
+    A member stored uncompressed with two or more axes (mapped from the file: a question reads a few rows of
+    it) gets one :func:`member_digest` for its npy header's bytes, then one for each row (first axis), so
+    that a question hashes the rows it reads and no other (:class:`_CheckedRows`); any other member gets one
+    :func:`member_digest` of its whole ``.npy``."""
+    out: dict[str, str | tuple[str, ...]] = {}
     with zipfile.ZipFile(path) as z:
-        return {n: member_digest(z.read(i)) for n, i in sorted(_zip_members(z).items())}
+        for name, info in sorted(_zip_members(z).items()):
+            raw = z.read(info)
+            out[name] = member_digest(raw)
+            if info.compress_type == zipfile.ZIP_STORED:
+                buf = io.BytesIO(raw)
+                shape, fortran, dtype = _npy_header(buf, np.lib.format.read_magic(buf))
+                if len(shape) >= 2 and not fortran and math.prod(shape):
+                    a = np.frombuffer(raw, dtype=dtype, count=math.prod(shape), offset=buf.tell()).reshape(shape)
+                    out[name] = (member_digest(raw[:buf.tell()]), *(member_digest(row) for row in a))
+    return out
 
 
 def _read_member(path: Path, info: zipfile.ZipInfo, spec: Mapping[str, Any] | None = None,
-                 digest: str | None = None) -> np.ndarray:
+                 digest: str | tuple[str, ...] | None = None) -> "np.ndarray | _CheckedRows":
     """One array of an .npz, read-only, its npy header checked against ``spec`` (the JSON header's entry).
 
     A member stored uncompressed is mapped from the file, so that only the pages a question touches are
     read; a compressed one is decompressed (its CRC checked). With ``digest`` (a shipped table's
     :func:`member_digest`) the member's bytes as read or mapped are hashed and compared first: the zip
     directory is not trusted for them. A member checked once in this process is not hashed again while its
-    file keeps its identity (device, inode, size, mtime, ctime).
+    file keeps its identity (device, inode, size, mtime, ctime). A mapped member listed row by row (``digest``
+    a tuple: :func:`member_digests`) has its npy header's bytes checked here and each row when it is first
+    read (:class:`_CheckedRows`).
     """
     import mmap
     import os
@@ -303,6 +331,8 @@ def _read_member(path: Path, info: zipfile.ZipInfo, spec: Mapping[str, Any] | No
         if info.compress_type != zipfile.ZIP_STORED:
             with zipfile.ZipFile(fh) as z:
                 raw = z.read(info)  # decompressed, CRC-checked
+            if isinstance(digest, tuple):  # listed row by row: a member stored uncompressed, as shipped
+                raise _EditedArray(f"array {name} is compressed; the shipped table's is stored")
             if digest is not None and not _verified(key, digest):
                 if member_digest(raw) != digest:
                     raise _EditedArray(f"array {name} differs from the shipped table's (digest mismatch)")
@@ -336,6 +366,16 @@ def _read_member(path: Path, info: zipfile.ZipInfo, spec: Mapping[str, Any] | No
         if info.file_size == 0 or st.st_size == 0:
             raise ValueError(f"{info.filename} is empty")
         mm = mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ)
+    if isinstance(digest, tuple):
+        if len(digest) != 1 + (shape[0] if shape else 0) or size == 0:
+            raise _EditedArray(f"array {name} has not the shipped table's rows")
+        head = key + ("npy header",)
+        if not _verified(head, digest[0]):
+            if member_digest(memoryview(mm)[start:offset]) != digest[0]:
+                raise _EditedArray(f"array {name} differs from the shipped table's (digest mismatch)")
+            _remember(head, digest[0])
+        return _CheckedRows(path, name, np.ndarray(shape, dtype=dtype, buffer=mm, offset=offset, order="C"),
+                            digest[1:], key)
     if digest is not None and not _verified(key, digest):
         if member_digest(memoryview(mm)[start:start + info.file_size]) != digest:
             raise _EditedArray(f"array {name} differs from the shipped table's (digest mismatch)")
@@ -365,19 +405,103 @@ _READ_ERRORS = (zipfile.BadZipFile, ValueError, OSError, EOFError, zlib.error, K
                 struct.error)
 
 
+class _CheckedRows(np.lib.mixins.NDArrayOperatorsMixin):
+    """A shipped array mapped from its file whose rows (first axis) are each checked against their shipped
+    digest (:func:`member_digests`) when first read: a fresh ``min-contact`` reads one noise row of svm-fine's
+    17, so it hashes (and pages in) that row only, not the table's 22 MB.
+
+    Indexing checks the rows its first index names (an integer, a slice, integer arrays; anything else:
+    every row) and returns numpy's result; ``np.asarray``, ufuncs, operators and every other ndarray
+    attribute check every row first. No byte of an unchecked row leaves it. A row checked once in this
+    process is not hashed again while the file keeps its identity.
+    """
+
+    def __init__(self, path: Path, name: str, array: np.ndarray, digests: tuple[str, ...], key: tuple):
+        self._path, self._name, self._a, self._digests, self._key = path, name, array, digests, key
+        self._checked: set[int] = set()
+
+    shape = property(lambda self: self._a.shape)
+    dtype = property(lambda self: self._a.dtype)
+    ndim = property(lambda self: self._a.ndim)
+    size = property(lambda self: self._a.size)
+
+    def __len__(self) -> int:
+        return len(self._a)
+
+    def _check(self, rows) -> None:
+        for r in rows:
+            if r in self._checked:
+                continue
+            key, digest = self._key + (r,), self._digests[r]
+            if not _verified(key, digest):
+                if member_digest(self._a[r]) != digest:
+                    raise _read_error(self._path, self._name, _EditedArray(
+                        f"array {self._name} differs from the shipped table's (digest mismatch in row {r})"))
+                _remember(key, digest)
+            self._checked.add(r)
+
+    def _rows(self, index):
+        """The rows (first axis) ``self._a[index]`` reads: those its first index names, else every row. (Cheap:
+        a question indexes each array it reads a few times, with small integer arrays.)"""
+        n = len(self._a)
+        if type(index) is tuple:
+            if not index:
+                return range(n)
+            index = index[0]
+        if isinstance(index, (np.ndarray, list)):
+            flat = np.asarray(index)
+            if flat.dtype.kind not in "iu":
+                return range(n)  # a mask, or anything else: every row
+            flat = flat.astype(np.int64, copy=False).ravel()
+            if flat.size > 64:  # one entry per row named (np.unique imports numpy.ma)
+                flat = np.flatnonzero(np.bincount(flat[(flat >= -n) & (flat < n)] % n, minlength=n))
+            return {r % n for r in flat.tolist() if -n <= r < n}  # out of range: numpy says so
+        if isinstance(index, (int, np.integer)) and not isinstance(index, (bool, np.bool_)):
+            return (int(index) % n,) if -n <= index < n else ()
+        if isinstance(index, slice):
+            return range(*index.indices(n))
+        return range(n)  # Ellipsis, a new axis, anything else: every row
+
+    def __getitem__(self, index):
+        self._check(self._rows(index))
+        return self._a[index]
+
+    def __array__(self, dtype=None, copy=None):
+        self._check(range(len(self._a)))
+        a = self._a if dtype is None else self._a.astype(dtype, copy=False)
+        return a.copy() if copy else a
+
+    def __array_ufunc__(self, ufunc, method, *inputs, **kwargs):
+        inputs = tuple(np.asarray(x) if isinstance(x, _CheckedRows) else x for x in inputs)
+        return getattr(ufunc, method)(*inputs, **kwargs)
+
+    def __iter__(self):
+        return iter(np.asarray(self))
+
+    def __getattr__(self, attr):  # every other ndarray attribute: every row checked first
+        if attr.startswith("_"):
+            raise AttributeError(attr)
+        return getattr(np.asarray(self), attr)
+
+    def __repr__(self) -> str:
+        return f"<{self._name} {self.dtype}{list(self.shape)} mapped from {self._path.name}, checked row by row>"
+
+
 class _NpzArrays(Mapping):
     """A shipped table's arrays, each read when a question first asks for it.
 
     A question reads a few slices of a few arrays (min-contact: the noise slices around its own, of
     ``delta_*`` and their intervals). Members stored uncompressed (the fine shipped table,
     :func:`write_table` with ``compress=False``) are mapped from the file, so only those pages are
-    read (decompressing the whole table would cost a fresh question more than its answer). Each member's bytes, mapped or decompressed, are checked against the shipped table's
-    :data:`SHIPPED_MEMBER_DIGESTS` when it is first read (once per process and file), and its npy header
-    against the JSON header. Plain data: picklable.
+    read (decompressing the whole table would cost a fresh question more than its answer). Each member's
+    bytes, mapped or decompressed, are checked against the shipped table's :data:`SHIPPED_MEMBER_DIGESTS`
+    when first read (once per process and file; a mapped member's row by row, :class:`_CheckedRows`), and
+    its npy header against the JSON header. Plain data: picklable.
     """
 
     def __init__(self, path: Path, members: Mapping[str, zipfile.ZipInfo],
-                 specs: Mapping[str, Any] | None = None, digests: Mapping[str, str] | None = None):
+                 specs: Mapping[str, Any] | None = None,
+                 digests: Mapping[str, str | tuple[str, ...]] | None = None):
         self._path = Path(path)
         self._members = dict(members)
         self._specs = dict(specs or {})
@@ -557,38 +681,38 @@ def resolve_table(name_or_path: str | Path) -> Path:
 SHIPPED_TABLES: dict[str, tuple[str, str]] = {
     "evidence-gradient-slope": (
         "sha256:b992e905af3f0312038aee27fcf71f1e96d444a9346caabd2bda2b9504f0399e",
-        "sha256:911e1adf9e1fa85eca6275993399f491d3006aefd443bd03e0ef6b1404c3d638"),
+        "xxh3_128:c2089ec1723258089fff5be2639cffde"),
     "f1-matrix-2s": (
         "sha256:60fa880ce4e50749e3aad5c48d061e41f743d89a6ca512f840793d16ade75c37",
-        "sha256:d39c9fbf935896606db255017df138f92fce5fcbcc0ff680b2ddeda2458f0ae8"),
+        "xxh3_128:964c420ee6f9392bee2d8275ca9f87f2"),
     "f1-matrix-500-r0p01": ("sha256:fb4b48404a6ee109f1f24fe1f63935839f10f7097e87944ee9dac187f3fc5b65",
-        "sha256:cf47f950d062a611aa463f133dbd858f40cb78b0236c4791b90aa90e3bb9face"),
+        "xxh3_128:82164ee19ad895f5a156ab66e5b1d4ed"),
     "f1-matrix-500-r0p02": ("sha256:a490cabcf1d28fda41f89a1e757325911544b7bf4fe31b36d66f8076d931ee5f",
-        "sha256:3304aec59926d0bb74749c6a2f3fde89503b46f49c60eeea03e3617ada742398"),
+        "xxh3_128:3acbaf20c1db0d99e462943af8936d58"),
     "f1-matrix-500-r0p005": ("sha256:e7e0cf174687bab40a6b3249fe771dc2701661744ce2d76263bc061e7a6ea708",
-        "sha256:e48b7145d0873852e752fb24582bf95a795890485b7c9be0320bb138bcd1b4f1"),
+        "xxh3_128:c9d6e99399122208ad7fd1d49983bc6f"),
     "f1-matrix-500-r0p002": ("sha256:10cd27049c815fa3e7605958855603653575c982c46824e8bf0190955a435f6f",
-        "sha256:d1c1949dbb11b78589acc2d584771b40787842e34a167d3561f6ad16da24cc1d"),
+        "xxh3_128:0ed1492909def9ff9d1e76ace2693848"),
     "f1-matrix-500-r0p001": ("sha256:66c441f90996e16d0d46415100dddfbb1564ca8c7dbd6fe8c63eee9711e66b6f",
-        "sha256:ddf96c99be765246dee76f9988b2f8ac3508365aea4c5005ce6eefd2a5b092aa"),
+        "xxh3_128:73ce269e3ba988145aeffa5e44260fe1"),
     "f1-matrix-fine-low": (
         "sha256:f4ecf487aec590490a63ec41215c6511218f038794ad33b52d5077bc1e5cf7ca",
-        "sha256:1f7cc68036078992caf4c20e0d201193b83d37dc3f3868688edb6a90e6cf7eb0"),
+        "xxh3_128:c20f14f97df8b20b488705711d1fd1ad"),
     "f1-matrix-paper": (
         "sha256:6290aff2cd7e4de3f9d1dc5ef445e66fdbb24a7cadd8e448a8733f373d111a60",
-        "sha256:d32ead9cde594f2c4d0d29e02aa369b6665b71cb0dd87bc71df0796163fbdcad"),
+        "xxh3_128:bdcb2235357b45589de4dc1fbf83c454"),
     "ideal-paper": (
         "sha256:1820bf01e2ffe9e79d35e4c0b9f8b310b10bbe7c8d481db47c9c09aa57564bae",
-        "sha256:ef844209edc8dcebd324634fea7fcdb146b0fc58fa814b05f76dfabf82c4e7f5"),
+        "xxh3_128:3f18fe49a25089bbd73bac9590327e88"),
     "svm-paper": (
         "sha256:55fdcf465d925b26f0ad45119eed7b7493efc8e6fb3d4983a86950354f136cab",
-        "sha256:b3704e57210bafc70b83a1015b44f1fbc54c9a8fcf5a1dfd5001fc6391a73a4f"),
+        "xxh3_128:63c9ba1136666bb584ceb3c72f732ff5"),
     "svm-paper-varied": (
         "sha256:7d72c28a50ff7ab6de9bfb6a3366e5c4dc5a4f6ed750a70de91c8b0098abd7b5",
-        "sha256:882e12fdd88e94f6dc0c0cd97172281e52fcc64852c8b0daaa62c7a505a15c0f"),
+        "xxh3_128:8ffcfa0e5f3372adccf7f4f3507478fc"),
     "svm-fine": (
         "sha256:579969bb66d390b4c6b48c5e25b586ece1db27ed9da0fa7b51224e4d56278c90",
-        "sha256:9fcb85950b49d6a98003061aa324b6ebf04ad7bebd319c78946e1aaa589f5a81"),
+        "xxh3_128:5648f2d380bfb36a16d80ffd81bdcbdb"),
 }
 
 #: Content hashes of the shipped tables. Their headers passed the schema when they were built and a test
@@ -608,23 +732,24 @@ SHIPPED_FILE_DIGESTS = frozenset(files for _, files in SHIPPED_TABLES.values())
 
 
 def file_digest(header_bytes: bytes, members: Mapping[str, zipfile.ZipInfo]) -> str:
-    """SHA-256 of a table's header file and its .npz's directory, as listed in :data:`SHIPPED_FILE_DIGESTS`.
+    """XXH3-128 of a table's header file and its .npz's directory, as listed in :data:`SHIPPED_FILE_DIGESTS`
+    (XXH3 as :func:`member_digest`, and why).
 
     The directory records each array's CRC-32, sizes, compression and place in the file, but it does
     not vouch for the bytes (an array edited in place keeps it): each array of a shipped table is
     hashed when first read, mapped or decompressed, and compared with :data:`SHIPPED_MEMBER_DIGESTS`.
 
-    >>> file_digest(b"{}", {})[:15]
-    'sha256:5fdf8f10'
+    >>> file_digest(b"{}", {})[:17]
+    'xxh3_128:070d65bc'
     """
-    h = hashlib.sha256(b"designkit-table-files\0")
+    h = xxhash.xxh3_128(b"designkit-table-files\0")
     h.update(len(header_bytes).to_bytes(8, "little"))
     h.update(header_bytes)
     for name in sorted(members):
         i = members[name]
         h.update(f"{name}\0{i.CRC}\0{i.compress_size}\0{i.file_size}\0{i.compress_type}\0{i.header_offset}\n"
                  .encode())
-    return "sha256:" + h.hexdigest()
+    return "xxh3_128:" + h.hexdigest()
 
 
 def _read_header(path: Path, *, schema: bool = True) -> dict:
@@ -706,7 +831,7 @@ def load_table(name_or_path: str | Path, *, verify: bool = True, thorough: bool 
     return Table(name=header["name"], path=path, header=header, arrays=arrays, checked=known)
 
 
-def _shipped_members(files_digest: str | None) -> dict[str, str] | None:
+def _shipped_members(files_digest: str | None) -> dict[str, str | tuple[str, ...]] | None:
     """The member digests of the shipped table whose files have ``files_digest``, or None (not shipped)."""
     if files_digest is None or files_digest not in SHIPPED_FILE_DIGESTS:
         return None

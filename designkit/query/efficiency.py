@@ -231,10 +231,8 @@ class CriticalNoiseGrid:
         i = np.flatnonzero(inside)
         if i.size:
             pu, pv = pu[i], pv[i]
-            su = np.minimum(np.maximum(np.floor(pu).astype(np.int64) - 1, 0), n - 4)
-            sv = np.minimum(np.maximum(np.floor(pv).astype(np.int64) - 1, 0), n - 4)
-            four = np.arange(4)
-            flat = (su[:, None, None] + four[None, :, None]) * n + (sv[:, None, None] + four[None, None, :])
+            su, sv = np.minimum(np.maximum(np.floor(np.stack([pu, pv])).astype(np.int64) - 1, 0), n - 4)
+            flat = (su[:, None, None] + _FOUR[None, :, None]) * n + (sv[:, None, None] + _FOUR[None, None, :])
             if not self.known[flat].all():
                 missing = flat[~self.known[flat]]  # the whole blocks of NOISE_GRID_BLOCK x NOISE_GRID_BLOCK nodes around them
                 b = NOISE_GRID_BLOCK
@@ -245,7 +243,8 @@ class CriticalNoiseGrid:
                 cols = (blocks % (n // b))[:, None, None] * b + np.arange(b)[None, None, :]
                 nodes = (rows * n + cols).ravel()
                 self._fill(nodes[~self.known[nodes]])
-            g = np.einsum("pi,pj,pij->p", _lagrange4(pu - su), _lagrange4(pv - sv), self.values[flat])
+            lu, lv = _lagrange4(np.stack([pu - su, pv - sv]))  # (both axes' weights in one evaluation)
+            g = np.einsum("pi,pj,pij->p", lu, lv, self.values[flat])
             w = self._weight(np.concatenate([hi[i], lo[i]]))
             out[i] = np.exp(g) * (w[:i.size] - w[i.size:])
         rest = np.flatnonzero(np.isnan(out) & np.isfinite(lo) & np.isfinite(hi))
@@ -255,6 +254,10 @@ class CriticalNoiseGrid:
             out[rest] = pair_critical_noise(self.sensor, lo[rest], hi[rest], width=self.width,
                                             threshold=self.threshold)
         return out.reshape(shape)
+
+
+_FOUR = np.arange(4)
+_FOUR.flags.writeable = False
 
 
 def _lagrange4(x: np.ndarray) -> np.ndarray:

@@ -329,8 +329,8 @@ def partner_in_grid(view, e, delta, direction: str):
 
 
 # ============================================================ the estimators: named strategies over arrays
-def nans(n: int) -> np.ndarray:
-    """``n`` NaNs: an answer array before its elements are answered ("none" until then)."""
+def nans(n) -> np.ndarray:
+    """``n`` NaNs (an int or a shape): an answer array before its elements are answered ("none" until then)."""
     return np.full(n, np.nan)
 
 
@@ -374,7 +374,7 @@ def _at(v, m: np.ndarray):
 def first_applicable(estimators, rd, n: int) -> dict[str, np.ndarray]:
     """Per element, the answer of the first estimator (in order) that applies to it (``kind`` "none" where none
     does)."""
-    out = {k: nans(n) for k in ("value", "low", "high")}
+    out = dict(zip(("value", "low", "high"), nans((3, n))))
     out["kind"], out["stated"] = np.full(n, "none", dtype=object), np.zeros(n, dtype=bool)
     taken = np.zeros(n, dtype=bool)
     for estimator in estimators:

@@ -23,6 +23,8 @@ Examples
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from cachetools import LRUCache
 
@@ -256,6 +258,18 @@ def pair_critical_noise(sensor, lo, hi, *, width=80.0, threshold: float = 0.9) -
     return _cached("critical-noise", sensor, (lo, hi, width), (float(threshold),), compute)
 
 
+@functools.lru_cache(maxsize=8)
+def _sample_logs(tau_s: float, rate_hz: float, n_max: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The sample counts ``0 .. n_max``, ``log(n / fs)`` and ``0.5 log(cum[n])`` (:func:`cumulative_g2`) at each,
+    read-only, once per sensor: what :func:`noise_k_contact` compares at every count."""
+    counts = np.arange(n_max + 1)
+    with np.errstate(divide="ignore"):  # (count 0: no signal yet, log 0)
+        log_t, half_log_cum = np.log(counts / rate_hz), 0.5 * np.log(cumulative_g2(tau_s, rate_hz, n_max))
+    for a in (counts, log_t, half_log_cum):
+        a.flags.writeable = False
+    return counts, log_t, half_log_cum
+
+
 def noise_k_contact(sensor, ratio, s_star, t_a, t_b, log_k_a, log_k_b, max_contact_s: float) -> np.ndarray:
     """First sample time [s] at which a classifier of noise efficiency ``k(t)`` separates a pair whose ideal
     observer needs projection noise at most ``s_star``: ``k(t) (sigma/dT) / |g(t)| <= s_star``, ``log k``
@@ -278,15 +292,15 @@ def noise_k_contact(sensor, ratio, s_star, t_a, t_b, log_k_a, log_k_b, max_conta
     ratio, s_star, t_a, t_b, ka, kb = (c.ravel() for c in cols)
     fs = float(sensor.sample_rate_hz)
     n_max = int(last_sample_index(max_contact_s, fs))
-    cum = cumulative_g2(float(sensor.tau_s), fs, max(n_max, 1))
+    counts, log_t, half_log_cum = _sample_logs(float(sensor.tau_s), fs, max(n_max, 1))
     with np.errstate(divide="ignore", invalid="ignore"):
         slope = np.where(t_a != t_b, (kb - ka) / np.log(t_b / t_a), 0.0)
         log_ta, log_r, log_s = np.log(t_a), np.log(ratio), np.log(s_star)
 
     def ok(n, rows):  # the classifier separates the pair at sample count n (an array, per element of rows)
         with np.errstate(divide="ignore", invalid="ignore"):
-            log_k = np.maximum(ka[rows] + slope[rows] * (np.log(n / fs) - log_ta[rows]), 0.0)
-            return log_k + log_r[rows] - 0.5 * np.log(cum[n]) <= log_s[rows]
+            log_k = np.maximum(ka[rows] + slope[rows] * (log_t[n] - log_ta[rows]), 0.0)
+            return log_k + log_r[rows] - half_log_cum[n] <= log_s[rows]
 
     out = np.full(ratio.shape, np.nan)
     # The response shape g rises with time, so cum[n] <= n g(n)^2 and cum[n+1] / cum[n] >= (n+1) / n: the
@@ -297,8 +311,10 @@ def noise_k_contact(sensor, ratio, s_star, t_a, t_b, log_k_a, log_k_b, max_conta
     scan = ~(slope <= 0.5) | (ratio.size <= 64)
     steep = np.nonzero(scan)[0]
     if steep.size:
-        n = np.arange(1, n_max + 1)
-        good = ok(n[None, :], steep[:, None])
+        n = counts[1:n_max + 1]
+        with np.errstate(divide="ignore", invalid="ignore"):  # (every count at once: the logs read, not taken)
+            good = (np.maximum(ka[steep, None] + slope[steep, None] * (log_t[None, 1:n_max + 1] - log_ta[steep, None]),
+                               0.0) + log_r[steep, None] - half_log_cum[None, 1:n_max + 1] <= log_s[steep, None])
         first = np.argmax(good, axis=1)
         out[steep] = np.where(good.any(axis=1), n[first] / fs, np.nan)
     mono = np.nonzero(~scan)[0]

@@ -54,6 +54,7 @@ class TableView:
         self._sensor_dict: dict | None = None
         self._mc_factor: float | None = None
         self._contact_norms: np.ndarray | None = None
+        self._scenes: dict[tuple[float, float], tuple[list, dict[str, bool]]] = {}
 
     def critical_noise(self, lo, hi) -> np.ndarray:
         """The ideal observer's critical noise of the table's classes ``[lo, lo + w)``, ``[hi, hi + w)`` (its
@@ -80,7 +81,17 @@ class TableView:
         return dict(self._sensor_dict)
 
     def scene_weights(self, noise_c: float, delta_t_c: float) -> tuple[list[tuple[tuple[int, ...], float]], dict[str, bool]]:
-        """Multilinear weights over the scene axes; in-grid flags per axis."""
+        """Multilinear weights over the scene axes; in-grid flags per axis (the caller's own dict). Kept per
+        scene (a table's weights of a scene never change; a question reads them more than once)."""
+        key = (noise_c, delta_t_c)
+        if key not in self._scenes:
+            if len(self._scenes) >= 256:  # (a sweep over scenes: the memo stays small)
+                self._scenes.clear()
+            self._scenes[key] = self._scene_weights(noise_c, delta_t_c)
+        combos, flags = self._scenes[key]
+        return combos, dict(flags)
+
+    def _scene_weights(self, noise_c: float, delta_t_c: float):
         ax = self.t.axes
         coords: list[list[tuple[int, float]]] = []
         flags: dict[str, bool] = {}
@@ -228,10 +239,10 @@ def contact_arrays(op, lo, hi, noise, dt, *, ideal_bound: bool, zc: float, class
     """
     view, n = op.view, lo.size
     grid, svm = view.contacts, op.tab.fidelity == "svm"
-    res: dict[str, Any] = {k: nans(n) for k in ("raw", "n_prev", "n_at", "mc_lo", "mc_hi", "ideal", "table_ideal")}
+    res: dict[str, Any] = dict(zip(("raw", "n_prev", "n_at", "mc_lo", "mc_hi", "ideal", "table_ideal"), nans((7, n))))
     res["k_cross"], res["in_grid"], res["mc_bounds"] = np.full(n, -1), np.zeros(n, dtype=bool), {}
     efficiency = svm and op.closed and "delta_up_ideal" in view.t.arrays
-    eff = {k: nans(n) for k in ("value", "low", "high", "k", "se_log", "k_a", "k_b", "t_a", "t_b")} if efficiency else None
+    eff = dict(zip(("value", "low", "high", "k", "se_log", "k_a", "k_b", "t_a", "t_b"), nans((9, n)))) if efficiency else None
     e_in = view.e_in(lo) & view.e_in(hi)
     # the pairs' own critical noises (the efficiency route's target, the closed-form bound): read with the
     # efficiency route's entries where it reads them (one call of the grid), the others' after the loop

@@ -386,6 +386,11 @@ def first_applicable(estimators, rd, n: int) -> dict[str, np.ndarray]:
         m = r.applies & ~taken
         if not m.any():
             continue
+        if m.all():  # it answers every element (a single question's usual case): its arrays whole
+            for k, v in (*((k, getattr(r, k)) for k in ("value", "low", "high")), *r.extra.items()):
+                out[k] = np.array(np.broadcast_to(v, (n,)), dtype=np.float64)
+            out["kind"], out["stated"] = np.full(n, r.kind, dtype=object), np.full(n, r.stated)
+            break
         for k in ("value", "low", "high"):
             out[k][m] = _at(getattr(r, k), m)
         out["kind"][m], out["stated"][m] = r.kind, r.stated

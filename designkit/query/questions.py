@@ -124,22 +124,16 @@ def ask(question: str, *, route: str = "auto", ideal_bound: bool = True,
     counted from the rig's detected onset, else the paper's defaults; the answer's ``scene["conditions"]``
     (an array answer's ``conditions``) says each value and where it came from (:func:`designkit.rig.rig_arguments`).
     """
-    if question not in QUESTIONS:
-        raise InputError(f"unknown question {question!r}; known: {', '.join(QUESTIONS)}")
-    if is_array_call(question, arguments):
-        asked, route, arguments, why, rig = _resolve(question, route, arguments)
-        fn = QUESTIONS[question].route(route)
-        own = _own(question, route, why)
-        ans = answer_arrays(question, functools.partial(fn, ideal_bound=False) if own else fn, route, arguments,
-                            ideal_bound=ideal_bound and not own)
-        if route == "table" and why.sensor_table:
-            ans = sensor_table_answer(question, ans, why, arguments.get("sensor"))
-        ans = dataclasses.replace(ans, route_reason=why.reason)
-        return ans if rig is None else for_rig(ans, rig, asked)
-    if not ideal_bound:
-        raise InputError("ideal_bound=False is for array inputs (a single answer always carries its bound)")
-    objects = {k: arguments.pop(k) for k in _OBJECTS[question] if k in arguments}
-    return ask_each(question, [objects], route=route, **arguments)[0]
+    if question in QUESTIONS and not is_array_call(question, arguments):
+        if not ideal_bound:
+            raise InputError("ideal_bound=False is for array inputs (a single answer always carries its bound)")
+        objects = {k: arguments.pop(k) for k in _OBJECTS[question] if k in arguments}
+        return ask_each(question, [objects], route=route, **arguments)[0]
+    asked, route, arguments, why, rig = _resolve(question, route, arguments)
+    fn, own = QUESTIONS[question].route(route), _own(question, route, why)
+    ans = answer_arrays(question, functools.partial(fn, ideal_bound=False) if own else fn, route, arguments,
+                        ideal_bound=ideal_bound and not own)
+    return _finished(question, ans, route, why, arguments, rig, asked)
 
 
 #: The arguments naming a question's objects (one element of :func:`ask_each`'s ``objects``).
@@ -154,8 +148,6 @@ def ask_each(question: str, objects: Sequence[Mapping[str, Any]], *, route: str 
     route answers every pair from one array call (:data:`designkit.query.table.EACH`: a 12-material matrix's 66
     pairs cost about what a few single questions do); a single :func:`ask` is element 0 of it.
     """
-    if question not in QUESTIONS:
-        raise InputError(f"unknown question {question!r}; known: {', '.join(QUESTIONS)}")
     asked, route, arguments, why, rig = _resolve(question, route, arguments)
     fn = QUESTIONS[question].route(route)
     extra = {"ideal_bound": False} if _own(question, route, why) else {}
@@ -168,7 +160,9 @@ def ask_each(question: str, objects: Sequence[Mapping[str, Any]], *, route: str 
 
 def _resolve(question: str, route: str, arguments: dict[str, Any]):
     """The asked contact, then the route, its arguments and why (:func:`~designkit.query.policy.choose_route`),
-    with the scene resolved for the sensor (:func:`~designkit.rig.rig_arguments`)."""
+    with the scene resolved for the sensor (:func:`~designkit.rig.rig_arguments`); an unknown question refused."""
+    if question not in QUESTIONS:
+        raise InputError(f"unknown question {question!r}; known: {', '.join(QUESTIONS)}")
     asked = arguments.get("contact_s")
     arguments, rig = rig_arguments(QUESTIONS[question].scene, arguments)
     route, arguments, why = choose_route(question, route, arguments)
@@ -180,11 +174,12 @@ def _own(question: str, route: str, why) -> bool:
     return route == "table" and why.sensor_table and question in MC_BOUND
 
 
-def _finished(question: str, ans: Answer, route: str, why, arguments, rig, asked) -> Answer:
-    """An answer as :func:`ask` gives it: a sensor table's, the route's reason, counted as the rig counts."""
+def _finished(question: str, ans, route: str, why, arguments, rig, asked):
+    """An answer (or array answer) as :func:`ask` gives it: a sensor table's, the route's reason, counted as the
+    rig counts."""
     if route == "table" and why.sensor_table:
         ans = sensor_table_answer(question, ans, why, arguments.get("sensor"))
-    notes = (*ans.notes, why.reason) if why.noted else None
+    notes = (*ans.notes, why.reason) if why.noted and isinstance(ans, Answer) else None
     ans = dataclasses.replace(ans, route_reason=why.reason, **({"notes": notes} if notes else {}))
     return ans if rig is None else for_rig(ans, rig, asked)
 

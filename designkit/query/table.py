@@ -195,10 +195,7 @@ def _points(pqs: list[PairQuestion], asked: list[int]) -> tuple[np.ndarray, np.n
 
 # ============================================================ min-contact
 def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | None = None,
-                m2: str | None = None, objects=None, noise_c: float = 0.05, delta_t_c: float = 10.0,
-                threshold: float | None = None, table: "Table | str" = DEFAULT_TABLE,
-                ideal_table: "Table | str | None" = DEFAULT_IDEAL_TABLE, sensor=None, model=None,
-                coverage: float = 0.9, sensor_temp_spread_c: float = 0.0, ideal_bound: bool = True) -> Answer:
+                m2: str | None = None, objects=None, **options: Any) -> Answer:
     """Shortest contact time [s] that separates two objects, from a table: :func:`min_contact_each` of the one
     pair (element 0 of :func:`~designkit.query.table_arrays.contact_arrays`; its estimators:
     :data:`CONTACT_ESTIMATORS`).
@@ -212,9 +209,9 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
     objects : (ObjectClass, ObjectClass), optional
         The classes instead.
     noise_c : float
-        Noise sigma per sample [degC].
+        Noise sigma per sample [degC] (default 0.05).
     delta_t_c : float
-        Sensor minus object temperature before contact [degC].
+        Sensor minus object temperature before contact [degC] (default 10).
     threshold : float, optional
         F1 threshold Phi; must be the table's (0.9 for the shipped tables).
     table, ideal_table : Table or name or path
@@ -248,10 +245,7 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
     >>> min_contact(35000, 20000, table="ideal-paper").to_dict()["quantity"]
     'contact_s'
     """
-    return min_contact_each([{"e1": e1, "e2": e2, "m1": m1, "m2": m2, "objects": objects}], noise_c=noise_c,
-                            delta_t_c=delta_t_c, threshold=threshold, table=table, ideal_table=ideal_table,
-                            sensor=sensor, model=model, coverage=coverage,
-                            sensor_temp_spread_c=sensor_temp_spread_c, ideal_bound=ideal_bound)[0]
+    return min_contact_each([{"e1": e1, "e2": e2, "m1": m1, "m2": m2, "objects": objects}], **options)[0]
 
 
 def min_contact_each(pairs: Sequence[Mapping[str, Any]], *, noise_c: float = 0.05, delta_t_c: float = 10.0,
@@ -347,8 +341,9 @@ def _cell_note(op, k: int, low: float, value: float) -> str:
 
 
 # ============================================================ max-noise / min-delta-t
-def _ratio_each(question: str, pairs, contact_s, noise_c, delta_t_c, threshold, table, ideal_table, sensor, model,
-                coverage: float = 0.9, sensor_temp_spread_c: float = 0.0) -> list[Answer]:
+def _ratio_each(question: str, pairs, *, contact_s: float, noise_c, delta_t_c, threshold=None, table=DEFAULT_TABLE,
+                ideal_table=DEFAULT_IDEAL_TABLE, sensor=None, model=None, coverage: float = 0.9,
+                sensor_temp_spread_c: float = 0.0) -> list[Answer]:
     """max-noise's or min-delta-t's answer for each pair of ``pairs`` in one scene, from one
     :func:`~designkit.query.table_arrays.ratio_arrays` call over them all."""
     contact = check_contact(contact_s)
@@ -430,50 +425,36 @@ def _ratio_answer(question: str, op: OpenedTable, pq: PairQuestion, r: dict, i: 
                    computation=computation, **common)
 
 
-def max_noise(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact_s: float, delta_t_c: float = 10.0,
-              threshold=None, table=DEFAULT_TABLE, ideal_table=DEFAULT_IDEAL_TABLE, sensor=None,
-              model=None, coverage: float = 0.9,
-              sensor_temp_spread_c: float = 0.0) -> Answer:
+def max_noise(e1=None, e2=None, *, m1=None, m2=None, objects=None, **options: Any) -> Answer:
     """Largest noise sigma [degC] at which ``contact_s`` still separates the objects (table): element 0 of
     :func:`~designkit.query.table_arrays.ratio_arrays` (its estimators: :data:`RATIO_ESTIMATORS`).
 
-    Arguments as :func:`min_contact`; ``contact_s`` [s] is the contact time.
+    Arguments as :func:`min_contact`; ``contact_s`` [s] is the contact time (no ``noise_c``); many pairs:
+    :func:`max_noise_each`.
     """
-    return max_noise_each([{"e1": e1, "e2": e2, "m1": m1, "m2": m2, "objects": objects}], contact_s=contact_s,
-                          delta_t_c=delta_t_c, threshold=threshold, table=table, ideal_table=ideal_table,
-                          sensor=sensor, model=model, coverage=coverage,
-                          sensor_temp_spread_c=sensor_temp_spread_c)[0]
+    return max_noise_each([{"e1": e1, "e2": e2, "m1": m1, "m2": m2, "objects": objects}], **options)[0]
 
 
-def max_noise_each(pairs: Sequence[Mapping[str, Any]], *, contact_s: float, delta_t_c: float = 10.0,
-                   threshold=None, table=DEFAULT_TABLE, ideal_table=DEFAULT_IDEAL_TABLE, sensor=None, model=None,
-                   coverage: float = 0.9, sensor_temp_spread_c: float = 0.0) -> list[Answer]:
-    """:func:`max_noise` of each pair of ``pairs`` (as :func:`min_contact_each`), from one array call."""
-    return _ratio_each("max-noise", pairs, contact_s, None, delta_t_c, threshold, table, ideal_table, sensor, model,
-                       coverage, sensor_temp_spread_c)
-
-
-def min_delta_t(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact_s: float, noise_c: float = 0.05,
-                threshold=None, table=DEFAULT_TABLE, ideal_table=DEFAULT_IDEAL_TABLE, sensor=None,
-                model=None, coverage: float = 0.9,
-                sensor_temp_spread_c: float = 0.0) -> Answer:
+def min_delta_t(e1=None, e2=None, *, m1=None, m2=None, objects=None, **options: Any) -> Answer:
     """Smallest sensor-object temperature difference [degC] that separates the objects (table), as
     :func:`max_noise`.
 
-    Arguments as :func:`min_contact`; ``contact_s`` [s] is the contact time.
+    Arguments as :func:`min_contact`; ``contact_s`` [s] is the contact time (no ``delta_t_c``); many pairs:
+    :func:`min_delta_t_each`.
     """
-    return min_delta_t_each([{"e1": e1, "e2": e2, "m1": m1, "m2": m2, "objects": objects}], contact_s=contact_s,
-                            noise_c=noise_c, threshold=threshold, table=table, ideal_table=ideal_table,
-                            sensor=sensor, model=model, coverage=coverage,
-                            sensor_temp_spread_c=sensor_temp_spread_c)[0]
+    return min_delta_t_each([{"e1": e1, "e2": e2, "m1": m1, "m2": m2, "objects": objects}], **options)[0]
+
+
+def max_noise_each(pairs: Sequence[Mapping[str, Any]], *, contact_s: float, delta_t_c: float = 10.0,
+                   **options: Any) -> list[Answer]:
+    """:func:`max_noise` of each pair of ``pairs`` (as :func:`min_contact_each`), from one array call."""
+    return _ratio_each("max-noise", pairs, contact_s=contact_s, noise_c=None, delta_t_c=delta_t_c, **options)
 
 
 def min_delta_t_each(pairs: Sequence[Mapping[str, Any]], *, contact_s: float, noise_c: float = 0.05,
-                     threshold=None, table=DEFAULT_TABLE, ideal_table=DEFAULT_IDEAL_TABLE, sensor=None, model=None,
-                     coverage: float = 0.9, sensor_temp_spread_c: float = 0.0) -> list[Answer]:
+                     **options: Any) -> list[Answer]:
     """:func:`min_delta_t` of each pair of ``pairs`` (as :func:`min_contact_each`), from one array call."""
-    return _ratio_each("min-delta-t", pairs, contact_s, noise_c, None, threshold, table, ideal_table, sensor, model,
-                       coverage, sensor_temp_spread_c)
+    return _ratio_each("min-delta-t", pairs, contact_s=contact_s, noise_c=noise_c, delta_t_c=None, **options)
 
 
 # ============================================================ delta-e
@@ -558,12 +539,10 @@ def _delta_details(e: float, sides: dict) -> dict[str, Any]:
 
 
 # ============================================================ distinguishable
-def distinguishable(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact_s: float, noise_c: float = 0.05,
-                    delta_t_c: float = 10.0, threshold=None, table=DEFAULT_TABLE, ideal_table=DEFAULT_IDEAL_TABLE,
-                    sensor=None, model=None, coverage: float = 0.9,
-                    sensor_temp_spread_c: float = 0.0) -> Answer:
-    """Whether ``contact_s`` separates the objects (table), with the ideal observer's F1 (closed form): element 0
-    of :func:`~designkit.query.table_arrays.distinguishable_arrays`.
+def distinguishable(e1=None, e2=None, *, m1=None, m2=None, objects=None, **options: Any) -> Answer:
+    """Whether ``contact_s`` [s] separates the objects (table), with the ideal observer's F1 (closed form): element 0
+    of :func:`~designkit.query.table_arrays.distinguishable_arrays` (arguments as :func:`min_contact`; many
+    pairs: :func:`distinguishable_each`).
 
     ``value`` follows from the same estimate :func:`min_contact` gives for the pair at the asked noise and
     dT (on a fixed-condition SVM table the noise-efficiency route, elsewhere the table's crossing): True iff
@@ -591,10 +570,7 @@ def distinguishable(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact
     >>> a.value == (1.45 >= m.value), a.details["verdict"]
     (True, 'confident')
     """
-    return distinguishable_each([{"e1": e1, "e2": e2, "m1": m1, "m2": m2, "objects": objects}], contact_s=contact_s,
-                                noise_c=noise_c, delta_t_c=delta_t_c, threshold=threshold, table=table,
-                                ideal_table=ideal_table, sensor=sensor, model=model, coverage=coverage,
-                                sensor_temp_spread_c=sensor_temp_spread_c)[0]
+    return distinguishable_each([{"e1": e1, "e2": e2, "m1": m1, "m2": m2, "objects": objects}], **options)[0]
 
 
 def distinguishable_each(pairs: Sequence[Mapping[str, Any]], *, contact_s: float, noise_c: float = 0.05,

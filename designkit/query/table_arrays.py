@@ -261,7 +261,7 @@ def contact_arrays(op, lo, hi, noise, dt, *, ideal_bound: bool, zc: float, class
         need = view.need(kinds, combos, l, h, readings)  # [kind, contact, pair]
         m = l.size
         value, k, _, _, n0, n1 = grid_crossing(grid, need.transpose(1, 0, 2).reshape(grid.size, -1),
-                                               np.tile(gap, len(kinds)))
+                                               np.concatenate([gap] * len(kinds)))
         cross = dict(zip(kinds, value.reshape(len(kinds), m)))
         k, n0, n1 = k[:m], n0[:m], n1[:m]
         res["raw"][idx], res["k_cross"][idx] = cross["svm"], k

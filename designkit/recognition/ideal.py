@@ -174,7 +174,7 @@ def shape_norm(sensor, contact_s) -> np.ndarray:
     2.6732
     """
     n = last_sample_index(contact_s, sensor.sample_rate_hz)
-    cum = cumulative_g2(float(sensor.tau_s), float(sensor.sample_rate_hz), int(max(np.max(n), 1)))
+    cum = cumulative_g2(float(sensor.tau_s), float(sensor.sample_rate_hz), int(max(np.asarray(n).max(), 1)))
     return np.sqrt(cum[n])
 
 

@@ -451,7 +451,7 @@ def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
     view, sensor = op.view, op.tab.sensor
     lo, hi, ratio, kb = columns(lo, hi, ratio, k_cross, dtypes=(np.float64,) * 3 + (np.int64,))
     n = lo.size
-    ka = k_baseline(view.contacts, kb)
+    ka = view.baselines()[kb]  # (k_baseline of every tabulated contact, kept with the table)
     slices, sw = _slices(combos, n)
     if s_pair is None:  # the pair's own critical noise read with its entries'
         lk, se, s_pair = _k_readings(op, slices, sw, ka, kb, lo, hi, extra=(lo, hi), readings=readings)

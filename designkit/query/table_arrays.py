@@ -25,7 +25,7 @@ from ..sensor import within_sample_limit
 from ..tables.store import Table
 from .crossing import coverage_of_z
 from .efficiency import (CLOSED_FORM_MAX_CONTACT_S, CriticalNoiseGrid, delta_efficiency_estimate, delta_entries,
-                         interp_e_by, mc_calibration, noise_k_min_contact, table_z)
+                         interp_e_by, k_baseline, mc_calibration, noise_k_min_contact, table_z)
 from .estimates import (ABOVE, BELOW, CELL, CONTACT_ESTIMATORS, INSIDE, RATIO_ESTIMATORS,
                         ContactReading, RatioReading, axis_weights_flagged, delta_estimate, first_applicable,
                         grid_crossing, interp_e_rows, nans, partner_in_grid, states_coverage, table_spread)
@@ -54,6 +54,7 @@ class TableView:
         self._sensor_dict: dict | None = None
         self._mc_factor: float | None = None
         self._contact_norms: np.ndarray | None = None
+        self._baselines: np.ndarray | None = None
         self._scenes: dict[tuple[float, float], tuple[list, dict[str, bool]]] = {}
 
     def critical_noise(self, lo, hi) -> np.ndarray:
@@ -64,6 +65,12 @@ class TableView:
             self._noise_grid = CriticalNoiseGrid(self.t.sensor, float(self.t.header["effusivity"]["width"]),
                                                  self.t.threshold, self.e_hi)
         return self._noise_grid(lo, hi)
+
+    def baselines(self) -> np.ndarray:
+        """:func:`~designkit.query.efficiency.k_baseline` of each tabulated contact index, computed once."""
+        if self._baselines is None:
+            self._baselines = k_baseline(self.contacts, np.arange(self.contacts.size))
+        return self._baselines
 
     def contact_norms(self) -> np.ndarray:
         """``|g|`` (:func:`~designkit.recognition.ideal.shape_norm`) of the table's sensor at each tabulated

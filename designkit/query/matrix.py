@@ -521,13 +521,6 @@ def _multiclass(mats, tab, *, noise_c: float, delta_t_c: float, svm_trials: int 
 
 
 # ============================================================ the matrix
-def _bound(question: str, a: Answer) -> str:
-    """Whether the value is a grid end beyond which the true answer lies (see :class:`MatrixCell`)."""
-    if a.value is None or isinstance(a.value, bool):
-        return ""
-    return a.bound  # the answer's own (its interval open at one end): one source for every surface
-
-
 def _worse_key(question: str) -> Callable[[MatrixCell], tuple]:
     """Sort key: the largest key is the hardest answered pair (no value within the table is hardest)."""
     sign = 1.0 if MATRIX_QUESTIONS[question] == "higher" else -1.0
@@ -636,7 +629,7 @@ def material_matrix(materials: Sequence[str | Material] = (), question: str = "m
         if question == "distinguishable":
             ideal = a.details.get("ideal_f1")
         cells.append(MatrixCell(i, j, a.value, None if ideal is None else float(ideal), status, a.note,
-                                _bound(question, a), a))
+                                a.bound, a))  # (the answer's own: one source for every surface)
         if progress is not None:
             progress(len(cells), total)
     curve = None

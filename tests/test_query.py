@@ -570,3 +570,13 @@ def test_ask_each_answers_each_pair_as_ask_does(question, scene):
     assert many[1].value is None and not many[1].limiting_pair  # the overlap: no answer, said so
     with pytest.raises(InputError, match="e1 and e2 are equal"):
         ask_each(question, [*objects, {"e1": 5.0e3, "e2": 5.0e3}], route="table", **scene)
+
+
+def test_a_views_scene_weights_are_the_callers_own():
+    # the table view keeps each scene's weights; a caller that adds a flag (the table route adds its effusivity
+    # and contact flags) changes its own dict, never what the next question reads
+    view = q.open_table("svm-paper").view
+    combos, flags = view.scene_weights(0.05, 10.0)
+    flags["effusivity"] = False
+    assert view.scene_weights(0.05, 10.0) == (combos, {"noise_ratio": True})
+    assert view.scene_weights(50.0, 10.0)[1] == {"noise_ratio": False}  # sigma/dT 5: beyond the grid, flagged

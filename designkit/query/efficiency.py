@@ -231,7 +231,8 @@ class CriticalNoiseGrid:
         i = np.flatnonzero(inside)
         if i.size:
             pu, pv = pu[i], pv[i]
-            su, sv = np.minimum(np.maximum(np.floor(np.array([pu, pv])).astype(np.int64) - 1, 0), n - 4)
+            su = np.minimum(np.maximum(np.floor(pu).astype(np.int64) - 1, 0), n - 4)
+            sv = np.minimum(np.maximum(np.floor(pv).astype(np.int64) - 1, 0), n - 4)
             flat = (su[:, None, None] + _FOUR[None, :, None]) * n + (sv[:, None, None] + _FOUR[None, None, :])
             if not self.known[flat].all():
                 missing = flat[~self.known[flat]]  # the whole blocks of NOISE_GRID_BLOCK x NOISE_GRID_BLOCK nodes around them
@@ -243,8 +244,7 @@ class CriticalNoiseGrid:
                 cols = (blocks % (n // b))[:, None, None] * b + np.arange(b)[None, None, :]
                 nodes = (rows * n + cols).ravel()
                 self._fill(nodes[~self.known[nodes]])
-            lu, lv = _lagrange4(np.array([pu - su, pv - sv]))  # (both axes' weights in one evaluation)
-            g = np.einsum("pi,pj,pij->p", lu, lv, self.values[flat])
+            g = np.einsum("pi,pj,pij->p", _lagrange4(pu - su), _lagrange4(pv - sv), self.values[flat])
             w = self._weight(np.concatenate([hi[i], lo[i]]))
             out[i] = np.exp(g) * (w[:i.size] - w[i.size:])
         rest = np.flatnonzero(np.isnan(out) & np.isfinite(lo) & np.isfinite(hi))

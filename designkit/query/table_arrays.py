@@ -145,7 +145,7 @@ class TableView:
         at += (np.arange(self.contacts.size)[:, None],)
         arrays = [self.t.arrays[n] for n in names]
         # only the entries read (the arrays may be mapped from the file)
-        return interp_e_by(lambda c: np.array([a[at + (c,)] for a in arrays]), self.centres, e)
+        return interp_e_by(lambda c: np.stack([a[at + (c,)] for a in arrays]), self.centres, e)
 
     def readings(self, kinds, combos, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """What :meth:`need` of the sequence ``kinds`` is made of: ``delta_up`` at ``lo`` and ``delta_down`` at

@@ -551,3 +551,32 @@ def test_the_library_chooses_the_route_and_says_why():
     assert a.route == "table" and a.to_dict()["route_reason"] == a.route_reason and "svm-fine" in a.route_reason
     arr = query.min_contact([35000, 30000], 20000)
     assert arr.route_reason == a.route_reason and arr.to_dict()[0]["route_reason"] == a.route_reason
+
+
+@pytest.mark.parametrize("question, scene", [("min-contact", {"noise_c": 0.03}), ("max-noise", {"contact_s": 1.5}),
+                                             ("min-delta-t", {"contact_s": 0.8}),
+                                             ("distinguishable", {"contact_s": 1.0})])
+def test_ask_each_answers_each_pair_as_ask_does(question, scene):
+    # many pairs from one array call of the table route (what `designkit matrix` asks): element i is what ask
+    # answers for pair i, an overlapping pair, a pair outside the grid and a pair given as classes included
+    from designkit.objects import ObjectClass
+    from designkit.query import ask, ask_each
+
+    objects = [{"m1": "copper", "m2": "glass"}, {"m1": "aluminum", "m2": "copper"}, {"e1": 35000.0, "e2": 20000.0},
+               {"e1": 100.0, "e2": 900.0},
+               {"objects": (ObjectClass("a", (3000.0, 3400.0)), ObjectClass("b", (5000.0, 5080.0)))}]
+    many = ask_each(question, objects, route="table", **scene)
+    assert [a.to_dict() for a in many] == [ask(question, route="table", **o, **scene).to_dict() for o in objects]
+    assert many[1].value is None and not many[1].limiting_pair  # the overlap: no answer, said so
+    with pytest.raises(InputError, match="e1 and e2 are equal"):
+        ask_each(question, [*objects, {"e1": 5.0e3, "e2": 5.0e3}], route="table", **scene)
+
+
+def test_a_views_scene_weights_are_the_callers_own():
+    # the table view keeps each scene's weights; a caller that adds a flag (the table route adds its effusivity
+    # and contact flags) changes its own dict, never what the next question reads
+    view = q.open_table("svm-paper").view
+    combos, flags = view.scene_weights(0.05, 10.0)
+    flags["effusivity"] = False
+    assert view.scene_weights(0.05, 10.0) == (combos, {"noise_ratio": True})
+    assert view.scene_weights(50.0, 10.0)[1] == {"noise_ratio": False}  # sigma/dT 5: beyond the grid, flagged

@@ -3,7 +3,7 @@
 =====================  ===========================================================
 module                 what it holds
 =====================  ===========================================================
-``questions``          the registry of questions (:data:`QUESTIONS`) and :func:`ask`
+``questions``          the registry of questions (:data:`QUESTIONS`), :func:`ask`, :func:`ask_each`
 ``answer``             the typed :class:`Answer`; its ``to_dict()`` is the ``--json`` schema
 ``inputs``             objects, the materials rule, scene inputs (shared by both routes)
 ``table``              the table route (milliseconds, no scikit-learn)
@@ -31,7 +31,7 @@ _LAZY = {
     **dict.fromkeys(("MATERIALS_RULE", "NeedsInput", "PairQuestion", "TableMismatch", "pair_question",
                      "reference_class"), ".inputs"),
     "ArrayAnswer": ".vectorized",
-    **dict.fromkeys(("QUESTIONS", "Question", "ask", "delta_e", "distinguishable", "max_noise", "min_contact",
+    **dict.fromkeys(("QUESTIONS", "Question", "ask", "ask_each", "delta_e", "distinguishable", "max_noise", "min_contact",
                      "min_delta_t"), ".questions"),
 }
 

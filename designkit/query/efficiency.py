@@ -233,8 +233,7 @@ class CriticalNoiseGrid:
             pu, pv = pu[i], pv[i]
             su = np.minimum(np.maximum(np.floor(pu).astype(np.int64) - 1, 0), n - 4)
             sv = np.minimum(np.maximum(np.floor(pv).astype(np.int64) - 1, 0), n - 4)
-            four = np.arange(4)
-            flat = (su[:, None, None] + four[None, :, None]) * n + (sv[:, None, None] + four[None, None, :])
+            flat = (su[:, None, None] + _FOUR[None, :, None]) * n + (sv[:, None, None] + _FOUR[None, None, :])
             if not self.known[flat].all():
                 missing = flat[~self.known[flat]]  # the whole blocks of NOISE_GRID_BLOCK x NOISE_GRID_BLOCK nodes around them
                 b = NOISE_GRID_BLOCK
@@ -255,6 +254,10 @@ class CriticalNoiseGrid:
             out[rest] = pair_critical_noise(self.sensor, lo[rest], hi[rest], width=self.width,
                                             threshold=self.threshold)
         return out.reshape(shape)
+
+
+_FOUR = np.arange(4)
+_FOUR.flags.writeable = False
 
 
 def _lagrange4(x: np.ndarray) -> np.ndarray:
@@ -388,8 +391,8 @@ def _k_var(u, se, la_, lb_, have_a, have_b, falls, wa, wb, disagree, far):
 def _slices(combos, n):
     """Shared scene weights as per-pair slice arrays (n, m)."""
     live = [(idx[0], w) for idx, w in combos if w]
-    return (np.tile(np.array([i for i, _ in live], dtype=np.int64), (n, 1)),
-            np.tile(np.array([w for _, w in live], dtype=np.float64), (n, 1)))
+    return (np.array([[i for i, _ in live]], dtype=np.int64).repeat(n, axis=0),
+            np.array([[w for _, w in live]], dtype=np.float64).repeat(n, axis=0))
 
 
 def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
@@ -443,14 +446,12 @@ def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
         ``se_log`` (of the answer, log); ``value`` NaN where the route does not apply.
     """
     from ..recognition.ideal import shape_norm
-    from .ideal_bound import noise_k_contact
+    from .ideal_bound import columns, noise_k_contact
 
     view, sensor = op.view, op.tab.sensor
-    lo, hi, ratio, kb = (np.atleast_1d(a) for a in np.broadcast_arrays(
-        np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64), np.asarray(ratio, dtype=np.float64),
-        np.asarray(k_cross, dtype=np.int64)))
+    lo, hi, ratio, kb = columns(lo, hi, ratio, k_cross, dtypes=(np.float64,) * 3 + (np.int64,))
     n = lo.size
-    ka = k_baseline(view.contacts, kb)
+    ka = view.baselines()[kb]  # (k_baseline of every tabulated contact, kept with the table)
     slices, sw = _slices(combos, n)
     if s_pair is None:  # the pair's own critical noise read with its entries'
         lk, se, s_pair = _k_readings(op, slices, sw, ka, kb, lo, hi, extra=(lo, hi), readings=readings)

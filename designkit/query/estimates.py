@@ -47,7 +47,7 @@ def cross2(x0, x1, n0, n1, gap) -> np.ndarray:
     >>> float(cross2(1.0, 2.0, 300.0, 50.0, 100.0))
     1.8
     """
-    x0, x1, n0, n1, gap = np.broadcast_arrays(*(np.asarray(a, dtype=np.float64) for a in (x0, x1, n0, n1, gap)))
+    x0, x1, n0, n1, gap = (np.asarray(a, dtype=np.float64) for a in (x0, x1, n0, n1, gap))  # (they broadcast)
     with np.errstate(invalid="ignore", divide="ignore"):
         ok0 = ~np.isnan(n0) & (n0 <= gap)
         ok1 = ~np.isnan(n1) & (n1 <= gap)
@@ -185,12 +185,11 @@ def grid_crossing(grid: np.ndarray, need: np.ndarray, gap) -> tuple[np.ndarray, 
     >>> [float(v[0]) for v in grid_crossing(np.array([1.0, 2.0, 3.0]), np.array([[300.0], [150.0], [50.0]]), 100.0)]
     [2.5, 2.0, 2.0, 3.0, 150.0, 50.0]
     """
-    with np.errstate(invalid="ignore"):
-        ok = ~np.isnan(need) & (need <= gap)
-    k = np.where(ok.any(axis=0), ok.argmax(axis=0), -1)
-    cols, k0, k1 = np.arange(need.shape[1]), np.maximum(k - 1, 0), np.maximum(k, 0)
-    x0, x1, n0, n1 = grid[k0], grid[k1], need[k0, cols], need[k1, cols]
     with np.errstate(invalid="ignore", divide="ignore"):
+        ok = ~np.isnan(need) & (need <= gap)
+        k = np.where(ok.any(axis=0), ok.argmax(axis=0), -1)
+        cols, k0, k1 = np.arange(need.shape[1]), np.maximum(k - 1, 0), np.maximum(k, 0)
+        x0, x1, n0, n1 = grid[k0], grid[k1], need[k0, cols], need[k1, cols]
         x = np.where(k > 0, cross2(x0, x1, n0, n1, gap), np.where(k == 0, grid[0], np.nan))
     return x, k, x0, x1, n0, n1
 
@@ -329,8 +328,8 @@ def partner_in_grid(view, e, delta, direction: str):
 
 
 # ============================================================ the estimators: named strategies over arrays
-def nans(n: int) -> np.ndarray:
-    """``n`` NaNs: an answer array before its elements are answered ("none" until then)."""
+def nans(n) -> np.ndarray:
+    """``n`` NaNs (an int or a shape): an answer array before its elements are answered ("none" until then)."""
     return np.full(n, np.nan)
 
 
@@ -374,8 +373,7 @@ def _at(v, m: np.ndarray):
 def first_applicable(estimators, rd, n: int) -> dict[str, np.ndarray]:
     """Per element, the answer of the first estimator (in order) that applies to it (``kind`` "none" where none
     does)."""
-    out = {k: nans(n) for k in ("value", "low", "high")}
-    out["kind"], out["stated"] = np.full(n, "none", dtype=object), np.zeros(n, dtype=bool)
+    out: dict[str, np.ndarray] = {}
     taken = np.zeros(n, dtype=bool)
     for estimator in estimators:
         if taken.all():  # (the later ones would answer nothing)
@@ -386,12 +384,26 @@ def first_applicable(estimators, rd, n: int) -> dict[str, np.ndarray]:
         m = r.applies & ~taken
         if not m.any():
             continue
+        if m.all():  # it answers every element (a single question's usual case): its arrays whole
+            for k, v in (*((k, getattr(r, k)) for k in ("value", "low", "high")), *r.extra.items()):
+                out[k] = np.array(v, dtype=np.float64) if np.ndim(v) else np.full(n, v, dtype=np.float64)
+            out["kind"], out["stated"] = np.full(n, r.kind, dtype=object), np.full(n, r.stated)
+            return out
+        if not out:
+            out = _unanswered(n)
         for k in ("value", "low", "high"):
             out[k][m] = _at(getattr(r, k), m)
         out["kind"][m], out["stated"][m] = r.kind, r.stated
         for k, v in r.extra.items():
             out.setdefault(k, nans(n))[m] = _at(v, m)
         taken |= m
+    return out or _unanswered(n)
+
+
+def _unanswered(n: int) -> dict[str, np.ndarray]:
+    """:func:`first_applicable`'s answers before any estimator answers: none."""
+    out = dict(zip(("value", "low", "high"), nans((3, n))))
+    out["kind"], out["stated"] = np.full(n, "none", dtype=object), np.zeros(n, dtype=bool)
     return out
 
 

@@ -23,6 +23,8 @@ Examples
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from cachetools import LRUCache
 
@@ -32,6 +34,7 @@ from ..sensor import last_sample_index
 __all__ = [
     "BOUND_CACHE_SIZE",
     "clear_bound_cache",
+    "columns",
     "contact_at_noise",
     "exact_ideal_delta",
     "exact_ideal_max_ratio",
@@ -41,6 +44,20 @@ __all__ = [
     "pair_critical_noise",
 ]
 
+
+
+def columns(*values, dtypes=None) -> list[np.ndarray]:
+    """``values`` as 1-D arrays of one length (float64, or ``dtypes`` each), broadcast only where their shapes
+    differ (the usual call passes arrays of one length already: no copies, no broadcasting).
+
+    >>> [a.tolist() for a in columns(2.0, [1.0, 3.0])]
+    [[2.0, 2.0], [1.0, 3.0]]
+    """
+    out = [np.asarray(v, dtype=d) for v, d in zip(values, dtypes or (np.float64,) * len(values))]
+    shapes = {a.shape for a in out if a.ndim}
+    if len(shapes) == 1 and len(shape := shapes.pop()) == 1:  # one length: numbers given once repeated
+        return [a if a.ndim else np.full(shape, a) for a in out]
+    return [np.atleast_1d(a) for a in np.broadcast_arrays(*out)]
 
 
 def _first_good_sample(ok, a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -115,18 +132,21 @@ def first_sample_at(cum: np.ndarray, ratio, s_star) -> np.ndarray:
     """First sample count ``n >= 1`` with ``ratio / sqrt(cum[n]) <= s_star`` (``cum``: the cumulative squared
     response shape, :func:`~designkit.recognition.ideal.cumulative_g2`), elementwise; NaN where no count up
     to ``cum.size - 1`` is."""
-    ratio, s_star = np.broadcast_arrays(np.asarray(ratio, dtype=np.float64), np.asarray(s_star, dtype=np.float64))
+    ratio, s_star = np.asarray(ratio, dtype=np.float64), np.asarray(s_star, dtype=np.float64)
+    if ratio.shape != s_star.shape:
+        ratio, s_star = np.broadcast_arrays(ratio, s_star)
+    top = cum.size - 1
+
+    def ok(k):  # the decision itself, as written, at count k (clipped into the table)
+        return ratio / np.sqrt(cum[np.minimum(np.maximum(k, 1), top)]) <= s_star
+
     with np.errstate(divide="ignore", invalid="ignore"):
         need = np.where(s_star > 0, (ratio / s_star) ** 2, np.where(ratio > 0, np.inf, 0.0))
-    need = np.where(np.isnan(s_star) | np.isnan(ratio), np.inf, need)
-    top = cum.size - 1
-    n = 1 + np.searchsorted(cum[1:], need, side="left")
-    # the decision itself, as written, at the count and the one before (rounding of the square)
-    def ok(k):
-        with np.errstate(divide="ignore", invalid="ignore"):
-            return ratio / np.sqrt(cum[np.clip(k, 1, top)]) <= s_star
-    n = np.where((n <= top) & ~ok(n), n + 1, n)
-    n = np.where((n > 1) & (n - 1 <= top) & ok(n - 1), n - 1, n)
+        need = np.where(np.isnan(s_star) | np.isnan(ratio), np.inf, need)
+        n = 1 + np.searchsorted(cum[1:], need, side="left")
+        # at the count and the one before (rounding of the square)
+        n = np.where((n <= top) & ~ok(n), n + 1, n)
+        n = np.where((n > 1) & (n - 1 <= top) & ok(n - 1), n - 1, n)
     return np.where((n <= top) & np.isfinite(need), n, np.nan)
 
 
@@ -256,6 +276,18 @@ def pair_critical_noise(sensor, lo, hi, *, width=80.0, threshold: float = 0.9) -
     return _cached("critical-noise", sensor, (lo, hi, width), (float(threshold),), compute)
 
 
+@functools.lru_cache(maxsize=8)
+def _sample_logs(tau_s: float, rate_hz: float, n_max: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The sample counts ``0 .. n_max``, ``log(n / fs)`` and ``0.5 log(cum[n])`` (:func:`cumulative_g2`) at each,
+    read-only, once per sensor: what :func:`noise_k_contact` compares at every count."""
+    counts = np.arange(n_max + 1)
+    with np.errstate(divide="ignore"):  # (count 0: no signal yet, log 0)
+        log_t, half_log_cum = np.log(counts / rate_hz), 0.5 * np.log(cumulative_g2(tau_s, rate_hz, n_max))
+    for a in (counts, log_t, half_log_cum):
+        a.flags.writeable = False
+    return counts, log_t, half_log_cum
+
+
 def noise_k_contact(sensor, ratio, s_star, t_a, t_b, log_k_a, log_k_b, max_contact_s: float) -> np.ndarray:
     """First sample time [s] at which a classifier of noise efficiency ``k(t)`` separates a pair whose ideal
     observer needs projection noise at most ``s_star``: ``k(t) (sigma/dT) / |g(t)| <= s_star``, ``log k``
@@ -272,21 +304,20 @@ def noise_k_contact(sensor, ratio, s_star, t_a, t_b, log_k_a, log_k_b, max_conta
     >>> float(noise_k_contact(s, 0.005, star, 1.0, 2.0, 0.4, 0.5, 10.0)) > t1
     True
     """
-    cols = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64) for x in (
-        ratio, s_star, t_a, t_b, log_k_a, log_k_b)))
-    shape = cols[0].shape
-    ratio, s_star, t_a, t_b, ka, kb = (c.ravel() for c in cols)
+    shapes = {np.shape(x) for x in (ratio, s_star, t_a, t_b, log_k_a, log_k_b)}
+    shape = shapes.pop() if len(shapes) == 1 else np.broadcast_shapes(*shapes)
+    ratio, s_star, t_a, t_b, ka, kb = (c.ravel() for c in columns(ratio, s_star, t_a, t_b, log_k_a, log_k_b))
     fs = float(sensor.sample_rate_hz)
     n_max = int(last_sample_index(max_contact_s, fs))
-    cum = cumulative_g2(float(sensor.tau_s), fs, max(n_max, 1))
+    counts, log_t, half_log_cum = _sample_logs(float(sensor.tau_s), fs, max(n_max, 1))
     with np.errstate(divide="ignore", invalid="ignore"):
         slope = np.where(t_a != t_b, (kb - ka) / np.log(t_b / t_a), 0.0)
         log_ta, log_r, log_s = np.log(t_a), np.log(ratio), np.log(s_star)
 
     def ok(n, rows):  # the classifier separates the pair at sample count n (an array, per element of rows)
         with np.errstate(divide="ignore", invalid="ignore"):
-            log_k = np.maximum(ka[rows] + slope[rows] * (np.log(n / fs) - log_ta[rows]), 0.0)
-            return log_k + log_r[rows] - 0.5 * np.log(cum[n]) <= log_s[rows]
+            log_k = np.maximum(ka[rows] + slope[rows] * (log_t[n] - log_ta[rows]), 0.0)
+            return log_k + log_r[rows] - half_log_cum[n] <= log_s[rows]
 
     out = np.full(ratio.shape, np.nan)
     # The response shape g rises with time, so cum[n] <= n g(n)^2 and cum[n+1] / cum[n] >= (n+1) / n: the
@@ -297,8 +328,10 @@ def noise_k_contact(sensor, ratio, s_star, t_a, t_b, log_k_a, log_k_b, max_conta
     scan = ~(slope <= 0.5) | (ratio.size <= 64)
     steep = np.nonzero(scan)[0]
     if steep.size:
-        n = np.arange(1, n_max + 1)
-        good = ok(n[None, :], steep[:, None])
+        n = counts[1:n_max + 1]
+        with np.errstate(divide="ignore", invalid="ignore"):  # (every count at once: the logs read, not taken)
+            good = (np.maximum(ka[steep, None] + slope[steep, None] * (log_t[None, 1:n_max + 1] - log_ta[steep, None]),
+                               0.0) + log_r[steep, None] - half_log_cum[None, 1:n_max + 1] <= log_s[steep, None])
         first = np.argmax(good, axis=1)
         out[steep] = np.where(good.any(axis=1), n[first] / fs, np.nan)
     mono = np.nonzero(~scan)[0]

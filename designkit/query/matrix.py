@@ -2,16 +2,15 @@
 
 :func:`material_matrix` asks one design question (``min-contact``,
 ``max-noise``, ``min-delta-t`` or ``distinguishable``) for every pair of N
-materials, each cell one call of the public question API
-(:func:`designkit.query.ask`, table route, the materials rule: the hardest
-pair of facing-edge classes), names the **limiting pair** (the pair that
+materials, every cell from one call of the public question API
+(:func:`designkit.query.questions.ask_each`, table route, the materials rule: the hardest
+pair of facing-edge classes; one array call over all pairs), names the **limiting pair** (the pair that
 decides the design), and adds the **multi-class view**: the accuracy of
 telling all N apart at once against contact time.
 
 The tables are loaded and verified once per call of :func:`material_matrix`
-and passed to every query as :class:`~designkit.tables.store.Table` objects,
-so a 12-material matrix (66 pairs) costs tens of milliseconds rather than 66
-table loads.
+and passed to the query as :class:`~designkit.tables.store.Table` objects,
+and the pairs are answered together, so a 12-material matrix (66 pairs) costs tens of milliseconds.
 
 Multi-class view
 ----------------
@@ -51,7 +50,7 @@ import numpy as np
 from .._validation import InputError
 from ..materials import Material, get_material, list_materials
 from .answer import QUANTITIES, Answer, QuestionQuantity, interval_dict, number
-from .questions import QUESTIONS, ask
+from .questions import QUESTIONS, ask_each
 
 __all__ = [
     "MATRIX_QUESTIONS",
@@ -522,53 +521,6 @@ def _multiclass(mats, tab, *, noise_c: float, delta_t_c: float, svm_trials: int 
 
 
 # ============================================================ the matrix
-def _prefill_bounds(question: str, mats, tab, itab, given: dict) -> None:
-    """The closed-form ideal bounds (and min-contact's efficiency estimates) of all pairs in one vectorized
-    call: the critical noises they read are solved together, into the table's critical-noise grid
-    (min-contact) or the cache of :mod:`designkit.query.ideal_bound` (max-noise, min-delta-t), where the
-    per-pair table questions find them (one solve per pair was most of a 12-material matrix:
-    docs/decisions-log.md).
-    Anything odd is left to the per-pair questions, which say what is wrong."""
-    if question not in ("min-contact", "max-noise", "min-delta-t"):
-        return
-    from . import table as table_route
-    from .ideal_bound import exact_ideal_max_ratio
-    from .inputs import check_contact, pair_question
-
-    try:
-        op = table_route.open_table(tab, itab, threshold=given.get("threshold"), sensor=given.get("sensor"),
-                                    model=given.get("model"))
-        if not op.closed:
-            return
-        los, his = [], []
-        for i in range(len(mats)):
-            for j in range(i + 1, len(mats)):
-                pq = pair_question(m1=mats[i].qualified_name, m2=mats[j].qualified_name, width=op.width,
-                                   model=op.model)
-                if pq.classes is not None and op.view.e_in_grid(*pq.points):
-                    los.append(pq.points[0])
-                    his.append(pq.points[1])
-        if not los:
-            return
-        if question == "min-contact":
-            # the array route: the grid nodes its closed-form bounds and efficiency estimates read are those
-            # the per-pair questions read (one vectorized solve for every pair)
-            ask("min-contact", route="table", e1=np.array(los), e2=np.array(his), table=tab, ideal_table=itab,
-                **given)
-        else:
-            exact_ideal_max_ratio(op.tab.sensor, los, his, check_contact(given["contact_s"]), width=op.width,
-                                  threshold=op.phi, bracket=table_route.CLOSED_FORM_RATIO_BRACKET)
-    except (InputError, KeyError):
-        return
-
-
-def _bound(question: str, a: Answer) -> str:
-    """Whether the value is a grid end beyond which the true answer lies (see :class:`MatrixCell`)."""
-    if a.value is None or isinstance(a.value, bool):
-        return ""
-    return a.bound  # the answer's own (its interval open at one end): one source for every surface
-
-
 def _worse_key(question: str) -> Callable[[MatrixCell], tuple]:
     """Sort key: the largest key is the hardest answered pair (no value within the table is hardest)."""
     sign = 1.0 if MATRIX_QUESTIONS[question] == "higher" else -1.0
@@ -667,19 +619,19 @@ def material_matrix(materials: Sequence[str | Material] = (), question: str = "m
     total = n * (n - 1) // 2 + n_svm
     if svm_trials is not None and (int(svm_trials) != svm_trials or svm_trials < 3):
         raise InputError(f"svm_trials must be an integer of at least 3 (3-fold cross-validation), got {svm_trials}")
-    _prefill_bounds(question, mats, tab, itab, given)
-    for i in range(n):
-        for j in range(i + 1, n):
-            a = ask(question, route="table", m1=mats[i].qualified_name, m2=mats[j].qualified_name, table=tab,
-                    ideal_table=itab, **given)
-            status = "overlap" if not a.limiting_pair else ("answered" if a.value is not None else "none")
-            ideal = a.ideal_bound.value
-            if question == "distinguishable":
-                ideal = a.details.get("ideal_f1")
-            cells.append(MatrixCell(i, j, a.value, None if ideal is None else float(ideal), status, a.note,
-                                    _bound(question, a), a))
-            if progress is not None:
-                progress(len(cells), total)
+    pairs = [(i, j) for i in range(n) for j in range(i + 1, n)]
+    # every pair from one array call of the table route (its closed-form bounds solved together)
+    answers = ask_each(question, [{"m1": mats[i].qualified_name, "m2": mats[j].qualified_name} for i, j in pairs],
+                       route="table", table=tab, ideal_table=itab, **given)
+    for (i, j), a in zip(pairs, answers):
+        status = "overlap" if not a.limiting_pair else ("answered" if a.value is not None else "none")
+        ideal = a.ideal_bound.value
+        if question == "distinguishable":
+            ideal = a.details.get("ideal_f1")
+        cells.append(MatrixCell(i, j, a.value, None if ideal is None else float(ideal), status, a.note,
+                                a.bound, a))  # (the answer's own: one source for every surface)
+        if progress is not None:
+            progress(len(cells), total)
     curve = None
     if multiclass:
         noise = float(scene.get("noise_c") if scene.get("noise_c") is not None else 0.05)

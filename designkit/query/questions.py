@@ -29,18 +29,18 @@ from __future__ import annotations
 import dataclasses
 import functools
 from dataclasses import dataclass
-from typing import Any, Callable, overload
+from typing import Any, Callable, Mapping, Sequence, overload
 
 from numpy.typing import ArrayLike
 
 from .._validation import InputError
 from ..rig import for_rig, rig_arguments
-from . import table as _table_route
+from . import table as table_route
 from .answer import Answer, QuestionQuantity
 from .policy import MC_BOUND, choose_route, sensor_table_answer
 from .vectorized import ArrayAnswer, answer_arrays, is_array_call
 
-__all__ = ["QUESTIONS", "Question", "ask", "delta_e", "distinguishable", "max_noise", "min_contact",
+__all__ = ["QUESTIONS", "Question", "ask", "ask_each", "delta_e", "distinguishable", "max_noise", "min_contact",
            "min_delta_t"]
 
 
@@ -93,15 +93,15 @@ class Question(QuestionQuantity):
 #: The registry: question name -> :class:`Question`.
 QUESTIONS: dict[str, Question] = {q.name: q for q in (
     Question("min-contact", "shortest contact time that separates two objects", ("noise_c", "delta_t_c"),
-             _table_route.min_contact, "exact_min_contact"),
+             table_route.min_contact, "exact_min_contact"),
     Question("max-noise", "largest noise sigma at which a contact time still separates two objects",
-             ("contact_s", "delta_t_c"), _table_route.max_noise, "exact_max_noise"),
+             ("contact_s", "delta_t_c"), table_route.max_noise, "exact_max_noise"),
     Question("min-delta-t", "smallest sensor-object temperature difference that separates two objects",
-             ("contact_s", "noise_c"), _table_route.min_delta_t, "exact_min_delta_t"),
+             ("contact_s", "noise_c"), table_route.min_delta_t, "exact_min_delta_t"),
     Question("delta-e", "smallest distinguishable effusivity difference from a reference, both directions",
-             ("contact_s", "noise_c", "delta_t_c"), _table_route.delta_e, "exact_delta_e"),
+             ("contact_s", "noise_c", "delta_t_c"), table_route.delta_e, "exact_delta_e"),
     Question("distinguishable", "whether a scene separates two objects, with the SVM's and ideal F1",
-             ("contact_s", "noise_c", "delta_t_c"), _table_route.distinguishable,
+             ("contact_s", "noise_c", "delta_t_c"), table_route.distinguishable,
              "exact_distinguishable"),
 )}
 
@@ -124,20 +124,59 @@ def ask(question: str, *, route: str = "auto", ideal_bound: bool = True,
     counted from the rig's detected onset, else the paper's defaults; the answer's ``scene["conditions"]``
     (an array answer's ``conditions``) says each value and where it came from (:func:`designkit.rig.rig_arguments`).
     """
+    if question in QUESTIONS and not is_array_call(question, arguments):
+        if not ideal_bound:
+            raise InputError("ideal_bound=False is for array inputs (a single answer always carries its bound)")
+        objects = {k: arguments.pop(k) for k in _OBJECTS[question] if k in arguments}
+        return ask_each(question, [objects], route=route, **arguments)[0]
+    asked, route, arguments, why, rig = _resolve(question, route, arguments)
+    fn, own = QUESTIONS[question].route(route), _own(question, route, why)
+    ans = answer_arrays(question, functools.partial(fn, ideal_bound=False) if own else fn, route, arguments,
+                        ideal_bound=ideal_bound and not own)
+    return _finished(question, ans, route, why, arguments, rig, asked)
+
+
+#: The arguments naming a question's objects (one element of :func:`ask_each`'s ``objects``).
+_OBJECTS = {q: (("e", "m") if q == "delta-e" else table_route.PAIR_KEYS) for q in QUESTIONS}
+
+
+def ask_each(question: str, objects: Sequence[Mapping[str, Any]], *, route: str = "auto",
+             **arguments: Any) -> list[Answer]:
+    """What :func:`ask` answers for each element of ``objects`` (each a mapping of the question's object
+    arguments: ``e1``, ``e2``, ``m1``, ``m2``, ``objects``; delta-e's ``e``, ``m``) with the same scene and options
+    ``arguments`` (numbers, not arrays): one list of :class:`~designkit.query.answer.Answer`, in order. The table
+    route answers every pair from one array call (:data:`designkit.query.table.EACH`: a 12-material matrix's 66
+    pairs cost about what a few single questions do); a single :func:`ask` is element 0 of it.
+    """
+    asked, route, arguments, why, rig = _resolve(question, route, arguments)
+    fn = QUESTIONS[question].route(route)
+    extra = {"ideal_bound": False} if _own(question, route, why) else {}
+    if route == "table" and question in table_route.EACH:
+        answers = table_route.EACH[question](objects, **arguments, **extra)
+    else:
+        answers = [fn(**o, **arguments, **extra) for o in objects]
+    return [_finished(question, a, route, why, arguments, rig, asked) for a in answers]
+
+
+def _resolve(question: str, route: str, arguments: dict[str, Any]):
+    """The asked contact, then the route, its arguments and why (:func:`~designkit.query.policy.choose_route`),
+    with the scene resolved for the sensor (:func:`~designkit.rig.rig_arguments`); an unknown question refused."""
     if question not in QUESTIONS:
         raise InputError(f"unknown question {question!r}; known: {', '.join(QUESTIONS)}")
     asked = arguments.get("contact_s")
     arguments, rig = rig_arguments(QUESTIONS[question].scene, arguments)
     route, arguments, why = choose_route(question, route, arguments)
-    fn = QUESTIONS[question].route(route)
-    own = route == "table" and why.sensor_table and question in MC_BOUND  # no Monte Carlo bound from it
-    if is_array_call(question, arguments):
-        ans = answer_arrays(question, functools.partial(fn, ideal_bound=False) if own else fn, route, arguments,
-                            ideal_bound=ideal_bound and not own)
-    elif not ideal_bound:
-        raise InputError("ideal_bound=False is for array inputs (a single answer always carries its bound)")
-    else:
-        ans = fn(**arguments, **({"ideal_bound": False} if own else {}))
+    return asked, route, arguments, why, rig
+
+
+def _own(question: str, route: str, why) -> bool:
+    """A sensor's own table: no Monte Carlo bound from it."""
+    return route == "table" and why.sensor_table and question in MC_BOUND
+
+
+def _finished(question: str, ans, route: str, why, arguments, rig, asked):
+    """An answer (or array answer) as :func:`ask` gives it: a sensor table's, the route's reason, counted as the
+    rig counts."""
     if route == "table" and why.sensor_table:
         ans = sensor_table_answer(question, ans, why, arguments.get("sensor"))
     notes = (*ans.notes, why.reason) if why.noted and isinstance(ans, Answer) else None

@@ -48,7 +48,7 @@ Examples
 from __future__ import annotations
 
 import math
-from typing import Any, Sequence
+from typing import Any, Mapping, Sequence
 
 import numpy as np
 
@@ -73,6 +73,7 @@ __all__ = [
     "DEFAULT_TABLE", "GRID_KINDS", "GRID_RTOL", "K_SLOPE_SPAN", "RATIO_ESTIMATORS", "SPREAD_TABLE_QUESTIONS",
     "VARIED_TABLE", "clear_table_cache", "delta_e", "distinguishable", "grid_answer", "k_baseline", "max_noise",
     "min_contact", "min_delta_t", "noise_k_max_ratio", "noise_k_min_contact", "open_table", "shipped_spread_table",
+    "EACH", "PAIR_KEYS", "distinguishable_each", "max_noise_each", "min_contact_each", "min_delta_t_each",
     "table_spread", "table_z",
 ]
 
@@ -169,20 +170,35 @@ def _one(x) -> np.ndarray:
     return np.array([x], dtype=np.float64)
 
 
-def _at0(r: dict, key: str) -> float | None:
-    """Element 0 of an array answer's ``key`` (None for NaN)."""
-    return number(r[key][0])
+def _el(r: dict, key: str, i: int) -> float | None:
+    """Element ``i`` of an array answer's ``key`` (None for NaN)."""
+    return number(r[key][i])
+
+
+#: The object arguments of a pair question (each element of ``pairs`` in the ``*_each`` functions holds some).
+PAIR_KEYS = ("e1", "e2", "m1", "m2", "objects")
+
+
+def _pairs(pairs, op: OpenedTable) -> tuple[list[PairQuestion], list[int]]:
+    """Each element's :func:`~designkit.query.inputs.pair_question` (a mapping of :data:`PAIR_KEYS`), and the
+    indices of those with two classes to answer for (the others overlap)."""
+    pqs = [pair_question(*(p.get(k) for k in PAIR_KEYS[:4]), objects=p.get("objects"), width=op.width,
+                         model=op.model) for p in pairs]
+    return pqs, [i for i, pq in enumerate(pqs) if pq.classes is not None]
+
+
+def _points(pqs: list[PairQuestion], asked: list[int]) -> tuple[np.ndarray, np.ndarray]:
+    """The pairs' lower edges ``lo < hi`` [J s^-1/2 K^-1 m^-2] of the elements ``asked``, as arrays."""
+    pts = np.array([pqs[i].points for i in asked], dtype=np.float64).reshape(len(asked), 2)
+    return pts[:, 0], pts[:, 1]
 
 
 # ============================================================ min-contact
 def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | None = None,
-                m2: str | None = None, objects=None, noise_c: float = 0.05, delta_t_c: float = 10.0,
-                threshold: float | None = None, table: "Table | str" = DEFAULT_TABLE,
-                ideal_table: "Table | str | None" = DEFAULT_IDEAL_TABLE, sensor=None, model=None,
-                coverage: float = 0.9,
-                sensor_temp_spread_c: float = 0.0, ideal_bound: bool = True) -> Answer:
-    """Shortest contact time [s] that separates two objects, from a table: element 0 of
-    :func:`~designkit.query.table_arrays.contact_arrays` (its estimators: :data:`CONTACT_ESTIMATORS`).
+                m2: str | None = None, objects=None, **options: Any) -> Answer:
+    """Shortest contact time [s] that separates two objects, from a table: :func:`min_contact_each` of the one
+    pair (element 0 of :func:`~designkit.query.table_arrays.contact_arrays`; its estimators:
+    :data:`CONTACT_ESTIMATORS`).
 
     Parameters
     ----------
@@ -193,9 +209,9 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
     objects : (ObjectClass, ObjectClass), optional
         The classes instead.
     noise_c : float
-        Noise sigma per sample [degC].
+        Noise sigma per sample [degC] (default 0.05).
     delta_t_c : float
-        Sensor minus object temperature before contact [degC].
+        Sensor minus object temperature before contact [degC] (default 10).
     threshold : float, optional
         F1 threshold Phi; must be the table's (0.9 for the shipped tables).
     table, ideal_table : Table or name or path
@@ -229,43 +245,66 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
     >>> min_contact(35000, 20000, table="ideal-paper").to_dict()["quantity"]
     'contact_s'
     """
+    return min_contact_each([{"e1": e1, "e2": e2, "m1": m1, "m2": m2, "objects": objects}], **options)[0]
+
+
+def min_contact_each(pairs: Sequence[Mapping[str, Any]], *, noise_c: float = 0.05, delta_t_c: float = 10.0,
+                     threshold: float | None = None, table: "Table | str" = DEFAULT_TABLE,
+                     ideal_table: "Table | str | None" = DEFAULT_IDEAL_TABLE, sensor=None, model=None,
+                     coverage: float = 0.9, sensor_temp_spread_c: float = 0.0,
+                     ideal_bound: bool = True) -> list[Answer]:
+    """:func:`min_contact` of each pair of ``pairs`` (each a mapping of :data:`PAIR_KEYS`) in one scene, from one
+    :func:`~designkit.query.table_arrays.contact_arrays` call over them all: element ``i`` is what
+    :func:`min_contact` answers for pair ``i`` (the other arguments as there)."""
     noise, dt = scene_inputs(noise_c, delta_t_c)
     coverage = check_coverage(coverage)
     op = open_table(table, ideal_table, threshold=threshold, sensor=sensor, model=model,
                     sensor_temp_spread_c=sensor_temp_spread_c)
-    pq = pair_question(e1, e2, m1, m2, objects=objects, width=op.width, model=op.model)
-    scene = scene_record(None, noise, dt)
-    if pq.classes is None:
-        return _no_pair("min-contact", op, pq, scene, {})
+    pqs, asked = _pairs(pairs, op)
+    view = op.view
+    scene_flags = view.scene_weights(noise, dt)[1]
+    r = {}
+    if asked:
+        lo, hi = _points(pqs, asked)
+        m = lo.size
+        r = contact_arrays(op, lo, hi, np.full(m, noise), np.full(m, dt), ideal_bound=ideal_bound or op.closed,
+                           zc=z_of_coverage(coverage), classes=[pqs[i].classes for i in asked])
+    at = {i: j for j, i in enumerate(asked)}
+    return [_no_pair("min-contact", op, pq, scene_record(None, noise, dt), {}) if pq.classes is None else
+            _contact_answer(op, pq, r, at[i], noise, dt, dict(scene_flags), coverage, ideal_bound)
+            for i, pq in enumerate(pqs)]
+
+
+def _contact_answer(op: OpenedTable, pq: PairQuestion, r: dict, i: int, noise: float, dt: float,
+                    flags: dict[str, bool], coverage: float, ideal_bound: bool) -> Answer:
+    """min-contact's answer for ``pq`` from element ``i`` of :func:`~designkit.query.table_arrays.contact_arrays`'
+    ``r`` (``flags``: the scene's in-grid flags)."""
     lo, hi = pq.points
     view = op.view
-    flags = view.scene_weights(noise, dt)[1]
     flags["effusivity"] = view.e_in_grid(lo, hi)
-    common = dict(objects=pq.objects_dicts(), limiting=pq.limiting_dicts(), rule=pq.rule, scene=scene,
-                  classes=pq.classes)
-    r = contact_arrays(op, _one(lo), _one(hi), _one(noise), _one(dt), ideal_bound=ideal_bound or op.closed,
-                       zc=z_of_coverage(coverage), classes=[pq.classes])
-    ideal = _at0(r, "ideal")
+    common = dict(objects=pq.objects_dicts(), limiting=pq.limiting_dicts(), rule=pq.rule,
+                  scene=scene_record(None, noise, dt), classes=pq.classes)
+    ideal = _el(r, "ideal", i)
     if not all(flags.values()):
         wanted = {**_scene_wanted(view, noise, dt), "effusivity": (lo, hi)}
         return _answer("min-contact", op, value=None, interval=(None, None), ideal=ideal if ideal_bound else None,
                        ideal_method="closed-form", in_grid=flags, details={},
                        notes=_outside_notes(view, flags, wanted), **common)
-    raw, kind = _at0(r, "raw"), r["kind"][0]
-    computation: dict[str, Any] = {"monte_carlo_interval": [_at0(r, "mc_lo"), _at0(r, "mc_hi")]}
+    raw, kind = _el(r, "raw", i), r["kind"][i]
+    computation: dict[str, Any] = {"monte_carlo_interval": [_el(r, "mc_lo", i), _el(r, "mc_hi", i)]}
     if "delta_up_ideal" in view.t.arrays:  # the grid's own bound, beside the exact one (its interpolation error)
-        computation["table_ideal_s"] = _at0(r, "table_ideal")
+        computation["table_ideal_s"] = _el(r, "table_ideal", i)
     ideal_interval, ideal_method = None, "closed-form" if op.closed else "table"
     if not op.closed and ideal_bound:  # no closed form: the Monte Carlo bound at query time
-        mcb = r["mc_bounds"][0]
+        mcb = r["mc_bounds"][i]
         ideal, ideal_method, ideal_interval = mcb.value, "monte-carlo", mcb.interval
         computation["ideal_monte_carlo"] = {"n_mc": mcb.n_mc, "evaluations": len(mcb.evaluations)}
-    value, note = _at0(r, "value"), ""
+    value, note = _el(r, "value", i), ""
     if kind in ("table-varied-estimate", "table-estimate"):
-        computation.update(interpolation_error_log=float(r["interp"][0]), rounding_error_log=float(r["rounding"][0]),
+        computation.update(interpolation_error_log=float(r["interp"][i]), rounding_error_log=float(r["rounding"][i]),
                            table_crossing_s=raw)
     elif kind == "table-efficiency":
-        e = {k: float(r[f"eff_{k}"][0]) for k in ("k", "se_log", "k_a", "k_b", "t_a", "t_b")}
+        e = {k: float(r[f"eff_{k}"][i]) for k in ("k", "se_log", "k_a", "k_b", "t_a", "t_b")}
         computation.update(efficiency=e["k"], efficiency_se_log=e["se_log"], table_crossing_s=raw,
                            noise_efficiency_at_s={f"{e['t_a']:g}": e["k_a"], f"{e['t_b']:g}": e["k_b"]})
         first = float(view.contacts[0])
@@ -275,15 +314,15 @@ def min_contact(e1: float | None = None, e2: float | None = None, *, m1: str | N
                     "efficiency read there is applied to the exact ideal observer (an extrapolation in contact "
                     "time; docs/accuracy.md measures it)")
     elif kind == "table-cell":
-        note = _cell_note(op, int(r["k_cross"][0]), _at0(r, "low"), value)
+        note = _cell_note(op, int(r["k_cross"][i]), _el(r, "low", i), value)
     else:
         note = (f"no tabulated contact time up to {view.contacts[-1]:g} s separates them "
                 "(the exact route examines longer contacts)")
     needed = value if value is not None else float(view.contacts[-1])
-    return _answer("min-contact", op, value=value, interval=(_at0(r, "low"), _at0(r, "high")), ideal=ideal,
+    return _answer("min-contact", op, value=value, interval=(_el(r, "low", i), _el(r, "high", i)), ideal=ideal,
                    ideal_method=ideal_method, ideal_interval=ideal_interval, in_grid=flags, details={}, notes=[note],
                    check_at=(needed, noise, dt), interval_kind=kind,
-                   interval_coverage=coverage if r["stated"][0] else None, computation=computation, **common)
+                   interval_coverage=coverage if r["stated"][i] else None, computation=computation, **common)
 
 
 def _cell_note(op, k: int, low: float, value: float) -> str:
@@ -302,35 +341,47 @@ def _cell_note(op, k: int, low: float, value: float) -> str:
 
 
 # ============================================================ max-noise / min-delta-t
-def _ratio_question(question: str, e1, e2, m1, m2, objects, contact_s, noise_c, delta_t_c, threshold, table,
-                    ideal_table, sensor, model, coverage: float = 0.9,
-                    sensor_temp_spread_c: float = 0.0) -> Answer:
+def _ratio_each(question: str, pairs, *, contact_s: float, noise_c, delta_t_c, threshold=None, table=DEFAULT_TABLE,
+                ideal_table=DEFAULT_IDEAL_TABLE, sensor=None, model=None, coverage: float = 0.9,
+                sensor_temp_spread_c: float = 0.0) -> list[Answer]:
+    """max-noise's or min-delta-t's answer for each pair of ``pairs`` in one scene, from one
+    :func:`~designkit.query.table_arrays.ratio_arrays` call over them all."""
     contact = check_contact(contact_s)
     coverage = check_coverage(coverage)
     if question == "max-noise":
         _, dt = scene_inputs(0.0, delta_t_c)
-        scene, scale = scene_record(contact, None, dt), abs(dt)
+        noise, scale = None, abs(dt)
     else:
         noise, _ = scene_inputs(noise_c, 1.0)
         if noise == 0:
             raise InputError("noise sigma is 0: any temperature difference separates them (no smallest one)")
-        scene, scale = scene_record(contact, noise, None), noise
+        dt, scale = None, noise
     op = open_table(table, ideal_table, threshold=threshold, sensor=sensor, model=model,
                     sensor_temp_spread_c=sensor_temp_spread_c)
     if "noise_ratio" not in op.tab.axes:
         raise TableMismatch(f"table {op.tab.name} has separate noise and temperature axes (varied initial "
                             f"conditions): it cannot answer {question}; the exact route can")
-    pq = pair_question(e1, e2, m1, m2, objects=objects, width=op.width, model=op.model)
-    if pq.classes is None:
-        return _no_pair(question, op, pq, scene, {})
+    pqs, asked = _pairs(pairs, op)
+    r = {}
+    if asked:
+        lo, hi = _points(pqs, asked)
+        r = ratio_arrays(question, op, lo, hi, np.full(lo.size, contact), np.full(lo.size, scale), ideal_bound=True,
+                         zc=z_of_coverage(coverage))
+    at = {i: j for j, i in enumerate(asked)}
+    return [_no_pair(question, op, pq, scene_record(contact, noise, dt), {}) if pq.classes is None else
+            _ratio_answer(question, op, pq, r, at[i], contact, noise, dt, scale, coverage) for i, pq in enumerate(pqs)]
+
+
+def _ratio_answer(question: str, op: OpenedTable, pq: PairQuestion, r: dict, i: int, contact: float, noise, dt,
+                  scale: float, coverage: float) -> Answer:
+    """max-noise's or min-delta-t's answer for ``pq`` from element ``i`` of
+    :func:`~designkit.query.table_arrays.ratio_arrays`' ``r``."""
     lo, hi = pq.points
     view = op.view
     flags = {"contact_s": axis_weights_flagged(view.contacts, contact)[1], "effusivity": view.e_in_grid(lo, hi)}
-    common = dict(objects=pq.objects_dicts(), limiting=pq.limiting_dicts(), rule=pq.rule, scene=scene,
-                  classes=pq.classes)
-    r = ratio_arrays(question, op, _one(lo), _one(hi), _one(contact), _one(scale), ideal_bound=True,
-                     zc=z_of_coverage(coverage))
-    ideal = _at0(r, "ideal")
+    common = dict(objects=pq.objects_dicts(), limiting=pq.limiting_dicts(), rule=pq.rule,
+                  scene=scene_record(contact, noise, dt), classes=pq.classes)
+    ideal = _el(r, "ideal", i)
     if not all(flags.values()):
         notes = _outside_notes(view, flags, {"contact_s": contact, "effusivity": (lo, hi)})
         return _answer(question, op, value=None, interval=(None, None), ideal=ideal, ideal_method="closed-form",
@@ -339,24 +390,24 @@ def _ratio_question(question: str, e1, e2, m1, m2, objects, contact_s, noise_c, 
     def to_answer(x):
         return None if x is None else x * scale if question == "max-noise" else scale / x
 
-    where, rr, kind = int(r["where"][0]), _at0(r, "r"), r["kind"][0]
+    where, rr, kind = int(r["where"][i]), _el(r, "r", i), r["kind"][i]
     ratios = view.t.axes["noise_ratio"]
     if where == ABOVE:
         flags["noise_ratio"] = False
     # the Monte Carlo ends: more noise allowed at the optimistic end ('lo': ratio >= the answer's)
-    ends = [to_answer(_at0(r, k)) for k in ("end_hi", "end_lo_any")]
+    ends = [to_answer(_el(r, k, i)) for k in ("end_hi", "end_lo_any")]
     mc = tuple(sorted(ends)) if None not in ends else tuple(ends)
     computation: dict[str, Any] = {"monte_carlo_interval": list(mc)}
     note = ""
     if kind == "table-efficiency":
-        computation.update(table_crossing_noise_ratio=rr, efficiency=float(r["eff_k"][0]),
-                           efficiency_se_log=float(r["eff_se_log"][0]))
+        computation.update(table_crossing_noise_ratio=rr, efficiency=float(r["eff_k"][i]),
+                           efficiency_se_log=float(r["eff_se_log"][i]))
     elif kind == "table-estimate":
-        computation.update(table_crossing_noise_ratio=rr, interpolation_error_log=float(r["interp"][0]),
-                           rounding_error_log=float(r["rounding"][0]))
+        computation.update(table_crossing_noise_ratio=rr, interpolation_error_log=float(r["interp"][i]),
+                           rounding_error_log=float(r["rounding"][i]))
     elif kind == "table-cell" and where == CELL:
         note = (f"sigma/dT {rr:g} is the table's last noise ratio where they separate; at the next, "
-                f"{float(r['next_ratio'][0]):g}, the pair lies beyond its effusivity range: the answer lies between "
+                f"{float(r['next_ratio'][i]):g}, the pair lies beyond its effusivity range: the answer lies between "
                 "them and the grid cannot support an interval of stated coverage there (the exact route estimates it)")
     elif kind == "table-cell":
         more = "at least" if question == "max-noise" else "at most"  # a larger ratio: more noise, a smaller dT
@@ -364,40 +415,46 @@ def _ratio_question(question: str, e1, e2, m1, m2, objects, contact_s, noise_c, 
                 "(the exact route looks further) (the grid cannot support an interval of stated coverage there)")
     elif where == BELOW:
         note = f"not separable even at the table's smallest noise ratio sigma/dT = {ratios[0]:g}"
-    answered = _at0(r, "ratio") if kind in ("table-efficiency", "table-estimate") else rr
+    answered = _el(r, "ratio", i) if kind in ("table-efficiency", "table-estimate") else rr
     r_check = answered if answered is not None else float(ratios[0])
     check_at = ((contact, r_check * scale, dt) if question == "max-noise"
                 else (contact, noise, noise / r_check))
-    return _answer(question, op, value=_at0(r, "value"), interval=(_at0(r, "low"), _at0(r, "high")), ideal=ideal,
+    return _answer(question, op, value=_el(r, "value", i), interval=(_el(r, "low", i), _el(r, "high", i)), ideal=ideal,
                    ideal_method="closed-form" if op.closed else "table", in_grid=flags, details={}, notes=[note],
-                   check_at=check_at, interval_kind=kind, interval_coverage=coverage if r["stated"][0] else None,
+                   check_at=check_at, interval_kind=kind, interval_coverage=coverage if r["stated"][i] else None,
                    computation=computation, **common)
 
 
-def max_noise(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact_s: float, delta_t_c: float = 10.0,
-              threshold=None, table=DEFAULT_TABLE, ideal_table=DEFAULT_IDEAL_TABLE, sensor=None,
-              model=None, coverage: float = 0.9,
-              sensor_temp_spread_c: float = 0.0) -> Answer:
+def max_noise(e1=None, e2=None, *, m1=None, m2=None, objects=None, **options: Any) -> Answer:
     """Largest noise sigma [degC] at which ``contact_s`` still separates the objects (table): element 0 of
     :func:`~designkit.query.table_arrays.ratio_arrays` (its estimators: :data:`RATIO_ESTIMATORS`).
 
-    Arguments as :func:`min_contact`; ``contact_s`` [s] is the contact time.
+    Arguments as :func:`min_contact`; ``contact_s`` [s] is the contact time (no ``noise_c``); many pairs:
+    :func:`max_noise_each`.
     """
-    return _ratio_question("max-noise", e1, e2, m1, m2, objects, contact_s, None, delta_t_c, threshold, table,
-                           ideal_table, sensor, model, coverage, sensor_temp_spread_c)
+    return max_noise_each([{"e1": e1, "e2": e2, "m1": m1, "m2": m2, "objects": objects}], **options)[0]
 
 
-def min_delta_t(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact_s: float, noise_c: float = 0.05,
-                threshold=None, table=DEFAULT_TABLE, ideal_table=DEFAULT_IDEAL_TABLE, sensor=None,
-                model=None, coverage: float = 0.9,
-                sensor_temp_spread_c: float = 0.0) -> Answer:
+def min_delta_t(e1=None, e2=None, *, m1=None, m2=None, objects=None, **options: Any) -> Answer:
     """Smallest sensor-object temperature difference [degC] that separates the objects (table), as
     :func:`max_noise`.
 
-    Arguments as :func:`min_contact`; ``contact_s`` [s] is the contact time.
+    Arguments as :func:`min_contact`; ``contact_s`` [s] is the contact time (no ``delta_t_c``); many pairs:
+    :func:`min_delta_t_each`.
     """
-    return _ratio_question("min-delta-t", e1, e2, m1, m2, objects, contact_s, noise_c, None, threshold, table,
-                           ideal_table, sensor, model, coverage, sensor_temp_spread_c)
+    return min_delta_t_each([{"e1": e1, "e2": e2, "m1": m1, "m2": m2, "objects": objects}], **options)[0]
+
+
+def max_noise_each(pairs: Sequence[Mapping[str, Any]], *, contact_s: float, delta_t_c: float = 10.0,
+                   **options: Any) -> list[Answer]:
+    """:func:`max_noise` of each pair of ``pairs`` (as :func:`min_contact_each`), from one array call."""
+    return _ratio_each("max-noise", pairs, contact_s=contact_s, noise_c=None, delta_t_c=delta_t_c, **options)
+
+
+def min_delta_t_each(pairs: Sequence[Mapping[str, Any]], *, contact_s: float, noise_c: float = 0.05,
+                     **options: Any) -> list[Answer]:
+    """:func:`min_delta_t` of each pair of ``pairs`` (as :func:`min_contact_each`), from one array call."""
+    return _ratio_each("min-delta-t", pairs, contact_s=contact_s, noise_c=noise_c, delta_t_c=None, **options)
 
 
 # ============================================================ delta-e
@@ -436,36 +493,36 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
                        zc=z_of_coverage(coverage), ideal_bound=ideal_bound, classes=[ref])
     if not all(flags.values()):
         wanted = {**_scene_wanted(view, noise, dt), "contact_s": contact, "effusivity": (x,)}
-        sides = {side: _no_side(_at0(r, f"{side}_ideal")) for side in ("lower", "upper")}
-        return _answer("delta-e", op, value=None, interval=(None, None), ideal=_at0(r, "ideal"),
+        sides = {side: _no_side(_el(r, f"{side}_ideal", 0)) for side in ("lower", "upper")}
+        return _answer("delta-e", op, value=None, interval=(None, None), ideal=_el(r, "ideal", 0),
                        ideal_method="closed-form", in_grid=flags, details=_delta_details(x, sides),
                        notes=_outside_notes(view, flags, wanted), **common)
     sides = {}
     for side in ("lower", "upper"):
         method = r[f"{side}_method"][0]
-        iv = [_at0(r, f"{side}_mc_lo"), _at0(r, f"{side}_mc_hi")]
+        iv = [_el(r, f"{side}_mc_lo", 0), _el(r, f"{side}_mc_hi", 0)]
         if method == "table-efficiency":  # the SVM's efficiency against the exact ideal observer
             sides[side] = {"value": float(r[side][0]), "interval": [float(r[f"{side}_low"][0]),
                                                                     float(r[f"{side}_high"][0])],
                            "ideal": float(r[f"{side}_ideal"][0]), "coverage": coverage,
                            "estimate_method": method, "monte_carlo_interval": iv,
-                           "table_value": _at0(r, f"{side}_table"), "table_ideal": _at0(r, f"{side}_table_ideal"),
+                           "table_value": _el(r, f"{side}_table", 0), "table_ideal": _el(r, f"{side}_table_ideal", 0),
                            "efficiency": float(r[f"{side}_efficiency"][0])}
             continue
         stated = method == "table-estimate"
-        sides[side] = {"value": _at0(r, f"{side}_table"),
-                       "interval": [_at0(r, f"{side}_low"), _at0(r, f"{side}_high")] if stated else [None, None],
-                       "ideal": _at0(r, f"{side}_ideal"), "coverage": coverage if stated else None,
+        sides[side] = {"value": _el(r, f"{side}_table", 0),
+                       "interval": [_el(r, f"{side}_low", 0), _el(r, f"{side}_high", 0)] if stated else [None, None],
+                       "ideal": _el(r, f"{side}_ideal", 0), "coverage": coverage if stated else None,
                        "estimate_method": method, "monte_carlo_interval": iv}
         if not op.closed and ideal_bound:  # the Monte Carlo bound, the grid's kept beside it
             mcb = r[f"{side}_mc_bounds"][0]
-            sides[side].update(table_ideal=_at0(r, f"{side}_table_ideal"),
+            sides[side].update(table_ideal=_el(r, f"{side}_table_ideal", 0),
                                ideal_interval=list(mcb.interval[:2]) if mcb.interval else None)
     kind = r["kind"][0]
     stated = kind != "none"
-    return _answer("delta-e", op, value=_at0(r, "value"),
-                   interval=(_at0(r, "low"), _at0(r, "high")) if stated else (None, None),
-                   interval_kind=kind, interval_coverage=coverage if stated else None, ideal=_at0(r, "ideal"),
+    return _answer("delta-e", op, value=_el(r, "value", 0),
+                   interval=(_el(r, "low", 0), _el(r, "high", 0)) if stated else (None, None),
+                   interval_kind=kind, interval_coverage=coverage if stated else None, ideal=_el(r, "ideal", 0),
                    ideal_method="closed-form" if kind == "table-efficiency" else "table" if op.closed or not ideal_bound
                    else "monte-carlo",
                    ideal_interval=nearer_side_interval(sides, coverage),
@@ -482,12 +539,10 @@ def _delta_details(e: float, sides: dict) -> dict[str, Any]:
 
 
 # ============================================================ distinguishable
-def distinguishable(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact_s: float, noise_c: float = 0.05,
-                    delta_t_c: float = 10.0, threshold=None, table=DEFAULT_TABLE, ideal_table=DEFAULT_IDEAL_TABLE,
-                    sensor=None, model=None, coverage: float = 0.9,
-                    sensor_temp_spread_c: float = 0.0) -> Answer:
-    """Whether ``contact_s`` separates the objects (table), with the ideal observer's F1 (closed form): element 0
-    of :func:`~designkit.query.table_arrays.distinguishable_arrays`.
+def distinguishable(e1=None, e2=None, *, m1=None, m2=None, objects=None, **options: Any) -> Answer:
+    """Whether ``contact_s`` [s] separates the objects (table), with the ideal observer's F1 (closed form): element 0
+    of :func:`~designkit.query.table_arrays.distinguishable_arrays` (arguments as :func:`min_contact`; many
+    pairs: :func:`distinguishable_each`).
 
     ``value`` follows from the same estimate :func:`min_contact` gives for the pair at the asked noise and
     dT (on a fixed-condition SVM table the noise-efficiency route, elsewhere the table's crossing): True iff
@@ -515,51 +570,78 @@ def distinguishable(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact
     >>> a.value == (1.45 >= m.value), a.details["verdict"]
     (True, 'confident')
     """
+    return distinguishable_each([{"e1": e1, "e2": e2, "m1": m1, "m2": m2, "objects": objects}], **options)[0]
+
+
+def distinguishable_each(pairs: Sequence[Mapping[str, Any]], *, contact_s: float, noise_c: float = 0.05,
+                         delta_t_c: float = 10.0, threshold=None, table=DEFAULT_TABLE,
+                         ideal_table=DEFAULT_IDEAL_TABLE, sensor=None, model=None, coverage: float = 0.9,
+                         sensor_temp_spread_c: float = 0.0) -> list[Answer]:
+    """:func:`distinguishable` of each pair of ``pairs`` (as :func:`min_contact_each`), from one
+    :func:`~designkit.query.table_arrays.distinguishable_arrays` call over them all."""
     coverage = check_coverage(coverage)
     contact = check_contact(contact_s)
     noise, dt = scene_inputs(noise_c, delta_t_c)
     op = open_table(table, ideal_table, threshold=threshold, sensor=sensor, model=model,
                     sensor_temp_spread_c=sensor_temp_spread_c)
-    pq = pair_question(e1, e2, m1, m2, objects=objects, width=op.width, model=op.model)
-    scene = scene_record(contact, noise, dt)
-    empty = {"distinguishable": None, "svm_f1": None, "svm_standard_error": None, "verdict": None,
-             "ideal_f1": None, "ideal_distinguishable": None}
-    if pq.classes is None:
-        return _no_pair("distinguishable", op, pq, scene, empty)
+    pqs, asked = _pairs(pairs, op)
+    view = op.view
+    scene_flags = view.scene_weights(noise, dt)[1]
+    scene_flags["contact_s"] = axis_weights_flagged(view.contacts, contact)[1]
+    zc = z_of_coverage(coverage)
+    r = {}
+    if asked:
+        lo, hi = _points(pqs, asked)
+        m = lo.size
+        r = distinguishable_arrays(op, lo, hi, np.full(m, contact), np.full(m, noise), np.full(m, dt),
+                                   ideal_bound=True, zc=zc, ideal_view=delta_e_ideal_view(op, ideal_table),
+                                   classes=[pqs[i].classes for i in asked])
+    at = {i: j for j, i in enumerate(asked)}
+    return [_no_pair("distinguishable", op, pq, scene_record(contact, noise, dt), _empty_verdict())
+            if pq.classes is None else
+            _distinguishable_answer(op, pq, r, at[i], contact, noise, dt, dict(scene_flags), coverage)
+            for i, pq in enumerate(pqs)]
+
+
+def _empty_verdict() -> dict[str, Any]:
+    """distinguishable's details where it answers nothing (a new dict each time)."""
+    return {"distinguishable": None, "svm_f1": None, "svm_standard_error": None, "verdict": None,
+            "ideal_f1": None, "ideal_distinguishable": None}
+
+
+def _distinguishable_answer(op: OpenedTable, pq: PairQuestion, r: dict, i: int, contact: float, noise: float,
+                            dt: float, flags: dict[str, bool], coverage: float) -> Answer:
+    """distinguishable's answer for ``pq`` from element ``i`` of
+    :func:`~designkit.query.table_arrays.distinguishable_arrays`' ``r`` (``flags``: the scene's in-grid flags)."""
     lo, hi = pq.points
     view = op.view
-    flags = view.scene_weights(noise, dt)[1]
-    flags["contact_s"] = axis_weights_flagged(view.contacts, contact)[1]
     flags["effusivity"] = view.e_in_grid(lo, hi)
-    common = dict(objects=pq.objects_dicts(), limiting=pq.limiting_dicts(), rule=pq.rule, scene=scene,
-                  classes=pq.classes)
-    zc = z_of_coverage(coverage)
-    r = distinguishable_arrays(op, _one(lo), _one(hi), _one(contact), _one(noise), _one(dt), ideal_bound=True,
-                               zc=zc, ideal_view=delta_e_ideal_view(op, ideal_table), classes=[pq.classes])
-    ideal_f1, ideal_method = _at0(r, "ideal"), r["ideal_method"][0]
+    common = dict(objects=pq.objects_dicts(), limiting=pq.limiting_dicts(), rule=pq.rule,
+                  scene=scene_record(contact, noise, dt), classes=pq.classes)
+    ideal_f1, ideal_method = _el(r, "ideal", i), r["ideal_method"][i]
     ideal_details = {} if ideal_f1 is None else {"ideal_f1": ideal_f1, "ideal_distinguishable": ideal_f1 >= op.phi}
     if not all(flags.values()):
         wanted = {**_scene_wanted(view, noise, dt), "contact_s": contact, "effusivity": (lo, hi)}
         return _answer("distinguishable", op, value=None, interval=(None, None), ideal=ideal_f1,
-                       ideal_method=ideal_method, in_grid=flags, details={**empty, **ideal_details},
+                       ideal_method=ideal_method, in_grid=flags, details={**_empty_verdict(), **ideal_details},
                        notes=_outside_notes(view, flags, wanted), **common)
-    grid = {k: bool(r[f"grid_{k}"][0]) for k in ("svm", "lo", "hi")}
-    yes, sure = bool(r["value"][0]), r["verdict"][0]
-    t_min, interval = _at0(r, "mc_value"), (_at0(r, "mc_low"), _at0(r, "mc_high"))
-    mc_kind = r["mc_kind"][0]
-    mc_stated = bool(r["mc_stated"][0])
+    grid = {k: bool(r[f"grid_{k}"][i]) for k in ("svm", "lo", "hi")}
+    yes, sure = bool(r["value"][i]), r["verdict"][i]
+    t_min, interval = _el(r, "mc_value", i), (_el(r, "mc_low", i), _el(r, "mc_high", i))
+    mc_kind = r["mc_kind"][i]
+    mc_stated = bool(r["mc_stated"][i])
     if not states_coverage(op.tab, "min-contact", mc_kind):
         mc_kind = "table-varied"
     note = _contact_verdict(contact, t_min, interval, mc_kind, mc_stated, coverage)
-    if r["unsure"][0]:  # inside min-contact's interval: max-noise or delta-e may still be sure of it
-        mn = tuple(_at0(r, f"mn_{k}") for k in ("value", "low", "high"))
+    if r["unsure"][i]:  # inside min-contact's interval: max-noise or delta-e may still be sure of it
+        mn = tuple(_el(r, f"mn_{k}", i) for k in ("value", "low", "high"))
         reads = _other_readings(noise, hi - lo, None if mn[0] is None else mn,
-                                [tuple(_at0(r, f"de_{side}_{k}") for k in ("value", "low", "high"))
+                                [tuple(_el(r, f"de_{side}_{k}", i) for k in ("value", "low", "high"))
                                  for side in ("upper", "lower")])
         a, b = interval
         inside = (f"{contact:g} s lies inside min-contact's interval ({t_min:.3g} s, {a:.3g} to {_fmt_or_open(b)} s)"
                   if a is not None else f"{contact:g} s is near min-contact's {t_min:.3g} s")
-        if r["decided"][0]:
+        if r["decided"][i]:
             note = f"verdict confident: {' and '.join(w for _, _, w in reads)} (while {inside})"
         elif reads:
             note += "; " + " but ".join(w for _, _, w in reads) + " (they disagree here)"
@@ -576,6 +658,12 @@ def distinguishable(e1=None, e2=None, *, m1=None, m2=None, objects=None, contact
                    computation={"grid_verdicts": grid, "monte_carlo_verdicts": [grid["hi"], grid["lo"]],
                                 "min_contact_s": t_min, "min_contact_interval_s": list(interval),
                                 "min_contact_interval_kind": mc_kind if t_min is not None else "none"}, **common)
+
+#: The questions answered for many pairs in one array call: question -> its ``*_each`` function (delta-e asks
+#: about one reference, not a pair).
+EACH = {"min-contact": min_contact_each, "max-noise": max_noise_each, "min-delta-t": min_delta_t_each,
+        "distinguishable": distinguishable_each}
+
 
 def _other_readings(noise: float, gap: float, mn, needs) -> list[tuple[str, bool, str]]:
     """The verdicts max-noise and delta-e are sure of, where min-contact is not: the asked ``noise`` [degC]

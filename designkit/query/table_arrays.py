@@ -25,7 +25,7 @@ from ..sensor import within_sample_limit
 from ..tables.store import Table
 from .crossing import coverage_of_z
 from .efficiency import (CLOSED_FORM_MAX_CONTACT_S, CriticalNoiseGrid, delta_efficiency_estimate, delta_entries,
-                         interp_e_by, mc_calibration, noise_k_min_contact, table_z)
+                         interp_e_by, k_baseline, mc_calibration, noise_k_min_contact, table_z)
 from .estimates import (ABOVE, BELOW, CELL, CONTACT_ESTIMATORS, INSIDE, RATIO_ESTIMATORS,
                         ContactReading, RatioReading, axis_weights_flagged, delta_estimate, first_applicable,
                         grid_crossing, interp_e_rows, nans, partner_in_grid, states_coverage, table_spread)
@@ -54,6 +54,8 @@ class TableView:
         self._sensor_dict: dict | None = None
         self._mc_factor: float | None = None
         self._contact_norms: np.ndarray | None = None
+        self._baselines: np.ndarray | None = None
+        self._scenes: dict[tuple[float, float], tuple[list, dict[str, bool]]] = {}
 
     def critical_noise(self, lo, hi) -> np.ndarray:
         """The ideal observer's critical noise of the table's classes ``[lo, lo + w)``, ``[hi, hi + w)`` (its
@@ -63,6 +65,12 @@ class TableView:
             self._noise_grid = CriticalNoiseGrid(self.t.sensor, float(self.t.header["effusivity"]["width"]),
                                                  self.t.threshold, self.e_hi)
         return self._noise_grid(lo, hi)
+
+    def baselines(self) -> np.ndarray:
+        """:func:`~designkit.query.efficiency.k_baseline` of each tabulated contact index, computed once."""
+        if self._baselines is None:
+            self._baselines = k_baseline(self.contacts, np.arange(self.contacts.size))
+        return self._baselines
 
     def contact_norms(self) -> np.ndarray:
         """``|g|`` (:func:`~designkit.recognition.ideal.shape_norm`) of the table's sensor at each tabulated
@@ -80,7 +88,17 @@ class TableView:
         return dict(self._sensor_dict)
 
     def scene_weights(self, noise_c: float, delta_t_c: float) -> tuple[list[tuple[tuple[int, ...], float]], dict[str, bool]]:
-        """Multilinear weights over the scene axes; in-grid flags per axis."""
+        """Multilinear weights over the scene axes; in-grid flags per axis (the caller's own dict). Kept per
+        scene (a table's weights of a scene never change; a question reads them more than once)."""
+        key = (noise_c, delta_t_c)
+        if key not in self._scenes:
+            if len(self._scenes) >= 256:  # (a sweep over scenes: the memo stays small)
+                self._scenes.clear()
+            self._scenes[key] = self._scene_weights(noise_c, delta_t_c)
+        combos, flags = self._scenes[key]
+        return combos, dict(flags)
+
+    def _scene_weights(self, noise_c: float, delta_t_c: float):
         ax = self.t.axes
         coords: list[list[tuple[int, float]]] = []
         flags: dict[str, bool] = {}
@@ -228,10 +246,10 @@ def contact_arrays(op, lo, hi, noise, dt, *, ideal_bound: bool, zc: float, class
     """
     view, n = op.view, lo.size
     grid, svm = view.contacts, op.tab.fidelity == "svm"
-    res: dict[str, Any] = {k: nans(n) for k in ("raw", "n_prev", "n_at", "mc_lo", "mc_hi", "ideal", "table_ideal")}
+    res: dict[str, Any] = dict(zip(("raw", "n_prev", "n_at", "mc_lo", "mc_hi", "ideal", "table_ideal"), nans((7, n))))
     res["k_cross"], res["in_grid"], res["mc_bounds"] = np.full(n, -1), np.zeros(n, dtype=bool), {}
     efficiency = svm and op.closed and "delta_up_ideal" in view.t.arrays
-    eff = {k: nans(n) for k in ("value", "low", "high", "k", "se_log", "k_a", "k_b", "t_a", "t_b")} if efficiency else None
+    eff = dict(zip(("value", "low", "high", "k", "se_log", "k_a", "k_b", "t_a", "t_b"), nans((9, n)))) if efficiency else None
     e_in = view.e_in(lo) & view.e_in(hi)
     # the pairs' own critical noises (the efficiency route's target, the closed-form bound): read with the
     # efficiency route's entries where it reads them (one call of the grid), the others' after the loop
@@ -250,7 +268,7 @@ def contact_arrays(op, lo, hi, noise, dt, *, ideal_bound: bool, zc: float, class
         need = view.need(kinds, combos, l, h, readings)  # [kind, contact, pair]
         m = l.size
         value, k, _, _, n0, n1 = grid_crossing(grid, need.transpose(1, 0, 2).reshape(grid.size, -1),
-                                               np.tile(gap, len(kinds)))
+                                               np.concatenate([gap] * len(kinds)))
         cross = dict(zip(kinds, value.reshape(len(kinds), m)))
         k, n0, n1 = k[:m], n0[:m], n1[:m]
         res["raw"][idx], res["k_cross"][idx] = cross["svm"], k

@@ -97,15 +97,12 @@ class OpenedTable:
     ikind: str
     iname: str | None
     ihash: str | None
+    #: The ideal bound is computed in closed form at query time (never read from a grid): :func:`_closed_form`.
+    closed: bool = False
 
     @property
     def width(self) -> float:
         return float(self.tab.header["effusivity"]["width"])
-
-    @property
-    def closed(self) -> bool:
-        """The ideal bound is computed in closed form at query time (never read from a grid)."""
-        return _closed_form(self.tab, self.model)
 
 
 def ideal_view(svm: TableView, ideal_table: "Table | str | None") -> tuple[TableView, str, Table | None]:
@@ -201,10 +198,10 @@ def open_table(table: "Table | str" = DEFAULT_TABLE, ideal_table: "Table | str |
     if _closed_form(tab, fm):  # the bound is computed at query time: the default ideal table is not read
         if ideal_table is not None and ideal_table != DEFAULT_IDEAL_TABLE:
             as_table(ideal_table)  # a table the caller named must exist: an error, not a silent fallback
-        return OpenedTable(tab, view, tab.threshold, fm, None, "", None, None)
+        return OpenedTable(tab, view, tab.threshold, fm, None, "", None, None, closed=True)
     iview, ikind, it = ideal_view(view, ideal_table)
     return OpenedTable(tab, view, tab.threshold, fm, iview, ikind, None if it is None else it.name,
-                   None if it is None else it.header.get("content_hash"))
+                       None if it is None else it.header.get("content_hash"))
 
 
 def _closed_form(tab: Table, fm) -> bool:

@@ -192,7 +192,7 @@ def _element(v: Any, shape: tuple[int, ...], i: int) -> Any:
 
 
 def _is_list(x: Any) -> bool:
-    return x is not None and not isinstance(x, (str, bytes)) and np.ndim(x) >= 1
+    return x is not None and not isinstance(x, (str, bytes, int, float)) and np.ndim(x) >= 1
 
 
 def is_array_call(question: str, arguments: Mapping[str, Any]) -> bool:

@@ -174,7 +174,7 @@ def shape_norm(sensor, contact_s) -> np.ndarray:
     2.6732
     """
     n = last_sample_index(contact_s, sensor.sample_rate_hz)
-    cum = cumulative_g2(float(sensor.tau_s), float(sensor.sample_rate_hz), int(max(np.max(n), 1)))
+    cum = cumulative_g2(float(sensor.tau_s), float(sensor.sample_rate_hz), int(max(np.asarray(n).max(), 1)))
     return np.sqrt(cum[n])
 
 
@@ -238,7 +238,7 @@ def class_density(t, e_low, e_high, e_sensor: float, s) -> np.ndarray:
                                                              for x in (t, e_low, e_high, s))))
     gx, gw = _rule(_NODES)
     _, half, z = _window_z(t, s, a, b, _weight(e_sensor, a), _weight(e_sensor, b), e_sensor, gx)
-    pdf = np.exp(-0.5 * z * z)
+    pdf = _gauss(z)
     pdf *= gw  # a row's sum alone, as in _survival
     return (_INV_SQRT_2PI * half / ((b - a) * s)) * pdf.sum(axis=1)
 
@@ -379,10 +379,24 @@ def _window_z(t, s, a, b, wa, wb, e_s, gx):
     its half width, and ``z = (w(e) - t) / s`` at the window's quadrature nodes ``gx`` (on [-1, 1])."""
     e_lo, e_hi = _window(t - _CUT * s, a, b, wa, wb, e_s), _window(t + _CUT * s, a, b, wa, wb, e_s)
     half, mid = 0.5 * (e_hi - e_lo), 0.5 * (e_hi + e_lo)
-    z = _weight(e_s, mid[:, None] + half[:, None] * gx)
+    # (in place: the (elements x nodes) temporaries are most of a quadrature's time; the same operations as
+    # _weight(e_s, mid + half * gx))
+    z = half[:, None] * gx
+    z += mid[:, None]
+    with np.errstate(divide="ignore"):
+        np.divide(e_s, z, out=z)
+        z += 1.0
+        np.divide(1.0, z, out=z)
     z -= t[:, None]
     z /= s[:, None]
     return e_hi, half, z
+
+
+def _gauss(z: np.ndarray) -> np.ndarray:
+    """``exp(-0.5 z z)``, its temporaries in place (a new array; ``z`` kept)."""
+    out = z * -0.5
+    out *= z
+    return np.exp(out, out=out)
 
 
 def _survival_derivatives(t, s, a, b, wa, wb, e_s, nodes: int):
@@ -392,7 +406,7 @@ def _survival_derivatives(t, s, a, b, wa, wb, e_s, nodes: int):
     precision at its ends, so the derivatives are the integrals of the integrand's."""
     gx, gw = _rule(nodes)
     e_hi, half, z = _window_z(t, s, a, b, wa, wb, e_s, gx)
-    pdf = np.exp(-0.5 * z * z)
+    pdf = _gauss(z)
     pdf *= _INV_SQRT_2PI
     c = half / (b - a)
 

@@ -229,11 +229,22 @@ class ForceRamp(ForwardModel):
             return dataclasses.replace(self.base, smoothing_window=0)
         return self.base
 
+    @functools.cached_property
     def _shares(self) -> tuple[np.ndarray, np.ndarray]:
-        """The ramp's contact times [s] and area increments ``dA_j`` (those > 0)."""
+        """The ramp's contact times [s] and area increments ``dA_j`` (those > 0), made once."""
         tj = np.asarray(self.ramp_time_s)
         da = np.diff(np.asarray(self.ramp_area), prepend=0.0)
         return tj[da > 0], da[da > 0]
+
+    def __hash__(self) -> int:
+        return self._hash
+
+    @functools.cached_property
+    def _hash(self) -> int:
+        """The dataclass's field hash, made once (a scene's cached panels are looked up class after class, and a
+        calibrated rig's 24 touch ramps take 0.3 ms to hash)."""
+        return hash((self.base, self.ramp_time_s, self.ramp_area, self.force_fraction, self.source,
+                     self.touch_ramps))
 
     @staticmethod
     def _duhamel(step, parts, e, sensor, diffusivity_m2_s, tolerance: float) -> list:
@@ -268,15 +279,18 @@ class ForceRamp(ForwardModel):
 
     @staticmethod
     def _on_grid(outs, grid, parts, step, e, sensor, diffusivity_m2_s, tolerance) -> None:
-        """The Duhamel sums on uniform grids of step ``dt`` as (sparse) convolutions: ``out[i] += dA_j S[n_j + i]``.
+        """The Duhamel sums on uniform grids of step ``dt`` as convolutions: ``out[i] += sum_j dA_j S[n_j + i]``.
 
         Share ``j``'s lags are ``t_0 + i dt - t_j = (n_j + f_j + i) dt`` with ``n_j`` whole and the phase
         ``f_j`` in [0, 1) (phases within 1e-6 of a step of each other taken as the smallest of them: ramp times
         on the grid's own step differ there only by the rounding of ``t - t_j`` and ``dt``, a shift of ~1e-9
         ``dt``, far below the readings' tolerance): the shares of one phase, of every part (a class's touch ramps,
-        read at their own delays), read one step response ``S_l = u_step((f + l) dt)`` of all their objects,
-        long enough for the latest share, each shifted by its ``n_j``.
+        read at their own delays), read one step response ``S_l = u_step((f + l) dt)`` of all their distinct
+        objects, long enough for the latest share; each part's sum is the correlation of ``S`` with its kernel
+        ``c_n = sum_{n_j = n} dA_j``, all parts in one real FFT (pocketfft: the same bits on every run).
         """
+        from scipy import fft
+
         dt = grid[0][1]
         shift = np.concatenate([(parts[p][0][0] - parts[p][1]) / dt for p, _, _ in grid])
         whole = np.floor(shift + 1e-9)
@@ -296,27 +310,32 @@ class ForceRamp(ForwardModel):
                     members.append((p, idx, m, whole[start[q] + js], parts[p][2][js]))
             if not members:
                 continue
+            pad = max(0, -min(int(n.min()) for _, _, _, n, _ in members))   # zeros before contact where n_j < 0
+            width = pad + max(int(n.max()) for _, _, _, n, _ in members) + 1   # kernel length
             length = max(int(n.max()) + m for _, _, m, n, _ in members)    # l = 0 .. n_j + m - 1 (> 0)
-            objects = np.unique(np.concatenate([idx for _, idx, _, _, _ in members]))
+            rows = np.concatenate([idx for _, idx, _, _, _ in members])
+            # distinct objects (an object read under several ramps is read once)
+            key = e[rows] if diffusivity_m2_s is None else rows
+            objects, at, where = np.unique(key, return_index=True, return_inverse=True)
+            at = rows[at]                                                   # a row of each distinct object
             lag = (f + np.arange(length)) * dt
             live = lag > 0
-            S = np.zeros((objects.size, length))
+            S = np.zeros((objects.size, pad + length))
             if live.any():
-                S[:, live] = step.response(lag[live], e[objects], sensor, tolerance=tolerance,
-                                           diffusivity_m2_s=None if diffusivity_m2_s is None
-                                           else diffusivity_m2_s[objects])
-            for p, idx, m, n, da in members:
-                # share by share, in order, each share's window of S (zeros before contact padded where n_j < 0)
-                # times its dA, into one buffer: elementwise, no BLAS (the same bits on every run)
-                pad = max(0, -int(n.min()))
-                Sp = S[np.searchsorted(objects, idx)]
-                Sp = np.concatenate([np.zeros((idx.size, pad)), Sp], axis=1) if pad else Sp
-                at, weight = (n + pad).tolist(), da.tolist()
-                total = np.multiply(Sp[:, at[0]:at[0] + m], weight[0])
-                term = np.empty_like(total)
-                for a, w in zip(at[1:], weight[1:]):
-                    total += np.multiply(Sp[:, a:a + m], w, out=term)
-                outs[p] += total
+                S[:, pad + np.flatnonzero(live)] = step.response(
+                    lag[live], e[at], sensor, tolerance=tolerance,
+                    diffusivity_m2_s=None if diffusivity_m2_s is None else diffusivity_m2_s[at])
+            kernel = np.zeros((len(members), width))
+            for k, (_, _, _, n, da) in enumerate(members):
+                np.add.at(kernel[k], width - 1 - (n + pad), da)              # reversed: a correlation
+            size = fft.next_fast_len(S.shape[1], real=True)
+            spectra = fft.rfft(S, size, axis=1)[where.ravel()] * np.repeat(
+                fft.rfft(kernel, size, axis=1), [idx.size for _, idx, _, _, _ in members], axis=0)
+            full = fft.irfft(spectra, size, axis=1)
+            first = 0
+            for p, idx, m, _, _ in members:
+                outs[p] += full[first:first + idx.size, width - 1:width - 1 + m]
+                first += idx.size
 
     def response(self, time_s, e_object, sensor, *, diffusivity_m2_s=None, tolerance: float = 1e-9) -> np.ndarray:
         """Normalized reading (K, m): the area-weighted sum of the base model's step responses.
@@ -327,12 +346,22 @@ class ForceRamp(ForwardModel):
         """
         return self._read(time_s, e_object, [(self, 0.0, slice(None))], sensor, diffusivity_m2_s, tolerance)
 
-    def touch_readings(self, time_s, e_object, touch, sensor, *, tolerance: float = 1e-9) -> np.ndarray:
+    def touch_readings(self, time_s, e_object, touch, sensor, *, diffusivity_m2_s=None,
+                       tolerance: float = 1e-9) -> np.ndarray:
         """Normalized readings (K, m) of objects ``e_object`` (K,), object ``k`` pressing as touch ramp ``touch[k]``
         (:meth:`touch`: its reading at ``time_s - delay``): each touch ramp's :meth:`response`, smoothed at once."""
         touch = np.asarray(touch)
         groups = [(*self.touch(j), touch == j) for j in np.unique(touch).tolist()]
-        return self._read(time_s, e_object, groups, sensor, None, tolerance)
+        return self._read(time_s, e_object, groups, sensor, diffusivity_m2_s, tolerance)
+
+    def touch_responses(self, time_s, e_object, sensor, *, tolerance: float = 1e-9) -> np.ndarray:
+        """Normalized readings (K, R, m) of objects ``e_object`` (K,) pressing as each of the ``R`` touch ramps:
+        one step response of the K objects for all ramps (:meth:`_on_grid`), what a scene's panels of every touch
+        ramp at once read (:func:`designkit.models.shared.class_readings` with ``touch``)."""
+        e = np.atleast_1d(np.asarray(e_object, dtype=np.float64))
+        k, r = e.size, len(self.touch_ramps)
+        groups = [(*self.touch(j), slice(j * k, (j + 1) * k)) for j in range(r)]
+        return self._read(time_s, np.tile(e, r), groups, sensor, None, tolerance).reshape(r, k, -1).transpose(1, 0, 2)
 
     def _read(self, time_s, e_object, groups, sensor, diffusivity_m2_s, tolerance: float) -> np.ndarray:
         """Objects ``e_object[rows]`` read as ``ramp`` at ``time_s - delay``, for each ``(ramp, delay, rows)``;
@@ -342,16 +371,18 @@ class ForceRamp(ForwardModel):
         t = np.atleast_1d(np.asarray(time_s, dtype=np.float64))
         e = np.atleast_1d(np.asarray(e_object, dtype=np.float64))
         window = int(getattr(self.base, "smoothing_window", 0) or 0)
-        parts = [(t - delay if window <= 1 else smoothing_grid(t - delay, sensor.sample_rate_hz, window,
-                                                              what="a smoothed model with a force ramp"),
-                  *ramp._shares(), rows) for ramp, delay, rows in groups]
+        grid = t if window <= 1 else smoothing_grid(t, sensor.sample_rate_hz, window,
+                                                    what="a smoothed model with a force ramp")
+        parts = [(grid - delay, *ramp._shares, rows) for ramp, delay, rows in groups]
         d = None if diffusivity_m2_s is None else np.broadcast_to(np.asarray(diffusivity_m2_s, dtype=np.float64),
                                                                     e.shape)
         raw = np.zeros((e.size, t.size)) if not groups else None
         for (_, _, _, rows), u in zip(parts, self._duhamel(self._step_model(), parts, e, sensor, d, tolerance)):
             raw = np.empty((e.size, u.shape[1])) if raw is None else raw
             raw[rows] = u
-        return raw if window <= 1 or not groups else smooth_cut(raw, t.size, window, int(self.base.smoothing_order))
+        if window <= 1 or not groups:
+            return np.clip(raw, 0.0, 1.0, out=raw)     # the FFT's rounding around 0 before contact
+        return smooth_cut(raw, t.size, window, int(self.base.smoothing_order))
 
     def check(self, objects, sensor, *, contact_s: float, noise_c: float, delta_t_c: float):
         """The base model's check (the ramp adds no validity limit of its own)."""

@@ -156,7 +156,7 @@ def test_a_class_s_touches_read_every_touch_ramp_from_panels_of_one_step_respons
     tol = 1e-6
     e = np.random.default_rng(5).uniform(331.0, 506.0, 40)
     touch = np.random.default_rng(6).integers(0, 4, e.size)
-    shared._cached_scene.cache_clear()
+    shared._cached_touch_scene.cache_clear()
     got = class_readings(ramp, t, e, SENSOR, tolerance=tol, touch=touch)
     scene = shared.scene_response(ramp, t, SENSOR, tolerance=tol, touches=True)
     assert scene.panels and reads == [5] * len(scene._panels)       # one base reading per panel, not one per ramp
@@ -165,7 +165,7 @@ def test_a_class_s_touches_read_every_touch_ramp_from_panels_of_one_step_respons
     for k in range(e.size):                                         # each touch as its own ramp reads it
         one, delay = ramp.touch(touch[k])
         assert np.max(np.abs(got[k] - one.response(t - delay, e[k:k + 1], SENSOR)[0])) <= tol
-    shared._cached_scene.cache_clear()
+    shared._cached_touch_scene.cache_clear()
     class_readings(ramp, t, np.random.default_rng(7).uniform(20.0, 30000.0, 40), SENSOR, tolerance=tol,
                    touch=touch)                                     # other panels read first
     np.testing.assert_array_equal(class_readings(ramp, t, e, SENSOR, tolerance=tol, touch=touch), got)

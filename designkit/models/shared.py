@@ -65,7 +65,8 @@ def _effusivity(w: np.ndarray, e_sensor: float) -> np.ndarray:
 
 class Panel(NamedTuple):
     """The model read at 5 Chebyshev-Lobatto ``weights`` of ``[index / 2^level, (index + 1) / 2^level]``:
-    ``values`` (5, m); ``error``: the 3-point interpolant's measured error (above the 5-point one's)."""
+    ``values`` (5, m), or (5, R, m) for every touch ramp (:class:`SceneResponse` ``touches``); ``error``: the
+    3-point interpolant's measured error (above the 5-point one's)."""
 
     level: int
     index: int
@@ -161,18 +162,24 @@ class _SensorKey(bytes):
     repr cost 5 ms for a calibrated rig's, per class and touch ramp)."""
 
 
-@functools.lru_cache(maxsize=64)   # a calibrated rig's 24 touch ramps at a contact or two
-def _cached_scene(model: ForwardModel, sensor: _SensorKey, time_bytes: bytes, tolerance: float,
-                  touches: bool) -> SceneResponse:
+def _new_scene(model: ForwardModel, sensor: _SensorKey, time_bytes: bytes, tolerance: float,
+               touches: bool) -> SceneResponse:
     return SceneResponse(model, np.frombuffer(time_bytes, dtype=np.float64).copy(), sensor.sensor, tolerance,
                          touches=touches)
 
 
+#: The last 64 scenes (a sweep's contacts and scene points); of every touch ramp at once, the last 2 (their panels
+#: hold R = 24 ramps each: up to 64 MB a scene at a calibrated rig's longest contact; a sweep renders contact after
+#: contact).
+_cached_scene = functools.lru_cache(maxsize=64)(_new_scene)
+_cached_touch_scene = functools.lru_cache(maxsize=2)(_new_scene)
+
+
 def scene_response(model: ForwardModel, time_s, sensor, *, tolerance: float, touches: bool = False) -> SceneResponse:
     """The :class:`SceneResponse` of a model, sensor, time grid, tolerance and ``touches``, one per process (the
-    last 64 kept).
+    last 64 kept; with ``touches`` the last 2).
 
-    Its panels are a pure function of those four, so sharing them changes no reading: it only saves reading
+    Its panels are a pure function of those five, so sharing them changes no reading: it only saves reading
     the model again for the next class or repeat of the same scene.
     """
     t = np.ascontiguousarray(np.atleast_1d(np.asarray(time_s, dtype=np.float64)))
@@ -182,7 +189,7 @@ def scene_response(model: ForwardModel, time_s, sensor, *, tolerance: float, tou
         return SceneResponse(model, t, sensor, tolerance, touches=touches)
     key = _SensorKey(pickle.dumps(sensor, protocol=5))
     key.sensor = sensor
-    return _cached_scene(model, key, t.tobytes(), float(tolerance), bool(touches))
+    return (_cached_touch_scene if touches else _cached_scene)(model, key, t.tobytes(), float(tolerance), bool(touches))
 
 
 def start_level(w_low: float, w_high: float) -> int:

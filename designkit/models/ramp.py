@@ -254,9 +254,7 @@ class ForceRamp(ForwardModel):
         for p, (t, tj, da, rows) in enumerate(parts):
             idx = np.arange(e.size)[rows]
             outs.append(np.zeros((idx.size, t.size)))
-            lags = t[None, :] - tj[:, None]                             # (J, m)
-            pos = lags > 0
-            if not pos.any():
+            if t.size == 0 or not t.max() > tj.min():                   # no share in contact by the last time
                 continue
             dt = float(t[1] - t[0]) if t.size > 1 else 0.0
             if dt > 0 and np.all(np.abs(np.diff(t) - dt) <= 1e-9 * dt) \
@@ -264,6 +262,8 @@ class ForceRamp(ForwardModel):
                 grid.append((p, dt, idx))
                 continue
             # any times: one evaluation of the step response at the distinct lags, then the sum share by share
+            lags = t[None, :] - tj[:, None]                             # (J, m)
+            pos = lags > 0
             key = np.round(lags[pos] * 1e9).astype(np.int64)
             uniq, first, inverse = np.unique(key, return_index=True, return_inverse=True)
             u = step.response(lags[pos][first], e[idx], sensor, tolerance=tolerance,
@@ -295,29 +295,28 @@ class ForceRamp(ForwardModel):
         shift = np.concatenate([(parts[p][0][0] - parts[p][1]) / dt for p, _, _ in grid])
         whole = np.floor(shift + 1e-9)
         frac, whole = np.maximum(shift - whole, 0.0), whole.astype(np.int64)
-        start = np.cumsum([0] + [parts[p][1].size for p, _, _ in grid])
+        sizes = [parts[p][1].size for p, _, _ in grid]
+        part = np.repeat(np.arange(len(grid)), sizes)                   # each share's part (index into grid)
+        m_of = np.array([parts[p][0].size for p, _, _ in grid])[part]
+        da_all = np.concatenate([parts[p][2] for p, _, _ in grid])
         order = np.argsort(frac, kind="stable")
         new = np.diff(frac[order], prepend=-1.0) > 1e-6
         label = np.empty(frac.size, dtype=np.int64)
         label[order] = np.cumsum(new) - 1
         for g, f in enumerate(frac[order][new].tolist()):
-            members = []
-            for q, (p, _, idx) in enumerate(grid):
-                m = parts[p][0].size
-                js = np.flatnonzero(label[start[q]:start[q + 1]] == g)
-                js = js[whole[start[q] + js] > -m]     # a share whose contact comes after the last time adds nothing
-                if js.size:
-                    members.append((p, idx, m, whole[start[q] + js], parts[p][2][js]))
-            if not members:
+            sel = np.flatnonzero((label == g) & (whole > -m_of))   # a share in contact after the last time adds nothing
+            if not sel.size:
                 continue
-            pad = max(0, -min(int(n.min()) for _, _, _, n, _ in members))   # zeros before contact where n_j < 0
-            width = pad + max(int(n.max()) for _, _, _, n, _ in members) + 1   # kernel length
-            length = max(int(n.max()) + m for _, _, m, n, _ in members)    # l = 0 .. n_j + m - 1 (> 0)
-            rows = np.concatenate([idx for _, idx, _, _, _ in members])
+            n, q = whole[sel], part[sel]
+            members = np.unique(q)
+            pad = max(0, -int(n.min()))                                 # zeros before contact where n_j < 0
+            width = pad + int(n.max()) + 1                              # kernel length
+            length = int((n + m_of[sel]).max())                         # l = 0 .. n_j + m - 1 (> 0)
+            rows = np.concatenate([grid[k][2] for k in members.tolist()])
             # distinct objects (an object read under several ramps is read once)
             key = e[rows] if diffusivity_m2_s is None else rows
             objects, at, where = np.unique(key, return_index=True, return_inverse=True)
-            at = rows[at]                                                   # a row of each distinct object
+            at = rows[at]                                               # a row of each distinct object
             lag = (f + np.arange(length)) * dt
             live = lag > 0
             S = np.zeros((objects.size, pad + length))
@@ -325,17 +324,17 @@ class ForceRamp(ForwardModel):
                 S[:, pad + np.flatnonzero(live)] = step.response(
                     lag[live], e[at], sensor, tolerance=tolerance,
                     diffusivity_m2_s=None if diffusivity_m2_s is None else diffusivity_m2_s[at])
-            kernel = np.zeros((len(members), width))
-            for k, (_, _, _, n, da) in enumerate(members):
-                np.add.at(kernel[k], width - 1 - (n + pad), da)              # reversed: a correlation
+            kernel = np.zeros((members.size, width))                    # reversed, share by share: a correlation
+            np.add.at(kernel, (np.searchsorted(members, q), width - 1 - (n + pad)), da_all[sel])
             size = fft.next_fast_len(S.shape[1], real=True)
-            spectra = fft.rfft(S, size, axis=1)[where.ravel()] * np.repeat(
-                fft.rfft(kernel, size, axis=1), [idx.size for _, idx, _, _, _ in members], axis=0)
-            full = fft.irfft(spectra, size, axis=1)
+            counts = [grid[k][2].size for k in members.tolist()]
+            full = fft.irfft(fft.rfft(S, size, axis=1)[where.ravel()]
+                             * np.repeat(fft.rfft(kernel, size, axis=1), counts, axis=0), size, axis=1)
             first = 0
-            for p, idx, m, _, _ in members:
-                outs[p] += full[first:first + idx.size, width - 1:width - 1 + m]
-                first += idx.size
+            for k, count in zip(members.tolist(), counts):
+                p = grid[k][0]
+                outs[p] += full[first:first + count, width - 1:width - 1 + parts[p][0].size]
+                first += count
 
     def response(self, time_s, e_object, sensor, *, diffusivity_m2_s=None, tolerance: float = 1e-9) -> np.ndarray:
         """Normalized reading (K, m): the area-weighted sum of the base model's step responses.

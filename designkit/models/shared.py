@@ -162,6 +162,28 @@ class _SensorKey(bytes):
     repr cost 5 ms for a calibrated rig's, per class and touch ramp)."""
 
 
+class _Same:
+    """An object compared by identity (a frozen sensor: its pickle made once per object, not per class)."""
+
+    __slots__ = ("obj",)
+
+    def __init__(self, obj):
+        self.obj = obj
+
+    def __hash__(self) -> int:
+        return id(self.obj)
+
+    def __eq__(self, other) -> bool:
+        return isinstance(other, _Same) and other.obj is self.obj
+
+
+@functools.lru_cache(maxsize=8)   # holds the sensor, so its id is not reused while cached
+def _sensor_key(sensor: _Same) -> _SensorKey:
+    key = _SensorKey(pickle.dumps(sensor.obj, protocol=5))
+    key.sensor = sensor.obj
+    return key
+
+
 def _new_scene(model: ForwardModel, sensor: _SensorKey, time_bytes: bytes, tolerance: float,
                touches: bool) -> SceneResponse:
     return SceneResponse(model, np.frombuffer(time_bytes, dtype=np.float64).copy(), sensor.sensor, tolerance,
@@ -187,8 +209,7 @@ def scene_response(model: ForwardModel, time_s, sensor, *, tolerance: float, tou
         hash(model)
     except TypeError:   # a model with unhashable parameters: a response of its own, not shared
         return SceneResponse(model, t, sensor, tolerance, touches=touches)
-    key = _SensorKey(pickle.dumps(sensor, protocol=5))
-    key.sensor = sensor
+    key = _sensor_key(_Same(sensor))
     return (_cached_touch_scene if touches else _cached_scene)(model, key, t.tobytes(), float(tolerance), bool(touches))
 
 

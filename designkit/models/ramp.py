@@ -239,6 +239,10 @@ class ForceRamp(ForwardModel):
     def __hash__(self) -> int:
         return self._hash
 
+    def __getstate__(self) -> dict:
+        """The fields and made-once parts, not the hash (a string's hash differs from process to process)."""
+        return {k: v for k, v in self.__dict__.items() if k != "_hash"}
+
     @functools.cached_property
     def _hash(self) -> int:
         """The dataclass's field hash, made once (a scene's cached panels are looked up class after class, and a

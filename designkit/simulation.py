@@ -324,36 +324,14 @@ def render_trials(draws: TrialDraws, sensor: Sensor, scene: Scene, model: "Forwa
     else:
         tol = response_tolerance(scene.noise_ratio, draws.n_samples)
         # a costly model is read at a few effusivities of the class and interpolated within tol
-        u = _class_readings(fm, time_s, draws.effusivity, sensor, diffusivity_m2_s, tol, ramp_index)
+        u = class_readings(fm, time_s, draws.effusivity, sensor, diffusivity_m2_s=diffusivity_m2_s, tolerance=tol,
+                           touch=ramp_index)
         temps = np.multiply(u, (ta - ts)[:, None], out=u)        # in place: ts + (ta - ts) u, as before
         temps += ts[:, None]
         if scene.noise_c > 0:
             temps += scene.noise_c * draws.noise
     return Trials(time_s, temps, draws.effusivity, ts, ta,
                   None if diffusivity_m2_s is None else np.asarray(diffusivity_m2_s, dtype=np.float64), fm.name)
-
-
-def _class_readings(fm, time_s, e, sensor, diffusivity_m2_s, tol, ramp_index) -> np.ndarray:
-    """A class's normalized readings; with ``ramp_index``, each trial pressing as its calibration touch did
-    (read at its own first contact: ``t - delay``)."""
-    if ramp_index is None:
-        return class_readings(fm, time_s, e, sensor, diffusivity_m2_s=diffusivity_m2_s, tolerance=tol)
-    from .models.shared import MIN_DISTINCT
-
-    idx = np.asarray(ramp_index)
-    u = np.empty((e.size, np.size(time_s)))
-    direct = np.zeros(e.size, dtype=bool)
-    for j in np.unique(idx):
-        rows = idx == j
-        if diffusivity_m2_s is None and (np.unique(e[rows]).size < MIN_DISTINCT or not np.all(np.isfinite(e[rows]))):
-            direct |= rows    # read directly (as class_readings would), every such touch in one call below
-            continue
-        ramp, delay = fm.touch(j)
-        u[rows] = class_readings(ramp, np.asarray(time_s) - delay, e[rows], sensor, tolerance=tol,
-                                 diffusivity_m2_s=None if diffusivity_m2_s is None else diffusivity_m2_s[rows])
-    if direct.any():
-        u[direct] = fm.touch_readings(time_s, e[direct], idx[direct], sensor, tolerance=tol)
-    return u
 
 
 def window_times_s(sensor: Sensor, scene: Scene) -> np.ndarray:

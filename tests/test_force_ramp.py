@@ -325,3 +325,23 @@ def test_a_class_s_touch_ramps_share_one_step_response():
     for k in range(e.size):
         one, delay = ramp.touch(touch[k])
         np.testing.assert_allclose(got[k], one.response(t - delay, e[k:k + 1], SENSOR)[0], rtol=0, atol=1e-13)
+
+
+def test_a_ramp_unpickled_in_another_process_hashes_as_one_made_there():
+    """A ramp's hash is made once per process (scene caches look it up class after class) and never carried by a
+    pickle (a string's hash differs between processes): a sweep worker's unpickled model hashes as an equal model
+    made there."""
+    import os
+    import pickle
+    import subprocess
+    import sys
+
+    ramp = ForceRamp(None, (0.0, 0.1), (0.5, 1.0), 0.1, "calibration touches")
+    hash(ramp)
+    code = ("import pickle, sys; from designkit.models.ramp import ForceRamp; "
+            "r = pickle.loads(sys.stdin.buffer.read()); "
+            "made = ForceRamp(None, (0.0, 0.1), (0.5, 1.0), 0.1, 'calibration touches'); "
+            "print(hash(r) == hash(made) and r == made)")
+    out = subprocess.run([sys.executable, "-c", code], input=pickle.dumps(ramp), capture_output=True, check=True,
+                         env={**os.environ, "PYTHONHASHSEED": "4321"})
+    assert out.stdout.strip() == b"True"

@@ -88,7 +88,9 @@ def test_few_distinct_objects_or_a_per_touch_diffusivity_are_read_directly():
 
 
 def test_a_ramp_off_the_sample_grid_is_the_sum_of_shifted_step_responses():
-    """Shares starting between samples (phase 0.4 of a sample) on a uniform grid: the convolution's phases."""
+    """Shares starting between samples (phase 0.4 of a sample) on a uniform grid: the convolution's phases. The
+    convolution is an FFT's: exact to rounding relative to the reading's scale (1e-15 of ``|Ts0 - Ta|``), not
+    relative to each tiny reading before the slow shares' heat arrives."""
     base = get_model("contact", conductance_w_m2k=2500.0)
     dt = 1 / 200.0
     ramp = ForceRamp(base, (0.0, 0.012, 0.05, 0.2), (0.1, 0.3, 0.7, 1.0))
@@ -98,7 +100,7 @@ def test_a_ramp_off_the_sample_grid_is_the_sum_of_shifted_step_responses():
         lag = t - tj
         pos = lag > 0
         want[:, pos] += da * base.response(lag[pos], [400.0, 9000.0], SENSOR)
-    np.testing.assert_allclose(ramp.response(t, [400.0, 9000.0], SENSOR), want, rtol=1e-13, atol=1e-300)
+    np.testing.assert_allclose(ramp.response(t, [400.0, 9000.0], SENSOR), want, rtol=1e-13, atol=1e-15)
 
 
 def test_the_layered_transform_is_its_object_independent_parts_divided_per_object():
@@ -128,3 +130,48 @@ def test_the_same_seed_gives_the_same_ramp_touches_in_another_process():
                          cwd=os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     here = render_trials(draw_trials(331.0, 506.0, 30, 161, [4, 2]), SENSOR, Scene(contact_s=0.8), RAMP)
     assert np.array_equal(np.array(json.loads(out.stdout)), here.temperature_c)
+
+
+def test_a_class_s_touches_read_every_touch_ramp_from_panels_of_one_step_response():
+    """Touches each pressing as one of a calibrated sensor's touch ramps (a rig table's touches) are read from the
+    scene's panels of all touch ramps at once: a panel node reads the base model once (one step response shared by
+    every ramp, the Duhamel sums as convolutions), each touch interpolates its own ramp's; within the tolerance of
+    the touches read directly, the same bits whatever was read before, and render_trials reads them so."""
+    from designkit.models import shared
+    from designkit.models.layered import Layered
+
+    reads = []
+
+    class Counting(Layered):
+        def response(self, time_s, e_object, sensor, **kw):
+            reads.append(np.size(e_object))
+            return super().response(time_s, e_object, sensor, **kw)
+
+    base = Counting(film_thickness_m=2.2e-4, backing_effusivity_ws05_m2k=5000.0, conductance_w_m2k=18000.0,
+                    lag_s=0.8, smoothing_window=99, smoothing_order=3)
+    ramp = ForceRamp.from_force_profile(base, TP, np.clip(0.1 + 0.9 * (TP + 0.2) / 0.9, 0, 1), 0.2,
+                                        touch_force_rel=[np.clip(0.1 + 0.9 * (TP + d) / w, 0, 1) for d, w in
+                                                         ((0.1, 0.5), (0.2, 0.9), (-0.1, 0.7), (0.0, 1.1))])
+    t = 0.3 + np.arange(160) / SENSOR.sample_rate_hz
+    tol = 1e-6
+    e = np.random.default_rng(5).uniform(331.0, 506.0, 40)
+    touch = np.random.default_rng(6).integers(0, 4, e.size)
+    shared._cached_touch_scene.cache_clear()
+    got = class_readings(ramp, t, e, SENSOR, tolerance=tol, touch=touch)
+    scene = shared.scene_response(ramp, t, SENSOR, tolerance=tol, touches=True)
+    assert scene.panels and reads == [5] * len(scene._panels)       # one base reading per panel, not one per ramp
+    direct = ramp.touch_readings(t, e, touch, SENSOR)
+    assert np.max(np.abs(got - direct)) <= tol
+    for k in range(e.size):                                         # each touch as its own ramp reads it
+        one, delay = ramp.touch(touch[k])
+        assert np.max(np.abs(got[k] - one.response(t - delay, e[k:k + 1], SENSOR)[0])) <= tol
+    shared._cached_touch_scene.cache_clear()
+    class_readings(ramp, t, np.random.default_rng(7).uniform(20.0, 30000.0, 40), SENSOR, tolerance=tol,
+                   touch=touch)                                     # other panels read first
+    np.testing.assert_array_equal(class_readings(ramp, t, e, SENSOR, tolerance=tol, touch=touch), got)
+    scene = Scene(contact_s=1.1, noise_c=0.0, onset_s=0.3)
+    draws = draw_trials(331.0, 506.0, 40, t.size, [1])
+    temps = render_trials(draws, SENSOR, scene, ramp, None, touch).temperature_c
+    u = class_readings(ramp, t, draws.effusivity, SENSOR, touch=touch,
+                       tolerance=response_tolerance(scene.noise_ratio, t.size))
+    np.testing.assert_array_equal(temps, scene.sensor_temp_c + (scene.ambient_temp_c - scene.sensor_temp_c) * u)

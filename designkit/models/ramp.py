@@ -229,11 +229,26 @@ class ForceRamp(ForwardModel):
             return dataclasses.replace(self.base, smoothing_window=0)
         return self.base
 
+    @functools.cached_property
     def _shares(self) -> tuple[np.ndarray, np.ndarray]:
-        """The ramp's contact times [s] and area increments ``dA_j`` (those > 0)."""
+        """The ramp's contact times [s] and area increments ``dA_j`` (those > 0), made once."""
         tj = np.asarray(self.ramp_time_s)
         da = np.diff(np.asarray(self.ramp_area), prepend=0.0)
         return tj[da > 0], da[da > 0]
+
+    def __hash__(self) -> int:
+        return self._hash
+
+    def __getstate__(self) -> dict:
+        """The fields and made-once parts, not the hash (a string's hash differs from process to process)."""
+        return {k: v for k, v in self.__dict__.items() if k != "_hash"}
+
+    @functools.cached_property
+    def _hash(self) -> int:
+        """The dataclass's field hash, made once (a scene's cached panels are looked up class after class, and a
+        calibrated rig's 24 touch ramps take 0.3 ms to hash)."""
+        return hash((self.base, self.ramp_time_s, self.ramp_area, self.force_fraction, self.source,
+                     self.touch_ramps))
 
     @staticmethod
     def _duhamel(step, parts, e, sensor, diffusivity_m2_s, tolerance: float) -> list:
@@ -243,9 +258,7 @@ class ForceRamp(ForwardModel):
         for p, (t, tj, da, rows) in enumerate(parts):
             idx = np.arange(e.size)[rows]
             outs.append(np.zeros((idx.size, t.size)))
-            lags = t[None, :] - tj[:, None]                             # (J, m)
-            pos = lags > 0
-            if not pos.any():
+            if t.size == 0 or not t.max() > tj.min():                   # no share in contact by the last time
                 continue
             dt = float(t[1] - t[0]) if t.size > 1 else 0.0
             if dt > 0 and np.all(np.abs(np.diff(t) - dt) <= 1e-9 * dt) \
@@ -253,6 +266,8 @@ class ForceRamp(ForwardModel):
                 grid.append((p, dt, idx))
                 continue
             # any times: one evaluation of the step response at the distinct lags, then the sum share by share
+            lags = t[None, :] - tj[:, None]                             # (J, m)
+            pos = lags > 0
             key = np.round(lags[pos] * 1e9).astype(np.int64)
             uniq, first, inverse = np.unique(key, return_index=True, return_inverse=True)
             u = step.response(lags[pos][first], e[idx], sensor, tolerance=tolerance,
@@ -268,55 +283,62 @@ class ForceRamp(ForwardModel):
 
     @staticmethod
     def _on_grid(outs, grid, parts, step, e, sensor, diffusivity_m2_s, tolerance) -> None:
-        """The Duhamel sums on uniform grids of step ``dt`` as (sparse) convolutions: ``out[i] += dA_j S[n_j + i]``.
+        """The Duhamel sums on uniform grids of step ``dt`` as convolutions: ``out[i] += sum_j dA_j S[n_j + i]``.
 
         Share ``j``'s lags are ``t_0 + i dt - t_j = (n_j + f_j + i) dt`` with ``n_j`` whole and the phase
         ``f_j`` in [0, 1) (phases within 1e-6 of a step of each other taken as the smallest of them: ramp times
         on the grid's own step differ there only by the rounding of ``t - t_j`` and ``dt``, a shift of ~1e-9
         ``dt``, far below the readings' tolerance): the shares of one phase, of every part (a class's touch ramps,
-        read at their own delays), read one step response ``S_l = u_step((f + l) dt)`` of all their objects,
-        long enough for the latest share, each shifted by its ``n_j``.
+        read at their own delays), read one step response ``S_l = u_step((f + l) dt)`` of all their distinct
+        objects, long enough for the latest share; each part's sum is the correlation of ``S`` with its kernel
+        ``c_n = sum_{n_j = n} dA_j``, all parts in one real FFT (pocketfft: the same bits on every run).
         """
+        from scipy import fft
+
         dt = grid[0][1]
         shift = np.concatenate([(parts[p][0][0] - parts[p][1]) / dt for p, _, _ in grid])
         whole = np.floor(shift + 1e-9)
         frac, whole = np.maximum(shift - whole, 0.0), whole.astype(np.int64)
-        start = np.cumsum([0] + [parts[p][1].size for p, _, _ in grid])
+        sizes = [parts[p][1].size for p, _, _ in grid]
+        part = np.repeat(np.arange(len(grid)), sizes)                   # each share's part (index into grid)
+        m_of = np.array([parts[p][0].size for p, _, _ in grid])[part]
+        da_all = np.concatenate([parts[p][2] for p, _, _ in grid])
         order = np.argsort(frac, kind="stable")
         new = np.diff(frac[order], prepend=-1.0) > 1e-6
         label = np.empty(frac.size, dtype=np.int64)
         label[order] = np.cumsum(new) - 1
         for g, f in enumerate(frac[order][new].tolist()):
-            members = []
-            for q, (p, _, idx) in enumerate(grid):
-                m = parts[p][0].size
-                js = np.flatnonzero(label[start[q]:start[q + 1]] == g)
-                js = js[whole[start[q] + js] > -m]     # a share whose contact comes after the last time adds nothing
-                if js.size:
-                    members.append((p, idx, m, whole[start[q] + js], parts[p][2][js]))
-            if not members:
+            sel = np.flatnonzero((label == g) & (whole > -m_of))   # a share in contact after the last time adds nothing
+            if not sel.size:
                 continue
-            length = max(int(n.max()) + m for _, _, m, n, _ in members)    # l = 0 .. n_j + m - 1 (> 0)
-            objects = np.unique(np.concatenate([idx for _, idx, _, _, _ in members]))
+            n, q = whole[sel], part[sel]
+            members = np.unique(q)
+            pad = max(0, -int(n.min()))                                 # zeros before contact where n_j < 0
+            width = pad + int(n.max()) + 1                              # kernel length
+            length = int((n + m_of[sel]).max())                         # l = 0 .. n_j + m - 1 (> 0)
+            rows = np.concatenate([grid[k][2] for k in members.tolist()])
+            # distinct objects (an object read under several ramps is read once)
+            key = e[rows] if diffusivity_m2_s is None else rows
+            objects, at, where = np.unique(key, return_index=True, return_inverse=True)
+            at = rows[at]                                               # a row of each distinct object
             lag = (f + np.arange(length)) * dt
             live = lag > 0
-            S = np.zeros((objects.size, length))
+            S = np.zeros((objects.size, pad + length))
             if live.any():
-                S[:, live] = step.response(lag[live], e[objects], sensor, tolerance=tolerance,
-                                           diffusivity_m2_s=None if diffusivity_m2_s is None
-                                           else diffusivity_m2_s[objects])
-            for p, idx, m, n, da in members:
-                # share by share, in order, each share's window of S (zeros before contact padded where n_j < 0)
-                # times its dA, into one buffer: elementwise, no BLAS (the same bits on every run)
-                pad = max(0, -int(n.min()))
-                Sp = S[np.searchsorted(objects, idx)]
-                Sp = np.concatenate([np.zeros((idx.size, pad)), Sp], axis=1) if pad else Sp
-                at, weight = (n + pad).tolist(), da.tolist()
-                total = np.multiply(Sp[:, at[0]:at[0] + m], weight[0])
-                term = np.empty_like(total)
-                for a, w in zip(at[1:], weight[1:]):
-                    total += np.multiply(Sp[:, a:a + m], w, out=term)
-                outs[p] += total
+                S[:, pad + np.flatnonzero(live)] = step.response(
+                    lag[live], e[at], sensor, tolerance=tolerance,
+                    diffusivity_m2_s=None if diffusivity_m2_s is None else diffusivity_m2_s[at])
+            kernel = np.zeros((members.size, width))                    # reversed, share by share: a correlation
+            np.add.at(kernel, (np.searchsorted(members, q), width - 1 - (n + pad)), da_all[sel])
+            size = fft.next_fast_len(S.shape[1], real=True)
+            counts = [grid[k][2].size for k in members.tolist()]
+            full = fft.irfft(fft.rfft(S, size, axis=1)[where.ravel()]
+                             * np.repeat(fft.rfft(kernel, size, axis=1), counts, axis=0), size, axis=1)
+            first = 0
+            for k, count in zip(members.tolist(), counts):
+                p = grid[k][0]
+                outs[p] += full[first:first + count, width - 1:width - 1 + parts[p][0].size]
+                first += count
 
     def response(self, time_s, e_object, sensor, *, diffusivity_m2_s=None, tolerance: float = 1e-9) -> np.ndarray:
         """Normalized reading (K, m): the area-weighted sum of the base model's step responses.
@@ -327,12 +349,22 @@ class ForceRamp(ForwardModel):
         """
         return self._read(time_s, e_object, [(self, 0.0, slice(None))], sensor, diffusivity_m2_s, tolerance)
 
-    def touch_readings(self, time_s, e_object, touch, sensor, *, tolerance: float = 1e-9) -> np.ndarray:
+    def touch_readings(self, time_s, e_object, touch, sensor, *, diffusivity_m2_s=None,
+                       tolerance: float = 1e-9) -> np.ndarray:
         """Normalized readings (K, m) of objects ``e_object`` (K,), object ``k`` pressing as touch ramp ``touch[k]``
         (:meth:`touch`: its reading at ``time_s - delay``): each touch ramp's :meth:`response`, smoothed at once."""
         touch = np.asarray(touch)
         groups = [(*self.touch(j), touch == j) for j in np.unique(touch).tolist()]
-        return self._read(time_s, e_object, groups, sensor, None, tolerance)
+        return self._read(time_s, e_object, groups, sensor, diffusivity_m2_s, tolerance)
+
+    def touch_responses(self, time_s, e_object, sensor, *, tolerance: float = 1e-9) -> np.ndarray:
+        """Normalized readings (K, R, m) of objects ``e_object`` (K,) pressing as each of the ``R`` touch ramps:
+        one step response of the K objects for all ramps (:meth:`_on_grid`), what a scene's panels of every touch
+        ramp at once read (:func:`designkit.models.shared.class_readings` with ``touch``)."""
+        e = np.atleast_1d(np.asarray(e_object, dtype=np.float64))
+        k, r = e.size, len(self.touch_ramps)
+        groups = [(*self.touch(j), slice(j * k, (j + 1) * k)) for j in range(r)]
+        return self._read(time_s, np.tile(e, r), groups, sensor, None, tolerance).reshape(r, k, -1).transpose(1, 0, 2)
 
     def _read(self, time_s, e_object, groups, sensor, diffusivity_m2_s, tolerance: float) -> np.ndarray:
         """Objects ``e_object[rows]`` read as ``ramp`` at ``time_s - delay``, for each ``(ramp, delay, rows)``;
@@ -342,16 +374,18 @@ class ForceRamp(ForwardModel):
         t = np.atleast_1d(np.asarray(time_s, dtype=np.float64))
         e = np.atleast_1d(np.asarray(e_object, dtype=np.float64))
         window = int(getattr(self.base, "smoothing_window", 0) or 0)
-        parts = [(t - delay if window <= 1 else smoothing_grid(t - delay, sensor.sample_rate_hz, window,
-                                                              what="a smoothed model with a force ramp"),
-                  *ramp._shares(), rows) for ramp, delay, rows in groups]
+        grid = t if window <= 1 else smoothing_grid(t, sensor.sample_rate_hz, window,
+                                                    what="a smoothed model with a force ramp")
+        parts = [(grid - delay, *ramp._shares, rows) for ramp, delay, rows in groups]
         d = None if diffusivity_m2_s is None else np.broadcast_to(np.asarray(diffusivity_m2_s, dtype=np.float64),
                                                                     e.shape)
         raw = np.zeros((e.size, t.size)) if not groups else None
         for (_, _, _, rows), u in zip(parts, self._duhamel(self._step_model(), parts, e, sensor, d, tolerance)):
             raw = np.empty((e.size, u.shape[1])) if raw is None else raw
             raw[rows] = u
-        return raw if window <= 1 or not groups else smooth_cut(raw, t.size, window, int(self.base.smoothing_order))
+        if window <= 1 or not groups:
+            return np.clip(raw, 0.0, 1.0, out=raw)     # the FFT's rounding around 0 before contact
+        return smooth_cut(raw, t.size, window, int(self.base.smoothing_order))
 
     def check(self, objects, sensor, *, contact_s: float, noise_c: float, delta_t_c: float):
         """The base model's check (the ramp adds no validity limit of its own)."""

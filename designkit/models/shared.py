@@ -65,7 +65,8 @@ def _effusivity(w: np.ndarray, e_sensor: float) -> np.ndarray:
 
 class Panel(NamedTuple):
     """The model read at 5 Chebyshev-Lobatto ``weights`` of ``[index / 2^level, (index + 1) / 2^level]``:
-    ``values`` (5, m); ``error``: the 3-point interpolant's measured error (above the 5-point one's)."""
+    ``values`` (5, m), or (5, R, m) for every touch ramp (:class:`SceneResponse` ``touches``); ``error``: the
+    3-point interpolant's measured error (above the 5-point one's)."""
 
     level: int
     index: int
@@ -86,15 +87,20 @@ class SceneResponse:
     sensor : designkit.Sensor
     tolerance : float
         Largest interpolation error (normalized reading), > 0.
+    touches : bool
+        Read the model's every touch ramp at once (a :class:`~designkit.models.ramp.ForceRamp` with
+        ``touch_ramps``: :meth:`~designkit.models.ramp.ForceRamp.touch_responses`): a panel's values are
+        (5, R, m), one step response per node shared by the R ramps, and a touch reads its own ramp's.
     """
 
-    def __init__(self, model: ForwardModel, time_s, sensor, tolerance: float):
+    def __init__(self, model: ForwardModel, time_s, sensor, tolerance: float, *, touches: bool = False):
         if not (tolerance > 0):
             raise InputError(f"interpolation tolerance must be > 0, got {tolerance!r}")
         self.model = model
         self.time_s = np.atleast_1d(np.asarray(time_s, dtype=np.float64))
         self.sensor = sensor
         self.tolerance = float(tolerance)
+        self.touches = bool(touches)
         self.e_sensor = float(sensor.effusivity)
         self._panels: dict[tuple[int, int], Panel | None] = {}   # None: failed, read its halves
         self.model_readings = 0   # effusivities the model was read at (for benchmarks)
@@ -105,17 +111,20 @@ class SceneResponse:
         if key not in self._panels:
             a, b = math.ldexp(index, -level), math.ldexp(index + 1, -level)
             w = _lobatto(4, a, b)
-            v = self.model.response(self.time_s, _effusivity(w, self.e_sensor), self.sensor,
-                                    tolerance=0.1 * self.tolerance)
+            read = self.model.touch_responses if self.touches else self.model.response
+            v = read(self.time_s, _effusivity(w, self.e_sensor), self.sensor, tolerance=0.1 * self.tolerance)
             self.model_readings += w.size
-            error = float(np.max(np.abs(_interpolate(w[0::2], v[0::2], w[1::2]) - v[1::2])))
+            flat = v.reshape(w.size, -1)
+            error = float(np.max(np.abs(_interpolate(w[0::2], flat[0::2], w[1::2]) - flat[1::2])))
             self._panels[key] = Panel(key[0], key[1], w, v, error) if error <= self.tolerance else None
         return self._panels[key]
 
-    def readings(self, e_object, level: int = 0) -> np.ndarray:
+    def readings(self, e_object, level: int = 0, touch=None) -> np.ndarray:
         """Normalized readings (K, m) of objects of effusivities ``e_object`` (>= 0, finite or inf), each
-        from the first panel that meets the tolerance on its way down from ``level``."""
+        from the first panel that meets the tolerance on its way down from ``level``; with ``touches``, object
+        ``k`` pressing as touch ramp ``touch[k]``."""
         e = np.atleast_1d(np.asarray(e_object, dtype=np.float64))
+        touch = None if touch is None else np.asarray(touch)
         w = object_weight(self.e_sensor, e)
         out = np.empty((e.size, self.time_s.size))
         pending = np.arange(e.size)
@@ -128,10 +137,15 @@ class SceneResponse:
                 p = self.panel(lev, i)
                 if p is not None:
                     sel = idx == i
-                    out[pending[sel]] = _interpolate(p.weights, p.values, w[pending[sel]])
+                    values = p.values if touch is None else p.values[:, touch[pending[sel]]]   # (5, k, m)
+                    out[pending[sel]] = _interpolate(p.weights, values, w[pending[sel]])
                     keep &= ~sel
             pending = pending[keep]
-        if pending.size:   # no panel met the tolerance: read directly
+        if pending.size and touch is not None:   # no panel met the tolerance: read directly
+            out[pending] = self.model.touch_readings(self.time_s, e[pending], touch[pending], self.sensor,
+                                                     tolerance=self.tolerance)
+            self.model_readings += pending.size
+        elif pending.size:
             uniq, inverse = np.unique(e[pending], return_inverse=True)
             out[pending] = self.model.response(self.time_s, uniq, self.sensor, tolerance=self.tolerance)[inverse.ravel()]
             self.model_readings += uniq.size
@@ -148,25 +162,55 @@ class _SensorKey(bytes):
     repr cost 5 ms for a calibrated rig's, per class and touch ramp)."""
 
 
-@functools.lru_cache(maxsize=64)   # a calibrated rig's 24 touch ramps at a contact or two
-def _cached_scene(model: ForwardModel, sensor: _SensorKey, time_bytes: bytes, tolerance: float) -> SceneResponse:
-    return SceneResponse(model, np.frombuffer(time_bytes, dtype=np.float64).copy(), sensor.sensor, tolerance)
+class _Same:
+    """An object compared by identity (a frozen sensor: its pickle made once per object, not per class)."""
+
+    __slots__ = ("obj",)
+
+    def __init__(self, obj):
+        self.obj = obj
+
+    def __hash__(self) -> int:
+        return id(self.obj)
+
+    def __eq__(self, other) -> bool:
+        return isinstance(other, _Same) and other.obj is self.obj
 
 
-def scene_response(model: ForwardModel, time_s, sensor, *, tolerance: float) -> SceneResponse:
-    """The :class:`SceneResponse` of a model, sensor, time grid and tolerance, one per process (the last 64 kept).
+@functools.lru_cache(maxsize=8)   # holds the sensor, so its id is not reused while cached
+def _sensor_key(sensor: _Same) -> _SensorKey:
+    key = _SensorKey(pickle.dumps(sensor.obj, protocol=5))
+    key.sensor = sensor.obj
+    return key
 
-    Its panels are a pure function of those four, so sharing them changes no reading: it only saves reading
+
+def _new_scene(model: ForwardModel, sensor: _SensorKey, time_bytes: bytes, tolerance: float,
+               touches: bool) -> SceneResponse:
+    return SceneResponse(model, np.frombuffer(time_bytes, dtype=np.float64).copy(), sensor.sensor, tolerance,
+                         touches=touches)
+
+
+#: The last 64 scenes (a sweep's contacts and scene points); of every touch ramp at once, the last 2 (their panels
+#: hold R = 24 ramps each: up to 64 MB a scene at a calibrated rig's longest contact; a sweep renders contact after
+#: contact).
+_cached_scene = functools.lru_cache(maxsize=64)(_new_scene)
+_cached_touch_scene = functools.lru_cache(maxsize=2)(_new_scene)
+
+
+def scene_response(model: ForwardModel, time_s, sensor, *, tolerance: float, touches: bool = False) -> SceneResponse:
+    """The :class:`SceneResponse` of a model, sensor, time grid, tolerance and ``touches``, one per process (the
+    last 64 kept; with ``touches`` the last 2).
+
+    Its panels are a pure function of those five, so sharing them changes no reading: it only saves reading
     the model again for the next class or repeat of the same scene.
     """
     t = np.ascontiguousarray(np.atleast_1d(np.asarray(time_s, dtype=np.float64)))
     try:
         hash(model)
     except TypeError:   # a model with unhashable parameters: a response of its own, not shared
-        return SceneResponse(model, t, sensor, tolerance)
-    key = _SensorKey(pickle.dumps(sensor, protocol=5))
-    key.sensor = sensor
-    return _cached_scene(model, key, t.tobytes(), float(tolerance))
+        return SceneResponse(model, t, sensor, tolerance, touches=touches)
+    key = _sensor_key(_Same(sensor))
+    return (_cached_touch_scene if touches else _cached_scene)(model, key, t.tobytes(), float(tolerance), bool(touches))
 
 
 def start_level(w_low: float, w_high: float) -> int:
@@ -215,7 +259,7 @@ def _interpolate(x_nodes: np.ndarray, values: np.ndarray, x: np.ndarray) -> np.n
 
 
 def class_readings(model: ForwardModel, time_s, e_object, sensor, *, tolerance: float,
-                   diffusivity_m2_s=None) -> np.ndarray:
+                   diffusivity_m2_s=None, touch=None) -> np.ndarray:
     """Normalized readings (K, m) of touches of one class: interpolated where the model is costly, else direct.
 
     Models with ``shared_response`` (the layered model, a force ramp) whose
@@ -223,7 +267,10 @@ def class_readings(model: ForwardModel, time_s, e_object, sensor, *, tolerance: 
     (:func:`scene_response`), starting at the class's :func:`start_level`;
     others, touches with a per-touch diffusivity, and classes of fewer than
     :data:`MIN_DISTINCT` distinct effusivities are read directly by
-    :meth:`ForwardModel.response`.
+    :meth:`ForwardModel.response`. With ``touch`` (a force ramp with ``touch_ramps``), touch ``k`` presses as
+    touch ramp ``touch[k]``: from the scene's panels of every touch ramp at once (one step response per panel
+    node for all ramps, :meth:`~designkit.models.ramp.ForceRamp.touch_responses`), or directly by
+    :meth:`~designkit.models.ramp.ForceRamp.touch_readings`.
 
     Parameters
     ----------
@@ -237,16 +284,21 @@ def class_readings(model: ForwardModel, time_s, e_object, sensor, *, tolerance: 
         Largest error asked of the readings (normalized).
     diffusivity_m2_s : array_like, shape (K,), optional
         Per-touch diffusivities (then read directly).
+    touch : array_like of int, shape (K,), optional
+        Per-touch touch ramp (indices into ``model.touch_ramps``).
     """
     e = np.atleast_1d(np.asarray(e_object, dtype=np.float64))
     t = np.atleast_1d(np.asarray(time_s, dtype=np.float64))
-    if not getattr(model, "shared_response", False) or diffusivity_m2_s is not None or e.size == 0 \
-            or not np.all(np.isfinite(e)) or np.any(e < 0):
+    direct = not getattr(model, "shared_response", False) or diffusivity_m2_s is not None or e.size == 0 \
+        or not np.all(np.isfinite(e)) or np.any(e < 0)
+    uniq, inverse = (None, None) if direct else np.unique(e, return_inverse=True)
+    if touch is not None and (direct or uniq.size < MIN_DISTINCT):
+        return model.touch_readings(t, e, touch, sensor, diffusivity_m2_s=diffusivity_m2_s, tolerance=tolerance)
+    if direct:
         return model.response(t, e, sensor, diffusivity_m2_s=diffusivity_m2_s, tolerance=tolerance)
-    uniq, inverse = np.unique(e, return_inverse=True)
     if uniq.size < MIN_DISTINCT:
         return model.response(t, uniq, sensor, tolerance=tolerance)[inverse.ravel()]
     es = float(sensor.effusivity)
     level = start_level(float(object_weight(es, uniq[0])), float(object_weight(es, uniq[-1])))
-    out = scene_response(model, t, sensor, tolerance=tolerance).readings(e, level)
+    out = scene_response(model, t, sensor, tolerance=tolerance, touches=touch is not None).readings(e, level, touch)
     return np.clip(out, 0.0, 1.0, out=out)

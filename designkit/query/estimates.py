@@ -197,17 +197,13 @@ def grid_crossing(grid: np.ndarray, need: np.ndarray, gap) -> tuple[np.ndarray, 
 
 def rounded_crossing(grid: np.ndarray, need: np.ndarray, gap, width: float) -> tuple[np.ndarray, ...]:
     """Where a tabulated need [grid point, n] crosses ``gap``, its rounding corrected: ``(value, interp,
-    rounding)`` per column (NaN where the corrected need suffices at the first grid point, follows a NaN need or
-    never suffices).
+    rounding)`` per column (NaN where the corrected need suffices at the first grid point or never).
 
-    A tabulated delta is the first grid distance whose F1 reaches Phi, on average w/2 above the distance where
-    the mean F1 crosses (``width``: w). So the need less w/2 is what crosses ``gap``, and the crossing lies in
-    *its* cell: between its first grid point at most ``gap`` and the one before, interpolated log-log (the need
-    falls roughly as a power of contact time). Correcting the needs of the uncorrected need's cell only, and
-    keeping the uncorrected crossing where the corrected one left that cell, answered late: a calibrated rig's
-    table 6.9 % late on 204 vs 535 J s^-1/2 K^-1 m^-2 against 32 fresh seeds per contact
-    (benchmarks/results/sensor_table_bias.txt). ``interp``: the distance (log) to the linear interpolant's
-    crossing; ``rounding``: the rounding's SD (w/sqrt(12)) through the local log-log slope (log).
+    A tabulated delta is the first grid distance whose F1 reaches Phi, on average w/2 (``width``) above the mean
+    F1's crossing: the need less w/2 crosses, in *its* own cell, log-log between its first grid point at most
+    ``gap`` and the one before (the uncorrected need's cell answered late: benchmarks/results/sensor_table_bias.txt).
+    ``interp``: the distance (log) to the linear interpolant's crossing; ``rounding``: w/sqrt(12) through the log-log
+    slope (log).
 
     >>> v, interp, rounding = rounded_crossing(np.array([1.0, 2.0, 4.0]), np.array([[600.0], [360.0], [160.0]]),
     ...                                        np.array([300.0]), 80.0)

@@ -11,6 +11,8 @@ Usage::
     nice -n 10 python benchmarks/bench_sensor_table.py --sensor /tmp/rig.yaml --out /tmp/bst --phase exact
     # the table's answers against them, and the time of a question from a fresh shell
     python benchmarks/bench_sensor_table.py --sensor /tmp/rig.yaml --out /tmp/bst --phase table
+    # the truth for a few pairs: fresh-seed F1 at fixed contacts around both answers, a smooth fit's crossing
+    nice -n 10 python benchmarks/bench_sensor_table.py --sensor /tmp/rig.yaml --out /tmp/bst --phase truth --indices 0,1,2
     # where a build's CPU goes (one block of 20 references at each contact; no table needed)
     python benchmarks/bench_sensor_table.py --sensor tests/data/rig_sensor.yaml --out /tmp/bst --phase profile
 
@@ -244,6 +246,103 @@ def fresh_shell(args, runs: int = 7) -> dict:
     return out
 
 
+def f1_draws(sensor_file: str, case: dict, contacts, calls: int, reps: int, out: Path) -> None:
+    """Fresh-seed SVM F1 of the exact route's scene for one pair at fixed contacts (model time) [s]: ``calls``
+    rounds of ``reps`` seeds at every contact, appended to ``out`` per (round, contact) with their CPU time.
+    Seeds ``[900000 + index, round, contact, r]``: neither route's (the exact route's are ``[1000 + index, r, k]``,
+    the table's ``[0, ...]``)."""
+    from designkit.models import sensor_model
+    from designkit.objects import ordered_pair
+    from designkit.query.exact import _Run
+    from designkit.query.inputs import pair_question
+    from designkit.recognition.batched_svm import batched_cv_f1
+    from designkit.recognition.features import feature_matrix
+    from designkit.sensor import load_sensor
+    from designkit.simulation import simulate_class
+
+    sen = load_sensor(sensor_file)
+    sc = _scene(sen)
+    run = _Run.make(sensor=sen, model=sensor_model(sen), threshold=0.9, width=80.0, trials=100, folds=3, seed=0,
+                    repeats=reps, z=2.0, jobs=1, n_mc=1000, solver="batched")
+    low, high = ordered_pair(*pair_question(case["e1"], case["e2"], None, None, objects=None, width=80.0,
+                                            diffusivity_m2_s=None, model=run.model).classes)
+    for call in range(calls):
+        for ci, c in enumerate(contacts):
+            scene = run.scene(c, sc["noise_c"], sc["delta_t_c"])
+            t = time.process_time()
+            lo, hi, seeds = [], [], []
+            for r in range(reps):
+                base = [900000 + case["index"], call, ci, r]
+                lo.append(feature_matrix(simulate_class(low, 100, sen, scene, base + [0], run.model).temperature_c,
+                                         sen.sample_rate_hz))
+                hi.append(feature_matrix(simulate_class(high, 100, sen, scene, base + [1], run.model).temperature_c,
+                                         sen.sample_rate_hz))
+                seeds.append(base + [2])
+            res = batched_cv_f1(lo, hi, seeds=seeds, folds=3)
+            with out.open("a") as fh:
+                fh.write(json.dumps({"index": case["index"], "e1": case["e1"], "e2": case["e2"],
+                                     "contact_model_s": round(float(c), 6), "round": call,
+                                     "f1": [float(x) for x in res.f1],
+                                     "fold_se": [float(x) for x in res.standard_error],
+                                     "cpu_s": time.process_time() - t}) + "\n")
+
+
+def true_crossing(contacts, draws, phi: float = 0.9, boot: int = 400, seed: int = 1) -> tuple[float, float]:
+    """Where the mean F1 crosses ``phi``: a quadratic in ``log(contact)`` through the contacts' mean F1, solved on a
+    fine grid (the first point at or above ``phi``), and its standard error by resampling each contact's seeds
+    (``draws``: per contact the seeds' F1). NaN where the fit does not cross inside the contacts."""
+    u = np.log(np.asarray(contacts, dtype=np.float64))
+    grid = np.linspace(u.min(), u.max(), 4001)
+
+    def cross(means):
+        f = np.polyval(np.polyfit(u, means, 2), grid)
+        k = np.flatnonzero(f >= phi)
+        return float(np.exp(grid[k[0]])) if k.size and k[0] > 0 else math.nan
+
+    rng = np.random.default_rng(seed)
+    value = cross(np.array([d.mean() for d in draws]))
+    b = np.array([cross(np.array([rng.choice(d, d.size).mean() for d in draws])) for _ in range(boot)])
+    return value, float(np.nanstd(b))
+
+
+def phase_truth(args) -> None:
+    """The true crossing of chosen pairs (``--indices``) at this engine: fresh-seed F1 at ``--points`` contacts
+    spanning both routes' answers (0.85 x the earlier to 1.12 x the later, model time), ``--rounds`` x 8 seeds
+    each (resumable: appends to truth.jsonl), a smooth fit's crossing with its standard error; beside it each
+    route's answer (from the detected onset)."""
+    from designkit.query import min_contact
+    from designkit.rig import model_start_s
+    from designkit.sensor import load_sensor
+
+    start = model_start_s(load_sensor(args.sensor)) or 0.0
+    rows = {r["index"]: r for r in map(json.loads, (Path(args.out) / "exact.jsonl").read_text().splitlines())}
+    path = Path(args.out) / "truth.jsonl"
+    for i in (int(x) for x in args.indices.split(",")):
+        r = rows[i]
+        table = min_contact(r["e1"], r["e2"], sensor=args.sensor).value - start  # model time
+        lo, hi = sorted((r["exact"]["value"], table))
+        contacts = np.round(np.geomspace(0.85 * lo, 1.12 * hi, args.points), 3)
+        have = [json.loads(x) for x in path.read_text().splitlines()] if path.exists() else []
+        done = len({x["round"] for x in have if x["index"] == i})
+        if done < args.rounds:
+            f1_draws(args.sensor, r, contacts, args.rounds - done, 8, path)
+    by = {}
+    for x in map(json.loads, path.read_text().splitlines()):
+        by.setdefault(x["index"], {}).setdefault(x["contact_model_s"], []).extend(x["f1"])
+    for i, cs in sorted(by.items()):
+        if i not in rows:  # its exact answer not computed yet
+            continue
+        r = rows[i]
+        xs = sorted(cs)
+        value, se = true_crossing(xs, [np.array(cs[c]) for c in xs])
+        t = min_contact(r["e1"], r["e2"], sensor=args.sensor)
+        print(f"pair {i} ({r['e1']:g} vs {r['e2']:g}): true {value + start:.3f} s +- {se:.3f} (from the onset; "
+              f"{min(len(v) for v in cs.values())} seeds per contact); exact {r['exact']['value'] + start:.3f} s "
+              f"({math.log((r['exact']['value']) / value):+.1%}); table {t.value:.3f} s [{t.interval[0]:.3f}, "
+              f"{t.interval[1]:.3f}] ({math.log((t.value - start) / value):+.1%}); F1 "
+              + " ".join(f"{c + start:.3f}:{np.mean(cs[c]):.3f}" for c in xs), flush=True)
+
+
 def phase_profile(args) -> None:
     """Where a build's CPU goes: one block of references (``--rows``) at each tabulated contact, run as a sweep worker
     runs it; per contact the fits per reference, CPU per fit, and the shares of simulation + features, libsvm's SMO
@@ -294,7 +393,10 @@ def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--sensor", required=True)
     p.add_argument("--out", required=True)
-    p.add_argument("--phase", choices=("exact", "table", "profile"), required=True)
+    p.add_argument("--phase", choices=("exact", "table", "truth", "profile"), required=True)
+    p.add_argument("--indices", default="0,1,2,17", help="truth: the pairs (indices of exact.jsonl)")
+    p.add_argument("--points", type=int, default=7, help="truth: contacts per pair")
+    p.add_argument("--rounds", type=int, default=4, help="truth: rounds of 8 fresh seeds at every contact")
     p.add_argument("--rows", type=int, default=20, help="profile: references per profiled block")
     p.add_argument("--first-within", type=float, nargs=2, default=None, metavar=("LO", "HI"),
                    help="exact: compute the pairs inside this effusivity range first")
@@ -311,7 +413,7 @@ def main() -> None:
     p.add_argument("--build-cpu-s", type=float, default=None, help="CPU seconds the build printed (projection)")
     args = p.parse_args()
     Path(args.out).mkdir(parents=True, exist_ok=True)
-    {"exact": phase_exact, "table": phase_table, "profile": phase_profile}[args.phase](args)
+    {"exact": phase_exact, "table": phase_table, "truth": phase_truth, "profile": phase_profile}[args.phase](args)
 
 
 if __name__ == "__main__":

@@ -902,3 +902,53 @@ def test_cli_writes_to_standard_output(cli, tmp_path):
     assert not Path("-").exists()
     r = cli("export", "--table", "ideal-paper", "--out", "-")
     assert r.exit_code == 2 and "needs --format" in r.stderr
+
+
+def _rig_table(tmp_path, sensor: str):
+    """A tiny fixed-condition SVM table of the contact model (no closed-form ideal observer) for ``sensor``: the
+    synthetic staircases of tests/test_table_crossing_bias.py."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from test_table_crossing_bias import _table
+
+    src = _table(0)
+    arrays = {k: np.asarray(v) for k, v in src.arrays.items()}
+    cfg = SweepConfig(name="rig-bias", e_min=0.0, e_max=src.header["effusivity"]["max"],
+                      intervals=int(src.arrays["delta_up"].shape[-1]), noise_ratio=(0.004,),
+                      contact_s=tuple(src.header["config"]["contact_s"]), sensor=sensor,
+                      model={"name": "contact", "conductance_w_m2k": 1500.0})
+    return load_table(write_table(tmp_path / "rig-bias.npz", table_header(cfg, arrays), arrays))
+
+
+@pytest.mark.parametrize("sensor", ["paper", "rig"])
+def test_a_table_without_closed_form_refuses_the_estimator_and_states_its_contact_frame(tmp_path, sensor):
+    """A calibrated rig's table (no closed-form ideal observer): the library averages both directions' needs,
+    crosses the rounding-corrected need and counts contact from the rig's detected onset; the export's estimator
+    (the grid rule's maximum, model time) answered up to 1.3 s later, so it refuses, saying why, and the provenance
+    says what the grid rule's contact times count from (issue 34)."""
+    from designkit.export import export_bytes
+    from designkit.export.estimator_data import estimator_of
+    from designkit.rig import model_start_s
+
+    path = str(Path(__file__).resolve().parent / "data" / "rig_sensor.yaml") if sensor == "rig" else "paper"
+    tab = _rig_table(tmp_path, path)
+    exp = slice_table(tab)
+    assert exp.estimator is None and "closed-form" in exp.provenance["estimator"]["unavailable"]
+    with pytest.raises(InputError, match="closed-form ideal observer"):
+        estimator_of(exp)
+    frame = exp.provenance["contact_frame"]
+    start = model_start_s(tab.sensor)
+    assert frame["onset_offset_s"] == (None if start is None else pytest.approx(start))
+    res = export_bytes(tab, "python")
+    mod_path = tmp_path / "rigmod.py"
+    mod_path.write_bytes(res.data)
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("rig_bias_mod", mod_path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    with pytest.raises(mod.NeedsDesignkit, match="closed-form"):
+        mod.min_contact_s(3000.0, 3400.0, 0.004, 1.0)
+    header = export_bytes(tab, "c").data.decode()
+    assert "#define DESIGNKIT_HAS_ESTIMATOR 0" in header and "closed-form" in header[:6000]
+    if start is not None:  # the rig's onset offset in both surfaces' opening text
+        assert start < 0 and f"{start:.6g}" in header[:6000] and f"{start:.6g}" in res.data.decode()[:6000]

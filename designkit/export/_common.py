@@ -281,6 +281,9 @@ def slice_lines(exp: "Exported") -> list[str]:
                    f"{s['contact_s']['source_columns']} = {list(c)} s")
     else:
         out.append(f"contact: all {len(c)} columns {c[0]:g}..{c[-1]:g} s")
+    frame = exp.provenance.get("contact_frame") or {}
+    if frame.get("onset_offset_s") is not None:  # a calibrated rig's: its controller counts from the onset
+        out.append(f"contact times count from {frame['counted_from']}: {frame['from_onset']}")
     ea = exp.provenance["effusivity_answered"]
     out.append(f"effusivity answered: {ea['min']:g} {'<=' if ea['min_inclusive'] else '<'} e <= {ea['max']:g}, "
                f"{len(exp.e_ref.values)} reference intervals (centres {exp.e_ref.values[0]:g}..{exp.e_ref.values[-1]:g})")

@@ -27,7 +27,7 @@ import numpy as np
 
 from .._validation import InputError
 
-__all__ = ["COVERAGE", "MORE_ARRAYS", "estimator_of", "estimator_params", "estimator_reason"]
+__all__ = ["COVERAGE", "MORE_ARRAYS", "closed_form", "contact_frame", "estimator_of", "estimator_params", "estimator_reason"]
 
 #: Coverage of the intervals an export states (the library's default).
 COVERAGE = 0.9
@@ -49,9 +49,36 @@ def estimator_reason(tab, kind: str, contact_sliced: bool) -> str | None:
                 "estimates its answers from each scene slice and the bound by simulation)")
     if any(n not in tab.arrays for n in MORE_ARRAYS):
         return "the table holds no Monte Carlo interval (delta_*_lo / delta_*_hi)"
+    if not closed_form(tab):
+        return ("its sensor model has no closed-form ideal observer (a calibrated rig's table: the library "
+                "averages both directions' needs, crosses the rounding-corrected need and counts contact from the "
+                "rig's detected onset; the export's estimator does not carry that rule)")
     if contact_sliced:
         return "--contact keeps some contact columns; the estimator reads the efficiency on the whole contact axis"
     return None
+
+
+def closed_form(tab) -> bool:
+    """Whether the library computes ``tab``'s ideal bound in closed form (the efficiency route the estimator
+    carries); a calibrated rig's table has none."""
+    from ..query.table import open_table, table_spread
+
+    return bool(open_table(tab, None, sensor_temp_spread_c=table_spread(tab)).closed)
+
+
+def contact_frame(tab) -> dict:
+    """What the export's contact times count from (plain JSON): the model's time 0 (its first heat flow), and,
+    for a calibrated rig's sensor, the offset of that time 0 from the rig's detected onset (what
+    ``designkit min-contact --sensor FILE`` counts from)."""
+    from ..rig import model_start_s
+
+    start = model_start_s(tab.sensor)
+    if start is None:
+        return {"counted_from": "the model's first heat flow (t = 0)", "onset_offset_s": None}
+    return {"counted_from": "the model's first heat flow (model time), not the rig's detected onset",
+            "onset_offset_s": float(start),
+            "from_onset": (f"contact after the rig's detected onset = contact_s + ({start:.6g}) s (at least 0), "
+                           "as designkit answers a question about this sensor")}
 
 
 @functools.lru_cache(maxsize=4)

@@ -431,11 +431,11 @@ def _provenance(tab: Table, kind: str, names: tuple[str, str], sensor: dict, axe
     """What an export records about itself (plain JSON)."""
     from .. import __version__
     from .estimator import ESTIMATOR, ESTIMATOR_VERSION
+    from .estimator_data import contact_frame
 
     hdr = tab.header
     fidelity = hdr.get("fidelity")
-    answers = ("grid rule only" if params is None else "library" if params["efficiency"] else
-               "library's value; interval low ends without its simulated ideal bound")
+    answers = "grid rule only" if params is None else "library"  # (a table without a closed form: refused)
     e_lo, e_hi, inclusive = answered
     return {
         "format": EXPORT_FORMAT,
@@ -461,6 +461,7 @@ def _provenance(tab: Table, kind: str, names: tuple[str, str], sensor: dict, axe
         "effusivity_answered": {"min": e_lo, "min_inclusive": inclusive, "max": e_hi, "max_inclusive": True,
                                 "units": E_UNITS},
         "slice": slice_info,
+        "contact_frame": contact_frame(tab),
         "shape": list(shape),
         "nan_means": "no distinguishable partner within the table's effusivity grid (not separable)",
         "decision_rule": "lo < hi are distinguishable when hi - lo >= max(delta_up(lo), delta_down(hi))",

@@ -74,3 +74,39 @@ def pytest_collection_modifyitems(config, items):
         slow[f] = slow.get(f, 0) + (item.get_closest_marker("slow") is not None)
     first = {f: i for i, f in enumerate(dict.fromkeys(item.nodeid.split("::", 1)[0] for item in items))}
     items.sort(key=lambda item: (lambda f: (-slow[f], -count[f], first[f]))(item.nodeid.split("::", 1)[0]))
+
+
+def read_until_closed(fd: int) -> bytes:
+    """Everything a pseudo-terminal's main side ``fd`` receives until the child closes the terminal."""
+    chunks = []
+    while True:
+        try:
+            b = os.read(fd, 65536)
+        except OSError:  # the child closed the terminal
+            break
+        if not b:
+            break
+        chunks.append(b)
+    return b"".join(chunks)
+
+
+@pytest.fixture
+def load_python_export(tmp_path):
+    """Import a Python export (its bytes, or an :class:`~designkit.export.Exported` rendered as Python) from a
+    file in ``tmp_path``; returns the module."""
+    import importlib.util
+
+    def load(data, name: str = "dk_module"):
+        if not isinstance(data, (bytes, bytearray)):
+            from designkit.export import render
+
+            data = render(data, "python")
+        path = tmp_path / f"{name}.py"
+        path.write_bytes(data)
+        spec = importlib.util.spec_from_file_location(name, path)
+        mod = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(mod)
+        return mod
+
+    return load
+

@@ -920,7 +920,8 @@ def _rig_table(tmp_path, sensor: str):
 
 
 @pytest.mark.parametrize("sensor", ["paper", "rig"])
-def test_a_table_without_closed_form_refuses_the_estimator_and_states_its_contact_frame(tmp_path, sensor):
+def test_a_table_without_closed_form_refuses_the_estimator_and_states_its_contact_frame(tmp_path, sensor,
+                                                                                        load_python_export):
     """A calibrated rig's table (no closed-form ideal observer): the library averages both directions' needs,
     crosses the rounding-corrected need and counts contact from the rig's detected onset; the export's estimator
     (the grid rule's maximum, model time) answered up to 1.3 s later, so it refuses, saying why, and the provenance
@@ -939,13 +940,7 @@ def test_a_table_without_closed_form_refuses_the_estimator_and_states_its_contac
     start = model_start_s(tab.sensor)
     assert frame["onset_offset_s"] == (None if start is None else pytest.approx(start))
     res = export_bytes(tab, "python")
-    mod_path = tmp_path / "rigmod.py"
-    mod_path.write_bytes(res.data)
-    import importlib.util
-
-    spec = importlib.util.spec_from_file_location("rig_bias_mod", mod_path)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
+    mod = load_python_export(res.data, "rig_bias_mod")
     with pytest.raises(mod.NeedsDesignkit, match="closed-form"):
         mod.min_contact_s(3000.0, 3400.0, 0.004, 1.0)
     header = export_bytes(tab, "c").data.decode()

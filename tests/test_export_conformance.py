@@ -115,19 +115,6 @@ def test_the_c_header_answers_as_the_library(reference, exported, tmp_path):
     check(got, q, ref, range(n), "C")
 
 
-def _module(exported, tmp_path):
-    import importlib.util
-
-    from designkit.export import render
-
-    path = tmp_path / "dk_module.py"
-    path.write_bytes(render(exported, "python"))
-    spec = importlib.util.spec_from_file_location("dk_module", path)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
-
-
 def _ask(functions, q, idx, questions=("min_contact", "delta_e", "distinguishable")) -> dict:
     out = {k: [] for k in questions}
     for i in idx:
@@ -141,9 +128,9 @@ def _ask(functions, q, idx, questions=("min_contact", "delta_e", "distinguishabl
     return out
 
 
-def test_the_python_module_answers_as_the_library(reference, exported, tmp_path):
+def test_the_python_module_answers_as_the_library(reference, exported, load_python_export):
     q, ref = reference
-    mod = _module(exported, tmp_path)
+    mod = load_python_export(exported)
     n = len(q["e1"])
     check(_ask(mod, q, range(n)), q, ref, range(n), "python")
     for bad in (math.nan, -1.0, 0.0, math.inf):  # invalid input: ValueError, as the library's InputError
@@ -209,7 +196,7 @@ def test_the_default_table_and_the_readme_number(tmp_path):
     assert r.stdout.split() == ["-3"] * len(queries), r.stdout
 
 
-def test_a_table_the_estimator_cannot_answer_says_so(tmp_path):
+def test_a_table_the_estimator_cannot_answer_says_so(load_python_export):
     """svm-paper-varied (the ideal observer needs simulation there): the header's functions return the sentinel,
     the module raises NeedsDesignkit, and both say why; the grid rule stays under its own name."""
     from designkit.export import export_bytes
@@ -217,13 +204,7 @@ def test_a_table_the_estimator_cannot_answer_says_so(tmp_path):
     res = export_bytes("svm-paper-varied", "python")
     why = res.provenance["estimator"]["unavailable"]
     assert res.provenance["estimator"]["answers"] == "grid rule only" and "simulation" in why
-    path = tmp_path / "varied.py"
-    path.write_bytes(res.data)
-    import importlib.util
-
-    spec = importlib.util.spec_from_file_location("varied_mod", path)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
+    mod = load_python_export(res.data, "varied_mod")
     with pytest.raises(mod.NeedsDesignkit, match="simulation"):
         mod.min_contact_s(35000, 20000, 0.05, 7.5)
     header = export_bytes("svm-paper-varied", "c").data.decode()

@@ -10,6 +10,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from conftest import read_until_closed
 
 REPO = Path(__file__).resolve().parent.parent
 pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="needs a pty")
@@ -20,18 +21,10 @@ def _run_with_pty_stderr(*args: str) -> tuple[int, str, str]:
     env = {**os.environ, "PYTHONPATH": str(REPO) + os.pathsep + os.environ.get("PYTHONPATH", ""), "COLUMNS": "120"}
     p = subprocess.Popen([sys.executable, "-m", "designkit", *args], stdout=subprocess.PIPE, stderr=slave, env=env)
     os.close(slave)
-    chunks = []
-    while True:
-        try:
-            b = os.read(master, 4096)
-        except OSError:  # the child closed the pty
-            break
-        if not b:
-            break
-        chunks.append(b)
+    err = read_until_closed(master)
     os.close(master)
     out = p.stdout.read().decode()
-    return p.wait(timeout=300), out, b"".join(chunks).decode(errors="replace")
+    return p.wait(timeout=300), out, err.decode(errors="replace")
 
 
 F1 = ("f1", "--e1", "35000", "--e2", "20000", "--contact", "1", "--trials", "20")

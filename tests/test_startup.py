@@ -12,6 +12,7 @@ from pathlib import Path
 
 import pytest
 
+from conftest import read_until_closed
 from designkit._schemas import schemas, validate
 from designkit.tables.store import SHIPPED_CONTENT_HASHES, list_tables, load_table
 
@@ -79,15 +80,7 @@ def _on_a_terminal(*args: str, env: dict | None = None) -> str:
     main, sub = pty.openpty()
     p = subprocess.Popen([sys.executable, *args], stdin=sub, stdout=sub, stderr=sub, env=env)
     os.close(sub)
-    out = b""
-    while True:
-        try:
-            chunk = os.read(main, 65536)
-        except OSError:  # the child closed the terminal
-            break
-        if not chunk:
-            break
-        out += chunk
+    out = read_until_closed(main)
     p.wait(timeout=120)
     os.close(main)
     assert p.returncode == 0, out

@@ -14,9 +14,10 @@ Decision rule for a pair ``e1 < e2`` (the lower edges of the two classes,
 reaches both ``delta_up(e1)`` (seen from the lower effusivity) and
 ``delta_down(e2)`` (seen from the higher one); the two agree up to Monte Carlo
 noise, and requiring both is the conservative choice. ``min-contact``'s estimate
-on a table with varied initial conditions averages the two instead, and
-interpolates each scene slice's answer rather than the need
-(:func:`varied_contact_estimate`; why: docs/decisions-log.md, "Question layer").
+on a table with varied initial conditions, or on one whose model has no closed-form
+ideal observer (a calibrated rig's), averages the two instead, and interpolates each
+scene slice's answer rather than the need (:func:`varied_contact_estimate`; why:
+docs/decisions-log.md, "Question layer").
 
 The ideal bound comes from an ideal-observer table (``ideal_table``) or the
 SVM table's own ideal arrays, interpolated the same way; ``distinguishable``

@@ -182,6 +182,12 @@ def test_one_question_has_one_answer_on_every_surface(built, data_dir, cli, tmp_
                                            else {"value": 14.0, "source": "user"})
         assert conditions["onset_offset_s"] == {"value": -0.3, "source": "sensor file"}
         assert d["route_reason"] == one["route_reason"] and "built for sensor rig" in d["route_reason"]
+        if not given:  # the matrix reads the sensor's registered table too, and gives the same answer
+            mat = cli("matrix", "--sensor", f, "--m", "wood", "--m", "glass", "--no-multiclass", "--json")
+            assert mat.exit_code == 0, mat.output
+            (cell,) = json.loads(mat.stdout)["cells"]
+            assert cell["value"] == d["value"], cell
+            assert (cell["interval"]["low"], cell["interval"]["high"]) == (d["interval"]["low"], d["interval"]["high"])
 
 
 def test_a_registered_sensors_question_from_a_fresh_shell_reads_no_yaml_and_no_schema(built, data_dir):

@@ -116,8 +116,8 @@ def matrix(
                                  progress=progress.step if progress else None,
                                  **{k: v for k, v in scene.items() if v is not None})
     except TableMismatch as exc:
-        raise TableMismatch(f"{exc}: matrix reads tables only; build one for this sensor with 'designkit sweep "
-                            f"--sensor {sensor} ...' and name it with --table, or ask one pair with --exact "
+        raise TableMismatch(f"{exc}: matrix reads tables only; build this sensor's with 'designkit tables build "
+                            f"--sensor {sensor}' (later matrices read it), or ask one pair with --exact "
                             "(designkit distinguishable --sensor ...)") from None
     finally:
         if progress:

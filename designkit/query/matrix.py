@@ -596,15 +596,24 @@ def material_matrix(materials: Sequence[str | Material] = (), question: str = "m
     -------
     MaterialMatrix
     """
-    from .table_open import DEFAULT_TABLE, as_table
+    from .table_open import as_table
 
     t0 = time.perf_counter()
     if question not in MATRIX_QUESTIONS:
         raise InputError(f"a matrix asks one of: {', '.join(MATRIX_QUESTIONS)}; got {question!r}")
     mats = resolve_materials(materials, set=set)
-    # (loaded once per process, with the table's memo: as every table question loads it)
-    tab = as_table(DEFAULT_TABLE if table is None else table)
-    itab = None if ideal_table is None else as_table(ideal_table)
+    # the route policy's table for this sensor and model (a sensor file's registered one), as a question's
+    from .inputs import TableMismatch
+    from .policy import table_for
+
+    choice = table_for(question, sensor=scene.get("sensor"), model=scene.get("model")) if table is None else None
+    if choice is not None and choice.table is None:
+        raise TableMismatch(choice.reason)
+    if choice is not None and choice.sensor_table:  # each question reads it as a single question does
+        tab, route = choice.loaded, {"route": "auto"}
+    else:  # (loaded once per process, with the table's memo: as every table question loads it)
+        tab = as_table(table if choice is None else choice.table)
+        route = {"route": "table", "table": tab, "ideal_table": None if ideal_table is None else as_table(ideal_table)}
     allowed = frozenset({"contact_s", "noise_c", "delta_t_c", "threshold", "sensor", "model"})
     unknown = sorted(k for k in scene if k not in allowed)
     if unknown:
@@ -622,7 +631,7 @@ def material_matrix(materials: Sequence[str | Material] = (), question: str = "m
     pairs = [(i, j) for i in range(n) for j in range(i + 1, n)]
     # every pair from one array call of the table route (its closed-form bounds solved together)
     answers = ask_each(question, [{"m1": mats[i].qualified_name, "m2": mats[j].qualified_name} for i, j in pairs],
-                       route="table", table=tab, ideal_table=itab, **given)
+                       **route, **given)
     for (i, j), a in zip(pairs, answers):
         status = "overlap" if not a.limiting_pair else ("answered" if a.value is not None else "none")
         ideal = a.ideal_bound.value

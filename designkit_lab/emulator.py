@@ -40,6 +40,7 @@ import termios
 import threading
 import time
 import tty
+from pathlib import Path
 from dataclasses import dataclass, replace
 from typing import Sequence
 
@@ -257,6 +258,11 @@ class Emulator:
         :class:`~designkit.models.ramp.ForceRamp` (a sensor file calibrated
         with the force-driven area) plays its base model with the area
         following the plan's own force ramp at its threshold c.
+    port_link : path, optional
+        Publish the port as this symbolic link to the pty (as udev's /dev/serial/by-id
+        names are), removed when the device vanishes or stops. A freed /dev/pts/N is
+        handed to the next program that opens a pty: a client reconnecting by the bare
+        pty path after a vanish could open someone else's device, by the link it cannot.
 
     Examples
     --------
@@ -270,7 +276,7 @@ class Emulator:
                  materials: Sequence[EmulatedMaterial], *, noise_c: float = 0.05,
                  sensor_temp_c: float = 35.0, ambient_c: float = 25.0, plan: TouchPlan = TouchPlan(),
                  speed: float = 1.0, faults: Faults = Faults(), seed=0, force_noise_n: float = 0.02,
-                 model=None) -> None:
+                 model=None, port_link=None) -> None:
         if not materials:
             raise InputError("the emulator needs at least one material to touch")
         self.profile = profile
@@ -343,6 +349,7 @@ class Emulator:
         self._master: int | None = None
         self._slave: int | None = None
         self._port: str | None = None
+        self._link = None if port_link is None else Path(port_link)
         self._thread: threading.Thread | None = None
         self._stop = threading.Event()
         self._closed = threading.Event()
@@ -678,6 +685,12 @@ class Emulator:
         flags = fcntl.fcntl(master, fcntl.F_GETFL)
         fcntl.fcntl(master, fcntl.F_SETFL, flags | os.O_NONBLOCK)
         self._port = os.ttyname(slave)
+        if self._link is not None:
+            tmp = self._link.with_name(self._link.name + ".new")
+            tmp.unlink(missing_ok=True)
+            os.symlink(self._port, tmp)
+            os.replace(tmp, self._link)
+            self._port = str(self._link)
         # Our own end stays closed until a client opens the port: the device clock starts then
         # (_wait_for_client). Streaming into a pty nobody has opened put the first touch in the
         # kernel's buffer, which pyserial flushes on open: a client never saw touch 1, so a
@@ -710,6 +723,8 @@ class Emulator:
         self.stop()
 
     def _close(self) -> None:
+        if self._link is not None and self._link.is_symlink():
+            self._link.unlink(missing_ok=True)   # before the pty's number is freed
         for name in ("_master", "_slave"):
             fd = getattr(self, name)
             if fd is not None:

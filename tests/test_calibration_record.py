@@ -38,9 +38,9 @@ def _profile(name: str, **serial) -> "object":
     return profile_from_dict(data, source=f"profile {name} (test)")
 
 
-def _emulator(profile, e=400.0, *, speed=50.0, faults=Faults(), seed=0, noise=0.05):
+def _emulator(profile, e=400.0, *, speed=50.0, faults=Faults(), seed=0, noise=0.05, port_link=None):
     return Emulator(profile, PAPER, [EmulatedMaterial("wood", e)], noise_c=noise, sensor_temp_c=SENSOR_T,
-                    ambient_c=AMBIENT, plan=PLAN, speed=speed, faults=faults, seed=seed)
+                    ambient_c=AMBIENT, plan=PLAN, speed=speed, faults=faults, seed=seed, port_link=port_link)
 
 
 def _expected_onsets(emu, n=40):
@@ -152,12 +152,14 @@ def test_gap_in_device_time_is_found_from_timestamps(tmp_path):
 # ------------------------------------------------------------------ failures
 def test_device_vanishing_mid_trial_keeps_what_was_written(tmp_path):
     prof = _profile("designkit", reconnect_s=0.3)
-    # touches start at 2, 15, 28 s: vanish 3 s into the third touch
-    with _emulator(prof, faults=Faults(vanish_after_s=31.0)) as emu, \
+    # touches start at 2, 15, 28 s: vanish 3 s into the third touch. The port is a link that vanishes with
+    # the device: by the bare /dev/pts/N the reconnect could open the pty another test's emulator was given.
+    with _emulator(prof, faults=Faults(vanish_after_s=31.0), port_link=tmp_path / "ttyEMU") as emu, \
             SerialRecorder(emu.port, prof, tmp_path) as rec:
         with pytest.raises(DeviceGone) as exc:
             rec.record("wood", 5)
     msg = str(exc.value)
+    assert not (tmp_path / "ttyEMU").is_symlink()  # gone with the device, before its pty number was freed
     assert "disappeared" in msg and "trial in progress was discarded" in msg and "\n" not in msg
     written = rec.written
     assert 1 <= len(written) <= 2 and f"{len(written)} trial(s) kept" in msg

@@ -144,7 +144,7 @@ def test_classify_export_c_writes_a_header_that_compiles(cli, tmp_path):
     assert r.exit_code == 2 and "prefix" in r.output
 
 
-def test_a_device_that_vanishes_mid_session_keeps_the_decisions_made(cli):
+def test_a_device_that_vanishes_mid_session_keeps_the_decisions_made(cli, tmp_path):
     """The pty closes after two touches: the two decisions are in --json's document beside the error (only the
     error was there, saying "trial(s) kept in None"), exit 2, and the text route prints them before its one
     error line."""
@@ -154,7 +154,8 @@ def test_a_device_that_vanishes_mid_session_keeps_the_decisions_made(cli):
     for json_ in (True, False):
         plan = TouchPlan(touch_every_s=10.0, contact_s=4.0, touches_per_material=1)
         with Emulator(load_profile("designkit"), PAPER, mats, noise_c=0.05, sensor_temp_c=35.0, ambient_c=25.0,
-                      plan=plan, speed=25.0, seed=3, faults=Faults(vanish_after_s=25.0)) as emu:
+                      plan=plan, speed=25.0, seed=3, faults=Faults(vanish_after_s=25.0),
+                      port_link=tmp_path / f"ttyEMU{int(json_)}") as emu:  # the link vanishes with the device
             r = cli("classify", "--port", emu.port, "--profile", "designkit", "--m", "metal=12767:25972",
                     "--m", "wood=331:506.46", "--touches", "6", "--time-offset", str(emu.expected_time_offset_s),
                     "--error-rate", "0.001", "--timeout", "5", *(["--json"] if json_ else []))

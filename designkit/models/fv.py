@@ -1,52 +1,24 @@
 """1-D finite-volume heat conduction through a stack of layers (sensor, object, backing).
 
-The numerical reference and fallback of :mod:`designkit.models.slab`. A heated sensor
-(left of the contact plane ``z = 0``) touches a stack of layers (right of it);
-every layer is homogeneous and starts at a uniform temperature. The equation
-is ``rho c dT/dt = d/dz (k dT/dz)`` with continuity of temperature and heat
-flux at every interface (perfect contact), discretized by cell-centred finite
-volumes (LeVeque, *Finite Volume Methods for Hyperbolic Problems*, ch. 4, and
-Patankar, *Numerical Heat Transfer and Fluid Flow*, 1980, sec. 4.2: harmonic
-mean conductances, cell faces on every material interface, so that interface
-conditions are exact in the discrete fluxes).
+The numerical reference and fallback of :mod:`designkit.models.slab` (the scheme, its
+grids and its checks: docs/thin_samples.md, "Numerical solver"). A heated sensor (left of
+the contact plane ``z = 0``) touches a stack of homogeneous layers, each starting at a
+uniform temperature; ``rho c dT/dt = d/dz (k dT/dz)`` with continuity of temperature and
+flux at every interface, by cell-centred finite volumes with harmonic-mean conductances
+and cell faces on every interface (Patankar, *Numerical Heat Transfer and Fluid Flow*,
+1980, sec. 4.2). Semi-infinite layers are cut where the heat entered within
+``time_max_s`` is negligible (:func:`truncation_depth_m`) and closed by an insulated face.
 
-Units: ``z`` [m], ``t`` [s], effusivity ``e = k / sqrt(alpha)`` [J s^-1/2 K^-1
-m^-2], diffusivity ``alpha`` [m^2 s^-1]; from these, conductivity
-``k = e sqrt(alpha)`` [W m^-1 K^-1] and volumetric heat capacity
-``rho c = e / sqrt(alpha)`` [J m^-3 K^-1]. Temperatures are normalized (the
-sensor starts at 0 and the object at 1 in :mod:`designkit.models.slab`), the problem is
-linear, so any two temperatures follow by an affine map.
+Units: ``z`` [m], ``t`` [s], effusivity ``e = k / sqrt(alpha)`` [J s^-1/2 K^-1 m^-2],
+diffusivity ``alpha`` [m^2 s^-1]; conductivity ``k = e sqrt(alpha)`` and volumetric heat
+capacity ``rho c = e / sqrt(alpha)``. Temperatures are normalized (sensor 0, object 1).
 
-Only what the contact time reaches is gridded: a semi-infinite layer (the
-sensor, a thick object, a backing) is cut at the depth where the heat that has
-entered within ``time_max_s`` is negligible (:func:`truncation_depth_m`) and
-closed there by an insulated face, so that the whole stack conserves energy
-(:func:`heat_content`; to rounding in the integrators). Cells are graded
-smoothly, fine at the interfaces and coarse far from them (an exponential map
-in each semi-infinite layer, a tanh map in each finite one); the thermistor sits
-on a cell face, with most of the sensor's cells between it and the contact,
-where the early reading is decided. Refining ``cells_per_layer`` refines all
-of them together, which keeps the scheme's formal second order in space
-(observed: 2.00, ``benchmarks/bench_slab.py``).
-
-Two time integrators for the semi-discrete system ``M du/dt = -A u``
-(``M`` diagonal heat capacities, ``A`` symmetric tridiagonal conductances):
-
-* :func:`integrate_crank_nicolson`: trapezoidal rule on a geometric time
-  grid, with Rannacher start-up (four backward-Euler quarter steps) against the
-  initial discontinuity, one banded solve per step
-  (:func:`scipy.linalg.solve_banded`); second order, A-stable. The default.
-* :func:`integrate_bdf`: :func:`scipy.integrate.solve_ivp` with the BDF method
-  (variable order 1-5, adaptive) and the constant sparse Jacobian; several
-  times slower here for the same accuracy.
-
-Forward Euler cannot be used here: it is stable only for ``dt < 2 / lambda_max``,
-nanoseconds for micrometre cells in copper (the demonstration is the lab's
-:mod:`designkit_lab.explicit_euler`).
-
-Both integrators take a stack of ``K`` property sets that share one geometry
-(the same diffusivities, different effusivities: the effusivity classes of a
-recognition task) and advance them together as one block-diagonal system.
+Two integrators of ``M du/dt = -A u``: :func:`integrate_crank_nicolson` (the default;
+geometric time grid, Rannacher start-up, one banded solve per step) and
+:func:`integrate_bdf` (:func:`scipy.integrate.solve_ivp`, BDF; a check, several times
+slower). Explicit stepping would need nanosecond steps for micrometre cells in copper
+(the lab's :mod:`designkit_lab.explicit_euler`). Both advance ``K`` property sets that
+share one geometry together, as one block-diagonal system.
 """
 
 from __future__ import annotations

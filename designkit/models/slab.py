@@ -1,60 +1,28 @@
 """Thin samples: the sensor touching an object slab of finite thickness on a backing.
 
 The paper's model (:mod:`designkit.models.semi_infinite`, eqs. 1-2) treats sensor and object
-as two semi-infinite solids. A real sample is a slab of thickness ``L`` lying
-on something (a wooden table, a steel plate, air); once heat has crossed it,
-what lies behind changes the reading. This module gives the sensor reading for
+as two semi-infinite solids; a real sample is a slab of thickness ``L`` on something (a
+wooden table, a steel plate, air), and once heat has crossed it, what lies behind changes
+the reading. This module gives the reading of a semi-infinite sensor (thermistor at depth
+``x``) on an object slab (``e_o``, ``alpha_o``, ``L``) on a semi-infinite backing (``e_b``; or
+an insulated back face, ``e_b = 0``), object and backing starting at ambient, perfect contact.
 
-    sensor (semi-infinite, e_s, alpha_s, thermistor at depth x)
-    | object slab (e_o, alpha_o, thickness L)
-    | backing (semi-infinite, e_b; or an insulated back face, e_b = 0),
-
-object and backing starting at ambient Ta and the sensor at Ts0, with perfect
-thermal contact everywhere.
-
-The closed form (image series)
-------------------------------
-With ``u = (T - Ts0) / (Ta - Ts0)`` (0 in the sensor, 1 in object and backing
-at t = 0), the Laplace transform of the reading at the thermistor is
-(Carslaw & Jaeger, *Conduction of Heat in Solids*, 2nd ed., 1959, sec. 12.8,
-composite media; derived in ``docs/thin_samples.md``)
-
-    U(p) = (w / p) * (1 - R_b E) / (1 - R_b R_s E) * exp(-2 sqrt(p tau)),
-    E = exp(-2 L sqrt(p / alpha_o)),
-
-with the contact weight of eq. 1 ``w = e_o / (e_s + e_o)`` and the reflection
-coefficients of a heat wave inside the slab at its two faces
-
-    R_s = (e_o - e_s) / (e_o + e_s)    (sensor side),
-    R_b = (e_o - e_b) / (e_o + e_b)    (backing side; 1 for an insulated back).
-
-Expanding the fraction in powers of ``R_b R_s E`` and inverting term by term
-(``L^-1[exp(-a sqrt(p)) / p] = erfc(a / (2 sqrt(t)))``) gives the method of
-images:
+The closed form (method of images; derived in docs/thin_samples.md, after Carslaw & Jaeger,
+*Conduction of Heat in Solids*, 2nd ed., 1959, sec. 12.8), with ``u = (T - Ts0) / (Ta - Ts0)``:
 
     u(t) = w [ erfc(sqrt(tau / t))
                - 2 (1 - w) sum_{n>=1} R_b^n R_s^(n-1) erfc((sqrt(tau) + 2 n sqrt(tau_L)) / sqrt(t)) ],
 
-``tau = x^2 / (4 alpha_s)`` the sensor's time constant and ``tau_L = L^2 /
-(4 alpha_o)`` the slab's: the n-th image arrives after ``n`` round trips
-through the slab, a time-of-flight offset of ``2 n sqrt(tau_L)`` in
-``sqrt(t)`` units. The first term is the paper's eq. 2. The series converges
-for every finite effusivity (``|R_b R_s| < 1``), geometrically in ``n`` and,
-for ``n >> sqrt(alpha_o t) / L``, faster than geometrically (erfc); the
-backing's diffusivity does not enter at all. ``L = inf`` or ``e_b = e_o`` leave
-the first term alone: the semi-infinite model.
+``w = e_o / (e_s + e_o)`` (eq. 1), reflection coefficients ``R_s = (e_o - e_s) / (e_o + e_s)``
+and ``R_b = (e_o - e_b) / (e_o + e_b)`` (1 for an insulated back), ``tau = x^2 / (4 alpha_s)``
+and ``tau_L = L^2 / (4 alpha_o)``. The series converges for every finite effusivity, faster
+than geometrically once ``n >> sqrt(alpha_o t) / L``; the first term is the paper's eq. 2.
 
-Which solver
-------------
-:func:`slab_response` picks per scene (and says which):
-
-* ``"semi-infinite"``: the paper's eq. 2, when a bound on all reflected terms
-  is below the tolerance (small Fourier number ``alpha_o t / L^2``);
-* ``"image-series"``: the series above, truncated where its tail bound is below
-  the tolerance, when that takes a reasonable number of terms;
-* ``"finite-volume"``: the 1-D finite-volume solver of :mod:`designkit.models.fv`
-  (implicit, stiff-safe), when the series would need too many terms (strong
-  reflections at a large Fourier number), or on request.
+Which solver: :func:`slab_response` picks per scene (and says which): ``"semi-infinite"``
+(eq. 2) when a bound on all reflected terms is below the tolerance (small Fourier number
+``alpha_o t / L^2``); ``"image-series"``, truncated where its tail bound is below the
+tolerance, when that takes a reasonable number of terms; ``"finite-volume"``
+(:mod:`designkit.models.fv`) when the series would need too many terms, or on request.
 
 Units: effusivity [J s^-1/2 K^-1 m^-2], diffusivity [m^2 s^-1], thickness and
 depth [m], time [s], temperatures [degC].

@@ -14,43 +14,22 @@ with libsvm's bias rule (average of ``y_i G_i`` over the free support vectors, t
 midpoint of the feasible interval when there are none) and libsvm's prediction
 (``sum_j y_j a_j x_j . x - rho > 0`` gives the lower class, ties the higher one).
 
-What differs is how the dual is solved. libsvm runs SMO one problem at a time to a
-KKT gap of 1e-3. Here all problems of a batch are solved together by a **primal-dual
-active-set (semismooth Newton) method**: guess which ``a_i`` are free, at 0 or at C;
-solve the equality-constrained KKT system of the free ones (one batched
-``(n+1) x (n+1)`` linear solve); move variables whose value leaves the box or whose
-gradient has the wrong sign; stop when the sets no longer change. At that point the
-KKT conditions hold to rounding (the reported ``kkt_gap`` is libsvm's own criterion,
-typically 1e-12 instead of libsvm's 1e-3). It takes 3-7 solves for the problems met
-here (n ~ 133 training touches, 200-1600 features). A ridge of ``1e-9 * mean(diag K)``
-keeps the systems nonsingular (it moves each free margin by at most ``1e-9 *
-mean(diag K) * a_i``, far below libsvm's tolerance); where the Gram matrix is rank
-deficient (short contacts, fewer samples than training touches) the active set can
-jump, and those problems are re-solved by continuation (ridge ``1e-3`` then ``1e-9``
-times ``mean(diag K)``); whatever still fails (classes that overlap, many bounded
-support vectors) is solved by libsvm itself (scikit-learn's ``SVC`` on the precomputed
-kernel, on the host, eps = 1e-2, at most 200,000 steps), and from libsvm's free and
-bounded sets the active-set method then finds the exact optimum in a few solves
-(``solver`` 2; where that does not converge, the same from libsvm at its own eps 1e-3;
-libsvm's own answer where that does not either, ``solver`` 3). On the calibrated rig's
-overlapping classes this gives the exact optimum on 90 of 90 such problems (from eps 1e-3:
-83, from the ``1e-3`` ridge's optimum: none) and per-fit F1 equal to libsvm's without a cap
-(the reference) on 30 of 30 fits, at 0.28x the reference's CPU; libsvm's capped answer alone
-moves F1 by sd 0.008, the ``1e-3`` ridge's optimum by 0.03 (a different classifier):
-``benchmarks/results/rig-duals.txt``.
+What differs is how the dual is solved: all problems of a batch together, by a **primal-dual
+active-set (semismooth Newton) method** (:func:`solve_svc_duals`): guess which ``a_i`` are
+free, at 0 or at C; solve the free ones' KKT system (one batched ``(n+1) x (n+1)`` solve);
+move the variables that leave the box or whose gradient has the wrong sign; stop when the
+sets no longer change, where the KKT conditions hold to rounding (libsvm stops at a gap of
+1e-3). A tiny ridge keeps the systems nonsingular; problems where the active set does not
+settle are re-solved by continuation, then from libsvm's own solution (scikit-learn's
+``SVC`` on the precomputed kernel), and as a last resort libsvm's answer is kept (the
+``solver`` code of each problem says which; evidence: ``benchmarks/results/rig-duals.txt``).
 
-Cost. The Gram products dominate (``n_train^2 d / 2`` multiply-adds per fold); by
-default they are formed in float32 from features centered in float64 (relative error
-of ``K`` about 1e-6, far below what moves a prediction); the solver runs in float64.
-Standardization is folded into the products: features are centered once per pair
-(the SVM is invariant to a common shift of all touches, training and test alike), then
-scaled by each fold's inverse standard deviation. On numpy (float32 Gram) each feature
-matrix is first prepared once (:func:`prepare_features`: float32 deviations from its
-own mean; a sweep caches these per interval); a pair's rows are gathered once into fold
-order, its fold statistics are block sums of them, the class offsets from the pair's
-center enter the Gram matrix as float64 rank-two terms, and the only ``n x d`` array
-written per fold is the scaled training set, reused from pair to pair (engine version 2,
-:func:`_chunk_prepared`).
+Cost: the Gram products dominate (``n_train^2 d / 2`` multiply-adds per fold). They are
+formed in float32 from features centered in float64 (``K`` to about 1e-6 relative, far
+below what moves a prediction; the solver runs in float64), with each fold's
+standardization folded into them: features are centered once per pair (the SVM is
+invariant to a common shift) and scaled by each fold's inverse standard deviation
+(:func:`prepare_features`, :func:`_chunk_prepared`).
 
 The code is written against the array API (``xp``: numpy by default, or the namespace
 ``array_api_compat`` finds for the inputs where it is installed); the fold assignment

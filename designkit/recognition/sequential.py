@@ -3,82 +3,27 @@
 A robot feeds the samples of one touch as they arrive; after each sample the
 test says "keep touching", names a material, or says that no contact time up to
 the longest allowed one will separate the candidates at the requested error
-rates. It stops as soon as the evidence suffices, which on average is far
-earlier than the fixed contact time reaching the same error rates.
+rates. The derivation, the evidence on simulated touches and the bound on any
+test are in docs/decisions.md; in short:
 
-The statistic (Gaussian white noise, shared-shape model)
---------------------------------------------------------
-The simulator's readings are ``y_k = Ts0 + A w(e) g_k + sigma z_k`` with
-``A = Ta - Ts0``, the model's shared response shape ``g`` (paper eq. 2,
-``g(t) = erfc(sqrt(tau / t))``), amplitude ``w(e) = e / (e_s + e)`` (eq. 1) and
-i.i.d. standard normal ``z`` added to the *raw* samples
-(:func:`designkit.simulation.noisy_readings`; the Savitzky-Golay smoothing
-belongs to the SVM's features only and is not used here). After ``n`` samples
-the log-likelihood of an amplitude ``w`` is, up to terms the same for every
-``w``,
-
-    l(w) = -(w - v)^2 / (2 s^2),   v = S_rg / (A S_gg),   s = sigma / (|A| sqrt(S_gg)),
-
-with the two running sums ``S_rg = sum (y_k - Ts0) g_k`` and
-``S_gg = sum g_k^2``: ``v`` is the running projection of the ideal observer
-(:mod:`designkit.recognition.ideal`) and ``s`` its noise, so the test needs
-two numbers of memory whatever the touch's length.
-
-Unknown effusivity within a class: a mixture, not a GLR
--------------------------------------------------------
-A candidate is a class of objects, effusivity uniform in ``[a, b)`` (as the
-simulator draws it and as the materials database gives a material). The
-likelihood of the class is the *mixture* over that range,
-``p(v | class) = integral p(w) N(v; w, s^2) dw``, not the maximum over it (the
-generalized likelihood ratio). The mixture is the exact likelihood of the
-Bayesian model of the class, so Wald's bounds hold for it (the error rate of
-deciding class i when the touch is of class j, averaged over class j's range,
-is at most ``exp(-A_ij)``); the GLR's ratio is inflated early in a touch, when
-``s`` is wide, and has no such bound. The prior ``p(w)`` is the image of the
-uniform-in-``e`` prior, approximated piecewise: the range is cut into pieces
-geometric in ``e_s + e`` (the density of ``w`` is ``(e_s + e)^2 / e_s`` times
-that of ``e``), so that the density varies by at most 10 % within a piece, and
-each piece is uniform in ``w`` with its exact mass. The mixture is then closed
-form,
-
-    p(v | class) = sum_m pi_m [Phi((w_{m+1} - v) / s) - Phi((w_m - v) / s)] / (w_{m+1} - w_m),
-
-(a piece narrower than 1e-3 s is a point: ``pi_m N(v; w_m, s^2)``), evaluated in
-log space from :func:`scipy.special.log_ndtr`. The paper's 80-wide classes are
-one piece, a database material a few.
-
-Thresholds (Wald 1945; Armitage 1950 for more than two)
--------------------------------------------------------
-With ``eps_j`` the requested probability of a wrong decision when the touch is
-of class ``j``, class ``i`` is decided as soon as, for every other ``j``,
-
-    l_i - l_j >= A_ij = log((k - 1) (1 - eps_i) / eps_j).
-
-For two classes with ``alpha = eps_0`` (deciding class 1 on a class-0 touch) and
-``beta = eps_1`` these are Wald's ``A = log((1 - beta) / alpha)`` and
-``B = log(beta / (1 - alpha))`` on ``l_1 - l_0``. Overshoot makes the true
-error rates smaller than the requested ones.
-
-Hopeless pairs
---------------
-No test that stops by ``T`` (sequential or not) has error rates below those of
-the best fixed test at ``T`` (Neyman-Pearson on all samples up to ``T``), and
-for ordered effusivity classes that test is a threshold on ``v``
-(:mod:`designkit.recognition.ideal`). :func:`min_fixed_contact_s` gives the shortest fixed
-contact at which it reaches the requested rates (the ideal observer's closed form); where none
-does for some pair by the longest allowed contact, the test says
-so before the first sample (:attr:`SequentialTest.plan`), and every
-:meth:`SequentialTest.update` answers ``"no decision possible"``.
-
-The optimal test: a bound
--------------------------
-Wald's thresholds are optimal when every sample carries the same information;
-here the information per sample ``(A dw g_k / sigma)^2`` grows steeply with time.
-The lab's :mod:`designkit_lab.sequential_bound` computes the Bayes-optimal stopping
-rule for two candidates and the bound on the mean time to decision that no test
-reaching the same error rate beats. On the paper's guideline pair it is within
-1-2 % of this SPRT at eps <= 0.01 (docs/decisions.md), so the test keeps Wald's
-thresholds.
+- **Statistic** (Gaussian white noise on the raw samples, shared-shape model
+  ``y_k = Ts0 + A w(e) g_k + sigma z_k``): the log-likelihood of an amplitude
+  ``w`` is ``-(w - v)^2 / (2 s^2)`` with ``v = S_rg / (A S_gg)`` and
+  ``s = sigma / (|A| sqrt(S_gg))``, from two running sums
+  ``S_rg = sum (y_k - Ts0) g_k`` and ``S_gg = sum g_k^2`` (the ideal observer's
+  projection and its noise, :mod:`designkit.recognition.ideal`).
+- **A class is a mixture, not a GLR**: the likelihood of a class (effusivity
+  uniform in ``[a, b)``) is the integral over its range, so Wald's bounds hold.
+  The prior of ``w`` is cut into pieces geometric in ``e_s + e`` (density
+  within 10 % in a piece, each uniform in ``w`` with its exact mass), which
+  makes the mixture a sum of normal-CDF differences, evaluated in log space
+  (:func:`scipy.special.log_ndtr`); a piece narrower than 1e-3 ``s`` is a point.
+- **Thresholds** (Wald 1945; Armitage 1950): class ``i`` is decided once
+  ``l_i - l_j >= log((k - 1) (1 - eps_i) / eps_j)`` for every other ``j``.
+- **Hopeless pairs**: no test that stops by ``T`` beats the best fixed test at
+  ``T``, a threshold on ``v`` (:func:`min_fixed_contact_s`); where a pair cannot
+  reach the rates by the longest contact, :attr:`SequentialTest.plan` says so
+  before the first sample and every update answers ``"no decision possible"``.
 """
 
 from __future__ import annotations

@@ -7,7 +7,7 @@ seeds (:func:`designkit.design.search.predict_and_confirm`). This script measure
 design (tests/data/rig_sensor.yaml, ``--set paper12 --identified --max-contact 8``):
 
 1. ``--reference``: the SVM's mean F1 curve near the crossing, from ``--ref-seeds`` fresh seeds per contact
-   (:func:`designkit.design.search.svm_f1_at`, the paper's SVM); its crossing is the truth the interval claims
+   (:func:`svm_f1_at` below, the paper's SVM); its crossing is the truth the interval claims
    to cover.
 2. ``--statements K``: K real statements with seeds 0..K-1 (the exact route, 4 seeds per contact): how many
    intervals cover the reference crossing.
@@ -53,9 +53,27 @@ def paper12_design():
     return recommend(targets, c, contact=contact, n_depth=3), targets
 
 
+def svm_f1_at(design, lo_class, hi_class, contact_s: float, noise_c: float, delta_t_c: float, *,
+              trials: int, seeds) -> float:
+    """Mean F1 of the paper's SVM for two classes under the design's sensor, model and scene, over ``seeds``
+    (contact counted from the rig's detected onset where the design is under a rig's contact)."""
+    from designkit.models import sensor_model
+    from designkit.recognition.svm import pair_f1
+    from designkit.rig import model_start_s, rig_scene, to_model_contact
+    from designkit.scene import Scene
+
+    sensor = design.sensor()
+    model = sensor_model(sensor)
+    start = model_start_s(sensor)
+    scene = Scene.from_delta_t(contact_s=to_model_contact(contact_s, start), noise_c=noise_c,
+                               delta_t_c=delta_t_c).replace(**rig_scene(sensor))
+    return float(np.mean([pair_f1(lo_class, hi_class, sensor, scene, model=model, trials=trials, seed=s).f1
+                          for s in seeds]))
+
+
 def measure_curve(result, targets, contacts, seeds, base=1000) -> dict:
     """Per-seed SVM F1 of the limiting pair at each contact [s from the detected onset]."""
-    from designkit.design.search import _pair_classes, svm_f1_at
+    from designkit.design.search import _pair_classes
     from designkit.objects import ObjectClass
 
     best, c = result.best, result.constraints

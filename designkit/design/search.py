@@ -32,7 +32,7 @@ from ..query.ideal_bound import exact_ideal_min_contact
 from ..sensor import Sensor, check_samples_per_touch
 
 __all__ = ["CONFIRM_REPEATS", "CONFIRM_SEED", "MIN_SAMPLES", "SKIN_SET", "Constraints", "Design", "DesignResult", "Target", "predict",
-           "predict_and_confirm", "recommend", "svm_f1_at", "targets_from"]
+           "predict_and_confirm", "recommend", "targets_from"]
 
 #: Common skin materials of a heated tactile sensor (materials database names): polymers, ceramics, metals.
 SKIN_SET = ("Polyetheretherketone (PEEK)", "Silicone elastomers", "Polytetrafluoroethylene (Teflon, PTFE)",
@@ -453,24 +453,6 @@ def _reason(best: Design, c: Constraints, contact) -> str:
     under = "" if contact is None else f", under the contact of {contact.source}, counted from the {contact.counted_from}"
     return (", ".join(parts) + f": the limiting pair {best.limiting_pair[0]} / {best.limiting_pair[1]} separates "
             f"{how} >= {c.threshold:g}) after {best.min_contact_s:.3g} s{floor}{under}")
-
-
-def svm_f1_at(design: Design, lo_class, hi_class, contact_s: float, noise_c: float, delta_t_c: float, *,
-              trials: int, seeds, jobs: int = 1) -> float:
-    """Mean F1 of the paper's SVM for two classes under the design's sensor, model and scene, over ``seeds``
-    (contact counted from the rig's detected onset where the design is under a rig's contact)."""
-    from ..models import sensor_model
-    from ..recognition.svm import pair_f1
-    from ..rig import model_start_s, rig_scene, to_model_contact
-    from ..scene import Scene
-
-    sensor = design.sensor()
-    model = sensor_model(sensor)
-    start = model_start_s(sensor)
-    scene = Scene.from_delta_t(contact_s=to_model_contact(contact_s, start), noise_c=noise_c,
-                               delta_t_c=delta_t_c).replace(**rig_scene(sensor))
-    return float(np.mean([pair_f1(lo_class, hi_class, sensor, scene, model=model, trials=trials, seed=s).f1
-                          for s in seeds]))
 
 
 #: Seeds per contact of the SVM confirmation: 4x the statement's, so the confirmation's own

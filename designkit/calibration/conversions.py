@@ -34,8 +34,6 @@ class Conversion:
     """Raw wire number <-> engineering value, exact inverses of each other."""
 
     kind = "conversion"
-    #: Raw values are integer ADC counts (checked when read).
-    integer_raw = False
 
     def to_value(self, raw):  # pragma: no cover - abstract
         raise NotImplementedError
@@ -92,10 +90,6 @@ class Linear(Conversion):
     adc_bits: int | None = None
     kind = "linear"
 
-    @property
-    def integer_raw(self) -> bool:  # type: ignore[override]
-        return self.adc_bits is not None
-
     def to_value(self, raw):
         return self.gain * np.asarray(raw, dtype=np.float64) + self.offset
 
@@ -151,7 +145,6 @@ class Thermistor(Conversion):
     t0_c: float | None = None
     sh: tuple[float, float, float] | None = None
     kind = "thermistor"
-    integer_raw = True
 
     @property
     def full_scale(self) -> int:

@@ -1,38 +1,18 @@
 """The sweep a calibrated sensor's questions need: its config, derived from the sensor file.
 
 A sensor file written by calibration (version 2) records the rig's conditions
-(:mod:`designkit.rig`): its noise, its temperature difference dT, the contact
-ramp and where the model's first heat flow lies relative to the rig's detected
-onset. :func:`sensor_sweep_config` turns them into a :class:`~designkit.sweep.SweepConfig`
-whose table answers that sensor's questions as the rig sees them:
-
-* **the model** is the one the file records (its forward model, force ramp included);
-* **the effusivity span** is that of the materials named (a named set such as
-  ``paper12``, or materials by name), or a range given, or the shipped tables'
-  whole range (0, 40000]; cut into intervals of the class width (80
-  J s^-1/2 K^-1 m^-2, what ``--exact`` and the shipped tables use), on the
-  shipped grid's multiples, one class beyond each end so that every material's
-  hardest class lies inside;
-* **the noise axis** is sigma/dT at the rig's own noise and dT (:data:`NOISE_FACTORS`;
-  more factors tabulate other noises, each as costly as the first): every forward model
-  here is linear in the temperatures, so sigma/dT alone decides (``designkit.sweep``'s
-  invariance);
-* **the touches** are the rig's, as the exact route plays them for a question about the
-  sensor (``SweepConfig.rig_scene``, :func:`designkit.rig.rig_scene`): the noise
-  correlated over the calibration residual's length, each touch read from the detected
-  onset on, pressed as the calibration touches were;
-* **the contact axis** counts, as the rig's controller does, from the detected
-  onset, on the sensor's own time scale (:func:`time_scale_s`: the longest of the contact
-  ramp's rise to 90 % of the force, the noise's correlation length and the thermistor's tau):
-  from one time scale (before the touch has settled and while the noise is one correlated
-  draw, nothing separates at the rig's noise: measured, F1 0.5 at 0.55 s for pairs 100 classes
-  apart) to :data:`LONGEST_CONTACT_SCALES` of them, capped at :data:`MAX_CONTACT_S` (the exact
-  route's longest contact, in the model's time), geometric at a ratio of at most
-  :data:`CONTACT_RATIO` (the need, convex in contact time, is not read late between two points),
-  and stored as the model counts it (the onset's offset subtracted,
-  :func:`designkit.rig.to_model_contact`). A pair no tabulated contact separates is answered with
-  that bound (none up to the last contact; ``--exact`` looks up to 10 s), a pair the first
-  contact already separates with the first contact (at most that).
+(:mod:`designkit.rig`). :func:`sensor_sweep_config` turns them into a
+:class:`~designkit.sweep.SweepConfig` whose table answers that sensor's questions as the
+rig sees them (the choices and their evidence: docs/engine.md, "Tables for your sensor"):
+the file's model; the effusivity span of the materials named, a range given, or the
+shipped tables' (0, 40000], in classes of 80 on the shipped grid's multiples, one class
+beyond each end; sigma/dT at the rig's noise and dT (:data:`NOISE_FACTORS`); the rig's
+touches (``SweepConfig.rig_scene``), as the exact route plays them; and contact times
+counted from the detected onset, geometric from one of the sensor's time scales
+(:func:`time_scale_s`) to :data:`LONGEST_CONTACT_SCALES` of them (capped at
+:data:`MAX_CONTACT_S`, at a ratio of at most :data:`CONTACT_RATIO`: the need, convex in
+contact time, is not read late between two points), stored as the model counts them
+(:func:`designkit.rig.to_model_contact`).
 
 Units: effusivity [J s^-1/2 K^-1 m^-2], times [s], noise [degC].
 """

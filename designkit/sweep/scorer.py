@@ -38,18 +38,11 @@ __all__ = ["BATCH_MB", "CHUNK_PAIRS", "CV_KEY", "ENGINE_VERSION", "FEATURE_CACHE
 #: Seed-key suffix of the fold-shuffle streams (distinguishes them from the trial streams).
 CV_KEY = 7919
 
-#: Version of the arithmetic that turns a config into a table (features and solver), recorded in every
-#: table's header (``engine_version``; a table without one is version 1) and in a sweep's working folder.
+#: Version of the arithmetic that turns a config into a table (features, solver, search path), recorded in
+#: every table's header (``engine_version``; a table without one is version 1) and in a sweep's working folder.
 #: The same config gives the same bytes on every run, split and backend of one version; another version
-#: rounds differently, so its answers may move within their Monte Carlo intervals (issue 35). Version 2:
-#: the Savitzky-Golay slope in cumulative-sum form (:mod:`designkit.recognition.features`) and the
-#: batched solver's one-gather fold statistics (:func:`~designkit.recognition.batched_svm.batched_cv_f1`).
-#: Version 3: a guided row's search gallops to ``g -+ 1, 2, 4, ...`` from its guess instead of ``g -+ 1, 3, 7, ...``
-#: (:func:`~designkit.sweep.search.staircase_searches`): fewer fits; on noisy decisions another crossing.
-#: Version 4: only every :data:`~designkit.sweep.search.SUPER_EVERY`-th reference is searched from its floor; the
-#: other anchors start from a guess scaled from those (the same gallop; fewer fits, another crossing where noisy);
-#: and a fold problem the batched solver hands to libsvm ends at the exact optimum reached from libsvm's active
-#: set, not libsvm's answer at its step cap (overlapping classes, e.g. a calibrated rig's table).
+#: rounds or searches differently, so its answers may move within their Monte Carlo intervals. What each
+#: version changed: docs/engine.md ("Engine version 2", "3", "4").
 ENGINE_VERSION = 4
 
 

@@ -108,7 +108,7 @@ def staircase_search(decide: Callable[[int, int], bool] | None, rows: Sequence[i
 ANCHOR_EVERY = 8
 
 
-#: Spacing of the top-level anchors of a guided search (engine version 4): every row ``i`` with
+#: Spacing of the top-level anchors of a guided search: every row ``i`` with
 #: ``i % SUPER_EVERY == 0`` is searched from its floor alone; the other anchors start from their floor's distance
 #: times the efficiency (``(J - i) / (floor - i)``) of these, interpolated (:func:`staircase_searches`).
 SUPER_EVERY = 64
@@ -147,26 +147,20 @@ def staircase_searches(searches: Sequence[tuple[Sequence[int], np.ndarray | None
     are fewer and larger (what a batched scorer needs).
 
     With ``anchor_every = A`` the search is *guided*: the anchor rows (``i % A == 0``; the
-    ones the given rows need are added, see :func:`with_anchors`) are searched first. The
-    top-level ones (``i % SUPER_EVERY == 0``) each from its floor alone, then the others from a
-    guess (below, the same gallop): with a floor, the floor's distance ``floor[i] - i`` times the
-    top anchors' efficiency ``(J - a) / (floor[a] - a)`` interpolated between them (engine version 4;
-    version 3 searched every anchor from its floor: a gallop ``f, f + 2, f + 6, ...`` from the ideal
-    observer's staircase, which lies at about 0.6 of the SVM's distance, cost an anchor row about
-    twice a guided row's fits; on svm-paper 0.977x the fits of two 250-reference blocks at four contacts each,
-    0.94-1.03x on ten 62-reference slices; where the model has no closed-form floor each anchor galloped
-    from ``i + 1``: 0.91x on two slices of the rig's table, benchmarks/results/engine-search-slice.txt), without one
-    the distance ``J - a`` interpolated geometrically between them. Every other row ``i`` between anchors ``a0 < i < a1 = a0 + A``
-    then starts from the guess ``g = J(a0) + (J(a1) - J(a0)) (i - a0) / A`` (``J(a0)``
-    above the last anchor), raised to its floor: one probe at ``g``, then galloping down
-    (if true) or up (if false) to ``g -+ 1, 2, 4, ...`` and bisecting (engine version 3; version 2
-    galloped to ``g -+ 1, 3, 7, ...``: the answers lie within 1-3 of the guess at short contact
-    times, where this costs 0.95x the fits, measured). A row's path depends
-    on its own decisions and its anchors', which depend on theirs and their top anchors'
-    alone, so the answer is still the same whatever other rows are searched with it. On exactly monotone
-    decisions it is ``min{j > i : decide(i, j)}`` as before; on noisy ones the crossing
-    nearest the guess. Where ``J`` follows the staircase of its neighbours it costs
-    2-4 probes per row instead of ``2 log2(J - f + 1) + 1``.
+    ones the given rows need are added, see :func:`with_anchors`) are searched first: the
+    top-level ones (``i % SUPER_EVERY == 0``) each from its floor alone, the others from a
+    guess, the floor's distance ``floor[i] - i`` times the top anchors' efficiency
+    ``(J - a) / (floor[a] - a)`` interpolated between them (without a floor: the distance
+    ``J - a`` interpolated geometrically). Every other row ``i`` between anchors
+    ``a0 < i < a1 = a0 + A`` then starts from ``g = J(a0) + (J(a1) - J(a0)) (i - a0) / A``
+    (``J(a0)`` above the last anchor), raised to its floor: one probe at ``g``, then galloping
+    down (if true) or up (if false) to ``g -+ 1, 2, 4, ...`` and bisecting. A row's path
+    depends on its own decisions and its anchors', which depend on theirs and their top
+    anchors' alone, so the answer is the same whatever other rows are searched with it. On
+    exactly monotone decisions it is ``min{j > i : decide(i, j)}``; on noisy ones the crossing
+    nearest the guess. Where ``J`` follows its neighbours' staircase a row costs 2-4 probes
+    instead of ``2 log2(J - f + 1) + 1`` (the engine versions that chose these steps, and
+    their measured costs: docs/engine.md).
 
     Examples
     --------

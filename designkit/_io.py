@@ -3,11 +3,12 @@ half-written file where a complete one is expected."""
 
 from __future__ import annotations
 
+import math
 import os
-import tempfile
 from pathlib import Path
+from typing import Any
 
-__all__ = ["WriteError", "atomic_write_bytes", "atomic_write_text", "fsync_folder"]
+__all__ = ["WriteError", "atomic_write_bytes", "atomic_write_text", "fsync_folder", "jsonable"]
 
 
 class WriteError(OSError):
@@ -63,6 +64,8 @@ def atomic_write_bytes(path: Path, data: bytes) -> Path:
         return path
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
+        import tempfile  # here: the commands that only print (through jsonable) never need it
+
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     except OSError as exc:  # name the file the user asked for, not the temporary one beside it
         raise _cannot_write(path, exc) from None
@@ -109,3 +112,19 @@ def _umask() -> int:
 def atomic_write_text(path: Path, text: str) -> Path:
     """Text version of :func:`atomic_write_bytes` (UTF-8)."""
     return atomic_write_bytes(path, text.encode("utf-8"))
+
+
+def jsonable(obj: Any) -> Any:
+    """``obj`` as plain JSON types: mappings as dicts with text keys, tuples as lists, numpy arrays and
+    scalars as lists and numbers, NaN and inf as None, paths as text."""
+    if isinstance(obj, dict):
+        return {str(k): jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [jsonable(v) for v in obj]
+    if hasattr(obj, "tolist"):  # numpy arrays and scalars
+        return jsonable(obj.tolist())
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    if isinstance(obj, Path):
+        return str(obj)
+    return obj

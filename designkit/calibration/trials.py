@@ -61,7 +61,7 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from .._io import atomic_write_text
+from .._io import atomic_write_text, jsonable
 from .._validation import InputError
 
 __all__ = ["COLUMNS", "FolderBusy", "FolderLock", "MAX_LABEL_CHARS", "MAX_STEM_CHARS", "Trial",
@@ -290,7 +290,7 @@ def write_trial(folder: Path, material: str, time_s, sensor_c, object_c, force_n
     csv_text = trial_csv_text(time_s, sensor_c, object_c, force_n)
     side = {"designkit_trial": TRIAL_FILE_VERSION, "file": csv_path.name, "material": material,
             "trial_index": k, **dict(meta)}
-    side_text = json.dumps(_plain(side), indent=2) + "\n"
+    side_text = json.dumps(jsonable(side), indent=2) + "\n"
     written: list[Path] = []
     with _sigint_held():
         try:
@@ -329,18 +329,6 @@ def _sigint_held():
         signal.signal(signal.SIGINT, previous)
         if pending:
             previous(*pending[0])
-
-
-def _plain(obj: Any) -> Any:
-    if isinstance(obj, dict):
-        return {str(k): _plain(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_plain(v) for v in obj]
-    if hasattr(obj, "tolist"):
-        return _plain(obj.tolist())
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    return obj
 
 
 def rebuild_index(folder: Path) -> Path:

@@ -15,12 +15,13 @@ JSON on stdout too (``{"error": {...}}``), so a script reads one format.
 from __future__ import annotations
 
 import json
-import math
 import sys
 from typing import Any
 
 import typer
 from typer.core import TyperCommand, TyperGroup
+
+from .._io import jsonable
 
 EXIT_BAD_INPUT = 2
 EXIT_BUG = 1
@@ -219,19 +220,6 @@ def sub_app(name: str, help: str, panel: str) -> typer.Typer:
                         pretty_exceptions_enable=False, rich_markup_mode="markdown")
     app.add_typer(group, name=name, rich_help_panel=panel)
     return group
-
-
-def jsonable(obj: Any) -> Any:
-    """``obj`` as plain JSON types: numpy arrays and scalars as lists and numbers, NaN and inf as None."""
-    if isinstance(obj, dict):
-        return {str(k): jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [jsonable(v) for v in obj]
-    if hasattr(obj, "tolist"):  # numpy arrays and scalars
-        return jsonable(obj.tolist())
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    return obj
 
 
 def import_lab(module: str, command: str) -> Any:

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any, Mapping, Sequence
 
 import numpy as np
 
+from designkit._io import jsonable
 from designkit._validation import InputError
 from .results import CostCurve, Row
 
@@ -610,20 +611,6 @@ def print_report(report: BenchReport, written: Mapping[str, Path], con: Any) -> 
         con.print(f"[bold green]wrote[/] {v}")
 
 
-def _jsonable(obj):
-    if isinstance(obj, dict):
-        return {str(k): _jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_jsonable(v) for v in obj]
-    if isinstance(obj, np.generic):
-        return _jsonable(obj.item())
-    if isinstance(obj, np.ndarray):
-        return _jsonable(obj.tolist())
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    return obj
-
-
 def write_report(report: BenchReport, out_dir) -> dict[str, Path]:
     """Write ``accuracy.md``, its figures and ``accuracy.json`` into ``out_dir``; returns the paths.
 
@@ -658,7 +645,7 @@ def write_report(report: BenchReport, out_dir) -> dict[str, Path]:
                                                                      var_png.name if var_png.exists() else None))
     md = atomic_write_text(out_dir / "accuracy.md", page)
     js = atomic_write_text(out_dir / "accuracy.json",
-                           json.dumps(_jsonable(report.to_dict()), indent=1, allow_nan=False) + "\n")
+                           json.dumps(jsonable(report.to_dict()), indent=1, allow_nan=False) + "\n")
     return {"markdown": md, "json": js, **{k: out_dir / v for k, v in figs.items()}}
 
 
@@ -953,7 +940,7 @@ def write_varied_coverage(run: Mapping[str, Any], out_dir) -> Path:
     doc = json.loads(js.read_text()) if js.exists() else {"runs": []}
     doc["runs"] = [r for r in doc["runs"] if (r["question"], r["seed"]) != (run["question"], run["seed"])]
     doc["runs"].append(dict(run))
-    atomic_write_text(js, json.dumps(_jsonable(doc), indent=1, allow_nan=False) + "\n")
+    atomic_write_text(js, json.dumps(jsonable(doc), indent=1, allow_nan=False) + "\n")
     png = varied_coverage_figure(doc, out_dir / VARIED_COVERAGE_FIGURE)
     page = out_dir / "accuracy.md"
     text = page.read_text() if page.exists() else "# Accuracy against run time\n"

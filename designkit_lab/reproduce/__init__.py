@@ -131,7 +131,7 @@ def reproduce(out_dir: "str | Path", only: "str | Sequence[str] | None" = None,
     -------
     ReproduceResult
     """
-    from designkit._io import atomic_write_text
+    from designkit._io import atomic_write_text, jsonable
 
     names = parse_only(only)
     out = Path(out_dir)
@@ -159,33 +159,13 @@ def reproduce(out_dir: "str | Path", only: "str | Sequence[str] | None" = None,
     result = ReproduceResult(out, report, out / "report.json", tuple(results), wall)
     payload = {"designkit_reproduce": 1, **result.to_dict(), "settings": _settings_dict(settings),
                "tables": ctx.tables_used()}
-    atomic_write_text(result.report_json, json.dumps(_jsonable(payload), indent=1, allow_nan=False) + "\n")
+    atomic_write_text(result.report_json, json.dumps(jsonable(payload), indent=1, allow_nan=False) + "\n")
     return result
 
 
 def _settings_dict(s: ReproduceSettings) -> dict:
     return {"tables_dir": None if s.tables_dir is None else str(s.tables_dir), "robot_data": str(s.robot_data_dir),
             "quick": s.quick, "seed": s.seed, "jobs": s.jobs}
-
-
-def _jsonable(obj):
-    import math
-
-    import numpy as np
-
-    if isinstance(obj, dict):
-        return {str(k): _jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_jsonable(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return _jsonable(obj.tolist())
-    if isinstance(obj, np.generic):
-        return _jsonable(obj.item())
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    if isinstance(obj, Path):
-        return str(obj)
-    return obj
 
 
 def _markdown(results: Sequence[SectionResult], settings: ReproduceSettings, ctx: Context, wall: float,

@@ -202,3 +202,29 @@ def test_export_with_a_sensor_file_writes_the_table_its_questions_read(registere
     mod = load_python_export(out.read_bytes(), "rig_cli")
     lib = ask("min-contact", e1=2000.0, e2=2600.0, noise_c=SCENE[0], delta_t_c=SCENE[1], sensor=RIG)
     assert lib.value is not None and mod.min_contact_s(2000.0, 2600.0, *SCENE) == pytest.approx(lib.value, rel=RTOL)
+
+
+def test_between_two_sigma_dt_rows_each_row_answers_and_log_t_is_interpolated(tmp_path):
+    """Two sigma/dT rows of a table without closed form (the paper's sensor: no onset offset): at noises between
+    them the reading rule answers as the library's array route without a simulated bound (what a sensor's own
+    table answers), value and interval."""
+    from designkit.query import min_contact
+
+    sys.path.insert(0, str(HERE))
+    from test_table_crossing_bias import _table
+
+    a, b = _table(0), _table(1)
+    arrays = {k: np.concatenate([np.asarray(a.arrays[k]), np.asarray(b.arrays[k])]) for k in a.arrays}
+    cfg = SweepConfig(name="two-rows", e_min=0.0, e_max=a.header["effusivity"]["max"],
+                      intervals=int(a.arrays["delta_up"].shape[-1]), noise_ratio=(0.004, 0.008),
+                      contact_s=tuple(a.header["config"]["contact_s"]), model={"name": "contact",
+                                                                               "conductance_w_m2k": 1500.0})
+    tab = load_table(write_table(tmp_path / "two.npz", table_header(cfg, arrays), arrays))
+    reader = estimator_of(slice_table(tab))
+    lo, hi, _ = _pairs(24, 35)
+    noise = np.random.default_rng(35).uniform(0.004, 0.008, lo.size)
+    lib = min_contact(lo, hi, noise_c=noise, delta_t_c=1.0, table=tab, ideal_bound=False, ideal_table=None)
+    assert np.isfinite(lib.value).sum() >= 20
+    for i in range(lo.size):
+        got = reader.min_contact_interval(lo[i], hi[i], noise[i], 1.0)
+        assert all(_same(g, w) for g, w in zip(got, (lib.value[i], lib.low[i], lib.high[i]))), i

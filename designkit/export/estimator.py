@@ -412,20 +412,16 @@ class Estimator:
     def _min_contact(self, lo, hi, combos, ratio):
         """min-contact in the table's time: the first of designkit.query.estimates.CONTACT_ESTIMATORS that answers."""
         C = self.contacts
-        if not self.efficiency:
-            both = self._both_estimate(lo, hi, combos)
-            if both is not None:
-                return both
+        if not self.efficiency and (both := self._both_estimate(lo, hi, combos)) is not None:
+            return both
         gap = hi - lo
         value, kb, needs = self._cross("", combos, lo, hi)
         if value is None:
             return None, None, None
-        ideal = math.nan
-        if self.efficiency:
-            ideal = self.k_contact(ratio, self.sstar(lo, hi), 1.0, 1.0, 0.0, 0.0)  # the ideal observer's (NaN: none)
-            est = self._efficiency_estimate(lo, hi, combos, ratio, kb, ideal)
-            if est is not None:
-                return est
+        # the ideal observer's (NaN: none), and the SVM's efficiency against it
+        ideal = self.k_contact(ratio, self.sstar(lo, hi), 1.0, 1.0, 0.0, 0.0) if self.efficiency else math.nan
+        if self.efficiency and (est := self._efficiency_estimate(lo, hi, combos, ratio, kb, ideal)) is not None:
+            return est
         # no efficiency reading: the log-log crossing between the two tabulated needs, or the grid cell
         prev = needs[kb - 1] if kb > 0 else math.nan
         if kb > 0 and not _isnan(prev):
@@ -462,10 +458,8 @@ class Estimator:
         for k in range(len(C)):
             start = (row * t._nc + k) * t._ne
             a, b = self._val(up, start, ews[0]), self._val(down, start, ews[1])
-            c0, c1 = c1, nan
-            if not (_isnan(a) and _isnan(b)):
-                c1 = math.sqrt((self.p["e_hi"] - lo + w if _isnan(a) else a)
-                               * (hi - self.p["e_lo"] + w if _isnan(b) else b)) - 0.5 * w
+            c0, c1 = c1, nan if _isnan(a) and _isnan(b) else math.sqrt(
+                (self.p["e_hi"] - lo + w if _isnan(a) else a) * (hi - self.p["e_lo"] + w if _isnan(b) else b)) - 0.5 * w
             if not _isnan(c1) and c1 <= gap:
                 break
         else:

@@ -136,6 +136,8 @@ def _lines_from(p: dict) -> list[str]:
         out.append(f"one scene: noise {sc['noise_c']:g} °C, dT {sc['delta_t_c']:g} °C")
     if s["contact_s"]:
         out.append(f"contact columns {s['contact_s']['source_columns']} of the table")
+    if (start := (p.get("contact_frame") or {}).get("onset_offset_s")) is not None:
+        out.append(f"contact counted from the rig's detected onset (the model's time 0 at {start:+.3g} s)")
     ea = p["effusivity_answered"]
     out.append(f"effusivities answered {ea['min']:g} {'<=' if ea['min_inclusive'] else '<'} e <= {ea['max']:g}")
     return out

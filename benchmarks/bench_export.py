@@ -7,6 +7,14 @@ dT in [5, 15] degC, contact in [0.5, 10] s; table svm-fine (the library's defaul
     python benchmarks/bench_export.py                 # conformance and timings
     python benchmarks/bench_export.py --reference     # also (re)write tests/data/export_conformance.json
     python benchmarks/bench_export.py --baseline REV  # also REV's exports, timed in the same run
+    DESIGNKIT_DATA_DIR=/tmp/rigfinal2/data python benchmarks/bench_export.py --rig-only  # the rig section alone
+
+The rig section (issues 33, 34): the table registered for tests/data/rig_sensor.yaml (``designkit tables build
+--sensor``, found in $DESIGNKIT_DATA_DIR) exported to Python and C; 50 random pairs (seed 34) of the paper's 12
+materials' effusivity span asked of both and of the library (``designkit min-contact --sensor FILE``'s answer, at
+the rig's recorded conditions, contact from its detected onset): max |difference| of value and ends in s, and how
+many intervals agree (both ends within 1e-9 of the library's, relative, or both open); the same for delta-e at random
+contacts from the onset within the table's contact axis. Skipped, saying so, where no table is registered.
 
 Per-call times are CPU times (the machines are shared): C's clock(), Python's time.process_time(). With
 ``--baseline REV`` the module and header that commit's ``designkit/export`` writes (over this tree's
@@ -188,10 +196,96 @@ def same_answers(a: dict, b: dict) -> str:
     return ", ".join(f"{k} {sum(x == y for x, y in zip(a[k], b[k]))}/{len(a[k])}" for k in a)
 
 
+RIG_SENSOR = HERE.parent / "tests" / "data" / "rig_sensor.yaml"
+
+
+def rig_section(n: int = 50, seed: int = 34) -> None:
+    """The rig's own table exported to Python and C against the library for that sensor (see the docstring)."""
+    import importlib.util
+
+    from designkit.export import render, slice_table
+    from designkit.materials import list_materials
+    from designkit.query import ask
+    from designkit.sensor import load_sensor
+    from designkit.tables.registry import table_for_sensor
+
+    tab = table_for_sensor(load_sensor(str(RIG_SENSOR)))
+    if tab is None:
+        print(f"rig: no table registered for {RIG_SENSOR.name} in DESIGNKIT_DATA_DIR="
+              f"{os.environ.get('DESIGNKIT_DATA_DIR')!r} ('designkit tables build --sensor'): section skipped")
+        return
+    mats = list_materials(set="paper12")
+    span = (min(m.e_min for m in mats), max(m.e_max for m in mats))
+    rng = np.random.default_rng(seed)
+    e1, e2 = rng.uniform(*span, n), rng.uniform(*span, n)
+    t = time.perf_counter()
+    lib = ask("min-contact", e1=e1, e2=e2, sensor=str(RIG_SENSOR))
+    lib_s = time.perf_counter() - t
+    cond = lib.conditions
+    noise, dt = cond["noise_c"]["value"], cond["delta_t_c"]["value"]
+    ref = np.stack([lib.value, lib.low, lib.high], axis=1)
+    exp = slice_table(tab)
+    # delta-e at contacts from the rig's detected onset within the table's (model-time) contact axis
+    grid = tab.axes["contact_s"] + exp.estimator["onset_offset_s"]
+    contact = rng.uniform(grid[0], grid[-1], n)
+    de = ask("delta-e", e=e1, contact_s=contact, sensor=str(RIG_SENSOR))
+    de_ref = np.stack([de.value, de.low, de.high], axis=1)
+    with tempfile.TemporaryDirectory() as d:
+        d = Path(d)
+        (d / "rig_table.py").write_bytes(render(exp, "python"))
+        spec = importlib.util.spec_from_file_location("rig_table", d / "rig_table.py")
+        mod = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(mod)
+        py = np.array([[np.nan if x is None else x for x in mod.min_contact_interval(e1[i], e2[i], noise, dt)]
+                       for i in range(n)])
+        py_de = np.array([[np.nan if x is None else x for x in mod.delta_e_interval(e1[i], noise, dt, contact[i])]
+                          for i in range(n)])
+        (d / "dk_table.h").write_bytes(render(exp, "c"))
+        (d / "main.c").write_text(r'''#include <stdio.h>
+#include "dk_table.h"
+int main(void) {
+    double e1, e2, n, dt, c, iv[3], de[3];
+    while (scanf("%lf %lf %lf %lf %lf", &e1, &e2, &n, &dt, &c) == 5) {
+        int s = designkit_min_contact_interval(e1, e2, n, dt, iv), s2 = designkit_delta_e_interval(e1, n, dt, c, de);
+        printf("%d %.17g %.17g %.17g %d %.17g %.17g %.17g\n", s, iv[0], iv[1], iv[2], s2, de[0], de[1], de[2]);
+    }
+    return 0;
+}
+''')
+        subprocess.run(["gcc", "-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic", "-O2", "main.c", "-lm", "-o",
+                        "main"], cwd=d, check=True)
+        lines = "".join(f"{float(e1[i])!r} {float(e2[i])!r} {noise!r} {dt!r} {float(contact[i])!r}\n" for i in range(n))
+        out = subprocess.run(["./main"], cwd=d, input=lines, capture_output=True, text=True, check=True).stdout
+        rows = [line.split() for line in out.splitlines()]
+        c, c_de = (np.array([[np.nan if int(f[j]) != 0 or float(x) < 0 else float(x) for x in f[j + 1:j + 4]]
+                             for f in rows]) for j in (0, 4))
+    print(f"rig: table {tab.name} ({tab.header['content_hash'][:19]}), sensor {RIG_SENSOR.name}, {n} random pairs "
+          f"in the paper's 12 materials' span {span[0]:.0f}-{span[1]:.0f} J s^-1/2 K^-1 m^-2 (seed {seed}), noise "
+          f"{noise:.4g} degC, dT {dt:.4g} degC (the sensor file's), contact from the rig's detected onset "
+          f"({exp.estimator['onset_offset_s']:+.4f} s); library {lib_s:.2f} s for the array")
+    print(f"rig: library answers {int(np.isfinite(ref[:, 0]).sum())}/{n} (none within the table: "
+          f"{int(np.isnan(ref[:, 0]).sum())}); intervals with both ends {int(np.isfinite(ref[:, 1:]).all(1).sum())}")
+    e_unit = "J s^-1/2 K^-1 m^-2"
+    for name, got, want, unit in (("python", py, ref, "s"), ("C", c, ref, "s"), ("python", py_de, de_ref, e_unit),
+                                  ("C", c_de, de_ref, e_unit)):
+        same_none = (np.isnan(got) == np.isnan(want)).all(axis=1)
+        diff = np.where(np.isnan(got) & np.isnan(want), 0.0, np.abs(got - want))
+        ends = same_none & (diff[:, 1:] <= 1e-9 * np.fmax(np.abs(want[:, :1]), 1.0)).all(axis=1)
+        print(f"rig: {name:6s} {'min-contact' if unit == 's' else 'delta-e'} max |difference| value "
+              f"{np.nanmax(diff[:, 0]):.2e} {unit}, low {np.nanmax(diff[:, 1]):.2e} {unit}, "
+              f"high {np.nanmax(diff[:, 2]):.2e} {unit}; none where the library's none {int(same_none.sum())}/{n}; "
+              f"intervals agreeing {int(ends.sum())}/{n}")
+    print(f"rig: delta-e at contacts {contact.min():.2f}-{contact.max():.2f} s from the onset: library answers "
+          f"{int(np.isfinite(de_ref[:, 0]).sum())}/{n}")
+
+
 def main(argv: list[str]) -> None:
     from designkit.export import export_bytes, read_export, render, slice_table
     from designkit.export.estimator_data import estimator_of
 
+    rig_section()
+    if "--rig-only" in argv:
+        return
     q = questions()
     baseline = argv[argv.index("--baseline") + 1] if "--baseline" in argv else None
     if "--reference" in argv or not REFERENCE.is_file():

@@ -30,7 +30,7 @@ _WHAT = {"json": "JSON", "csv": "CSV", "npz": "NumPy npz", "mat": "MATLAB .mat",
 @app.command("export", rich_help_panel=_app.TABLES)
 def export_cmd(
     out: Annotated[str, typer.Option("--out", "-o", help="File to write (.json, .csv, .npz, .mat, .h or .py); - for standard output (give --format; a CSV then goes without its provenance sidecar).")],
-    table: Annotated[str, typer.Option("--table", help="Lookup table (name or path); default the one every question reads.")] = "svm-fine",
+    table: Annotated[Optional[str], typer.Option("--table", help="Lookup table (name or path); default the one every question reads (with --sensor FILE: the table built for that sensor, if one is).")] = None,
     fmt: Annotated[Optional[str], typer.Option("--format", "-f", help=f"Format: {_FORMATS}. Default: from --out's suffix.")] = None,
     noise: Annotated[Optional[float], typer.Option("--noise", help="Keep one scene: noise sigma per sample [°C] (with --delta-t).")] = None,
     delta_t: Annotated[Optional[float], typer.Option("--delta-t", help="Keep one scene: sensor minus object temperature [°C] (with --noise).")] = None,
@@ -53,6 +53,11 @@ def export_cmd(
     """
     from ..export import export_bytes, export_table
 
+    if table is None:  # the table the questions read: a calibrated sensor's own, where one is built for it
+        from ..tables.registry import table_for_sensor
+
+        own = table_for_sensor(sensor) if sensor is not None else None
+        table = str(own.path) if own is not None else "svm-fine"
     if sensor is not None:
         _check_sensor(table, sensor)
     slice_opts = dict(prefix=prefix, noise_c=noise, delta_t_c=delta_t, contact=contact, e_min=e_min, e_max=e_max,
@@ -131,6 +136,8 @@ def _lines_from(p: dict) -> list[str]:
         out.append(f"one scene: noise {sc['noise_c']:g} °C, dT {sc['delta_t_c']:g} °C")
     if s["contact_s"]:
         out.append(f"contact columns {s['contact_s']['source_columns']} of the table")
+    if (start := (p.get("contact_frame") or {}).get("onset_offset_s")) is not None:
+        out.append(f"contact counted from the rig's detected onset (the model's time 0 at {start:+.3g} s)")
     ea = p["effusivity_answered"]
     out.append(f"effusivities answered {ea['min']:g} {'<=' if ea['min_inclusive'] else '<'} e <= {ea['max']:g}")
     return out

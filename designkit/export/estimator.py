@@ -19,6 +19,10 @@ What it computes (:mod:`designkit.query.table`'s efficiency route, step by step)
   (:func:`designkit.query.table.noise_k_min_contact`), with its 90 % interval.
   Where no reading exists, the log-log crossing
   (:func:`designkit.query.table.contact_estimate`) or the grid cell.
+  Without a closed-form ideal observer (a calibrated rig's table): both
+  directions' needs averaged (:meth:`Estimator._both_estimate`), no ideal floor.
+* Contact times count from a calibrated rig's detected onset (``onset_offset_s``)
+  as ``designkit ... --sensor FILE`` counts them; the table's axis: model time.
 * ``delta_e``: each direction's SVM efficiency (tabulated need over the ideal
   observer's, computed at every entry around the question) applied to the ideal
   observer's delta(e) at the asked contact and sigma/dT
@@ -47,7 +51,7 @@ __all__ = ["ESTIMATOR", "ESTIMATOR_VERSION", "Estimator"]
 
 #: Name and version of the estimator every export records (bump the version when an answer changes).
 ESTIMATOR = "designkit.query.table efficiency route (noise_k_min_contact, delta_efficiency_estimate)"
-ESTIMATOR_VERSION = 1
+ESTIMATOR_VERSION = 2  # 2: tables without a closed-form ideal observer, contact from a rig's detected onset
 
 _K_SLOPE_SPAN = 1.14       # designkit.query.table.K_SLOPE_SPAN
 _SAMPLE_TOLERANCE = 1e-9   # designkit.sensor._SAMPLE_TOLERANCE
@@ -75,7 +79,9 @@ class Estimator:
         The constants: ``e_s`` [J s^-1/2 K^-1 m^-2], ``fs`` [Hz], ``width``, ``threshold``, ``z_table``,
         ``zc`` (the interval's z), ``mc_factor``, ``e_lo`` / ``e_hi`` (the source table's effusivity range),
         ``max_contact_s``, ``cum`` (cumulative g^2 per sample), and the critical-noise grid ``s_a0``,
-        ``s_u0``, ``s_du``, ``s_nu``, ``s_v0``, ``s_dv``, ``s_nv``, ``s_f`` (flat, [u][v]).
+        ``s_u0``, ``s_du``, ``s_nu``, ``s_v0``, ``s_dv``, ``s_nv``, ``s_f`` (flat, [u][v]); ``efficiency``
+        (False: no closed-form ideal observer, none of the above ideal-observer constants is read),
+        ``onset_offset_s`` (the model's time 0 from a rig's detected onset [s]; 0 or absent: none).
     """
 
     def __init__(self, lookup, up_lo, down_lo, up_hi, down_hi, p):
@@ -92,9 +98,10 @@ class Estimator:
         self.h = 0.5 * self.w
         self.n_max = int(math.floor(float(p["max_contact_s"]) * self.fs + _SAMPLE_TOLERANCE))
         self.contacts = list(lookup.contact_s)
-        # False: the table's ideal observer has no closed form (designkit simulates it): the library's estimate
-        # without the efficiency route and without the ideal observer's floor under its intervals
+        # False: the table's ideal observer has no closed form: both directions' needs averaged, no efficiency
+        # route and no ideal floor under the intervals (designkit's answer from a sensor's own table)
         self.efficiency = bool(p.get("efficiency", True))
+        self.onset = float(p.get("onset_offset_s") or 0.0)  # contact from the rig's detected onset = model's + it
         # per sample n: log(n / fs) and log |g| (n = 0: no signal)
         self._log_t = [-math.inf] + [math.log(n / self.fs) for n in range(1, len(self.cum))]
         self._log_norm = [0.5 * math.log(c) if c > 0 else -math.inf for c in self.cum]
@@ -381,10 +388,6 @@ class Estimator:
         return total
 
     # ---------------------------------------------------------------- min-contact
-    def ideal_min_contact(self, lo, hi, ratio):
-        """The ideal observer's shortest contact [s] (first sample where it separates the pair); NaN: none."""
-        return self.k_contact(ratio, self.sstar(lo, hi), 1.0, 1.0, 0.0, 0.0)
-
     def min_contact_interval(self, e1, e2, noise_c, delta_t_c):
         """``(value, low, high)`` [s] of designkit.query.min_contact (None for none / an open end).
 
@@ -394,23 +397,80 @@ class Estimator:
         t = self.t
         combos = t.scene_weights(noise, dt)
         t._check_e(lo, hi)
-        return self._min_contact(lo, hi, combos, noise / abs(dt))
+        # counted from the rig's detected onset, at least 0 (designkit.rig.for_rig)
+        return tuple(None if v is None else max(v + self.onset, 0.0)
+                     for v in self._min_contact(lo, hi, combos, noise / abs(dt)))
+
+    def _model_contact(self, contact):
+        """An asked contact [s] (from the rig's detected onset) in the table's time (designkit.rig.resolve_scene)."""
+        c = contact - self.onset
+        if not c > 0:
+            raise ValueError(f"contact {contact:g} s after the rig's detected onset ends before the model's first "
+                             f"heat flow ({self.onset:+.3g} s from the onset): give a longer contact")
+        return c
 
     def _min_contact(self, lo, hi, combos, ratio):
-        p, C = self.p, self.contacts
+        """min-contact in the table's time: the first of designkit.query.estimates.CONTACT_ESTIMATORS that answers."""
+        C = self.contacts
+        if not self.efficiency and (both := self._both_estimate(lo, hi, combos)) is not None:
+            return both
         gap = hi - lo
         value, kb, needs = self._cross("", combos, lo, hi)
         if value is None:
             return None, None, None
-        zc = p["zc"]
-        if self.efficiency:
-            ideal = self.ideal_min_contact(lo, hi, ratio)
-            # the SVM's noise efficiency against the exact ideal observer
-            ka = self._baseline(kb)
-            slices = [(row, wt) for row, wt in combos if wt]
-            lk, se = self._k_readings(slices, ka, kb, lo, hi)
+        # the ideal observer's (NaN: none), and the SVM's efficiency against it
+        ideal = self.k_contact(ratio, self.sstar(lo, hi), 1.0, 1.0, 0.0, 0.0) if self.efficiency else math.nan
+        if self.efficiency and (est := self._efficiency_estimate(lo, hi, combos, ratio, kb, ideal)) is not None:
+            return est
+        # no efficiency reading: the log-log crossing between the two tabulated needs, or the grid cell
+        prev = needs[kb - 1] if kb > 0 else math.nan
+        if kb > 0 and not _isnan(prev):
+            mc_lo = self._cross("_lo", combos, lo, hi)[0]
+            mc_hi = self._cross("_hi", combos, lo, hi)[0]
+            return self._contact_estimate(C[kb - 1], C[kb], prev, needs[kb], gap, value, mc_lo, mc_hi, ideal)
+        start = C[kb - 1] if kb > 0 else 0.0
+        return value, (max(start, ideal) if _finite(ideal) else start), value
+
+    def _both_estimate(self, lo, hi, combos):
+        """designkit.query.estimates.varied_contact_estimate, fixed conditions: per row :meth:`_rounded_crossing`
+        and its Monte Carlo ends' (z sqrt 2: two readings averaged), log t across rows; None where a row has none."""
+        zt, zc = self.p["z_table"] * math.sqrt(2.0), self.p["zc"]
+        ews, rows = (self._ew(lo), self._ew(hi)), []
+        for row, wt in ((row, wt) for row, wt in combos if wt != 0):
+            v, interp, rnd = self._rounded_crossing("", row, lo, hi, ews)
+            if _isnan(v):
+                return None
+            ends = (self._rounded_crossing(k, row, lo, hi, ews)[0] for k in ("_lo", "_hi"))
+            rows.append((wt, math.log(v), *map(math.log, _stated_log(v, *ends, math.hypot(interp, rnd), zt, zc))))
+        log_v, log_lo, log_hi = (sum(r[0] * r[i] for r in rows) for i in (1, 2, 3))
+        interp = 0.25 * sum(wt * abs(lv - log_v) for wt, lv, _, _ in rows)
+        low = math.exp(log_v - math.hypot(log_v - log_lo, zc * interp))
+        high = math.exp(log_v + math.hypot(log_hi - log_v, zc * interp))
+        return math.exp(log_v), (None if _isnan(low) else low), (None if _isnan(high) else high)
+
+    def _rounded_crossing(self, kind, row, lo, hi, ews):
+        """designkit.query.estimates.rounded_crossing of row ``row``'s need of ``kind`` ("", "_lo", "_hi") with both
+        directions averaged (pair_need_both): ``(value, interp, rounding)``, NaN at the first contact or none."""
+        w, t, C = self.w, self.t, self.contacts
+        up, down = self.arr[("up", kind)], self.arr[("down", kind)]
+        gap, nan = hi - lo, math.nan
+        c0 = c1 = nan
+        for k in range(len(C)):
+            start = (row * t._nc + k) * t._ne
+            a, b = self._val(up, start, ews[0]), self._val(down, start, ews[1])
+            c0, c1 = c1, nan if _isnan(a) and _isnan(b) else math.sqrt(
+                (self.p["e_hi"] - lo + w if _isnan(a) else a) * (hi - self.p["e_lo"] + w if _isnan(b) else b)) - 0.5 * w
+            if not _isnan(c1) and c1 <= gap:
+                break
         else:
-            ideal, ka, lk, se = math.nan, -1, [math.nan, math.nan], [math.nan, math.nan]
+            return nan, nan, nan
+        return (nan, nan, nan) if k == 0 else _loglog_cell(C[k - 1], C[k], c0, c1, gap, w)
+
+    def _efficiency_estimate(self, lo, hi, combos, ratio, kb, ideal):
+        """designkit.query.estimates.efficiency_estimate: (value, low, high), or None where it reads nothing."""
+        C, zc = self.contacts, self.p["zc"]
+        ka = self._baseline(kb)
+        lk, se = self._k_readings([(row, wt) for row, wt in combos if wt], ka, kb, lo, hi)
         t_a, t_b = C[ka if ka >= 0 else kb], C[kb]
         have_a, have_b = not _isnan(lk[0]), not _isnan(lk[1])
         if have_a or have_b:
@@ -445,14 +505,7 @@ class Estimator:
                     if _finite(ideal):
                         low = min(max(low, ideal), value_k)
                     return value_k, low, high
-        # no efficiency reading: the log-log crossing between the two tabulated needs, or the grid cell
-        prev = needs[kb - 1] if kb > 0 else math.nan
-        if kb > 0 and not _isnan(prev):
-            mc_lo = self._cross("_lo", combos, lo, hi)[0]
-            mc_hi = self._cross("_hi", combos, lo, hi)[0]
-            return self._contact_estimate(C[kb - 1], C[kb], prev, needs[kb], gap, value, mc_lo, mc_hi, ideal)
-        start = C[kb - 1] if kb > 0 else 0.0
-        return value, (max(start, ideal) if _finite(ideal) else start), value
+        return None
 
     def _contact_estimate(self, x0, x1, n0, n1, gap, raw, mc_lo, mc_hi, ideal):
         """designkit.query.table.contact_estimate for an SVM table (one element)."""
@@ -460,16 +513,8 @@ class Estimator:
         lx0, lx1, lg = math.log(x0), math.log(x1), math.log(gap)
         raw_ll = _cross2(lx0, lx1, _log(n0), _log(n1), lg)
         raw_interp = 0.0 if _isnan(raw_ll) else abs(math.log(raw) - raw_ll)
-        c0, c1 = n0 - 0.5 * w, n1 - 0.5 * w
-        loglog = _cross2(lx0, lx1, math.log(c0), math.log(c1), lg) if min(c0, c1) > 0 else math.nan
-        linear = _cross2(x0, x1, c0, c1, gap)
-        est = math.exp(loglog) if not _isnan(loglog) else math.nan
-        use = not _isnan(loglog) and not _isnan(linear) and x0 < est <= x1
-        if use:
-            l0, l1 = math.log(c0), math.log(c1)
-            slope = abs((lx1 - lx0) / (l1 - l0)) if l1 != l0 else 0.0
-            value, interp, rounding = est, abs(loglog - math.log(linear)), slope * (w / _SQRT12) / gap
-        else:
+        value, interp, rounding = _loglog_cell(x0, x1, n0 - 0.5 * w, n1 - 0.5 * w, gap, w)
+        if _isnan(interp) or not x0 < value <= x1:  # (NaN: not crossed in the cell)
             value, interp, rounding = raw, raw_interp, 0.0
         shift = math.log(value) - math.log(raw)
         ends = [math.nan if m is None else math.exp(math.log(m) + shift) for m in (mc_lo, mc_hi)]
@@ -488,7 +533,7 @@ class Estimator:
         """``(yes, sure)``: whether ``contact_s`` [s] reaches min-contact's answer for the pair, and whether
         it lies outside min-contact's interval (the library's "confident"; inside it, the library may decide
         by max-noise or delta-e instead)."""
-        contact = contact_input(contact_s)
+        contact = self._model_contact(contact_input(contact_s))
         noise, dt = scene_inputs(noise_c, delta_t_c)
         lo, hi = pair_input(e1, e2)
         t = self.t
@@ -512,7 +557,7 @@ class Estimator:
         """``{"lower": (value, low, high), "upper": (...)}`` [J s^-1/2 K^-1 m^-2] of designkit delta-e (None:
         none within the grid that way / an open end)."""
         x = effusivity_input("e", e)
-        contact = contact_input(contact_s)
+        contact = self._model_contact(contact_input(contact_s))
         noise, dt = scene_inputs(noise_c, delta_t_c)
         t = self.t
         combos = t.scene_weights(noise, dt)
@@ -712,6 +757,17 @@ def _cross2(x0, x1, n0, n1, gap):
         w = (n0 - gap) / (n0 - n1) if n0 != n1 else 1.0
         return x0 + w * (x1 - x0)
     return math.nan
+
+
+def _loglog_cell(x0, x1, c0, c1, gap, w):
+    """The rounding-corrected needs ``c0 > gap >= c1`` at contacts ``x0 < x1`` crossed log-log (designkit.query.
+    estimates.rounded_crossing's cell): ``(value, interp, rounding)``; NaN where a need is not positive."""
+    if not (c0 > 0 and c1 > 0):
+        return math.nan, math.nan, math.nan
+    lx0, lx1, l0, l1 = math.log(x0), math.log(x1), math.log(c0), math.log(c1)
+    loglog = _cross2(lx0, lx1, l0, l1, math.log(gap))
+    slope = abs((lx1 - lx0) / (l1 - l0)) if l1 != l0 else 0.0
+    return math.exp(loglog), abs(loglog - math.log(_cross2(x0, x1, c0, c1, gap))), slope * (w / _SQRT12) / gap
 
 
 def _stated_log(value, lo_end, hi_end, interp, z_table, zc):

@@ -20,14 +20,14 @@ Examples
 
 from __future__ import annotations
 
-import functools
 import math
 
 import numpy as np
 
 from .._validation import InputError
 
-__all__ = ["COVERAGE", "MORE_ARRAYS", "closed_form", "contact_frame", "estimator_of", "estimator_params", "estimator_reason"]
+__all__ = ["COVERAGE", "MORE_ARRAYS", "contact_frame", "estimator_of", "estimator_params", "estimator_reason",
+           "lookup_of"]
 
 #: Coverage of the intervals an export states (the library's default).
 COVERAGE = 0.9
@@ -49,53 +49,38 @@ def estimator_reason(tab, kind: str, contact_sliced: bool) -> str | None:
                 "estimates its answers from each scene slice and the bound by simulation)")
     if any(n not in tab.arrays for n in MORE_ARRAYS):
         return "the table holds no Monte Carlo interval (delta_*_lo / delta_*_hi)"
-    if not closed_form(tab):
-        return ("its sensor model has no closed-form ideal observer (a calibrated rig's table: the library "
-                "averages both directions' needs, crosses the rounding-corrected need and counts contact from the "
-                "rig's detected onset; the export's estimator does not carry that rule)")
     if contact_sliced:
         return "--contact keeps some contact columns; the estimator reads the efficiency on the whole contact axis"
     return None
 
 
-def closed_form(tab) -> bool:
-    """Whether the library computes ``tab``'s ideal bound in closed form (the efficiency route the estimator
-    carries); a calibrated rig's table has none."""
-    from ..query.table import open_table, table_spread
-
-    return bool(open_table(tab, None, sensor_temp_spread_c=table_spread(tab)).closed)
-
-
 def contact_frame(tab) -> dict:
-    """What the export's contact times count from (plain JSON): the model's time 0 (its first heat flow), and,
-    for a calibrated rig's sensor, the offset of that time 0 from the rig's detected onset (what
-    ``designkit min-contact --sensor FILE`` counts from)."""
+    """What the export's contact times count from (plain JSON): the table's axis and the grid rule count from the
+    model's time 0 (its first heat flow); for a calibrated rig's sensor ``onset_offset_s`` is that time 0 from
+    the rig's detected onset, and the estimator's answers and asked contacts count from the onset, as
+    ``designkit min-contact --sensor FILE`` does."""
     from ..rig import model_start_s
 
     start = model_start_s(tab.sensor)
     if start is None:
         return {"counted_from": "the model's first heat flow (t = 0)", "onset_offset_s": None}
-    return {"counted_from": "the model's first heat flow (model time), not the rig's detected onset",
+    return {"counted_from": "the model's first heat flow (model time) on the contact_s axis and in the grid rule; "
+                            "the rig's detected onset in the estimator's answers and asked contacts",
             "onset_offset_s": float(start),
             "from_onset": (f"contact after the rig's detected onset = contact_s + ({start:.6g}) s (at least 0), "
                            "as designkit answers a question about this sensor")}
 
 
-@functools.lru_cache(maxsize=4)
-def _sstar_grid(e_s: float, width: float, threshold: float, e_top: float):
-    """The critical-noise grid (a function of the sensor's effusivity, the class width and the threshold only:
-    the scene enters through the projection noise alone). Computed once per process and key (3,600 critical
-    noises)."""
-    from ..query.ideal_bound import critical_noise
-
-    sensor = _SensorLike(e_s)
+def _sstar_grid(view, e_s: float, width: float, e_top: float):
+    """The critical-noise grid the export carries: ``log(s* / (w(b) - w(a)))`` at its nodes, read off the query
+    layer's (:meth:`designkit.query.table_arrays.TableView.critical_noise`, kept with the table: within 4.2e-7 in
+    log of a fresh solve at every separable node of svm-fine's)."""
     u = np.linspace(math.log(_A0), math.log(e_top + 2 * width + _A0), _N)
     v = np.linspace(math.log(_D_MIN), math.log(e_top + 3 * width), _N)
-    a = np.exp(u)[:, None] - _A0 + 0.0 * v[None, :]
-    d = np.exp(v)[None, :] + 0.0 * u[:, None]
-    star = critical_noise(sensor, a.ravel(), (a + d).ravel(), width=width, threshold=threshold).reshape(a.shape)
-    dw = 1.0 / (1.0 + e_s / (a + d)) - np.where(a > 0, 1.0 / (1.0 + e_s / np.maximum(a, 1e-300)), 0.0)
-    f = np.log(star) - np.log(dw)
+    a, d = np.meshgrid(np.exp(u) - _A0, np.exp(v), indexing="ij")
+    with np.errstate(divide="ignore", invalid="ignore"):
+        f = np.log(view.critical_noise(a.ravel(), (a + d).ravel()).reshape(a.shape)) - np.log(
+            1.0 / (1.0 + e_s / (a + d)) - np.where(a > 0, 1.0 / (1.0 + e_s / np.maximum(a, 1e-300)), 0.0))
     # Classes that overlap too much never separate (the library's critical noise is NaN there): the bicubic
     # reading still needs a value at such nodes next to separable ones; extend each row linearly in log
     # distance from its first two finite nodes (docs/decisions-log.md, Exports)
@@ -109,18 +94,12 @@ def _sstar_grid(e_s: float, width: float, threshold: float, e_top: float):
     return (float(u[0]), float(u[1] - u[0]), float(v[0]), float(v[1] - v[0]), tuple(f.ravel().tolist()))
 
 
-class _SensorLike:
-    """What :func:`critical_noise` reads of a sensor: its effusivity."""
-
-    def __init__(self, e_s):
-        self.effusivity = e_s
-
-
 def estimator_params(tab) -> dict:
     """The estimator's constants for table ``tab`` (plain JSON data: floats and lists of floats)."""
     from ..query.crossing import z_of_coverage
     from ..query.ideal_bound import shape_norm
     from ..query.table import CLOSED_FORM_MAX_CONTACT_S, open_table, table_spread, table_z
+    from ..rig import model_start_s
     from ..sensor import last_sample_index
 
     sensor = tab.sensor
@@ -131,8 +110,8 @@ def estimator_params(tab) -> dict:
     n_max = int(last_sample_index(CLOSED_FORM_MAX_CONTACT_S, fs))
     if op.closed:
         cum = shape_norm(sensor, np.arange(max(n_max, 1) + 1) / fs) ** 2  # sum_{k<=n} g(k/fs)^2 per sample n
-        # one grid for every table up to 40,000 (the shipped range): computed once per process and sensor
-        u0, du, v0, dv, f = _sstar_grid(float(sensor.effusivity), width, float(tab.threshold), max(e_hi, 40000.0))
+        # one grid for every table up to 40,000 (the shipped range), read off the table's own memo
+        u0, du, v0, dv, f = _sstar_grid(op.view, float(sensor.effusivity), width, max(e_hi, 40000.0))
     else:  # no closed form: no efficiency route (and no ideal observer) to carry
         cum, (u0, du, v0, dv, f) = [0.0], (0.0, 1.0, 0.0, 1.0, (0.0,))
     return {
@@ -142,23 +121,26 @@ def estimator_params(tab) -> dict:
         "max_contact_s": CLOSED_FORM_MAX_CONTACT_S, "cum": [float(x) for x in cum],
         "s_a0": _A0, "s_dmin": _D_MIN, "s_u0": u0, "s_du": du, "s_nu": _N if op.closed else 1, "s_v0": v0,
         "s_dv": dv, "s_nv": _N if op.closed else 1,
-        "s_f": list(f),
+        "s_f": list(f), "onset_offset_s": float(model_start_s(sensor) or 0.0),
     }
+
+
+def lookup_of(exp):
+    """The grid rule over an export's arrays (:class:`designkit.tables.lookup.Lookup`: the module's ``TABLE``)."""
+    from ..tables.lookup import Lookup
+    from ._common import log_grid
+
+    return Lookup([(a.name, a.scale, list(a.values), log_grid(a)) for a in exp.scene_axes], list(exp.contact.values),
+                  list(exp.e_ref.values), exp.delta_up.ravel().tolist(), exp.delta_down.ravel().tolist(), exp.e_lo,
+                  exp.e_hi, exp.e_lo_inclusive, exp.contact_adjacent, exp.provenance["source_table"])
 
 
 def estimator_of(exp):
     """The documented reading rule of a data export (JSON, CSV, npz, or :class:`Exported`): the library's
     estimator over its arrays; an :class:`InputError` where the export carries none (its provenance says why)."""
-    from ..tables.lookup import Lookup
     from .estimator import Estimator
 
     if exp.estimator is None:
         why = exp.provenance.get("estimator", {}).get("unavailable") or "it carries none"
         raise InputError(f"this export cannot answer as the library does: {why}")
-    scene = [(a.name, a.scale, list(a.values), np.log(np.asarray(a.values)).tolist() if a.scale == "log"
-              else list(a.values)) for a in exp.scene_axes]
-    lk = Lookup(scene, list(exp.contact.values), list(exp.e_ref.values), exp.delta_up.ravel().tolist(),
-                exp.delta_down.ravel().tolist(), exp.e_lo, exp.e_hi, exp.e_lo_inclusive, exp.contact_adjacent,
-                exp.provenance["source_table"])
-    more = [exp.more[n].ravel().tolist() for n in MORE_ARRAYS]
-    return Estimator(lk, more[0], more[1], more[2], more[3], exp.estimator)
+    return Estimator(lookup_of(exp), *(exp.more[n].ravel().tolist() for n in MORE_ARRAYS), exp.estimator)

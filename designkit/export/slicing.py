@@ -435,7 +435,7 @@ def _provenance(tab: Table, kind: str, names: tuple[str, str], sensor: dict, axe
 
     hdr = tab.header
     fidelity = hdr.get("fidelity")
-    answers = "grid rule only" if params is None else "library"  # (a table without a closed form: refused)
+    answers = "grid rule only" if params is None else "library"
     e_lo, e_hi, inclusive = answered
     return {
         "format": EXPORT_FORMAT,

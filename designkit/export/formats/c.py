@@ -140,10 +140,10 @@ def _how_lines(exp: Exported, prefix: str, grid_is_library: bool) -> list[str]:
     p, est, P = exp.provenance, exp.estimator, prefix.upper()
     named = "Estimator: " + p["estimator"]["name"] + ", version " + str(p["estimator"]["version"])
     if est is not None and not est.get("efficiency", True):
-        return [named + ", without",
-                "its efficiency route: the table's model has no closed-form ideal observer, so designkit answers",
-                "from the table alone (as here: the same value) and simulates the ideal bound under its intervals",
-                "(not here: the low ends are the table's own). max-noise and min-delta-t are not here."]
+        return [named + ": no closed-form ideal observer; the functions below answer as designkit",
+                "min-contact / delta-e / distinguishable --sensor FILE do from the sensor's own table (the same",
+                "value and 90 % interval, contact from the rig's detected onset), double precision, libm only.",
+                "max-noise and min-delta-t are not here."]
     if est is not None:
         return [named + ": the",
                 "functions below answer as designkit min-contact / delta-e / distinguishable do (the same value",
@@ -180,6 +180,7 @@ def _provenance_values(exp: Exported, prefix: str) -> dict[str, str]:
                                  f"{_num(sensor, 'diffusivity_m2_s')!r} m^2/s, depth {_num(sensor, 'depth_m')!r} m, "
                                  f"{_num(sensor, 'sample_rate_hz')!r} Hz"),
         "MODEL": c_comment(describe_model(model)),
+        "ONSET": c_double((p.get("contact_frame") or {}).get("onset_offset_s") or 0.0),
         "FIDELITY": c_comment(p["fidelity"]), "KIND": c_comment(p["kind"]),
         "KIND_MEANING": c_comment(p["kind_meaning"]),
         "THRESHOLD": c_comment(f"{p['threshold']:g}"), "EXPORT_HASH": c_comment(p["export_hash"]),

@@ -89,13 +89,10 @@ def example_answer(exp: Exported):
         from ..estimator_data import estimator_of
 
         return q, estimator_of(exp).min_contact_s(*q)
-    from ...tables.lookup import Lookup
+    from ..estimator_data import lookup_of
 
-    scene = [(a.name, a.scale, list(a.values), log_grid(a)) for a in exp.scene_axes]
-    lk = Lookup(scene, list(exp.contact.values), list(exp.e_ref.values), exp.delta_up.ravel().tolist(),
-                exp.delta_down.ravel().tolist(), exp.e_lo, exp.e_hi, exp.e_lo_inclusive, exp.contact_adjacent)
     try:
-        return q, lk.min_contact_s(*q)
+        return q, lookup_of(exp).min_contact_s(*q)
     except ValueError:
         return q, None
 

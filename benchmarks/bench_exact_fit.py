@@ -87,13 +87,14 @@ def main() -> None:
             moved.append(m)
             ins = old.low <= new.value <= old.high
             inside += ins
+            width = math.log(new.high / new.low) / math.log(old.high / old.low)
             print(f"{what}: old {old.value:.4g} [{old.low:.4g}, {old.high:.4g}], new {new.value:.4g} "
-                  f"[{new.low:.4g}, {new.high:.4g}]: moved {m:+.1%}, width x{math.log(new.high / new.low) / math.log(old.high / old.low):.2f}, "
+                  f"[{new.low:.4g}, {new.high:.4g}]: moved {m:+.1%}, width x{width:.2f}, "
                   f"{'inside' if ins else 'OUTSIDE'} the old interval ({time.process_time() - t0:.0f} CPU s)",
                   flush=True)
     if moved:
-        print(f"{len(moved)} estimates: {inside} inside their old interval; moved median {statistics.median(moved):+.1%}, "
-              f"median |moved| {statistics.median(abs(m) for m in moved):.1%}, largest {max(moved, key=abs):+.1%}")
+        print(f"{len(moved)} estimates: {inside} inside their old interval; moved median "
+              f"{statistics.median(moved):+.1%}, median |moved| {statistics.median(abs(m) for m in moved):.1%}, largest {max(moved, key=abs):+.1%}")
 
 
 if __name__ == "__main__":

@@ -138,16 +138,13 @@ QUADRATIC_MIN_POINTS = 5
 def _fit_crossing(u, y, w, target: float, increasing: bool, quadratic: bool = True) -> tuple[float, float] | None:
     """Where the weighted least-squares fit of ``y`` on ``u`` reaches ``target``: ``(u*, sd of u*)``, or None.
 
-    The fit is ``y = a + b v + c v^2`` with ``v = u - mean(u)`` when at least :data:`QUADRATIC_MIN_POINTS`
-    points are given, else ``a + b v``. The curvature term is there because the SVM's F1 is not logit-linear in
-    log x over the fit's window (a factor of about 2 around the crossing): on the calibrated rig the logit slope
-    rises from about 4 below the threshold to 7-10 above it, and a straight line through such points lies above
-    the curve at the crossing, so it answered early (issue 34: by a median 2 % on replays of the rig's measured
-    F1, 4-7 % on four of six checked pairs; the straight line on logistic curves is unbiased, and so is this).
-    ``sd`` is the delta method's on ``(a, b, c)``, widened by the lack of fit (residual variance above the
-    stated errors). Where the quadratic does not reach ``target`` with the curve's slope within the points'
-    span (padded by that span on each side), the straight line answers (``quadratic=False``). None when the
-    fit never reaches ``target`` with the right slope.
+    ``y = a + b v + c v^2`` (``v = u - mean(u)``) with at least :data:`QUADRATIC_MIN_POINTS` points, else
+    ``a + b v``: the SVM's F1 is not logit-linear in log x over the fit's window (on the calibrated rig its logit
+    slope rises through the threshold), and a straight line there answered early (issue 34: 4-8 % on 7 of 10 rig
+    pairs; benchmarks/results/sensor_table_bias.txt). ``sd``: the delta method's, widened by the lack of fit,
+    and never below the straight line's on the same points (the quadratic's lack of fit has 2 degrees of
+    freedom, its errors come from 4 seeds: a low middle draw passes for curvature). A quadratic root outside the
+    points' span (padded by the span) gives way to the line. None: no crossing with the curve's slope.
 
     >>> u = np.linspace(-1.0, 1.0, 5)
     >>> round(_fit_crossing(u, 1.0 + 2.0 * u + 0.5 * u ** 2, np.ones(5), 1.0, True)[0], 9)
@@ -178,7 +175,11 @@ def _fit_crossing(u, y, w, target: float, increasing: bool, quadratic: bool = Tr
             return _fit_crossing(u, y, w, target, increasing, quadratic=False)
     slope = beta + 2.0 * gamma * v_star
     grad = -np.array([1.0, v_star, v_star ** 2][:X.shape[1]]) / slope
-    return v0 + v_star, math.sqrt(max(float(grad @ cov @ grad), 0.0))
+    sd = math.sqrt(max(float(grad @ cov @ grad), 0.0))
+    if X.shape[1] == 3:  # never narrower than the straight line's interval on the same points
+        line = _fit_crossing(u, y, w, target, increasing, quadratic=False)
+        sd = sd if line is None else max(sd, line[1])
+    return v0 + v_star, sd
 
 
 def estimate_crossing(f: Callable[[float], tuple[float, float]], x_lo: float, x_hi: float, phi: float, *,

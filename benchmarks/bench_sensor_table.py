@@ -13,6 +13,10 @@ Usage::
     python benchmarks/bench_sensor_table.py --sensor /tmp/rig.yaml --out /tmp/bst --phase table
     # the truth for a few pairs: fresh-seed F1 at fixed contacts around both answers, a smooth fit's crossing
     nice -n 10 python benchmarks/bench_sensor_table.py --sensor /tmp/rig.yaml --out /tmp/bst --phase truth --indices 0,1,2
+    # --exact against that truth, the straight-line fit (before issue 34) and the curvature fit (now) on the same
+    # evaluations of the route (the route runs once per pair with this tree; its evaluations are replayed)
+    nice -n 5 python benchmarks/bench_sensor_table.py --sensor tests/data/rig_sensor.yaml --out /tmp/bst --phase bias \
+        --indices 0,1,2,9,15,17 --truth benchmarks/results/sensor_table_truth.jsonl
     # where a build's CPU goes (one block of 20 references at each contact; no table needed)
     python benchmarks/bench_sensor_table.py --sensor tests/data/rig_sensor.yaml --out /tmp/bst --phase profile
 
@@ -67,7 +71,7 @@ def _scene(sensor):
     return resolve_scene(sensor, {"noise_c": None, "delta_t_c": None}).values
 
 
-def exact_case(sensor_file: str, case: dict, repeats: int = 4, solver: str = "batched") -> dict:
+def exact_case(sensor_file: str, case: dict, repeats: int = 4, solver: str = "batched", evaluations: bool = False) -> dict:
     from designkit.models import sensor_model
     from designkit.query.exact import exact_min_contact
     from designkit.sensor import load_sensor
@@ -79,9 +83,12 @@ def exact_case(sensor_file: str, case: dict, repeats: int = 4, solver: str = "ba
                           model=sensor_model(sen), seed=1000 + case["index"], repeats=repeats, jobs=1,
                           solver=solver)
     d = a.to_dict()
+    extra = {"evaluations": d["computation"]["evaluations"], "ideal_interval": d["ideal"].get("interval")} \
+        if evaluations else {}
     return {**case, "exact": {"value": d["value"], "low": d["interval"]["low"], "high": d["interval"]["high"],
-                              "coverage": d["interval"]["coverage"], "ideal": d["ideal"]["value"]},
-            "repeats": repeats, "solver": solver, "load": os.getloadavg()[0], "wall_s": time.perf_counter() - t0, "cpu_s": time.process_time() - c0}
+                              "coverage": d["interval"]["coverage"], "ideal": d["ideal"]["value"], **extra},
+            "repeats": repeats, "solver": solver, "load": os.getloadavg()[0], "wall_s": time.perf_counter() - t0,
+            "cpu_s": time.process_time() - c0}
 
 
 def phase_exact(args) -> None:
@@ -343,6 +350,76 @@ def phase_truth(args) -> None:
               + " ".join(f"{c + start:.3f}:{np.mean(cs[c]):.3f}" for c in xs), flush=True)
 
 
+def refit(row: dict, curvature: bool) -> tuple:
+    """The exact route's crossing estimate replayed on its own evaluations (``row["exact"]["evaluations"]``, model
+    time): ``(value, low, high)`` with the route's floor at the ideal observer. The route's design depends only on
+    the values it has seen, so the replay asks the same contacts and, with ``curvature=True`` (this tree's fit),
+    returns the route's own answer; ``curvature=False`` is the straight-line fit of the route before issue 34."""
+    from designkit.query.answer import ideal_floor
+    from designkit.query.crossing import estimate_crossing
+
+    ex = row["exact"]
+    seen = {e["contact_s"]: (e["svm_f1"], e["standard_error"]) for e in ex["evaluations"]}
+    iv = ex.get("ideal_interval")
+    ideal = ex["ideal"]
+    start = min(seen)  # the route searches from the ideal observer's contact (its first evaluation)
+    e = estimate_crossing(lambda x: seen[x], start, max(seen), 0.9, curvature=curvature)
+    floor = ideal_floor(ideal, None if iv is None else (iv["low"], iv["high"]))
+    value = e.value if e.value is None or ideal is None else max(e.value, ideal)
+    low = e.low if e.low is None or floor is None else max(e.low, floor)
+    return value, low, e.high
+
+
+def phase_bias(args) -> None:
+    """--exact against the truth of ``--indices`` (``--truth``: fresh-seed F1 draws, :func:`phase_truth`), before
+    and after issue 34's fix in one run. Before: the route at main as stored (``--before``, exact.jsonl of
+    ``--phase exact``, the same seeds). Now: the route runs once per pair with this tree (appended to
+    OUT/exact_evaluations.jsonl, resumable); beside it, its own evaluations fitted by the straight line
+    (:func:`refit`, ``curvature=False``: the fix's share, apart from the Monte Carlo ideal bound's own change, which
+    moves where the search starts). Errors are of the time from the rig's detected onset, as the answer states it.
+    Prints per pair the truth, each estimate with its 90 % interval, its error and whether it holds the truth;
+    then the median error, its range and the count held."""
+    from designkit.rig import model_start_s
+    from designkit.sensor import load_sensor
+    from designkit.sweep.for_sensor import effusivity_span
+
+    start = model_start_s(load_sensor(args.sensor)) or 0.0
+    pairs = {r["index"]: r for r in draw_pairs(max(int(i) for i in args.indices.split(",")) + 1, args.seed,
+                                              effusivity_span(material_set=args.materials).e_max)}
+    path = Path(args.out) / "exact_evaluations.jsonl"
+    rows = {r["index"]: r for r in map(json.loads, path.read_text().splitlines())} if path.exists() else {}
+    before = {r["index"]: r for r in map(json.loads, Path(args.before).read_text().splitlines())}
+    by: dict = {}
+    for x in map(json.loads, Path(args.truth).read_text().splitlines()):
+        by.setdefault(x["index"], {}).setdefault(x["contact_model_s"], []).extend(x["f1"])
+    labels = {"main": "main's route (stored)", "line": "straight line, these evaluations", "now": "now"}
+    out: dict = {k: [] for k in labels}
+    print(f"times from the onset [s]; pair e1 e2 | truth | " + " | ".join(labels.values()))
+    for i in (int(x) for x in args.indices.split(",")):
+        if i not in rows:
+            r = exact_case(args.sensor, pairs[i], args.repeats, args.solver, evaluations=True)
+            with path.open("a") as fh:
+                fh.write(json.dumps(r) + "\n")
+            rows[i] = r
+        r = rows[i]
+        cs = sorted(by[i])
+        truth, se = true_crossing(cs, [np.array(by[i][c]) for c in cs])
+        b = before[i]["exact"]
+        est = {"main": (b["value"], b["low"], b["high"]), "line": refit(r, False), "now": refit(r, True)}
+        if not math.isclose(est["now"][0], r["exact"]["value"], rel_tol=1e-9):
+            sys.exit(f"pair {i}: the replay ({est['now'][0]}) is not the route's own answer ({r['exact']['value']})")
+        line = f"{i:3d} {r['e1']:<7g} {r['e2']:<7g} | {truth + start:.3f} +- {se:.3f} "
+        for k, (v, lo, hi) in est.items():
+            err, held = math.log((v + start) / (truth + start)), lo <= truth <= hi
+            out[k].append((err, held))
+            line += f"| {v + start:.3f} [{lo + start:.3f}, {hi + start:.3f}] {err:+6.1%} {'held  ' if held else 'MISSED'} "
+        print(line, flush=True)
+    for k, label in labels.items():
+        e = [x for x, _ in out[k]]
+        print(f"{label}: median error {statistics.median(e):+.1%} (range {min(e):+.1%} to {max(e):+.1%}), "
+              f"{sum(h for _, h in out[k])} of {len(e)} intervals hold the truth")
+
+
 def phase_profile(args) -> None:
     """Where a build's CPU goes: one block of references (``--rows``) at each tabulated contact, run as a sweep worker
     runs it; per contact the fits per reference, CPU per fit, and the shares of simulation + features, libsvm's SMO
@@ -393,8 +470,12 @@ def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--sensor", required=True)
     p.add_argument("--out", required=True)
-    p.add_argument("--phase", choices=("exact", "table", "truth", "profile"), required=True)
-    p.add_argument("--indices", default="0,1,2,17", help="truth: the pairs (indices of exact.jsonl)")
+    p.add_argument("--phase", choices=("exact", "table", "truth", "bias", "profile"), required=True)
+    p.add_argument("--indices", default="0,1,2,17", help="truth, bias: the pairs (indices of exact.jsonl)")
+    p.add_argument("--truth", default="benchmarks/results/sensor_table_truth.jsonl",
+                   help="bias: the truth's F1 draws (truth.jsonl of --phase truth)")
+    p.add_argument("--before", default="benchmarks/results/sensor_table_exact.jsonl",
+                   help="bias: the exact route's answers at main (exact.jsonl of --phase exact)")
     p.add_argument("--points", type=int, default=7, help="truth: contacts per pair")
     p.add_argument("--rounds", type=int, default=4, help="truth: rounds of 8 fresh seeds at every contact")
     p.add_argument("--rows", type=int, default=20, help="profile: references per profiled block")
@@ -413,7 +494,8 @@ def main() -> None:
     p.add_argument("--build-cpu-s", type=float, default=None, help="CPU seconds the build printed (projection)")
     args = p.parse_args()
     Path(args.out).mkdir(parents=True, exist_ok=True)
-    {"exact": phase_exact, "table": phase_table, "truth": phase_truth, "profile": phase_profile}[args.phase](args)
+    {"exact": phase_exact, "table": phase_table, "truth": phase_truth, "bias": phase_bias,
+     "profile": phase_profile}[args.phase](args)
 
 
 if __name__ == "__main__":

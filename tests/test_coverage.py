@@ -36,12 +36,14 @@ def test_independent_points_cover_and_common_random_numbers_do_not(increasing):
     # issue 13's root cause on a known truth: the fit assumes independent design points. Rising (contact,
     # delta-e) and falling (sigma/dT) curves alike are covered near nominal when they are; with the
     # seed-to-seed correlation the exact route once had between neighbouring points (~0.85 on the
-    # sigma/dT and delta-e axes) the stated intervals are about 1.7x too narrow and cover ~65 %
+    # sigma/dT and delta-e axes) the stated intervals are too narrow: 1.7x and ~68 % covered with the straight-line
+    # fit, 1.2x and 82-84 % with the curvature fit (issue 34; its interval is never narrower than the line's,
+    # whose lack of fit the correlated draws inflate), against 0.9x and 92-93 % for independent points
     ok = synthetic_coverage(300, seed=21, increasing=increasing)
     assert ok["none"] == 0 and 0.85 <= ok["coverage"] <= 0.97, ok
     assert 0.8 <= ok["z_sd"] <= 1.15, ok
     crn = synthetic_coverage(300, seed=21, increasing=increasing, correlation=0.85)
-    assert crn["coverage"] < 0.8 and crn["z_sd"] > 1.4, crn
+    assert crn["coverage"] < ok["coverage"] - 0.05 and crn["z_sd"] > 1.15, crn
 
 
 def test_exact_route_draws_fresh_touches_at_every_evaluation():

@@ -8,18 +8,19 @@ a model of the curve near the crossing and solves it:
 1. coarse bisection in ``log x`` brackets the crossing (``bracket_ratio``);
 2. a small design of points spread across the bracket (``design`` points)
    is evaluated;
-3. ``logit((F1 - 0.5) / 0.5) = a + b log x`` is fitted by weighted least squares
-   (weights ``1 / SE^2`` on that scale, SE floored at ``se_floor``) to the evaluations whose mean is
+3. ``logit((F1 - 0.5) / 0.5) = a + b v + c v^2`` (``v = log x`` less its mean over the points; the
+   curvature term ``c`` where five points are informative, :func:`_fit_crossing`) is fitted by weighted
+   least squares (weights ``1 / SE^2`` on that scale, SE floored at ``se_floor``) to the evaluations whose mean is
    informative (strictly between chance and 1), nearest the threshold first; where fewer than three
    are (a steep curve), the bracket is first narrowed around the crossing by bisection down to
    ``fine_ratio``, and without a fit then, that bracket is the answer (no stated coverage);
 4. the crossing ``x*`` where the fit reaches ``phi`` and its ``coverage`` confidence
-   interval by the delta method on ``(a, b)``, widened by the lack of fit
+   interval by the delta method on ``(a, b, c)``, widened by the lack of fit
    (residual variance above the stated SEs).
 
 The interval covers the crossing of the *mean* F1 curve (the answer with
 infinitely many seeds), at the stated coverage, to the extent the local
-linear model holds (the coverage benchmark, :mod:`designkit_lab.accuracy.coverage`,
+quadratic model holds (the coverage benchmark, :mod:`designkit_lab.accuracy.coverage`,
 measures it).
 
 Examples
@@ -129,10 +130,63 @@ def _logit_se(m, se):
     return se / (0.5 * p * (1.0 - p))
 
 
+#: Fewest informative points for the curvature term of the fit (three parameters and two degrees of freedom
+#: left for the lack of fit); with fewer the fit is a straight line.
+QUADRATIC_MIN_POINTS = 5
+
+
+def _fit_crossing(u, y, w, target: float, increasing: bool, quadratic: bool = True) -> tuple[float, float] | None:
+    """Where the weighted least-squares fit of ``y`` on ``u`` reaches ``target``: ``(u*, sd of u*)``, or None.
+
+    ``y = a + b v + c v^2`` (``v = u - mean(u)``) with at least :data:`QUADRATIC_MIN_POINTS` points, else
+    ``a + b v``: the SVM's F1 is not logit-linear in log x over the fit's window (on the calibrated rig its logit
+    slope rises through the threshold), and a straight line there answered early (issue 34: 4-8 % on 7 of 10 rig
+    pairs; benchmarks/results/sensor_table_bias.txt). ``sd``: the delta method's, widened by the lack of fit,
+    and never below the straight line's on the same points (the quadratic's lack of fit has 2 degrees of
+    freedom, its errors come from 4 seeds: a low middle draw passes for curvature). A quadratic root outside the
+    points' span (padded by the span) gives way to the line. None: no crossing with the curve's slope.
+
+    >>> u = np.linspace(-1.0, 1.0, 5)
+    >>> round(_fit_crossing(u, 1.0 + 2.0 * u + 0.5 * u ** 2, np.ones(5), 1.0, True)[0], 9)
+    0.0
+    """
+    v0 = float(np.mean(u))
+    v = u - v0
+    cols = [np.ones_like(v), v] + ([v ** 2] if quadratic and v.size >= QUADRATIC_MIN_POINTS else [])
+    X = np.column_stack(cols)
+    cov = np.linalg.inv(X.T @ (X * w[:, None]))
+    coef = cov @ (X.T @ (w * y))
+    resid = y - X @ coef
+    chi2 = float(np.sum(w * resid ** 2)) / max(v.size - X.shape[1], 1)
+    cov = cov * max(1.0, chi2)  # lack of fit beyond the stated errors widens the interval
+    alpha, beta = float(coef[0]), float(coef[1])
+    gamma = float(coef[2]) if X.shape[1] == 3 else 0.0
+    if gamma == 0.0:
+        if (beta <= 0) == increasing or beta == 0:
+            return None
+        v_star = (target - alpha) / beta
+    else:
+        disc = beta * beta - 4.0 * gamma * (alpha - target)
+        # the root where the slope b + 2 c v (= +-sqrt(disc) there) has the curve's sign
+        den = beta + (1.0 if increasing else -1.0) * math.sqrt(max(disc, 0.0))
+        span = float(v.max() - v.min())
+        v_star = 2.0 * (target - alpha) / den if disc > 0 and den != 0 else math.inf
+        if not v.min() - span <= v_star <= v.max() + span:
+            return _fit_crossing(u, y, w, target, increasing, quadratic=False)
+    slope = beta + 2.0 * gamma * v_star
+    grad = -np.array([1.0, v_star, v_star ** 2][:X.shape[1]]) / slope
+    sd = math.sqrt(max(float(grad @ cov @ grad), 0.0))
+    if X.shape[1] == 3:  # never narrower than the straight line's interval on the same points
+        line = _fit_crossing(u, y, w, target, increasing, quadratic=False)
+        sd = sd if line is None else max(sd, line[1])
+    return v0 + v_star, sd
+
+
 def estimate_crossing(f: Callable[[float], tuple[float, float]], x_lo: float, x_hi: float, phi: float, *,
                       increasing: bool = True, coverage: float = 0.9, bracket_ratio: float = 1.6,
                       design: int = 4, se_floor: float = 0.004, fine_ratio: float = 1.05,
-                      progress: Callable[[int, int, str], None] | None = None) -> CrossingEstimate:
+                      progress: Callable[[int, int, str], None] | None = None,
+                      curvature: bool = True) -> CrossingEstimate:
     """Estimate where the mean of ``f`` crosses ``phi`` on ``[x_lo, x_hi]`` (``x > 0``), log scale.
 
     Parameters
@@ -158,6 +212,9 @@ def estimate_crossing(f: Callable[[float], tuple[float, float]], x_lo: float, x_
         Smallest standard error used as a weight (a mean of a few seeds can show SE 0).
     progress : callable, optional
         ``progress(done, total, message)`` after each evaluation (``total`` is an estimate).
+    curvature : bool
+        Fit the curvature term where enough points are informative (:func:`_fit_crossing`); False fits the
+        straight line alone (the estimator before issue 34, kept for the benchmark that compares the two).
 
     Returns
     -------
@@ -226,19 +283,11 @@ def estimate_crossing(f: Callable[[float], tuple[float, float]], x_lo: float, x_
         a, b = bisect(max([x for x in evals if x < b and not beyond(x)], default=a), b, fine_ratio)
     u = np.log(xs[use])
     y, w = _logit(ms[use]), 1.0 / _logit_se(ms[use], ss[use]) ** 2
-    X = np.column_stack([np.ones_like(u), u])
-    cov = np.linalg.inv(X.T @ (X * w[:, None]))
-    coef = cov @ (X.T @ (w * y))
-    resid = y - X @ coef
-    chi2 = float(np.sum(w * resid ** 2)) / max(len(use) - 2, 1)
-    cov = cov * max(1.0, chi2)  # lack of fit beyond the stated errors widens the interval
-    alpha, beta = float(coef[0]), float(coef[1])
-    if (beta <= 0) == increasing or beta == 0:
-        return CrossingEstimate(math.sqrt(a * b), a, b, coverage, "bracket", log_of(evals))
     target = float(_logit(np.array(phi)))
-    u_star = (target - alpha) / beta
-    grad = np.array([-1.0 / beta, -(target - alpha) / beta ** 2])
-    sd = math.sqrt(max(float(grad @ cov @ grad), 0.0))
+    fit = _fit_crossing(u, y, w, target, increasing, quadratic=curvature)
+    if fit is None:
+        return CrossingEstimate(math.sqrt(a * b), a, b, coverage, "bracket", log_of(evals))
+    u_star, sd = fit
     # clipped to the range examined in log space, before exp: a nearly flat fit has u_star +- z sd far
     # outside it (exp overflowed on a flat, noisy curve)
     def x_of(u: float) -> float:

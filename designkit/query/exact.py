@@ -294,7 +294,7 @@ def exact_min_contact(e1=None, e2=None, *, m1=None, m2=None, objects=None, noise
     """Shortest contact time [s] computed for this pair: an estimate of where the SVM's mean F1 crosses Phi.
 
     The crossing of the noisy monotone F1 curve is estimated by a logistic fit in
-    log(contact) near it (:func:`designkit.query.crossing.estimate_crossing`),
+    log(contact), with a curvature term, near it (:func:`designkit.query.crossing.estimate_crossing`),
     with a confidence interval at ``coverage``, clipped below at the exact
     ideal-observer bound (no classifier needs less contact).
 
@@ -605,7 +605,7 @@ def exact_delta_e(e: float | None = None, *, m: str | None = None, contact_s: fl
 
     Per direction, the mean SVM F1 of the reference against a partner ``d`` away
     rises with ``d``; its crossing of Phi is estimated like min-contact's
-    (:func:`designkit.query.crossing.estimate_crossing`, logistic fit in log d,
+    (:func:`designkit.query.crossing.estimate_crossing`, logistic fit in log d with a curvature term,
     searched from the exact ideal-observer delta up). ``interval`` is the
     interval of the direction giving ``value``; each direction's is in ``details``.
 

@@ -196,6 +196,8 @@ class CriticalNoiseGrid:
         self.du = (math.log(e_top + 2.0 * width + NOISE_GRID_A0) - self.u0) / (n - 1)
         self.v0 = math.log(NOISE_GRID_MIN_WIDTHS * width)
         self.dv = (math.log(e_top + 3.0 * width) - self.v0) / (n - 1)
+        self._origin = np.array([[self.u0], [self.v0]])  # (u, v) of node (0, 0) and the steps, [2, 1] each
+        self._step = np.array([[self.du], [self.dv]])
         self.values = np.full(n * n, np.nan)  # log(s* / dw) at node (i, j), flat i * n + j
         self.known = np.zeros(n * n, dtype=bool)
 
@@ -225,15 +227,14 @@ class CriticalNoiseGrid:
         n = NOISE_GRID_NODES
         out = np.full(lo.size, np.nan)
         with np.errstate(divide="ignore", invalid="ignore"):
-            pu = (np.log(lo + NOISE_GRID_A0) - self.u0) / self.du
-            pv = (np.log(hi - lo) - self.v0) / self.dv
-        inside = (lo >= 0) & (pu <= n - 1) & (pv >= 0) & (pv <= n - 1)
+            # the grid coordinates (u, v) of every pair, [2, pair]
+            p = (np.log(np.stack([lo + NOISE_GRID_A0, hi - lo])) - self._origin) / self._step
+            inside = (lo >= 0) & (p[0] <= n - 1) & (p[1] >= 0) & (p[1] <= n - 1)
         i = np.flatnonzero(inside)
         if i.size:
-            pu, pv = pu[i], pv[i]
-            su = np.minimum(np.maximum(np.floor(pu).astype(np.int64) - 1, 0), n - 4)
-            sv = np.minimum(np.maximum(np.floor(pv).astype(np.int64) - 1, 0), n - 4)
-            flat = (su[:, None, None] + _FOUR[None, :, None]) * n + (sv[:, None, None] + _FOUR[None, None, :])
+            p = p[:, i]
+            s = np.minimum(np.maximum(np.floor(p).astype(np.int64) - 1, 0), n - 4)  # the first of 4 nodes a side
+            flat = (s[0][:, None, None] + _FOUR[None, :, None]) * n + (s[1][:, None, None] + _FOUR[None, None, :])
             if not self.known[flat].all():
                 missing = flat[~self.known[flat]]  # the whole blocks of NOISE_GRID_BLOCK x NOISE_GRID_BLOCK nodes around them
                 b = NOISE_GRID_BLOCK
@@ -244,7 +245,8 @@ class CriticalNoiseGrid:
                 cols = (blocks % (n // b))[:, None, None] * b + np.arange(b)[None, None, :]
                 nodes = (rows * n + cols).ravel()
                 self._fill(nodes[~self.known[nodes]])
-            g = np.einsum("pi,pj,pij->p", _lagrange4(pu - su), _lagrange4(pv - sv), self.values[flat])
+            lu, lv = _lagrange4(p - s)
+            g = np.einsum("pi,pj,pij->p", lu, lv, self.values[flat])
             w = self._weight(np.concatenate([hi[i], lo[i]]))
             out[i] = np.exp(g) * (w[:i.size] - w[i.size:])
         rest = np.flatnonzero(np.isnan(out) & np.isfinite(lo) & np.isfinite(hi))
@@ -258,39 +260,41 @@ class CriticalNoiseGrid:
 
 _FOUR = np.arange(4)
 _FOUR.flags.writeable = False
+#: The cubic Lagrange weights' factors: weight j is ``F1 F2 F3 / DIV`` with ``F = x - m`` (m the other nodes),
+#: the first signed (:func:`_lagrange4`).
+_LAGRANGE = (np.array([1, 0, 0, 0]), np.array([-1.0, 1.0, -1.0, 1.0]), np.array([2, 2, 1, 1]), np.array([3, 3, 3, 2]),
+             np.array([6.0, 2.0, 2.0, 6.0]))
 
 
 def _lagrange4(x: np.ndarray) -> np.ndarray:
-    """Cubic Lagrange weights of the nodes 0, 1, 2, 3 at positions ``x`` (in [0, 3]): shape ``x.shape + (4,)``."""
-    a, b, c, d = x, x - 1.0, x - 2.0, x - 3.0
-    out = np.empty(x.shape + (4,))
-    out[..., 0], out[..., 1], out[..., 2], out[..., 3] = -b * c * d / 6.0, a * c * d / 2.0, -a * b * d / 2.0, a * b * c / 6.0
-    return out
+    """Cubic Lagrange weights of the nodes 0, 1, 2, 3 at positions ``x`` (in [0, 3]): shape ``x.shape + (4,)``,
+    each weight's product in one order (``-(x-1)(x-2)(x-3)/6``, ``x(x-2)(x-3)/2``, ``-x(x-1)(x-3)/2``,
+    ``x(x-1)(x-2)/6``)."""
+    first, sign, second, third, div = _LAGRANGE
+    f = x[..., None] - _FOUR  # x - m for the nodes m = 0 .. 3
+    return f[..., first] * sign * f[..., second] * f[..., third] / div
 
 
 # ============================================================ the noise efficiency (min-contact)
 def _entries(view, slices, ka, kb, lo, hi, readings=None):
-    """The table's entries a pair's noise efficiency is read from, in one gather per array: the SVM need and its
-    Monte Carlo ends (``delta_{up,down}{,_lo,_hi}``, interpolated in effusivity as
+    """The table's entries a pair's noise efficiency is read from, in one gather: the SVM need and its Monte
+    Carlo ends (``delta_{up,down}{,_lo,_hi}``, interpolated in effusivity as
     :func:`designkit.tables.lookup.interp_e`) upwards at ``lo`` and downwards at ``hi``, at the contacts ``ka``
-    (row 0) and ``kb`` (row 1), in each of the pair's slices ``slices`` (n, m): three arrays shaped
-    (contact 2, slice m, direction 2, pair n), and the (clipped) contact indices (2, n). ``readings``: these
-    arrays upwards and downwards at every contact in the slices (the first three kinds of
-    :meth:`~designkit.query.table_arrays.TableView.readings`), read already."""
+    (row 0) and ``kb`` (row 1), in each of the pair's slices ``slices`` (n, m): one array shaped (need / lo /
+    hi 3, contact 2, slice m, direction 2, pair n), and the (clipped) contact indices (2, n). ``readings``: these
+    arrays upwards and downwards at every contact in the slices, [direction, kind, slice, contact, pair] (the
+    first three kinds of :meth:`~designkit.query.table_arrays.TableView.readings`), read already."""
     jj = np.minimum(np.maximum(np.array([ka, kb]), 0), view.contacts.size - 1)  # (2, n)
-    if readings is not None:  # [kind, slice, contact, pair] -> [kind, contact, slice, pair] at jj
-        pair = np.arange(lo.size)
-        sides = [r[:, :, jj, pair].transpose(0, 2, 1, 3) for r in readings]
-    else:
-        si = slices.T[None]  # (1, m, n)
-        j = jj[:, None, :]  # (2, 1, n)
-        sides = []
-        for d, e in (("up", lo), ("down", hi)):  # the need and its two ends in one reading per direction
-            arrays = [view.t.arrays[f"delta_{d}{suffix}"] for suffix in ("", "_lo", "_hi")]
-            sides.append(interp_e_by(lambda c: np.stack([a[si, j, c] for a in arrays]), view.centres,
-                                     np.broadcast_to(e, (2, si.shape[1], e.size))))
-    out = np.stack(sides, axis=3)  # [need / lo / hi, contact, slice, direction, pair]
-    return list(out), jj
+    if readings is not None:  # [direction, kind, slice, contact, pair] at jj -> [kind, contact, slice, direction, pair]
+        return readings[:, :3, :, jj, np.arange(lo.size)].transpose(1, 3, 2, 0, 4), jj
+    si = slices.T[None]  # (1, m, n)
+    j = jj[:, None, :]  # (2, 1, n)
+    sides = []
+    for d, e in (("up", lo), ("down", hi)):  # the need and its two ends in one reading per direction
+        arrays = [view.t.arrays[f"delta_{d}{suffix}"] for suffix in ("", "_lo", "_hi")]
+        sides.append(interp_e_by(lambda c: np.stack([a[si, j, c] for a in arrays]), view.centres,
+                                 np.broadcast_to(e, (2, si.shape[1], e.size))))
+    return np.stack(sides, axis=3), jj  # [need / lo / hi, contact, slice, direction, pair]
 
 
 def _k_readings(op, slices, sw, ka, kb, lo, hi, extra=None, readings=None):
@@ -300,89 +304,86 @@ def _k_readings(op, slices, sw, ka, kb, lo, hi, extra=None, readings=None):
     :func:`noise_k_min_contact`. The entries' critical noises are read off the table's
     :class:`CriticalNoiseGrid`; ``extra``: (lo, hi) of further pairs read in the same call, whose critical
     noises are returned third (None: not asked)."""
-    view, tab = op.view, op.tab
-    width = op.width
-    z_table = table_z(tab)
+    view, width = op.view, op.width
+    z_table = table_z(op.tab)
     n = lo.size
     h, rnd_sd = 0.5 * width, width / math.sqrt(12.0)
-    (d, dl, dh), jj = _entries(view, slices, ka, kb, lo, hi, readings)  # (2, m, 2, n)
+    entries, jj = _entries(view, slices, ka, kb, lo, hi, readings)  # (3, 2, m, 2, n)
+    d = entries[0]
     shape = d.shape
-    m = shape[1]
-    kk = np.array([ka, kb])
-    ok_j = ((kk >= 0) & (kk < view.contacts.size))[:, None, None, :]
+    ok_j = ((ka >= 0) & (ka < view.contacts.size), (kb >= 0) & (kb < view.contacts.size))
     with np.errstate(invalid="ignore"):
-        ok = np.isfinite(d) & (d > width) & ok_j & (sw.T[None, :, None, :] > 0)
+        ok = np.isfinite(d) & (d > width) & (sw.T[None, :, None, :] > 0)
         ok[:, :, 1] &= hi - (d[:, :, 1] - h) > 0  # downwards: the partner stays above 0
+        ok[0] &= ok_j[0]
+        ok[1] &= ok_j[1]
     # the entries in (contact, slice, direction, pair) order
-    C4, M4, S4, P4 = np.unravel_index(np.flatnonzero(ok), shape)
-    D, DL, DH = d[ok], dl[ok], dh[ok]
-    P, Cc, SIGN = P4, C4, np.where(S4 == 0, 1.0, -1.0)
+    Cc, M4, S4, P = np.unravel_index(np.flatnonzero(ok), shape)
+    D, DL, DH = entries[:, ok]
     W = sw[P, M4]
     RS = view.t.axes["noise_ratio"][slices[P, M4]]
-    e_ref = np.where(SIGN > 0, lo[P], hi[P])
-    s_t = RS / view.contact_norms()[jj[C4, P]]
-
-    def pair_of(dist):  # the entry's pair of lower edges at distance dist from its reference
-        return np.where(SIGN > 0, e_ref, e_ref - dist), np.where(SIGN > 0, e_ref + dist, e_ref)
-
-    a1, b1 = pair_of(D - h)
-    a2, b2 = pair_of(D - h + width)
-    a2 = np.maximum(a2, 0.0)
+    s_t = RS / view.contact_norms()[jj[Cc, P]]
+    # the entry's pairs of lower edges at its need and one width further, from its reference (upwards at lo,
+    # downwards at hi): one reading of the grid for every entry, at both distances, and the extra pairs
+    up = S4 == 0
+    e_ref = np.stack([lo, hi])[S4, P]
+    dist = (D - h) + np.array([[0.0], [width]])  # (2, k)
+    a = np.where(up, e_ref, e_ref - dist)
+    b = np.where(up, e_ref + dist, e_ref)
+    np.maximum(a[1], 0.0, out=a[1])
     k = P.size
-    # one reading: every entry at its need and one width further
-    xa, xb = extra if extra is not None else (np.zeros(0),) * 2
-    star = op.view.critical_noise(np.concatenate([a1, a2, xa]), np.concatenate([b1, b2, xb]))
+    if extra is not None:
+        a, b = np.concatenate([a.ravel(), extra[0]]), np.concatenate([b.ravel(), extra[1]])
+    star = view.critical_noise(a.ravel(), b.ravel())
     s1, s2 = star[:k], star[k:2 * k]
     with np.errstate(divide="ignore", invalid="ignore"):
         log_k = np.log(s1 / s_t)
-        gamma = np.log(s2 / s1) / np.log((D - h + width) / (D - h))
+        gamma = np.abs(np.log(s2 / s1) / np.log(dist[1] / dist[0]))
         mc = np.where(np.isfinite(DH) & np.isfinite(DL) & (DL > h), np.log((DH - h) / (DL - h)) / (2.0 * z_table),
-                      np.where(np.isfinite(DL) & (DL > h), np.log((D - h) / (DL - h)) / z_table, 0.0))
-        rnd = np.abs(gamma) * rnd_sd / (D - h)
-        mck = np.abs(gamma) * mc
+                      np.where(np.isfinite(DL) & (DL > h), np.log(dist[0] / (DL - h)) / z_table, 0.0))
+        rnd = gamma * rnd_sd / dist[0]
+        mck = gamma * mc
         sd = np.maximum(np.hypot(rnd, mck), 1e-3)
-    good = np.isfinite(log_k) & np.isfinite(sd)
-    # the entries' Monte Carlo errors are combined as independent (measured on svm-paper, the residuals of
-    # log k about each slice's trend correlate 0.14 between neighbouring noise-ratio slices and 0.07 between
-    # neighbouring contact times, needs >= 5 widths); their rounding errors are not: the grid rounds the
-    # similar needs of neighbouring entries the same way (at needs under 5 widths neighbouring readings of
-    # log k are identical), so the rounding term is the entries' weighted mean, not reduced by averaging
-    om = np.where(good, W / sd ** 2, 0.0)
-    # per (contact, pair): bin c * n + p, each bin's entries summed in their order
-    at = Cc * n + P
-
-    def total(x):
-        return np.bincount(at, x, minlength=2 * n).reshape(2, n)
-
-    num, den = total(om * np.where(good, log_k, 0.0)), total(om)
-    var, rnd_mean = total(om ** 2 * np.where(good, mck ** 2, 0.0)), total(om * np.where(good, rnd, 0.0))
-    with np.errstate(divide="ignore", invalid="ignore"):
+        good = np.isfinite(log_k) & np.isfinite(sd)
+        # the entries' Monte Carlo errors are combined as independent (measured on svm-paper, the residuals of
+        # log k about each slice's trend correlate 0.14 between neighbouring noise-ratio slices and 0.07 between
+        # neighbouring contact times, needs >= 5 widths); their rounding errors are not: the grid rounds the
+        # similar needs of neighbouring entries the same way (at needs under 5 widths neighbouring readings of
+        # log k are identical), so the rounding term is the entries' weighted mean, not reduced by averaging
+        om = np.where(good, W / sd ** 2, 0.0)
+        # per (contact, pair): bin c * n + p, each bin's entries summed in their order; the four sums in one count
+        parts = np.where(good, [om * log_k, om, om ** 2 * mck ** 2, om * rnd], 0.0)
+        num, den, var, rnd_mean = np.bincount((Cc * n + P + (2 * n) * np.arange(4)[:, None]).ravel(),
+                                              parts.ravel(), minlength=8 * n).reshape(4, 2, n)
         lk = np.where(den > 0, num / den, np.nan)
         se = np.where(den > 0, np.hypot(np.sqrt(var) / den, rnd_mean / den), np.nan)
     return (lk, se) if extra is None else (lk, se, star[2 * k:])
 
 
-def _k_line(lk, se, t_a, t_b):
+def _k_line(lk, se, t_a, t_b, log_ab=None):
     """``log k`` at ``t_a`` and ``t_b`` (one held at the other's where it has no reading; two that fall pooled:
     k never falls with contact time, on svm-paper the slice medians rise at every step in every slice), the
-    weights and the readings' disagreement where they fell."""
-    have_a, have_b = np.isfinite(lk[0]), np.isfinite(lk[1])
-    la_, lb_ = np.where(have_a, lk[0], lk[1]), np.where(have_b, lk[1], lk[0])
+    weights and the readings' disagreement where they fell (``log_ab``: ``log(t_b / t_a)``, if computed)."""
+    have = np.isfinite(lk)  # [a / b, n]
+    lab = np.where(have, lk, lk[::-1])
     with np.errstate(invalid="ignore", divide="ignore"):
-        wa, wb = np.where(have_a, 1.0 / se[0] ** 2, 0.0), np.where(have_b, 1.0 / se[1] ** 2, 0.0)
-        falls = have_a & have_b & ((lb_ - la_) * np.sign(np.log(t_b / t_a)) < 0)
+        w = np.where(have, 1.0 / se ** 2, 0.0)
+        rise = lab[1] - lab[0]
+        falls = have[0] & have[1] & (rise * np.sign(np.log(t_b / t_a) if log_ab is None else log_ab) < 0)
         # (la_, lb_ are finite or NaN: a reading is a weighted mean of finite log k)
-        pooled = (np.where(have_a, la_, 0.0) * wa + np.where(have_b, lb_, 0.0) * wb) / (wa + wb)
-        disagree = np.where(falls, np.abs(lb_ - la_), 0.0)
-    la_, lb_ = np.where(falls, pooled, la_), np.where(falls, pooled, lb_)
-    return la_, lb_, have_a, have_b, falls, wa, wb, disagree
+        held = np.where(have, lab, 0.0) * w
+        pooled = (held[0] + held[1]) / (w[0] + w[1])
+        disagree = np.where(falls, np.abs(rise), 0.0)
+    la_, lb_ = np.where(falls, pooled, lab)
+    return la_, lb_, have[0], have[1], falls, w[0], w[1], disagree
 
 
 def _k_var(u, se, la_, lb_, have_a, have_b, falls, wa, wb, disagree, far):
     """Variance of ``log k`` at fraction ``u`` of the way from ``t_a`` to ``t_b`` (``far``: log distance to
     the one reading where only one exists)."""
     dk = np.abs(lb_ - la_)
-    v = np.where(have_a & have_b, ((1 - u) * se[0]) ** 2 + (u * se[1]) ** 2 + (u * (1 - u) * dk / 2) ** 2,
+    w = 1 - u
+    v = np.where(have_a & have_b, (w * se[0]) ** 2 + (u * se[1]) ** 2 + (u * w * dk / 2) ** 2,
                  np.where(have_a, se[0], se[1]) ** 2 + (0.5 * far) ** 2)
     with np.errstate(divide="ignore", invalid="ignore"):
         return np.where(falls, 1.0 / (wa + wb) + (disagree / 2) ** 2, v)
@@ -434,9 +435,9 @@ def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
         Pairs [J s^-1/2 K^-1 m^-2] and the asked sigma/dT.
     zc : float
         z of the asked coverage.
-    readings : (ndarray, ndarray), optional
+    readings : ndarray, optional
         The pairs' entries read already: ``delta_up{,_lo,_hi}`` at ``lo`` and ``delta_down{,_lo,_hi}`` at
-        ``hi`` in each weighted slice of ``combos`` at every contact, [kind, slice, contact, pair] each
+        ``hi`` in each weighted slice of ``combos`` at every contact, [direction, kind, slice, contact, pair]
         (:meth:`~designkit.query.table_arrays.TableView.readings`); None: read here.
 
     Returns
@@ -459,28 +460,33 @@ def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
         lk, se = _k_readings(op, slices, sw, ka, kb, lo, hi, readings=readings)
         s_pair = np.atleast_1d(s_pair)
     t_a, t_b = view.contacts[np.where(ka >= 0, ka, kb)], view.contacts[kb]
-    la_, lb_, have_a, have_b, falls, wa, wb, disagree = _k_line(lk, se, t_a, t_b)
+    log_ab = np.log(t_b / t_a)
+    la_, lb_, have_a, have_b, falls, wa, wb, disagree = _k_line(lk, se, t_a, t_b, log_ab)
     ok = have_a | have_b
-    value = np.full(n, np.nan)
-    if ok.any():
-        value[ok] = noise_k_contact(sensor, ratio[ok], s_pair[ok], t_a[ok], t_b[ok], la_[ok], lb_[ok], max_contact_s)
+    if ok.all():  # (every pair: the arrays themselves)
+        value = noise_k_contact(sensor, ratio, s_pair, t_a, t_b, la_, lb_, max_contact_s)
+    else:
+        value = np.full(n, np.nan)
+        if ok.any():
+            value[ok] = noise_k_contact(sensor, ratio[ok], s_pair[ok], t_a[ok], t_b[ok], la_[ok], lb_[ok],
+                                        max_contact_s)
     ok &= np.isfinite(value)
     with np.errstate(divide="ignore", invalid="ignore"):
-        u = np.log(value / t_a) / np.log(t_b / t_a)
-        var_k = _k_var(u, se, la_, lb_, have_a, have_b, falls, wa, wb, disagree,
-                       np.log(value / np.where(have_a, t_a, t_b)))
-        slope_k = np.where(have_a & have_b & (t_a != t_b), (lb_ - la_) / np.log(t_b / t_a), 0.0)
+        # log(value / t_a), and the log distance to the one reading where only one exists
+        lv = np.log(value / np.stack([t_a, np.where(have_a, t_a, t_b)]))
+        u = lv[0] / log_ab
+        var_k = _k_var(u, se, la_, lb_, have_a, have_b, falls, wa, wb, disagree, lv[1])
+        slope_k = np.where(have_a & have_b & (t_a != t_b), (lb_ - la_) / log_ab, 0.0)
         v_ok = np.where(ok, value, 1.0)  # (shape_norm takes finite contact times only)
         g = shape_norm(sensor, np.concatenate([v_ok * 1.05, v_ok / 1.05]))
         beta_g = np.log(g[:n] / g[n:]) / (2 * math.log(1.05))
         se_t = np.sqrt(var_k) / np.maximum(beta_g - slope_k, 0.05)
-        low, high = value * np.exp(-zc * se_t), value * np.exp(zc * se_t)
-        k_at = np.exp(np.maximum(la_ + slope_k * np.log(value / t_a), 0.0))
-    nan = ~ok
-    return {"value": np.where(nan, np.nan, value), "low": np.where(nan, np.nan, low),
-            "high": np.where(nan, np.nan, high), "k_a": np.where(have_a & ok, np.exp(lk[0]), np.nan),
-            "k_b": np.where(have_b & ok, np.exp(lk[1]), np.nan), "t_a": t_a, "t_b": t_b,
-            "k": np.where(nan, np.nan, k_at), "se_log": np.where(nan, np.nan, se_t), "s_pair": s_pair}
+        ends = value * np.exp(np.multiply.outer([-zc, zc], se_t))
+        k_at = np.exp(np.maximum(la_ + slope_k * lv[0], 0.0))
+    out = np.where(ok, [value, ends[0], ends[1], k_at, se_t], np.nan)
+    k_ab = np.where([have_a & ok, have_b & ok], np.exp(lk), np.nan)
+    return {"value": out[0], "low": out[1], "high": out[2], "k_a": k_ab[0], "k_b": k_ab[1], "t_a": t_a, "t_b": t_b,
+            "k": out[3], "se_log": out[4], "s_pair": s_pair}
 
 
 def noise_k_max_ratio(op, contact_s, r_table, r_ideal, lo, hi, *, zc: float) -> dict[str, np.ndarray]:

@@ -56,6 +56,11 @@ class TableView:
         self._contact_norms: np.ndarray | None = None
         self._baselines: np.ndarray | None = None
         self._scenes: dict[tuple[float, float], tuple[list, dict[str, bool]]] = {}
+        # the entries arrays as one plain array (_plain), and the gathers' index prefixes (slices)
+        self._names = {n: i for i, n in enumerate(n for n in table.arrays if n.startswith("delta_"))}
+        self._plain_rows: np.ndarray | None = None
+        self._plain_read: set[int] = set()
+        self._at: dict[tuple, tuple] = {}
 
     def critical_noise(self, lo, hi) -> np.ndarray:
         """The ideal observer's critical noise of the table's classes ``[lo, lo + w)``, ``[hi, hi + w)`` (its
@@ -140,24 +145,53 @@ class TableView:
     def slices(self, names, combos, e: np.ndarray) -> np.ndarray:
         """The arrays ``names`` (a sequence) in each weighted scene slice of ``combos`` (in their order), at every
         contact and every ``e``: [name, slice, contact, len(e)] (NaN: none), in one reading."""
-        live = [idx for idx, w in combos if w != 0]
-        at = tuple(np.array(k)[:, None, None] for k in zip(*live))  # each [slice, 1, 1]
-        at += (np.arange(self.contacts.size)[:, None],)
-        arrays = [self.t.arrays[n] for n in names]
-        # only the entries read (the arrays may be mapped from the file)
-        return interp_e_by(lambda c: np.stack([a[at + (c,)] for a in arrays]), self.centres, e)
+        return self._read((tuple(names),), combos, e[None])[0]
 
-    def readings(self, kinds, combos, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def _read(self, names: tuple[tuple[str, ...], ...], combos, e: np.ndarray) -> np.ndarray:
+        """Groups of arrays, ``names[g]`` each at its own effusivities ``e[g]`` (``e``: [group, n]), in each
+        weighted scene slice of ``combos``, at every contact: [group, name, slice, contact, n], in one
+        interpolation (two gathers of the view's plain copy of the table, :meth:`_plain`)."""
+        key = (names, tuple(idx for idx, w in combos if w != 0))
+        at = self._at.get(key)
+        if at is None:
+            if len(self._at) >= 256:  # (a sweep over scenes: the memo stays small)
+                self._at.clear()
+            live = key[1]
+            at = ((np.array([[self._names[n] for n in group] for group in names])[:, :, None, None, None],)
+                  + tuple(np.array(k)[None, None, :, None, None] for k in zip(*live))  # each [1, 1, slice, 1, 1]
+                  + (np.arange(self.contacts.size)[None, None, None, :, None],))
+            self._at[key] = at
+            self._plain({k[0] for k in live})
+        rows = self._plain_rows
+        return interp_e_by(lambda c: rows[at + (c,)], self.centres, e[:, None, None, None, :])
+
+    def _plain(self, first: set[int]) -> None:
+        """Read the scene rows ``first`` (indices on the first scene axis) of every ``delta_*`` array into the
+        view's plain copy [array, scene..., contact, e_ref], each row once per process, through the table's own
+        (checked) reader: the questions gather from it instead of from the mapped, row-checked arrays."""
+        todo = sorted(first - self._plain_read)
+        if not todo:
+            return
+        if self._plain_rows is None:
+            shape = self.t.arrays[next(iter(self._names))].shape
+            self._plain_rows = np.empty((len(self._names),) + tuple(shape))  # (memory taken as rows are read)
+        for name, i in self._names.items():
+            a = self.t.arrays[name]
+            for r in todo:
+                self._plain_rows[i, r] = a[r]
+        self._plain_read.update(todo)
+
+    def readings(self, kinds, combos, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
         """What :meth:`need` of the sequence ``kinds`` is made of: ``delta_up`` at ``lo`` and ``delta_down`` at
-        ``hi`` of each kind in each weighted scene slice, [kind, slice, contact, n] each."""
+        ``hi`` of each kind in each weighted scene slice, [direction (up, down), kind, slice, contact, n]."""
         names = []
         for k in kinds:
             suffix = {"svm": "", "lo": "_lo", "hi": "_hi", "ideal": "_ideal"}[k]
             if f"delta_up{suffix}" not in self.t.arrays:  # ideal tables carry only delta_up / delta_down
                 suffix = ""
             names.append(suffix)
-        return (self.slices([f"delta_up{x}" for x in names], combos, lo),
-                self.slices([f"delta_down{x}" for x in names], combos, hi))
+        return self._read((tuple(f"delta_up{x}" for x in names), tuple(f"delta_down{x}" for x in names)), combos,
+                          np.stack([lo, hi]))
 
     def need(self, kind, combos, lo: np.ndarray, hi: np.ndarray, readings=None) -> np.ndarray:
         """Distance needed to separate ``lo < hi``, ``max(delta_up(lo), delta_down(hi))``, at every contact and
@@ -284,7 +318,7 @@ def contact_arrays(op, lo, hi, noise, dt, *, ideal_bound: bool, zc: float, class
         if efficiency and (has := k >= 0).any():
             sel = slice(None) if has.all() else has  # (every pair: the readings themselves, no copy)
             r = noise_k_min_contact(op, combos, k[sel], l[sel], h[sel], nz / abs(d), zc=zc,
-                                    readings=[x[:3][..., sel] for x in readings])
+                                    readings=readings[:, :3][..., sel])
             for key in eff:
                 eff[key][idx[has]] = r[key]
             star[idx[has]], have_star[idx[has]] = r["s_pair"], True

@@ -10,7 +10,10 @@ import math
 
 import numpy as np
 
+from ..models.semi_infinite import object_weight
+from ..recognition.ideal import critical_noise, shape_norm
 from ..tables.store import Table
+from .ideal_bound import columns, exact_ideal_delta, noise_k_contact, pair_critical_noise
 
 
 __all__ = [
@@ -202,14 +205,10 @@ class CriticalNoiseGrid:
         self.known = np.zeros(n * n, dtype=bool)
 
     def _weight(self, e):
-        from ..models.semi_infinite import object_weight
-
         return object_weight(self.e_s, e)
 
     def _fill(self, nodes: np.ndarray) -> None:
         """Solve the nodes ``nodes`` (flat indices) exactly, in one vectorized call."""
-        from ..recognition.ideal import critical_noise
-
         n = NOISE_GRID_NODES
         lo = np.maximum(np.exp(self.u0 + self.du * (nodes // n)) - NOISE_GRID_A0, 0.0)
         hi = lo + np.exp(self.v0 + self.dv * (nodes % n))
@@ -225,7 +224,8 @@ class CriticalNoiseGrid:
             lo, hi = np.broadcast_arrays(lo, hi)
         shape, lo, hi = lo.shape, lo.ravel(), hi.ravel()
         n = NOISE_GRID_NODES
-        out = np.full(lo.size, np.nan)
+        out = np.empty(lo.size)
+        out.fill(np.nan)
         with np.errstate(divide="ignore", invalid="ignore"):
             # the grid coordinates (u, v) of every pair, [2, pair]
             p = (np.log(np.stack([lo + NOISE_GRID_A0, hi - lo])) - self._origin) / self._step
@@ -251,8 +251,6 @@ class CriticalNoiseGrid:
             out[i] = np.exp(g) * (w[:i.size] - w[i.size:])
         rest = np.flatnonzero(np.isnan(out) & np.isfinite(lo) & np.isfinite(hi))
         if rest.size:  # outside the grid (or next to a node that does not separate): the exact solve
-            from .ideal_bound import pair_critical_noise
-
             out[rest] = pair_critical_noise(self.sensor, lo[rest], hi[rest], width=self.width,
                                             threshold=self.threshold)
         return out.reshape(shape)
@@ -446,9 +444,6 @@ def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
         ``value``, ``low``, ``high`` [s], ``k_a``, ``k_b`` (NaN: no reading there), ``t_a``, ``t_b``,
         ``se_log`` (of the answer, log); ``value`` NaN where the route does not apply.
     """
-    from ..recognition.ideal import shape_norm
-    from .ideal_bound import columns, noise_k_contact
-
     view, sensor = op.view, op.tab.sensor
     lo, hi, ratio, kb = columns(lo, hi, ratio, k_cross, dtypes=(np.float64,) * 3 + (np.int64,))
     n = lo.size
@@ -603,8 +598,6 @@ def delta_efficiency_estimate(sensor, e, contact_s, ratio, direction, t_a, t_b, 
     >>> float(r["ideal"][0]) < float(r["low"][0]) < float(r["value"][0]) < float(r["high"][0])
     True
     """
-    from .ideal_bound import exact_ideal_delta
-
     S, L, H = (np.asarray(a, dtype=np.float64) for a in (svm, svm_lo, svm_hi))
     m, n = S.shape[1], S.shape[2]
     e, contact, ratio, direction, t_a, t_b = (np.broadcast_to(np.asarray(a, dtype=np.float64), (n,)) for a in (

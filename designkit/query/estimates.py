@@ -23,7 +23,7 @@ from .efficiency import interp_e_by, noise_k_max_ratio, table_z
 __all__ = [
     "ABOVE", "BELOW", "CELL", "CONTACT_ESTIMATORS", "ContactReading", "Estimates", "INSIDE",
     "RATIO_ESTIMATORS", "RatioReading", "axis_weights_flagged", "cell_estimate", "contact_estimate", "cross2",
-    "delta_estimate", "efficiency_estimate", "first_applicable", "grid_crossing", "held_interval", "interp_e_rows",
+    "delta_estimate", "efficiency_estimate", "filled", "first_applicable", "grid_crossing", "held_interval", "interp_e_rows",
     "nans", "pair_need_both", "partner_in_grid", "ratio_beyond", "ratio_cell", "ratio_efficiency", "ratio_estimate",
     "ratio_ideal_table", "ratio_rounding", "rounded_crossing", "rounding_estimate", "stated_log", "states_coverage",
     "table_spread", "varied_contact_estimate", "varied_estimate"
@@ -49,8 +49,7 @@ def cross2(x0, x1, n0, n1, gap) -> np.ndarray:
     """
     x0, x1, n0, n1, gap = (np.asarray(a, dtype=np.float64) for a in (x0, x1, n0, n1, gap))  # (they broadcast)
     with np.errstate(invalid="ignore", divide="ignore"):
-        ok0 = ~np.isnan(n0) & (n0 <= gap)
-        ok1 = ~np.isnan(n1) & (n1 <= gap)
+        ok0, ok1 = n0 <= gap, n1 <= gap  # (False at NaN)
         w = np.where(n0 != n1, (n0 - gap) / (n0 - n1), 1.0)
         inside = np.where(np.isnan(n0), x1, x0 + w * (x1 - x0))
     return np.where(ok0, x0, np.where(ok1, inside, np.nan))
@@ -186,7 +185,7 @@ def grid_crossing(grid: np.ndarray, need: np.ndarray, gap) -> tuple[np.ndarray, 
     [2.5, 2.0, 2.0, 3.0, 150.0, 50.0]
     """
     with np.errstate(invalid="ignore", divide="ignore"):
-        ok = ~np.isnan(need) & (need <= gap)
+        ok = need <= gap  # (False at NaN)
         k = np.where(ok.any(axis=0), ok.argmax(axis=0), -1)
         cols, k0, k1 = np.arange(need.shape[1]), np.maximum(k - 1, 0), np.maximum(k, 0)
         x0, x1, n0, n1 = grid[k0], grid[k1], need[k0, cols], need[k1, cols]
@@ -356,7 +355,16 @@ def partner_in_grid(view, e, delta, direction: str):
 # ============================================================ the estimators: named strategies over arrays
 def nans(n) -> np.ndarray:
     """``n`` NaNs (an int or a shape): an answer array before its elements are answered ("none" until then)."""
-    return np.full(n, np.nan)
+    out = np.empty(n)  # (not np.full: a Python-level call, several times the cost on a single question's arrays)
+    out.fill(np.nan)
+    return out
+
+
+def filled(n: int, value, dtype=None) -> np.ndarray:
+    """``n`` copies of ``value`` (as :func:`numpy.full`, at the cost of :func:`numpy.empty`)."""
+    out = np.empty(n, dtype=dtype if dtype is not None else np.asarray(value).dtype)
+    out.fill(value)
+    return out
 
 
 #: The (question, interval kind) pairs a table with varied initial conditions shows as ``table-varied``, with
@@ -412,8 +420,8 @@ def first_applicable(estimators, rd, n: int) -> dict[str, np.ndarray]:
             continue
         if m.all():  # it answers every element (a single question's usual case): its arrays whole
             for k, v in (*((k, getattr(r, k)) for k in ("value", "low", "high")), *r.extra.items()):
-                out[k] = np.array(v, dtype=np.float64) if np.ndim(v) else np.full(n, v, dtype=np.float64)
-            out["kind"], out["stated"] = np.full(n, r.kind, dtype=object), np.full(n, r.stated)
+                out[k] = np.array(v, dtype=np.float64) if np.ndim(v) else filled(n, v, np.float64)
+            out["kind"], out["stated"] = filled(n, r.kind, object), filled(n, r.stated, bool)
             return out
         if not out:
             out = _unanswered(n)
@@ -429,7 +437,7 @@ def first_applicable(estimators, rd, n: int) -> dict[str, np.ndarray]:
 def _unanswered(n: int) -> dict[str, np.ndarray]:
     """:func:`first_applicable`'s answers before any estimator answers: none."""
     out = dict(zip(("value", "low", "high"), nans((3, n))))
-    out["kind"], out["stated"] = np.full(n, "none", dtype=object), np.zeros(n, dtype=bool)
+    out["kind"], out["stated"] = filled(n, "none", object), np.zeros(n, dtype=bool)
     return out
 
 

@@ -60,7 +60,7 @@ from .answer import Answer, IdealBound, number, scene_record
 from .crossing import check_coverage, z_of_coverage
 from .efficiency import CLOSED_FORM_MAX_CONTACT_S, K_SLOPE_SPAN, k_baseline, noise_k_max_ratio, noise_k_min_contact, \
     table_z
-from .estimates import (ABOVE, BELOW, CELL, CONTACT_ESTIMATORS, RATIO_ESTIMATORS, axis_weights_flagged,
+from .estimates import (ABOVE, BELOW, CELL, CONTACT_ESTIMATORS, RATIO_ESTIMATORS, axis_weights_flagged, filled,
                         states_coverage, table_spread)
 from .inputs import REFERENCE_RULE, PairQuestion, TableMismatch, check_contact, pair_question, reference_class, \
     scene_inputs
@@ -268,7 +268,8 @@ def min_contact_each(pairs: Sequence[Mapping[str, Any]], *, noise_c: float = 0.0
     if asked:
         lo, hi = _points(pqs, asked)
         m = lo.size
-        r = contact_arrays(op, lo, hi, np.full(m, noise), np.full(m, dt), ideal_bound=ideal_bound or op.closed,
+        r = contact_arrays(op, lo, hi, filled(m, noise, np.float64), filled(m, dt, np.float64),
+                           ideal_bound=ideal_bound or op.closed,
                            zc=z_of_coverage(coverage), classes=[pqs[i].classes for i in asked])
     at = {i: j for j, i in enumerate(asked)}
     return [_no_pair("min-contact", op, pq, scene_record(None, noise, dt), {}) if pq.classes is None else

@@ -26,8 +26,9 @@ from ..tables.store import Table
 from .crossing import coverage_of_z
 from .efficiency import (CLOSED_FORM_MAX_CONTACT_S, CriticalNoiseGrid, delta_efficiency_estimate, delta_entries,
                          interp_e_by, k_baseline, mc_calibration, noise_k_min_contact, table_z)
+from .ideal_bound import contact_at_noise, exact_ideal_delta, exact_ideal_max_ratio
 from .estimates import (ABOVE, BELOW, CELL, CONTACT_ESTIMATORS, INSIDE, RATIO_ESTIMATORS,
-                        ContactReading, RatioReading, axis_weights_flagged, delta_estimate, first_applicable,
+                        ContactReading, RatioReading, axis_weights_flagged, delta_estimate, filled, first_applicable,
                         grid_crossing, interp_e_rows, nans, partner_in_grid, states_coverage, table_spread)
 
 __all__ = ["CLOSED_FORM_RATIO_BRACKET", "TableView", "at_contact", "contact_arrays", "delta_e_arrays",
@@ -281,7 +282,7 @@ def contact_arrays(op, lo, hi, noise, dt, *, ideal_bound: bool, zc: float, class
     view, n = op.view, lo.size
     grid, svm = view.contacts, op.tab.fidelity == "svm"
     res: dict[str, Any] = dict(zip(("raw", "n_prev", "n_at", "mc_lo", "mc_hi", "ideal", "table_ideal"), nans((7, n))))
-    res["k_cross"], res["in_grid"], res["mc_bounds"] = np.full(n, -1), np.zeros(n, dtype=bool), {}
+    res["k_cross"], res["in_grid"], res["mc_bounds"] = filled(n, -1), np.zeros(n, dtype=bool), {}
     efficiency = svm and op.closed and "delta_up_ideal" in view.t.arrays
     eff = dict(zip(("value", "low", "high", "k", "se_log", "k_a", "k_b", "t_a", "t_b"), nans((9, n)))) if efficiency else None
     e_in = view.e_in(lo) & view.e_in(hi)
@@ -326,8 +327,6 @@ def contact_arrays(op, lo, hi, noise, dt, *, ideal_bound: bool, zc: float, class
         slices.append((combos, idx))
     sel = np.ones(n, dtype=bool) if outside else res["in_grid"]
     if op.closed and ideal_bound and sel.any():  # outside the grid too: the closed form needs no table
-        from .ideal_bound import contact_at_noise
-
         if (rest := sel & ~have_star).any():
             star[rest] = view.critical_noise(lo[rest], hi[rest])
         res["ideal"][sel] = contact_at_noise(op.tab.sensor, (noise / np.abs(dt))[sel], star[sel],
@@ -441,8 +440,6 @@ def ratio_arrays(question: str, op, lo, hi, contact, scale, *, ideal_bound: bool
                 a_r, a_w = max_ratio(view, "svm", cw, l[est], h[est], **kw)
                 alt[key][j] = np.where(a_w == INSIDE, a_r, np.nan)
     if op.closed and ideal_bound:  # every element, outside the grid too: the closed form needs no table
-        from .ideal_bound import exact_ideal_max_ratio
-
         ok = within_sample_limit(contact, op.tab.sensor.sample_rate_hz)
         if ok.any():
             ri[ok] = exact_ideal_max_ratio(op.tab.sensor, lo[ok], hi[ok], contact[ok], width=op.width,
@@ -552,8 +549,6 @@ def delta_e_arrays(op, e, contact, noise, dt, *, ideal_view, zc: float, ideal_bo
     # form needs no table
     out = np.nonzero(~res["in_grid"] & e_in & within_sample_limit(contact, op.tab.sensor.sample_rate_hz))[0]
     if op.closed and ideal_bound and out.size:
-        from .ideal_bound import exact_ideal_delta
-
         ratio = noise[out] / np.abs(dt[out])
         for side, sign in (("lower", -1.0), ("upper", 1.0)):
             res[f"{side}_ideal"][out] = exact_ideal_delta(op.tab.sensor, e[out], contact[out], ratio,
@@ -612,14 +607,14 @@ def distinguishable_arrays(op, lo, hi, contact, noise, dt, *, ideal_bound: bool,
         l, h = lo[idx], hi[idx]
         for kind in (("svm", "lo", "hi") if svm else ("svm",)):
             nd = at_contact(cw, view.need(kind, combos, l, h))
-            res[f"grid_{kind}"][idx] = (~np.isnan(nd) & (nd <= h - l)).astype(np.float64)
+            res[f"grid_{kind}"][idx] = (nd <= h - l).astype(np.float64)  # (False at NaN)
     if not svm:
         res["grid_lo"] = res["grid_hi"] = res["grid_svm"]
     todo = res["in_grid"]
     mc = contact_arrays(op, lo, hi, noise, dt, ideal_bound=op.closed, zc=zc, outside=False)
     t, a, b, stated = mc["value"], mc["low"], mc["high"], mc["stated"]
     with np.errstate(invalid="ignore"):
-        yes = ~np.isnan(t) & (contact >= t)
+        yes = contact >= t  # (False at NaN)
         below_high = (contact <= b) | np.isnan(b)
         unsure = todo & ~np.isnan(t) & ~np.isnan(a) & below_high & np.where(stated, a <= contact, a < contact)
     verdict = np.where(~todo | np.isnan(t), None, np.where(unsure, "uncertain", np.where(stated & ~np.isnan(a),

@@ -279,12 +279,14 @@ def _entries(view, slices, ka, kb, lo, hi, readings=None):
     Carlo ends (``delta_{up,down}{,_lo,_hi}``, interpolated in effusivity as
     :func:`designkit.tables.lookup.interp_e`) upwards at ``lo`` and downwards at ``hi``, at the contacts ``ka``
     (row 0) and ``kb`` (row 1), in each of the pair's slices ``slices`` (n, m): one array shaped (need / lo /
-    hi 3, contact 2, slice m, direction 2, pair n), and the (clipped) contact indices (2, n). ``readings``: these
+    hi 3, contact 2, slice m, direction 2, pair n), the (clipped) contact indices (2, n) and whether each is the
+    one asked (not clipped). ``readings``: these
     arrays upwards and downwards at every contact in the slices, [direction, kind, slice, contact, pair] (the
     first three kinds of :meth:`~designkit.query.table_arrays.TableView.readings`), read already."""
-    jj = np.minimum(np.maximum(np.array([ka, kb]), 0), view.contacts.size - 1)  # (2, n)
+    kk = np.array([ka, kb])
+    jj = np.minimum(np.maximum(kk, 0), view.contacts.size - 1)  # (2, n)
     if readings is not None:  # [direction, kind, slice, contact, pair] at jj -> [kind, contact, slice, direction, pair]
-        return readings[:, :3, :, jj, np.arange(lo.size)].transpose(1, 3, 2, 0, 4), jj
+        return readings[:, :3, :, jj, np.arange(lo.size)].transpose(1, 3, 2, 0, 4), jj, jj == kk
     si = slices.T[None]  # (1, m, n)
     j = jj[:, None, :]  # (2, 1, n)
     sides = []
@@ -292,7 +294,7 @@ def _entries(view, slices, ka, kb, lo, hi, readings=None):
         arrays = [view.t.arrays[f"delta_{d}{suffix}"] for suffix in ("", "_lo", "_hi")]
         sides.append(interp_e_by(lambda c: np.stack([a[si, j, c] for a in arrays]), view.centres,
                                  np.broadcast_to(e, (2, si.shape[1], e.size))))
-    return np.stack(sides, axis=3), jj  # [need / lo / hi, contact, slice, direction, pair]
+    return np.stack(sides, axis=3), jj, jj == kk  # [need / lo / hi, contact, slice, direction, pair]
 
 
 def _k_readings(op, slices, sw, ka, kb, lo, hi, extra=None, readings=None):
@@ -306,15 +308,12 @@ def _k_readings(op, slices, sw, ka, kb, lo, hi, extra=None, readings=None):
     z_table = table_z(op.tab)
     n = lo.size
     h, rnd_sd = 0.5 * width, width / math.sqrt(12.0)
-    entries, jj = _entries(view, slices, ka, kb, lo, hi, readings)  # (3, 2, m, 2, n)
+    entries, jj, ok_j = _entries(view, slices, ka, kb, lo, hi, readings)  # (3, 2, m, 2, n); (2, n) twice
     d = entries[0]
     shape = d.shape
-    ok_j = ((ka >= 0) & (ka < view.contacts.size), (kb >= 0) & (kb < view.contacts.size))
     with np.errstate(invalid="ignore"):
-        ok = np.isfinite(d) & (d > width) & (sw.T[None, :, None, :] > 0)
+        ok = np.isfinite(d) & (d > width) & (sw.T[None, :, None, :] > 0) & ok_j[:, None, None, :]
         ok[:, :, 1] &= hi - (d[:, :, 1] - h) > 0  # downwards: the partner stays above 0
-        ok[0] &= ok_j[0]
-        ok[1] &= ok_j[1]
     # the entries in (contact, slice, direction, pair) order
     Cc, M4, S4, P = np.unravel_index(np.flatnonzero(ok), shape)
     D, DL, DH = entries[:, ok]
@@ -337,8 +336,9 @@ def _k_readings(op, slices, sw, ka, kb, lo, hi, extra=None, readings=None):
     with np.errstate(divide="ignore", invalid="ignore"):
         log_k = np.log(s1 / s_t)
         gamma = np.abs(np.log(s2 / s1) / np.log(dist[1] / dist[0]))
-        mc = np.where(np.isfinite(DH) & np.isfinite(DL) & (DL > h), np.log((DH - h) / (DL - h)) / (2.0 * z_table),
-                      np.where(np.isfinite(DL) & (DL > h), np.log(dist[0] / (DL - h)) / z_table, 0.0))
+        low = np.isfinite(DL) & (DL > h)
+        logs = np.log(np.stack([DH - h, dist[0]]) / (DL - h))  # the interval's width, the low end's distance
+        mc = np.where(np.isfinite(DH) & low, logs[0] / (2.0 * z_table), np.where(low, logs[1] / z_table, 0.0))
         rnd = gamma * rnd_sd / dist[0]
         mck = gamma * mc
         sd = np.maximum(np.hypot(rnd, mck), 1e-3)

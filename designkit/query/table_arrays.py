@@ -306,28 +306,31 @@ def contact_arrays(op, lo, hi, noise, dt, *, ideal_bound: bool, zc: float, class
                                                np.concatenate([gap] * len(kinds)))
         cross = dict(zip(kinds, value.reshape(len(kinds), m)))
         k, n0, n1 = k[:m], n0[:m], n1[:m]
-        res["raw"][idx], res["k_cross"][idx] = cross["svm"], k
-        res["n_prev"][idx], res["n_at"][idx] = np.where(k > 0, n0, np.nan), n1
+        at = slice(None) if m == n else idx  # (every element in this group: slices, not index arrays)
+        res["raw"][at], res["k_cross"][at] = cross["svm"], k
+        res["n_prev"][at], res["n_at"][at] = np.where(k > 0, n0, np.nan), n1
         for end in ("lo", "hi"):
-            res[f"mc_{end}"][idx] = cross.get(end, cross["svm"])
+            res[f"mc_{end}"][at] = cross.get(end, cross["svm"])
         if "ideal" in cross:  # the grid's own bound, beside the exact one
-            res["table_ideal"][idx] = cross["ideal"]
+            res["table_ideal"][at] = cross["ideal"]
         if not op.closed and not ideal_bound and op.iview is not None:  # the table's own floor (no Monte Carlo)
             icombos, iflags = op.iview.scene_weights(nz, d)
             if all(iflags.values()):
                 res["ideal"][idx] = grid_crossing(op.iview.contacts, op.iview.need(op.ikind, icombos, l, h), gap)[0]
         if efficiency and (has := k >= 0).any():
-            sel = slice(None) if has.all() else has  # (every pair: the readings themselves, no copy)
+            every = has.all()
+            sel = slice(None) if every else has  # (every pair: the readings themselves, no copy)
             r = noise_k_min_contact(op, combos, k[sel], l[sel], h[sel], nz / abs(d), zc=zc,
                                     readings=readings[:, :3][..., sel])
+            hat = at if every else idx[has]
             for key in eff:
-                eff[key][idx[has]] = r[key]
-            star[idx[has]], have_star[idx[has]] = r["s_pair"], True
-        res["in_grid"][idx] = True
+                eff[key][hat] = r[key]
+            star[hat], have_star[hat] = r["s_pair"], True
+        res["in_grid"][at] = True
         slices.append((combos, idx))
-    sel = np.ones(n, dtype=bool) if outside else res["in_grid"]
-    if op.closed and ideal_bound and sel.any():  # outside the grid too: the closed form needs no table
-        if (rest := sel & ~have_star).any():
+    sel = slice(None) if outside else res["in_grid"]  # (every element: a slice)
+    if op.closed and ideal_bound and (n > 0 if outside else sel.any()):  # outside the grid too: no table needed
+        if (rest := ~have_star if outside else sel & ~have_star).any():
             star[rest] = view.critical_noise(lo[rest], hi[rest])
         res["ideal"][sel] = contact_at_noise(op.tab.sensor, (noise / np.abs(dt))[sel], star[sel],
                                              CLOSED_FORM_MAX_CONTACT_S)

@@ -54,14 +54,14 @@ def interp_e_by(at, centres: np.ndarray, e: np.ndarray) -> np.ndarray:
     [10.0, 15.0, 20.0, nan, nan]
     """
     n = centres.size
-    c = np.minimum(np.maximum(np.searchsorted(centres, e, side="right") - 1, 0), n - 2)
+    c = np.minimum(np.maximum(centres.searchsorted(e, side="right") - 1, 0), n - 2)
     a, b = at(c), at(c + 1)
     w = (e - centres[c]) / (centres[c + 1] - centres[c])
     # (NaN, a value beyond the grid, propagates through a + w (b - a); on a centre itself only a is read)
     out = np.where(w == 0.0, a, a + w * (b - a))
-    if (top := e >= centres[-1]).any():
+    if np.count_nonzero(top := e >= centres[-1]):
         out = np.where(top, at(np.full_like(c, n - 1)), out)
-    if (bottom := e <= centres[0]).any():
+    if np.count_nonzero(bottom := e <= centres[0]):
         out = np.where(bottom, at(np.zeros_like(c)), out)
     return out
 
@@ -228,14 +228,17 @@ class CriticalNoiseGrid:
         out.fill(np.nan)
         with np.errstate(divide="ignore", invalid="ignore"):
             # the grid coordinates (u, v) of every pair, [2, pair]
-            p = (np.log(np.stack([lo + NOISE_GRID_A0, hi - lo])) - self._origin) / self._step
+            p = (np.log(np.array([lo + NOISE_GRID_A0, hi - lo])) - self._origin) / self._step
             inside = (lo >= 0) & (p[0] <= n - 1) & (p[1] >= 0) & (p[1] <= n - 1)
-        i = np.flatnonzero(inside)
+        i = inside.nonzero()[0]
         if i.size:
-            p = p[:, i]
+            if i.size < lo.size:  # (every pair inside: the arrays themselves)
+                p, lo_i, hi_i = p[:, i], lo[i], hi[i]
+            else:
+                i, lo_i, hi_i = slice(None), lo, hi
             s = np.minimum(np.maximum(np.floor(p).astype(np.int64) - 1, 0), n - 4)  # the first of 4 nodes a side
-            flat = (s[0][:, None, None] + _FOUR[None, :, None]) * n + (s[1][:, None, None] + _FOUR[None, None, :])
-            if not self.known[flat].all():
+            flat = (s[0] * n + s[1])[:, None, None] + _NODES4  # the 4 x 4 nodes around each pair
+            if np.count_nonzero(known := self.known[flat]) < known.size:
                 missing = flat[~self.known[flat]]  # the whole blocks of NOISE_GRID_BLOCK x NOISE_GRID_BLOCK nodes around them
                 b = NOISE_GRID_BLOCK
                 wanted = np.zeros((n // b) ** 2, dtype=bool)  # (not np.unique: its first call imports numpy.ma)
@@ -247,9 +250,9 @@ class CriticalNoiseGrid:
                 self._fill(nodes[~self.known[nodes]])
             lu, lv = _lagrange4(p - s)
             g = np.einsum("pi,pj,pij->p", lu, lv, self.values[flat])
-            w = self._weight(np.concatenate([hi[i], lo[i]]))
-            out[i] = np.exp(g) * (w[:i.size] - w[i.size:])
-        rest = np.flatnonzero(np.isnan(out) & np.isfinite(lo) & np.isfinite(hi))
+            w = self._weight(np.array([hi_i, lo_i]))
+            out[i] = np.exp(g) * (w[0] - w[1])
+        rest = (np.isnan(out) & np.isfinite(lo) & np.isfinite(hi)).nonzero()[0]
         if rest.size:  # outside the grid (or next to a node that does not separate): the exact solve
             out[rest] = pair_critical_noise(self.sensor, lo[rest], hi[rest], width=self.width,
                                             threshold=self.threshold)
@@ -258,10 +261,15 @@ class CriticalNoiseGrid:
 
 _FOUR = np.arange(4)
 _FOUR.flags.writeable = False
-#: The cubic Lagrange weights' factors: weight j is ``F1 F2 F3 / DIV`` with ``F = x - m`` (m the other nodes),
-#: the first signed (:func:`_lagrange4`).
-_LAGRANGE = (np.array([1, 0, 0, 0]), np.array([-1.0, 1.0, -1.0, 1.0]), np.array([2, 2, 1, 1]), np.array([3, 3, 3, 2]),
-             np.array([6.0, 2.0, 2.0, 6.0]))
+#: The flat offsets of the 4 x 4 nodes from the first (row-major, :data:`NOISE_GRID_NODES` a row).
+_NODES4 = _FOUR[:, None] * NOISE_GRID_NODES + _FOUR[None, :]
+_NODES4.flags.writeable = False
+#: The cubic Lagrange weights' factors: weight j is ``(x - A) S (x - B) (x - C) / D`` (the other nodes A, B, C;
+#: S the sign), elementwise over j (:func:`_lagrange4`).
+_LAGRANGE = tuple(np.array(v) for v in ([1.0, 0.0, 0.0, 0.0], [-1.0, 1.0, -1.0, 1.0], [2.0, 2.0, 1.0, 1.0],
+                                         [3.0, 3.0, 3.0, 2.0], [6.0, 2.0, 2.0, 6.0]))
+for _a in _LAGRANGE:
+    _a.flags.writeable = False
 
 
 def _lagrange4(x: np.ndarray) -> np.ndarray:
@@ -269,8 +277,8 @@ def _lagrange4(x: np.ndarray) -> np.ndarray:
     each weight's product in one order (``-(x-1)(x-2)(x-3)/6``, ``x(x-2)(x-3)/2``, ``-x(x-1)(x-3)/2``,
     ``x(x-1)(x-2)/6``)."""
     first, sign, second, third, div = _LAGRANGE
-    f = x[..., None] - _FOUR  # x - m for the nodes m = 0 .. 3
-    return f[..., first] * sign * f[..., second] * f[..., third] / div
+    x = x[..., None]
+    return (x - first) * sign * (x - second) * (x - third) / div
 
 
 # ============================================================ the noise efficiency (min-contact)
@@ -297,6 +305,7 @@ def _entries(view, slices, ka, kb, lo, hi, readings=None):
     return np.stack(sides, axis=3), jj, jj == kk  # [need / lo / hi, contact, slice, direction, pair]
 
 
+@np.errstate(divide="ignore", invalid="ignore")  # (one context for the whole computation)
 def _k_readings(op, slices, sw, ka, kb, lo, hi, extra=None, readings=None):
     """The noise efficiency ``log k`` and its standard error at the tabulated contacts ``ka`` and ``kb`` (rows
     0 and 1 of the (2, n) arrays; NaN: no usable entry), per pair, from the pair's own entries (upwards at
@@ -311,11 +320,10 @@ def _k_readings(op, slices, sw, ka, kb, lo, hi, extra=None, readings=None):
     entries, jj, ok_j = _entries(view, slices, ka, kb, lo, hi, readings)  # (3, 2, m, 2, n); (2, n) twice
     d = entries[0]
     shape = d.shape
-    with np.errstate(invalid="ignore"):
-        ok = np.isfinite(d) & (d > width) & (sw.T[None, :, None, :] > 0) & ok_j[:, None, None, :]
-        ok[:, :, 1] &= hi - (d[:, :, 1] - h) > 0  # downwards: the partner stays above 0
+    ok = np.isfinite(d) & (d > width) & (sw.T[None, :, None, :] > 0) & ok_j[:, None, None, :]
+    ok[:, :, 1] &= hi - (d[:, :, 1] - h) > 0  # downwards: the partner stays above 0
     # the entries in (contact, slice, direction, pair) order
-    Cc, M4, S4, P = np.unravel_index(np.flatnonzero(ok), shape)
+    Cc, M4, S4, P = np.unravel_index(ok.ravel().nonzero()[0], shape)
     D, DL, DH = entries[:, ok]
     W = sw[P, M4]
     RS = view.t.axes["noise_ratio"][slices[P, M4]]
@@ -323,7 +331,7 @@ def _k_readings(op, slices, sw, ka, kb, lo, hi, extra=None, readings=None):
     # the entry's pairs of lower edges at its need and one width further, from its reference (upwards at lo,
     # downwards at hi): one reading of the grid for every entry, at both distances, and the extra pairs
     up = S4 == 0
-    e_ref = np.stack([lo, hi])[S4, P]
+    e_ref = np.array([lo, hi])[S4, P]
     dist = (D - h) + np.array([[0.0], [width]])  # (2, k)
     a = np.where(up, e_ref, e_ref - dist)
     b = np.where(up, e_ref + dist, e_ref)
@@ -333,28 +341,29 @@ def _k_readings(op, slices, sw, ka, kb, lo, hi, extra=None, readings=None):
         a, b = np.concatenate([a.ravel(), extra[0]]), np.concatenate([b.ravel(), extra[1]])
     star = view.critical_noise(a.ravel(), b.ravel())
     s1, s2 = star[:k], star[k:2 * k]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        log_k = np.log(s1 / s_t)
-        gamma = np.abs(np.log(s2 / s1) / np.log(dist[1] / dist[0]))
-        low = np.isfinite(DL) & (DL > h)
-        logs = np.log(np.stack([DH - h, dist[0]]) / (DL - h))  # the interval's width, the low end's distance
-        mc = np.where(np.isfinite(DH) & low, logs[0] / (2.0 * z_table), np.where(low, logs[1] / z_table, 0.0))
-        rnd = gamma * rnd_sd / dist[0]
-        mck = gamma * mc
-        sd = np.maximum(np.hypot(rnd, mck), 1e-3)
-        good = np.isfinite(log_k) & np.isfinite(sd)
-        # the entries' Monte Carlo errors are combined as independent (measured on svm-paper, the residuals of
-        # log k about each slice's trend correlate 0.14 between neighbouring noise-ratio slices and 0.07 between
-        # neighbouring contact times, needs >= 5 widths); their rounding errors are not: the grid rounds the
-        # similar needs of neighbouring entries the same way (at needs under 5 widths neighbouring readings of
-        # log k are identical), so the rounding term is the entries' weighted mean, not reduced by averaging
-        om = np.where(good, W / sd ** 2, 0.0)
-        # per (contact, pair): bin c * n + p, each bin's entries summed in their order; the four sums in one count
-        parts = np.where(good, [om * log_k, om, om ** 2 * mck ** 2, om * rnd], 0.0)
-        num, den, var, rnd_mean = np.bincount((Cc * n + P + (2 * n) * np.arange(4)[:, None]).ravel(),
-                                              parts.ravel(), minlength=8 * n).reshape(4, 2, n)
-        lk = np.where(den > 0, num / den, np.nan)
-        se = np.where(den > 0, np.hypot(np.sqrt(var) / den, rnd_mean / den), np.nan)
+    log_k = np.log(s1 / s_t)
+    gamma = np.abs(np.log(s2 / s1) / np.log(dist[1] / dist[0]))
+    low = np.isfinite(DL) & (DL > h)
+    logs = np.log(np.array([DH - h, dist[0]]) / (DL - h))  # the interval's width, the low end's distance
+    mc = np.where(np.isfinite(DH) & low, logs[0] / (2.0 * z_table), np.where(low, logs[1] / z_table, 0.0))
+    rnd = gamma * rnd_sd / dist[0]
+    mck = gamma * mc
+    sd = np.maximum(np.hypot(rnd, mck), 1e-3)
+    good = np.isfinite(log_k) & np.isfinite(sd)
+    # the entries' Monte Carlo errors are combined as independent (measured on svm-paper, the residuals of
+    # log k about each slice's trend correlate 0.14 between neighbouring noise-ratio slices and 0.07 between
+    # neighbouring contact times, needs >= 5 widths); their rounding errors are not: the grid rounds the
+    # similar needs of neighbouring entries the same way (at needs under 5 widths neighbouring readings of
+    # log k are identical), so the rounding term is the entries' weighted mean, not reduced by averaging
+    all_good = np.count_nonzero(good) == good.size
+    om = W / sd ** 2 if all_good else np.where(good, W / sd ** 2, 0.0)
+    # per (contact, pair): bin c * n + p, each bin's entries summed in their order; the four sums in one count
+    parts = np.array([om * log_k, om, om ** 2 * mck ** 2, om * rnd])
+    if not all_good:
+        parts = np.where(good, parts, 0.0)
+    num, den, var, rnd_mean = np.bincount(np.add.outer((2 * n) * _FOUR, Cc * n + P).ravel(), parts.ravel(),
+                                          minlength=8 * n).reshape(4, 2, n)
+    lk, se = np.where(den > 0, [num / den, np.hypot(np.sqrt(var) / den, rnd_mean / den)], np.nan)
     return (lk, se) if extra is None else (lk, se, star[2 * k:])
 
 
@@ -364,14 +373,15 @@ def _k_line(lk, se, t_a, t_b, log_ab=None):
     weights and the readings' disagreement where they fell (``log_ab``: ``log(t_b / t_a)``, if computed)."""
     have = np.isfinite(lk)  # [a / b, n]
     lab = np.where(have, lk, lk[::-1])
-    with np.errstate(invalid="ignore", divide="ignore"):
-        w = np.where(have, 1.0 / se ** 2, 0.0)
-        rise = lab[1] - lab[0]
-        falls = have[0] & have[1] & (rise * np.sign(np.log(t_b / t_a) if log_ab is None else log_ab) < 0)
-        # (la_, lb_ are finite or NaN: a reading is a weighted mean of finite log k)
-        held = np.where(have, lab, 0.0) * w
-        pooled = (held[0] + held[1]) / (w[0] + w[1])
-        disagree = np.where(falls, np.abs(rise), 0.0)
+    w = np.where(have, 1.0 / se ** 2, 0.0)
+    rise = lab[1] - lab[0]
+    falls = have[0] & have[1] & (rise * np.sign(np.log(t_b / t_a) if log_ab is None else log_ab) < 0)
+    if not np.count_nonzero(falls):  # (none fell: nothing pooled)
+        return lab[0], lab[1], have[0], have[1], falls, w[0], w[1], np.zeros(rise.shape)
+    # (la_, lb_ are finite or NaN: a reading is a weighted mean of finite log k)
+    held = np.where(have, lab, 0.0) * w
+    pooled = (held[0] + held[1]) / (w[0] + w[1])
+    disagree = np.where(falls, np.abs(rise), 0.0)
     la_, lb_ = np.where(falls, pooled, lab)
     return la_, lb_, have[0], have[1], falls, w[0], w[1], disagree
 
@@ -381,19 +391,26 @@ def _k_var(u, se, la_, lb_, have_a, have_b, falls, wa, wb, disagree, far):
     the one reading where only one exists)."""
     dk = np.abs(lb_ - la_)
     w = 1 - u
-    v = np.where(have_a & have_b, (w * se[0]) ** 2 + (u * se[1]) ** 2 + (u * w * dk / 2) ** 2,
-                 np.where(have_a, se[0], se[1]) ** 2 + (0.5 * far) ** 2)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return np.where(falls, 1.0 / (wa + wb) + (disagree / 2) ** 2, v)
+    both = have_a & have_b
+    v = (w * se[0]) ** 2 + (u * se[1]) ** 2 + (u * w * dk / 2) ** 2
+    if np.count_nonzero(both) < both.size:  # (one reading only somewhere)
+        v = np.where(both, v, np.where(have_a, se[0], se[1]) ** 2 + (0.5 * far) ** 2)
+    if np.count_nonzero(falls):
+        v = np.where(falls, 1.0 / (wa + wb) + (disagree / 2) ** 2, v)
+    return v
 
 
 def _slices(combos, n):
-    """Shared scene weights as per-pair slice arrays (n, m)."""
+    """Shared scene weights as per-pair slice arrays (n, m), read-only."""
     live = [(idx[0], w) for idx, w in combos if w]
-    return (np.array([[i for i, _ in live]], dtype=np.int64).repeat(n, axis=0),
-            np.array([[w for _, w in live]], dtype=np.float64).repeat(n, axis=0))
+    out = (np.array([[i for i, _ in live]], dtype=np.int64).repeat(n, axis=0),
+           np.array([[w for _, w in live]], dtype=np.float64).repeat(n, axis=0))
+    for a in out:
+        a.flags.writeable = False
+    return out
 
 
+@np.errstate(divide="ignore", invalid="ignore")  # (one context for the whole computation)
 def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
                         max_contact_s: float = CLOSED_FORM_MAX_CONTACT_S, s_pair=None,
                         readings=None) -> dict[str, np.ndarray]:
@@ -448,7 +465,7 @@ def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
     lo, hi, ratio, kb = columns(lo, hi, ratio, k_cross, dtypes=(np.float64,) * 3 + (np.int64,))
     n = lo.size
     ka = view.baselines()[kb]  # (k_baseline of every tabulated contact, kept with the table)
-    slices, sw = _slices(combos, n)
+    slices, sw = view.memo(("slices", tuple(combos), n), lambda: _slices(combos, n)) if n <= 64 else _slices(combos, n)
     if s_pair is None:  # the pair's own critical noise read with its entries'
         lk, se, s_pair = _k_readings(op, slices, sw, ka, kb, lo, hi, extra=(lo, hi), readings=readings)
     else:
@@ -458,32 +475,32 @@ def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
     log_ab = np.log(t_b / t_a)
     la_, lb_, have_a, have_b, falls, wa, wb, disagree = _k_line(lk, se, t_a, t_b, log_ab)
     ok = have_a | have_b
-    if ok.all():  # (every pair: the arrays themselves)
+    if (n_ok := np.count_nonzero(ok)) == n:  # (every pair: the arrays themselves)
         value = noise_k_contact(sensor, ratio, s_pair, t_a, t_b, la_, lb_, max_contact_s)
     else:
         value = np.full(n, np.nan)
-        if ok.any():
+        if n_ok:
             value[ok] = noise_k_contact(sensor, ratio[ok], s_pair[ok], t_a[ok], t_b[ok], la_[ok], lb_[ok],
                                         max_contact_s)
     ok &= np.isfinite(value)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        # log(value / t_a), and the log distance to the one reading where only one exists
-        lv = np.log(value / np.stack([t_a, np.where(have_a, t_a, t_b)]))
-        u = lv[0] / log_ab
-        var_k = _k_var(u, se, la_, lb_, have_a, have_b, falls, wa, wb, disagree, lv[1])
-        slope_k = np.where(have_a & have_b & (t_a != t_b), (lb_ - la_) / log_ab, 0.0)
-        v_ok = np.where(ok, value, 1.0)  # (shape_norm takes finite contact times only)
-        g = shape_norm(sensor, np.concatenate([v_ok * 1.05, v_ok / 1.05]))
-        beta_g = np.log(g[:n] / g[n:]) / (2 * math.log(1.05))
-        se_t = np.sqrt(var_k) / np.maximum(beta_g - slope_k, 0.05)
-        ends = value * np.exp(np.multiply.outer([-zc, zc], se_t))
-        k_at = np.exp(np.maximum(la_ + slope_k * lv[0], 0.0))
+    # log(value / t_a), and the log distance to the one reading where only one exists
+    lv = np.log(value / np.array([t_a, np.where(have_a, t_a, t_b)]))
+    u = lv[0] / log_ab
+    var_k = _k_var(u, se, la_, lb_, have_a, have_b, falls, wa, wb, disagree, lv[1])
+    slope_k = np.where(have_a & have_b & (t_a != t_b), (lb_ - la_) / log_ab, 0.0)
+    v_ok = np.where(ok, value, 1.0)  # (shape_norm takes finite contact times only)
+    g = shape_norm(sensor, np.concatenate([v_ok * 1.05, v_ok / 1.05]))
+    beta_g = np.log(g[:n] / g[n:]) / (2 * math.log(1.05))
+    se_t = np.sqrt(var_k) / np.maximum(beta_g - slope_k, 0.05)
+    ends = value * np.exp(np.multiply.outer([-zc, zc], se_t))
+    k_at = np.exp(np.maximum(la_ + slope_k * lv[0], 0.0))
     out = np.where(ok, [value, ends[0], ends[1], k_at, se_t], np.nan)
     k_ab = np.where([have_a & ok, have_b & ok], np.exp(lk), np.nan)
     return {"value": out[0], "low": out[1], "high": out[2], "k_a": k_ab[0], "k_b": k_ab[1], "t_a": t_a, "t_b": t_b,
             "k": out[3], "se_log": out[4], "s_pair": s_pair}
 
 
+@np.errstate(divide="ignore", invalid="ignore")  # (one context for the whole computation)
 def noise_k_max_ratio(op, contact_s, r_table, r_ideal, lo, hi, *, zc: float) -> dict[str, np.ndarray]:
     """max-noise / min-delta-t from the SVM's noise efficiency (:func:`noise_k_min_contact`): the SVM separates
     the pair up to ``sigma/dT = r_ideal / k(contact)``, ``r_ideal`` the ideal observer's exact largest
@@ -509,12 +526,11 @@ def noise_k_max_ratio(op, contact_s, r_table, r_ideal, lo, hi, *, zc: float) -> 
     lk, se = _k_readings(op, slices, sw, ka, kb, lo, hi)
     t_a, t_b = C[ka], C[kb]
     la_, lb_, have_a, have_b, falls, wa, wb, disagree = _k_line(lk, se, t_a, t_b)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        u = np.where(t_a != t_b, np.log(contact / t_a) / np.log(t_b / t_a), 1.0)
-        log_k = np.maximum((1 - u) * la_ + u * lb_, 0.0)
-        var_k = _k_var(u, se, la_, lb_, have_a, have_b, falls, wa, wb, disagree,
-                       np.log(contact / np.where(have_a, t_a, t_b)))
-        sd = np.sqrt(var_k)
+    u = np.where(t_a != t_b, np.log(contact / t_a) / np.log(t_b / t_a), 1.0)
+    log_k = np.maximum((1 - u) * la_ + u * lb_, 0.0)
+    var_k = _k_var(u, se, la_, lb_, have_a, have_b, falls, wa, wb, disagree,
+                   np.log(contact / np.where(have_a, t_a, t_b)))
+    sd = np.sqrt(var_k)
     ok = (have_a | have_b) & np.isfinite(r_ideal) & np.isfinite(sd)
     value = r_ideal * np.exp(-log_k)
     return {"value": np.where(ok, value, np.nan), "low": np.where(ok, value * np.exp(-zc * sd), np.nan),

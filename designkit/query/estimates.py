@@ -184,12 +184,11 @@ def grid_crossing(grid: np.ndarray, need: np.ndarray, gap) -> tuple[np.ndarray, 
     >>> [float(v[0]) for v in grid_crossing(np.array([1.0, 2.0, 3.0]), np.array([[300.0], [150.0], [50.0]]), 100.0)]
     [2.5, 2.0, 2.0, 3.0, 150.0, 50.0]
     """
-    with np.errstate(invalid="ignore", divide="ignore"):
-        ok = need <= gap  # (False at NaN)
-        k = np.where(ok.any(axis=0), ok.argmax(axis=0), -1)
-        cols, k0, k1 = np.arange(need.shape[1]), np.maximum(k - 1, 0), np.maximum(k, 0)
-        x0, x1, n0, n1 = grid[k0], grid[k1], need[k0, cols], need[k1, cols]
-        x = np.where(k > 0, cross2(x0, x1, n0, n1, gap), np.where(k == 0, grid[0], np.nan))
+    ok = need <= gap  # (False at NaN)
+    k = np.where(ok.any(axis=0), ok.argmax(axis=0), -1)
+    cols, k0, k1 = np.arange(need.shape[1]), np.maximum(k - 1, 0), np.maximum(k, 0)
+    x0, x1, n0, n1 = grid[k0], grid[k1], need[k0, cols], need[k1, cols]
+    x = np.where(k > 0, cross2(x0, x1, n0, n1, gap), np.where(k == 0, grid[0], np.nan))
     return x, k, x0, x1, n0, n1
 
 
@@ -410,15 +409,15 @@ def first_applicable(estimators, rd, n: int) -> dict[str, np.ndarray]:
     out: dict[str, np.ndarray] = {}
     taken = np.zeros(n, dtype=bool)
     for estimator in estimators:
-        if taken.all():  # (the later ones would answer nothing)
-            break
+        if np.count_nonzero(taken) == n:  # (the later ones would answer nothing; count_nonzero: ndarray.all's
+            break                         # result at a tenth of its cost on a single question's arrays)
         r = estimator(rd)
         if r is None:
             continue
         m = r.applies & ~taken
-        if not m.any():
+        if not (n_m := np.count_nonzero(m)):
             continue
-        if m.all():  # it answers every element (a single question's usual case): its arrays whole
+        if n_m == n:  # it answers every element (a single question's usual case): its arrays whole
             for k, v in (*((k, getattr(r, k)) for k in ("value", "low", "high")), *r.extra.items()):
                 out[k] = np.array(v, dtype=np.float64) if np.ndim(v) else filled(n, v, np.float64)
             out["kind"], out["stated"] = filled(n, r.kind, object), filled(n, r.stated, bool)

@@ -150,11 +150,11 @@ def first_sample_at(cum: np.ndarray, ratio, s_star) -> np.ndarray:
     with np.errstate(divide="ignore", invalid="ignore"):
         need = np.where(s_star > 0, (ratio / s_star) ** 2, np.where(ratio > 0, np.inf, 0.0))
         need = np.where(np.isnan(s_star) | np.isnan(ratio), np.inf, need)
-        n = 1 + np.searchsorted(cum[1:], need, side="left")
+        n = 1 + cum[1:].searchsorted(need, side="left")
         # at the count and the one before (rounding of the square): the next where the count fails, else the one
         # before where it holds
         before = n - 1
-        at, prev = ok(np.stack([n, before]))
+        at, prev = ok(np.array([n, before]))
         n = np.where((n <= top) & ~at, n + 1, np.where((n > 1) & (before <= top) & prev, before, n))
     return np.where((n <= top) & np.isfinite(need), n, np.nan)
 
@@ -297,6 +297,7 @@ def _sample_logs(tau_s: float, rate_hz: float, n_max: int) -> tuple[np.ndarray, 
     return counts, log_t, half_log_cum
 
 
+@np.errstate(divide="ignore", invalid="ignore")  # (one context for the whole computation)
 def noise_k_contact(sensor, ratio, s_star, t_a, t_b, log_k_a, log_k_b, max_contact_s: float) -> np.ndarray:
     """First sample time [s] at which a classifier of noise efficiency ``k(t)`` separates a pair whose ideal
     observer needs projection noise at most ``s_star``: ``k(t) (sigma/dT) / |g(t)| <= s_star``, ``log k``
@@ -319,14 +320,12 @@ def noise_k_contact(sensor, ratio, s_star, t_a, t_b, log_k_a, log_k_b, max_conta
     fs = float(sensor.sample_rate_hz)
     n_max = int(last_sample_index(max_contact_s, fs))
     counts, log_t, half_log_cum = _sample_logs(float(sensor.tau_s), fs, max(n_max, 1))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        slope = np.where(t_a != t_b, (kb - ka) / np.log(t_b / t_a), 0.0)
-        log_ta, log_r, log_s = np.log(t_a), np.log(ratio), np.log(s_star)
+    slope = np.where(t_a != t_b, (kb - ka) / np.log(t_b / t_a), 0.0)
+    log_ta, log_r, log_s = np.log(t_a), np.log(ratio), np.log(s_star)
 
     def ok(n, rows):  # the classifier separates the pair at sample count n (an array, per element of rows)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            log_k = np.maximum(ka[rows] + slope[rows] * (log_t[n] - log_ta[rows]), 0.0)
-            return log_k + log_r[rows] - half_log_cum[n] <= log_s[rows]
+        log_k = np.maximum(ka[rows] + slope[rows] * (log_t[n] - log_ta[rows]), 0.0)
+        return log_k + log_r[rows] - half_log_cum[n] <= log_s[rows]
 
     out = np.empty(ratio.shape)
     out.fill(np.nan)
@@ -342,10 +341,9 @@ def noise_k_contact(sensor, ratio, s_star, t_a, t_b, log_k_a, log_k_b, max_conta
         steep, mono = np.nonzero(scan)[0], np.nonzero(~scan)[0]
     if ratio[steep].size:
         n = counts[1:n_max + 1]
-        with np.errstate(divide="ignore", invalid="ignore"):  # (every count at once: the logs read, not taken)
-            good = (np.maximum(ka[steep, None] + slope[steep, None] * (log_t[None, 1:n_max + 1] - log_ta[steep, None]),
-                               0.0) + log_r[steep, None] - half_log_cum[None, 1:n_max + 1] <= log_s[steep, None])
-        first = np.argmax(good, axis=1)  # (0 where none is good)
+        good = (np.maximum(ka[steep, None] + slope[steep, None] * (log_t[None, 1:n_max + 1] - log_ta[steep, None]),
+                           0.0) + log_r[steep, None] - half_log_cum[None, 1:n_max + 1] <= log_s[steep, None])
+        first = good.argmax(axis=1)  # (0 where none is good)
         out[steep] = np.where(good[np.arange(first.size), first], n[first] / fs, np.nan)
     if mono.size:
         top = ok(np.full(mono.size, max(n_max, 1)), mono)

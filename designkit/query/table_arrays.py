@@ -62,6 +62,7 @@ class TableView:
         self._plain_rows: np.ndarray | None = None
         self._plain_read: set[int] = set()
         self._at: dict[tuple, tuple] = {}
+        self._memo: dict[tuple, Any] = {}
 
     def critical_noise(self, lo, hi) -> np.ndarray:
         """The ideal observer's critical noise of the table's classes ``[lo, lo + w)``, ``[hi, hi + w)`` (its
@@ -121,6 +122,16 @@ class TableView:
         for pts in coords:
             combos = [(idx + (k,), w * wk) for idx, w in combos for k, wk in pts]
         return combos, flags
+
+    def memo(self, key: tuple, make):
+        """``make()``, kept with the view under ``key`` (what a question reads again for every pair of a scene:
+        its slices' index and weight arrays, read-only); at most 256 kept (a sweep over scenes)."""
+        hit = self._memo.get(key)
+        if hit is None:
+            if len(self._memo) >= 256:
+                self._memo.clear()
+            hit = self._memo[key] = make()
+        return hit
 
     def mc_calibration(self) -> float:
         """:func:`designkit.query.efficiency.mc_calibration` of this table (computed once)."""
@@ -192,7 +203,7 @@ class TableView:
                 suffix = ""
             names.append(suffix)
         return self._read((tuple(f"delta_up{x}" for x in names), tuple(f"delta_down{x}" for x in names)), combos,
-                          np.stack([lo, hi]))
+                          np.array([lo, hi]))
 
     def need(self, kind, combos, lo: np.ndarray, hi: np.ndarray, readings=None) -> np.ndarray:
         """Distance needed to separate ``lo < hi``, ``max(delta_up(lo), delta_down(hi))``, at every contact and
@@ -317,8 +328,8 @@ def contact_arrays(op, lo, hi, noise, dt, *, ideal_bound: bool, zc: float, class
             icombos, iflags = op.iview.scene_weights(nz, d)
             if all(iflags.values()):
                 res["ideal"][idx] = grid_crossing(op.iview.contacts, op.iview.need(op.ikind, icombos, l, h), gap)[0]
-        if efficiency and (has := k >= 0).any():
-            every = has.all()
+        if efficiency and (n_has := np.count_nonzero(has := k >= 0)):  # (count_nonzero: any / all at a tenth
+            every = n_has == has.size  # of ndarray.any's cost on a single question's arrays)
             sel = slice(None) if every else has  # (every pair: the readings themselves, no copy)
             r = noise_k_min_contact(op, combos, k[sel], l[sel], h[sel], nz / abs(d), zc=zc,
                                     readings=readings[:, :3][..., sel])
@@ -329,8 +340,8 @@ def contact_arrays(op, lo, hi, noise, dt, *, ideal_bound: bool, zc: float, class
         res["in_grid"][at] = True
         slices.append((combos, idx))
     sel = slice(None) if outside else res["in_grid"]  # (every element: a slice)
-    if op.closed and ideal_bound and (n > 0 if outside else sel.any()):  # outside the grid too: no table needed
-        if (rest := ~have_star if outside else sel & ~have_star).any():
+    if op.closed and ideal_bound and (n > 0 if outside else np.count_nonzero(sel)):  # outside the grid: no table
+        if np.count_nonzero(rest := ~have_star if outside else sel & ~have_star):
             star[rest] = view.critical_noise(lo[rest], hi[rest])
         res["ideal"][sel] = contact_at_noise(op.tab.sensor, (noise / np.abs(dt))[sel], star[sel],
                                              CLOSED_FORM_MAX_CONTACT_S)

@@ -55,8 +55,10 @@ def interp_e_by(at, centres: np.ndarray, e: np.ndarray) -> np.ndarray:
     """
     n = centres.size
     c = np.minimum(np.maximum(centres.searchsorted(e, side="right") - 1, 0), n - 2)
-    a, b = at(c), at(c + 1)
-    w = (e - centres[c]) / (centres[c + 1] - centres[c])
+    c1 = c + 1
+    a, b = at(c), at(c1)
+    left = centres[c]
+    w = (e - left) / (centres[c1] - left)
     # (NaN, a value beyond the grid, propagates through a + w (b - a); on a centre itself only a is read)
     out = np.where(w == 0.0, a, a + w * (b - a))
     if np.count_nonzero(top := e >= centres[-1]):
@@ -252,7 +254,9 @@ class CriticalNoiseGrid:
             g = np.einsum("pi,pj,pij->p", lu, lv, self.values[flat])
             w = self._weight(np.array([hi_i, lo_i]))
             out[i] = np.exp(g) * (w[0] - w[1])
-        rest = (np.isnan(out) & np.isfinite(lo) & np.isfinite(hi)).nonzero()[0]
+        # (every pair inside the grid has finite lo and hi)
+        rest = (np.isnan(out) if isinstance(i, slice) else
+                np.isnan(out) & np.isfinite(lo) & np.isfinite(hi)).nonzero()[0]
         if rest.size:  # outside the grid (or next to a node that does not separate): the exact solve
             out[rest] = pair_critical_noise(self.sensor, lo[rest], hi[rest], width=self.width,
                                             threshold=self.threshold)
@@ -264,18 +268,15 @@ _FOUR.flags.writeable = False
 #: The flat offsets of the 4 x 4 nodes from the first (row-major, :data:`NOISE_GRID_NODES` a row).
 _NODES4 = _FOUR[:, None] * NOISE_GRID_NODES + _FOUR[None, :]
 _NODES4.flags.writeable = False
-#: The cubic Lagrange weights' factors: weight j is ``(x - A) S (x - B) (x - C) / D`` (the other nodes A, B, C;
-#: S the sign), elementwise over j (:func:`_lagrange4`).
-_LAGRANGE = tuple(np.array(v) for v in ([1.0, 0.0, 0.0, 0.0], [-1.0, 1.0, -1.0, 1.0], [2.0, 2.0, 1.0, 1.0],
-                                         [3.0, 3.0, 3.0, 2.0], [6.0, 2.0, 2.0, 6.0]))
-for _a in _LAGRANGE:
-    _a.flags.writeable = False
+#: Weight j of :func:`_lagrange4` is ``(x - A) S (x - B) (x - C) / D``: the other nodes A, B, C, sign S.
+_LAGRANGE = np.array([[1.0, 0.0, 0.0, 0.0], [-1.0, 1.0, -1.0, 1.0], [2.0, 2.0, 1.0, 1.0], [3.0, 3.0, 3.0, 2.0],
+                      [6.0, 2.0, 2.0, 6.0]])
+_LAGRANGE.flags.writeable = False
 
 
 def _lagrange4(x: np.ndarray) -> np.ndarray:
-    """Cubic Lagrange weights of the nodes 0, 1, 2, 3 at positions ``x`` (in [0, 3]): shape ``x.shape + (4,)``,
-    each weight's product in one order (``-(x-1)(x-2)(x-3)/6``, ``x(x-2)(x-3)/2``, ``-x(x-1)(x-3)/2``,
-    ``x(x-1)(x-2)/6``)."""
+    """Cubic Lagrange weights of the nodes 0, 1, 2, 3 at positions ``x`` (in [0, 3]): shape ``x.shape + (4,)``
+    (``-(x-1)(x-2)(x-3)/6``, ``x(x-2)(x-3)/2``, ``-x(x-1)(x-3)/2``, ``x(x-1)(x-2)/6``, in that order)."""
     first, sign, second, third, div = _LAGRANGE
     x = x[..., None]
     return (x - first) * sign * (x - second) * (x - third) / div
@@ -283,14 +284,10 @@ def _lagrange4(x: np.ndarray) -> np.ndarray:
 
 # ============================================================ the noise efficiency (min-contact)
 def _entries(view, slices, ka, kb, lo, hi, readings=None):
-    """The table's entries a pair's noise efficiency is read from, in one gather: the SVM need and its Monte
-    Carlo ends (``delta_{up,down}{,_lo,_hi}``, interpolated in effusivity as
-    :func:`designkit.tables.lookup.interp_e`) upwards at ``lo`` and downwards at ``hi``, at the contacts ``ka``
-    (row 0) and ``kb`` (row 1), in each of the pair's slices ``slices`` (n, m): one array shaped (need / lo /
-    hi 3, contact 2, slice m, direction 2, pair n), the (clipped) contact indices (2, n) and whether each is the
-    one asked (not clipped). ``readings``: these
-    arrays upwards and downwards at every contact in the slices, [direction, kind, slice, contact, pair] (the
-    first three kinds of :meth:`~designkit.query.table_arrays.TableView.readings`), read already."""
+    """The entries of a pair's noise efficiency (``delta_{up,down}{,_lo,_hi}`` upwards at ``lo``, downwards at
+    ``hi``, at contacts ``ka`` / ``kb`` in the pair's slices ``slices`` (n, m)): (need / lo / hi 3, contact 2,
+    slice m, direction 2, pair n), the clipped contacts (2, n) and whether each is the one asked. ``readings``:
+    :meth:`~designkit.query.table_arrays.TableView.readings` of the first three kinds, read already."""
     kk = np.array([ka, kb])
     jj = np.minimum(np.maximum(kk, 0), view.contacts.size - 1)  # (2, n)
     if readings is not None:  # [direction, kind, slice, contact, pair] at jj -> [kind, contact, slice, direction, pair]
@@ -412,8 +409,7 @@ def _slices(combos, n):
 
 @np.errstate(divide="ignore", invalid="ignore")  # (one context for the whole computation)
 def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
-                        max_contact_s: float = CLOSED_FORM_MAX_CONTACT_S, s_pair=None,
-                        readings=None) -> dict[str, np.ndarray]:
+                        max_contact_s: float = CLOSED_FORM_MAX_CONTACT_S, readings=None) -> dict[str, np.ndarray]:
     """min-contact from the SVM's *noise efficiency* against the exact ideal observer, for pairs of one scene.
 
     The SVM separates a pair when the ideal observer would at a larger noise: ``k(t)`` times the projection
@@ -466,11 +462,8 @@ def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
     n = lo.size
     ka = view.baselines()[kb]  # (k_baseline of every tabulated contact, kept with the table)
     slices, sw = view.memo(("slices", tuple(combos), n), lambda: _slices(combos, n)) if n <= 64 else _slices(combos, n)
-    if s_pair is None:  # the pair's own critical noise read with its entries'
-        lk, se, s_pair = _k_readings(op, slices, sw, ka, kb, lo, hi, extra=(lo, hi), readings=readings)
-    else:
-        lk, se = _k_readings(op, slices, sw, ka, kb, lo, hi, readings=readings)
-        s_pair = np.atleast_1d(s_pair)
+    lk, se, s_pair = _k_readings(  # (the pair's own critical noise read with its entries')
+        op, slices, sw, ka, kb, lo, hi, extra=(lo, hi), readings=readings)
     t_a, t_b = view.contacts[np.where(ka >= 0, ka, kb)], view.contacts[kb]
     log_ab = np.log(t_b / t_a)
     la_, lb_, have_a, have_b, falls, wa, wb, disagree = _k_line(lk, se, t_a, t_b, log_ab)

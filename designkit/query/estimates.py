@@ -23,7 +23,7 @@ from .efficiency import interp_e_by, noise_k_max_ratio, table_z
 __all__ = [
     "ABOVE", "BELOW", "CELL", "CONTACT_ESTIMATORS", "ContactReading", "Estimates", "INSIDE",
     "RATIO_ESTIMATORS", "RatioReading", "axis_weights_flagged", "cell_estimate", "contact_estimate", "cross2",
-    "delta_estimate", "efficiency_estimate", "filled", "first_applicable", "grid_crossing", "held_interval", "interp_e_rows",
+    "delta_estimate", "efficiency_estimate", "filled", "first_applicable", "grid_crossing", "held_interval",
     "nans", "pair_need_both", "partner_in_grid", "ratio_beyond", "ratio_cell", "ratio_efficiency", "ratio_estimate",
     "ratio_ideal_table", "ratio_rounding", "rounded_crossing", "rounding_estimate", "stated_log", "states_coverage",
     "table_spread", "varied_contact_estimate", "varied_estimate"
@@ -148,12 +148,6 @@ def contact_estimate(x0, x1, n0, n1, gap, raw, mc_lo, mc_hi, ideal, *, width: fl
     return {"value": value, "low": low, "high": high, "interp": interp, "rounding": rounding}
 
 
-def interp_e_rows(rows: np.ndarray, centres: np.ndarray, e: np.ndarray) -> np.ndarray:
-    """:func:`designkit.tables.lookup.interp_e` for every row of ``rows`` [..., centre] at every ``e``:
-    shape [..., len(e)]."""
-    return interp_e_by(lambda c: rows[..., c], centres, e)
-
-
 def pair_need_both(view, kind: str, idx: tuple[int, ...], lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     """One scene slice's need of pairs ``lo < hi`` at every contact, both directions averaged: [contact, n].
 
@@ -166,8 +160,8 @@ def pair_need_both(view, kind: str, idx: tuple[int, ...], lo: np.ndarray, hi: np
     """
     suffix = {"svm": "", "lo": "_lo", "hi": "_hi"}[kind]
     w = float(view.t.header["effusivity"]["width"])
-    up = interp_e_rows(view.t.arrays[f"delta_up{suffix}"][idx], view.centres, lo)
-    down = interp_e_rows(view.t.arrays[f"delta_down{suffix}"][idx], view.centres, hi)
+    up, down = (interp_e_by(lambda c, rows=view.t.arrays[f"delta_{d}{suffix}"][idx]: rows[..., c], view.centres, e)
+                for d, e in (("up", lo), ("down", hi)))
     both_out = np.isnan(up) & np.isnan(down)
     up = np.where(np.isnan(up), view.e_hi - lo + w, up)
     down = np.where(np.isnan(down), hi - view.e_lo + w, down)
@@ -185,8 +179,8 @@ def grid_crossing(grid: np.ndarray, need: np.ndarray, gap) -> tuple[np.ndarray, 
     [2.5, 2.0, 2.0, 3.0, 150.0, 50.0]
     """
     ok = need <= gap  # (False at NaN)
-    k = np.where(ok.any(axis=0), ok.argmax(axis=0), -1)
-    cols, k0, k1 = np.arange(need.shape[1]), np.maximum(k - 1, 0), np.maximum(k, 0)
+    cols, k1 = np.arange(need.shape[1]), ok.argmax(axis=0)  # (the first that suffices; 0 where none does)
+    k, k0 = np.where(ok[k1, cols], k1, -1), np.maximum(k1 - 1, 0)
     x0, x1, n0, n1 = grid[k0], grid[k1], need[k0, cols], need[k1, cols]
     x = np.where(k > 0, cross2(x0, x1, n0, n1, gap), np.where(k == 0, grid[0], np.nan))
     return x, k, x0, x1, n0, n1

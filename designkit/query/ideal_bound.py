@@ -56,15 +56,8 @@ def columns(*values, dtypes=None) -> list[np.ndarray]:
     out = [np.asarray(v, dtype=d) for v, d in zip(values, dtypes or (np.float64,) * len(values))]
     shapes = {a.shape for a in out if a.ndim}
     if len(shapes) == 1 and len(shape := shapes.pop()) == 1:  # one length: numbers given once repeated
-        return [a if a.ndim else _repeated(shape, a) for a in out]
+        return [a if a.ndim else np.full(shape, a) for a in out]
     return [np.atleast_1d(a) for a in np.broadcast_arrays(*out)]
-
-
-def _repeated(shape, a: np.ndarray) -> np.ndarray:
-    """The 0-d ``a`` repeated to ``shape`` (numpy.full's result, without its Python-level call)."""
-    out = np.empty(shape, dtype=a.dtype)
-    out.fill(a)
-    return out
 
 
 def _first_good_sample(ok, a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -167,10 +167,6 @@ def _no_pair(question: str, op: OpenedTable, pq: PairQuestion, scene: dict, deta
                    value=None, interval=(None, None), ideal=None, in_grid={}, details=details, notes=[pq.note])
 
 
-def _one(x) -> np.ndarray:
-    return np.array([x], dtype=np.float64)
-
-
 def _el(r: dict, key: str, i: int) -> float | None:
     """Element ``i`` of an array answer's ``key`` (None for NaN)."""
     return number(r[key][i])
@@ -491,7 +487,7 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
     flags["effusivity"] = view.e_in_grid(x)
     common = dict(objects=(ref.to_dict(),), limiting=(ref.to_dict(),), rule=REFERENCE_RULE,
                   scene=scene_record(contact, noise, dt), classes=(ref,))
-    r = delta_e_arrays(op, _one(x), _one(contact), _one(noise), _one(dt), ideal_view=delta_e_ideal_view(op, ideal_table),
+    r = delta_e_arrays(op, *np.array([[x], [contact], [noise], [dt]], dtype=np.float64), ideal_view=delta_e_ideal_view(op, ideal_table),
                        zc=z_of_coverage(coverage), ideal_bound=ideal_bound, classes=[ref])
     if not all(flags.values()):
         wanted = {**_scene_wanted(view, noise, dt), "contact_s": contact, "effusivity": (x,)}

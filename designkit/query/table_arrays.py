@@ -29,7 +29,7 @@ from .efficiency import (CLOSED_FORM_MAX_CONTACT_S, CriticalNoiseGrid, delta_eff
 from .ideal_bound import contact_at_noise, exact_ideal_delta, exact_ideal_max_ratio
 from .estimates import (ABOVE, BELOW, CELL, CONTACT_ESTIMATORS, INSIDE, RATIO_ESTIMATORS,
                         ContactReading, RatioReading, axis_weights_flagged, delta_estimate, filled, first_applicable,
-                        grid_crossing, interp_e_rows, nans, partner_in_grid, states_coverage, table_spread)
+                        grid_crossing, nans, partner_in_grid, states_coverage, table_spread)
 
 __all__ = ["CLOSED_FORM_RATIO_BRACKET", "TableView", "at_contact", "contact_arrays", "delta_e_arrays",
            "distinguishable_arrays", "groups", "max_ratio", "ratio_arrays", "scene_groups"]
@@ -57,11 +57,10 @@ class TableView:
         self._contact_norms: np.ndarray | None = None
         self._baselines: np.ndarray | None = None
         self._scenes: dict[tuple[float, float], tuple[list, dict[str, bool]]] = {}
-        # the entries arrays as one plain array (_plain), and the gathers' index prefixes (slices)
+        # the entries' arrays as one plain array (_plain), and what questions read again for each pair (memo)
         self._names = {n: i for i, n in enumerate(n for n in table.arrays if n.startswith("delta_"))}
         self._plain_rows: np.ndarray | None = None
         self._plain_read: set[int] = set()
-        self._at: dict[tuple, tuple] = {}
         self._memo: dict[tuple, Any] = {}
 
     def critical_noise(self, lo, hi) -> np.ndarray:
@@ -124,8 +123,7 @@ class TableView:
         return combos, flags
 
     def memo(self, key: tuple, make):
-        """``make()``, kept with the view under ``key`` (what a question reads again for every pair of a scene:
-        its slices' index and weight arrays, read-only); at most 256 kept (a sweep over scenes)."""
+        """``make()``, kept with the view under ``key`` (what every pair of a scene reads again); at most 256."""
         hit = self._memo.get(key)
         if hit is None:
             if len(self._memo) >= 256:
@@ -151,46 +149,33 @@ class TableView:
         ``e``: [contact, len(e)], or [len(names), contact, len(e)] for a sequence (NaN: none), all the weighted
         scene slices of all the arrays in one reading."""
         many = not isinstance(names, str)
-        out = _weighted(combos, self.slices(names if many else [names], combos, e))
+        out = _weighted(combos, self._read((tuple(names) if many else (names,),), combos, e[None])[0])
         return out if many else out[0]
-
-    def slices(self, names, combos, e: np.ndarray) -> np.ndarray:
-        """The arrays ``names`` (a sequence) in each weighted scene slice of ``combos`` (in their order), at every
-        contact and every ``e``: [name, slice, contact, len(e)] (NaN: none), in one reading."""
-        return self._read((tuple(names),), combos, e[None])[0]
 
     def _read(self, names: tuple[tuple[str, ...], ...], combos, e: np.ndarray) -> np.ndarray:
         """Groups of arrays, ``names[g]`` each at its own effusivities ``e[g]`` (``e``: [group, n]), in each
-        weighted scene slice of ``combos``, at every contact: [group, name, slice, contact, n], in one
-        interpolation (two gathers of the view's plain copy of the table, :meth:`_plain`)."""
-        key = (names, tuple(idx for idx, w in combos if w != 0))
-        at = self._at.get(key)
-        if at is None:
-            if len(self._at) >= 256:  # (a sweep over scenes: the memo stays small)
-                self._at.clear()
-            live = key[1]
-            at = ((np.array([[self._names[n] for n in group] for group in names])[:, :, None, None, None],)
-                  + tuple(np.array(k)[None, None, :, None, None] for k in zip(*live))  # each [1, 1, slice, 1, 1]
-                  + (np.arange(self.contacts.size)[None, None, None, :, None],))
-            self._at[key] = at
+        weighted scene slice of ``combos`` (in their order), at every contact: [group, name, slice, contact, n]
+        (NaN: none), in one interpolation (two gathers of the view's plain copy of the table, :meth:`_plain`)."""
+        live = tuple(idx for idx, w in combos if w != 0)
+
+        def index():  # the gathers' index arrays but the effusivity's, each row read once
             self._plain({k[0] for k in live})
-        rows = self._plain_rows
+            return ((np.array([[self._names[n] for n in group] for group in names])[:, :, None, None, None],)
+                    + tuple(np.array(k)[None, None, :, None, None] for k in zip(*live))  # each [1, 1, slice, 1, 1]
+                    + (np.arange(self.contacts.size)[None, None, None, :, None],))
+        at, rows = self.memo(("read", names, live), index), self._plain_rows
         return interp_e_by(lambda c: rows[at + (c,)], self.centres, e[:, None, None, None, :])
 
     def _plain(self, first: set[int]) -> None:
-        """Read the scene rows ``first`` (indices on the first scene axis) of every ``delta_*`` array into the
-        view's plain copy [array, scene..., contact, e_ref], each row once per process, through the table's own
-        (checked) reader: the questions gather from it instead of from the mapped, row-checked arrays."""
-        todo = sorted(first - self._plain_read)
-        if not todo:
+        """Read the scene rows ``first`` (on the first scene axis) of every ``delta_*`` array into the view's plain
+        copy [array, scene..., contact, e_ref] through the table's (checked) reader, once per process and row."""
+        if not (todo := sorted(first - self._plain_read)):
             return
-        if self._plain_rows is None:
-            shape = self.t.arrays[next(iter(self._names))].shape
-            self._plain_rows = np.empty((len(self._names),) + tuple(shape))  # (memory taken as rows are read)
+        if self._plain_rows is None:  # (memory taken as rows are read)
+            self._plain_rows = np.empty((len(self._names),) + tuple(self.t.arrays[next(iter(self._names))].shape))
         for name, i in self._names.items():
-            a = self.t.arrays[name]
             for r in todo:
-                self._plain_rows[i, r] = a[r]
+                self._plain_rows[i, r] = self.t.arrays[name][r]
         self._plain_read.update(todo)
 
     def readings(self, kinds, combos, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
@@ -213,7 +198,7 @@ class TableView:
         many = not isinstance(kind, str)
         up, down = (_weighted(combos, r) for r in (
             readings if readings is not None else self.readings(kind if many else [kind], combos, lo, hi)))
-        out = np.where(np.isnan(up) | np.isnan(down), np.nan, np.maximum(up, down))
+        out = np.maximum(up, down)  # (NaN where either is: maximum propagates it)
         return out if many else out[0]
 
 
@@ -488,7 +473,7 @@ def delta_geometric(e: np.ndarray, v, cmb, cws, name: str) -> np.ndarray:
             for i, wi in cmb:
                 if not wi:
                     continue
-                y = interp_e_rows(v.t.arrays[name][i][k:k + 1], v.centres, e)[0]
+                y = interp_e_by(lambda c, rows=v.t.arrays[name][i][k:k + 1]: rows[..., c], v.centres, e)[0]
                 bad |= np.isnan(y) | (y <= 0)
                 total = total + w * wi * np.log(y)
         return np.where(bad, np.nan, np.exp(total))

@@ -22,6 +22,10 @@ load is printed beside them)::
 5. **The answers**: ``min_contact`` (at two noises) and ``max_noise`` (at 2 s) of ``--answers`` seeded random
    pairs in each tree: how many values changed, whether each lies inside the baseline's interval, how far
    the interval ends and the ideal bounds moved.
+6. **numpy calls per single new pair** (warm grid): the numpy functions and array methods one ``min_contact`` of
+   a new pair calls (``sys.setprofile``: calls from outside numpy into numpy's Python functions, its C functions
+   and ndarray / ufunc methods; operators such as ``a + b`` are not calls and not counted), and the Python
+   function calls; a single pair's cost is mostly numpy's per-call overhead on one-element arrays.
 
 The baseline is ``git archive`` of ``--rev`` into a temporary folder, imported through ``PYTHONPATH``
 (the tables are read from each tree's own ``tables/``).
@@ -110,6 +114,34 @@ for tag, ans in (("min-contact", min_contact(a, b)), ("min-contact at 0.02 degC"
 print(json.dumps(out))
 """
 
+CALLS = r"""
+import json, sys
+import numpy as np
+from designkit.query import min_contact
+min_contact(35000.0, 20000.0)
+rng = np.random.default_rng(int(sys.argv[1]))
+w = rng.uniform(2000.0, 39000.0, size=(3000, 2))
+min_contact(w[:, 0], w[:, 1])
+pairs = [p for p in rng.uniform(2000.0, 39000.0, size=(60, 2)).tolist() if abs(p[0] - p[1]) >= 500.0][:40]
+for a, b in pairs:  # (the grid's nodes these pairs read, solved first)
+    min_contact(a, b)
+n = {"numpy": 0, "python": 0}
+
+def count(frame, event, arg):
+    if event == "call":
+        n["python"] += 1
+        n["numpy"] += "numpy" in frame.f_code.co_filename and "numpy" not in frame.f_back.f_code.co_filename
+    elif event == "c_call":
+        n["numpy"] += ((getattr(arg, "__module__", None) or "").startswith("numpy")
+                       or isinstance(getattr(arg, "__self__", None), (np.ndarray, np.ufunc, np.generic)))
+
+sys.setprofile(count)
+for a, b in pairs:
+    min_contact(a, b)
+sys.setprofile(None)
+print(json.dumps({k: v / len(pairs) for k, v in n.items()}))
+"""
+
 
 def answers_changed(trees: dict[str, Path], n: int) -> None:
     """Count the answers of ``n`` seeded random pairs that differ between the trees, and whether each lies
@@ -191,6 +223,9 @@ def main(argv=None) -> None:
             print(f"| {label} | " + " | ".join(f"{x:.3g}" for x in v) + f" | {v[1] / v[0]:.2f}x | {target} |")
         print(f"\n{len(figs['this tree']['cold'])} new pairs and {a.runs} runs per tree; load (1 min) "
               f"{min(loads):.1f}-{max(loads):.1f} over the run; ratio = baseline / this tree\n")
+        calls = {name: _child(tree, CALLS, 300) for name, tree in trees.items()}
+        print(" | ".join(f"{name}: {c['numpy']:.0f} numpy calls, {c['python']:.0f} Python calls per single new pair"
+                         for name, c in calls.items()) + "\n")
         if a.answers:
             answers_changed(trees, a.answers)
 

@@ -22,7 +22,7 @@ Examples
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any, Mapping, Sequence
 
 __all__ = ["ANSWER_KEYS", "INTERVAL_MEANING", "QUANTITIES", "Answer", "IdealBound", "QuestionQuantity", "bound_of",
@@ -283,6 +283,14 @@ class Answer(QuestionQuantity):
     interval_kind: str | None = None
     route_reason: str | None = None
 
+    def replaced(self, **changes: Any) -> "Answer":
+        """:func:`dataclasses.replace` (every field is an ``__init__`` field, none derived), at a tenth of its cost."""
+        if unknown := changes.keys() - _FIELDS:
+            raise TypeError(f"Answer has no field {sorted(unknown)[0]!r}")
+        new = object.__new__(type(self))
+        new.__dict__.update(self.__dict__, **changes)
+        return new
+
     # ------------------------------------------------------------ schema
     @property
     def ideal(self) -> float | None:
@@ -363,6 +371,8 @@ class Answer(QuestionQuantity):
             out.update(d)
         return out
 
+
+_FIELDS = frozenset(f.name for f in fields(Answer))
 
 #: The parts of an answer's dictionary a record (one flat row: CSV, pandas) keeps, flattened ``part_key``;
 #: ``scene``'s keys keep their own names (``contact_s`` ...).

@@ -10,7 +10,10 @@ import math
 
 import numpy as np
 
+from ..models.semi_infinite import object_weight
+from ..recognition.ideal import critical_noise, shape_norm
 from ..tables.store import Table
+from .ideal_bound import columns, exact_ideal_delta, noise_k_contact, pair_critical_noise
 
 
 __all__ = [
@@ -51,14 +54,16 @@ def interp_e_by(at, centres: np.ndarray, e: np.ndarray) -> np.ndarray:
     [10.0, 15.0, 20.0, nan, nan]
     """
     n = centres.size
-    c = np.minimum(np.maximum(np.searchsorted(centres, e, side="right") - 1, 0), n - 2)
-    a, b = at(c), at(c + 1)
-    w = (e - centres[c]) / (centres[c + 1] - centres[c])
+    c = np.minimum(np.maximum(centres.searchsorted(e, side="right") - 1, 0), n - 2)
+    c1 = c + 1
+    a, b = at(c), at(c1)
+    left = centres[c]
+    w = (e - left) / (centres[c1] - left)
     # (NaN, a value beyond the grid, propagates through a + w (b - a); on a centre itself only a is read)
     out = np.where(w == 0.0, a, a + w * (b - a))
-    if (top := e >= centres[-1]).any():
+    if np.count_nonzero(top := e >= centres[-1]):
         out = np.where(top, at(np.full_like(c, n - 1)), out)
-    if (bottom := e <= centres[0]).any():
+    if np.count_nonzero(bottom := e <= centres[0]):
         out = np.where(bottom, at(np.zeros_like(c)), out)
     return out
 
@@ -196,18 +201,16 @@ class CriticalNoiseGrid:
         self.du = (math.log(e_top + 2.0 * width + NOISE_GRID_A0) - self.u0) / (n - 1)
         self.v0 = math.log(NOISE_GRID_MIN_WIDTHS * width)
         self.dv = (math.log(e_top + 3.0 * width) - self.v0) / (n - 1)
+        self._origin = np.array([[self.u0], [self.v0]])  # (u, v) of node (0, 0) and the steps, [2, 1] each
+        self._step = np.array([[self.du], [self.dv]])
         self.values = np.full(n * n, np.nan)  # log(s* / dw) at node (i, j), flat i * n + j
         self.known = np.zeros(n * n, dtype=bool)
 
     def _weight(self, e):
-        from ..models.semi_infinite import object_weight
-
         return object_weight(self.e_s, e)
 
     def _fill(self, nodes: np.ndarray) -> None:
         """Solve the nodes ``nodes`` (flat indices) exactly, in one vectorized call."""
-        from ..recognition.ideal import critical_noise
-
         n = NOISE_GRID_NODES
         lo = np.maximum(np.exp(self.u0 + self.du * (nodes // n)) - NOISE_GRID_A0, 0.0)
         hi = lo + np.exp(self.v0 + self.dv * (nodes % n))
@@ -223,18 +226,21 @@ class CriticalNoiseGrid:
             lo, hi = np.broadcast_arrays(lo, hi)
         shape, lo, hi = lo.shape, lo.ravel(), hi.ravel()
         n = NOISE_GRID_NODES
-        out = np.full(lo.size, np.nan)
+        out = np.empty(lo.size)
+        out.fill(np.nan)
         with np.errstate(divide="ignore", invalid="ignore"):
-            pu = (np.log(lo + NOISE_GRID_A0) - self.u0) / self.du
-            pv = (np.log(hi - lo) - self.v0) / self.dv
-        inside = (lo >= 0) & (pu <= n - 1) & (pv >= 0) & (pv <= n - 1)
-        i = np.flatnonzero(inside)
+            # the grid coordinates (u, v) of every pair, [2, pair]
+            p = (np.log(np.array([lo + NOISE_GRID_A0, hi - lo])) - self._origin) / self._step
+            inside = (lo >= 0) & (p[0] <= n - 1) & (p[1] >= 0) & (p[1] <= n - 1)
+        i = inside.nonzero()[0]
         if i.size:
-            pu, pv = pu[i], pv[i]
-            su = np.minimum(np.maximum(np.floor(pu).astype(np.int64) - 1, 0), n - 4)
-            sv = np.minimum(np.maximum(np.floor(pv).astype(np.int64) - 1, 0), n - 4)
-            flat = (su[:, None, None] + _FOUR[None, :, None]) * n + (sv[:, None, None] + _FOUR[None, None, :])
-            if not self.known[flat].all():
+            if i.size < lo.size:  # (every pair inside: the arrays themselves)
+                p, lo_i, hi_i = p[:, i], lo[i], hi[i]
+            else:
+                i, lo_i, hi_i = slice(None), lo, hi
+            s = np.minimum(np.maximum(np.floor(p).astype(np.int64) - 1, 0), n - 4)  # the first of 4 nodes a side
+            flat = (s[0] * n + s[1])[:, None, None] + _NODES4  # the 4 x 4 nodes around each pair
+            if np.count_nonzero(known := self.known[flat]) < known.size:
                 missing = flat[~self.known[flat]]  # the whole blocks of NOISE_GRID_BLOCK x NOISE_GRID_BLOCK nodes around them
                 b = NOISE_GRID_BLOCK
                 wanted = np.zeros((n // b) ** 2, dtype=bool)  # (not np.unique: its first call imports numpy.ma)
@@ -244,13 +250,14 @@ class CriticalNoiseGrid:
                 cols = (blocks % (n // b))[:, None, None] * b + np.arange(b)[None, None, :]
                 nodes = (rows * n + cols).ravel()
                 self._fill(nodes[~self.known[nodes]])
-            g = np.einsum("pi,pj,pij->p", _lagrange4(pu - su), _lagrange4(pv - sv), self.values[flat])
-            w = self._weight(np.concatenate([hi[i], lo[i]]))
-            out[i] = np.exp(g) * (w[:i.size] - w[i.size:])
-        rest = np.flatnonzero(np.isnan(out) & np.isfinite(lo) & np.isfinite(hi))
+            lu, lv = _lagrange4(p - s)
+            g = np.einsum("pi,pj,pij->p", lu, lv, self.values[flat])
+            w = self._weight(np.array([hi_i, lo_i]))
+            out[i] = np.exp(g) * (w[0] - w[1])
+        # (every pair inside the grid has finite lo and hi)
+        rest = (np.isnan(out) if isinstance(i, slice) else
+                np.isnan(out) & np.isfinite(lo) & np.isfinite(hi)).nonzero()[0]
         if rest.size:  # outside the grid (or next to a node that does not separate): the exact solve
-            from .ideal_bound import pair_critical_noise
-
             out[rest] = pair_critical_noise(self.sensor, lo[rest], hi[rest], width=self.width,
                                             threshold=self.threshold)
         return out.reshape(shape)
@@ -258,41 +265,44 @@ class CriticalNoiseGrid:
 
 _FOUR = np.arange(4)
 _FOUR.flags.writeable = False
+#: The flat offsets of the 4 x 4 nodes from the first (row-major, :data:`NOISE_GRID_NODES` a row).
+_NODES4 = _FOUR[:, None] * NOISE_GRID_NODES + _FOUR[None, :]
+_NODES4.flags.writeable = False
+#: Weight j of :func:`_lagrange4` is ``(x - A) S (x - B) (x - C) / D``: the other nodes A, B, C, sign S.
+_LAGRANGE = np.array([[1.0, 0.0, 0.0, 0.0], [-1.0, 1.0, -1.0, 1.0], [2.0, 2.0, 1.0, 1.0], [3.0, 3.0, 3.0, 2.0],
+                      [6.0, 2.0, 2.0, 6.0]])
+_LAGRANGE.flags.writeable = False
 
 
 def _lagrange4(x: np.ndarray) -> np.ndarray:
-    """Cubic Lagrange weights of the nodes 0, 1, 2, 3 at positions ``x`` (in [0, 3]): shape ``x.shape + (4,)``."""
-    a, b, c, d = x, x - 1.0, x - 2.0, x - 3.0
-    out = np.empty(x.shape + (4,))
-    out[..., 0], out[..., 1], out[..., 2], out[..., 3] = -b * c * d / 6.0, a * c * d / 2.0, -a * b * d / 2.0, a * b * c / 6.0
-    return out
+    """Cubic Lagrange weights of the nodes 0, 1, 2, 3 at positions ``x`` (in [0, 3]): shape ``x.shape + (4,)``
+    (``-(x-1)(x-2)(x-3)/6``, ``x(x-2)(x-3)/2``, ``-x(x-1)(x-3)/2``, ``x(x-1)(x-2)/6``, in that order)."""
+    first, sign, second, third, div = _LAGRANGE
+    x = x[..., None]
+    return (x - first) * sign * (x - second) * (x - third) / div
 
 
 # ============================================================ the noise efficiency (min-contact)
 def _entries(view, slices, ka, kb, lo, hi, readings=None):
-    """The table's entries a pair's noise efficiency is read from, in one gather per array: the SVM need and its
-    Monte Carlo ends (``delta_{up,down}{,_lo,_hi}``, interpolated in effusivity as
-    :func:`designkit.tables.lookup.interp_e`) upwards at ``lo`` and downwards at ``hi``, at the contacts ``ka``
-    (row 0) and ``kb`` (row 1), in each of the pair's slices ``slices`` (n, m): three arrays shaped
-    (contact 2, slice m, direction 2, pair n), and the (clipped) contact indices (2, n). ``readings``: these
-    arrays upwards and downwards at every contact in the slices (the first three kinds of
-    :meth:`~designkit.query.table_arrays.TableView.readings`), read already."""
-    jj = np.minimum(np.maximum(np.array([ka, kb]), 0), view.contacts.size - 1)  # (2, n)
-    if readings is not None:  # [kind, slice, contact, pair] -> [kind, contact, slice, pair] at jj
-        pair = np.arange(lo.size)
-        sides = [r[:, :, jj, pair].transpose(0, 2, 1, 3) for r in readings]
-    else:
-        si = slices.T[None]  # (1, m, n)
-        j = jj[:, None, :]  # (2, 1, n)
-        sides = []
-        for d, e in (("up", lo), ("down", hi)):  # the need and its two ends in one reading per direction
-            arrays = [view.t.arrays[f"delta_{d}{suffix}"] for suffix in ("", "_lo", "_hi")]
-            sides.append(interp_e_by(lambda c: np.stack([a[si, j, c] for a in arrays]), view.centres,
-                                     np.broadcast_to(e, (2, si.shape[1], e.size))))
-    out = np.stack(sides, axis=3)  # [need / lo / hi, contact, slice, direction, pair]
-    return list(out), jj
+    """The entries of a pair's noise efficiency (``delta_{up,down}{,_lo,_hi}`` upwards at ``lo``, downwards at
+    ``hi``, at contacts ``ka`` / ``kb`` in the pair's slices ``slices`` (n, m)): (need / lo / hi 3, contact 2,
+    slice m, direction 2, pair n), the clipped contacts (2, n) and whether each is the one asked. ``readings``:
+    :meth:`~designkit.query.table_arrays.TableView.readings` of the first three kinds, read already."""
+    kk = np.array([ka, kb])
+    jj = np.minimum(np.maximum(kk, 0), view.contacts.size - 1)  # (2, n)
+    if readings is not None:  # [direction, kind, slice, contact, pair] at jj -> [kind, contact, slice, direction, pair]
+        return readings[:, :3, :, jj, np.arange(lo.size)].transpose(1, 3, 2, 0, 4), jj, jj == kk
+    si = slices.T[None]  # (1, m, n)
+    j = jj[:, None, :]  # (2, 1, n)
+    sides = []
+    for d, e in (("up", lo), ("down", hi)):  # the need and its two ends in one reading per direction
+        arrays = [view.t.arrays[f"delta_{d}{suffix}"] for suffix in ("", "_lo", "_hi")]
+        sides.append(interp_e_by(lambda c: np.stack([a[si, j, c] for a in arrays]), view.centres,
+                                 np.broadcast_to(e, (2, si.shape[1], e.size))))
+    return np.stack(sides, axis=3), jj, jj == kk  # [need / lo / hi, contact, slice, direction, pair]
 
 
+@np.errstate(divide="ignore", invalid="ignore")  # (one context for the whole computation)
 def _k_readings(op, slices, sw, ka, kb, lo, hi, extra=None, readings=None):
     """The noise efficiency ``log k`` and its standard error at the tabulated contacts ``ka`` and ``kb`` (rows
     0 and 1 of the (2, n) arrays; NaN: no usable entry), per pair, from the pair's own entries (upwards at
@@ -300,104 +310,106 @@ def _k_readings(op, slices, sw, ka, kb, lo, hi, extra=None, readings=None):
     :func:`noise_k_min_contact`. The entries' critical noises are read off the table's
     :class:`CriticalNoiseGrid`; ``extra``: (lo, hi) of further pairs read in the same call, whose critical
     noises are returned third (None: not asked)."""
-    view, tab = op.view, op.tab
-    width = op.width
-    z_table = table_z(tab)
+    view, width = op.view, op.width
+    z_table = table_z(op.tab)
     n = lo.size
     h, rnd_sd = 0.5 * width, width / math.sqrt(12.0)
-    (d, dl, dh), jj = _entries(view, slices, ka, kb, lo, hi, readings)  # (2, m, 2, n)
+    entries, jj, ok_j = _entries(view, slices, ka, kb, lo, hi, readings)  # (3, 2, m, 2, n); (2, n) twice
+    d = entries[0]
     shape = d.shape
-    m = shape[1]
-    kk = np.array([ka, kb])
-    ok_j = ((kk >= 0) & (kk < view.contacts.size))[:, None, None, :]
-    with np.errstate(invalid="ignore"):
-        ok = np.isfinite(d) & (d > width) & ok_j & (sw.T[None, :, None, :] > 0)
-        ok[:, :, 1] &= hi - (d[:, :, 1] - h) > 0  # downwards: the partner stays above 0
+    ok = np.isfinite(d) & (d > width) & (sw.T[None, :, None, :] > 0) & ok_j[:, None, None, :]
+    ok[:, :, 1] &= hi - (d[:, :, 1] - h) > 0  # downwards: the partner stays above 0
     # the entries in (contact, slice, direction, pair) order
-    C4, M4, S4, P4 = np.unravel_index(np.flatnonzero(ok), shape)
-    D, DL, DH = d[ok], dl[ok], dh[ok]
-    P, Cc, SIGN = P4, C4, np.where(S4 == 0, 1.0, -1.0)
+    Cc, M4, S4, P = np.unravel_index(ok.ravel().nonzero()[0], shape)
+    D, DL, DH = entries[:, ok]
     W = sw[P, M4]
     RS = view.t.axes["noise_ratio"][slices[P, M4]]
-    e_ref = np.where(SIGN > 0, lo[P], hi[P])
-    s_t = RS / view.contact_norms()[jj[C4, P]]
-
-    def pair_of(dist):  # the entry's pair of lower edges at distance dist from its reference
-        return np.where(SIGN > 0, e_ref, e_ref - dist), np.where(SIGN > 0, e_ref + dist, e_ref)
-
-    a1, b1 = pair_of(D - h)
-    a2, b2 = pair_of(D - h + width)
-    a2 = np.maximum(a2, 0.0)
+    s_t = RS / view.contact_norms()[jj[Cc, P]]
+    # the entry's pairs of lower edges at its need and one width further, from its reference (upwards at lo,
+    # downwards at hi): one reading of the grid for every entry, at both distances, and the extra pairs
+    up = S4 == 0
+    e_ref = np.array([lo, hi])[S4, P]
+    dist = (D - h) + np.array([[0.0], [width]])  # (2, k)
+    a = np.where(up, e_ref, e_ref - dist)
+    b = np.where(up, e_ref + dist, e_ref)
+    np.maximum(a[1], 0.0, out=a[1])
     k = P.size
-    # one reading: every entry at its need and one width further
-    xa, xb = extra if extra is not None else (np.zeros(0),) * 2
-    star = op.view.critical_noise(np.concatenate([a1, a2, xa]), np.concatenate([b1, b2, xb]))
+    if extra is not None:
+        a, b = np.concatenate([a.ravel(), extra[0]]), np.concatenate([b.ravel(), extra[1]])
+    star = view.critical_noise(a.ravel(), b.ravel())
     s1, s2 = star[:k], star[k:2 * k]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        log_k = np.log(s1 / s_t)
-        gamma = np.log(s2 / s1) / np.log((D - h + width) / (D - h))
-        mc = np.where(np.isfinite(DH) & np.isfinite(DL) & (DL > h), np.log((DH - h) / (DL - h)) / (2.0 * z_table),
-                      np.where(np.isfinite(DL) & (DL > h), np.log((D - h) / (DL - h)) / z_table, 0.0))
-        rnd = np.abs(gamma) * rnd_sd / (D - h)
-        mck = np.abs(gamma) * mc
-        sd = np.maximum(np.hypot(rnd, mck), 1e-3)
+    log_k = np.log(s1 / s_t)
+    gamma = np.abs(np.log(s2 / s1) / np.log(dist[1] / dist[0]))
+    low = np.isfinite(DL) & (DL > h)
+    logs = np.log(np.array([DH - h, dist[0]]) / (DL - h))  # the interval's width, the low end's distance
+    mc = np.where(np.isfinite(DH) & low, logs[0] / (2.0 * z_table), np.where(low, logs[1] / z_table, 0.0))
+    rnd = gamma * rnd_sd / dist[0]
+    mck = gamma * mc
+    sd = np.maximum(np.hypot(rnd, mck), 1e-3)
     good = np.isfinite(log_k) & np.isfinite(sd)
     # the entries' Monte Carlo errors are combined as independent (measured on svm-paper, the residuals of
     # log k about each slice's trend correlate 0.14 between neighbouring noise-ratio slices and 0.07 between
     # neighbouring contact times, needs >= 5 widths); their rounding errors are not: the grid rounds the
     # similar needs of neighbouring entries the same way (at needs under 5 widths neighbouring readings of
     # log k are identical), so the rounding term is the entries' weighted mean, not reduced by averaging
-    om = np.where(good, W / sd ** 2, 0.0)
-    # per (contact, pair): bin c * n + p, each bin's entries summed in their order
-    at = Cc * n + P
-
-    def total(x):
-        return np.bincount(at, x, minlength=2 * n).reshape(2, n)
-
-    num, den = total(om * np.where(good, log_k, 0.0)), total(om)
-    var, rnd_mean = total(om ** 2 * np.where(good, mck ** 2, 0.0)), total(om * np.where(good, rnd, 0.0))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        lk = np.where(den > 0, num / den, np.nan)
-        se = np.where(den > 0, np.hypot(np.sqrt(var) / den, rnd_mean / den), np.nan)
+    all_good = np.count_nonzero(good) == good.size
+    om = W / sd ** 2 if all_good else np.where(good, W / sd ** 2, 0.0)
+    # per (contact, pair): bin c * n + p, each bin's entries summed in their order; the four sums in one count
+    parts = np.array([om * log_k, om, om ** 2 * mck ** 2, om * rnd])
+    if not all_good:
+        parts = np.where(good, parts, 0.0)
+    num, den, var, rnd_mean = np.bincount(np.add.outer((2 * n) * _FOUR, Cc * n + P).ravel(), parts.ravel(),
+                                          minlength=8 * n).reshape(4, 2, n)
+    lk, se = np.where(den > 0, [num / den, np.hypot(np.sqrt(var) / den, rnd_mean / den)], np.nan)
     return (lk, se) if extra is None else (lk, se, star[2 * k:])
 
 
-def _k_line(lk, se, t_a, t_b):
+def _k_line(lk, se, t_a, t_b, log_ab=None):
     """``log k`` at ``t_a`` and ``t_b`` (one held at the other's where it has no reading; two that fall pooled:
     k never falls with contact time, on svm-paper the slice medians rise at every step in every slice), the
-    weights and the readings' disagreement where they fell."""
-    have_a, have_b = np.isfinite(lk[0]), np.isfinite(lk[1])
-    la_, lb_ = np.where(have_a, lk[0], lk[1]), np.where(have_b, lk[1], lk[0])
-    with np.errstate(invalid="ignore", divide="ignore"):
-        wa, wb = np.where(have_a, 1.0 / se[0] ** 2, 0.0), np.where(have_b, 1.0 / se[1] ** 2, 0.0)
-        falls = have_a & have_b & ((lb_ - la_) * np.sign(np.log(t_b / t_a)) < 0)
-        # (la_, lb_ are finite or NaN: a reading is a weighted mean of finite log k)
-        pooled = (np.where(have_a, la_, 0.0) * wa + np.where(have_b, lb_, 0.0) * wb) / (wa + wb)
-        disagree = np.where(falls, np.abs(lb_ - la_), 0.0)
-    la_, lb_ = np.where(falls, pooled, la_), np.where(falls, pooled, lb_)
-    return la_, lb_, have_a, have_b, falls, wa, wb, disagree
+    weights and the readings' disagreement where they fell (``log_ab``: ``log(t_b / t_a)``, if computed)."""
+    have = np.isfinite(lk)  # [a / b, n]
+    lab = np.where(have, lk, lk[::-1])
+    w = np.where(have, 1.0 / se ** 2, 0.0)
+    rise = lab[1] - lab[0]
+    falls = have[0] & have[1] & (rise * np.sign(np.log(t_b / t_a) if log_ab is None else log_ab) < 0)
+    if not np.count_nonzero(falls):  # (none fell: nothing pooled)
+        return lab[0], lab[1], have[0], have[1], falls, w[0], w[1], np.zeros(rise.shape)
+    # (la_, lb_ are finite or NaN: a reading is a weighted mean of finite log k)
+    held = np.where(have, lab, 0.0) * w
+    pooled = (held[0] + held[1]) / (w[0] + w[1])
+    disagree = np.where(falls, np.abs(rise), 0.0)
+    la_, lb_ = np.where(falls, pooled, lab)
+    return la_, lb_, have[0], have[1], falls, w[0], w[1], disagree
 
 
 def _k_var(u, se, la_, lb_, have_a, have_b, falls, wa, wb, disagree, far):
     """Variance of ``log k`` at fraction ``u`` of the way from ``t_a`` to ``t_b`` (``far``: log distance to
     the one reading where only one exists)."""
     dk = np.abs(lb_ - la_)
-    v = np.where(have_a & have_b, ((1 - u) * se[0]) ** 2 + (u * se[1]) ** 2 + (u * (1 - u) * dk / 2) ** 2,
-                 np.where(have_a, se[0], se[1]) ** 2 + (0.5 * far) ** 2)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return np.where(falls, 1.0 / (wa + wb) + (disagree / 2) ** 2, v)
+    w = 1 - u
+    both = have_a & have_b
+    v = (w * se[0]) ** 2 + (u * se[1]) ** 2 + (u * w * dk / 2) ** 2
+    if np.count_nonzero(both) < both.size:  # (one reading only somewhere)
+        v = np.where(both, v, np.where(have_a, se[0], se[1]) ** 2 + (0.5 * far) ** 2)
+    if np.count_nonzero(falls):
+        v = np.where(falls, 1.0 / (wa + wb) + (disagree / 2) ** 2, v)
+    return v
 
 
 def _slices(combos, n):
-    """Shared scene weights as per-pair slice arrays (n, m)."""
+    """Shared scene weights as per-pair slice arrays (n, m), read-only."""
     live = [(idx[0], w) for idx, w in combos if w]
-    return (np.array([[i for i, _ in live]], dtype=np.int64).repeat(n, axis=0),
-            np.array([[w for _, w in live]], dtype=np.float64).repeat(n, axis=0))
+    out = (np.array([[i for i, _ in live]], dtype=np.int64).repeat(n, axis=0),
+           np.array([[w for _, w in live]], dtype=np.float64).repeat(n, axis=0))
+    for a in out:
+        a.flags.writeable = False
+    return out
 
 
+@np.errstate(divide="ignore", invalid="ignore")  # (one context for the whole computation)
 def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
-                        max_contact_s: float = CLOSED_FORM_MAX_CONTACT_S, s_pair=None,
-                        readings=None) -> dict[str, np.ndarray]:
+                        max_contact_s: float = CLOSED_FORM_MAX_CONTACT_S, readings=None) -> dict[str, np.ndarray]:
     """min-contact from the SVM's *noise efficiency* against the exact ideal observer, for pairs of one scene.
 
     The SVM separates a pair when the ideal observer would at a larger noise: ``k(t)`` times the projection
@@ -434,9 +446,9 @@ def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
         Pairs [J s^-1/2 K^-1 m^-2] and the asked sigma/dT.
     zc : float
         z of the asked coverage.
-    readings : (ndarray, ndarray), optional
+    readings : ndarray, optional
         The pairs' entries read already: ``delta_up{,_lo,_hi}`` at ``lo`` and ``delta_down{,_lo,_hi}`` at
-        ``hi`` in each weighted slice of ``combos`` at every contact, [kind, slice, contact, pair] each
+        ``hi`` in each weighted slice of ``combos`` at every contact, [direction, kind, slice, contact, pair]
         (:meth:`~designkit.query.table_arrays.TableView.readings`); None: read here.
 
     Returns
@@ -445,44 +457,43 @@ def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
         ``value``, ``low``, ``high`` [s], ``k_a``, ``k_b`` (NaN: no reading there), ``t_a``, ``t_b``,
         ``se_log`` (of the answer, log); ``value`` NaN where the route does not apply.
     """
-    from ..recognition.ideal import shape_norm
-    from .ideal_bound import columns, noise_k_contact
-
     view, sensor = op.view, op.tab.sensor
     lo, hi, ratio, kb = columns(lo, hi, ratio, k_cross, dtypes=(np.float64,) * 3 + (np.int64,))
     n = lo.size
     ka = view.baselines()[kb]  # (k_baseline of every tabulated contact, kept with the table)
-    slices, sw = _slices(combos, n)
-    if s_pair is None:  # the pair's own critical noise read with its entries'
-        lk, se, s_pair = _k_readings(op, slices, sw, ka, kb, lo, hi, extra=(lo, hi), readings=readings)
-    else:
-        lk, se = _k_readings(op, slices, sw, ka, kb, lo, hi, readings=readings)
-        s_pair = np.atleast_1d(s_pair)
+    slices, sw = view.memo(("slices", tuple(combos), n), lambda: _slices(combos, n)) if n <= 64 else _slices(combos, n)
+    lk, se, s_pair = _k_readings(  # (the pair's own critical noise read with its entries')
+        op, slices, sw, ka, kb, lo, hi, extra=(lo, hi), readings=readings)
     t_a, t_b = view.contacts[np.where(ka >= 0, ka, kb)], view.contacts[kb]
-    la_, lb_, have_a, have_b, falls, wa, wb, disagree = _k_line(lk, se, t_a, t_b)
+    log_ab = np.log(t_b / t_a)
+    la_, lb_, have_a, have_b, falls, wa, wb, disagree = _k_line(lk, se, t_a, t_b, log_ab)
     ok = have_a | have_b
-    value = np.full(n, np.nan)
-    if ok.any():
-        value[ok] = noise_k_contact(sensor, ratio[ok], s_pair[ok], t_a[ok], t_b[ok], la_[ok], lb_[ok], max_contact_s)
+    if (n_ok := np.count_nonzero(ok)) == n:  # (every pair: the arrays themselves)
+        value = noise_k_contact(sensor, ratio, s_pair, t_a, t_b, la_, lb_, max_contact_s)
+    else:
+        value = np.full(n, np.nan)
+        if n_ok:
+            value[ok] = noise_k_contact(sensor, ratio[ok], s_pair[ok], t_a[ok], t_b[ok], la_[ok], lb_[ok],
+                                        max_contact_s)
     ok &= np.isfinite(value)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        u = np.log(value / t_a) / np.log(t_b / t_a)
-        var_k = _k_var(u, se, la_, lb_, have_a, have_b, falls, wa, wb, disagree,
-                       np.log(value / np.where(have_a, t_a, t_b)))
-        slope_k = np.where(have_a & have_b & (t_a != t_b), (lb_ - la_) / np.log(t_b / t_a), 0.0)
-        v_ok = np.where(ok, value, 1.0)  # (shape_norm takes finite contact times only)
-        g = shape_norm(sensor, np.concatenate([v_ok * 1.05, v_ok / 1.05]))
-        beta_g = np.log(g[:n] / g[n:]) / (2 * math.log(1.05))
-        se_t = np.sqrt(var_k) / np.maximum(beta_g - slope_k, 0.05)
-        low, high = value * np.exp(-zc * se_t), value * np.exp(zc * se_t)
-        k_at = np.exp(np.maximum(la_ + slope_k * np.log(value / t_a), 0.0))
-    nan = ~ok
-    return {"value": np.where(nan, np.nan, value), "low": np.where(nan, np.nan, low),
-            "high": np.where(nan, np.nan, high), "k_a": np.where(have_a & ok, np.exp(lk[0]), np.nan),
-            "k_b": np.where(have_b & ok, np.exp(lk[1]), np.nan), "t_a": t_a, "t_b": t_b,
-            "k": np.where(nan, np.nan, k_at), "se_log": np.where(nan, np.nan, se_t), "s_pair": s_pair}
+    # log(value / t_a), and the log distance to the one reading where only one exists
+    lv = np.log(value / np.array([t_a, np.where(have_a, t_a, t_b)]))
+    u = lv[0] / log_ab
+    var_k = _k_var(u, se, la_, lb_, have_a, have_b, falls, wa, wb, disagree, lv[1])
+    slope_k = np.where(have_a & have_b & (t_a != t_b), (lb_ - la_) / log_ab, 0.0)
+    v_ok = np.where(ok, value, 1.0)  # (shape_norm takes finite contact times only)
+    g = shape_norm(sensor, np.concatenate([v_ok * 1.05, v_ok / 1.05]))
+    beta_g = np.log(g[:n] / g[n:]) / (2 * math.log(1.05))
+    se_t = np.sqrt(var_k) / np.maximum(beta_g - slope_k, 0.05)
+    ends = value * np.exp(np.multiply.outer([-zc, zc], se_t))
+    k_at = np.exp(np.maximum(la_ + slope_k * lv[0], 0.0))
+    out = np.where(ok, [value, ends[0], ends[1], k_at, se_t], np.nan)
+    k_ab = np.where([have_a & ok, have_b & ok], np.exp(lk), np.nan)
+    return {"value": out[0], "low": out[1], "high": out[2], "k_a": k_ab[0], "k_b": k_ab[1], "t_a": t_a, "t_b": t_b,
+            "k": out[3], "se_log": out[4], "s_pair": s_pair}
 
 
+@np.errstate(divide="ignore", invalid="ignore")  # (one context for the whole computation)
 def noise_k_max_ratio(op, contact_s, r_table, r_ideal, lo, hi, *, zc: float) -> dict[str, np.ndarray]:
     """max-noise / min-delta-t from the SVM's noise efficiency (:func:`noise_k_min_contact`): the SVM separates
     the pair up to ``sigma/dT = r_ideal / k(contact)``, ``r_ideal`` the ideal observer's exact largest
@@ -508,12 +519,11 @@ def noise_k_max_ratio(op, contact_s, r_table, r_ideal, lo, hi, *, zc: float) -> 
     lk, se = _k_readings(op, slices, sw, ka, kb, lo, hi)
     t_a, t_b = C[ka], C[kb]
     la_, lb_, have_a, have_b, falls, wa, wb, disagree = _k_line(lk, se, t_a, t_b)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        u = np.where(t_a != t_b, np.log(contact / t_a) / np.log(t_b / t_a), 1.0)
-        log_k = np.maximum((1 - u) * la_ + u * lb_, 0.0)
-        var_k = _k_var(u, se, la_, lb_, have_a, have_b, falls, wa, wb, disagree,
-                       np.log(contact / np.where(have_a, t_a, t_b)))
-        sd = np.sqrt(var_k)
+    u = np.where(t_a != t_b, np.log(contact / t_a) / np.log(t_b / t_a), 1.0)
+    log_k = np.maximum((1 - u) * la_ + u * lb_, 0.0)
+    var_k = _k_var(u, se, la_, lb_, have_a, have_b, falls, wa, wb, disagree,
+                   np.log(contact / np.where(have_a, t_a, t_b)))
+    sd = np.sqrt(var_k)
     ok = (have_a | have_b) & np.isfinite(r_ideal) & np.isfinite(sd)
     value = r_ideal * np.exp(-log_k)
     return {"value": np.where(ok, value, np.nan), "low": np.where(ok, value * np.exp(-zc * sd), np.nan),
@@ -597,8 +607,6 @@ def delta_efficiency_estimate(sensor, e, contact_s, ratio, direction, t_a, t_b, 
     >>> float(r["ideal"][0]) < float(r["low"][0]) < float(r["value"][0]) < float(r["high"][0])
     True
     """
-    from .ideal_bound import exact_ideal_delta
-
     S, L, H = (np.asarray(a, dtype=np.float64) for a in (svm, svm_lo, svm_hi))
     m, n = S.shape[1], S.shape[2]
     e, contact, ratio, direction, t_a, t_b = (np.broadcast_to(np.asarray(a, dtype=np.float64), (n,)) for a in (

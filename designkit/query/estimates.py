@@ -23,7 +23,7 @@ from .efficiency import interp_e_by, noise_k_max_ratio, table_z
 __all__ = [
     "ABOVE", "BELOW", "CELL", "CONTACT_ESTIMATORS", "ContactReading", "Estimates", "INSIDE",
     "RATIO_ESTIMATORS", "RatioReading", "axis_weights_flagged", "cell_estimate", "contact_estimate", "cross2",
-    "delta_estimate", "efficiency_estimate", "first_applicable", "grid_crossing", "held_interval", "interp_e_rows",
+    "delta_estimate", "efficiency_estimate", "filled", "first_applicable", "grid_crossing", "held_interval",
     "nans", "pair_need_both", "partner_in_grid", "ratio_beyond", "ratio_cell", "ratio_efficiency", "ratio_estimate",
     "ratio_ideal_table", "ratio_rounding", "rounded_crossing", "rounding_estimate", "stated_log", "states_coverage",
     "table_spread", "varied_contact_estimate", "varied_estimate"
@@ -49,8 +49,7 @@ def cross2(x0, x1, n0, n1, gap) -> np.ndarray:
     """
     x0, x1, n0, n1, gap = (np.asarray(a, dtype=np.float64) for a in (x0, x1, n0, n1, gap))  # (they broadcast)
     with np.errstate(invalid="ignore", divide="ignore"):
-        ok0 = ~np.isnan(n0) & (n0 <= gap)
-        ok1 = ~np.isnan(n1) & (n1 <= gap)
+        ok0, ok1 = n0 <= gap, n1 <= gap  # (False at NaN)
         w = np.where(n0 != n1, (n0 - gap) / (n0 - n1), 1.0)
         inside = np.where(np.isnan(n0), x1, x0 + w * (x1 - x0))
     return np.where(ok0, x0, np.where(ok1, inside, np.nan))
@@ -149,12 +148,6 @@ def contact_estimate(x0, x1, n0, n1, gap, raw, mc_lo, mc_hi, ideal, *, width: fl
     return {"value": value, "low": low, "high": high, "interp": interp, "rounding": rounding}
 
 
-def interp_e_rows(rows: np.ndarray, centres: np.ndarray, e: np.ndarray) -> np.ndarray:
-    """:func:`designkit.tables.lookup.interp_e` for every row of ``rows`` [..., centre] at every ``e``:
-    shape [..., len(e)]."""
-    return interp_e_by(lambda c: rows[..., c], centres, e)
-
-
 def pair_need_both(view, kind: str, idx: tuple[int, ...], lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     """One scene slice's need of pairs ``lo < hi`` at every contact, both directions averaged: [contact, n].
 
@@ -167,8 +160,8 @@ def pair_need_both(view, kind: str, idx: tuple[int, ...], lo: np.ndarray, hi: np
     """
     suffix = {"svm": "", "lo": "_lo", "hi": "_hi"}[kind]
     w = float(view.t.header["effusivity"]["width"])
-    up = interp_e_rows(view.t.arrays[f"delta_up{suffix}"][idx], view.centres, lo)
-    down = interp_e_rows(view.t.arrays[f"delta_down{suffix}"][idx], view.centres, hi)
+    up, down = (interp_e_by(lambda c, rows=view.t.arrays[f"delta_{d}{suffix}"][idx]: rows[..., c], view.centres, e)
+                for d, e in (("up", lo), ("down", hi)))
     both_out = np.isnan(up) & np.isnan(down)
     up = np.where(np.isnan(up), view.e_hi - lo + w, up)
     down = np.where(np.isnan(down), hi - view.e_lo + w, down)
@@ -185,12 +178,11 @@ def grid_crossing(grid: np.ndarray, need: np.ndarray, gap) -> tuple[np.ndarray, 
     >>> [float(v[0]) for v in grid_crossing(np.array([1.0, 2.0, 3.0]), np.array([[300.0], [150.0], [50.0]]), 100.0)]
     [2.5, 2.0, 2.0, 3.0, 150.0, 50.0]
     """
-    with np.errstate(invalid="ignore", divide="ignore"):
-        ok = ~np.isnan(need) & (need <= gap)
-        k = np.where(ok.any(axis=0), ok.argmax(axis=0), -1)
-        cols, k0, k1 = np.arange(need.shape[1]), np.maximum(k - 1, 0), np.maximum(k, 0)
-        x0, x1, n0, n1 = grid[k0], grid[k1], need[k0, cols], need[k1, cols]
-        x = np.where(k > 0, cross2(x0, x1, n0, n1, gap), np.where(k == 0, grid[0], np.nan))
+    ok = need <= gap  # (False at NaN)
+    cols, k1 = np.arange(need.shape[1]), ok.argmax(axis=0)  # (the first that suffices; 0 where none does)
+    k, k0 = np.where(ok[k1, cols], k1, -1), np.maximum(k1 - 1, 0)
+    x0, x1, n0, n1 = grid[k0], grid[k1], need[k0, cols], need[k1, cols]
+    x = np.where(k > 0, cross2(x0, x1, n0, n1, gap), np.where(k == 0, grid[0], np.nan))
     return x, k, x0, x1, n0, n1
 
 
@@ -356,7 +348,16 @@ def partner_in_grid(view, e, delta, direction: str):
 # ============================================================ the estimators: named strategies over arrays
 def nans(n) -> np.ndarray:
     """``n`` NaNs (an int or a shape): an answer array before its elements are answered ("none" until then)."""
-    return np.full(n, np.nan)
+    out = np.empty(n)  # (not np.full: a Python-level call, several times the cost on a single question's arrays)
+    out.fill(np.nan)
+    return out
+
+
+def filled(n: int, value, dtype=None) -> np.ndarray:
+    """``n`` copies of ``value`` (as :func:`numpy.full`, at the cost of :func:`numpy.empty`)."""
+    out = np.empty(n, dtype=dtype if dtype is not None else np.asarray(value).dtype)
+    out.fill(value)
+    return out
 
 
 #: The (question, interval kind) pairs a table with varied initial conditions shows as ``table-varied``, with
@@ -402,18 +403,18 @@ def first_applicable(estimators, rd, n: int) -> dict[str, np.ndarray]:
     out: dict[str, np.ndarray] = {}
     taken = np.zeros(n, dtype=bool)
     for estimator in estimators:
-        if taken.all():  # (the later ones would answer nothing)
-            break
+        if np.count_nonzero(taken) == n:  # (the later ones would answer nothing; count_nonzero: ndarray.all's
+            break                         # result at a tenth of its cost on a single question's arrays)
         r = estimator(rd)
         if r is None:
             continue
         m = r.applies & ~taken
-        if not m.any():
+        if not (n_m := np.count_nonzero(m)):
             continue
-        if m.all():  # it answers every element (a single question's usual case): its arrays whole
+        if n_m == n:  # it answers every element (a single question's usual case): its arrays whole
             for k, v in (*((k, getattr(r, k)) for k in ("value", "low", "high")), *r.extra.items()):
-                out[k] = np.array(v, dtype=np.float64) if np.ndim(v) else np.full(n, v, dtype=np.float64)
-            out["kind"], out["stated"] = np.full(n, r.kind, dtype=object), np.full(n, r.stated)
+                out[k] = np.array(v, dtype=np.float64) if np.ndim(v) else filled(n, v, np.float64)
+            out["kind"], out["stated"] = filled(n, r.kind, object), filled(n, r.stated, bool)
             return out
         if not out:
             out = _unanswered(n)
@@ -429,7 +430,7 @@ def first_applicable(estimators, rd, n: int) -> dict[str, np.ndarray]:
 def _unanswered(n: int) -> dict[str, np.ndarray]:
     """:func:`first_applicable`'s answers before any estimator answers: none."""
     out = dict(zip(("value", "low", "high"), nans((3, n))))
-    out["kind"], out["stated"] = np.full(n, "none", dtype=object), np.zeros(n, dtype=bool)
+    out["kind"], out["stated"] = filled(n, "none", object), np.zeros(n, dtype=bool)
     return out
 
 

@@ -143,10 +143,12 @@ def first_sample_at(cum: np.ndarray, ratio, s_star) -> np.ndarray:
     with np.errstate(divide="ignore", invalid="ignore"):
         need = np.where(s_star > 0, (ratio / s_star) ** 2, np.where(ratio > 0, np.inf, 0.0))
         need = np.where(np.isnan(s_star) | np.isnan(ratio), np.inf, need)
-        n = 1 + np.searchsorted(cum[1:], need, side="left")
-        # at the count and the one before (rounding of the square)
-        n = np.where((n <= top) & ~ok(n), n + 1, n)
-        n = np.where((n > 1) & (n - 1 <= top) & ok(n - 1), n - 1, n)
+        n = 1 + cum[1:].searchsorted(need, side="left")
+        # at the count and the one before (rounding of the square): the next where the count fails, else the one
+        # before where it holds
+        before = n - 1
+        at, prev = ok(np.array([n, before]))
+        n = np.where((n <= top) & ~at, n + 1, np.where((n > 1) & (before <= top) & prev, before, n))
     return np.where((n <= top) & np.isfinite(need), n, np.nan)
 
 
@@ -288,6 +290,7 @@ def _sample_logs(tau_s: float, rate_hz: float, n_max: int) -> tuple[np.ndarray, 
     return counts, log_t, half_log_cum
 
 
+@np.errstate(divide="ignore", invalid="ignore")  # (one context for the whole computation)
 def noise_k_contact(sensor, ratio, s_star, t_a, t_b, log_k_a, log_k_b, max_contact_s: float) -> np.ndarray:
     """First sample time [s] at which a classifier of noise efficiency ``k(t)`` separates a pair whose ideal
     observer needs projection noise at most ``s_star``: ``k(t) (sigma/dT) / |g(t)| <= s_star``, ``log k``
@@ -310,31 +313,31 @@ def noise_k_contact(sensor, ratio, s_star, t_a, t_b, log_k_a, log_k_b, max_conta
     fs = float(sensor.sample_rate_hz)
     n_max = int(last_sample_index(max_contact_s, fs))
     counts, log_t, half_log_cum = _sample_logs(float(sensor.tau_s), fs, max(n_max, 1))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        slope = np.where(t_a != t_b, (kb - ka) / np.log(t_b / t_a), 0.0)
-        log_ta, log_r, log_s = np.log(t_a), np.log(ratio), np.log(s_star)
+    slope = np.where(t_a != t_b, (kb - ka) / np.log(t_b / t_a), 0.0)
+    log_ta, log_r, log_s = np.log(t_a), np.log(ratio), np.log(s_star)
 
     def ok(n, rows):  # the classifier separates the pair at sample count n (an array, per element of rows)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            log_k = np.maximum(ka[rows] + slope[rows] * (log_t[n] - log_ta[rows]), 0.0)
-            return log_k + log_r[rows] - half_log_cum[n] <= log_s[rows]
+        log_k = np.maximum(ka[rows] + slope[rows] * (log_t[n] - log_ta[rows]), 0.0)
+        return log_k + log_r[rows] - half_log_cum[n] <= log_s[rows]
 
-    out = np.full(ratio.shape, np.nan)
+    out = np.empty(ratio.shape)
+    out.fill(np.nan)
     # The response shape g rises with time, so cum[n] <= n g(n)^2 and cum[n+1] / cum[n] >= (n+1) / n: the
     # noise falls at least like n^-1/2, and where log k rises no faster than 0.5 per unit of log t the
     # decision is monotone in n and a bisection finds its first sample. Steeper k (not seen on svm-paper,
     # whose k rises 0.29 per log t) is decided at every sample: (pairs x samples) arrays, 10x the time.
     # a few elements: the scan's one pass over 2,000 samples beats a bisection's dozen small calls (same answers)
-    scan = ~(slope <= 0.5) | (ratio.size <= 64)
-    steep = np.nonzero(scan)[0]
-    if steep.size:
+    if ratio.size <= 64:
+        steep, mono = slice(None), np.zeros(0, dtype=np.int64)
+    else:
+        scan = ~(slope <= 0.5)
+        steep, mono = np.nonzero(scan)[0], np.nonzero(~scan)[0]
+    if ratio[steep].size:
         n = counts[1:n_max + 1]
-        with np.errstate(divide="ignore", invalid="ignore"):  # (every count at once: the logs read, not taken)
-            good = (np.maximum(ka[steep, None] + slope[steep, None] * (log_t[None, 1:n_max + 1] - log_ta[steep, None]),
-                               0.0) + log_r[steep, None] - half_log_cum[None, 1:n_max + 1] <= log_s[steep, None])
-        first = np.argmax(good, axis=1)
-        out[steep] = np.where(good.any(axis=1), n[first] / fs, np.nan)
-    mono = np.nonzero(~scan)[0]
+        good = (np.maximum(ka[steep, None] + slope[steep, None] * (log_t[None, 1:n_max + 1] - log_ta[steep, None]),
+                           0.0) + log_r[steep, None] - half_log_cum[None, 1:n_max + 1] <= log_s[steep, None])
+        first = good.argmax(axis=1)  # (0 where none is good)
+        out[steep] = np.where(good[np.arange(first.size), first], n[first] / fs, np.nan)
     if mono.size:
         top = ok(np.full(mono.size, max(n_max, 1)), mono)
         rows = mono[top]

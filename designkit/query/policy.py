@@ -22,7 +22,9 @@ from dataclasses import dataclass, field
 from typing import Any, Mapping
 
 from .._validation import InputError
+from ..sensor import load_sensor
 from .inputs import NeedsInput, table_reroute
+from .table_open import DEFAULT_TABLE, shipped_spread_table
 
 __all__ = ["EXACT_OPTIONS", "MC_BOUND", "OutsideSensorTable", "ROUTES", "TABLE_OPTIONS", "TableChoice", "choose_route", "sensor_table_answer",
            "table_for"]
@@ -76,10 +78,6 @@ def table_for(question: str, *, sensor=None, model=None, sensor_temp_spread_c: f
         semi-infinite model: ``svm-fine`` at fixed initial conditions, ``svm-paper-varied`` at its spread and
         dT; anything else has none (None).
     """
-    from .table import DEFAULT_TABLE, shipped_spread_table
-
-    from ..sensor import load_sensor
-
     spread = float(sensor_temp_spread_c or 0.0)
     own = _registered_table(load_sensor(sensor if sensor is not None else "paper"), model, spread)
     if own is not None:
@@ -122,8 +120,6 @@ def _registered_table(sen, fm, spread: float) -> TableChoice | None:
 def _sensor_and_model(sensor, model):
     """The sensor asked about (the paper's by default) and the model that answers for it (a sensor file's own
     where none is asked; None: the default)."""
-    from ..sensor import load_sensor
-
     sen = load_sensor(sensor if sensor is not None else "paper")
     if model is None and getattr(sen, "model", None) is not None:
         from ..models import sensor_model
@@ -163,8 +159,6 @@ def choose_route(question: str, route: str, arguments: Mapping[str, Any]) -> tup
         return "exact", {k: v for k, v in args.items() if k not in TABLE_OPTIONS}, choice
     if args.get("diffusivity_m2_s") is not None:
         raise NeedsInput("a diffusivity was given but tables answer for effusivity alone", "diffusivity-unused")
-    from .table import DEFAULT_TABLE
-
     args = {k: v for k, v in args.items() if k not in EXACT_OPTIONS}
     if "table" not in args and choice.table != DEFAULT_TABLE:
         args["table"] = choice.table
@@ -200,7 +194,6 @@ def sensor_table_answer(question: str, ans, choice: TableChoice, sensor):
 
     import numpy as np
 
-    from ..sensor import load_sensor
     from .answer import Answer
 
     sen = load_sensor(sensor)

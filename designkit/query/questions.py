@@ -180,7 +180,8 @@ def _finished(question: str, ans, route: str, why, arguments, rig, asked):
     if route == "table" and why.sensor_table:
         ans = sensor_table_answer(question, ans, why, arguments.get("sensor"))
     notes = (*ans.notes, why.reason) if why.noted and isinstance(ans, Answer) else None
-    ans = dataclasses.replace(ans, route_reason=why.reason, **({"notes": notes} if notes else {}))
+    changes = {"route_reason": why.reason, **({"notes": notes} if notes else {})}
+    ans = ans.replaced(**changes) if type(ans) is Answer else dataclasses.replace(ans, **changes)
     return ans if rig is None else for_rig(ans, rig, asked)
 
 

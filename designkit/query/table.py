@@ -60,7 +60,7 @@ from .answer import Answer, IdealBound, number, scene_record
 from .crossing import check_coverage, z_of_coverage
 from .efficiency import CLOSED_FORM_MAX_CONTACT_S, K_SLOPE_SPAN, k_baseline, noise_k_max_ratio, noise_k_min_contact, \
     table_z
-from .estimates import (ABOVE, BELOW, CELL, CONTACT_ESTIMATORS, RATIO_ESTIMATORS, axis_weights_flagged,
+from .estimates import (ABOVE, BELOW, CELL, CONTACT_ESTIMATORS, RATIO_ESTIMATORS, axis_weights_flagged, filled,
                         states_coverage, table_spread)
 from .inputs import REFERENCE_RULE, PairQuestion, TableMismatch, check_contact, pair_question, reference_class, \
     scene_inputs
@@ -167,10 +167,6 @@ def _no_pair(question: str, op: OpenedTable, pq: PairQuestion, scene: dict, deta
                    value=None, interval=(None, None), ideal=None, in_grid={}, details=details, notes=[pq.note])
 
 
-def _one(x) -> np.ndarray:
-    return np.array([x], dtype=np.float64)
-
-
 def _el(r: dict, key: str, i: int) -> float | None:
     """Element ``i`` of an array answer's ``key`` (None for NaN)."""
     return number(r[key][i])
@@ -268,7 +264,8 @@ def min_contact_each(pairs: Sequence[Mapping[str, Any]], *, noise_c: float = 0.0
     if asked:
         lo, hi = _points(pqs, asked)
         m = lo.size
-        r = contact_arrays(op, lo, hi, np.full(m, noise), np.full(m, dt), ideal_bound=ideal_bound or op.closed,
+        r = contact_arrays(op, lo, hi, filled(m, noise, np.float64), filled(m, dt, np.float64),
+                           ideal_bound=ideal_bound or op.closed,
                            zc=z_of_coverage(coverage), classes=[pqs[i].classes for i in asked])
     at = {i: j for j, i in enumerate(asked)}
     return [_no_pair("min-contact", op, pq, scene_record(None, noise, dt), {}) if pq.classes is None else
@@ -490,7 +487,7 @@ def delta_e(e: float | None = None, *, m: str | None = None, contact_s: float, n
     flags["effusivity"] = view.e_in_grid(x)
     common = dict(objects=(ref.to_dict(),), limiting=(ref.to_dict(),), rule=REFERENCE_RULE,
                   scene=scene_record(contact, noise, dt), classes=(ref,))
-    r = delta_e_arrays(op, _one(x), _one(contact), _one(noise), _one(dt), ideal_view=delta_e_ideal_view(op, ideal_table),
+    r = delta_e_arrays(op, *np.array([[x], [contact], [noise], [dt]], dtype=np.float64), ideal_view=delta_e_ideal_view(op, ideal_table),
                        zc=z_of_coverage(coverage), ideal_bound=ideal_bound, classes=[ref])
     if not all(flags.values()):
         wanted = {**_scene_wanted(view, noise, dt), "contact_s": contact, "effusivity": (x,)}

@@ -26,9 +26,10 @@ from ..tables.store import Table
 from .crossing import coverage_of_z
 from .efficiency import (CLOSED_FORM_MAX_CONTACT_S, CriticalNoiseGrid, delta_efficiency_estimate, delta_entries,
                          interp_e_by, k_baseline, mc_calibration, noise_k_min_contact, table_z)
+from .ideal_bound import contact_at_noise, exact_ideal_delta, exact_ideal_max_ratio
 from .estimates import (ABOVE, BELOW, CELL, CONTACT_ESTIMATORS, INSIDE, RATIO_ESTIMATORS,
-                        ContactReading, RatioReading, axis_weights_flagged, delta_estimate, first_applicable,
-                        grid_crossing, interp_e_rows, nans, partner_in_grid, states_coverage, table_spread)
+                        ContactReading, RatioReading, axis_weights_flagged, delta_estimate, filled, first_applicable,
+                        grid_crossing, nans, partner_in_grid, states_coverage, table_spread)
 
 __all__ = ["CLOSED_FORM_RATIO_BRACKET", "TableView", "at_contact", "contact_arrays", "delta_e_arrays",
            "distinguishable_arrays", "groups", "max_ratio", "ratio_arrays", "scene_groups"]
@@ -56,6 +57,11 @@ class TableView:
         self._contact_norms: np.ndarray | None = None
         self._baselines: np.ndarray | None = None
         self._scenes: dict[tuple[float, float], tuple[list, dict[str, bool]]] = {}
+        # the entries' arrays as one plain array (_plain), and what questions read again for each pair (memo)
+        self._names = {n: i for i, n in enumerate(n for n in table.arrays if n.startswith("delta_"))}
+        self._plain_rows: np.ndarray | None = None
+        self._plain_read: set[int] = set()
+        self._memo: dict[tuple, Any] = {}
 
     def critical_noise(self, lo, hi) -> np.ndarray:
         """The ideal observer's critical noise of the table's classes ``[lo, lo + w)``, ``[hi, hi + w)`` (its
@@ -116,6 +122,15 @@ class TableView:
             combos = [(idx + (k,), w * wk) for idx, w in combos for k, wk in pts]
         return combos, flags
 
+    def memo(self, key: tuple, make):
+        """``make()``, kept with the view under ``key`` (what every pair of a scene reads again); at most 256."""
+        hit = self._memo.get(key)
+        if hit is None:
+            if len(self._memo) >= 256:
+                self._memo.clear()
+            hit = self._memo[key] = make()
+        return hit
+
     def mc_calibration(self) -> float:
         """:func:`designkit.query.efficiency.mc_calibration` of this table (computed once)."""
         if self._mc_factor is None:
@@ -134,30 +149,46 @@ class TableView:
         ``e``: [contact, len(e)], or [len(names), contact, len(e)] for a sequence (NaN: none), all the weighted
         scene slices of all the arrays in one reading."""
         many = not isinstance(names, str)
-        out = _weighted(combos, self.slices(names if many else [names], combos, e))
+        out = _weighted(combos, self._read((tuple(names) if many else (names,),), combos, e[None])[0])
         return out if many else out[0]
 
-    def slices(self, names, combos, e: np.ndarray) -> np.ndarray:
-        """The arrays ``names`` (a sequence) in each weighted scene slice of ``combos`` (in their order), at every
-        contact and every ``e``: [name, slice, contact, len(e)] (NaN: none), in one reading."""
-        live = [idx for idx, w in combos if w != 0]
-        at = tuple(np.array(k)[:, None, None] for k in zip(*live))  # each [slice, 1, 1]
-        at += (np.arange(self.contacts.size)[:, None],)
-        arrays = [self.t.arrays[n] for n in names]
-        # only the entries read (the arrays may be mapped from the file)
-        return interp_e_by(lambda c: np.stack([a[at + (c,)] for a in arrays]), self.centres, e)
+    def _read(self, names: tuple[tuple[str, ...], ...], combos, e: np.ndarray) -> np.ndarray:
+        """Groups of arrays, ``names[g]`` each at its own effusivities ``e[g]`` (``e``: [group, n]), in each
+        weighted scene slice of ``combos`` (in their order), at every contact: [group, name, slice, contact, n]
+        (NaN: none), in one interpolation (two gathers of the view's plain copy of the table, :meth:`_plain`)."""
+        live = tuple(idx for idx, w in combos if w != 0)
 
-    def readings(self, kinds, combos, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        def index():  # the gathers' index arrays but the effusivity's, each row read once
+            self._plain({k[0] for k in live})
+            return ((np.array([[self._names[n] for n in group] for group in names])[:, :, None, None, None],)
+                    + tuple(np.array(k)[None, None, :, None, None] for k in zip(*live))  # each [1, 1, slice, 1, 1]
+                    + (np.arange(self.contacts.size)[None, None, None, :, None],))
+        at, rows = self.memo(("read", names, live), index), self._plain_rows
+        return interp_e_by(lambda c: rows[at + (c,)], self.centres, e[:, None, None, None, :])
+
+    def _plain(self, first: set[int]) -> None:
+        """Read the scene rows ``first`` (on the first scene axis) of every ``delta_*`` array into the view's plain
+        copy [array, scene..., contact, e_ref] through the table's (checked) reader, once per process and row."""
+        if not (todo := sorted(first - self._plain_read)):
+            return
+        if self._plain_rows is None:  # (memory taken as rows are read)
+            self._plain_rows = np.empty((len(self._names),) + tuple(self.t.arrays[next(iter(self._names))].shape))
+        for name, i in self._names.items():
+            for r in todo:
+                self._plain_rows[i, r] = self.t.arrays[name][r]
+        self._plain_read.update(todo)
+
+    def readings(self, kinds, combos, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
         """What :meth:`need` of the sequence ``kinds`` is made of: ``delta_up`` at ``lo`` and ``delta_down`` at
-        ``hi`` of each kind in each weighted scene slice, [kind, slice, contact, n] each."""
+        ``hi`` of each kind in each weighted scene slice, [direction (up, down), kind, slice, contact, n]."""
         names = []
         for k in kinds:
             suffix = {"svm": "", "lo": "_lo", "hi": "_hi", "ideal": "_ideal"}[k]
             if f"delta_up{suffix}" not in self.t.arrays:  # ideal tables carry only delta_up / delta_down
                 suffix = ""
             names.append(suffix)
-        return (self.slices([f"delta_up{x}" for x in names], combos, lo),
-                self.slices([f"delta_down{x}" for x in names], combos, hi))
+        return self._read((tuple(f"delta_up{x}" for x in names), tuple(f"delta_down{x}" for x in names)), combos,
+                          np.array([lo, hi]))
 
     def need(self, kind, combos, lo: np.ndarray, hi: np.ndarray, readings=None) -> np.ndarray:
         """Distance needed to separate ``lo < hi``, ``max(delta_up(lo), delta_down(hi))``, at every contact and
@@ -167,7 +198,7 @@ class TableView:
         many = not isinstance(kind, str)
         up, down = (_weighted(combos, r) for r in (
             readings if readings is not None else self.readings(kind if many else [kind], combos, lo, hi)))
-        out = np.where(np.isnan(up) | np.isnan(down), np.nan, np.maximum(up, down))
+        out = np.maximum(up, down)  # (NaN where either is: maximum propagates it)
         return out if many else out[0]
 
 
@@ -247,7 +278,7 @@ def contact_arrays(op, lo, hi, noise, dt, *, ideal_bound: bool, zc: float, class
     view, n = op.view, lo.size
     grid, svm = view.contacts, op.tab.fidelity == "svm"
     res: dict[str, Any] = dict(zip(("raw", "n_prev", "n_at", "mc_lo", "mc_hi", "ideal", "table_ideal"), nans((7, n))))
-    res["k_cross"], res["in_grid"], res["mc_bounds"] = np.full(n, -1), np.zeros(n, dtype=bool), {}
+    res["k_cross"], res["in_grid"], res["mc_bounds"] = filled(n, -1), np.zeros(n, dtype=bool), {}
     efficiency = svm and op.closed and "delta_up_ideal" in view.t.arrays
     eff = dict(zip(("value", "low", "high", "k", "se_log", "k_a", "k_b", "t_a", "t_b"), nans((9, n)))) if efficiency else None
     e_in = view.e_in(lo) & view.e_in(hi)
@@ -271,30 +302,31 @@ def contact_arrays(op, lo, hi, noise, dt, *, ideal_bound: bool, zc: float, class
                                                np.concatenate([gap] * len(kinds)))
         cross = dict(zip(kinds, value.reshape(len(kinds), m)))
         k, n0, n1 = k[:m], n0[:m], n1[:m]
-        res["raw"][idx], res["k_cross"][idx] = cross["svm"], k
-        res["n_prev"][idx], res["n_at"][idx] = np.where(k > 0, n0, np.nan), n1
+        at = slice(None) if m == n else idx  # (every element in this group: slices, not index arrays)
+        res["raw"][at], res["k_cross"][at] = cross["svm"], k
+        res["n_prev"][at], res["n_at"][at] = np.where(k > 0, n0, np.nan), n1
         for end in ("lo", "hi"):
-            res[f"mc_{end}"][idx] = cross.get(end, cross["svm"])
+            res[f"mc_{end}"][at] = cross.get(end, cross["svm"])
         if "ideal" in cross:  # the grid's own bound, beside the exact one
-            res["table_ideal"][idx] = cross["ideal"]
+            res["table_ideal"][at] = cross["ideal"]
         if not op.closed and not ideal_bound and op.iview is not None:  # the table's own floor (no Monte Carlo)
             icombos, iflags = op.iview.scene_weights(nz, d)
             if all(iflags.values()):
                 res["ideal"][idx] = grid_crossing(op.iview.contacts, op.iview.need(op.ikind, icombos, l, h), gap)[0]
-        if efficiency and (has := k >= 0).any():
-            sel = slice(None) if has.all() else has  # (every pair: the readings themselves, no copy)
+        if efficiency and (n_has := np.count_nonzero(has := k >= 0)):  # (count_nonzero: any / all at a tenth
+            every = n_has == has.size  # of ndarray.any's cost on a single question's arrays)
+            sel = slice(None) if every else has  # (every pair: the readings themselves, no copy)
             r = noise_k_min_contact(op, combos, k[sel], l[sel], h[sel], nz / abs(d), zc=zc,
-                                    readings=[x[:3][..., sel] for x in readings])
+                                    readings=readings[:, :3][..., sel])
+            hat = at if every else idx[has]
             for key in eff:
-                eff[key][idx[has]] = r[key]
-            star[idx[has]], have_star[idx[has]] = r["s_pair"], True
-        res["in_grid"][idx] = True
+                eff[key][hat] = r[key]
+            star[hat], have_star[hat] = r["s_pair"], True
+        res["in_grid"][at] = True
         slices.append((combos, idx))
-    sel = np.ones(n, dtype=bool) if outside else res["in_grid"]
-    if op.closed and ideal_bound and sel.any():  # outside the grid too: the closed form needs no table
-        from .ideal_bound import contact_at_noise
-
-        if (rest := sel & ~have_star).any():
+    sel = slice(None) if outside else res["in_grid"]  # (every element: a slice)
+    if op.closed and ideal_bound and (n > 0 if outside else np.count_nonzero(sel)):  # outside the grid: no table
+        if np.count_nonzero(rest := ~have_star if outside else sel & ~have_star):
             star[rest] = view.critical_noise(lo[rest], hi[rest])
         res["ideal"][sel] = contact_at_noise(op.tab.sensor, (noise / np.abs(dt))[sel], star[sel],
                                              CLOSED_FORM_MAX_CONTACT_S)
@@ -407,8 +439,6 @@ def ratio_arrays(question: str, op, lo, hi, contact, scale, *, ideal_bound: bool
                 a_r, a_w = max_ratio(view, "svm", cw, l[est], h[est], **kw)
                 alt[key][j] = np.where(a_w == INSIDE, a_r, np.nan)
     if op.closed and ideal_bound:  # every element, outside the grid too: the closed form needs no table
-        from .ideal_bound import exact_ideal_max_ratio
-
         ok = within_sample_limit(contact, op.tab.sensor.sample_rate_hz)
         if ok.any():
             ri[ok] = exact_ideal_max_ratio(op.tab.sensor, lo[ok], hi[ok], contact[ok], width=op.width,
@@ -443,7 +473,7 @@ def delta_geometric(e: np.ndarray, v, cmb, cws, name: str) -> np.ndarray:
             for i, wi in cmb:
                 if not wi:
                     continue
-                y = interp_e_rows(v.t.arrays[name][i][k:k + 1], v.centres, e)[0]
+                y = interp_e_by(lambda c, rows=v.t.arrays[name][i][k:k + 1]: rows[..., c], v.centres, e)[0]
                 bad |= np.isnan(y) | (y <= 0)
                 total = total + w * wi * np.log(y)
         return np.where(bad, np.nan, np.exp(total))
@@ -518,8 +548,6 @@ def delta_e_arrays(op, e, contact, noise, dt, *, ideal_view, zc: float, ideal_bo
     # form needs no table
     out = np.nonzero(~res["in_grid"] & e_in & within_sample_limit(contact, op.tab.sensor.sample_rate_hz))[0]
     if op.closed and ideal_bound and out.size:
-        from .ideal_bound import exact_ideal_delta
-
         ratio = noise[out] / np.abs(dt[out])
         for side, sign in (("lower", -1.0), ("upper", 1.0)):
             res[f"{side}_ideal"][out] = exact_ideal_delta(op.tab.sensor, e[out], contact[out], ratio,
@@ -578,14 +606,14 @@ def distinguishable_arrays(op, lo, hi, contact, noise, dt, *, ideal_bound: bool,
         l, h = lo[idx], hi[idx]
         for kind in (("svm", "lo", "hi") if svm else ("svm",)):
             nd = at_contact(cw, view.need(kind, combos, l, h))
-            res[f"grid_{kind}"][idx] = (~np.isnan(nd) & (nd <= h - l)).astype(np.float64)
+            res[f"grid_{kind}"][idx] = (nd <= h - l).astype(np.float64)  # (False at NaN)
     if not svm:
         res["grid_lo"] = res["grid_hi"] = res["grid_svm"]
     todo = res["in_grid"]
     mc = contact_arrays(op, lo, hi, noise, dt, ideal_bound=op.closed, zc=zc, outside=False)
     t, a, b, stated = mc["value"], mc["low"], mc["high"], mc["stated"]
     with np.errstate(invalid="ignore"):
-        yes = ~np.isnan(t) & (contact >= t)
+        yes = contact >= t  # (False at NaN)
         below_high = (contact <= b) | np.isnan(b)
         unsure = todo & ~np.isnan(t) & ~np.isnan(a) & below_high & np.where(stated, a <= contact, a < contact)
     verdict = np.where(~todo | np.isnan(t), None, np.where(unsure, "uncertain", np.where(stated & ~np.isnan(a),

@@ -16,6 +16,7 @@ import numpy as np
 from cachetools import LRUCache
 
 from .._validation import check_nonnegative
+from ..models import get_model
 from ..tables.store import Table, load_table, resolve_table
 from .estimates import table_spread
 from .inputs import TableMismatch, check_threshold
@@ -165,8 +166,6 @@ def open_table(table: "Table | str" = DEFAULT_TABLE, ideal_table: "Table | str |
     by default). Returns the :class:`OpenedTable`: ``tab``, ``view`` (:class:`~designkit.query.table_arrays.TableView`),
     ``phi``, ``model``, ``width``, ``closed`` (the ideal bound is computed in closed form), ``iview`` / ``ikind``
     (the ideal bound's view and array kind when read from a grid)."""
-    from ..models import get_model
-
     spread = check_nonnegative("sensor temperature spread [degC]", sensor_temp_spread_c)
     if spread > 0 and isinstance(table, str) and table == DEFAULT_TABLE:
         table = VARIED_TABLE

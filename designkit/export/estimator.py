@@ -50,7 +50,7 @@ from designkit.tables.lookup import (axis_weights, contact_input, crossing, effu
 __all__ = ["ESTIMATOR", "ESTIMATOR_VERSION", "Estimator"]
 
 #: Name and version of the estimator every export records (bump the version when an answer changes).
-ESTIMATOR = "designkit.query.table efficiency route (noise_k_min_contact, delta_efficiency_estimate)"
+ESTIMATOR = "designkit.query.table route (noise_k_min_contact, delta_efficiency_estimate; varied_contact_estimate)"
 ESTIMATOR_VERSION = 2  # 2: tables without a closed-form ideal observer, contact from a rig's detected onset
 
 _K_SLOPE_SPAN = 1.14       # designkit.query.table.K_SLOPE_SPAN

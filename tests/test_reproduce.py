@@ -370,3 +370,19 @@ def test_paper_grid_row_counts_every_pair_of_the_shipped_500_interval_matrices(t
         assert got["intervals"]["percent_indistinguishable"] == pytest.approx(100.0 * np.count_nonzero(upper < 0.9)
                                                                               / upper.size)
         assert got["build"]["fits"] >= 124_750
+
+
+@pytest.mark.slow
+def test_real_prediction_counts_contact_from_the_onset_as_the_library_does(robot_data_dir):
+    """The prediction against the real rig asks the library, which counts a calibrated sensor's contact from its
+    detected onset: converting again (as this section did after the library took the onset over) asked F1 at
+    0.25 + 0.64 s and gave a min-contact of -0.04 s against the real 0.59 s. Issue 34's targets: F1 within 0.05 of
+    the real at every contact 0.25-1.5 s, min-contact inside its interval or within 25 %."""
+    from designkit_lab.reproduce.prediction import predict_against_real
+    from designkit_lab.reproduce.robot import load_real
+
+    res = predict_against_real(robot_data_dir, load_real(robot_data_dir), repeats=3, parts=False, log=lambda *_: None)
+    pred, real = res["predicted_min_contact"], res["real_min_contact_s"]
+    assert pred["value"] > 0 and pred["interval"][0] > 0 and real > 0
+    assert res["min_contact_met"], (pred, real)
+    assert res["worst_error"] <= 0.05, [(r["contact_s"], r["predicted_f1"], r["real_f1"]) for r in res["rows"]]

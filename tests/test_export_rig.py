@@ -201,6 +201,8 @@ def test_export_with_a_sensor_file_writes_the_table_its_questions_read(registere
     assert r.exit_code == 0, r.output
     assert "from table rig-bias" in r.output and "answers as designkit does" in r.output
     assert "contact counted from the rig's detected onset (the model's time 0 at -0.643 s)" in r.output
+    # its one sigma/dT row, which an export reads to 1e-6 (this table's is not the sensor file's noise / dT)
+    assert "one sigma/dT row, 0.004: ask at that ratio (to 1e-6)" in r.output, r.output
     mod = load_python_export(out.read_bytes(), "rig_cli")
     lib = ask("min-contact", e1=2000.0, e2=2600.0, noise_c=SCENE[0], delta_t_c=SCENE[1], sensor=RIG)
     assert lib.value is not None and mod.min_contact_s(2000.0, 2600.0, *SCENE) == pytest.approx(lib.value, rel=RTOL)

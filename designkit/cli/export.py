@@ -136,6 +136,14 @@ def _lines_from(p: dict) -> list[str]:
         out.append(f"one scene: noise {sc['noise_c']:g} °C, dT {sc['delta_t_c']:g} °C")
     if s["contact_s"]:
         out.append(f"contact columns {s['contact_s']['source_columns']} of the table")
+    one = [a for a in p["axes"] if a["name"] == "noise_ratio" and a["points"] == 1]
+    if one and not s["scene"]:  # a sensor's own table: one row, read to 1e-6 (no extrapolation)
+        cond = (p.get("sensor") or {}).get("conditions") or {}
+        dt = cond.get("delta_t_c")
+        dt = dt.get("mean") if isinstance(dt, dict) else dt
+        rig = (f" (the sensor file's noise {cond['noise_c']:.9g} °C at dT {dt:.9g} °C)" if cond.get("noise_c") and dt
+               and abs(cond["noise_c"] / dt / one[0]["min"] - 1.0) <= 1e-6 else "")
+        out.append(f"one sigma/dT row, {one[0]['min']:.9g}{rig}: ask at that ratio (to 1e-6)")
     if (start := (p.get("contact_frame") or {}).get("onset_offset_s")) is not None:
         out.append(f"contact counted from the rig's detected onset (the model's time 0 at {start:+.3g} s)")
     ea = p["effusivity_answered"]

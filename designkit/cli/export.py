@@ -138,11 +138,15 @@ def _lines_from(p: dict) -> list[str]:
         out.append(f"contact columns {s['contact_s']['source_columns']} of the table")
     one = [a for a in p["axes"] if a["name"] == "noise_ratio" and a["points"] == 1]
     if one and not s["scene"]:  # a sensor's own table: one row, read to 1e-6 (no extrapolation)
-        cond = (p.get("sensor") or {}).get("conditions") or {}
-        dt = cond.get("delta_t_c")
-        dt = dt.get("mean") if isinstance(dt, dict) else dt
-        rig = (f" (the sensor file's noise {cond['noise_c']:.9g} °C at dT {dt:.9g} °C)" if cond.get("noise_c") and dt
-               and abs(cond["noise_c"] / dt / one[0]["min"] - 1.0) <= 1e-6 else "")
+        from ..rig import resolve_scene
+        from ..sensor import Sensor
+
+        # the scene a question about this sensor takes by default (designkit.rig: the one place that resolves it)
+        sc = resolve_scene(Sensor.from_dict(p["sensor"], source="the export's provenance"),
+                           {"noise_c": None, "delta_t_c": None})
+        noise, dt = sc.values["noise_c"], sc.values["delta_t_c"]
+        rig = (f" (the sensor file's noise {noise:.9g} °C at dT {dt:.9g} °C)" if sc.sources["noise_c"] == "sensor file"
+               and abs(noise / dt / one[0]["min"] - 1.0) <= 1e-6 else "")
         out.append(f"one sigma/dT row, {one[0]['min']:.9g}{rig}: ask at that ratio (to 1e-6)")
     if (start := (p.get("contact_frame") or {}).get("onset_offset_s")) is not None:
         out.append(f"contact counted from the rig's detected onset (the model's time 0 at {start:+.3g} s)")

@@ -295,7 +295,14 @@ def test_touches_below_the_contact_threshold_get_a_hint_with_their_peak_force(cl
         r = cli("calibrate", "--port", emu.port, "--profile", "designkit", "--material", "wood", "--trials", "2",
                 "--range", "wood=380:420", "--out", tmp_path / "run", "--model", "semi-infinite", "--yes", "--timeout", "30")
     assert r.exit_code == 2, r.output
-    assert "touches were not recorded" in r.output and "threshold of 5 N" in r.output and "4.2 N" in r.output
+    assert "touches were not recorded" in r.output and "threshold of 5 N" in r.output
+    # the peaks are the highest live force readings, 4.2 N plus the emulator's 0.02 N force noise: "4.2 N" or,
+    # when one touch's noisiest reading rounds up, a range such as "4.2-4.3 N" (CI stop 45 printed the latter)
+    import re
+
+    peaks = re.search(r"peaked at ([0-9.]+)(?:-([0-9.]+))? N", " ".join(r.output.split()))
+    assert peaks, r.output
+    assert all(4.0 <= float(v) <= 4.4 for v in peaks.groups() if v is not None), peaks.group(0)
     assert "force_threshold_n" in r.output
 
 

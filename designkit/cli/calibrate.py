@@ -158,9 +158,10 @@ class _ForceWatch:
         if len(self.peaks) >= self.MISSED:
             from .._validation import InputError
 
+            lo, hi = f"{min(self.peaks):.2g}", f"{max(self.peaks):.2g}"
             raise InputError(
-                f"{len(self.peaks)} touches were not recorded: their force peaked at {min(self.peaks):.2g}-"
-                f"{max(self.peaks):.2g} N, below the profile's contact threshold of {self.threshold:g} N. Lower "
+                f"{len(self.peaks)} touches were not recorded: their force peaked at "
+                f"{lo if lo == hi else f'{lo}-{hi}'} N, below the profile's contact threshold of {self.threshold:g} N. Lower "
                 f"force_threshold_n in the profile (e.g. to {0.75 * min(self.peaks):.2g} N, with release_n below "
                 "it), or press harder")
 

@@ -8,7 +8,7 @@ header and arrays, and loads the result with every check of ``load_table``. Only
 
     python benchmarks/rehash_tables.py                  # the shipped tables in tables/
     python benchmarks/rehash_tables.py path/to/T.json   # your own (check its header first)
-    python benchmarks/rehash_tables.py --members        # print designkit/tables/_shipped_members.py
+    python benchmarks/rehash_tables.py --members        # rewrite designkit/data/shipped_members.json
 """
 
 from __future__ import annotations
@@ -39,29 +39,20 @@ def rehash(jpath: Path) -> str:
     return header["content_hash"]
 
 
-def members_module() -> str:
-    """The text of designkit/tables/_shipped_members.py for the shipped tables as they are now."""
-    from designkit.tables import _shipped_members
+def write_members() -> Path:
+    """Rewrite designkit/data/shipped_members.json (every array's digest of each shipped table, as it is now)."""
     from designkit.tables.store import SHIPPED_TABLES, member_digests
 
-    root = Path(__file__).resolve().parents[1] / "tables"
-    doc = _shipped_members.__doc__
-    lines = [f'"""{doc}"""', "", "SHIPPED_MEMBER_DIGESTS: dict[str, dict[str, str | tuple[str, ...]]] = {"]
-    for name in SHIPPED_TABLES:
-        lines.append(f"    {name!r}: {{")
-        for k, v in member_digests(root / f"{name}.npz").items():
-            if isinstance(v, tuple):  # a mapped member: its npy header, then each row (two a line)
-                lines += [f"        {k!r}: ("] + [
-                    "            " + " ".join(f"{d!r}," for d in v[i:i + 2]) for i in range(0, len(v), 2)] + ["        ),"]
-            else:
-                lines.append(f"        {k!r}: {v!r},")
-        lines.append("    },")
-    return "\n".join(lines + ["}", ""])
+    repo = Path(__file__).resolve().parents[1]
+    listed = {name: member_digests(repo / "tables" / f"{name}.npz") for name in SHIPPED_TABLES}
+    out = repo / "designkit" / "data" / "shipped_members.json"
+    out.write_text(json.dumps(listed, indent=1) + "\n")
+    return out
 
 
 def main(argv: list[str]) -> None:
     if argv == ["--members"]:
-        sys.stdout.write(members_module())
+        print(write_members())
         return
     paths = [Path(a) for a in argv] or sorted((Path(__file__).resolve().parents[1] / "tables").glob("*.json"))
     for p in paths:

@@ -146,6 +146,9 @@ def test_every_shipped_table_is_listed_by_file_digest_and_its_arrays_pass_the_lo
         digest = file_digest(t.path.with_suffix(".json").read_bytes(), _zip_members(z))
     assert digest in SHIPPED_FILE_DIGESTS, (f"shipped table {name} (files {digest}) is not in "
                                             "designkit.tables.store.SHIPPED_FILE_DIGESTS: add it to SHIPPED_TABLES")
+    assert type(t.arrays).__name__ == "_NpzArrays", (f"shipped table {name} has no array digests in "
+                                                     "designkit/data/shipped_members.json: run python "
+                                                     "benchmarks/rehash_tables.py --members")
     assert content_hash(dict(t.arrays), t.header) == t.header["content_hash"]  # what the digest stands for
     assert not load_table(name, thorough=True).arrays.__class__.__name__.startswith("_")  # the long way
 
@@ -204,10 +207,8 @@ def test_an_uncompressed_table_is_mapped_and_reads_the_same_arrays(tmp_path, mon
         digest = store.file_digest(path.with_suffix(".json").read_bytes(), store._zip_members(z))
     monkeypatch.setattr(store, "SHIPPED_FILE_DIGESTS", store.SHIPPED_FILE_DIGESTS | {digest})
     assert not isinstance(load_table(path).arrays, store._NpzArrays)  # no member digests listed: the long way
-    from designkit.tables import _shipped_members
-
     monkeypatch.setitem(store.SHIPPED_TABLES, "svm-paper-stored", (src.header["content_hash"], digest))
-    monkeypatch.setitem(_shipped_members.SHIPPED_MEMBER_DIGESTS, "svm-paper-stored", store.member_digests(path))
+    monkeypatch.setitem(store.shipped_member_digests(), "svm-paper-stored", store.member_digests(path))
     t = load_table(path)
     assert isinstance(t.arrays, store._NpzArrays) and t.shipped
     assert t.header["content_hash"] == src.header["content_hash"]

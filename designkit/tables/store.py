@@ -65,6 +65,7 @@ __all__ = [
     "file_digest",
     "member_digest",
     "member_digests",
+    "shipped_member_digests",
     "SCHEMA_VERSION",
     "Table",
     "content_hash",
@@ -274,7 +275,7 @@ def _remember(key: tuple, digest: str) -> None:
 def member_digest(npy_bytes) -> str:
     """XXH3-128 of one member of a table's .npz: its whole ``.npy`` (header and data), decompressed.
 
-    What :data:`SHIPPED_MEMBER_DIGESTS` lists, and what a shipped table's array is checked against when it is
+    What :func:`shipped_member_digests` lists, and what a shipped table's array is checked against when it is
     first read (the npy header included: dtype, shape and order as well as every byte). XXH3 (the xxhash
     library) rather than SHA-256: a fresh question hashes every byte of the arrays it reads (about 22 MB of
     the fine table: SHA-256 took 12-18 ms of a 375 ms start, XXH3 about 1 ms), and a cryptographic digest
@@ -494,7 +495,7 @@ class _NpzArrays(Mapping):
     ``delta_*`` and their intervals). Members stored uncompressed (the fine shipped table,
     :func:`write_table` with ``compress=False``) are mapped from the file, so only those pages are
     read (decompressing the whole table would cost a fresh question more than its answer). Each member's
-    bytes, mapped or decompressed, are checked against the shipped table's :data:`SHIPPED_MEMBER_DIGESTS`
+    bytes, mapped or decompressed, are checked against the shipped table's :func:`shipped_member_digests`
     when first read (once per process and file; a mapped member's row by row, :class:`_CheckedRows`), and
     its npy header against the JSON header. Plain data: picklable.
     """
@@ -726,7 +727,7 @@ SHIPPED_CONTENT_HASHES = frozenset(content for content, _ in SHIPPED_TABLES.valu
 #: (tests/test_startup.py checks every shipped table again, the long way), so loading them checks the
 #: digest instead of hashing every decompressed array, and
 #: reads an array only when a question asks for it, hashing that array's bytes then against its shipped
-#: digest (:mod:`designkit.tables._shipped_members`). Files that differ (a rebuilt table, an edited one, a
+#: digest (:func:`shipped_member_digests`). Files that differ (a rebuilt table, an edited one, a
 #: header rewritten with other line endings) take the long way: hash, schema, consistency.
 SHIPPED_FILE_DIGESTS = frozenset(files for _, files in SHIPPED_TABLES.values())
 
@@ -737,7 +738,7 @@ def file_digest(header_bytes: bytes, members: Mapping[str, zipfile.ZipInfo]) -> 
 
     The directory records each array's CRC-32, sizes, compression and place in the file, but it does
     not vouch for the bytes (an array edited in place keeps it): each array of a shipped table is
-    hashed when first read, mapped or decompressed, and compared with :data:`SHIPPED_MEMBER_DIGESTS`.
+    hashed when first read, mapped or decompressed, and compared with :func:`shipped_member_digests`.
 
     >>> file_digest(b"{}", {})[:17]
     'xxh3_128:070d65bc'
@@ -831,15 +832,33 @@ def load_table(name_or_path: str | Path, *, verify: bool = True, thorough: bool 
     return Table(name=header["name"], path=path, header=header, arrays=arrays, checked=known)
 
 
+@functools.cache
+def shipped_member_digests() -> dict[str, dict[str, str | tuple[str, ...]]]:
+    """Digests of every array of each shipped table, as shipped (:func:`member_digests`), by table name.
+
+    A shipped table's files are recognised by :func:`file_digest` of their header and zip directory, so that a
+    question reads only the arrays (and, for a table stored uncompressed, only the rows) it needs. The
+    directory does not vouch for the bytes: each array (each row of one listed row by row) is hashed when it
+    is first read and compared with its digest here. Read once per process from the package's data file
+    ``designkit/data/shipped_members.json`` (by its path, as ``materials.yaml`` is: importing
+    importlib.resources cost a fresh question about 8 ms, the read 0.2 ms); after rebuilding a shipped table,
+    regenerate it with ``python benchmarks/rehash_tables.py --members`` (tests/test_startup.py names a table
+    missing from it).
+    """
+    path = Path(__file__).resolve().parent.parent / "data" / "shipped_members.json"
+    listed = json.loads(path.read_text(encoding="utf-8"))
+    return {table: {name: tuple(d) if isinstance(d, list) else d for name, d in members.items()}
+            for table, members in listed.items()}
+
+
 def _shipped_members(files_digest: str | None) -> dict[str, str | tuple[str, ...]] | None:
     """The member digests of the shipped table whose files have ``files_digest``, or None (not shipped)."""
     if files_digest is None or files_digest not in SHIPPED_FILE_DIGESTS:
         return None
-    from ._shipped_members import SHIPPED_MEMBER_DIGESTS
-
+    listed = shipped_member_digests()
     for name, (_, files) in SHIPPED_TABLES.items():
-        if files == files_digest and name in SHIPPED_MEMBER_DIGESTS:
-            return SHIPPED_MEMBER_DIGESTS[name]
+        if files == files_digest and name in listed:
+            return listed[name]
     return None
 
 

@@ -40,6 +40,13 @@ times, 6 touches: seconds) and registered in a scratch data folder, then ``desig
 the registry looked up where no table is registered (what every ``--sensor`` question pays first)::
 
     python benchmarks/bench_startup.py --runs 11 --sensor tests/data/rig_sensor.yaml
+
+``--help-rows`` adds what reads the installed packages' entry points (the commands other packages add,
+``designkit.commands``: the lab's ``bench``, ``reproduce``, ``emulate``): ``designkit --help``, ``designkit
+reproduce --help``, and the entry points read alone (``python -c``); with ``--baseline`` the first two for
+that tree too. ``designkit min-contact`` never reads them::
+
+    python benchmarks/bench_startup.py --runs 11 --baseline /tmp/base --help-rows
 """
 
 from __future__ import annotations
@@ -62,6 +69,13 @@ ARGS = {
     "designkit --version": ["-m", "designkit", "--version"],
     "designkit min-contact": ["-m", "designkit", "min-contact", "--e1", "35000", "--e2", "20000"],
     "designkit min-contact --json": ["-m", "designkit", "min-contact", "--e1", "35000", "--e2", "20000", "--json"],
+}
+#: ``--help-rows``: the commands that read the installed entry points, and that read alone.
+HELP_ARGS = {
+    "designkit --help": ["-m", "designkit", "--help"],
+    "designkit reproduce --help": ["-m", "designkit", "reproduce", "--help"],
+    "entry points read alone": ["-c", "from importlib.metadata import entry_points; "
+                                      "entry_points(group='designkit.commands')"],
 }
 #: A command's first item when it runs on a pseudo-terminal (:func:`_run`).
 TERMINAL = "<terminal>"
@@ -120,6 +134,8 @@ def main(argv=None) -> dict:
                     help="another designkit tree (e.g. /work/main): its min-contact runs in the same round robin, "
                          "with that tree first on PYTHONPATH (a before/after in one run)")
     ap.add_argument("--sensor", type=Path, help="a calibrated sensor file: also time its question from a fresh shell")
+    ap.add_argument("--help-rows", action="store_true",
+                    help="also time designkit --help, a lab command's --help and the entry points read alone")
     ap.add_argument("--python", type=Path, default=Path(PY),
                     help="the interpreter every command runs with (default: this one), e.g. a virtual environment "
                          "with designkit installed non-editable")
@@ -136,8 +152,9 @@ def main(argv=None) -> dict:
     where = subprocess.run([str(args.python), "-c", "import designkit; print(designkit.__file__)"], cwd=home,
                            env=own, capture_output=True, text=True)
     print(f"{args.python}: designkit from {where.stdout.strip() or where.stderr.strip()}")
+    rows = {**ARGS, **(HELP_ARGS if args.help_rows else {})}
     commands = {name: ([TERMINAL, str(args.python), *a[1:]] if a[0] == TERMINAL else [str(args.python), *a], own, home)
-                for name, a in ARGS.items()}
+                for name, a in rows.items()}
     if args.sensor is not None:
         commands.update(_sensor_commands(args.sensor.resolve(), Path(scratch.name), str(args.python)))
         if args.baseline is not None:
@@ -150,6 +167,9 @@ def main(argv=None) -> dict:
         commands["baseline min-contact"] = (commands["designkit min-contact"][0], env, args.baseline)
         commands["baseline min-contact (terminal)"] = (commands["designkit min-contact (terminal)"][0], env,
                                                        args.baseline)
+        if args.help_rows:
+            for name in ("designkit --help", "designkit reproduce --help"):
+                commands[f"baseline {name[len('designkit '):]}"] = (commands[name][0], env, args.baseline)
     for cmd, env, cwd in commands.values():  # warm-up: page cache, .pyc files
         _run(cmd, env, cwd)
     times: dict[str, list[float]] = {k: [] for k in commands}

@@ -7,9 +7,9 @@
 :mod:`designkit_lab.explicit_euler` (why the slab model's finite volumes step implicitly),
 :mod:`designkit_lab.roundtrip` (synthetic calibration round trips, ``benchmarks/bench_roundtrip.py``) and
 :mod:`designkit_lab.sequential_bound` (the optimal sequential test: the bound on the core's live decisions).
-The lab imports the core (:mod:`designkit`); the core never imports the lab, except the three CLI
-commands above, which load it when they run. Installed by the same distribution; its figures need
-``pip install 'designkit[lab]'`` (matplotlib, networkx).
+The lab imports the core (:mod:`designkit`); the core never imports the lab. The three commands above are
+the lab's (:mod:`designkit_lab.cli`), added to ``designkit`` through the ``designkit.commands`` entry points.
+Installed by the same distribution; its figures need ``pip install 'designkit[lab]'`` (matplotlib, networkx).
 """
 
-__all__ = ["accuracy", "emulator", "explicit_euler", "reproduce", "roundtrip", "sequential_bound"]
+__all__ = ["accuracy", "cli", "emulator", "explicit_euler", "reproduce", "roundtrip", "sequential_bound"]

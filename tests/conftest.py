@@ -11,6 +11,25 @@ import pytest
 REPO = Path(__file__).resolve().parent.parent
 
 
+def pytest_configure(config):
+    """Stop at once, with the remedy, where designkit's installed metadata predates pyproject.toml's command
+    entry points (an editable install made before they changed): the lab's commands would be missing."""
+    try:
+        import tomllib
+    except ImportError:  # pragma: no cover - Python 3.10
+        return
+    from importlib.metadata import entry_points
+
+    pyproject = REPO / "pyproject.toml"
+    if not pyproject.is_file():
+        return
+    declared = tomllib.loads(pyproject.read_text())["project"].get("entry-points", {}).get("designkit.commands", {})
+    installed = {ep.name: ep.value for ep in entry_points(group="designkit.commands")}
+    if installed != declared:
+        raise pytest.UsageError(f"designkit's installed entry points {installed} are not pyproject.toml's {declared}: "
+                                "reinstall it (pip install --no-deps -e .) and run the tests again")
+
+
 @pytest.fixture(scope="session")
 def paper_sensor():
     from designkit import SENSORS

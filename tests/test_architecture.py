@@ -35,7 +35,7 @@ LAYERS = [
     {"designkit.query", "designkit.io_batch"},
     {"designkit.export", "designkit.calibration", "designkit.design"},
     {"designkit_lab"},
-    {"designkit.cli", "designkit.__main__"},
+    {"designkit.cli", "designkit.__main__", "designkit_lab.cli"},
 ]
 
 
@@ -82,13 +82,14 @@ def _imports(mod: str) -> list[tuple[str, list[str], int]]:
 
 
 def _layer(mod: str) -> int:
+    """The layer of ``mod``: that of the longest prefix in :data:`LAYERS` it falls under."""
     if mod == "designkit":
         return 0  # the top-level namespace loads its nouns lazily (PEP 562)
-    for i, layer in enumerate(LAYERS):
-        for prefix in layer:
-            if mod == prefix or mod.startswith(prefix + "."):
-                return i
-    raise AssertionError(f"{mod} is in no layer: add it to LAYERS in {__file__}")
+    found = [(len(prefix), i) for i, layer in enumerate(LAYERS) for prefix in layer
+             if mod == prefix or mod.startswith(prefix + ".")]
+    if not found:
+        raise AssertionError(f"{mod} is in no layer: add it to LAYERS in {__file__}")
+    return max(found)[1]
 
 
 MODULES = _modules()
@@ -158,7 +159,7 @@ def test_no_import_cycles_between_modules():
 
 
 @pytest.mark.parametrize("mod", [m for m in MODULES if not m.rsplit(".", 1)[-1].startswith("_")
-                                 and not m.startswith("designkit.cli")])
+                                 and not m.startswith(("designkit.cli", "designkit_lab.cli"))])
 def test_public_modules_declare_all_with_names_that_exist(mod):
     module = importlib.import_module(mod)
     assert hasattr(module, "__all__"), f"{mod} declares no __all__"
@@ -182,8 +183,12 @@ def test_docstring_examples_run(mod):
 
 def test_the_core_never_imports_the_lab():
     """The installed core answers a user's questions without the lab: no core module imports
-    ``designkit_lab``; the ``bench`` and ``reproduce`` commands load it when they run, through
-    ``designkit.cli._app.import_lab`` (one line naming what to install when it is missing)."""
+    ``designkit_lab``, and the core's CLI does not even name it (the lab's commands reach ``designkit`` through
+    the ``designkit.commands`` entry points, :data:`designkit.cli.ENTRY_POINT_GROUP`)."""
     bad = [f"{mod}:{line} imports {t}" for mod in MODULES if mod.split(".")[0] == "designkit"
            for t, _, line in _imports(mod) if t.split(".")[0] == "designkit_lab"]
     assert not bad, "\n".join(bad)
+    named = [f"{p.relative_to(PKG.parent)}:{i}" for p in sorted((PKG / "cli").glob("*.py"))
+             for i, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1) if "designkit_lab" in line]
+    assert not named, f"the core's CLI names the lab (import_module strings too): {named}"
+

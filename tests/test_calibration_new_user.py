@@ -73,7 +73,7 @@ def test_guided_run_refuses_an_emulator_that_alternates(cli, tmp_path):
 
 def test_emulate_and_guided_defaults_agree(cli):
     from designkit.cli import calibrate as cal
-    from designkit.cli import emulate as emu
+    from designkit_lab.cli import emulate as emu
 
     r = cli("emulate", "--help")
     assert r.exit_code == 0

@@ -42,7 +42,10 @@ def test_every_command_has_help_with_an_example(cli, path):
 
 
 def test_the_console_script_knows_which_module_registers_each_command():
-    """``designkit NAME`` imports only NAME's module: the map must name every top-level command, and right."""
+    """``designkit NAME`` imports only NAME's module: the map (and, for a command another package adds, its
+    entry point) must name every top-level command, and right."""
+    from importlib.metadata import entry_points
+
     import designkit.cli as cli_pkg
 
     app = cli_pkg.app
@@ -51,9 +54,11 @@ def test_the_console_script_knows_which_module_registers_each_command():
         registered[c.name or c.callback.__name__.replace("_", "-")] = c.callback.__module__
     for g in app.registered_groups:
         registered[g.name] = g.typer_instance.registered_commands[0].callback.__module__
-    assert set(cli_pkg.COMMAND_MODULE) == set(registered)
+    added = {ep.name: ep.value for ep in entry_points(group=cli_pkg.ENTRY_POINT_GROUP)}
+    assert not set(added) & set(cli_pkg.COMMAND_MODULE)
+    assert set(cli_pkg.COMMAND_MODULE) | set(added) == set(registered)
     for name, module in registered.items():
-        assert module == f"designkit.cli.{cli_pkg.COMMAND_MODULE[name]}", name
+        assert module == added.get(name, f"designkit.cli.{cli_pkg.COMMAND_MODULE.get(name)}"), name
     assert set(cli_pkg.COMMAND_MODULE.values()) == set(cli_pkg.COMMAND_MODULES)
 
 

@@ -78,13 +78,42 @@ def test_every_data_file_in_a_package_folder_is_installed():
     assert not missing, f"not in [tool.setuptools.package-data]: {missing}"
 
 
-def test_bench_without_the_lab_is_one_line_naming_what_to_install():
-    """The core runs without designkit_lab; `designkit bench` then says what is missing (exit 2), no traceback."""
+def test_the_lab_commands_come_through_the_entry_points():
+    """``designkit bench``, ``reproduce`` and ``emulate`` are registered by the lab's modules that the installed
+    ``designkit.commands`` entry points name, as pyproject.toml declares them (the core's CLI names no lab
+    module: tests/test_architecture.py)."""
+    from importlib.metadata import entry_points
+
+    from designkit.cli import ENTRY_POINT_GROUP, app
+
+    pyproject = REPO / "pyproject.toml"
+    if not pyproject.is_file():
+        pytest.skip("not running from a source checkout")
+    declared = tomllib.loads(pyproject.read_text())["project"]["entry-points"][ENTRY_POINT_GROUP]
+    assert declared == {"bench": "designkit_lab.cli.bench", "reproduce": "designkit_lab.cli.reproduce",
+                        "emulate": "designkit_lab.cli.emulate"}
+    installed = {ep.name: ep.value for ep in entry_points(group=ENTRY_POINT_GROUP)}
+    assert installed == declared, ("the installed metadata's entry points are not pyproject.toml's: reinstall "
+                                   "designkit (pip install --no-deps -e .)")
+    where = {c.name or c.callback.__name__: c.callback.__module__ for c in app.registered_commands}
+    assert {name: where.get(name) for name in declared} == declared
+
+
+def test_a_lab_command_that_cannot_be_imported_is_one_line_naming_it():
+    """The core runs without designkit_lab; a lab command whose entry point is installed but whose module
+    cannot be imported says so in one line (exit 2, JSON too under --json), no traceback; ``designkit --help``
+    still lists the core's commands."""
     import subprocess
 
-    code = ("import sys; sys.modules['designkit_lab'] = None; sys.argv = ['designkit', 'bench', '--quick', '--json'];"
-            " from designkit.cli import main; main()")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    def run(*argv):
+        code = (f"import sys; sys.modules['designkit_lab'] = None; sys.argv = ['designkit', *{argv!r}];"
+                " from designkit.cli import main; main()")
+        return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+
+    out = run("bench", "--quick", "--json")
     assert out.returncode == 2, out.stderr
-    assert out.stderr.count("\n") == 1 and "designkit_lab" in out.stderr and "Traceback" not in out.stderr
+    assert out.stderr.count("\n") == 1 and "designkit_lab.cli.bench" in out.stderr and "Traceback" not in out.stderr
     assert '"exit_status": 2' in out.stdout
+    helped = run("--help")
+    assert helped.returncode == 0, helped.stderr
+    assert "min-contact" in helped.stdout and "reproduce" not in helped.stdout and "Traceback" not in helped.stderr

@@ -17,8 +17,8 @@ from . import _app  # noqa: E402
 
 #: The modules that register commands on ``app``, in the order of ``designkit --help`` within each panel
 #: (questions first). Each keeps its imports cheap (no numpy work, no scikit-learn) at module level.
-COMMAND_MODULES = ("query", "matrix", "thin", "materials", "tables", "export", "calibrate", "emulate", "classify",
-                   "design", "core", "sweep", "reproduce", "bench")
+COMMAND_MODULES = ("query", "matrix", "thin", "materials", "tables", "export", "calibrate", "classify",
+                   "design", "core", "sweep")
 
 #: Which module registers each top-level command or command group. The console script imports only the
 #: module of the command it runs; anything else (help, an unknown name, shell completion) imports them all.
@@ -26,10 +26,15 @@ COMMAND_MODULES = ("query", "matrix", "thin", "materials", "tables", "export", "
 COMMAND_MODULE = {
     "min-contact": "query", "max-noise": "query", "min-delta-t": "query", "delta-e": "query",
     "distinguishable": "query", "matrix": "matrix", "validity": "thin", "materials": "materials",
-    "tables": "tables", "export": "export", "calibrate": "calibrate", "emulate": "emulate",
-    "classify": "classify", "design": "design", "simulate": "core", "f1": "core", "sweep": "sweep",
-    "reproduce": "reproduce", "bench": "bench",
+    "tables": "tables", "export": "export", "calibrate": "calibrate", "classify": "classify",
+    "design": "design", "simulate": "core", "f1": "core", "sweep": "sweep",
 }
+
+#: The entry-point group through which other installed packages add commands (pyproject.toml's
+#: ``[project.entry-points."designkit.commands"]``): each entry point is named after its command and names
+#: the module that registers it on ``app`` when imported. The installed packages' metadata is read only for
+#: a command outside :data:`COMMAND_MODULE`, help and completion (benchmarks/bench_startup.py times it).
+ENTRY_POINT_GROUP = "designkit.commands"
 
 
 def _register(modules) -> None:
@@ -37,9 +42,22 @@ def _register(modules) -> None:
         importlib.import_module(f"{__name__}.{name}")
 
 
+def _entry_points(name: str | None = None) -> list:
+    """The installed ``designkit.commands`` entry points (only ``name``'s, if given)."""
+    from importlib.metadata import entry_points
+
+    return [ep for ep in entry_points(group=ENTRY_POINT_GROUP) if name is None or ep.name == name]
+
+
 def _register_all() -> "_app.typer.Typer":
-    """Every command on ``app``, in help order whatever was imported first."""
+    """Every command on ``app``, in help order whatever was imported first (an entry point's after the core's;
+    one whose module cannot be imported is left out: ``designkit NAME`` says why)."""
     _register(COMMAND_MODULES)
+    for ep in _entry_points():
+        try:
+            ep.load()
+        except ImportError:
+            pass
     rank = {f"{__name__}.{m}": i for i, m in enumerate(COMMAND_MODULES)}
 
     def module_rank(callback) -> int:
@@ -52,6 +70,21 @@ def _register_all() -> "_app.typer.Typer":
     return app
 
 
+def _register_entry_point(argv: list[str]) -> bool:
+    """Register the command ``argv[0]`` names if an entry point adds it; False if none does. One whose module
+    cannot be imported is one line naming it (exit 2, JSON too under ``--json``), not a traceback."""
+    eps = _entry_points(argv[0])
+    for ep in eps:
+        try:
+            ep.load()
+        except ImportError as exc:
+            _app._report_error("bad-input", f"`designkit {ep.name}` comes from {ep.value}, which cannot be imported "
+                               f"here ({exc}): reinstall the package that provides it", _app.EXIT_BAD_INPUT,
+                               _app._wants_json(argv))
+            sys.exit(_app.EXIT_BAD_INPUT)
+    return bool(eps)
+
+
 def main() -> None:
     """Console-script entry point: registers the command asked for (or all), then runs it."""
     argv = sys.argv[1:]
@@ -60,7 +93,9 @@ def main() -> None:
         _register_all()
     elif module is not None:
         _register((module,))
-    elif not (argv and argv[0] in ("--version", "-V")):  # answered while parsing the top-level options
+    elif argv and argv[0] in ("--version", "-V"):  # answered while parsing the top-level options
+        pass
+    elif not (argv and not argv[0].startswith("-") and _register_entry_point(argv)):
         _register_all()
     _app.main()
 
@@ -72,4 +107,4 @@ def __getattr__(name: str):
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
-__all__ = ["BLAS_THREAD_VARIABLES", "COMMAND_MODULE", "COMMAND_MODULES", "app", "main"]
+__all__ = ["BLAS_THREAD_VARIABLES", "COMMAND_MODULE", "COMMAND_MODULES", "ENTRY_POINT_GROUP", "app", "main"]

@@ -211,7 +211,6 @@ ASK = "Ask a design question"
 TABLES = "Lookup tables and embedding"
 SENSOR = "Your sensor"
 MODEL = "Model and sweeps"
-REPORTS = "The paper and accuracy"
 
 
 def sub_app(name: str, help: str, panel: str) -> typer.Typer:
@@ -220,22 +219,6 @@ def sub_app(name: str, help: str, panel: str) -> typer.Typer:
                         pretty_exceptions_enable=False, rich_markup_mode="markdown")
     app.add_typer(group, name=name, rich_help_panel=panel)
     return group
-
-
-def import_lab(module: str, command: str) -> Any:
-    """``designkit_lab.<module>``: the lab (benchmarks, the paper's report) ships beside the core and is
-    imported only by the commands that need it; missing, it is one line naming what to install."""
-    import importlib
-
-    try:
-        return importlib.import_module(f"designkit_lab.{module}")
-    except ModuleNotFoundError as exc:
-        if exc.name not in ("designkit_lab", f"designkit_lab.{module}"):
-            raise
-        from .._validation import InputError
-
-        raise InputError(f"`designkit {command}` needs the designkit_lab package, which is not installed here: "
-                         "reinstall designkit (pip install 'designkit[lab]' also adds its figures' libraries)") from None
 
 
 def emit_json(payload: Any) -> None:

@@ -1,9 +1,9 @@
-"""``designkit calibrate`` (record, fit, and the guided run) and ``designkit emulate``.
+"""``designkit calibrate`` (record, fit, and the guided run).
 
 Turning one's own sensor into a sensor file that ``--sensor`` accepts:
 record touches of materials with known effusivity ranges over serial, then
-identify e_s and alpha_s (paper appendix). ``designkit emulate`` plays a
-simulated rig on a pseudo-terminal, for trying all of this without hardware.
+identify e_s and alpha_s (paper appendix). ``designkit emulate`` (the lab's)
+plays a simulated rig on a pseudo-terminal, for trying all of this without hardware.
 """
 
 from __future__ import annotations

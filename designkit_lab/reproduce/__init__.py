@@ -19,7 +19,7 @@ Sections (``only=`` / ``--only`` picks some):
 Heavy parts come from shipped lookup tables built by the sweep engine
 (``tables/*.yaml``); what is computed at run time is small (about 5 minutes
 on 2 cores for the whole report). The library does the work; the command
-line (:mod:`designkit.cli.reproduce`) adds a progress bar.
+line (:mod:`designkit_lab.cli.reproduce`) adds a progress bar.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""``designkit reproduce``: the paper's analyses as a report (designkit_lab.reproduce)."""
+"""``designkit reproduce``: the paper's analyses as a report (:mod:`designkit_lab.reproduce`)."""
 
 from __future__ import annotations
 
@@ -7,15 +7,16 @@ from typing import Annotated, List, Optional
 
 import typer
 
-from ._app import app, console, emit_json, import_lab
-from . import _app
-from ._options import Json, Seed
+from designkit.cli._app import app, console, emit_json
+from designkit.cli._options import Json, Seed
+
+from . import REPORTS
 
 _SECTIONS_HELP = ("f1-matrices, delta-curves, effusivity, node-graphs, table1, guideline, real-robot, "
                   "sim-to-real, multiclass")
 
 
-@app.command(rich_help_panel=_app.REPORTS)
+@app.command(rich_help_panel=REPORTS)
 def reproduce(
     out: Annotated[Path, typer.Option("--out", help="Report folder: report.md, report.json, figures/, data/.")],
     only: Annotated[Optional[List[str]], typer.Option(
@@ -43,8 +44,8 @@ def reproduce(
 
     Example: `designkit reproduce --out report --only f1-matrices --figure-format svg`
     """
-    lab = import_lab("reproduce", "reproduce")
-    ReproduceSettings, parse_only, run = lab.ReproduceSettings, lab.parse_only, lab.reproduce
+    from ..reproduce import ReproduceSettings, parse_only
+    from ..reproduce import reproduce as run
 
     names = parse_only(only)
     settings = ReproduceSettings(tables_dir=tables, robot_data=robot_data, quick=quick, seed=seed, jobs=jobs,

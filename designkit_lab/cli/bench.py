@@ -7,14 +7,15 @@ from typing import Annotated, List, Optional
 
 import typer
 
-from ._app import app, console, emit_json, import_lab
-from . import _app
-from ._options import Json
+from designkit.cli._app import app, console, emit_json
+from designkit.cli._options import Json
+
+from . import REPORTS
 
 SECTION_HELP = "Only these sections (repeatable): physics, recognition, delta, queries, cost. Default: all."
 
 
-@app.command("bench", rich_help_panel=_app.REPORTS)
+@app.command("bench", rich_help_panel=REPORTS)
 def bench_cmd(
     quick: Annotated[bool, typer.Option("--quick", help="Fewer cases and smaller references: a few minutes on 2 cores.")] = False,
     out: Annotated[Optional[Path], typer.Option("--out", help="Folder to write accuracy.md, its figures and accuracy.json into (docs/ for the shipped page).")] = None,
@@ -35,12 +36,12 @@ def bench_cmd(
     """
     import time
 
-    accuracy = import_lab("accuracy", "bench")
+    from designkit.cli._format import check_out_dir
 
-    from ._format import check_out_dir
+    from .. import accuracy
 
     sections = accuracy.check_sections(section or accuracy.SECTIONS)
-    from .._workers import worker_count
+    from designkit._workers import worker_count
 
     worker_count(jobs)  # the one rule of --jobs, before minutes of measuring (0 was taken)
     if out is not None:

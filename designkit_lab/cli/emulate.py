@@ -9,10 +9,10 @@ from typing import Annotated, Optional
 
 import typer
 
-from . import _app
-from ._app import app, console, emit_json, import_lab
-from ._options import Json, Noise, Seed, SensorOpt, sensor_and_model
-from .calibrate import DEFAULT_TRIALS, ProfileOpt, guided_command
+from designkit.cli import _app
+from designkit.cli._app import app, console, emit_json
+from designkit.cli._options import Json, Noise, Seed, SensorOpt, sensor_and_model
+from designkit.cli.calibrate import DEFAULT_TRIALS, ProfileOpt, guided_command
 
 
 def _hint_ranges(mats) -> list[str]:
@@ -20,8 +20,8 @@ def _hint_ranges(mats) -> list[str]:
 
     The emulator knows their effusivity exactly; the hint gives it +-10 %, as an effusivity meter would.
     """
-    from .._validation import InputError
-    from ..materials import get_material
+    from designkit._validation import InputError
+    from designkit.materials import get_material
 
     out = []
     for m in mats:
@@ -64,10 +64,10 @@ def emulate(
 
     Example (a rig playing two objects for 5 s; without --duration until Ctrl-C): `designkit emulate --material wood=400 --material aluminium=20000 --speed 20 --duration 5`
     """
-    from .._validation import InputError, check_temperature
-    from ..calibration.profiles import load_profile
+    from designkit._validation import InputError, check_temperature
+    from designkit.calibration.profiles import load_profile
 
-    lab = import_lab("emulator", "emulate")
+    from .. import emulator as lab
 
     sensor_temp = check_temperature("--sensor-temp [degC]", sensor_temp)
     ambient = check_temperature("--ambient [degC]", ambient)
@@ -125,8 +125,8 @@ def emulate(
 
 def _check_emulation(touch_every: float, duration: Optional[float], speed: float, touches_per_material: int) -> None:
     """emulate's timing options, each refused in one line before the rig starts."""
-    from .._validation import InputError
-    from ..calibration.profiles import MAX_PROFILE_SECONDS
+    from designkit._validation import InputError
+    from designkit.calibration.profiles import MAX_PROFILE_SECONDS
 
     if not 0 < touch_every <= MAX_PROFILE_SECONDS:
         raise InputError(f"--touch-every must be a positive number of seconds up to {MAX_PROFILE_SECONDS:g} (a day), "
@@ -142,15 +142,15 @@ def _check_emulation(touch_every: float, duration: Optional[float], speed: float
 
 def _emulated_materials(material: Optional[list[str]], e: Optional[float], object_temp: Optional[float]) -> list:
     """The objects the emulated rig touches: ``--material`` NAME or LABEL=E (in turn), then ``--e``."""
-    from .._validation import InputError
+    from designkit._validation import InputError
 
-    EmulatedMaterial = import_lab("emulator", "emulate").EmulatedMaterial
+    from ..emulator import EmulatedMaterial
 
     mats = []
     for spec in material or []:
         label, sep, value = spec.rpartition("=")   # the effusivity follows the last "="
         if sep:
-            from .._validation import check_label
+            from designkit._validation import check_label
 
             check_label(f"--material {spec!r}: the label", label)  # '=400' and a newline were taken
             try:
@@ -159,7 +159,7 @@ def _emulated_materials(material: Optional[list[str]], e: Optional[float], objec
                 raise InputError(f"--material {spec!r}: use NAME or LABEL=EFFUSIVITY") from None
             mats.append(EmulatedMaterial(label.strip(" "), e_label, object_temp))  # a newline is refused, not cut
         else:
-            from ..materials import get_material
+            from designkit.materials import get_material
 
             m = get_material(spec)
             eo = m.identified if m.identified is not None else math.sqrt(m.e_min * m.e_max)
@@ -173,7 +173,7 @@ def _emulated_materials(material: Optional[list[str]], e: Optional[float], objec
 
 def _print_emulation(emu, prof, fm, mats: list, info: dict) -> None:
     """emulate's banner for people: the port, what the rig touches, and the commands to try on it."""
-    from ._app import escape
+    from designkit.cli._app import escape
 
     con = console()
     con.print(f"Emulating a '{prof.name}' rig on [bold]{info['port']}[/]  (speed {info['speed']:g}x; Ctrl-C to stop)")

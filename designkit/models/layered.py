@@ -1,67 +1,16 @@
 """A layered sensor: a heater film on a backing, touching an object through a contact conductance.
 
-The paper's model (:mod:`designkit.models.semi_infinite`) treats the sensor as a
-semi-infinite solid. A real heated tactile sensor is a thin film (a polyimide
-heater with the thermistor in or under it) on a backing (the finger), and the
-reading passes through a measurement chain (the thermistor's own lag, the
-host's filtering). This module gives the reading of
-
-    object (semi-infinite, e_o; initial temperature Ta)
-    | interface conductance h_c
-    | film (effusivity e_s and diffusivity alpha_s of the sensor, thickness L; thermistor at depth x)
-    | backing (effusivity e_b, diffusivity alpha_b; semi-infinite, or of thickness L_b
-      with its far face held at Ts0: the rest of the finger and the heater around
-      the contact spot, which stay near the set point)
-
-with film and backing initially at Ts0, followed by a first-order thermistor lag
-(time constant ``lag_s``) and, optionally, a Savitzky-Golay smoothing of the
-sampled reading like the host's of the shared robot recordings (window 99,
-order 3 at 200 Hz).
-
-The exact solution in the Laplace domain
-----------------------------------------
-With ``u = (T - Ts0) / (Ta - Ts0)`` and ``q = sqrt(p / alpha_s)``, a heat wave
-in the film is reflected at the backing with ``R = (e_s - e_b) / (e_s + e_b)``,
-so the film temperature is ``P(p) (exp(-q z) + R exp(-q (2L - z)))`` and its
-(for a backing of thickness ``L_b`` with its far face at Ts0, ``e_b`` becomes
-``e_b coth(q_b L_b)`` in ``R``, ``q_b = sqrt(p / alpha_b)``)
-input admittance (heat flux per surface temperature) is
-
-    Y(p) = e_s sqrt(p) (1 - R E) / (1 + R E),      E = exp(-2 q L).
-
-Object, interface and sensor are heat resistances in series
-(``1/(e_o sqrt(p))``, ``1/h_c``, ``1/Y``): the sensor surface is at
-
-    U_0(p) = (1/p) / (1 + Y / (e_o sqrt(p)) + Y / h_c),
-
-and the thermistor (depth ``x <= L``) reads, through its lag,
-
-    U(p) = U_0(p) (exp(-q x) + R exp(-q (2L - x))) / (1 + R E) / (1 + lag_s p).
-
-(A thermistor below the film, ``x > L``, reads
-``U_0 (1 + R) exp(-q_b (x - L)) exp(-q L) / (1 + R E)`` with ``q_b = sqrt(p / alpha_b)``.)
-Every exponential has a non-positive real part on the inversion contour, so
-nothing overflows. ``U`` is inverted with the fixed Talbot method of Abate and
-Valko [1]_ (``nodes`` points per time; about ``0.6 nodes`` significant digits,
-limited by double-precision rounding to about 1e-11), vectorized over times and
-objects.
-
-Limits (tested): ``L -> 0`` or ``e_b = e_s`` is the :class:`~designkit.models.contact.Contact`
-model, and with ``h_c = inf`` the paper's semi-infinite model; ``t = 0`` gives
-the initial-value limit (0 for a buried thermistor, a finite contact or a lag);
-``e_o = 0`` gives 0 and ``e_o = inf`` a perfect conductor.
-
-Like every model here it is linear in the temperatures, so only the ratios of
-effusivities (and ``h_c``) to ``e_s`` matter: scaling ``e_s``, ``e_b``, ``h_c``
-and every ``e_o`` together changes nothing. A calibration fixes the scale only
-through the objects' effusivity ranges (:mod:`designkit.calibration.identify`).
-
-References
-----------
-.. [1] J. Abate and P. P. Valko, "Multi-precision Laplace transform inversion",
-   Int. J. Numer. Meth. Eng. 60 (2004) 979-993 (the fixed Talbot method).
-.. [2] H. S. Carslaw and J. C. Jaeger, *Conduction of Heat in Solids*, 2nd ed.,
-   Oxford, 1959, sections 12.8 (composite media) and 2.7 (contact conductance).
+The reading of a semi-infinite object (e_o, at Ta) touching, through an interface conductance h_c, a
+film (the sensor's e_s and alpha_s, thickness L, thermistor at depth x) on a backing (e_b, alpha_b;
+semi-infinite, or of thickness L_b with its far face held at Ts0), film and backing initially at Ts0;
+then a first-order thermistor lag (``lag_s``) and, optionally, a Savitzky-Golay smoothing of the sampled
+reading like the host's of the shared robot recordings (window 99, order 3 at 200 Hz). The exact solution
+in the Laplace domain (the film's admittance in reflection form, object, interface and sensor in series)
+is inverted with the fixed Talbot method (Abate and Valko, 2004; about 1e-11), vectorized over times and
+objects. Limits (tested): ``L -> 0`` or ``e_b = e_s`` is the
+:class:`~designkit.models.contact.Contact` model, and with ``h_c = inf`` the paper's semi-infinite model.
+Only the ratios of effusivities (and ``h_c``) to ``e_s`` matter. The derivation, its limits and its
+references: docs/sensor-models.md, "The layered model's exact solution".
 """
 
 from __future__ import annotations

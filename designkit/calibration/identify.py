@@ -6,43 +6,17 @@ model of :mod:`designkit.models` (a :class:`~designkit.calibration.candidates.Ca
 one least-squares problem; :mod:`~designkit.calibration.compare` chooses between them on touches
 the fit has not seen.
 
-The problem
------------
-Trial ``i`` of material ``m`` on its own time grid (contact detected at 0,
-heat flowing from ``t_off``)::
-
-    T_i(t) = Ts0_i (1 - v_m(t)) + To_i v_m(t),    v_m = S[ u(t - t_off; e_o,m / e_s, theta) ]
-
-``u`` is the model's normalized reading (0 before contact), ``S`` the
-recordings' host smoothing (Savitzky-Golay over the whole trial, as the host
-did) when the candidate includes it, ``theta`` the model's sensor parameters.
-
-* Every model here is linear in the temperatures and changes nothing when all
-  effusivities (and h_c) are scaled together, so the fit runs with ``e_s = 1``:
-  it identifies ratios ``rho_m = e_o,m / e_s``, ``e_b / e_s`` and ``h_c / e_s``.
-  e_s itself comes from the materials' handbook ranges, as in the paper: each
-  material allows ``e_s`` in ``[e_min,m / rho_m, e_max,m / rho_m]``; one e_s
-  consistent with every range exists when these overlap (else: *conflict*).
-* Each touch's own initial temperatures: the sensor's ``Ts0_i`` is fitted
-  (closed form, variable projection; the pre-contact samples are in the fit),
-  the object's ``To_i`` is the passive thermistor before contact where it sits
-  still, ambient (a number) where there is none, or fitted per touch where the
-  object is not at room temperature (its passive channel moves in contact).
-* Nonlinear parameters (transformed: logs of positive quantities) by
-  :func:`scipy.optimize.least_squares` (trust-region reflective, bounded,
-  finite-difference Jacobian of the projected residual).
-
-Uncertainty and identifiability
--------------------------------
-Residuals of a smoothed, imperfect model are correlated along a touch, so the
-covariance is the cluster-robust sandwich with touches as clusters, bias-reduced
-for few touches (CR2), and each interval takes Student's t with that parameter's
-Bell-McCaffrey degrees of freedom: a parameter carried by a few touches gets few
-(:mod:`~designkit.calibration.robust`; measured by the pty round trips of
-:mod:`~designkit_lab.roundtrip`). The Jacobian's singular values (columns
-scaled to unit norm) give its numerical rank; a parameter is reported *not
-identified* when the Jacobian is rank-deficient along it, its interval spans
-more than a factor of 10, or it sits on a search bound.
+Trial ``i`` of material ``m`` is fitted as ``T_i(t) = Ts0_i (1 - v_m(t)) + To_i v_m(t)`` with
+``v_m = S[u(t - t_off; e_o,m / e_s, theta)]``: the model's normalized reading ``u``, the host's smoothing
+``S`` when the candidate includes it, each touch's own ``Ts0_i`` in closed form (variable projection) and
+its ``To_i`` from the passive thermistor, a number or the fit; the nonlinear parameters (logs of positive
+quantities) by :func:`scipy.optimize.least_squares` (trust-region reflective, bounded). The fit runs at
+``e_s = 1`` (only ratios to e_s are identifiable; e_s comes from the materials' handbook ranges, or a
+*conflict*). Intervals: the cluster-robust CR2 sandwich, touches as clusters, with each parameter's
+Bell-McCaffrey degrees of freedom (:mod:`~designkit.calibration.robust`); a parameter is *not
+identified* when the Jacobian (columns scaled to unit norm) is rank-deficient along it, its interval
+spans more than a factor of 10, or it sits on a search bound. Why, and what it gives on the shared
+recordings: docs/sensor-models.md ("The models", "What the data can identify").
 """
 
 from __future__ import annotations

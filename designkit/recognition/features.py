@@ -9,9 +9,8 @@ features (docs/physics.md section 2). designkit uses the Savitzky-Golay derivati
 least-squares quadratic over a window of ``window_s`` seconds (0.25 s, 51
 samples at 200 Hz, by default). Its noise falls as ``window^-3/2``.
 
-It is computed here in its cumulative-sum form, not by ``savgol_filter`` (a 51-tap
-convolution: 7.6 ms of a 100 x 2,000-sample matrix at 10 s of contact, the largest
-part of building a sweep's features, measured). In a symmetric window the quadratic
+It is computed here in its cumulative-sum form, not by ``savgol_filter`` (why:
+docs/decisions-log.md, "Recognition"). In a symmetric window the quadratic
 term is orthogonal to the linear one, so the derivative at the window's centre is the
 least-squares line's slope, ``sum_k k x_(i+k) / sum_k k^2`` (``k = -M..M``): two
 running sums give it at every interior sample in O(1) each. The first and last ``M``
@@ -20,12 +19,6 @@ samples take the derivative of the quadratic fitted to the first / last window, 
 ``savgol_filter`` to rounding (about 1e-12 of the slope's scale; tests check it); the
 rounding differs, which is why the sweep's engine version changed with it
 (:data:`designkit.sweep.ENGINE_VERSION`).
-
-Measured (35,000 vs 20,000, sigma 0.05, dT 10, contact 1 s, 6 seeds): SVM F1
-0.65 with ``np.gradient``, 0.73 with the 0.25 s Savitzky-Golay slope, 0.77 with
-a 0.5 s window; the window barely matters at longer contacts or near
-threshold pairs (within 0.02), so 0.25 s is kept as a window that also fits
-short touches.
 
 The slope is a linear function of the samples, so it adds no information a
 linear classifier could not extract from the raw samples; what it changes is

@@ -1,42 +1,15 @@
 """Lookup tables on disk: one documented format, loaded without pickle.
 
-A table ``NAME`` is two files side by side:
-
-``NAME.npz``
-    numpy arrays (``np.savez``, no object arrays; read with ``allow_pickle=False``).
-``NAME.json``
-    the header: ``format`` ("designkit-table"), ``schema_version``, ``name``,
-    ``fidelity`` ("svm" or "ideal"), ``sensor`` (the sensor's parameters),
-    ``effusivity`` (grid: ``min``, ``max``, ``intervals``, ``width``, units),
-    ``axes`` (name, units, values, scale; in array order), ``arrays`` (for each
-    array: shape, dtype, units, meaning), ``threshold``, ``trials``, ``folds``,
-    ``seed``, ``max_repeats``, ``z``, ``designkit_version``, ``created``,
-    ``config`` (the full sweep config, to rebuild it), ``stats`` (SVM fits and
-    compute time per scene), and ``content_hash``: SHA-256 over the header
-    (canonical JSON, without the hash itself and the fields that change no
-    answer: ``created`` and ``stats``) and every array's name, dtype, shape
-    and bytes in name order. The hash is verified on load, and the header is
-    checked against its schema and the arrays (axis lengths, units, fidelity,
-    sensor, model): a corrupted, truncated or edited table is refused.
-
-Schema version 2 (this one) hashes the header with the arrays; version 1 hashed
-the arrays only, so its header could be edited unnoticed. A version-1 table is
-refused with the remedy: ``python benchmarks/rehash_tables.py TABLE.json``
-re-hashes it (arrays untouched) after you have checked its header, or rebuild it.
-
-Arrays (shape ``[scene axes..., contact, effusivity]``; effusivity units
-J s^-1/2 K^-1 m^-2; NaN where no distinguishable partner lies inside the grid):
-
-``delta_up``, ``delta_down``
-    delta(e) towards higher / lower effusivity.
-``delta_up_lo``, ``delta_up_hi``, ``delta_down_lo``, ``delta_down_hi``
-    Monte Carlo interval of delta (SVM tables; an ideal table is exact).
-``delta_up_ideal``, ``delta_down_ideal``
-    The ideal observer's delta on the same grid (SVM tables).
-``fits``, ``chunk_wall_s``
-    SVM fits and compute seconds per (scene point, contact).
-``f1_matrix`` (optional)
-    Full F1 matrices, ``[scene..., contact, n, n]``.
+A table ``NAME`` is two files side by side: ``NAME.npz``, numpy arrays (``delta_up``, ``delta_down``, their
+Monte Carlo ends and the ideal observer's; shape ``[scene axes..., contact, effusivity]``, effusivity in
+J s^-1/2 K^-1 m^-2, NaN where no distinguishable partner lies inside the grid; read with
+``allow_pickle=False``), and ``NAME.json``, the header (grid, axes, sensor, model, sweep config, the
+arrays' shapes, units and meanings) with ``content_hash``: SHA-256 over the header, less the fields that
+change no answer, and every array. The hash is verified on load, and the header is checked against its
+schema and the arrays: a corrupted, truncated or edited table is refused. Schema version 2 (this one)
+hashes the header with the arrays; a version-1 table (arrays only) is refused with the remedy
+(``python benchmarks/rehash_tables.py TABLE.json`` after checking its header, or a rebuild). Every field:
+tables/README.md, "File format" (installed as ``designkit/shipped_tables/README.md``).
 """
 
 from __future__ import annotations

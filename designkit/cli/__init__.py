@@ -78,9 +78,9 @@ def _register_entry_point(argv: list[str]) -> bool:
         try:
             ep.load()
         except ImportError as exc:
-            _app._report_error("bad-input", f"`designkit {ep.name}` comes from {ep.value}, which cannot be imported "
-                               f"here ({exc}): reinstall the package that provides it", _app.EXIT_BAD_INPUT,
-                               _app._wants_json(argv))
+            _app.report_error("bad-input", f"`designkit {ep.name}` comes from {ep.value}, which cannot be imported "
+                              f"here ({exc}): reinstall the package that provides it", _app.EXIT_BAD_INPUT,
+                              _app.wants_json(argv))
             sys.exit(_app.EXIT_BAD_INPUT)
     return bool(eps)
 

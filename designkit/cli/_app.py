@@ -30,7 +30,7 @@ ISSUES_URL = "https://github.com/designkit-dev/designkit/issues"
 _DEBUG_KEY = "designkit.debug"
 
 
-def _wants_json(args: Any) -> bool:
+def wants_json(args: Any) -> bool:
     """Whether the command line asks for JSON (``--json``, ``--format json``, ``-f json``): errors then come
     as JSON on stdout too."""
     args = [str(a) for a in (args or ())]
@@ -48,7 +48,7 @@ def _command_line(ctx: Any, sub_args: list) -> list:
     return ([name] if name and name not in sub_args else []) + list(sub_args)
 
 
-def _report_error(kind: str, message: str, status: int, as_json: bool) -> None:
+def report_error(kind: str, message: str, status: int, as_json: bool) -> None:
     """Print one error: a line on stderr, and under --json also ``{"error": ...}`` on stdout."""
     typer.echo(f"Error: {message}", err=True)
     if as_json:
@@ -108,7 +108,7 @@ class _Group(TyperGroup):
             if ctx is not None:
                 hint = f" (see '{ctx.command_path} --help')"
             argv = kwargs.get("args") if kwargs.get("args") is not None else (args[0] if args else sys.argv[1:])
-            _report_error("usage", f"{exc.format_message()}{hint}", exc.exit_code, _wants_json(argv))
+            report_error("usage", f"{exc.format_message()}{hint}", exc.exit_code, wants_json(argv))
             sys.exit(exc.exit_code)
         except typer.Abort:
             typer.echo("Aborted.", err=True)
@@ -151,12 +151,12 @@ class _Group(TyperGroup):
             message = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
             if isinstance(exc, OSError) and exc.filename and str(exc.filename) not in message:
                 message = f"{message}: {exc.filename}"
-            _report_error("bad-input", message, EXIT_BAD_INPUT, _wants_json(sub_args))
+            report_error("bad-input", message, EXIT_BAD_INPUT, wants_json(sub_args))
             raise typer.Exit(EXIT_BAD_INPUT) from None
         except MemoryError:
-            _report_error("bad-input", "out of memory: the request is too large for this machine "
-                          "(ask for fewer trials, intervals or a shorter contact)", EXIT_BAD_INPUT,
-                          _wants_json(sub_args))
+            report_error("bad-input", "out of memory: the request is too large for this machine "
+                         "(ask for fewer trials, intervals or a shorter contact)", EXIT_BAD_INPUT,
+                         wants_json(sub_args))
             raise typer.Exit(EXIT_BAD_INPUT) from None
         except Exception as exc:  # a bug: say so in one line; the traceback only with --debug
             if ctx.meta.get(_DEBUG_KEY):
@@ -167,7 +167,7 @@ class _Group(TyperGroup):
             message = (f"internal error in designkit {__version__} ({where.rstrip(': ')}); this is a bug: "
                        f"please report it at {ISSUES_URL} with the output of 'designkit --debug "
                        f"{' '.join(str(a) for a in _command_line(ctx, sub_args))}'")
-            _report_error("internal", message, EXIT_BUG, _wants_json(sub_args))
+            report_error("internal", message, EXIT_BUG, wants_json(sub_args))
             raise typer.Exit(EXIT_BUG) from None
 
 

@@ -1,27 +1,17 @@
 """Two sensors at different temperatures: the heated sensor and a passive thermistor on the object side.
 
-One heated sensor sees an object through the temperature difference ``Ts0 - To``
-and its effusivity together: a cold block of wood draws heat from the sensor
-like a room-temperature metal block does (the shared recordings' cold wood is
-read as metal). A second sensor at *another* initial temperature separates the
-two causes (Bhattacharjee et al., cited by the paper): here the rig's passive
-thermistor, which rests at room temperature ``Tp0`` beside the heated one and
-touches the same object. Its reading,
+The heated sensor's reading ``T(t) = Ts0 + (To - Ts0) u(t; e_o)`` mixes the object's temperature with its
+effusivity (a cold block of wood reads as room-temperature metal); the rig's passive thermistor, at room
+temperature ``Tp0`` and touching the same object, reads
 
 .. math::
 
-    T_p(t) = T_{p0} + (T_o - T_{p0})\\, u_p(t; e_o),
+    T_p(t) = T_{p0} + (T_o - T_{p0})\, u_p(t; e_o),
 
-moves only when the object is *not* at room temperature, so it measures
-``To - Tp0`` directly, while the heated sensor's
-``T(t) = Ts0 + (To - Ts0) u(t; e_o)`` mixes it with the effusivity.
-
-Each channel is a reading of the same forward-model seam (the passive
-thermistor by default is the same kind of sensor, unheated), with its own
-noise draw; the **feature set** is the paper's features (raw samples and local
-slope, :func:`~designkit.recognition.features.feature_matrix`) of both channels
-side by side, and the classifier is the paper's (standardized in each fold,
-linear SVM).
+which moves only when the object is *not* at room temperature (Bhattacharjee et al., cited by the paper;
+docs/sensor-models.md, "Two sensors"). Each channel is a reading of the same forward-model seam with its
+own noise draw; the features are the paper's (:func:`~designkit.recognition.features.feature_matrix`) of
+both channels side by side, the classifier the paper's (standardized in each fold, linear SVM).
 
 Examples
 --------

@@ -6,7 +6,7 @@ temperature ``Tp0`` and touching the same object, reads
 
 .. math::
 
-    T_p(t) = T_{p0} + (T_o - T_{p0})\, u_p(t; e_o),
+    T_p(t) = T_{p0} + (T_o - T_{p0})\\, u_p(t; e_o),
 
 which moves only when the object is *not* at room temperature (Bhattacharjee et al., cited by the paper;
 docs/sensor-models.md, "Two sensors"). Each channel is a reading of the same forward-model seam with its

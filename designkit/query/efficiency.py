@@ -206,9 +206,6 @@ class CriticalNoiseGrid:
         self.values = np.full(n * n, np.nan)  # log(s* / dw) at node (i, j), flat i * n + j
         self.known = np.zeros(n * n, dtype=bool)
 
-    def _weight(self, e):
-        return object_weight(self.e_s, e)
-
     def _fill(self, nodes: np.ndarray) -> None:
         """Solve the nodes ``nodes`` (flat indices) exactly, in one vectorized call."""
         n = NOISE_GRID_NODES
@@ -216,7 +213,7 @@ class CriticalNoiseGrid:
         hi = lo + np.exp(self.v0 + self.dv * (nodes % n))
         star = critical_noise(self.sensor, lo, hi, width=self.width, threshold=self.threshold)
         with np.errstate(divide="ignore", invalid="ignore"):
-            self.values[nodes] = np.log(star) - np.log(self._weight(hi) - self._weight(lo))
+            self.values[nodes] = np.log(star) - np.log(object_weight(self.e_s, hi) - object_weight(self.e_s, lo))
         self.known[nodes] = True
 
     def __call__(self, lo, hi) -> np.ndarray:
@@ -226,18 +223,20 @@ class CriticalNoiseGrid:
             lo, hi = np.broadcast_arrays(lo, hi)
         shape, lo, hi = lo.shape, lo.ravel(), hi.ravel()
         n = NOISE_GRID_NODES
-        out = np.empty(lo.size)
-        out.fill(np.nan)
         with np.errstate(divide="ignore", invalid="ignore"):
             # the grid coordinates (u, v) of every pair, [2, pair]
             p = (np.log(np.array([lo + NOISE_GRID_A0, hi - lo])) - self._origin) / self._step
             inside = (lo >= 0) & (p[0] <= n - 1) & (p[1] >= 0) & (p[1] <= n - 1)
         i = inside.nonzero()[0]
+        every = 0 < i.size == lo.size  # (every pair inside: the arrays themselves, the answer itself)
+        if not every:
+            out = np.empty(lo.size)
+            out.fill(np.nan)
         if i.size:
-            if i.size < lo.size:  # (every pair inside: the arrays themselves)
-                p, lo_i, hi_i = p[:, i], lo[i], hi[i]
-            else:
+            if every:
                 i, lo_i, hi_i = slice(None), lo, hi
+            else:
+                p, lo_i, hi_i = p[:, i], lo[i], hi[i]
             s = np.minimum(np.maximum(np.floor(p).astype(np.int64) - 1, 0), n - 4)  # the first of 4 nodes a side
             flat = (s[0] * n + s[1])[:, None, None] + _NODES4  # the 4 x 4 nodes around each pair
             if np.count_nonzero(known := self.known[flat]) < known.size:
@@ -252,10 +251,13 @@ class CriticalNoiseGrid:
                 self._fill(nodes[~self.known[nodes]])
             lu, lv = _lagrange4(p - s)
             g = np.einsum("pi,pj,pij->p", lu, lv, self.values[flat])
-            w = self._weight(np.array([hi_i, lo_i]))
-            out[i] = np.exp(g) * (w[0] - w[1])
+            w = object_weight(self.e_s, np.array([hi_i, lo_i]))
+            if every:
+                out = np.exp(g) * (w[0] - w[1])
+            else:
+                out[i] = np.exp(g) * (w[0] - w[1])
         # (every pair inside the grid has finite lo and hi)
-        rest = (np.isnan(out) if isinstance(i, slice) else
+        rest = (np.isnan(out) if every else
                 np.isnan(out) & np.isfinite(lo) & np.isfinite(hi)).nonzero()[0]
         if rest.size:  # outside the grid (or next to a node that does not separate): the exact solve
             out[rest] = pair_critical_noise(self.sensor, lo[rest], hi[rest], width=self.width,
@@ -320,7 +322,7 @@ def _k_readings(op, slices, sw, ka, kb, lo, hi, extra=None, readings=None):
     ok = np.isfinite(d) & (d > width) & (sw.T[None, :, None, :] > 0) & ok_j[:, None, None, :]
     ok[:, :, 1] &= hi - (d[:, :, 1] - h) > 0  # downwards: the partner stays above 0
     # the entries in (contact, slice, direction, pair) order
-    Cc, M4, S4, P = np.unravel_index(ok.ravel().nonzero()[0], shape)
+    Cc, M4, S4, P = ok.nonzero()  # (C order: contact, slice, direction, pair)
     D, DL, DH = entries[:, ok]
     W = sw[P, M4]
     RS = view.t.axes["noise_ratio"][slices[P, M4]]
@@ -485,7 +487,7 @@ def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
     g = shape_norm(sensor, np.concatenate([v_ok * 1.05, v_ok / 1.05]))
     beta_g = np.log(g[:n] / g[n:]) / (2 * math.log(1.05))
     se_t = np.sqrt(var_k) / np.maximum(beta_g - slope_k, 0.05)
-    ends = value * np.exp(np.multiply.outer([-zc, zc], se_t))
+    ends = value * np.exp(np.array([[-zc], [zc]]) * se_t)
     k_at = np.exp(np.maximum(la_ + slope_k * lv[0], 0.0))
     out = np.where(ok, [value, ends[0], ends[1], k_at, se_t], np.nan)
     k_ab = np.where([have_a & ok, have_b & ok], np.exp(lk), np.nan)

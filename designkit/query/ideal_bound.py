@@ -56,8 +56,15 @@ def columns(*values, dtypes=None) -> list[np.ndarray]:
     out = [np.asarray(v, dtype=d) for v, d in zip(values, dtypes or (np.float64,) * len(values))]
     shapes = {a.shape for a in out if a.ndim}
     if len(shapes) == 1 and len(shape := shapes.pop()) == 1:  # one length: numbers given once repeated
-        return [a if a.ndim else np.full(shape, a) for a in out]
+        return [a if a.ndim else _repeated(shape, a) for a in out]
     return [np.atleast_1d(a) for a in np.broadcast_arrays(*out)]
+
+
+def _repeated(shape: tuple[int, ...], a: np.ndarray) -> np.ndarray:
+    """``np.full(shape, a)`` at the cost of ``np.empty`` (the 0-d array ``a``'s dtype)."""
+    out = np.empty(shape, dtype=a.dtype)
+    out.fill(a)
+    return out
 
 
 def _first_good_sample(ok, a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -140,6 +147,11 @@ def first_sample_at(cum: np.ndarray, ratio, s_star) -> np.ndarray:
     def ok(k):  # the decision itself, as written, at count k (clipped into the table)
         return ratio / np.sqrt(cum[np.minimum(np.maximum(k, 1), top)]) <= s_star
 
+    if ratio.size <= 64 and top >= 1:  # a few elements: the decision at every count in one pass (the count the
+        with np.errstate(divide="ignore", invalid="ignore"):  # search below finds), not a dozen small calls
+            good = ratio.reshape(-1, 1) / np.sqrt(cum[1:]) <= s_star.reshape(-1, 1)
+        first = good.argmax(axis=1)
+        return np.where(good[np.arange(first.size), first], first + 1.0, np.nan).reshape(ratio.shape)
     with np.errstate(divide="ignore", invalid="ignore"):
         need = np.where(s_star > 0, (ratio / s_star) ** 2, np.where(ratio > 0, np.inf, 0.0))
         need = np.where(np.isnan(s_star) | np.isnan(ratio), np.inf, need)

@@ -369,15 +369,16 @@ def _k_readings(op, slices, sw, ka, kb, lo, hi, extra=None, readings=None):
 def _k_line(lk, se, t_a, t_b, log_ab=None):
     """``log k`` at ``t_a`` and ``t_b`` (one held at the other's where it has no reading; two that fall pooled:
     k never falls with contact time, on svm-paper the slice medians rise at every step in every slice), the
-    weights and the readings' disagreement where they fell (``log_ab``: ``log(t_b / t_a)``, if computed)."""
+    weights and the readings' disagreement where they fell (``log_ab``: ``log(t_b / t_a)``, if computed; the
+    weights and the disagreement None where none fell: :func:`_k_var` reads them only where one did)."""
     have = np.isfinite(lk)  # [a / b, n]
     lab = np.where(have, lk, lk[::-1])
-    w = np.where(have, 1.0 / se ** 2, 0.0)
     rise = lab[1] - lab[0]
     falls = have[0] & have[1] & (rise * np.sign(np.log(t_b / t_a) if log_ab is None else log_ab) < 0)
     if not np.count_nonzero(falls):  # (none fell: nothing pooled)
-        return lab[0], lab[1], have[0], have[1], falls, w[0], w[1], np.zeros(rise.shape)
+        return lab[0], lab[1], have[0], have[1], falls, None, None, None
     # (la_, lb_ are finite or NaN: a reading is a weighted mean of finite log k)
+    w = np.where(have, 1.0 / se ** 2, 0.0)
     held = np.where(have, lab, 0.0) * w
     pooled = (held[0] + held[1]) / (w[0] + w[1])
     disagree = np.where(falls, np.abs(rise), 0.0)
@@ -386,14 +387,14 @@ def _k_line(lk, se, t_a, t_b, log_ab=None):
 
 
 def _k_var(u, se, la_, lb_, have_a, have_b, falls, wa, wb, disagree, far):
-    """Variance of ``log k`` at fraction ``u`` of the way from ``t_a`` to ``t_b`` (``far``: log distance to
-    the one reading where only one exists)."""
+    """Variance of ``log k`` at fraction ``u`` of the way from ``t_a`` to ``t_b`` (``far()``: the log distance
+    to the one reading where only one exists, computed where one does)."""
     dk = np.abs(lb_ - la_)
     w = 1 - u
     both = have_a & have_b
     v = (w * se[0]) ** 2 + (u * se[1]) ** 2 + (u * w * dk / 2) ** 2
     if np.count_nonzero(both) < both.size:  # (one reading only somewhere)
-        v = np.where(both, v, np.where(have_a, se[0], se[1]) ** 2 + (0.5 * far) ** 2)
+        v = np.where(both, v, np.where(have_a, se[0], se[1]) ** 2 + (0.5 * far()) ** 2)
     if np.count_nonzero(falls):
         v = np.where(falls, 1.0 / (wa + wb) + (disagree / 2) ** 2, v)
     return v
@@ -478,17 +479,17 @@ def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
             value[ok] = noise_k_contact(sensor, ratio[ok], s_pair[ok], t_a[ok], t_b[ok], la_[ok], lb_[ok],
                                         max_contact_s)
     ok &= np.isfinite(value)
-    # log(value / t_a), and the log distance to the one reading where only one exists
-    lv = np.log(value / np.array([t_a, np.where(have_a, t_a, t_b)]))
-    u = lv[0] / log_ab
-    var_k = _k_var(u, se, la_, lb_, have_a, have_b, falls, wa, wb, disagree, lv[1])
+    lv = np.log(value / t_a)
+    u = lv / log_ab
+    var_k = _k_var(u, se, la_, lb_, have_a, have_b, falls, wa, wb, disagree,
+                   lambda: np.log(value / np.where(have_a, t_a, t_b)))  # (the log distance to the one reading)
     slope_k = np.where(have_a & have_b & (t_a != t_b), (lb_ - la_) / log_ab, 0.0)
     v_ok = np.where(ok, value, 1.0)  # (shape_norm takes finite contact times only)
     g = shape_norm(sensor, np.concatenate([v_ok * 1.05, v_ok / 1.05]))
     beta_g = np.log(g[:n] / g[n:]) / (2 * math.log(1.05))
     se_t = np.sqrt(var_k) / np.maximum(beta_g - slope_k, 0.05)
     ends = value * np.exp(np.array([[-zc], [zc]]) * se_t)
-    k_at = np.exp(np.maximum(la_ + slope_k * lv[0], 0.0))
+    k_at = np.exp(np.maximum(la_ + slope_k * lv, 0.0))
     out = np.where(ok, [value, ends[0], ends[1], k_at, se_t], np.nan)
     k_ab = np.where([have_a & ok, have_b & ok], np.exp(lk), np.nan)
     return {"value": out[0], "low": out[1], "high": out[2], "k_a": k_ab[0], "k_b": k_ab[1], "t_a": t_a, "t_b": t_b,
@@ -524,7 +525,7 @@ def noise_k_max_ratio(op, contact_s, r_table, r_ideal, lo, hi, *, zc: float) -> 
     u = np.where(t_a != t_b, np.log(contact / t_a) / np.log(t_b / t_a), 1.0)
     log_k = np.maximum((1 - u) * la_ + u * lb_, 0.0)
     var_k = _k_var(u, se, la_, lb_, have_a, have_b, falls, wa, wb, disagree,
-                   np.log(contact / np.where(have_a, t_a, t_b)))
+                   lambda: np.log(contact / np.where(have_a, t_a, t_b)))
     sd = np.sqrt(var_k)
     ok = (have_a | have_b) & np.isfinite(r_ideal) & np.isfinite(sd)
     value = r_ideal * np.exp(-log_k)

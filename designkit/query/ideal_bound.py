@@ -319,7 +319,7 @@ def noise_k_contact(sensor, ratio, s_star, t_a, t_b, log_k_a, log_k_b, max_conta
     >>> float(noise_k_contact(s, 0.005, star, 1.0, 2.0, 0.4, 0.5, 10.0)) > t1
     True
     """
-    shapes = {np.shape(x) for x in (ratio, s_star, t_a, t_b, log_k_a, log_k_b)}
+    shapes = {x.shape if type(x) is np.ndarray else np.shape(x) for x in (ratio, s_star, t_a, t_b, log_k_a, log_k_b)}
     shape = shapes.pop() if len(shapes) == 1 else np.broadcast_shapes(*shapes)
     ratio, s_star, t_a, t_b, ka, kb = (c.ravel() for c in columns(ratio, s_star, t_a, t_b, log_k_a, log_k_b))
     fs = float(sensor.sample_rate_hz)
@@ -332,24 +332,26 @@ def noise_k_contact(sensor, ratio, s_star, t_a, t_b, log_k_a, log_k_b, max_conta
         log_k = np.maximum(ka[rows] + slope[rows] * (log_t[n] - log_ta[rows]), 0.0)
         return log_k + log_r[rows] - half_log_cum[n] <= log_s[rows]
 
-    out = np.empty(ratio.shape)
-    out.fill(np.nan)
+    def scan(steep):  # the decision at every count of the elements steep, in one pass: their first good count [s]
+        n = counts[1:n_max + 1]
+        good = (np.maximum(ka[steep, None] + slope[steep, None] * (log_t[None, 1:n_max + 1] - log_ta[steep, None]),
+                           0.0) + log_r[steep, None] - half_log_cum[None, 1:n_max + 1] <= log_s[steep, None])
+        first = good.argmax(axis=1)  # (0 where none is good)
+        return np.where(good[np.arange(first.size), first], n[first] / fs, np.nan)
+
     # The response shape g rises with time, so cum[n] <= n g(n)^2 and cum[n+1] / cum[n] >= (n+1) / n: the
     # noise falls at least like n^-1/2, and where log k rises no faster than 0.5 per unit of log t the
     # decision is monotone in n and a bisection finds its first sample. Steeper k (not seen on svm-paper,
     # whose k rises 0.29 per log t) is decided at every sample: (pairs x samples) arrays, 10x the time.
     # a few elements: the scan's one pass over 2,000 samples beats a bisection's dozen small calls (same answers)
-    if ratio.size <= 64:
-        steep, mono = slice(None), np.zeros(0, dtype=np.int64)
-    else:
-        scan = ~(slope <= 0.5)
-        steep, mono = np.nonzero(scan)[0], np.nonzero(~scan)[0]
-    if ratio[steep].size:
-        n = counts[1:n_max + 1]
-        good = (np.maximum(ka[steep, None] + slope[steep, None] * (log_t[None, 1:n_max + 1] - log_ta[steep, None]),
-                           0.0) + log_r[steep, None] - half_log_cum[None, 1:n_max + 1] <= log_s[steep, None])
-        first = good.argmax(axis=1)  # (0 where none is good)
-        out[steep] = np.where(good[np.arange(first.size), first], n[first] / fs, np.nan)
+    if 0 < ratio.size <= 64:
+        return scan(slice(None)).reshape(shape)
+    out = np.empty(ratio.shape)
+    out.fill(np.nan)
+    steep = ~(slope <= 0.5)
+    steep, mono = np.nonzero(steep)[0], np.nonzero(~steep)[0]
+    if steep.size:
+        out[steep] = scan(steep)
     if mono.size:
         top = ok(np.full(mono.size, max(n_max, 1)), mono)
         rows = mono[top]

@@ -304,14 +304,14 @@ def _entries(view, slices, ka, kb, lo, hi, readings=None):
     return np.stack(sides, axis=3), jj, jj == kk  # [need / lo / hi, contact, slice, direction, pair]
 
 
-@np.errstate(divide="ignore", invalid="ignore")  # (one context for the whole computation)
 def _k_readings(op, slices, sw, ka, kb, lo, hi, extra=None, readings=None):
     """The noise efficiency ``log k`` and its standard error at the tabulated contacts ``ka`` and ``kb`` (rows
     0 and 1 of the (2, n) arrays; NaN: no usable entry), per pair, from the pair's own entries (upwards at
     ``lo``, downwards at ``hi``) in the noise-ratio slices ``slices`` (n, m) weighted ``sw`` (n, m); see
     :func:`noise_k_min_contact`. The entries' critical noises are read off the table's
     :class:`CriticalNoiseGrid`; ``extra``: (lo, hi) of further pairs read in the same call, whose critical
-    noises are returned third (None: not asked)."""
+    noises are returned third (None: not asked). Called inside its callers' ``np.errstate(divide="ignore",
+    invalid="ignore")`` (one context for the whole computation)."""
     view, width = op.view, op.width
     z_table = table_z(op.tab)
     n = lo.size

@@ -93,6 +93,10 @@ class TableView:
             self._sensor_dict = self.t.sensor.to_dict()
         return dict(self._sensor_dict)
 
+    def model_dict(self) -> dict:
+        """The table's ``model.to_dict()``, computed once (each caller gets its own top-level dict)."""
+        return dict(self.memo(("model-dict",), self.t.model.to_dict))
+
     def scene_weights(self, noise_c: float, delta_t_c: float) -> tuple[list[tuple[tuple[int, ...], float]], dict[str, bool]]:
         """Multilinear weights over the scene axes; in-grid flags per axis (the caller's own dict). Kept per
         scene (a table's weights of a scene never change; a question reads them more than once)."""
@@ -158,12 +162,12 @@ class TableView:
         (NaN: none), in one interpolation (two gathers of the view's plain copy of the table, :meth:`_plain`)."""
         live = tuple(idx for idx, w in combos if w != 0)
 
-        def index():  # the flat index of every entry read at the first effusivity centre, each row read once
-            self._plain({k[0] for k in live})
+        def index():  # the flat index of every entry [group, name, slice, contact, 1] at the first effusivity
+            self._plain({k[0] for k in live})  # centre (each row read once), and the flat copy it indexes
             step = np.array(self._plain_rows.strides) // self._plain_rows.itemsize  # (C order: the last is 1)
             at = ((np.array([[self._names[n] for n in group] for group in names]) * step[0])[:, :, None, None, None]
                   + sum(np.array(k)[None, None, :, None, None] * st for k, st in zip(zip(*live), step[1:-2]))
-                  + (np.arange(self.contacts.size) * step[-2])[None, None, None, :, None])  # [group, name, slice, contact, 1]
+                  + (np.arange(self.contacts.size) * step[-2])[None, None, None, :, None])
             return at, self._plain_rows.reshape(-1)
         at, flat = self.memo(("read", names, live), index)
         return interp_e_by(lambda c: flat[at + c], self.centres, e[:, None, None, None, :])
@@ -183,14 +187,15 @@ class TableView:
     def readings(self, kinds, combos, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
         """What :meth:`need` of the sequence ``kinds`` is made of: ``delta_up`` at ``lo`` and ``delta_down`` at
         ``hi`` of each kind in each weighted scene slice, [direction (up, down), kind, slice, contact, n]."""
-        names = []
-        for k in kinds:
-            suffix = {"svm": "", "lo": "_lo", "hi": "_hi", "ideal": "_ideal"}[k]
-            if f"delta_up{suffix}" not in self.t.arrays:  # ideal tables carry only delta_up / delta_down
-                suffix = ""
-            names.append(suffix)
-        return self._read((tuple(f"delta_up{x}" for x in names), tuple(f"delta_down{x}" for x in names)), combos,
-                          np.array([lo, hi]))
+        def arrays():  # each kind's arrays, upwards and downwards
+            names = []
+            for k in kinds:
+                suffix = {"svm": "", "lo": "_lo", "hi": "_hi", "ideal": "_ideal"}[k]
+                if f"delta_up{suffix}" not in self.t.arrays:  # ideal tables carry only delta_up / delta_down
+                    suffix = ""
+                names.append(suffix)
+            return tuple(f"delta_up{x}" for x in names), tuple(f"delta_down{x}" for x in names)
+        return self._read(self.memo(("arrays", tuple(kinds)), arrays), combos, np.array([lo, hi]))
 
     def need(self, kind, combos, lo: np.ndarray, hi: np.ndarray, readings=None) -> np.ndarray:
         """Distance needed to separate ``lo < hi``, ``max(delta_up(lo), delta_down(hi))``, at every contact and

@@ -147,8 +147,10 @@ def first_sample_at(cum: np.ndarray, ratio, s_star) -> np.ndarray:
     def ok(k):  # the decision itself, as written, at count k (clipped into the table)
         return ratio / np.sqrt(cum[np.minimum(np.maximum(k, 1), top)]) <= s_star
 
-    if ratio.size <= 64 and top >= 1:  # a few elements: the decision at every count in one pass (the count the
-        with np.errstate(divide="ignore", invalid="ignore"):  # search below finds), not a dozen small calls
+    # a few elements: the decision at every count in one pass (its first count that holds, what the search below
+    # finds: the decision is monotone in the count), not a dozen calls on one-element arrays
+    if ratio.size <= 64 and top >= 1:
+        with np.errstate(divide="ignore", invalid="ignore"):
             good = ratio.reshape(-1, 1) / np.sqrt(cum[1:]) <= s_star.reshape(-1, 1)
         first = good.argmax(axis=1)
         return np.where(good[np.arange(first.size), first], first + 1.0, np.nan).reshape(ratio.shape)

@@ -233,10 +233,7 @@ class CriticalNoiseGrid:
             out = np.empty(lo.size)
             out.fill(np.nan)
         if i.size:
-            if every:
-                i, lo_i, hi_i = slice(None), lo, hi
-            else:
-                p, lo_i, hi_i = p[:, i], lo[i], hi[i]
+            i, p, lo_i, hi_i = (slice(None), p, lo, hi) if every else (i, p[:, i], lo[i], hi[i])
             s = np.minimum(np.maximum(np.floor(p).astype(np.int64) - 1, 0), n - 4)  # the first of 4 nodes a side
             flat = (s[0] * n + s[1])[:, None, None] + _NODES4  # the 4 x 4 nodes around each pair
             if np.count_nonzero(known := self.known[flat]) < known.size:
@@ -470,15 +467,9 @@ def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
     t_a, t_b = view.contacts[np.where(ka >= 0, ka, kb)], view.contacts[kb]
     log_ab = np.log(t_b / t_a)
     la_, lb_, have_a, have_b, falls, wa, wb, disagree = _k_line(lk, se, t_a, t_b, log_ab)
-    ok = have_a | have_b
-    if (n_ok := np.count_nonzero(ok)) == n:  # (every pair: the arrays themselves)
-        value = noise_k_contact(sensor, ratio, s_pair, t_a, t_b, la_, lb_, max_contact_s)
-    else:
-        value = np.full(n, np.nan)
-        if n_ok:
-            value[ok] = noise_k_contact(sensor, ratio[ok], s_pair[ok], t_a[ok], t_b[ok], la_[ok], lb_[ok],
-                                        max_contact_s)
-    ok &= np.isfinite(value)
+    # (NaN where neither contact has a reading: its log k is NaN, no count is decided good)
+    value = noise_k_contact(sensor, ratio, s_pair, t_a, t_b, la_, lb_, max_contact_s)
+    ok = (have_a | have_b) & np.isfinite(value)
     lv = np.log(value / t_a)
     u = lv / log_ab
     var_k = _k_var(u, se, la_, lb_, have_a, have_b, falls, wa, wb, disagree,

@@ -413,8 +413,7 @@ def first_applicable(estimators, rd, n: int) -> dict[str, np.ndarray]:
             continue
         if n_m == n:  # it answers every element (a single question's usual case): its arrays whole
             for k, v in (*((k, getattr(r, k)) for k in ("value", "low", "high")), *r.extra.items()):
-                out[k] = (v.astype(np.float64) if isinstance(v, np.ndarray) else
-                          np.array(v, dtype=np.float64) if np.ndim(v) else filled(n, v, np.float64))
+                out[k] = np.array(v, dtype=np.float64) if np.ndim(v) else filled(n, v, np.float64)
             out["kind"], out["stated"] = filled(n, r.kind, object), filled(n, r.stated, bool)
             return out
         if not out:

@@ -56,15 +56,8 @@ def columns(*values, dtypes=None) -> list[np.ndarray]:
     out = [np.asarray(v, dtype=d) for v, d in zip(values, dtypes or (np.float64,) * len(values))]
     shapes = {a.shape for a in out if a.ndim}
     if len(shapes) == 1 and len(shape := shapes.pop()) == 1:  # one length: numbers given once repeated
-        return [a if a.ndim else _repeated(shape, a) for a in out]
+        return [a if a.ndim else np.full(shape, a) for a in out]
     return [np.atleast_1d(a) for a in np.broadcast_arrays(*out)]
-
-
-def _repeated(shape: tuple[int, ...], a: np.ndarray) -> np.ndarray:
-    """``np.full(shape, a)`` at the cost of ``np.empty`` (the 0-d array ``a``'s dtype)."""
-    out = np.empty(shape, dtype=a.dtype)
-    out.fill(a)
-    return out
 
 
 def _first_good_sample(ok, a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -147,12 +140,9 @@ def first_sample_at(cum: np.ndarray, ratio, s_star) -> np.ndarray:
     def ok(k):  # the decision itself, as written, at count k (clipped into the table)
         return ratio / np.sqrt(cum[np.minimum(np.maximum(k, 1), top)]) <= s_star
 
-    # a few elements: the decision at every count in one pass (its first count that holds, what the search below
-    # finds: the decision is monotone in the count), not a dozen calls on one-element arrays
-    if ratio.size <= 64 and top >= 1:
+    if ratio.size <= 64 and top >= 1:  # a few: the (monotone) decision at every count in one pass, as found below
         with np.errstate(divide="ignore", invalid="ignore"):
-            good = ratio.reshape(-1, 1) / np.sqrt(cum[1:]) <= s_star.reshape(-1, 1)
-        first = good.argmax(axis=1)
+            first = (good := ratio.reshape(-1, 1) / np.sqrt(cum[1:]) <= s_star.reshape(-1, 1)).argmax(axis=1)
         return np.where(good[np.arange(first.size), first], first + 1.0, np.nan).reshape(ratio.shape)
     with np.errstate(divide="ignore", invalid="ignore"):
         need = np.where(s_star > 0, (ratio / s_star) ** 2, np.where(ratio > 0, np.inf, 0.0))
@@ -334,26 +324,24 @@ def noise_k_contact(sensor, ratio, s_star, t_a, t_b, log_k_a, log_k_b, max_conta
         log_k = np.maximum(ka[rows] + slope[rows] * (log_t[n] - log_ta[rows]), 0.0)
         return log_k + log_r[rows] - half_log_cum[n] <= log_s[rows]
 
-    def scan(steep):  # the decision at every count of the elements steep, in one pass: their first good count [s]
-        n = counts[1:n_max + 1]
-        good = (np.maximum(ka[steep, None] + slope[steep, None] * (log_t[None, 1:n_max + 1] - log_ta[steep, None]),
-                           0.0) + log_r[steep, None] - half_log_cum[None, 1:n_max + 1] <= log_s[steep, None])
-        first = good.argmax(axis=1)  # (0 where none is good)
-        return np.where(good[np.arange(first.size), first], n[first] / fs, np.nan)
-
+    out = np.empty(ratio.shape)
+    out.fill(np.nan)
     # The response shape g rises with time, so cum[n] <= n g(n)^2 and cum[n+1] / cum[n] >= (n+1) / n: the
     # noise falls at least like n^-1/2, and where log k rises no faster than 0.5 per unit of log t the
     # decision is monotone in n and a bisection finds its first sample. Steeper k (not seen on svm-paper,
     # whose k rises 0.29 per log t) is decided at every sample: (pairs x samples) arrays, 10x the time.
     # a few elements: the scan's one pass over 2,000 samples beats a bisection's dozen small calls (same answers)
-    if 0 < ratio.size <= 64:
-        return scan(slice(None)).reshape(shape)
-    out = np.empty(ratio.shape)
-    out.fill(np.nan)
-    steep = ~(slope <= 0.5)
-    steep, mono = np.nonzero(steep)[0], np.nonzero(~steep)[0]
-    if steep.size:
-        out[steep] = scan(steep)
+    if ratio.size <= 64:
+        steep, mono = slice(None), np.zeros(0, dtype=np.int64)
+    else:
+        scan = ~(slope <= 0.5)
+        steep, mono = np.nonzero(scan)[0], np.nonzero(~scan)[0]
+    if ratio[steep].size:
+        n = counts[1:n_max + 1]
+        good = (np.maximum(ka[steep, None] + slope[steep, None] * (log_t[None, 1:n_max + 1] - log_ta[steep, None]),
+                           0.0) + log_r[steep, None] - half_log_cum[None, 1:n_max + 1] <= log_s[steep, None])
+        first = good.argmax(axis=1)  # (0 where none is good)
+        out[steep] = np.where(good[np.arange(first.size), first], n[first] / fs, np.nan)
     if mono.size:
         top = ok(np.full(mono.size, max(n_max, 1)), mono)
         rows = mono[top]

@@ -93,10 +93,6 @@ class TableView:
             self._sensor_dict = self.t.sensor.to_dict()
         return dict(self._sensor_dict)
 
-    def model_dict(self) -> dict:
-        """The table's ``model.to_dict()``, computed once (each caller gets its own top-level dict)."""
-        return dict(self.memo(("model-dict",), self.t.model.to_dict))
-
     def scene_weights(self, noise_c: float, delta_t_c: float) -> tuple[list[tuple[tuple[int, ...], float]], dict[str, bool]]:
         """Multilinear weights over the scene axes; in-grid flags per axis (the caller's own dict). Kept per
         scene (a table's weights of a scene never change; a question reads them more than once)."""
@@ -187,14 +183,10 @@ class TableView:
     def readings(self, kinds, combos, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
         """What :meth:`need` of the sequence ``kinds`` is made of: ``delta_up`` at ``lo`` and ``delta_down`` at
         ``hi`` of each kind in each weighted scene slice, [direction (up, down), kind, slice, contact, n]."""
-        def arrays():  # each kind's arrays, upwards and downwards
-            names = []
-            for k in kinds:
-                suffix = {"svm": "", "lo": "_lo", "hi": "_hi", "ideal": "_ideal"}[k]
-                if f"delta_up{suffix}" not in self.t.arrays:  # ideal tables carry only delta_up / delta_down
-                    suffix = ""
-                names.append(suffix)
-            return tuple(f"delta_up{x}" for x in names), tuple(f"delta_down{x}" for x in names)
+        def arrays():  # each kind's arrays, upwards and downwards (ideal tables carry only delta_up / delta_down)
+            x = [s if f"delta_up{s}" in self.t.arrays else "" for s in (
+                {"svm": "", "lo": "_lo", "hi": "_hi", "ideal": "_ideal"}[k] for k in kinds)]
+            return tuple(f"delta_up{s}" for s in x), tuple(f"delta_down{s}" for s in x)
         return self._read(self.memo(("arrays", tuple(kinds)), arrays), combos, np.array([lo, hi]))
 
     def need(self, kind, combos, lo: np.ndarray, hi: np.ndarray, readings=None) -> np.ndarray:

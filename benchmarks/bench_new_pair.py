@@ -3,7 +3,8 @@
 Run from the repository root (one command; the figures are CPU seconds of each child process, the machine's
 load is printed beside them)::
 
-    python benchmarks/bench_new_pair.py                  # against e9a377f (before the critical-noise grid)
+    python benchmarks/bench_new_pair.py                  # against 624300e (stop 45's main)
+    python benchmarks/bench_new_pair.py --breakdown      # also where a single pair's time goes, per piece
     python benchmarks/bench_new_pair.py --rev HEAD~3 --pairs 60 --runs 3
 
 1. **A single new pair in-process** (target at most 1 ms): ``min_contact(e1, e2)`` on the default table, each
@@ -26,6 +27,9 @@ load is printed beside them)::
    a new pair calls (``sys.setprofile``: calls from outside numpy into numpy's Python functions, its C functions
    and ndarray / ufunc methods; operators such as ``a + b`` are not calls and not counted), and the Python
    function calls; a single pair's cost is mostly numpy's per-call overhead on one-element arrays.
+7. **Where a single new pair's time goes** (warm grid, ``--breakdown``): each piece of the table route's path
+   wrapped with a timer (its own cost about 0.3 us a call), the median over 600 new pairs of each piece's
+   inclusive wall time per answer, per tree (pieces a tree does not have are blank).
 
 The baseline is ``git archive`` of ``--rev`` into a temporary folder, imported through ``PYTHONPATH``
 (the tables are read from each tree's own ``tables/``).
@@ -142,6 +146,85 @@ sys.setprofile(None)
 print(json.dumps({k: v / len(pairs) for k, v in n.items()}))
 """
 
+BREAKDOWN = r"""
+import functools, importlib, json, statistics, sys, time
+import numpy as np
+from designkit.query import min_contact, table
+min_contact(35000.0, 20000.0)
+rng = np.random.default_rng(100)
+w = rng.uniform(2000.0, 39000.0, size=(10000, 2))
+min_contact(w[:, 0], w[:, 1])
+pairs = [p for p in rng.uniform(2000.0, 39000.0, size=(1200, 2)).tolist() if abs(p[0] - p[1]) >= 500.0][:900]
+for a, b in pairs[:300]:  # (the grid's nodes these pairs read, solved first)
+    min_contact(a, b)
+acc = {}
+
+def wrap(spec):
+    mod, attr = spec.rsplit(".", 1)
+    owner, parts = importlib.import_module("designkit.query." + mod), attr.split(":")
+    for p in parts[:-1]:
+        owner = getattr(owner, p)
+    f = getattr(owner, parts[-1], None)
+    if f is None:
+        return
+
+    @functools.wraps(f)
+    def timed(*a, **k):
+        t0 = time.perf_counter()
+        try:
+            return f(*a, **k)
+        finally:
+            acc[spec] = acc.get(spec, 0.0) + time.perf_counter() - t0
+    setattr(owner, parts[-1], timed)
+    for m in list(sys.modules.values()):  # (the modules that imported the function by name)
+        if getattr(m, "__name__", "").startswith("designkit.") and len(parts) == 1 and getattr(m, parts[-1], None) is f:
+            setattr(m, parts[-1], timed)
+
+for spec in sys.argv[1:]:
+    wrap(spec)
+table.EACH["min-contact"] = table.min_contact_each
+per, total = [], []
+for a, b in pairs[300:]:
+    acc.clear()
+    t0 = time.perf_counter()
+    min_contact(a, b)
+    total.append(time.perf_counter() - t0)
+    per.append(dict(acc))
+print(json.dumps({"total": statistics.median(total), **{k: statistics.median(r.get(k, 0.0) for r in per)
+                                                        for k in sys.argv[1:]}}))
+"""
+
+#: The pieces of a single pair's path the breakdown times, outermost first (module.function; a method as
+#: ``module.Class:method``), each with how it nests.
+PIECES = (("questions._resolve", "route and scene (choose_route)"),
+          ("table.min_contact_each", "the table route (below)"),
+          ("table.open_table", "  open and check the table"),
+          ("table._pairs", "  the pair's objects (materials rule)"),
+          ("table_arrays.contact_arrays", "  the arrays (below)"),
+          ("table_arrays.TableView:readings", "    read the needs (4 kinds, 2 directions)"),
+          ("table_arrays.TableView:need", "    weigh the scene slices"),
+          ("estimates.grid_crossing", "    the grid crossings"),
+          ("efficiency.noise_k_min_contact", "    the noise efficiency (below)"),
+          ("efficiency._k_readings", "      log k from the entries (below)"),
+          ("table_arrays.TableView:critical_noise", "        the critical-noise grid (2 reads an entry, and the pair)"),
+          ("ideal_bound.noise_k_contact", "      the first sample k s reaches s*"),
+          ("ideal_bound.contact_at_noise", "    the ideal bound's first sample"),
+          ("estimates.first_applicable", "    the estimators"),
+          ("table._contact_answer", "  the Answer"),
+          ("questions._finished", "route reason"))
+
+
+def breakdown(trees: dict[str, Path]) -> None:
+    """Print the median inclusive wall time [us] per answer of each piece of :data:`PIECES`, per tree."""
+    got = {name: _child(tree, BREAKDOWN, *(p for p, _ in PIECES)) for name, tree in trees.items()}
+    names = list(trees)
+    print(f"| piece (inclusive, median us per answer) | {' | '.join(names)} |")
+    print("|---|" + "---|" * len(names))
+    for spec, label in (("total", "min_contact(e1, e2), wrapped"), *PIECES):
+        cells = [f"{1e6 * got[n][spec]:.0f}" if got[n].get(spec) else "" for n in names]
+        print(f"| {label} (`{spec}`) | " + " | ".join(cells) + " |")
+    print()
+
 
 def answers_changed(trees: dict[str, Path], n: int) -> None:
     """Count the answers of ``n`` seeded random pairs that differ between the trees, and whether each lies
@@ -187,11 +270,12 @@ def matrix_wall(tree: Path) -> float:
 
 def main(argv=None) -> None:
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--rev", default="e9a377f", help="baseline revision (git archive)")
+    p.add_argument("--rev", default="624300e", help="baseline revision (git archive)")
     p.add_argument("--array", type=int, default=10000, help="new pairs in the array call")
     p.add_argument("--pairs", type=int, default=40, help="new pairs per process")
     p.add_argument("--runs", type=int, default=3, help="runs of each measurement per tree")
     p.add_argument("--answers", type=int, default=3000, help="random pairs whose answers are compared (0: none)")
+    p.add_argument("--breakdown", action="store_true", help="also time each piece of a single pair's path")
     a = p.parse_args(argv)
     loads = [os.getloadavg()[0]]
     with tempfile.TemporaryDirectory(prefix="dk-bench-") as tmp:
@@ -226,6 +310,8 @@ def main(argv=None) -> None:
         calls = {name: _child(tree, CALLS, 300) for name, tree in trees.items()}
         print(" | ".join(f"{name}: {c['numpy']:.0f} numpy calls, {c['python']:.0f} Python calls per single new pair"
                          for name, c in calls.items()) + "\n")
+        if a.breakdown:
+            breakdown(trees)
         if a.answers:
             answers_changed(trees, a.answers)
 

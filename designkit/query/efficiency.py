@@ -206,9 +206,6 @@ class CriticalNoiseGrid:
         self.values = np.full(n * n, np.nan)  # log(s* / dw) at node (i, j), flat i * n + j
         self.known = np.zeros(n * n, dtype=bool)
 
-    def _weight(self, e):
-        return object_weight(self.e_s, e)
-
     def _fill(self, nodes: np.ndarray) -> None:
         """Solve the nodes ``nodes`` (flat indices) exactly, in one vectorized call."""
         n = NOISE_GRID_NODES
@@ -216,7 +213,7 @@ class CriticalNoiseGrid:
         hi = lo + np.exp(self.v0 + self.dv * (nodes % n))
         star = critical_noise(self.sensor, lo, hi, width=self.width, threshold=self.threshold)
         with np.errstate(divide="ignore", invalid="ignore"):
-            self.values[nodes] = np.log(star) - np.log(self._weight(hi) - self._weight(lo))
+            self.values[nodes] = np.log(star) - np.log(object_weight(self.e_s, hi) - object_weight(self.e_s, lo))
         self.known[nodes] = True
 
     def __call__(self, lo, hi) -> np.ndarray:
@@ -226,18 +223,17 @@ class CriticalNoiseGrid:
             lo, hi = np.broadcast_arrays(lo, hi)
         shape, lo, hi = lo.shape, lo.ravel(), hi.ravel()
         n = NOISE_GRID_NODES
-        out = np.empty(lo.size)
-        out.fill(np.nan)
         with np.errstate(divide="ignore", invalid="ignore"):
             # the grid coordinates (u, v) of every pair, [2, pair]
             p = (np.log(np.array([lo + NOISE_GRID_A0, hi - lo])) - self._origin) / self._step
             inside = (lo >= 0) & (p[0] <= n - 1) & (p[1] >= 0) & (p[1] <= n - 1)
         i = inside.nonzero()[0]
+        every = 0 < i.size == lo.size  # (every pair inside: the arrays themselves, the answer itself)
+        if not every:
+            out = np.empty(lo.size)
+            out.fill(np.nan)
         if i.size:
-            if i.size < lo.size:  # (every pair inside: the arrays themselves)
-                p, lo_i, hi_i = p[:, i], lo[i], hi[i]
-            else:
-                i, lo_i, hi_i = slice(None), lo, hi
+            i, p, lo_i, hi_i = (slice(None), p, lo, hi) if every else (i, p[:, i], lo[i], hi[i])
             s = np.minimum(np.maximum(np.floor(p).astype(np.int64) - 1, 0), n - 4)  # the first of 4 nodes a side
             flat = (s[0] * n + s[1])[:, None, None] + _NODES4  # the 4 x 4 nodes around each pair
             if np.count_nonzero(known := self.known[flat]) < known.size:
@@ -252,10 +248,13 @@ class CriticalNoiseGrid:
                 self._fill(nodes[~self.known[nodes]])
             lu, lv = _lagrange4(p - s)
             g = np.einsum("pi,pj,pij->p", lu, lv, self.values[flat])
-            w = self._weight(np.array([hi_i, lo_i]))
-            out[i] = np.exp(g) * (w[0] - w[1])
+            w = object_weight(self.e_s, np.array([hi_i, lo_i]))
+            if every:
+                out = np.exp(g) * (w[0] - w[1])
+            else:
+                out[i] = np.exp(g) * (w[0] - w[1])
         # (every pair inside the grid has finite lo and hi)
-        rest = (np.isnan(out) if isinstance(i, slice) else
+        rest = (np.isnan(out) if every else
                 np.isnan(out) & np.isfinite(lo) & np.isfinite(hi)).nonzero()[0]
         if rest.size:  # outside the grid (or next to a node that does not separate): the exact solve
             out[rest] = pair_critical_noise(self.sensor, lo[rest], hi[rest], width=self.width,
@@ -302,14 +301,14 @@ def _entries(view, slices, ka, kb, lo, hi, readings=None):
     return np.stack(sides, axis=3), jj, jj == kk  # [need / lo / hi, contact, slice, direction, pair]
 
 
-@np.errstate(divide="ignore", invalid="ignore")  # (one context for the whole computation)
 def _k_readings(op, slices, sw, ka, kb, lo, hi, extra=None, readings=None):
     """The noise efficiency ``log k`` and its standard error at the tabulated contacts ``ka`` and ``kb`` (rows
     0 and 1 of the (2, n) arrays; NaN: no usable entry), per pair, from the pair's own entries (upwards at
     ``lo``, downwards at ``hi``) in the noise-ratio slices ``slices`` (n, m) weighted ``sw`` (n, m); see
     :func:`noise_k_min_contact`. The entries' critical noises are read off the table's
     :class:`CriticalNoiseGrid`; ``extra``: (lo, hi) of further pairs read in the same call, whose critical
-    noises are returned third (None: not asked)."""
+    noises are returned third (None: not asked). Called inside its callers' ``np.errstate(divide="ignore",
+    invalid="ignore")`` (one context for the whole computation)."""
     view, width = op.view, op.width
     z_table = table_z(op.tab)
     n = lo.size
@@ -320,7 +319,7 @@ def _k_readings(op, slices, sw, ka, kb, lo, hi, extra=None, readings=None):
     ok = np.isfinite(d) & (d > width) & (sw.T[None, :, None, :] > 0) & ok_j[:, None, None, :]
     ok[:, :, 1] &= hi - (d[:, :, 1] - h) > 0  # downwards: the partner stays above 0
     # the entries in (contact, slice, direction, pair) order
-    Cc, M4, S4, P = np.unravel_index(ok.ravel().nonzero()[0], shape)
+    Cc, M4, S4, P = ok.nonzero()  # (C order: contact, slice, direction, pair)
     D, DL, DH = entries[:, ok]
     W = sw[P, M4]
     RS = view.t.axes["noise_ratio"][slices[P, M4]]
@@ -367,15 +366,16 @@ def _k_readings(op, slices, sw, ka, kb, lo, hi, extra=None, readings=None):
 def _k_line(lk, se, t_a, t_b, log_ab=None):
     """``log k`` at ``t_a`` and ``t_b`` (one held at the other's where it has no reading; two that fall pooled:
     k never falls with contact time, on svm-paper the slice medians rise at every step in every slice), the
-    weights and the readings' disagreement where they fell (``log_ab``: ``log(t_b / t_a)``, if computed)."""
+    weights and the readings' disagreement where they fell (``log_ab``: ``log(t_b / t_a)``, if computed; the
+    weights and the disagreement None where none fell: :func:`_k_var` reads them only where one did)."""
     have = np.isfinite(lk)  # [a / b, n]
     lab = np.where(have, lk, lk[::-1])
-    w = np.where(have, 1.0 / se ** 2, 0.0)
     rise = lab[1] - lab[0]
     falls = have[0] & have[1] & (rise * np.sign(np.log(t_b / t_a) if log_ab is None else log_ab) < 0)
     if not np.count_nonzero(falls):  # (none fell: nothing pooled)
-        return lab[0], lab[1], have[0], have[1], falls, w[0], w[1], np.zeros(rise.shape)
+        return lab[0], lab[1], have[0], have[1], falls, None, None, None
     # (la_, lb_ are finite or NaN: a reading is a weighted mean of finite log k)
+    w = np.where(have, 1.0 / se ** 2, 0.0)
     held = np.where(have, lab, 0.0) * w
     pooled = (held[0] + held[1]) / (w[0] + w[1])
     disagree = np.where(falls, np.abs(rise), 0.0)
@@ -384,14 +384,14 @@ def _k_line(lk, se, t_a, t_b, log_ab=None):
 
 
 def _k_var(u, se, la_, lb_, have_a, have_b, falls, wa, wb, disagree, far):
-    """Variance of ``log k`` at fraction ``u`` of the way from ``t_a`` to ``t_b`` (``far``: log distance to
-    the one reading where only one exists)."""
+    """Variance of ``log k`` at fraction ``u`` of the way from ``t_a`` to ``t_b`` (``far()``: the log distance
+    to the one reading where only one exists, computed where one does)."""
     dk = np.abs(lb_ - la_)
     w = 1 - u
     both = have_a & have_b
     v = (w * se[0]) ** 2 + (u * se[1]) ** 2 + (u * w * dk / 2) ** 2
     if np.count_nonzero(both) < both.size:  # (one reading only somewhere)
-        v = np.where(both, v, np.where(have_a, se[0], se[1]) ** 2 + (0.5 * far) ** 2)
+        v = np.where(both, v, np.where(have_a, se[0], se[1]) ** 2 + (0.5 * far()) ** 2)
     if np.count_nonzero(falls):
         v = np.where(falls, 1.0 / (wa + wb) + (disagree / 2) ** 2, v)
     return v
@@ -467,26 +467,20 @@ def noise_k_min_contact(op, combos, k_cross, lo, hi, ratio, *, zc: float,
     t_a, t_b = view.contacts[np.where(ka >= 0, ka, kb)], view.contacts[kb]
     log_ab = np.log(t_b / t_a)
     la_, lb_, have_a, have_b, falls, wa, wb, disagree = _k_line(lk, se, t_a, t_b, log_ab)
-    ok = have_a | have_b
-    if (n_ok := np.count_nonzero(ok)) == n:  # (every pair: the arrays themselves)
-        value = noise_k_contact(sensor, ratio, s_pair, t_a, t_b, la_, lb_, max_contact_s)
-    else:
-        value = np.full(n, np.nan)
-        if n_ok:
-            value[ok] = noise_k_contact(sensor, ratio[ok], s_pair[ok], t_a[ok], t_b[ok], la_[ok], lb_[ok],
-                                        max_contact_s)
-    ok &= np.isfinite(value)
-    # log(value / t_a), and the log distance to the one reading where only one exists
-    lv = np.log(value / np.array([t_a, np.where(have_a, t_a, t_b)]))
-    u = lv[0] / log_ab
-    var_k = _k_var(u, se, la_, lb_, have_a, have_b, falls, wa, wb, disagree, lv[1])
+    # (NaN where neither contact has a reading: its log k is NaN, no count is decided good)
+    value = noise_k_contact(sensor, ratio, s_pair, t_a, t_b, la_, lb_, max_contact_s)
+    ok = (have_a | have_b) & np.isfinite(value)
+    lv = np.log(value / t_a)
+    u = lv / log_ab
+    var_k = _k_var(u, se, la_, lb_, have_a, have_b, falls, wa, wb, disagree,
+                   lambda: np.log(value / np.where(have_a, t_a, t_b)))  # (the log distance to the one reading)
     slope_k = np.where(have_a & have_b & (t_a != t_b), (lb_ - la_) / log_ab, 0.0)
     v_ok = np.where(ok, value, 1.0)  # (shape_norm takes finite contact times only)
     g = shape_norm(sensor, np.concatenate([v_ok * 1.05, v_ok / 1.05]))
     beta_g = np.log(g[:n] / g[n:]) / (2 * math.log(1.05))
     se_t = np.sqrt(var_k) / np.maximum(beta_g - slope_k, 0.05)
-    ends = value * np.exp(np.multiply.outer([-zc, zc], se_t))
-    k_at = np.exp(np.maximum(la_ + slope_k * lv[0], 0.0))
+    ends = value * np.exp(np.array([[-zc], [zc]]) * se_t)
+    k_at = np.exp(np.maximum(la_ + slope_k * lv, 0.0))
     out = np.where(ok, [value, ends[0], ends[1], k_at, se_t], np.nan)
     k_ab = np.where([have_a & ok, have_b & ok], np.exp(lk), np.nan)
     return {"value": out[0], "low": out[1], "high": out[2], "k_a": k_ab[0], "k_b": k_ab[1], "t_a": t_a, "t_b": t_b,
@@ -522,7 +516,7 @@ def noise_k_max_ratio(op, contact_s, r_table, r_ideal, lo, hi, *, zc: float) -> 
     u = np.where(t_a != t_b, np.log(contact / t_a) / np.log(t_b / t_a), 1.0)
     log_k = np.maximum((1 - u) * la_ + u * lb_, 0.0)
     var_k = _k_var(u, se, la_, lb_, have_a, have_b, falls, wa, wb, disagree,
-                   np.log(contact / np.where(have_a, t_a, t_b)))
+                   lambda: np.log(contact / np.where(have_a, t_a, t_b)))
     sd = np.sqrt(var_k)
     ok = (have_a | have_b) & np.isfinite(r_ideal) & np.isfinite(sd)
     value = r_ideal * np.exp(-log_k)

@@ -401,14 +401,14 @@ def first_applicable(estimators, rd, n: int) -> dict[str, np.ndarray]:
     """Per element, the answer of the first estimator (in order) that applies to it (``kind`` "none" where none
     does)."""
     out: dict[str, np.ndarray] = {}
-    taken = np.zeros(n, dtype=bool)
+    taken, n_taken = None, 0  # (the elements answered, None: none yet; and how many)
     for estimator in estimators:
-        if np.count_nonzero(taken) == n:  # (the later ones would answer nothing; count_nonzero: ndarray.all's
-            break                         # result at a tenth of its cost on a single question's arrays)
+        if n_taken == n:  # (the later ones would answer nothing)
+            break
         r = estimator(rd)
         if r is None:
             continue
-        m = r.applies & ~taken
+        m = r.applies if taken is None else r.applies & ~taken
         if not (n_m := np.count_nonzero(m)):
             continue
         if n_m == n:  # it answers every element (a single question's usual case): its arrays whole
@@ -423,7 +423,7 @@ def first_applicable(estimators, rd, n: int) -> dict[str, np.ndarray]:
         out["kind"][m], out["stated"][m] = r.kind, r.stated
         for k, v in r.extra.items():
             out.setdefault(k, nans(n))[m] = _at(v, m)
-        taken |= m
+        taken, n_taken = (m if taken is None else taken | m), n_taken + n_m
     return out or _unanswered(n)
 
 
@@ -497,7 +497,7 @@ def efficiency_estimate(rd: ContactReading) -> Estimates | None:
         return None
     with np.errstate(invalid="ignore"):
         low = np.where(np.isnan(rd.ideal), eff["low"], np.minimum(np.maximum(eff["low"], rd.ideal), eff["value"]))
-    return Estimates(~np.isnan(rd.raw) & ~np.isnan(eff["value"]), eff["value"], low, eff["high"],
+    return Estimates(~(np.isnan(rd.raw) | np.isnan(eff["value"])), eff["value"], low, eff["high"],
                      "table-efficiency", True, {f"eff_{k}": eff[k] for k in ("k", "se_log", "k_a", "k_b", "t_a", "t_b")})
 
 

@@ -140,6 +140,10 @@ def first_sample_at(cum: np.ndarray, ratio, s_star) -> np.ndarray:
     def ok(k):  # the decision itself, as written, at count k (clipped into the table)
         return ratio / np.sqrt(cum[np.minimum(np.maximum(k, 1), top)]) <= s_star
 
+    if ratio.size <= 64 and top >= 1:  # a few: the (monotone) decision at every count in one pass, as found below
+        with np.errstate(divide="ignore", invalid="ignore"):
+            first = (good := ratio.reshape(-1, 1) / np.sqrt(cum[1:]) <= s_star.reshape(-1, 1)).argmax(axis=1)
+        return np.where(good[np.arange(first.size), first], first + 1.0, np.nan).reshape(ratio.shape)
     with np.errstate(divide="ignore", invalid="ignore"):
         need = np.where(s_star > 0, (ratio / s_star) ** 2, np.where(ratio > 0, np.inf, 0.0))
         need = np.where(np.isnan(s_star) | np.isnan(ratio), np.inf, need)
@@ -307,7 +311,7 @@ def noise_k_contact(sensor, ratio, s_star, t_a, t_b, log_k_a, log_k_b, max_conta
     >>> float(noise_k_contact(s, 0.005, star, 1.0, 2.0, 0.4, 0.5, 10.0)) > t1
     True
     """
-    shapes = {np.shape(x) for x in (ratio, s_star, t_a, t_b, log_k_a, log_k_b)}
+    shapes = {x.shape if type(x) is np.ndarray else np.shape(x) for x in (ratio, s_star, t_a, t_b, log_k_a, log_k_b)}
     shape = shapes.pop() if len(shapes) == 1 else np.broadcast_shapes(*shapes)
     ratio, s_star, t_a, t_b, ka, kb = (c.ravel() for c in columns(ratio, s_star, t_a, t_b, log_k_a, log_k_b))
     fs = float(sensor.sample_rate_hz)

@@ -158,13 +158,15 @@ class TableView:
         (NaN: none), in one interpolation (two gathers of the view's plain copy of the table, :meth:`_plain`)."""
         live = tuple(idx for idx, w in combos if w != 0)
 
-        def index():  # the gathers' index arrays but the effusivity's, each row read once
-            self._plain({k[0] for k in live})
-            return ((np.array([[self._names[n] for n in group] for group in names])[:, :, None, None, None],)
-                    + tuple(np.array(k)[None, None, :, None, None] for k in zip(*live))  # each [1, 1, slice, 1, 1]
-                    + (np.arange(self.contacts.size)[None, None, None, :, None],))
-        at, rows = self.memo(("read", names, live), index), self._plain_rows
-        return interp_e_by(lambda c: rows[at + (c,)], self.centres, e[:, None, None, None, :])
+        def index():  # the flat index of every entry [group, name, slice, contact, 1] at the first effusivity
+            self._plain({k[0] for k in live})  # centre (each row read once), and the flat copy it indexes
+            step = np.array(self._plain_rows.strides) // self._plain_rows.itemsize  # (C order: the last is 1)
+            at = ((np.array([[self._names[n] for n in group] for group in names]) * step[0])[:, :, None, None, None]
+                  + sum(np.array(k)[None, None, :, None, None] * st for k, st in zip(zip(*live), step[1:-2]))
+                  + (np.arange(self.contacts.size) * step[-2])[None, None, None, :, None])
+            return at, self._plain_rows.reshape(-1)
+        at, flat = self.memo(("read", names, live), index)
+        return interp_e_by(lambda c: flat[at + c], self.centres, e[:, None, None, None, :])
 
     def _plain(self, first: set[int]) -> None:
         """Read the scene rows ``first`` (on the first scene axis) of every ``delta_*`` array into the view's plain
@@ -181,14 +183,11 @@ class TableView:
     def readings(self, kinds, combos, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
         """What :meth:`need` of the sequence ``kinds`` is made of: ``delta_up`` at ``lo`` and ``delta_down`` at
         ``hi`` of each kind in each weighted scene slice, [direction (up, down), kind, slice, contact, n]."""
-        names = []
-        for k in kinds:
-            suffix = {"svm": "", "lo": "_lo", "hi": "_hi", "ideal": "_ideal"}[k]
-            if f"delta_up{suffix}" not in self.t.arrays:  # ideal tables carry only delta_up / delta_down
-                suffix = ""
-            names.append(suffix)
-        return self._read((tuple(f"delta_up{x}" for x in names), tuple(f"delta_down{x}" for x in names)), combos,
-                          np.array([lo, hi]))
+        def arrays():  # each kind's arrays, upwards and downwards (ideal tables carry only delta_up / delta_down)
+            x = [s if f"delta_up{s}" in self.t.arrays else "" for s in (
+                {"svm": "", "lo": "_lo", "hi": "_hi", "ideal": "_ideal"}[k] for k in kinds)]
+            return tuple(f"delta_up{s}" for s in x), tuple(f"delta_down{s}" for s in x)
+        return self._read(self.memo(("arrays", tuple(kinds)), arrays), combos, np.array([lo, hi]))
 
     def need(self, kind, combos, lo: np.ndarray, hi: np.ndarray, readings=None) -> np.ndarray:
         """Distance needed to separate ``lo < hi``, ``max(delta_up(lo), delta_down(hi))``, at every contact and
@@ -196,17 +195,17 @@ class TableView:
         sequence of them: [kind, contact, n], in one reading (``readings``: :meth:`readings` of them, read
         already)."""
         many = not isinstance(kind, str)
-        up, down = (_weighted(combos, r) for r in (
-            readings if readings is not None else self.readings(kind if many else [kind], combos, lo, hi)))
+        up, down = _weighted(combos, readings if readings is not None else
+                             self.readings(kind if many else [kind], combos, lo, hi))  # (both directions at once)
         out = np.maximum(up, down)  # (NaN where either is: maximum propagates it)
         return out if many else out[0]
 
 
 def _weighted(combos, per_slice: np.ndarray) -> np.ndarray:
-    """The weighted sum over the scene slices (axis 1) of ``per_slice`` (NaN where any weighted slice is NaN;
-    summed in the slices' order)."""
+    """The weighted sum over the scene slices (the third axis from the end: [..., slice, contact, n]) of
+    ``per_slice`` (NaN where any weighted slice is NaN; summed in the slices' order)."""
     w = np.array([w for _, w in combos if w != 0])
-    return np.sum(w[:, None, None] * per_slice, axis=1)
+    return np.add.reduce(w[:, None, None] * per_slice, axis=-3)
 
 
 def at_contact(cw, per_contact: np.ndarray) -> np.ndarray:

@@ -403,10 +403,10 @@ def exact_min_contact(e1=None, e2=None, *, m1=None, m2=None, objects=None, noise
         f_top = est.evaluations[-1]["svm_f1"]
         c = 2.0 * start
         while c < tmax:
-            f_c = svm_at(c)
-            if f_c[0] >= run.phi:
+            f_c = svm_at(c).mean
+            if f_c >= run.phi:
                 est = estimate_crossing(svm_at, start, c, run.phi, coverage=cov, progress=progress)
-                falls = (c, f_c[0], tmax, f_top)
+                falls = (c, f_c, tmax, f_top)
                 break
             c *= 2.0
     value = est.value if est.value is None or ideal is None else max(est.value, ideal)

@@ -367,7 +367,7 @@ def refit(row: dict, curvature: bool = True, pooled: bool = True) -> tuple:
     def reading(e):
         if "per_seed" not in e:
             return e["svm_f1"], e["standard_error"]
-        d = SeedDraws.from_records(e["per_seed"])
+        d = SeedDraws([r["f1"] for r in e["per_seed"]], [r["standard_error"] for r in e["per_seed"]])
         return d if pooled else (d.mean, d.standard_error())
 
     seen = {e["contact_s"]: reading(e) for e in ex["evaluations"]}

@@ -19,17 +19,10 @@ a model of the curve near the crossing and solves it:
    (residual variance above the stated SEs), with Student's t quantile on the pooled error's degrees
    of freedom where the error was estimated from the seeds (the normal quantile where it is given).
 
-The error of an evaluation read over seeds (issue 34). Each seed's F1 comes with the standard error its
-cross-validation reports, which covers the test touches but not the training set's variation; the seeds'
-F1 scatter more than that (on the calibrated rig by 1.15-1.2x, pooled over 70 contacts of 10 pairs, 16-32
-seeds each: benchmarks/results/crossing_seed_spread.txt). The spread of an evaluation's own 4 seeds has 3
-degrees of freedom: as the error of that one evaluation it was off by 0.55x to 2.3x (30 of the rig's
-evaluations against fresh-seed truth), and those errors were the fit's weights. The pooled model: a seed's
-F1 varies by ``kappa`` times its own standard error, ``kappa^2`` the mean over the crossing's informative
-evaluations of (seeds' variance / own variance), each weighted by its degrees of freedom, and at least 1
-(the spread includes the seed's own test error); an evaluation's error is ``kappa`` times the RMS of its
-seeds' own errors over ``sqrt(n)``, and the interval's quantile Student's t on the pooled degrees of
-freedom (``sum(n - 1)``, about 24 for a search of 4 seeds).
+An evaluation read over seeds (:class:`SeedDraws`) states the error of :func:`pooled_seed_scale`: seeds
+scatter beyond their own cross-validation errors (1.18x on the calibrated rig), and one evaluation's 4
+seeds (3 degrees of freedom) measured that 0.56-2.45x off, weighting the fit at random (issue 34;
+benchmarks/results/crossing_seed_spread.txt).
 
 The interval covers the crossing of the *mean* F1 curve (the answer with
 infinitely many seeds), at the stated coverage, to the extent the local
@@ -114,25 +107,12 @@ class SeedDraws:
         if not self.f1 or len(self.f1) != len(self.within_se):
             raise ValueError("SeedDraws needs one standard error per seed's F1, and at least one seed")
 
-    @property
-    def n(self) -> int:
-        """Seeds."""
-        return len(self.f1)
-
-    @property
-    def mean(self) -> float:
-        """Mean F1 over the seeds."""
-        return float(np.mean(self.f1))
-
-    @property
-    def sd(self) -> float:
-        """Standard deviation of the seeds' F1 (``ddof=1``; 0 for one seed)."""
-        return float(np.std(self.f1, ddof=1)) if self.n > 1 else 0.0
-
-    @property
-    def within(self) -> float:
-        """Root mean square of the seeds' own standard errors."""
-        return math.sqrt(float(np.mean(np.square(self.within_se))))
+    n = property(lambda self: len(self.f1), doc="Seeds.")
+    mean = property(lambda self: float(np.mean(self.f1)), doc="Mean F1 over the seeds.")
+    sd = property(lambda self: float(np.std(self.f1, ddof=1)) if self.n > 1 else 0.0,
+                  doc="Standard deviation of the seeds' F1 (``ddof=1``; 0 for one seed).")
+    within = property(lambda self: math.sqrt(float(np.mean(np.square(self.within_se)))),
+                      doc="Root mean square of the seeds' own standard errors.")
 
     def standard_error(self, scale: float | None = None) -> float:
         """Standard error of :attr:`mean`: ``scale`` times :attr:`within` over ``sqrt(n)`` (the pooled model,
@@ -142,17 +122,8 @@ class SeedDraws:
         return per_seed / math.sqrt(self.n)
 
     def to_records(self) -> list[dict]:
-        """``[{"f1", "standard_error"}]``, one per seed: its F1 and own error (replays refit from them).
-
-        >>> SeedDraws((0.9,), (0.02,)).to_records()
-        [{'f1': 0.9, 'standard_error': 0.02}]
-        """
+        """``[{"f1", "standard_error"}]``, one per seed: what an answer records, so that replays refit from it."""
         return [{"f1": f, "standard_error": s} for f, s in zip(self.f1, self.within_se)]
-
-    @classmethod
-    def from_records(cls, records) -> "SeedDraws":
-        """The inverse of :meth:`to_records`."""
-        return cls([r["f1"] for r in records], [r["standard_error"] for r in records])
 
 
 def pooled_seed_scale(draws, lo: float = 0.5, hi: float = 0.999) -> tuple[float, int]:

@@ -40,8 +40,10 @@ from designkit.query.crossing import SeedDraws, estimate_crossing
 from designkit.recognition.svm import f1_standard_error
 
 
-def replay(curvature: bool, *, n: int, seed: int, repeats: int, trials: int = 100) -> tuple[float, ...]:
-    """(signed median, mean, median |log error|, coverage) of ``n`` crossings."""
+def replay(curvature: bool, *, n: int, seed: int, repeats: int, trials: int = 100,
+           pooled: bool = True) -> tuple[float, ...]:
+    """(signed median, mean, median |log error|, coverage) of ``n`` crossings; each seed with its own error (the
+    route's pooled error model), or with ``pooled=False`` each evaluation's own error (the model before)."""
     rng = np.random.default_rng(seed)
     errs, held = [], []
     for _ in range(n):
@@ -54,7 +56,8 @@ def replay(curvature: bool, *, n: int, seed: int, repeats: int, trials: int = 10
             m = 0.5 + 0.5 / (1.0 + (x / x50) ** -k)
             se1 = f1_standard_error(min(1.0, m), max(0.0, 1.0 - m), trials)
             draws = np.clip(m + se1 * draws_rng.standard_normal(repeats), 0.0, 1.0)
-            return float(draws.mean()), max(se1, float(np.std(draws, ddof=1))) / math.sqrt(repeats)
+            d = SeedDraws(draws, [f1_standard_error(v, 1.0 - v, trials) for v in draws])
+            return d if pooled else (d.mean, d.standard_error())
 
         e = estimate_crossing(f, 0.05, 10.0, 0.9, curvature=curvature)
         if e.value is None:
@@ -179,10 +182,10 @@ def main(argv=None) -> None:
     print(f"{a.n} logit-linear curves, seed {a.seed}: log error of the crossing [signed median, mean, median |.|], "
           "coverage of the 90 % interval")
     for repeats in (4, 16):
-        for curvature in (False, True):
-            med, mean, mad, cov = replay(curvature, n=a.n, seed=a.seed, repeats=repeats)
-            print(f"  {repeats:2d} seeds, {'curvature term' if curvature else 'straight line '}: "
-                  f"{med:+.2%} {mean:+.2%} {mad:.2%}  coverage {cov:.1%}")
+        for curvature, pooled in ((False, True), (True, False), (True, True)):
+            med, mean, mad, cov = replay(curvature, n=a.n, seed=a.seed, repeats=repeats, pooled=pooled)
+            print(f"  {repeats:2d} seeds, {'curvature term' if curvature else 'straight line '}, "
+                  f"{'pooled error' if pooled else 'own error   '}: {med:+.2%} {mean:+.2%} {mad:.2%}  coverage {cov:.1%}")
 
 
 if __name__ == "__main__":

@@ -63,6 +63,7 @@ def main() -> None:
     p.add_argument("--compare", choices=("errors", "curvature"), default="errors")
     p.add_argument("--coverage-cases", default=None, help="a coverage run's cases (JSON lines): recompute min-contact ones")
     p.add_argument("--take", type=int, default=10, help="--coverage-cases: how many")
+    p.add_argument("--skip", type=int, default=0, help="--coverage-cases: after the first this many")
     args = p.parse_args()
     real = crossing.estimate_crossing
     fits: list = []
@@ -125,7 +126,7 @@ def coverage_cases(args, exact, fits: list) -> None:
     """Recompute min-contact cases of a coverage run, answer and reference, and score both fits (module doc)."""
     rows = [json.loads(line) for line in open(args.coverage_cases)]
     cases = [r for r in rows if r["question"] == "min-contact" and r["exact"].get("coverage")
-             and r["reference"].get("coverage")][:args.take]
+             and r["reference"].get("coverage")][args.skip:args.skip + args.take]
     z90 = 1.6448536269514722
     out: dict = {"old": [], "new": []}
     print(f"load {os.getloadavg()[0]:.1f}; {len(cases)} min-contact cases of {args.coverage_cases}", flush=True)

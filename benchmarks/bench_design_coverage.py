@@ -37,7 +37,8 @@ import numpy as np
 REPO = Path(__file__).resolve().parent.parent
 RIG = REPO / "tests" / "data" / "rig_sensor.yaml"
 #: Per-seed standard error the paper's 3-fold cross-validation reports near the crossing (measured: 0.017-0.025
-#: at 3-5 s for this design); the exact route's evaluation SE is max(fold SE, the seeds' spread) / sqrt(R).
+#: at 3-5 s for this design); the exact route pools the seeds' spread in units of it over a search's evaluations
+#: (:func:`designkit.query.crossing.pooled_seed_scale`).
 FOLD_SE = 0.02
 
 
@@ -132,13 +133,12 @@ def add(points: dict, x: float, f) -> None:
 
 def replay(curve: Curve, start_s: float, x_lo: float, x_hi: float, rng, repeats: int) -> tuple:
     """The exact route's estimate (model time = onset time - start) on the measured curve: (value, low, high)."""
-    from designkit.query.crossing import estimate_crossing
+    from designkit.query.crossing import SeedDraws, estimate_crossing
 
-    def f(xm):
+    def f(xm):  # the seeds' F1, each with the CV error the paper's protocol reports (the route pools them)
         x = xm + start_s
         draws = np.minimum(curve(x) + curve.sd_at(x) * rng.standard_normal(repeats), 1.0)
-        se = max(FOLD_SE, float(np.std(draws, ddof=1))) / math.sqrt(repeats)
-        return float(np.mean(draws)), se
+        return SeedDraws(draws, [FOLD_SE] * repeats)
 
     try:
         e = estimate_crossing(f, x_lo - start_s, x_hi - start_s, 0.9, coverage=0.9)

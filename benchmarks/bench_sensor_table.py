@@ -350,16 +350,27 @@ def phase_truth(args) -> None:
               + " ".join(f"{c + start:.3f}:{np.mean(cs[c]):.3f}" for c in xs), flush=True)
 
 
-def refit(row: dict, curvature: bool) -> tuple:
+def refit(row: dict, curvature: bool = True, pooled: bool = True) -> tuple:
     """The exact route's crossing estimate replayed on its own evaluations (``row["exact"]["evaluations"]``, model
     time): ``(value, low, high)`` with the route's floor at the ideal observer. The route's design depends only on
-    the values it has seen, so the replay asks the same contacts and, with ``curvature=True`` (this tree's fit),
-    returns the route's own answer; ``curvature=False`` is the straight-line fit of the route before issue 34."""
+    the values it has seen, so the replay asks the same contacts and, with ``curvature=True`` and ``pooled=True``
+    (this tree's fit), returns the route's own answer. ``curvature=False``: the straight-line fit of the route
+    before issue 34's curvature term; ``pooled=False``: each evaluation's own error (the larger of its seeds' own
+    errors and their spread, over sqrt(n), the normal quantile: the error model before the pooled one,
+    :func:`designkit.query.crossing.pooled_seed_scale`), possible where the evaluations hold their seeds' draws
+    (``per_seed``; rows computed before it hold the old error only, used as it is)."""
     from designkit.query.answer import ideal_floor
-    from designkit.query.crossing import estimate_crossing
+    from designkit.query.crossing import SeedDraws, estimate_crossing
 
     ex = row["exact"]
-    seen = {e["contact_s"]: (e["svm_f1"], e["standard_error"]) for e in ex["evaluations"]}
+
+    def reading(e):
+        if "per_seed" not in e:
+            return e["svm_f1"], e["standard_error"]
+        d = SeedDraws([r["f1"] for r in e["per_seed"]], [r["standard_error"] for r in e["per_seed"]])
+        return d if pooled else (d.mean, d.standard_error())
+
+    seen = {e["contact_s"]: reading(e) for e in ex["evaluations"]}
     iv = ex.get("ideal_interval")
     ideal = ex["ideal"]
     start = min(seen)  # the route searches from the ideal observer's contact (its first evaluation)
@@ -392,7 +403,8 @@ def phase_bias(args) -> None:
     by: dict = {}
     for x in map(json.loads, Path(args.truth).read_text().splitlines()):
         by.setdefault(x["index"], {}).setdefault(x["contact_model_s"], []).extend(x["f1"])
-    labels = {"main": "main's route (stored)", "line": "straight line, these evaluations", "now": "now"}
+    labels = {"main": "main's route (stored)", "own": "each evaluation's own error, these evaluations",
+              "now": "now (pooled error)"}
     out: dict = {k: [] for k in labels}
     print(f"times from the onset [s]; pair e1 e2 | truth | " + " | ".join(labels.values()))
     for i in (int(x) for x in args.indices.split(",")):
@@ -405,19 +417,21 @@ def phase_bias(args) -> None:
         cs = sorted(by[i])
         truth, se = true_crossing(cs, [np.array(by[i][c]) for c in cs])
         b = before[i]["exact"]
-        est = {"main": (b["value"], b["low"], b["high"]), "line": refit(r, False), "now": refit(r, True)}
+        est = {"main": (b["value"], b["low"], b["high"]), "own": refit(r, pooled=False), "now": refit(r)}
         if not math.isclose(est["now"][0], r["exact"]["value"], rel_tol=1e-9):
             sys.exit(f"pair {i}: the replay ({est['now'][0]}) is not the route's own answer ({r['exact']['value']})")
         line = f"{i:3d} {r['e1']:<7g} {r['e2']:<7g} | {truth + start:.3f} +- {se:.3f} "
         for k, (v, lo, hi) in est.items():
             err, held = math.log((v + start) / (truth + start)), lo <= truth <= hi
-            out[k].append((err, held))
+            out[k].append((err, held, (hi - lo) / (v + start)))
             line += f"| {v + start:.3f} [{lo + start:.3f}, {hi + start:.3f}] {err:+6.1%} {'held  ' if held else 'MISSED'} "
         print(line, flush=True)
     for k, label in labels.items():
-        e = [x for x, _ in out[k]]
+        e = [x for x, _, _ in out[k]]
+        w = statistics.median(x for _, _, x in out[k])
         print(f"{label}: median error {statistics.median(e):+.1%} (range {min(e):+.1%} to {max(e):+.1%}), "
-              f"{sum(h for _, h in out[k])} of {len(e)} intervals hold the truth")
+              f"median relative width {w:.1%}, "
+              f"{sum(h for _, h, _ in out[k])} of {len(e)} intervals hold the truth")
 
 
 def phase_profile(args) -> None:

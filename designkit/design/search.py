@@ -495,12 +495,12 @@ def predict(result: DesignResult, targets: list[Target], *, trials: int = 100, r
     def onset(v):  # a model contact counted from the detected onset, credited MIN_SAMPLES samples
         return None if v is None else round(_credited(float(from_model_contact(v, start)), best.sample_rate_hz), 6)
 
-    evals = [{"contact_s": onset(e["contact_s"]), "svm_f1": e["svm_f1"], "standard_error": e["standard_error"]}
-             for e in ans.computation.get("evaluations", ())]
+    evals = [{**e, "contact_s": onset(e["contact_s"])} for e in ans.computation.get("evaluations", ())]
     return {"value": onset(ans.value), "interval": {"low": onset(ans.interval[0]), "high": onset(ans.interval[1]),
                                                     "coverage": ans.interval_coverage},
             "covers": "the crossing of the SVM's mean F1 over seeds", "trials": trials, "repeats": repeats,
             "seed": seed, "solver": solver, "evaluations": evals,
+            "seed_spread_scale": ans.computation.get("seed_spread_scale"), "error_dof": ans.computation.get("error_dof"),
             "counted_from": "detected onset" if start is not None else "first contact"}
 
 

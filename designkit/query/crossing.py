@@ -16,7 +16,13 @@ a model of the curve near the crossing and solves it:
    ``fine_ratio``, and without a fit then, that bracket is the answer (no stated coverage);
 4. the crossing ``x*`` where the fit reaches ``phi`` and its ``coverage`` confidence
    interval by the delta method on ``(a, b, c)``, widened by the lack of fit
-   (residual variance above the stated SEs).
+   (residual variance above the stated SEs), with Student's t quantile on the pooled error's degrees
+   of freedom where the error was estimated from the seeds (the normal quantile where it is given).
+
+An evaluation read over seeds (:class:`SeedDraws`) states the error of :func:`pooled_seed_scale`: seeds
+scatter beyond their own cross-validation errors (1.18x on the calibrated rig), and one evaluation's 4
+seeds (3 degrees of freedom) measured that 0.56-2.45x off, weighting the fit at random (issue 34;
+benchmarks/results/crossing_seed_spread.txt).
 
 The interval covers the crossing of the *mean* F1 curve (the answer with
 infinitely many seeds), at the stated coverage, to the extent the local
@@ -43,7 +49,8 @@ import numpy as np
 
 from .._validation import InputError
 
-__all__ = ["CrossingEstimate", "check_coverage", "coverage_of_z", "estimate_crossing", "z_of_coverage"]
+__all__ = ["CrossingEstimate", "SeedDraws", "check_coverage", "coverage_of_z", "estimate_crossing",
+           "pooled_seed_scale", "t_of_coverage", "z_of_coverage"]
 
 
 def check_coverage(coverage: float) -> float:
@@ -78,6 +85,81 @@ def z_of_coverage(coverage: float) -> float:
     return 0.5 * (lo + hi)
 
 
+@dataclass(frozen=True)
+class SeedDraws:
+    """One evaluation of an F1 curve read over independent seeds: each seed's F1 and its own standard error.
+
+    A seed's own error (the cross-validation's, :func:`designkit.recognition.svm.f1_standard_error`) covers
+    its test touches, not the variation of its training set; how far the seeds' F1 scatter beyond it is
+    estimated over a crossing's evaluations together (:func:`pooled_seed_scale`).
+
+    >>> d = SeedDraws((0.90, 0.92, 0.88, 0.90), (0.02, 0.02, 0.02, 0.02))
+    >>> round(d.mean, 3), d.n, round(d.sd, 4), round(d.within, 3), round(d.standard_error(), 3)
+    (0.9, 4, 0.0163, 0.02, 0.01)
+    """
+
+    f1: tuple
+    within_se: tuple
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "f1", tuple(float(x) for x in self.f1))
+        object.__setattr__(self, "within_se", tuple(float(x) for x in self.within_se))
+        if not self.f1 or len(self.f1) != len(self.within_se):
+            raise ValueError("SeedDraws needs one standard error per seed's F1, and at least one seed")
+
+    n = property(lambda self: len(self.f1), doc="Seeds.")
+    mean = property(lambda self: float(np.mean(self.f1)), doc="Mean F1 over the seeds.")
+    sd = property(lambda self: float(np.std(self.f1, ddof=1)) if self.n > 1 else 0.0,
+                  doc="Standard deviation of the seeds' F1 (``ddof=1``; 0 for one seed).")
+    within = property(lambda self: math.sqrt(float(np.mean(np.square(self.within_se)))),
+                      doc="Root mean square of the seeds' own standard errors.")
+
+    def standard_error(self, scale: float | None = None) -> float:
+        """Standard error of :attr:`mean`: ``scale`` times :attr:`within` over ``sqrt(n)`` (the pooled model,
+        :func:`pooled_seed_scale`), or without a scale this evaluation alone, the larger of :attr:`within` and
+        :attr:`sd` over ``sqrt(n)``."""
+        per_seed = max(self.within, self.sd) if scale is None else scale * self.within
+        return per_seed / math.sqrt(self.n)
+
+    def to_records(self) -> list[dict]:
+        """``[{"f1", "standard_error"}]``, one per seed: what an answer records, so that replays refit from it."""
+        return [{"f1": f, "standard_error": s} for f, s in zip(self.f1, self.within_se)]
+
+
+def pooled_seed_scale(draws, lo: float = 0.5, hi: float = 0.999) -> tuple[float, int]:
+    """``(kappa, dof)``: how far seeds' F1 scatter in units of their own standard errors, pooled over evaluations.
+
+    ``kappa^2`` is the mean of ``sd^2 / within^2`` over the evaluations (:class:`SeedDraws`) with at least two
+    seeds, a positive own error and a mean strictly inside ``(lo, hi)`` (an F1 of 1 does not scatter), each
+    weighted by its ``n - 1`` degrees of freedom (the maximum-likelihood estimate where a seed's variance is
+    ``kappa^2`` times its own); at least 1, since the seeds' spread includes their own test error. ``dof`` is
+    the sum of those degrees of freedom; ``(1.0, 0)`` where no evaluation qualifies.
+
+    >>> d = [SeedDraws((0.86, 0.90, 0.94, 0.90), (0.02,) * 4), SeedDraws((0.80, 0.86, 0.83, 0.83), (0.025,) * 4)]
+    >>> k, dof = pooled_seed_scale(d); round(k, 3), dof
+    (1.347, 6)
+    """
+    ratio, dof = 0.0, 0
+    for d in draws:
+        if d.n >= 2 and d.within > 0.0 and lo < d.mean < hi:
+            ratio += (d.n - 1) * (d.sd / d.within) ** 2
+            dof += d.n - 1
+    return (max(1.0, math.sqrt(ratio / dof)), dof) if dof else (1.0, 0)
+
+
+def t_of_coverage(coverage: float, dof: int) -> float:
+    """Two-sided Student's t quantile for ``coverage`` on ``dof`` degrees of freedom (the normal's for 0).
+
+    >>> round(t_of_coverage(0.9, 24), 3), round(t_of_coverage(0.9, 0), 3)
+    (1.711, 1.645)
+    """
+    if dof <= 0:
+        return z_of_coverage(coverage)
+    from scipy.special import stdtrit  # the exact route only (it imports scikit-learn): not on a table question's path
+
+    return float(stdtrit(dof, 0.5 + 0.5 * check_coverage(coverage)))
+
+
 @dataclass
 class CrossingEstimate:
     """The crossing ``x*`` of the threshold by the mean F1 curve.
@@ -94,7 +176,12 @@ class CrossingEstimate:
         ``"wls-logit-log"`` (the fit), ``"bracket"`` (too few informative
         points: the interval is the bracket) or ``"none"``.
     evaluations : list of dict
-        ``{"x", "svm_f1", "standard_error"}`` per evaluated point.
+        ``{"x", "svm_f1", "standard_error"}`` per evaluated point (the error the fit used), and where the point
+        was read over seeds (:class:`SeedDraws`) ``"per_seed"``: its seeds' F1 and own errors.
+    seed_spread_scale : float or None
+        ``kappa`` of the pooled error model (:func:`pooled_seed_scale`); None where the errors were given.
+    error_dof : int
+        Degrees of freedom of the pooled error (0: given, the normal quantile).
     """
 
     value: float | None
@@ -103,6 +190,8 @@ class CrossingEstimate:
     coverage: float
     method: str
     evaluations: list = field(default_factory=list)
+    seed_spread_scale: float | None = None
+    error_dof: int = 0
 
     @property
     def stated(self) -> bool:
@@ -117,6 +206,11 @@ def coverage_of_z(z: float) -> float:
     0.9
     """
     return round(math.erf(z / math.sqrt(2.0)), 12)
+
+
+def _mean(r) -> float:
+    """The mean F1 of an evaluation: a :class:`SeedDraws` or a ``(mean, standard error)`` pair."""
+    return r.mean if isinstance(r, SeedDraws) else float(r[0])
 
 
 def _logit(m):
@@ -192,7 +286,8 @@ def estimate_crossing(f: Callable[[float], tuple[float, float]], x_lo: float, x_
     Parameters
     ----------
     f : callable
-        ``f(x) -> (mean F1, standard error)``.
+        ``f(x) -> (mean F1, standard error)``, or ``f(x) -> SeedDraws`` (the seeds' F1 and own errors: the
+        errors then come from the pooled model, :func:`pooled_seed_scale`, and the quantile from Student's t).
     x_lo, x_hi : float
         Range examined (> 0).
     phi : float
@@ -222,33 +317,46 @@ def estimate_crossing(f: Callable[[float], tuple[float, float]], x_lo: float, x_
     """
     if not 0.0 < x_lo < x_hi:
         raise ValueError(f"the range examined must satisfy 0 < x_lo < x_hi, not [{x_lo!r}, {x_hi!r}]")
-    z = z_of_coverage(coverage)
-    evals: dict[float, tuple[float, float]] = {}
+    check_coverage(coverage)
+    evals: dict = {}  # x -> (mean, standard error) or SeedDraws
     n_bisect = max(1, math.ceil(math.log2(math.log(x_hi / x_lo) / math.log(bracket_ratio))))
     total = 2 + n_bisect + design
 
-    def ev(x: float) -> tuple[float, float]:
+    def ev(x: float) -> float:  # the mean F1 at x
         if x not in evals:
             evals[x] = f(x)
             if progress is not None:
-                progress(len(evals), max(total, len(evals)), f"x = {x:.4g}: F1 {evals[x][0]:.3f}")
-        return evals[x]
+                progress(len(evals), max(total, len(evals)), f"x = {x:.4g}: F1 {_mean(evals[x]):.3f}")
+        return _mean(evals[x])
 
     def beyond(x: float) -> bool:  # x lies at or past the crossing (F1 on the far side of phi)
-        return (ev(x)[0] >= phi) == increasing
+        return (ev(x) >= phi) == increasing
+
+    def errors():  # (kappa, dof, x -> standard error) of what was evaluated: the pooled model over seed draws
+        kappa, dof = pooled_seed_scale([r for r in evals.values() if isinstance(r, SeedDraws)])
+        se = {x: r.standard_error(kappa if dof else None) if isinstance(r, SeedDraws) else float(r[1])
+              for x, r in evals.items()}
+        return kappa, dof, se
 
     def log_of(found):
-        return [{"x": x, "svm_f1": m, "standard_error": s} for x, (m, s) in sorted(found.items())]
+        se = errors()[2]
+        return [{"x": x, "svm_f1": _mean(r), "standard_error": se[x],
+                 **({"per_seed": r.to_records()} if isinstance(r, SeedDraws) else {})} for x, r in sorted(found.items())]
+
+    def done(value, low, high, method):
+        kappa, dof, _ = errors()
+        seeded = any(isinstance(r, SeedDraws) for r in evals.values())
+        return CrossingEstimate(value, low, high, coverage, method, log_of(evals), kappa if seeded else None, dof)
 
     # 1. bracket [a, b]: a before the crossing, b past it
     if not beyond(x_hi):  # the crossing lies beyond x_hi
         if increasing:  # F1 never reaches phi in the range: no answer
-            return CrossingEstimate(None, None, None, coverage, "none", log_of(evals))
-        return CrossingEstimate(x_hi, x_hi, None, coverage, "none", log_of(evals))  # reaches phi even at x_hi
+            return done(None, None, None, "none")
+        return done(x_hi, x_hi, None, "none")  # reaches phi even at x_hi
     if beyond(x_lo):  # the crossing lies below x_lo
         if increasing:  # reaches phi already at x_lo
-            return CrossingEstimate(x_lo, None, x_lo, coverage, "none", log_of(evals))
-        return CrossingEstimate(None, None, None, coverage, "none", log_of(evals))  # never reaches phi
+            return done(x_lo, None, x_lo, "none")
+        return done(None, None, None, "none")  # never reaches phi
     def bisect(a: float, b: float, ratio: float) -> tuple[float, float]:  # a before the crossing, b past it
         while b / a > ratio:
             mid = math.sqrt(a * b)
@@ -269,16 +377,17 @@ def estimate_crossing(f: Callable[[float], tuple[float, float]], x_lo: float, x_
     # fine_ratio (measured: 1,000 vs 20,000 J s^-1/2 K^-1 m^-2 answered 0.501 s, the middle of [0.41, 0.61] s,
     # although F1 was 0.84 at 0.41 s and 0.95 at 0.45 s), and the fit is tried once more on what that added
     for attempt in range(2):
+        _, dof, se = errors()
         xs = np.array(sorted(evals))
-        ms = np.array([evals[x][0] for x in xs])
-        ss = np.maximum(np.array([evals[x][1] for x in xs]), se_floor)
+        ms = np.array([_mean(evals[x]) for x in xs])
+        ss = np.maximum(np.array([se[x] for x in xs]), se_floor)
         inform = (ms > 0.5) & (ms < 0.999)
         near = np.argsort(np.abs(ms - phi) / ss)
         use = [i for i in near if inform[i]][:max(design + 1, 4)]
         if len(use) >= 3:
             break
         if attempt:
-            return CrossingEstimate(math.sqrt(a * b), a, b, coverage, "bracket", log_of(evals))
+            return done(math.sqrt(a * b), a, b, "bracket")
         b = min(x for x in evals if beyond(x))  # cached: no new evaluation
         a, b = bisect(max([x for x in evals if x < b and not beyond(x)], default=a), b, fine_ratio)
     u = np.log(xs[use])
@@ -286,12 +395,12 @@ def estimate_crossing(f: Callable[[float], tuple[float, float]], x_lo: float, x_
     target = float(_logit(np.array(phi)))
     fit = _fit_crossing(u, y, w, target, increasing, quadratic=curvature)
     if fit is None:
-        return CrossingEstimate(math.sqrt(a * b), a, b, coverage, "bracket", log_of(evals))
+        return done(math.sqrt(a * b), a, b, "bracket")
     u_star, sd = fit
+    z = t_of_coverage(coverage, dof)  # Student's t where the error was estimated from the seeds
     # clipped to the range examined in log space, before exp: a nearly flat fit has u_star +- z sd far
     # outside it (exp overflowed on a flat, noisy curve)
     def x_of(u: float) -> float:
         return x_lo if u <= math.log(x_lo) else x_hi if u >= math.log(x_hi) else min(max(math.exp(u), x_lo), x_hi)
 
-    return CrossingEstimate(x_of(u_star), x_of(u_star - z * sd), x_of(u_star + z * sd), coverage,
-                            "wls-logit-log", log_of(evals))
+    return done(x_of(u_star), x_of(u_star - z * sd), x_of(u_star + z * sd), "wls-logit-log")

@@ -152,9 +152,10 @@ class _Run:
         k, self.svm_calls = self.svm_calls, self.svm_calls + 1
         return [[self.seed, r, k] for r in range(self.repeats)]
 
-    def svm(self, classes, scene) -> tuple[float, float]:
-        """Mean SVM F1 over ``repeats`` seeds and its standard error, for the pair's classes
-        (fresh seeds at every call, :meth:`seeds`)."""
+    def svm(self, classes, scene):
+        """Each of ``repeats`` seeds' SVM F1 with its own (cross-validation) standard error, for the pair's
+        classes (fresh seeds at every call, :meth:`seeds`): a :class:`~designkit.query.crossing.SeedDraws`,
+        whose error the crossing estimate pools over its evaluations."""
         from joblib import Parallel, delayed
 
         from .._workers import local_processes
@@ -169,12 +170,11 @@ class _Run:
             results = Parallel(n_jobs=jobs)(
                 delayed(pair_f1)(a, b, self.sensor, scene, model=self.model, trials=self.trials, folds=self.folds,
                                  seed=s) for s in self.seeds())
-        f1 = np.array([r.f1 for r in results])
-        se_fold = math.sqrt(float(np.mean([r.standard_error ** 2 for r in results])))
-        se_rep = float(np.std(f1, ddof=1)) if f1.size > 1 else 0.0
-        return float(f1.mean()), max(se_fold, se_rep) / math.sqrt(f1.size)
+        from .crossing import SeedDraws
 
-    def _svm_batched(self, a, b, scene) -> tuple[float, float]:
+        return SeedDraws([r.f1 for r in results], [r.standard_error for r in results])
+
+    def _svm_batched(self, a, b, scene):
         """:meth:`svm` with every seed's cross-validation solved at once (same touches, folds and
         classifier as :func:`~designkit.recognition.svm.pair_f1`; predictions can differ only at
         near-ties, :mod:`designkit.recognition.batched_svm`)."""
@@ -192,11 +192,10 @@ class _Run:
             hi.append(feature_matrix(simulate_class(high, self.trials, self.sensor, scene, base + [1],
                                                     self.model).temperature_c, fs))
             seeds.append(base + [2])
+        from .crossing import SeedDraws
+
         res = batched_cv_f1(lo, hi, seeds=seeds, folds=self.folds)
-        f1 = np.asarray(res.f1, dtype=np.float64)
-        se_fold = math.sqrt(float(np.mean(np.asarray(res.standard_error) ** 2)))
-        se_rep = float(np.std(f1, ddof=1)) if f1.size > 1 else 0.0
-        return float(f1.mean()), max(se_fold, se_rep) / math.sqrt(f1.size)
+        return SeedDraws(np.asarray(res.f1, dtype=np.float64), np.asarray(res.standard_error, dtype=np.float64))
 
     # ---------------------------------------------------------------- the ideal observer
     def scene(self, contact_s: float, noise_c: float, delta_t_c: float):
@@ -275,6 +274,19 @@ def _check_spread(spread: float, dt: float) -> None:
     if spread and spread >= abs(dt):
         raise InputError(f"a sensor temperature spread of {spread:g} degC around dT {dt:g} degC makes the "
                          "sensor-object temperature difference cross zero; give a spread below |dT|")
+
+
+def _evaluations(est, axis: str) -> list[dict]:
+    """A crossing estimate's evaluations as an answer records them: ``axis`` (the asked quantity), the mean F1,
+    the standard error the fit used and the seeds' own F1 and errors (``per_seed``, from which a replay refits)."""
+    return [{axis: e["x"], "svm_f1": e["svm_f1"], "standard_error": e["standard_error"],
+             **({"per_seed": e["per_seed"]} if "per_seed" in e else {})} for e in est.evaluations]
+
+
+def _error_model(est) -> dict:
+    """The pooled error model of a crossing estimate (:func:`designkit.query.crossing.pooled_seed_scale`):
+    ``seed_spread_scale`` (how far the seeds' F1 scatter in units of their own errors) and ``error_dof``."""
+    return {"seed_spread_scale": est.seed_spread_scale, "error_dof": est.error_dof}
 
 
 def _no_pair(question, run: _Run, pq, scene, details) -> Answer:
@@ -391,18 +403,17 @@ def exact_min_contact(e1=None, e2=None, *, m1=None, m2=None, objects=None, noise
         f_top = est.evaluations[-1]["svm_f1"]
         c = 2.0 * start
         while c < tmax:
-            f_c = svm_at(c)
-            if f_c[0] >= run.phi:
+            f_c = svm_at(c).mean
+            if f_c >= run.phi:
                 est = estimate_crossing(svm_at, start, c, run.phi, coverage=cov, progress=progress)
-                falls = (c, f_c[0], tmax, f_top)
+                falls = (c, f_c, tmax, f_top)
                 break
             c *= 2.0
     value = est.value if est.value is None or ideal is None else max(est.value, ideal)
     # the SVM's interval never reaches below the ideal observer's (a Monte Carlo bound: its low end)
     floor = ideal_floor(ideal, ideal_interval)
     interval = (est.low if est.low is None or floor is None else max(est.low, floor), est.high)
-    evaluations = [{"contact_s": e["x"], "svm_f1": e["svm_f1"], "standard_error": e["standard_error"]}
-                   for e in est.evaluations]
+    evaluations = _evaluations(est, "contact_s")
     needed = tmax if value is None else max(x for x in (value, ideal, interval[1]) if x is not None)
     note = "" if value is not None else f"not separable by any contact time up to {tmax:g} s"
     if falls is not None:
@@ -412,7 +423,7 @@ def exact_min_contact(e1=None, e2=None, *, m1=None, m2=None, objects=None, noise
                       ideal_method=run.ideal_method(closed), objects=pq.objects_dicts(),
                       limiting=pq.limiting_dicts(), rule=pq.rule, scene=scene_d, details={}, check_classes=cls,
                       check_at=(needed, noise, dt), notes=[note], evaluations=evaluations, max_contact_s=tmax,
-                      estimate_method=est.method,
+                      estimate_method=est.method, **_error_model(est),
                       interval_coverage=cov if est.stated else None,
                       interval_kind="exact-estimate" if est.stated else "exact")
 
@@ -496,8 +507,7 @@ def _exact_ratio(question: str, kw: dict) -> Answer:
         conv = lambda x: None if x is None else noise / x  # noqa: E731
         interval = (conv(r_hi), conv(r_lo))
         ideal_interval = None if ideal_iv is None else (conv(ideal_iv[1]), conv(ideal_iv[0]), cov)
-    evaluations = [{"noise_ratio": e["x"], "svm_f1": e["svm_f1"], "standard_error": e["standard_error"]}
-                   for e in est.evaluations]
+    evaluations = _evaluations(est, "noise_ratio")
     # the model check at the answer: the smaller sigma/dT of the SVM's and the ideal observer's is the stricter
     r_check = min([x for x in (r, ideal_r) if x is not None], default=lo_r)
     check_at = (contact, r_check * abs(dt), dt) if question == "max-noise" else (contact, noise, noise / r_check)
@@ -506,7 +516,7 @@ def _exact_ratio(question: str, kw: dict) -> Answer:
                       ideal_method=run.ideal_method(closed), objects=pq.objects_dicts(),
                       limiting=pq.limiting_dicts(), rule=pq.rule, scene=scene_d, details={}, check_classes=cls,
                       check_at=check_at, notes=[note], evaluations=evaluations, estimate_method=est.method,
-                      noise_ratio_estimate={"value": r, "low": r_lo, "high": r_hi},
+                      noise_ratio_estimate={"value": r, "low": r_lo, "high": r_hi}, **_error_model(est),
                       interval_coverage=cov if est.stated else None,
                       interval_kind="exact-estimate" if est.stated else "exact")
 
@@ -577,7 +587,8 @@ def exact_distinguishable(e1=None, e2=None, *, m1=None, m2=None, objects=None, c
     cls = pq.classes
     _check_spread(run.spread, dt)
     scene = run.scene(contact, noise, dt)
-    f1, se = run.svm(cls, scene)
+    draws = run.svm(cls, scene)
+    f1, se = draws.mean, draws.standard_error()  # one evaluation: its own seeds' spread or their own error
     if progress is not None:
         progress(1, 1, f"F1 {f1:.3f}")
     ideal = run.ideal_f1(cls, scene)
@@ -672,8 +683,7 @@ def exact_delta_e(e: float | None = None, *, m: str | None = None, contact_s: fl
             val, lo_d = max(val, ideal), (None if lo_d is None else max(lo_d, ideal_floor(ideal, ideal_interval)))
         sides[side] = {"value": val, "interval": [lo_d, hi_d], "ideal": ideal, "ideal_interval": ideal_interval,
                        "coverage": cov if est.stated else None, "estimate_method": est.method,
-                       "evaluations": [{"delta_e": e["x"], "svm_f1": e["svm_f1"],
-                                        "standard_error": e["standard_error"]} for e in est.evaluations]}
+                       **_error_model(est), "evaluations": _evaluations(est, "delta_e")}
         found = [v for v in (val, ideal) if v is not None]
         if found:
             checked.append(part(max(found)))

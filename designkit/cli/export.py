@@ -53,11 +53,12 @@ def export_cmd(
     """
     from ..export import export_bytes, export_table
 
-    if table is None:  # the table the questions read: a calibrated sensor's own, where one is built for it
-        from ..tables.registry import table_for_sensor
+    if table is None:  # the table the questions read (the route policy's one answer): a calibrated sensor's own
+        from ..query.policy import table_for
+        from ..query.table_open import DEFAULT_TABLE
 
-        own = table_for_sensor(sensor) if sensor is not None else None
-        table = str(own.path) if own is not None else "svm-fine"
+        # (a sensor with none: the default table, which _check_sensor then refuses as another sensor's)
+        table = table_for("min-contact", sensor=sensor).table or DEFAULT_TABLE
     if sensor is not None:
         _check_sensor(table, sensor)
     slice_opts = dict(prefix=prefix, noise_c=noise, delta_t_c=delta_t, contact=contact, e_min=e_min, e_max=e_max,

@@ -338,15 +338,12 @@ def estimate_crossing(f: Callable[[float], tuple[float, float]], x_lo: float, x_
               for x, r in evals.items()}
         return kappa, dof, se
 
-    def log_of(found):
-        se = errors()[2]
-        return [{"x": x, "svm_f1": _mean(r), "standard_error": se[x],
-                 **({"per_seed": r.to_records()} if isinstance(r, SeedDraws) else {})} for x, r in sorted(found.items())]
-
-    def done(value, low, high, method):
-        kappa, dof, _ = errors()
+    def done(value, low, high, method):  # the estimate, with every evaluation as the fit weighed it
+        kappa, dof, se = errors()
         seeded = any(isinstance(r, SeedDraws) for r in evals.values())
-        return CrossingEstimate(value, low, high, coverage, method, log_of(evals), kappa if seeded else None, dof)
+        log = [{"x": x, "svm_f1": _mean(r), "standard_error": se[x],
+                **({"per_seed": r.to_records()} if isinstance(r, SeedDraws) else {})} for x, r in sorted(evals.items())]
+        return CrossingEstimate(value, low, high, coverage, method, log, kappa if seeded else None, dof)
 
     # 1. bracket [a, b]: a before the crossing, b past it
     if not beyond(x_hi):  # the crossing lies beyond x_hi
